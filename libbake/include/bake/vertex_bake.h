@@ -1,0 +1,52 @@
+// bake/vertex_bake.h — per-vertex bakes: every output vertex of a Mesh is a shade point (its
+// position, its baked normal, its welded 1-ring), integrated in parallel with oneTBB.
+// Results are a function of (mesh, request, integrator parameters, seed) only: each vertex's
+// randomisation is keyed by its index, so any thread count gives the same numbers.
+#pragma once
+
+#include <bake/integrator.h>
+#include <bake/mesh.h>
+#include <bake/progress.h>
+
+#include <string>
+#include <vector>
+
+namespace prt::bake {
+
+struct VertexBake {
+  ProductLayout layout{ProductRequest{}};
+  std::vector<double> values;     // [V][layout.width]
+  std::vector<double> std_error;  // [V][layout.width], the integrator's per-value standard error
+  double seconds = 0;             // wall time of the integration
+};
+
+ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32_t vertex);
+
+VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
+                         ProgressMode progress = ProgressMode::Quiet, const std::string& label = "baking vertices");
+
+// Error against a converged reference on a seeded sample of vertices (DESIGN.md §6).
+struct ProductError {
+  std::string product;              // "ao", "transfer/diffuse", "transfer/visibility", "radiance/band1"
+  size_t values = 0;                // numbers compared
+  double rmse = 0, max_abs = 0;     // bake − reference
+  double reference_rms = 0;         // RMS of the reference values (for relative errors)
+  double bake_std_error = 0;        // RMS of the bake's own estimated standard errors
+  double reference_std_error = 0;   // RMS of the reference's standard errors (its own noise)
+};
+struct ErrorReport {
+  std::vector<uint32_t> vertices;
+  std::vector<ProductError> products;
+  std::string reference;            // the reference integrator's description
+  double reference_seconds = 0;     // apart from the bake time
+};
+
+// Picks min(n_points, V) distinct vertices with `seed`, integrates them with `reference`, and
+// compares with `bake` (which must have the same layout).
+ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
+                                   const Integrator& reference, size_t n_points, uint64_t seed);
+
+// Distinct indices in [0, n), min(k, n) of them, chosen by seed (partial Fisher–Yates), sorted.
+std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed);
+
+} // namespace prt::bake

@@ -1,0 +1,109 @@
+#include <bake/error.h>
+#include <bake/sampling.h>
+#include <bake/vertex_bake.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+namespace prt::bake {
+
+ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32_t vertex) {
+  ShadePoint sp;
+  sp.p = mesh.positions[vertex].cast<double>();
+  sp.n = mesh.normals[vertex].cast<double>().normalized();
+  sp.welded = topology.weld[vertex];
+  return sp;
+}
+
+VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
+                         ProgressMode progress_mode, const std::string& label) {
+  VertexBake out;
+  out.layout = integrator.layout();
+  const size_t V = mesh.positions.size(), W = out.layout.width;
+  out.values.assign(V * W, 0.0);
+  out.std_error.assign(V * W, 0.0);
+  Progress progress(label, V, progress_mode);
+  const auto t0 = std::chrono::steady_clock::now();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, V, 16), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      integrator.integrate(vertex_shade_point(mesh, topology, uint32_t(v)), v,
+                           std::span(out.values).subspan(v * W, W), std::span(out.std_error).subspan(v * W, W));
+    }
+    progress.advance(r.size());
+  });
+  progress.finish();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (double x : out.values)
+    if (!std::isfinite(x)) throw ContractError("bake_vertices: non-finite value from integrator " + integrator.name());
+  return out;
+}
+
+std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {
+  std::vector<uint32_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0u);
+  k = std::min<size_t>(k, n);
+  for (size_t i = 0; i < k; ++i) {
+    const uint64_t r = mix64(seed ^ mix64(i + 0x5851f42d4c957f2dull));
+    const size_t j = i + size_t(r % (n - i));
+    std::swap(idx[i], idx[j]);
+  }
+  idx.resize(k);
+  std::sort(idx.begin(), idx.end());
+  return idx;
+}
+
+ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
+                                   const Integrator& reference, size_t n_points, uint64_t seed) {
+  const ProductLayout& L = bake.layout;
+  PRT_CHECK_OP(reference.layout().width, ==, L.width);
+  ErrorReport report;
+  report.reference = reference.description();
+  report.vertices = seeded_sample(uint32_t(mesh.positions.size()), n_points, seed);
+  const size_t K = report.vertices.size(), W = L.width;
+  std::vector<double> ref(K * W), ref_se(K * W);
+  const auto t0 = std::chrono::steady_clock::now();
+  tbb::parallel_for(size_t(0), K, [&](size_t i) {
+    const uint32_t v = report.vertices[i];
+    // Index the reference's randomisation apart from the bake's (point index offset by V).
+    reference.integrate(vertex_shade_point(mesh, topology, v), uint64_t(v) + mesh.positions.size(),
+                        std::span(ref).subspan(i * W, W), std::span(ref_se).subspan(i * W, W));
+  });
+  report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  auto add = [&](const char* name, size_t offset, size_t count) {
+    if (count == 0) return;
+    ProductError e;
+    e.product = name;
+    double se2 = 0, bse2 = 0, err2 = 0, r2 = 0;
+    for (size_t i = 0; i < K; ++i) {
+      const size_t v = report.vertices[i];
+      for (size_t c = 0; c < count; ++c) {
+        const double b = bake.values[v * W + offset + c], r = ref[i * W + offset + c];
+        err2 += (b - r) * (b - r);
+        r2 += r * r;
+        se2 += ref_se[i * W + offset + c] * ref_se[i * W + offset + c];
+        bse2 += bake.std_error[v * W + offset + c] * bake.std_error[v * W + offset + c];
+        e.max_abs = std::max(e.max_abs, std::abs(b - r));
+      }
+    }
+    e.values = K * count;
+    const double n = double(std::max<size_t>(e.values, 1));
+    e.rmse = std::sqrt(err2 / n);
+    e.reference_rms = std::sqrt(r2 / n);
+    e.reference_std_error = std::sqrt(se2 / n);
+    e.bake_std_error = std::sqrt(bse2 / n);
+    report.products.push_back(e);
+  };
+  add("ao", L.ao, L.ao_count);
+  add("transfer/diffuse", L.transfer, L.transfer_count);
+  add("transfer/visibility", L.visibility, L.visibility_count);
+  add("radiance/band1", L.radiance, L.radiance_count);
+  return report;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# tools/run.sh — one command from a fresh Debian 12 machine to a result.
+#   tools/run.sh demo   install dependencies, build (release), bake the default scene
+#                       (data/bunny_ground.obj under data/sunset.exr) to out/default.prt.h5
+#                       and show what was baked.
+#   tools/run.sh test   install dependencies, build (ci preset: warnings are errors), run every
+#                       test with ctest. This is what CI runs (.ci/run).
+#   tools/run.sh deps   only install the Debian packages (apt-get; needs root or sudo).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev hdf5-tools
+          libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py)
+JOBS=${JOBS:-$(nproc)}
+
+install_deps() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -eq 0 ]; then echo "deps: all ${#PACKAGES[@]} packages present"; return; fi
+  echo "deps: installing ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+build() {  # $1 = preset
+  cmake --preset "$1" >/dev/null
+  cmake --build --preset "$1" -j "$JOBS"
+}
+
+case "${1:-}" in
+  deps) install_deps ;;
+  demo)
+    install_deps
+    build release
+    mkdir -p out
+    ./build/release/tools/prtbake vertex data/bunny_ground.obj --ao --transfer 3 --visibility 3 \
+      --radiance data/sunset.exr -o out/default.prt.h5
+    ./build/release/tools/prtdump out/default.prt.h5
+    ;;
+  test)
+    install_deps
+    build ci
+    ctest --preset ci
+    ;;
+  *)
+    sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'
+    exit 2 ;;
+esac
