@@ -1,0 +1,221 @@
+// End-to-end tests of the prtbake binary: what a user runs, what lands on disk, what a bad input
+// does. Values are checked through the formats reader (the same one prtdump uses).
+#include <formats/prtfile.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+
+namespace {
+
+const fs::path kData = PRT_DATA_DIR;
+const std::string kBake = PRT_PRTBAKE;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "prtbake";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+struct Run {
+  int code;
+  std::string out, err;
+};
+
+// Runs prtbake with `args` (already shell-quoted where needed), capturing stdout and stderr.
+Run run(const std::string& args, const std::string& env = "") {
+  static int counter = 0;
+  const fs::path o = scratch("stdout." + std::to_string(counter)), e = scratch("stderr." + std::to_string(counter));
+  ++counter;
+  const std::string cmd = env + " " + kBake + " " + args + " > " + o.string() + " 2> " + e.string();
+  const int status = std::system(cmd.c_str());
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+  };
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
+}
+
+std::string slurp_bytes(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), {}};
+}
+
+void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
+
+// No file under `out` and no temporary beside it.
+void expect_no_output(const fs::path& out) {
+  EXPECT_FALSE(fs::exists(out)) << out;
+  if (fs::exists(out.parent_path()))
+    for (auto& e : fs::directory_iterator(out.parent_path()))
+      EXPECT_EQ(e.path().filename().string().find(out.filename().string() + ".tmp"), std::string::npos) << e.path();
+}
+
+const std::string kTetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+
+} // namespace
+
+TEST(Prtbake, BakesEveryProductOfARealMeshInOnePass) {
+  const fs::path out = scratch("spider.prt.h5");
+  fs::remove(out);
+  const Run r = run((kData / "spider.obj").string() + " -o " + out.string() +
+                    " --ao --transfer 3 --visibility 2 --radiance " + (kData / "sunset.exr").string() +
+                    " --samples 64 --report 8 --quiet");
+  // ("vertex" is the command; given after the options here on purpose: order is free.)
+  ASSERT_NE(r.code, 0) << "no command given must fail";
+  const Run ok = run("vertex " + (kData / "spider.obj").string() + " -o " + out.string() +
+                     " --ao --transfer 3 --visibility 2 --radiance " + (kData / "sunset.exr").string() +
+                     " --samples 64 --report 8 --quiet");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_TRUE(ok.out.empty()) << "--quiet prints nothing: " << ok.out;
+  const F::File f = F::read_file(out);
+  const F::Dataset* tri = F::find_dataset(f, "/mesh/triangles");
+  const F::Dataset* pos = F::find_dataset(f, "/mesh/positions");
+  ASSERT_TRUE(tri && pos);
+  EXPECT_EQ(tri->shape[0], 1368u) << "every triangle of spider.obj reaches the file";
+  EXPECT_EQ(pos->shape[0], 762u) << "one row per file vertex";
+  const size_t V = pos->shape[0];
+  for (const char* p : {"/ao", "/transfer/diffuse", "/transfer/visibility", "/radiance/band1", "/report/ao"})
+    EXPECT_NE(F::find_dataset(f, p), nullptr) << p;
+  const auto& ao = std::get<std::vector<float>>(F::find_dataset(f, "/ao")->data);
+  ASSERT_EQ(ao.size(), V);
+  // Every per-sample estimate is f·V/p ≥ 0, so AO ≥ 0 exactly; with the mixture of strategies
+  // it may exceed 1 by noise (it is unbiased, not clamped) — AO alone is bounded, see below.
+  for (float a : ao) {
+    EXPECT_TRUE(std::isfinite(a));
+    EXPECT_GE(a, 0.0f);
+  }
+  EXPECT_EQ(F::find_dataset(f, "/transfer/diffuse")->shape, (std::vector<uint64_t>{V, 9}));
+  EXPECT_EQ(F::find_dataset(f, "/transfer/visibility")->shape, (std::vector<uint64_t>{V, 4}));
+  EXPECT_EQ(F::find_dataset(f, "/radiance/band1")->shape, (std::vector<uint64_t>{V, 3, 3}));
+  const F::Attr* sha = F::find_attr(f.root_attrs, "source_sha256");
+  ASSERT_TRUE(sha);
+  EXPECT_EQ(std::get<std::string>(sha->value).size(), 64u);
+}
+
+TEST(Prtbake, AoAloneIsCosineSampledAndLiesInUnitInterval) {
+  // With --ao alone every ray is cosine-distributed and weighs exactly 1 (f/p = (c/π)/(c/π)),
+  // so each AO is a fraction k/N: in [0, 1] and a multiple of 1/N up to float rounding.
+  const fs::path out = scratch("ao.prt.h5");
+  ASSERT_EQ(run("vertex " + (kData / "wuson.obj").string() + " --ao --samples 64 --report 0 --quiet -o " + out.string()).code, 0);
+  const F::File f = F::read_file(out);
+  EXPECT_EQ(F::find_dataset(f, "/mesh/triangles")->shape[0], 3732u);
+  EXPECT_EQ(F::find_dataset(f, "/report/ao"), nullptr) << "--report 0 writes no report";
+  for (float a : std::get<std::vector<float>>(F::find_dataset(f, "/ao")->data)) {
+    EXPECT_GE(a, 0.0f);
+    EXPECT_LE(a, 1.0f);
+    EXPECT_NEAR(a * 64, std::round(a * 64), 64 * 1e-6);
+  }
+}
+
+TEST(Prtbake, SameSeedGivesIdenticalBytesWhateverTheThreadCount) {
+  const fs::path a = scratch("det1.prt.h5"), b = scratch("det2.prt.h5");
+  const std::string common = "vertex " + (kData / "bunny.obj").string() +
+                             " --ao --transfer 3 --radiance " + (kData / "sunset.exr").string() +
+                             " --samples 32 --seed 5 --report 4 --quiet";
+  ASSERT_EQ(run(common + " --threads 1 -o " + a.string(), "SOURCE_DATE_EPOCH=1700000000").code, 0);
+  ASSERT_EQ(run(common + " --threads 2 -o " + b.string(), "SOURCE_DATE_EPOCH=1700000000").code, 0);
+  const std::string x = slurp_bytes(a), y = slurp_bytes(b);
+  ASSERT_GT(x.size(), 1000u);
+  EXPECT_TRUE(x == y) << "files differ between --threads 1 and --threads 2";
+  // A different seed changes the numbers (the test above would pass vacuously otherwise).
+  const fs::path c = scratch("det3.prt.h5");
+  ASSERT_EQ(run("vertex " + (kData / "bunny.obj").string() + " --ao --transfer 3 --radiance " +
+                (kData / "sunset.exr").string() + " --samples 32 --seed 6 --report 4 --quiet --threads 2 -o " +
+                c.string(), "SOURCE_DATE_EPOCH=1700000000").code, 0);
+  EXPECT_FALSE(slurp_bytes(c) == x);
+}
+
+TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
+  const fs::path out = scratch("talk.prt.h5");
+  const Run r = run("vertex " + (kData / "bunny.obj").string() + " --ao --samples 32 --report 8 -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"1839 vertices", "3674 triangles", "baked 1839 vertices in", "RMSE", "wrote"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
+}
+
+struct BadInput {
+  const char* name;
+  std::string file_contents;  // written to the mesh path unless empty
+  bool mesh_is_env = false;   // the bad file is the environment, the mesh is good
+};
+
+TEST(Prtbake, BadInputsFailWithOneLineNamingTheFileAndLeaveNothing) {
+  const fs::path good_mesh = scratch("good.obj");
+  write_text(good_mesh, kTetra);
+  const std::string truncated_exr = slurp_bytes(kData / "sunset.exr").substr(0, 40000);
+  const std::vector<BadInput> cases = {
+      {"missing.obj", ""},
+      {"garbled.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nthis is not a ply file\n"},
+      {"truncated.obj", kTetra.substr(0, kTetra.size() - 9)},  // last face cut mid-line: "f 3 1" …
+      {"nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n"},
+      {"range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"},
+      {"empty.obj", "# nothing here\n"},
+      {"missing.exr", "", true},
+      {"truncated.exr", truncated_exr, true},
+      {"garbled.exr", std::string("v/1\x01 this is not an EXR file at all") + std::string(200, 'x'), true},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path bad = scratch(c.name);
+    fs::remove(bad);
+    if (!c.file_contents.empty()) {
+      std::ofstream f(bad, std::ios::binary);
+      f << c.file_contents;
+    }
+    const fs::path out = scratch(std::string(c.name) + ".prt.h5");
+    fs::remove(out);
+    const std::string mesh = c.mesh_is_env ? good_mesh.string() : bad.string();
+    const std::string env = c.mesh_is_env ? " --radiance " + bad.string() : "";
+    const Run r = run("vertex " + mesh + " --ao" + env + " --samples 8 -o " + out.string());
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find(bad.string()), std::string::npos) << "error must name " << bad << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+    expect_no_output(out);
+  }
+}
+
+TEST(Prtbake, UnwritableOutputFailsBeforeBaking) {
+  const fs::path mesh = scratch("tetra.obj");
+  write_text(mesh, kTetra);
+  const Run r = run("vertex " + mesh.string() + " --ao -o /nonexistent-dir/x.prt.h5");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("/nonexistent-dir/x.prt.h5"), std::string::npos) << r.err;
+  // Exists but is read-only (root ignores permissions, so use a path under /proc).
+  const Run r2 = run("vertex " + mesh.string() + " --ao -o /proc/x.prt.h5");
+  EXPECT_EQ(r2.code, 1) << r2.err;
+  EXPECT_FALSE(fs::exists("/proc/x.prt.h5"));
+}
+
+TEST(Prtbake, ExistingOutputIsUntouchedWhenABakeFails) {
+  const fs::path out = scratch("keep.prt.h5");
+  write_text(out, "previous contents");
+  const Run r = run("vertex " + scratch("does-not-exist.obj").string() + " --ao -o " + out.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(slurp_bytes(out), "previous contents");
+}
+
+TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("vertex x.obj -o y.prt.h5").code, 2) << "nothing to bake";
+  EXPECT_EQ(run("vertex x.obj --ao").code, 2) << "no output";
+  EXPECT_EQ(run("vertex x.obj --ao -o y --transfer 0").code, 2);
+  EXPECT_EQ(run("vertex x.obj --ao -o y --samples lots").code, 2);
+  EXPECT_EQ(run("vertex x.obj --ao -o y --frobnicate").code, 2);
+  const Run h = run("--help");
+  EXPECT_EQ(h.code, 0);
+  for (const char* s : {"--ao", "--transfer", "--visibility", "--radiance", "--samples", "--seed", "--threads", "--up",
+                        "EXAMPLES", "EXIT STATUS"})
+    EXPECT_NE(h.out.find(s), std::string::npos) << s;
+}
