@@ -1,0 +1,257 @@
+// mesh.cpp — in-memory meshes, normals and welded topology (contracts in bake/mesh.h).
+#include <bake/error.h>
+#include <bake/mesh.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+
+namespace prt::bake {
+namespace {
+
+// Bitwise key of a position with −0 mapped to +0 (x + 0.0f does exactly that for every finite x).
+using PositionKey = std::array<uint32_t, 3>;
+
+PositionKey position_key(const Eigen::Vector3f& p) {
+  return {std::bit_cast<uint32_t>(p.x() + 0.0f), std::bit_cast<uint32_t>(p.y() + 0.0f),
+          std::bit_cast<uint32_t>(p.z() + 0.0f)};
+}
+
+struct PositionKeyHash {
+  size_t operator()(const PositionKey& k) const noexcept {
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (uint32_t c : k) h = (h ^ c) * 0xBF58476D1CE4E5B9ull, h ^= h >> 31;
+    return static_cast<size_t>(h);
+  }
+};
+
+// Welded id per vertex, ids in order of first appearance; returns the number of welded positions.
+uint32_t weld_positions(std::span<const Eigen::Vector3f> positions, std::vector<uint32_t>& weld) {
+  std::unordered_map<PositionKey, uint32_t, PositionKeyHash> ids;
+  ids.reserve(positions.size());
+  weld.resize(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const auto [it, inserted] = ids.try_emplace(position_key(positions[v]), static_cast<uint32_t>(ids.size()));
+    weld[v] = it->second;
+  }
+  return static_cast<uint32_t>(ids.size());
+}
+
+// Σ_t α_t(v) n̂_t per index of `corners` (which map triangle corners to accumulator slots).
+std::vector<Eigen::Vector3d> accumulate_angle_weighted(std::span<const Eigen::Vector3f> positions,
+                                                       std::span<const std::array<uint32_t, 3>> triangles,
+                                                       std::span<const uint32_t> slot_of_vertex, size_t slots) {
+  std::vector<Eigen::Vector3d> sum(slots, Eigen::Vector3d::Zero());
+  for (const auto& t : triangles) {
+    for (uint32_t i : t) PRT_CHECK_OP(i, <, positions.size());
+    const Eigen::Vector3d p[3] = {positions[t[0]].cast<double>(), positions[t[1]].cast<double>(),
+                                  positions[t[2]].cast<double>()};
+    const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    const double len = n.norm();
+    if (!(len > 0.0) || !std::isfinite(len)) continue;  // zero-area: no direction to contribute
+    const Eigen::Vector3d unit = n / len;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+      // atan2(|e1×e2|, e1·e2) is accurate for needles, where acos of a normalised dot is not.
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      sum[slot_of_vertex[t[k]]] += angle * unit;
+    }
+  }
+  return sum;
+}
+
+Eigen::Vector3f unit_or_up(const Eigen::Vector3d& s) {
+  const double len = s.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) return Eigen::Vector3f::UnitY();
+  return (s / len).cast<float>();
+}
+
+} // namespace
+
+std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
+                                                    std::span<const std::array<uint32_t, 3>> triangles) {
+  std::vector<uint32_t> identity(positions.size());
+  std::iota(identity.begin(), identity.end(), 0u);
+  const auto sum = accumulate_angle_weighted(positions, triangles, identity, positions.size());
+  std::vector<Eigen::Vector3f> normals(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) normals[v] = unit_or_up(sum[v]);
+  return normals;
+}
+
+std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
+                                                           std::span<const std::array<uint32_t, 3>> triangles) {
+  std::vector<uint32_t> weld;
+  const uint32_t n_welded = weld_positions(positions, weld);
+  const auto sum = accumulate_angle_weighted(positions, triangles, weld, n_welded);
+  std::vector<Eigen::Vector3f> welded(n_welded);
+  for (uint32_t w = 0; w < n_welded; ++w) welded[w] = unit_or_up(sum[w]);
+  std::vector<Eigen::Vector3f> normals(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) normals[v] = welded[weld[v]];
+  return normals;
+}
+
+Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<uint32_t, 3>> triangles,
+               std::string name, std::vector<Eigen::Vector3f> normals) {
+  if (positions.size() >= std::numeric_limits<uint32_t>::max())
+    throw InputError(name, "too many vertices (" + std::to_string(positions.size()) + ") for 32-bit indices");
+  if (triangles.empty()) throw InputError(name, "mesh has no triangles");
+  for (size_t v = 0; v < positions.size(); ++v) {
+    if (!positions[v].allFinite()) {
+      std::ostringstream os;
+      os << "vertex " << v << " has a non-finite coordinate (" << positions[v].transpose() << ")";
+      throw InputError(name, os.str());
+    }
+  }
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (uint32_t i : triangles[t]) {
+      if (i >= positions.size())
+        throw InputError(name, "triangle " + std::to_string(t) + " references vertex " + std::to_string(i) +
+                                   " but there are " + std::to_string(positions.size()) + " vertices");
+    }
+  }
+  Mesh mesh;
+  if (!normals.empty()) {
+    if (normals.size() != positions.size())
+      throw InputError(name, std::to_string(normals.size()) + " normals for " + std::to_string(positions.size()) +
+                                 " vertices");
+    for (size_t v = 0; v < normals.size(); ++v) {
+      const float len = normals[v].norm();
+      if (!std::isfinite(len) || !(len > 0.0f))
+        throw InputError(name, "normal " + std::to_string(v) + " is zero or not finite");
+      normals[v] /= len;
+    }
+    mesh.normals = std::move(normals);
+    mesh.normal_source = Mesh::NormalSource::File;
+  } else {
+    mesh.normals = welded_angle_weighted_normals(positions, triangles);
+    mesh.normal_source = Mesh::NormalSource::AngleWeighted;
+  }
+  mesh.source_position.resize(positions.size());
+  std::iota(mesh.source_position.begin(), mesh.source_position.end(), 0u);
+  mesh.file_positions = positions.size();
+  mesh.file_faces = triangles.size();
+  mesh.positions = std::move(positions);
+  mesh.triangles = std::move(triangles);
+  mesh.source = std::move(name);
+  return mesh;
+}
+
+Mesh merge_meshes(std::span<const Mesh> parts, std::string name) {
+  PRT_CHECK(!parts.empty());
+  Mesh out;
+  out.source = std::move(name);
+  out.normal_source = Mesh::NormalSource::File;
+  size_t n_vertices = 0, n_triangles = 0;
+  for (const Mesh& m : parts) {
+    PRT_CHECK_OP(m.normals.size(), ==, m.positions.size());
+    PRT_CHECK_OP(m.source_position.size(), ==, m.positions.size());
+    n_vertices += m.positions.size();
+    n_triangles += m.triangles.size();
+  }
+  PRT_CHECK_OP(n_vertices, <, size_t{std::numeric_limits<uint32_t>::max()});
+  out.positions.reserve(n_vertices);
+  out.normals.reserve(n_vertices);
+  out.source_position.reserve(n_vertices);
+  out.triangles.reserve(n_triangles);
+  for (const Mesh& m : parts) {
+    const auto vertex_offset = static_cast<uint32_t>(out.positions.size());
+    const size_t position_offset = out.file_positions;
+    PRT_CHECK_OP(position_offset + m.file_positions, <, size_t{std::numeric_limits<uint32_t>::max()});
+    out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
+    out.normals.insert(out.normals.end(), m.normals.begin(), m.normals.end());
+    for (uint32_t s : m.source_position) out.source_position.push_back(s + static_cast<uint32_t>(position_offset));
+    for (const auto& t : m.triangles)
+      out.triangles.push_back({t[0] + vertex_offset, t[1] + vertex_offset, t[2] + vertex_offset});
+    if (m.normal_source != Mesh::NormalSource::File) out.normal_source = Mesh::NormalSource::AngleWeighted;
+    out.file_positions += m.file_positions;
+    out.file_faces += m.file_faces;
+    out.warnings.insert(out.warnings.end(), m.warnings.begin(), m.warnings.end());
+  }
+  return out;
+}
+
+std::span<const uint32_t> Topology::ring(uint32_t welded) const {
+  PRT_CHECK_OP(size_t{welded} + 1, <, ring_offsets.size());
+  return std::span<const uint32_t>(ring_faces).subspan(ring_offsets[welded], ring_offsets[welded + 1] - ring_offsets[welded]);
+}
+
+std::span<const uint32_t> Topology::faces_of_edge(uint32_t edge) const {
+  PRT_CHECK_OP(size_t{edge} + 1, <, edge_face_offsets.size());
+  return std::span<const uint32_t>(edge_faces)
+      .subspan(edge_face_offsets[edge], edge_face_offsets[edge + 1] - edge_face_offsets[edge]);
+}
+
+std::optional<uint32_t> Topology::find_edge(uint32_t a, uint32_t b) const {
+  const std::array<uint32_t, 2> key = {std::min(a, b), std::max(a, b)};
+  const auto it = std::lower_bound(edges.begin(), edges.end(), key);
+  if (it == edges.end() || *it != key) return std::nullopt;
+  return static_cast<uint32_t>(it - edges.begin());
+}
+
+Topology build_topology(const Mesh& mesh) {
+  Topology topo;
+  const uint32_t n_welded = weld_positions(mesh.positions, topo.weld);
+  topo.welded_positions.resize(n_welded);
+  for (size_t v = mesh.positions.size(); v-- > 0;) topo.welded_positions[topo.weld[v]] = mesh.positions[v];
+
+  // Welded corners per triangle, each distinct corner once.
+  const auto n_triangles = static_cast<uint32_t>(mesh.triangles.size());
+  std::vector<std::array<uint32_t, 3>> corners(n_triangles);
+  for (uint32_t t = 0; t < n_triangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      PRT_CHECK_OP(mesh.triangles[t][k], <, mesh.positions.size());
+      corners[t][k] = topo.weld[mesh.triangles[t][k]];
+    }
+  }
+
+  // Rings: counting sort by welded corner; triangles visited in order, so each ring ascends.
+  topo.ring_offsets.assign(size_t{n_welded} + 1, 0);
+  auto for_distinct = [&](const std::array<uint32_t, 3>& c, auto&& f) {
+    f(c[0]);
+    if (c[1] != c[0]) f(c[1]);
+    if (c[2] != c[0] && c[2] != c[1]) f(c[2]);
+  };
+  for (const auto& c : corners) for_distinct(c, [&](uint32_t w) { ++topo.ring_offsets[w + 1]; });
+  std::partial_sum(topo.ring_offsets.begin(), topo.ring_offsets.end(), topo.ring_offsets.begin());
+  topo.ring_faces.resize(topo.ring_offsets.back());
+  {
+    std::vector<uint32_t> cursor(topo.ring_offsets.begin(), topo.ring_offsets.end() - 1);
+    for (uint32_t t = 0; t < n_triangles; ++t) for_distinct(corners[t], [&](uint32_t w) { topo.ring_faces[cursor[w]++] = t; });
+  }
+
+  // Edges: (a, b, face) for each distinct undirected side, sorted; no orientation is used.
+  struct EdgeFace {
+    uint32_t a, b, face;
+    auto operator<=>(const EdgeFace&) const = default;
+  };
+  std::vector<EdgeFace> sides;
+  sides.reserve(size_t{n_triangles} * 3);
+  for (uint32_t t = 0; t < n_triangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = corners[t][k], w = corners[t][(k + 1) % 3];
+      if (u != w) sides.push_back({std::min(u, w), std::max(u, w), t});
+    }
+  }
+  std::sort(sides.begin(), sides.end());
+  sides.erase(std::unique(sides.begin(), sides.end()), sides.end());  // (a, a, b) lists its face once
+  topo.edge_face_offsets.push_back(0);
+  topo.edge_faces.reserve(sides.size());
+  for (size_t i = 0; i < sides.size(); ++i) {
+    if (i == 0 || sides[i].a != sides[i - 1].a || sides[i].b != sides[i - 1].b) {
+      if (i != 0) topo.edge_face_offsets.push_back(static_cast<uint32_t>(topo.edge_faces.size()));
+      topo.edges.push_back({sides[i].a, sides[i].b});
+    }
+    topo.edge_faces.push_back(sides[i].face);
+  }
+  if (!sides.empty()) topo.edge_face_offsets.push_back(static_cast<uint32_t>(topo.edge_faces.size()));
+  return topo;
+}
+
+} // namespace prt::bake
