@@ -4,6 +4,7 @@
 #include <bake/error.h>
 #include <bake/mesh.h>
 #include <bake/qmc.h>
+#include <bake/sampling.h>
 #include <bake/sha256.h>
 #include <bake/vertex_bake.h>
 #include <formats/prtfile.h>
@@ -232,6 +233,7 @@ int run_vertex(const Args& a) {
   const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
   const std::string mesh_sha = bake::sha256_file(a.mesh);
+  for (const auto& w : mesh.warnings) std::fprintf(stderr, "prtbake: warning: %s\n", w.c_str());
   if (say)
     std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s\n",
                 a.mesh.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
