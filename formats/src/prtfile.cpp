@@ -1,1 +1,87 @@
-// placeholder: replaced by the HDF5 writer/reader
+// prtfile.cpp — model helpers (lookups, dtype names) and the shared HDF5 plumbing of h5util.h.
+#include <formats/prtfile.h>
+
+#include "h5util.h"
+
+#include <limits>
+
+namespace prt::formats {
+
+const Attr* find_attr(const std::vector<Attr>& attrs, std::string_view name) {
+  for (const Attr& a : attrs)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+const Dataset* find_dataset(const File& file, std::string_view path) {
+  for (const Dataset& d : file.datasets)
+    if (d.path == path) return &d;
+  return nullptr;
+}
+
+const std::vector<Attr>* find_group_attrs(const File& file, std::string_view group_path) {
+  for (const auto& [path, attrs] : file.group_attrs)
+    if (path == group_path) return &attrs;
+  return nullptr;
+}
+
+std::string_view dtype_name(const DatasetData& data) {
+  switch (data.index()) {
+  case 0: return "float32";
+  case 1: return "uint32";
+  default: return "uint8";
+  }
+}
+
+std::size_t element_count(const DatasetData& data) {
+  return std::visit([](const auto& v) { return v.size(); }, data);
+}
+
+uint64_t shape_product(const std::vector<uint64_t>& shape) {
+  uint64_t n = 1;
+  for (uint64_t d : shape) {
+    if (d != 0 && n > std::numeric_limits<uint64_t>::max() / d)
+      throw FormatError("", "shape product overflows 64 bits");
+    n *= d;
+  }
+  return n;
+}
+
+namespace detail {
+
+std::mutex& hdf5_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+void silence_hdf5_errors() { H5Eset_auto(H5E_DEFAULT, nullptr, nullptr); }
+
+namespace {
+herr_t first_error(unsigned n, const H5E_error2_t* err, void* out) {
+  auto* s = static_cast<std::string*>(out);
+  if (n == 0 && err != nullptr && err->desc != nullptr) *s = err->desc;
+  return 0;
+}
+} // namespace
+
+std::string take_hdf5_error() {
+  std::string msg;
+  // Upward: the first record is the most specific one (e.g. "truncated file: eof = ...").
+  H5Ewalk(H5E_DEFAULT, H5E_WALK_UPWARD, &first_error, &msg);
+  H5Eclear(H5E_DEFAULT);
+  // Keep the message on one line.
+  for (char& c : msg)
+    if (c == '\n' || c == '\r') c = ' ';
+  return msg;
+}
+
+Hid make_utf8_string_type(std::size_t bytes) {
+  Hid t = type_id(H5Tcopy(H5T_C_S1));
+  if (!t.valid() || H5Tset_size(t.get(), bytes > 0 ? bytes : 1) < 0 ||
+      H5Tset_strpad(t.get(), H5T_STR_NULLPAD) < 0 || H5Tset_cset(t.get(), H5T_CSET_UTF8) < 0)
+    return {};
+  return t;
+}
+
+} // namespace detail
+} // namespace prt::formats

@@ -1,0 +1,129 @@
+// formats/prtfile.h — the baked file (HDF5, schema version 1): the in-memory model, the one
+// writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
+// depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
+// specified in formats/SCHEMA.md; DESIGN.md §3 and §5 are its source.
+//
+// Model
+//   A File is a list of root attributes, a list of datasets (each with an absolute path, a
+//   row-major shape, typed data and attributes) and a list of group attributes. Groups are not
+//   listed: they exist because a dataset lies under them or because they carry attributes.
+//   On-disk types: std::vector<float> <-> float32 (IEEE little endian), std::vector<uint32_t>
+//   <-> uint32, std::vector<uint8_t> <-> uint8. Attribute values: std::string <-> variable-length
+//   UTF-8 string, int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
+//   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
+//
+// Writer contract (write_file)
+//   * Validates the whole File against schema v1 (validate()) before touching the disk.
+//   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
+//     other required root attribute (generator, created, command_line, source, source_sha256,
+//     up_axis, sh_convention).
+//   * Writes "<dir>/<name>.tmp.<pid>" and renames it onto the final name: on any error the
+//     temporary file is removed, nothing new exists under the final name and a file already
+//     there is untouched.
+//   * Deterministic: the same File gives the same bytes (no object time stamps, fixed library
+//     format bounds). Datasets are chunked along the first axis (~64 KiB chunks), shuffled,
+//     deflated (level 6) and fletcher32-checksummed.
+//
+// Reader contract (read_file)
+//   * Reads every dataset and every attribute of the root, of each group and of each dataset.
+//     Datasets come back sorted by path, attributes sorted by name, group_attrs sorted by path
+//     (the writer keeps the caller's order; compare by name, not by position).
+//   * Checks format=="prtbake" and format_version (a newer version is rejected with
+//     "written by a newer prtbake (format_version N > 1)"). With ReadCheck::full (the default)
+//     it then applies validate(), so callers can trust shapes, index ranges and finiteness.
+//   * Damaged, truncated or non-HDF5 files give a FormatError naming the file; never a crash.
+//
+// Errors: every failure is a FormatError whose what() is one line "<file>: <defect>".
+// Threads: serial HDF5 is not thread-safe; write_file/read_file serialise their HDF5 calls with
+// one process-wide mutex, so they may be called from any thread.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace prt::formats {
+
+// Schema version written by this library and the newest one it reads (policy: SCHEMA.md).
+inline constexpr int kFormatVersion = 1;
+// Value of the root attribute "format".
+inline constexpr std::string_view kFormatName = "prtbake";
+
+using AttrValue =
+    std::variant<std::string, int64_t, double, std::vector<double>, std::vector<int64_t>>;
+
+struct Attr {
+  std::string name;
+  AttrValue value;
+};
+
+using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>>;
+
+struct Dataset {
+  std::string path;              // absolute, e.g. "/transfer/diffuse"; parent groups are created
+  std::vector<uint64_t> shape;   // row-major; data.size() == product(shape)
+  DatasetData data;              // float32 / uint32 / uint8 on disk
+  std::vector<Attr> attrs;
+};
+
+struct File {
+  std::vector<Attr> root_attrs;
+  std::vector<Dataset> datasets;
+  // Attributes of groups, by absolute group path, e.g. {"/report", {{"rmse", 1e-3}, ...}}.
+  // Allowed groups: /mesh, /transfer, /radiance, /fiv, /fiv/occluders, /fiv/occluders/<name>,
+  // /report and any group under /report. The root's attributes go in root_attrs, not here.
+  std::vector<std::pair<std::string, std::vector<Attr>>> group_attrs;
+};
+
+// An input error about a baked file: what() == "<file>: <defect>" (one line).
+class FormatError : public std::runtime_error {
+public:
+  FormatError(const std::string& file, const std::string& defect)
+      : std::runtime_error(file.empty() ? defect : file + ": " + defect), file_(file),
+        defect_(defect) {}
+  const std::string& file() const noexcept { return file_; }
+  const std::string& defect() const noexcept { return defect_; }
+
+private:
+  std::string file_, defect_;
+};
+
+// Writes `file` to `final_path` (see the writer contract above). Throws FormatError.
+void write_file(const std::filesystem::path& final_path, const File& file);
+
+enum class ReadCheck {
+  full,    // format, format_version and the whole schema v1 (validate())
+  header,  // format and format_version only: for inspectors (prtdump) that show what is wrong
+};
+
+// Reads the whole file at `path` (see the reader contract above). Throws FormatError.
+File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::full);
+
+// Checks `file` against schema v1 exactly as write_file does; messages name `file_for_messages`.
+// Root "format"/"format_version" may be absent (the writer adds them) but, if present, must be
+// "prtbake" / kFormatVersion. Throws FormatError on the first defect found.
+void validate(const File& file, const std::filesystem::path& file_for_messages);
+
+// Lookups; nullptr when absent.
+const Attr* find_attr(const std::vector<Attr>& attrs, std::string_view name);
+const Dataset* find_dataset(const File& file, std::string_view path);
+const std::vector<Attr>* find_group_attrs(const File& file, std::string_view group_path);
+
+// True for the schema's per-vertex datasets (first axis = V = rows of /mesh/positions):
+// /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
+// /transfer/visibility, /radiance/band1. /report datasets are never per-vertex.
+bool is_per_vertex_path(std::string_view path);
+
+// "float32", "uint32" or "uint8".
+std::string_view dtype_name(const DatasetData& data);
+// Number of elements of `data`.
+std::size_t element_count(const DatasetData& data);
+// Product of `shape` (1 for an empty shape); throws FormatError("", ...) on overflow.
+uint64_t shape_product(const std::vector<uint64_t>& shape);
+
+} // namespace prt::formats

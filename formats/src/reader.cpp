@@ -1,0 +1,263 @@
+// reader.cpp — read_file: open, check format/format_version, read everything, validate.
+// Hostile input: every HDF5 call is checked, sizes are checked before allocation, link cycles
+// and depth are bounded, and only hard links are followed (never external files).
+#include <formats/prtfile.h>
+
+#include "h5util.h"
+
+#include <algorithm>
+#include <limits>
+#include <new>
+
+namespace prt::formats {
+namespace {
+
+using detail::Hid;
+
+constexpr int kMaxDepth = 32;
+constexpr std::size_t kMaxObjects = 1'000'000;
+
+class Reader {
+public:
+  Reader(std::string file_for_messages, uint64_t file_size)
+      : msg_file_(std::move(file_for_messages)), file_size_(file_size) {}
+
+  // Deflate cannot expand data by more than ~1032:1, so a dataset (attributes are stored
+  // uncompressed) claiming more bytes than that is damaged: refuse before allocating.
+  bool plausible(uint64_t bytes, bool compressed) const {
+    const uint64_t slack = uint64_t{16} << 20;
+    const uint64_t ratio = compressed ? 1100 : 1;
+    return file_size_ <= (std::numeric_limits<uint64_t>::max() - slack) / ratio &&
+           bytes <= file_size_ * ratio + slack;
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    const std::string detail = detail::take_hdf5_error();
+    throw FormatError(msg_file_, what + (detail.empty() ? "" : " (HDF5: " + detail + ")"));
+  }
+  Hid check(Hid id, const std::string& what) const {
+    if (!id.valid()) fail(what);
+    return id;
+  }
+
+  std::vector<Attr> read_attrs(hid_t obj, const std::string& owner) const {
+    H5O_info_t info;
+    if (H5Oget_info2(obj, &info, H5O_INFO_NUM_ATTRS) < 0) fail("cannot inspect " + owner);
+    std::vector<Attr> out;
+    for (hsize_t i = 0; i < info.num_attrs; ++i) {
+      Hid a = check(detail::attr_id(H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i,
+                                                  H5P_DEFAULT, H5P_DEFAULT)),
+                    "cannot open attribute " + std::to_string(i) + " of " + owner);
+      out.push_back(read_attr(a.get(), owner));
+    }
+    return out;
+  }
+
+  Attr read_attr(hid_t a, const std::string& owner) const {
+    Attr out;
+    const ssize_t len = H5Aget_name(a, 0, nullptr);
+    if (len < 0) fail("cannot read an attribute name of " + owner);
+    out.name.resize(static_cast<std::size_t>(len) + 1);
+    if (H5Aget_name(a, out.name.size(), out.name.data()) < 0)
+      fail("cannot read an attribute name of " + owner);
+    out.name.resize(static_cast<std::size_t>(len));
+    const std::string what = "attribute '" + out.name + "' of " + owner;
+
+    Hid type = check(detail::type_id(H5Aget_type(a)), "cannot read the type of " + what);
+    Hid space = check(detail::space_id(H5Aget_space(a)), "cannot read the shape of " + what);
+    const H5S_class_t sclass = H5Sget_simple_extent_type(space.get());
+    const hssize_t npoints = sclass == H5S_NULL ? 0 : H5Sget_simple_extent_npoints(space.get());
+    if (npoints < 0) fail("cannot read the shape of " + what);
+    const auto n = static_cast<std::size_t>(npoints);
+    const H5T_class_t tclass = H5Tget_class(type.get());
+
+    if (tclass == H5T_STRING) {
+      if (sclass != H5S_SCALAR) fail(what + " is an array of strings (not supported)");
+      const htri_t is_var = H5Tis_variable_str(type.get());
+      if (is_var < 0) fail("cannot read the type of " + what);
+      if (is_var > 0)
+        fail(what + " is a variable-length string; schema v1 stores strings as fixed-length "
+                    "UTF-8 (variable-length strings are not read: HDF5 cannot read them safely "
+                    "from a damaged file)");
+      {
+        const std::size_t size = H5Tget_size(type.get());
+        if (size == 0 || !plausible(size, false)) fail(what + " has an invalid string size");
+        std::string s(size, '\0');
+        Hid mem = check(detail::type_id(H5Tcopy(type.get())), what);
+        if (H5Aread(a, mem.get(), s.data()) < 0) fail("cannot read " + what);
+        s.resize(std::min(s.size(), s.find('\0')));
+        if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD)
+          s.erase(s.find_last_not_of(' ') + 1);
+        out.value = std::move(s);
+      }
+      return out;
+    }
+    if (tclass != H5T_INTEGER && tclass != H5T_FLOAT) fail(what + " has an unsupported type");
+    if (n > (std::size_t{1} << 28) || !plausible(uint64_t{8} * n, false))
+      fail(what + " claims " + std::to_string(n) + " values, more than the file can hold (damaged?)");
+    const bool scalar = sclass == H5S_SCALAR;
+    if (tclass == H5T_INTEGER) {
+      std::vector<int64_t> v(n);
+      if (n > 0 && H5Aread(a, H5T_NATIVE_INT64, v.data()) < 0) fail("cannot read " + what);
+      if (scalar) out.value = v.at(0);
+      else out.value = std::move(v);
+    } else {
+      std::vector<double> v(n);
+      if (n > 0 && H5Aread(a, H5T_NATIVE_DOUBLE, v.data()) < 0) fail("cannot read " + what);
+      if (scalar) out.value = v.at(0);
+      else out.value = std::move(v);
+    }
+    return out;
+  }
+
+  Dataset read_dataset(hid_t parent, const std::string& link, const std::string& path) const {
+    const std::string name = "dataset '" + path + "'";
+    Dataset out;
+    out.path = path;
+    Hid ds = check(detail::dataset_id(H5Dopen2(parent, link.c_str(), H5P_DEFAULT)), "cannot open " + name);
+    Hid type = check(detail::type_id(H5Dget_type(ds.get())), "cannot read the type of " + name);
+    Hid space = check(detail::space_id(H5Dget_space(ds.get())), "cannot read the shape of " + name);
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    if (rank < 0 || rank > 32) fail("cannot read the shape of " + name);
+    std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+    if (rank > 0 && H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) < 0)
+      fail("cannot read the shape of " + name);
+    out.shape.assign(dims.begin(), dims.end());
+    uint64_t n = 0;
+    try {
+      n = shape_product(out.shape);
+    } catch (const FormatError&) {
+      fail(name + " has a shape whose size overflows");
+    }
+    if (H5Sget_simple_extent_type(space.get()) == H5S_NULL) n = 0;
+
+    const H5T_class_t tclass = H5Tget_class(type.get());
+    const std::size_t size = H5Tget_size(type.get());
+    if (n > std::numeric_limits<uint64_t>::max() / 8 || !plausible(n * std::max<std::size_t>(size, 1), true))
+      fail(name + " claims " + std::to_string(n) + " values, more than the file can hold (damaged?)");
+    hid_t mem = H5I_INVALID_HID;
+    void* buf = nullptr;
+    try {
+      if (tclass == H5T_FLOAT && size == 4) {
+        out.data = std::vector<float>(n);
+        buf = std::get<0>(out.data).data(), mem = H5T_NATIVE_FLOAT;
+      } else if (tclass == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_NONE && size == 4) {
+        out.data = std::vector<uint32_t>(n);
+        buf = std::get<1>(out.data).data(), mem = H5T_NATIVE_UINT32;
+      } else if (tclass == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_NONE && size == 1) {
+        out.data = std::vector<uint8_t>(n);
+        buf = std::get<2>(out.data).data(), mem = H5T_NATIVE_UINT8;
+      } else {
+        fail(name + " has an unsupported type (schema v1 uses float32, uint32 and uint8)");
+      }
+    } catch (const std::bad_alloc&) {
+      fail(name + " is too large to read (" + std::to_string(n) + " values)");
+    } catch (const std::length_error&) {
+      fail(name + " is too large to read (" + std::to_string(n) + " values)");
+    }
+    if (n > 0 && H5Dread(ds.get(), mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+      fail("cannot read " + name + " (damaged or truncated data, or a checksum mismatch)");
+    out.attrs = read_attrs(ds.get(), name);
+    return out;
+  }
+
+  // Depth-first over hard links in name order: groups, datasets, attributes.
+  void read_group(hid_t group, const std::string& path, int depth, File& out) {
+    if (depth > kMaxDepth) fail("groups nest deeper than " + std::to_string(kMaxDepth) + " (a link cycle?)");
+    H5G_info_t ginfo;
+    if (H5Gget_info(group, &ginfo) < 0) fail("cannot read group '" + path + "'");
+    for (hsize_t i = 0; i < ginfo.nlinks; ++i) {
+      if (++objects_ > kMaxObjects) fail("too many objects (a link cycle?)");
+      const ssize_t len = H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
+      if (len < 0) fail("cannot read a link name in group '" + path + "'");
+      std::string link(static_cast<std::size_t>(len) + 1, '\0');
+      if (H5Lget_name_by_idx(group, ".", H5_INDEX_NAME, H5_ITER_INC, i, link.data(), link.size(),
+                             H5P_DEFAULT) < 0)
+        fail("cannot read a link name in group '" + path + "'");
+      link.resize(static_cast<std::size_t>(len));
+      const std::string child = (path == "/" ? "" : path) + "/" + link;
+      H5L_info_t linfo;
+      if (H5Lget_info(group, link.c_str(), &linfo, H5P_DEFAULT) < 0) fail("cannot inspect '" + child + "'");
+      if (linfo.type != H5L_TYPE_HARD) fail("'" + child + "' is a soft or external link (not supported)");
+      Hid obj = check(detail::object_id(H5Oopen(group, link.c_str(), H5P_DEFAULT)), "cannot open '" + child + "'");
+      const H5I_type_t t = H5Iget_type(obj.get());
+      if (t == H5I_GROUP) {
+        std::vector<Attr> attrs = read_attrs(obj.get(), "group '" + child + "'");
+        if (!attrs.empty()) out.group_attrs.emplace_back(child, std::move(attrs));
+        read_group(obj.get(), child, depth + 1, out);
+      } else if (t == H5I_DATASET) {
+        obj.close();
+        out.datasets.push_back(read_dataset(group, link, child));
+      } else {
+        fail("'" + child + "' is neither a group nor a dataset (not supported)");
+      }
+    }
+  }
+
+private:
+  std::string msg_file_;
+  uint64_t file_size_;
+  std::size_t objects_ = 0;
+};
+
+} // namespace
+
+File read_file(const std::filesystem::path& path, ReadCheck check) {
+  const std::string msg_file = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw FormatError(msg_file, "no such file");
+  if (std::filesystem::is_directory(status)) throw FormatError(msg_file, "is a directory, not a file");
+
+  File out;
+  {
+    const std::lock_guard lock(detail::hdf5_mutex());
+    detail::silence_hdf5_errors();
+    Reader r(msg_file, static_cast<uint64_t>(std::filesystem::file_size(path, ec)));
+    try {
+      const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
+      if (is_hdf5 <= 0) {
+        detail::take_hdf5_error();
+        throw FormatError(msg_file, "not an HDF5 file (or damaged beyond recognition)");
+      }
+      Hid fapl = detail::plist_id(H5Pcreate(H5P_FILE_ACCESS));
+      if (!fapl.valid() || H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0)
+        r.fail("cannot create HDF5 file properties");
+      Hid f = detail::file_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
+      if (!f.valid()) r.fail("cannot open the HDF5 file (damaged or truncated?)");
+      Hid root = r.check(detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT)), "cannot open the root group");
+      out.root_attrs = r.read_attrs(root.get(), "the root group");
+
+      const Attr* fmt = find_attr(out.root_attrs, "format");
+      const auto* fmt_s = fmt ? std::get_if<std::string>(&fmt->value) : nullptr;
+      if (fmt_s == nullptr) throw FormatError(msg_file, "not a prtbake file (no 'format' attribute)");
+      if (*fmt_s != kFormatName)
+        throw FormatError(msg_file, "not a prtbake file (format = \"" + *fmt_s + "\")");
+      const Attr* ver = find_attr(out.root_attrs, "format_version");
+      const auto* ver_i = ver ? std::get_if<int64_t>(&ver->value) : nullptr;
+      if (ver_i == nullptr)
+        throw FormatError(msg_file, "prtbake file without an integer 'format_version' attribute");
+      if (*ver_i > kFormatVersion)
+        throw FormatError(msg_file, "written by a newer prtbake (format_version " +
+                                        std::to_string(*ver_i) + " > " +
+                                        std::to_string(kFormatVersion) + "); update prtbake to read it");
+      if (*ver_i < 1)
+        throw FormatError(msg_file, "invalid format_version " + std::to_string(*ver_i));
+
+      r.read_group(root.get(), "/", 1, out);
+      root.close();
+      if (f.close() < 0) r.fail("cannot close the file");
+    } catch (const std::bad_alloc&) {
+      detail::take_hdf5_error();
+      throw FormatError(msg_file, "out of memory while reading (damaged sizes?)");
+    }
+  }
+  std::sort(out.datasets.begin(), out.datasets.end(),
+            [](const Dataset& a, const Dataset& b) { return a.path < b.path; });
+  std::sort(out.group_attrs.begin(), out.group_attrs.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (check == ReadCheck::full) validate(out, path);
+  return out;
+}
+
+} // namespace prt::formats

@@ -1,0 +1,388 @@
+// schema.cpp — schema v1 (formats/SCHEMA.md) as code: validate() is the single check that the
+// writer applies before writing and the reader applies after reading.
+#include <formats/prtfile.h>
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace prt::formats {
+namespace {
+
+constexpr std::array<std::string_view, 7> kRequiredRootStrings = {
+    "generator", "created", "command_line", "source", "source_sha256", "up_axis", "sh_convention"};
+
+constexpr int kMaxRank = 32;  // H5S_MAX_RANK
+
+enum class Kind {
+  positions, normals, triangles, source_position, ao, transfer, band1,
+  fiv_environment, fiv_cube, fiv_shells, fiv_valid, report, unknown
+};
+
+std::vector<std::string_view> split_path(std::string_view path) {
+  std::vector<std::string_view> parts;
+  std::size_t i = 1;
+  while (i <= path.size()) {
+    std::size_t j = path.find('/', i);
+    if (j == std::string_view::npos) j = path.size();
+    parts.push_back(path.substr(i, j - i));
+    i = j + 1;
+  }
+  return parts;
+}
+
+bool valid_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    uint32_t cp = 0;
+    if (c < 0x80) { ++i; continue; }
+    if ((c & 0xE0) == 0xC0) { n = 1; cp = c & 0x1F; }
+    else if ((c & 0xF0) == 0xE0) { n = 2; cp = c & 0x0F; }
+    else if ((c & 0xF8) == 0xF0) { n = 3; cp = c & 0x07; }
+    else return false;
+    if (i + n >= s.size()) return false;  // truncated sequence
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    // Overlong forms, surrogates and out-of-range code points are invalid.
+    if ((n == 1 && cp < 0x80) || (n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) ||
+        cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+      return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+// A link name HDF5 and h5py accept unchanged: non-empty, not "." or "..", no control chars.
+bool valid_component(std::string_view c) {
+  if (c.empty() || c == "." || c == "..") return false;
+  for (char ch : c)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7F) return false;
+  return valid_utf8(c);
+}
+
+std::string shape_str(const std::vector<uint64_t>& shape) {
+  std::ostringstream os;
+  os << '[';
+  for (std::size_t i = 0; i < shape.size(); ++i) os << (i ? ", " : "") << shape[i];
+  os << ']';
+  return os.str();
+}
+
+std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
+  std::vector<uint64_t> idx(shape.size());
+  for (std::size_t d = shape.size(); d-- > 0;) {
+    idx[d] = shape[d] ? flat % shape[d] : 0;
+    flat = shape[d] ? flat / shape[d] : 0;
+  }
+  return shape_str(idx);
+}
+
+class Checker {
+public:
+  explicit Checker(const std::filesystem::path& file) : file_(file.string()) {}
+
+  [[noreturn]] void fail(const std::string& defect) const { throw FormatError(file_, defect); }
+
+  void attrs(const std::vector<Attr>& list, const std::string& owner) const {
+    std::set<std::string_view> seen;
+    for (const Attr& a : list) {
+      if (a.name.empty()) fail(owner + " has an attribute with an empty name");
+      if (!valid_utf8(a.name) || a.name.find('\0') != std::string::npos)
+        fail(owner + " has an attribute name that is not valid UTF-8 text");
+      if (!seen.insert(a.name).second) fail(owner + " has attribute '" + a.name + "' twice");
+      const std::string what = "attribute '" + a.name + "' of " + owner;
+      if (const auto* s = std::get_if<std::string>(&a.value)) {
+        if (s->find('\0') != std::string::npos) fail(what + " contains a NUL character");
+        if (!valid_utf8(*s)) fail(what + " is not valid UTF-8");
+      } else if (const auto* d = std::get_if<double>(&a.value)) {
+        if (!std::isfinite(*d)) fail(what + " is not finite (" + std::to_string(*d) + ")");
+      } else if (const auto* v = std::get_if<std::vector<double>>(&a.value)) {
+        for (std::size_t i = 0; i < v->size(); ++i)
+          if (!std::isfinite((*v)[i]))
+            fail(what + " has a non-finite value at index " + std::to_string(i));
+      }
+    }
+  }
+
+  const std::string& required_string(const std::vector<Attr>& list, std::string_view name,
+                                     const std::string& owner) const {
+    const Attr* a = find_attr(list, name);
+    if (a == nullptr) fail(owner + " lacks the required attribute '" + std::string(name) + "'");
+    const auto* s = std::get_if<std::string>(&a->value);
+    if (s == nullptr) fail("attribute '" + std::string(name) + "' of " + owner + " must be a string");
+    return *s;
+  }
+
+  void root(const std::vector<Attr>& list) const {
+    attrs(list, "the root group");
+    if (const Attr* f = find_attr(list, "format")) {
+      const auto* s = std::get_if<std::string>(&f->value);
+      if (s == nullptr || *s != kFormatName)
+        fail("root attribute 'format' must be the string \"prtbake\"");
+    }
+    if (const Attr* v = find_attr(list, "format_version")) {
+      const auto* i = std::get_if<int64_t>(&v->value);
+      if (i == nullptr || *i != kFormatVersion)
+        fail("root attribute 'format_version' must be the integer " +
+             std::to_string(kFormatVersion));
+    }
+    for (std::string_view name : kRequiredRootStrings) {
+      const std::string& s = required_string(list, name, "the root group");
+      if (s.empty()) fail("root attribute '" + std::string(name) + "' is empty");
+    }
+    const std::string& up = required_string(list, "up_axis", "the root group");
+    if (up != "y" && up != "z")
+      fail("root attribute 'up_axis' must be \"y\" or \"z\", not \"" + up + "\"");
+    const std::string& sha = required_string(list, "source_sha256", "the root group");
+    bool hex = sha.size() == 64;
+    for (char c : sha) hex = hex && ((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'));
+    if (!hex) fail("root attribute 'source_sha256' must be 64 lowercase hex digits");
+  }
+
+  static Kind classify(const std::vector<std::string_view>& p) {
+    if (p[0] == "report") return p.size() >= 2 ? Kind::report : Kind::unknown;
+    if (p.size() == 1 && p[0] == "ao") return Kind::ao;
+    if (p.size() == 2 && p[0] == "mesh") {
+      if (p[1] == "positions") return Kind::positions;
+      if (p[1] == "normals") return Kind::normals;
+      if (p[1] == "triangles") return Kind::triangles;
+      if (p[1] == "source_position") return Kind::source_position;
+    }
+    if (p.size() == 2 && p[0] == "transfer" && (p[1] == "diffuse" || p[1] == "visibility"))
+      return Kind::transfer;
+    if (p.size() == 2 && p[0] == "radiance" && p[1] == "band1") return Kind::band1;
+    if (p.size() == 2 && p[0] == "fiv" && p[1] == "environment") return Kind::fiv_environment;
+    if (p.size() == 2 && p[0] == "fiv" && p[1] == "irradiance_cube") return Kind::fiv_cube;
+    if (p.size() == 4 && p[0] == "fiv" && p[1] == "occluders") {
+      if (p[3] == "shells") return Kind::fiv_shells;
+      if (p[3] == "valid") return Kind::fiv_valid;
+    }
+    return Kind::unknown;
+  }
+
+  void dtype(const Dataset& d, std::size_t want) const {
+    static constexpr std::array<std::string_view, 3> names = {"float32", "uint32", "uint8"};
+    if (d.data.index() != want)
+      fail("dataset '" + d.path + "' must be " + std::string(names[want]) + ", not " +
+           std::string(dtype_name(d.data)));
+  }
+
+  void shape(const Dataset& d, const std::vector<uint64_t>& want, const std::string& rule) const {
+    if (d.shape != want)
+      fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected " + rule +
+           " = " + shape_str(want));
+  }
+
+  const std::string file_;
+};
+
+} // namespace
+
+bool is_per_vertex_path(std::string_view path) {
+  return path == "/mesh/positions" || path == "/mesh/normals" || path == "/mesh/source_position" ||
+         path == "/ao" || path == "/transfer/diffuse" || path == "/transfer/visibility" ||
+         path == "/radiance/band1";
+}
+
+void validate(const File& file, const std::filesystem::path& file_for_messages) {
+  const Checker c(file_for_messages);
+  c.root(file.root_attrs);
+
+  // Paths: absolute, well-formed, unique, known, and no dataset lies under another dataset.
+  std::set<std::string_view> paths;
+  std::vector<Kind> kinds;
+  for (const Dataset& d : file.datasets) {
+    if (d.path.size() < 2 || d.path[0] != '/' || d.path.back() == '/')
+      c.fail("dataset path '" + d.path + "' must be absolute, like \"/mesh/positions\"");
+    const auto parts = split_path(d.path);
+    for (std::string_view part : parts)
+      if (!valid_component(part))
+        c.fail("dataset path '" + d.path + "' has an invalid component '" + std::string(part) + "'");
+    if (!paths.insert(d.path).second) c.fail("dataset '" + d.path + "' is given twice");
+    const Kind k = Checker::classify(parts);
+    if (k == Kind::unknown)
+      c.fail("unknown dataset path '" + d.path +
+             "' (schema v1 allows /mesh/{positions,normals,triangles,source_position}, /ao, "
+             "/transfer/{diffuse,visibility}, /radiance/band1, /fiv/{environment,irradiance_cube}, "
+             "/fiv/occluders/<name>/{shells,valid} and anything under /report/)");
+    kinds.push_back(k);
+  }
+  for (const Dataset& d : file.datasets)
+    for (std::size_t slash = d.path.find('/', 1); slash != std::string::npos;
+         slash = d.path.find('/', slash + 1))
+      if (paths.count(std::string_view(d.path).substr(0, slash)))
+        c.fail("dataset '" + d.path + "' lies under dataset '" + d.path.substr(0, slash) + "'");
+
+  // Generic per-dataset rules: rank, size, finiteness, attributes.
+  for (const Dataset& d : file.datasets) {
+    if (d.shape.empty() || d.shape.size() > kMaxRank)
+      c.fail("dataset '" + d.path + "' must have 1 to 32 dimensions, not " +
+             std::to_string(d.shape.size()));
+    uint64_t n = 0;
+    try {
+      n = shape_product(d.shape);
+    } catch (const FormatError&) {
+      c.fail("dataset '" + d.path + "' has a shape whose size overflows: " + shape_str(d.shape));
+    }
+    if (n != element_count(d.data))
+      c.fail("dataset '" + d.path + "' has " + std::to_string(element_count(d.data)) +
+             " values but shape " + shape_str(d.shape) + " needs " + std::to_string(n));
+    if (const auto* f = std::get_if<std::vector<float>>(&d.data))
+      for (std::size_t i = 0; i < f->size(); ++i)
+        if (!std::isfinite((*f)[i]))
+          c.fail("dataset '" + d.path + "' has a non-finite value (" +
+                 (std::isnan((*f)[i]) ? std::string("NaN") : std::string("Inf")) +
+                 ") at index " + std::to_string(i) + " " + index_str(i, d.shape));
+    c.attrs(d.attrs, "dataset '" + d.path + "'");
+  }
+
+  // Schema rules per known dataset.
+  const Dataset* positions = find_dataset(file, "/mesh/positions");
+  const uint64_t V = positions ? positions->shape.at(0) : 0;
+  const bool has_normals = find_dataset(file, "/mesh/normals") != nullptr;
+  std::map<std::string, const Dataset*> shells;  // occluder dir -> shells
+  for (std::size_t i = 0; i < file.datasets.size(); ++i) {
+    const Dataset& d = file.datasets[i];
+    const Kind k = kinds[i];
+    if (is_per_vertex_path(d.path) && positions == nullptr)
+      c.fail("dataset '" + d.path + "' is per-vertex but the file has no /mesh/positions to " +
+             "define the vertex count V");
+    switch (k) {
+    case Kind::positions:
+    case Kind::normals:
+      c.dtype(d, 0);
+      c.shape(d, {V, 3}, "[V, 3]");
+      break;
+    case Kind::triangles: {
+      if (positions == nullptr)
+        c.fail("dataset '/mesh/triangles' needs /mesh/positions (its indices refer to it)");
+      c.dtype(d, 1);
+      if (d.shape.size() != 2 || d.shape[1] != 3)
+        c.fail("dataset '/mesh/triangles' has shape " + shape_str(d.shape) + "; expected [T, 3]");
+      const auto& idx = std::get<std::vector<uint32_t>>(d.data);
+      for (std::size_t j = 0; j < idx.size(); ++j)
+        if (idx[j] >= V)
+          c.fail("dataset '/mesh/triangles' has vertex index " + std::to_string(idx[j]) +
+                 " >= V = " + std::to_string(V) + " at index " + std::to_string(j) + " " +
+                 index_str(j, d.shape));
+      break;
+    }
+    case Kind::source_position:
+      c.dtype(d, 1);
+      c.shape(d, {V}, "[V]");
+      break;
+    case Kind::ao:
+      c.dtype(d, 0);
+      c.shape(d, {V}, "[V]");
+      break;
+    case Kind::transfer: {
+      c.dtype(d, 0);
+      const Attr* a = find_attr(d.attrs, "sh_order");
+      const auto* L = a ? std::get_if<int64_t>(&a->value) : nullptr;
+      if (L == nullptr)
+        c.fail("dataset '" + d.path + "' lacks the integer attribute 'sh_order' (number of bands L)");
+      if (*L < 1 || *L > 65535)
+        c.fail("dataset '" + d.path + "' has sh_order " + std::to_string(*L) +
+               "; the number of bands must be in 1..65535");
+      const auto L2 = static_cast<uint64_t>(*L) * static_cast<uint64_t>(*L);
+      c.shape(d, {V, L2}, "[V, L*L] with L = sh_order = " + std::to_string(*L));
+      break;
+    }
+    case Kind::band1:
+      c.dtype(d, 0);
+      c.shape(d, {V, 3, 3}, "[V, 3 (RGB), 3 (m = -1, 0, 1)]");
+      break;
+    case Kind::fiv_environment:
+      c.dtype(d, 0);
+      c.shape(d, {3, 3}, "[3 (RGB), 3 (xyz)]");
+      break;
+    case Kind::fiv_cube:
+      c.dtype(d, 0);
+      if (d.shape.size() != 4 || d.shape[0] != 6 || d.shape[1] != d.shape[2] || d.shape[1] == 0 ||
+          d.shape[3] != 3)
+        c.fail("dataset '/fiv/irradiance_cube' has shape " + shape_str(d.shape) +
+               "; expected [6, S, S, 3] with S >= 1");
+      break;
+    case Kind::fiv_shells: {
+      c.dtype(d, 0);
+      if (d.shape.size() != 5 || d.shape[3] != 3 || d.shape[4] != 3 || d.shape[0] == 0 ||
+          d.shape[1] == 0 || d.shape[2] == 0)
+        c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) +
+               "; expected [Nr, Ntheta, Nphi, 3 (RGB), 3 (xyz)] with Nr, Ntheta, Nphi >= 1");
+      const Attr* centre = find_attr(d.attrs, "centre");
+      const auto* cv = centre ? std::get_if<std::vector<double>>(&centre->value) : nullptr;
+      if (cv == nullptr || cv->size() != 3)
+        c.fail("dataset '" + d.path + "' needs attribute 'centre': 3 doubles (bounding-sphere centre)");
+      const Attr* radius = find_attr(d.attrs, "radius");
+      const auto* r = radius ? std::get_if<double>(&radius->value) : nullptr;
+      if (r == nullptr || !(*r > 0))
+        c.fail("dataset '" + d.path + "' needs attribute 'radius': a double > 0 (bounding-sphere radius)");
+      const Attr* radii = find_attr(d.attrs, "radii");
+      const auto* rv = radii ? std::get_if<std::vector<double>>(&radii->value) : nullptr;
+      if (rv == nullptr || rv->size() != d.shape[0])
+        c.fail("dataset '" + d.path + "' needs attribute 'radii': Nr = " +
+               std::to_string(d.shape[0]) + " doubles (shell radii)");
+      shells[d.path.substr(0, d.path.size() - 6)] = &d;  // strip "shells"
+      break;
+    }
+    case Kind::fiv_valid:
+    case Kind::report:
+    case Kind::unknown:
+      break;
+    }
+  }
+  for (std::size_t i = 0; i < file.datasets.size(); ++i) {
+    const Dataset& d = file.datasets[i];
+    if (kinds[i] != Kind::fiv_valid) continue;
+    c.dtype(d, 2);
+    const auto it = shells.find(d.path.substr(0, d.path.size() - 5));  // strip "valid"
+    if (it == shells.end())
+      c.fail("dataset '" + d.path + "' has no 'shells' dataset beside it");
+    const auto& s = it->second->shape;
+    c.shape(d, {s[0], s[1], s[2]}, "[Nr, Ntheta, Nphi] of its shells");
+    for (std::size_t j = 0; j < std::get<std::vector<uint8_t>>(d.data).size(); ++j)
+      if (std::get<std::vector<uint8_t>>(d.data)[j] > 1)
+        c.fail("dataset '" + d.path + "' must hold 0 or 1, not " +
+               std::to_string(std::get<std::vector<uint8_t>>(d.data)[j]) + " at index " +
+               std::to_string(j));
+  }
+  for (std::size_t i = 0; i < file.datasets.size(); ++i)
+    if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer || kinds[i] == Kind::band1) &&
+        !has_normals)
+      c.fail("dataset '" + file.datasets[i].path +
+             "' needs /mesh/normals (the normals the bake used)");
+
+  // Group attributes: only on schema groups (or anything under /report), each group once.
+  std::set<std::string_view> groups;
+  for (const auto& [g, list] : file.group_attrs) {
+    if (g.size() < 2 || g[0] != '/' || g.back() == '/')
+      c.fail("group path '" + g + "' must be absolute, like \"/report\" (root attributes go in "
+             "root_attrs)");
+    const auto parts = split_path(g);
+    for (std::string_view part : parts)
+      if (!valid_component(part))
+        c.fail("group path '" + g + "' has an invalid component '" + std::string(part) + "'");
+    const bool ok = g == "/mesh" || g == "/transfer" || g == "/radiance" || g == "/fiv" ||
+                    g == "/fiv/occluders" || (parts.size() == 3 && g.starts_with("/fiv/occluders/")) ||
+                    parts[0] == "report";
+    if (!ok)
+      c.fail("attributes on group '" + g + "' are not allowed (schema v1 allows them on /mesh, "
+             "/transfer, /radiance, /fiv, /fiv/occluders, /fiv/occluders/<name> and /report...)");
+    if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");
+    if (paths.count(g)) c.fail("group '" + g + "' is also a dataset path");
+    for (std::size_t slash = g.find('/', 1); slash != std::string::npos;
+         slash = g.find('/', slash + 1))
+      if (paths.count(std::string_view(g).substr(0, slash)))
+        c.fail("group '" + g + "' lies under dataset '" + g.substr(0, slash) + "'");
+    c.attrs(list, "group '" + g + "'");
+  }
+}
+
+} // namespace prt::formats
