@@ -69,6 +69,10 @@ OPTIONS
   --report N         after the bake, re-integrate N seeded vertices with 10x the samples
                      and print/store the error (RMSE, max) next to the run time
                      (default 32; 0 turns it off). Stored under /report in the file.
+  --reproducible     make the file a pure function of the inputs: 'created' is pinned to
+                     SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not
+                     stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).
+                     The baked values are identical with or without it.
   --quiet            print nothing but errors.
   -h, --help         this text.   --version   the version.
 
@@ -97,7 +101,7 @@ template <class T> T parse_number(const std::string& opt, const std::string& s, 
 
 struct Args {
   std::string command, mesh, output, radiance, integrator = "qmc";
-  bool ao = false, quiet = false, file_normals = true;
+  bool ao = false, quiet = false, file_normals = true, reproducible = false;
   int transfer = 0, visibility = 0;
   uint32_t samples = 1024, report = 32;
   uint64_t seed = 1;
@@ -164,6 +168,8 @@ Args parse(int argc, char** argv) {
     } else if (s == "--report") {
       a.report = parse_number<uint32_t>(s, value(), 0, 1u << 20);
       record(v[i]);
+    } else if (s == "--reproducible") {
+      a.reproducible = true;
     } else if (s == "--quiet" || s == "-q") {
       a.quiet = true;
     } else if (!s.empty() && s[0] == '-') {
@@ -178,6 +184,7 @@ Args parse(int argc, char** argv) {
       throw UsageError("unexpected argument '" + s + "'");
     }
   }
+  if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
   if (a.command != "vertex") throw UsageError("unknown command '" + a.command + "' (available: vertex)");
   if (a.mesh.empty()) throw UsageError("vertex: no MESH given");
   if (a.output.empty()) throw UsageError("vertex: no output file given (-o OUT.prt.h5)");
@@ -195,11 +202,14 @@ void check_output_writable(const fs::path& out) {
   if (access(dir.c_str(), W_OK) != 0) throw bake::InputError(out.string(), "cannot write: directory '" + dir.string() + "' is not writable");
 }
 
-std::string timestamp() {
-  // Reproducible builds convention: SOURCE_DATE_EPOCH pins the 'created' attribute, so the same
+std::string timestamp(bool reproducible) {
+  // Reproducible-builds convention: SOURCE_DATE_EPOCH pins the 'created' attribute, so the same
   // inputs give identical bytes across runs too.
   std::time_t t = std::time(nullptr);
-  if (const char* e = std::getenv("SOURCE_DATE_EPOCH")) t = std::time_t(std::strtoll(e, nullptr, 10));
+  if (reproducible) {
+    const char* e = std::getenv("SOURCE_DATE_EPOCH");
+    t = e ? std::time_t(std::strtoll(e, nullptr, 10)) : 0;
+  }
   char buf[32];
   std::tm tm{};
   gmtime_r(&t, &tm);
@@ -302,7 +312,7 @@ int run_vertex(const Args& a) {
   F::File file;
   file.root_attrs = {
       {"generator", std::string("prtbake ") + kVersion},
-      {"created", timestamp()},
+      {"created", timestamp(a.reproducible)},
       {"command_line", a.command_line},
       {"source", a.mesh},
       {"source_sha256", mesh_sha},
@@ -364,16 +374,20 @@ int run_vertex(const Args& a) {
   }
   if (report) {
     for (const auto& e : report->products) {
+      std::vector<F::Attr> attrs = {
+          {"columns", std::string("rmse, max_abs, reference_rms, bake_std_error, reference_std_error")},
+          {"points", int64_t(report->vertices.size())},
+          {"reference", report->reference}};
+      if (!a.reproducible) {  // wall times differ run to run: kept out of reproducible files
+        attrs.push_back({"reference_seconds", report->reference_seconds});
+        attrs.push_back({"bake_seconds", result.seconds});
+        attrs.push_back({"integrals_per_second", double(V) / result.seconds});
+      }
       file.datasets.push_back(
           {"/report/" + e.product, {5},
            std::vector<float>{float(e.rmse), float(e.max_abs), float(e.reference_rms), float(e.bake_std_error),
                               float(e.reference_std_error)},
-           {{"columns", std::string("rmse, max_abs, reference_rms, bake_std_error, reference_std_error")},
-            {"points", int64_t(report->vertices.size())},
-            {"reference", report->reference},
-            {"reference_seconds", report->reference_seconds},
-            {"bake_seconds", result.seconds},
-            {"integrals_per_second", double(V) / result.seconds}}});
+           std::move(attrs)});
     }
     file.datasets.push_back({"/report/vertices", {report->vertices.size()}, report->vertices, {}});
   }
