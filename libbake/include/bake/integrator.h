@@ -20,6 +20,9 @@ struct ShadePoint {
   Eigen::Vector3d p{0, 0, 0};
   Eigen::Vector3d n{0, 0, 1};  // unit; defines H(ω,n) = [n·ω > 0]
   int64_t welded = -1;
+  // false: full-sphere mode, H ≡ 1 in every integrand (the FIV products: ∫ V L y_1m dω over the
+  // whole sphere). n then only sets the side the limit p + εn is taken from.
+  bool hemisphere = true;
 };
 
 class Integrator {
