@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 namespace F = prt::formats;
@@ -48,7 +49,9 @@ struct Outcome {
 // Runs prtbake with `args` (already shell-quoted where needed), capturing stdout and stderr.
 Outcome run(const std::string& args, const std::string& env = "") {
   static int counter = 0;
-  const fs::path o = scratch("stdout." + std::to_string(counter)), e = scratch("stderr." + std::to_string(counter));
+  // ctest runs each case in its own process, in parallel: the pid keeps their captures apart.
+  const std::string tag = std::to_string(getpid()) + "." + std::to_string(counter);
+  const fs::path o = scratch("stdout." + tag), e = scratch("stderr." + tag);
   ++counter;
   const std::string cmd = env + " " + kBake + " " + args + " > " + o.string() + " 2> " + e.string();
   const int status = std::system(cmd.c_str());
