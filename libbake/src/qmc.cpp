@@ -5,7 +5,6 @@
 
 #include <prtshade/sh.h>
 
-#include <embree3/rtcore.h>
 
 #include <cmath>
 #include <limits>
@@ -16,87 +15,6 @@
 namespace prt::bake {
 
 using Eigen::Vector3d;
-
-bool occludes_from_above(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& n,
-                         const Vector3d& d) {
-  const Vector3d e1 = a - p, e2 = b - p;
-  const Vector3d m = e1.cross(e2);
-  const double mm = m.squaredNorm();
-  if (!(mm > 0)) return false;  // zero-area: no solid angle, blocks nothing
-  const double md = m.dot(d), mn = m.dot(n);
-  if (md == 0) return false;    // ray parallel to the plane: a set of measure zero
-  const double s = -mn / md;
-  if (!(s > 0)) return false;   // the plane is behind the ray (or through p + εn itself)
-  const Vector3d q = n + s * d; // in the plane of the triangle, up to rounding
-  // q = α e1 + β e2 with α = ((q × e2)·m)/|m|², β = ((e1 × q)·m)/|m|²; inside the cone iff α, β ≥ 0.
-  const double alpha = q.cross(e2).dot(m), beta = e1.cross(q).dot(m);
-  return alpha >= 0 && beta >= 0;
-}
-
-// ---- Embree scene -------------------------------------------------------------------------
-
-namespace {
-// The intersect context carries the shade point's welded id so the filter can drop its 1-ring.
-struct RingContext {
-  RTCIntersectContext base;
-  int64_t welded;
-  const uint32_t* weld;                    // output vertex -> welded id
-  const std::array<uint32_t, 3>* triangles;
-};
-
-void ring_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* ctx = reinterpret_cast<const RingContext*>(args->context);
-  if (ctx->welded < 0) return;
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] == 0) continue;
-    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-    const auto& t = ctx->triangles[prim];
-    const auto w = uint32_t(ctx->welded);
-    if (ctx->weld[t[0]] == w || ctx->weld[t[1]] == w || ctx->weld[t[2]] == w) args->valid[i] = 0;
-  }
-}
-
-void embree_error(void* user, RTCError code, const char* str) {
-  auto* msg = static_cast<std::string*>(user);
-  if (msg->empty()) *msg = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
-}
-} // namespace
-
-struct QmcIntegrator::Embree {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::string error;
-
-  Embree(const Mesh& mesh) {
-    device = rtcNewDevice(nullptr);
-    if (!device) throw ContractError("Embree: rtcNewDevice failed (error " +
-                                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
-    rtcSetDeviceErrorFunction(device, embree_error, &error);
-    scene = rtcNewScene(device);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), mesh.positions.size()));
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
-    if (!v || !idx) throw ContractError("Embree: cannot allocate geometry buffers: " + error);
-    for (size_t i = 0; i < mesh.positions.size(); ++i)
-      for (int k = 0; k < 3; ++k) v[3 * i + k] = mesh.positions[i][k];
-    for (size_t i = 0; i < mesh.triangles.size(); ++i)
-      for (int k = 0; k < 3; ++k) idx[3 * i + k] = mesh.triangles[i][k];
-    rtcSetGeometryOccludedFilterFunction(geom, ring_filter);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene);
-    if (!error.empty()) throw ContractError(error);
-  }
-  ~Embree() {
-    if (scene) rtcReleaseScene(scene);
-    if (device) rtcReleaseDevice(device);
-  }
-};
 
 // ---- integrator ---------------------------------------------------------------------------
 
@@ -118,7 +36,7 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
   }
   sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0});
   PRT_CHECK_OP(sh_order_, <=, sh::kMaxOrder);
-  rt_ = std::make_unique<Embree>(mesh);
+  rays_ = std::make_unique<RayScene>(mesh, topology);
 }
 
 QmcIntegrator::~QmcIntegrator() = default;
@@ -130,39 +48,7 @@ std::string QmcIntegrator::description() const {
   return os.str();
 }
 
-bool QmcIntegrator::visible(const ShadePoint& point, const Vector3d& d) const {
-  if (point.welded >= 0) {
-    const auto w = uint32_t(point.welded);
-    for (uint32_t f : topo_.ring(w)) {
-      const auto& t = mesh_.triangles[f];
-      // Rotate the corners so that c0 is the shade point's corner (any corner welded to it).
-      int k = 0;
-      while (k < 3 && topo_.weld[t[k]] != w) ++k;
-      if (k == 3) continue;
-      const Vector3d a = mesh_.positions[t[(k + 1) % 3]].cast<double>();
-      const Vector3d b = mesh_.positions[t[(k + 2) % 3]].cast<double>();
-      if (occludes_from_above(point.p, a, b, point.n, d)) return false;
-    }
-  }
-  RingContext ctx;
-  rtcInitIntersectContext(&ctx.base);
-  ctx.welded = point.welded;
-  ctx.weld = topo_.weld.data();
-  ctx.triangles = mesh_.triangles.data();
-  RTCRay ray{};
-  ray.org_x = float(point.p.x());
-  ray.org_y = float(point.p.y());
-  ray.org_z = float(point.p.z());
-  ray.dir_x = float(d.x());
-  ray.dir_y = float(d.y());
-  ray.dir_z = float(d.z());
-  ray.tnear = 0.0f;
-  ray.tfar = std::numeric_limits<float>::infinity();
-  ray.mask = 0xFFFFFFFFu;
-  ray.flags = 0;
-  rtcOccluded1(rt_->scene, &ctx.base, &ray);
-  return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
-}
+bool QmcIntegrator::visible(const ShadePoint& point, const Vector3d& d) const { return rays_->visible(point, d); }
 
 void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                               std::span<double> std_error) const {

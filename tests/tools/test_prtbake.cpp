@@ -118,11 +118,12 @@ TEST(Prtbake, BakesEveryProductOfARealMeshInOnePass) {
   EXPECT_EQ(std::get<std::string>(sha->value).size(), 64u);
 }
 
-TEST(Prtbake, AoAloneIsCosineSampledAndLiesInUnitInterval) {
+TEST(Prtbake, QmcAoAloneIsCosineSampledAndLiesInUnitInterval) {
   // With --ao alone every ray is cosine-distributed and weighs exactly 1 (f/p = (c/π)/(c/π)),
   // so each AO is a fraction k/N: in [0, 1] and a multiple of 1/N up to float rounding.
   const fs::path out = scratch("ao.prt.h5");
-  ASSERT_EQ(run("vertex " + (kData / "wuson.obj").string() + " --ao --samples 64 --report 0 --quiet -o " + out.string()).code, 0);
+  ASSERT_EQ(run("vertex " + (kData / "wuson.obj").string() +
+                " --ao --integrator qmc --samples 64 --report 0 --quiet -o " + out.string()).code, 0);
   const F::File f = F::read_file(out);
   EXPECT_EQ(F::find_dataset(f, "/mesh/triangles")->shape[0], 3732u);
   EXPECT_EQ(F::find_dataset(f, "/report/ao"), nullptr) << "--report 0 writes no report";

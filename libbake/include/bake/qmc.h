@@ -19,13 +19,14 @@
 //
 // Visibility at a mesh vertex is the limit from above (bake/integrator.h): the ray starts at the
 // vertex itself (tnear = 0); Embree's hits on the vertex's own 1-ring are filtered out and the
-// 1-ring is tested analytically instead (occludes_from_above in this header). Hits on any other
+// 1-ring is tested analytically instead (occludes_from_above, bake/raycast.h). Hits on any other
 // triangle at any t ≥ 0 occlude.
 #pragma once
 
 #include <bake/integrator.h>
 #include <bake/mesh.h>
 #include <bake/products.h>
+#include <bake/raycast.h>
 
 #include <memory>
 
@@ -35,13 +36,6 @@ struct QmcOptions {
   uint32_t samples = 1024;  // rays per shade point
   uint64_t seed = 1;
 };
-
-// True if the triangle with corners (p, a, b), p being the shade point, blocks direction d as
-// seen from p + εn for all small ε > 0. Exact limit: the ray p + εn + t d meets the triangle's
-// plane at t = ε s with s = -(m·n)/(m·d), m = (a-p)×(b-p); it is blocked iff s > 0 and
-// n + s d lies in the cone spanned by a-p and b-p at p. Zero-area triangles never block.
-bool occludes_from_above(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& n, const Eigen::Vector3d& d);
 
 class QmcIntegrator final : public Integrator {
 public:
@@ -63,7 +57,6 @@ public:
   const QmcOptions& options() const { return options_; }
 
 private:
-  struct Embree;
   const Mesh& mesh_;
   const Topology& topo_;
   ProductRequest request_;
@@ -71,7 +64,7 @@ private:
   QmcOptions options_;
   double w_cos_ = 0, w_uni_ = 0, w_env_ = 0;  // mixture weights, sum to 1
   int sh_order_ = 0;                          // SH order evaluated per sample
-  std::unique_ptr<Embree> rt_;
+  std::unique_ptr<RayScene> rays_;
 };
 
 } // namespace prt::bake

@@ -45,6 +45,7 @@ struct SilhouetteOptions {
 // Work counters, summed over all integrate() calls (relaxed atomics).
 struct SilhouetteStats {
   uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
+  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
   double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
 };
 

@@ -1,0 +1,57 @@
+// bake/raycast.h — Embree 3 ray queries with the visibility semantics of prtbake: a shade point
+// sees from p + εn, ε → 0+ (bake/integrator.h). Shared by the QMC integrator (occlusion rays)
+// and the silhouette integrator (one counted ray per shade point: the depth complexity W at a
+// start direction, from which the DCF walk propagates; paper 001 §3.2, made robust: no
+// "minimum W is 0" assumption).
+//
+// The shade point's own 1-ring (every triangle with a corner welded to it) is removed from
+// Embree's answers by a filter and decided analytically (occludes_from_above). In counted rays,
+// hits close to p (triangles whose plane passes through or near p, e.g. a ground plane through
+// the vertex) are decided by the exact ε-limit orientation predicate orient_eps (bake/contour.h),
+// and a hit whose barycentrics put it on a triangle's edge makes the count ambiguous: the caller
+// picks another direction.
+#pragma once
+
+#include <bake/integrator.h>
+#include <bake/mesh.h>
+
+#include <Eigen/Core>
+#include <memory>
+
+namespace prt::bake {
+
+// True if the triangle (p, a, b), p the shade point, blocks direction d as seen from p + εn for
+// all small ε > 0: the ray p + εn + t d meets the plane at t = ε s, s = -(m·n)/(m·d), m = (a-p)×(b-p);
+// blocked iff s > 0 and n + s d lies in the cone spanned by a-p and b-p. Zero-area: never blocks.
+// `ambiguous` (optional) is set when the answer is within rounding of flipping (d on the cone's
+// boundary or parallel to the plane).
+bool occludes_from_above(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& n, const Eigen::Vector3d& d, bool* ambiguous = nullptr);
+
+struct CrossingCount {
+  int count = 0;           // triangles the ray from p + εn crosses (its depth complexity W)
+  bool ambiguous = false;  // the direction grazes an edge: choose another direction
+};
+
+class RayScene {
+public:
+  RayScene(const Mesh& mesh, const Topology& topology);  // both must outlive the scene
+  ~RayScene();
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  // Visibility of unit direction d from the shade point (limit from above).
+  bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
+  // Number of triangles the ray from p + εn in unit direction d crosses.
+  CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
+  double scene_diagonal() const { return diagonal_; }
+
+private:
+  struct Embree;
+  const Mesh& mesh_;
+  const Topology& topo_;
+  std::unique_ptr<Embree> rt_;
+  double diagonal_ = 0;
+};
+
+} // namespace prt::bake

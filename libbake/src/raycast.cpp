@@ -1,0 +1,247 @@
+#include <bake/contour.h>
+#include <bake/error.h>
+#include <bake/raycast.h>
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace prt::bake {
+
+using Eigen::Vector3d;
+
+bool occludes_from_above(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& n,
+                         const Vector3d& d, bool* ambiguous) {
+  const Vector3d e1 = a - p, e2 = b - p;
+  const Vector3d m = e1.cross(e2);
+  const double mm = m.squaredNorm();
+  if (!(mm > 0)) return false;  // zero-area: no solid angle, blocks nothing
+  const double md = m.dot(d), mn = m.dot(n);
+  const double mlen = std::sqrt(mm);
+  // Relative tolerance for "within rounding of the boundary" (only used to flag ambiguity).
+  constexpr double kRel = 1e-9;
+  if (ambiguous && std::abs(md) <= kRel * mlen) *ambiguous = true;
+  if (md == 0) return false;    // ray parallel to the plane: a set of measure zero
+  const double s = -mn / md;
+  if (!(s > 0)) return false;   // the plane is behind the ray (or through p + εn itself)
+  const Vector3d q = n + s * d; // in the plane of the triangle, up to rounding
+  // q = α e1 + β e2 with α = ((q × e2)·m)/|m|², β = ((e1 × q)·m)/|m|²; inside the cone iff α, β ≥ 0.
+  const double alpha = q.cross(e2).dot(m), beta = e1.cross(q).dot(m);
+  if (ambiguous) {
+    const double scale = q.norm() * mlen;
+    if (std::abs(alpha) <= kRel * scale * e2.norm() || std::abs(beta) <= kRel * scale * e1.norm()) *ambiguous = true;
+  }
+  return alpha >= 0 && beta >= 0;
+}
+
+namespace {
+
+constexpr unsigned kMaxHits = 512;
+struct Hit {
+  unsigned prim;
+  float t, u, v;
+};
+
+// The intersect context carries the shade point's welded id so the filter can drop its 1-ring,
+// and, for counted rays, the list of hits (every hit is recorded and rejected so traversal goes on).
+struct RingContext {
+  RTCIntersectContext base;
+  int64_t welded;
+  const uint32_t* weld;  // output vertex -> welded id
+  const std::array<uint32_t, 3>* triangles;
+  Hit* hits = nullptr;   // counted rays only
+  unsigned n_hits = 0;
+  bool overflow = false;
+};
+
+bool in_ring(const RingContext* ctx, unsigned prim) {
+  if (ctx->welded < 0) return false;
+  const auto& t = ctx->triangles[prim];
+  const auto w = uint32_t(ctx->welded);
+  return ctx->weld[t[0]] == w || ctx->weld[t[1]] == w || ctx->weld[t[2]] == w;
+}
+
+void ring_filter(const RTCFilterFunctionNArguments* args) {
+  auto* ctx = reinterpret_cast<RingContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    if (in_ring(ctx, prim)) {
+      args->valid[i] = 0;
+      continue;
+    }
+    if (ctx->hits) {  // counted ray: record and keep going
+      if (ctx->n_hits < kMaxHits)
+        ctx->hits[ctx->n_hits++] = {prim, RTCRayN_tfar(args->ray, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                                    RTCHitN_v(args->hit, args->N, i)};
+      else
+        ctx->overflow = true;
+      args->valid[i] = 0;
+    }
+  }
+}
+
+void embree_error(void* user, RTCError code, const char* str) {
+  auto* msg = static_cast<std::string*>(user);
+  if (msg->empty()) *msg = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
+}
+
+} // namespace
+
+struct RayScene::Embree {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::string error;
+
+  explicit Embree(const Mesh& mesh) {
+    device = rtcNewDevice(nullptr);
+    if (!device) throw ContractError("Embree: rtcNewDevice failed (error " +
+                                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(device, embree_error, &error);
+    scene = rtcNewScene(device);
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), mesh.positions.size()));
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
+    if (!v || !idx) throw ContractError("Embree: cannot allocate geometry buffers: " + error);
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+      for (int k = 0; k < 3; ++k) v[3 * i + k] = mesh.positions[i][k];
+    for (size_t i = 0; i < mesh.triangles.size(); ++i)
+      for (int k = 0; k < 3; ++k) idx[3 * i + k] = mesh.triangles[i][k];
+    rtcSetGeometryOccludedFilterFunction(geom, ring_filter);
+    rtcSetGeometryIntersectFilterFunction(geom, ring_filter);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+    if (!error.empty()) throw ContractError(error);
+  }
+  ~Embree() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+RayScene::RayScene(const Mesh& mesh, const Topology& topology)
+    : mesh_(mesh), topo_(topology), rt_(std::make_unique<Embree>(mesh)) {
+  PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
+  Eigen::Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& q : mesh.positions) {
+    lo = lo.cwiseMin(q.cast<double>());
+    hi = hi.cwiseMax(q.cast<double>());
+  }
+  diagonal_ = mesh.positions.empty() ? 0.0 : (hi - lo).norm();
+}
+
+RayScene::~RayScene() = default;
+
+namespace {
+RTCRay make_ray(const Vector3d& o, const Vector3d& d) {
+  RTCRay ray{};
+  ray.org_x = float(o.x());
+  ray.org_y = float(o.y());
+  ray.org_z = float(o.z());
+  ray.dir_x = float(d.x());
+  ray.dir_y = float(d.y());
+  ray.dir_z = float(d.z());
+  ray.tnear = 0.0f;
+  ray.tfar = std::numeric_limits<float>::infinity();
+  ray.mask = 0xFFFFFFFFu;
+  ray.flags = 0;
+  return ray;
+}
+} // namespace
+
+bool RayScene::visible(const ShadePoint& point, const Vector3d& d) const {
+  if (point.welded >= 0) {
+    const auto w = uint32_t(point.welded);
+    for (uint32_t f : topo_.ring(w)) {
+      const auto& t = mesh_.triangles[f];
+      int k = 0;  // rotate the corners so that corner k is the shade point's
+      while (k < 3 && topo_.weld[t[k]] != w) ++k;
+      if (k == 3) continue;
+      const Vector3d a = mesh_.positions[t[(k + 1) % 3]].cast<double>();
+      const Vector3d b = mesh_.positions[t[(k + 2) % 3]].cast<double>();
+      if (occludes_from_above(point.p, a, b, point.n, d)) return false;
+    }
+  }
+  RingContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.welded = point.welded;
+  ctx.weld = topo_.weld.data();
+  ctx.triangles = mesh_.triangles.data();
+  RTCRay ray = make_ray(point.p, d);
+  rtcOccluded1(rt_->scene, &ctx.base, &ray);
+  return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+CrossingCount RayScene::count_crossings(const ShadePoint& point, const Vector3d& d) const {
+  CrossingCount out;
+  if (point.welded >= 0) {
+    const auto w = uint32_t(point.welded);
+    for (uint32_t f : topo_.ring(w)) {
+      const auto& t = mesh_.triangles[f];
+      int k = 0;
+      while (k < 3 && topo_.weld[t[k]] != w) ++k;
+      if (k == 3) continue;
+      // A triangle with two corners welded to the shade point has no area seen from it.
+      if (topo_.weld[t[(k + 1) % 3]] == w || topo_.weld[t[(k + 2) % 3]] == w) continue;
+      const Vector3d a = mesh_.positions[t[(k + 1) % 3]].cast<double>();
+      const Vector3d b = mesh_.positions[t[(k + 2) % 3]].cast<double>();
+      if (occludes_from_above(point.p, a, b, point.n, d, &out.ambiguous)) ++out.count;
+    }
+  }
+  // Cast from δ behind p so that triangles through p are reported too; hits within 2δ of the
+  // origin (i.e. within δ of p) are decided exactly below.
+  const double delta = 1e-4 * std::max(diagonal_, 1e-30) + 1e-6 * point.p.cwiseAbs().maxCoeff();
+  Hit hits[kMaxHits];
+  RingContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.welded = point.welded;
+  ctx.weld = topo_.weld.data();
+  ctx.triangles = mesh_.triangles.data();
+  ctx.hits = hits;
+  RTCRayHit rh{};
+  rh.ray = make_ray(point.p - delta * d, d);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rt_->scene, &ctx.base, &rh);
+  if (ctx.overflow) out.ambiguous = true;
+  constexpr float kEdge = 1e-5f;  // barycentric distance to an edge that makes a hit ambiguous
+  for (unsigned i = 0; i < ctx.n_hits; ++i) {
+    const Hit& h = hits[i];
+    const float w0 = 1.0f - h.u - h.v;
+    const bool near_edge = h.u < kEdge || h.v < kEdge || w0 < kEdge;
+    if (double(h.t) > 2 * delta) {
+      if (near_edge) out.ambiguous = true;
+      ++out.count;
+      continue;
+    }
+    // Near p: the ray from p + εn crosses the triangle's plane forwards iff
+    // orient_eps(a,b,c,p,n) · sign(N·d) > 0 (N = (b−a)×(c−a); orient_eps = −sign_ε(N·(p−a))).
+    // A hit that cannot count (behind p, or the ray leaving the plane) is not ambiguous either.
+    const auto& t = mesh_.triangles[h.prim];
+    const Vector3d a = mesh_.positions[t[0]].cast<double>(), b = mesh_.positions[t[1]].cast<double>(),
+                   c = mesh_.positions[t[2]].cast<double>();
+    const Vector3d N = (b - a).cross(c - a);
+    const double nd = N.dot(d);
+    if (std::abs(nd) <= 1e-9 * N.norm()) {
+      out.ambiguous = true;
+      continue;
+    }
+    const int side = orient_eps(a, b, c, point.p, point.n);
+    if (side * (nd > 0 ? 1 : -1) > 0) {
+      if (near_edge) out.ambiguous = true;
+      ++out.count;
+    }
+  }
+  return out;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,359 @@
+// The silhouette integrator (paper 001 §3). See bake/silhouette.h for the conventions; the
+// stages are: contour edges (bake/contour.h) → arcs in the octahedral frame → crossings with
+// the u-isolines, bucketed per isoline, and with the spine → W at the spine start from one
+// counted ray → DCF walk along every isoline loop with summed-area tables (bake/isoline_tables.h).
+#include <bake/contour.h>
+#include <bake/envmap.h>
+#include <bake/error.h>
+#include <bake/isoline_tables.h>
+#include <bake/octahedral.h>
+#include <bake/raycast.h>
+#include <bake/sampling.h>
+#include <bake/silhouette.h>
+
+#include <prtshade/sh.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace prt::bake {
+
+using Eigen::Vector3d;
+
+namespace {
+
+// The octahedral frame is the world frame turned by a fixed, generic rotation, so that scenes
+// built on the world axes (axis-aligned boxes, ground planes, walls) never put their edges on
+// the octahedral seams or the spine, where crossings would be decided by ties.
+Eigen::Matrix3d frame_rotation() {
+  return Eigen::AngleAxisd(0.7236, Vector3d(0.3141, 0.5926, 0.7418).normalized()).toRotationMatrix();
+}
+
+inline int sign_of(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+
+struct Arc {
+  Vector3d a, b, m;  // endpoints (unnormalised, frame coordinates) and m = a × b
+  int side_sum;      // S: the step across the arc is sign(m · t) · S for travel direction t
+};
+struct Crossing {
+  int iso;
+  double t;
+  int step;
+};
+struct SpineCrossing {
+  double u;
+  int step;
+};
+
+struct Scratch {
+  std::vector<ContourEdge> edges;
+  std::vector<Arc> arcs;
+  std::vector<Crossing> crossings, sorted;
+  std::vector<SpineCrossing> spine;
+  std::vector<uint32_t> bucket_start;
+  std::vector<double> acc, g;
+};
+thread_local Scratch tl_scratch;
+
+} // namespace
+
+struct SilhouetteIntegrator::Impl {
+  const Mesh& mesh;
+  const Topology& topo;
+  ProductRequest req;
+  ProductLayout layout;
+  SilhouetteOptions opt;
+  ContourFinder contours;
+  RayScene rays;
+  oct::Grid grid;
+  Eigen::Matrix3d frame_from_world;
+  int sh_order = 0;
+  size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, F = 0;
+  int subsamples = 1;
+  std::unique_ptr<IsolineTables> tables;
+
+  mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0};
+  mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
+
+  Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o)
+      : mesh(m), topo(t), req(r), layout(r), opt(o), contours(m, t), rays(m, t), grid(even_isolines(o.isolines)),
+        frame_from_world(frame_rotation()) {
+    const int lt = r.transfer_order, lv = r.visibility_order;
+    sh_order = std::max({lt, lv, r.radiance ? 2 : 0});
+    c_ao = 0;
+    c_t = c_ao + (r.ao ? 3 : 0);
+    c_u = c_t + size_t(3 * lt * lt);
+    c_r = c_u + size_t(lv * lv);
+    F = c_r + (r.radiance ? 9 : 0);
+    PRT_CHECK(F > 0);
+    if (r.radiance) {
+      // Box-filter the environment over each cell: ~2 sub-samples per texel width.
+      const double texel = std::sqrt(4 * std::numbers::pi / double(std::max<size_t>(r.radiance->texel_count(), 1)));
+      subsamples = std::clamp(int(std::ceil(2.0 * grid.h / texel)), 1, 8);
+    }
+    const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
+      const Vector3d w = world_from_frame * w_frame;
+      double y[sh::num_coeffs(16)];
+      std::vector<double> ybig;
+      double* yp = y;
+      if (sh_order > 16) {
+        ybig.resize(size_t(sh::num_coeffs(sh_order)));
+        yp = ybig.data();
+      }
+      if (sh_order > 0) sh::eval(sh_order, w.x(), w.y(), w.z(), std::span(yp, size_t(sh::num_coeffs(sh_order))));
+      constexpr double kInvPi = std::numbers::inv_pi;
+      if (req.ao)
+        for (int a = 0; a < 3; ++a) out[c_ao + size_t(a)] = w[a] * kInvPi;
+      const size_t nt = size_t(lt * lt);
+      for (int a = 0; a < 3; ++a)
+        for (size_t i = 0; i < nt; ++i) out[c_t + size_t(a) * nt + i] = w[a] * yp[i] * kInvPi;
+      for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
+      if (req.radiance) {
+        const Rgb L = req.radiance->radiance(w);
+        const double rgb[3] = {L.r, L.g, L.b};
+        for (int c = 0; c < 3; ++c)
+          for (int mm = 0; mm < 3; ++mm) out[c_r + size_t(3 * c + mm)] = rgb[c] * yp[1 + mm];
+      }
+    });
+  }
+
+  static int even_isolines(int n) {
+    PRT_CHECK(n >= 2);
+    return n + (n & 1);
+  }
+
+  // Crossings of one arc with the isolines (per octant piece) and with the spine.
+  void add_arc(const Arc& arc, Scratch& s) const {
+    if (arc.m.squaredNorm() == 0 || arc.side_sum == 0) return;
+    const Vector3d d = arc.b - arc.a;
+    double lam[5] = {0, 1, 1, 1, 1};
+    int nl = 1;
+    for (int c = 0; c < 3; ++c)
+      if (oct::sgn0(arc.a[c]) != oct::sgn0(arc.b[c])) lam[nl++] = arc.a[c] / (arc.a[c] - arc.b[c]);
+    lam[nl++] = 1.0;
+    for (int k = 1; k < nl; ++k)  // insertion sort of ≤ 5 values
+      for (int j = k; j > 0 && lam[j] < lam[j - 1]; --j) std::swap(lam[j], lam[j - 1]);
+    for (int k = 0; k + 1 < nl; ++k) {
+      if (!(lam[k + 1] > lam[k])) continue;
+      const Vector3d xa = arc.a + lam[k] * d, xb = arc.a + lam[k + 1] * d;
+      const Vector3d mid = arc.a + (0.5 * (lam[k] + lam[k + 1])) * d;
+      const Vector3d sg(oct::sgn0(mid.x()), oct::sgn0(mid.y()), oct::sgn0(mid.z()));
+      const double da = sg.dot(xa), db = sg.dot(xb);
+      if (!(da > 0) || !(db > 0)) continue;  // a piece through the origin (edge through p): no extent
+      const double ua = xa.x() / da, va = xa.y() / da, ub = xb.x() / db, vb = xb.y() / db;
+      if (ua == ub) continue;  // parallel to the isolines: crosses none
+      const int sheet = sg.z() > 0 ? 0 : 1;
+      const double umin = std::min(ua, ub), umax = std::max(ua, ub);
+      const int i0 = std::max(grid.first_at_or_after(umin), 0), i1 = std::min(grid.first_at_or_after(umax), grid.n);
+      const double slope = (vb - va) / (ub - ua);
+      for (int i = i0; i < i1; ++i) {
+        const double l = grid.half_length(i);
+        const double v = std::clamp(va + (grid.u(i) - ua) * slope, -l, l);
+        const int step = sign_of(arc.m.dot(oct::Grid::loop_tangent(v, sheet))) * arc.side_sum;
+        if (step != 0) s.crossings.push_back({i, grid.t_of(i, v, sheet), step});
+      }
+    }
+    // The spine: z = 0 with y < 0.
+    if (oct::sgn0(arc.a.z()) != oct::sgn0(arc.b.z())) {
+      const double l = arc.a.z() / (arc.a.z() - arc.b.z());
+      const Vector3d x = arc.a + l * d;
+      if (x.y() < 0) {
+        const double u = x.x() / (std::abs(x.x()) + std::abs(x.y()));
+        const int step = sign_of(arc.m.dot(oct::spine_tangent(u))) * arc.side_sum;
+        if (step != 0) s.spine.push_back({u, step});
+      }
+    }
+  }
+
+  // Change of W along the great-circle arc from P to Q (frame coordinates): the sum of the steps
+  // of every arc it crosses.
+  static int path_steps(const std::vector<Arc>& arcs, const Vector3d& P, const Vector3d& Q) {
+    const Vector3d m2 = P.cross(Q);
+    int w = 0;
+    for (const Arc& arc : arcs) {
+      const Vector3d dir = arc.m.cross(m2);
+      if (dir.squaredNorm() == 0) continue;
+      for (const Vector3d& c : {dir, Vector3d(-dir)}) {
+        if (arc.a.cross(c).dot(arc.m) >= 0 && c.cross(arc.b).dot(arc.m) >= 0 && P.cross(c).dot(m2) >= 0 &&
+            c.cross(Q).dot(m2) >= 0)
+          w += sign_of(arc.m.dot(m2.cross(c))) * arc.side_sum;
+      }
+    }
+    return w;
+  }
+
+  void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out) const {
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    Scratch& s = tl_scratch;
+    contours.find(point, s.edges);
+    const auto t1 = clock::now();
+
+    // ---- arcs in the octahedral frame ----
+    s.arcs.clear();
+    const Vector3d n = point.n;
+    for (const ContourEdge& ce : s.edges) {
+      const auto& e = topo.edges[ce.edge];
+      auto dir = [&](uint32_t w) -> Vector3d {
+        if (point.welded >= 0 && w == uint32_t(point.welded)) return -n;  // seen from p + εn
+        return topo.welded_positions[w].cast<double>() - point.p;
+      };
+      Arc arc;
+      arc.a = frame_from_world * dir(e[0]);
+      arc.b = frame_from_world * dir(e[1]);
+      arc.m = arc.a.cross(arc.b);
+      arc.side_sum = ce.side_sum;
+      s.arcs.push_back(arc);
+    }
+    if (point.hemisphere) {
+      // The horizon as a virtual occluder boundary: +1 when crossing into n·ω < 0.
+      const Vector3d nf = frame_from_world * n;
+      const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
+      const Vector3d t2v = nf.cross(t1v);
+      const Vector3d c[4] = {t1v, t2v, -t1v, -t2v};
+      for (int k = 0; k < 4; ++k) s.arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -1});
+    }
+
+    // ---- crossings ----
+    s.crossings.clear();
+    s.spine.clear();
+    for (const Arc& arc : s.arcs) add_arc(arc, s);
+
+    // ---- W at the spine start (frame direction (−1, 0, 0)) from one counted ray ----
+    const Vector3d s0(-1, 0, 0);
+    const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    int W0 = 0;
+    bool found = false;
+    for (int attempt = 0; attempt < 16 && !found; ++attempt) {
+      Vector3d wr = world_from_frame * s0;
+      if (attempt > 0) {
+        const uint64_t h = mix64(opt.seed ^ mix64(point_index * 64 + uint64_t(attempt)));
+        const double z = 2 * to_unit(mix64(h + 1)) - 1, phi = 2 * std::numbers::pi * to_unit(mix64(h + 2));
+        const double r = std::sqrt(std::max(0.0, 1 - z * z));
+        wr = Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+        if ((frame_from_world * wr).dot(s0) < -0.99) continue;  // nearly antipodal: the path is ill-defined
+      }
+      const CrossingCount cc = rays.count_crossings(point, wr);
+      n_rays.fetch_add(1, std::memory_order_relaxed);
+      if (cc.ambiguous) continue;
+      int w = cc.count;
+      if (point.hemisphere) {
+        const double hz = n.dot(wr);
+        if (std::abs(hz) < 1e-12) continue;
+        w += hz < 0 ? 1 : 0;
+      }
+      if (attempt > 0) {
+        w += path_steps(s.arcs, frame_from_world * wr, s0);
+        n_retries.fetch_add(1, std::memory_order_relaxed);
+      }
+      W0 = w;
+      found = true;
+    }
+    if (!found) throw ContractError("silhouette: no unambiguous start ray after 16 directions");
+
+    // ---- bucket the crossings per isoline (counting sort), then sort each bucket by t ----
+    const int N = grid.n;
+    s.bucket_start.assign(size_t(N) + 1, 0);
+    for (const Crossing& c : s.crossings) ++s.bucket_start[size_t(c.iso) + 1];
+    for (int i = 0; i < N; ++i) s.bucket_start[size_t(i) + 1] += s.bucket_start[size_t(i)];
+    s.sorted.resize(s.crossings.size());
+    {
+      std::vector<uint32_t>& next = s.bucket_start;  // reuse: fill, then restore by recomputation
+      std::vector<uint32_t> fill(next.begin(), next.end() - 1);
+      for (const Crossing& c : s.crossings) s.sorted[fill[size_t(c.iso)]++] = c;
+    }
+    std::sort(s.spine.begin(), s.spine.end(),
+              [](const SpineCrossing& x, const SpineCrossing& y) { return x.u < y.u || (x.u == y.u && x.step < y.step); });
+
+    // ---- DCF walk ----
+    s.acc.assign(F, 0.0);
+    double* acc = s.acc.data();
+    int W = W0;
+    size_t sp = 0;
+    uint64_t inconsistent = 0;
+    for (int i = 0; i < N; ++i) {
+      const double ui = grid.u(i);
+      while (sp < s.spine.size() && s.spine[sp].u < ui) W += s.spine[sp++].step;
+      auto* b0 = s.sorted.data() + s.bucket_start[size_t(i)];
+      auto* b1 = s.sorted.data() + s.bucket_start[size_t(i) + 1];
+      std::sort(b0, b1, [](const Crossing& x, const Crossing& y) { return x.t < y.t || (x.t == y.t && x.step < y.step); });
+      int w = W;
+      for (auto* c = b0; c != b1; ++c) {
+        const int next = w + c->step;
+        if (w == 0 && next != 0) tables->accumulate(i, c->t, +1.0, acc);  // a visible run ends
+        if (w != 0 && next == 0) tables->accumulate(i, c->t, -1.0, acc);  // a visible run starts
+        w = next;
+      }
+      if (w == 0) {
+        const double* total = tables->loop_total(i);
+        for (size_t c = 0; c < F; ++c) acc[c] += total[c];
+      }
+      if (w != W || W < 0) ++inconsistent;
+    }
+    const double h = grid.h;
+    for (size_t c = 0; c < F; ++c) acc[c] *= h;
+
+    // ---- products ----
+    const ProductLayout& L = layout;
+    if (L.ao_count) out[L.ao] = n.x() * acc[c_ao] + n.y() * acc[c_ao + 1] + n.z() * acc[c_ao + 2];
+    for (size_t k = 0; k < L.transfer_count; ++k) {
+      const size_t nt = L.transfer_count;
+      out[L.transfer + k] = n.x() * acc[c_t + k] + n.y() * acc[c_t + nt + k] + n.z() * acc[c_t + 2 * nt + k];
+    }
+    for (size_t k = 0; k < L.visibility_count; ++k) out[L.visibility + k] = acc[c_u + k];
+    for (size_t k = 0; k < L.radiance_count; ++k) out[L.radiance + k] = acc[c_r + k];
+
+    const auto t2 = clock::now();
+    n_points.fetch_add(1, std::memory_order_relaxed);
+    n_edges.fetch_add(s.edges.size(), std::memory_order_relaxed);
+    n_crossings.fetch_add(s.crossings.size(), std::memory_order_relaxed);
+    if (inconsistent) n_inconsistent.fetch_add(inconsistent, std::memory_order_relaxed);
+    contour_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), std::memory_order_relaxed);
+    integrate_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t2 - t1).count(), std::memory_order_relaxed);
+  }
+};
+
+SilhouetteIntegrator::SilhouetteIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
+                                           const SilhouetteOptions& options)
+    : impl_(std::make_unique<Impl>(mesh, topology, request, options)) {}
+
+SilhouetteIntegrator::~SilhouetteIntegrator() = default;
+
+std::string SilhouetteIntegrator::description() const {
+  std::ostringstream os;
+  os << "visibility silhouettes (paper 001 §3): " << impl_->grid.n << " u-isolines (k = " << impl_->grid.n << "^2), "
+     << impl_->F << " integrand components in " << (impl_->tables->bytes() >> 20) << " MiB of isoline tables, "
+     << impl_->subsamples << "x" << impl_->subsamples << " sub-samples per cell";
+  return os.str();
+}
+
+const ProductLayout& SilhouetteIntegrator::layout() const { return impl_->layout; }
+const SilhouetteOptions& SilhouetteIntegrator::options() const { return impl_->opt; }
+
+void SilhouetteIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
+                                     std::span<double> std_error) const {
+  PRT_CHECK_OP(out.size(), >=, impl_->layout.width);
+  impl_->integrate(point, point_index, out);
+  for (double& e : std_error) e = 0.0;
+}
+
+SilhouetteStats SilhouetteIntegrator::stats() const {
+  SilhouetteStats s;
+  s.points = impl_->n_points.load();
+  s.contour_edges = impl_->n_edges.load();
+  s.crossings = impl_->n_crossings.load();
+  s.start_rays = impl_->n_rays.load();
+  s.start_retries = impl_->n_retries.load();
+  s.inconsistent_loops = impl_->n_inconsistent.load();
+  s.contour_seconds = double(impl_->contour_ns.load()) * 1e-9;
+  s.integrate_seconds = double(impl_->integrate_ns.load()) * 1e-9;
+  return s;
+}
+
+} // namespace prt::bake
