@@ -1,0 +1,111 @@
+// bake/contour.h — contour-edge extraction, the first stage of the silhouette integrator
+// (paper 001 §3.1, eq. 6; DESIGN.md §4).
+//
+// An undirected welded edge e = (a, b), a < b, with incident faces k (corner c_k not on e) is a
+// contour edge seen from the shade point p when its side sum
+//     S_e = Σ_k σ_k,   σ_k = orient_eps(pos(a), pos(b), pos(c_k), p, n)
+// is non-zero: σ_k tells on which side of the plane through p, a, b the face k lies, evaluated
+// exactly and in the limit p + εn, ε → 0+ (DESIGN.md §3). A path crossing e's projection in
+// direction t changes the depth complexity by sign(m·t)·S_e with m = (a−p)×(b−p): the number of
+// faces on the far side minus those on the near side. Nothing assumes consistent winding or a
+// manifold: boundary edges (1 face) have |S_e| = 1, non-manifold edges any value.
+//
+// Search (paper §3.1): for a face k of e, σ_k = −sign(π_k(p)) with π_k(x) = N_k·(x − a),
+// N_k = (b−a)×(c_k−a), an affine function of p: a 4-vector g_k with π_k(p) = g_k·(p, 1). A
+// 2-face edge is a contour iff σ_1 = σ_2 ≠ 0 iff the hyperplane {x : x·(p, 1) = 0} of R⁴ meets
+// (crosses or touches) its dual segment [ĝ_1, −ĝ_2] (ĝ = g/|N|). ContourFinder keeps a BVH of
+// 4D boxes over those segments and queries it with a rigorous floating-point tolerance, so it
+// can never miss an edge the exact test reports; every candidate is then decided exactly.
+// Edges with 1 or 3+ faces, or with a degenerate / ill-conditioned face, are always tested.
+#pragma once
+
+#include <bake/integrator.h>
+#include <bake/mesh.h>
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace prt::bake {
+
+// Exact sign of det(a−p, b−p, c−p) seen from p + εn as ε → 0+: the sign of
+// D0 = det(a−p, b−p, c−p) if it is non-zero, else the sign of its ε-derivative
+// D1 = −[det(n, B, C) + det(A, n, C) + det(A, B, n)] = −n·((b−a)×(c−a)) (A = a−p, …), else 0.
+// A floating-point filter with Shewchuk's proven error bound decides almost every call; when it
+// cannot, the determinant is evaluated exactly with floating-point expansions (Shewchuk 1997).
+// Exact for any finite double inputs whose products do not overflow or underflow (always true
+// for float mesh positions and points of comparable magnitude). Thread-safe, no allocation.
+int orient_eps(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+               const Eigen::Vector3d& p, const Eigen::Vector3d& n);
+
+// The same determinant without the ε rule: the exact sign of D0 (−1, 0, +1).
+int orient3d_exact(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                   const Eigen::Vector3d& p);
+
+struct ContourEdge {
+  uint32_t edge;     // index into Topology::edges (undirected welded edge (a, b), a < b)
+  int32_t side_sum;  // S_e = Σ over faces k incident to e of σ_k (see the file comment); a face
+                     // whose corners are not 3 distinct welded ids has σ = 0
+  friend bool operator==(const ContourEdge&, const ContourEdge&) = default;
+};
+
+struct ContourFinderStats {
+  size_t edges = 0;            // Topology::edges.size()
+  size_t bvh_edges = 0;        // 2-face edges with well-conditioned faces, in the BVH
+  size_t always_tested = 0;    // 1-face, 3+-face and degenerate / ill-conditioned edges
+  size_t bvh_nodes = 0, bvh_depth = 0;
+  double normal_error = 0;     // η: max error bound of the BVH's unit face normals
+};
+
+class ContourFinder {
+public:
+  // Builds the 4D dual BVH. `mesh` and `topology` (build_topology(mesh)) must outlive the finder.
+  ContourFinder(const Mesh& mesh, const Topology& topology);
+  ContourFinder(const ContourFinder&) = delete;
+  ContourFinder& operator=(const ContourFinder&) = delete;
+
+  // All edges with S_e != 0 at the shade point, sorted by edge index (`out` is cleared first).
+  // Uses the BVH; equals find_brute_force exactly. Thread-safe; allocates only to grow `out`.
+  // Only point.p and point.n are used (the ε-limit is geometric: a shade point at a vertex
+  // position gets its 1-ring right whatever point.welded says).
+  void find(const ShadePoint& point, std::vector<ContourEdge>& out) const;
+  // Reference: every edge, every face, orient_eps.
+  void find_brute_force(const ShadePoint& point, std::vector<ContourEdge>& out) const;
+
+  size_t edge_count() const;
+  size_t bvh_node_count() const;
+  const ContourFinderStats& stats() const { return stats_; }
+
+private:
+  struct Node {  // 40 bytes; boxes rounded outward to float
+    float lo[4], hi[4];
+    uint32_t index;  // leaf: first record; inner: right child (left child is this + 1)
+    uint32_t count;  // leaf: record count (> 0); inner: 0
+  };
+  struct Record {  // a BVH edge, in leaf order: what the leaf test reads
+    double g1[4];  // ĝ_1 (unit normal, offset) in the finder's centred, scaled frame
+    double g2[4];  // −ĝ_2
+  };
+  struct Corners {  // the same edge's positions for the exact test (world frame), same order
+    float a[3], b[3], c1[3], c2[3];
+    uint32_t edge;
+  };
+
+  int side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const;
+
+  const Mesh* mesh_;
+  const Topology* topology_;
+  std::vector<Node> nodes_;
+  std::vector<Record> records_;
+  std::vector<Corners> corners_;
+  std::vector<uint32_t> always_;  // edges tested on every query, ascending
+  Eigen::Vector3d origin_{0, 0, 0};
+  double scale_ = 1;       // frame: q = (p − origin)·scale, scale a power of two
+  double delta_coef_ = 0;  // δ(q) = delta_coef_ · (|q|₁ + max_a_)
+  double max_a_ = 0;       // max |a'|₁ over BVH faces (centred, scaled corner a)
+  ContourFinderStats stats_;
+};
+
+} // namespace prt::bake
