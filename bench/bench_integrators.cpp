@@ -1,0 +1,139 @@
+// bench_integrators — cost of one spherical integral (one shade point, AO + order-3 transfer
+// on the default scene), single-threaded, for the QMC baseline next to the silhouette
+// integrator (DESIGN.md §4, §6; paper 001 Table 1 is the model).
+//
+//   BM_Qmc/samples:N                QMC, N rays per integral           (level-0 scene)
+//   BM_Silhouette/isolines:N        silhouette, k = N² samples         (level-0 scene)
+//   BM_QmcTriangles/level:L         QMC at 1024 rays,  bunny Loop-subdivided L times
+//   BM_SilhouetteTriangles/level:L  silhouette at N = 64, the same scenes
+//
+// One benchmark iteration integrates every shade point of the scene once, in order, on the
+// calling thread; the counter `per_integral` is CPU seconds per integral (per core; printed as e.g. 83.6us).
+// Integrator construction (BVHs, tables) is outside the timed loop and reported as `setup_s`.
+// Silhouette cases also report SilhouetteIntegrator::stats() per integral over the timed loop:
+// contour-search and integration CPU µs, contour edges and isoline crossings.
+//
+// Sizes (environment; Google Benchmark's own flags such as --benchmark_filter also work):
+//   PRT_BENCH_QMC_SAMPLES   default 256,1024,4096,16384
+//   PRT_BENCH_ISOLINES      default 16,32,64,128,256,512
+//   PRT_BENCH_LEVELS        default 0,1,2,3
+//   PRT_BENCH_POINTS, PRT_BENCH_SEED (bench_common.h)
+#include <bench_common.h>
+
+#include <bake/qmc.h>
+#if PRT_BENCH_SILHOUETTE
+#include <bake/silhouette.h>
+#endif
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace prt;
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The timed loop shared by every case: all shade points once per iteration.
+void integrate_all(benchmark::State& state, const bench::Scene& s, const bake::Integrator& integ) {
+  std::vector<double> row(integ.layout().width);
+  const size_t n = s.points.size();
+  for (auto _ : state) {
+    for (size_t i = 0; i < n; ++i) {
+      integ.integrate(s.points[i], s.vertices[i], row);
+      benchmark::DoNotOptimize(row.data());
+    }
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(n));
+  // Rate inverted = CPU seconds per integral (the console prints it with an SI prefix: "83.6us").
+  state.counters["per_integral"] =
+      benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["triangles"] = double(s.mesh.triangles.size());
+  state.counters["points"] = double(n);
+}
+
+void qmc_case(benchmark::State& state, int level, uint32_t samples) {
+  const bench::Scene& s = bench::scene(level);
+  const auto t0 = std::chrono::steady_clock::now();
+  bake::QmcOptions opt;
+  opt.samples = samples;
+  const bake::QmcIntegrator integ(s.mesh, s.topology, bench::request(), opt);
+  state.counters["setup_s"] = since(t0);
+  integrate_all(state, s, integ);
+}
+
+#if PRT_BENCH_SILHOUETTE
+void silhouette_case(benchmark::State& state, int level, int isolines) {
+  const bench::Scene& s = bench::scene(level);
+  const auto t0 = std::chrono::steady_clock::now();
+  bake::SilhouetteOptions opt;
+  opt.isolines = isolines;
+  const bake::SilhouetteIntegrator integ(s.mesh, s.topology, bench::request(), opt);
+  state.counters["setup_s"] = since(t0);
+  const bake::SilhouetteStats before = integ.stats();
+  integrate_all(state, s, integ);
+  const bake::SilhouetteStats after = integ.stats();
+  const double k = double(after.points - before.points);
+  if (k > 0) {
+    state.counters["contour_us"] = 1e6 * (after.contour_seconds - before.contour_seconds) / k;
+    state.counters["integrate_us"] = 1e6 * (after.integrate_seconds - before.integrate_seconds) / k;
+    state.counters["contour_edges"] = double(after.contour_edges - before.contour_edges) / k;
+    state.counters["crossings"] = double(after.crossings - before.crossings) / k;
+    state.counters["start_rays"] = double(after.start_rays - before.start_rays) / k;
+  }
+  state.counters["k"] = double(isolines) * double(isolines);
+}
+#endif
+
+} // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const auto samples = bench::env_list("PRT_BENCH_QMC_SAMPLES", {256, 1024, 4096, 16384});
+    const auto isolines = bench::env_list("PRT_BENCH_ISOLINES", {16, 32, 64, 128, 256, 512});
+    const auto levels = bench::env_list("PRT_BENCH_LEVELS", {0, 1, 2, 3});
+    // Baseline next to the optimised method, accuracy knob first, then the triangle sweep.
+    for (long n : samples)
+      benchmark::RegisterBenchmark(("BM_Qmc/samples:" + std::to_string(n)).c_str(),
+                                   [n](benchmark::State& st) { qmc_case(st, 0, uint32_t(n)); })
+          ->Unit(benchmark::kMillisecond);
+#if PRT_BENCH_SILHOUETTE
+    for (long n : isolines)
+      benchmark::RegisterBenchmark(("BM_Silhouette/isolines:" + std::to_string(n)).c_str(),
+                                   [n](benchmark::State& st) { silhouette_case(st, 0, int(n)); })
+          ->Unit(benchmark::kMillisecond);
+#else
+    (void)isolines;
+    std::fprintf(stderr, "bench_integrators: silhouette cases compiled out (libbake/src/silhouette.cpp "
+                         "did not exist at configure time)\n");
+#endif
+    for (long l : levels) {
+      benchmark::RegisterBenchmark(("BM_QmcTriangles/level:" + std::to_string(l)).c_str(),
+                                   [l](benchmark::State& st) { qmc_case(st, int(l), 1024); })
+          ->Unit(benchmark::kMillisecond);
+#if PRT_BENCH_SILHOUETTE
+      benchmark::RegisterBenchmark(("BM_SilhouetteTriangles/level:" + std::to_string(l)).c_str(),
+                                   [l](benchmark::State& st) { silhouette_case(st, int(l), 64); })
+          ->Unit(benchmark::kMillisecond);
+#endif
+    }
+    benchmark::AddCustomContext("cpu_model", bench::cpu_model());
+    benchmark::AddCustomContext("silhouette", PRT_BENCH_SILHOUETTE ? "built" : "not built (silhouette.cpp missing)");
+    benchmark::AddCustomContext("points", std::to_string(bench::n_points()));
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_integrators: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
