@@ -305,3 +305,42 @@ TEST(Stiff, VeryLowAndVeryHighK) {
     }
   }
 }
+
+TEST(Stiff, BoundaryVertexOfAHalfPlane) {
+  // A flat half-plane z = 0, y ≥ 0 (a fan of 4 large triangles) shaded at the origin on its
+  // boundary: the spokes along the boundary are 1-face contour edges that start at the shade
+  // point itself, seen from p + εn in direction −n.
+  const float S = 1000;
+  std::vector<Vector3f> p = {{0, 0, 0}, {S, 0, 0}, {S, S, 0}, {-S, S, 0}, {-S, 0, 0}};
+  const Tris t = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}};
+  // Full sphere: the half-plane covers exactly half of the lower hemisphere (solid angle π) in the
+  // limit, so ∫ V y_00 = (4π − π) · y_00 (the planes' far edges, 1000 away, cut < 1e-6 of it).
+  {
+    const Mesh m = make_mesh(p, t, "halfplane", std::vector<Vector3f>(p.size(), Vector3f(0, 0, 1)));
+    const Topology topo = build_topology(m);
+    ProductRequest req;
+    req.visibility_order = 1;
+    SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+    ShadePoint sp = vertex_shade_point(m, topo, 0);
+    sp.hemisphere = false;
+    double u0;
+    sil.integrate(sp, 0, std::span(&u0, 1));
+    EXPECT_NEAR(u0, 3 * pi / (2 * std::sqrt(pi)), kTol);
+  }
+  // Hemisphere with n tilted over the plane (+y): part of the upper hemisphere dips below z = 0 on
+  // the plane's side and is blocked. Compare with QMC's independent analytic 1-ring test.
+  const Vector3f tilt = Vector3f(0, 0.5f, 1).normalized();
+  const Mesh m = make_mesh(p, t, "halfplane", std::vector<Vector3f>(p.size(), tilt));
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.ao = true;
+  req.transfer_order = 2;
+  SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+  QmcIntegrator qmc(m, topo, req, {65536, 13});
+  const ShadePoint sp = vertex_shade_point(m, topo, 0);
+  std::vector<double> a(5), b(5), se(5);
+  sil.integrate(sp, 0, a);
+  qmc.integrate(sp, 0, b, se);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << k;
+  EXPECT_LT(a[0], 0.99);
+}
