@@ -383,6 +383,23 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
       }
       corner[k] = (w0 != ia && w0 != ib) ? w0 : (w1 != ia && w1 != ib) ? w1 : w2;
     }
+    if (bvh) {
+      // A flat edge — both faces exactly coplanar and on opposite sides of it — has σ_1 = −σ_2
+      // from every viewpoint (π_2 = −π_1 up to a positive factor, so their ε-limit signs are
+      // opposite too): S ≡ 0, never a contour. Interiors of floors, walls and ground planes drop
+      // out of the search entirely, which matters most for shade points on the same plane.
+      const Eigen::Vector3d a = wp[ia].cast<double>(), b = wp[ib].cast<double>();
+      const Eigen::Vector3d c1 = wp[corner[0]].cast<double>(), c2 = wp[corner[1]].cast<double>();
+      if (orient3d_exact(a, b, c1, c2) == 0) {
+        const Eigen::Vector3d n1 = (b - a).cross(c1 - a), n2 = (b - a).cross(c2 - a);
+        // Exactly parallel (coplanar); opposite sides iff the normals point opposite ways. Only
+        // a clearly negative dot is trusted (slivers with c on the edge line stay in).
+        if (n1.dot(n2) < -1e-6 * n1.norm() * n2.norm()) {
+          ++stats_.flat_edges;
+          continue;
+        }
+      }
+    }
     FaceDual d1{}, d2{};
     if (bvh) {
       d1 = face_dual(wp[ia], wp[ib], wp[corner[0]], origin_, scale_);

@@ -301,7 +301,11 @@ struct SilhouetteIntegrator::Impl {
 
     // ---- products ----
     const ProductLayout& L = layout;
-    if (L.ao_count) out[L.ao] = n.x() * acc[c_ao] + n.y() * acc[c_ao + 1] + n.z() * acc[c_ao + 2];
+    // AO lies in [0, 1] exactly; a cell straddling the horizon carries the cell-mean of n·ω, so a
+    // visible sliver above the horizon can come out slightly negative (an O(h²) error). Clamping
+    // to the exact range can only reduce the error.
+    if (L.ao_count)
+      out[L.ao] = std::clamp(n.x() * acc[c_ao] + n.y() * acc[c_ao + 1] + n.z() * acc[c_ao + 2], 0.0, 1.0);
     for (size_t k = 0; k < L.transfer_count; ++k) {
       const size_t nt = L.transfer_count;
       out[L.transfer + k] = n.x() * acc[c_t + k] + n.y() * acc[c_t + nt + k] + n.z() * acc[c_t + 2 * nt + k];

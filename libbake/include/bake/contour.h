@@ -55,6 +55,7 @@ struct ContourFinderStats {
   size_t edges = 0;            // Topology::edges.size()
   size_t bvh_edges = 0;        // 2-face edges with well-conditioned faces, in the BVH
   size_t always_tested = 0;    // 1-face, 3+-face and degenerate / ill-conditioned edges
+  size_t flat_edges = 0;       // 2-face edges with coplanar faces on opposite sides: never contours, dropped
   size_t bvh_nodes = 0, bvh_depth = 0;
   double normal_error = 0;     // η: max error bound of the BVH's unit face normals
 };
