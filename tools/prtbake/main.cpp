@@ -283,6 +283,7 @@ int run_vertex(const Args& a) {
   qopt.samples = a.samples;
   qopt.seed = a.seed;
   std::unique_ptr<bake::Integrator> integrator_ptr;
+  const auto setup_start = std::chrono::steady_clock::now();
   if (a.integrator == "qmc") {
     integrator_ptr = std::make_unique<bake::QmcIntegrator>(mesh, topo, req, qopt);
   } else {
@@ -292,13 +293,15 @@ int run_vertex(const Args& a) {
     integrator_ptr = std::make_unique<bake::SilhouetteIntegrator>(mesh, topo, req, sopt);
   }
   const bake::Integrator& integrator = *integrator_ptr;
+  const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   if (say) {
     std::printf("baking:");
     if (a.ao) std::printf(" ao");
     if (a.transfer) std::printf(" transfer/diffuse (order %d, %d coefficients)", a.transfer, a.transfer * a.transfer);
     if (a.visibility) std::printf(" transfer/visibility (order %d, %d coefficients)", a.visibility, a.visibility * a.visibility);
     if (env) std::printf(" radiance/band1 (3x3)");
-    std::printf("\nintegrator: %s; %d threads\n", integrator.description().c_str(), threads);
+    std::printf("\nintegrator: %s; %d threads; setup (ray/contour BVHs, tables) %.2f s\n",
+                integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
   }
   const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
