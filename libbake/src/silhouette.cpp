@@ -19,6 +19,8 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <functional>
+#include <limits>
 #include <sstream>
 
 namespace prt::bake {
@@ -53,10 +55,10 @@ struct SpineCrossing {
 struct Scratch {
   std::vector<ContourEdge> edges;
   std::vector<Arc> arcs;
-  std::vector<Crossing> crossings, sorted;
+  std::vector<Crossing> crossings, hot_crossings, sorted;
   std::vector<SpineCrossing> spine;
   std::vector<uint32_t> bucket_start;
-  std::vector<double> acc, g;
+  std::vector<double> acc, hot_acc;
 };
 thread_local Scratch tl_scratch;
 
@@ -76,6 +78,14 @@ struct SilhouetteIntegrator::Impl {
   size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, F = 0;
   int subsamples = 1;
   std::unique_ptr<IsolineTables> tables;
+  // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
+  // integrated on a fine isoline grid of their own (a quarter texel apart) so that suns cut by a
+  // shadow edge or by the horizon are resolved below texel size, not smeared over a strip.
+  static constexpr double kHotFactor = 64;
+  static constexpr size_t kMaxHot = 4096;
+  std::vector<uint8_t> hot_mask;  // per texel
+  size_t hot_texels = 0;
+  std::unique_ptr<SparseIsolineTables> hot;
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0};
   mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
@@ -97,6 +107,41 @@ struct SilhouetteIntegrator::Impl {
       subsamples = std::clamp(int(std::ceil(2.0 * grid.h / texel)), 1, 8);
     }
     const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    std::vector<Vector3d> hot_samples;
+    int n_fine = 0;
+    if (r.radiance && r.radiance->texel_count() > 0) {
+      const EnvMap& env = *r.radiance;
+      const int T = env.texel_count();
+      std::vector<double> lum(static_cast<size_t>(T));
+      for (int tx = 0; tx < T; ++tx) lum[size_t(tx)] = luminance(env.texel_value(tx));
+      double threshold = kHotFactor * env.info().mean_luminance;
+      if (size_t(T) > kMaxHot) {
+        std::vector<double> sorted_lum = lum;
+        std::nth_element(sorted_lum.begin(), sorted_lum.begin() + (kMaxHot - 1), sorted_lum.end(), std::greater<>());
+        threshold = std::max(threshold, std::nextafter(sorted_lum[kMaxHot - 1], std::numeric_limits<double>::infinity()));
+      }
+      hot_mask.assign(size_t(T), 0);
+      const double texel = std::sqrt(4 * std::numbers::pi / double(T));
+      // A quarter texel apart, and at least 4× finer than the base grid.
+      n_fine = std::max(4 * grid.n, even_isolines(int(std::ceil(2.0 / (texel / 4)))));
+      // Support samples dense enough that every fine strip and cell a hot texel touches gets one
+      // (a texel spans about texel / (2 / n_fine) strips; octahedral u moves at most ~1.4× faster
+      // than the angle).
+      const int kS = std::clamp(int(std::ceil(3.0 * texel / (2.0 / n_fine))), 6, 96);
+      for (int tx = 0; tx < T; ++tx)
+        if (lum[size_t(tx)] > threshold && lum[size_t(tx)] > 0) {
+          hot_mask[size_t(tx)] = 1;
+          ++hot_texels;
+          for (int a = 0; a < kS; ++a)
+            for (int b = 0; b < kS; ++b)
+              hot_samples.push_back(frame_from_world * env.sample_texel(tx, (a + 0.5) / kS, (b + 0.5) / kS));
+        }
+    }
+    auto is_hot = [&](const Vector3d& w) {
+      if (hot_mask.empty()) return false;
+      const int tx = req.radiance->texel_of(w);
+      return tx >= 0 && hot_mask[size_t(tx)] != 0;
+    };
     tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
       const Vector3d w = world_from_frame * w_frame;
       double y[sh::num_coeffs(16)];
@@ -115,12 +160,28 @@ struct SilhouetteIntegrator::Impl {
         for (size_t i = 0; i < nt; ++i) out[c_t + size_t(a) * nt + i] = w[a] * yp[i] * kInvPi;
       for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
       if (req.radiance) {
-        const Rgb L = req.radiance->radiance(w);
+        const Rgb L = is_hot(w) ? Rgb{} : req.radiance->radiance(w);  // hot texels: the fine grid's part
         const double rgb[3] = {L.r, L.g, L.b};
         for (int c = 0; c < 3; ++c)
           for (int mm = 0; mm < 3; ++mm) out[c_r + size_t(3 * c + mm)] = rgb[c] * yp[1 + mm];
       }
     });
+    if (!hot_samples.empty()) {
+      hot = std::make_unique<SparseIsolineTables>(
+          oct::Grid(n_fine), 9, 2,
+          [&](const Vector3d& w_frame, std::span<double> out) {
+            const Vector3d w = world_from_frame * w_frame;
+            std::fill(out.begin(), out.end(), 0.0);
+            if (!is_hot(w)) return;
+            const Rgb L = req.radiance->radiance(w);
+            double y[4];
+            sh::eval(2, w.x(), w.y(), w.z(), std::span(y, 4));
+            const double rgb[3] = {L.r, L.g, L.b};
+            for (int c = 0; c < 3; ++c)
+              for (int mm = 0; mm < 3; ++mm) out[size_t(3 * c + mm)] = rgb[c] * y[1 + mm];
+          },
+          hot_samples);
+    }
   }
 
   static int even_isolines(int n) {
@@ -128,8 +189,8 @@ struct SilhouetteIntegrator::Impl {
     return n + (n & 1);
   }
 
-  // Crossings of one arc with the isolines (per octant piece) and with the spine.
-  void add_arc(const Arc& arc, Scratch& s) const {
+  // Crossings of one arc with isolines [i_begin, i_end) of grid g, per octant piece.
+  static void add_arc(const Arc& arc, const oct::Grid& g, int i_begin, int i_end, std::vector<Crossing>& out) {
     if (arc.m.squaredNorm() == 0 || arc.side_sum == 0) return;
     const Vector3d d = arc.b - arc.a;
     double lam[5] = {0, 1, 1, 1, 1};
@@ -150,25 +211,70 @@ struct SilhouetteIntegrator::Impl {
       if (ua == ub) continue;  // parallel to the isolines: crosses none
       const int sheet = sg.z() > 0 ? 0 : 1;
       const double umin = std::min(ua, ub), umax = std::max(ua, ub);
-      const int i0 = std::max(grid.first_at_or_after(umin), 0), i1 = std::min(grid.first_at_or_after(umax), grid.n);
+      const int i0 = std::max(g.first_at_or_after(umin), i_begin), i1 = std::min(g.first_at_or_after(umax), i_end);
       const double slope = (vb - va) / (ub - ua);
       for (int i = i0; i < i1; ++i) {
-        const double l = grid.half_length(i);
-        const double v = std::clamp(va + (grid.u(i) - ua) * slope, -l, l);
+        const double l = g.half_length(i);
+        const double v = std::clamp(va + (g.u(i) - ua) * slope, -l, l);
         const int step = sign_of(arc.m.dot(oct::Grid::loop_tangent(v, sheet))) * arc.side_sum;
-        if (step != 0) s.crossings.push_back({i, grid.t_of(i, v, sheet), step});
+        if (step != 0) out.push_back({i, g.t_of(i, v, sheet), step});
       }
     }
-    // The spine: z = 0 with y < 0.
-    if (oct::sgn0(arc.a.z()) != oct::sgn0(arc.b.z())) {
-      const double l = arc.a.z() / (arc.a.z() - arc.b.z());
-      const Vector3d x = arc.a + l * d;
-      if (x.y() < 0) {
-        const double u = x.x() / (std::abs(x.x()) + std::abs(x.y()));
-        const int step = sign_of(arc.m.dot(oct::spine_tangent(u))) * arc.side_sum;
-        if (step != 0) s.spine.push_back({u, step});
-      }
+  }
+
+  // Crossing of one arc with the spine (z = 0, y < 0).
+  static void add_spine(const Arc& arc, std::vector<SpineCrossing>& out) {
+    if (arc.m.squaredNorm() == 0 || arc.side_sum == 0) return;
+    if (oct::sgn0(arc.a.z()) == oct::sgn0(arc.b.z())) return;
+    const double l = arc.a.z() / (arc.a.z() - arc.b.z());
+    const Vector3d x = arc.a + l * (arc.b - arc.a);
+    if (!(x.y() < 0)) return;
+    const double u = x.x() / (std::abs(x.x()) + std::abs(x.y()));
+    const int step = sign_of(arc.m.dot(oct::spine_tangent(u))) * arc.side_sum;
+    if (step != 0) out.push_back({u, step});
+  }
+
+  // The DCF walk over isolines [i_begin, i_end) of grid g: W at each loop start comes from the
+  // sorted spine crossings; runs with W = 0 add C(t_end) − C(t_start) of `tables`.
+  template <class Tables>
+  static uint64_t walk(const oct::Grid& g, int i_begin, int i_end, const Tables& tables, int W0,
+                       const std::vector<SpineCrossing>& spine, std::vector<Crossing>& crossings,
+                       std::vector<Crossing>& sorted, std::vector<uint32_t>& start, double* acc, size_t F) {
+    const int n = i_end - i_begin;
+    start.assign(size_t(n) + 1, 0);
+    for (const Crossing& c : crossings) ++start[size_t(c.iso - i_begin) + 1];
+    for (int i = 0; i < n; ++i) start[size_t(i) + 1] += start[size_t(i)];
+    sorted.resize(crossings.size());
+    {
+      std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+      for (const Crossing& c : crossings) sorted[fill[size_t(c.iso - i_begin)]++] = c;
     }
+    int W = W0;
+    size_t sp = 0;
+    uint64_t inconsistent = 0;
+    for (int i = i_begin; i < i_end; ++i) {
+      const double ui = g.u(i);
+      while (sp < spine.size() && spine[sp].u < ui) W += spine[sp++].step;
+      if constexpr (requires { tables.has(i); }) {
+        if (!tables.has(i)) continue;
+      }
+      auto* b0 = sorted.data() + start[size_t(i - i_begin)];
+      auto* b1 = sorted.data() + start[size_t(i - i_begin) + 1];
+      std::sort(b0, b1, [](const Crossing& x, const Crossing& y) { return x.t < y.t || (x.t == y.t && x.step < y.step); });
+      int w = W;
+      for (auto* c = b0; c != b1; ++c) {
+        const int next = w + c->step;
+        if (w == 0 && next != 0) tables.accumulate(i, c->t, +1.0, acc);  // a visible run ends
+        if (w != 0 && next == 0) tables.accumulate(i, c->t, -1.0, acc);  // a visible run starts
+        w = next;
+      }
+      if (w == 0) {
+        const double* total = tables.loop_total(i);
+        for (size_t c = 0; c < F; ++c) acc[c] += total[c];
+      }
+      if (w != W || W < 0) ++inconsistent;
+    }
+    return inconsistent;
   }
 
   // Change of W along the great-circle arc from P to Q (frame coordinates): the sum of the steps
@@ -222,8 +328,13 @@ struct SilhouetteIntegrator::Impl {
 
     // ---- crossings ----
     s.crossings.clear();
+    s.hot_crossings.clear();
     s.spine.clear();
-    for (const Arc& arc : s.arcs) add_arc(arc, s);
+    for (const Arc& arc : s.arcs) {
+      add_arc(arc, grid, 0, grid.n, s.crossings);
+      add_spine(arc, s.spine);
+      if (hot) add_arc(arc, hot->grid(), hot->first_isoline(), hot->last_isoline(), s.hot_crossings);
+    }
 
     // ---- W at the spine start (frame direction (−1, 0, 0)) from one counted ray ----
     const Vector3d s0(-1, 0, 0);
@@ -257,47 +368,21 @@ struct SilhouetteIntegrator::Impl {
     }
     if (!found) throw ContractError("silhouette: no unambiguous start ray after 16 directions");
 
-    // ---- bucket the crossings per isoline (counting sort), then sort each bucket by t ----
-    const int N = grid.n;
-    s.bucket_start.assign(size_t(N) + 1, 0);
-    for (const Crossing& c : s.crossings) ++s.bucket_start[size_t(c.iso) + 1];
-    for (int i = 0; i < N; ++i) s.bucket_start[size_t(i) + 1] += s.bucket_start[size_t(i)];
-    s.sorted.resize(s.crossings.size());
-    {
-      std::vector<uint32_t>& next = s.bucket_start;  // reuse: fill, then restore by recomputation
-      std::vector<uint32_t> fill(next.begin(), next.end() - 1);
-      for (const Crossing& c : s.crossings) s.sorted[fill[size_t(c.iso)]++] = c;
-    }
+    // ---- DCF walks: the base tables on the isoline grid, the hot texels on their fine grid ----
     std::sort(s.spine.begin(), s.spine.end(),
               [](const SpineCrossing& x, const SpineCrossing& y) { return x.u < y.u || (x.u == y.u && x.step < y.step); });
-
-    // ---- DCF walk ----
     s.acc.assign(F, 0.0);
     double* acc = s.acc.data();
-    int W = W0;
-    size_t sp = 0;
-    uint64_t inconsistent = 0;
-    for (int i = 0; i < N; ++i) {
-      const double ui = grid.u(i);
-      while (sp < s.spine.size() && s.spine[sp].u < ui) W += s.spine[sp++].step;
-      auto* b0 = s.sorted.data() + s.bucket_start[size_t(i)];
-      auto* b1 = s.sorted.data() + s.bucket_start[size_t(i) + 1];
-      std::sort(b0, b1, [](const Crossing& x, const Crossing& y) { return x.t < y.t || (x.t == y.t && x.step < y.step); });
-      int w = W;
-      for (auto* c = b0; c != b1; ++c) {
-        const int next = w + c->step;
-        if (w == 0 && next != 0) tables->accumulate(i, c->t, +1.0, acc);  // a visible run ends
-        if (w != 0 && next == 0) tables->accumulate(i, c->t, -1.0, acc);  // a visible run starts
-        w = next;
-      }
-      if (w == 0) {
-        const double* total = tables->loop_total(i);
-        for (size_t c = 0; c < F; ++c) acc[c] += total[c];
-      }
-      if (w != W || W < 0) ++inconsistent;
+    uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
+    if (hot) {
+      s.hot_acc.assign(9, 0.0);
+      inconsistent += walk(hot->grid(), hot->first_isoline(), hot->last_isoline(), *hot, W0, s.spine, s.hot_crossings,
+                           s.sorted, s.bucket_start, s.hot_acc.data(), 9);
     }
     const double h = grid.h;
     for (size_t c = 0; c < F; ++c) acc[c] *= h;
+    if (hot)
+      for (size_t c = 0; c < 9; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
 
     // ---- products ----
     const ProductLayout& L = layout;
@@ -334,6 +419,10 @@ std::string SilhouetteIntegrator::description() const {
   os << "visibility silhouettes (paper 001 §3): " << impl_->grid.n << " u-isolines (k = " << impl_->grid.n << "^2), "
      << impl_->F << " integrand components in " << (impl_->tables->bytes() >> 20) << " MiB of isoline tables, "
      << impl_->subsamples << "x" << impl_->subsamples << " sub-samples per cell";
+  if (impl_->hot)
+    os << "; " << impl_->hot_texels << " hot environment texels (>= " << Impl::kHotFactor
+       << "x mean luminance) on " << impl_->hot->grid().n << " fine isolines ("
+       << (impl_->hot->bytes() >> 10) << " KiB)";
   return os.str();
 }
 
