@@ -9,7 +9,8 @@
 #   PRT_BENCH_BUILD_DIR=dir bench/run.sh --no-build   run the binaries of another build tree
 # Sizes can be set through the environment, as the binaries read it: PRT_BENCH_POINTS,
 # PRT_BENCH_SEED, PRT_BENCH_QMC_SAMPLES, PRT_BENCH_ISOLINES, PRT_BENCH_LEVELS (bench_integrators),
-# PRT_BENCH_REF_RAYS (bench_error_vs_time), PRT_BENCH_MIN_TIME (Google Benchmark min time, s).
+# PRT_BENCH_REF_RAYS (bench_error_vs_time), PRT_BENCH_MIN_TIME (Google Benchmark min time, s),
+# PRT_AGREE_POINTS, PRT_AGREE_ISOLINES, PRT_AGREE_RAYS (bench_agreement).
 # Numbers are CPU time of one thread; other processes on the machine (parallel builds) still
 # make them noisy — the load average at start and end is recorded next to them.
 set -euo pipefail
@@ -30,7 +31,7 @@ cd "$root"
 bindir="${PRT_BENCH_BUILD_DIR:-$root/build/release}"  # override to run another build tree
 if ((build)); then
   cmake --preset release >/dev/null
-  cmake --build --preset release --target bench_integrators bench_error_vs_time
+  cmake --build --preset release --target bench_integrators bench_error_vs_time bench_agreement
 fi
 if ((quick)); then
   export PRT_BENCH_POINTS="${PRT_BENCH_POINTS:-16}"
@@ -56,6 +57,15 @@ echo "+ ${env_used}$cmd2" >&2
 t0=$(date +%s)
 "$bindir/bench/bench_error_vs_time" >"$tmp/error_vs_time.md"
 t1=$(date +%s)
+cmd3="${bindir#$root/}/bench/bench_agreement"
+if [[ -x "$bindir/bench/bench_agreement" ]]; then
+  echo "+ $cmd3" >&2
+  if ((quick)); then
+    PRT_AGREE_POINTS=8 PRT_AGREE_RAYS=100000 "$bindir/bench/bench_agreement" >"$tmp/agreement.md"
+  else
+    "$bindir/bench/bench_agreement" >"$tmp/agreement.md"
+  fi
+fi
 load_end="$(cut -d' ' -f1-3 /proc/loadavg)"
 
 cpu="$(grep -m1 '^model name' /proc/cpuinfo | sed 's/^model name[[:space:]]*:[[:space:]]*//' || echo unknown)"
@@ -127,5 +137,13 @@ PY
   echo "\`${env_used}$cmd2\`"
   echo
   cat "$tmp/error_vs_time.md"
+  if [[ -f "$tmp/agreement.md" ]]; then
+    echo
+    echo "## bench_agreement"
+    echo
+    echo "\`$cmd3\`"
+    echo
+    cat "$tmp/agreement.md"
+  fi
 } >"$out"
 echo "wrote $out" >&2
