@@ -8,6 +8,27 @@
 
 namespace prt::bake {
 
+namespace {
+// h · mean of f·J over the cell [v_lo, v_lo + h] of the strip [u_i − h/2, u_i + h/2] on a sheet,
+// by s × s midpoint sub-samples (v clamped to the diamond where the strip's u leaves it).
+void cell_integral(const IsolineTables::Integrand& f, double h, double ui, double v_lo, int sheet, int S,
+                   std::vector<double>& g, std::vector<double>& cell) {
+  std::fill(cell.begin(), cell.end(), 0.0);
+  for (int a = 0; a < S; ++a) {
+    const double u = ui + ((a + 0.5) / S - 0.5) * h;
+    const double lu = 1.0 - std::abs(u);
+    for (int b = 0; b < S; ++b) {
+      const double v = std::clamp(v_lo + (b + 0.5) / S * h, -lu, lu);
+      f(oct::dir_from_uv(u, v, sheet).normalized(), g);
+      const double J = oct::jacobian(u, v);
+      for (size_t c = 0; c < cell.size(); ++c) cell[c] += g[c] * J;
+    }
+  }
+  const double scale = h / double(S * S);
+  for (double& c : cell) c *= scale;
+}
+} // namespace
+
 IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsamples, const Integrand& f)
     : grid_(grid), components_(components) {
   PRT_CHECK(grid.n >= 2 && grid.n % 2 == 0);
@@ -31,20 +52,8 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
       const int sheet = j < M ? 0 : 1;
       // The cell's v-interval (sheet 1 runs downwards in v).
       const double v_lo = sheet == 0 ? -l + j * h : l - (j - M + 1) * h;
-      std::fill(cell.begin(), cell.end(), 0.0);
-      for (int a = 0; a < S; ++a) {
-        const double u = ui + ((a + 0.5) / S - 0.5) * h;
-        const double lu = 1.0 - std::abs(u);
-        for (int b = 0; b < S; ++b) {
-          const double v = std::clamp(v_lo + (b + 0.5) / S * h, -lu, lu);
-          const Eigen::Vector3d w = oct::dir_from_uv(u, v, sheet).normalized();
-          f(w, g);
-          const double J = oct::jacobian(u, v);
-          for (size_t c = 0; c < F; ++c) cell[c] += g[c] * J;
-        }
-      }
-      const double scale = h / double(S * S);
-      for (size_t c = 0; c < F; ++c) row[(size_t(j) + 1) * F + c] = row[size_t(j) * F + c] + cell[c] * scale;
+      cell_integral(f, h, ui, v_lo, sheet, S, g, cell);
+      for (size_t c = 0; c < F; ++c) row[(size_t(j) + 1) * F + c] = row[size_t(j) * F + c] + cell[c];
     }
   });
 }
@@ -129,19 +138,8 @@ SparseIsolineTables::SparseIsolineTables(const oct::Grid& grid, int components, 
     for (int j = range_[k].first, rj = 0; j <= range_[k].second; ++j, ++rj) {
       const int sheet = j < M ? 0 : 1;
       const double v_lo = sheet == 0 ? -l + j * h : l - (j - M + 1) * h;
-      std::fill(cell.begin(), cell.end(), 0.0);
-      for (int a = 0; a < S; ++a) {
-        const double u = ui + ((a + 0.5) / S - 0.5) * h;
-        const double lu = 1.0 - std::abs(u);
-        for (int b = 0; b < S; ++b) {
-          const double v = std::clamp(v_lo + (b + 0.5) / S * h, -lu, lu);
-          f(oct::dir_from_uv(u, v, sheet).normalized(), g);
-          const double J = oct::jacobian(u, v);
-          for (size_t c = 0; c < F; ++c) cell[c] += g[c] * J;
-        }
-      }
-      const double scale = h / double(S * S);
-      for (size_t c = 0; c < F; ++c) row[(size_t(rj) + 1) * F + c] = row[size_t(rj) * F + c] + cell[c] * scale;
+      cell_integral(f, h, ui, v_lo, sheet, S, g, cell);
+      for (size_t c = 0; c < F; ++c) row[(size_t(rj) + 1) * F + c] = row[size_t(rj) * F + c] + cell[c];
     }
   });
 }

@@ -7,12 +7,16 @@
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>
+#include <test_scenes.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
 #include <numbers>
 
 using namespace prt::bake;
+using prt::testing::grid;
+using prt::testing::grid_centre;
+using prt::testing::polygon_form_factor;
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 using std::numbers::pi;
@@ -25,33 +29,7 @@ namespace {
 constexpr double kZ = 4.0;
 
 // Flat square grid in the z = 0 plane, (2n+1)² vertices, half-width h; centre vertex index.
-Mesh grid(int n, float h, float z = 0) {
-  std::vector<Vector3f> p;
-  std::vector<std::array<uint32_t, 3>> t;
-  const int m = 2 * n + 1;
-  for (int j = 0; j < m; ++j)
-    for (int i = 0; i < m; ++i) p.emplace_back(-h + 2 * h * i / (m - 1), -h + 2 * h * j / (m - 1), z);
-  for (int j = 0; j + 1 < m; ++j)
-    for (int i = 0; i + 1 < m; ++i) {
-      const uint32_t a = uint32_t(j * m + i), b = a + 1, c = a + uint32_t(m) + 1, d = a + uint32_t(m);
-      t.push_back({a, b, c});
-      t.push_back({a, c, d});
-    }
-  return make_mesh(std::move(p), std::move(t), "grid");
-}
-uint32_t grid_centre(int n) { return uint32_t((2 * n + 1) * n + n); }
 
-// Lambert's formula: the cosine-weighted fraction of the hemisphere covered by a polygon seen
-// from p with normal n, F = 1/(2π) Σ_i angle(r_i, r_{i+1}) · (n · unit(r_i × r_{i+1})).
-double polygon_form_factor(const Vector3d& p, const Vector3d& n, const std::vector<Vector3d>& poly) {
-  double f = 0;
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Vector3d a = (poly[i] - p).normalized(), b = (poly[(i + 1) % poly.size()] - p).normalized();
-    const Vector3d c = a.cross(b);
-    f += std::atan2(c.norm(), a.dot(b)) * n.dot(c.normalized());
-  }
-  return std::abs(f) / (2 * pi);
-}
 
 } // namespace
 

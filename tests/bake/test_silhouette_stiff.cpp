@@ -8,11 +8,15 @@
 #include <bake/vertex_bake.h>
 
 #include <gtest/gtest.h>
+#include <test_scenes.h>
 
 #include <cmath>
 #include <numbers>
 
 using namespace prt::bake;
+using prt::testing::grid;
+using prt::testing::grid_centre;
+using prt::testing::polygon_form_factor;
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 using std::numbers::pi;
@@ -24,15 +28,6 @@ namespace {
 constexpr double kTol = 1e-4;
 constexpr int kN = 256;
 
-double polygon_form_factor(const Vector3d& p, const Vector3d& n, const std::vector<Vector3d>& poly) {
-  double f = 0;
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Vector3d a = (poly[i] - p).normalized(), b = (poly[(i + 1) % poly.size()] - p).normalized();
-    const Vector3d c = a.cross(b);
-    f += std::atan2(c.norm(), a.dot(b)) * n.dot(c.normalized());
-  }
-  return std::abs(f) / (2 * pi);
-}
 
 // Solid angle of a planar convex polygon seen from p (fan of Van Oosterom–Strackee triangles).
 double polygon_solid_angle(const Vector3d& p, const std::vector<Vector3d>& poly) {
@@ -49,20 +44,6 @@ double polygon_solid_angle(const Vector3d& p, const std::vector<Vector3d>& poly)
 
 Mesh quad(const std::vector<Vector3f>& c, const std::string& name) { return make_mesh(c, {{0, 1, 2}, {0, 2, 3}}, name); }
 
-Mesh ground(float half, int n, float z = 0) {
-  std::vector<Vector3f> p;
-  Tris t;
-  const int m = 2 * n + 1;
-  for (int j = 0; j < m; ++j)
-    for (int i = 0; i < m; ++i) p.emplace_back(-half + 2 * half * i / (m - 1), -half + 2 * half * j / (m - 1), z);
-  for (int j = 0; j + 1 < m; ++j)
-    for (int i = 0; i + 1 < m; ++i) {
-      const uint32_t a = uint32_t(j * m + i), b = a + 1, c = a + uint32_t(m) + 1, d = a + uint32_t(m);
-      t.push_back({a, b, c});
-      t.push_back({a, c, d});
-    }
-  return make_mesh(std::move(p), std::move(t), "ground");
-}
 
 Mesh merge(std::vector<Mesh> parts) { return merge_meshes(parts, "scene"); }
 
@@ -140,7 +121,7 @@ TEST(Stiff, EdgeSharedByThreeFacesMatchesQmc) {
   std::vector<Vector3f> p = {{-1, 0, 1}, {1, 0, 1}, {-1, 1, 1.2f}, {1, 1, 1.2f}, {-1, -1, 1.3f}, {1, -1, 1.3f},
                              {-1, 0.3f, 2}, {1, 0.3f, 2}};
   Tris t = {{0, 1, 3}, {0, 3, 2}, {0, 1, 5}, {0, 5, 4}, {0, 1, 7}, {0, 7, 6}};
-  std::vector<Mesh> parts{ground(3, 2), make_mesh(p, t, "book")};
+  std::vector<Mesh> parts{grid(2, 3), make_mesh(p, t, "book")};
   const Mesh m = merge(parts);
   const Topology topo = build_topology(m);
   bool has_three = false;
@@ -183,7 +164,7 @@ TEST(Stiff, GroundPlaneThroughP) {
   // p on a ground triangle's interior (not a vertex) and at a ground vertex: the plane itself
   // occludes nothing of the upper hemisphere.
   const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
-  const Mesh m = merge({ground(4, 2), quad(kSquare, "sq")});
+  const Mesh m = merge({grid(2, 4), quad(kSquare, "sq")});
   EXPECT_NEAR(ao_at(m, free_point({0.1234, 0.0567, 0})), 1 - polygon_form_factor({0.1234, 0.0567, 0}, Vector3d::UnitZ(), to_d(kSquare)), kTol);
   const Topology topo = build_topology(m);
   EXPECT_NEAR(ao_at(m, vertex_shade_point(m, topo, 2 * 5 + 2)), exact, kTol);
@@ -276,7 +257,7 @@ TEST(Stiff, TranslationAndScaleInvariance) {
   auto scene = [](float s, Vector3f off) {
     std::vector<Vector3f> sq, g;
     for (const auto& v : kSquare) sq.push_back(v * s + off);
-    Mesh gr = ground(4, 2);
+    Mesh gr = grid(2, 4);
     for (auto& v : gr.positions) v = v * s + off;
     gr = make_mesh(gr.positions, gr.triangles, "ground");
     return merge({gr, quad(sq, "sq")});
@@ -294,7 +275,7 @@ TEST(Stiff, TranslationAndScaleInvariance) {
 
 TEST(Stiff, VeryLowAndVeryHighK) {
   const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
-  const Mesh m = merge({ground(4, 2), quad(kSquare, "sq")});
+  const Mesh m = merge({grid(2, 4), quad(kSquare, "sq")});
   const Topology topo = build_topology(m);
   for (int n : {2, 4, 1024}) {
     const double ao = ao_at(m, vertex_shade_point(m, topo, 12), n);

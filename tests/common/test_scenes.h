@@ -1,0 +1,43 @@
+// Small scenes and closed forms shared by the integrator tests.
+#pragma once
+
+#include <bake/mesh.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace prt::testing {
+
+// Flat square grid in the plane z, (2n+1)² vertices over [-h, h]², two triangles per cell.
+inline bake::Mesh grid(int n, float h, float z = 0) {
+  std::vector<Eigen::Vector3f> p;
+  std::vector<std::array<uint32_t, 3>> t;
+  const int m = 2 * n + 1;
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) p.emplace_back(-h + 2 * h * i / (m - 1), -h + 2 * h * j / (m - 1), z);
+  for (int j = 0; j + 1 < m; ++j)
+    for (int i = 0; i + 1 < m; ++i) {
+      const uint32_t a = uint32_t(j * m + i), b = a + 1, c = a + uint32_t(m) + 1, d = a + uint32_t(m);
+      t.push_back({a, b, c});
+      t.push_back({a, c, d});
+    }
+  return bake::make_mesh(std::move(p), std::move(t), "grid");
+}
+inline uint32_t grid_centre(int n) { return uint32_t((2 * n + 1) * n + n); }
+
+// Lambert's formula: the cosine-weighted fraction of the hemisphere (p, n) covered by a planar
+// polygon, F = 1/(2π) Σ_i angle(r_i, r_{i+1}) · (n · unit(r_i × r_{i+1})).
+inline double polygon_form_factor(const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                  const std::vector<Eigen::Vector3d>& poly) {
+  double f = 0;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector3d a = (poly[i] - p).normalized(), b = (poly[(i + 1) % poly.size()] - p).normalized();
+    const Eigen::Vector3d c = a.cross(b);
+    f += std::atan2(c.norm(), a.dot(b)) * n.dot(c.normalized());
+  }
+  return std::abs(f) / (2 * std::numbers::pi);
+}
+
+} // namespace prt::testing
