@@ -53,7 +53,10 @@ bool QmcIntegrator::visible(const ShadePoint& point, const Vector3d& d) const { 
 void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                               std::span<double> std_error) const {
   PRT_CHECK_OP(out.size(), >=, layout_.width);
-  PRT_CHECK(point.hemisphere);  // full-sphere mode: not in the QMC baseline yet (the FIV issue)
+  // Full-sphere mode (H ≡ 1): the hemisphere strategies become one uniform-sphere strategy of the
+  // same total weight; AO and diffuse transfer (defined with n·ω) are hemisphere products only.
+  const bool full = !point.hemisphere;
+  PRT_CHECK(!full || (layout_.ao_count == 0 && layout_.transfer_count == 0));
   const size_t W = layout_.width;
   std::vector<double> sum(W, 0.0), sum2(W, 0.0), x(W, 0.0);
   std::vector<double> y(size_t(sh::num_coeffs(std::max(sh_order_, 1))));
@@ -67,6 +70,8 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
     if (u[0] < w_env_) {
       double pdf_unused;
       d = request_.radiance->sample(u[1], u[2], &pdf_unused);
+    } else if (full) {
+      d = uniform_sphere(u[1], u[2]);
     } else if (u[0] < w_env_ + w_cos_) {
       d = frame.to_world(cosine_hemisphere(u[1], u[2]));
     } else {
@@ -75,10 +80,10 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
     d.normalize();
     const double c = point.n.dot(d);
     std::fill(x.begin(), x.end(), 0.0);
-    if (c > 0 && visible(point, d)) {
-      double p = w_cos_ * c * kInvPi + w_uni_ * (0.5 * kInvPi);
+    if ((full || c > 0) && visible(point, d)) {
+      double p = full ? (1.0 - w_env_) * (0.25 * kInvPi) : w_cos_ * c * kInvPi + w_uni_ * (0.5 * kInvPi);
       if (w_env_ > 0) p += w_env_ * request_.radiance->pdf(d);
-      const double inv_p = 1.0 / p;  // p ≥ w_cos c/π > 0 or w_uni/2π > 0 here
+      const double inv_p = 1.0 / p;  // p ≥ w_cos c/π > 0, w_uni/2π or w_sphere/4π > 0 here
       if (sh_order_ > 0) sh::eval(sh_order_, d.x(), d.y(), d.z(), y);
       if (layout_.ao_count) x[layout_.ao] = c * kInvPi * inv_p;
       for (size_t k = 0; k < layout_.transfer_count; ++k) x[layout_.transfer + k] = c * kInvPi * y[k] * inv_p;

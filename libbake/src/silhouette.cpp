@@ -436,6 +436,26 @@ void SilhouetteIntegrator::integrate(const ShadePoint& point, uint64_t point_ind
   for (double& e : std_error) e = 0.0;
 }
 
+void SilhouetteIntegrator::unoccluded(std::span<double> out) const {
+  const Impl& m = *impl_;
+  PRT_CHECK_OP(out.size(), >=, m.layout.width);
+  std::vector<double> acc(m.F, 0.0), hot(9, 0.0);
+  for (int i = 0; i < m.grid.n; ++i) {
+    const double* total = m.tables->loop_total(i);
+    for (size_t c = 0; c < m.F; ++c) acc[c] += total[c] * m.grid.h;
+  }
+  if (m.hot)
+    for (int i = m.hot->first_isoline(); i < m.hot->last_isoline(); ++i)
+      if (m.hot->has(i)) {
+        const double* total = m.hot->loop_total(i);
+        for (size_t c = 0; c < 9; ++c) acc[m.c_r + c] += total[c] * m.hot->grid().h;
+      }
+  const ProductLayout& L = m.layout;
+  std::fill(out.begin(), out.begin() + std::ptrdiff_t(L.width), 0.0);
+  for (size_t k = 0; k < L.visibility_count; ++k) out[L.visibility + k] = acc[m.c_u + k];
+  for (size_t k = 0; k < L.radiance_count; ++k) out[L.radiance + k] = acc[m.c_r + k];
+}
+
 SilhouetteStats SilhouetteIntegrator::stats() const {
   SilhouetteStats s;
   s.points = impl_->n_points.load();

@@ -95,4 +95,10 @@ inline Eigen::Vector3d uniform_hemisphere(double u0, double u1) noexcept {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
+// Uniform sphere: pdf = 1 / 4π.
+inline Eigen::Vector3d uniform_sphere(double u0, double u1) noexcept {
+  const double z = 1 - 2 * u0, r = std::sqrt(std::max(0.0, 1 - z * z)), phi = 2 * std::numbers::pi * u1;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
 } // namespace prt::bake

@@ -65,6 +65,11 @@ public:
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                  std::span<double> std_error = {}) const override;
 
+  // The full-sphere integrals with V ≡ 1 from the same tables (the visibility and radiance rows of
+  // the layout; others 0). ∫ (1 − V) f = unoccluded − integrate(full sphere) then shares the
+  // discretisation of both terms, so an occluder subtending little keeps its relative accuracy.
+  void unoccluded(std::span<double> out) const;
+
   SilhouetteStats stats() const;
   const SilhouetteOptions& options() const;
 

@@ -1,0 +1,82 @@
+// bake/fiv.h — Fullsphere Irradiance Vectors (Michael & Chrysanthou, "Fullsphere Irradiance
+// Factorization for Real-Time All-Frequency Illumination for Dynamic Scenes", CGF 2010; paper
+// 004 in ../shared/papers, §3 eq. 9 and §4.1–4.2), computed with the silhouette integrator's
+// full-sphere mode (paper 001 §3) instead of rasterised occlusion cube masks.
+//
+// Quantities (per RGB channel c; [RGB][xyz] = 9 numbers, row-major):
+//   environment FIV       F_c^env = ∫_{S²} L_c(ω) ω dω                         (eq. 9)
+//   occluded FIV          F_c(s)  = ∫_{S²} (1 − V_O(s, ω)) L_c(ω) ω dω          at receiver offset s
+//                         from the occluder's bounding-sphere centre; the unoccluded FIV at s is
+//                         F^env − F(s), and a receiver with normal n gets n · (that) (eq. 8–9).
+//   DifMap                E_tot(n) = ∫ L(ω) H(ω, n) (n · ω) dω                   (eq. 5), per normal.
+//
+// Shell grid (stored as attributes so any reader can rebuild the positions):
+//   s(k, i, j) = centre + ρ_k d(θ_i, φ_j),  θ_i = π i / (Nθ − 1) (poles included, θ from +Y),
+//   φ_j = 2π j / Nφ (from +Z towards +X):   d = (sin θ sin φ, cos θ, sin θ cos φ).
+//   Radii: geometric, ρ_0 = inner · R up to ρ_far = R / (2 √fraction) over Nρ shells (a sphere of
+//   radius R at distance ρ hides ≈ R²/(4ρ²) of the sphere); the bake stops after the first shell
+//   whose max_c |F_c| / ∫ L_c dω is below `fraction` and stores the radii it used. (The scale is
+//   the full-sphere irradiance ∫ L dω, not |F^env|, which cancels to 0 for a uniform sky. Under a
+//   sun, a distant occluder still blocks the sun wholly from some shell directions, so the shells
+//   run out to the last radius: that shadow is real.)
+//   valid = 0 where the offset is inside closed geometry (nothing visible: F = F^env there).
+//
+// Cube map of the DifMap: faces +X, −X, +Y, −Y, +Z, −Z; texel (row r, column q) of size S has
+// s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction (OpenGL's cube-map convention)
+//   +X (1, −t, −s)   −X (−1, −t, s)   +Y (s, 1, t)   −Y (s, −1, −t)   +Z (s, −t, 1)   −Z (−s, −t, −1).
+#pragma once
+
+#include <bake/envmap.h>
+#include <bake/mesh.h>
+#include <bake/progress.h>
+#include <bake/silhouette.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace prt::bake {
+
+using Fiv = std::array<double, 9>;  // [RGB][xyz]
+
+// ∫ L ω dω, exact per texel up to its 4×4 sub-sampled ∫_texel ω dω.
+Fiv environment_fiv(const EnvMap& env);
+
+// DifMap: [6][S][S][3] float, E_tot(n) per texel direction (see the header comment); texels cut by
+// the horizon of n are integrated with 8×8 sub-samples, the rest with their exact ∫_texel ω dω.
+std::vector<float> irradiance_cube(const EnvMap& env, int size);
+Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
+
+struct ShellSpec {
+  int n_phi = 128, n_theta = 65, n_rho = 30;
+  double inner = 0.5;      // ρ_0 / R: the first shell lies inside the bounding sphere (self-shadows)
+  double fraction = 1e-3;  // stop once |occluded FIV| is below this fraction of ∫ L dω
+  int isolines = 128;      // silhouette sampling rate k = isolines²
+};
+
+struct FivShells {
+  Eigen::Vector3d centre{0, 0, 0};
+  double radius = 0;
+  int n_phi = 0, n_theta = 0;
+  std::vector<double> radii;    // the shells baked (≤ n_rho)
+  std::vector<float> shells;    // [Nρ][Nθ][Nφ][RGB][xyz]
+  std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  double seconds = 0;
+  uint64_t integrals = 0;
+};
+
+Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi);
+
+// Bounding sphere used by the shells: the centre of the axis-aligned bounds and the largest
+// distance from it to a vertex.
+void bounding_sphere(const Mesh& mesh, Eigen::Vector3d& centre, double& radius);
+
+FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                          ProgressMode progress = ProgressMode::Quiet);
+
+// The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1}
+// in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
+// direction is visible.
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr);
+
+} // namespace prt::bake

@@ -1,0 +1,219 @@
+#include <bake/error.h>
+#include <bake/fiv.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+namespace prt::bake {
+
+using Eigen::Vector3d;
+
+namespace {
+// y_{1,-1} = −k y, y_{1,0} = k z, y_{1,1} = −k x with k = √(3/4π): ω from band-1 rows [c][m].
+constexpr double kBand1 = 0.48860251190291992159;  // √(3 / 4π)
+void omega_from_band1(const double* r, double* f) {
+  for (int c = 0; c < 3; ++c) {
+    f[3 * c + 0] = -r[3 * c + 2] / kBand1;
+    f[3 * c + 1] = -r[3 * c + 0] / kBand1;
+    f[3 * c + 2] = r[3 * c + 1] / kBand1;
+  }
+}
+
+// ∫_texel ω dω by 4×4 uniform-in-solid-angle sub-samples.
+std::vector<Vector3d> texel_moments(const EnvMap& env) {
+  const int T = env.texel_count();
+  std::vector<Vector3d> m(static_cast<size_t>(T));
+  tbb::parallel_for(0, T, [&](int t) {
+    Vector3d s = Vector3d::Zero();
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) s += env.sample_texel(t, (a + 0.5) / 4, (b + 0.5) / 4);
+    m[size_t(t)] = s * (env.texel_solid_angle(t) / 16.0);
+  });
+  return m;
+}
+} // namespace
+
+Fiv environment_fiv(const EnvMap& env) {
+  Fiv f{};
+  if (env.texel_count() == 0) return f;  // constant(): ∫ ω dω = 0
+  const auto m = texel_moments(env);
+  for (int t = 0; t < env.texel_count(); ++t) {
+    const Rgb L = env.texel_value(t);
+    const double c[3] = {L.r, L.g, L.b};
+    for (int ch = 0; ch < 3; ++ch)
+      for (int a = 0; a < 3; ++a) f[size_t(3 * ch + a)] += c[ch] * m[size_t(t)][a];
+  }
+  return f;
+}
+
+Eigen::Vector3d cube_direction(int face, int row, int column, int size) {
+  const double s = 2 * (column + 0.5) / size - 1, t = 2 * (row + 0.5) / size - 1;
+  Vector3d d;
+  switch (face) {
+    case 0: d = {1, -t, -s}; break;
+    case 1: d = {-1, -t, s}; break;
+    case 2: d = {s, 1, t}; break;
+    case 3: d = {s, -1, -t}; break;
+    case 4: d = {s, -t, 1}; break;
+    default: d = {-s, -t, -1}; break;
+  }
+  return d.normalized();
+}
+
+std::vector<float> irradiance_cube(const EnvMap& env, int size) {
+  PRT_CHECK(size >= 1);
+  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
+  if (env.texel_count() == 0) {  // constant L: E = π L for every normal
+    const Rgb L = env.radiance(Vector3d::UnitY());
+    for (size_t i = 0; i < out.size(); i += 3) {
+      out[i] = float(std::numbers::pi * L.r);
+      out[i + 1] = float(std::numbers::pi * L.g);
+      out[i + 2] = float(std::numbers::pi * L.b);
+    }
+    return out;
+  }
+  const int T = env.texel_count();
+  const auto m = texel_moments(env);
+  // A texel is cut by the horizon of n when its angular radius reaches past n's great circle.
+  std::vector<Vector3d> centre(static_cast<size_t>(T));
+  std::vector<double> sin_radius(static_cast<size_t>(T));
+  for (int t = 0; t < T; ++t) {
+    centre[size_t(t)] = env.texel_center(t).normalized();
+    double r = 0;
+    for (int a = 0; a <= 1; ++a)
+      for (int b = 0; b <= 1; ++b) r = std::max(r, std::acos(std::clamp(centre[size_t(t)].dot(env.sample_texel(t, a * 0.999999, b * 0.999999)), -1.0, 1.0)));
+    sin_radius[size_t(t)] = std::sin(std::min(1.5 * r + 1e-6, std::numbers::pi / 2));
+  }
+  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
+    const int face = idx / (size * size), row = (idx / size) % size, col = idx % size;
+    const Vector3d n = cube_direction(face, row, col, size);
+    double e[3] = {0, 0, 0};
+    for (int t = 0; t < T; ++t) {
+      const Rgb L = env.texel_value(t);
+      if (L.r == 0 && L.g == 0 && L.b == 0) continue;
+      const double cn = n.dot(centre[size_t(t)]);
+      double w;
+      if (std::abs(cn) >= sin_radius[size_t(t)]) {
+        if (cn <= 0) continue;
+        w = n.dot(m[size_t(t)]);  // wholly above the horizon: exact moment
+      } else {
+        constexpr int kS = 8;  // cut by the horizon: sub-sample
+        double acc = 0;
+        for (int a = 0; a < kS; ++a)
+          for (int b = 0; b < kS; ++b) acc += std::max(0.0, n.dot(env.sample_texel(t, (a + 0.5) / kS, (b + 0.5) / kS)));
+        w = acc * env.texel_solid_angle(t) / (kS * kS);
+      }
+      e[0] += L.r * w;
+      e[1] += L.g * w;
+      e[2] += L.b * w;
+    }
+    for (int c = 0; c < 3; ++c) out[size_t(idx) * 3 + size_t(c)] = float(e[c]);
+  });
+  return out;
+}
+
+Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {
+  const double th = std::numbers::pi * i_theta / std::max(n_theta - 1, 1), ph = 2 * std::numbers::pi * j_phi / n_phi;
+  return {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+}
+
+void bounding_sphere(const Mesh& mesh, Vector3d& centre, double& radius) {
+  PRT_CHECK(!mesh.positions.empty());
+  Vector3d lo = mesh.positions[0].cast<double>(), hi = lo;
+  for (const auto& p : mesh.positions) {
+    lo = lo.cwiseMin(p.cast<double>());
+    hi = hi.cwiseMax(p.cast<double>());
+  }
+  centre = 0.5 * (lo + hi);
+  radius = 0;
+  for (const auto& p : mesh.positions) radius = std::max(radius, (p.cast<double>() - centre).norm());
+}
+
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& position, bool* inside) {
+  const ProductLayout& L = integrator.layout();
+  PRT_CHECK(L.radiance_count == 9 && L.visibility_count >= 1);
+  std::vector<double> vis(L.width), all(L.width);
+  ShadePoint sp;
+  sp.p = position;
+  sp.n = Vector3d(0.3, 0.8, -0.52).normalized();  // only decides ties of a point exactly on a face plane
+  sp.hemisphere = false;
+  integrator.integrate(sp, 0, vis);
+  integrator.unoccluded(all);
+  double occ[9];
+  for (int k = 0; k < 9; ++k) occ[k] = all[L.radiance + size_t(k)] - vis[L.radiance + size_t(k)];
+  if (inside) *inside = vis[L.visibility] == 0.0;
+  Fiv f{};
+  omega_from_band1(occ, f.data());
+  return f;
+}
+
+FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                          ProgressMode progress_mode) {
+  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
+  FivShells out;
+  bounding_sphere(occluder, out.centre, out.radius);
+  out.n_phi = spec.n_phi;
+  out.n_theta = spec.n_theta;
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  const SilhouetteIntegrator integrator(occluder, topology, req, {spec.isolines, 1});
+  // The scale the occluded FIV is compared with: ∫ L_c dω, the full-sphere irradiance. (|F^env|
+  // itself cancels to 0 for a uniform sky, so a fraction of it is ill-posed.)
+  double env_norm[3] = {0, 0, 0};
+  if (env.texel_count() == 0) {
+    const Rgb L = env.radiance(Vector3d::UnitY());
+    env_norm[0] = 4 * std::numbers::pi * L.r;
+    env_norm[1] = 4 * std::numbers::pi * L.g;
+    env_norm[2] = 4 * std::numbers::pi * L.b;
+  }
+  for (int t = 0; t < env.texel_count(); ++t) {
+    const Rgb L = env.texel_value(t);
+    const double w = env.texel_solid_angle(t);
+    env_norm[0] += L.r * w;
+    env_norm[1] += L.g * w;
+    env_norm[2] += L.b * w;
+  }
+  const double R = std::max(out.radius, 1e-30);
+  const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
+  const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
+  const size_t per_shell = size_t(spec.n_theta) * size_t(spec.n_phi);
+  Progress progress("baking FIV shells", uint64_t(spec.n_rho) * per_shell, progress_mode);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < spec.n_rho; ++k) {
+    const double rho = rho0 * std::pow(g, k);
+    std::vector<float> shell(per_shell * 9);
+    std::vector<uint8_t> valid(per_shell);
+    std::vector<double> ratio(per_shell, 0.0);
+    tbb::parallel_for(size_t(0), per_shell, [&](size_t idx) {
+      const int i = int(idx / size_t(spec.n_phi)), j = int(idx % size_t(spec.n_phi));
+      bool inside = false;
+      const Fiv f = occluded_fiv(integrator, out.centre + rho * shell_direction(i, spec.n_theta, j, spec.n_phi), &inside);
+      double r = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
+                                    f[size_t(3 * c + 2)] * f[size_t(3 * c + 2)]);
+        if (env_norm[c] > 0) r = std::max(r, nf / env_norm[c]);
+      }
+      ratio[idx] = inside ? 0.0 : r;  // offsets inside the geometry say nothing about distance
+      for (int q = 0; q < 9; ++q) shell[idx * 9 + size_t(q)] = float(f[size_t(q)]);
+      valid[idx] = inside ? 0 : 1;
+      progress.advance();
+    });
+    out.radii.push_back(rho);
+    out.shells.insert(out.shells.end(), shell.begin(), shell.end());
+    out.valid.insert(out.valid.end(), valid.begin(), valid.end());
+    out.integrals += per_shell;
+    // Far enough (and outside the bounding sphere, so never inside the occluder): stop.
+    if (rho >= R && *std::max_element(ratio.begin(), ratio.end()) < spec.fraction) break;
+  }
+  progress.finish();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+} // namespace prt::bake
