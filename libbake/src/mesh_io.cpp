@@ -613,39 +613,53 @@ private:
   bool valid(VertexHandle v) const { return v.idx() >= 0 && static_cast<size_t>(v.idx()) < points.size(); }
 };
 
-// Captures omerr / omlog / omout for the duration of a read (they are process-wide, hence the
-// lock) and restores whatever they were connected to.
+// Captures omerr / omlog / omout during a read. They are process-wide, hence the lock. OpenMesh's
+// multiplex_streambuf::disconnect() forgets a target without deleting it (mostream.hh), so
+// connecting per read leaked every time: the capture streams are connected once, for the life of
+// the process (reachable through a static pointer), and emptied before each read. Side effect:
+// after the first read, OpenMesh's chatter no longer reaches std::cerr from other OpenMesh users
+// in the process either; their errors must be turned into exceptions where they happen.
 class OpenMeshChatter {
 public:
   OpenMeshChatter() : lock_(mutex()) {
-    had_cerr_ = ::omerr().disconnect(std::cerr);
-    had_clog_ = ::omlog().disconnect(std::clog);
-    had_cout_ = ::omout().disconnect(std::cout);
-    ::omerr().connect(err_);
-    ::omlog().connect(log_);
-    ::omout().connect(log_);
+    static const bool connected = [] {
+      ::omerr().disconnect(std::cerr);
+      ::omlog().disconnect(std::clog);
+      ::omout().disconnect(std::cout);
+      ::omerr().connect(err_stream());
+      ::omlog().connect(log_stream());
+      ::omout().connect(log_stream());
+      return true;
+    }();
+    (void)connected;
+    flush_all();
+    err_stream().str("");
+    log_stream().str("");
   }
-  ~OpenMeshChatter() {
-    ::omerr().flush();
-    ::omlog().flush();
-    ::omout().flush();
-    ::omerr().disconnect(err_);
-    ::omlog().disconnect(log_);
-    ::omout().disconnect(log_);
-    if (had_cerr_) ::omerr().connect(std::cerr);
-    if (had_clog_) ::omlog().connect(std::clog);
-    if (had_cout_) ::omout().connect(std::cout);
-  }
+  ~OpenMeshChatter() { flush_all(); }
   OpenMeshChatter(const OpenMeshChatter&) = delete;
   OpenMeshChatter& operator=(const OpenMeshChatter&) = delete;
 
-  std::vector<std::string> errors() { return lines(err_, ::omerr()); }
+  std::vector<std::string> errors() { return lines(err_stream(), ::omerr()); }
   std::vector<std::string> logs() {
     ::omout().flush();
-    return lines(log_, ::omlog());
+    return lines(log_stream(), ::omlog());
   }
 
 private:
+  static std::ostringstream& err_stream() {
+    static std::ostringstream* s = new std::ostringstream;
+    return *s;
+  }
+  static std::ostringstream& log_stream() {
+    static std::ostringstream* s = new std::ostringstream;
+    return *s;
+  }
+  static void flush_all() {
+    ::omerr().flush();
+    ::omlog().flush();
+    ::omout().flush();
+  }
   static std::mutex& mutex() {
     static std::mutex m;
     return m;
@@ -659,8 +673,6 @@ private:
     return out;
   }
   std::lock_guard<std::mutex> lock_;
-  std::ostringstream err_, log_;
-  bool had_cerr_ = false, had_clog_ = false, had_cout_ = false;
 };
 
 // OBJ material-library complaints do not touch geometry: a missing or partial .mtl is a warning.

@@ -236,3 +236,25 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
                         "EXAMPLES", "EXIT STATUS"})
     EXPECT_NE(h.out.find(s), std::string::npos) << s;
 }
+
+TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
+  const fs::path out = scratch("fiv.prt.h5");
+  fs::remove(out);
+  const Outcome r = run("fiv " + (kData / "spider.obj").string() + " --env " + (kData / "studio.exr").string() +
+                        " --shells 8x5x4 --cube 2 --samples 1024 --quiet -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const F::File f = F::read_file(out);
+  EXPECT_EQ(F::find_dataset(f, "/fiv/environment")->shape, (std::vector<uint64_t>{3, 3}));
+  EXPECT_EQ(F::find_dataset(f, "/fiv/irradiance_cube")->shape, (std::vector<uint64_t>{6, 2, 2, 3}));
+  const F::Dataset* sh = F::find_dataset(f, "/fiv/occluders/spider/shells");
+  ASSERT_NE(sh, nullptr);
+  ASSERT_EQ(sh->shape.size(), 5u);
+  EXPECT_LE(sh->shape[0], 4u);
+  EXPECT_EQ(sh->shape[1], 5u);
+  EXPECT_EQ(sh->shape[2], 8u);
+  EXPECT_NE(F::find_dataset(f, "/fiv/occluders/spider/valid"), nullptr);
+  EXPECT_EQ(F::find_dataset(f, "/mesh/positions"), nullptr) << "no per-vertex data was asked for";
+  for (float x : std::get<std::vector<float>>(F::find_dataset(f, "/fiv/irradiance_cube")->data)) EXPECT_GT(x, 0.0f);
+  EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " -o " + out.string()).code, 2) << "no --env";
+  EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);
+}

@@ -2,6 +2,7 @@
 // reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/envmap.h>
 #include <bake/error.h>
+#include <bake/fiv.h>
 #include <bake/mesh.h>
 #include <bake/qmc.h>
 #include <bake/sampling.h>
@@ -14,6 +15,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -38,6 +40,7 @@ constexpr const char* kHelp = R"(prtbake — bake precomputed radiance transfer 
 
 USAGE
   prtbake vertex MESH -o OUT.prt.h5 [PRODUCTS] [OPTIONS]
+  prtbake fiv OCCLUDER --env ENV.exr -o OUT.prt.h5 [--shells 128x65x30] [--cube 16] [OPTIONS]
   prtbake --help | --version
 
   Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL) in one pass: the
@@ -45,7 +48,14 @@ USAGE
   a position with several normals in the file (OBJ v//vn hard edges) gives one row per
   (position, normal) pair, and /mesh/source_position says which file vertex each row is.
 
-PRODUCTS (at least one)
+  fiv bakes an occluder's Fullsphere Irradiance Vectors (paper 004): the environment's FIV
+  F_env = Int L w dw, the diffuse irradiance cube map (DifMap) E(n) = Int L H (n.w) dw (exact,
+  not SH9), and the occluded FIV F(s) = Int (1 - V(s,w)) L w dw on concentric shells around the
+  occluder's bounding sphere: --shells NPHIxNTHETAxNRHO (poles included in NTHETA), radii from
+  half the bounding radius outwards, stopping once |F| < --fraction (default 1e-3) of Int L dw.
+  --cube S sets the DifMap resolution (default 16); --samples k the silhouette rate (128^2).
+
+PRODUCTS of vertex (at least one)
   --ao               ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]
   --transfer L       diffuse transfer vectors T_i = 1/pi * Int V H (n.w) y_i dw, SH order L
                      (L bands, L*L coefficients; shade with albedo * sum_i T_i L_i)
@@ -88,6 +98,7 @@ OPTIONS
 EXAMPLES
   prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5
   prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5
+  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5
   prtdump bunny.prt.h5            # what was baked, statistics, the error report
 
 EXIT STATUS
@@ -116,6 +127,8 @@ struct Args {
   uint64_t seed = 1;
   int threads = 0;
   bake::UpAxis up = bake::UpAxis::Y;
+  int n_phi = 128, n_theta = 65, n_rho = 30, cube = 16;  // fiv
+  double fraction = 1e-3;
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
 };
 
@@ -149,6 +162,30 @@ Args parse(int argc, char** argv) {
     } else if (s == "--visibility") {
       a.visibility = parse_number<int>(s, value(), 1, sh::kMaxOrder);
       record(v[i]);
+    } else if (s == "--env") {
+      a.radiance = value();
+      record(a.radiance);
+    } else if (s == "--shells") {
+      const std::string g = value();
+      int n1 = 0, n2 = 0, n3 = 0;
+      char x1 = 0, x2 = 0;
+      if (std::sscanf(g.c_str(), "%d%c%d%c%d", &n1, &x1, &n2, &x2, &n3) != 5 || x1 != 'x' || x2 != 'x' || n1 < 1 ||
+          n2 < 2 || n3 < 1 || n1 > 4096 || n2 > 4096 || n3 > 1024)
+        throw UsageError("--shells expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
+      a.n_phi = n1;
+      a.n_theta = n2;
+      a.n_rho = n3;
+      record(g);
+    } else if (s == "--cube") {
+      a.cube = parse_number<int>(s, value(), 1, 1024);
+      record(v[i]);
+    } else if (s == "--fraction") {
+      const std::string f = value();
+      char* end = nullptr;
+      a.fraction = std::strtod(f.c_str(), &end);
+      if (end == f.c_str() || *end != 0 || !(a.fraction > 0 && a.fraction < 1))
+        throw UsageError("--fraction expects a number in (0, 1), got '" + f + "'");
+      record(f);
     } else if (s == "--radiance") {
       a.radiance = value();
       record(a.radiance);
@@ -197,7 +234,15 @@ Args parse(int argc, char** argv) {
   if (a.samples == 0) a.samples = a.integrator == "qmc" ? 1024 : 16384;
   if (a.integrator == "silhouette" && a.samples < 4)
     throw UsageError("--samples: the silhouette integrator needs k >= 4 (2 u-isolines)");
-  if (a.command != "vertex") throw UsageError("unknown command '" + a.command + "' (available: vertex)");
+  if (a.command != "vertex" && a.command != "fiv")
+    throw UsageError("unknown command '" + a.command + "' (available: vertex, fiv)");
+  if (a.command == "fiv") {
+    if (a.mesh.empty()) throw UsageError("fiv: no OCCLUDER mesh given");
+    if (a.output.empty()) throw UsageError("fiv: no output file given (-o OUT.prt.h5)");
+    if (a.radiance.empty()) throw UsageError("fiv: no environment given (--env ENV.exr)");
+    if (a.integrator != "silhouette") throw UsageError("fiv: shells are baked with the silhouette integrator");
+    return a;
+  }
   if (a.mesh.empty()) throw UsageError("vertex: no MESH given");
   if (a.output.empty()) throw UsageError("vertex: no output file given (-o OUT.prt.h5)");
   if (!a.ao && !a.transfer && !a.visibility && a.radiance.empty())
@@ -242,6 +287,21 @@ std::string human_bytes(uintmax_t b) {
   if (b >= (1u << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1 << 20));
   else std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / 1024);
   return buf;
+}
+
+// The root attributes every file carries (formats/SCHEMA.md).
+std::vector<prt::formats::Attr> root_attrs(const Args& a, const std::string& source_sha) {
+  return {
+      {"generator", std::string("prtbake ") + kVersion},
+      {"created", timestamp(a.reproducible)},
+      {"command_line", a.command_line},
+      {"source", a.mesh},
+      {"source_sha256", source_sha},
+      {"up_axis", std::string(a.up == bake::UpAxis::Y ? "y" : "z")},
+      {"sh_convention", std::string("real orthonormal SH, Condon-Shortley phase, index l*(l+1)+m, order = number of "
+                                    "bands L (L*L coefficients); bands 0-2 equal DirectXMath XMSHEvalDirection; "
+                                    "directions in the mesh frame")},
+  };
 }
 
 int run_vertex(const Args& a) {
@@ -346,17 +406,7 @@ int run_vertex(const Args& a) {
   // ---- the file (formats/SCHEMA.md) ----
   namespace F = prt::formats;
   F::File file;
-  file.root_attrs = {
-      {"generator", std::string("prtbake ") + kVersion},
-      {"created", timestamp(a.reproducible)},
-      {"command_line", a.command_line},
-      {"source", a.mesh},
-      {"source_sha256", mesh_sha},
-      {"up_axis", std::string(a.up == bake::UpAxis::Y ? "y" : "z")},
-      {"sh_convention", std::string("real orthonormal SH, Condon-Shortley phase, index l*(l+1)+m, order = number of "
-                                    "bands L (L*L coefficients); bands 0-2 equal DirectXMath XMSHEvalDirection; "
-                                    "directions in the mesh frame")},
-  };
+  file.root_attrs = root_attrs(a, mesh_sha);
   const size_t V = mesh.positions.size(), T = mesh.triangles.size(), W = result.layout.width;
   {
     std::vector<float> pos(3 * V), nrm(3 * V);
@@ -435,12 +485,91 @@ int run_vertex(const Args& a) {
   return 0;
 }
 
+int run_fiv(const Args& a) {
+  const bool say = !a.quiet;
+  check_output_writable(a.output);
+  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
+  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+  bake::MeshLoadOptions mopt;
+  mopt.use_file_normals = false;  // an occluder's normals play no part in its FIVs
+  const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
+  const bake::Topology topo = bake::build_topology(mesh);
+  for (const auto& w : mesh.warnings) std::fprintf(stderr, "prtbake: warning: %s\n", w.c_str());
+  const bake::EnvMap env = bake::EnvMap::load(a.radiance, a.up);
+  const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
+  if (say)
+    std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.mesh.c_str(), mesh.triangles.size(),
+                a.radiance.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const bake::Fiv fenv = bake::environment_fiv(env);
+  const std::vector<float> cube = bake::irradiance_cube(env, a.cube);
+  const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  bake::ShellSpec spec;
+  spec.n_phi = a.n_phi;
+  spec.n_theta = a.n_theta;
+  spec.n_rho = a.n_rho;
+  spec.fraction = a.fraction;
+  spec.isolines = std::max(2, int(std::lround(std::sqrt(double(a.samples)))));
+  const bake::FivShells sh = bake::bake_fiv_shells(mesh, topo, env, spec, progress);
+  if (say) {
+    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.cube, a.cube, env_seconds);
+    std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
+                "integrals/s)\n",
+                a.n_phi, a.n_theta, sh.radii.size(), a.n_rho, sh.radii.front(), sh.radii.back(), sh.radius, sh.seconds,
+                double(sh.integrals) / sh.seconds);
+  }
+
+  namespace F = prt::formats;
+  F::File file;
+  file.root_attrs = root_attrs(a, bake::sha256_file(a.mesh));
+  std::vector<F::Attr> env_attrs = {{"environment", a.radiance}, {"environment_sha256", env.info().sha256}};
+  std::vector<float> fe(9);
+  for (int k = 0; k < 9; ++k) fe[size_t(k)] = float(fenv[size_t(k)]);
+  auto with = [](std::vector<F::Attr> x, std::vector<F::Attr> y) {
+    x.insert(x.end(), y.begin(), y.end());
+    return x;
+  };
+  file.datasets.push_back({"/fiv/environment", {3, 3}, std::move(fe),
+                           with(env_attrs, {{"integrand", std::string("F_c = Int L_c(w) w dw, layout [RGB][xyz]")}})});
+  file.datasets.push_back(
+      {"/fiv/irradiance_cube", {6, uint64_t(a.cube), uint64_t(a.cube), 3}, cube,
+       with(env_attrs, {{"integrand", std::string("E_c(n) = Int L_c H(w,n) (n.w) dw, exact per texel")},
+                        {"face_convention", std::string("faces +X,-X,+Y,-Y,+Z,-Z; texel (row r, column q): s = "
+                                                        "2(q+0.5)/S-1, t = 2(r+0.5)/S-1; +X (1,-t,-s), -X (-1,-t,s), "
+                                                        "+Y (s,1,t), -Y (s,-1,-t), +Z (s,-t,1), -Z (-s,-t,-1)")}})});
+  std::string name = fs::path(a.mesh).stem().string();
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+  const std::string dir = "/fiv/occluders/" + (name.empty() ? std::string("occluder") : name);
+  const uint64_t nr = sh.radii.size();
+  file.datasets.push_back(
+      {dir + "/shells", {nr, uint64_t(a.n_theta), uint64_t(a.n_phi), 3, 3}, sh.shells,
+       with(env_attrs, {{"integrand", std::string("F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]")},
+                        {"centre", std::vector<double>{sh.centre.x(), sh.centre.y(), sh.centre.z()}},
+                        {"radius", sh.radius},
+                        {"radii", sh.radii},
+                        {"angular_convention", std::string("s = centre + rho_k d(theta_i, phi_j), theta_i = pi i/(Ntheta-1) "
+                                                           "from +Y, phi_j = 2 pi j/Nphi from +Z towards +X, d = (sin "
+                                                           "theta sin phi, cos theta, sin theta cos phi)")},
+                        {"fraction", a.fraction},
+                        {"samples", int64_t(a.samples)}})});
+  file.datasets.push_back({dir + "/valid", {nr, uint64_t(a.n_theta), uint64_t(a.n_phi)}, sh.valid,
+                           {{"meaning", std::string("0: the offset lies inside the occluder (nothing visible)")}}});
+  F::write_file(a.output, file);
+  if (say) {
+    std::error_code ec;
+    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
+  }
+  return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
   try {
     const Args a = parse(argc, argv);
-    return run_vertex(a);
+    return a.command == "fiv" ? run_fiv(a) : run_vertex(a);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "prtbake: %s\n", e.what());
     return 2;

@@ -43,7 +43,7 @@ using Fiv = std::array<double, 9>;  // [RGB][xyz]
 Fiv environment_fiv(const EnvMap& env);
 
 // DifMap: [6][S][S][3] float, E_tot(n) per texel direction (see the header comment); texels cut by
-// the horizon of n are integrated with 8×8 sub-samples, the rest with their exact ∫_texel ω dω.
+// the horizon of n are integrated with 4×4 sub-samples, the rest with their exact ∫_texel ω dω.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
 Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
 
