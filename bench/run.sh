@@ -31,7 +31,7 @@ cd "$root"
 bindir="${PRT_BENCH_BUILD_DIR:-$root/build/release}"  # override to run another build tree
 if ((build)); then
   cmake --preset release >/dev/null
-  cmake --build --preset release --target bench_integrators bench_error_vs_time bench_agreement
+  cmake --build --preset release --target bench_integrators bench_error_vs_time bench_agreement bench_fiv
 fi
 if ((quick)); then
   export PRT_BENCH_POINTS="${PRT_BENCH_POINTS:-16}"
@@ -64,6 +64,15 @@ if [[ -x "$bindir/bench/bench_agreement" ]]; then
     PRT_AGREE_POINTS=8 PRT_AGREE_RAYS=100000 "$bindir/bench/bench_agreement" >"$tmp/agreement.md"
   else
     "$bindir/bench/bench_agreement" >"$tmp/agreement.md"
+  fi
+fi
+cmd4="${bindir#$root/}/bench/bench_fiv"
+if [[ -x "$bindir/bench/bench_fiv" ]]; then
+  echo "+ $cmd4" >&2
+  if ((quick)); then
+    PRT_FIV_SIZES=32x17x15 PRT_FIV_POINTS=8 PRT_FIV_RAYS=100000 "$bindir/bench/bench_fiv" >"$tmp/fiv.md"
+  else
+    "$bindir/bench/bench_fiv" >"$tmp/fiv.md"
   fi
 fi
 load_end="$(cut -d' ' -f1-3 /proc/loadavg)"
@@ -144,6 +153,14 @@ PY
     echo "\`$cmd3\`"
     echo
     cat "$tmp/agreement.md"
+  fi
+  if [[ -f "$tmp/fiv.md" ]]; then
+    echo
+    echo "## bench_fiv"
+    echo
+    echo "\`$cmd4\`"
+    echo
+    cat "$tmp/fiv.md"
   fi
 } >"$out"
 echo "wrote $out" >&2
