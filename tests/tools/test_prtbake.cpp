@@ -254,6 +254,11 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   EXPECT_EQ(sh->shape[2], 8u);
   EXPECT_NE(F::find_dataset(f, "/fiv/occluders/spider/valid"), nullptr);
   EXPECT_EQ(F::find_dataset(f, "/mesh/positions"), nullptr) << "no per-vertex data was asked for";
+  const F::Dataset* rep = F::find_dataset(f, "/report/fiv/spider");
+  ASSERT_NE(rep, nullptr) << "every bake reports its error (--report defaults to 32)";
+  const auto& rv = std::get<std::vector<float>>(rep->data);
+  // k = 32² against 65,536 QMC rays at 32 shell samples: the gap is a small fraction of |F_env|.
+  EXPECT_LT(rv[0], 0.05f * rv[2]);
   for (float x : std::get<std::vector<float>>(F::find_dataset(f, "/fiv/irradiance_cube")->data)) EXPECT_GT(x, 0.0f);
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " -o " + out.string()).code, 2) << "no --env";
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);
