@@ -1,5 +1,6 @@
 #include <bake/error.h>
 #include <bake/fiv.h>
+#include <bake/qmc.h>
 
 #include <tbb/parallel_for.h>
 
@@ -167,6 +168,27 @@ Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& positio
   if (inside) *inside = vis[L.visibility] == 0.0;
   Fiv f{};
   omega_from_band1(occ, f.data());
+  return f;
+}
+
+Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, const Vector3d& position,
+                     uint64_t point_index, Fiv* std_error) {
+  const ProductLayout& L = integrator.layout();
+  PRT_CHECK(L.radiance_count == 9);
+  std::vector<double> v(L.width), se(L.width);
+  ShadePoint sp;
+  sp.p = position;
+  sp.hemisphere = false;
+  integrator.integrate(sp, point_index, v, se);
+  Fiv vis{}, f{};
+  omega_from_band1(v.data() + L.radiance, vis.data());
+  for (int k = 0; k < 9; ++k) f[size_t(k)] = environment[size_t(k)] - vis[size_t(k)];
+  if (std_error) {
+    double s[9];
+    for (int k = 0; k < 9; ++k) s[k] = se[L.radiance + size_t(k)];
+    omega_from_band1(s, std_error->data());
+    for (double& x : *std_error) x = std::abs(x);
+  }
   return f;
 }
 

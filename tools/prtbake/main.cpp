@@ -570,21 +570,14 @@ int run_fiv(const Args& a) {
     tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
       const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
       const int i = int(ij / size_t(a.n_phi)), j = int(ij % size_t(a.n_phi));
-      bake::ShadePoint sp;
-      sp.p = sh.centre + sh.radii[k] * bake::shell_direction(i, a.n_theta, j, a.n_phi);
-      sp.hemisphere = false;
-      std::vector<double> v(10), se(10);
-      qmc.integrate(sp, idx, v, se);
-      constexpr double kk = 0.48860251190291992159;  // √(3/4π): ω from the band-1 rows
-      for (int c = 0; c < 3; ++c) {
-        const double vis[3] = {-v[1 + size_t(3 * c + 2)] / kk, -v[1 + size_t(3 * c)] / kk, v[1 + size_t(3 * c + 1)] / kk};
-        const double s3[3] = {se[1 + size_t(3 * c + 2)] / kk, se[1 + size_t(3 * c)] / kk, se[1 + size_t(3 * c + 1)] / kk};
-        for (int x = 0; x < 3; ++x) {
-          const double d = double(sh.shells[idx * 9 + size_t(3 * c + x)]) - (fenv[size_t(3 * c + x)] - vis[x]);
-          err2[q] += d * d;
-          se2[q] += s3[x] * s3[x];
-          maxe[q] = std::max(maxe[q], std::abs(d));
-        }
+      bake::Fiv se;
+      const bake::Fiv ref = bake::qmc_occluded_fiv(
+          qmc, fenv, sh.centre + sh.radii[k] * bake::shell_direction(i, a.n_theta, j, a.n_phi), idx, &se);
+      for (int x = 0; x < 9; ++x) {
+        const double d = double(sh.shells[idx * 9 + size_t(x)]) - ref[size_t(x)];
+        err2[q] += d * d;
+        se2[q] += se[size_t(x)] * se[size_t(x)];
+        maxe[q] = std::max(maxe[q], std::abs(d));
       }
     });
     const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();

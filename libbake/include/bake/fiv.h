@@ -79,4 +79,11 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
 // direction is visible.
 Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr);
 
+// The same quantity from the QMC reference (an integrator built for {radiance = &env, visibility
+// order 1}) in full-sphere mode: F = F^env − ∫ V L ω dω with F^env = environment_fiv(env).
+// `std_error` (optional) receives the standard error of each component.
+class QmcIntegrator;
+Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, const Eigen::Vector3d& position,
+                     uint64_t point_index, Fiv* std_error = nullptr);
+
 } // namespace prt::bake
