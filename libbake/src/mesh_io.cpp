@@ -22,19 +22,7 @@
 #include <bake/error.h>
 #include <bake/mesh.h>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Woverloaded-virtual"
-#pragma GCC diagnostic ignored "-Wnull-dereference"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wcast-align"
-#pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-#include <OpenMesh/Core/IO/IOManager.hh>
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
-#include <OpenMesh/Core/System/omstream.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.h"
 
 #include <algorithm>
 #include <bit>

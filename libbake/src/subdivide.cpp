@@ -2,17 +2,7 @@
 #include <bake/error.h>
 #include <bake/subdivide.h>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Woverloaded-virtual"
-#pragma GCC diagnostic ignored "-Wnull-dereference"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wcast-align"
-#pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
-#pragma GCC diagnostic pop
+#include "openmesh.h"
 
 #include <algorithm>
 #include <cmath>

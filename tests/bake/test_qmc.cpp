@@ -66,13 +66,13 @@ TEST(Qmc, UnoccludedVertexClosedForms) {
   qmc.integrate(vertex_shade_point(m, topo, grid_centre(2)), 0, v, se);
   // Closed forms: T_0 = 0.282095 = 1/(2√π), T_2 = 0.325735 = 1/√(3π)... (∫H cos y_10 / π = √3/(3√π)),
   // T_6 = 0.157696 = √5/(8√π); the other T_i = 0; AO = 1; U_0 = √π; U_i = 0 for m ≠ 0.
-  const double T0 = 1 / (2 * std::sqrt(pi)), T2 = std::sqrt(3.0) / (3 * std::sqrt(pi)), T6 = std::sqrt(5.0) / (8 * std::sqrt(pi));
-  EXPECT_NEAR(T0, 0.282095, 5e-7);
-  EXPECT_NEAR(T2, 0.325735, 5e-7);
-  EXPECT_NEAR(T6, 0.157696, 5e-7);
+  // The closed forms agree with the 6-digit values.
+  EXPECT_NEAR(prt::testing::unoccluded_transfer_z(0), 0.282095, 5e-7);
+  EXPECT_NEAR(prt::testing::unoccluded_transfer_z(2), 0.325735, 5e-7);
+  EXPECT_NEAR(prt::testing::unoccluded_transfer_z(6), 0.157696, 5e-7);
   EXPECT_NEAR(v[L.ao], 1.0, kZ * se[L.ao] + 1e-12);
   for (int i = 0; i < 9; ++i) {
-    const double exact = i == 0 ? T0 : i == 2 ? T2 : i == 6 ? T6 : 0.0;
+    const double exact = prt::testing::unoccluded_transfer_z(i);
     EXPECT_NEAR(v[L.transfer + i], exact, kZ * se[L.transfer + i] + 1e-12) << "T_" << i;
   }
   EXPECT_NEAR(v[L.visibility + 0], std::sqrt(pi), kZ * se[L.visibility] + 1e-12);
@@ -84,7 +84,7 @@ TEST(Qmc, UnoccludedVertexClosedForms) {
   std::vector<double> v2(2);
   q2.integrate(vertex_shade_point(m, topo, grid_centre(2)), 0, v2);
   EXPECT_NEAR(v2[0], 1.0, 1e-12);
-  EXPECT_NEAR(v2[1], T0, 1e-12);
+  EXPECT_NEAR(v2[1], prt::testing::unoccluded_transfer_z(0), 1e-12);
 }
 
 TEST(Qmc, WhiteFurnaceBand1IrradianceIsPi) {

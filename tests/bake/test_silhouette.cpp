@@ -76,10 +76,9 @@ TEST(Silhouette, UnoccludedVertexClosedForms) {
   SilhouetteIntegrator sil(m, topo, req, {256, 1});
   const auto& L = sil.layout();
   const Row r = integrate(sil, vertex_shade_point(m, topo, grid_centre(2)));
-  const double T0 = 1 / (2 * std::sqrt(pi)), T2 = std::sqrt(3.0) / (3 * std::sqrt(pi)), T6 = std::sqrt(5.0) / (8 * std::sqrt(pi));
   EXPECT_NEAR(r[L.ao], 1.0, kAnalyticTol);
   for (int i = 0; i < 9; ++i) {
-    const double exact = i == 0 ? T0 : i == 2 ? T2 : i == 6 ? T6 : 0.0;
+    const double exact = prt::testing::unoccluded_transfer_z(i);
     EXPECT_NEAR(r[L.transfer + size_t(i)], exact, kAnalyticTol) << "T_" << i;
   }
   EXPECT_NEAR(r[L.visibility], std::sqrt(pi), kAnalyticTol);

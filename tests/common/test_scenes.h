@@ -40,4 +40,12 @@ inline double polygon_form_factor(const Eigen::Vector3d& p, const Eigen::Vector3
   return std::abs(f) / (2 * std::numbers::pi);
 }
 
+// Closed forms for an unoccluded shade point with n = +z (order-3 SH, index l(l+1)+m):
+// diffuse transfer T_0 = 1/(2√π) = 0.282095, T_2 = √3/(3√π) = 0.325735, T_6 = √5/(8√π) = 0.157696,
+// every other T_i = 0; visibility transfer U_0 = √π; AO = 1.
+inline double unoccluded_transfer_z(int i) {
+  const double rpi = std::sqrt(std::numbers::pi);
+  return i == 0 ? 1 / (2 * rpi) : i == 2 ? std::sqrt(3.0) / (3 * rpi) : i == 6 ? std::sqrt(5.0) / (8 * rpi) : 0.0;
+}
+
 } // namespace prt::testing
