@@ -86,6 +86,7 @@ struct SilhouetteIntegrator::Impl {
   std::vector<uint8_t> hot_mask;  // per texel
   size_t hot_texels = 0;
   std::unique_ptr<SparseIsolineTables> hot;
+  std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0};
   mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
@@ -182,6 +183,26 @@ struct SilhouetteIntegrator::Impl {
           },
           hot_samples);
     }
+    unoccluded_row = unoccluded_totals();
+  }
+
+  // Σ_i h · (loop total of isoline i) over both grids, mapped to the layout (visibility and
+  // radiance rows; the n-dependent AO/transfer rows stay 0).
+  std::vector<double> unoccluded_totals() const {
+    std::vector<double> acc(F, 0.0), row(layout.width, 0.0);
+    for (int i = 0; i < grid.n; ++i) {
+      const double* total = tables->loop_total(i);
+      for (size_t c = 0; c < F; ++c) acc[c] += total[c] * grid.h;
+    }
+    if (hot)
+      for (int i = hot->first_isoline(); i < hot->last_isoline(); ++i)
+        if (hot->has(i)) {
+          const double* total = hot->loop_total(i);
+          for (size_t c = 0; c < 9; ++c) acc[c_r + c] += total[c] * hot->grid().h;
+        }
+    for (size_t k = 0; k < layout.visibility_count; ++k) row[layout.visibility + k] = acc[c_u + k];
+    for (size_t k = 0; k < layout.radiance_count; ++k) row[layout.radiance + k] = acc[c_r + k];
+    return row;
   }
 
   static int even_isolines(int n) {
@@ -437,23 +458,8 @@ void SilhouetteIntegrator::integrate(const ShadePoint& point, uint64_t point_ind
 }
 
 void SilhouetteIntegrator::unoccluded(std::span<double> out) const {
-  const Impl& m = *impl_;
-  PRT_CHECK_OP(out.size(), >=, m.layout.width);
-  std::vector<double> acc(m.F, 0.0), hot(9, 0.0);
-  for (int i = 0; i < m.grid.n; ++i) {
-    const double* total = m.tables->loop_total(i);
-    for (size_t c = 0; c < m.F; ++c) acc[c] += total[c] * m.grid.h;
-  }
-  if (m.hot)
-    for (int i = m.hot->first_isoline(); i < m.hot->last_isoline(); ++i)
-      if (m.hot->has(i)) {
-        const double* total = m.hot->loop_total(i);
-        for (size_t c = 0; c < 9; ++c) acc[m.c_r + c] += total[c] * m.hot->grid().h;
-      }
-  const ProductLayout& L = m.layout;
-  std::fill(out.begin(), out.begin() + std::ptrdiff_t(L.width), 0.0);
-  for (size_t k = 0; k < L.visibility_count; ++k) out[L.visibility + k] = acc[m.c_u + k];
-  for (size_t k = 0; k < L.radiance_count; ++k) out[L.radiance + k] = acc[m.c_r + k];
+  PRT_CHECK_OP(out.size(), >=, impl_->layout.width);
+  std::copy(impl_->unoccluded_row.begin(), impl_->unoccluded_row.end(), out.begin());
 }
 
 SilhouetteStats SilhouetteIntegrator::stats() const {
