@@ -10,7 +10,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev hdf5-tools
-          libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py)
+          libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py
+          glslc libvulkan-dev mesa-vulkan-drivers)
 JOBS=${JOBS:-$(nproc)}
 
 install_deps() {
