@@ -1,4 +1,4 @@
-// schema.cpp — schema v1 (formats/SCHEMA.md) as code: validate() is the single check that the
+// schema.cpp — schema v2 (formats/SCHEMA.md) as code: validate() is the single check that the
 // writer applies before writing and the reader applies after reading.
 #include <formats/prtfile.h>
 
@@ -129,8 +129,8 @@ public:
     }
     if (const Attr* v = find_attr(list, "format_version")) {
       const auto* i = std::get_if<int64_t>(&v->value);
-      if (i == nullptr || *i != kFormatVersion)
-        fail("root attribute 'format_version' must be the integer " +
+      if (i == nullptr || *i < 1 || *i > kFormatVersion)
+        fail("root attribute 'format_version' must be an integer in 1.." +
              std::to_string(kFormatVersion));
     }
     for (std::string_view name : kRequiredRootStrings) {
@@ -146,8 +146,17 @@ public:
     if (!hex) fail("root attribute 'source_sha256' must be 64 lowercase hex digits");
   }
 
-  static Kind classify(const std::vector<std::string_view>& p) {
+  // The kind of a dataset path; `prefix` receives the vertex set it belongs to: "" for the
+  // root layout (one mesh per file), "/objects/<name>" for an object of a scene file (v2).
+  static Kind classify(std::vector<std::string_view> p, std::string* prefix = nullptr) {
+    if (prefix) prefix->clear();
     if (p[0] == "report") return p.size() >= 2 ? Kind::report : Kind::unknown;
+    const bool object = p[0] == "objects";
+    if (object) {
+      if (p.size() < 3) return Kind::unknown;
+      if (prefix) *prefix = "/objects/" + std::string(p[1]);
+      p.erase(p.begin(), p.begin() + 2);
+    }
     if (p.size() == 1 && p[0] == "ao") return Kind::ao;
     if (p.size() == 2 && p[0] == "mesh") {
       if (p[1] == "positions") return Kind::positions;
@@ -158,6 +167,7 @@ public:
     if (p.size() == 2 && p[0] == "transfer" && (p[1] == "diffuse" || p[1] == "visibility"))
       return Kind::transfer;
     if (p.size() == 2 && p[0] == "radiance" && p[1] == "band1") return Kind::band1;
+    if (object) return Kind::unknown;
     if (p.size() == 2 && p[0] == "fiv" && p[1] == "environment") return Kind::fiv_environment;
     if (p.size() == 2 && p[0] == "fiv" && p[1] == "irradiance_cube") return Kind::fiv_cube;
     if (p.size() == 4 && p[0] == "fiv" && p[1] == "occluders") {
@@ -186,9 +196,21 @@ public:
 } // namespace
 
 bool is_per_vertex_path(std::string_view path) {
-  return path == "/mesh/positions" || path == "/mesh/normals" || path == "/mesh/source_position" ||
-         path == "/ao" || path == "/transfer/diffuse" || path == "/transfer/visibility" ||
-         path == "/radiance/band1";
+  if (path.size() < 2 || path[0] != '/') return false;
+  std::string prefix;
+  switch (Checker::classify(split_path(path), &prefix)) {
+  case Kind::positions: case Kind::normals: case Kind::source_position: case Kind::ao:
+  case Kind::transfer: case Kind::band1:
+    return true;
+  default:
+    return false;
+  }
+}
+
+std::string vertex_set_of(std::string_view path) {
+  std::string prefix;
+  if (path.size() >= 2 && path[0] == '/') (void)Checker::classify(split_path(path), &prefix);
+  return prefix;
 }
 
 void validate(const File& file, const std::filesystem::path& file_for_messages) {
@@ -198,6 +220,10 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   // Paths: absolute, well-formed, unique, known, and no dataset lies under another dataset.
   std::set<std::string_view> paths;
   std::vector<Kind> kinds;
+  std::vector<std::string> prefixes;  // vertex set of each dataset ("" or "/objects/<name>")
+  int64_t version = kFormatVersion;
+  if (const Attr* v = find_attr(file.root_attrs, "format_version"))
+    if (const auto* i = std::get_if<int64_t>(&v->value)) version = *i;
   for (const Dataset& d : file.datasets) {
     if (d.path.size() < 2 || d.path[0] != '/' || d.path.back() == '/')
       c.fail("dataset path '" + d.path + "' must be absolute, like \"/mesh/positions\"");
@@ -206,13 +232,19 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       if (!valid_component(part))
         c.fail("dataset path '" + d.path + "' has an invalid component '" + std::string(part) + "'");
     if (!paths.insert(d.path).second) c.fail("dataset '" + d.path + "' is given twice");
-    const Kind k = Checker::classify(parts);
+    std::string prefix;
+    const Kind k = Checker::classify(parts, &prefix);
     if (k == Kind::unknown)
       c.fail("unknown dataset path '" + d.path +
-             "' (schema v1 allows /mesh/{positions,normals,triangles,source_position}, /ao, "
-             "/transfer/{diffuse,visibility}, /radiance/band1, /fiv/{environment,irradiance_cube}, "
-             "/fiv/occluders/<name>/{shells,valid} and anything under /report/)");
+             "' (schema v2 allows /mesh/{positions,normals,triangles,source_position}, /ao, "
+             "/transfer/{diffuse,visibility}, /radiance/band1, the same under /objects/<name>/, "
+             "/fiv/{environment,irradiance_cube}, /fiv/occluders/<name>/{shells,valid} and anything "
+             "under /report/)");
+    if (!prefix.empty() && version < 2)
+      c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
+             std::to_string(version) + ")");
     kinds.push_back(k);
+    prefixes.push_back(std::move(prefix));
   }
   for (const Dataset& d : file.datasets)
     for (std::size_t slash = d.path.find('/', 1); slash != std::string::npos;
@@ -243,16 +275,31 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     c.attrs(d.attrs, "dataset '" + d.path + "'");
   }
 
-  // Schema rules per known dataset.
-  const Dataset* positions = find_dataset(file, "/mesh/positions");
-  const uint64_t V = positions ? positions->shape.at(0) : 0;
-  const bool has_normals = find_dataset(file, "/mesh/normals") != nullptr;
+  // Schema rules per known dataset. Each vertex set (the root layout, or one scene object under
+  // /objects/<name>) has its own V = rows of its mesh/positions.
+  struct VertexSet {
+    const Dataset* positions = nullptr;
+    uint64_t V = 0;
+    bool has_normals = false;
+  };
+  auto vertex_set = [&](const std::string& prefix) {
+    VertexSet v;
+    v.positions = find_dataset(file, prefix + "/mesh/positions");
+    v.V = v.positions && !v.positions->shape.empty() ? v.positions->shape[0] : 0;
+    v.has_normals = find_dataset(file, prefix + "/mesh/normals") != nullptr;
+    return v;
+  };
   std::map<std::string, const Dataset*> shells;  // occluder dir -> shells
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];
     const Kind k = kinds[i];
+    const std::string& prefix = prefixes[i];
+    const VertexSet vs = vertex_set(prefix);
+    const Dataset* positions = vs.positions;
+    const uint64_t V = vs.V;
+    const std::string mesh_positions = prefix + "/mesh/positions";
     if (is_per_vertex_path(d.path) && positions == nullptr)
-      c.fail("dataset '" + d.path + "' is per-vertex but the file has no /mesh/positions to " +
+      c.fail("dataset '" + d.path + "' is per-vertex but the file has no " + mesh_positions + " to " +
              "define the vertex count V");
     switch (k) {
     case Kind::positions:
@@ -262,14 +309,14 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       break;
     case Kind::triangles: {
       if (positions == nullptr)
-        c.fail("dataset '/mesh/triangles' needs /mesh/positions (its indices refer to it)");
+        c.fail("dataset '" + d.path + "' needs " + mesh_positions + " (its indices refer to it)");
       c.dtype(d, 1);
       if (d.shape.size() != 2 || d.shape[1] != 3)
-        c.fail("dataset '/mesh/triangles' has shape " + shape_str(d.shape) + "; expected [T, 3]");
+        c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [T, 3]");
       const auto& idx = std::get<std::vector<uint32_t>>(d.data);
       for (std::size_t j = 0; j < idx.size(); ++j)
         if (idx[j] >= V)
-          c.fail("dataset '/mesh/triangles' has vertex index " + std::to_string(idx[j]) +
+          c.fail("dataset '" + d.path + "' has vertex index " + std::to_string(idx[j]) +
                  " >= V = " + std::to_string(V) + " at index " + std::to_string(j) + " " +
                  index_str(j, d.shape));
       break;
@@ -355,9 +402,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i)
     if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer || kinds[i] == Kind::band1) &&
-        !has_normals)
-      c.fail("dataset '" + file.datasets[i].path +
-             "' needs /mesh/normals (the normals the bake used)");
+        !vertex_set(prefixes[i]).has_normals)
+      c.fail("dataset '" + file.datasets[i].path + "' needs " + prefixes[i] +
+             "/mesh/normals (the normals the bake used)");
 
   // Group attributes: only on schema groups (or anything under /report), each group once.
   std::set<std::string_view> groups;
@@ -369,12 +416,19 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     for (std::string_view part : parts)
       if (!valid_component(part))
         c.fail("group path '" + g + "' has an invalid component '" + std::string(part) + "'");
-    const bool ok = g == "/mesh" || g == "/transfer" || g == "/radiance" || g == "/fiv" ||
+    auto product_group = [](std::string_view x) { return x == "mesh" || x == "transfer" || x == "radiance"; };
+    const bool ok = (parts.size() == 1 && (product_group(parts[0]) || parts[0] == "fiv" || parts[0] == "scene" ||
+                                           parts[0] == "objects")) ||
                     g == "/fiv/occluders" || (parts.size() == 3 && g.starts_with("/fiv/occluders/")) ||
+                    (parts[0] == "objects" && parts.size() == 2) ||
+                    (parts[0] == "objects" && parts.size() == 3 && product_group(parts[2])) ||
                     parts[0] == "report";
     if (!ok)
-      c.fail("attributes on group '" + g + "' are not allowed (schema v1 allows them on /mesh, "
-             "/transfer, /radiance, /fiv, /fiv/occluders, /fiv/occluders/<name> and /report...)");
+      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on /mesh, "
+             "/transfer, /radiance, /scene, /objects, /objects/<name>[/mesh|/transfer|/radiance], /fiv, "
+             "/fiv/occluders, /fiv/occluders/<name> and /report...)");
+    if (parts[0] == "objects" && version < 2)
+      c.fail("group '" + g + "' is a scene object's, which needs format_version 2");
     if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");
     if (paths.count(g)) c.fail("group '" + g + "' is also a dataset path");
     for (std::size_t slash = g.find('/', 1); slash != std::string::npos;

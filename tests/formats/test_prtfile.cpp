@@ -275,8 +275,33 @@ INSTANTIATE_TEST_SUITE_P(
                "'up_axis' must be \"y\" or \"z\""},
         Defect{"bad_sha", [](File& f) { drop_root(f, "source_sha256"); f.root_attrs.push_back({"source_sha256", std::string("abc")}); },
                "'source_sha256' must be 64 lowercase hex digits"},
-        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{2}}); },
-               "'format_version' must be the integer 1"},
+        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{3}}); },
+               "'format_version' must be an integer in 1..2"},
+        Defect{"object_in_v1_file",
+               [](File& f) {
+                 f.root_attrs.push_back({"format_version", int64_t{1}});
+                 f.datasets.push_back({"/objects/a/mesh/positions", {1, 3}, std::vector<float>{0, 0, 0}, {}});
+               },
+               "is a scene object's, which needs format_version 2"},
+        Defect{"object_ao_without_its_positions",
+               [](File& f) { f.datasets.push_back({"/objects/a/ao", {1}, std::vector<float>{1}, {}}); },
+               "no /objects/a/mesh/positions to define the vertex count V"},
+        Defect{"object_ao_wrong_length",
+               [](File& f) {
+                 f.datasets.push_back({"/objects/a/mesh/positions", {2, 3}, std::vector<float>(6, 0.f), {}});
+                 f.datasets.push_back({"/objects/a/mesh/normals", {2, 3}, std::vector<float>(6, 0.f), {}});
+                 f.datasets.push_back({"/objects/a/ao", {3}, std::vector<float>{1, 1, 1}, {}});
+               },
+               "dataset '/objects/a/ao' has shape [3]; expected [V] = [2]"},
+        Defect{"object_triangles_out_of_range",
+               [](File& f) {
+                 f.datasets.push_back({"/objects/a/mesh/positions", {2, 3}, std::vector<float>(6, 0.f), {}});
+                 f.datasets.push_back({"/objects/a/mesh/triangles", {1, 3}, std::vector<uint32_t>{0, 1, 2}, {}});
+               },
+               "dataset '/objects/a/mesh/triangles' has vertex index 2 >= V = 2"},
+        Defect{"object_unknown_product",
+               [](File& f) { f.datasets.push_back({"/objects/a/fiv/environment", {3, 3}, std::vector<float>(9, 0.f), {}}); },
+               "unknown dataset path '/objects/a/fiv/environment'"},
         Defect{"duplicate_attr", [](File& f) { f.root_attrs.push_back(f.root_attrs[0]); },
                "has attribute 'generator' twice"},
         Defect{"bad_utf8", [](File& f) { f.root_attrs[0].value = std::string("\xff\xfe"); },
@@ -424,9 +449,50 @@ TEST(Reader, NewerVersionIsRejectedClearly) {
   const fs::path dir = scratch("newer");
   File f = make_file();
   f.root_attrs.push_back({"format", std::string("prtbake")});
-  f.root_attrs.push_back({"format_version", int64_t{2}});
-  prt::formats::testing::write_file_unvalidated(dir / "v2.prt.h5", f);
-  expect_read_error(dir / "v2.prt.h5", "written by a newer prtbake (format_version 2 > 1)");
+  f.root_attrs.push_back({"format_version", int64_t{3}});
+  prt::formats::testing::write_file_unvalidated(dir / "v3.prt.h5", f);
+  expect_read_error(dir / "v3.prt.h5", "written by a newer prtbake (format_version 3 > 2)");
+}
+
+TEST(Reader, Version1FilesStayReadable) {
+  // Schema v2 only added the /objects/<name>/ layout of scene files; v1 files read unchanged.
+  const fs::path dir = scratch("v1");
+  File f = make_file();
+  f.root_attrs.push_back({"format", std::string("prtbake")});
+  f.root_attrs.push_back({"format_version", int64_t{1}});
+  prt::formats::testing::write_file_unvalidated(dir / "v1.prt.h5", f);
+  const File r = read_file(dir / "v1.prt.h5");
+  EXPECT_EQ(std::get<int64_t>(find_attr(r.root_attrs, "format_version")->value), 1);
+  EXPECT_EQ(r.datasets.size(), f.datasets.size());
+}
+
+TEST(Schema, SceneObjectsHaveTheirOwnVertexSets) {
+  // Two objects with different V, each validated against its own mesh/positions; group attributes
+  // on the object groups; round trip keeps them.
+  const fs::path dir = scratch("objects");
+  File f = make_file();
+  auto add_object = [&](const std::string& name, uint64_t V) {
+    const std::string o = "/objects/" + name;
+    f.datasets.push_back({o + "/mesh/positions", {V, 3}, std::vector<float>(3 * V, 0.5f), {}});
+    f.datasets.push_back({o + "/mesh/normals", {V, 3}, std::vector<float>(3 * V, 0.f), {}});
+    f.datasets.push_back({o + "/ao", {V}, std::vector<float>(V, 1.f), {}});
+    f.datasets.push_back({o + "/transfer/visibility", {V, 4}, std::vector<float>(4 * V, 0.25f),
+                          {{"sh_order", int64_t{2}}}});
+    f.group_attrs.push_back({o, {{"role", std::string("both")}}});
+  };
+  add_object("ground", 5);
+  add_object("bunny", 2);
+  write_file(dir / "scene.prt.h5", f);
+  const File r = read_file(dir / "scene.prt.h5");
+  ASSERT_NE(find_dataset(r, "/objects/ground/ao"), nullptr);
+  EXPECT_EQ(find_dataset(r, "/objects/ground/ao")->shape, (std::vector<uint64_t>{5}));
+  EXPECT_EQ(find_dataset(r, "/objects/bunny/ao")->shape, (std::vector<uint64_t>{2}));
+  ASSERT_NE(find_group_attrs(r, "/objects/bunny"), nullptr);
+  EXPECT_EQ(std::get<std::string>(find_attr(*find_group_attrs(r, "/objects/bunny"), "role")->value), "both");
+  EXPECT_TRUE(is_per_vertex_path("/objects/bunny/radiance/band1"));
+  EXPECT_FALSE(is_per_vertex_path("/objects/bunny/mesh/triangles"));
+  EXPECT_EQ(vertex_set_of("/objects/bunny/ao"), "/objects/bunny");
+  EXPECT_EQ(vertex_set_of("/ao"), "");
 }
 
 TEST(Reader, NonPrtbakeHdf5FileIsRejected) {
@@ -488,7 +554,7 @@ TEST(Interop, H5pyReadsValuesAndAttributes) {
       "a = f.attrs\n"
       "s = lambda v: v.decode('utf-8')  # fixed-length strings come back as bytes\n"
       "assert s(a['format']) == 'prtbake', a['format']\n"
-      "assert int(a['format_version']) == 1\n"
+      "assert int(a['format_version']) == 2\n"
       "assert s(a['source']) == 'data/D\\u00fcsseldorf \\u2713.obj', a['source']\n"
       "assert f['ao'][2] == 0.75\n"
       "assert f['mesh/triangles'][1, 2] == 3 and f['mesh/triangles'].dtype == 'uint32'\n"

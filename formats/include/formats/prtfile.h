@@ -13,7 +13,7 @@
 //   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
 //
 // Writer contract (write_file)
-//   * Validates the whole File against schema v1 (validate()) before touching the disk.
+//   * Validates the whole File against schema v2 (validate()) before touching the disk.
 //   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
 //     other required root attribute (generator, created, command_line, source, source_sha256,
 //     up_axis, sh_convention).
@@ -50,7 +50,7 @@
 namespace prt::formats {
 
 // Schema version written by this library and the newest one it reads (policy: SCHEMA.md).
-inline constexpr int kFormatVersion = 1;
+inline constexpr int kFormatVersion = 2;
 // Value of the root attribute "format".
 inline constexpr std::string_view kFormatName = "prtbake";
 
@@ -97,16 +97,16 @@ private:
 void write_file(const std::filesystem::path& final_path, const File& file);
 
 enum class ReadCheck {
-  full,    // format, format_version and the whole schema v1 (validate())
+  full,    // format, format_version and the whole schema v2 (validate())
   header,  // format and format_version only: for inspectors (prtdump) that show what is wrong
 };
 
 // Reads the whole file at `path` (see the reader contract above). Throws FormatError.
 File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::full);
 
-// Checks `file` against schema v1 exactly as write_file does; messages name `file_for_messages`.
+// Checks `file` against schema v2 exactly as write_file does; messages name `file_for_messages`.
 // Root "format"/"format_version" may be absent (the writer adds them) but, if present, must be
-// "prtbake" / kFormatVersion. Throws FormatError on the first defect found.
+// "prtbake" / 1..kFormatVersion. Throws FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
 // Lookups; nullptr when absent.
@@ -114,10 +114,14 @@ const Attr* find_attr(const std::vector<Attr>& attrs, std::string_view name);
 const Dataset* find_dataset(const File& file, std::string_view path);
 const std::vector<Attr>* find_group_attrs(const File& file, std::string_view group_path);
 
-// True for the schema's per-vertex datasets (first axis = V = rows of /mesh/positions):
-// /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
-// /transfer/visibility, /radiance/band1. /report datasets are never per-vertex.
+// True for the schema's per-vertex datasets (first axis = V = rows of the vertex set's
+// mesh/positions): /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
+// /transfer/visibility, /radiance/band1, and the same under /objects/<name>/ (schema v2 scene
+// files). /report datasets are never per-vertex.
 bool is_per_vertex_path(std::string_view path);
+// The vertex set a dataset path belongs to: "" for the root layout, "/objects/<name>" for a scene
+// object (its V is the rows of "<set>/mesh/positions").
+std::string vertex_set_of(std::string_view path);
 
 // "float32", "uint32" or "uint8".
 std::string_view dtype_name(const DatasetData& data);
