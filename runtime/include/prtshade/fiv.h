@@ -1,0 +1,136 @@
+// prtshade/fiv.h — run-time shading with Fullsphere Irradiance Vectors (Michael & Chrysanthou,
+// "Fullsphere Irradiance Factorization for Real-Time All-Frequency Illumination for Dynamic
+// Scenes", CGF 2010; paper 004 in ../shared/papers, §4.3 "Run time"): DifMap lookup, trilinear
+// lookup of an occluder's baked FIV shells, the three occluder cases A/B/C with the partial-
+// occluder factor, the overlap correction for several occluders (eq. 13–14) and self-shadows
+// (eq. 12). The contract shared with the C API and the GLSL mirrors is spec/runtime_api.md; the
+// baked data and its conventions are libbake/include/bake/fiv.h and formats/SCHEMA.md.
+//
+// Quantities (per RGB channel c; an FIV is [RGB][xyz] = 9 floats, row-major):
+//   environment FIV  F_c^env = ∫ L_c(ω) ω dω                        (/fiv/environment)
+//   occluded FIV     F_c(s)  = ∫ (1 − V_O(s, ω)) L_c(ω) ω dω         at offset s = p − centre
+//   DifMap           E_tot(n) = ∫ L(ω) H(ω, n) (n·ω) dω              (/fiv/irradiance_cube)
+// A receiver p with normal n shadowed by occluders O_i gets (eq. 11)
+//   E(p, n) = E_tot(n) − Σ_i I_i,   I_i = n · F_i(p − centre_i)   (case A, eq. 10),
+// an unshadowed irradiance minus what each occluder hides. Units: radiance × steradian, like E.
+//
+// Shell grid (bake/fiv.h): sample (k, i, j) sits at centre + ρ_k d(θ_i, φ_j) with
+//   θ_i = π i / (Nθ − 1) from +Y (poles included), φ_j = 2π j / Nφ from +Z towards +X,
+//   d(θ, φ) = (sin θ sin φ, cos θ, sin θ cos φ), radii ρ_k increasing;
+//   shells [Nρ][Nθ][Nφ][RGB][xyz], valid [Nρ][Nθ][Nφ] (0 = inside closed geometry).
+// Lookup (continuous grid coordinates; φ wraps, θ and ρ clamp):
+//   ρ = |s|, d = s/ρ (ρ == 0: d = +Y), θ = acos(d_y), φ = atan2(d_x, d_z) wrapped to [0, 2π),
+//   t = θ/π · (Nθ − 1), u = φ/(2π) · Nφ; ρ < ρ_0 clamps to ρ_0; ρ > ρ_last returns the last
+//   shell's value times (ρ_last/ρ)² (a distant occluder hides a solid angle ∝ 1/ρ²; continuous at
+//   the last shell). Trilinear over the 8 neighbours; neighbours with valid == 0 get weight 0 and
+//   the rest are renormalised (§4.3.2: "samples that fall within the geometry of the object are
+//   not taken into account"); if the valid neighbours carry no weight (in particular all 8
+//   invalid), the plain trilinear value of the stored samples is used.
+//
+// Cube map (DifMap): faces +X, −X, +Y, −Y, +Z, −Z, OpenGL convention; texel (row r, column q) of
+// a size-S face has s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction
+//   +X (1, −t, −s)  −X (−1, −t, s)  +Y (s, 1, t)  −Y (s, −1, −t)  +Z (s, −t, 1)  −Z (−s, −t, −1).
+// A direction selects the face of its largest |component| (ties: X before Y before Z); bilinear
+// inside that face, coordinates clamped to the outermost texel centres (no cross-face filtering).
+//
+// Occluder cases (§4.3.1, Figure 7; R = bounding-sphere radius, h = n·(centre − p), the signed
+// distance of the centre from the receiver's tangent plane):
+//   C  h <= −R   the occluder lies wholly below the horizon: I = 0;
+//   A  h >=  R   wholly above: I = n·F;
+//   B  otherwise partly above: I = (h + R)/(2R) · n·F — the fraction of the occluder above the
+//      plane, "(d + R)/2R" in the paper (after Malmer et al. 2007). (For R == 0, h == 0 is C.)
+//   Per channel, I is clamped to >= 0 (an occluder never adds light).
+// Overlap (eq. 13–14, "Unit Bounding Discs"): occluder i seen from p has axis a_i = (centre_i −
+//   p)/D_i, D_i = |centre_i − p|, angular radius α_i = asin(min(1, R_i/D_i)) (α = π/2 when p is
+//   inside the bounding sphere, then a_i = n if D_i == 0). Each is replaced by a planar disc of
+//   radius α_i; two discs at centre distance γ = ∠(a_i, a_j) overlap in a lens of area A_ij and
+//   O_ij = A_ij / (π α_i² + π α_j²). Pairwise inclusion–exclusion (second-order truncation):
+//     E = E_tot(n) − Σ_i I_i + Σ_{i<j} O_ij (I_i + I_j),   clamped to >= 0 per channel;
+//   pairs where either occluder hides nothing (I = 0 in all channels, e.g. case C) are skipped.
+//   Two identical occluders give O = ½, so I_1 + I_2 − ½(2I) = I, not 2I; disjoint discs give
+//   O = 0. With three or more mutually overlapping occluders the truncation over-corrects
+//   (three identical ones give E_tot − 3I + 3I): the paper's approximation, kept as specified.
+// Self-shadows (§4.3.2, eq. 12): a receiver ON occluder O sees unoccluded light only in its
+//   positive hemisphere, so E = max(0, n·F^env − n·F(p − centre)) per channel.
+//
+// Numerics: inputs and outputs are float; |s| and |centre − p| are formed in double (no overflow
+// for any finite float input), the angles in float. Every output is finite for finite inputs,
+// including p at an occluder's centre, ρ far beyond the last shell, normals of any length
+// (a zero normal gives E_tot(+Y) and I = 0) and NaN offsets (treated as ρ = 0).
+// Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
+// validate_difmap once when the data arrives — the C API and the loader do); they allocate
+// nothing except shade_fiv for more than 128 occluders. Thread-safe (no shared state).
+#pragma once
+
+#include <cstdint>
+
+namespace prt::shade {
+
+// Non-owning view of one baked occluder (/fiv/occluders/<name>): shells [n_rho][n_theta][n_phi]
+// [3 RGB][3 xyz], valid [n_rho][n_theta][n_phi], radii[n_rho] increasing, centre in world space,
+// radius R of the bounding sphere.
+struct FivOccluder {
+  float centre[3];
+  float radius;
+  int n_rho, n_theta, n_phi;
+  const float* radii;
+  const float* shells;
+  const uint8_t* valid;
+};
+
+// The DifMap /fiv/irradiance_cube [6][size][size][3], faces +X,−X,+Y,−Y,+Z,−Z (header comment).
+struct DifMap {
+  int size;
+  const float* texels;
+};
+
+// Throw std::invalid_argument naming the problem unless: pointers non-null; n_rho >= 1,
+// n_theta >= 2, n_phi >= 1 and n_rho·n_theta·n_phi <= 2^26; centre finite; radius finite and > 0;
+// radii finite, > 0 and strictly increasing; every shell value finite. O(size of the shells).
+void validate_occluder(const FivOccluder& occ);
+// size in [1, 2^13], texels non-null and finite. O(6 size²).
+void validate_difmap(const DifMap& map);
+
+// Bilinear lookup of E_tot in the face the direction n selects (any length; zero → +Y).
+void lookup_difmap(const DifMap& map, const float n[3], float out[3]);
+
+// Occluded FIV F(s) [RGB][xyz] at offset s = p − centre (world units), see the header comment.
+void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]);
+
+// Partial-occluder factor (§4.3.1 "Partial Occluders"): h = n·(centre − p); case C (h <= −R): 0;
+// case A (h >= R): 1; case B: (h + R) / (2R). n unit.
+float partial_factor(const FivOccluder& occ, const float p[3], const float n[3]);
+
+// Occluded irradiance of one occluder at (p, n): per channel max(0, factor · n·F_c(p − centre)),
+// factor = partial_factor, or 1 when `partial` is false (case C stays 0).
+void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n[3], bool partial, float out[3]);
+
+struct FivShadeOptions {
+  bool partial_occluders = true;
+  bool overlap_correction = true;
+};
+
+// Irradiance at a receiver point (eq. 11, 13, 14), see the header comment. count >= 0.
+void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n[3],
+               const FivShadeOptions& options, float out[3]);
+
+// Self-shadows (eq. 12): E_c = max(0, n·F^env_c − n·F_c(p − centre)), env_fiv = /fiv/environment.
+void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]);
+
+// --- pieces and references (tests, mirrors) ----------------------------------------------------
+
+// Area of the intersection (lens) of two planar discs of radii r1, r2 >= 0 whose centres are d >= 0
+// apart: 0 when d >= r1 + r2, π min(r1, r2)² when d <= |r1 − r2|, else the closed form
+// r1² acos((d² + r1² − r2²)/(2 d r1)) + r2² acos((d² + r2² − r1²)/(2 d r2)) − ½ √((−d+r1+r2)(d+r1−r2)(d−r1+r2)(d+r1+r2)).
+double lens_area(double r1, double r2, double d);
+
+// O_ij of eq. 14 for discs of angular radii alpha_i, alpha_j at angular distance gamma (0 when
+// both radii are 0).
+double overlap_fraction(double alpha_i, double alpha_j, double gamma);
+
+// shade_fiv written straight from the formulas (double, every pair, γ = acos(clamp(a_i·a_j))): the
+// slow reference the fast path is tested against.
+void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int count, const float p[3],
+                         const float n[3], const FivShadeOptions& options, float out[3]);
+
+} // namespace prt::shade

@@ -1,0 +1,129 @@
+/* prtshade/prtshade.h — the C API of the prtshade run-time library, for engines that are not C++.
+ *
+ * It mirrors the C++ core one to one (spec/runtime_api.md): <prtshade/sh.h> (SH rotation),
+ * <prtshade/shade.h> (lat-long projection, transfer · light, band-1 shading) and
+ * <prtshade/fiv.h> (paper 004 §4.3 FIV shading). Conventions, units, frames and the papers and
+ * equations each function implements are stated in those headers; this one states the C
+ * contract only.
+ *
+ * Contract
+ *   - Every function returns a prt_status (PRT_OK == 0) except the destroy functions, the
+ *     string functions and prt_version. No C++ exception ever crosses this boundary.
+ *   - Null pointers, sizes that do not match (the *_count arguments are the number of floats
+ *     the caller's array holds), out-of-range orders and non-finite or inconsistent baked data
+ *     give PRT_ERROR_INVALID_ARGUMENT; nothing is written to the outputs then.
+ *     prt_last_error() returns a message naming the function and the problem (per thread,
+ *     valid until the next failing call on that thread).
+ *   - Handles are opaque. A prt_fiv_scene COPIES the DifMap, the environment FIV and every
+ *     occluder's arrays, so the caller may free its buffers after the call. A scene may be
+ *     shaded from many threads at once; modifying it (add / set_centre) needs exclusive
+ *     access. A prt_sh_rotation is immutable and may be shared between threads.
+ *   - SH vectors are float, order = NUMBER OF BANDS L (L² coefficients, index l(l+1)+m);
+ *     RGB SH lighting is channel-major [3][L²].
+ */
+#ifndef PRTSHADE_PRTSHADE_H
+#define PRTSHADE_PRTSHADE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum prt_status {
+  PRT_OK = 0,
+  PRT_ERROR_INVALID_ARGUMENT = 1, /* null pointer, bad size or order, non-finite data */
+  PRT_ERROR_OUT_OF_MEMORY = 2,    /* an allocation failed (scene copies, rotation tables) */
+  PRT_ERROR_INTERNAL = 3          /* anything else: a bug, please report */
+} prt_status;
+
+/* Short fixed description of a status ("invalid argument", ...); never NULL. */
+const char* prt_status_string(prt_status status);
+/* Detailed message of the last failing call on this thread ("" if none). */
+const char* prt_last_error(void);
+/* Library version "MAJOR.MINOR.PATCH". */
+const char* prt_version(void);
+
+/* ---- spherical harmonics ----------------------------------------------------------------- */
+
+/* Maximum supported order (number of bands): 64. */
+int prt_sh_max_order(void);
+
+/* SH basis y_0 .. y_{L²−1} at the unit direction (x, y, z); out holds out_count >= order² floats. */
+prt_status prt_sh_eval(int order, float x, float y, float z, float* out, size_t out_count);
+
+typedef struct prt_sh_rotation prt_sh_rotation;
+/* rotation: row-major 3×3 proper rotation R (d ↦ R d); see <prtshade/sh.h>. */
+prt_status prt_sh_rotation_create(const double rotation[9], int order, prt_sh_rotation** out);
+void prt_sh_rotation_destroy(prt_sh_rotation* rotation);
+/* Rotates `channels` consecutive SH vectors of order² floats each (e.g. 3 for RGB lighting):
+ * in and out hold count >= channels·order² floats and must not overlap. */
+prt_status prt_sh_rotation_apply(const prt_sh_rotation* rotation, const float* in, float* out, int channels,
+                                 size_t count);
+
+/* ---- diffuse PRT and band-1 shading (<prtshade/shade.h>) --------------------------------- */
+
+/* SH lighting [3][order²] of a [height][width][3] lat-long image (row 0 = north pole, +Y up). */
+prt_status prt_project_latlong(const float* rgb, int width, int height, int order, float* out, size_t out_count);
+
+/* out[v][c] = Σ_i transfer[v][i] · light[c][i] for vertex_count vertices; transfer holds
+ * vertex_count·order² floats (the /transfer/diffuse rows), light 3·order², out 3·vertex_count. */
+prt_status prt_shade_transfer(const float* transfer, size_t vertex_count, int order, const float* light_rgb,
+                              float* out);
+
+/* E[v][c] = (4π/3) Σ_m y_1m(n_v) R[v][c][m] for vertex_count vertices: normals [V][3],
+ * radiance [V][3][3] (/radiance/band1 rows), out [V][3]. */
+prt_status prt_shade_band1(const float* normals, const float* radiance, size_t vertex_count, float* out);
+
+/* ---- FIV shading (<prtshade/fiv.h>, paper 004 §4.3) -------------------------------------- */
+
+/* One baked occluder, laid out as /fiv/occluders/<name>: shells [n_rho][n_theta][n_phi][3][3],
+ * valid [n_rho][n_theta][n_phi], radii [n_rho]. */
+typedef struct prt_fiv_occluder_desc {
+  float centre[3];
+  float radius;
+  int n_rho, n_theta, n_phi;
+  const float* radii;
+  const float* shells;
+  const uint8_t* valid;
+} prt_fiv_occluder_desc;
+
+typedef struct prt_fiv_options {
+  int partial_occluders;  /* nonzero: the (h + R)/2R factor for case B (default 1) */
+  int overlap_correction; /* nonzero: eq. 13–14 unit-bounding-disc correction (default 1) */
+} prt_fiv_options;
+
+typedef struct prt_fiv_scene prt_fiv_scene;
+
+/* A scene lit by one environment: DifMap cube [6][size][size][3] (/fiv/irradiance_cube) and the
+ * environment FIV [3][3] (/fiv/environment). Copies both. */
+prt_status prt_fiv_scene_create(int difmap_size, const float* difmap_texels, const float environment_fiv[9],
+                                prt_fiv_scene** out);
+void prt_fiv_scene_destroy(prt_fiv_scene* scene);
+/* Copies the occluder's arrays; *out_index (may be NULL) receives its index (0, 1, ...). */
+prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occluder_desc* occluder, int* out_index);
+/* Moves occluder `index` (dynamic scenes: the shells are relative to the centre). */
+prt_status prt_fiv_scene_set_centre(prt_fiv_scene* scene, int index, const float centre[3]);
+prt_status prt_fiv_scene_occluder_count(const prt_fiv_scene* scene, int* out_count);
+
+/* DifMap E_tot(n). */
+prt_status prt_fiv_scene_lookup_difmap(const prt_fiv_scene* scene, const float n[3], float out[3]);
+/* Occluded FIV [3][3] of occluder `index` at offset s = p − centre. */
+prt_status prt_fiv_scene_lookup_fiv(const prt_fiv_scene* scene, int index, const float s[3], float out[9]);
+/* I of occluder `index` at (p, n) (partial: nonzero applies the case-B factor). */
+prt_status prt_fiv_scene_occluded_irradiance(const prt_fiv_scene* scene, int index, const float p[3],
+                                             const float n[3], int partial, float out[3]);
+/* Irradiance at `count` receivers: positions and normals [count][3], out [count][3], all occluders
+ * of the scene; options NULL means both corrections on. */
+prt_status prt_fiv_scene_shade(const prt_fiv_scene* scene, const float* positions, const float* normals,
+                               size_t count, const prt_fiv_options* options, float* out);
+/* Self-shadowed irradiance of `count` receivers lying on occluder `index` (eq. 12). */
+prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const float* positions,
+                                    const float* normals, size_t count, float* out);
+
+#ifdef __cplusplus
+} /* extern "C" */
+#endif
+
+#endif /* PRTSHADE_PRTSHADE_H */

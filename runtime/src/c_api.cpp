@@ -1,0 +1,301 @@
+// c_api.cpp — the C API (prtshade/prtshade.h) over the C++ core: argument checks, copies into
+// owning handles, and every exception converted to a prt_status at the boundary.
+#include <prtshade/prtshade.h>
+
+#include <prtshade/fiv.h>
+#include <prtshade/sh.h>
+#include <prtshade/shade.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#ifndef PRTSHADE_VERSION
+#error "PRTSHADE_VERSION must be defined by the build"
+#endif
+
+struct prt_sh_rotation {
+  explicit prt_sh_rotation(const double R[3][3], int order) : rotation(R, order) {}
+  prt::sh::Rotation rotation;
+};
+
+namespace {
+
+// Owning copy of one occluder's arrays (its view lives in prt_fiv_scene::views).
+struct OwnedOccluder {
+  std::vector<float> radii, shells;
+  std::vector<uint8_t> valid;
+};
+
+} // namespace
+
+struct prt_fiv_scene {
+  int difmap_size = 0;
+  std::vector<float> difmap;
+  float environment[9] = {};
+  std::vector<std::unique_ptr<OwnedOccluder>> owned;
+  std::vector<prt::shade::FivOccluder> views;  // contiguous, for shade_fiv
+
+  prt::shade::DifMap map() const { return {difmap_size, difmap.data()}; }
+};
+
+namespace {
+
+thread_local std::string g_last_error;
+
+prt_status fail(prt_status status, const char* function, const std::string& message) {
+  try {
+    g_last_error = std::string(function) + ": " + message;
+  } catch (...) {
+    g_last_error.clear();
+  }
+  return status;
+}
+
+// Runs f (which returns nothing or throws) and maps exceptions to statuses.
+template <class F>
+prt_status guarded(const char* function, F&& f) noexcept {
+  try {
+    f();
+    return PRT_OK;
+  } catch (const std::bad_alloc&) {
+    return fail(PRT_ERROR_OUT_OF_MEMORY, function, "out of memory");
+  } catch (const std::invalid_argument& e) {
+    return fail(PRT_ERROR_INVALID_ARGUMENT, function, e.what());
+  } catch (const std::length_error& e) {
+    return fail(PRT_ERROR_OUT_OF_MEMORY, function, e.what());
+  } catch (const std::exception& e) {
+    return fail(PRT_ERROR_INTERNAL, function, e.what());
+  } catch (...) {
+    return fail(PRT_ERROR_INTERNAL, function, "unknown exception");
+  }
+}
+
+// Argument failure inside guarded(): becomes PRT_ERROR_INVALID_ARGUMENT with this message.
+[[noreturn]] void bad_argument(const std::string& message) { throw std::invalid_argument(message); }
+
+void require(bool ok, const char* message) {
+  if (!ok) bad_argument(message);
+}
+
+void require_order(int order) {
+  if (order < 1 || order > prt::sh::kMaxOrder)
+    bad_argument("order " + std::to_string(order) + " outside [1, " + std::to_string(prt::sh::kMaxOrder) + "]");
+}
+
+void require_count(size_t have, size_t need, const char* what) {
+  if (have < need)
+    bad_argument(std::string(what) + " holds " + std::to_string(have) + " floats, needs " + std::to_string(need));
+}
+
+const prt::shade::FivOccluder& occluder_at(const prt_fiv_scene* scene, int index) {
+  if (index < 0 || size_t(index) >= scene->views.size())
+    bad_argument("occluder index " + std::to_string(index) + " outside [0, " + std::to_string(scene->views.size()) +
+                 ")");
+  return scene->views[size_t(index)];
+}
+
+} // namespace
+
+extern "C" {
+
+const char* prt_status_string(prt_status status) {
+  switch (status) {
+  case PRT_OK: return "ok";
+  case PRT_ERROR_INVALID_ARGUMENT: return "invalid argument";
+  case PRT_ERROR_OUT_OF_MEMORY: return "out of memory";
+  case PRT_ERROR_INTERNAL: return "internal error";
+  }
+  return "unknown status";
+}
+
+const char* prt_last_error(void) { return g_last_error.c_str(); }
+
+const char* prt_version(void) { return PRTSHADE_VERSION; }
+
+int prt_sh_max_order(void) { return prt::sh::kMaxOrder; }
+
+prt_status prt_sh_eval(int order, float x, float y, float z, float* out, size_t out_count) {
+  return guarded(__func__, [&] {
+    require(out != nullptr, "out is null");
+    require_order(order);
+    require_count(out_count, size_t(order) * size_t(order), "out");
+    const double r2 = double(x) * x + double(y) * y + double(z) * z;
+    require(std::isfinite(r2) && std::fabs(r2 - 1.0) <= 1e-4, "direction is not unit length (to 1e-4)");
+    prt::sh::eval(order, x, y, z, std::span<float>(out, out_count));
+  });
+}
+
+prt_status prt_sh_rotation_create(const double rotation[9], int order, prt_sh_rotation** out) {
+  return guarded(__func__, [&] {
+    require(rotation != nullptr && out != nullptr, "null pointer");
+    require_order(order);
+    for (int k = 0; k < 9; ++k) require(std::isfinite(rotation[k]), "rotation matrix is not finite");
+    const double R[3][3] = {{rotation[0], rotation[1], rotation[2]},
+                            {rotation[3], rotation[4], rotation[5]},
+                            {rotation[6], rotation[7], rotation[8]}};
+    *out = new prt_sh_rotation(R, order);
+  });
+}
+
+void prt_sh_rotation_destroy(prt_sh_rotation* rotation) { delete rotation; }
+
+prt_status prt_sh_rotation_apply(const prt_sh_rotation* rotation, const float* in, float* out, int channels,
+                                 size_t count) {
+  return guarded(__func__, [&] {
+    require(rotation != nullptr && in != nullptr && out != nullptr, "null pointer");
+    require(channels >= 1, "channels must be >= 1");
+    const size_t n = size_t(prt::sh::num_coeffs(rotation->rotation.order()));
+    require_count(count, size_t(channels) * n, "in/out");
+    const size_t total = size_t(channels) * n;
+    const auto a = reinterpret_cast<uintptr_t>(in), b = reinterpret_cast<uintptr_t>(out);
+    require(a + total * sizeof(float) <= b || b + total * sizeof(float) <= a, "in and out overlap");
+    for (int c = 0; c < channels; ++c)
+      rotation->rotation.apply(std::span<const float>(in + size_t(c) * n, n), std::span<float>(out + size_t(c) * n, n));
+  });
+}
+
+prt_status prt_project_latlong(const float* rgb, int width, int height, int order, float* out, size_t out_count) {
+  return guarded(__func__, [&] {
+    require(rgb != nullptr && out != nullptr, "null pointer");
+    require_order(order);
+    require_count(out_count, 3 * size_t(order) * size_t(order), "out");
+    // Project into a scratch buffer so a failure writes nothing to out.
+    std::vector<float> tmp(3 * size_t(order) * size_t(order));
+    prt::shade::project_latlong(rgb, width, height, order, tmp.data());
+    std::memcpy(out, tmp.data(), tmp.size() * sizeof(float));
+  });
+}
+
+prt_status prt_shade_transfer(const float* transfer, size_t vertex_count, int order, const float* light_rgb,
+                              float* out) {
+  return guarded(__func__, [&] {
+    require_order(order);
+    prt::shade::shade_transfer_vertices(transfer, vertex_count, order, light_rgb, out);
+  });
+}
+
+prt_status prt_shade_band1(const float* normals, const float* radiance, size_t vertex_count, float* out) {
+  return guarded(__func__, [&] { prt::shade::shade_band1_vertices(normals, radiance, vertex_count, out); });
+}
+
+prt_status prt_fiv_scene_create(int difmap_size, const float* difmap_texels, const float environment_fiv[9],
+                                prt_fiv_scene** out) {
+  return guarded(__func__, [&] {
+    require(difmap_texels != nullptr && environment_fiv != nullptr && out != nullptr, "null pointer");
+    prt::shade::validate_difmap({difmap_size, difmap_texels});
+    for (int k = 0; k < 9; ++k) require(std::isfinite(environment_fiv[k]), "environment FIV is not finite");
+    auto scene = std::make_unique<prt_fiv_scene>();
+    scene->difmap_size = difmap_size;
+    scene->difmap.assign(difmap_texels, difmap_texels + size_t(6) * size_t(difmap_size) * size_t(difmap_size) * 3);
+    std::memcpy(scene->environment, environment_fiv, sizeof scene->environment);
+    *out = scene.release();
+  });
+}
+
+void prt_fiv_scene_destroy(prt_fiv_scene* scene) { delete scene; }
+
+prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occluder_desc* occluder, int* out_index) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && occluder != nullptr, "null pointer");
+    prt::shade::FivOccluder v{{occluder->centre[0], occluder->centre[1], occluder->centre[2]},
+                              occluder->radius,
+                              occluder->n_rho,
+                              occluder->n_theta,
+                              occluder->n_phi,
+                              occluder->radii,
+                              occluder->shells,
+                              occluder->valid};
+    prt::shade::validate_occluder(v);
+    require(scene->views.size() < size_t(1) << 30, "too many occluders");
+    auto own = std::make_unique<OwnedOccluder>();
+    const size_t samples = size_t(v.n_rho) * size_t(v.n_theta) * size_t(v.n_phi);
+    own->radii.assign(v.radii, v.radii + v.n_rho);
+    own->shells.assign(v.shells, v.shells + samples * 9);
+    own->valid.assign(v.valid, v.valid + samples);
+    v.radii = own->radii.data();
+    v.shells = own->shells.data();
+    v.valid = own->valid.data();
+    scene->views.reserve(scene->views.size() + 1);
+    scene->owned.push_back(std::move(own));
+    scene->views.push_back(v);
+    if (out_index != nullptr) *out_index = int(scene->views.size() - 1);
+  });
+}
+
+prt_status prt_fiv_scene_set_centre(prt_fiv_scene* scene, int index, const float centre[3]) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && centre != nullptr, "null pointer");
+    occluder_at(scene, index);
+    require(std::isfinite(centre[0]) && std::isfinite(centre[1]) && std::isfinite(centre[2]), "centre is not finite");
+    for (int k = 0; k < 3; ++k) scene->views[size_t(index)].centre[k] = centre[k];
+  });
+}
+
+prt_status prt_fiv_scene_occluder_count(const prt_fiv_scene* scene, int* out_count) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && out_count != nullptr, "null pointer");
+    *out_count = int(scene->views.size());
+  });
+}
+
+prt_status prt_fiv_scene_lookup_difmap(const prt_fiv_scene* scene, const float n[3], float out[3]) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && n != nullptr && out != nullptr, "null pointer");
+    prt::shade::lookup_difmap(scene->map(), n, out);
+  });
+}
+
+prt_status prt_fiv_scene_lookup_fiv(const prt_fiv_scene* scene, int index, const float s[3], float out[9]) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && s != nullptr && out != nullptr, "null pointer");
+    prt::shade::lookup_fiv(occluder_at(scene, index), s, out);
+  });
+}
+
+prt_status prt_fiv_scene_occluded_irradiance(const prt_fiv_scene* scene, int index, const float p[3],
+                                             const float n[3], int partial, float out[3]) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr && p != nullptr && n != nullptr && out != nullptr, "null pointer");
+    prt::shade::occluded_irradiance(occluder_at(scene, index), p, n, partial != 0, out);
+  });
+}
+
+prt_status prt_fiv_scene_shade(const prt_fiv_scene* scene, const float* positions, const float* normals,
+                               size_t count, const prt_fiv_options* options, float* out) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr, "scene is null");
+    if (count == 0) return;
+    require(positions != nullptr && normals != nullptr && out != nullptr, "null pointer");
+    prt::shade::FivShadeOptions o;
+    if (options != nullptr) {
+      o.partial_occluders = options->partial_occluders != 0;
+      o.overlap_correction = options->overlap_correction != 0;
+    }
+    const prt::shade::DifMap map = scene->map();
+    for (size_t k = 0; k < count; ++k)
+      prt::shade::shade_fiv(map, scene->views.data(), int(scene->views.size()), positions + 3 * k, normals + 3 * k, o,
+                            out + 3 * k);
+  });
+}
+
+prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const float* positions,
+                                    const float* normals, size_t count, float* out) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr, "scene is null");
+    const prt::shade::FivOccluder& occ = occluder_at(scene, index);
+    if (count == 0) return;
+    require(positions != nullptr && normals != nullptr && out != nullptr, "null pointer");
+    for (size_t k = 0; k < count; ++k)
+      prt::shade::shade_fiv_self(scene->environment, occ, positions + 3 * k, normals + 3 * k, out + 3 * k);
+  });
+}
+
+} // extern "C"
