@@ -70,8 +70,8 @@ DiscView disc_view(const FivOccluder& occ, const float p[3], const float n[3]) {
   return v;
 }
 
-void add_scaled(float acc[3], const float a[3], const float b[3], double w) {
-  for (int c = 0; c < 3; ++c) acc[c] += float(w * (double(a[c]) + double(b[c])));
+void add_scaled(double acc[3], const float a[3], const float b[3], double w) {
+  for (int c = 0; c < 3; ++c) acc[c] += w * (double(a[c]) + double(b[c]));
 }
 
 inline bool hides_something(const float I[3]) { return I[0] > 0 || I[1] > 0 || I[2] > 0; }
@@ -249,7 +249,11 @@ void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n
 
 void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n[3],
                const FivShadeOptions& options, float out[3]) {
-  lookup_difmap(map, n, out);
+  // Accumulated in double: with hundreds of occluders and pair terms, float sums would drift by
+  // ~count·ε·E_tot; the per-occluder work stays in float.
+  float tot[3];
+  lookup_difmap(map, n, tot);
+  double acc[3] = {tot[0], tot[1], tot[2]};
   struct State {
     float I[3];
     DiscView disc;
@@ -267,7 +271,7 @@ void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const
     State& s = st[active];
     occluded_irradiance(occluders[i], p, n, options.partial_occluders, s.I);
     if (!hides_something(s.I)) continue;
-    for (int c = 0; c < 3; ++c) out[c] -= s.I[c];
+    for (int c = 0; c < 3; ++c) acc[c] -= s.I[c];
     if (options.overlap_correction) s.disc = disc_view(occluders[i], p, n);
     ++active;
   }
@@ -286,11 +290,11 @@ void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const
         const float cz = a.axis[0] * b.axis[1] - a.axis[1] * b.axis[0];
         const float gamma = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), cos_gamma);
         const double o = overlap_fraction(a.alpha, b.alpha, gamma);
-        if (o > 0) add_scaled(out, st[i].I, st[j].I, o);
+        if (o > 0) add_scaled(acc, st[i].I, st[j].I, o);
       }
     }
   }
-  for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c]);
+  for (int c = 0; c < 3; ++c) out[c] = float(std::max(0.0, acc[c]));
 }
 
 void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]) {

@@ -53,7 +53,8 @@
 // Self-shadows (§4.3.2, eq. 12): a receiver ON occluder O sees unoccluded light only in its
 //   positive hemisphere, so E = max(0, n·F^env − n·F(p − centre)) per channel.
 //
-// Numerics: inputs and outputs are float; |s| and |centre − p| are formed in double (no overflow
+// Numerics: inputs and outputs are float; shade_fiv sums its terms in double (hundreds of
+// occluders and pair terms would otherwise drift by count·ε·E_tot); |s| and |centre − p| are formed in double (no overflow
 // for any finite float input), the angles in float. Every output is finite for finite inputs,
 // including p at an occluder's centre, ρ far beyond the last shell, normals of any length
 // (a zero normal gives E_tot(+Y) and I = 0) and NaN offsets (treated as ρ = 0).

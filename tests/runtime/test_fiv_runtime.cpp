@@ -1,0 +1,507 @@
+// Tests of prtshade/fiv.h (paper 004 §4.3): DifMap lookup (texel centres, bilinear, clamping,
+// face selection), the shell lookup (grid points exact, linear between, φ wrap, poles, radius
+// clamp and 1/ρ² falloff, invalid-sample renormalisation), cases A/B/C, the overlap correction
+// (identical, disjoint, lens area against numerical integration, fast path against the slow
+// reference), self-shadows, validation, and finiteness at extreme inputs.
+#include <prtshade/fiv.h>
+
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+namespace {
+
+namespace shade = prt::shade;
+using shade::DifMap;
+using shade::FivOccluder;
+
+constexpr double kPi = 3.14159265358979323846264338327950288;
+
+// An occluder with owned arrays; value(k, i, j, e) fills the shells.
+struct Shells {
+  int n_rho, n_theta, n_phi;
+  std::vector<float> radii, shells;
+  std::vector<uint8_t> valid;
+  float centre[3] = {0, 0, 0};
+  float radius = 1;
+
+  template <class F>
+  Shells(int nr, int nt, int np, F value) : n_rho(nr), n_theta(nt), n_phi(np) {
+    for (int k = 0; k < nr; ++k) radii.push_back(0.5f * float(1 << k));  // 0.5, 1, 2, 4, ...: exact in float
+    for (int k = 0; k < nr; ++k)
+      for (int i = 0; i < nt; ++i)
+        for (int j = 0; j < np; ++j)
+          for (int e = 0; e < 9; ++e) shells.push_back(value(k, i, j, e));
+    valid.assign(size_t(nr * nt * np), 1);
+  }
+  size_t index(int k, int i, int j) const { return (size_t(k) * size_t(n_theta) + size_t(i)) * size_t(n_phi) + size_t(j); }
+  float& at(int k, int i, int j, int e) { return shells[index(k, i, j) * 9 + size_t(e)]; }
+  FivOccluder view() const {
+    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
+  }
+};
+
+// Offset s at continuous grid coordinates (t, u) and radius rho (bake/fiv.h grid convention).
+void offset_at(const Shells& o, double t, double u, double rho, float s[3]) {
+  const double theta = kPi * t / (o.n_theta - 1), phi = 2 * kPi * u / o.n_phi;
+  s[0] = float(rho * std::sin(theta) * std::sin(phi));
+  s[1] = float(rho * std::cos(theta));
+  s[2] = float(rho * std::sin(theta) * std::cos(phi));
+}
+
+// A value linear in the grid coordinates (k, i, j), different per component.
+float linear_value(int k, int i, int j, int e) { return float(1 + e) + 0.5f * float(k) + 0.25f * float(i) - 0.125f * float(j * (e + 1)); }
+
+// Angles are formed in float (acos/atan2 of float components): t and u come back within a few
+// float ulps of π (≤ ~1e-6 grid units at these sizes), times the slope of linear_value (≤ 1.2 per
+// grid unit).
+constexpr float kAngleRoundTrip = 2e-5f;
+
+TEST(LookupFiv, GridPointsAreExact) {
+  Shells o(3, 5, 8, linear_value);
+  // Axis-aligned grid points are computed without rounding: θ ∈ {0, π/2, π} and φ ∈ {0, π/2, π,
+  // 3π/2} come out of acos/atan2 as the float multiples of π, t and u exactly integral, and ρ ==
+  // radii[k] exactly, so the trilinear weights are (1, 0, ...) and the value is the stored one.
+  struct P {
+    int i, j;
+    float dir[3];
+  } pts[] = {{2, 0, {0, 0, 1}}, {2, 2, {1, 0, 0}}, {2, 4, {0, 0, -1}}, {2, 6, {-1, 0, 0}}, {0, 0, {0, 1, 0}}, {4, 0, {0, -1, 0}}};
+  for (int k = 0; k < o.n_rho; ++k)
+    for (const P& p : pts) {
+      const float s[3] = {p.dir[0] * o.radii[size_t(k)], p.dir[1] * o.radii[size_t(k)], p.dir[2] * o.radii[size_t(k)]};
+      float out[9];
+      shade::lookup_fiv(o.view(), s, out);
+      // The south pole (θ = π) is reached with t = Nθ − 1 exactly and weight 1 on the last row.
+      for (int e = 0; e < 9; ++e) EXPECT_EQ(out[e], o.at(k, p.i, p.j, e)) << "k " << k << " i " << p.i << " j " << p.j;
+    }
+  // Generic grid points (all angles rounded): equal to float round-trip accuracy.
+  for (int k = 0; k < o.n_rho; ++k)
+    for (int i = 1; i < o.n_theta - 1; ++i)
+      for (int j = 0; j < o.n_phi; ++j) {
+        float s[3], out[9];
+        offset_at(o, i, j, o.radii[size_t(k)], s);
+        shade::lookup_fiv(o.view(), s, out);
+        for (int e = 0; e < 9; ++e) EXPECT_NEAR(out[e], o.at(k, i, j, e), kAngleRoundTrip * 8) << k << i << j;
+      }
+}
+
+TEST(LookupFiv, LinearBetweenGridPoints) {
+  Shells o(3, 5, 8, linear_value);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> ut(0, 4), uu(0, 6.99), ur(0, 1);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double t = ut(rng), u = uu(rng), fr = ur(rng);
+    const int k = trial % 2;
+    const double rho = o.radii[size_t(k)] + fr * (o.radii[size_t(k + 1)] - o.radii[size_t(k)]);
+    float s[3], out[9];
+    offset_at(o, t, u, rho, s);
+    shade::lookup_fiv(o.view(), s, out);
+    // Trilinear interpolation of a function linear in (k, i, j) is exact (away from the φ seam,
+    // u < Nφ − 1, where linear_value is not periodic).
+    for (int e = 0; e < 9; ++e) {
+      const double expect = (1 + e) + 0.5 * (k + fr) + 0.25 * t - 0.125 * u * (e + 1);
+      EXPECT_NEAR(out[e], expect, kAngleRoundTrip * (e + 1) + 1e-5) << "t " << t << " u " << u << " rho " << rho;
+    }
+  }
+}
+
+TEST(LookupFiv, WrapsInPhi) {
+  // Only j = Nφ − 1 and j = 0 differ; between them (u ∈ (Nφ − 1, Nφ)) the lookup blends the two.
+  Shells o(1, 3, 8, [](int, int, int j, int e) { return j == 7 ? 10.0f + float(e) : j == 0 ? 2.0f : 0.0f; });
+  for (double u : {7.25, 7.5, 7.9}) {
+    float s[3], out[9];
+    offset_at(o, 1, u, 0.5, s);  // θ = π/2 (t = 1), on shell 0
+    shade::lookup_fiv(o.view(), s, out);
+    const double f = u - 7;
+    for (int e = 0; e < 9; ++e) EXPECT_NEAR(out[e], (1 - f) * (10 + e) + f * 2, 1e-4 * (10 + e)) << u;
+  }
+  // φ just below 0 (atan2 negative) wraps to just below 2π: the value of j = 0 blended with a
+  // tiny weight of j = 7... i.e. continuous across the seam.
+  float a[9], b[9];
+  const float s1[3] = {-1e-4f, 0, 0.5f}, s2[3] = {1e-4f, 0, 0.5f};
+  shade::lookup_fiv(o.view(), s1, a);
+  shade::lookup_fiv(o.view(), s2, b);
+  // |Δφ| = 2e-4 rad = 2.5e-4 grid units of φ, times the jump of 8..16 between j = 7 and j = 0.
+  for (int e = 0; e < 9; ++e) EXPECT_NEAR(a[e], b[e], 2.5e-4 * 2 * (10 + e) + 1e-5);
+}
+
+TEST(LookupFiv, PolesUseTheirRowAndRhoZeroIsNorthPole) {
+  // Pole rows constant in φ (as baked: every φ sample of a pole is the same position).
+  Shells o(2, 5, 8, [](int k, int i, int j, int e) {
+    return i == 0 ? 3.0f + float(k + e) : i == 4 ? -2.0f - float(k) : float(j + e + k);
+  });
+  for (double u : {0.0, 1.3, 4.5, 7.7}) {
+    float s[3], out[9];
+    offset_at(o, 0, u, 0.5, s);
+    shade::lookup_fiv(o.view(), s, out);
+    for (int e = 0; e < 9; ++e) EXPECT_EQ(out[e], 3.0f + float(e)) << u;  // θ = 0: weight 1 on row 0, any φ blend of equal values
+    offset_at(o, 4, u, 1.0, s);
+    shade::lookup_fiv(o.view(), s, out);
+    // θ = π from float rounding of cos: t within ~1e-4 of the last row; rows 3 and 4 differ by ≤ 12.
+    for (int e = 0; e < 9; ++e) EXPECT_NEAR(out[e], -3.0f, 2e-3) << u;
+  }
+  const float zero[3] = {0, 0, 0};
+  float out[9];
+  shade::lookup_fiv(o.view(), zero, out);  // ρ = 0: d = +Y, clamped to the inner shell
+  for (int e = 0; e < 9; ++e) EXPECT_EQ(out[e], 3.0f + float(e));
+}
+
+TEST(LookupFiv, RadiusClampsInsideAndFallsOffOutside) {
+  Shells o(3, 3, 4, linear_value);  // radii 0.5, 1, 2
+  const float dir[3] = {1, 0, 0};     // t = 1, u = 1: a grid point
+  auto at_rho = [&](float rho, float out[9]) {
+    const float s[3] = {dir[0] * rho, dir[1] * rho, dir[2] * rho};
+    shade::lookup_fiv(o.view(), s, out);
+  };
+  float a[9], b[9];
+  at_rho(0.1f, a);
+  for (int e = 0; e < 9; ++e) EXPECT_EQ(a[e], o.at(0, 1, 1, e));  // ρ < ρ_0 clamps
+  at_rho(8.0f, a);
+  // (2/8)² = 1/16: exact in float.
+  for (int e = 0; e < 9; ++e) EXPECT_EQ(a[e], o.at(2, 1, 1, e) / 16.0f);
+  at_rho(2.0f, a);
+  at_rho(2.0f * (1 + 1e-6f), b);  // continuous at the last shell
+  for (int e = 0; e < 9; ++e) EXPECT_NEAR(a[e], b[e], 3e-6f * std::abs(a[e]));
+  at_rho(1.5f, a);  // halfway between shells 1 and 2
+  for (int e = 0; e < 9; ++e) EXPECT_EQ(a[e], 0.5f * (o.at(1, 1, 1, e) + o.at(2, 1, 1, e)));
+  // Huge and tiny offsets stay finite.
+  for (float rho : {1e30f, 3e38f, 1e-30f, 1e-45f}) {
+    at_rho(rho, a);
+    for (int e = 0; e < 9; ++e) EXPECT_TRUE(std::isfinite(a[e])) << rho;
+  }
+  const float huge[3] = {3e38f, -3e38f, 3e38f}, nan[3] = {std::numeric_limits<float>::quiet_NaN(), 0, 1};
+  shade::lookup_fiv(o.view(), huge, a);
+  for (int e = 0; e < 9; ++e) EXPECT_TRUE(std::isfinite(a[e]));
+  shade::lookup_fiv(o.view(), nan, a);
+  for (int e = 0; e < 9; ++e) EXPECT_TRUE(std::isfinite(a[e]));
+}
+
+TEST(LookupFiv, InvalidSamplesAreDroppedAndTheRestRenormalised) {
+  Shells o(2, 3, 4, [](int k, int i, int j, int e) { return float(k * 100 + i * 10 + j) + 0.001f * float(e); });
+  // The centre of the cell k ∈ {0,1}, i ∈ {0,1}, j ∈ {0,1}: every neighbour has weight 1/8.
+  const double t = 0.5, u = 0.5, rho = 0.75;
+  float s[3];
+  offset_at(o, t, u, rho, s);
+  o.valid[o.index(1, 1, 1)] = 0;
+  o.at(1, 1, 1, 0) = 1e6f;  // would dominate if it were used
+  float out[9];
+  shade::lookup_fiv(o.view(), s, out);
+  // The mean of the 7 valid neighbours (the weights are 1/8 up to the float angle round trip).
+  double mean = 0;
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        if (!(k == 1 && i == 1 && j == 1)) mean += (k * 100 + i * 10 + j) / 7.0;
+  // Weights off 1/8 by ≤ 1e-6 (angle round trip) times value spread ≤ 111.
+  EXPECT_NEAR(out[0], mean, 1e-3);
+  // All 8 invalid: the plain trilinear value (here the plain mean of all eight, with the 1e6).
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) o.valid[o.index(k, i, j)] = 0;
+  shade::lookup_fiv(o.view(), s, out);
+  double plain = 0;
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) plain += double(o.at(k, i, j, 0)) / 8;
+  EXPECT_NEAR(out[0], plain, 1e-6 * plain + 1e-3);
+}
+
+// ---- DifMap --------------------------------------------------------------------------------
+
+struct Cube {
+  int S;
+  std::vector<float> texels;
+  explicit Cube(int size) : S(size), texels(size_t(6 * size * size * 3)) {
+    for (size_t k = 0; k < texels.size(); ++k) texels[k] = float((k * 37) % 101) * 0.5f;  // distinct values
+  }
+  float at(int face, int r, int q, int c) const { return texels[((size_t(face) * S + size_t(r)) * S + size_t(q)) * 3 + size_t(c)]; }
+  DifMap view() const { return {S, texels.data()}; }
+};
+
+// Unnormalised direction of texel (face, r, q) in the OpenGL convention of bake/fiv.h.
+void texel_direction(int face, int r, int q, int S, float d[3]) {
+  const float s = 2.0f * (float(q) + 0.5f) / float(S) - 1.0f, t = 2.0f * (float(r) + 0.5f) / float(S) - 1.0f;
+  const float dirs[6][3] = {{1, -t, -s}, {-1, -t, s}, {s, 1, t}, {s, -1, -t}, {s, -t, 1}, {-s, -t, -1}};
+  for (int a = 0; a < 3; ++a) d[a] = dirs[face][a];
+}
+
+TEST(LookupDifmap, TexelCentresAreExactAndBetweenIsBilinear) {
+  const Cube cube(8);  // S a power of 2: texel-centre coordinates are exact in float
+  for (int face = 0; face < 6; ++face)
+    for (int r = 0; r < cube.S; ++r)
+      for (int q = 0; q < cube.S; ++q) {
+        float d[3], out[3];
+        texel_direction(face, r, q, cube.S, d);
+        shade::lookup_difmap(cube.view(), d, out);
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(out[c], cube.at(face, r, q, c)) << face << " " << r << " " << q;
+        // Normalised direction: the division by the major component rounds (≤ 2 ulps of s, t),
+        // moving the sample by ≤ 1e-6 texels; neighbour values differ by ≤ 50.
+        const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        const float dn[3] = {d[0] / len, d[1] / len, d[2] / len};
+        shade::lookup_difmap(cube.view(), dn, out);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[c], cube.at(face, r, q, c), 1e-4f);
+      }
+  // Halfway between texels (r, q) and (r, q + 1) of face +Z: the mean.
+  const float s = 2.0f * 4.0f / 8.0f - 1.0f, t = 2.0f * 2.5f / 8.0f - 1.0f;  // q = 3.5, r = 2
+  const float d[3] = {s, -t, 1};
+  float out[3];
+  shade::lookup_difmap(cube.view(), d, out);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 0.5f * (cube.at(4, 2, 3, c) + cube.at(4, 2, 4, c)));
+  // A cube corner clamps to the corner texel of the face that wins the tie (X first).
+  const float corner[3] = {1, 1, 1};
+  shade::lookup_difmap(cube.view(), corner, out);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], cube.at(0, 0, 0, c));  // +X: s = −z = −1 → q = 0, t = −y → r = 0
+  // Zero normal: +Y face centre (finite, documented).
+  const float zero[3] = {0, 0, 0};
+  shade::lookup_difmap(cube.view(), zero, out);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 0.25f * (cube.at(2, 3, 3, c) + cube.at(2, 3, 4, c) + cube.at(2, 4, 3, c) + cube.at(2, 4, 4, c)));
+}
+
+// ---- cases A/B/C, shadows, overlap, self-shadows ------------------------------------------------
+
+// An occluder whose FIV is the same F everywhere inside ρ = 64 R (F[c][a] = f[a] · (c + 1)).
+Shells constant_occluder(const float f[3], float radius, const float centre[3]) {
+  Shells o(2, 3, 4, [f](int, int, int, int e) { return f[e % 3] * float(e / 3 + 1); });
+  o.radius = radius;
+  for (int a = 0; a < 3; ++a) o.centre[a] = centre[a];
+  o.radii = {radius, 64 * radius};  // receivers in the tests lie inside: no 1/ρ² falloff
+  return o;
+}
+
+TEST(PartialFactor, CasesABC) {
+  const float f[3] = {0, 1, 0}, centre[3] = {0, 2, 0};
+  const Shells o = constant_occluder(f, 1.0f, centre);
+  const float n[3] = {0, 1, 0};
+  // h = n·(centre − p) = 2 − p_y; R = 1.
+  const struct {
+    float py, expect;
+  } cases[] = {{0.0f, 1.0f}, {1.0f, 1.0f}, {1.5f, 0.75f}, {2.0f, 0.5f}, {2.5f, 0.25f}, {3.0f, 0.0f}, {5.0f, 0.0f}};
+  for (const auto& cs : cases) {
+    const float p[3] = {0.3f, cs.py, -0.2f};
+    // Closed forms (h + R)/2R with h, R small binary fractions: exact in float.
+    EXPECT_EQ(shade::partial_factor(o.view(), p, n), cs.expect) << cs.py;
+  }
+}
+
+TEST(OccludedIrradiance, FactorTimesProjectedFivClampedAtZero) {
+  const float f[3] = {0.5f, 2.0f, -1.0f}, centre[3] = {0, 2, 0};
+  const Shells o = constant_occluder(f, 1.0f, centre);
+  const float n[3] = {0, 1, 0};
+  float out[3];
+  const float pa[3] = {0, 0, 0}, pb[3] = {0, 1.5f, 0}, pc[3] = {0, 3.5f, 0};
+  shade::occluded_irradiance(o.view(), pa, n, true, out);  // case A: n·F_c = 2 (c + 1)
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 2.0f * float(c + 1));
+  shade::occluded_irradiance(o.view(), pb, n, true, out);  // case B: factor 3/4
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 1.5f * float(c + 1));
+  shade::occluded_irradiance(o.view(), pb, n, false, out);  // partial correction off: factor 1
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 2.0f * float(c + 1));
+  shade::occluded_irradiance(o.view(), pc, n, false, out);  // case C stays 0 even without it
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 0.0f);
+  const float down[3] = {0, 0, 1}, pd[3] = {0, 2, -0.5f};  // n·F = −(c+1) < 0: clamped
+  shade::occluded_irradiance(o.view(), pd, down, true, out);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out[c], 0.0f);
+}
+
+// A constant cube map with value e in every texel.
+std::vector<float> flat_cube(int S, float e) { return std::vector<float>(size_t(6 * S * S * 3), e); }
+
+TEST(ShadeFiv, SingleIdenticalAndDisjointOccluders) {
+  const std::vector<float> cube = flat_cube(4, 10.0f);
+  const DifMap map{4, cube.data()};
+  const float f[3] = {0, 1, 0}, n[3] = {0, 1, 0}, p[3] = {0, 0, 0};
+  const float c1[3] = {0, 3, 0}, c2[3] = {6, 3, 0};  // c2 is 63° from c1 as seen from p; α = 19.5° each
+  const Shells a = constant_occluder(f, 1.0f, c1), a2 = constant_occluder(f, 1.0f, c1), b = constant_occluder(f, 1.0f, c2);
+  const FivOccluder one[1] = {a.view()}, same[2] = {a.view(), a2.view()}, apart[2] = {a.view(), b.view()};
+  float e1[3], e2[3], e3[3], e4[3];
+  shade::shade_fiv(map, one, 1, p, n, {}, e1);
+  shade::shade_fiv(map, same, 2, p, n, {}, e2);
+  shade::shade_fiv(map, same, 2, p, n, {true, false}, e3);
+  shade::shade_fiv(map, apart, 2, p, n, {}, e4);
+  for (int c = 0; c < 3; ++c) {
+    const float I = float(c + 1);  // n·F_c, case A (h = 3 >= R)
+    // The lookup renormalises by the float sum of its 8 weights (1 to within 2ε), so I is n·F to
+    // a few ε; the sums are in double and rounded once: 4ε · E_tot.
+    const float tol = 4 * FLT_EPSILON * 10;
+    EXPECT_NEAR(e1[c], 10.0f - I, tol);
+    // Identical occluders: O = πα²/(2πα²) = ½, so E = E_tot − 2I + ½·2I = E_tot − I.
+    EXPECT_NEAR(e2[c], 10.0f - I, tol);
+    EXPECT_NEAR(e3[c], 10.0f - 2 * I, tol);  // without the correction: counted twice
+    EXPECT_NEAR(e4[c], 10.0f - 2 * I, tol);  // disjoint discs (γ = 63° > 2α = 39°): I1 + I2
+  }
+  // Clamped at zero when the occluders hide more than the DifMap holds.
+  const std::vector<float> dim = flat_cube(4, 0.5f);
+  shade::shade_fiv({4, dim.data()}, apart, 2, p, n, {}, e1);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(e1[c], 0.0f);
+}
+
+// Lens area by 1D integration: the vertical chords of both discs are centred on the axis, so the
+// overlap at abscissa x is 2 min(h1(x), h2(x)).
+double lens_area_numeric(double r1, double r2, double d, int steps) {
+  const double x0 = std::max(-r1, d - r2), x1 = std::min(r1, d + r2);
+  if (x1 <= x0) return 0;
+  const double h = (x1 - x0) / steps;
+  double sum = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double x = x0 + (i + 0.5) * h;
+    const double h1 = std::sqrt(std::max(0.0, r1 * r1 - x * x)), h2 = std::sqrt(std::max(0.0, r2 * r2 - (x - d) * (x - d)));
+    sum += 2 * std::min(h1, h2);
+  }
+  return sum * h;
+}
+
+TEST(Overlap, LensAreaMatchesNumericalIntegration) {
+  const struct {
+    double r1, r2, d;
+  } cases[] = {{1, 1, 0.5}, {1, 1, 1.9}, {1, 0.3, 0.9}, {0.2, 0.7, 0.6}, {0.5, 0.5, 1e-3}, {1.5, 0.4, 1.2}, {0.3, 0.3, 0.59}};
+  for (const auto& cs : cases) {
+    const double exact = shade::lens_area(cs.r1, cs.r2, cs.d);
+    const double numeric = lens_area_numeric(cs.r1, cs.r2, cs.d, 400000);
+    // Midpoint rule on an integrand with square-root ends (and one kink): error O(h^1.5) ≈
+    // (2.5e-6)^1.5 · r ≈ 4e-9 per end; 1e-7 of π min(r)² covers it with room.
+    EXPECT_NEAR(exact, numeric, 1e-7 * kPi * std::min(cs.r1, cs.r2) * std::min(cs.r1, cs.r2) + 1e-9)
+        << cs.r1 << " " << cs.r2 << " " << cs.d;
+  }
+  EXPECT_EQ(shade::lens_area(1, 0.5, 2), 0.0);                     // disjoint
+  EXPECT_DOUBLE_EQ(shade::lens_area(1, 0.5, 0.2), kPi * 0.25);     // contained: the small disc
+  EXPECT_DOUBLE_EQ(shade::overlap_fraction(0.3, 0.3, 0.0), 0.5);   // identical discs
+  EXPECT_EQ(shade::overlap_fraction(0, 0, 0), 0.0);                // no disc at all
+}
+
+TEST(ShadeFiv, FastPathMatchesSlowReference) {
+  // Ten occluders with random positions/sizes around a receiver, some overlapping, some below
+  // the horizon (case C), some straddling it (case B).
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> pos(-2.5f, 2.5f), rad(0.2f, 1.2f);
+  Cube cube(6);
+  std::vector<Shells> occ;
+  for (int i = 0; i < 10; ++i) {
+    const float centre[3] = {pos(rng), pos(rng) + 1.0f, pos(rng)};
+    occ.push_back(Shells(3, 9, 16, [&](int k, int ti, int j, int e) {
+      return 0.5f + 0.1f * float((k * 7 + ti * 3 + j * 5 + e) % 11) + 0.05f * float(i);
+    }));
+    occ.back().radius = rad(rng);
+    occ.back().radii = {0.5f * occ.back().radius, occ.back().radius, 3 * occ.back().radius};
+    for (int a = 0; a < 3; ++a) occ.back().centre[a] = centre[a];
+  }
+  std::vector<FivOccluder> views;
+  for (const Shells& o : occ) views.push_back(o.view());
+  std::uniform_real_distribution<float> un(-1, 1);
+  int pairs_overlapping = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const float p[3] = {pos(rng) * 0.5f, 0, pos(rng) * 0.5f};
+    float n[3] = {un(rng), 1.5f, un(rng)};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (float& v : n) v /= len;
+    for (const shade::FivShadeOptions opt : {shade::FivShadeOptions{}, shade::FivShadeOptions{false, true}}) {
+      float fast[3], slow[3];
+      shade::shade_fiv(cube.view(), views.data(), int(views.size()), p, n, opt, fast);
+      shade::shade_fiv_reference(cube.view(), views.data(), int(views.size()), p, n, opt, slow);
+      for (int c = 0; c < 3; ++c)
+        // Float vs double accumulation of ~10 terms of size ≤ 50 and ~45 pair terms (the pair
+        // angle in float: ≤ 1e-6 rad, O's slope in γ ≤ 1/α_min ≈ 10): ≤ 1e-4 absolute.
+        EXPECT_NEAR(fast[c], slow[c], 1e-4f) << trial << " " << c;
+      float no_overlap[3];
+      shade::shade_fiv(cube.view(), views.data(), int(views.size()), p, n, {opt.partial_occluders, false}, no_overlap);
+      if (fast[0] != no_overlap[0]) ++pairs_overlapping;
+    }
+  }
+  EXPECT_GT(pairs_overlapping, 50);  // the overlap path was exercised
+}
+
+TEST(ShadeFiv, ManyOccludersUseTheHeapPathAndStayFinite) {
+  const std::vector<float> cube = flat_cube(2, 100.0f);
+  const float f[3] = {0.1f, 0.2f, 0.05f};
+  std::vector<Shells> occ;
+  for (int i = 0; i < 200; ++i) {
+    const float centre[3] = {float(i % 20) - 10.0f, 2.0f, float(i / 20) - 5.0f};
+    occ.push_back(constant_occluder(f, 0.4f, centre));
+  }
+  std::vector<FivOccluder> views;
+  for (const Shells& o : occ) views.push_back(o.view());
+  const float p[3] = {0.1f, 0, 0.2f}, n[3] = {0, 1, 0};
+  float fast[3], slow[3];
+  shade::shade_fiv({2, cube.data()}, views.data(), 200, p, n, {}, fast);
+  shade::shade_fiv_reference({2, cube.data()}, views.data(), 200, p, n, {}, slow);
+  // Both accumulate in double from the same float I; they differ by the pair angles (float γ vs
+  // double acos: ≤ 1e-6 rad, O's slope in γ ≤ 1/α ≈ 10, times I_i + I_j ≤ 1.2) over the overlapping
+  // pairs (≤ 8 neighbours each: ≤ 800), plus the final float rounding (ε · 100): ≤ 1e-4.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(fast[c], slow[c], 1e-4f);
+}
+
+TEST(ShadeFiv, ExtremeInputsStayFinite) {
+  const std::vector<float> cube = flat_cube(3, 5.0f);
+  const float f[3] = {1, 2, 3}, centre[3] = {1, 2, 3};
+  const Shells o = constant_occluder(f, 1.0f, centre);
+  Shells tiny = constant_occluder(f, 1e-30f, centre);
+  const FivOccluder occ[2] = {o.view(), tiny.view()};
+  const float inf = std::numeric_limits<float>::infinity();
+  const float points[][3] = {{1, 2, 3}, {1e30f, -1e30f, 1e30f}, {3e38f, 3e38f, -3e38f}, {1, 2, 3.0000001f}, {0, 0, 0}};
+  const float normals[][3] = {{0, 1, 0}, {0, 0, 0}, {1e-30f, 0, 0}, {1e30f, 1e30f, 0}, {-1, 0, 0}};
+  for (const auto& p : points)
+    for (const auto& n : normals) {
+      float e[3], s[3];
+      shade::shade_fiv({3, cube.data()}, occ, 2, p, n, {}, e);
+      shade::shade_fiv_self(o.shells.data(), o.view(), p, n, s);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(std::isfinite(e[c]) && e[c] >= 0 && e[c] != inf) << p[0] << " " << n[0];
+        EXPECT_TRUE(std::isfinite(s[c]) && s[c] >= 0);
+      }
+    }
+  // p exactly at the centre: the disc covers the hemisphere (α = π/2), a = n; with two such
+  // occluders O = ½ and the result is that of one.
+  const FivOccluder two[2] = {o.view(), o.view()};
+  float e1[3], e2[3];
+  const float n[3] = {0, 1, 0};
+  shade::shade_fiv({3, cube.data()}, two, 2, centre, n, {}, e2);
+  shade::shade_fiv({3, cube.data()}, occ, 1, centre, n, {}, e1);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(e2[c], e1[c], 1e-5f);
+}
+
+TEST(ShadeFivSelf, EnvironmentMinusOccludedClamped) {
+  const float f[3] = {0.25f, 0.5f, 0.0f}, centre[3] = {0, 0, 0};
+  const Shells o = constant_occluder(f, 1.0f, centre);
+  const float env[9] = {1, 2, 0, 2, 4, 0, 0.1f, 0.2f, 0};
+  const float p[3] = {0.3f, 0.4f, 0}, n[3] = {0.6f, 0.8f, 0};
+  float e[3];
+  shade::shade_fiv_self(env, o.view(), p, n, e);
+  // n·F^env = (2.2, 4.4, 0.22); n·F_c = 0.55 (c + 1): E = (1.65, 3.3, 0) with the last clamped.
+  EXPECT_NEAR(e[0], 1.65f, 4 * FLT_EPSILON * 2.2f);
+  EXPECT_NEAR(e[1], 3.3f, 4 * FLT_EPSILON * 4.4f);
+  EXPECT_EQ(e[2], 0.0f);
+}
+
+TEST(Validate, RejectsBrokenOccludersAndMaps) {
+  const float f[3] = {1, 0, 0}, centre[3] = {0, 0, 0};
+  Shells o = constant_occluder(f, 1.0f, centre);
+  EXPECT_NO_THROW(shade::validate_occluder(o.view()));
+  FivOccluder v = o.view();
+  v.radius = 0;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  v = o.view();
+  v.n_theta = 1;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  v = o.view();
+  v.shells = nullptr;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  o.radii = {1.0f, 1.0f};
+  EXPECT_THROW(shade::validate_occluder(o.view()), std::invalid_argument);
+  o.radii = {1.0f, 2.0f};
+  o.shells[5] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    shade::validate_occluder(o.view());
+    FAIL() << "NaN accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("shell value 5 is not finite"), std::string::npos) << e.what();
+  }
+  const std::vector<float> cube = flat_cube(2, 1.0f);
+  EXPECT_NO_THROW(shade::validate_difmap({2, cube.data()}));
+  EXPECT_THROW(shade::validate_difmap({0, cube.data()}), std::invalid_argument);
+  EXPECT_THROW(shade::validate_difmap({2, nullptr}), std::invalid_argument);
+}
+
+} // namespace
