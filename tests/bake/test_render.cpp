@@ -1,0 +1,453 @@
+// bake/render.h and bake/image_io.h: PNG bytes (decoded by Python's zlib, an independent inflater),
+// checksums against their published check values, rasterizer coverage and perspective-correct
+// interpolation against closed forms, the exact unshadowed irradiance, and the reference renderer
+// against π·L and Lambert's form factor.
+#include <bake/envmap.h>
+#include <bake/error.h>
+#include <bake/fiv.h>
+#include <bake/image_io.h>
+#include <bake/mesh.h>
+#include <bake/render.h>
+#include <bake/sampling.h>
+
+#include <test_scenes.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <unistd.h>
+
+using namespace prt::bake;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+using std::numbers::pi;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "render";
+  fs::create_directories(dir);
+  return dir / (std::to_string(getpid()) + "." + name);
+}
+
+std::vector<uint8_t> read_bytes(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+// Inflates a zlib stream with Python's zlib (which also verifies the Adler-32 trailer). Sets ok.
+std::vector<uint8_t> python_inflate(const std::vector<uint8_t>& z, bool& ok) {
+  const fs::path in = scratch("z.in"), out = scratch("z.out");
+  std::ofstream(in, std::ios::binary).write(reinterpret_cast<const char*>(z.data()), std::streamsize(z.size()));
+  const std::string cmd = "python3 -c \"import sys, zlib; open(sys.argv[2], 'wb').write(zlib.decompress(open(sys.argv[1], "
+                          "'rb').read()))\" " + in.string() + " " + out.string();
+  ok = std::system(cmd.c_str()) == 0;
+  auto bytes = read_bytes(out);
+  fs::remove(in);
+  fs::remove(out);
+  return bytes;
+}
+
+uint32_t be32(const uint8_t* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+
+} // namespace
+
+TEST(Checksums, PublishedCheckValues) {
+  // The standard check inputs: CRC-32/ISO-HDLC("123456789") = 0xCBF43926; Adler-32 of
+  // "Wikipedia" = 0x11E60398 (RFC 1950 example value used widely); Adler-32 of "" = 1.
+  const std::string s = "123456789", w = "Wikipedia";
+  EXPECT_EQ(crc32({reinterpret_cast<const uint8_t*>(s.data()), s.size()}), 0xCBF43926u);
+  EXPECT_EQ(adler32({reinterpret_cast<const uint8_t*>(w.data()), w.size()}), 0x11E60398u);
+  EXPECT_EQ(adler32({}), 1u);
+  // Chaining: crc32(a ‖ b) == crc32(b, crc32(a)).
+  const auto* p = reinterpret_cast<const uint8_t*>(s.data());
+  EXPECT_EQ(crc32({p + 4, 5}, crc32({p, 4})), 0xCBF43926u);
+}
+
+TEST(Zlib, PythonInflatesOurStreamsExactly) {
+  std::vector<std::vector<uint8_t>> inputs(4);
+  inputs[1] = {42};
+  for (int i = 0; i < 100000; ++i) inputs[2].push_back(uint8_t((i * i) % 7));  // long matches, long distances
+  uint64_t h = 1;
+  for (int i = 0; i < 70000; ++i) inputs[3].push_back(uint8_t((h = mix64(h)) >> 60));  // short random runs > window
+  for (const auto& in : inputs) {
+    const auto z = zlib_compress(in);
+    bool ok = false;
+    const auto out = python_inflate(z, ok);
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(out, in);
+    ASSERT_GE(z.size(), 6u);
+    EXPECT_EQ(be32(z.data() + z.size() - 4), adler32(in));
+  }
+  EXPECT_LT(zlib_compress(inputs[2]).size(), inputs[2].size() / 20);  // periodic data must compress
+}
+
+TEST(Png, ChunksCheckAndPixelsDecode) {
+  Image8 img(37, 23);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) img.rgb[size_t(3 * (y * img.width + x) + c)] = uint8_t((x * 7 + y * 13 * (c + 1) + (x * y) % 5) & 0xFF);
+  const auto png = encode_png(img);
+  ASSERT_GT(png.size(), 8u);
+  const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  ASSERT_TRUE(std::equal(sig, sig + 8, png.begin()));
+  std::vector<uint8_t> idat;
+  std::vector<std::string> types;
+  size_t pos = 8;
+  while (pos + 12 <= png.size()) {
+    const uint32_t len = be32(&png[pos]);
+    ASSERT_LE(pos + 12 + len, png.size());
+    const std::string type(png.begin() + std::ptrdiff_t(pos + 4), png.begin() + std::ptrdiff_t(pos + 8));
+    types.push_back(type);
+    EXPECT_EQ(be32(&png[pos + 8 + len]), crc32({&png[pos + 4], len + 4})) << type;
+    if (type == "IHDR") {
+      EXPECT_EQ(be32(&png[pos + 8]), 37u);
+      EXPECT_EQ(be32(&png[pos + 12]), 23u);
+      EXPECT_EQ(png[pos + 16], 8);  // bit depth
+      EXPECT_EQ(png[pos + 17], 2);  // RGB
+    }
+    if (type == "IDAT") idat.insert(idat.end(), png.begin() + std::ptrdiff_t(pos + 8), png.begin() + std::ptrdiff_t(pos + 8 + len));
+    pos += 12 + len;
+  }
+  EXPECT_EQ(pos, png.size());
+  ASSERT_FALSE(types.empty());
+  EXPECT_EQ(types.front(), "IHDR");
+  EXPECT_EQ(types.back(), "IEND");
+  bool ok = false;
+  const auto raw = python_inflate(idat, ok);
+  ASSERT_TRUE(ok);
+  const size_t stride = size_t(img.width) * 3;
+  ASSERT_EQ(raw.size(), (stride + 1) * size_t(img.height));
+  // Undo the filters (PNG spec §9) and compare every byte.
+  std::vector<uint8_t> prev(stride, 0), cur(stride);
+  for (int y = 0; y < img.height; ++y) {
+    const uint8_t type = raw[size_t(y) * (stride + 1)];
+    ASSERT_LE(type, 4);
+    const uint8_t* f = &raw[size_t(y) * (stride + 1) + 1];
+    for (size_t i = 0; i < stride; ++i) {
+      const int a = i >= 3 ? cur[i - 3] : 0, b = prev[i], c = i >= 3 ? prev[i - 3] : 0;
+      int pred = 0;
+      if (type == 1) pred = a;
+      else if (type == 2) pred = b;
+      else if (type == 3) pred = (a + b) / 2;
+      else if (type == 4) {
+        const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+        pred = (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
+      }
+      cur[i] = uint8_t((f[i] + pred) & 0xFF);
+    }
+    for (size_t i = 0; i < stride; ++i) ASSERT_EQ(cur[i], img.rgb[size_t(y) * stride + i]) << "row " << y;
+    prev = cur;
+  }
+}
+
+TEST(Png, WriteIsAtomicAndFailureLeavesNothing) {
+  const fs::path p = scratch("a.png");
+  write_png(p, Image8(4, 3, 200));
+  EXPECT_EQ(read_bytes(p), encode_png(Image8(4, 3, 200)));
+  fs::remove(p);
+  const fs::path bad = fs::path(PRT_TEST_TMP) / "no-such-dir" / "x.png";
+  EXPECT_THROW(write_png(bad, Image8(4, 3)), InputError);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+TEST(ToneMap, SrgbEndpointsAndExposure) {
+  Image im(4, 1);
+  const float v[4] = {0.0f, 1.0f, 0.5f, 10.0f};
+  for (int x = 0; x < 4; ++x)
+    for (int c = 0; c < 3; ++c) im.at(x, 0)[c] = v[x];
+  const Image8 t = tone_map(im, 1.0);
+  EXPECT_EQ(t.rgb[0], 0);
+  EXPECT_EQ(t.rgb[3], 255);
+  EXPECT_EQ(t.rgb[6], 188);  // 1.055 · 0.5^(1/2.4) − 0.055 = 0.7354 → 187.5 → 188
+  EXPECT_EQ(t.rgb[9], 255);  // clipped
+  EXPECT_EQ(tone_map(im, 0.1).rgb[9], 255);  // 10 · 0.1 = 1
+}
+
+TEST(Nrmse, IdenticalIsZeroAndOffsetIsClosedForm) {
+  Image ref(8, 8), test(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) ref.at(x, y)[c] = float(x + 2 * y + c);  // min 0, max 7 + 14 + 2 = 23
+  auto e = compare_images(ref, ref);
+  EXPECT_EQ(e.rmse, 0.0);
+  EXPECT_EQ(e.nrmse, 0.0);
+  EXPECT_EQ(e.pixels, 64u);
+  for (size_t i = 0; i < test.rgb.size(); ++i) test.rgb[i] = ref.rgb[i] + 0.5f;
+  e = compare_images(test, ref);
+  EXPECT_NEAR(e.rmse, 0.5, 1e-12);  // every difference is 0.5 exactly (floats of small integers + ½)
+  EXPECT_NEAR(e.nrmse, 0.5 / 23.0, 1e-12);
+  // A mask restricts both the error and the range: pixel (0,0) only → range 2 (its channels 0, 1, 2).
+  std::vector<uint8_t> mask(64, 0);
+  mask[0] = 1;
+  e = compare_images(test, ref, mask);
+  EXPECT_EQ(e.pixels, 1u);
+  EXPECT_NEAR(e.nrmse, 0.25, 1e-12);
+  // Reference noise σ = 0.3 everywhere: noise-corrected RMSE = sqrt(0.25 − 0.09) = 0.4.
+  Image se(8, 8);
+  for (float& s : se.rgb) s = 0.3f;
+  e = compare_images(test, ref, {}, &se);
+  EXPECT_NEAR(e.ref_noise, 0.3 / 23.0, 1e-7);  // float 0.3
+  EXPECT_NEAR(e.nrmse_noise_corrected, 0.4 / 23.0, 1e-7);
+}
+
+// ---- camera -----------------------------------------------------------------------------------------
+
+TEST(Camera, ParsesAndRejects) {
+  const Camera c = parse_camera("eye=0,1,5:at=0,1,0:fov=30", 64, 32);
+  EXPECT_EQ(c.eye, Vector3d(0, 1, 5));
+  EXPECT_EQ(c.fov_y_degrees, 30);
+  // The centre of the picture looks along forward; the top edge centre is fov/2 above it.
+  EXPECT_NEAR((c.ray_direction(32, 16) - Vector3d(0, 0, -1)).norm(), 0, 1e-15);
+  EXPECT_NEAR(std::acos(c.ray_direction(32, 0).dot(c.forward())), 15 * pi / 180, 1e-12);
+  for (const char* bad : {"", "eye=0,0,1", "eye=0,0,1:at=0,0,1", "eye=0,0,1:at=0,0,0:up=0,0,1", "eye=0,0:at=0,0,0",
+                          "eye=0,0,1:at=0,0,0:fov=180", "eye=0,0,1:at=0,0,0:zoom=2", "eye=a,0,1:at=0,0,0",
+                          "eye=0,0,1:at=0,0,0:eye=1,1,1"})
+    EXPECT_THROW(parse_camera(bad, 8, 8), InputError) << bad;
+  try {
+    parse_camera("eye=0,0,1:at=0,0,0:zoom=2", 8, 8);
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("zoom"), std::string::npos);
+  }
+  EXPECT_EQ(parse_size("256x128"), (std::array<int, 2>{256, 128}));
+  for (const char* bad : {"256", "0x5", "x", "12x-3", "100000x2"}) EXPECT_THROW(parse_size(bad), InputError) << bad;
+}
+
+// ---- rasterizer ---------------------------------------------------------------------------------------
+
+namespace {
+
+// Looking down −Z from (0, 0, d) at the plane z = 0 with a 90° vertical fov: the visible square is
+// [−d·a, d·a] × [−d, d] (a = W/H), pixel (x, y) ↔ world (d a (2(x+½)/W − 1), d (1 − 2(y+½)/H)).
+Camera top_camera(int W, int H, double d = 2) {
+  Camera c;
+  c.eye = {0, 0, d};
+  c.at = {0, 0, 0};
+  c.up = {0, 1, 0};
+  c.fov_y_degrees = 90;
+  c.width = W;
+  c.height = H;
+  return c;
+}
+
+// World point of continuous pixel position (sx, sy) on z = 0 for top_camera.
+Vector3f world_of_pixel(const Camera& c, double sx, double sy) {
+  const double d = c.eye.z(), a = double(c.width) / c.height, t = std::tan(0.5 * c.fov_y_degrees * pi / 180);
+  return Vector3f(float(d * a * t * (2 * sx / c.width - 1)), float(d * t * (1 - 2 * sy / c.height)), 0.0f);
+}
+
+// Coverage count per pixel when each triangle of `mesh` is rasterized alone.
+std::vector<int> coverage(const Mesh& mesh, const Camera& cam) {
+  std::vector<int> count(size_t(cam.width) * size_t(cam.height), 0);
+  for (const auto& t : mesh.triangles) {
+    const Mesh one = make_mesh(mesh.positions, {t}, "one", mesh.normals);
+    const GBuffer g = rasterize(one, cam);
+    for (size_t i = 0; i < count.size(); ++i) count[i] += g.triangle[i] >= 0;
+  }
+  return count;
+}
+
+} // namespace
+
+TEST(Rasterizer, ScreenFillingQuadCoversEveryPixelOnce) {
+  const Camera cam = top_camera(40, 30);
+  // Corners exactly on the frustum's edges (pixel boundaries x = 0, W; y = 0, H).
+  std::vector<Vector3f> p = {world_of_pixel(cam, 0, 0), world_of_pixel(cam, 40, 0), world_of_pixel(cam, 40, 30),
+                             world_of_pixel(cam, 0, 30)};
+  const Mesh quad = make_mesh(p, {{0, 1, 2}, {0, 2, 3}}, "quad");
+  const auto count = coverage(quad, cam);
+  for (size_t i = 0; i < count.size(); ++i) ASSERT_EQ(count[i], 1) << "pixel " << i;
+  EXPECT_EQ(rasterize(quad, cam).covered(), size_t(40 * 30));
+}
+
+TEST(Rasterizer, SharedEdgesThroughPixelCentresCoverEachPixelOnce) {
+  // A fan of 8 triangles around a vertex at a pixel centre, its spokes horizontal, vertical and
+  // diagonal through pixel centres: exactly the edge/vertex ties the top-left rule must settle.
+  const Camera cam = top_camera(32, 32);
+  std::vector<Vector3f> p = {world_of_pixel(cam, 16.5, 16.5)};
+  const int ring[8][2] = {{26, 16}, {26, 6}, {16, 6}, {6, 6}, {6, 16}, {6, 26}, {16, 26}, {26, 26}};
+  for (const auto& r : ring) p.push_back(world_of_pixel(cam, r[0] + 0.5, r[1] + 0.5));
+  std::vector<std::array<uint32_t, 3>> t;
+  for (uint32_t k = 0; k < 8; ++k) t.push_back({0, 1 + k, 1 + (k + 1) % 8});
+  const Mesh fan = make_mesh(p, t, "fan");
+  const auto count = coverage(fan, cam);
+  int total = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const int c = count[size_t(y * 32 + x)];
+      ASSERT_LE(c, 1) << x << "," << y;
+      if (x > 6 && x < 26 && y > 6 && y < 26) {  // strictly inside the square
+        ASSERT_EQ(c, 1) << x << "," << y;
+      }
+      total += c;
+    }
+  // The square's boundary pixel centres lie on edges: the top-left rule gives the top row and the
+  // left column to the fan and the bottom row and right column to the outside: 20 × 20 pixels.
+  EXPECT_EQ(total, 20 * 20);
+}
+
+TEST(Rasterizer, PerspectiveCorrectPositionsAndClipping) {
+  // A tilted quad crossing the camera plane (clipped) seen in perspective: the interpolated world
+  // position of every covered pixel must be the closed-form ray/plane intersection through the pixel
+  // centre. Tolerance 2e-5 · scene size: barycentrics are stored as float (ulp 6e-8), positions as
+  // float, and the ray direction is exact in double.
+  Camera cam;
+  cam.eye = {0, 1, 0};
+  cam.at = {0, 0.2, -3};
+  cam.fov_y_degrees = 70;
+  cam.width = 48;
+  cam.height = 40;
+  const Vector3d n = Vector3d(0.1, 1, 0.05).normalized();
+  const double offset = 0.0;  // plane n·x = 0 through the origin
+  auto on_plane = [&](double x, double z) {  // solve n·(x, y, z) = 0 for y
+    return Vector3f(float(x), float(-(n.x() * x + n.z() * z) / n.y()), float(z));
+  };
+  const Mesh quad = make_mesh({on_plane(-20, 20), on_plane(20, 20), on_plane(20, -20), on_plane(-20, -20)},
+                              {{0, 1, 2}, {0, 2, 3}}, "plane");
+  const GBuffer g = rasterize(quad, cam);
+  size_t checked = 0;
+  double worst = 0;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const Fragment f = make_fragment(quad, g, x, y);
+      const Vector3d d = cam.ray_direction(x + 0.5, y + 0.5);
+      const double t = (offset - n.dot(cam.eye)) / n.dot(d);
+      const bool hits = t > 0 && std::abs((cam.eye + t * d).x()) < 20 && std::abs((cam.eye + t * d).z()) < 20;
+      if (!hits) {
+        EXPECT_LT(f.triangle, 0) << x << "," << y;
+        continue;
+      }
+      ASSERT_GE(f.triangle, 0) << x << "," << y;
+      worst = std::max(worst, (f.p - (cam.eye + t * d)).norm());
+      EXPECT_NEAR(g.depth[size_t(y * cam.width + x)], t * d.dot(cam.forward()), 2e-5 * 40 + 1e-5 * t);
+      ++checked;
+    }
+  EXPECT_GT(checked, size_t(cam.width * cam.height / 3));
+  EXPECT_LT(worst, 2e-5 * 40);
+  // The ray tracer's primary hits see the same triangles at the same points.
+  const ReferenceRenderer rr(quad, EnvMap::constant({1, 1, 1}), {});
+  const GBuffer h = rr.trace_primary(cam);
+  size_t same = 0;
+  for (size_t i = 0; i < g.triangle.size(); ++i) same += (g.triangle[i] >= 0) == (h.triangle[i] >= 0);
+  EXPECT_GE(same, g.triangle.size() - 2);  // the far edge may flip a pixel or two (float ray vs double edge)
+}
+
+TEST(Rasterizer, GouraudInterpolationIsExactForLinearAttributes) {
+  // Per-vertex colour = world x: the interpolated colour must equal the fragment's x (linear in
+  // the triangle), to float precision.
+  const Camera cam = top_camera(24, 24);
+  std::vector<Vector3f> p = {world_of_pixel(cam, 1, 2), world_of_pixel(cam, 23, 5), world_of_pixel(cam, 8, 22)};
+  p[1].z() = -1.0f;  // tilted: perspective matters
+  const Mesh tri = make_mesh(p, {{0, 1, 2}}, "tri");
+  std::vector<float> rgb;
+  for (const auto& q : p) rgb.insert(rgb.end(), {q.x(), q.y(), q.z()});
+  const GBuffer g = rasterize(tri, cam);
+  const Image im = interpolate_vertices(tri, g, rgb);
+  ASSERT_GT(g.covered(), 50u);
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 24; ++x) {
+      const Fragment f = make_fragment(tri, g, x, y);
+      if (f.triangle < 0) continue;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(im.at(x, y)[c], f.p[c], 1e-5);
+    }
+}
+
+// ---- irradiance and the reference ----------------------------------------------------------------------------
+
+TEST(UnoccludedIrradiance, MatchesFlatSumAndTheExactDifMap) {
+  const int W = 256, H = 128;
+  std::vector<float> rgb(size_t(W * H * 3));
+  uint64_t h = 7;
+  for (float& v : rgb) v = 0.5f + float(to_unit(h = mix64(h)));  // in [0.5, 1.5)
+  const EnvMap env = EnvMap::from_latlong(W, H, rgb, UpAxis::Y, "random");
+  const UnoccludedIrradiance E(env);
+  // (a) The tile hierarchy is the flat texel sum Σ_t L_t max(0, n·M_t) (same M_t recipe) to rounding.
+  std::vector<Vector3d> M(size_t(env.texel_count()));
+  for (int t = 0; t < env.texel_count(); ++t) {
+    Vector3d m = Vector3d::Zero();
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) m += env.sample_texel(t, (a + 0.5) / 4, (b + 0.5) / 4);
+    M[size_t(t)] = m * env.texel_solid_angle(t) / 16;
+  }
+  for (int k = 0; k < 12; ++k) {
+    const double u0 = to_unit(h = mix64(h)), u1 = to_unit(h = mix64(h));
+    const Vector3d n = uniform_sphere(u0, u1);
+    double flat = 0;
+    for (int t = 0; t < env.texel_count(); ++t) flat += env.texel_value(t).r * std::max(0.0, n.dot(M[size_t(t)]));
+    EXPECT_NEAR(E(n).r, flat, 1e-11 * flat);
+  }
+  // (b) Against the exact DifMap of bake/fiv.h (horizon-cut texels 4×4 sub-sampled there): the
+  // header's bound 2π δ² L_max with δ the largest texel diameter (√2 · 2π/(W−1) at the equator).
+  const auto cube = irradiance_cube(env, 3);
+  const double delta = std::sqrt(2.0) * 2 * pi / (W - 1), bound = 2 * pi * delta * delta * 1.5;
+  for (int face = 0; face < 6; ++face)
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) {
+        const Rgb e = E(cube_direction(face, r, q, 3));
+        EXPECT_NEAR(e.g, cube[size_t(((face * 3 + r) * 3 + q) * 3 + 1)], bound);
+      }
+  // Constant environment: π L exactly.
+  EXPECT_EQ(UnoccludedIrradiance(EnvMap::constant({2, 2, 2}))(Vector3d(0, 1, 0)).r, 2 * pi);
+}
+
+TEST(Reference, UnoccludedPlaneUnderConstantSkyIsPiL) {
+  const Mesh ground = ground_quad(0.0, 0.0, 0.0, 5.0);
+  const EnvMap env = EnvMap::constant({0.5, 1.0, 2.0});
+  ReferenceOptions opt;
+  opt.samples = 64;
+  const ReferenceRenderer rr(ground, env, opt);
+  Camera cam;
+  cam.eye = {0, 3, 4};
+  cam.at = {0, 0, 0};
+  cam.width = cam.height = 24;
+  const ReferenceImage ref = rr.render(cam);
+  ASSERT_GT(ref.gbuffer.covered(), 100u);
+  const double L[3] = {0.5, 1.0, 2.0};
+  for (size_t i = 0; i < ref.gbuffer.triangle.size(); ++i) {
+    if (ref.gbuffer.triangle[i] < 0) continue;
+    // E/π = L: within 4 standard errors plus float rounding of the stored value (the plane cannot
+    // shadow itself, so the QMC term is exactly 0 and so is its standard error).
+    for (size_t c = 0; c < 3; ++c) {
+      EXPECT_NEAR(ref.radiance.rgb[3 * i + c], L[c], 4 * ref.std_error.rgb[3 * i + c] + 1e-6 * L[c]);
+      EXPECT_EQ(ref.std_error.rgb[3 * i + c], 0.0f);
+    }
+  }
+}
+
+TEST(Reference, SquareOccluderMatchesLambertFormFactor) {
+  // A 2 × 2 square at height 1 over a ground plane, constant sky L: at a ground point, E = π L (1 − F)
+  // with F the square's form factor (Lambert's polygon formula, tests/common/test_scenes.h).
+  std::vector<Vector3f> p = {{-1, 1, -1}, {1, 1, -1}, {1, 1, 1}, {-1, 1, 1}};
+  const Mesh square = make_mesh(p, {{0, 2, 1}, {0, 3, 2}}, "square");
+  const Mesh ground = ground_quad(0.0, 0.0, 0.0, 10.0);
+  const Mesh parts[2] = {ground, square};
+  const Mesh scene = merge_meshes(parts, "scene");
+  const EnvMap env = EnvMap::constant({1, 1, 1});
+  std::vector<Vector3d> poly = {{-1, 1, -1}, {1, 1, -1}, {1, 1, 1}, {-1, 1, 1}};
+  for (bool cones : {false, true}) {
+    ReferenceOptions opt;
+    opt.samples = 4096;
+    if (cones) opt.occluder_spheres.push_back({Vector3d(0, 1, 0), std::sqrt(2.0)});
+    const ReferenceRenderer rr(scene, env, opt);
+    for (double x : {0.0, 0.7, 1.5, 3.0}) {
+      Fragment f;
+      f.triangle = 0;
+      f.p = {x, 0, 0.3};
+      f.n = f.ng = {0, 1, 0};
+      double E[3], se[3];
+      rr.irradiance(f, uint64_t(x * 10), E, se);
+      const double F = prt::testing::polygon_form_factor(f.p, f.n, poly);
+      EXPECT_GT(se[0], 0.0);
+      // 4 standard errors (the estimate is unbiased; its error is statistical).
+      EXPECT_NEAR(E[0], pi * (1 - F), 4 * se[0]) << "x " << x << " cones " << cones << " F " << F;
+      EXPECT_LT(se[0], 0.02 * pi);  // and precise enough to mean something (2 % of π L at 4096 rays)
+    }
+  }
+}
