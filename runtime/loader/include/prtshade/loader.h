@@ -1,0 +1,86 @@
+// prtshade/loader.h — the optional HDF5 loader of prtshade (target prt::prtshade_hdf5): reads a
+// baked .prt.h5 file (formats/SCHEMA.md, schema v1 and v2) with formats/ and returns plain owning
+// arrays in the file's own layout, plus the non-owning views the std-only core shades with
+// (<prtshade/fiv.h> FivOccluder / DifMap). The core never needs HDF5; an engine with its own
+// asset pipeline can skip this library and fill the views itself.
+//
+// Layout (unchanged from the file; V vertices, T triangles, L = sh_order):
+//   positions, normals [V][3] float; triangles [T][3] uint32; ao [V]; transfer [V][L²];
+//   visibility [V][L²]; radiance_band1 [V][RGB][m = −1, 0, 1];
+//   fiv_environment [RGB][xyz]; irradiance_cube [6][S][S][RGB];
+//   occluder shells [Nρ][Nθ][Nφ][RGB][xyz], valid [Nρ][Nθ][Nφ], radii [Nρ] (the file stores the
+//   radii, centre and radius as float64 attributes; they are rounded once to float here).
+// Vertex sets: a v1 file (and the root layout of a v2 file) has one, named ""; a v2 scene file has
+// one per /objects/<name> as well (named "<name>"), root first then by name.
+// Errors: prt::formats::FormatError "<file>: <defect>" for anything unreadable or inconsistent,
+// including occluder data the core would refuse (prt::shade::validate_occluder / validate_difmap).
+#pragma once
+
+#include <prtshade/fiv.h>
+
+#include <formats/prtfile.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace prt::shade {
+
+struct LoadedVertexSet {
+  std::string name;                // "" for the root layout, else the object's name
+  std::vector<float> positions;    // [V][3]
+  std::vector<float> normals;      // [V][3] or empty
+  std::vector<uint32_t> triangles; // [T][3] or empty
+  std::vector<float> ao;           // [V] or empty
+  int transfer_order = 0;          // L of /transfer/diffuse (0: absent)
+  std::vector<float> transfer;     // [V][L²]
+  int visibility_order = 0;        // L of /transfer/visibility (0: absent)
+  std::vector<float> visibility;   // [V][L²]
+  std::vector<float> radiance_band1;  // [V][3][3] or empty
+
+  std::size_t vertex_count() const noexcept { return positions.size() / 3; }
+};
+
+struct LoadedOccluder {
+  std::string name;  // <name> of /fiv/occluders/<name>
+  std::array<float, 3> centre{};
+  float radius = 0;
+  int n_rho = 0, n_theta = 0, n_phi = 0;
+  std::vector<float> radii;     // [Nρ]
+  std::vector<float> shells;    // [Nρ][Nθ][Nφ][3][3]
+  std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  std::string grid;             // the file's angular-convention string ("" if absent)
+  std::vector<formats::Attr> attrs;  // every attribute of the shells dataset, as stored
+
+  // View for the core; valid while this object lives and is not modified.
+  FivOccluder view() const noexcept;
+};
+
+struct LoadedAsset {
+  std::filesystem::path path;
+  int64_t format_version = 0;
+  std::string up_axis;  // "y" or "z"
+  std::vector<LoadedVertexSet> vertex_sets;
+
+  bool has_fiv_environment = false;
+  std::array<float, 9> fiv_environment{};  // [RGB][xyz]
+  int irradiance_cube_size = 0;            // S (0: absent)
+  std::vector<float> irradiance_cube;      // [6][S][S][3]
+  std::vector<LoadedOccluder> occluders;   // sorted by name
+
+  // The vertex set named `name` ("" = root layout), or nullptr.
+  const LoadedVertexSet* find_vertex_set(std::string_view name) const noexcept;
+  // The DifMap view ({0, nullptr} when the file has no /fiv/irradiance_cube).
+  DifMap difmap() const noexcept;
+  // Views of every occluder, in `occluders` order.
+  std::vector<FivOccluder> occluder_views() const;
+};
+
+// Reads `path` (formats::read_file with the full schema check) into a LoadedAsset.
+LoadedAsset load_prt(const std::filesystem::path& path);
+
+} // namespace prt::shade

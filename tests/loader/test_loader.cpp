@@ -1,0 +1,151 @@
+// Tests of prtshade/loader.h (prt::prtshade_hdf5): a file written by the real writer comes back as
+// the same arrays, its views shade exactly like views of the original arrays, scene objects (v2)
+// are separate vertex sets, and broken occluder data is refused with a message naming the file.
+#include <prtshade/loader.h>
+#include <prtshade/shade.h>
+
+#include <formats/prtfile.h>
+#include <formats/testing.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace {
+
+using prt::formats::Attr;
+using prt::formats::Dataset;
+using prt::formats::File;
+
+std::filesystem::path tmp(const std::string& name) { return std::filesystem::path(PRT_TEST_TMP) / name; }
+
+std::vector<float> ramp(size_t n, float scale) {
+  std::vector<float> v(n);
+  for (size_t k = 0; k < n; ++k) v[k] = scale * float(k % 97) - 1.0f;
+  return v;
+}
+
+File make_file(bool with_object) {
+  File f;
+  f.root_attrs = {{"generator", std::string("test_loader")},
+                  {"created", std::string("2024-01-02T03:04:05Z")},
+                  {"command_line", std::string("test_loader")},
+                  {"source", std::string("synthetic")},
+                  {"source_sha256", std::string(64, 'b')},
+                  {"up_axis", std::string("y")},
+                  {"sh_convention", std::string("real orthonormal, i = l(l+1)+m, Condon-Shortley")}};
+  const uint64_t V = 3;
+  f.datasets.push_back({"/mesh/positions", {V, 3}, std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}, {}});
+  f.datasets.push_back({"/mesh/normals", {V, 3}, std::vector<float>{0, 0, 1, 0, 0, 1, 0.6f, 0, 0.8f}, {}});
+  f.datasets.push_back({"/mesh/triangles", {1, 3}, std::vector<uint32_t>{0, 1, 2}, {}});
+  f.datasets.push_back({"/ao", {V}, std::vector<float>{1, 0.5f, 0.25f}, {}});
+  f.datasets.push_back({"/transfer/diffuse", {V, 9}, ramp(V * 9, 0.01f), {{"sh_order", int64_t{3}}}});
+  f.datasets.push_back({"/radiance/band1", {V, 3, 3}, ramp(V * 9, 0.02f), {}});
+  f.datasets.push_back({"/fiv/environment", {3, 3}, std::vector<float>{1, 2, 3, 4, 5, 6, 7, 8, 9}, {}});
+  f.datasets.push_back({"/fiv/irradiance_cube", {6, 2, 2, 3}, ramp(6 * 2 * 2 * 3, 0.5f), {}});
+  const uint64_t nr = 2, nt = 3, np = 4;
+  f.datasets.push_back({"/fiv/occluders/rock/shells", {nr, nt, np, 3, 3}, ramp(nr * nt * np * 9, 0.03f),
+                        {{"centre", std::vector<double>{0.5, 2.0, -1.0}},
+                         {"radius", 0.75},
+                         {"radii", std::vector<double>{0.375, 1.5}},
+                         {"grid", std::string("theta from +Y, phi from +Z towards +X")}}});
+  std::vector<uint8_t> valid(nr * nt * np, 1);
+  valid[5] = 0;
+  f.datasets.push_back({"/fiv/occluders/rock/valid", {nr, nt, np}, valid, {}});
+  if (with_object) {
+    f.datasets.push_back({"/objects/tree/mesh/positions", {2, 3}, std::vector<float>{5, 5, 5, 6, 6, 6}, {}});
+    f.datasets.push_back({"/objects/tree/mesh/normals", {2, 3}, std::vector<float>{0, 1, 0, 1, 0, 0}, {}});
+    f.datasets.push_back({"/objects/tree/ao", {2}, std::vector<float>{0.125f, 1}, {}});
+  }
+  return f;
+}
+
+TEST(Loader, ArraysAndViewsMatchTheFile) {
+  const File f = make_file(false);
+  const auto path = tmp("loader_roundtrip.prt.h5");
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  ASSERT_EQ(a.vertex_sets.size(), 1u);
+  const prt::shade::LoadedVertexSet* v = a.find_vertex_set("");
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(v->vertex_count(), 3u);
+  EXPECT_EQ(a.up_axis, "y");
+  // Float data round-trips bit for bit through HDF5 float32.
+  EXPECT_EQ(v->positions, std::get<std::vector<float>>(f.datasets[0].data));
+  EXPECT_EQ(v->transfer, std::get<std::vector<float>>(f.datasets[4].data));
+  EXPECT_EQ(v->transfer_order, 3);
+  EXPECT_EQ(v->radiance_band1, std::get<std::vector<float>>(f.datasets[5].data));
+  EXPECT_EQ(v->triangles, (std::vector<uint32_t>{0, 1, 2}));
+  ASSERT_TRUE(a.has_fiv_environment);
+  EXPECT_EQ(a.fiv_environment[8], 9.0f);
+  ASSERT_EQ(a.occluders.size(), 1u);
+  const prt::shade::LoadedOccluder& o = a.occluders[0];
+  EXPECT_EQ(o.name, "rock");
+  EXPECT_EQ(o.n_rho, 2);
+  EXPECT_EQ(o.n_theta, 3);
+  EXPECT_EQ(o.n_phi, 4);
+  EXPECT_EQ(o.radius, 0.75f);  // exact binary fractions: the double → float rounding is exact
+  EXPECT_EQ(o.centre[1], 2.0f);
+  EXPECT_EQ(o.radii, (std::vector<float>{0.375f, 1.5f}));
+  EXPECT_EQ(o.grid, "theta from +Y, phi from +Z towards +X");
+  EXPECT_EQ(o.valid[5], 0);
+
+  // Shading with the loaded views equals shading with views of the original arrays.
+  const auto& shells = std::get<std::vector<float>>(f.datasets[8].data);
+  const auto& valid = std::get<std::vector<uint8_t>>(f.datasets[9].data);
+  const std::vector<float> radii = {0.375f, 1.5f};
+  const prt::shade::FivOccluder direct{{0.5f, 2.0f, -1.0f}, 0.75f, 2, 3, 4, radii.data(), shells.data(), valid.data()};
+  const auto& cube = std::get<std::vector<float>>(f.datasets[7].data);
+  const prt::shade::DifMap map{2, cube.data()};
+  const std::vector<prt::shade::FivOccluder> views = a.occluder_views();
+  const float p[3] = {0.2f, 0.1f, -0.3f}, n[3] = {0, 1, 0};
+  float e_loaded[3], e_direct[3];
+  prt::shade::shade_fiv(a.difmap(), views.data(), 1, p, n, {}, e_loaded);
+  prt::shade::shade_fiv(map, &direct, 1, p, n, {}, e_direct);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(e_loaded[c], e_direct[c]);  // the same data, the same code
+  float b1[3];
+  prt::shade::shade_band1(v->normals.data() + 6, v->radiance_band1.data() + 18, b1);
+  for (float x : b1) EXPECT_TRUE(std::isfinite(x));
+}
+
+TEST(Loader, SceneObjectsAreSeparateVertexSets) {
+  const auto path = tmp("loader_objects.prt.h5");
+  prt::formats::write_file(path, make_file(true));
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  ASSERT_EQ(a.vertex_sets.size(), 2u);
+  const prt::shade::LoadedVertexSet* tree = a.find_vertex_set("tree");
+  ASSERT_NE(tree, nullptr);
+  EXPECT_EQ(tree->vertex_count(), 2u);
+  EXPECT_EQ(tree->ao, (std::vector<float>{0.125f, 1}));
+  EXPECT_EQ(a.find_vertex_set("")->vertex_count(), 3u);
+  EXPECT_EQ(a.find_vertex_set("nope"), nullptr);
+}
+
+TEST(Loader, BrokenOccluderIsRefusedNamingTheFile) {
+  File f = make_file(false);
+  for (Dataset& d : f.datasets)
+    if (d.path == "/fiv/occluders/rock/shells")
+      for (Attr& at : d.attrs)
+        if (at.name == "radii") at.value = std::vector<double>{1.5, 0.375};  // decreasing
+  const auto path = tmp("loader_bad_radii.prt.h5");
+  prt::formats::testing::write_file_unvalidated(path, [&] {
+    File g = f;
+    g.root_attrs.push_back({"format", std::string("prtbake")});
+    g.root_attrs.push_back({"format_version", int64_t{2}});
+    return g;
+  }());
+  try {
+    prt::shade::load_prt(path);
+    FAIL() << "decreasing radii accepted";
+  } catch (const prt::formats::FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("radi"), std::string::npos) << what;
+  }
+  EXPECT_THROW(prt::shade::load_prt(tmp("no_such_file.prt.h5")), prt::formats::FormatError);
+}
+
+} // namespace
