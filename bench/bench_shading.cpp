@@ -1,0 +1,132 @@
+// bench_shading — run-time shading cost of prtshade (issue 5): per vertex for the diffuse PRT
+// dot product transfer · light (orders 3 and 6) and for band-1 shading, and per pixel for FIV
+// shading (paper 004 §4.3) with 1, 10 and 100 occluders, the fast path next to its slow
+// reference (shade_fiv_reference: double, every pair, acos) in one run.
+//
+//   BM_ShadeTransfer/order:L        shade_transfer, 4096 vertices per iteration
+//   BM_ShadeBand1                   shade_band1, 4096 vertices per iteration
+//   BM_ShadeFiv/occluders:N         shade_fiv, 4096 receivers per iteration, both corrections on
+//   BM_ShadeFivReference/occluders:N  the slow reference on the same inputs
+//
+// Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
+// "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
+// the paper's 64x33x30 size (Nφ × Nθ × Nρ, radii 0.5 R … 16 R, 2.3 MB) shared by all occluders
+// (instances of one baked asset, as a forest of one tree), occluders of radius 1 scattered over a
+// 40 × 40 area from 1.5 below to 4 units above a ground plane, receivers on the plane inside it (normal +Y), so
+// occluders are in cases A, B and C and many pairs overlap; a 32² DifMap.
+#include <prtshade/fiv.h>
+#include <prtshade/shade.h>
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace {
+
+constexpr int kItems = 4096;
+
+void per_item(benchmark::State& state) {
+  state.SetItemsProcessed(int64_t(state.iterations()) * kItems);
+  state.counters["per_item"] =
+      benchmark::Counter(double(kItems), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+std::vector<float> normal_floats(size_t n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  std::vector<float> v(n);
+  for (float& x : v) x = g(rng);
+  return v;
+}
+
+void BM_ShadeTransfer(benchmark::State& state) {
+  const int order = int(state.range(0)), n = order * order;
+  const std::vector<float> transfer = normal_floats(size_t(kItems) * size_t(n), 1);
+  const std::vector<float> light = normal_floats(size_t(3 * n), 2);
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int v = 0; v < kItems; ++v) prt::shade::shade_transfer(transfer.data() + size_t(v) * size_t(n), order, light.data(), out.data() + 3 * v);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+BENCHMARK(BM_ShadeTransfer)->ArgName("order")->Arg(3)->Arg(6);
+
+void BM_ShadeBand1(benchmark::State& state) {
+  std::vector<float> normals = normal_floats(size_t(3 * kItems), 3);
+  for (int v = 0; v < kItems; ++v) {
+    float* nv = normals.data() + 3 * v;
+    const float len = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    for (int a = 0; a < 3; ++a) nv[a] /= len;
+  }
+  const std::vector<float> radiance = normal_floats(size_t(9 * kItems), 4);
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int v = 0; v < kItems; ++v) prt::shade::shade_band1(normals.data() + 3 * v, radiance.data() + 9 * v, out.data() + 3 * v);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+BENCHMARK(BM_ShadeBand1);
+
+struct FivScene {
+  int n_phi = 64, n_theta = 33, n_rho = 30;
+  std::vector<float> radii, shells, cube, positions;
+  std::vector<uint8_t> valid;
+  std::vector<prt::shade::FivOccluder> occluders;
+
+  explicit FivScene(int count) {
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> u01(0, 1);
+    for (int k = 0; k < n_rho; ++k) radii.push_back(0.5f * std::pow(32.0f, float(k) / float(n_rho - 1)));
+    const size_t samples = size_t(n_rho) * size_t(n_theta) * size_t(n_phi);
+    shells.resize(samples * 9);
+    for (float& x : shells) x = u01(rng);
+    valid.assign(samples, 1);
+    for (size_t s = 0; s < size_t(n_theta) * size_t(n_phi); ++s) valid[s] = uint8_t(u01(rng) > 0.3f);  // inner shell partly inside
+    cube.resize(size_t(6 * 32 * 32 * 3));
+    for (float& x : cube) x = 5 + u01(rng);
+    for (int i = 0; i < count; ++i) {
+      const float c[3] = {40 * u01(rng) - 20, 5.5f * u01(rng) - 1.5f, 40 * u01(rng) - 20};
+      occluders.push_back({{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()});
+    }
+    for (int p = 0; p < kItems; ++p) {
+      positions.push_back(40 * u01(rng) - 20);
+      positions.push_back(0);
+      positions.push_back(40 * u01(rng) - 20);
+    }
+  }
+};
+
+template <bool kReference>
+void shade_fiv_case(benchmark::State& state) {
+  const FivScene scene(int(state.range(0)));
+  const prt::shade::DifMap map{32, scene.cube.data()};
+  const float n[3] = {0, 1, 0};
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int p = 0; p < kItems; ++p) {
+      const float* pos = scene.positions.data() + 3 * p;
+      if constexpr (kReference)
+        prt::shade::shade_fiv_reference(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, {}, out.data() + 3 * p);
+      else
+        prt::shade::shade_fiv(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, {}, out.data() + 3 * p);
+    }
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+void BM_ShadeFiv(benchmark::State& state) { shade_fiv_case<false>(state); }
+void BM_ShadeFivReference(benchmark::State& state) { shade_fiv_case<true>(state); }
+BENCHMARK(BM_ShadeFiv)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
+BENCHMARK(BM_ShadeFivReference)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
+
+} // namespace
+
+BENCHMARK_MAIN();
