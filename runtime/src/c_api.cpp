@@ -7,6 +7,7 @@
 #include <prtshade/shade.h>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <exception>
@@ -20,6 +21,13 @@
 #ifndef PRTSHADE_VERSION
 #error "PRTSHADE_VERSION must be defined by the build"
 #endif
+
+// prt_fiv_occluder_desc is the C spelling of prt::shade::FivOccluder: the same members in the same
+// order (the C header cannot include the C++ one), kept in step by these checks.
+static_assert(sizeof(prt_fiv_occluder_desc) == sizeof(prt::shade::FivOccluder));
+static_assert(offsetof(prt_fiv_occluder_desc, radius) == offsetof(prt::shade::FivOccluder, radius));
+static_assert(offsetof(prt_fiv_occluder_desc, n_phi) == offsetof(prt::shade::FivOccluder, n_phi));
+static_assert(offsetof(prt_fiv_occluder_desc, valid) == offsetof(prt::shade::FivOccluder, valid));
 
 struct prt_sh_rotation {
   explicit prt_sh_rotation(const double R[3][3], int order) : rotation(R, order) {}
