@@ -7,6 +7,7 @@
 //   BM_ShadeBand1                   shade_band1, 4096 vertices per iteration
 //   BM_ShadeFiv/occluders:N         shade_fiv, 4096 receivers per iteration, both corrections on
 //   BM_ShadeFivReference/occluders:N  the slow reference on the same inputs
+//   BM_ShadeFivNoOverlap/occluders:N  shade_fiv without the overlap correction (its pair-loop share)
 //
 // Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
 // "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
@@ -103,19 +104,20 @@ struct FivScene {
   }
 };
 
-template <bool kReference>
+template <bool kReference, bool kOverlap = true>
 void shade_fiv_case(benchmark::State& state) {
   const FivScene scene(int(state.range(0)));
   const prt::shade::DifMap map{32, scene.cube.data()};
   const float n[3] = {0, 1, 0};
+  const prt::shade::FivShadeOptions options{true, kOverlap};
   std::vector<float> out(size_t(3 * kItems));
   for (auto _ : state) {
     for (int p = 0; p < kItems; ++p) {
       const float* pos = scene.positions.data() + 3 * p;
       if constexpr (kReference)
-        prt::shade::shade_fiv_reference(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, {}, out.data() + 3 * p);
+        prt::shade::shade_fiv_reference(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, options, out.data() + 3 * p);
       else
-        prt::shade::shade_fiv(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, {}, out.data() + 3 * p);
+        prt::shade::shade_fiv(map, scene.occluders.data(), int(scene.occluders.size()), pos, n, options, out.data() + 3 * p);
     }
     benchmark::DoNotOptimize(out.data());
     benchmark::ClobberMemory();
@@ -124,8 +126,10 @@ void shade_fiv_case(benchmark::State& state) {
 }
 void BM_ShadeFiv(benchmark::State& state) { shade_fiv_case<false>(state); }
 void BM_ShadeFivReference(benchmark::State& state) { shade_fiv_case<true>(state); }
+void BM_ShadeFivNoOverlap(benchmark::State& state) { shade_fiv_case<false, false>(state); }
 BENCHMARK(BM_ShadeFiv)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivReference)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
+BENCHMARK(BM_ShadeFivNoOverlap)->ArgName("occluders")->Arg(10)->Arg(100);
 
 } // namespace
 
