@@ -1,0 +1,720 @@
+// runtime/shaders/fiv.glsl run as a Vulkan compute shader (lavapipe on CI) against the C++ core
+// (prt::shade::lookup_fiv, lookup_difmap, partial_factor, occluded_irradiance, shade_fiv,
+// shade_fiv_self) and against a double-precision transcription of the contract
+// (spec/runtime_api.md), on synthetic occluders: random shells with invalid samples (one cell
+// wholly invalid), several grid sizes including the minimal 1 × 2 × 1, receivers at the poles,
+// across the φ seam, inside the first shell, at ρ = 0 and beyond the last shell.
+//
+// Tolerances. Both implementations round the same float inputs; their results differ through
+// (a) the grid coordinates (θ, φ, ρ) they compute — GLSL: A&S atan2 + float rounding, within
+//     16 ulps of π in θ and of 2π in φ and 8 ulps of ρ; C++: the same bounds plus acos(d_y) near
+//     the poles, whose error is min(2ε/sin θ, 2√ε) (ε = 2^-24: d_y is rounded to float and
+//     acos' = −1/sin θ) — and
+// (b) the rounding of the weighted sums, ≤ 32 ε × the largest |sample| involved.
+// (a) is turned into a value bound by evaluating the double reference at the corners of the box
+// of coordinate perturbations and taking twice the largest change (the lookup is piecewise
+// multilinear; the factor 2 covers a texel boundary inside the box). So a tolerance is large
+// exactly where the lookup is ill-conditioned (renormalisation over nearly weightless valid
+// samples, a wholly invalid face) and ~1e-6 relative elsewhere. The shading functions compose
+// these bounds through their formulas (stated where they are computed).
+#include "shader_test.h"
+
+#include <prtshade/fiv.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+namespace {
+
+using prt::test::kFloatEps;
+constexpr double kPi = 3.14159265358979323846;
+using Fiv9 = std::array<double, 9>;
+
+// ---------------------------------------------------------------------------------------------
+// Synthetic data
+
+struct SynthOccluder {
+  float centre[3];
+  float radius;
+  int n_rho, n_theta, n_phi;
+  std::vector<float> radii, shells;
+  std::vector<uint8_t> valid;
+  prt::shade::FivOccluder view() const {
+    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
+  }
+  std::size_t sample(int k, int i, int j) const {
+    return (static_cast<std::size_t>(k) * static_cast<std::size_t>(n_theta) + static_cast<std::size_t>(i)) *
+               static_cast<std::size_t>(n_phi) +
+           static_cast<std::size_t>(j);
+  }
+};
+
+// Random shells: per channel a smooth decaying field plus noise (values of both signs, as
+// occluded FIVs have), the pole rows constant in φ (they are one point), ~20% invalid samples.
+SynthOccluder make_occluder(std::mt19937& rng, const std::array<float, 3>& centre, float radius, int n_rho,
+                            int n_theta, int n_phi) {
+  SynthOccluder o{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, {}, {}, {}};
+  std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+  for (int k = 0; k < n_rho; ++k) o.radii.push_back(radius * 0.5f * std::pow(2.0f, float(k) * 3.0f / float(std::max(1, n_rho - 1))));
+  o.shells.resize(o.sample(n_rho, 0, 0) * 9);
+  o.valid.resize(o.sample(n_rho, 0, 0));
+  std::bernoulli_distribution invalid(0.2);
+  for (int k = 0; k < n_rho; ++k)
+    for (int i = 0; i < n_theta; ++i)
+      for (int j = 0; j < n_phi; ++j) {
+        const bool pole = i == 0 || i == n_theta - 1;
+        const std::size_t idx = o.sample(k, i, j);
+        if (pole && j > 0) {  // one point: copy column 0
+          std::copy_n(&o.shells[o.sample(k, i, 0) * 9], 9, &o.shells[idx * 9]);
+          o.valid[idx] = o.valid[o.sample(k, i, 0)];
+          continue;
+        }
+        const float scale = 3.0f / (1.0f + float(k));
+        for (int e = 0; e < 9; ++e) o.shells[idx * 9 + static_cast<std::size_t>(e)] = scale * (0.6f + 0.4f * uni(rng)) * uni(rng);
+        o.valid[idx] = invalid(rng) ? 0 : 1;
+      }
+  return o;
+}
+
+// Packed buffers of fiv.glsl (its header comment): the occluder table (48 bytes each), radii,
+// shells, valid bytes packed 4 per uint (little-endian) from a word boundary, DifMap.
+struct GpuOccluder {
+  float centre_radius[4];
+  int32_t dims[4];
+  uint32_t offsets[4];
+};
+static_assert(sizeof(GpuOccluder) == 48, "std430 PrtFivOccluder is 48 bytes");
+
+struct GpuScene {
+  std::vector<std::byte> occluders, radii, shells, valid, difmap;
+};
+
+GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std::vector<float>& texels) {
+  std::vector<GpuOccluder> table;
+  std::vector<float> radii, shells;
+  std::vector<uint8_t> valid;
+  for (const SynthOccluder& o : occ) {
+    GpuOccluder g{{o.centre[0], o.centre[1], o.centre[2], o.radius},
+                  {o.n_rho, o.n_theta, o.n_phi, 0},
+                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4), 0}};
+    table.push_back(g);
+    radii.insert(radii.end(), o.radii.begin(), o.radii.end());
+    shells.insert(shells.end(), o.shells.begin(), o.shells.end());
+    valid.insert(valid.end(), o.valid.begin(), o.valid.end());
+    valid.resize((valid.size() + 3) / 4 * 4, 0);  // next occluder starts on a word boundary
+  }
+  GpuScene s;
+  s.occluders = prt::test::to_bytes(table);
+  s.radii = prt::test::to_bytes(radii);
+  s.shells = prt::test::to_bytes(shells);
+  s.valid = prt::test::to_bytes(valid);  // little-endian host: the bytes are the packed words
+  const uint32_t header[4] = {uint32_t(difmap_size), 0, 0, 0};
+  s.difmap.resize(16 + texels.size() * sizeof(float));
+  std::memcpy(s.difmap.data(), header, 16);
+  std::memcpy(s.difmap.data() + 16, texels.data(), texels.size() * sizeof(float));
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Double-precision transcription of the contract
+
+struct FivRef {
+  Fiv9 v{};
+  double max_sample = 0;  // largest |stored value| among the 8 neighbours (× falloff)
+  bool plain = false;     // no valid neighbour carries weight: plain trilinear
+};
+
+// The lookup at continuous grid coordinates (t, u, ρ): t clamps to [0, Nθ − 1], u wraps.
+FivRef fiv_at(const SynthOccluder& o, double t, double u, double rho) {
+  t = std::clamp(t, 0.0, double(o.n_theta - 1));
+  const int i0 = std::min(int(std::floor(t)), o.n_theta - 2);
+  const double ft = t - i0;
+  u = std::fmod(u, double(o.n_phi));
+  if (u < 0) u += o.n_phi;
+  const int ju = std::min(int(std::floor(u)), o.n_phi);
+  const double fu = u - ju;
+  const int j0 = ju % o.n_phi, j1 = (ju + 1) % o.n_phi;
+  const int last = o.n_rho - 1;
+  int k0 = 0, k1 = 0;
+  double fr = 0, falloff = 1;
+  if (rho <= o.radii[0] || last == 0) {
+    if (rho > o.radii[0]) falloff = (o.radii[0] / rho) * (o.radii[0] / rho);
+  } else if (rho >= o.radii[static_cast<std::size_t>(last)]) {
+    k0 = k1 = last;
+    falloff = (o.radii[static_cast<std::size_t>(last)] / rho) * (o.radii[static_cast<std::size_t>(last)] / rho);
+  } else {
+    k1 = 1;
+    while (o.radii[static_cast<std::size_t>(k1)] <= rho) ++k1;
+    k0 = k1 - 1;
+    fr = (rho - o.radii[static_cast<std::size_t>(k0)]) /
+         (double(o.radii[static_cast<std::size_t>(k1)]) - o.radii[static_cast<std::size_t>(k0)]);
+  }
+  const int ks[2] = {k0, k1}, is[2] = {i0, i0 + 1}, js[2] = {j0, j1};
+  const double wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  Fiv9 plain{}, masked{};
+  double mw = 0, biggest = 0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const double w = wk[a] * wi[b] * wj[c];
+        const std::size_t idx = o.sample(ks[a], is[b], js[c]);
+        for (int e = 0; e < 9; ++e) {
+          const double v = o.shells[idx * 9 + static_cast<std::size_t>(e)];
+          biggest = std::max(biggest, std::abs(v));
+          plain[static_cast<std::size_t>(e)] += w * v;
+          if (o.valid[idx]) masked[static_cast<std::size_t>(e)] += w * v;
+        }
+        if (o.valid[idx]) mw += w;
+      }
+  FivRef r;
+  for (std::size_t e = 0; e < 9; ++e) r.v[e] = (mw > 0 ? masked[e] / mw : plain[e]) * falloff;
+  r.max_sample = biggest * falloff;
+  r.plain = !(mw > 0);
+  return r;
+}
+
+struct Coords {
+  double t, u, rho, theta;
+};
+Coords coords_of(const SynthOccluder& o, const float s[3]) {
+  const double x = s[0], y = s[1], z = s[2];
+  const double rho = std::sqrt(x * x + y * y + z * z);
+  const double theta = std::atan2(std::hypot(x, z), y);
+  double phi = std::atan2(x, z);
+  if (phi < 0) phi += 2 * kPi;
+  return {theta / kPi * (o.n_theta - 1), phi / (2 * kPi) * o.n_phi, rho, theta};
+}
+
+// Coordinate error budgets (radians, radians, world units) of one implementation.
+struct Budget {
+  double theta, phi, rho;
+};
+Budget glsl_budget(const Coords& c) { return {16 * kFloatEps * kPi, 16 * kFloatEps * 2 * kPi, 8 * kFloatEps * c.rho}; }
+Budget core_budget(const Coords& c) {
+  const double pole = std::min(2 * kFloatEps / std::max(std::sin(c.theta), 1e-300), 2 * std::sqrt(kFloatEps));
+  return {16 * kFloatEps * kPi + pole, 16 * kFloatEps * 2 * kPi, 4 * kFloatEps * c.rho};
+}
+Budget operator+(const Budget& a, const Budget& b) { return {a.theta + b.theta, a.phi + b.phi, a.rho + b.rho}; }
+
+// Per-component tolerance of a lookup at s under coordinate errors `b` (see the file comment).
+Fiv9 fiv_tolerance(const SynthOccluder& o, const float s[3], const Budget& b) {
+  const Coords c = coords_of(o, s);
+  const double dt = b.theta / kPi * (o.n_theta - 1), du = b.phi / (2 * kPi) * o.n_phi;
+  const FivRef centre = fiv_at(o, c.t, c.u, c.rho);
+  Fiv9 tol{};
+  double biggest = centre.max_sample;
+  for (int corner = 0; corner < 8; ++corner) {
+    const FivRef r = fiv_at(o, c.t + (corner & 1 ? dt : -dt), c.u + (corner & 2 ? du : -du),
+                            c.rho + (corner & 4 ? b.rho : -b.rho));
+    biggest = std::max(biggest, r.max_sample);
+    for (std::size_t e = 0; e < 9; ++e) tol[e] = std::max(tol[e], 2 * std::abs(r.v[e] - centre.v[e]));
+  }
+  for (double& t : tol) t += 32 * kFloatEps * biggest;
+  return tol;
+}
+
+// DifMap in double: face of the largest |component| (ties X, Y, Z; zero → +Y), face coordinates
+// (s, t) in [−1, 1], bilinear, clamped to the outermost texel centres.
+struct FacePoint {
+  int face;
+  double s, t;
+};
+FacePoint difmap_face(const double n[3]) {
+  const double ax = std::abs(n[0]), ay = std::abs(n[1]), az = std::abs(n[2]);
+  if (ax >= ay && ax >= az && ax > 0) return {n[0] > 0 ? 0 : 1, (n[0] > 0 ? -n[2] : n[2]) / ax, -n[1] / ax};
+  if (ay >= az && ay > 0) return {n[1] > 0 ? 2 : 3, n[0] / ay, (n[1] > 0 ? n[2] : -n[2]) / ay};
+  if (az > 0) return {n[2] > 0 ? 4 : 5, (n[2] > 0 ? n[0] : -n[0]) / az, -n[1] / az};
+  return {2, 0, 0};
+}
+std::array<double, 3> difmap_bilinear(int size, const std::vector<float>& texels, const FacePoint& fp) {
+  auto axis = [&](double v, int& q0, int& q1, double& f) {
+    const double q = std::clamp((v + 1) * 0.5 * size - 0.5, 0.0, double(size - 1));
+    q0 = std::min(int(q), size - 1);
+    q1 = std::min(q0 + 1, size - 1);
+    f = q - q0;
+  };
+  int q0, q1, r0, r1;
+  double fq, fr;
+  axis(fp.s, q0, q1, fq);
+  axis(fp.t, r0, r1, fr);
+  auto texel = [&](int r, int q, int c) {
+    return double(
+        texels[((static_cast<std::size_t>(fp.face) * size + r) * size + q) * 3 + static_cast<std::size_t>(c)]);
+  };
+  std::array<double, 3> out{};
+  for (int c = 0; c < 3; ++c) {
+    const double top = texel(r0, q0, c) + fq * (texel(r0, q1, c) - texel(r0, q0, c));
+    const double bottom = texel(r1, q0, c) + fq * (texel(r1, q1, c) - texel(r1, q0, c));
+    out[static_cast<std::size_t>(c)] = top + fr * (bottom - top);
+  }
+  return out;
+}
+std::array<double, 3> difmap_at(int size, const std::vector<float>& texels, const double n[3]) {
+  return difmap_bilinear(size, texels, difmap_face(n));
+}
+
+// DifMap tolerance. Both implementations pick the face by exact comparisons of the same floats,
+// so they pick the same face (ties included); they differ only in (s, t), which the division
+// and the texel-coordinate arithmetic round within 16 ε (s, t in [−1, 1]). So: twice the largest
+// change over the box (s ± 16 ε, t ± 16 ε) in that face, plus 16 ε × the largest texel for the
+// bilinear sums.
+std::array<double, 3> difmap_tolerance(int size, const std::vector<float>& texels, const float n[3]) {
+  const double nd[3] = {n[0], n[1], n[2]};
+  const FacePoint fp = difmap_face(nd);
+  const auto centre = difmap_bilinear(size, texels, fp);
+  double biggest = 0;
+  for (float v : texels) biggest = std::max(biggest, double(std::abs(v)));
+  std::array<double, 3> tol{};
+  const double d = 16 * kFloatEps;
+  for (int corner = 0; corner < 4; ++corner) {
+    const auto r = difmap_bilinear(size, texels, {fp.face, fp.s + (corner & 1 ? d : -d), fp.t + (corner & 2 ? d : -d)});
+    for (std::size_t c = 0; c < 3; ++c) tol[c] = std::max(tol[c], 2 * std::abs(r[c] - centre[c]));
+  }
+  for (double& t : tol) t += 16 * kFloatEps * biggest;
+  return tol;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene
+
+struct Receiver {
+  float p[4];
+  float n[4];
+  uint32_t info[4];  // occluder, first, count; w (unused by the kernel): 1 = random receiver
+};
+static_assert(sizeof(Receiver) == 48, "std430 Receiver is 48 bytes");
+
+struct PushBlock {
+  uint32_t count;
+  float env[9];
+};
+
+struct Scene {
+  std::vector<SynthOccluder> occ;
+  int difmap_size = 5;
+  std::vector<float> texels;
+  float env[9];
+  // Occluder groups for shade_fiv: {first, count}.
+  std::vector<std::array<uint32_t, 2>> groups;
+};
+
+Scene make_scene() {
+  std::mt19937 rng(404u);
+  Scene sc;
+  sc.occ.push_back(make_occluder(rng, {0.3f, -0.2f, 0.5f}, 1.0f, 4, 7, 10));
+  // A wholly invalid cell (both shells 0–1, rows 3–4, columns 2–3): plain trilinear inside it.
+  for (int k = 0; k < 2; ++k)
+    for (int i = 3; i < 5; ++i)
+      for (int j = 2; j < 4; ++j) sc.occ[0].valid[sc.occ[0].sample(k, i, j)] = 0;
+  sc.occ.push_back(make_occluder(rng, {1.6f, 0.1f, 0.2f}, 0.7f, 3, 5, 8));
+  sc.occ.push_back(make_occluder(rng, {-0.2f, 0.4f, -1.1f}, 0.5f, 1, 2, 1));  // minimal grid
+  sc.occ.push_back(sc.occ[0]);                                                 // a duplicate: O = ½
+  sc.occ.push_back(make_occluder(rng, {-2.0f, 1.5f, 2.5f}, 0.3f, 5, 9, 16));
+  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}};
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  sc.texels.resize(6 * 5 * 5 * 3);
+  for (float& t : sc.texels) t = 2.0f + 3.0f * uni(rng);
+  for (float& e : sc.env) e = 4.0f * (uni(rng) - 0.5f);
+  return sc;
+}
+
+std::vector<Receiver> make_receivers(const Scene& sc) {
+  std::mt19937 rng(55u);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  auto unit = [&](double v[3]) {
+    const double r = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; ++k) v[k] /= r;
+  };
+  std::vector<Receiver> out;
+  auto add = [&](uint32_t o, const double s[3], const double n[3], uint32_t group, bool random) {
+    const SynthOccluder& oc = sc.occ[o];
+    Receiver r{};
+    for (int k = 0; k < 3; ++k) {
+      r.p[k] = float(oc.centre[k] + s[k]);
+      r.n[k] = float(n[k]);
+    }
+    const auto& gr = sc.groups[group % sc.groups.size()];
+    r.info[0] = o, r.info[1] = gr[0], r.info[2] = gr[1], r.info[3] = random ? 1 : 0;
+    out.push_back(r);
+  };
+  uint32_t serial = 0;
+  for (uint32_t o = 0; o < sc.occ.size(); ++o) {
+    const SynthOccluder& oc = sc.occ[o];
+    const double r_last = oc.radii.back();
+    // Random offsets: ρ from 0 to 2.5 × the last radius (inside the first shell, between
+    // shells, beyond the last), random directions and normals.
+    for (int i = 0; i < 400; ++i) {
+      double d[3] = {g(rng), g(rng), g(rng)}, n[3] = {g(rng), g(rng), g(rng)};
+      unit(d), unit(n);
+      const double rho = 2.5 * r_last * uni(rng);
+      const double s[3] = {rho * d[0], rho * d[1], rho * d[2]};
+      add(o, s, n, serial++, true);
+    }
+    // Poles, near-poles, the φ seam (s_x → ±0 with s_z > 0: φ → 0 or 2π), exact radii, ρ = 0.
+    for (int i = 0; i < 40; ++i) {
+      const double rho = oc.radii[static_cast<std::size_t>(i) % oc.radii.size()] * (i % 3 == 0 ? 1.0 : 0.5 + uni(rng));
+      const double tiny = std::pow(10.0, -1.0 - 6.0 * uni(rng));
+      const double sign = i % 2 ? 1.0 : -1.0;
+      double n[3] = {g(rng), g(rng), g(rng)};
+      unit(n);
+      const double poles[][3] = {{0, rho, 0}, {0, -rho, 0}, {tiny * rho, rho, 0.3 * tiny * rho},
+                                 {sign * tiny * rho, 0.2 * rho, rho}, {sign * 1e-30, -0.5 * rho, rho}, {0, 0, 0}};
+      for (const auto& s : poles) add(o, s, n, serial++, false);
+    }
+  }
+  // Inside occluder 0's wholly invalid cell (shells 0–1, rows 3–4, columns 2–3): the plain
+  // trilinear fallback.
+  for (int i = 0; i < 20; ++i) {
+    const SynthOccluder& oc = sc.occ[0];
+    const double theta = (3.0 + uni(rng)) * kPi / (oc.n_theta - 1), phi = (2.0 + uni(rng)) * 2 * kPi / oc.n_phi;
+    const double rho = oc.radii[0] + uni(rng) * (oc.radii[1] - oc.radii[0]);
+    const double s[3] = {rho * std::sin(theta) * std::sin(phi), rho * std::cos(theta), rho * std::sin(theta) * std::cos(phi)};
+    double n[3] = {g(rng), g(rng), g(rng)};
+    unit(n);
+    add(0, s, n, serial++, false);
+  }
+  // DifMap face edges and corners (ties), axis normals, a zero normal.
+  const double h = std::sqrt(0.5), c3 = std::sqrt(1.0 / 3.0);
+  const double special[][3] = {{1, 0, 0}, {0, -1, 0}, {0, 0, 1},  {h, h, 0},     {-h, 0, h},  {0, h, -h},
+                               {c3, c3, c3}, {-c3, c3, -c3}, {0, 0, 0}, {0.5, 0.5, -h}};
+  for (const auto& n : special) {
+    const double s[3] = {0.7, 0.2, -0.4};
+    add(0, s, n, serial++, false);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+class FivGlsl : public ::testing::Test {
+protected:
+  static void SetUpTestSuite() {
+    scene_ = new Scene(make_scene());
+    receivers_ = new std::vector<Receiver>(make_receivers(*scene_));
+    GpuScene g = pack(scene_->occ, scene_->difmap_size, scene_->texels);
+    auto in = prt::test::to_bytes(*receivers_);
+    std::vector<std::byte> res(receivers_->size() * 36 * sizeof(float));
+    PushBlock push{uint32_t(receivers_->size()), {}};
+    std::copy_n(scene_->env, 9, push.env);
+    ran_ = prt::test::run_kernel("fiv_eval", {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res},
+                                 prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
+    results_ = new std::vector<float>(prt::test::from_bytes<float>(res));
+  }
+  static void TearDownTestSuite() {
+    delete scene_;
+    delete receivers_;
+    delete results_;
+  }
+  void SetUp() override { ASSERT_TRUE(ran_) << "the fiv_eval kernel did not run (see the failure above)"; }
+
+  static const float* result(std::size_t r) { return &(*results_)[36 * r]; }
+  static prt::shade::DifMap difmap() { return {scene_->difmap_size, scene_->texels.data()}; }
+
+  static Scene* scene_;
+  static std::vector<Receiver>* receivers_;
+  static std::vector<float>* results_;
+  static bool ran_;
+};
+Scene* FivGlsl::scene_ = nullptr;
+std::vector<Receiver>* FivGlsl::receivers_ = nullptr;
+std::vector<float>* FivGlsl::results_ = nullptr;
+bool FivGlsl::ran_ = false;
+
+void offset(const Receiver& r, const SynthOccluder& o, float s[3]) {
+  for (int k = 0; k < 3; ++k) s[k] = r.p[k] - o.centre[k];  // float, as both implementations form it
+}
+
+// lookup_fiv: GLSL vs the C++ core and vs the double transcription; the C++ core vs the
+// transcription too (so a disagreement names the side that is off).
+TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
+  double worst_core = 0, worst_ref = 0;
+  std::size_t checked = 0, ill_conditioned = 0, plain = 0, beyond = 0;
+  std::vector<double> rel_tols;
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const SynthOccluder& o = scene_->occ[rc.info[0]];
+    float s[3];
+    offset(rc, o, s);
+    const Coords c = coords_of(o, s);
+    const Fiv9 tol_ref = fiv_tolerance(o, s, glsl_budget(c));
+    const Fiv9 tol_core = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
+    const Fiv9 tol_core_ref = fiv_tolerance(o, s, core_budget(c));
+    const FivRef ref = fiv_at(o, c.t, c.u, c.rho);
+    plain += ref.plain ? 1 : 0;
+    beyond += c.rho > o.radii.back() ? 1 : 0;
+    float core[9];
+    prt::shade::lookup_fiv(o.view(), s, core);
+    const float* got = result(r);
+    for (std::size_t e = 0; e < 9; ++e) {
+      ASSERT_TRUE(std::isfinite(got[e])) << "receiver " << r;
+      const double err_core = std::abs(got[e] - core[e]), err_ref = std::abs(got[e] - ref.v[e]);
+      worst_core = std::max(worst_core, err_core / tol_core[e]);
+      worst_ref = std::max(worst_ref, err_ref / tol_ref[e]);
+      // Strength of the GLSL check on the random receivers (the special ones sit on purpose at
+      // the poles, where an invalid pole sample makes the lookup jump): its tolerance against the
+      // reference relative to the samples.
+      if (rc.info[3] == 1) {
+        if (tol_ref[e] > 1e-3 * std::max(1e-3, ref.max_sample)) ++ill_conditioned;
+        rel_tols.push_back(tol_ref[e] / std::max(1e-3, ref.max_sample));
+      }
+      ++checked;
+      ASSERT_LE(err_core, tol_core[e]) << "receiver " << r << " component " << e << " s = (" << s[0] << ", " << s[1]
+                                       << ", " << s[2] << ") glsl " << got[e] << " core " << core[e];
+      ASSERT_LE(err_ref, tol_ref[e]) << "receiver " << r << " component " << e << " glsl " << got[e] << " ref "
+                                     << ref.v[e];
+      ASSERT_LE(std::abs(core[e] - ref.v[e]), tol_core_ref[e]) << "C++ core vs reference: receiver " << r
+                                                                 << " component " << e;
+    }
+  }
+  std::sort(rel_tols.begin(), rel_tols.end());
+  std::printf("lookup_fiv: %zu values; worst GLSL-core %.3f x tol, GLSL-reference %.3f x tol; tolerance / largest "
+              "sample: median %.2g, 99%% %.2g; %zu values ill-conditioned (tol > 1e-3 x samples)\n",
+              checked, worst_core, worst_ref, rel_tols[rel_tols.size() / 2], rel_tols[rel_tols.size() * 99 / 100],
+              ill_conditioned);
+  // The bound must stay a float bound for nearly all samples, or the test proves little: only
+  // lookups renormalised over nearly weightless valid samples may be ill-conditioned (the
+  // wholly invalid cell and random invalid samples: a few percent of the cells).
+  EXPECT_LT(double(ill_conditioned), 0.02 * double(rel_tols.size()));
+  EXPECT_LT(rel_tols[rel_tols.size() / 2], 1e-4);
+  std::printf("lookup_fiv: %zu receivers in the plain-trilinear fallback, %zu beyond the last shell\n", plain, beyond);
+  EXPECT_GE(plain, 20u);  // the wholly invalid cell was visited
+  EXPECT_GT(beyond, 500u);
+}
+
+TEST_F(FivGlsl, LookupDifMapMatchesCoreAndReference) {
+  double worst = 0;
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const auto tol = difmap_tolerance(scene_->difmap_size, scene_->texels, rc.n);
+    const double nd[3] = {rc.n[0], rc.n[1], rc.n[2]};
+    const auto ref = difmap_at(scene_->difmap_size, scene_->texels, nd);
+    float core[3];
+    prt::shade::lookup_difmap(difmap(), rc.n, core);
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double got = result(r)[9 + c];
+      worst = std::max(worst, std::abs(got - core[c]) / tol[c]);
+      ASSERT_LE(std::abs(got - core[c]), tol[c]) << "receiver " << r << " n = (" << rc.n[0] << ", " << rc.n[1] << ", "
+                                                 << rc.n[2] << ")";
+      ASSERT_LE(std::abs(got - ref[c]), tol[c]) << "receiver " << r;
+    }
+  }
+  std::printf("lookup_difmap: worst GLSL-core %.3f x tol\n", worst);
+}
+
+// Partial factor and occluded irradiance. h = n·(c − p) rounds within δh = 8 ε Σ_k |n_k|(|c_k| +
+// |p_k|) on each side, so the factor within δh/(2R) + 4 ε; I_c = max(0, f n·F_c) within
+// δf |n·F_c| + f Σ_k |n_k| tolF_ck + 8 ε f Σ_k |n_k F_ck|; without the partial factor, a receiver
+// within δh of case C may get 0 or the full value.
+struct IrradianceCheck {
+  double factor, factor_tol;
+  std::array<double, 3> I_partial, tol_partial, I_full, tol_full;
+  // Whether the occluder "hides something" (I > 0 in some channel) could come out differently
+  // in the two implementations: the pre-clamp value of some channel is within its tolerance of
+  // 0, or the receiver is within δh of case C.
+  bool unsure_partial = false, unsure_full = false;
+};
+
+IrradianceCheck irradiance_check(const SynthOccluder& o, const float p[3], const float n[3]) {
+  IrradianceCheck k{};
+  double h = 0, dh = 0;
+  for (int a = 0; a < 3; ++a) {
+    h += double(n[a]) * (double(o.centre[a]) - p[a]);
+    dh += std::abs(n[a]) * (std::abs(o.centre[a]) + std::abs(p[a]));
+  }
+  dh *= 8 * kFloatEps;
+  const double R = o.radius;
+  k.factor = h <= -R ? 0.0 : (h >= R ? 1.0 : (h + R) / (2 * R));
+  k.factor_tol = dh / (2 * R) + 4 * kFloatEps;
+  float s[3];
+  for (int a = 0; a < 3; ++a) s[a] = p[a] - o.centre[a];
+  const Coords c = coords_of(o, s);
+  const FivRef F = fiv_at(o, c.t, c.u, c.rho);
+  const Fiv9 tolF = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
+  const bool near_c = std::abs(h + R) <= dh;
+  std::array<double, 3> raw_partial{}, raw_full{};
+  for (std::size_t ch = 0; ch < 3; ++ch) {
+    double nf = 0, nf_abs = 0, nf_tol = 0;
+    for (std::size_t a = 0; a < 3; ++a) {
+      nf += n[a] * F.v[3 * ch + a];
+      nf_abs += std::abs(n[a] * F.v[3 * ch + a]);
+      nf_tol += std::abs(n[a]) * tolF[3 * ch + a];
+    }
+    k.I_partial[ch] = std::max(0.0, k.factor * nf);
+    k.tol_partial[ch] = k.factor_tol * std::abs(nf) + std::min(1.0, k.factor + k.factor_tol) * (nf_tol + 8 * kFloatEps * nf_abs);
+    k.I_full[ch] = h > -R ? std::max(0.0, nf) : 0.0;
+    k.tol_full[ch] = nf_tol + 8 * kFloatEps * nf_abs + (near_c ? std::abs(nf) : 0.0);
+    raw_partial[ch] = k.factor * nf;
+    raw_full[ch] = h > -R ? nf : 0.0;
+  }
+  auto unsure = [&](const std::array<double, 3>& raw, const std::array<double, 3>& tol) {
+    bool sure_hides = false, ambiguous = false;
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      sure_hides = sure_hides || raw[ch] > tol[ch];
+      ambiguous = ambiguous || std::abs(raw[ch]) <= tol[ch];
+    }
+    return !sure_hides && (ambiguous || near_c);
+  };
+  k.unsure_partial = unsure(raw_partial, k.tol_partial);
+  k.unsure_full = unsure(raw_full, k.tol_full);
+  return k;
+}
+
+TEST_F(FivGlsl, PartialFactorAndOccludedIrradianceMatchCore) {
+  int cases[3] = {0, 0, 0};  // C, B, A
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const SynthOccluder& o = scene_->occ[rc.info[0]];
+    const IrradianceCheck k = irradiance_check(o, rc.p, rc.n);
+    ++cases[k.factor == 0 ? 0 : (k.factor == 1 ? 2 : 1)];
+    const float* got = result(r);
+    const float core_f = prt::shade::partial_factor(o.view(), rc.p, rc.n);
+    ASSERT_LE(std::abs(got[12] - core_f), k.factor_tol) << "receiver " << r;
+    ASSERT_LE(std::abs(got[12] - k.factor), k.factor_tol) << "receiver " << r;
+    float core_p[3], core_full[3];
+    prt::shade::occluded_irradiance(o.view(), rc.p, rc.n, true, core_p);
+    prt::shade::occluded_irradiance(o.view(), rc.p, rc.n, false, core_full);
+    for (std::size_t c = 0; c < 3; ++c) {
+      ASSERT_LE(std::abs(got[13 + c] - core_p[c]), k.tol_partial[c]) << "receiver " << r << " channel " << c;
+      ASSERT_LE(std::abs(got[13 + c] - k.I_partial[c]), k.tol_partial[c]) << "receiver " << r;
+      ASSERT_LE(std::abs(got[16 + c] - core_full[c]), k.tol_full[c]) << "receiver " << r << " channel " << c;
+      ASSERT_LE(std::abs(got[16 + c] - k.I_full[c]), k.tol_full[c]) << "receiver " << r;
+    }
+  }
+  std::printf("occluded irradiance: cases C/B/A = %d/%d/%d receivers\n", cases[0], cases[1], cases[2]);
+  EXPECT_GT(cases[0], 50);  // every case exercised
+  EXPECT_GT(cases[1], 50);
+  EXPECT_GT(cases[2], 50);
+}
+
+// Self-shadows: E_c = max(0, n·F^env_c − n·F_c) within Σ_k |n_k| tolF_ck + 8 ε (|n·F^env_c| terms + |n F_c| terms).
+TEST_F(FivGlsl, ShadeFivSelfMatchesCore) {
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const SynthOccluder& o = scene_->occ[rc.info[0]];
+    float s[3];
+    offset(rc, o, s);
+    const Coords c = coords_of(o, s);
+    const FivRef F = fiv_at(o, c.t, c.u, c.rho);
+    const Fiv9 tolF = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
+    float core[3];
+    prt::shade::shade_fiv_self(scene_->env, o.view(), rc.p, rc.n, core);
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      double e = 0, mag = 0, tol = 0;
+      for (std::size_t a = 0; a < 3; ++a) {
+        e += rc.n[a] * (scene_->env[3 * ch + a] - F.v[3 * ch + a]);
+        mag += std::abs(rc.n[a] * scene_->env[3 * ch + a]) + std::abs(rc.n[a] * F.v[3 * ch + a]);
+        tol += std::abs(rc.n[a]) * tolF[3 * ch + a];
+      }
+      tol += 8 * kFloatEps * mag;
+      const double got = result(r)[19 + ch];
+      ASSERT_LE(std::abs(got - core[ch]), tol) << "receiver " << r << " channel " << ch;
+      ASSERT_LE(std::abs(got - std::max(0.0, e)), tol) << "receiver " << r << " channel " << ch;
+    }
+  }
+}
+
+// shade_fiv on groups of 1–5 occluders (a duplicate pair gives O = ½), all four option
+// combinations, vs the C++ core. Tolerance, composed through E = D − Σ I_i + Σ_{i<j} O_ij (I_i + I_j):
+//   tol_D + Σ_i tol_I_i (1 + Σ_j O_ij) + Σ_{i<j} tol_O_ij (I_i + I_j)
+//   + Σ over pairs whose "hides something" test is within tolerance of flipping: O_ij (I_i + I_j + tol)
+//   + 16 ε (count + 2) (|D| + Σ_i I_i (1 + Σ_j O_ij))   (summation order differs: GLSL sums
+//     I_i Σ_j O_ij, the core O_ij (I_i + I_j)),
+// tol_O_ij = twice the largest change of O over the box α ± δα, γ ± δγ plus 64 ε (the float lens
+// formula), δα = 16 ε + min(4 ε/cos α, 4 √ε) (asin near α = π/2), δγ = 32 ε π + min(4 ε/sin γ, 4 √ε)
+// (the core's cosine test for disjoint discs resolves γ only to ε/sin γ).
+TEST_F(FivGlsl, ShadeFivMatchesCore) {
+  const std::vector<SynthOccluder>& occ = scene_->occ;
+  double worst = 0;
+  int pairs_overlapping = 0;
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const uint32_t first = rc.info[1], count = rc.info[2];
+    std::vector<prt::shade::FivOccluder> views;
+    for (uint32_t i = 0; i < count; ++i) views.push_back(occ[first + i].view());
+    const auto D = difmap_at(scene_->difmap_size, scene_->texels, std::array<double, 3>{rc.n[0], rc.n[1], rc.n[2]}.data());
+    const auto tol_D = difmap_tolerance(scene_->difmap_size, scene_->texels, rc.n);
+    // Discs in double.
+    std::vector<std::array<double, 3>> axis(count);
+    std::vector<double> alpha(count), d_alpha(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      const SynthOccluder& o = occ[first + i];
+      double v[3], D2 = 0;
+      for (int a = 0; a < 3; ++a) v[a] = double(o.centre[a]) - rc.p[a], D2 += v[a] * v[a];
+      const double Dl = std::sqrt(D2);
+      for (std::size_t a = 0; a < 3; ++a) axis[i][a] = Dl > 0 ? v[a] / Dl : rc.n[a];
+      alpha[i] = Dl > 0 ? std::asin(std::min(1.0, o.radius / Dl)) : kPi / 2;
+      d_alpha[i] = 16 * kFloatEps + std::min(4 * kFloatEps / std::max(std::cos(alpha[i]), 1e-300), 4 * std::sqrt(kFloatEps));
+    }
+    for (int option = 0; option < 4; ++option) {
+      const bool partial = option < 2, overlap = option % 2 == 0;
+      std::vector<IrradianceCheck> k;
+      for (uint32_t i = 0; i < count; ++i) k.push_back(irradiance_check(occ[first + i], rc.p, rc.n));
+      std::array<double, 3> E{}, tol{}, mag{};
+      for (std::size_t c = 0; c < 3; ++c) E[c] = D[c], tol[c] = tol_D[c], mag[c] = std::abs(D[c]);
+      std::vector<std::array<double, 3>> I(count), tI(count);
+      std::vector<double> weight(count, 0.0);
+      std::vector<bool> hides(count), unsure(count);
+      for (uint32_t i = 0; i < count; ++i) {
+        I[i] = partial ? k[i].I_partial : k[i].I_full;
+        tI[i] = partial ? k[i].tol_partial : k[i].tol_full;
+        hides[i] = I[i][0] > 0 || I[i][1] > 0 || I[i][2] > 0;
+        unsure[i] = partial ? k[i].unsure_partial : k[i].unsure_full;
+        for (std::size_t c = 0; c < 3; ++c) E[c] -= I[i][c];
+      }
+      if (overlap)
+        for (uint32_t i = 0; i < count; ++i)
+          for (uint32_t j = i + 1; j < count; ++j) {
+            const double cg = std::clamp(axis[i][0] * axis[j][0] + axis[i][1] * axis[j][1] + axis[i][2] * axis[j][2], -1.0, 1.0);
+            const double gamma = std::acos(cg);
+            const double d_gamma =
+                32 * kFloatEps * kPi + std::min(4 * kFloatEps / std::max(std::sin(gamma), 1e-300), 4 * std::sqrt(kFloatEps));
+            const double O = prt::shade::overlap_fraction(alpha[i], alpha[j], gamma);
+            double tol_O = 0;
+            for (int corner = 0; corner < 8; ++corner) {
+              const double O2 = prt::shade::overlap_fraction(
+                  std::max(0.0, alpha[i] + (corner & 1 ? d_alpha[i] : -d_alpha[i])),
+                  std::max(0.0, alpha[j] + (corner & 2 ? d_alpha[j] : -d_alpha[j])),
+                  std::max(0.0, gamma + (corner & 4 ? d_gamma : -d_gamma)));
+              tol_O = std::max(tol_O, 2 * std::abs(O2 - O));
+            }
+            tol_O += 64 * kFloatEps;
+            if (O > 0) ++pairs_overlapping;
+            for (std::size_t c = 0; c < 3; ++c) {
+              const double sum = I[i][c] + I[j][c];
+              if (hides[i] && hides[j]) {
+                E[c] += O * sum;
+                weight[i] += O, weight[j] += O;
+                tol[c] += tol_O * sum;
+              }
+              if (unsure[i] || unsure[j]) tol[c] += (O + tol_O) * (sum + tI[i][c] + tI[j][c]);
+            }
+          }
+      for (uint32_t i = 0; i < count; ++i)
+        for (std::size_t c = 0; c < 3; ++c) {
+          tol[c] += tI[i][c] * (1 + weight[i]);
+          mag[c] += I[i][c] * (1 + weight[i]);
+        }
+      float core[3];
+      prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, overlap}, core);
+      for (std::size_t c = 0; c < 3; ++c) {
+        tol[c] += 16 * kFloatEps * (count + 2) * mag[c];
+        const double got = result(r)[22 + 3 * static_cast<std::size_t>(option) + c];
+        ASSERT_TRUE(std::isfinite(got));
+        worst = std::max(worst, std::abs(got - core[c]) / tol[c]);
+        ASSERT_LE(std::abs(got - core[c]), tol[c])
+            << "receiver " << r << " occluders " << first << "+" << count << " partial " << partial << " overlap "
+            << overlap << " channel " << c << " glsl " << got << " core " << core[c];
+        ASSERT_LE(std::abs(got - std::max(0.0, E[c])), tol[c])
+            << "vs reference: receiver " << r << " partial " << partial << " overlap " << overlap << " channel " << c;
+      }
+    }
+  }
+  std::printf("shade_fiv: worst GLSL-core %.3f x tol; %d overlapping pairs seen\n", worst, pairs_overlapping);
+  EXPECT_GT(pairs_overlapping, 100);  // the overlap correction was exercised
+}
+
+} // namespace
