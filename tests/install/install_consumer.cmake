@@ -39,10 +39,15 @@ foreach(g ${glsl_source})
   endif()
 endforeach()
 
-# A consumer that sees only the installed prefix.
+# A consumer that sees only the installed prefix. A sanitizer build (PRT_SANITIZE) installs an
+# instrumented library, so its consumer must link the sanitizer runtimes too.
+set(extra)
+if(SANITIZE)
+  list(APPEND extra -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined)
+endif()
 run("consumer configure" ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE} -B ${WORK_DIR}/build -G ${GENERATOR}
     -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix}
-    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF)
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF ${extra})
 run("consumer build" ${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run("consumer run" ${WORK_DIR}/build/prtshade_consumer)
 message(STATUS "consumer output:\n${last_output}")
