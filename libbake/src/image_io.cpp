@@ -267,10 +267,6 @@ std::vector<uint8_t> encode_png(const Image8& image) {
   return png;
 }
 
-namespace {
-
-// Writes through `write_to(tmp)` into "<path>.tmp.<pid>" and renames it onto `path`; the
-// temporary file is removed on any failure.
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write_to) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
@@ -286,8 +282,6 @@ void write_atomically(const fs::path& path, const std::function<void(const fs::p
     throw;
   }
 }
-
-} // namespace
 
 void write_png(const fs::path& path, const Image8& image) {
   const std::vector<uint8_t> bytes = encode_png(image);

@@ -5,6 +5,12 @@
 #include <bake/sampling.h>
 
 #include <embree3/rtcore.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
@@ -13,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -21,6 +28,10 @@
 namespace prt::bake {
 
 using Eigen::Vector3d;
+
+namespace {
+constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel (reference renderer)
+}
 
 // ---- camera -----------------------------------------------------------------------------------------
 
@@ -482,7 +493,7 @@ struct ReferenceRenderer::Embree {
 
 ReferenceRenderer::ReferenceRenderer(const Mesh& mesh, const EnvMap& env, ReferenceOptions options)
     : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env), rt_(std::make_unique<Embree>(mesh)) {
-  PRT_CHECK(options_.samples > 0);
+  PRT_CHECK(options_.samples > 0 && (options_.samples % kReplicates == 0 || options_.samples < kReplicates));
   PRT_CHECK(!mesh.triangles.empty());
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const auto& q : mesh.positions) {
@@ -554,40 +565,50 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, double E[3
   const double w_cos = 0.5 * (1 - w_cone_total), w_env = w_cos;
   const double w_cone = cones.empty() ? 0.0 : w_cone_total / double(cones.size());
   const Frame frame(f.n);
-  const RotatedHalton3 halton(options_.seed, index);
-  const uint32_t N = options_.samples;
-  double sum[3] = {0, 0, 0}, sum2[3] = {0, 0, 0};
-  for (uint32_t i = 0; i < N; ++i) {
-    const auto u = halton(i);
-    Vector3d d;
-    if (u[0] < w_cos) {
-      d = frame.to_world(cosine_hemisphere(u[1], u[2]));
-    } else if (u[0] < w_cos + w_env) {
-      d = env_.sample(u[1], u[2], nullptr);
-    } else {
-      const size_t k = std::min(cones.size() - 1, size_t((u[0] - w_cos - w_env) / w_cone));
-      const Cone& c = cones[k];
-      const double z = 1 - u[1] * (1 - c.cos_a), r = std::sqrt(std::max(0.0, 1 - z * z));
-      const double phi = 2 * std::numbers::pi * u[2];
-      d = c.frame.to_world(Vector3d(r * std::cos(phi), r * std::sin(phi), z));
+  // Independent replicates (randomised QMC): B rotations of the Halton sequence, N/B points each.
+  // The spread of the replicate means is an honest standard error for the RQMC estimate, which
+  // converges faster than 1/sqrt(N); the iid sample variance would overstate it.
+  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
+  const uint32_t per = std::max<uint32_t>(1, options_.samples / B);
+  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
+  for (uint32_t b = 0; b < B; ++b) {
+    const RotatedHalton3 halton(options_.seed, index * kReplicates + b);
+    double sum[3] = {0, 0, 0};
+    for (uint32_t i = 0; i < per; ++i) {
+      const auto u = halton(i);
+      Vector3d d;
+      if (u[0] < w_cos) {
+        d = frame.to_world(cosine_hemisphere(u[1], u[2]));
+      } else if (u[0] < w_cos + w_env) {
+        d = env_.sample(u[1], u[2], nullptr);
+      } else {
+        const size_t k = std::min(cones.size() - 1, size_t((u[0] - w_cos - w_env) / w_cone));
+        const Cone& c = cones[k];
+        const double z = 1 - u[1] * (1 - c.cos_a), r = std::sqrt(std::max(0.0, 1 - z * z));
+        const double phi = 2 * std::numbers::pi * u[2];
+        d = c.frame.to_world(Vector3d(r * std::cos(phi), r * std::sin(phi), z));
+      }
+      d.normalize();
+      const double cn = f.n.dot(d);
+      if (!(cn > 0) || !rt_->occluded(o, d)) continue;  // contributes 0 to the occluded part
+      double p = w_cos * cn * kInvPi + w_env * env_.pdf(d);
+      for (const Cone& c : cones)
+        if (c.axis.dot(d) >= c.cos_a) p += w_cone * c.inv_solid_angle;
+      const Rgb L = env_.radiance(d);
+      sum[0] += L.r * cn / p;
+      sum[1] += L.g * cn / p;
+      sum[2] += L.b * cn / p;
     }
-    d.normalize();
-    const double cn = f.n.dot(d);
-    if (!(cn > 0) || !rt_->occluded(o, d)) continue;  // contributes 0 to the occluded part
-    double p = w_cos * cn * kInvPi + w_env * env_.pdf(d);
-    for (const Cone& c : cones)
-      if (c.axis.dot(d) >= c.cos_a) p += w_cone * c.inv_solid_angle;
-    const Rgb L = env_.radiance(d);
-    const double x[3] = {L.r * cn / p, L.g * cn / p, L.b * cn / p};
     for (int c = 0; c < 3; ++c) {
-      sum[c] += x[c];
-      sum2[c] += x[c] * x[c];
+      const double m = sum[c] / per;
+      block_sum[c] += m;
+      block_sum2[c] += m * m;
     }
   }
   const double un[3] = {unocc.r, unocc.g, unocc.b};
   for (int c = 0; c < 3; ++c) {
-    const double mean = sum[c] / N;
-    const double var = N > 1 ? std::max(0.0, (sum2[c] - N * mean * mean) / (double(N) * (N - 1))) : 0.0;
+    const double mean = block_sum[c] / B;
+    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean * mean) / (double(B) * (B - 1))) : 0.0;
     E[c] = un[c] - mean;
     std_error[c] = std::sqrt(var);
   }
@@ -618,11 +639,91 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, ProgressMode prog
     bar.advance();
   });
   bar.finish();
-  out.rays = uint64_t(camera.width) * uint64_t(camera.height) + pixels.load() * options_.samples;
+  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
+  out.rays = uint64_t(camera.width) * uint64_t(camera.height) + pixels.load() * B * std::max<uint32_t>(1, options_.samples / B);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (float v : out.radiance.rgb)
     if (!std::isfinite(v)) throw ContractError("reference render produced a non-finite value");
   return out;
+}
+
+// ---- reference cache -----------------------------------------------------------------------------------
+
+namespace {
+constexpr const char* kKeyAttr = "prt_reference_key";
+constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
+} // namespace
+
+void save_reference(const std::filesystem::path& path, const ReferenceImage& image, const std::string& key) {
+  const int W = image.radiance.width, H = image.radiance.height;
+  PRT_CHECK(W > 0 && H > 0 && image.std_error.rgb.size() == image.radiance.rgb.size());
+  PRT_CHECK_OP(image.gbuffer.triangle.size(), ==, size_t(W) * size_t(H));
+  std::vector<uint32_t> tri(image.gbuffer.triangle.size());
+  for (size_t i = 0; i < tri.size(); ++i) tri[i] = image.gbuffer.triangle[i] < 0 ? kNoTriangle : uint32_t(image.gbuffer.triangle[i]);
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    try {
+      Imf::Header header(W, H);
+      header.insert(kKeyAttr, Imf::StringAttribute(key));
+      Imf::FrameBuffer fb;
+      const char* names[6] = {"R", "G", "B", "se.R", "se.G", "se.B"};
+      for (int c = 0; c < 6; ++c) {
+        const Image& src = c < 3 ? image.radiance : image.std_error;
+        header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(src.rgb.data() + c % 3)),
+                                       3 * sizeof(float), 3 * sizeof(float) * size_t(W)));
+      }
+      header.channels().insert("triangle", Imf::Channel(Imf::UINT));
+      fb.insert("triangle", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(tri.data()), sizeof(uint32_t), sizeof(uint32_t) * size_t(W)));
+      Imf::OutputFile out(tmp.c_str(), header, 1);
+      out.setFrameBuffer(fb);
+      out.writePixels(H);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {  // Iex::BaseExc
+      throw InputError(path.string(), std::string("cannot write the reference: ") + e.what());
+    }
+  });
+}
+
+std::optional<ReferenceImage> load_reference(const std::filesystem::path& path, const std::string& key) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  try {
+    Imf::InputFile in(path.c_str(), 1);
+    const auto* k = in.header().findTypedAttribute<Imf::StringAttribute>(kKeyAttr);
+    if (!k || k->value() != key) return std::nullopt;
+    const Imath::Box2i dw = in.header().dataWindow();
+    const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+    ReferenceImage r;
+    r.radiance = Image(W, H);
+    r.std_error = Image(W, H);
+    std::vector<uint32_t> tri(size_t(W) * size_t(H), kNoTriangle);
+    Imf::FrameBuffer fb;
+    const char* names[6] = {"R", "G", "B", "se.R", "se.G", "se.B"};
+    for (int c = 0; c < 6; ++c) {
+      if (!in.header().channels().findChannel(names[c])) throw InputError(path.string(), std::string("no channel ") + names[c]);
+      Image& dst = c < 3 ? r.radiance : r.std_error;
+      char* base = reinterpret_cast<char*>(dst.rgb.data() + c % 3) -
+                   (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * W) * ptrdiff_t(3 * sizeof(float));
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), 3 * sizeof(float) * size_t(W)));
+    }
+    if (!in.header().channels().findChannel("triangle")) throw InputError(path.string(), "no channel triangle");
+    fb.insert("triangle", Imf::Slice(Imf::UINT,
+                                     reinterpret_cast<char*>(tri.data()) - (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * W) *
+                                                                               ptrdiff_t(sizeof(uint32_t)),
+                                     sizeof(uint32_t), sizeof(uint32_t) * size_t(W)));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    r.gbuffer = empty_gbuffer(W, H);
+    for (size_t i = 0; i < tri.size(); ++i) r.gbuffer.triangle[i] = tri[i] == kNoTriangle ? -1 : int32_t(tri[i]);
+    for (float v : r.radiance.rgb)
+      if (!std::isfinite(v)) throw InputError(path.string(), "non-finite pixel in the cached reference");
+    return r;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path.string(), std::string("cannot read the cached reference: ") + e.what());
+  }
 }
 
 // ---- scene assembly --------------------------------------------------------------------------------------

@@ -40,6 +40,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -65,6 +66,10 @@ struct Image8 {
 uint32_t crc32(std::span<const uint8_t> bytes, uint32_t crc = 0);  // ISO-HDLC / PNG CRC; chain by passing the previous value
 uint32_t adler32(std::span<const uint8_t> bytes);
 std::vector<uint8_t> zlib_compress(std::span<const uint8_t> bytes);  // RFC 1950 around RFC 1951
+
+// Calls write_to(tmp) with tmp = "<path>.tmp.<pid>" in the same directory, then renames tmp onto
+// path; on any exception tmp is removed and the exception propagates. Checks the directory first.
+void write_atomically(const std::filesystem::path& path, const std::function<void(const std::filesystem::path&)>& write_to);
 
 // ---- PNG and EXR -------------------------------------------------------------------------------
 std::vector<uint8_t> encode_png(const Image8& image);

@@ -45,9 +45,12 @@
 // computed as E = E_unocc(n) − ∫ L (1 − V) H (n · ω) dω:
 //   * E_unocc(n) = Σ_t L_t max(0, n · M_t), M_t = ∫_texel ω dω (UnoccludedIrradiance below), a
 //     deterministic sum over every environment texel: no noise where nothing occludes;
-//   * the occluded part by randomised QMC (bake/sampling.h: a 3D Halton sequence with a per-pixel
-//     Cranley–Patterson rotation keyed by (seed, pixel index) — identical bytes for any thread
-//     count), directions drawn from a one-sample mixture weighted by the balance heuristic:
+//   * the occluded part by randomised QMC (bake/sampling.h: a 3D Halton sequence with a
+//     Cranley–Patterson rotation keyed by (seed, pixel index, replicate) — identical bytes for any
+//     thread count), as 8 independent replicates of samples/8 points each: the estimate is their
+//     mean and its standard error the spread of the 8 means / √8 (the honest RQMC error; the iid
+//     sample variance would overstate it because QMC converges faster than 1/√N). Directions
+//     are drawn from a one-sample mixture weighted by the balance heuristic:
 //     cosine-weighted hemisphere around n, the environment's luminance (EnvMap::sample) and,
 //     when `occluder_spheres` are given, a uniform cone around each sphere that p sees from
 //     outside (half-angle asin(R / D)) — the FIV scenes pass their occluders' bounding spheres,
@@ -56,7 +59,7 @@
 //     L (n·ω) (1 − V) / p_mixture with p_mixture ≥ w_cos (n·ω)/π, so it is bounded.
 //   * visibility: a shadow ray from p + ε n_g (n_g the geometric normal turned to the side of n,
 //     ε = 1e-5 × the scene's bounding-box diagonal) to infinity; any hit occludes.
-// The per-pixel standard error (of the QMC term, from the sample variance) is returned with the
+// The per-pixel standard error (of the QMC term, from the replicates) is returned with the
 // picture; compare_images (bake/image_io.h) turns it into the reference's own noise figure.
 #pragma once
 
@@ -68,7 +71,9 @@
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -166,7 +171,7 @@ struct Sphere {
 };
 
 struct ReferenceOptions {
-  uint32_t samples = 1024;  // QMC shadow rays per pixel (occluded part)
+  uint32_t samples = 1024;  // QMC shadow rays per pixel (occluded part); a multiple of 8 (8 replicates)
   uint64_t seed = 1;
   std::vector<Sphere> occluder_spheres;
 };
@@ -204,6 +209,16 @@ private:
   std::unique_ptr<Embree> rt_;
   double epsilon_ = 0;
 };
+
+// A reference render kept on disk so several runtime renders of one view can be compared against
+// it without tracing it again (prtview --reference-cache). OpenEXR file: channels R, G, B (radiance),
+// se.R, se.G, se.B (standard errors) as float, "triangle" as uint (0xFFFFFFFF = nothing hit), and
+// a string attribute "prt_reference_key" that names what was rendered (the caller builds it from
+// everything that determines the picture). save writes a temporary file and renames it.
+// load returns nothing when the file does not exist or its key differs; a damaged file throws
+// InputError. Only gbuffer.triangle is restored (barycentrics are not kept).
+void save_reference(const std::filesystem::path& path, const ReferenceImage& image, const std::string& key);
+std::optional<ReferenceImage> load_reference(const std::filesystem::path& path, const std::string& key);
 
 // ---- scene assembly for the previews ---------------------------------------------------------
 // A square in the plane y = `y` (normal +Y), centred at (cx, cz), half-size `half`, two triangles.

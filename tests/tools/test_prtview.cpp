@@ -1,0 +1,183 @@
+// End-to-end tests of the prtview binary: bad input fails cleanly (message, exit status, no file
+// left behind), and real renders of small baked files give the numbers their closed forms predict.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = PRT_DATA_DIR;
+
+std::string slurp(const fs::path& p) {
+  std::string s;
+  if (FILE* f = std::fopen(p.c_str(), "rb")) {
+    char buf[65536];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
+    std::fclose(f);
+  }
+  return s;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "prtview";
+  fs::create_directories(dir);
+  return dir / (std::to_string(getpid()) + "." + name);
+}
+
+struct Outcome {
+  int code;
+  std::string out, err;
+};
+
+Outcome run(const std::string& exe, const std::string& args) {
+  static int counter = 0;
+  const std::string tag = std::to_string(counter++);
+  const fs::path o = scratch("stdout." + tag), e = scratch("stderr." + tag);
+  const std::string cmd = exe + " " + args + " > " + o.string() + " 2> " + e.string();
+  const int status = std::system(cmd.c_str());
+  Outcome r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(o), slurp(e)};
+  fs::remove(o);
+  fs::remove(e);
+  return r;
+}
+Outcome view(const std::string& args) { return run(PRT_PRTVIEW, args); }
+
+void expect_no_output(const fs::path& out) {
+  EXPECT_FALSE(fs::exists(out)) << out;
+  for (auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find(out.filename().string() + ".tmp"), std::string::npos) << e.path();
+}
+
+// The number on the line that starts with "NRMSE " (NaN if there is none).
+double nrmse(const std::string& out) {
+  const std::string key = "NRMSE ";
+  size_t at = out.rfind("\n" + key) != std::string::npos ? out.rfind("\n" + key) + 1 : out.compare(0, key.size(), key) == 0 ? 0 : std::string::npos;
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(out.c_str() + at + key.size(), nullptr);
+}
+
+// Width and height from a PNG's IHDR (bytes 16..23).
+std::pair<uint32_t, uint32_t> png_size(const fs::path& p) {
+  const std::string s = slurp(p);
+  if (s.size() < 24 || s.compare(1, 3, "PNG") != 0) return {0, 0};
+  auto be = [&](size_t i) {
+    return uint32_t(uint8_t(s[i])) << 24 | uint32_t(uint8_t(s[i + 1])) << 16 | uint32_t(uint8_t(s[i + 2])) << 8 |
+           uint32_t(uint8_t(s[i + 3]));
+  };
+  return {be(16), be(20)};
+}
+
+const std::string kCamera = "--camera eye=0,3,4:at=0,0,0:fov=50";
+
+// A flat 4 × 4 grid in y = 0 (normals +Y from the angle-weighted rule).
+fs::path plane_obj() {
+  const fs::path p = scratch("plane.obj");
+  std::ofstream f(p);
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) f << "v " << (i - 2) << " 0 " << (j - 2) << "\n";
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int a = j * 5 + i + 1;
+      f << "f " << a << " " << a + 5 << " " << a + 6 << " " << a + 1 << "\n";
+    }
+  return p;
+}
+
+} // namespace
+
+TEST(Prtview, MissingFileFailsNamingItAndLeavesNoOutput) {
+  const fs::path out = scratch("missing.png");
+  const Outcome r = view("/no/such/file.prt.h5 " + kCamera + " -o " + out.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("/no/such/file.prt.h5"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
+  expect_no_output(out);
+}
+
+TEST(Prtview, BadCameraAndCommandLinesFailWithTheProblemNamed) {
+  const fs::path out = scratch("bad.png");
+  const std::string f = (kData / "bunny.obj").string();  // never read: the camera is checked first
+  struct Case {
+    std::string args, needle;
+    int code;
+  } cases[] = {
+      {"--camera eye=0,0,1 -o " + out.string(), "eye=X,Y,Z and at=X,Y,Z are required", 1},
+      {"--camera eye=0,0,1:at=0,0,1 -o " + out.string(), "eye and at are the same point", 1},
+      {"--camera eye=0,x,1:at=0,0,0 -o " + out.string(), "'x' is not a finite number", 1},
+      {"--camera eye=0,0,1:at=0,0,0:zoom=3 -o " + out.string(), "unknown key 'zoom'", 1},
+      {"--camera eye=0,0,1:at=0,0,0:fov=200 -o " + out.string(), "fov must be in (0, 180)", 1},
+      {kCamera + " --size 12 -o " + out.string(), "--size", 2},
+      {kCamera + " --samples 12 -o " + out.string(), "multiple of 8", 2},
+      {kCamera + " -o " + scratch("bad.jpg").string(), "must end in .png or .exr", 2},
+      {kCamera + " --error --reference -o " + out.string(), "exclude each other", 2},
+      {kCamera + " --wat -o " + out.string(), "unknown option '--wat'", 2},
+      {kCamera, "no output given", 2},
+  };
+  for (const auto& c : cases) {
+    const Outcome r = view(f + " " + c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  }
+  expect_no_output(out);
+}
+
+TEST(Prtview, Band1OfAnOpenPlaneMatchesTheReference) {
+  // An unoccluded plane: band-1 shading at the baked normal is the exact irradiance (up to the
+  // silhouette integrator's discretisation, ~5e-4 relative at k = 128², bench/RESULTS.md), and the
+  // reference is the exact texel sum with no occluded part (zero noise, horizon term below 1e-4,
+  // bake/render.h). The image is constant, so NRMSE is normalised by |reference|: < 2e-3.
+  const fs::path h5 = scratch("plane.prt.h5"), out = scratch("plane.png");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
+                                         " --report 0 --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const Outcome r = view(h5.string() + " " + kCamera + " --size 40x30 --samples 8 --error -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double e = nrmse(r.out);
+  ASSERT_TRUE(std::isfinite(e)) << r.out;
+  EXPECT_LT(e, 2e-3) << r.out;
+  EXPECT_NE(r.out.find("reference noise 0.00000"), std::string::npos) << r.out;
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{40, 30}));
+  // A wrong environment is refused: band-1 radiance belongs to the environment it was baked with.
+  const Outcome w = view(h5.string() + " " + kCamera + " --env " + (kData / "forest.exr").string() + " -o " + scratch("w.png").string());
+  EXPECT_EQ(w.code, 1);
+  EXPECT_NE(w.err.find("is not the environment"), std::string::npos) << w.err;
+  expect_no_output(scratch("w.png"));
+  fs::remove(out);
+  fs::remove(h5);
+}
+
+TEST(Prtview, FivTriptychOfACopiedOccluder) {
+  // A small cube occluder (fast to bake at coarse shells) shown as two copies on the ground.
+  const fs::path cube = scratch("cube.obj"), h5 = scratch("cube.prt.h5"), out = scratch("cube.png");
+  std::ofstream(cube) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                         "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+  const Outcome b = run(PRT_PRTBAKE, "fiv " + cube.string() + " --env " + (kData / "studio.exr").string() +
+                                         " --shells 8x5x4 --cube 4 --samples 256 --report 0 --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::string cam = "--camera eye=0.5,6,5:at=0.5,0,0.5:fov=40";
+  const Outcome r = view(h5.string() + " " + cam + " --instance -1,0,0 --instance 1.5,0,0 --size 32x24 --samples 16 --triptych -o " +
+                         out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(std::isfinite(nrmse(r.out))) << r.out;
+  EXPECT_NE(r.out.find("2 copies"), std::string::npos) << r.out;
+  // Three 32 × 24 panels and two 4-pixel gaps (bake::hstack).
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{3 * 32 + 2 * 4, 24}));
+  // The shells belong to cube.obj: another mesh is refused by its SHA-256.
+  const Outcome w = view(h5.string() + " " + cam + " --occluder-mesh " + plane_obj().string() + " -o " + scratch("w.png").string());
+  EXPECT_EQ(w.code, 1);
+  EXPECT_NE(w.err.find("is not the mesh"), std::string::npos) << w.err;
+  expect_no_output(scratch("w.png"));
+  fs::remove(out);
+  fs::remove(h5);
+}
