@@ -424,8 +424,21 @@ std::vector<Receiver>* FivGlsl::receivers_ = nullptr;
 std::vector<float>* FivGlsl::results_ = nullptr;
 bool FivGlsl::ran_ = false;
 
-void offset(const Receiver& r, const SynthOccluder& o, float s[3]) {
-  for (int k = 0; k < 3; ++k) s[k] = r.p[k] - o.centre[k];  // float, as both implementations form it
+// One lookup of occluder o from receiver point p: the offset as both implementations form it
+// (float subtraction), its coordinates, the reference value and the GLSL-vs-core tolerance.
+struct Lookup {
+  float s[3];
+  Coords c;
+  FivRef ref;
+  Fiv9 tol;
+};
+Lookup lookup_case(const SynthOccluder& o, const float p[3]) {
+  Lookup l{};
+  for (int k = 0; k < 3; ++k) l.s[k] = p[k] - o.centre[k];
+  l.c = coords_of(o, l.s);
+  l.ref = fiv_at(o, l.c.t, l.c.u, l.c.rho);
+  l.tol = fiv_tolerance(o, l.s, glsl_budget(l.c) + core_budget(l.c));
+  return l;
 }
 
 // lookup_fiv: GLSL vs the C++ core and vs the double transcription; the C++ core vs the
@@ -437,13 +450,13 @@ TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const SynthOccluder& o = scene_->occ[rc.info[0]];
-    float s[3];
-    offset(rc, o, s);
-    const Coords c = coords_of(o, s);
+    const Lookup l = lookup_case(o, rc.p);
+    const float* s = l.s;
+    const Coords& c = l.c;
+    const FivRef& ref = l.ref;
+    const Fiv9& tol_core = l.tol;
     const Fiv9 tol_ref = fiv_tolerance(o, s, glsl_budget(c));
-    const Fiv9 tol_core = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
     const Fiv9 tol_core_ref = fiv_tolerance(o, s, core_budget(c));
-    const FivRef ref = fiv_at(o, c.t, c.u, c.rho);
     plain += ref.plain ? 1 : 0;
     beyond += c.rho > o.radii.back() ? 1 : 0;
     float core[9];
@@ -529,11 +542,9 @@ IrradianceCheck irradiance_check(const SynthOccluder& o, const float p[3], const
   const double R = o.radius;
   k.factor = h <= -R ? 0.0 : (h >= R ? 1.0 : (h + R) / (2 * R));
   k.factor_tol = dh / (2 * R) + 4 * kFloatEps;
-  float s[3];
-  for (int a = 0; a < 3; ++a) s[a] = p[a] - o.centre[a];
-  const Coords c = coords_of(o, s);
-  const FivRef F = fiv_at(o, c.t, c.u, c.rho);
-  const Fiv9 tolF = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
+  const Lookup l = lookup_case(o, p);
+  const FivRef& F = l.ref;
+  const Fiv9& tolF = l.tol;
   const bool near_c = std::abs(h + R) <= dh;
   std::array<double, 3> raw_partial{}, raw_full{};
   for (std::size_t ch = 0; ch < 3; ++ch) {
@@ -595,11 +606,9 @@ TEST_F(FivGlsl, ShadeFivSelfMatchesCore) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const SynthOccluder& o = scene_->occ[rc.info[0]];
-    float s[3];
-    offset(rc, o, s);
-    const Coords c = coords_of(o, s);
-    const FivRef F = fiv_at(o, c.t, c.u, c.rho);
-    const Fiv9 tolF = fiv_tolerance(o, s, glsl_budget(c) + core_budget(c));
+    const Lookup l = lookup_case(o, rc.p);
+    const FivRef& F = l.ref;
+    const Fiv9& tolF = l.tol;
     float core[3];
     prt::shade::shade_fiv_self(scene_->env, o.view(), rc.p, rc.n, core);
     for (std::size_t ch = 0; ch < 3; ++ch) {
