@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -297,9 +298,9 @@ ScenePlan plan_scene(const Scene& scene, std::span<const Mesh> meshes) {
   const std::string env_name = env ? scene.environment->filename().string() : "";
   const int diffuse_order = clamped_power_order(1.0, scene.sh_tolerance, sh::kMaxOrder);
   auto pct = [](double x) {
-    std::ostringstream os;
-    os << x * 100 << "%";
-    return os.str();
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2g%%", x * 100);
+    return std::string(buf);
   };
 
   // Bounding spheres for the FIV rule.

@@ -5,6 +5,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <run_tool.h>
 
 #include <sys/wait.h>
 
@@ -29,25 +30,10 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary | std::ios::ate);
-  std::string s(static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0)), '\0');
-  in.seekg(0);
-  in.read(s.data(), static_cast<std::streamsize>(s.size()));
-  return s;
-}
-
 // Runs prtdump with `args` (already shell-quoted), capturing stdout and stderr separately.
 CmdResult prtdump(const fs::path& dir, const std::string& args) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + PRT_PRTDUMP + "' " + args + " >'" + out.string() +
-                          "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  CmdResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_text(out);
-  r.err = read_text(err);
-  return r;
+  const auto r = prt::testing::run_tool(PRT_PRTDUMP, args, dir);
+  return {r.code, r.out, r.err};
 }
 
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
