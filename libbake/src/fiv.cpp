@@ -1,6 +1,8 @@
 #include <bake/error.h>
 #include <bake/fiv.h>
 #include <bake/qmc.h>
+#include <bake/sampling.h>
+#include <bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 
@@ -255,6 +257,46 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   progress.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& sh,
+                                const Fiv& fenv, size_t points, uint64_t seed) {
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  const QmcIntegrator qmc(occluder, topology, req, {65536, mix64(seed ^ 0x66697672656675ull)});
+  const size_t per_shell = size_t(sh.n_theta) * size_t(sh.n_phi), total = sh.radii.size() * per_shell;
+  const auto picks = seeded_sample(uint32_t(total), points, seed);
+  std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);
+  const auto r0 = std::chrono::steady_clock::now();
+  tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
+    const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
+    const int i = int(ij / size_t(sh.n_phi)), j = int(ij % size_t(sh.n_phi));
+    Fiv se;
+    const Fiv ref = qmc_occluded_fiv(qmc, fenv, sh.centre + sh.radii[k] * shell_direction(i, sh.n_theta, j, sh.n_phi), idx, &se);
+    for (size_t x = 0; x < 9; ++x) {
+      const double d = double(sh.shells[idx * 9 + x]) - ref[x];
+      err2[q] += d * d;
+      se2[q] += se[x] * se[x];
+      maxe[q] = std::max(maxe[q], std::abs(d));
+    }
+  });
+  FivErrorReport r;
+  r.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+  r.points = picks.size();
+  r.reference = qmc.description() + " (full sphere)";
+  double e = 0, s2 = 0, n2 = 0;
+  for (size_t q = 0; q < picks.size(); ++q) {
+    e += err2[q];
+    s2 += se2[q];
+    r.max_abs = std::max(r.max_abs, maxe[q]);
+  }
+  for (double x : fenv) n2 += x * x;
+  const double nval = double(std::max<size_t>(9 * picks.size(), 1));
+  r.rmse = std::sqrt(e / nval);
+  r.reference_std_error = std::sqrt(s2 / nval);
+  r.reference_rms = std::sqrt(n2 / 9);
+  return r;
 }
 
 } // namespace prt::bake

@@ -5,10 +5,12 @@
 #include <embree3/rtcore.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace prt::bake {
 
@@ -138,6 +140,7 @@ RayScene::RayScene(const Mesh& mesh, const Topology& topology)
     hi = hi.cwiseMax(q.cast<double>());
   }
   diagonal_ = mesh.positions.empty() ? 0.0 : (hi - lo).norm();
+  centre_ = mesh.positions.empty() ? Vector3d::Zero() : Vector3d(0.5 * (lo + hi));
 }
 
 RayScene::~RayScene() = default;
@@ -157,6 +160,26 @@ RTCRay make_ray(const Vector3d& o, const Vector3d& d) {
   ray.flags = 0;
   return ray;
 }
+// Point query: every triangle (not in the shade point's 1-ring) whose bounds meet the query ball.
+struct NearQuery {
+  int64_t welded = -1;
+  const uint32_t* weld = nullptr;
+  const std::array<uint32_t, 3>* triangles = nullptr;
+  std::vector<unsigned> prims;
+};
+
+bool collect_near(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<NearQuery*>(args->userPtr);
+  const unsigned prim = args->primID;
+  if (q->welded >= 0) {
+    const auto& t = q->triangles[prim];
+    const auto w = uint32_t(q->welded);
+    if (q->weld[t[0]] == w || q->weld[t[1]] == w || q->weld[t[2]] == w) return false;
+  }
+  q->prims.push_back(prim);
+  return false;  // the query radius is unchanged
+}
+
 } // namespace
 
 bool RayScene::visible(const ShadePoint& point, const Vector3d& d) const {
@@ -198,9 +221,50 @@ CrossingCount RayScene::count_crossings(const ShadePoint& point, const Vector3d&
       if (occludes_from_above(point.p, a, b, point.n, d, &out.ambiguous)) ++out.count;
     }
   }
-  // Cast from δ behind p so that triangles through p are reported too; hits within 2δ of the
-  // origin (i.e. within δ of p) are decided exactly below.
-  const double delta = 1e-4 * std::max(diagonal_, 1e-30) + 1e-6 * point.p.cwiseAbs().maxCoeff();
+  // Triangles within ρ of p are decided exactly for the whole ray (below): near p, float hit tests
+  // cannot tell which of two adjacent triangles a ray enters — e.g. at a vertex a few ulps from
+  // another surface's vertex (near-duplicate shells, T-junctions), where every direction grazes
+  // that vertex's fan. Everything farther is left to Embree, with edge grazes flagged ambiguous.
+  const double rho = 2e-4 * std::max(diagonal_, 1e-30) + 2e-6 * point.p.cwiseAbs().maxCoeff();
+  NearQuery near;
+  near.welded = point.welded;
+  near.weld = topo_.weld.data();
+  near.triangles = mesh_.triangles.data();
+  RTCPointQuery q{};
+  q.x = float(point.p.x());
+  q.y = float(point.p.y());
+  q.z = float(point.p.z());
+  q.time = 0;
+  q.radius = float(rho);
+  RTCPointQueryContext qctx;
+  rtcInitPointQueryContext(&qctx);
+  rtcPointQuery(rt_->scene, &q, &qctx, collect_near, &near);
+  std::sort(near.prims.begin(), near.prims.end());
+  near.prims.erase(std::unique(near.prims.begin(), near.prims.end()), near.prims.end());
+
+  // The ray is the segment from p + εn to a point r beyond the scene: its exact predicates are
+  // those of that segment, whatever rounding r carries.
+  const double reach = 4 * (diagonal_ + (point.p - centre_).norm()) + 1;
+  const Vector3d r = point.p + reach * d;
+  for (const unsigned prim : near.prims) {
+    const auto& t = mesh_.triangles[prim];
+    const Vector3d a = mesh_.positions[t[0]].cast<double>(), b = mesh_.positions[t[1]].cast<double>(),
+                   c = mesh_.positions[t[2]].cast<double>();
+    const int sp = orient_eps(a, b, c, point.p, point.n), sr = orient3d_exact(a, b, c, r);
+    if (sp == 0) continue;  // degenerate triangle (or p + εn in its plane): no area to cross
+    if (sr == 0) {
+      out.ambiguous = true;  // the far end lies in the plane: choose another direction
+      continue;
+    }
+    if (sp == sr) continue;  // the segment does not reach the plane
+    const int s1 = orient_eps(a, b, r, point.p, point.n), s2 = orient_eps(b, c, r, point.p, point.n),
+              s3 = orient_eps(c, a, r, point.p, point.n);
+    const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
+    if (has_pos && has_neg) continue;                   // outside the triangle
+    if (s1 == 0 || s2 == 0 || s3 == 0) out.ambiguous = true;  // through an edge or a corner exactly
+    else ++out.count;
+  }
+
   Hit hits[kMaxHits];
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);
@@ -209,37 +273,18 @@ CrossingCount RayScene::count_crossings(const ShadePoint& point, const Vector3d&
   ctx.triangles = mesh_.triangles.data();
   ctx.hits = hits;
   RTCRayHit rh{};
-  rh.ray = make_ray(point.p - delta * d, d);
+  rh.ray = make_ray(point.p, d);
+  rh.ray.tfar = float(reach);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(rt_->scene, &ctx.base, &rh);
   if (ctx.overflow) out.ambiguous = true;
   constexpr float kEdge = 1e-5f;  // barycentric distance to an edge that makes a hit ambiguous
   for (unsigned i = 0; i < ctx.n_hits; ++i) {
     const Hit& h = hits[i];
+    if (std::binary_search(near.prims.begin(), near.prims.end(), h.prim)) continue;  // decided exactly above
     const float w0 = 1.0f - h.u - h.v;
-    const bool near_edge = h.u < kEdge || h.v < kEdge || w0 < kEdge;
-    if (double(h.t) > 2 * delta) {
-      if (near_edge) out.ambiguous = true;
-      ++out.count;
-      continue;
-    }
-    // Near p: the ray from p + εn crosses the triangle's plane forwards iff
-    // orient_eps(a,b,c,p,n) · sign(N·d) > 0 (N = (b−a)×(c−a); orient_eps = −sign_ε(N·(p−a))).
-    // A hit that cannot count (behind p, or the ray leaving the plane) is not ambiguous either.
-    const auto& t = mesh_.triangles[h.prim];
-    const Vector3d a = mesh_.positions[t[0]].cast<double>(), b = mesh_.positions[t[1]].cast<double>(),
-                   c = mesh_.positions[t[2]].cast<double>();
-    const Vector3d N = (b - a).cross(c - a);
-    const double nd = N.dot(d);
-    if (std::abs(nd) <= 1e-9 * N.norm()) {
-      out.ambiguous = true;
-      continue;
-    }
-    const int side = orient_eps(a, b, c, point.p, point.n);
-    if (side * (nd > 0 ? 1 : -1) > 0) {
-      if (near_edge) out.ambiguous = true;
-      ++out.count;
-    }
+    if (h.u < kEdge || h.v < kEdge || w0 < kEdge) out.ambiguous = true;
+    ++out.count;
   }
   return out;
 }

@@ -10,11 +10,15 @@
 #include <bake/raycast.h>
 #include <bake/sampling.h>
 #include <bake/silhouette.h>
+#include <bake/zonal.h>
 
 #include <prtshade/sh.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
+#include <map>
+#include <mutex>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -88,7 +92,12 @@ struct SilhouetteIntegrator::Impl {
   std::unique_ptr<SparseIsolineTables> hot;
   std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
-  mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0};
+  mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
+      n_closed_form{0}, n_enclosed{0};
+  // Band-1 radiance of the unoccluded hemisphere about n, per distinct normal (bit pattern): the one
+  // environment-dependent part of the closed form (see closed_form()).
+  mutable std::mutex hemisphere_mutex;
+  mutable std::map<std::array<double, 3>, std::array<double, 9>> hemisphere_radiance_cache;
   mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
 
   Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o)
@@ -315,12 +324,125 @@ struct SilhouetteIntegrator::Impl {
     return w;
   }
 
+  // The horizon of n as a virtual occluder boundary (four quarter arcs): +1 when crossing into n·ω < 0.
+  void add_horizon(const Vector3d& n, std::vector<Arc>& arcs) const {
+    const Vector3d nf = frame_from_world * n;
+    const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
+    const Vector3d t2v = nf.cross(t1v);
+    const Vector3d c[4] = {t1v, t2v, -t1v, -t2v};
+    for (int k = 0; k < 4; ++k) arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -1});
+  }
+
+  // Isoline crossings and spine crossings of every arc in s.arcs.
+  void add_crossings(Scratch& s) const {
+    s.crossings.clear();
+    s.hot_crossings.clear();
+    s.spine.clear();
+    for (const Arc& arc : s.arcs) {
+      add_arc(arc, grid, 0, grid.n, s.crossings);
+      add_spine(arc, s.spine);
+      if (hot) add_arc(arc, hot->grid(), hot->first_isoline(), hot->last_isoline(), s.hot_crossings);
+    }
+  }
+
+  // DCF walks from W0 at the spine start: the base tables on the isoline grid, the hot texels on
+  // their fine grid. Leaves the F integrals (in the tables' column layout) in s.acc; returns the
+  // number of inconsistent loops.
+  uint64_t walk_all(Scratch& s, int W0) const {
+    std::sort(s.spine.begin(), s.spine.end(),
+              [](const SpineCrossing& x, const SpineCrossing& y) { return x.u < y.u || (x.u == y.u && x.step < y.step); });
+    s.acc.assign(F, 0.0);
+    double* acc = s.acc.data();
+    uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
+    if (hot) {
+      s.hot_acc.assign(9, 0.0);
+      inconsistent += walk(hot->grid(), hot->first_isoline(), hot->last_isoline(), *hot, W0, s.spine, s.hot_crossings,
+                           s.sorted, s.bucket_start, s.hot_acc.data(), 9);
+    }
+    for (size_t c = 0; c < F; ++c) acc[c] *= grid.h;
+    if (hot)
+      for (size_t c = 0; c < 9; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
+    return inconsistent;
+  }
+
+  // No contour edge in the visible hemisphere (DESIGN.md §5, "no integrator work where no contour
+  // edge is seen"): the depth complexity is then constant over the open upper hemisphere, so one
+  // ray along n decides between "enclosed" (W > 0: nothing visible, every product is 0) and
+  // "open" (V = H). Open rows are closed forms (bake/zonal.h, Funk–Hecke): AO = 1,
+  // T_lm = 2 I_l(1) y_lm(n), U_lm = 2π I_l(0) y_lm(n). The band-1 radiance ∫ L H y_1m dω depends on
+  // the environment: it is the horizon-only walk of the same tables (no contour edges, no rays),
+  // computed once per distinct normal. Returns false (use the general path) if the ray is ambiguous.
+  // True if no contour edge reaches into the open upper hemisphere of (p, n): both end points on
+  // or below the tangent plane (the shade point's own vertex is seen in direction −n). Rounding
+  // can only make an edge on the horizon look visible, which sends the point down the general path.
+  bool none_in_view(const ShadePoint& point, const std::vector<ContourEdge>& edges) const {
+    for (const ContourEdge& ce : edges)
+      for (const uint32_t w : topo.edges[ce.edge]) {
+        if (point.welded >= 0 && w == uint32_t(point.welded)) continue;
+        if (point.n.dot(topo.welded_positions[w].cast<double>() - point.p) > 0) return false;
+      }
+    return true;
+  }
+
+  bool closed_form(const ShadePoint& point, std::span<double> out) const {
+    const CrossingCount cc = rays.count_crossings(point, point.n);
+    n_rays.fetch_add(1, std::memory_order_relaxed);
+    if (cc.ambiguous) return false;
+    const ProductLayout& L = layout;
+    std::fill(out.begin(), out.begin() + std::ptrdiff_t(L.width), 0.0);
+    n_closed_form.fetch_add(1, std::memory_order_relaxed);
+    if (cc.count > 0) {
+      n_enclosed.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
+    if (L.ao_count) out[L.ao] = 1.0;
+    if (L.transfer_count) {
+      clamped_power_sh(1.0, req.transfer_order, point.n, out.subspan(L.transfer, L.transfer_count));
+      for (size_t k = 0; k < L.transfer_count; ++k) out[L.transfer + k] *= std::numbers::inv_pi;
+    }
+    if (L.visibility_count) clamped_power_sh(0.0, req.visibility_order, point.n, out.subspan(L.visibility, L.visibility_count));
+    if (L.radiance_count) {
+      const std::array<double, 9> r = hemisphere_radiance(point.n);
+      std::copy(r.begin(), r.end(), out.begin() + std::ptrdiff_t(L.radiance));
+    }
+    return true;
+  }
+
+  std::array<double, 9> hemisphere_radiance(const Vector3d& n) const {
+    const std::array<double, 3> key = {n.x(), n.y(), n.z()};
+    {
+      const std::lock_guard lock(hemisphere_mutex);
+      if (const auto it = hemisphere_radiance_cache.find(key); it != hemisphere_radiance_cache.end()) return it->second;
+    }
+    Scratch& s = tl_scratch;
+    s.arcs.clear();
+    add_horizon(n, s.arcs);
+    add_crossings(s);
+    // W at the spine start: 1 below the horizon, 0 above; the generic frame makes n·s0 = 0 a
+    // measure-zero case, in which a start just off the spine along the walk direction decides.
+    const Vector3d s0_world = frame_from_world.transpose() * Vector3d(-1, 0, 0);
+    double hz = n.dot(s0_world);
+    if (hz == 0) hz = n.dot(frame_from_world.transpose() * Vector3d(-1, 0, -1e-9).normalized());
+    (void)walk_all(s, hz < 0 ? 1 : 0);
+    std::array<double, 9> r{};
+    for (size_t c = 0; c < 9; ++c) r[c] = s.acc[c_r + c];
+    const std::lock_guard lock(hemisphere_mutex);
+    return hemisphere_radiance_cache.emplace(key, r).first->second;
+  }
+
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out) const {
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
     Scratch& s = tl_scratch;
     contours.find(point, s.edges);
     const auto t1 = clock::now();
+    if (point.hemisphere && none_in_view(point, s.edges) && closed_form(point, out)) {
+      n_points.fetch_add(1, std::memory_order_relaxed);
+      contour_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), std::memory_order_relaxed);
+      integrate_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(clock::now() - t1).count(),
+                             std::memory_order_relaxed);
+      return;
+    }
 
     // ---- arcs in the octahedral frame ----
     s.arcs.clear();
@@ -338,24 +460,8 @@ struct SilhouetteIntegrator::Impl {
       arc.side_sum = ce.side_sum;
       s.arcs.push_back(arc);
     }
-    if (point.hemisphere) {
-      // The horizon as a virtual occluder boundary: +1 when crossing into n·ω < 0.
-      const Vector3d nf = frame_from_world * n;
-      const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
-      const Vector3d t2v = nf.cross(t1v);
-      const Vector3d c[4] = {t1v, t2v, -t1v, -t2v};
-      for (int k = 0; k < 4; ++k) s.arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -1});
-    }
-
-    // ---- crossings ----
-    s.crossings.clear();
-    s.hot_crossings.clear();
-    s.spine.clear();
-    for (const Arc& arc : s.arcs) {
-      add_arc(arc, grid, 0, grid.n, s.crossings);
-      add_spine(arc, s.spine);
-      if (hot) add_arc(arc, hot->grid(), hot->first_isoline(), hot->last_isoline(), s.hot_crossings);
-    }
+    if (point.hemisphere) add_horizon(n, s.arcs);
+    add_crossings(s);
 
     // ---- W at the spine start (frame direction (−1, 0, 0)) from one counted ray ----
     const Vector3d s0(-1, 0, 0);
@@ -389,21 +495,8 @@ struct SilhouetteIntegrator::Impl {
     }
     if (!found) throw ContractError("silhouette: no unambiguous start ray after 16 directions");
 
-    // ---- DCF walks: the base tables on the isoline grid, the hot texels on their fine grid ----
-    std::sort(s.spine.begin(), s.spine.end(),
-              [](const SpineCrossing& x, const SpineCrossing& y) { return x.u < y.u || (x.u == y.u && x.step < y.step); });
-    s.acc.assign(F, 0.0);
-    double* acc = s.acc.data();
-    uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
-    if (hot) {
-      s.hot_acc.assign(9, 0.0);
-      inconsistent += walk(hot->grid(), hot->first_isoline(), hot->last_isoline(), *hot, W0, s.spine, s.hot_crossings,
-                           s.sorted, s.bucket_start, s.hot_acc.data(), 9);
-    }
-    const double h = grid.h;
-    for (size_t c = 0; c < F; ++c) acc[c] *= h;
-    if (hot)
-      for (size_t c = 0; c < 9; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
+    const uint64_t inconsistent = walk_all(s, W0);
+    const double* acc = s.acc.data();
 
     // ---- products ----
     const ProductLayout& L = layout;
@@ -470,6 +563,8 @@ SilhouetteStats SilhouetteIntegrator::stats() const {
   s.start_rays = impl_->n_rays.load();
   s.start_retries = impl_->n_retries.load();
   s.inconsistent_loops = impl_->n_inconsistent.load();
+  s.closed_form = impl_->n_closed_form.load();
+  s.enclosed = impl_->n_enclosed.load();
   s.contour_seconds = double(impl_->contour_ns.load()) * 1e-9;
   s.integrate_seconds = double(impl_->integrate_ns.load()) * 1e-9;
   return s;

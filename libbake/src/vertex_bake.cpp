@@ -1,5 +1,7 @@
 #include <bake/error.h>
+#include <bake/qmc.h>
 #include <bake/sampling.h>
+#include <bake/silhouette.h>
 #include <bake/vertex_bake.h>
 
 #include <tbb/blocked_range.h>
@@ -20,27 +22,65 @@ ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32
   return sp;
 }
 
-VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
-                         ProgressMode progress_mode, const std::string& label) {
+std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& topology) {
+  std::vector<ShadePoint> points(mesh.positions.size());
+  for (size_t v = 0; v < points.size(); ++v) points[v] = vertex_shade_point(mesh, topology, uint32_t(v));
+  return points;
+}
+
+VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator, ProgressMode progress_mode,
+                       const std::string& label) {
   VertexBake out;
   out.layout = integrator.layout();
-  const size_t V = mesh.positions.size(), W = out.layout.width;
+  const size_t V = points.size(), W = out.layout.width;
   out.values.assign(V * W, 0.0);
   out.std_error.assign(V * W, 0.0);
   Progress progress(label, V, progress_mode);
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, V, 16), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v) {
-      integrator.integrate(vertex_shade_point(mesh, topology, uint32_t(v)), v,
-                           std::span(out.values).subspan(v * W, W), std::span(out.std_error).subspan(v * W, W));
-    }
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      integrator.integrate(points[v], v, std::span(out.values).subspan(v * W, W), std::span(out.std_error).subspan(v * W, W));
     progress.advance(r.size());
   });
   progress.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (double x : out.values)
-    if (!std::isfinite(x)) throw ContractError("bake_vertices: non-finite value from integrator " + integrator.name());
+    if (!std::isfinite(x)) throw ContractError("bake_points: non-finite value from integrator " + integrator.name());
   return out;
+}
+
+VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
+                         ProgressMode progress_mode, const std::string& label) {
+  return bake_points(vertex_shade_points(mesh, topology), integrator, progress_mode, label);
+}
+
+uint32_t default_samples(const std::string& integrator) { return integrator == "qmc" ? 1024u : 16384u; }
+
+std::unique_ptr<Integrator> make_integrator(const std::string& name, uint32_t samples, uint64_t seed, const Mesh& mesh,
+                                            const Topology& topology, const ProductRequest& request) {
+  if (samples == 0) samples = default_samples(name);
+  if (name == "qmc") {
+    QmcOptions q;
+    q.samples = samples;
+    q.seed = seed;
+    return std::make_unique<QmcIntegrator>(mesh, topology, request, q);
+  }
+  if (name == "silhouette") {
+    SilhouetteOptions s;
+    s.isolines = std::max(2, int(std::lround(std::sqrt(double(samples)))));
+    s.seed = seed;
+    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, s);
+  }
+  throw InputError("integrator", "unknown integrator '" + name + "' (silhouette or qmc)");
+}
+
+std::unique_ptr<Integrator> make_reference(const std::string& bake_integrator, uint32_t samples, uint64_t seed,
+                                           const Mesh& mesh, const Topology& topology, const ProductRequest& request) {
+  if (samples == 0) samples = default_samples(bake_integrator);
+  QmcOptions q;
+  q.samples = bake_integrator == "qmc" ? samples * 10 : 65536;
+  q.seed = mix64(seed ^ 0x7265666572656e63ull);  // independent of the bake's points
+  return std::make_unique<QmcIntegrator>(mesh, topology, request, q);
 }
 
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {
@@ -59,18 +99,24 @@ std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {
 
 ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
                                    const Integrator& reference, size_t n_points, uint64_t seed) {
+  return compare_points_with_reference(vertex_shade_points(mesh, topology), bake, reference, n_points, seed);
+}
+
+ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
+                                          const Integrator& reference, size_t n_points, uint64_t seed) {
   const ProductLayout& L = bake.layout;
   PRT_CHECK_OP(reference.layout().width, ==, L.width);
+  PRT_CHECK_OP(bake.values.size(), ==, points.size() * L.width);
   ErrorReport report;
   report.reference = reference.description();
-  report.vertices = seeded_sample(uint32_t(mesh.positions.size()), n_points, seed);
+  report.vertices = seeded_sample(uint32_t(points.size()), n_points, seed);
   const size_t K = report.vertices.size(), W = L.width;
   std::vector<double> ref(K * W), ref_se(K * W);
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(size_t(0), K, [&](size_t i) {
     const uint32_t v = report.vertices[i];
     // Index the reference's randomisation apart from the bake's (point index offset by V).
-    reference.integrate(vertex_shade_point(mesh, topology, v), uint64_t(v) + mesh.positions.size(),
+    reference.integrate(points[v], uint64_t(v) + points.size(),
                         std::span(ref).subspan(i * W, W), std::span(ref_se).subspan(i * W, W));
   });
   report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

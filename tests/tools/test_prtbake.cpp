@@ -3,6 +3,7 @@
 #include <formats/prtfile.h>
 
 #include <gtest/gtest.h>
+#include <run_tool.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,17 +24,7 @@ namespace {
 const fs::path kData = PRT_DATA_DIR;
 const std::string kBake = PRT_PRTBAKE;
 
-// Reads a whole file (empty if it does not exist).
-std::string slurp_bytes(const fs::path& p) {
-  std::string s;
-  if (FILE* f = std::fopen(p.c_str(), "rb")) {
-    char buf[65536];
-    size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) s.append(buf, n);
-    std::fclose(f);
-  }
-  return s;
-}
+std::string slurp_bytes(const fs::path& p) { return prt::testing::read_bytes(p); }
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(PRT_TEST_TMP) / "prtbake";
@@ -48,16 +39,9 @@ struct Outcome {
 
 // Runs prtbake with `args` (already shell-quoted where needed), capturing stdout and stderr.
 Outcome run(const std::string& args, const std::string& env = "") {
-  static int counter = 0;
-  // ctest runs each case in its own process, in parallel: the pid keeps their captures apart.
-  const std::string tag = std::to_string(getpid()) + "." + std::to_string(counter);
-  const fs::path o = scratch("stdout." + tag), e = scratch("stderr." + tag);
-  ++counter;
-  const std::string cmd = env + " " + kBake + " " + args + " > " + o.string() + " 2> " + e.string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp_bytes(o), slurp_bytes(e)};
+  const auto r = prt::testing::run_tool(kBake, args, fs::path(PRT_TEST_TMP) / "prtbake", env);
+  return {r.code, r.out, r.err};
 }
-
 
 void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
 

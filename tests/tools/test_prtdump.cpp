@@ -5,6 +5,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <run_tool.h>
 
 #include <sys/wait.h>
 
@@ -29,25 +30,10 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary | std::ios::ate);
-  std::string s(static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0)), '\0');
-  in.seekg(0);
-  in.read(s.data(), static_cast<std::streamsize>(s.size()));
-  return s;
-}
-
 // Runs prtdump with `args` (already shell-quoted), capturing stdout and stderr separately.
 CmdResult prtdump(const fs::path& dir, const std::string& args) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + PRT_PRTDUMP + "' " + args + " >'" + out.string() +
-                          "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  CmdResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = read_text(out);
-  r.err = read_text(err);
-  return r;
+  const auto r = prt::testing::run_tool(PRT_PRTDUMP, args, dir);
+  return {r.code, r.out, r.err};
 }
 
 std::string q(const fs::path& p) { return "'" + p.string() + "'"; }
@@ -85,7 +71,7 @@ TEST(Prtdump, SummaryListsLayoutAttributesAndExactStatistics) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   for (const char* s : {"/mesh/positions", "/mesh/normals", "/mesh/triangles", "/ao", "/transfer/diffuse",
-                        "/radiance/band1", "format_version 1", "schema   valid", "sh_order = 2",
+                        "/radiance/band1", "format_version 2", "schema   valid", "sh_order = 2",
                         "rmse = 0.0625", "up_axis", "\"z\"", "float32  [4, 3]", "uint32   [4, 3]"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << r.out;
   // /ao = {0.25, 0.5, 0.75, 1}: min 0.25, max 1, mean 0.625, no NaN or Inf.
@@ -118,7 +104,7 @@ TEST(Prtdump, JsonHasTheKeyFieldsAndParses) {
   write_file(dir / "a.prt.h5", make_file());
   const CmdResult r = prtdump(dir, "--json " + q(dir / "a.prt.h5"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* s : {"\"format_version\": 1", "\"schema_valid\": true", "\"path\": \"/ao\"",
+  for (const char* s : {"\"format_version\": 2", "\"schema_valid\": true", "\"path\": \"/ao\"",
                         "\"dtype\": \"uint32\"", "\"sh_order\": 2", "\"min\": 0.25", "\"mean\": 0.625",
                         "\"nan\": 0", "\"/report\": {", "\"rmse\": 0.0625",
                         "\"command_line\": \"prtbake vertex \\\"q.obj\\\"\\t-o x\""})

@@ -8,14 +8,18 @@
 #include <bake/sampling.h>
 #include <bake/sha256.h>
 #include <bake/silhouette.h>
+#include <bake/scene.h>
 #include <bake/vertex_bake.h>
 #include <formats/prtfile.h>
 #include <prtshade/sh.h>
+
+#include "bakefile.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <chrono>
@@ -42,6 +46,7 @@ constexpr const char* kHelp = R"(prtbake — bake precomputed radiance transfer 
 USAGE
   prtbake vertex MESH -o OUT.prt.h5 [PRODUCTS] [OPTIONS]
   prtbake fiv OCCLUDER --env ENV.exr -o OUT.prt.h5 [--shells 128x65x30] [--cube 16] [OPTIONS]
+  prtbake scene SCENE.json -o OUT.prt.h5 [--dry-run] [--report N] [--threads T] [--quiet]
   prtbake --help | --version
 
   Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL) in one pass: the
@@ -55,6 +60,17 @@ USAGE
   occluder's bounding sphere: --shells NPHIxNTHETAxNRHO (poles included in NTHETA), radii from
   half the bounding radius outwards, stopping once |F| < --fraction (default 1e-3) of Int L dw.
   --cube S sets the DifMap resolution (default 16); --samples k the silhouette rate (128^2).
+
+  scene bakes a scene file (JSON: objects with mesh, transform, material and role receiver /
+  occluder / both; one environment; what may be baked — see data/scene_example.json and the
+  README) and bakes only what the scene needs, printing what it leaves out and why:
+  occluder-only objects get no per-vertex products; a diffuse receiver gets band-1 radiance
+  under the environment (exact) and no higher order, or diffuse transfer at the order the SH
+  tolerance needs when there is no environment (or "relight"); a glossy (Phong) receiver gets
+  visibility transfer at the smallest order whose lobe energy beyond it is under the tolerance;
+  no radiance or FIV without an environment; FIV shells only for occluders that can shadow
+  another receiver; vertices that see no contour edge get closed forms. --dry-run prints the
+  plan and stops. Per-object results go under /objects/<name>/ in the file.
 
 PRODUCTS of vertex (at least one)
   --ao               ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]
@@ -100,6 +116,7 @@ EXAMPLES
   prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5
   prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5
   prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5
+  prtbake scene data/scene_example.json -o scene.prt.h5
   prtdump bunny.prt.h5            # what was baked, statistics, the error report
 
 EXIT STATUS
@@ -122,7 +139,8 @@ template <class T> T parse_number(const std::string& opt, const std::string& s, 
 
 struct Args {
   std::string command, mesh, output, radiance, integrator = "silhouette";
-  bool ao = false, quiet = false, file_normals = true, reproducible = false;
+  bool ao = false, quiet = false, file_normals = true, reproducible = false, dry_run = false, report_given = false;
+  std::vector<std::string> given;  // the options given (for commands that accept only some)
   int transfer = 0, visibility = 0;
   uint32_t samples = 0, report = 32;  // samples 0: the integrator's default
   uint64_t seed = 1;
@@ -145,6 +163,7 @@ Args parse(int argc, char** argv) {
       return v[++i];
     };
     auto record = [&](const std::string& val) { a.command_line += " " + s + " " + val; };
+    if (!s.empty() && s[0] == '-') a.given.push_back(s);
     if (s == "-h" || s == "--help") {
       std::fputs(kHelp, stdout);
       std::exit(0);
@@ -214,7 +233,10 @@ Args parse(int argc, char** argv) {
       a.command_line += " " + s;
     } else if (s == "--report") {
       a.report = parse_number<uint32_t>(s, value(), 0, 1u << 20);
+      a.report_given = true;
       record(v[i]);
+    } else if (s == "--dry-run") {
+      a.dry_run = true;
     } else if (s == "--reproducible") {
       a.reproducible = true;
     } else if (s == "--quiet" || s == "-q") {
@@ -235,8 +257,19 @@ Args parse(int argc, char** argv) {
   if (a.samples == 0) a.samples = a.integrator == "qmc" ? 1024 : 16384;
   if (a.integrator == "silhouette" && a.samples < 4)
     throw UsageError("--samples: the silhouette integrator needs k >= 4 (2 u-isolines)");
-  if (a.command != "vertex" && a.command != "fiv")
-    throw UsageError("unknown command '" + a.command + "' (available: vertex, fiv)");
+  if (a.command != "vertex" && a.command != "fiv" && a.command != "scene")
+    throw UsageError("unknown command '" + a.command + "' (available: vertex, fiv, scene)");
+  if (a.command == "scene") {
+    for (const std::string& g : a.given)
+      if (g != "-o" && g != "--output" && g != "--threads" && g != "--quiet" && g != "-q" && g != "--reproducible" &&
+          g != "--report" && g != "--dry-run")
+        throw UsageError("scene: option " + g + " is not for scenes: products, integrator, samples, seed and FIV "
+                         "shells are set in the scene file's \"bake\" section");
+    if (a.mesh.empty()) throw UsageError("scene: no SCENE file given");
+    if (a.output.empty() && !a.dry_run) throw UsageError("scene: no output file given (-o OUT.prt.h5)");
+    return a;
+  }
+  if (a.dry_run) throw UsageError("--dry-run is for scene");
   if (a.command == "fiv") {
     if (a.mesh.empty()) throw UsageError("fiv: no OCCLUDER mesh given");
     if (a.output.empty()) throw UsageError("fiv: no output file given (-o OUT.prt.h5)");
@@ -275,12 +308,16 @@ std::string timestamp(bool reproducible) {
   return buf;
 }
 
-std::vector<float> to_float(std::span<const double> src, size_t stride, size_t offset, size_t count) {
-  const size_t rows = src.size() / stride;
-  std::vector<float> out(rows * count);
-  for (size_t r = 0; r < rows; ++r)
-    for (size_t c = 0; c < count; ++c) out[r * count + c] = float(src[r * stride + offset + c]);
-  return out;
+// Prints reader warnings once each, with a count for repeats (a missing .mtl repeats per face).
+void print_warnings(const std::vector<std::string>& warnings) {
+  std::vector<std::pair<std::string, size_t>> seen;
+  for (const auto& w : warnings) {
+    auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& x) { return x.first == w; });
+    if (it == seen.end()) seen.emplace_back(w, 1);
+    else ++it->second;
+  }
+  for (const auto& [w, n] : seen)
+    std::fprintf(stderr, "prtbake: warning: %s%s\n", w.c_str(), n > 1 ? (" (" + std::to_string(n) + " times)").c_str() : "");
 }
 
 std::string human_bytes(uintmax_t b) {
@@ -316,7 +353,7 @@ int run_vertex(const Args& a) {
   const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
   const std::string mesh_sha = bake::sha256_file(a.mesh);
-  for (const auto& w : mesh.warnings) std::fprintf(stderr, "prtbake: warning: %s\n", w.c_str());
+  print_warnings(mesh.warnings);
   if (say)
     std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s\n",
                 a.mesh.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
@@ -340,19 +377,9 @@ int run_vertex(const Args& a) {
   req.visibility_order = a.visibility;
   req.radiance = env ? &*env : nullptr;
 
-  bake::QmcOptions qopt;
-  qopt.samples = a.samples;
-  qopt.seed = a.seed;
-  std::unique_ptr<bake::Integrator> integrator_ptr;
   const auto setup_start = std::chrono::steady_clock::now();
-  if (a.integrator == "qmc") {
-    integrator_ptr = std::make_unique<bake::QmcIntegrator>(mesh, topo, req, qopt);
-  } else {
-    bake::SilhouetteOptions sopt;
-    sopt.isolines = std::max(2, int(std::lround(std::sqrt(double(a.samples)))));
-    sopt.seed = a.seed;
-    integrator_ptr = std::make_unique<bake::SilhouetteIntegrator>(mesh, topo, req, sopt);
-  }
+  const std::unique_ptr<bake::Integrator> integrator_ptr =
+      bake::make_integrator(a.integrator, a.samples, a.seed, mesh, topo, req);
   const bake::Integrator& integrator = *integrator_ptr;
   const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   if (say) {
@@ -385,17 +412,13 @@ int run_vertex(const Args& a) {
   }
 
   std::optional<bake::ErrorReport> report;
-  std::optional<bake::QmcIntegrator> reference;
   if (a.report > 0) {
-    bake::QmcOptions ropt = qopt;
-    ropt.samples = a.integrator == "qmc" ? a.samples * 10 : 65536;
-    ropt.seed = bake::mix64(a.seed ^ 0x7265666572656e63ull);  // independent of the bake's points
-    reference.emplace(mesh, topo, req, ropt);
+    const auto reference = bake::make_reference(a.integrator, a.samples, a.seed, mesh, topo, req);
     report = bake::compare_with_reference(mesh, topo, result, *reference, a.report, a.seed);
     if (say) {
       std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                   "counted in the bake time):\n",
-                  ropt.samples, report->vertices.size(), report->reference_seconds);
+                  a.integrator == "qmc" ? a.samples * 10 : 65536u, report->vertices.size(), report->reference_seconds);
       for (const auto& e : report->products)
         std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (bake's estimated std. error %.3e; "
                     "reference's own %.3e)\n",
@@ -408,76 +431,11 @@ int run_vertex(const Args& a) {
   namespace F = prt::formats;
   F::File file;
   file.root_attrs = root_attrs(a, mesh_sha);
-  const size_t V = mesh.positions.size(), T = mesh.triangles.size(), W = result.layout.width;
-  {
-    std::vector<float> pos(3 * V), nrm(3 * V);
-    for (size_t i = 0; i < V; ++i)
-      for (int k = 0; k < 3; ++k) {
-        pos[3 * i + k] = mesh.positions[i][k];
-        nrm[3 * i + k] = mesh.normals[i][k];
-      }
-    std::vector<uint32_t> tri(3 * T);
-    for (size_t i = 0; i < T; ++i)
-      for (int k = 0; k < 3; ++k) tri[3 * i + k] = mesh.triangles[i][k];
-    file.datasets.push_back({"/mesh/positions", {V, 3}, std::move(pos), {}});
-    file.datasets.push_back({"/mesh/normals", {V, 3}, std::move(nrm),
-                             {{"source", std::string(mesh.normal_source == bake::Mesh::NormalSource::File
-                                                         ? "file" : "angle-weighted")}}});
-    file.datasets.push_back({"/mesh/triangles", {T, 3}, std::move(tri), {}});
-    file.datasets.push_back({"/mesh/source_position", {V}, mesh.source_position, {}});
-  }
-  auto common = [&](std::vector<F::Attr> attrs) {
-    attrs.push_back({"integrator", integrator.name()});
-    attrs.push_back({"integrator_description", integrator.description()});
-    attrs.push_back({"samples", int64_t(a.samples)});  // rays per vertex (qmc) or k (silhouette)
-    attrs.push_back({"seed", int64_t(a.seed)});
-    attrs.push_back({"visibility", std::string("limit from just above the surface (p + eps*n, eps -> 0+)")});
-    return attrs;
-  };
-  const auto& L = result.layout;
-  if (L.ao_count)
-    file.datasets.push_back({"/ao", {V}, to_float(result.values, W, L.ao, 1),
-                             common({{"integrand", std::string("A = (1/pi) Int V H (n.w) dw")}})});
-  if (L.transfer_count)
-    file.datasets.push_back({"/transfer/diffuse", {V, L.transfer_count},
-                             to_float(result.values, W, L.transfer, L.transfer_count),
-                             common({{"integrand", std::string("T_i = (1/pi) Int V H (n.w) y_i dw")},
-                                     {"sh_order", int64_t(a.transfer)}})});
-  if (L.visibility_count)
-    file.datasets.push_back({"/transfer/visibility", {V, L.visibility_count},
-                             to_float(result.values, W, L.visibility, L.visibility_count),
-                             common({{"integrand", std::string("U_i = Int V H y_i dw")},
-                                     {"sh_order", int64_t(a.visibility)}})});
-  if (L.radiance_count) {
-    const auto& i = env->info();
-    file.datasets.push_back(
-        {"/radiance/band1", {V, 3, 3}, to_float(result.values, W, L.radiance, 9),
-         common({{"integrand", std::string("R_c,m = Int L_c V H y_1m dw, layout [vertex][RGB][m=-1,0,1]")},
-                 {"shading", std::string("E_c = (4 pi / 3) sum_m y_1m(n) R_c,m")},
-                 {"environment", a.radiance},
-                 {"environment_sha256", i.sha256},
-                 {"environment_layout", i.layout},
-                 {"negative_pixels_clamped", int64_t(i.negative_pixels_clamped)}})});
-  }
-  if (report) {
-    for (const auto& e : report->products) {
-      std::vector<F::Attr> attrs = {
-          {"columns", std::string("rmse, max_abs, reference_rms, bake_std_error, reference_std_error")},
-          {"points", int64_t(report->vertices.size())},
-          {"reference", report->reference}};
-      if (!a.reproducible) {  // wall times differ run to run: kept out of reproducible files
-        attrs.push_back({"reference_seconds", report->reference_seconds});
-        attrs.push_back({"bake_seconds", result.seconds});
-        attrs.push_back({"integrals_per_second", double(V) / result.seconds});
-      }
-      file.datasets.push_back(
-          {"/report/" + e.product, {5},
-           std::vector<float>{float(e.rmse), float(e.max_abs), float(e.reference_rms), float(e.bake_std_error),
-                              float(e.reference_std_error)},
-           std::move(attrs)});
-    }
-    file.datasets.push_back({"/report/vertices", {report->vertices.size()}, report->vertices, {}});
-  }
+  tool::add_mesh(file, "", mesh);
+  tool::add_products(file, "", result,
+                     {integrator.name(), integrator.description(), a.samples, a.seed, a.transfer, a.visibility,
+                      env ? &*env : nullptr, a.radiance});
+  if (report) tool::add_report(file, "/report", *report, result.seconds, mesh.positions.size(), a.reproducible);
   F::write_file(a.output, file);
   if (say) {
     std::error_code ec;
@@ -495,7 +453,7 @@ int run_fiv(const Args& a) {
   mopt.use_file_normals = false;  // an occluder's normals play no part in its FIVs
   const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
-  for (const auto& w : mesh.warnings) std::fprintf(stderr, "prtbake: warning: %s\n", w.c_str());
+  print_warnings(mesh.warnings);
   const bake::EnvMap env = bake::EnvMap::load(a.radiance, a.up);
   const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
   if (say)
@@ -524,89 +482,143 @@ int run_fiv(const Args& a) {
   namespace F = prt::formats;
   F::File file;
   file.root_attrs = root_attrs(a, bake::sha256_file(a.mesh));
-  std::vector<F::Attr> env_attrs = {{"environment", a.radiance}, {"environment_sha256", env.info().sha256}};
-  std::vector<float> fe(9);
-  for (int k = 0; k < 9; ++k) fe[size_t(k)] = float(fenv[size_t(k)]);
-  auto with = [](std::vector<F::Attr> x, std::vector<F::Attr> y) {
-    x.insert(x.end(), y.begin(), y.end());
-    return x;
-  };
-  file.datasets.push_back({"/fiv/environment", {3, 3}, std::move(fe),
-                           with(env_attrs, {{"integrand", std::string("F_c = Int L_c(w) w dw, layout [RGB][xyz]")}})});
-  file.datasets.push_back(
-      {"/fiv/irradiance_cube", {6, uint64_t(a.cube), uint64_t(a.cube), 3}, cube,
-       with(env_attrs, {{"integrand", std::string("E_c(n) = Int L_c H(w,n) (n.w) dw, exact per texel")},
-                        {"face_convention", std::string("faces +X,-X,+Y,-Y,+Z,-Z; texel (row r, column q): s = "
-                                                        "2(q+0.5)/S-1, t = 2(r+0.5)/S-1; +X (1,-t,-s), -X (-1,-t,s), "
-                                                        "+Y (s,1,t), -Y (s,-1,-t), +Z (s,-t,1), -Z (-s,-t,-1)")}})});
-  std::string name = fs::path(a.mesh).stem().string();
-  for (char& c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
-  const std::string dir = "/fiv/occluders/" + (name.empty() ? std::string("occluder") : name);
-  const uint64_t nr = sh.radii.size();
-  file.datasets.push_back(
-      {dir + "/shells", {nr, uint64_t(a.n_theta), uint64_t(a.n_phi), 3, 3}, sh.shells,
-       with(env_attrs, {{"integrand", std::string("F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]")},
-                        {"centre", std::vector<double>{sh.centre.x(), sh.centre.y(), sh.centre.z()}},
-                        {"radius", sh.radius},
-                        {"radii", sh.radii},
-                        {"angular_convention", std::string("s = centre + rho_k d(theta_i, phi_j), theta_i = pi i/(Ntheta-1) "
-                                                           "from +Y, phi_j = 2 pi j/Nphi from +Z towards +X, d = (sin "
-                                                           "theta sin phi, cos theta, sin theta cos phi)")},
-                        {"fraction", a.fraction},
-                        {"samples", int64_t(a.samples)}})});
-  file.datasets.push_back({dir + "/valid", {nr, uint64_t(a.n_theta), uint64_t(a.n_phi)}, sh.valid,
-                           {{"meaning", std::string("0: the offset lies inside the occluder (nothing visible)")}}});
+  tool::add_fiv_environment(file, env, a.radiance, fenv, cube, a.cube);
+  const std::string name = tool::safe_name(fs::path(a.mesh).stem().string());
+  tool::add_fiv_occluder(file, name, sh, env, a.radiance, a.fraction, a.samples);
   if (a.report > 0) {
     // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
-    bake::ProductRequest req;
-    req.radiance = &env;
-    req.visibility_order = 1;
-    const bake::QmcIntegrator qmc(mesh, topo, req, {65536, bake::mix64(a.seed ^ 0x66697672656675ull)});
-    const size_t per_shell = size_t(a.n_theta) * size_t(a.n_phi), total = sh.radii.size() * per_shell;
-    const auto picks = bake::seeded_sample(uint32_t(total), a.report, a.seed);
-    std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);
-    const auto r0 = std::chrono::steady_clock::now();
-    tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
-      const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
-      const int i = int(ij / size_t(a.n_phi)), j = int(ij % size_t(a.n_phi));
-      bake::Fiv se;
-      const bake::Fiv ref = bake::qmc_occluded_fiv(
-          qmc, fenv, sh.centre + sh.radii[k] * bake::shell_direction(i, a.n_theta, j, a.n_phi), idx, &se);
-      for (int x = 0; x < 9; ++x) {
-        const double d = double(sh.shells[idx * 9 + size_t(x)]) - ref[size_t(x)];
-        err2[q] += d * d;
-        se2[q] += se[size_t(x)] * se[size_t(x)];
-        maxe[q] = std::max(maxe[q], std::abs(d));
-      }
-    });
-    const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-    double e = 0, s2 = 0, mx = 0, n2 = 0;
-    for (size_t q = 0; q < picks.size(); ++q) {
-      e += err2[q];
-      s2 += se2[q];
-      mx = std::max(mx, maxe[q]);
-    }
-    for (double x : fenv) n2 += x * x;
-    const double nval = double(9 * picks.size()), norm = std::sqrt(n2 / 9);
-    const double rmse = std::sqrt(e / nval), ref_se = std::sqrt(s2 / nval);
+    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, sh, fenv, a.report, a.seed);
     if (say)
       std::printf("error against a 65536-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
-                  picks.size(), ref_seconds, rmse, mx, norm > 0 ? rmse / norm : 0.0, ref_se);
-    std::vector<F::Attr> attrs = {
-        {"columns", std::string("rmse, max_abs, reference_rms (RMS of F_env components), bake_std_error (0: "
-                                "deterministic), reference_std_error")},
-        {"points", int64_t(picks.size())},
-        {"reference", qmc.description() + " (full sphere)"}};
-    if (!a.reproducible) {
-      attrs.push_back({"reference_seconds", ref_seconds});
-      attrs.push_back({"bake_seconds", sh.seconds});
-      attrs.push_back({"integrals_per_second", double(sh.integrals) / sh.seconds});
-    }
-    file.datasets.push_back({"/report/fiv/" + name, {5}, std::vector<float>{float(rmse), float(mx), float(norm), 0.0f, float(ref_se)},
-                             std::move(attrs)});
+                  r.points, r.reference_seconds, r.rmse, r.max_abs, r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
+                  r.reference_std_error);
+    tool::add_fiv_report(file, name, r, sh, a.reproducible);
   }
+  F::write_file(a.output, file);
+  if (say) {
+    std::error_code ec;
+    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
+  }
+  return 0;
+}
+
+int run_scene(const Args& a) {
+  const bool say = !a.quiet;
+  if (!a.dry_run) check_output_writable(a.output);
+  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
+  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+  bake::Scene scene = bake::load_scene(a.mesh);
+  if (a.report_given) scene.report = a.report;
+  Args file_args = a;  // the root attributes follow the scene file
+  file_args.up = scene.up;
+
+  std::vector<bake::Mesh> meshes;
+  std::vector<std::string> mesh_sha;
+  for (const auto& o : scene.objects) {
+    try {
+      meshes.push_back(bake::load_scene_mesh(o));
+    } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
+      throw std::runtime_error(std::string(e.what()) + " (object '" + o.name + "' of " + a.mesh + ")");
+    }
+    mesh_sha.push_back(bake::sha256_file(o.mesh));
+    print_warnings(meshes.back().warnings);
+  }
+  std::optional<bake::EnvMap> env;
+  if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
+  const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
+
+  if (say) {
+    std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.mesh.c_str(),
+                scene.objects.size(), env ? scene.environment->string().c_str() : "none", scene.integrator.c_str(),
+                scene.sh_tolerance);
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const auto& o = scene.objects[i];
+      std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n", o.name.c_str(), bake::role_name(o.role),
+                  o.mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size());
+      for (const auto& b : plan.objects[i].baked) std::printf("      bake       %s\n", b.c_str());
+      for (const auto& l : plan.objects[i].left_out) std::printf("      leave out  %s\n", l.c_str());
+    }
+    for (const auto& n : plan.notes) std::printf("  %s\n", n.c_str());
+    std::fflush(stdout);
+  }
+  if (a.dry_run) return 0;
+
+  const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
+  const bake::SceneBake result = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
+                                                  [&](const std::string& line) {
+                                                    if (say) std::printf("%s\n", line.c_str());
+                                                    std::fflush(stdout);
+                                                  });
+  if (say)
+    std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
+                (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
+                result.environment_seconds);
+
+  namespace F = prt::formats;
+  F::File file;
+  file.root_attrs = root_attrs(file_args, bake::sha256_file(a.mesh));
+  const std::string env_path = env ? scene.environment->string() : std::string();
+  std::vector<F::Attr> scene_attrs = {
+      {"scene_file", a.mesh},
+      {"integrator", scene.integrator},
+      {"samples", int64_t(scene.samples ? scene.samples : bake::default_samples(scene.integrator))},
+      {"seed", int64_t(scene.seed)},
+      {"sh_tolerance", scene.sh_tolerance},
+      {"relight", int64_t(scene.relight)}};
+  if (env) {
+    scene_attrs.push_back({"environment", env_path});
+    scene_attrs.push_back({"environment_sha256", env->info().sha256});
+  }
+  std::string notes;
+  for (const auto& n : plan.notes) notes += (notes.empty() ? "" : "\n") + n;
+  scene_attrs.push_back({"plan", notes});
+  file.group_attrs.push_back({"/scene", std::move(scene_attrs)});
+  auto join = [](const std::vector<std::string>& lines) {
+    std::string s;
+    for (const auto& l : lines) s += (s.empty() ? "" : "\n") + l;
+    return s.empty() ? std::string("-") : s;
+  };
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const auto& o = scene.objects[i];
+    const auto& p = plan.objects[i];
+    const auto& ob = result.objects[i];
+    const std::string prefix = "/objects/" + o.name;
+    std::vector<double> transform(16);
+    for (int k = 0; k < 16; ++k) transform[size_t(k)] = o.transform(k / 4, k % 4);
+    std::vector<F::Attr> attrs = {
+        {"role", std::string(bake::role_name(o.role))},
+        {"mesh", o.mesh.string()},
+        {"mesh_sha256", mesh_sha[i]},
+        {"transform", transform},
+        {"albedo", std::vector<double>(o.material.albedo.begin(), o.material.albedo.end())},
+        {"phong_exponent", o.material.phong_exponent},
+        {"sh_order_diffuse", int64_t(p.transfer_order)},
+        {"sh_order_glossy", int64_t(p.visibility_order)},
+        {"baked", join(p.baked)},
+        {"left_out", join(p.left_out)}};
+    if (o.material.glossy())
+      attrs.push_back({"specular", std::vector<double>(o.material.specular.begin(), o.material.specular.end())});
+    if (ob.values) attrs.push_back({"closed_form_vertices", int64_t(ob.closed_form_vertices)});
+    file.group_attrs.push_back({prefix, std::move(attrs)});
+    tool::add_mesh(file, prefix, meshes[i]);
+    if (ob.values) {
+      tool::add_products(file, prefix, *ob.values,
+                         {scene.integrator, ob.integrator_description,
+                          scene.samples ? scene.samples : bake::default_samples(scene.integrator), scene.seed,
+                          p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+      if (ob.report)
+        tool::add_report(file, "/report/objects/" + o.name, *ob.report, ob.values->seconds, meshes[i].positions.size(),
+                         a.reproducible);
+    }
+    if (ob.fiv) {
+      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fraction,
+                             scene.samples ? scene.samples : 16384u);
+      if (ob.fiv_report) tool::add_fiv_report(file, o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
+    }
+  }
+  if (plan.fiv_environment)
+    tool::add_fiv_environment(file, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.cube);
   F::write_file(a.output, file);
   if (say) {
     std::error_code ec;
@@ -620,7 +632,7 @@ int run_fiv(const Args& a) {
 int main(int argc, char** argv) {
   try {
     const Args a = parse(argc, argv);
-    return a.command == "fiv" ? run_fiv(a) : run_vertex(a);
+    return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "prtbake: %s\n", e.what());
     return 2;

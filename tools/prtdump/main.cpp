@@ -42,14 +42,18 @@ Example:
   prtdump --json bunny.prt.h5 | python3 -m json.tool
 
 What the summary shows:
-  format / schema  the format version and whether the file passes the schema-v1 check
+  format / schema  the format version and whether the file passes the schema check
                    (prtdump still shows a file that fails it, so you can see what is wrong;
                    the runtime and other readers reject such files).
   Root attributes  who wrote the file, when, from which source (and its SHA-256), the
                    command line, the up axis and the SH convention (see formats/SCHEMA.md).
   Layout           each dataset: path, element type, shape and its attributes (e.g. sh_order
                    = L, the number of SH bands, so a transfer vector has L*L coefficients).
-  Group attributes attributes on groups such as /report (error against run time).
+  Scene            for scene files (prtbake scene): each object's role and what the bake
+                   baked and left out, with the reasons.
+  Error report     per product: RMSE and max error against the converged reference, the
+                   reference's own standard error, bake and reference wall times.
+  Group attributes attributes on groups such as /scene and /objects/<name>.
   Statistics       per dataset: min, max and mean over the finite values, and the number of
                    NaN and Inf values (a valid file has none). For a dataset whose last axis is
                    small (<= 16, e.g. xyz, RGB or SH coefficients) also per-column min/max/mean,
@@ -325,11 +329,67 @@ int64_t version_of(const fmt::File& f) {
   return v ? std::get<int64_t>(v->value) : 0;  // read_file checked it is an int64
 }
 
+// The plan of a scene file: each object's role, what was baked and what was left out.
+void scene_text(std::ostream& os, const fmt::File& f) {
+  bool header = false;
+  for (const auto& [g, attrs] : f.group_attrs) {
+    if (!g.starts_with("/objects/")) continue;
+    if (!header) os << "\nScene (objects, what was baked and what was left out)\n";
+    header = true;
+    const fmt::Attr* role = fmt::find_attr(attrs, "role");
+    const auto* role_s = role ? std::get_if<std::string>(&role->value) : nullptr;
+    os << "  " << g.substr(9) << " (" << (role_s ? *role_s : std::string("?")) << ")\n";
+    for (const char* key : {"baked", "left_out"}) {
+      const fmt::Attr* a = fmt::find_attr(attrs, key);
+      const auto* text = a ? std::get_if<std::string>(&a->value) : nullptr;
+      if (text == nullptr || *text == "-") continue;
+      std::size_t start = 0;
+      while (start <= text->size()) {
+        const std::size_t end = std::min(text->find('\n', start), text->size());
+        os << "      " << (key[0] == 'b' ? "baked      " : "left out   ") << text->substr(start, end - start) << '\n';
+        start = end + 1;
+      }
+    }
+  }
+}
+
+// The error against run time stored under /report: [5] datasets with a 'columns' attribute.
+void report_text(std::ostream& os, const fmt::File& f) {
+  bool header = false;
+  for (const fmt::Dataset& d : f.datasets) {
+    if (!d.path.starts_with("/report/") || d.shape != std::vector<uint64_t>{5} || d.data.index() != 0) continue;
+    if (!header)
+      os << "\nError report (against a converged reference; times are wall seconds)\n"
+         << "  " << pad("product", 40) << pad("RMSE", 12) << pad("max", 12) << pad("ref. RMS", 12)
+         << pad("ref. s.e.", 12) << pad("bake s", 9) << pad("ref. s", 9) << "integrals/s\n";
+    header = true;
+    const auto& v = std::get<std::vector<float>>(d.data);
+    auto num = [](double x, int w) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%-*.3e", w, x);
+      return std::string(buf);
+    };
+    auto attr_num = [&](const char* name) {
+      const fmt::Attr* a = fmt::find_attr(d.attrs, name);
+      const auto* x = a ? std::get_if<double>(&a->value) : nullptr;
+      char buf[32];
+      if (x) std::snprintf(buf, sizeof buf, "%-9.3g", *x);
+      else std::snprintf(buf, sizeof buf, "%-9s", "-");
+      return std::string(buf);
+    };
+    os << "  " << pad(d.path.substr(8), 40) << num(v[0], 12) << num(v[1], 12) << num(v[2], 12) << num(v[4], 12)
+       << attr_num("bake_seconds") << attr_num("reference_seconds") << attr_num("integrals_per_second") << '\n';
+  }
+}
+
 void summary_text(std::ostream& os, const std::string& path, const fmt::File& f,
                   const std::optional<std::string>& schema_error) {
   os << "file     " << path << '\n';
   os << "format   prtbake, format_version " << version_of(f) << '\n';
-  os << "schema   " << (schema_error ? "INVALID: " + *schema_error : std::string("valid (schema v1)"))
+  os << "schema   "
+     << (schema_error ? "INVALID: " + *schema_error
+                      : "valid (schema v" + std::to_string(version_of(f)) + ", this prtdump reads 1.." +
+                            std::to_string(fmt::kFormatVersion) + ")")
      << "\n\nRoot attributes\n";
   std::size_t w = 0;
   for (const fmt::Attr& a : f.root_attrs) w = std::max(w, a.name.size());
@@ -343,6 +403,8 @@ void summary_text(std::ostream& os, const std::string& path, const fmt::File& f,
        << shape_text(d.shape) << '\n';
     for (const fmt::Attr& a : d.attrs) os << "      " << a.name << " = " << attr_text(a.value) << '\n';
   }
+  scene_text(os, f);
+  report_text(os, f);
   if (!f.group_attrs.empty()) {
     os << "\nGroup attributes\n";
     for (const auto& [g, attrs] : f.group_attrs) {

@@ -33,6 +33,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 namespace prt::bake {
@@ -85,5 +86,18 @@ Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& 
 class QmcIntegrator;
 Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, const Eigen::Vector3d& position,
                      uint64_t point_index, Fiv* std_error = nullptr);
+
+// Error of baked shells against the QMC reference (65,536 rays, full sphere) at `points` shell
+// samples chosen with `seed` (DESIGN.md §6): RMSE and max over the 9 numbers of each sample.
+struct FivErrorReport {
+  size_t points = 0;
+  double rmse = 0, max_abs = 0;
+  double reference_rms = 0;        // RMS of the F^env components: the scale errors are relative to
+  double reference_std_error = 0;  // RMS of the reference's own standard errors
+  double reference_seconds = 0;    // apart from the bake time
+  std::string reference;           // the reference integrator's description
+};
+FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
+                                const Fiv& environment, size_t points, uint64_t seed);
 
 } // namespace prt::bake

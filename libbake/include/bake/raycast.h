@@ -52,6 +52,7 @@ private:
   const Topology& topo_;
   std::unique_ptr<Embree> rt_;
   double diagonal_ = 0;
+  Eigen::Vector3d centre_{0, 0, 0};  // of the bounding box
 };
 
 } // namespace prt::bake

@@ -22,6 +22,8 @@
 //  * The hemisphere H(ω,n) is a virtual occluder: the horizon great circle is walked like an
 //    edge with step +1 into the lower hemisphere (paper §4: clamping is part of visibility), so
 //    integrands never carry H and the tables are shared by all shade points.
+//  * A hemisphere point with no contour edge in view takes closed forms (bake/zonal.h) after one
+//    ray decides enclosed / open; its band-1 radiance is the horizon-only walk, once per normal.
 //  * Visibility is the limit from p + εn, ε → 0+: every orientation predicate at p is evaluated
 //    symbolically at p + εn (sign of the value, else of its ε-derivative), and the shade point's
 //    own vertex is seen in direction −n. A flat 1-ring therefore covers exactly the lower
@@ -46,6 +48,9 @@ struct SilhouetteOptions {
 struct SilhouetteStats {
   uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
   uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
+  // Hemisphere points with no contour edge in view, given closed forms instead of a DCF walk
+  // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
+  uint64_t closed_form = 0, enclosed = 0;
   double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
 };
 

@@ -8,6 +8,8 @@
 #include <bake/mesh.h>
 #include <bake/progress.h>
 
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,14 @@ ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
                          ProgressMode progress = ProgressMode::Quiet, const std::string& label = "baking vertices");
+
+// The shade points of every vertex of `mesh` (vertex_shade_point for each, in order).
+std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& topology);
+
+// The general form: any shade points (e.g. a scene receiver's vertices against the scene's
+// occluders, bake/scene.h); row i belongs to points[i], randomised by the index i.
+VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
+                       ProgressMode progress = ProgressMode::Quiet, const std::string& label = "baking vertices");
 
 // Error against a converged reference on a seeded sample of vertices (DESIGN.md §6).
 struct ProductError {
@@ -45,6 +55,20 @@ struct ErrorReport {
 // compares with `bake` (which must have the same layout).
 ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
                                    const Integrator& reference, size_t n_points, uint64_t seed);
+
+ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
+                                          const Integrator& reference, size_t n_points, uint64_t seed);
+
+// The integrators by name, as the tools offer them: "silhouette" (k = samples, √k isolines rounded
+// to even; default 16384) or "qmc" (samples rays per point; default 1024). Throws InputError for
+// another name. `mesh`, `topology` and the request's environment must outlive the integrator.
+std::unique_ptr<Integrator> make_integrator(const std::string& name, uint32_t samples, uint64_t seed, const Mesh& mesh,
+                                            const Topology& topology, const ProductRequest& request);
+// The converged reference of the error reports (DESIGN.md §6): QMC with 10× the bake's rays for a
+// qmc bake, 65,536 rays for a silhouette bake, seeded apart from the bake's points.
+std::unique_ptr<Integrator> make_reference(const std::string& bake_integrator, uint32_t samples, uint64_t seed,
+                                           const Mesh& mesh, const Topology& topology, const ProductRequest& request);
+uint32_t default_samples(const std::string& integrator);
 
 // Distinct indices in [0, n), min(k, n) of them, chosen by seed (partial Fisher–Yates), sorted.
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed);

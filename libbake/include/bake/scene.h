@@ -1,0 +1,156 @@
+// bake/scene.h — scene files: several objects, their roles and materials, one environment, and
+// a plan that bakes what the scene needs and nothing else (DESIGN.md §5 "Only what was asked for,
+// and what the scene needs, is written").
+//
+// The scene file (JSON, RFC 8259; documented with an example in data/scene_example.json and in
+// README.md "Scene files"):
+//   {
+//     "prtbake_scene": 1,                        required: the scene-file version
+//     "up": "y",                                 optional: "y" (default) or "z"
+//     "environment": "sunset.exr",               optional: HDR environment (lat-long or cube EXR)
+//     "bake": {                                  optional, every member too:
+//       "products": ["ao", "transfer", "radiance", "fiv"],   what may be baked (default: all four)
+//       "integrator": "silhouette" | "qmc",  "samples": k or rays,  "seed": 1,  "report": 32,
+//       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
+//       "relight": false,                      diffuse receivers also get transfer vectors
+//       "fiv": {"shells": "64x33x30", "cube": 16, "fraction": 0.001}
+//     },
+//     "objects": [ {                             one or more
+//       "name": "bunny",                         optional: default the mesh file's stem; unique
+//       "mesh": "bunny.obj",                     required; relative paths are relative to the scene file
+//       "role": "receiver" | "occluder" | "both",  required
+//       "transform": {"translate": [x,y,z], "rotate": [rx,ry,rz] (degrees, about X then Y then Z),
+//                     "scale": s | [sx,sy,sz]}  or  {"matrix": [16 numbers, row-major, last row 0 0 0 1]},
+//       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]}
+//     } ]
+//   }
+// Unknown keys are errors (a typo must not silently change a bake); every error names the file,
+// the line and column, and the key.
+//
+// Roles: a receiver gets per-vertex products; an occluder casts shadows (it is part of every
+// receiver's visibility, and gets FIV shells for dynamic use); "both" does both (self-shadowing).
+// A receiver-only object casts no shadow, not even on itself.
+//
+// The rules of plan_scene (each decision is printed with its reason and stored in the file):
+//   * occluder-only objects get no per-vertex products (no transfer, AO or radiance);
+//   * diffuse lobe (albedo): band-1 shadowed radiance when there is an environment — exact
+//     diffuse shading with 3 coefficients per channel (paper 001 §4) — and no higher order; diffuse
+//     transfer (relightable) only without an environment or with "relight", at the smallest order
+//     whose clamped-cosine energy beyond it is ≤ sh_tolerance (order 3 for 1%, bake/zonal.h);
+//   * glossy lobe (phong_exponent s): visibility transfer at the smallest order whose Phong-lobe
+//     energy beyond it is ≤ sh_tolerance (Ramamoorthi & Hanrahan 2002; paper 001 §4 glossy);
+//   * no radiance and no FIV without an environment;
+//   * FIV shells only for an occluder that can shadow some other receiver: its bounding sphere
+//     reaches above the tangent plane of at least one vertex of another receiver (paper 004 §4.3.1:
+//     case C, wholly below the horizon, occludes nothing);
+//   * the environment's FIV and DifMap only when some occluder gets shells;
+//   * vertices that see no contour edge get closed forms (bake/silhouette.h, bake/zonal.h).
+#pragma once
+
+#include <bake/envmap.h>
+#include <bake/fiv.h>
+#include <bake/mesh.h>
+#include <bake/progress.h>
+#include <bake/vertex_bake.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace prt::bake {
+
+enum class Role { Receiver, Occluder, Both };
+const char* role_name(Role);
+
+struct Material {
+  std::array<double, 3> albedo{0, 0, 0};    // diffuse lobe (none if all 0)
+  double phong_exponent = 0;                // glossy lobe max(r·ω, 0)^s (none if 0)
+  std::array<double, 3> specular{0, 0, 0};  // its colour
+  bool diffuse() const { return albedo[0] > 0 || albedo[1] > 0 || albedo[2] > 0; }
+  bool glossy() const { return phong_exponent > 0; }
+};
+
+struct SceneObject {
+  std::string name;
+  std::filesystem::path mesh;                     // resolved against the scene file's directory
+  Role role = Role::Both;
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  Material material;
+};
+
+struct Scene {
+  std::filesystem::path file;
+  UpAxis up = UpAxis::Y;
+  std::optional<std::filesystem::path> environment;
+  bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
+  std::string integrator = "silhouette";
+  uint32_t samples = 0;  // 0: the integrator's default
+  uint64_t seed = 1;
+  uint32_t report = 32;
+  double sh_tolerance = 0.01;
+  bool relight = false;
+  int n_phi = 64, n_theta = 33, n_rho = 30, cube = 16;
+  double fraction = 1e-3;
+  std::vector<SceneObject> objects;
+};
+
+// Parses and validates a scene file (InputError naming the file, line, column and key).
+Scene load_scene(const std::filesystem::path& file);
+
+// An object's mesh in world space: the transform applied to positions; normals from the file
+// transformed by the inverse transpose, angle-weighted normals recomputed on the world positions.
+Mesh load_scene_mesh(const SceneObject& object);
+
+struct ObjectPlan {
+  bool receiver = false, occluder = false;
+  bool ao = false, radiance = false, fiv = false;
+  int transfer_order = 0;    // diffuse transfer T (0: none)
+  int visibility_order = 0;  // visibility transfer U for the glossy lobe (0: none)
+  std::vector<std::string> baked, left_out;  // "product: reason", one line each
+  bool any_vertex_product() const { return ao || radiance || transfer_order > 0 || visibility_order > 0; }
+};
+
+struct ScenePlan {
+  std::vector<ObjectPlan> objects;  // parallel to Scene::objects
+  bool fiv_environment = false;     // /fiv/environment and /fiv/irradiance_cube
+  std::vector<std::string> notes;   // scene-wide decisions
+};
+
+// Decides what to bake (the rules in the file comment). `meshes` are the world-space meshes of
+// scene.objects (load_scene_mesh), used by the FIV rule. Throws InputError when a material has no
+// SH order within kMaxOrder for the tolerance.
+ScenePlan plan_scene(const Scene& scene, std::span<const Mesh> meshes);
+
+// ---- the bake itself ----
+
+struct ObjectBake {
+  // Receivers: one row per vertex of the object's world mesh, in its layout.
+  std::optional<VertexBake> values;
+  std::optional<ErrorReport> report;
+  std::string integrator_description;
+  uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
+  // Occluders with shells (in world space: centre and radii in scene units).
+  std::optional<FivShells> fiv;
+  std::optional<FivErrorReport> fiv_report;
+};
+
+struct SceneBake {
+  std::vector<ObjectBake> objects;  // parallel to Scene::objects
+  Fiv environment_fiv{};            // when plan.fiv_environment
+  std::vector<float> irradiance_cube;
+  double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0;
+  uint64_t vertices = 0;  // receiver vertices integrated
+};
+
+// Runs the plan. Visibility for every receiver is the union of the occluders ("occluder" and
+// "both" objects) in world space; a "both" receiver's vertices are shade points of that union
+// (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
+// `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
+SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
+                     ProgressMode progress, const std::function<void(const std::string&)>& log);
+
+} // namespace prt::bake

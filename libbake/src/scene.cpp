@@ -1,0 +1,392 @@
+// scene.cpp — scene files and the bake plan (bake/scene.h).
+#include <bake/error.h>
+#include <bake/fiv.h>
+#include <bake/json.h>
+#include <bake/scene.h>
+#include <bake/zonal.h>
+
+#include <prtshade/sh.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+namespace prt::bake {
+
+const char* role_name(Role r) {
+  switch (r) {
+  case Role::Receiver: return "receiver";
+  case Role::Occluder: return "occluder";
+  case Role::Both: return "both";
+  }
+  return "?";
+}
+
+namespace {
+
+// Reads typed members with messages that name file, position and key path.
+class Reader {
+public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const json::Value& at, const std::string& what) const {
+    throw InputError(file_, "line " + std::to_string(at.line) + ", column " + std::to_string(at.column) + ": " + what);
+  }
+
+  const json::Value& object(const json::Value& v, const std::string& key_path,
+                            std::initializer_list<std::string_view> allowed) const {
+    if (!v.is_object()) fail(v, key_path + " must be an object, not " + v.type_name());
+    for (const auto& [k, member] : v.object()) {
+      bool ok = false;
+      for (std::string_view a : allowed) ok = ok || k == a;
+      if (!ok) {
+        std::string list;
+        for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(member, "unknown key \"" + k + "\" in " + key_path + " (allowed: " + list + ")");
+      }
+    }
+    return v;
+  }
+
+  double number(const json::Value& v, const std::string& key, double lo, double hi) const {
+    if (!v.is_number()) fail(v, key + " must be a number, not " + v.type_name());
+    const double x = std::get<double>(v.v);
+    if (!(x >= lo && x <= hi)) {
+      std::ostringstream os;
+      os << key << " must be in [" << lo << ", " << hi << "], got " << x;
+      fail(v, os.str());
+    }
+    return x;
+  }
+
+  int64_t integer(const json::Value& v, const std::string& key, int64_t lo, int64_t hi) const {
+    const double x = number(v, key, double(lo), double(hi));
+    if (x != std::floor(x)) fail(v, key + " must be an integer");
+    return int64_t(x);
+  }
+
+  const std::string& string(const json::Value& v, const std::string& key) const {
+    if (!v.is_string()) fail(v, key + " must be a string, not " + v.type_name());
+    const std::string& s = std::get<std::string>(v.v);
+    if (s.empty()) fail(v, key + " must not be empty");
+    return s;
+  }
+
+  bool boolean(const json::Value& v, const std::string& key) const {
+    if (!v.is_bool()) fail(v, key + " must be true or false, not " + v.type_name());
+    return std::get<bool>(v.v);
+  }
+
+  std::array<double, 3> vec3(const json::Value& v, const std::string& key, double lo, double hi) const {
+    if (!v.is_array() || v.array().size() != 3) fail(v, key + " must be an array of 3 numbers");
+    std::array<double, 3> out{};
+    for (int i = 0; i < 3; ++i) out[size_t(i)] = number(v.array()[size_t(i)], key + "[" + std::to_string(i) + "]", lo, hi);
+    return out;
+  }
+
+private:
+  std::string file_;
+};
+
+constexpr double kHuge = 1e30;
+
+Eigen::Matrix4d parse_transform(const Reader& r, const json::Value& v, const std::string& key) {
+  r.object(v, key, {"translate", "rotate", "scale", "matrix"});
+  Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+  if (const json::Value* m = v.find("matrix")) {
+    if (v.object().size() != 1) r.fail(v, key + ": give either \"matrix\" or translate/rotate/scale, not both");
+    if (!m->is_array() || m->array().size() != 16) r.fail(*m, key + ".matrix must be an array of 16 numbers (row-major 4x4)");
+    for (int i = 0; i < 16; ++i)
+      M(i / 4, i % 4) = r.number(m->array()[size_t(i)], key + ".matrix[" + std::to_string(i) + "]", -kHuge, kHuge);
+    if (M(3, 0) != 0 || M(3, 1) != 0 || M(3, 2) != 0 || M(3, 3) != 1)
+      r.fail(*m, key + ".matrix must be affine: its last row must be 0 0 0 1");
+  } else {
+    Eigen::Vector3d t(0, 0, 0), rot(0, 0, 0), s(1, 1, 1);
+    if (const json::Value* x = v.find("translate")) {
+      const auto a = r.vec3(*x, key + ".translate", -kHuge, kHuge);
+      t = Eigen::Vector3d(a[0], a[1], a[2]);
+    }
+    if (const json::Value* x = v.find("rotate")) {
+      const auto a = r.vec3(*x, key + ".rotate", -36000, 36000);
+      rot = Eigen::Vector3d(a[0], a[1], a[2]) * (std::numbers::pi / 180);
+    }
+    if (const json::Value* x = v.find("scale")) {
+      if (x->is_number()) {
+        const double k = r.number(*x, key + ".scale", -kHuge, kHuge);
+        s = Eigen::Vector3d(k, k, k);
+      } else {
+        const auto a = r.vec3(*x, key + ".scale", -kHuge, kHuge);
+        s = Eigen::Vector3d(a[0], a[1], a[2]);
+      }
+    }
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(rot.z(), Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(rot.y(), Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(rot.x(), Eigen::Vector3d::UnitX())).toRotationMatrix();
+    M.topLeftCorner<3, 3>() = R * s.asDiagonal();
+    M.topRightCorner<3, 1>() = t;
+  }
+  const double det = M.topLeftCorner<3, 3>().determinant();
+  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) r.fail(v, key + " is singular (determinant " + std::to_string(det) + ")");
+  return M;
+}
+
+bool valid_name(const std::string& n) {
+  if (n.empty() || n.size() > 128) return false;
+  for (char c : n)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return n != "." && n != "..";
+}
+
+} // namespace
+
+Scene load_scene(const std::filesystem::path& file) {
+  const json::Value root = json::parse_file(file);
+  const Reader r(file.string());
+  r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
+  Scene sc;
+  sc.file = file;
+  const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  auto resolve = [&](const std::string& p) {
+    const std::filesystem::path q(p);
+    return q.is_absolute() ? q : dir / q;
+  };
+  const json::Value* version = root.find("prtbake_scene");
+  if (version == nullptr) r.fail(root, "the scene lacks \"prtbake_scene\": 1 (the scene-file version)");
+  if (r.integer(*version, "prtbake_scene", 1, 1000) != 1)
+    r.fail(*version, "prtbake_scene version " + std::to_string(r.integer(*version, "prtbake_scene", 1, 1000)) +
+                         " is newer than this prtbake reads (1)");
+  if (const json::Value* up = root.find("up")) {
+    const std::string& u = r.string(*up, "up");
+    if (u != "y" && u != "z") r.fail(*up, "up must be \"y\" or \"z\", not \"" + u + "\"");
+    sc.up = u == "y" ? UpAxis::Y : UpAxis::Z;
+  }
+  if (const json::Value* env = root.find("environment")) sc.environment = resolve(r.string(*env, "environment"));
+  if (const json::Value* bake = root.find("bake")) {
+    r.object(*bake, "bake",
+             {"products", "integrator", "samples", "seed", "report", "sh_tolerance", "relight", "fiv"});
+    if (const json::Value* p = bake->find("products")) {
+      if (!p->is_array()) r.fail(*p, "bake.products must be an array of strings");
+      sc.want_ao = sc.want_transfer = sc.want_radiance = sc.want_fiv = false;
+      for (const json::Value& item : p->array()) {
+        const std::string& s = r.string(item, "bake.products[]");
+        if (s == "ao") sc.want_ao = true;
+        else if (s == "transfer") sc.want_transfer = true;
+        else if (s == "radiance") sc.want_radiance = true;
+        else if (s == "fiv") sc.want_fiv = true;
+        else r.fail(item, "unknown product \"" + s + "\" in bake.products (ao, transfer, radiance, fiv)");
+      }
+    }
+    if (const json::Value* x = bake->find("integrator")) {
+      sc.integrator = r.string(*x, "bake.integrator");
+      if (sc.integrator != "silhouette" && sc.integrator != "qmc")
+        r.fail(*x, "bake.integrator must be \"silhouette\" or \"qmc\", not \"" + sc.integrator + "\"");
+    }
+    if (const json::Value* x = bake->find("samples")) sc.samples = uint32_t(r.integer(*x, "bake.samples", 4, 1 << 24));
+    if (const json::Value* x = bake->find("seed")) sc.seed = uint64_t(r.integer(*x, "bake.seed", 0, int64_t(1) << 52));
+    if (const json::Value* x = bake->find("report")) sc.report = uint32_t(r.integer(*x, "bake.report", 0, 1 << 20));
+    if (const json::Value* x = bake->find("sh_tolerance")) {
+      sc.sh_tolerance = r.number(*x, "bake.sh_tolerance", 0, 1);
+      if (!(sc.sh_tolerance > 0)) r.fail(*x, "bake.sh_tolerance must be > 0");
+    }
+    if (const json::Value* x = bake->find("relight")) sc.relight = r.boolean(*x, "bake.relight");
+    if (const json::Value* f = bake->find("fiv")) {
+      r.object(*f, "bake.fiv", {"shells", "cube", "fraction"});
+      if (const json::Value* x = f->find("shells")) {
+        const std::string& s = r.string(*x, "bake.fiv.shells");
+        int a = 0, b = 0, c = 0;
+        char x1 = 0, x2 = 0, extra = 0;
+        std::istringstream is(s);
+        if (!(is >> a >> x1 >> b >> x2 >> c) || x1 != 'x' || x2 != 'x' || (is >> extra) || a < 4 || b < 3 || c < 1 ||
+            a > 4096 || b > 4096 || c > 256)
+          r.fail(*x, "bake.fiv.shells must be \"NPHIxNTHETAxNRHO\" (e.g. \"64x33x30\"; NPHI >= 4, NTHETA >= 3), not \"" +
+                         s + "\"");
+        sc.n_phi = a;
+        sc.n_theta = b;
+        sc.n_rho = c;
+      }
+      if (const json::Value* x = f->find("cube")) sc.cube = int(r.integer(*x, "bake.fiv.cube", 1, 1024));
+      if (const json::Value* x = f->find("fraction")) {
+        sc.fraction = r.number(*x, "bake.fiv.fraction", 0, 0.5);
+        if (!(sc.fraction > 0)) r.fail(*x, "bake.fiv.fraction must be > 0");
+      }
+    }
+  }
+  const json::Value* objects = root.find("objects");
+  if (objects == nullptr) r.fail(root, "the scene lacks \"objects\" (an array of one or more objects)");
+  if (!objects->is_array() || objects->array().empty()) r.fail(*objects, "objects must be a non-empty array");
+  std::set<std::string> names;
+  for (size_t i = 0; i < objects->array().size(); ++i) {
+    const json::Value& o = objects->array()[i];
+    const std::string key = "objects[" + std::to_string(i) + "]";
+    r.object(o, key, {"name", "mesh", "role", "transform", "material"});
+    SceneObject obj;
+    const json::Value* mesh = o.find("mesh");
+    if (mesh == nullptr) r.fail(o, key + " lacks \"mesh\" (the mesh file)");
+    const std::string& mesh_path = r.string(*mesh, key + ".mesh");
+    obj.mesh = resolve(mesh_path);
+    if (const json::Value* n = o.find("name")) {
+      obj.name = r.string(*n, key + ".name");
+      if (!valid_name(obj.name))
+        r.fail(*n, key + ".name \"" + obj.name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
+    } else {
+      obj.name = std::filesystem::path(mesh_path).stem().string();
+      for (char& c : obj.name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) c = '_';
+      if (!valid_name(obj.name)) obj.name = "object" + std::to_string(i);
+    }
+    if (!names.insert(obj.name).second)
+      r.fail(o, key + ": the name \"" + obj.name + "\" is already used by another object (names must be unique; set \"name\")");
+    const json::Value* role = o.find("role");
+    if (role == nullptr) r.fail(o, key + " lacks \"role\": \"receiver\", \"occluder\" or \"both\"");
+    const std::string& rs = r.string(*role, key + ".role");
+    if (rs == "receiver") obj.role = Role::Receiver;
+    else if (rs == "occluder") obj.role = Role::Occluder;
+    else if (rs == "both") obj.role = Role::Both;
+    else r.fail(*role, key + ".role must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
+    if (const json::Value* t = o.find("transform")) obj.transform = parse_transform(r, *t, key + ".transform");
+    obj.material.albedo = {0.8, 0.8, 0.8};
+    if (const json::Value* m = o.find("material")) {
+      r.object(*m, key + ".material", {"albedo", "phong_exponent", "specular"});
+      obj.material.albedo = {0, 0, 0};
+      if (const json::Value* a = m->find("albedo")) obj.material.albedo = r.vec3(*a, key + ".material.albedo", 0, 1);
+      if (const json::Value* s = m->find("phong_exponent"))
+        obj.material.phong_exponent = r.number(*s, key + ".material.phong_exponent", 0, 1e6);
+      if (const json::Value* s = m->find("specular")) {
+        obj.material.specular = r.vec3(*s, key + ".material.specular", 0, 1);
+        if (!obj.material.glossy()) r.fail(*s, key + ".material.specular needs phong_exponent > 0");
+      } else if (obj.material.glossy()) {
+        obj.material.specular = {1, 1, 1};
+      }
+      if (obj.role != Role::Occluder && !obj.material.diffuse() && !obj.material.glossy())
+        r.fail(*m, key + ".material has neither a diffuse albedo > 0 nor a phong_exponent > 0: the receiver reflects "
+                         "nothing");
+    }
+    sc.objects.push_back(std::move(obj));
+  }
+  return sc;
+}
+
+Mesh load_scene_mesh(const SceneObject& object) {
+  Mesh m = load_mesh(object.mesh);
+  const Eigen::Matrix3d A = object.transform.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = object.transform.topRightCorner<3, 1>();
+  const Eigen::Matrix3d N = A.inverse().transpose();
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    const Eigen::Vector3d p = A * m.positions[i].cast<double>() + t;
+    if (!p.allFinite() || p.cwiseAbs().maxCoeff() > 1e30)
+      throw InputError(object.mesh.string(), "vertex " + std::to_string(i) + " is not finite after the scene transform of '" +
+                                                 object.name + "'");
+    m.positions[i] = p.cast<float>();
+  }
+  if (m.normal_source == Mesh::NormalSource::File) {
+    for (auto& n : m.normals) n = (N * n.cast<double>()).normalized().cast<float>();
+  } else {
+    m.normals = welded_angle_weighted_normals(m.positions, m.triangles);
+  }
+  return m;
+}
+
+ScenePlan plan_scene(const Scene& scene, std::span<const Mesh> meshes) {
+  PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
+  ScenePlan plan;
+  plan.objects.resize(scene.objects.size());
+  const bool env = scene.environment.has_value();
+  const std::string env_name = env ? scene.environment->filename().string() : "";
+  const int diffuse_order = clamped_power_order(1.0, scene.sh_tolerance, sh::kMaxOrder);
+  auto pct = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2g%%", x * 100);
+    return std::string(buf);
+  };
+
+  // Bounding spheres for the FIV rule.
+  std::vector<Eigen::Vector3d> centre(meshes.size());
+  std::vector<double> radius(meshes.size());
+  for (size_t i = 0; i < meshes.size(); ++i) bounding_sphere(meshes[i], centre[i], radius[i]);
+
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& o = scene.objects[i];
+    ObjectPlan& p = plan.objects[i];
+    p.receiver = o.role != Role::Occluder;
+    p.occluder = o.role != Role::Receiver;
+    if (!p.receiver) {
+      p.left_out.push_back("ao, transfer, radiance: occluder only (role \"occluder\"): nothing is shaded on it");
+    } else {
+      if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
+      else p.left_out.push_back("ao: not in bake.products");
+      const Material& m = o.material;
+      if (m.diffuse()) {
+        if (!scene.want_radiance) p.left_out.push_back("radiance/band1: not in bake.products");
+        else if (!env) p.left_out.push_back("radiance/band1: the scene has no environment");
+        else p.radiance = true, p.baked.push_back("radiance/band1: diffuse albedo under " + env_name +
+                                                  ": exact shadowed irradiance with 3 coefficients per channel (paper 001 §4)");
+        if (!scene.want_transfer) {
+          p.left_out.push_back("transfer/diffuse: not in bake.products");
+        } else if (p.radiance && !scene.relight) {
+          p.left_out.push_back("transfer/diffuse: band-1 radiance is exact for a diffuse receiver under the scene's "
+                               "environment; no higher order is needed (set bake.relight for relightable transfer)");
+        } else {
+          p.transfer_order = diffuse_order;
+          p.baked.push_back("transfer/diffuse: order " + std::to_string(diffuse_order) +
+                            ", the smallest whose clamped-cosine energy beyond it (" +
+                            pct(clamped_power_energy_beyond(1.0, diffuse_order)) + ") is <= sh_tolerance " +
+                            pct(scene.sh_tolerance) + (env ? " (bake.relight)" : " (no environment: relightable)"));
+        }
+      } else {
+        p.left_out.push_back("radiance/band1, transfer/diffuse: the material has no diffuse albedo");
+      }
+      if (m.glossy()) {
+        if (!scene.want_transfer) {
+          p.left_out.push_back("transfer/visibility: not in bake.products");
+        } else {
+          const int L = clamped_power_order(m.phong_exponent, scene.sh_tolerance, sh::kMaxOrder);
+          if (L == 0) {
+            std::ostringstream os;
+            os << "object '" << o.name << "': a Phong exponent of " << m.phong_exponent
+               << " needs more than " << sh::kMaxOrder << " SH bands to keep the energy beyond them under "
+               << pct(scene.sh_tolerance) << " (" << pct(clamped_power_energy_beyond(m.phong_exponent, sh::kMaxOrder))
+               << " at order " << sh::kMaxOrder << "); lower the exponent or raise bake.sh_tolerance";
+            throw InputError(scene.file.string(), os.str());
+          }
+          p.visibility_order = L;
+          std::ostringstream os;
+          os << "transfer/visibility: order " << L << " for the Phong exponent " << m.phong_exponent
+             << ", the smallest whose lobe energy beyond it (" << pct(clamped_power_energy_beyond(m.phong_exponent, L))
+             << ") is <= sh_tolerance " << pct(scene.sh_tolerance);
+          p.baked.push_back(os.str());
+        }
+      }
+    }
+    if (p.occluder) {
+      if (!scene.want_fiv) {
+        p.left_out.push_back("fiv: not in bake.products");
+      } else if (!env) {
+        p.left_out.push_back("fiv: the scene has no environment (F = Int (1 - V) L w dw needs one)");
+      } else {
+        // Can it shadow another receiver? Paper 004 §4.3.1: an occluder whose bounding sphere lies
+        // wholly below a receiver point's tangent plane (case C) occludes nothing there.
+        bool other_receiver = false, reaches = false;
+        for (size_t j = 0; j < scene.objects.size() && !reaches; ++j) {
+          if (j == i || scene.objects[j].role == Role::Occluder) continue;
+          other_receiver = true;
+          const Mesh& R = meshes[j];
+          for (size_t v = 0; v < R.positions.size() && !reaches; ++v)
+            reaches = R.normals[v].cast<double>().dot(centre[i] - R.positions[v].cast<double>()) > -radius[i];
+        }
+        if (!other_receiver) p.left_out.push_back("fiv: no other receiver in the scene for it to shadow");
+        else if (!reaches) p.left_out.push_back("fiv: its bounding sphere lies below the horizon of every vertex of every other receiver");
+        else p.fiv = true, p.baked.push_back("fiv: it can shadow another receiver");
+      }
+    }
+    plan.fiv_environment = plan.fiv_environment || p.fiv;
+  }
+  if (plan.fiv_environment) plan.notes.push_back("fiv/environment and fiv/irradiance_cube: some occluder has shells");
+  else plan.notes.push_back("fiv/environment and fiv/irradiance_cube: left out, no occluder has shells");
+  return plan;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,144 @@
+// scene_bake.cpp — runs a scene plan (bake/scene.h): the receivers' per-vertex products against
+// the union of the occluders, then FIV shells per occluder that needs them.
+#include <bake/error.h>
+#include <bake/scene.h>
+#include <bake/silhouette.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <tuple>
+
+namespace prt::bake {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string fmt(const char* f, double a, double b = 0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, f, a, b);
+  return buf;
+}
+
+} // namespace
+
+SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
+                     ProgressMode progress, const std::function<void(const std::string&)>& log) {
+  PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
+  PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
+  SceneBake out;
+  out.objects.resize(scene.objects.size());
+  const auto t_setup = std::chrono::steady_clock::now();
+
+  // The occluder union, and where each occluder's vertices start in it.
+  std::vector<Mesh> parts;
+  std::vector<size_t> base(scene.objects.size(), SIZE_MAX);
+  size_t offset = 0;
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (plan.objects[i].occluder) {
+      base[i] = offset;
+      offset += meshes[i].positions.size();
+      parts.push_back(meshes[i]);
+    }
+  Mesh occluders;  // empty when nothing casts shadows: every receiver point is then unoccluded
+  if (!parts.empty()) occluders = merge_meshes(parts, "occluders");
+  parts.clear();
+  const Topology topo = build_topology(occluders);
+
+  // One integrator (and one reference) per distinct product request.
+  using Key = std::tuple<bool, int, int, bool>;
+  std::map<Key, std::pair<std::unique_ptr<Integrator>, std::unique_ptr<Integrator>>> integrators;
+  auto request_of = [&](const ObjectPlan& p) {
+    ProductRequest r;
+    r.ao = p.ao;
+    r.transfer_order = p.transfer_order;
+    r.visibility_order = p.visibility_order;
+    r.radiance = p.radiance ? env : nullptr;
+    return r;
+  };
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectPlan& p = plan.objects[i];
+    if (!p.receiver || !p.any_vertex_product()) continue;
+    const ProductRequest r = request_of(p);
+    const Key key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr};
+    if (integrators.count(key)) continue;
+    auto integ = make_integrator(scene.integrator, scene.samples, scene.seed, occluders, topo, r);
+    std::unique_ptr<Integrator> ref;
+    if (scene.report > 0) ref = make_reference(scene.integrator, scene.samples, scene.seed, occluders, topo, r);
+    integrators.emplace(key, std::make_pair(std::move(integ), std::move(ref)));
+  }
+  out.setup_seconds = seconds_since(t_setup);
+
+  // ---- receivers ----
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectPlan& p = plan.objects[i];
+    if (!p.receiver || !p.any_vertex_product()) continue;
+    const Mesh& m = meshes[i];
+    const ProductRequest r = request_of(p);
+    const auto& [integ, ref] = integrators.at(Key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr});
+    std::vector<ShadePoint> points(m.positions.size());
+    for (size_t v = 0; v < points.size(); ++v) {
+      if (p.occluder) {
+        points[v] = vertex_shade_point(occluders, topo, uint32_t(base[i] + v));
+      } else {
+        points[v].p = m.positions[v].cast<double>();
+        points[v].n = m.normals[v].cast<double>().normalized();
+      }
+    }
+    const auto* sil = dynamic_cast<const SilhouetteIntegrator*>(integ.get());
+    const uint64_t closed_before = sil ? sil->stats().closed_form : 0;
+    ObjectBake& ob = out.objects[i];
+    ob.values = bake_points(points, *integ, progress, "baking " + scene.objects[i].name);
+    ob.integrator_description = integ->description();
+    ob.closed_form_vertices = sil ? sil->stats().closed_form - closed_before : 0;
+    out.vertex_seconds += ob.values->seconds;
+    out.vertices += points.size();
+    log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
+        fmt("%.2f s", ob.values->seconds) +
+        (sil ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
+    if (ref) {
+      ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.report, scene.seed);
+      for (const auto& e : ob.report->products)
+        log("  " + e.product + ": " + fmt("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
+            fmt("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
+                ob.report->reference_seconds));
+    }
+  }
+
+  // ---- FIV ----
+  if (plan.fiv_environment) {
+    PRT_CHECK(env != nullptr);
+    const auto t0 = std::chrono::steady_clock::now();
+    out.environment_fiv = environment_fiv(*env);
+    out.irradiance_cube = irradiance_cube(*env, scene.cube);
+    out.environment_seconds = seconds_since(t0);
+    log("environment FIV and " + std::to_string(scene.cube) + "x" + std::to_string(scene.cube) + "x6 DifMap in " +
+        fmt("%.2f s", out.environment_seconds));
+  }
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    if (!plan.objects[i].fiv) continue;
+    const Mesh& m = meshes[i];
+    const Topology t = build_topology(m);
+    ShellSpec spec;
+    spec.n_phi = scene.n_phi;
+    spec.n_theta = scene.n_theta;
+    spec.n_rho = scene.n_rho;
+    spec.fraction = scene.fraction;
+    spec.isolines = std::max(2, int(std::lround(std::sqrt(double(scene.samples ? scene.samples : 16384u)))));
+    ObjectBake& ob = out.objects[i];
+    ob.fiv = bake_fiv_shells(m, t, *env, spec, progress);
+    out.fiv_seconds += ob.fiv->seconds;
+    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.n_phi) + "x" + std::to_string(scene.n_theta) +
+        "x" + std::to_string(ob.fiv->radii.size()) + " in " + fmt("%.2f s", ob.fiv->seconds));
+    if (scene.report > 0) {
+      ob.fiv_report = fiv_error_report(m, t, *env, *ob.fiv, out.environment_fiv, scene.report, scene.seed);
+      log("  fiv: " + fmt("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
+                          ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
+    }
+  }
+  return out;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,245 @@
+// `prtbake scene`: a scene file bakes what the scene needs and nothing else (issue 4, DESIGN.md
+// §5). One test per rule, each checking what the file does and does not contain; then the
+// scene-file errors a user can make, each named with file, line and column.
+#include <formats/prtfile.h>
+
+#include <gtest/gtest.h>
+#include <run_tool.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+
+namespace {
+
+const fs::path kData = PRT_DATA_DIR;
+
+fs::path dir_for(const std::string& name) {
+  const fs::path d = fs::path(PRT_TEST_TMP) / "scene" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
+
+// A ground grid 9×9 vertices over [-4, 4]² at y = 0 facing +Y, and a small closed box above it.
+void write_meshes(const fs::path& d) {
+  std::string g;
+  for (int j = 0; j < 9; ++j)
+    for (int i = 0; i < 9; ++i) g += "v " + std::to_string(i - 4) + " 0 " + std::to_string(j - 4) + "\n";
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const int a = j * 9 + i + 1, b = a + 1, c = a + 10, e = a + 9;
+      g += "f " + std::to_string(a) + " " + std::to_string(e) + " " + std::to_string(c) + " " + std::to_string(b) + "\n";
+    }
+  write_text(d / "ground.obj", g);
+  write_text(d / "box.obj", "v -1 1 -1\nv 1 1 -1\nv -1 3 -1\nv 1 3 -1\nv -1 1 1\nv 1 1 1\nv -1 3 1\nv 1 3 1\n"
+                            "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n");
+}
+
+// A scene with the given environment line ("" for none), bake section and objects.
+std::string scene_text(const std::string& env, const std::string& bake, const std::string& objects) {
+  std::string s = "{\n  \"prtbake_scene\": 1,\n";
+  if (!env.empty()) s += "  \"environment\": \"" + env + "\",\n";
+  s += "  \"bake\": {\"samples\": 1024, \"report\": 4, \"fiv\": {\"shells\": \"8x5x3\", \"cube\": 4}" +
+       (bake.empty() ? std::string() : ", " + bake) + "},\n";
+  s += "  \"objects\": [" + objects + "]\n}\n";
+  return s;
+}
+
+const std::string kSunset = (kData / "sunset.exr").string();
+
+struct Baked {
+  prt::testing::ToolRun run;
+  F::File file;
+};
+
+Baked bake(const fs::path& d, const std::string& scene) {
+  write_text(d / "scene.json", scene);
+  Baked b;
+  b.run = prt::testing::run_tool(PRT_PRTBAKE, "scene '" + (d / "scene.json").string() + "' -o '" +
+                                                  (d / "out.prt.h5").string() + "'",
+                                 d);
+  EXPECT_EQ(b.run.code, 0) << b.run.err;
+  if (b.run.code == 0) b.file = F::read_file(d / "out.prt.h5");
+  return b;
+}
+
+bool has(const F::File& f, const std::string& path) { return F::find_dataset(f, path) != nullptr; }
+
+int64_t sh_order(const F::File& f, const std::string& path) {
+  const F::Dataset* d = F::find_dataset(f, path);
+  return d ? std::get<int64_t>(F::find_attr(d->attrs, "sh_order")->value) : -1;
+}
+
+std::string group_string(const F::File& f, const std::string& group, const std::string& name) {
+  const auto* attrs = F::find_group_attrs(f, group);
+  const F::Attr* a = attrs ? F::find_attr(*attrs, name) : nullptr;
+  return a ? std::get<std::string>(a->value) : std::string();
+}
+
+const std::string kGround = R"({"name": "ground", "mesh": "ground.obj", "role": "receiver", "material": {"albedo": [0.5, 0.5, 0.5]}})";
+const std::string kBoxBoth = R"({"name": "box", "mesh": "box.obj", "role": "both", "material": {"albedo": [0.7, 0.7, 0.7]}})";
+const std::string kBoxOccluder = R"({"name": "box", "mesh": "box.obj", "role": "occluder"})";
+
+} // namespace
+
+TEST(SceneRules, OccluderOnlyObjectGetsNoPerVertexProducts) {
+  const fs::path d = dir_for("occluder_only");
+  write_meshes(d);
+  const Baked b = bake(d, scene_text(kSunset, "", kGround + ", " + kBoxOccluder));
+  // The box shadows the ground (its ground AO is below 1 under it) but has no products itself.
+  EXPECT_TRUE(has(b.file, "/objects/box/mesh/positions"));
+  for (const char* p : {"/objects/box/ao", "/objects/box/transfer/diffuse", "/objects/box/transfer/visibility",
+                        "/objects/box/radiance/band1"})
+    EXPECT_FALSE(has(b.file, p)) << p;
+  EXPECT_NE(group_string(b.file, "/objects/box", "left_out").find("occluder only"), std::string::npos);
+  const auto& ao = std::get<std::vector<float>>(F::find_dataset(b.file, "/objects/ground/ao")->data);
+  EXPECT_LT(ao[4 * 9 + 4], 0.9f) << "the ground under the box is shadowed by it";
+}
+
+TEST(SceneRules, DiffuseReceiverGetsBand1RadianceAndNoHigherOrder) {
+  const fs::path d = dir_for("diffuse_env");
+  write_meshes(d);
+  const Baked b = bake(d, scene_text(kSunset, "", kGround + ", " + kBoxBoth));
+  for (const char* o : {"ground", "box"}) {
+    const std::string p = std::string("/objects/") + o;
+    EXPECT_TRUE(has(b.file, p + "/radiance/band1")) << o;
+    EXPECT_FALSE(has(b.file, p + "/transfer/diffuse")) << o << ": band-1 radiance is exact under the environment";
+    EXPECT_FALSE(has(b.file, p + "/transfer/visibility")) << o << ": no glossy lobe";
+  }
+  EXPECT_NE(b.run.out.find("leave out  transfer/diffuse: band-1 radiance is exact"), std::string::npos) << b.run.out;
+}
+
+TEST(SceneRules, RelightAndNoEnvironmentGiveDiffuseTransferAtTheToleranceOrder) {
+  // Clamped cosine: 1/128 of its energy lies beyond order 3 and 1/8 + 1/128 beyond order 2
+  // (bake/zonal.h), so a 1% tolerance gives order 3 and 20% gives order 2.
+  const fs::path d = dir_for("relight");
+  write_meshes(d);
+  const Baked relit = bake(d, scene_text(kSunset, "\"relight\": true", kGround + ", " + kBoxBoth));
+  EXPECT_EQ(sh_order(relit.file, "/objects/ground/transfer/diffuse"), 3);
+  EXPECT_TRUE(has(relit.file, "/objects/ground/radiance/band1"));
+  const fs::path e = dir_for("no_env");
+  write_meshes(e);
+  const Baked dark = bake(e, scene_text("", "\"sh_tolerance\": 0.2", kGround + ", " + kBoxBoth));
+  EXPECT_EQ(sh_order(dark.file, "/objects/ground/transfer/diffuse"), 2);
+  EXPECT_FALSE(has(dark.file, "/objects/ground/radiance/band1")) << "no radiance without an environment";
+  EXPECT_FALSE(has(dark.file, "/fiv/environment")) << "no FIV without an environment";
+  EXPECT_FALSE(has(dark.file, "/fiv/occluders/box/shells"));
+  EXPECT_NE(group_string(dark.file, "/objects/box", "left_out").find("fiv: the scene has no environment"),
+            std::string::npos);
+}
+
+TEST(SceneRules, GlossyReceiverGetsVisibilityTransferAtThePhongOrder) {
+  // Phong exponent 24 at 1%: order 11 (0.67% beyond 11, above 1% beyond 10 — bake/zonal.h);
+  // exponent 4: order 5. No diffuse lobe, so no band-1 radiance and no diffuse transfer.
+  const fs::path d = dir_for("glossy");
+  write_meshes(d);
+  const std::string glossy24 =
+      R"({"name": "box", "mesh": "box.obj", "role": "both", "material": {"phong_exponent": 24}})";
+  const std::string glossy4 =
+      R"({"name": "floor", "mesh": "ground.obj", "role": "receiver", "material": {"phong_exponent": 4, "specular": [1, 1, 1]}})";
+  const Baked b = bake(d, scene_text(kSunset, "", glossy4 + ", " + glossy24));
+  EXPECT_EQ(sh_order(b.file, "/objects/box/transfer/visibility"), 11);
+  EXPECT_EQ(sh_order(b.file, "/objects/floor/transfer/visibility"), 5);
+  EXPECT_FALSE(has(b.file, "/objects/box/radiance/band1"));
+  EXPECT_FALSE(has(b.file, "/objects/box/transfer/diffuse"));
+}
+
+TEST(SceneRules, FivOnlyForOccludersThatCanShadowAnotherReceiver) {
+  const fs::path d = dir_for("fiv");
+  write_meshes(d);
+  // Above the ground: shells. Below the ground's horizon (case C for every ground vertex):
+  // none, and then no environment FIV or DifMap either. Alone (no other receiver): none.
+  const Baked above = bake(d, scene_text(kSunset, "", kGround + ", " + kBoxOccluder));
+  EXPECT_TRUE(has(above.file, "/fiv/occluders/box/shells"));
+  EXPECT_TRUE(has(above.file, "/fiv/environment"));
+  EXPECT_TRUE(has(above.file, "/fiv/irradiance_cube"));
+  EXPECT_TRUE(has(above.file, "/report/fiv/box"));
+
+  const std::string buried = R"({"name": "box", "mesh": "box.obj", "role": "occluder", "transform": {"translate": [0, -10, 0]}})";
+  const Baked below = bake(d, scene_text(kSunset, "", kGround + ", " + buried));
+  EXPECT_FALSE(has(below.file, "/fiv/occluders/box/shells"));
+  EXPECT_FALSE(has(below.file, "/fiv/environment"));
+  EXPECT_FALSE(has(below.file, "/fiv/irradiance_cube"));
+  EXPECT_NE(group_string(below.file, "/objects/box", "left_out").find("below the horizon of every vertex"),
+            std::string::npos);
+
+  const Baked alone = bake(d, scene_text(kSunset, "", kBoxBoth));
+  EXPECT_FALSE(has(alone.file, "/fiv/occluders/box/shells"));
+  EXPECT_NE(group_string(alone.file, "/objects/box", "left_out").find("no other receiver"), std::string::npos);
+}
+
+TEST(SceneRules, VerticesThatSeeNoContourEdgeGetTheClosedForm) {
+  // The box buried below the ground: no ground vertex sees a contour edge above its horizon, so
+  // all 81 take the closed form — AO exactly 1 — and the file says how many did.
+  const fs::path d = dir_for("closed_form");
+  write_meshes(d);
+  const std::string buried = R"({"name": "box", "mesh": "box.obj", "role": "occluder", "transform": {"translate": [0, -10, 0]}})";
+  const Baked b = bake(d, scene_text(kSunset, "", kGround + ", " + buried));
+  const auto* attrs = F::find_group_attrs(b.file, "/objects/ground");
+  ASSERT_NE(attrs, nullptr);
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(*attrs, "closed_form_vertices")->value), 81);
+  for (float a : std::get<std::vector<float>>(F::find_dataset(b.file, "/objects/ground/ao")->data)) EXPECT_EQ(a, 1.0f);
+  EXPECT_NE(b.run.out.find("81 saw no contour edge (closed form)"), std::string::npos) << b.run.out;
+}
+
+TEST(SceneRules, ExampleSceneParsesAndPlans) {
+  // data/scene_example.json, as documented: the plan (dry run) names every decision.
+  const auto r = prt::testing::run_tool(PRT_PRTBAKE, "scene '" + (kData / "scene_example.json").string() + "' --dry-run",
+                                        fs::path(PRT_TEST_TMP) / "scene");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"ground (receiver)", "bunny (both)", "statue (both)", "spider (occluder)",
+                        "transfer/visibility: order 11 for the Phong exponent 24",
+                        "leave out  ao, transfer, radiance: occluder only"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
+
+struct BadScene {
+  const char* name;
+  std::string text;
+  const char* message;
+};
+
+class SceneErrors : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneErrors, NameFileLineAndProblemAndWriteNothing) {
+  const BadScene& c = GetParam();
+  const fs::path d = dir_for(std::string("error_") + c.name);
+  write_meshes(d);
+  write_text(d / "scene.json", c.text);
+  const auto r = prt::testing::run_tool(
+      PRT_PRTBAKE, "scene '" + (d / "scene.json").string() + "' -o '" + (d / "out.prt.h5").string() + "'", d);
+  EXPECT_EQ(r.code, 1) << r.out;
+  EXPECT_NE(r.err.find((d / "scene.json").string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected '" << c.message << "' in: " << r.err;
+  EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scene, SceneErrors,
+    ::testing::Values(
+        BadScene{"not_json", "{\"prtbake_scene\": 1,\n  \"objects\": [}\n", "line 2, column 15: unexpected character '}' (expected a value)"},
+        BadScene{"unknown_key", scene_text("", "\"relite\": true", kGround),
+                 "unknown key \"relite\" in bake (allowed: products"},
+        BadScene{"missing_role", scene_text("", "", R"({"mesh": "ground.obj"})"), "lacks \"role\""},
+        BadScene{"bad_role", scene_text("", "", R"({"mesh": "ground.obj", "role": "shadow"})"),
+                 "objects[0].role must be \"receiver\", \"occluder\" or \"both\", not \"shadow\""},
+        BadScene{"duplicate_name", scene_text("", "", kGround + ", " + kGround), "the name \"ground\" is already used"},
+        BadScene{"singular_transform",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "transform": {"scale": 0}})"),
+                 "objects[0].transform is singular"},
+        BadScene{"albedo_range",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "material": {"albedo": [2, 0, 0]}})"),
+                 "objects[0].material.albedo[0] must be in [0, 1], got 2"},
+        BadScene{"mirror_lobe",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "material": {"phong_exponent": 100000}})"),
+                 "needs more than 64 SH bands"},
+        BadScene{"missing_mesh", scene_text("", "", R"({"mesh": "nothere.obj", "role": "both"})"), "nothere.obj: no such file (object 'nothere' of "},
+        BadScene{"newer_version", "{\"prtbake_scene\": 2, \"objects\": []}", "prtbake_scene version 2 is newer"}),
+    [](const ::testing::TestParamInfo<BadScene>& i) { return std::string(i.param.name); });
