@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # tools/run.sh — one command from a fresh Debian 12 machine to a result.
 #   tools/run.sh demo   install dependencies, build (release), bake the default scene
-#                       (data/bunny_ground.obj under data/sunset.exr) to out/default.prt.h5
-#                       and show what was baked.
+#                       (data/bunny_ground.obj under data/sunset.exr) to out/default.prt.h5,
+#                       show what was baked, then bake data/scene_example.json to out/scene.prt.h5.
 #   tools/run.sh test   install dependencies, build (ci preset: warnings are errors), run every
 #                       test with ctest. This is what CI runs (.ci/run).
 #   tools/run.sh deps   only install the Debian packages (apt-get; needs root or sudo).
@@ -41,6 +41,9 @@ case "${1:-}" in
     ./build/release/tools/prtbake vertex data/bunny_ground.obj --ao --transfer 3 --visibility 3 \
       --radiance data/sunset.exr -o out/default.prt.h5
     ./build/release/tools/prtdump out/default.prt.h5
+    # A scene file: several objects, roles and materials; prtbake bakes what the scene needs
+    # and prints what it leaves out and why (README "Scene files").
+    ./build/release/tools/prtbake scene data/scene_example.json -o out/scene.prt.h5
     ;;
   test)
     install_deps
