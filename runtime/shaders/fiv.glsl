@@ -56,6 +56,8 @@
 // for small angles, where acos(·) loses half the digits. The lens area uses the same atan2 form
 // (one √k shared by all terms, so its cancellation at tangency is first-order exact). Inputs must
 // be finite; ρ = |s| is formed in float (the C++ core uses double: |s| < 1e18 is safe).
+// prt_shade_fiv accumulates E in float (the C++ core in double), so its rounding grows like
+// (count + 2) ε (E_tot + Σ_i I_i (1 + Σ_j O_ij)) — the bound the test allows.
 // Agreement with the C++ core on lavapipe is asserted in tests/shaders/test_fiv_glsl.cpp with
 // tolerances from the sensitivity of the result to the angles' and radii's rounding.
 //
