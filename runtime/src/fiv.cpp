@@ -163,7 +163,10 @@ void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
   float theta = 0, phi = 0;
   if (rho > 0 && std::isfinite(rho)) {
     const float dx = float(sx / rho), dy = float(sy / rho), dz = float(sz / rho);
-    theta = std::acos(clamp_nan_safe(dy, -1.0f, 1.0f));
+    // θ from atan2(|d_xz|, d_y), not acos(d_y): within ~3.5e-4 rad of ±Y, d_y rounds to ±1 in
+    // float and acos would snap θ onto the pole (and an invalid pole sample would then take all
+    // the weight). The GLSL mirror (runtime/shaders/fiv.glsl) computes θ the same way.
+    theta = std::atan2(float(std::sqrt(sx * sx + sz * sz) / rho), dy);
     phi = std::atan2(dx, dz);
     if (phi < 0) phi += kTwoPiF;
   } else {

@@ -151,6 +151,22 @@ TEST(LookupFiv, PolesUseTheirRowAndRhoZeroIsNorthPole) {
   for (int e = 0; e < 9; ++e) EXPECT_EQ(out[e], 3.0f + float(e));
 }
 
+TEST(LookupFiv, NearThePoleAnInvalidPoleSampleStaysIgnored) {
+  // s 1e-4 rad from +Y: in float d_y rounds to 1, and θ = acos(d_y) snapped onto the pole, where
+  // the invalid pole row then took all the weight (10 instead of 1; found by the GLSL mirror
+  // test). With θ = atan2(|d_xz|, d_y) the valid row keeps its small weight and wins the
+  // renormalisation: the value is the valid rows' 1 up to rounding.
+  Shells o(1, 3, 1, [](int, int i, int, int) { return i == 0 ? 10.0f : 1.0f; });
+  o.radii = {1.0f};
+  for (int j = 0; j < 1; ++j) o.valid[o.index(0, 0, j)] = 0;
+  for (float x : {1e-4f, 3e-4f, 1e-6f}) {
+    const float s[3] = {x, 1.0f, 0.0f};
+    float out[9];
+    shade::lookup_fiv(o.view(), s, out);
+    for (int e = 0; e < 9; ++e) EXPECT_NEAR(out[e], 1.0f, 4e-7f) << "x = " << x;  // renormalisation: a few ulps
+  }
+}
+
 TEST(LookupFiv, RadiusClampsInsideAndFallsOffOutside) {
   Shells o(3, 3, 4, linear_value);  // radii 0.5, 1, 2
   const float dir[3] = {1, 0, 0};     // t = 1, u = 1: a grid point
