@@ -205,6 +205,21 @@ bool RayScene::visible(const ShadePoint& point, const Vector3d& d) const {
   return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
+std::optional<RayHit> RayScene::closest_hit(const Vector3d& origin, const Vector3d& d, double tnear) const {
+  RingContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.welded = -1;
+  ctx.weld = topo_.weld.data();
+  ctx.triangles = mesh_.triangles.data();
+  RTCRayHit rh{};
+  rh.ray = make_ray(origin, d);
+  rh.ray.tnear = float(tnear);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rt_->scene, &ctx.base, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return RayHit{rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v};
+}
+
 CrossingCount RayScene::count_crossings(const ShadePoint& point, const Vector3d& d) const {
   CrossingCount out;
   if (point.welded >= 0) {

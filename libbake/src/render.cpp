@@ -1,10 +1,10 @@
 // render.cpp — camera, rasterizer, exact unshadowed irradiance and the Embree reference renderer.
 // Conventions, coverage rules and estimators: bake/render.h.
 #include <bake/error.h>
+#include <bake/raycast.h>
 #include <bake/render.h>
 #include <bake/sampling.h>
 
-#include <embree3/rtcore.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -428,71 +428,22 @@ Rgb UnoccludedIrradiance::operator()(const Vector3d& n) const {
   return {e[0], e[1], e[2]};
 }
 
-// ---- Embree -----------------------------------------------------------------------------------------------
+// ---- reference renderer -------------------------------------------------------------------------------------
 
-namespace {
-void on_embree_error(void* user, RTCError code, const char* str) {
-  auto* msg = static_cast<std::string*>(user);
-  if (msg->empty()) *msg = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
-}
-} // namespace
-
-struct ReferenceRenderer::Embree {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::string error;
-
-  explicit Embree(const Mesh& mesh) {
-    device = rtcNewDevice(nullptr);
-    if (!device) throw ContractError("Embree: rtcNewDevice failed");
-    rtcSetDeviceErrorFunction(device, on_embree_error, &error);
-    scene = rtcNewScene(device);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* pos = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                            3 * sizeof(float), mesh.positions.size()));
-    auto* tri = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
-    if (!pos || !tri) throw ContractError("Embree: cannot allocate buffers: " + error);
-    for (size_t v = 0; v < mesh.positions.size(); ++v)
-      for (int k = 0; k < 3; ++k) pos[3 * v + size_t(k)] = mesh.positions[v][k];
-    for (size_t t = 0; t < mesh.triangles.size(); ++t)
-      for (size_t k = 0; k < 3; ++k) tri[3 * t + k] = mesh.triangles[t][k];
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene);
-    if (!error.empty()) throw ContractError(error);
-  }
-  ~Embree() {
-    if (scene) rtcReleaseScene(scene);
-    if (device) rtcReleaseDevice(device);
-  }
-  static RTCRay ray(const Vector3d& o, const Vector3d& d, double tnear) {
-    RTCRay r{};
-    r.org_x = float(o.x());
-    r.org_y = float(o.y());
-    r.org_z = float(o.z());
-    r.dir_x = float(d.x());
-    r.dir_y = float(d.y());
-    r.dir_z = float(d.z());
-    r.tnear = float(tnear);
-    r.tfar = std::numeric_limits<float>::infinity();
-    r.mask = 0xFFFFFFFFu;
-    return r;
-  }
+// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh.
+struct ReferenceRenderer::Rays {
+  Topology topology;
+  RayScene scene;
+  explicit Rays(const Mesh& mesh) : topology(build_topology(mesh)), scene(mesh, topology) {}
   bool occluded(const Vector3d& o, const Vector3d& d) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay r = ray(o, d, 0.0);
-    rtcOccluded1(scene, &ctx, &r);
-    return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+    ShadePoint sp;
+    sp.p = o;  // a free point (welded = -1): the ray starts at o itself
+    return !scene.visible(sp, d);
   }
 };
 
 ReferenceRenderer::ReferenceRenderer(const Mesh& mesh, const EnvMap& env, ReferenceOptions options)
-    : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env), rt_(std::make_unique<Embree>(mesh)) {
+    : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env), rt_(std::make_unique<Rays>(mesh)) {
   PRT_CHECK(options_.samples > 0 && (options_.samples % kReplicates == 0 || options_.samples < kReplicates));
   PRT_CHECK(!mesh.triangles.empty());
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -524,17 +475,12 @@ GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
     for (int x = 0; x < camera.width; ++x) {
       const Vector3d d = camera.ray_direction(x + 0.5, y + 0.5);
       const double df = d.dot(f);
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      RTCRayHit rh{};
-      rh.ray = Embree::ray(camera.eye, d, near / df);
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rtcIntersect1(rt_->scene, &ctx, &rh);
-      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+      const auto hit = rt_->scene.closest_hit(camera.eye, d, near / df);
+      if (!hit) continue;
       const size_t i = size_t(y) * size_t(camera.width) + size_t(x);
-      g.triangle[i] = int32_t(rh.hit.primID);
-      g.bary[i] = {1.0f - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v};
-      g.depth[i] = float(double(rh.ray.tfar) * df);
+      g.triangle[i] = int32_t(hit->triangle);
+      g.bary[i] = {1.0f - hit->u - hit->v, hit->u, hit->v};
+      g.depth[i] = float(double(hit->t) * df);
     }
   });
   return g;

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 
 namespace prt::bake {
 
@@ -33,6 +34,11 @@ struct CrossingCount {
   bool ambiguous = false;  // the direction grazes an edge: choose another direction
 };
 
+struct RayHit {
+  uint32_t triangle;
+  float t, u, v;  // distance along the unit direction; Embree's barycentrics (weights of corners 1, 2)
+};
+
 class RayScene {
 public:
   RayScene(const Mesh& mesh, const Topology& topology);  // both must outlive the scene
@@ -44,6 +50,9 @@ public:
   bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
   // Number of triangles the ray from p + εn in unit direction d crosses.
   CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
+  // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
+  // rays of bake/render.h).
+  std::optional<RayHit> closest_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear) const;
   double scene_diagonal() const { return diagonal_; }
 
 private:

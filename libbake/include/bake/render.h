@@ -201,12 +201,12 @@ public:
   std::string description() const;
 
 private:
-  struct Embree;
+  struct Rays;  // bake/raycast.h RayScene over the mesh
   const Mesh& mesh_;
   const EnvMap& env_;
   ReferenceOptions options_;
   UnoccludedIrradiance unoccluded_;
-  std::unique_ptr<Embree> rt_;
+  std::unique_ptr<Rays> rt_;
   double epsilon_ = 0;
 };
 
