@@ -548,6 +548,30 @@ Eigen::Vector3d EnvMap::sample_texel(int texel, double u0, double u1) const {
   return scene_from_map(d, up_);
 }
 
+void EnvMap::sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out) const {
+  PRT_CHECK(k >= 1 && k <= 16 && out.size() >= size_t(k) * size_t(k));
+  PRT_CHECK(texel >= 0 && texel < texel_count());
+  const Region r = region(texel);
+  if (r.face >= 0) {
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) out[size_t(a * k + b)] = sample_texel(texel, (a + 0.5) / k, (b + 0.5) / k);
+    return;
+  }
+  double s[16], c[16], sl[16], cl[16];
+  for (int a = 0; a < k; ++a) {  // exactly sample_texel's arithmetic, shared across the grid
+    s[a] = std::clamp(r.t0 + ((a + 0.5) / k) * (r.t1 - r.t0), -1.0, 1.0);
+    c[a] = std::sqrt(std::max(0.0, (1.0 - s[a]) * (1.0 + s[a])));
+  }
+  for (int b = 0; b < k; ++b) {
+    const double lon = r.s0 + ((b + 0.5) / k) * (r.s1 - r.s0);
+    sl[b] = std::sin(lon);
+    cl[b] = std::cos(lon);
+  }
+  for (int a = 0; a < k; ++a)
+    for (int b = 0; b < k; ++b)
+      out[size_t(a * k + b)] = scene_from_map(Eigen::Vector3d(sl[b] * c[a], s[a], cl[b] * c[a]), up_);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Importance sampling
 

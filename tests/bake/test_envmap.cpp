@@ -725,3 +725,24 @@ TEST(EnvMapFiles, BadInputsAreInputErrors) {
 }
 
 } // namespace
+
+TEST(EnvMapTexels, SampleGridEqualsSampleTexelBitForBit) {
+  // sample_texel_grid shares latitudes and longitudes across the grid (lat-long) but must give
+  // exactly sample_texel's directions: the DifMap's cut texels use it (bake/fiv.h).
+  for (UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    std::vector<float> rgb(size_t(16 * 8 * 3), 1.0f);
+    const EnvMap ll = EnvMap::from_latlong(16, 8, rgb, up, "ll");
+    const EnvMap cube = EnvMap::from_cube(4, std::vector<float>(size_t(3 * 6 * 4 * 4), 1.0f), up, "cube");
+    for (const EnvMap* m : {&ll, &cube})
+      for (int t = 0; t < m->texel_count(); t += 7)
+        for (int k : {1, 3, 4}) {
+          std::vector<Eigen::Vector3d> grid(size_t(k * k));
+          m->sample_texel_grid(t, k, grid);
+          for (int a = 0; a < k; ++a)
+            for (int b = 0; b < k; ++b) {
+              const Eigen::Vector3d d = m->sample_texel(t, (a + 0.5) / k, (b + 0.5) / k);
+              EXPECT_EQ(grid[size_t(a * k + b)], d) << t << " " << k << " " << a << " " << b;
+            }
+        }
+  }
+}

@@ -70,6 +70,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -155,6 +156,10 @@ public:
   // A scene direction uniformly distributed in solid angle over the texel's region, from
   // (u0, u1) ∈ [0, 1)² (the warp sample() uses inside the chosen texel).
   Eigen::Vector3d sample_texel(int texel, double u0, double u1) const;
+  // The k × k stratified sub-samples sample_texel(texel, (a + ½)/k, (b + ½)/k) into out[a·k + b]
+  // (1 ≤ k ≤ 16), the same values bit for bit; lat-long texels share the k latitudes and k
+  // longitudes (2k transcendental pairs instead of k²).
+  void sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out) const;
 
   // OpenEXR's own texel-centre direction (map space, float precision) for pixel (x, y) of a
   // `layout` ("latlong" | "cube") image of width × height, computed by Imf::LatLongMap::

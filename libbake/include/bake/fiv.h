@@ -46,6 +46,9 @@ Fiv environment_fiv(const EnvMap& env);
 // DifMap: [6][S][S][3] float, E_tot(n) per texel direction (see the header comment); texels cut by
 // the horizon of n are integrated with 4×4 sub-samples, the rest with their exact ∫_texel ω dω.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
+// The same sum texel by texel for every normal (no cell hierarchy): the slow reference of
+// irradiance_cube, equal to it up to summation order. Needs a map with texels.
+std::vector<float> irradiance_cube_reference(const EnvMap& env, int size);
 Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
 
 struct ShellSpec {
