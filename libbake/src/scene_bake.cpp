@@ -126,7 +126,7 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     spec.n_theta = scene.n_theta;
     spec.n_rho = scene.n_rho;
     spec.fraction = scene.fraction;
-    spec.isolines = std::max(2, int(std::lround(std::sqrt(double(scene.samples ? scene.samples : 16384u)))));
+    spec.isolines = std::max(2, int(std::lround(std::sqrt(double(scene.fiv_samples())))));
     ObjectBake& ob = out.objects[i];
     ob.fiv = bake_fiv_shells(m, t, *env, spec, progress);
     out.fiv_seconds += ob.fiv->seconds;

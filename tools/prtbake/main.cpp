@@ -612,8 +612,7 @@ int run_scene(const Args& a) {
                          a.reproducible);
     }
     if (ob.fiv) {
-      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fraction,
-                             scene.samples ? scene.samples : 16384u);
+      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fraction, scene.fiv_samples());
       if (ob.fiv_report) tool::add_fiv_report(file, o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
     }
   }

@@ -89,6 +89,9 @@ struct Scene {
   bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
   std::string integrator = "silhouette";
   uint32_t samples = 0;  // 0: the integrator's default
+  // The silhouette rate k of the FIV shells (always baked with the silhouette integrator):
+  // `samples` for a silhouette scene, else the default 128².
+  uint32_t fiv_samples() const { return integrator == "silhouette" && samples ? samples : 16384u; }
   uint64_t seed = 1;
   uint32_t report = 32;
   double sh_tolerance = 0.01;
