@@ -332,8 +332,16 @@ Image shade_pixels(const Mesh& mesh, const GBuffer& g, const std::function<void(
 }
 
 Image interpolate_vertices(const Mesh& mesh, const GBuffer& g, std::span<const float> vertex_rgb) {
+  const std::vector<uint8_t> none(mesh.triangles.size(), 0);
+  return shade_mixed(mesh, g, vertex_rgb, none, [](const Fragment&, float*) {});
+}
+
+Image shade_mixed(const Mesh& mesh, const GBuffer& g, std::span<const float> vertex_rgb, std::span<const uint8_t> per_pixel,
+                  const std::function<void(const Fragment&, float*)>& shade) {
   PRT_CHECK_OP(vertex_rgb.size(), ==, 3 * mesh.positions.size());
+  PRT_CHECK_OP(per_pixel.size(), ==, mesh.triangles.size());
   return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
+    if (per_pixel[size_t(f.triangle)]) return shade(f, out);
     const auto& t = mesh.triangles[size_t(f.triangle)];
     for (size_t c = 0; c < 3; ++c) {
       double v = 0;
@@ -430,22 +438,40 @@ Rgb UnoccludedIrradiance::operator()(const Vector3d& n) const {
 
 // ---- reference renderer -------------------------------------------------------------------------------------
 
-// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh.
+// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh for
+// primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
 struct ReferenceRenderer::Rays {
   Topology topology;
   RayScene scene;
-  explicit Rays(const Mesh& mesh) : topology(build_topology(mesh)), scene(mesh, topology) {}
+  Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
+  std::optional<Topology> caster_topology;
+  std::unique_ptr<RayScene> casters;
+  bool any_caster = true;
+  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), scene(mesh, topology) {
+    if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
+    caster_mesh = mesh;
+    caster_mesh.triangles.clear();
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+      if (casts_shadow[t]) caster_mesh.triangles.push_back(mesh.triangles[t]);
+    any_caster = !caster_mesh.triangles.empty();
+    if (!any_caster) return;
+    caster_topology = build_topology(caster_mesh);
+    casters = std::make_unique<RayScene>(caster_mesh, *caster_topology);
+  }
   bool occluded(const Vector3d& o, const Vector3d& d) const {
     ShadePoint sp;
     sp.p = o;  // a free point (welded = -1): the ray starts at o itself
-    return !scene.visible(sp, d);
+    return !(casters ? *casters : scene).visible(sp, d);
   }
 };
 
 ReferenceRenderer::ReferenceRenderer(const Mesh& mesh, const EnvMap& env, ReferenceOptions options)
-    : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env), rt_(std::make_unique<Rays>(mesh)) {
+    : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env),
+      rt_(std::make_unique<Rays>(mesh, options_.casts_shadow)) {
   PRT_CHECK(options_.samples > 0 && (options_.samples % kReplicates == 0 || options_.samples < kReplicates));
   PRT_CHECK(!mesh.triangles.empty());
+  PRT_CHECK(options_.casts_shadow.empty() || options_.casts_shadow.size() == mesh.triangles.size());
+  PRT_CHECK(options_.albedo.empty() || options_.albedo.size() == mesh.triangles.size());
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const auto& q : mesh.positions) {
     lo = lo.cwiseMin(q.cast<double>());
@@ -463,6 +489,11 @@ std::string ReferenceRenderer::description() const {
      << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
      << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
      << "), seed " << options_.seed;
+  if (!options_.casts_shadow.empty()) {
+    const auto n = std::count_if(options_.casts_shadow.begin(), options_.casts_shadow.end(), [](uint8_t c) { return c != 0; });
+    os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
+  }
+  if (!options_.albedo.empty()) os << "; per-object albedo";
   return os.str();
 }
 
@@ -488,6 +519,14 @@ GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
 
 void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const {
   const Rgb unocc = unoccluded_(f.n);
+  if (!rt_->any_caster) {  // nothing casts a shadow: the exact unshadowed sum, no noise
+    const double un[3] = {unocc.r, unocc.g, unocc.b};
+    for (int c = 0; c < 3; ++c) {
+      E[c] = un[c];
+      std_error[c] = 0;
+    }
+    return;
+  }
   const Vector3d o = f.p + epsilon_ * f.ng;
   constexpr double kInvPi = std::numbers::inv_pi;
   // Cones around the occluder spheres that o sees from outside and that reach above the horizon.
@@ -576,8 +615,9 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, ProgressMode prog
       double E[3], se[3];
       irradiance(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), E, se);
       for (int c = 0; c < 3; ++c) {
-        out.radiance.at(x, y)[c] = float(E[c] * std::numbers::inv_pi);
-        out.std_error.at(x, y)[c] = float(se[c] * std::numbers::inv_pi);
+        const double albedo = options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(f.triangle)][size_t(c)]);
+        out.radiance.at(x, y)[c] = float(albedo * E[c] * std::numbers::inv_pi);
+        out.std_error.at(x, y)[c] = float(albedo * se[c] * std::numbers::inv_pi);
       }
       ++n;
     }
@@ -586,7 +626,8 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, ProgressMode prog
   });
   bar.finish();
   const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
-  out.rays = uint64_t(camera.width) * uint64_t(camera.height) + pixels.load() * B * std::max<uint32_t>(1, options_.samples / B);
+  out.rays = uint64_t(camera.width) * uint64_t(camera.height) +
+             (rt_->any_caster ? pixels.load() * B * std::max<uint32_t>(1, options_.samples / B) : 0);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (float v : out.radiance.rgb)
     if (!std::isfinite(v)) throw ContractError("reference render produced a non-finite value");

@@ -42,7 +42,8 @@ USAGE
 
 WHAT IS DRAWN
   Every picture shows outgoing radiance of a white diffuse surface, E/pi (albedo 1), where E is
-  the irradiance; a constant sky of radiance L shows as L. Two kinds of file:
+  the irradiance; a constant sky of radiance L shows as L (scene files: times each object's
+  albedo). Three kinds of file:
 
   per-vertex files (/mesh + /transfer/diffuse or /radiance/band1, from 'prtbake vertex'):
     the mesh is rasterized (software, top-left fill rule, z-buffer, perspective-correct
@@ -59,6 +60,26 @@ WHAT IS DRAWN
     prt::shade::shade_fiv (DifMap minus each occluder's trilinear FIV lookup, cases A/B/C with
     the partial-occluder factor, overlap correction for several occluders: paper 004 sec. 4.3.1),
     the occluder with prt::shade::shade_fiv_self (sec. 4.3.2) minus the other copies' shadows.
+
+  scene files (/objects/<name>/ and /scene from 'prtbake scene', schema v2): every object, in world
+    space, in one z-buffer, each shaded with what the file holds for it, times its diffuse albedo
+    (the 'albedo' attribute of /objects/<name>; white if it is zero):
+      band1     band-1 radiance when the object has it (shade_band1, E/pi), else
+      transfer  diffuse transfer (project_latlong + shade_transfer), else
+      AO        AO x E_unocc(n)/pi at each vertex, E_unocc the unshadowed irradiance from the
+                file's DifMap (lookup_difmap; the exact texel sum if the file has none) - the
+                ambient-occlusion approximation. Glossy-only objects (transfer/visibility only)
+                land here: glossy shading is not in the runtime (prtshade) yet, so they show
+                their AO-shaded diffuse response, not their highlights.
+      FIV self  objects without per-vertex products (occluder-only) that have FIV shells
+                (/fiv/occluders/<name>) and /fiv/environment: per pixel with shade_fiv_self
+                (self-shadows, eq. 12; the other objects' shadows are not added), else
+      flat      grey: 0.5 x the environment's mean radiance.
+    The environment must be the one of /scene (checked by SHA-256); default: its 'environment'.
+    --shade, --instance, --occluder(-mesh), --ground(-size), --no-overlap/--no-partial do not
+    apply. The reference renders the same objects: "occluder" and "both" objects cast shadows,
+    "receiver" objects do not (not even on themselves: the scene semantics, bake/scene.h), and a
+    pixel shows albedo x E/pi.
 
   --reference renders the same view by ray tracing (Embree): a primary ray per pixel centre, then
   E = (exact sum over every environment texel of L max(0, n.M_texel)) - (QMC estimate of the
@@ -80,14 +101,18 @@ ERROR NUMBERS
   NRMSE = RMSE / (max - min of the reference), RMSE over the compared pixels and the three
   channels (paper 004 sec. 5 reports NRMSE without printing its normalisation; this is the
   common range-normalised one). Compared pixels (--region): 'receiver' = where both renders see
-  the ground plane (FIV files; paper 004 measures the shadow on the ground), 'all' = where both
-  see geometry (the default for per-vertex files). The reference's own noise is printed too
+  the ground plane (FIV files; paper 004 measures the shadow on the ground) or a receiver object
+  ("receiver" or "both"; scene files), 'all' = where both see geometry (the default for per-vertex
+  files). Scene files also print each receiver's NRMSE: its RMSE over the pixels where both
+  renders see that object, over the same range (so NRMSE^2 = sum_k pixels_k/pixels NRMSE_k^2 but
+  for the few silhouette pixels where the two renders see different receivers), and each
+  object's mean runtime value. The reference's own noise is printed too
   (RMS standard error / range) with the noise-corrected NRMSE sqrt(RMSE^2 - sigma^2)/range.
 
 OPTIONS
   --env ENV.exr        environment (OpenEXR lat-long or cube). Default: the file's 'environment'
-                       attribute. band1 and FIV files must be shown under the environment they
-                       were baked with (checked by SHA-256).
+                       attribute. band1, FIV and scene files must be shown under the environment
+                       they were baked with (checked by SHA-256).
   --camera SPEC        eye, at (required), up (default 0,1,0), fov = vertical field of view in
                        degrees (default 45); world units of the mesh.
   --size WxH           image size in pixels (default 256x256).
@@ -125,6 +150,8 @@ EXAMPLES
   prtview bunny.fiv.prt.h5 --camera eye=0,22,24:at=0,0,2 --instance -4,0,0 --instance 4,0,0 --error -o e.png
   prtbake vertex data/bunny_ground.obj --transfer 3 -o default.prt.h5
   prtview default.prt.h5 --env data/sunset.exr --camera eye=0,14,26:at=0,3,0 --triptych -o t.png
+  prtbake scene data/scene_example.json -o scene.prt.h5
+  prtview scene.prt.h5 --camera eye=0,18,34:at=0,2,0 --size 320x240 --triptych -o scene.png
 
 EXIT STATUS
   0 success; 1 bad input (one line on stderr names the file or option and the problem; no
@@ -280,13 +307,18 @@ const F::Attr& need_attr(const F::Dataset& d, std::string_view name, const std::
   return *a;
 }
 
-// The environment the file was baked with must be the one we shade / reference with.
-void check_same_environment(const F::Dataset& d, const bake::EnvMap& env, const std::string& file) {
-  const std::string sha = string_attr(d.attrs, "environment_sha256");
+// The environment the file was baked with must be the one we shade / reference with. `where` names
+// the dataset or group whose attributes (environment, environment_sha256) say which it was.
+void check_same_environment(const std::vector<F::Attr>& attrs, const std::string& where, const bake::EnvMap& env,
+                            const std::string& file) {
+  const std::string sha = string_attr(attrs, "environment_sha256");
   if (!sha.empty() && sha != env.info().sha256)
-    throw bake::InputError(env.info().source, "is not the environment " + file + " was baked with (" + d.path +
-                                                  " was baked under '" + string_attr(d.attrs, "environment") +
+    throw bake::InputError(env.info().source, "is not the environment " + file + " was baked with (" + where +
+                                                  " was baked under '" + string_attr(attrs, "environment") +
                                                   "', SHA-256 " + sha.substr(0, 12) + "...)");
+}
+void check_same_environment(const F::Dataset& d, const bake::EnvMap& env, const std::string& file) {
+  check_same_environment(d.attrs, d.path, env, file);
 }
 
 struct Timer {
@@ -301,16 +333,23 @@ struct Scene {
   size_t receiver_triangles = 0;  // triangles [0, receiver_triangles) are the receiver
   std::vector<bake::Sphere> spheres;
   std::string what;
+  // Scene files: the reference's per-triangle shadow casters and albedos (bake::ReferenceOptions),
+  // and the objects' triangle ranges: object k owns [first_triangle[k], first_triangle[k + 1]).
+  std::vector<uint8_t> casts_shadow;
+  std::vector<std::array<float, 3>> albedo;
+  std::vector<std::string> object_names;
+  std::vector<bool> object_receiver;
+  std::vector<size_t> first_triangle;
 };
 
 // ---- per-vertex files ------------------------------------------------------------------------------------
 
-bake::Image render_vertex_file(const F::File& f, const Args& a, const std::string& kind, const bake::EnvMap& env,
-                               const bake::Camera& cam, Scene& scene, std::string& how) {
-  const auto& pos = floats(f, a.file, "/mesh/positions", {3});
-  const auto& nrm = floats(f, a.file, "/mesh/normals", {3});
-  const F::Dataset* td = F::find_dataset(f, "/mesh/triangles");
-  if (!td) throw bake::InputError(a.file, "no dataset /mesh/triangles (nothing to rasterize)");
+// The mesh of a vertex set: prefix "" (root layout) or "/objects/<name>" (scene files).
+bake::Mesh read_mesh(const F::File& f, const std::string& file, const std::string& prefix) {
+  const auto& pos = floats(f, file, prefix + "/mesh/positions", {3});
+  const auto& nrm = floats(f, file, prefix + "/mesh/normals", {3});
+  const F::Dataset* td = F::find_dataset(f, prefix + "/mesh/triangles");
+  if (!td) throw bake::InputError(file, "no dataset " + prefix + "/mesh/triangles (nothing to rasterize)");
   const auto& tri = std::get<std::vector<uint32_t>>(td->data);
   const size_t V = pos.size() / 3;
   std::vector<Eigen::Vector3f> P(V), N(V);
@@ -320,47 +359,112 @@ bake::Image render_vertex_file(const F::File& f, const Args& a, const std::strin
   }
   std::vector<std::array<uint32_t, 3>> T(tri.size() / 3);
   for (size_t t = 0; t < T.size(); ++t) T[t] = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]};
-  scene.mesh = bake::make_mesh(std::move(P), std::move(T), a.file, std::move(N));
-  scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
+  return bake::make_mesh(std::move(P), std::move(T), prefix.empty() ? file : prefix.substr(9), std::move(N));
+}
 
-  std::vector<float> colour(3 * V);
-  if (kind == "transfer") {
-    const F::Dataset* d = F::find_dataset(f, "/transfer/diffuse");
-    if (!d) throw bake::InputError(a.file, "no dataset /transfer/diffuse (try --shade band1)");
-    const int order = int(std::get<int64_t>(need_attr(*d, "sh_order", a.file).value));
-    const auto& transfer = std::get<std::vector<float>>(d->data);
-    const size_t n = size_t(order) * size_t(order);
-    std::vector<float> light(3 * n);
-    if (env.info().layout == "latlong" && env.up() == bake::UpAxis::Y) {
-      // The runtime path: the pixels as an engine holds them (after libbake's load policy).
-      const int W = env.info().width, H = env.info().height;
-      std::vector<float> px(size_t(W) * size_t(H) * 3);
-      for (int t = 0; t < W * H; ++t) {
-        const bake::Rgb c = env.texel_value(t);
-        px[3 * size_t(t)] = float(c.r);
-        px[3 * size_t(t) + 1] = float(c.g);
-        px[3 * size_t(t) + 2] = float(c.b);
-      }
-      shade::project_latlong(px.data(), W, H, order, light.data());
-      how = "prt::shade::project_latlong (order " + std::to_string(order) + ") + shade_transfer per vertex, Gouraud";
-    } else {  // cube maps and Z-up scenes: libbake's projection (same quadrature, any layout)
-      const auto L = env.project_sh(order);
-      for (size_t i = 0; i < n; ++i)
-        for (size_t c = 0; c < 3; ++c) light[c * n + i] = float(L[i * 3 + c]);
-      how = "EnvMap::project_sh (order " + std::to_string(order) + ", cube map or Z-up) + prt::shade::shade_transfer, Gouraud";
+// The environment's SH coefficients [3][order²] (channel-major, as prtshade wants them).
+std::vector<float> environment_sh(const bake::EnvMap& env, int order, std::string& how) {
+  const size_t n = size_t(order) * size_t(order);
+  std::vector<float> light(3 * n);
+  if (env.info().layout == "latlong" && env.up() == bake::UpAxis::Y) {
+    // The runtime path: the pixels as an engine holds them (after libbake's load policy).
+    const int W = env.info().width, H = env.info().height;
+    std::vector<float> px(size_t(W) * size_t(H) * 3);
+    for (int t = 0; t < W * H; ++t) {
+      const bake::Rgb c = env.texel_value(t);
+      px[3 * size_t(t)] = float(c.r);
+      px[3 * size_t(t) + 1] = float(c.g);
+      px[3 * size_t(t) + 2] = float(c.b);
     }
-    shade::shade_transfer_vertices(transfer.data(), V, order, light.data(), colour.data());
-  } else {
-    const F::Dataset* d = F::find_dataset(f, "/radiance/band1");
-    if (!d) throw bake::InputError(a.file, "no dataset /radiance/band1 (try --shade transfer)");
-    check_same_environment(*d, env, a.file);
-    const auto& R = std::get<std::vector<float>>(d->data);
-    shade::shade_band1_vertices(nrm.data(), R.data(), V, colour.data());
-    for (float& c : colour) c *= float(std::numbers::inv_pi);
-    how = "prt::shade::shade_band1 per vertex (E/pi), Gouraud";
+    shade::project_latlong(px.data(), W, H, order, light.data());
+    how = "prt::shade::project_latlong (order " + std::to_string(order) + ") + shade_transfer per vertex, Gouraud";
+  } else {  // cube maps and Z-up scenes: libbake's projection (same quadrature, any layout)
+    const auto L = env.project_sh(order);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t c = 0; c < 3; ++c) light[c * n + i] = float(L[i * 3 + c]);
+    how = "EnvMap::project_sh (order " + std::to_string(order) + ", cube map or Z-up) + prt::shade::shade_transfer, Gouraud";
   }
+  return light;
+}
+
+// Per-vertex E/pi from diffuse transfer (any environment) or band-1 radiance (the baked one), of
+// the vertex set under `prefix`.
+std::vector<float> shade_transfer_set(const F::File& f, const std::string& file, const std::string& prefix,
+                                      const bake::EnvMap& env, size_t V, std::string& how) {
+  const std::string path = prefix + "/transfer/diffuse";
+  const F::Dataset* d = F::find_dataset(f, path);
+  if (!d) throw bake::InputError(file, "no dataset " + path + (prefix.empty() ? " (try --shade band1)" : ""));
+  const int order = int(std::get<int64_t>(need_attr(*d, "sh_order", file).value));
+  const std::vector<float> light = environment_sh(env, order, how);
+  std::vector<float> colour(3 * V);
+  shade::shade_transfer_vertices(std::get<std::vector<float>>(d->data).data(), V, order, light.data(), colour.data());
+  return colour;
+}
+std::vector<float> shade_band1_set(const F::File& f, const std::string& file, const std::string& prefix,
+                                   const bake::EnvMap& env, const bake::Mesh& mesh, std::string& how) {
+  const std::string path = prefix + "/radiance/band1";
+  const F::Dataset* d = F::find_dataset(f, path);
+  if (!d) throw bake::InputError(file, "no dataset " + path + (prefix.empty() ? " (try --shade transfer)" : ""));
+  check_same_environment(*d, env, file);
+  const auto& nrm = floats(f, file, prefix + "/mesh/normals", {3});
+  std::vector<float> colour(3 * mesh.positions.size());
+  shade::shade_band1_vertices(nrm.data(), std::get<std::vector<float>>(d->data).data(), mesh.positions.size(), colour.data());
+  for (float& c : colour) c *= float(std::numbers::inv_pi);
+  how = "prt::shade::shade_band1 per vertex (E/pi), Gouraud";
+  return colour;
+}
+
+bake::Image render_vertex_file(const F::File& f, const Args& a, const std::string& kind, const bake::EnvMap& env,
+                               const bake::Camera& cam, Scene& scene, std::string& how) {
+  scene.mesh = read_mesh(f, a.file, "");
+  const size_t V = scene.mesh.positions.size();
+  scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
+  const std::vector<float> colour = kind == "transfer" ? shade_transfer_set(f, a.file, "", env, V, how)
+                                                       : shade_band1_set(f, a.file, "", env, scene.mesh, how);
   const bake::GBuffer g = bake::rasterize(scene.mesh, cam);
   return bake::interpolate_vertices(scene.mesh, g, colour);
+}
+
+// ---- FIV shells ---------------------------------------------------------------------------------------------
+
+// One baked occluder, /fiv/occluders/<name>, checked (validate_occluder) and viewed by prtshade.
+struct BakedOccluder {
+  std::vector<double> centre;
+  double radius = 0;
+  std::vector<float> radii;  // view.radii points here
+  shade::FivOccluder view{};
+};
+
+BakedOccluder read_occluder(const F::File& f, const std::string& file, const std::string& name, const bake::EnvMap& env) {
+  const std::string dir = "/fiv/occluders/" + name;
+  const F::Dataset* sd = F::find_dataset(f, dir + "/shells");
+  if (!sd) throw bake::InputError(file, "no dataset " + dir + "/shells");
+  check_same_environment(*sd, env, file);
+  const auto& shells = floats(f, file, dir + "/shells", {0, 0, 0, 3, 3});
+  const F::Dataset* vd = F::find_dataset(f, dir + "/valid");
+  if (!vd) throw bake::InputError(file, "no dataset " + dir + "/valid");
+  BakedOccluder b;
+  b.centre = std::get<std::vector<double>>(need_attr(*sd, "centre", file).value);
+  b.radius = std::get<double>(need_attr(*sd, "radius", file).value);
+  const auto& radii_d = std::get<std::vector<double>>(need_attr(*sd, "radii", file).value);
+  b.radii.assign(radii_d.begin(), radii_d.end());
+  if (b.centre.size() != 3) throw bake::InputError(file, dir + "/shells: 'centre' must hold 3 numbers");
+  shade::FivOccluder& o = b.view;
+  for (int c = 0; c < 3; ++c) o.centre[c] = float(b.centre[size_t(c)]);
+  o.radius = float(b.radius);
+  o.n_rho = int(sd->shape[0]);
+  o.n_theta = int(sd->shape[1]);
+  o.n_phi = int(sd->shape[2]);
+  o.radii = b.radii.data();
+  o.shells = shells.data();
+  o.valid = std::get<std::vector<uint8_t>>(vd->data).data();
+  if (b.radii.size() != sd->shape[0]) throw bake::InputError(file, dir + "/shells: 'radii' must hold one radius per shell");
+  try {
+    shade::validate_occluder(o);
+  } catch (const std::invalid_argument& e) {
+    throw bake::InputError(file, dir + ": " + e.what());
+  }
+  return b;  // moving the vector keeps its buffer: view.radii stays valid
 }
 
 // ---- FIV files --------------------------------------------------------------------------------------------
@@ -382,17 +486,9 @@ bake::Image render_fiv_file(const F::File& f, const Args& a, const bake::EnvMap&
   } else if (std::find(names.begin(), names.end(), name) == names.end()) {
     throw bake::InputError(a.file, "has no occluder '" + name + "'");
   }
-  const std::string dir = "/fiv/occluders/" + name;
-  const F::Dataset& sd = *F::find_dataset(f, dir + "/shells");
-  check_same_environment(sd, env, a.file);
-  const auto& shells = floats(f, a.file, dir + "/shells", {0, 0, 0, 3, 3});
-  const F::Dataset* vd = F::find_dataset(f, dir + "/valid");
-  if (!vd) throw bake::InputError(a.file, "no dataset " + dir + "/valid");
-  const auto& valid = std::get<std::vector<uint8_t>>(vd->data);
-  const auto& centre = std::get<std::vector<double>>(need_attr(sd, "centre", a.file).value);
-  const double R = std::get<double>(need_attr(sd, "radius", a.file).value);
-  const auto& radii_d = std::get<std::vector<double>>(need_attr(sd, "radii", a.file).value);
-  const std::vector<float> radii(radii_d.begin(), radii_d.end());
+  const BakedOccluder baked = read_occluder(f, a.file, name, env);
+  const auto& centre = baked.centre;
+  const double R = baked.radius;
   const auto& env_fiv = floats(f, a.file, "/fiv/environment", {3, 3});
   const F::Dataset* cd = F::find_dataset(f, "/fiv/irradiance_cube");
   if (!cd) throw bake::InputError(a.file, "no dataset /fiv/irradiance_cube");
@@ -438,16 +534,8 @@ bake::Image render_fiv_file(const F::File& f, const Args& a, const bake::EnvMap&
   std::vector<shade::FivOccluder> occluders;
   for (size_t k = 0; k < inst.size(); ++k) {
     parts.push_back(bake::translated(occ, inst[k], name + "#" + std::to_string(k)));
-    shade::FivOccluder o{};
+    shade::FivOccluder o = baked.view;
     for (int c = 0; c < 3; ++c) o.centre[c] = float(centre[size_t(c)] + inst[k][c]);
-    o.radius = float(R);
-    o.n_rho = int(sd.shape[0]);
-    o.n_theta = int(sd.shape[1]);
-    o.n_phi = int(sd.shape[2]);
-    o.radii = radii.data();
-    o.shells = shells.data();
-    o.valid = valid.data();
-    shade::validate_occluder(o);
     occluders.push_back(o);
     scene.spheres.push_back({c0 + inst[k], R});
   }
@@ -484,6 +572,154 @@ bake::Image render_fiv_file(const F::File& f, const Args& a, const bake::EnvMap&
   });
 }
 
+// ---- scene files (prtbake scene, schema v2) -----------------------------------------------------------------
+
+bool is_scene_file(const F::File& f) {
+  if (F::find_group_attrs(f, "/scene")) return true;
+  return std::any_of(f.datasets.begin(), f.datasets.end(), [](const F::Dataset& d) { return d.path.starts_with("/objects/"); });
+}
+
+// One object as prtview draws it.
+struct ViewObject {
+  std::string name, role, how;
+  bool receiver = false, casts_shadow = false;
+  std::array<float, 3> albedo{1, 1, 1};
+  bake::Mesh mesh;                     // world space
+  std::vector<float> rgb;              // E/pi per vertex (white surface), Gouraud; empty: per pixel
+  std::optional<BakedOccluder> shells; // per pixel: FIV self-shadows (eq. 12)
+};
+
+bake::Image render_scene_file(const F::File& f, const Args& a, const bake::EnvMap& env, const bake::Camera& cam,
+                              Scene& scene, std::string& how) {
+  if (!a.shade.empty() || !a.instances.empty() || !a.occluder_mesh.empty() || !a.occluder.empty() || a.ground ||
+      a.ground_size || !a.overlap || !a.partial)
+    throw UsageError("--shade, --instance, --occluder(-mesh), --ground(-size), --no-overlap and --no-partial do not apply to "
+                     "scene files (" + a.file + "): each object is shaded with what it holds (see 'prtview --help')");
+  if (const auto* sa = F::find_group_attrs(f, "/scene")) check_same_environment(*sa, "/scene", env, a.file);
+  std::vector<std::string> names;
+  const std::string pre = "/objects/", post = "/mesh/positions";
+  for (const auto& d : f.datasets)
+    if (d.path.starts_with(pre) && d.path.ends_with(post) && d.path.size() > pre.size() + post.size())
+      names.push_back(d.path.substr(pre.size(), d.path.size() - pre.size() - post.size()));
+  if (names.empty()) throw bake::InputError(a.file, "is a scene file without objects (no /objects/<name>/mesh/positions)");
+
+  // What the runtime has beside the per-vertex data: the DifMap (unshadowed irradiance) and the
+  // environment FIV, when some occluder got shells.
+  std::optional<shade::DifMap> difmap;
+  if (const F::Dataset* cd = F::find_dataset(f, "/fiv/irradiance_cube")) {
+    check_same_environment(*cd, env, a.file);
+    difmap = shade::DifMap{int(cd->shape[1]), floats(f, a.file, cd->path, {6, 0, 0, 3}).data()};
+    shade::validate_difmap(*difmap);
+  }
+  const F::Dataset* env_fiv_d = F::find_dataset(f, "/fiv/environment");
+  if (env_fiv_d) check_same_environment(*env_fiv_d, env, a.file);
+  const float* env_fiv = env_fiv_d ? floats(f, a.file, env_fiv_d->path, {3, 3}).data() : nullptr;
+  std::optional<bake::UnoccludedIrradiance> exact;  // AO without a DifMap
+  // Flat grey: half the outgoing radiance of a white surface under a uniform sky of the
+  // environment's mean radiance Lbar = L_00 / sqrt(4 pi) (mean over RGB).
+  const auto L00 = env.project_sh(1);
+  const float flat = float(0.5 * (L00[0] + L00[1] + L00[2]) / 3.0 / std::sqrt(4 * std::numbers::pi));
+
+  std::vector<ViewObject> objects;
+  for (const std::string& name : names) {
+    ViewObject o;
+    o.name = name;
+    const std::string prefix = pre + name;
+    const auto* attrs = F::find_group_attrs(f, prefix);
+    o.role = attrs ? string_attr(*attrs, "role") : std::string();
+    if (o.role != "receiver" && o.role != "occluder" && o.role != "both")
+      throw bake::InputError(a.file, prefix + " has no valid 'role' attribute (receiver, occluder or both)");
+    o.receiver = o.role != "occluder";
+    o.casts_shadow = o.role != "receiver";
+    if (const F::Attr* al = F::find_attr(*attrs, "albedo")) {
+      const auto* v = std::get_if<std::vector<double>>(&al->value);
+      if (!v || v->size() != 3) throw bake::InputError(a.file, prefix + ": 'albedo' must be 3 numbers");
+      if ((*v)[0] > 0 || (*v)[1] > 0 || (*v)[2] > 0)
+        for (size_t c = 0; c < 3; ++c) o.albedo[c] = float(std::max(0.0, (*v)[c]));
+    }
+    o.mesh = read_mesh(f, a.file, prefix);
+    const size_t V = o.mesh.positions.size();
+    const bool glossy_only = F::find_dataset(f, prefix + "/transfer/visibility") &&
+                             !F::find_dataset(f, prefix + "/radiance/band1") && !F::find_dataset(f, prefix + "/transfer/diffuse");
+    const std::string glossy_note = glossy_only ? " (glossy: not shaded by the runtime yet)" : "";
+    if (F::find_dataset(f, prefix + "/radiance/band1")) {
+      o.rgb = shade_band1_set(f, a.file, prefix, env, o.mesh, o.how);
+      o.how = "band-1 radiance (shade_band1)";
+    } else if (F::find_dataset(f, prefix + "/transfer/diffuse")) {
+      o.rgb = shade_transfer_set(f, a.file, prefix, env, V, o.how);
+      o.how = "diffuse transfer (project_latlong + shade_transfer)";
+    } else if (F::find_dataset(f, prefix + "/ao")) {
+      // AO x the unshadowed irradiance at the vertex normal: the runtime's DifMap when the file has
+      // one (lookup_difmap), else the exact texel sum (bake::UnoccludedIrradiance).
+      const auto& ao = floats(f, a.file, prefix + "/ao", {});
+      if (!difmap && !exact) exact.emplace(env);
+      o.rgb.resize(3 * V);
+      for (size_t v = 0; v < V; ++v) {
+        const float n[3] = {o.mesh.normals[v].x(), o.mesh.normals[v].y(), o.mesh.normals[v].z()};
+        float e[3];
+        if (difmap) {
+          shade::lookup_difmap(*difmap, n, e);
+        } else {
+          const bake::Rgb u = (*exact)(o.mesh.normals[v].cast<double>());
+          e[0] = float(u.r), e[1] = float(u.g), e[2] = float(u.b);
+        }
+        for (size_t c = 0; c < 3; ++c) o.rgb[3 * v + c] = ao[v] * e[c] * float(std::numbers::inv_pi);
+      }
+      o.how = std::string("AO x ") + (difmap ? "DifMap (lookup_difmap)" : "exact unshadowed irradiance") + " / pi" + glossy_note;
+    } else if (env_fiv && F::find_dataset(f, "/fiv/occluders/" + name + "/shells")) {
+      o.shells = read_occluder(f, a.file, name, env);
+      o.how = "FIV self-shadows per pixel (shade_fiv_self)" + glossy_note;
+    } else {
+      o.rgb.assign(3 * V, flat);
+      o.how = "flat grey (no per-vertex products, no FIV shells)" + glossy_note;
+    }
+    objects.push_back(std::move(o));
+  }
+  // Receivers first: the compared region is the triangle range [0, receiver_triangles).
+  std::stable_partition(objects.begin(), objects.end(), [](const ViewObject& o) { return o.receiver; });
+
+  std::vector<bake::Mesh> parts;
+  std::vector<float> rgb;
+  std::vector<uint8_t> per_pixel;
+  scene.first_triangle = {0};
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects";
+  how = "per object, times its albedo (white if none):";
+  for (const ViewObject& o : objects) {
+    const size_t T = o.mesh.triangles.size();
+    for (size_t v = 0; v < o.mesh.positions.size(); ++v)
+      for (size_t c = 0; c < 3; ++c) rgb.push_back(o.rgb.empty() ? 0.0f : o.rgb[3 * v + c] * o.albedo[c]);
+    per_pixel.insert(per_pixel.end(), T, o.rgb.empty() ? 1 : 0);
+    scene.casts_shadow.insert(scene.casts_shadow.end(), T, o.casts_shadow ? 1 : 0);
+    scene.albedo.insert(scene.albedo.end(), T, o.albedo);
+    scene.object_names.push_back(o.name);
+    scene.object_receiver.push_back(o.receiver);
+    scene.first_triangle.push_back(scene.first_triangle.back() + T);
+    if (o.receiver) scene.receiver_triangles += T;
+    if (o.casts_shadow) {
+      bake::Sphere sp;
+      bake::bounding_sphere(o.mesh, sp.centre, sp.radius);
+      scene.spheres.push_back(sp);
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s %s (%zu vertices, albedo %.3g %.3g %.3g)", o.name.c_str(), o.role.c_str(),
+                  o.mesh.positions.size(), o.albedo[0], o.albedo[1], o.albedo[2]);
+    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + buf;
+    how += "\n  " + o.name + ": " + o.how;
+    parts.push_back(o.mesh);
+  }
+  scene.mesh = bake::merge_meshes(parts, a.file);
+  const bake::GBuffer g = bake::rasterize(scene.mesh, cam);
+  return bake::shade_mixed(scene.mesh, g, rgb, per_pixel, [&](const bake::Fragment& fr, float* out) {
+    const size_t k = size_t(std::upper_bound(scene.first_triangle.begin(), scene.first_triangle.end(), size_t(fr.triangle)) -
+                            scene.first_triangle.begin()) - 1;
+    const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
+    const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
+    float e[3];
+    shade::shade_fiv_self(env_fiv, objects[k].shells->view, p, n, e);
+    for (size_t c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi) * objects[k].albedo[c];
+  });
+}
+
 // Everything that determines the reference picture, for --reference-cache.
 std::string reference_key(const Scene& scene, const bake::EnvMap& env, const bake::Camera& cam,
                           const bake::ReferenceOptions& o, const std::string& description) {
@@ -492,6 +728,8 @@ std::string reference_key(const Scene& scene, const bake::EnvMap& env, const bak
   for (const auto& q : scene.mesh.positions) put(q.data(), 3 * sizeof(float));
   for (const auto& q : scene.mesh.normals) put(q.data(), 3 * sizeof(float));
   for (const auto& t : scene.mesh.triangles) put(t.data(), 3 * sizeof(uint32_t));
+  put(o.casts_shadow.data(), o.casts_shadow.size());
+  for (const auto& c : o.albedo) put(c.data(), 3 * sizeof(float));
   char buf[512];
   std::snprintf(buf, sizeof buf, "|%zu|eye %.17g %.17g %.17g at %.17g %.17g %.17g up %.17g %.17g %.17g fov %.17g near %.17g %dx%d",
                 scene.receiver_triangles, cam.eye.x(), cam.eye.y(), cam.eye.z(), cam.at.x(), cam.at.y(), cam.at.z(),
@@ -526,15 +764,22 @@ int run(const Args& a) {
   if (!fs::exists(a.file)) throw bake::InputError(a.file, "no such file");
   const F::File f = F::read_file(a.file);
   const bool has_fiv = F::find_dataset(f, "/fiv/irradiance_cube") != nullptr;
+  const bool scene_file = is_scene_file(f);
   std::string kind = a.shade;
-  if (kind.empty()) kind = has_fiv ? "fiv" : F::find_dataset(f, "/transfer/diffuse") ? "transfer" : "band1";
+  if (scene_file) kind = "scene";
+  else if (kind.empty()) kind = has_fiv ? "fiv" : F::find_dataset(f, "/transfer/diffuse") ? "transfer" : "band1";
   std::string env_path = a.env;
   if (env_path.empty()) {
+    const auto* scene_attrs = F::find_group_attrs(f, "/scene");
+    if (scene_file && scene_attrs) env_path = string_attr(*scene_attrs, "environment");
     for (const char* p : {"/fiv/irradiance_cube", "/radiance/band1"})
       if (const auto* d = F::find_dataset(f, p); d && env_path.empty()) env_path = string_attr(d->attrs, "environment");
     if (env_path.empty()) throw bake::InputError(a.file, "holds no environment name: give one with --env ENV.exr");
     if (!fs::exists(env_path) && fs::exists(fs::path(a.file).parent_path() / env_path))
       env_path = (fs::path(a.file).parent_path() / env_path).string();
+    if (const std::string sf = scene_attrs ? string_attr(*scene_attrs, "scene_file") : std::string();
+        !fs::exists(env_path) && !sf.empty() && fs::exists(fs::path(sf).parent_path() / env_path))
+      env_path = (fs::path(sf).parent_path() / env_path).string();
     if (!fs::exists(env_path))
       throw bake::InputError(env_path, "no such file (the environment " + a.file + " was baked with): give it with --env ENV.exr");
   }
@@ -544,8 +789,9 @@ int run(const Args& a) {
   Scene scene;
   std::string how;
   Timer t_run;
-  bake::Image runtime = kind == "fiv" ? render_fiv_file(f, a, env, cam, scene, how)
-                                      : render_vertex_file(f, a, kind, env, cam, scene, how);
+  bake::Image runtime = kind == "scene" ? render_scene_file(f, a, env, cam, scene, how)
+                        : kind == "fiv"   ? render_fiv_file(f, a, env, cam, scene, how)
+                                          : render_vertex_file(f, a, kind, env, cam, scene, how);
   const double runtime_seconds = t_run.seconds();
   if (say) {
     std::printf("%s: %s\nenvironment: %s (%dx%d %s)\nview: %dx%d, %s\n", a.file.c_str(), scene.what.c_str(),
@@ -556,6 +802,22 @@ int run(const Args& a) {
   }
   for (float v : runtime.rgb)
     if (!std::isfinite(v)) throw bake::ContractError("the runtime render produced a non-finite value");
+  if (say && !scene.object_names.empty()) {  // scene files: what each object shows (mean over its pixels)
+    const bake::GBuffer g = bake::rasterize(scene.mesh, cam);
+    for (size_t k = 0; k < scene.object_names.size(); ++k) {
+      double sum[3] = {0, 0, 0};
+      size_t n = 0;
+      for (size_t i = 0; i < g.triangle.size(); ++i) {
+        const int32_t t = g.triangle[i];
+        if (t < 0 || size_t(t) < scene.first_triangle[k] || size_t(t) >= scene.first_triangle[k + 1]) continue;
+        for (size_t c = 0; c < 3; ++c) sum[c] += double(runtime.rgb[3 * i + c]);
+        ++n;
+      }
+      if (n > 0)
+        std::printf("  object %s: runtime mean %.9g %.9g %.9g (%zu pixels)\n", scene.object_names[k].c_str(), sum[0] / double(n),
+                    sum[1] / double(n), sum[2] / double(n), n);
+    }
+  }
 
   if (a.mode == Output::Runtime) {
     const double exposure = a.exposure ? *a.exposure : bake::auto_exposure(runtime, {});
@@ -568,6 +830,8 @@ int run(const Args& a) {
   ropt.samples = a.samples;
   ropt.seed = a.seed;
   ropt.occluder_spheres = scene.spheres;
+  ropt.casts_shadow = scene.casts_shadow;
+  ropt.albedo = scene.albedo;
   const bake::ReferenceRenderer rr(scene.mesh, env, ropt);
   std::optional<bake::ReferenceImage> cached;
   const std::string key = reference_key(scene, env, cam, ropt, rr.description());
@@ -581,7 +845,7 @@ int run(const Args& a) {
   if (!cached && !a.reference_cache.empty()) bake::save_reference(a.reference_cache, ref, key);
   const bake::GBuffer raster = bake::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
-  const std::string region = !a.region.empty() ? a.region : kind == "fiv" ? "receiver" : "all";
+  const std::string region = !a.region.empty() ? a.region : kind == "fiv" || kind == "scene" ? "receiver" : "all";
   const size_t n_px = size_t(a.width) * size_t(a.height);
   std::vector<uint8_t> mask(n_px, 0), covered(n_px, 0);
   for (size_t i = 0; i < n_px; ++i) {
@@ -607,6 +871,19 @@ int run(const Args& a) {
   std::printf("reference noise %.5f (RMS standard error / range); noise-corrected NRMSE %.5f\n", e.ref_noise,
               e.nrmse_noise_corrected);
   if (region != "all") std::printf("NRMSE over all covered pixels %.5f (%zu pixels)\n", all.nrmse, all.pixels);
+  // Scene files: each receiver's share, RMSE over the pixels where both renders see that object,
+  // divided by the same range (so NRMSE^2 = sum_k (pixels_k / pixels) NRMSE_k^2).
+  const double range = e.ref_max - e.ref_min > 0 ? e.ref_max - e.ref_min : std::abs(e.ref_max) > 0 ? std::abs(e.ref_max) : 1.0;
+  for (size_t k = 0; k < scene.object_names.size(); ++k) {
+    if (!scene.object_receiver[k]) continue;
+    std::vector<uint8_t> mk(n_px, 0);
+    const auto in = [&](int32_t t) { return t >= 0 && size_t(t) >= scene.first_triangle[k] && size_t(t) < scene.first_triangle[k + 1]; };
+    for (size_t i = 0; i < n_px; ++i) mk[i] = in(raster.triangle[i]) && in(ref.gbuffer.triangle[i]);
+    if (std::count(mk.begin(), mk.end(), 1) == 0) continue;
+    const bake::ImageError ek = bake::compare_images(runtime, ref.radiance, mk, &ref.std_error);
+    std::printf("  object %s: NRMSE %.5f (%zu pixels; its RMSE %.4g / the range above)\n", scene.object_names[k].c_str(),
+                ek.rmse / range, ek.pixels, ek.rmse);
+  }
   bake::Image diff(a.width, a.height);
   for (size_t i = 0; i < diff.rgb.size(); ++i) diff.rgb[i] = mask[i / 3] ? runtime.rgb[i] - ref.radiance.rgb[i] : 0.0f;
   const bake::Image8 err8 = bake::false_colour_error(runtime, ref.radiance, mask, e.ref_max - e.ref_min, a.error_scale);

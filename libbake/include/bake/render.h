@@ -59,6 +59,8 @@
 //     L (n·ω) (1 − V) / p_mixture with p_mixture ≥ w_cos (n·ω)/π, so it is bounded.
 //   * visibility: a shadow ray from p + ε n_g (n_g the geometric normal turned to the side of n,
 //     ε = 1e-5 × the scene's bounding-box diagonal) to infinity; any hit occludes.
+//   * scenes of several objects (ReferenceOptions::casts_shadow / albedo): shadow rays see only
+//     the casting triangles (a separate Embree scene over them), the pixel is albedo · E / π.
 // The per-pixel standard error (of the QMC term, from the replicates) is returned with the
 // picture; compare_images (bake/image_io.h) turns it into the reference's own noise figure.
 #pragma once
@@ -132,6 +134,11 @@ Fragment make_fragment(const Mesh& mesh, const GBuffer& g, int x, int y);
 Image shade_pixels(const Mesh& mesh, const GBuffer& g, const std::function<void(const Fragment&, float*)>& shade);
 // Gouraud: per-vertex RGB (3 floats per mesh vertex) interpolated with the G-buffer's weights.
 Image interpolate_vertices(const Mesh& mesh, const GBuffer& g, std::span<const float> vertex_rgb);
+// Several objects drawn as one mesh: Gouraud of `vertex_rgb` (3 floats per mesh vertex) on every
+// triangle t with per_pixel[t] == 0, `shade` per pixel on the others (prtview: the FIV self-shadows
+// of occluder-only objects next to per-vertex receivers). per_pixel has one entry per triangle.
+Image shade_mixed(const Mesh& mesh, const GBuffer& g, std::span<const float> vertex_rgb,
+                  std::span<const uint8_t> per_pixel, const std::function<void(const Fragment&, float*)>& shade);
 
 // Exact unshadowed irradiance of a piecewise-constant environment (bake/envmap.h) for any unit
 // normal: E_unocc(n) = Σ_t L_t max(0, n · M_t), with M_t = ∫_texel ω dω from a 4 × 4 grid of
@@ -174,6 +181,15 @@ struct ReferenceOptions {
   uint32_t samples = 1024;  // QMC shadow rays per pixel (occluded part); a multiple of 8 (8 replicates)
   uint64_t seed = 1;
   std::vector<Sphere> occluder_spheres;
+  // Scenes of several objects (prtview on scene files, roles of bake/scene.h), one entry per
+  // triangle of the rendered mesh; empty vectors keep the single-object behaviour above.
+  //   casts_shadow[t] == 0: triangle t is seen by primary rays but never blocks a shadow ray (an
+  //     object with role "receiver" casts no shadow, not even on itself). When no triangle casts,
+  //     nothing is occluded and E = E_unocc exactly (no shadow rays, standard error 0).
+  //   albedo[t]: diffuse albedo (RGB) of triangle t: the pixel shows albedo · E/π and its standard
+  //     error scales alike. Empty: white (albedo 1), the E/π above.
+  std::vector<uint8_t> casts_shadow;
+  std::vector<std::array<float, 3>> albedo;
 };
 
 struct ReferenceImage {
