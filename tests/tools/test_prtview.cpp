@@ -86,16 +86,17 @@ std::pair<uint32_t, uint32_t> png_size(const fs::path& p) {
 
 const std::string kCamera = "--camera eye=0,3,4:at=0,0,0:fov=50";
 
-// A flat 4 × 4 grid in y = 0 (normals +Y from the angle-weighted rule).
-fs::path plane_obj() {
-  const fs::path p = scratch("plane.obj");
+// A flat n × n grid of unit cells in y = 0 centred on the origin (normals +Y from the
+// angle-weighted rule), written to `p` (default: a 4 × 4 grid in the scratch directory).
+fs::path plane_obj(int n = 4, fs::path p = {}) {
+  if (p.empty()) p = scratch("plane.obj");
   std::ofstream f(p);
-  for (int j = 0; j <= 4; ++j)
-    for (int i = 0; i <= 4; ++i) f << "v " << (i - 2) << " 0 " << (j - 2) << "\n";
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) {
-      const int a = j * 5 + i + 1;
-      f << "f " << a << " " << a + 5 << " " << a + 6 << " " << a + 1 << "\n";
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) f << "v " << (i - n / 2) << " 0 " << (j - n / 2) << "\n";
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i + 1;
+      f << "f " << a << " " << a + n + 1 << " " << a + n + 2 << " " << a + 1 << "\n";
     }
   return p;
 }
@@ -200,15 +201,7 @@ fs::path bake_scene(const std::string& tag, double ground_albedo) {
   const fs::path d = fs::path(PRT_TEST_TMP) / "prtview" / ("scene_" + std::to_string(getpid()) + "_" + tag);
   fs::remove_all(d);
   fs::create_directories(d);
-  std::string g;
-  for (int j = 0; j < 9; ++j)
-    for (int i = 0; i < 9; ++i) g += "v " + std::to_string(i - 4) + " 0 " + std::to_string(j - 4) + "\n";
-  for (int j = 0; j < 8; ++j)
-    for (int i = 0; i < 8; ++i) {
-      const int a = j * 9 + i + 1, b = a + 1, c = a + 10, e = a + 9;
-      g += "f " + std::to_string(a) + " " + std::to_string(e) + " " + std::to_string(c) + " " + std::to_string(b) + "\n";
-    }
-  std::ofstream(d / "ground.obj") << g;
+  plane_obj(8, d / "ground.obj");
   std::ofstream(d / "box.obj") << "v -1 1 -1\nv 1 1 -1\nv -1 3 -1\nv 1 3 -1\nv -1 1 1\nv 1 1 1\nv -1 3 1\nv 1 3 1\n"
                                   "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
   char albedo[96];
