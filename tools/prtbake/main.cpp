@@ -342,6 +342,15 @@ std::vector<prt::formats::Attr> root_attrs(const Args& a, const std::string& sou
   };
 }
 
+// Writes the file (validated, temp + rename: formats/prtfile.h) and says where and how big.
+void write_file(const Args& a, const prt::formats::File& file) {
+  prt::formats::write_file(a.output, file);
+  if (!a.quiet) {
+    std::error_code ec;
+    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
+  }
+}
+
 int run_vertex(const Args& a) {
   const bool say = !a.quiet;
   check_output_writable(a.output);
@@ -436,11 +445,7 @@ int run_vertex(const Args& a) {
                      {integrator.name(), integrator.description(), a.samples, a.seed, a.transfer, a.visibility,
                       env ? &*env : nullptr, a.radiance});
   if (report) tool::add_report(file, "/report", *report, result.seconds, mesh.positions.size(), a.reproducible);
-  F::write_file(a.output, file);
-  if (say) {
-    std::error_code ec;
-    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
-  }
+  write_file(a, file);
   return 0;
 }
 
@@ -495,11 +500,7 @@ int run_fiv(const Args& a) {
                   r.reference_std_error);
     tool::add_fiv_report(file, name, r, sh, a.reproducible);
   }
-  F::write_file(a.output, file);
-  if (say) {
-    std::error_code ec;
-    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
-  }
+  write_file(a, file);
   return 0;
 }
 
@@ -618,11 +619,7 @@ int run_scene(const Args& a) {
   }
   if (plan.fiv_environment)
     tool::add_fiv_environment(file, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.cube);
-  F::write_file(a.output, file);
-  if (say) {
-    std::error_code ec;
-    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
-  }
+  write_file(a, file);
   return 0;
 }
 
