@@ -107,6 +107,11 @@ struct RayScene::Embree {
     scene = rtcNewScene(device);
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    if (mesh.triangles.empty()) {  // nothing occludes (e.g. a scene with receivers only)
+      rtcCommitScene(scene);
+      if (!error.empty()) throw ContractError(error);
+      return;
+    }
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), mesh.positions.size()));

@@ -189,6 +189,20 @@ TEST(SceneRules, VerticesThatSeeNoContourEdgeGetTheClosedForm) {
   EXPECT_NE(b.run.out.find("81 saw no contour edge (closed form)"), std::string::npos) << b.run.out;
 }
 
+TEST(SceneRules, ReceiversOnlySceneHasNothingToIntegrateAgainst) {
+  // No object casts shadows: the occluder union is empty (an empty Embree scene), every vertex
+  // takes the closed form, AO is exactly 1 and the flat ground's band-1 radiance is one value.
+  const fs::path d = dir_for("receivers_only");
+  write_meshes(d);
+  const Baked b = bake(d, scene_text(kSunset, "", kGround));
+  const auto* attrs = F::find_group_attrs(b.file, "/objects/ground");
+  ASSERT_NE(attrs, nullptr);
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(*attrs, "closed_form_vertices")->value), 81);
+  for (float a : std::get<std::vector<float>>(F::find_dataset(b.file, "/objects/ground/ao")->data)) EXPECT_EQ(a, 1.0f);
+  const auto& R = std::get<std::vector<float>>(F::find_dataset(b.file, "/objects/ground/radiance/band1")->data);
+  for (size_t i = 0; i < R.size(); ++i) EXPECT_EQ(R[i], R[i % 9]) << i;
+}
+
 TEST(SceneRules, SameSceneAndSeedGiveIdenticalBytesForAnyThreadCount) {
   // Receivers, closed forms (cached per normal), FIV shells and reports: all keyed by point
   // index, so 1 and 2 threads write the same bytes under SOURCE_DATE_EPOCH.
