@@ -6,11 +6,13 @@
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>
+#include <test_scenes.h>
 
 #include <cmath>
 #include <numbers>
 
 using namespace prt::bake;
+using prt::testing::box;
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 using std::numbers::pi;
@@ -51,12 +53,6 @@ std::array<double, 3> quad(const EnvMap& env, G g, int n = 2048) {
   return s;
 }
 
-Mesh box(Vector3f lo, Vector3f hi) {
-  std::vector<Vector3f> p;
-  for (int k = 0; k < 8; ++k) p.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
-  return make_mesh(p, {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                       {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}}, "box");
-}
 
 } // namespace
 

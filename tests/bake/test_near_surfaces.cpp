@@ -13,23 +13,12 @@ using namespace prt::bake;
 using Eigen::Vector3d;
 using Eigen::Vector3f;
 
-namespace {
-
-Mesh box(float h, Vector3f shift = {0, 0, 0}) {
-  std::vector<Vector3f> p;
-  for (int k = 0; k < 8; ++k) p.push_back(Vector3f(k & 1 ? h : -h, k & 2 ? h : -h, k & 4 ? h : -h) + shift);
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                                             {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-  return make_mesh(std::move(p), std::move(t), "box");
-}
-
-} // namespace
-
 TEST(NearSurfaces, ShellInsideANearDuplicateShellIsEnclosed) {
   // A unit box inside a copy 2 ulps larger: every vertex of the inner box sees only the outer
   // box, so AO is exactly 0 and the diffuse transfer vanishes; the outer box's vertices see the
   // open sky above their faces. Before the exact near-p test every start ray was "ambiguous".
-  const Mesh inner = box(1.0f), outer = box(std::nextafter(std::nextafter(1.0f, 2.0f), 2.0f));
+  const float h = std::nextafter(std::nextafter(1.0f, 2.0f), 2.0f);
+  const Mesh inner = prt::testing::box({-1, -1, -1}, {1, 1, 1}), outer = prt::testing::box({-h, -h, -h}, {h, h, h});
   const Mesh both[] = {inner, outer};
   const Mesh m = merge_meshes(both, "shells");
   const Topology topo = build_topology(m);

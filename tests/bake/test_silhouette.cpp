@@ -16,6 +16,7 @@
 #include <numbers>
 
 using namespace prt::bake;
+using prt::testing::box;
 using prt::testing::grid;
 using prt::testing::grid_centre;
 using prt::testing::polygon_form_factor;
@@ -31,14 +32,6 @@ constexpr double kAnalyticTol = 1e-4;
 
 
 
-// A closed, consistently wound axis-aligned box [lo, hi]³ (12 triangles, outward normals).
-Mesh box(Vector3f lo, Vector3f hi, std::string name = "box") {
-  std::vector<Vector3f> p;
-  for (int k = 0; k < 8; ++k) p.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                                             {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-  return make_mesh(std::move(p), std::move(t), std::move(name));
-}
 
 struct Row {
   std::vector<double> v;

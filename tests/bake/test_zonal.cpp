@@ -183,11 +183,7 @@ TEST(SilhouetteClosedForm, UnoccludedVerticesSkipTheWalkAndAreExact) {
 TEST(SilhouetteClosedForm, EnclosedPointGetsZerosFromOneRay) {
   // Inside a closed box no edge is a contour edge (both face planes face the point), so the
   // closed-form path runs and its one ray finds W > 0: every product is exactly 0.
-  std::vector<Vector3f> p;
-  for (int k = 0; k < 8; ++k) p.emplace_back(k & 1 ? 1.f : -1.f, k & 2 ? 1.f : -1.f, k & 4 ? 1.f : -1.f);
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                                             {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-  const Mesh m = make_mesh(std::move(p), std::move(t), "box");
+  const Mesh m = prt::testing::box({-1, -1, -1}, {1, 1, 1});
   const Topology topo = build_topology(m);
   const EnvMap white = EnvMap::constant({1, 1, 1});
   ProductRequest req;

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace prt::testing {
@@ -26,6 +27,16 @@ inline bake::Mesh grid(int n, float h, float z = 0) {
   return bake::make_mesh(std::move(p), std::move(t), "grid");
 }
 inline uint32_t grid_centre(int n) { return uint32_t((2 * n + 1) * n + n); }
+
+// A closed, consistently wound axis-aligned box [lo, hi]³ (8 vertices, 12 triangles, outward
+// normals).
+inline bake::Mesh box(Eigen::Vector3f lo, Eigen::Vector3f hi, std::string name = "box") {
+  std::vector<Eigen::Vector3f> p;
+  for (int k = 0; k < 8; ++k) p.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                                             {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return bake::make_mesh(std::move(p), std::move(t), std::move(name));
+}
 
 // Lambert's formula: the cosine-weighted fraction of the hemisphere (p, n) covered by a planar
 // polygon, F = 1/(2π) Σ_i angle(r_i, r_{i+1}) · (n · unit(r_i × r_{i+1})).
