@@ -287,7 +287,7 @@ Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, co
 }
 
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
-                          ProgressMode progress_mode) {
+                          const Monitor& monitor) {
   PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
   FivShells out;
   bounding_sphere(occluder, out.centre, out.radius);
@@ -317,7 +317,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
   const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
   const size_t per_shell = size_t(spec.n_theta) * size_t(spec.n_phi);
-  Progress progress("baking FIV shells", uint64_t(spec.n_rho) * per_shell, progress_mode);
+  Task progress(monitor, "baking FIV shells", uint64_t(spec.n_rho) * per_shell);
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < spec.n_rho; ++k) {
     const double rho = rho0 * std::pow(g, k);

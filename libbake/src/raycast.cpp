@@ -99,17 +99,27 @@ struct RayScene::Embree {
   RTCScene scene = nullptr;
   std::string error;
 
+  // Embree failures (no device, no memory for the BVH) are the machine's, not the input's:
+  // SystemError. The constructor releases what it made before it throws, so nothing leaks.
   explicit Embree(const Mesh& mesh) {
+    try {
+      build(mesh);
+    } catch (...) {
+      release();
+      throw;
+    }
+  }
+  void build(const Mesh& mesh) {
     device = rtcNewDevice(nullptr);
-    if (!device) throw ContractError("Embree: rtcNewDevice failed (error " +
-                                     std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    if (!device) throw SystemError("Embree: rtcNewDevice failed (error " +
+                                   std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(device, embree_error, &error);
     scene = rtcNewScene(device);
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     if (mesh.triangles.empty()) {  // nothing occludes (e.g. a scene with receivers only)
       rtcCommitScene(scene);
-      if (!error.empty()) throw ContractError(error);
+      if (!error.empty()) throw SystemError(error);
       return;
     }
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -117,7 +127,10 @@ struct RayScene::Embree {
                                                           3 * sizeof(float), mesh.positions.size()));
     auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                3 * sizeof(uint32_t), mesh.triangles.size()));
-    if (!v || !idx) throw ContractError("Embree: cannot allocate geometry buffers: " + error);
+    if (!v || !idx) {
+      rtcReleaseGeometry(geom);
+      throw SystemError("Embree: cannot allocate geometry buffers: " + error);
+    }
     for (size_t i = 0; i < mesh.positions.size(); ++i)
       for (int k = 0; k < 3; ++k) v[3 * i + k] = mesh.positions[i][k];
     for (size_t i = 0; i < mesh.triangles.size(); ++i)
@@ -128,11 +141,14 @@ struct RayScene::Embree {
     rtcAttachGeometry(scene, geom);
     rtcReleaseGeometry(geom);
     rtcCommitScene(scene);
-    if (!error.empty()) throw ContractError(error);
+    if (!error.empty()) throw SystemError(error);
   }
-  ~Embree() {
+  ~Embree() { release(); }
+  void release() noexcept {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
+    scene = nullptr;
+    device = nullptr;
   }
 };
 

@@ -599,13 +599,13 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, double E[3
   }
 }
 
-ReferenceImage ReferenceRenderer::render(const Camera& camera, ProgressMode progress) const {
+ReferenceImage ReferenceRenderer::render(const Camera& camera, const Monitor& monitor) const {
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceImage out;
   out.gbuffer = trace_primary(camera);
   out.radiance = Image(camera.width, camera.height);
   out.std_error = Image(camera.width, camera.height);
-  Progress bar("reference", uint64_t(camera.height), progress);
+  Task bar(monitor, "reference", uint64_t(camera.height));
   std::atomic<uint64_t> pixels{0};
   tbb::parallel_for(0, camera.height, [&](int y) {
     uint64_t n = 0;

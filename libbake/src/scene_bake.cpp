@@ -25,7 +25,7 @@ std::string fmt(const char* f, double a, double b = 0) {
 } // namespace
 
 SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     ProgressMode progress, const std::function<void(const std::string&)>& log) {
+                     const Monitor& monitor, const std::function<void(const std::string&)>& log) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
   SceneBake out;
@@ -90,7 +90,7 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     const auto* sil = dynamic_cast<const SilhouetteIntegrator*>(integ.get());
     const uint64_t closed_before = sil ? sil->stats().closed_form : 0;
     ObjectBake& ob = out.objects[i];
-    ob.values = bake_points(points, *integ, progress, "baking " + scene.objects[i].name);
+    ob.values = bake_points(points, *integ, monitor, "baking " + scene.objects[i].name);
     ob.integrator_description = integ->description();
     ob.closed_form_vertices = sil ? sil->stats().closed_form - closed_before : 0;
     out.vertex_seconds += ob.values->seconds;
@@ -128,7 +128,7 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     spec.fraction = scene.fraction;
     spec.isolines = std::max(2, int(std::lround(std::sqrt(double(scene.fiv_samples())))));
     ObjectBake& ob = out.objects[i];
-    ob.fiv = bake_fiv_shells(m, t, *env, spec, progress);
+    ob.fiv = bake_fiv_shells(m, t, *env, spec, monitor);
     out.fiv_seconds += ob.fiv->seconds;
     log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.n_phi) + "x" + std::to_string(scene.n_theta) +
         "x" + std::to_string(ob.fiv->radii.size()) + " in " + fmt("%.2f s", ob.fiv->seconds));

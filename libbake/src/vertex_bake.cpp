@@ -28,14 +28,14 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
   return points;
 }
 
-VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator, ProgressMode progress_mode,
+VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator, const Monitor& monitor,
                        const std::string& label) {
   VertexBake out;
   out.layout = integrator.layout();
   const size_t V = points.size(), W = out.layout.width;
   out.values.assign(V * W, 0.0);
   out.std_error.assign(V * W, 0.0);
-  Progress progress(label, V, progress_mode);
+  Task progress(monitor, label, V);
   const auto t0 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, V, 16), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v)
@@ -50,8 +50,8 @@ VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& int
 }
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
-                         ProgressMode progress_mode, const std::string& label) {
-  return bake_points(vertex_shade_points(mesh, topology), integrator, progress_mode, label);
+                         const Monitor& monitor, const std::string& label) {
+  return bake_points(vertex_shade_points(mesh, topology), integrator, monitor, label);
 }
 
 uint32_t default_samples(const std::string& integrator) { return integrator == "qmc" ? 1024u : 16384u; }

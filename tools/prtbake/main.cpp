@@ -14,6 +14,8 @@
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
+#include "progress_bar.h"
+#include "tool_main.h"
 
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
@@ -119,14 +121,9 @@ EXAMPLES
   prtbake scene data/scene_example.json -o scene.prt.h5
   prtdump bunny.prt.h5            # what was baked, statistics, the error report
 
-EXIT STATUS
-  0 success; 1 bad input or failed bake (one line on stderr names the file and the problem,
-  and no output file is left behind); 2 bad command line.
 )";
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tool::UsageError;
 
 template <class T> T parse_number(const std::string& opt, const std::string& s, T lo, T hi) {
   T v{};
@@ -166,6 +163,7 @@ Args parse(int argc, char** argv) {
     if (!s.empty() && s[0] == '-') a.given.push_back(s);
     if (s == "-h" || s == "--help") {
       std::fputs(kHelp, stdout);
+      std::fputs(tool::kExitStatusHelp, stdout);
       std::exit(0);
     } else if (s == "--version") {
       std::printf("prtbake %s\n", kVersion);
@@ -401,7 +399,8 @@ int run_vertex(const Args& a) {
                 integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
   }
-  const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
@@ -460,7 +459,8 @@ int run_fiv(const Args& a) {
   const bake::Topology topo = bake::build_topology(mesh);
   print_warnings(mesh.warnings);
   const bake::EnvMap env = bake::EnvMap::load(a.radiance, a.up);
-  const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   if (say)
     std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.mesh.c_str(), mesh.triangles.size(),
                 a.radiance.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
@@ -520,7 +520,7 @@ int run_scene(const Args& a) {
     try {
       meshes.push_back(bake::load_scene_mesh(o));
     } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
-      throw std::runtime_error(std::string(e.what()) + " (object '" + o.name + "' of " + a.mesh + ")");
+      throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.mesh + ")");
     }
     mesh_sha.push_back(bake::sha256_file(o.mesh));
     print_warnings(meshes.back().warnings);
@@ -545,7 +545,8 @@ int run_scene(const Args& a) {
   }
   if (a.dry_run) return 0;
 
-  const auto progress = a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto;
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::SceneBake result = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
                                                   [&](const std::string& line) {
                                                     if (say) std::printf("%s\n", line.c_str());
@@ -623,17 +624,12 @@ int run_scene(const Args& a) {
   return 0;
 }
 
+int prtbake_main(int argc, char** argv) {
+  const Args a = parse(argc, argv);
+  tool::install_interrupt_handler();
+  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
+}
+
 } // namespace
 
-int main(int argc, char** argv) {
-  try {
-    const Args a = parse(argc, argv);
-    return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "prtbake: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "prtbake: error: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return tool::run_tool("prtbake", prtbake_main, argc, argv); }

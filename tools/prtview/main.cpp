@@ -2,6 +2,9 @@
 // same view with Embree ray-traced ground truth, and show and measure the difference. A thin
 // shell: formats/ reads the file, prtshade shades, libbake (bake/render.h, bake/image_io.h)
 // rasterizes, ray-traces, compares and writes the pictures.
+#include "progress_bar.h"
+#include "tool_main.h"
+
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <bake/fiv.h>
@@ -153,14 +156,9 @@ EXAMPLES
   prtbake scene data/scene_example.json -o scene.prt.h5
   prtview scene.prt.h5 --camera eye=0,18,34:at=0,2,0 --size 320x240 --triptych -o scene.png
 
-EXIT STATUS
-  0 success; 1 bad input (one line on stderr names the file or option and the problem; no
-  output file is left behind); 2 bad command line.
 )";
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using tool::UsageError;
 
 enum class Output { Runtime, Reference, Error, Triptych };
 
@@ -207,6 +205,7 @@ Args parse(int argc, char** argv) {
     };
     if (s == "-h" || s == "--help") {
       std::fputs(kHelp, stdout);
+      std::fputs(tool::kExitStatusHelp, stdout);
       std::exit(0);
     } else if (s == "-o" || s == "--output") a.output = value();
     else if (s == "--env") a.env = value();
@@ -836,8 +835,9 @@ int run(const Args& a) {
   std::optional<bake::ReferenceImage> cached;
   const std::string key = reference_key(scene, env, cam, ropt, rr.description());
   if (!a.reference_cache.empty()) cached = bake::load_reference(a.reference_cache, key);
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::ReferenceImage ref =
-      cached ? std::move(*cached) : rr.render(cam, a.quiet ? bake::ProgressMode::Quiet : bake::ProgressMode::Auto);
+      cached ? std::move(*cached) : rr.render(cam, bar.monitor(&tool::interrupt_token()));
   if (say && cached) std::printf("reference: %s: read from %s\n", rr.description().c_str(), a.reference_cache.c_str());
   if (say && !cached)
     std::printf("reference: %s: %.2f s, %.2f M rays/s\n", rr.description().c_str(), ref.seconds,
@@ -908,16 +908,12 @@ int run(const Args& a) {
   return 0;
 }
 
+int prtview_main(int argc, char** argv) {
+  const Args a = parse(argc, argv);
+  tool::install_interrupt_handler();
+  return run(a);
+}
+
 } // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(parse(argc, argv));
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "prtview: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "prtview: error: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return tool::run_tool("prtview", prtview_main, argc, argv); }

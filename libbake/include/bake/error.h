@@ -1,8 +1,13 @@
-// bake/error.h — the two kinds of failure in libbake (after Filament's utils/Panic.h and
-// pbrt's util/error.h):
-//   * InputError: the user's input is bad (a mesh, an EXR, an option). what() is one line that
-//     names the file and the defect: "<file>: <what is wrong>". Tools print it and exit 1.
-//   * ContractError / PRT_CHECK: a bug in prtbake (a broken precondition). Always on.
+// bake/error.h — the three kinds of failure in libbake (after Filament's utils/Panic.h and
+// pbrt's util/error.h); the tools map each to its own exit code (tools/common/tool_main.h,
+// docs/ARCHITECTURE.md "Errors"):
+//   * InputError: the user's input is bad (a mesh, an EXR, a scene file, a value in it). what() is
+//     one line that names the file and the defect: "<file>: <what is wrong>". Exit 1. libbake's
+//     messages name files, keys and values, never a tool's command-line flags.
+//   * SystemError: the machine failed us, not the input: the Embree device could not be created,
+//     memory ran out, a system call failed. Exit 3.
+//   * ContractError / PRT_CHECK: a bug in prtbake (a broken precondition). Always on. Exit 4,
+//     "internal error".
 // Exceptions never leave a library unconverted: third-party exceptions (OpenEXR's Iex, Embree
 // error codes) are caught at the boundary and rethrown as one of these.
 #pragma once
@@ -22,6 +27,11 @@ public:
 
 private:
   std::string file_, defect_;
+};
+
+class SystemError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
 };
 
 class ContractError : public std::logic_error {

@@ -76,7 +76,7 @@ Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi);
 void bounding_sphere(const Mesh& mesh, Eigen::Vector3d& centre, double& radius);
 
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
-                          ProgressMode progress = ProgressMode::Quiet);
+                          const Monitor& monitor = {});
 
 // The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1}
 // in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no

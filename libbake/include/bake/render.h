@@ -210,7 +210,7 @@ public:
 
   // Primary rays only: the G-buffer of what each pixel centre sees.
   GBuffer trace_primary(const Camera& camera) const;
-  ReferenceImage render(const Camera& camera, ProgressMode progress = ProgressMode::Quiet) const;
+  ReferenceImage render(const Camera& camera, const Monitor& monitor = {}) const;
 
   // Irradiance E (RGB) at a fragment and its standard error; `index` keys the randomisation.
   void irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const;

@@ -154,6 +154,6 @@ struct SceneBake {
 // (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
 SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     ProgressMode progress, const std::function<void(const std::string&)>& log);
+                     const Monitor& monitor, const std::function<void(const std::string&)>& log);
 
 } // namespace prt::bake

@@ -25,7 +25,7 @@ struct VertexBake {
 ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32_t vertex);
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
-                         ProgressMode progress = ProgressMode::Quiet, const std::string& label = "baking vertices");
+                         const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
 // The shade points of every vertex of `mesh` (vertex_shade_point for each, in order).
 std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& topology);
@@ -33,7 +33,7 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 // The general form: any shade points (e.g. a scene receiver's vertices against the scene's
 // occluders, bake/scene.h); row i belongs to points[i], randomised by the index i.
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
-                       ProgressMode progress = ProgressMode::Quiet, const std::string& label = "baking vertices");
+                       const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
 // Error against a converged reference on a seeded sample of vertices (DESIGN.md §6).
 struct ProductError {
