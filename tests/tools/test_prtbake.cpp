@@ -56,6 +56,13 @@ void expect_no_output(const fs::path& out) {
 
 const std::string kTetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
 
+// A closed tetrahedron written to the scratch file `name`.
+fs::path tetra(const std::string& name) {
+  const fs::path p = scratch(name);
+  write_text(p, kTetra);
+  return p;
+}
+
 } // namespace
 
 TEST(Prtbake, BakesEveryProductOfARealMeshInOnePass) {
@@ -233,8 +240,7 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
 
 TEST(Prtbake, OutputMustBeAnHdf5FileName) {
   // stdout cannot take an HDF5 file, and another extension would silently get HDF5 contents.
-  const fs::path mesh = scratch("tetra_out.obj");
-  write_text(mesh, kTetra);
+  const fs::path mesh = tetra("tetra_out.obj");
   const Outcome dash = run("vertex " + mesh.string() + " --ao -o -");
   EXPECT_EQ(dash.code, 2);
   EXPECT_NE(dash.err.find("standard output"), std::string::npos) << dash.err;
@@ -249,8 +255,7 @@ TEST(Prtbake, OutputMustBeAnHdf5FileName) {
 
 TEST(Prtbake, OptionsBelongToTheirCommand) {
   // An option that has no meaning for a command is refused, not ignored.
-  const fs::path mesh = scratch("tetra_cmd.obj");
-  write_text(mesh, kTetra);
+  const fs::path mesh = tetra("tetra_cmd.obj");
   const std::string out = scratch("cmd.prt.h5").string();
   EXPECT_EQ(run("scene " + (kData / "scene_example.json").string() + " --samples 64 -o " + out).code, 2);
   EXPECT_EQ(run("scene " + (kData / "scene_example.json").string() + " --up z --dry-run").code, 2);
@@ -261,8 +266,7 @@ TEST(Prtbake, OptionsBelongToTheirCommand) {
 
 TEST(Prtbake, EqualsFormOfOptionsIsTheSameCommand) {
   // --opt=value works and is stored as "--opt value"; --threads and --quiet are not stored.
-  const fs::path mesh = scratch("tetra_eq.obj");
-  write_text(mesh, kTetra);
+  const fs::path mesh = tetra("tetra_eq.obj");
   const fs::path out = scratch("eq.prt.h5");
   fs::remove(out);
   const Outcome r = run("vertex " + mesh.string() + " --ao --integrator=qmc --samples=16 --report=0 --threads=1 "

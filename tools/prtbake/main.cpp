@@ -1,13 +1,11 @@
-// prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments,
-// reports progress and calls libbake (integration) and formats (the HDF5 file).
+// prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments (CLI11:
+// one subcommand per kind of bake, each with only the options that apply to it, into the typed
+// specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <bake/fiv.h>
 #include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/sampling.h>
 #include <bake/sha256.h>
-#include <bake/silhouette.h>
 #include <bake/scene.h>
 #include <bake/vertex_bake.h>
 #include <formats/prtfile.h>
@@ -23,14 +21,11 @@
 #include <tbb/info.h>
 
 #include <algorithm>
-#include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -312,7 +307,8 @@ std::optional<Args> parse(int argc, char** argv) {
   if (samples != 0) a.integrator.set_samples(samples);
   if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
       a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
-    throw UsageError("--samples: the silhouette integrator needs k >= 4 (2 u-isolines)");
+    throw UsageError("--samples: the silhouette integrator needs k >= " +
+                     std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
   if (a.command == "fiv") {
     a.shells.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
     return a;
