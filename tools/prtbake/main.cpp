@@ -116,7 +116,8 @@ std::string content_command_line(int argc, char** argv) {
 
 // Why `path` cannot be the output file ("" if it can): prtbake writes HDF5 files only.
 std::string output_problem(const std::string& path) {
-  if (path == "-") return "cannot write to standard output: an HDF5 file needs a seekable file; give a name ending in .prt.h5";
+  if (path == "-")
+    return "cannot write to standard output: an HDF5 file needs a seekable file; give a name ending in .prt.h5";
   if (!path.ends_with(".h5"))
     return "'" + path + "' does not end in .h5: prtbake writes HDF5 files only (.prt.h5 or .h5 expected)";
   return "";
@@ -207,7 +208,8 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          "--integrator",
          [&a](const std::string& name) {
            const auto kind = bake::parse_integrator_kind(name);
-           if (!kind) throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc)");
+           if (!kind)
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc)");
            a.integrator.kind = *kind;
          },
          "silhouette (default): semi-analytic visibility silhouettes (paper 001\n"
@@ -241,7 +243,8 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
          "--shells",
          [&a](const std::string& g) {
            if (!bake::parse_shell_grid(g, a.shells))
-             throw CLI::ValidationError("--shells", "expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
+             throw CLI::ValidationError("--shells",
+                                        "expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
          },
          "the shell grid: NPHI x NTHETA (poles included) directions on each of\nNRHO shells (default " +
              std::to_string(d.n_phi) + "x" + std::to_string(d.n_theta) + "x" + std::to_string(d.n_rho) + ")")
@@ -258,7 +261,8 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
       });
   add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help() + ").");
   add_report(cmd, a,
-             std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays, full sphere, at seeded shell samples");
+             std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) +
+                 " rays, full sphere, at seeded shell samples");
   add_run_options(cmd, a);
 }
 
@@ -527,7 +531,8 @@ int run_fiv(const Args& a) {
     if (say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
-                  bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs, r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
+                  bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,
+                  r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
     tool::add_fiv_report(file, name, r, sh, a.reproducible);
   }
@@ -639,7 +644,8 @@ int run_scene(const Args& a) {
     if (ob.values) {
       tool::add_products(file, prefix, *ob.values,
                          {bake::to_string(scene.integrator.kind), ob.integrator_description,
-                          scene.integrator.samples(), scene.integrator.seed, p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+                          scene.integrator.samples(), scene.integrator.seed, p.transfer_order, p.visibility_order,
+                          env ? &*env : nullptr, env_path});
       if (ob.report)
         tool::add_report(file, "/report/objects/" + o.name, *ob.report, ob.values->seconds, meshes[i].positions.size(),
                          a.reproducible);
