@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   std::stringstream ss(sizes);
   for (std::string item; std::getline(ss, item, ',');) {
     ShellSpec spec;
-    if (std::sscanf(item.c_str(), "%dx%dx%d", &spec.n_phi, &spec.n_theta, &spec.n_rho) != 3) continue;
+    if (!parse_shell_grid(item, spec)) continue;
     const FivShells s = bake_fiv_shells(mesh, topo, env, spec);
     std::printf("| %s | %llu | %zu | %.2f | %.0f |\n", item.c_str(), (unsigned long long)s.integrals, s.radii.size(),
                 s.seconds, double(s.integrals) / s.seconds);

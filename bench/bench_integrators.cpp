@@ -77,9 +77,9 @@ void silhouette_case(benchmark::State& state, int level, int isolines) {
   opt.isolines = isolines;
   const bake::SilhouetteIntegrator integ(s.mesh, s.topology, bench::request(), opt);
   state.counters["setup_s"] = since(t0);
-  const bake::SilhouetteStats before = integ.stats();
+  const bake::IntegratorStats before = integ.stats();
   integrate_all(state, s, integ);
-  const bake::SilhouetteStats after = integ.stats();
+  const bake::IntegratorStats after = integ.stats();
   const double k = double(after.points - before.points);
   if (k > 0) {
     state.counters["contour_us"] = 1e6 * (after.contour_seconds - before.contour_seconds) / k;

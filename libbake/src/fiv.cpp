@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -286,6 +287,23 @@ Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, co
   return f;
 }
 
+bool parse_shell_grid(std::string_view text, ShellSpec& spec) {
+  int n[3] = {0, 0, 0};
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0 && (p == end || *p++ != 'x')) return false;
+    const auto [q, ec] = std::from_chars(p, end, n[i]);
+    if (ec != std::errc() || q == p) return false;
+    p = q;
+  }
+  if (p != end || n[0] < 1 || n[0] > 4096 || n[1] < 2 || n[1] > 4096 || n[2] < 1 || n[2] > 1024) return false;
+  spec.n_phi = n[0];
+  spec.n_theta = n[1];
+  spec.n_rho = n[2];
+  return true;
+}
+
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
                           const Monitor& monitor) {
   PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
@@ -296,7 +314,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   ProductRequest req;
   req.radiance = &env;
   req.visibility_order = 1;
-  const SilhouetteIntegrator integrator(occluder, topology, req, {spec.isolines, 1});
+  const SilhouetteIntegrator integrator(occluder, topology, req, {silhouette_isolines(spec.silhouette_k), 1});
   // The scale the occluded FIV is compared with: ∫ L_c dω, the full-sphere irradiance. (|F^env|
   // itself cancels to 0 for a uniform sky, so a fraction of it is ill-posed.)
   double env_norm[3] = {0, 0, 0};
@@ -356,7 +374,7 @@ FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, 
   ProductRequest req;
   req.radiance = &env;
   req.visibility_order = 1;
-  const QmcIntegrator qmc(occluder, topology, req, {65536, mix64(seed ^ 0x66697672656675ull)});
+  const QmcIntegrator qmc(occluder, topology, req, {IntegratorSpec::kSilhouetteReferenceRays, mix64(seed ^ 0x66697672656675ull)});
   const size_t per_shell = size_t(sh.n_theta) * size_t(sh.n_phi), total = sh.radii.size() * per_shell;
   const auto picks = seeded_sample(uint32_t(total), points, seed);
   std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);

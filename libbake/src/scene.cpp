@@ -1,19 +1,22 @@
 // scene.cpp — scene files and the bake plan (bake/scene.h).
 #include <bake/error.h>
 #include <bake/fiv.h>
-#include <bake/json.h>
 #include <bake/scene.h>
 #include <bake/zonal.h>
 
 #include <prtshade/sh.h>
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <numbers>
 #include <set>
 #include <sstream>
+#include <vector>
 
 namespace prt::bake {
 
@@ -28,63 +31,145 @@ const char* role_name(Role r) {
 
 namespace {
 
-// Reads typed members with messages that name file, position and key path.
+using Json = nlohmann::ordered_json;  // keeps the file's key order, so messages follow it
+
+constexpr size_t kMaxDepth = 128;  // nesting deeper than this is refused
+
+// "objects[2].material" for the value at that path; "the scene" for the root.
+std::string shown_path(const std::string& path) { return path.empty() ? "the scene" : path; }
+
+// Parses a scene file strictly: nlohmann's RFC 8259 parser (syntax errors with line and column),
+// and what it lets through refused here with the key path: a duplicate key (nlohmann keeps the
+// last one silently) and nesting deeper than kMaxDepth.
+Json parse_json(const std::string& text, const std::string& file) {
+  struct Container {
+    std::string path;
+    bool object = false;
+    std::set<std::string> keys;
+    std::string key;    // object: the member being read
+    size_t index = 0;   // array: the next element's index
+  };
+  std::vector<Container> open;
+  auto child_path = [&]() -> std::string {
+    if (open.empty()) return "";
+    Container& c = open.back();
+    if (c.object) return (c.path.empty() ? "" : c.path + ".") + c.key;
+    return c.path + "[" + std::to_string(c.index++) + "]";
+  };
+  const Json::parser_callback_t strict = [&](int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+    case Json::parse_event_t::object_start:
+    case Json::parse_event_t::array_start: {
+      std::string path = child_path();
+      if (open.size() >= kMaxDepth)
+        throw InputError(file, (path.size() > 60 ? path.substr(0, 60) + "..." : path) + " is nested deeper than " +
+                                   std::to_string(kMaxDepth) + " levels");
+      open.push_back({std::move(path), event == Json::parse_event_t::object_start, {}, {}, 0});
+      break;
+    }
+    case Json::parse_event_t::key: {
+      Container& c = open.back();
+      c.key = parsed.get<std::string>();
+      if (!c.keys.insert(c.key).second)
+        throw InputError(file, "duplicate key \"" + c.key + "\" in " + shown_path(c.path));
+      break;
+    }
+    case Json::parse_event_t::object_end:
+    case Json::parse_event_t::array_end: open.pop_back(); break;
+    case Json::parse_event_t::value:
+      if (!open.empty() && !open.back().object) ++open.back().index;
+      break;
+    }
+    return true;
+  };
+  try {
+    return Json::parse(text, strict);
+  } catch (const Json::parse_error& e) {
+    // e.byte counts the bytes read up to and including the one in error (1-based).
+    const size_t at = std::min(text.size(), e.byte > 0 ? size_t(e.byte - 1) : size_t(0));
+    const size_t line_start = text.rfind('\n', at == 0 ? std::string::npos : at - 1);
+    const size_t line = 1 + size_t(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n'));
+    const size_t column = at - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line L, column C: <problem>"
+    const size_t colon = what.find(": ");
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    throw InputError(file, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what);
+  } catch (const Json::exception& e) {  // e.g. a number too large for a double ("1e400")
+    std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw InputError(file, bracket == std::string::npos ? what : what.substr(bracket + 2));
+  }
+}
+
+Json parse_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "cannot open the file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw InputError(file.string(), "cannot read the file");
+  return parse_json(ss.str(), file.string());
+}
+
+// An object's member, nullptr if absent.
+const Json* find_key(const Json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+// Reads typed members with messages that name the file and the key path.
 class Reader {
 public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
-  [[noreturn]] void fail(const json::Value& at, const std::string& what) const {
-    throw InputError(file_, "line " + std::to_string(at.line) + ", column " + std::to_string(at.column) + ": " + what);
-  }
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(file_, what); }
 
-  const json::Value& object(const json::Value& v, const std::string& key_path,
-                            std::initializer_list<std::string_view> allowed) const {
-    if (!v.is_object()) fail(v, key_path + " must be an object, not " + v.type_name());
-    for (const auto& [k, member] : v.object()) {
+  const Json& object(const Json& v, const std::string& key_path, std::initializer_list<std::string_view> allowed) const {
+    if (!v.is_object()) fail(key_path + " must be an object, not " + v.type_name());
+    for (const auto& [k, member] : v.items()) {
       bool ok = false;
       for (std::string_view a : allowed) ok = ok || k == a;
       if (!ok) {
         std::string list;
         for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        fail(member, "unknown key \"" + k + "\" in " + key_path + " (allowed: " + list + ")");
+        fail("unknown key \"" + k + "\" in " + key_path + " (allowed: " + list + ")");
       }
     }
     return v;
   }
 
-  double number(const json::Value& v, const std::string& key, double lo, double hi) const {
-    if (!v.is_number()) fail(v, key + " must be a number, not " + v.type_name());
-    const double x = std::get<double>(v.v);
+  double number(const Json& v, const std::string& key, double lo, double hi) const {
+    if (!v.is_number()) fail(key + " must be a number, not " + v.type_name());
+    const double x = v.get<double>();
     if (!(x >= lo && x <= hi)) {
       std::ostringstream os;
       os << key << " must be in [" << lo << ", " << hi << "], got " << x;
-      fail(v, os.str());
+      fail(os.str());
     }
     return x;
   }
 
-  int64_t integer(const json::Value& v, const std::string& key, int64_t lo, int64_t hi) const {
+  int64_t integer(const Json& v, const std::string& key, int64_t lo, int64_t hi) const {
     const double x = number(v, key, double(lo), double(hi));
-    if (x != std::floor(x)) fail(v, key + " must be an integer");
+    if (x != std::floor(x)) fail(key + " must be an integer");
     return int64_t(x);
   }
 
-  const std::string& string(const json::Value& v, const std::string& key) const {
-    if (!v.is_string()) fail(v, key + " must be a string, not " + v.type_name());
-    const std::string& s = std::get<std::string>(v.v);
-    if (s.empty()) fail(v, key + " must not be empty");
+  const std::string& string(const Json& v, const std::string& key) const {
+    if (!v.is_string()) fail(key + " must be a string, not " + v.type_name());
+    const std::string& s = v.get_ref<const std::string&>();
+    if (s.empty()) fail(key + " must not be empty");
     return s;
   }
 
-  bool boolean(const json::Value& v, const std::string& key) const {
-    if (!v.is_bool()) fail(v, key + " must be true or false, not " + v.type_name());
-    return std::get<bool>(v.v);
+  bool boolean(const Json& v, const std::string& key) const {
+    if (!v.is_boolean()) fail(key + " must be true or false, not " + v.type_name());
+    return v.get<bool>();
   }
 
-  std::array<double, 3> vec3(const json::Value& v, const std::string& key, double lo, double hi) const {
-    if (!v.is_array() || v.array().size() != 3) fail(v, key + " must be an array of 3 numbers");
+  std::array<double, 3> vec3(const Json& v, const std::string& key, double lo, double hi) const {
+    if (!v.is_array() || v.size() != 3) fail(key + " must be an array of 3 numbers");
     std::array<double, 3> out{};
-    for (int i = 0; i < 3; ++i) out[size_t(i)] = number(v.array()[size_t(i)], key + "[" + std::to_string(i) + "]", lo, hi);
+    for (size_t i = 0; i < 3; ++i) out[i] = number(v[i], key + "[" + std::to_string(i) + "]", lo, hi);
     return out;
   }
 
@@ -94,27 +179,27 @@ private:
 
 constexpr double kHuge = 1e30;
 
-Eigen::Matrix4d parse_transform(const Reader& r, const json::Value& v, const std::string& key) {
+Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::string& key) {
   r.object(v, key, {"translate", "rotate", "scale", "matrix"});
   Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
-  if (const json::Value* m = v.find("matrix")) {
-    if (v.object().size() != 1) r.fail(v, key + ": give either \"matrix\" or translate/rotate/scale, not both");
-    if (!m->is_array() || m->array().size() != 16) r.fail(*m, key + ".matrix must be an array of 16 numbers (row-major 4x4)");
+  if (const Json* m = find_key(v, "matrix")) {
+    if (v.size() != 1) r.fail(key + ": give either \"matrix\" or translate/rotate/scale, not both");
+    if (!m->is_array() || m->size() != 16) r.fail(key + ".matrix must be an array of 16 numbers (row-major 4x4)");
     for (int i = 0; i < 16; ++i)
-      M(i / 4, i % 4) = r.number(m->array()[size_t(i)], key + ".matrix[" + std::to_string(i) + "]", -kHuge, kHuge);
+      M(i / 4, i % 4) = r.number((*m)[size_t(i)], key + ".matrix[" + std::to_string(i) + "]", -kHuge, kHuge);
     if (M(3, 0) != 0 || M(3, 1) != 0 || M(3, 2) != 0 || M(3, 3) != 1)
-      r.fail(*m, key + ".matrix must be affine: its last row must be 0 0 0 1");
+      r.fail(key + ".matrix must be affine: its last row must be 0 0 0 1");
   } else {
     Eigen::Vector3d t(0, 0, 0), rot(0, 0, 0), s(1, 1, 1);
-    if (const json::Value* x = v.find("translate")) {
+    if (const Json* x = find_key(v, "translate")) {
       const auto a = r.vec3(*x, key + ".translate", -kHuge, kHuge);
       t = Eigen::Vector3d(a[0], a[1], a[2]);
     }
-    if (const json::Value* x = v.find("rotate")) {
+    if (const Json* x = find_key(v, "rotate")) {
       const auto a = r.vec3(*x, key + ".rotate", -36000, 36000);
       rot = Eigen::Vector3d(a[0], a[1], a[2]) * (std::numbers::pi / 180);
     }
-    if (const json::Value* x = v.find("scale")) {
+    if (const Json* x = find_key(v, "scale")) {
       if (x->is_number()) {
         const double k = r.number(*x, key + ".scale", -kHuge, kHuge);
         s = Eigen::Vector3d(k, k, k);
@@ -130,7 +215,7 @@ Eigen::Matrix4d parse_transform(const Reader& r, const json::Value& v, const std
     M.topRightCorner<3, 1>() = t;
   }
   const double det = M.topLeftCorner<3, 3>().determinant();
-  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) r.fail(v, key + " is singular (determinant " + std::to_string(det) + ")");
+  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) r.fail(key + " is singular (determinant " + std::to_string(det) + ")");
   return M;
 }
 
@@ -144,7 +229,7 @@ bool valid_name(const std::string& n) {
 } // namespace
 
 Scene load_scene(const std::filesystem::path& file) {
-  const json::Value root = json::parse_file(file);
+  const Json root = parse_json_file(file);
   const Reader r(file.string());
   r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
   Scene sc;
@@ -154,84 +239,83 @@ Scene load_scene(const std::filesystem::path& file) {
     const std::filesystem::path q(p);
     return q.is_absolute() ? q : dir / q;
   };
-  const json::Value* version = root.find("prtbake_scene");
-  if (version == nullptr) r.fail(root, "the scene lacks \"prtbake_scene\": 1 (the scene-file version)");
+  const Json* version = find_key(root, "prtbake_scene");
+  if (version == nullptr) r.fail("the scene lacks \"prtbake_scene\": 1 (the scene-file version)");
   if (r.integer(*version, "prtbake_scene", 1, 1000) != 1)
-    r.fail(*version, "prtbake_scene version " + std::to_string(r.integer(*version, "prtbake_scene", 1, 1000)) +
+    r.fail("prtbake_scene version " + std::to_string(r.integer(*version, "prtbake_scene", 1, 1000)) +
                          " is newer than this prtbake reads (1)");
-  if (const json::Value* up = root.find("up")) {
+  if (const Json* up = find_key(root, "up")) {
     const std::string& u = r.string(*up, "up");
-    if (u != "y" && u != "z") r.fail(*up, "up must be \"y\" or \"z\", not \"" + u + "\"");
+    if (u != "y" && u != "z") r.fail("up must be \"y\" or \"z\", not \"" + u + "\"");
     sc.up = u == "y" ? UpAxis::Y : UpAxis::Z;
   }
-  if (const json::Value* env = root.find("environment")) sc.environment = resolve(r.string(*env, "environment"));
-  if (const json::Value* bake = root.find("bake")) {
+  if (const Json* env = find_key(root, "environment")) sc.environment = resolve(r.string(*env, "environment"));
+  if (const Json* bake = find_key(root, "bake")) {
     r.object(*bake, "bake",
              {"products", "integrator", "samples", "seed", "report", "sh_tolerance", "relight", "fiv"});
-    if (const json::Value* p = bake->find("products")) {
-      if (!p->is_array()) r.fail(*p, "bake.products must be an array of strings");
+    if (const Json* p = find_key(*bake, "products")) {
+      if (!p->is_array()) r.fail("bake.products must be an array of strings");
       sc.want_ao = sc.want_transfer = sc.want_radiance = sc.want_fiv = false;
-      for (const json::Value& item : p->array()) {
-        const std::string& s = r.string(item, "bake.products[]");
+      for (size_t i = 0; i < p->size(); ++i) {
+        const std::string& s = r.string((*p)[i], "bake.products[" + std::to_string(i) + "]");
         if (s == "ao") sc.want_ao = true;
         else if (s == "transfer") sc.want_transfer = true;
         else if (s == "radiance") sc.want_radiance = true;
         else if (s == "fiv") sc.want_fiv = true;
-        else r.fail(item, "unknown product \"" + s + "\" in bake.products (ao, transfer, radiance, fiv)");
+        else r.fail("unknown product \"" + s + "\" in bake.products (ao, transfer, radiance, fiv)");
       }
     }
-    if (const json::Value* x = bake->find("integrator")) {
-      sc.integrator = r.string(*x, "bake.integrator");
-      if (sc.integrator != "silhouette" && sc.integrator != "qmc")
-        r.fail(*x, "bake.integrator must be \"silhouette\" or \"qmc\", not \"" + sc.integrator + "\"");
+    if (const Json* x = find_key(*bake, "integrator")) {
+      const std::string& name = r.string(*x, "bake.integrator");
+      const auto kind = parse_integrator_kind(name);
+      if (!kind) r.fail("bake.integrator must be \"silhouette\" or \"qmc\", not \"" + name + "\"");
+      sc.integrator.kind = *kind;
     }
-    if (const json::Value* x = bake->find("samples")) sc.samples = uint32_t(r.integer(*x, "bake.samples", 4, 1 << 24));
-    if (const json::Value* x = bake->find("seed")) sc.seed = uint64_t(r.integer(*x, "bake.seed", 0, int64_t(1) << 52));
-    if (const json::Value* x = bake->find("report")) sc.report = uint32_t(r.integer(*x, "bake.report", 0, 1 << 20));
-    if (const json::Value* x = bake->find("sh_tolerance")) {
+    // The knob of the chosen integrator: k for silhouette, rays for qmc.
+    if (const Json* x = find_key(*bake, "samples")) sc.integrator.set_samples(uint32_t(r.integer(*x, "bake.samples", 4, 1 << 24)));
+    if (const Json* x = find_key(*bake, "seed")) sc.integrator.seed = uint64_t(r.integer(*x, "bake.seed", 0, int64_t(1) << 52));
+    if (const Json* x = find_key(*bake, "report"))
+      sc.integrator.report_points = uint32_t(r.integer(*x, "bake.report", 0, 1 << 20));
+    if (const Json* x = find_key(*bake, "sh_tolerance")) {
       sc.sh_tolerance = r.number(*x, "bake.sh_tolerance", 0, 1);
-      if (!(sc.sh_tolerance > 0)) r.fail(*x, "bake.sh_tolerance must be > 0");
+      if (!(sc.sh_tolerance > 0)) r.fail("bake.sh_tolerance must be > 0");
     }
-    if (const json::Value* x = bake->find("relight")) sc.relight = r.boolean(*x, "bake.relight");
-    if (const json::Value* f = bake->find("fiv")) {
+    if (const Json* x = find_key(*bake, "relight")) sc.relight = r.boolean(*x, "bake.relight");
+    if (const Json* f = find_key(*bake, "fiv")) {
       r.object(*f, "bake.fiv", {"shells", "cube", "fraction"});
-      if (const json::Value* x = f->find("shells")) {
-        const std::string& s = r.string(*x, "bake.fiv.shells");
-        int a = 0, b = 0, c = 0;
-        char x1 = 0, x2 = 0, extra = 0;
-        std::istringstream is(s);
-        if (!(is >> a >> x1 >> b >> x2 >> c) || x1 != 'x' || x2 != 'x' || (is >> extra) || a < 4 || b < 3 || c < 1 ||
-            a > 4096 || b > 4096 || c > 256)
-          r.fail(*x, "bake.fiv.shells must be \"NPHIxNTHETAxNRHO\" (e.g. \"64x33x30\"; NPHI >= 4, NTHETA >= 3), not \"" +
-                         s + "\"");
-        sc.n_phi = a;
-        sc.n_theta = b;
-        sc.n_rho = c;
+      if (const Json* x = find_key(*f, "shells")) {
+        const std::string& g = r.string(*x, "bake.fiv.shells");
+        if (!parse_shell_grid(g, sc.fiv))
+          r.fail("bake.fiv.shells must be \"NPHIxNTHETAxNRHO\" (e.g. \"128x65x30\"; NPHI >= 1, NTHETA >= 2), not \"" + g +
+                 "\"");
       }
-      if (const json::Value* x = f->find("cube")) sc.cube = int(r.integer(*x, "bake.fiv.cube", 1, 1024));
-      if (const json::Value* x = f->find("fraction")) {
-        sc.fraction = r.number(*x, "bake.fiv.fraction", 0, 0.5);
-        if (!(sc.fraction > 0)) r.fail(*x, "bake.fiv.fraction must be > 0");
+      if (const Json* x = find_key(*f, "cube")) sc.fiv.cube = int(r.integer(*x, "bake.fiv.cube", 1, 1024));
+      if (const Json* x = find_key(*f, "fraction")) {
+        sc.fiv.fraction = r.number(*x, "bake.fiv.fraction", 0, 0.5);
+        if (!(sc.fiv.fraction > 0)) r.fail("bake.fiv.fraction must be > 0");
       }
     }
   }
-  const json::Value* objects = root.find("objects");
-  if (objects == nullptr) r.fail(root, "the scene lacks \"objects\" (an array of one or more objects)");
-  if (!objects->is_array() || objects->array().empty()) r.fail(*objects, "objects must be a non-empty array");
+  // The FIV shells are always baked with the silhouette integrator: at the scene's k for a
+  // silhouette scene, at the default k for a qmc one.
+  sc.fiv.silhouette_k = sc.integrator.silhouette_k;
+  const Json* objects = find_key(root, "objects");
+  if (objects == nullptr) r.fail("the scene lacks \"objects\" (an array of one or more objects)");
+  if (!objects->is_array() || objects->empty()) r.fail("objects must be a non-empty array");
   std::set<std::string> names;
-  for (size_t i = 0; i < objects->array().size(); ++i) {
-    const json::Value& o = objects->array()[i];
+  for (size_t i = 0; i < objects->size(); ++i) {
+    const Json& o = (*objects)[i];
     const std::string key = "objects[" + std::to_string(i) + "]";
     r.object(o, key, {"name", "mesh", "role", "transform", "material"});
     SceneObject obj;
-    const json::Value* mesh = o.find("mesh");
-    if (mesh == nullptr) r.fail(o, key + " lacks \"mesh\" (the mesh file)");
+    const Json* mesh = find_key(o, "mesh");
+    if (mesh == nullptr) r.fail(key + " lacks \"mesh\" (the mesh file)");
     const std::string& mesh_path = r.string(*mesh, key + ".mesh");
     obj.mesh = resolve(mesh_path);
-    if (const json::Value* n = o.find("name")) {
+    if (const Json* n = find_key(o, "name")) {
       obj.name = r.string(*n, key + ".name");
       if (!valid_name(obj.name))
-        r.fail(*n, key + ".name \"" + obj.name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
+        r.fail(key + ".name \"" + obj.name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
     } else {
       obj.name = std::filesystem::path(mesh_path).stem().string();
       for (char& c : obj.name)
@@ -239,30 +323,30 @@ Scene load_scene(const std::filesystem::path& file) {
       if (!valid_name(obj.name)) obj.name = "object" + std::to_string(i);
     }
     if (!names.insert(obj.name).second)
-      r.fail(o, key + ": the name \"" + obj.name + "\" is already used by another object (names must be unique; set \"name\")");
-    const json::Value* role = o.find("role");
-    if (role == nullptr) r.fail(o, key + " lacks \"role\": \"receiver\", \"occluder\" or \"both\"");
+      r.fail(key + ": the name \"" + obj.name + "\" is already used by another object (names must be unique; set \"name\")");
+    const Json* role = find_key(o, "role");
+    if (role == nullptr) r.fail(key + " lacks \"role\": \"receiver\", \"occluder\" or \"both\"");
     const std::string& rs = r.string(*role, key + ".role");
     if (rs == "receiver") obj.role = Role::Receiver;
     else if (rs == "occluder") obj.role = Role::Occluder;
     else if (rs == "both") obj.role = Role::Both;
-    else r.fail(*role, key + ".role must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
-    if (const json::Value* t = o.find("transform")) obj.transform = parse_transform(r, *t, key + ".transform");
+    else r.fail(key + ".role must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
+    if (const Json* t = find_key(o, "transform")) obj.transform = parse_transform(r, *t, key + ".transform");
     obj.material.albedo = {0.8, 0.8, 0.8};
-    if (const json::Value* m = o.find("material")) {
+    if (const Json* m = find_key(o, "material")) {
       r.object(*m, key + ".material", {"albedo", "phong_exponent", "specular"});
       obj.material.albedo = {0, 0, 0};
-      if (const json::Value* a = m->find("albedo")) obj.material.albedo = r.vec3(*a, key + ".material.albedo", 0, 1);
-      if (const json::Value* s = m->find("phong_exponent"))
+      if (const Json* a = find_key(*m, "albedo")) obj.material.albedo = r.vec3(*a, key + ".material.albedo", 0, 1);
+      if (const Json* s = find_key(*m, "phong_exponent"))
         obj.material.phong_exponent = r.number(*s, key + ".material.phong_exponent", 0, 1e6);
-      if (const json::Value* s = m->find("specular")) {
+      if (const Json* s = find_key(*m, "specular")) {
         obj.material.specular = r.vec3(*s, key + ".material.specular", 0, 1);
-        if (!obj.material.glossy()) r.fail(*s, key + ".material.specular needs phong_exponent > 0");
+        if (!obj.material.glossy()) r.fail(key + ".material.specular needs phong_exponent > 0");
       } else if (obj.material.glossy()) {
         obj.material.specular = {1, 1, 1};
       }
       if (obj.role != Role::Occluder && !obj.material.diffuse() && !obj.material.glossy())
-        r.fail(*m, key + ".material has neither a diffuse albedo > 0 nor a phong_exponent > 0: the receiver reflects "
+        r.fail(key + ".material has neither a diffuse albedo > 0 nor a phong_exponent > 0: the receiver reflects "
                          "nothing");
     }
     sc.objects.push_back(std::move(obj));

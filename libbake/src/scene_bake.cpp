@@ -2,7 +2,6 @@
 // the union of the occluders, then FIV shells per occluder that needs them.
 #include <bake/error.h>
 #include <bake/scene.h>
-#include <bake/silhouette.h>
 
 #include <chrono>
 #include <cstdio>
@@ -64,9 +63,9 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     const ProductRequest r = request_of(p);
     const Key key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr};
     if (integrators.count(key)) continue;
-    auto integ = make_integrator(scene.integrator, scene.samples, scene.seed, occluders, topo, r);
+    auto integ = make_integrator(scene.integrator, occluders, topo, r);
     std::unique_ptr<Integrator> ref;
-    if (scene.report > 0) ref = make_reference(scene.integrator, scene.samples, scene.seed, occluders, topo, r);
+    if (scene.integrator.report_points > 0) ref = make_reference(scene.integrator, occluders, topo, r);
     integrators.emplace(key, std::make_pair(std::move(integ), std::move(ref)));
   }
   out.setup_seconds = seconds_since(t_setup);
@@ -87,19 +86,20 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
         points[v].n = m.normals[v].cast<double>().normalized();
       }
     }
-    const auto* sil = dynamic_cast<const SilhouetteIntegrator*>(integ.get());
-    const uint64_t closed_before = sil ? sil->stats().closed_form : 0;
+    const bool silhouette = integ->kind() == IntegratorKind::Silhouette;
+    const uint64_t closed_before = integ->stats().closed_form;
     ObjectBake& ob = out.objects[i];
     ob.values = bake_points(points, *integ, monitor, "baking " + scene.objects[i].name);
     ob.integrator_description = integ->description();
-    ob.closed_form_vertices = sil ? sil->stats().closed_form - closed_before : 0;
+    ob.closed_form_vertices = integ->stats().closed_form - closed_before;
     out.vertex_seconds += ob.values->seconds;
     out.vertices += points.size();
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
         fmt("%.2f s", ob.values->seconds) +
-        (sil ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
+        (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref) {
-      ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.report, scene.seed);
+      ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.integrator.report_points,
+                                                scene.integrator.seed);
       for (const auto& e : ob.report->products)
         log("  " + e.product + ": " + fmt("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
             fmt("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
@@ -112,28 +112,23 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     PRT_CHECK(env != nullptr);
     const auto t0 = std::chrono::steady_clock::now();
     out.environment_fiv = environment_fiv(*env);
-    out.irradiance_cube = irradiance_cube(*env, scene.cube);
+    out.irradiance_cube = irradiance_cube(*env, scene.fiv.cube);
     out.environment_seconds = seconds_since(t0);
-    log("environment FIV and " + std::to_string(scene.cube) + "x" + std::to_string(scene.cube) + "x6 DifMap in " +
+    log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
         fmt("%.2f s", out.environment_seconds));
   }
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     if (!plan.objects[i].fiv) continue;
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
-    ShellSpec spec;
-    spec.n_phi = scene.n_phi;
-    spec.n_theta = scene.n_theta;
-    spec.n_rho = scene.n_rho;
-    spec.fraction = scene.fraction;
-    spec.isolines = std::max(2, int(std::lround(std::sqrt(double(scene.fiv_samples())))));
     ObjectBake& ob = out.objects[i];
-    ob.fiv = bake_fiv_shells(m, t, *env, spec, monitor);
+    ob.fiv = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
     out.fiv_seconds += ob.fiv->seconds;
-    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.n_phi) + "x" + std::to_string(scene.n_theta) +
+    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
         "x" + std::to_string(ob.fiv->radii.size()) + " in " + fmt("%.2f s", ob.fiv->seconds));
-    if (scene.report > 0) {
-      ob.fiv_report = fiv_error_report(m, t, *env, *ob.fiv, out.environment_fiv, scene.report, scene.seed);
+    if (scene.integrator.report_points > 0) {
+      ob.fiv_report = fiv_error_report(m, t, *env, *ob.fiv, out.environment_fiv, scene.integrator.report_points,
+                                       scene.integrator.seed);
       log("  fiv: " + fmt("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
                           ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
     }

@@ -555,8 +555,8 @@ void SilhouetteIntegrator::unoccluded(std::span<double> out) const {
   std::copy(impl_->unoccluded_row.begin(), impl_->unoccluded_row.end(), out.begin());
 }
 
-SilhouetteStats SilhouetteIntegrator::stats() const {
-  SilhouetteStats s;
+IntegratorStats SilhouetteIntegrator::stats() const {
+  IntegratorStats s;
   s.points = impl_->n_points.load();
   s.contour_edges = impl_->n_edges.load();
   s.crossings = impl_->n_crossings.load();

@@ -1,7 +1,5 @@
 #include <bake/error.h>
-#include <bake/qmc.h>
 #include <bake/sampling.h>
-#include <bake/silhouette.h>
 #include <bake/vertex_bake.h>
 
 #include <tbb/blocked_range.h>
@@ -52,35 +50,6 @@ VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& int
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
                          const Monitor& monitor, const std::string& label) {
   return bake_points(vertex_shade_points(mesh, topology), integrator, monitor, label);
-}
-
-uint32_t default_samples(const std::string& integrator) { return integrator == "qmc" ? 1024u : 16384u; }
-
-std::unique_ptr<Integrator> make_integrator(const std::string& name, uint32_t samples, uint64_t seed, const Mesh& mesh,
-                                            const Topology& topology, const ProductRequest& request) {
-  if (samples == 0) samples = default_samples(name);
-  if (name == "qmc") {
-    QmcOptions q;
-    q.samples = samples;
-    q.seed = seed;
-    return std::make_unique<QmcIntegrator>(mesh, topology, request, q);
-  }
-  if (name == "silhouette") {
-    SilhouetteOptions s;
-    s.isolines = std::max(2, int(std::lround(std::sqrt(double(samples)))));
-    s.seed = seed;
-    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, s);
-  }
-  throw InputError("integrator", "unknown integrator '" + name + "' (silhouette or qmc)");
-}
-
-std::unique_ptr<Integrator> make_reference(const std::string& bake_integrator, uint32_t samples, uint64_t seed,
-                                           const Mesh& mesh, const Topology& topology, const ProductRequest& request) {
-  if (samples == 0) samples = default_samples(bake_integrator);
-  QmcOptions q;
-  q.samples = bake_integrator == "qmc" ? samples * 10 : 65536;
-  q.seed = mix64(seed ^ 0x7265666572656e63ull);  // independent of the bake's points
-  return std::make_unique<QmcIntegrator>(mesh, topology, request, q);
 }
 
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {

@@ -194,7 +194,7 @@ TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
   spec.n_phi = 8;
   spec.n_theta = 5;
   spec.n_rho = 12;
-  spec.isolines = 64;
+  spec.silhouette_k = 64 * 64;  // 64 u-isolines
   spec.fraction = 0.02;
   const FivShells s = bake_fiv_shells(m, topo, env, spec);
   EXPECT_NEAR(s.radius, std::sqrt(2.0001), 1e-6);

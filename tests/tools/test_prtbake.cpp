@@ -56,6 +56,13 @@ void expect_no_output(const fs::path& out) {
 
 const std::string kTetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
 
+// A closed tetrahedron written to the scratch file `name`.
+fs::path tetra(const std::string& name) {
+  const fs::path p = scratch(name);
+  write_text(p, kTetra);
+  return p;
+}
+
 } // namespace
 
 TEST(Prtbake, BakesEveryProductOfARealMeshInOnePass) {
@@ -219,6 +226,61 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
   for (const char* s : {"--ao", "--transfer", "--visibility", "--radiance", "--samples", "--seed", "--threads", "--up",
                         "EXAMPLES", "EXIT STATUS"})
     EXPECT_NE(h.out.find(s), std::string::npos) << s;
+  // Each command's help teaches its own options and ends with the exit codes too.
+  for (const char* cmd : {"vertex", "fiv", "scene"}) {
+    const Outcome c = run(std::string(cmd) + " --help");
+    EXPECT_EQ(c.code, 0) << cmd;
+    EXPECT_NE(c.out.find("--output"), std::string::npos) << cmd;
+    EXPECT_NE(c.out.find("EXIT STATUS"), std::string::npos) << cmd;
+  }
+  const Outcome v = run("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_EQ(v.out.rfind("prtbake ", 0), 0u) << v.out;
+}
+
+TEST(Prtbake, OutputMustBeAnHdf5FileName) {
+  // stdout cannot take an HDF5 file, and another extension would silently get HDF5 contents.
+  const fs::path mesh = tetra("tetra_out.obj");
+  const Outcome dash = run("vertex " + mesh.string() + " --ao -o -");
+  EXPECT_EQ(dash.code, 2);
+  EXPECT_NE(dash.err.find("standard output"), std::string::npos) << dash.err;
+  EXPECT_FALSE(fs::exists(fs::path(PRT_TEST_TMP) / "prtbake" / "-"));
+  const fs::path glb = scratch("out.glb");
+  fs::remove(glb);
+  const Outcome g = run("vertex " + mesh.string() + " --ao -o " + glb.string());
+  EXPECT_EQ(g.code, 2);
+  EXPECT_NE(g.err.find(".prt.h5 or .h5 expected"), std::string::npos) << g.err;
+  expect_no_output(glb);
+}
+
+TEST(Prtbake, OptionsBelongToTheirCommand) {
+  // An option that has no meaning for a command is refused, not ignored.
+  const fs::path mesh = tetra("tetra_cmd.obj");
+  const std::string out = scratch("cmd.prt.h5").string();
+  EXPECT_EQ(run("scene " + (kData / "scene_example.json").string() + " --samples 64 -o " + out).code, 2);
+  EXPECT_EQ(run("scene " + (kData / "scene_example.json").string() + " --up z --dry-run").code, 2);
+  EXPECT_EQ(run("fiv " + mesh.string() + " --env " + (kData / "studio.exr").string() + " --ao -o " + out).code, 2);
+  EXPECT_EQ(run("vertex " + mesh.string() + " --ao --shells 8x5x4 -o " + out).code, 2);
+  EXPECT_EQ(run("vertex " + mesh.string() + " --ao --dry-run -o " + out).code, 2);
+}
+
+TEST(Prtbake, EqualsFormOfOptionsIsTheSameCommand) {
+  // --opt=value works and is stored as "--opt value"; --threads and --quiet are not stored.
+  const fs::path mesh = tetra("tetra_eq.obj");
+  const fs::path out = scratch("eq.prt.h5");
+  fs::remove(out);
+  const Outcome r = run("vertex " + mesh.string() + " --ao --integrator=qmc --samples=16 --report=0 --threads=1 "
+                        "--quiet --output=" + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const F::File f = F::read_file(out);
+  const F::Attr* cl = F::find_attr(f.root_attrs, "command_line");
+  ASSERT_NE(cl, nullptr);
+  EXPECT_EQ(std::get<std::string>(cl->value), "prtbake vertex " + mesh.string() +
+                                                  " --ao --integrator qmc --samples 16 --report 0 --output " +
+                                                  out.string());
+  const auto* ao = F::find_dataset(f, "/ao");
+  ASSERT_NE(ao, nullptr);
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(ao->attrs, "samples")->value), 16) << "--samples=16 reached the qmc integrator";
 }
 
 TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {

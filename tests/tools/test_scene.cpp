@@ -1,6 +1,7 @@
-// `prtbake scene`: a scene file bakes what the scene needs and nothing else (issue 4, DESIGN.md
-// §5). One test per rule, each checking what the file does and does not contain; then the
-// scene-file errors a user can make, each named with file, line and column.
+// `prtbake scene`: a scene file bakes what the scene needs and nothing else (issue 4, docs/ARCHITECTURE.md
+// "Data path"). One test per rule, each checking what the file does and does not contain; then the
+// scene-file errors a user can make, each named with the file and the line and column (syntax) or
+// the key path (everything else).
 #include <formats/prtfile.h>
 
 #include <gtest/gtest.h>
@@ -258,7 +259,15 @@ TEST_P(SceneErrors, NameFileLineAndProblemAndWriteNothing) {
 INSTANTIATE_TEST_SUITE_P(
     Scene, SceneErrors,
     ::testing::Values(
-        BadScene{"not_json", "{\"prtbake_scene\": 1,\n  \"objects\": [}\n", "line 2, column 15: unexpected character '}' (expected a value)"},
+        BadScene{"not_json", "{\"prtbake_scene\": 1,\n  \"objects\": [}\n",
+                 "line 2, column 15: syntax error while parsing value - unexpected '}'"},
+        BadScene{"not_json_later_line", "{\"prtbake_scene\": 1,\n \"objects\": [1,\n   2 3]}\n",
+                 "line 3, column 6: syntax error while parsing array"},
+        // The JSON library keeps the last of two equal keys; a scene file refuses them (with the key path).
+        BadScene{"duplicate_key", "{\"prtbake_scene\": 1, \"bake\": {\"seed\": 1, \"seed\": 2}, \"objects\": []}",
+                 "duplicate key \"seed\" in bake"},
+        BadScene{"too_deep", "{\"prtbake_scene\": 1, \"x\": " + std::string(200, '[') + std::string(200, ']') + "}",
+                 "is nested deeper than 128 levels"},
         BadScene{"unknown_key", scene_text("", "\"relite\": true", kGround),
                  "unknown key \"relite\" in bake (allowed: products"},
         BadScene{"missing_role", scene_text("", "", R"({"mesh": "ground.obj"})"), "lacks \"role\""},

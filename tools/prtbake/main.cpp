@@ -1,13 +1,11 @@
-// prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments,
-// reports progress and calls libbake (integration) and formats (the HDF5 file).
+// prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments (CLI11:
+// one subcommand per kind of bake, each with only the options that apply to it, into the typed
+// specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <bake/fiv.h>
 #include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/sampling.h>
 #include <bake/sha256.h>
-#include <bake/silhouette.h>
 #include <bake/scene.h>
 #include <bake/vertex_bake.h>
 #include <formats/prtfile.h>
@@ -17,19 +15,17 @@
 #include "progress_bar.h"
 #include "tool_main.h"
 
+#include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/info.h>
 
 #include <algorithm>
-#include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -43,241 +39,285 @@ namespace {
 
 constexpr const char* kVersion = "0.1.0";
 
-constexpr const char* kHelp = R"(prtbake — bake precomputed radiance transfer (PRT) data for game geometry
+constexpr const char* kDescription = "prtbake — bake precomputed radiance transfer (PRT) data for game geometry";
 
-USAGE
-  prtbake vertex MESH -o OUT.prt.h5 [PRODUCTS] [OPTIONS]
-  prtbake fiv OCCLUDER --env ENV.exr -o OUT.prt.h5 [--shells 128x65x30] [--cube 16] [OPTIONS]
-  prtbake scene SCENE.json -o OUT.prt.h5 [--dry-run] [--report N] [--threads T] [--quiet]
-  prtbake --help | --version
+constexpr const char* kVertexHelp =
+    "Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL) in one pass: the\n"
+    "rays cast from a vertex serve every product at once. Rows follow the file's vertex order;\n"
+    "a position with several normals in the file (OBJ v//vn hard edges) gives one row per\n"
+    "(position, normal) pair, and /mesh/source_position says which file vertex each row is.\n"
+    "Give at least one of the products.";
 
-  Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL) in one pass: the
-  rays cast from a vertex serve every product at once. Rows follow the file's vertex order;
-  a position with several normals in the file (OBJ v//vn hard edges) gives one row per
-  (position, normal) pair, and /mesh/source_position says which file vertex each row is.
+constexpr const char* kFivHelp =
+    "Bakes an occluder's Fullsphere Irradiance Vectors (paper 004): the environment's FIV\n"
+    "F_env = Int L w dw, the diffuse irradiance cube map (DifMap) E(n) = Int L H (n.w) dw (exact,\n"
+    "not SH9), and the occluded FIV F(s) = Int (1 - V(s,w)) L w dw on concentric shells around the\n"
+    "occluder's bounding sphere, radii from half the bounding radius outwards, stopping once\n"
+    "|F| < --fraction of Int L dw. Always with the silhouette integrator.";
 
-  fiv bakes an occluder's Fullsphere Irradiance Vectors (paper 004): the environment's FIV
-  F_env = Int L w dw, the diffuse irradiance cube map (DifMap) E(n) = Int L H (n.w) dw (exact,
-  not SH9), and the occluded FIV F(s) = Int (1 - V(s,w)) L w dw on concentric shells around the
-  occluder's bounding sphere: --shells NPHIxNTHETAxNRHO (poles included in NTHETA), radii from
-  half the bounding radius outwards, stopping once |F| < --fraction (default 1e-3) of Int L dw.
-  --cube S sets the DifMap resolution (default 16); --samples k the silhouette rate (128^2).
+constexpr const char* kSceneHelp =
+    "Bakes a scene file (JSON: objects with mesh, transform, material and role receiver /\n"
+    "occluder / both; one environment; what may be baked — see data/scene_example.json and the\n"
+    "README) and bakes only what the scene needs, printing what it leaves out and why:\n"
+    "occluder-only objects get no per-vertex products; a diffuse receiver gets band-1 radiance\n"
+    "under the environment (exact) and no higher order, or diffuse transfer at the order the SH\n"
+    "tolerance needs when there is no environment (or \"relight\"); a glossy (Phong) receiver gets\n"
+    "visibility transfer at the smallest order whose lobe energy beyond it is under the tolerance;\n"
+    "no radiance or FIV without an environment; FIV shells only for occluders that can shadow\n"
+    "another receiver; vertices that see no contour edge get closed forms. Products, integrator,\n"
+    "samples, seed and FIV shells are set in the file's \"bake\" section. Per-object results go\n"
+    "under /objects/<name>/ in the file.";
 
-  scene bakes a scene file (JSON: objects with mesh, transform, material and role receiver /
-  occluder / both; one environment; what may be baked — see data/scene_example.json and the
-  README) and bakes only what the scene needs, printing what it leaves out and why:
-  occluder-only objects get no per-vertex products; a diffuse receiver gets band-1 radiance
-  under the environment (exact) and no higher order, or diffuse transfer at the order the SH
-  tolerance needs when there is no environment (or "relight"); a glossy (Phong) receiver gets
-  visibility transfer at the smallest order whose lobe energy beyond it is under the tolerance;
-  no radiance or FIV without an environment; FIV shells only for occluders that can shadow
-  another receiver; vertices that see no contour edge get closed forms. --dry-run prints the
-  plan and stops. Per-object results go under /objects/<name>/ in the file.
-
-PRODUCTS of vertex (at least one)
-  --ao               ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]
-  --transfer L       diffuse transfer vectors T_i = 1/pi * Int V H (n.w) y_i dw, SH order L
-                     (L bands, L*L coefficients; shade with albedo * sum_i T_i L_i)
-  --visibility L     visibility transfer vectors U_i = Int V H y_i dw, SH order L (glossy,
-                     triple products)
-  --radiance ENV     band-1 shadowed radiance R_c,m = Int L_c V H y_1m dw from the HDR
-                     environment ENV (OpenEXR lat-long or cube map): exact all-frequency
-                     diffuse shadows with 3 coefficients per channel. Irradiance at the
-                     baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m.
-
-OPTIONS
-  -o, --output FILE  the .prt.h5 file to write (HDF5; see formats/SCHEMA.md). Written to a
-                     temporary file first and renamed, so FILE is never half-written.
-  --integrator NAME  silhouette (default): semi-analytic visibility silhouettes (paper 001
-                     §3): contour edges, depth complexity along octahedral u-isolines,
-                     summed-area tables. Deterministic; error falls with k, no noise.
-                     qmc: Embree ray casting, importance-sampled randomised Halton QMC, the
-                     baseline and the reference.
-  --samples N        silhouette: k = N, the number of spherical samples (sqrt(k) u-isolines,
-                     rounded to even; default 16384 = 128^2; 64^2 to 256^2 converge for HDR
-                     environments). qmc: rays per vertex (default 1024); the error falls like
-                     1/sqrt(N) or faster.
-  --seed S           randomisation seed (default 1). Same inputs and seed give identical
-                     bytes whatever --threads is.
-  --threads T        worker threads (default: all cores).
-  --up y|z           the scene's up axis (default y). With z (Blender), scene direction
-                     (x,y,z) is looked up in the environment as (x,z,-y).
-  --no-file-normals  ignore normals in the mesh file; use angle-weighted vertex normals.
-  --report N         after the bake, re-integrate N seeded vertices with a converged QMC
-                     reference (10x the bake's rays for qmc, 65536 rays for silhouette) and
-                     print/store the error (RMSE, max) next to the run time (default 32;
-                     0 turns it off). Stored under /report in the file.
-  --reproducible     make the file a pure function of the inputs: 'created' is pinned to
-                     SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not
-                     stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).
-                     The baked values are identical with or without it.
-  --quiet            print nothing but errors.
-  -h, --help         this text.   --version   the version.
-
-EXAMPLES
-  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5
-  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5
-  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5
-  prtbake scene data/scene_example.json -o scene.prt.h5
-  prtdump bunny.prt.h5            # what was baked, statistics, the error report
-
-)";
+constexpr const char* kExamples =
+    "EXAMPLES\n"
+    "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
+    "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
+    "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
+    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
 using tool::UsageError;
 
-template <class T> T parse_number(const std::string& opt, const std::string& s, T lo, T hi) {
-  T v{};
-  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || p != s.data() + s.size() || v < lo || v > hi)
-    throw UsageError(opt + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                     "], got '" + s + "'");
-  return v;
-}
-
 struct Args {
-  std::string command, mesh, output, radiance, integrator = "silhouette";
-  bool ao = false, quiet = false, file_normals = true, reproducible = false, dry_run = false, report_given = false;
-  std::vector<std::string> given;  // the options given (for commands that accept only some)
-  int transfer = 0, visibility = 0;
-  uint32_t samples = 0, report = 32;  // samples 0: the integrator's default
-  uint64_t seed = 1;
-  int threads = 0;
+  std::string command;      // vertex, fiv or scene
+  std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file (scene)
+  std::string output;       // the .prt.h5 file
+  std::string environment;  // vertex: --radiance ENV; fiv: --env ENV
+  bool ao = false;
+  int transfer = 0, visibility = 0;  // SH orders (0: not baked)
+  // vertex: the integrator; fiv: seed and report (its k is shells.silhouette_k); scene: --report.
+  bake::IntegratorSpec integrator;
+  bake::ShellSpec shells;   // fiv
+  bool report_given = false;  // scene: --report overrides the scene file's
+  int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
-  int n_phi = 128, n_theta = 65, n_rho = 30, cube = 16;  // fiv
-  double fraction = 1e-3;
+  bool file_normals = true, quiet = false, reproducible = false, dry_run = false;
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
 };
 
-Args parse(int argc, char** argv) {
-  Args a;
-  std::vector<std::string> v(argv + 1, argv + argc);
-  if (v.empty()) throw UsageError("no command given (try 'prtbake --help')");
-  a.command_line = "prtbake";
-  for (size_t i = 0; i < v.size(); ++i) {
-    const std::string& s = v[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= v.size()) throw UsageError(s + " needs a value");
-      return v[++i];
-    };
-    auto record = [&](const std::string& val) { a.command_line += " " + s + " " + val; };
-    if (!s.empty() && s[0] == '-') a.given.push_back(s);
-    if (s == "-h" || s == "--help") {
-      std::fputs(kHelp, stdout);
-      std::fputs(tool::kExitStatusHelp, stdout);
-      std::exit(0);
-    } else if (s == "--version") {
-      std::printf("prtbake %s\n", kVersion);
-      std::exit(0);
-    } else if (s == "-o" || s == "--output") {
-      a.output = value();
-      record(a.output);
-    } else if (s == "--ao") {
-      a.ao = true;
-      a.command_line += " --ao";
-    } else if (s == "--transfer") {
-      a.transfer = parse_number<int>(s, value(), 1, sh::kMaxOrder);
-      record(v[i]);
-    } else if (s == "--visibility") {
-      a.visibility = parse_number<int>(s, value(), 1, sh::kMaxOrder);
-      record(v[i]);
-    } else if (s == "--env") {
-      a.radiance = value();
-      record(a.radiance);
-    } else if (s == "--shells") {
-      const std::string g = value();
-      int n1 = 0, n2 = 0, n3 = 0;
-      char x1 = 0, x2 = 0;
-      if (std::sscanf(g.c_str(), "%d%c%d%c%d", &n1, &x1, &n2, &x2, &n3) != 5 || x1 != 'x' || x2 != 'x' || n1 < 1 ||
-          n2 < 2 || n3 < 1 || n1 > 4096 || n2 > 4096 || n3 > 1024)
-        throw UsageError("--shells expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
-      a.n_phi = n1;
-      a.n_theta = n2;
-      a.n_rho = n3;
-      record(g);
-    } else if (s == "--cube") {
-      a.cube = parse_number<int>(s, value(), 1, 1024);
-      record(v[i]);
-    } else if (s == "--fraction") {
-      const std::string f = value();
-      char* end = nullptr;
-      a.fraction = std::strtod(f.c_str(), &end);
-      if (end == f.c_str() || *end != 0 || !(a.fraction > 0 && a.fraction < 1))
-        throw UsageError("--fraction expects a number in (0, 1), got '" + f + "'");
-      record(f);
-    } else if (s == "--radiance") {
-      a.radiance = value();
-      record(a.radiance);
-    } else if (s == "--integrator") {
-      a.integrator = value();
-      if (a.integrator != "qmc" && a.integrator != "silhouette")
-        throw UsageError("--integrator: unknown integrator '" + a.integrator + "' (available: silhouette, qmc)");
-      record(a.integrator);
-    } else if (s == "--samples") {
-      a.samples = parse_number<uint32_t>(s, value(), 1, 1u << 24);
-      record(v[i]);
-    } else if (s == "--seed") {
-      a.seed = parse_number<uint64_t>(s, value(), 0, UINT64_MAX);
-      record(v[i]);
-    } else if (s == "--threads") {
-      a.threads = parse_number<int>(s, value(), 1, 4096);
-    } else if (s == "--up") {
-      const std::string u = value();
-      if (u == "y" || u == "Y") a.up = bake::UpAxis::Y;
-      else if (u == "z" || u == "Z") a.up = bake::UpAxis::Z;
-      else throw UsageError("--up expects y or z, got '" + u + "'");
-      record(u);
-    } else if (s == "--no-file-normals") {
-      a.file_normals = false;
-      a.command_line += " " + s;
-    } else if (s == "--report") {
-      a.report = parse_number<uint32_t>(s, value(), 0, 1u << 20);
-      a.report_given = true;
-      record(v[i]);
-    } else if (s == "--dry-run") {
-      a.dry_run = true;
-    } else if (s == "--reproducible") {
-      a.reproducible = true;
-    } else if (s == "--quiet" || s == "-q") {
-      a.quiet = true;
-    } else if (!s.empty() && s[0] == '-') {
-      throw UsageError("unknown option '" + s + "' (try 'prtbake --help')");
-    } else if (a.command.empty()) {
-      a.command = s;
-      a.command_line += " " + s;
-    } else if (a.mesh.empty()) {
-      a.mesh = s;
-      a.command_line += " " + s;
-    } else {
-      throw UsageError("unexpected argument '" + s + "'");
+// The command line as stored in the file: the arguments that determine its contents, as typed
+// (without --threads, --quiet, --dry-run, --reproducible); "--opt=value" is stored as "--opt value".
+std::string content_command_line(int argc, char** argv) {
+  std::string line = "prtbake";
+  for (int i = 1; i < argc; ++i) {
+    std::string s = argv[i], value;
+    const size_t eq = s.rfind("--", 0) == 0 ? s.find('=') : std::string::npos;
+    if (eq != std::string::npos) value = s.substr(eq + 1), s.resize(eq);
+    if (s == "--threads") {
+      if (eq == std::string::npos) ++i;
+      continue;
     }
+    if (s == "--quiet" || s == "-q" || s == "--dry-run" || s == "--reproducible") continue;
+    line += " " + s;
+    if (eq != std::string::npos) line += " " + value;
   }
+  return line;
+}
+
+// Why `path` cannot be the output file ("" if it can): prtbake writes HDF5 files only.
+std::string output_problem(const std::string& path) {
+  if (path == "-")
+    return "cannot write to standard output: an HDF5 file needs a seekable file; give a name ending in .prt.h5";
+  if (!path.ends_with(".h5"))
+    return "'" + path + "' does not end in .h5: prtbake writes HDF5 files only (.prt.h5 or .h5 expected)";
+  return "";
+}
+
+// ---- the options, each defined once and added to the subcommands it applies to ----
+
+void add_output(CLI::App& cmd, Args& a) {
+  cmd.add_option("-o,--output", a.output,
+                 "the .prt.h5 file to write (HDF5; see formats/SCHEMA.md). Written to a\n"
+                 "temporary file first and renamed, so FILE is never half-written.")
+      ->option_text("FILE")
+      ->check(output_problem);
+}
+
+void add_report(CLI::App& cmd, Args& a, const std::string& reference) {
+  cmd.add_option("--report", a.integrator.report_points,
+                 "after the bake, re-integrate N seeded points with a converged QMC\nreference (" + reference +
+                     ")\nand print/store the error (RMSE, max) next to the run time (default " +
+                     std::to_string(bake::IntegratorSpec{}.report_points) +
+                     ";\n0 turns it off). Stored under /report in the file.")
+      ->option_text("N")
+      ->check(CLI::Range(0u, 1u << 20));
+}
+
+void add_run_options(CLI::App& cmd, Args& a) {
+  cmd.add_option("--threads", a.threads, "worker threads (default: all cores).")
+      ->option_text("T")
+      ->check(CLI::Range(1, 4096));
+  cmd.add_flag("--reproducible", a.reproducible,
+               "make the file a pure function of the inputs: 'created' is pinned to\n"
+               "SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not\n"
+               "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).\n"
+               "The baked values are identical with or without it.");
+  cmd.add_flag("-q,--quiet", a.quiet, "print nothing but errors.");
+}
+
+// --samples, --seed and --up: what samples the sphere around a shade point.
+void add_sampling(CLI::App& cmd, Args& a, uint32_t& samples, const std::string& samples_help) {
+  cmd.add_option("--samples", samples, samples_help)->option_text("N")->check(CLI::Range(1u, 1u << 24));
+  cmd.add_option("--seed", a.integrator.seed,
+                 "randomisation seed (default " + std::to_string(bake::IntegratorSpec{}.seed) +
+                     "). Same inputs and seed give identical\nbytes whatever --threads is.")
+      ->option_text("S");
+  cmd.add_option_function<std::string>(
+         "--up",
+         [&a](const std::string& u) {
+           if (u == "y" || u == "Y") a.up = bake::UpAxis::Y;
+           else if (u == "z" || u == "Z") a.up = bake::UpAxis::Z;
+           else throw CLI::ValidationError("--up", "expects y or z, got '" + u + "'");
+         },
+         "the scene's up axis (default y). With z (Blender), scene direction\n"
+         "(x,y,z) is looked up in the environment as (x,z,-y).")
+      ->option_text("y|z");
+}
+
+std::string silhouette_k_help() {
+  const bake::IntegratorSpec d;
+  return "k = N, the number of spherical samples\n(sqrt(k) u-isolines, rounded to even; default " +
+         std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2";
+}
+
+void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
+  CLI::App& cmd = *app.add_subcommand("vertex", kVertexHelp);
+  cmd.add_option("MESH", a.input, "the mesh (OBJ, PLY, OFF, STL)")->required()->type_name("");
+  add_output(cmd, a);
+  const std::string products = "Products (at least one)";
+  cmd.add_flag("--ao", a.ao, "ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]")->group(products);
+  cmd.add_option("--transfer", a.transfer,
+                 "diffuse transfer vectors T_i = 1/pi * Int V H (n.w) y_i dw, SH order L\n"
+                 "(L bands, L*L coefficients; shade with albedo * sum_i T_i L_i)")
+      ->option_text("L")
+      ->check(CLI::Range(1, sh::kMaxOrder))
+      ->group(products);
+  cmd.add_option("--visibility", a.visibility,
+                 "visibility transfer vectors U_i = Int V H y_i dw, SH order L (glossy,\ntriple products)")
+      ->option_text("L")
+      ->check(CLI::Range(1, sh::kMaxOrder))
+      ->group(products);
+  cmd.add_option("--radiance", a.environment,
+                 "band-1 shadowed radiance R_c,m = Int L_c V H y_1m dw from the HDR\n"
+                 "environment ENV (OpenEXR lat-long or cube map): exact all-frequency\n"
+                 "diffuse shadows with 3 coefficients per channel. Irradiance at the\n"
+                 "baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m.")
+      ->option_text("ENV")
+      ->group(products);
+  cmd.add_option_function<std::string>(
+         "--integrator",
+         [&a](const std::string& name) {
+           const auto kind = bake::parse_integrator_kind(name);
+           if (!kind)
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc)");
+           a.integrator.kind = *kind;
+         },
+         "silhouette (default): semi-analytic visibility silhouettes (paper 001\n"
+         "§3): contour edges, depth complexity along octahedral u-isolines,\n"
+         "summed-area tables. Deterministic; error falls with k, no noise.\n"
+         "qmc: Embree ray casting, importance-sampled randomised Halton QMC, the\n"
+         "baseline and the reference.")
+      ->option_text("NAME");
+  const bake::IntegratorSpec d;
+  add_sampling(cmd, a, samples,
+               "silhouette: " + silhouette_k_help() +
+                   ";\n64^2 to 256^2 converge for HDR environments). qmc: rays per vertex\n(default " +
+                   std::to_string(d.qmc_rays) + "); the error falls like 1/sqrt(N) or faster.");
+  cmd.add_flag_callback("--no-file-normals", [&a] { a.file_normals = false; },
+                        "ignore normals in the mesh file; use angle-weighted vertex normals.");
+  add_report(cmd, a,
+             std::to_string(bake::IntegratorSpec::kQmcReferenceFactor) + "x the bake's rays for qmc, " +
+                 std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays for silhouette");
+  add_run_options(cmd, a);
+}
+
+void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
+  CLI::App& cmd = *app.add_subcommand("fiv", kFivHelp);
+  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL)")->required()->type_name("");
+  add_output(cmd, a);
+  cmd.add_option("--env", a.environment, "the HDR environment (OpenEXR lat-long or cube map)")
+      ->option_text("ENV")
+      ->required();
+  const bake::ShellSpec d;
+  cmd.add_option_function<std::string>(
+         "--shells",
+         [&a](const std::string& g) {
+           if (!bake::parse_shell_grid(g, a.shells))
+             throw CLI::ValidationError("--shells",
+                                        "expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
+         },
+         "the shell grid: NPHI x NTHETA (poles included) directions on each of\nNRHO shells (default " +
+             std::to_string(d.n_phi) + "x" + std::to_string(d.n_theta) + "x" + std::to_string(d.n_rho) + ")")
+      ->option_text("NPHIxNTHETAxNRHO");
+  cmd.add_option("--cube", a.shells.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
+      ->option_text("S")
+      ->check(CLI::Range(1, 1024));
+  cmd.add_option("--fraction", a.shells.fraction,
+                 "stop adding shells once |F| < FRACTION of Int L dw (default 1e-3)")
+      ->option_text("FRACTION")
+      ->check([](const std::string& s) -> std::string {
+        const double f = std::strtod(s.c_str(), nullptr);
+        return f > 0 && f < 1 ? "" : "expects a number in (0, 1), got '" + s + "'";
+      });
+  add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help() + ").");
+  add_report(cmd, a,
+             std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) +
+                 " rays, full sphere, at seeded shell samples");
+  add_run_options(cmd, a);
+}
+
+void add_scene(CLI::App& app, Args& a) {
+  CLI::App& cmd = *app.add_subcommand("scene", kSceneHelp);
+  cmd.add_option("SCENE", a.input, "the scene file (JSON)")->required()->type_name("");
+  add_output(cmd, a);
+  cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
+  add_report(cmd, a, "overrides the scene file's bake.report");
+  add_run_options(cmd, a);
+}
+
+// Parses the command line; nullopt when it asked for help or the version (printed).
+std::optional<Args> parse(int argc, char** argv) {
+  Args a;
+  uint32_t samples = 0;  // --samples: 0 if not given
+  CLI::App app(kDescription, "prtbake");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("prtbake ") + kVersion);
+  app.footer(std::string(kExamples) + tool::kExitStatusHelp);
+  app.get_formatter()->column_width(24);
+  add_vertex(app, a, samples);
+  add_fiv(app, a, samples);
+  add_scene(app, a);
+  for (CLI::App* cmd : app.get_subcommands({})) cmd->footer(app.get_footer());
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help("", CLI::AppFormatMode::All);
+    return std::nullopt;
+  } catch (const CLI::Success& e) {  // --version
+    app.exit(e);
+    return std::nullopt;
+  } catch (const CLI::ParseError& e) {
+    throw UsageError(e.what());
+  }
+  a.command = app.get_subcommands().front()->get_name();
+  a.command_line = content_command_line(argc, argv);
   if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
-  if (a.samples == 0) a.samples = a.integrator == "qmc" ? 1024 : 16384;
-  if (a.integrator == "silhouette" && a.samples < 4)
-    throw UsageError("--samples: the silhouette integrator needs k >= 4 (2 u-isolines)");
-  if (a.command != "vertex" && a.command != "fiv" && a.command != "scene")
-    throw UsageError("unknown command '" + a.command + "' (available: vertex, fiv, scene)");
   if (a.command == "scene") {
-    for (const std::string& g : a.given)
-      if (g != "-o" && g != "--output" && g != "--threads" && g != "--quiet" && g != "-q" && g != "--reproducible" &&
-          g != "--report" && g != "--dry-run")
-        throw UsageError("scene: option " + g + " is not for scenes: products, integrator, samples, seed and FIV "
-                         "shells are set in the scene file's \"bake\" section");
-    if (a.mesh.empty()) throw UsageError("scene: no SCENE file given");
+    a.report_given = app.get_subcommand("scene")->count("--report") > 0;
     if (a.output.empty() && !a.dry_run) throw UsageError("scene: no output file given (-o OUT.prt.h5)");
     return a;
   }
-  if (a.dry_run) throw UsageError("--dry-run is for scene");
+  if (a.output.empty()) throw UsageError(a.command + ": no output file given (-o OUT.prt.h5)");
+  if (samples != 0) a.integrator.set_samples(samples);
+  if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
+      a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
+    throw UsageError("--samples: the silhouette integrator needs k >= " +
+                     std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
   if (a.command == "fiv") {
-    if (a.mesh.empty()) throw UsageError("fiv: no OCCLUDER mesh given");
-    if (a.output.empty()) throw UsageError("fiv: no output file given (-o OUT.prt.h5)");
-    if (a.radiance.empty()) throw UsageError("fiv: no environment given (--env ENV.exr)");
-    if (a.integrator != "silhouette") throw UsageError("fiv: shells are baked with the silhouette integrator");
+    a.shells.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
     return a;
   }
-  if (a.mesh.empty()) throw UsageError("vertex: no MESH given");
-  if (a.output.empty()) throw UsageError("vertex: no output file given (-o OUT.prt.h5)");
-  if (!a.ao && !a.transfer && !a.visibility && a.radiance.empty())
+  if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
     throw UsageError("vertex: nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV");
   return a;
 }
@@ -331,7 +371,7 @@ std::vector<prt::formats::Attr> root_attrs(const Args& a, const std::string& sou
       {"generator", std::string("prtbake ") + kVersion},
       {"created", timestamp(a.reproducible)},
       {"command_line", a.command_line},
-      {"source", a.mesh},
+      {"source", a.input},
       {"source_sha256", source_sha},
       {"up_axis", std::string(a.up == bake::UpAxis::Y ? "y" : "z")},
       {"sh_convention", std::string("real orthonormal SH, Condon-Shortley phase, index l*(l+1)+m, order = number of "
@@ -357,23 +397,23 @@ int run_vertex(const Args& a) {
 
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = a.file_normals;
-  const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
+  const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
-  const std::string mesh_sha = bake::sha256_file(a.mesh);
+  const std::string mesh_sha = bake::sha256_file(a.input);
   print_warnings(mesh.warnings);
   if (say)
     std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s\n",
-                a.mesh.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
+                a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
                 mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted");
 
   std::optional<bake::EnvMap> env;
-  if (!a.radiance.empty()) {
-    env = bake::EnvMap::load(a.radiance, a.up);
+  if (!a.environment.empty()) {
+    env = bake::EnvMap::load(a.environment, a.up);
     const auto& i = env->info();
     if (say)
       std::printf("environment: %s: %dx%d %s, luminance max %.4g / mean %.4g (%.0fx), %llu negative pixel values "
                   "clamped to 0 (min seen %.3g)\n",
-                  a.radiance.c_str(), i.width, i.height, i.layout.c_str(), i.max_luminance, i.mean_luminance,
+                  a.environment.c_str(), i.width, i.height, i.layout.c_str(), i.max_luminance, i.mean_luminance,
                   i.mean_luminance > 0 ? i.max_luminance / i.mean_luminance : 0.0,
                   (unsigned long long)i.negative_pixels_clamped, i.min_value_seen);
   }
@@ -386,7 +426,7 @@ int run_vertex(const Args& a) {
 
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =
-      bake::make_integrator(a.integrator, a.samples, a.seed, mesh, topo, req);
+      bake::make_integrator(a.integrator, mesh, topo, req);
   const bake::Integrator& integrator = *integrator_ptr;
   const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   if (say) {
@@ -405,10 +445,10 @@ int run_vertex(const Args& a) {
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
                 mesh.positions.size() / result.seconds);
-    if (a.integrator == "qmc")
-      std::printf(", %.2f M rays/s", double(mesh.positions.size()) * a.samples / result.seconds / 1e6);
-    if (const auto* sil = dynamic_cast<const bake::SilhouetteIntegrator*>(&integrator)) {
-      const auto st = sil->stats();
+    if (a.integrator.kind == bake::IntegratorKind::Qmc)
+      std::printf(", %.2f M rays/s", double(mesh.positions.size()) * a.integrator.qmc_rays / result.seconds / 1e6);
+    if (a.integrator.kind == bake::IntegratorKind::Silhouette) {
+      const bake::IntegratorStats st = integrator.stats();
       std::printf("; per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% "
                   "integration",
                   double(st.contour_edges) / double(std::max<uint64_t>(st.points, 1)),
@@ -420,13 +460,13 @@ int run_vertex(const Args& a) {
   }
 
   std::optional<bake::ErrorReport> report;
-  if (a.report > 0) {
-    const auto reference = bake::make_reference(a.integrator, a.samples, a.seed, mesh, topo, req);
-    report = bake::compare_with_reference(mesh, topo, result, *reference, a.report, a.seed);
+  if (a.integrator.report_points > 0) {
+    const auto reference = bake::make_reference(a.integrator, mesh, topo, req);
+    report = bake::compare_with_reference(mesh, topo, result, *reference, a.integrator.report_points, a.integrator.seed);
     if (say) {
       std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                   "counted in the bake time):\n",
-                  a.integrator == "qmc" ? a.samples * 10 : 65536u, report->vertices.size(), report->reference_seconds);
+                  a.integrator.reference_rays(), report->vertices.size(), report->reference_seconds);
       for (const auto& e : report->products)
         std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (bake's estimated std. error %.3e; "
                     "reference's own %.3e)\n",
@@ -441,8 +481,8 @@ int run_vertex(const Args& a) {
   file.root_attrs = root_attrs(a, mesh_sha);
   tool::add_mesh(file, "", mesh);
   tool::add_products(file, "", result,
-                     {integrator.name(), integrator.description(), a.samples, a.seed, a.transfer, a.visibility,
-                      env ? &*env : nullptr, a.radiance});
+                     {integrator.name(), integrator.description(), a.integrator.samples(), a.integrator.seed, a.transfer,
+                      a.visibility, env ? &*env : nullptr, a.environment});
   if (report) tool::add_report(file, "/report", *report, result.seconds, mesh.positions.size(), a.reproducible);
   write_file(a, file);
   return 0;
@@ -455,48 +495,44 @@ int run_fiv(const Args& a) {
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = false;  // an occluder's normals play no part in its FIVs
-  const bake::Mesh mesh = bake::load_mesh(a.mesh, mopt);
+  const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
   print_warnings(mesh.warnings);
-  const bake::EnvMap env = bake::EnvMap::load(a.radiance, a.up);
+  const bake::EnvMap env = bake::EnvMap::load(a.environment, a.up);
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   if (say)
-    std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.mesh.c_str(), mesh.triangles.size(),
-                a.radiance.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
+    std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.input.c_str(), mesh.triangles.size(),
+                a.environment.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
 
   const auto t0 = std::chrono::steady_clock::now();
   const bake::Fiv fenv = bake::environment_fiv(env);
-  const std::vector<float> cube = bake::irradiance_cube(env, a.cube);
+  const std::vector<float> cube = bake::irradiance_cube(env, a.shells.cube);
   const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  bake::ShellSpec spec;
-  spec.n_phi = a.n_phi;
-  spec.n_theta = a.n_theta;
-  spec.n_rho = a.n_rho;
-  spec.fraction = a.fraction;
-  spec.isolines = std::max(2, int(std::lround(std::sqrt(double(a.samples)))));
-  const bake::FivShells sh = bake::bake_fiv_shells(mesh, topo, env, spec, progress);
+  const bake::FivShells sh = bake::bake_fiv_shells(mesh, topo, env, a.shells, progress);
   if (say) {
-    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.cube, a.cube, env_seconds);
+    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.shells.cube, a.shells.cube, env_seconds);
     std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
                 "integrals/s)\n",
-                a.n_phi, a.n_theta, sh.radii.size(), a.n_rho, sh.radii.front(), sh.radii.back(), sh.radius, sh.seconds,
+                a.shells.n_phi, a.shells.n_theta, sh.radii.size(), a.shells.n_rho, sh.radii.front(), sh.radii.back(), sh.radius, sh.seconds,
                 double(sh.integrals) / sh.seconds);
   }
 
   namespace F = prt::formats;
   F::File file;
-  file.root_attrs = root_attrs(a, bake::sha256_file(a.mesh));
-  tool::add_fiv_environment(file, env, a.radiance, fenv, cube, a.cube);
-  const std::string name = tool::safe_name(fs::path(a.mesh).stem().string());
-  tool::add_fiv_occluder(file, name, sh, env, a.radiance, a.fraction, a.samples);
-  if (a.report > 0) {
-    // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
-    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, sh, fenv, a.report, a.seed);
+  file.root_attrs = root_attrs(a, bake::sha256_file(a.input));
+  tool::add_fiv_environment(file, env, a.environment, fenv, cube, a.shells.cube);
+  const std::string name = tool::safe_name(fs::path(a.input).stem().string());
+  tool::add_fiv_occluder(file, name, sh, env, a.environment, a.shells.fraction, a.shells.silhouette_k);
+  if (a.integrator.report_points > 0) {
+    // Error against a QMC reference (full-sphere mode) at seeded shell samples.
+    const bake::FivErrorReport r =
+        bake::fiv_error_report(mesh, topo, env, sh, fenv, a.integrator.report_points, a.integrator.seed);
     if (say)
-      std::printf("error against a 65536-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
+      std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
-                  r.points, r.reference_seconds, r.rmse, r.max_abs, r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
+                  bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,
+                  r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
     tool::add_fiv_report(file, name, r, sh, a.reproducible);
   }
@@ -509,8 +545,8 @@ int run_scene(const Args& a) {
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  bake::Scene scene = bake::load_scene(a.mesh);
-  if (a.report_given) scene.report = a.report;
+  bake::Scene scene = bake::load_scene(a.input);
+  if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
 
@@ -520,7 +556,7 @@ int run_scene(const Args& a) {
     try {
       meshes.push_back(bake::load_scene_mesh(o));
     } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
-      throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.mesh + ")");
+      throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.input + ")");
     }
     mesh_sha.push_back(bake::sha256_file(o.mesh));
     print_warnings(meshes.back().warnings);
@@ -530,8 +566,9 @@ int run_scene(const Args& a) {
   const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
 
   if (say) {
-    std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.mesh.c_str(),
-                scene.objects.size(), env ? scene.environment->string().c_str() : "none", scene.integrator.c_str(),
+    std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.input.c_str(),
+                scene.objects.size(), env ? scene.environment->string().c_str() : "none",
+                bake::to_string(scene.integrator.kind),
                 scene.sh_tolerance);
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const auto& o = scene.objects[i];
@@ -559,13 +596,13 @@ int run_scene(const Args& a) {
 
   namespace F = prt::formats;
   F::File file;
-  file.root_attrs = root_attrs(file_args, bake::sha256_file(a.mesh));
+  file.root_attrs = root_attrs(file_args, bake::sha256_file(a.input));
   const std::string env_path = env ? scene.environment->string() : std::string();
   std::vector<F::Attr> scene_attrs = {
-      {"scene_file", a.mesh},
-      {"integrator", scene.integrator},
-      {"samples", int64_t(scene.samples ? scene.samples : bake::default_samples(scene.integrator))},
-      {"seed", int64_t(scene.seed)},
+      {"scene_file", a.input},
+      {"integrator", std::string(bake::to_string(scene.integrator.kind))},
+      {"samples", int64_t(scene.integrator.samples())},
+      {"seed", int64_t(scene.integrator.seed)},
       {"sh_tolerance", scene.sh_tolerance},
       {"relight", int64_t(scene.relight)}};
   if (env) {
@@ -606,26 +643,28 @@ int run_scene(const Args& a) {
     tool::add_mesh(file, prefix, meshes[i]);
     if (ob.values) {
       tool::add_products(file, prefix, *ob.values,
-                         {scene.integrator, ob.integrator_description,
-                          scene.samples ? scene.samples : bake::default_samples(scene.integrator), scene.seed,
-                          p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+                         {bake::to_string(scene.integrator.kind), ob.integrator_description,
+                          scene.integrator.samples(), scene.integrator.seed, p.transfer_order, p.visibility_order,
+                          env ? &*env : nullptr, env_path});
       if (ob.report)
         tool::add_report(file, "/report/objects/" + o.name, *ob.report, ob.values->seconds, meshes[i].positions.size(),
                          a.reproducible);
     }
     if (ob.fiv) {
-      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fraction, scene.fiv_samples());
+      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k);
       if (ob.fiv_report) tool::add_fiv_report(file, o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
     }
   }
   if (plan.fiv_environment)
-    tool::add_fiv_environment(file, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.cube);
+    tool::add_fiv_environment(file, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
   write_file(a, file);
   return 0;
 }
 
 int prtbake_main(int argc, char** argv) {
-  const Args a = parse(argc, argv);
+  const std::optional<Args> parsed = parse(argc, argv);
+  if (!parsed) return 0;  // --help or --version
+  const Args& a = *parsed;
   tool::install_interrupt_handler();
   return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
 }

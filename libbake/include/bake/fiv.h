@@ -34,6 +34,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace prt::bake {
@@ -51,12 +52,19 @@ std::vector<float> irradiance_cube(const EnvMap& env, int size);
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size);
 Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
 
+// What an FIV bake computes, with its defaults (the same for `prtbake fiv` and scene files).
 struct ShellSpec {
   int n_phi = 128, n_theta = 65, n_rho = 30;
   double inner = 0.5;      // ρ_0 / R: the first shell lies inside the bounding sphere (self-shadows)
   double fraction = 1e-3;  // stop once |occluded FIV| is below this fraction of ∫ L dω
-  int isolines = 128;      // silhouette sampling rate k = isolines²
+  // The silhouette integrator's k (silhouette_isolines(k) u-isolines, bake/integrator.h).
+  uint32_t silhouette_k = IntegratorSpec::kDefaultSilhouetteK;
+  int cube = 16;           // DifMap face size S (irradiance_cube)
 };
+// The grid as files and tools spell it, "NPHIxNTHETAxNRHO" (e.g. "128x65x30"). Returns false and
+// leaves `spec` as it was unless 1 <= NPHI <= 4096, 2 <= NTHETA <= 4096 (poles included) and
+// 1 <= NRHO <= 1024.
+bool parse_shell_grid(std::string_view text, ShellSpec& spec);
 
 struct FivShells {
   Eigen::Vector3d centre{0, 0, 0};
@@ -90,8 +98,8 @@ class QmcIntegrator;
 Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, const Eigen::Vector3d& position,
                      uint64_t point_index, Fiv* std_error = nullptr);
 
-// Error of baked shells against the QMC reference (65,536 rays, full sphere) at `points` shell
-// samples chosen with `seed` (DESIGN.md §6): RMSE and max over the 9 numbers of each sample.
+// Error of baked shells against the QMC reference (IntegratorSpec::kSilhouetteReferenceRays, full sphere) at `points` shell
+// samples chosen with `seed` (docs/ARCHITECTURE.md "Data path"): RMSE and max over the 9 numbers of each sample.
 struct FivErrorReport {
   size_t points = 0;
   double rmse = 0, max_abs = 0;

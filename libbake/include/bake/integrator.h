@@ -1,19 +1,21 @@
 // bake/integrator.h — the interface every spherical integrator implements, so products can be
 // baked by either the QMC baseline (bake/qmc.h) or the silhouette integrator (paper 001 §3, next)
-// and compared value by value.
+// and compared value by value — and the typed configuration that chooses one (IntegratorSpec).
 #pragma once
 
 #include <bake/products.h>
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 
 namespace prt::bake {
 
 // A point to integrate at. Visibility is the limit from just above the surface, p + εn, ε → 0+
-// (DESIGN.md §3): when `welded` names a welded mesh position (bake/mesh.h Topology), the
+// (docs/ARCHITECTURE.md "Conventions"): when `welded` names a welded mesh position (bake/mesh.h Topology), the
 // triangles of its 1-ring occlude exactly as they do in that limit (a concave ring occludes, a
 // flat one does not) with no ε offset; welded = -1 is a free point in space.
 struct ShadePoint {
@@ -25,10 +27,60 @@ struct ShadePoint {
   bool hemisphere = true;
 };
 
+enum class IntegratorKind { Silhouette, Qmc };
+
+// The names files and tools use ("silhouette", "qmc"): the one place they are spelled.
+const char* to_string(IntegratorKind kind);
+std::optional<IntegratorKind> parse_integrator_kind(std::string_view name);  // nullopt for another name
+
+// The silhouette integrator's k → N rule: N = round(√k) u-isolines (at least 2; the integrator
+// then rounds N up to even), k = N² spherical samples.
+int silhouette_isolines(uint32_t k);
+
+// Which integrator, its sampling knob, its seed and the error report's reference settings; each
+// default is spelled here once. Files and tools carry one user-facing "samples" number, which is
+// the knob of the chosen kind (samples() / set_samples()).
+struct IntegratorSpec {
+  static constexpr uint32_t kDefaultSilhouetteK = 16384;  // 128² spherical samples
+  static constexpr uint32_t kDefaultQmcRays = 1024;
+  static constexpr uint32_t kMinSilhouetteK = 4;          // 2 u-isolines
+  // The converged reference of a silhouette bake (and of FIV shells, bake/fiv.h): QMC rays per point.
+  static constexpr uint32_t kSilhouetteReferenceRays = 65536;
+  static constexpr uint32_t kQmcReferenceFactor = 10;     // a qmc bake's reference: 10× its rays
+
+  IntegratorKind kind = IntegratorKind::Silhouette;
+  uint32_t silhouette_k = kDefaultSilhouetteK;  // silhouette: k spherical samples (silhouette_isolines(k))
+  uint32_t qmc_rays = kDefaultQmcRays;          // qmc: rays per shade point
+  uint64_t seed = 1;
+  uint32_t report_points = 32;                  // error report: seeded points re-integrated (0: none)
+
+  uint32_t samples() const { return kind == IntegratorKind::Qmc ? qmc_rays : silhouette_k; }
+  void set_samples(uint32_t n) { (kind == IntegratorKind::Qmc ? qmc_rays : silhouette_k) = n; }
+  int isolines() const { return silhouette_isolines(silhouette_k); }
+  // Rays per point of the QMC reference the error report compares with.
+  uint32_t reference_rays() const {
+    return kind == IntegratorKind::Qmc ? qmc_rays * kQmcReferenceFactor : kSilhouetteReferenceRays;
+  }
+  // The reference's randomisation seed, apart from the bake's points.
+  uint64_t reference_seed() const;
+};
+
+// Work counters, summed over all integrate() calls. A counter an integrator does not keep stays
+// 0 (the QMC integrator keeps none; the silhouette integrator all of them, bake/silhouette.h).
+struct IntegratorStats {
+  uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
+  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
+  // Hemisphere points with no contour edge in view, given closed forms instead of a DCF walk
+  // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
+  uint64_t closed_form = 0, enclosed = 0;
+  double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
+};
+
 class Integrator {
 public:
   virtual ~Integrator() = default;
-  virtual std::string name() const = 0;            // "qmc", "silhouette"
+  virtual IntegratorKind kind() const = 0;
+  std::string name() const { return to_string(kind()); }
   virtual std::string description() const = 0;     // one line: method and its parameters
   virtual const ProductLayout& layout() const = 0;
   // Writes one row of estimates (layout().width doubles) for the shade point. `point_index`
@@ -37,6 +89,7 @@ public:
   // Thread-safe: called concurrently for different points.
   virtual void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                          std::span<double> std_error = {}) const = 0;
+  virtual IntegratorStats stats() const { return {}; }
 };
 
 } // namespace prt::bake

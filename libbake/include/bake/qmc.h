@@ -33,7 +33,7 @@
 namespace prt::bake {
 
 struct QmcOptions {
-  uint32_t samples = 1024;  // rays per shade point
+  uint32_t samples = IntegratorSpec::kDefaultQmcRays;  // rays per shade point
   uint64_t seed = 1;
 };
 
@@ -46,7 +46,7 @@ public:
   QmcIntegrator(const QmcIntegrator&) = delete;
   QmcIntegrator& operator=(const QmcIntegrator&) = delete;
 
-  std::string name() const override { return "qmc"; }
+  IntegratorKind kind() const override { return IntegratorKind::Qmc; }
   std::string description() const override;
   const ProductLayout& layout() const override { return layout_; }
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,

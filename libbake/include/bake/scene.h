@@ -1,9 +1,9 @@
 // bake/scene.h — scene files: several objects, their roles and materials, one environment, and
-// a plan that bakes what the scene needs and nothing else (DESIGN.md §5 "Only what was asked for,
-// and what the scene needs, is written").
+// a plan that bakes what the scene needs and nothing else (docs/ARCHITECTURE.md "Data path": only
+// what was asked for, and what the scene needs, is written).
 //
-// The scene file (JSON, RFC 8259; documented with an example in data/scene_example.json and in
-// README.md "Scene files"):
+// The scene file (JSON, RFC 8259, read with nlohmann-json; documented with an example in
+// data/scene_example.json and in README.md "Scene files"):
 //   {
 //     "prtbake_scene": 1,                        required: the scene-file version
 //     "up": "y",                                 optional: "y" (default) or "z"
@@ -13,7 +13,7 @@
 //       "integrator": "silhouette" | "qmc",  "samples": k or rays,  "seed": 1,  "report": 32,
 //       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
 //       "relight": false,                      diffuse receivers also get transfer vectors
-//       "fiv": {"shells": "64x33x30", "cube": 16, "fraction": 0.001}
+//       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/fiv.h ShellSpec)
 //     },
 //     "objects": [ {                             one or more
 //       "name": "bunny",                         optional: default the mesh file's stem; unique
@@ -24,8 +24,9 @@
 //       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]}
 //     } ]
 //   }
-// Unknown keys are errors (a typo must not silently change a bake); every error names the file,
-// the line and column, and the key.
+// Unknown and duplicate keys are errors (a typo must not silently change a bake); every error
+// names the file, and the line and column of a syntax error or the key path of any other
+// ("objects[2].material.albedo[0] must be in [0, 1]").
 //
 // Roles: a receiver gets per-vertex products; an occluder casts shadows (it is part of every
 // receiver's visibility, and gets FIV shells for dynamic use); "both" does both (self-shadowing).
@@ -87,21 +88,17 @@ struct Scene {
   UpAxis up = UpAxis::Y;
   std::optional<std::filesystem::path> environment;
   bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
-  std::string integrator = "silhouette";
-  uint32_t samples = 0;  // 0: the integrator's default
-  // The silhouette rate k of the FIV shells (always baked with the silhouette integrator):
-  // `samples` for a silhouette scene, else the default 128².
-  uint32_t fiv_samples() const { return integrator == "silhouette" && samples ? samples : 16384u; }
-  uint64_t seed = 1;
-  uint32_t report = 32;
+  // "integrator", "samples" (the chosen integrator's knob), "seed" and "report".
+  IntegratorSpec integrator;
   double sh_tolerance = 0.01;
   bool relight = false;
-  int n_phi = 64, n_theta = 33, n_rho = 30, cube = 16;
-  double fraction = 1e-3;
+  // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
+  // silhouette scene, else the default).
+  ShellSpec fiv;
   std::vector<SceneObject> objects;
 };
 
-// Parses and validates a scene file (InputError naming the file, line, column and key).
+// Parses and validates a scene file (InputError naming the file and the line and column or the key).
 Scene load_scene(const std::filesystem::path& file);
 
 // An object's mesh in world space: the transform applied to positions; normals from the file

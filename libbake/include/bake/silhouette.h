@@ -40,18 +40,8 @@
 namespace prt::bake {
 
 struct SilhouetteOptions {
-  int isolines = 256;  // N; k = N² ("--samples k" on the command line gives N = round(√k))
+  int isolines = 256;  // N; k = N² (IntegratorSpec's k gives N = silhouette_isolines(k), bake/integrator.h)
   uint64_t seed = 1;   // only for the direction of the counted start ray when the default is degenerate
-};
-
-// Work counters, summed over all integrate() calls (relaxed atomics).
-struct SilhouetteStats {
-  uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
-  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
-  // Hemisphere points with no contour edge in view, given closed forms instead of a DCF walk
-  // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
-  uint64_t closed_form = 0, enclosed = 0;
-  double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
 };
 
 class SilhouetteIntegrator final : public Integrator {
@@ -63,7 +53,7 @@ public:
   SilhouetteIntegrator(const SilhouetteIntegrator&) = delete;
   SilhouetteIntegrator& operator=(const SilhouetteIntegrator&) = delete;
 
-  std::string name() const override { return "silhouette"; }
+  IntegratorKind kind() const override { return IntegratorKind::Silhouette; }
   std::string description() const override;
   const ProductLayout& layout() const override;
   // std_error is filled with 0: the integrator is deterministic; its error is discretisation.
@@ -75,7 +65,8 @@ public:
   // discretisation of both terms, so an occluder subtending little keeps its relative accuracy.
   void unoccluded(std::span<double> out) const;
 
-  SilhouetteStats stats() const;
+  // Every counter of IntegratorStats (bake/integrator.h), kept with relaxed atomics.
+  IntegratorStats stats() const override;
   const SilhouetteOptions& options() const;
 
 private:

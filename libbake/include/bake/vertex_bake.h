@@ -35,7 +35,7 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
                        const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
-// Error against a converged reference on a seeded sample of vertices (DESIGN.md §6).
+// Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md "Data path").
 struct ProductError {
   std::string product;              // "ao", "transfer/diffuse", "transfer/visibility", "radiance/band1"
   size_t values = 0;                // numbers compared
@@ -59,16 +59,14 @@ ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, c
 ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
                                           const Integrator& reference, size_t n_points, uint64_t seed);
 
-// The integrators by name, as the tools offer them: "silhouette" (k = samples, √k isolines rounded
-// to even; default 16384) or "qmc" (samples rays per point; default 1024). Throws InputError for
-// another name. `mesh`, `topology` and the request's environment must outlive the integrator.
-std::unique_ptr<Integrator> make_integrator(const std::string& name, uint32_t samples, uint64_t seed, const Mesh& mesh,
-                                            const Topology& topology, const ProductRequest& request);
-// The converged reference of the error reports (DESIGN.md §6): QMC with 10× the bake's rays for a
-// qmc bake, 65,536 rays for a silhouette bake, seeded apart from the bake's points.
-std::unique_ptr<Integrator> make_reference(const std::string& bake_integrator, uint32_t samples, uint64_t seed,
-                                           const Mesh& mesh, const Topology& topology, const ProductRequest& request);
-uint32_t default_samples(const std::string& integrator);
+// The integrator a spec describes (bake/integrator.h). `mesh`, `topology` and the request's
+// environment must outlive it.
+std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
+                                            const ProductRequest& request);
+// The converged reference of the error reports (docs/ARCHITECTURE.md "Data path"): QMC with
+// spec.reference_rays() rays per point, seeded apart from the bake's points.
+std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
+                                           const ProductRequest& request);
 
 // Distinct indices in [0, n), min(k, n) of them, chosen by seed (partial Fisher–Yates), sorted.
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed);

@@ -1,0 +1,49 @@
+// integrator.cpp — the integrator kinds' names and the defaults' rules (bake/integrator.h), and
+// the integrators built from a spec (bake/vertex_bake.h).
+#include <bake/error.h>
+#include <bake/integrator.h>
+#include <bake/qmc.h>
+#include <bake/sampling.h>
+#include <bake/silhouette.h>
+#include <bake/vertex_bake.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace prt::bake {
+
+const char* to_string(IntegratorKind kind) {
+  switch (kind) {
+  case IntegratorKind::Silhouette: return "silhouette";
+  case IntegratorKind::Qmc: return "qmc";
+  }
+  return "?";
+}
+
+std::optional<IntegratorKind> parse_integrator_kind(std::string_view name) {
+  for (IntegratorKind k : {IntegratorKind::Silhouette, IntegratorKind::Qmc})
+    if (name == to_string(k)) return k;
+  return std::nullopt;
+}
+
+int silhouette_isolines(uint32_t k) { return std::max(2, int(std::lround(std::sqrt(double(k))))); }
+
+uint64_t IntegratorSpec::reference_seed() const { return mix64(seed ^ 0x7265666572656e63ull); }
+
+std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
+                                            const ProductRequest& request) {
+  switch (spec.kind) {
+  case IntegratorKind::Qmc: return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.qmc_rays, spec.seed});
+  case IntegratorKind::Silhouette:
+    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{spec.isolines(), spec.seed});
+  }
+  PRT_CHECK(false);
+  return nullptr;
+}
+
+std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
+                                           const ProductRequest& request) {
+  return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.reference_rays(), spec.reference_seed()});
+}
+
+} // namespace prt::bake
