@@ -83,7 +83,7 @@ ReferenceRenderer::~ReferenceRenderer() = default;
 
 std::string ReferenceRenderer::description() const {
   std::ostringstream os;
-  os << "Embree 3 ray tracing: primary ray per pixel centre; E = exact unshadowed texel sum - randomised Halton QMC "
+  os << "Embree 3 ray tracing: primary ray per pixel centre; E = unshadowed irradiance (the DifMap's texel sum) - randomised Halton QMC "
         "of the occluded part, "
      << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
      << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
@@ -138,7 +138,10 @@ GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
 }
 
 void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const {
-  const Rgb unocc = unoccluded_(f.n);
+  irradiance(f, index, unoccluded_(f.n), E, std_error);
+}
+
+void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb& unocc, double E[3], double std_error[3]) const {
   if (!rt_->any_caster) {  // nothing casts a shadow: the exact unshadowed sum, no noise
     const double un[3] = {unocc.r, unocc.g, unocc.b};
     for (int c = 0; c < 3; ++c) {
@@ -225,15 +228,34 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monit
   out.gbuffer = trace_primary(camera);
   out.radiance = Image(camera.width, camera.height);
   out.std_error = Image(camera.width, camera.height);
-  Task bar(monitor, "reference", uint64_t(camera.height));
+  // E_unocc once per distinct shading normal (every pixel of a plane shares one): the normals of
+  // the covered pixels, sorted and made unique, evaluated in parallel.
+  using Key = std::array<double, 3>;
+  std::vector<Key> normals;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x)
+      if (out.gbuffer.triangle[size_t(y) * size_t(camera.width) + size_t(x)] >= 0) {
+        const Vector3d n = make_fragment(mesh_, out.gbuffer, x, y).n;
+        normals.push_back({n.x(), n.y(), n.z()});
+      }
+  std::sort(normals.begin(), normals.end());
+  normals.erase(std::unique(normals.begin(), normals.end()), normals.end());
+  Task bar(monitor, "reference", uint64_t(normals.size()) + uint64_t(camera.height));
+  std::vector<Rgb> unocc(normals.size());
+  tbb::parallel_for(size_t(0), normals.size(), [&](size_t k) {
+    unocc[k] = unoccluded_(Vector3d(normals[k][0], normals[k][1], normals[k][2]));
+    bar.advance();
+  });
   std::atomic<uint64_t> pixels{0};
   tbb::parallel_for(0, camera.height, [&](int y) {
     uint64_t n = 0;
     for (int x = 0; x < camera.width; ++x) {
       const Fragment f = make_fragment(mesh_, out.gbuffer, x, y);
       if (f.triangle < 0) continue;
+      const Key key{f.n.x(), f.n.y(), f.n.z()};
+      const size_t k = size_t(std::lower_bound(normals.begin(), normals.end(), key) - normals.begin());
       double E[3], se[3];
-      irradiance(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), E, se);
+      irradiance(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), unocc[k], E, se);
       for (int c = 0; c < 3; ++c) {
         const double albedo = options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(f.triangle)][size_t(c)]);
         out.radiance.at(x, y)[c] = float(albedo * E[c] * std::numbers::inv_pi);

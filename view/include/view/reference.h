@@ -103,6 +103,8 @@ public:
   std::string cache_key(const Camera& camera) const;
 
 private:
+  // irradiance() with the unshadowed part E_unocc(f.n) already known.
+  void irradiance(const Fragment& f, uint64_t index, const bake::Rgb& unocc, double E[3], double std_error[3]) const;
   struct Rays;  // bake/raycast.h RayScene over the mesh
   const bake::Mesh& mesh_;
   const bake::EnvMap& env_;
