@@ -83,8 +83,8 @@ ReferenceRenderer::~ReferenceRenderer() = default;
 
 std::string ReferenceRenderer::description() const {
   std::ostringstream os;
-  os << "Embree 3 ray tracing: primary ray per pixel centre; E = unshadowed irradiance (the DifMap's texel sum) - randomised Halton QMC "
-        "of the occluded part, "
+  os << "Embree 3 ray tracing: primary ray per pixel centre; E = unshadowed irradiance (the DifMap's texel sum) - "
+        "randomised Halton QMC of the occluded part, "
      << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
      << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
      << "), seed " << options_.seed;
