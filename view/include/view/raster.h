@@ -25,7 +25,6 @@
 // depth is 1 / Σ_j (λ_j / z_j). The G-buffer keeps, per pixel, the triangle and its barycentric
 // coordinates in the ORIGINAL triangle; position, normal (interpolated vertex normals,
 // normalised) and per-vertex attributes follow from them.
-//
 #pragma once
 
 #include <view/camera.h>
