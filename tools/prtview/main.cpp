@@ -232,7 +232,7 @@ std::optional<Args> parse(int argc, char** argv) {
       app.add_option("--ground-size", ground_size, "FIV files: half-size of the ground square (default 4R + the copies' spread).");
   app.add_flag("--no-overlap", no_overlap, "FIV files: switch off the overlap correction for several occluders (eq. 13-14).");
   app.add_flag("--no-partial", no_partial, "FIV files: switch off the partial-occluder factor (h+R)/2R (case B).");
-  app.add_option("--threads", a.threads, "worker threads (default: all cores).")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", a.threads, "worker threads (default: all cores).")->check(CLI::Range(1, 4096));
   app.add_flag("-q,--quiet", a.quiet, "only errors.");
   for (CLI::Option* o : app.get_options()) o->description(wrap(o->get_description()));
   if (argc <= 1) throw UsageError("no file given");
@@ -267,7 +267,6 @@ std::optional<Args> parse(int argc, char** argv) {
     a.exposure = exposure;
   }
   if (!(a.error_scale > 0 && std::isfinite(a.error_scale))) throw UsageError("--error-scale must be > 0");
-  if (a.threads < 0 || a.threads > 4096) throw UsageError("--threads expects an integer in [1, 4096]");
   if (!a.reference_cache.empty() && fs::path(a.reference_cache).extension() != ".exr")
     throw UsageError("--reference-cache expects a FILE.exr");
   for (const std::string& t : instances) a.fiv.instances.push_back(parse_offset(t));
