@@ -1,5 +1,6 @@
 #include <bake/error.h>
 #include <bake/fiv.h>
+#include <bake/irradiance.h>
 #include <bake/qmc.h>
 #include <bake/sampling.h>
 #include <bake/vertex_bake.h>
@@ -11,7 +12,6 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
-#include <numeric>
 
 namespace prt::bake {
 
@@ -26,20 +26,6 @@ void omega_from_band1(const double* r, double* f) {
     f[3 * c + 1] = -r[3 * c + 0] / kBand1;
     f[3 * c + 2] = r[3 * c + 1] / kBand1;
   }
-}
-
-// ∫_texel ω dω by 4×4 uniform-in-solid-angle sub-samples.
-std::vector<Vector3d> texel_moments(const EnvMap& env) {
-  const int T = env.texel_count();
-  std::vector<Vector3d> m(static_cast<size_t>(T));
-  tbb::parallel_for(0, T, [&](int t) {
-    Vector3d d[16];
-    env.sample_texel_grid(t, 4, d);  // = sample_texel(t, (a + ½)/4, (b + ½)/4) at d[4a + b]
-    Vector3d s = Vector3d::Zero();
-    for (const Vector3d& di : d) s += di;
-    m[size_t(t)] = s * (env.texel_solid_angle(t) / 16.0);
-  });
-  return m;
 }
 } // namespace
 
@@ -71,164 +57,30 @@ Eigen::Vector3d cube_direction(int face, int row, int column, int size) {
 }
 
 namespace {
-
-// One texel of the DifMap sum (non-black texels only): value, moment ∫ω dω, centre, and a
-// bound r on its angular radius (inflated 1.5×) — it is cut by the horizon of n when
-// |n · centre| < sin(r).
-struct DifTexel {
-  double L[3], m[3], c[3], r, sin_r;
-  int index;
-};
-
-std::vector<DifTexel> dif_texels(const EnvMap& env, const std::vector<Vector3d>& m) {
-  const int T = env.texel_count();
-  std::vector<DifTexel> tex;
-  tex.reserve(static_cast<size_t>(T));
-  for (int t = 0; t < T; ++t) {
-    const Rgb L = env.texel_value(t);
-    if (L.r == 0 && L.g == 0 && L.b == 0) continue;
-    DifTexel x{};
-    x.L[0] = L.r;
-    x.L[1] = L.g;
-    x.L[2] = L.b;
-    const Vector3d c = env.texel_center(t).normalized();
-    double r = 0;
-    for (int a = 0; a <= 1; ++a)
-      for (int b = 0; b <= 1; ++b)
-        r = std::max(r, std::acos(std::clamp(c.dot(env.sample_texel(t, a * 0.999999, b * 0.999999)), -1.0, 1.0)));
-    for (int k = 0; k < 3; ++k) {
-      x.m[k] = m[size_t(t)][k];
-      x.c[k] = c[k];
-    }
-    x.r = std::min(1.5 * r + 1e-6, std::numbers::pi / 2);
-    x.sin_r = std::sin(x.r);
-    x.index = t;
-    tex.push_back(x);
-  }
-  return tex;
+// The DifMap [6][S][S][3]: E(n) at every cube texel direction, as float.
+template <class Irradiance>
+std::vector<float> cube_of(int size, const Irradiance& E) {
+  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
+  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
+    const Rgb e = E(cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
+    out[size_t(idx) * 3] = float(e.r);
+    out[size_t(idx) * 3 + 1] = float(e.g);
+    out[size_t(idx) * 3 + 2] = float(e.b);
+  });
+  return out;
 }
-
-// Adds texel x's L ∫ H(ω, n) (n·ω) dω to e: its exact moment when wholly above the horizon of n,
-// nothing when wholly below, 4×4 sub-samples when cut (O((h/4)²) per cut texel).
-inline void add_texel(const EnvMap& env, const Vector3d& n, const DifTexel& x, double e[3]) {
-  const double cn = n.x() * x.c[0] + n.y() * x.c[1] + n.z() * x.c[2];
-  double w;
-  if (cn >= x.sin_r) {
-    w = n.x() * x.m[0] + n.y() * x.m[1] + n.z() * x.m[2];
-  } else if (cn <= -x.sin_r) {
-    return;
-  } else {
-    constexpr int kS = 4;
-    Vector3d d[kS * kS];
-    env.sample_texel_grid(x.index, kS, d);
-    double acc = 0;
-    for (const Vector3d& di : d) acc += std::max(0.0, n.dot(di));
-    w = acc * env.texel_solid_angle(x.index) / (kS * kS);
-  }
-  e[0] += x.L[0] * w;
-  e[1] += x.L[1] * w;
-  e[2] += x.L[2] * w;
-}
-
 } // namespace
 
 std::vector<float> irradiance_cube(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1);
-  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
-  if (env.texel_count() == 0) {  // constant L: E = π L for every normal
-    const Rgb L = env.radiance(Vector3d::UnitY());
-    for (size_t i = 0; i < out.size(); i += 3) {
-      out[i] = float(std::numbers::pi * L.r);
-      out[i + 1] = float(std::numbers::pi * L.g);
-      out[i + 2] = float(std::numbers::pi * L.b);
-    }
-    return out;
-  }
-  const std::vector<DifTexel> tex = dif_texels(env, texel_moments(env));
-  // Cells: texels grouped by the direction of their centre on a coarse 64 × 32 lat-long grid,
-  // each with the sum of its texels' L_c ∫ω dω and a cone (axis, half-angle R) that holds every
-  // texel's own cone: R = max_t ∠(axis, c_t) + r_t. A cell wholly above the horizon of n (n·axis
-  // ≥ sin R) adds its sum, exactly what its texels' "wholly above" branch would add one by one;
-  // wholly below, nothing; only the cells the horizon crosses are visited texel by texel. Same
-  // numbers up to summation order, ~20× fewer texel visits per normal.
-  constexpr int kCellsPhi = 64, kCellsTheta = 32;
-  auto cell_of = [&](const DifTexel& x) {
-    const double th = std::acos(std::clamp(x.c[1], -1.0, 1.0)), ph = std::atan2(x.c[0], x.c[2]) + std::numbers::pi;
-    const int i = std::min(kCellsTheta - 1, int(th / std::numbers::pi * kCellsTheta));
-    const int j = std::min(kCellsPhi - 1, int(ph / (2 * std::numbers::pi) * kCellsPhi));
-    return i * kCellsPhi + j;
-  };
-  std::vector<int> cell(tex.size());
-  for (size_t k = 0; k < tex.size(); ++k) cell[k] = cell_of(tex[k]);
-  std::vector<size_t> order(tex.size());
-  std::iota(order.begin(), order.end(), size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cell[a] < cell[b]; });
-  std::vector<DifTexel> sorted;
-  sorted.reserve(tex.size());
-  for (size_t k : order) sorted.push_back(tex[k]);
-  struct Cell {
-    size_t begin = 0, end = 0;
-    double axis[3] = {0, 0, 0}, sin_R = 1, S[3][3] = {};  // S[c][xyz] = Σ L_c ∫ω dω
-    bool bounded = false;                                    // R < π/2: can be wholly above or below
-  };
-  std::vector<Cell> cells;
-  for (size_t k = 0; k < sorted.size();) {
-    Cell q;
-    q.begin = k;
-    const int id = cell[order[k]];
-    Vector3d sum(0, 0, 0);
-    while (k < sorted.size() && cell[order[k]] == id) {
-      const DifTexel& x = sorted[k];
-      sum += Vector3d(x.c[0], x.c[1], x.c[2]);
-      for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a) q.S[c][a] += x.L[c] * x.m[a];
-      ++k;
-    }
-    q.end = k;
-    const Vector3d axis = sum.normalized();
-    double R = 0;
-    for (size_t t = q.begin; t < q.end; ++t) {
-      const DifTexel& x = sorted[t];
-      R = std::max(R, std::acos(std::clamp(axis.dot(Vector3d(x.c[0], x.c[1], x.c[2])), -1.0, 1.0)) + x.r);
-    }
-    R += 1e-9;  // acos rounding
-    q.bounded = sum.norm() > 0 && R < std::numbers::pi / 2;
-    for (int a = 0; a < 3; ++a) q.axis[a] = axis[a];
-    q.sin_R = std::sin(std::min(R, std::numbers::pi / 2));
-    cells.push_back(q);
-  }
-
-  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
-    const int face = idx / (size * size), row = (idx / size) % size, col = idx % size;
-    const Vector3d n = cube_direction(face, row, col, size);
-    double e[3] = {0, 0, 0};
-    for (const Cell& q : cells) {
-      if (q.bounded) {
-        const double cn = n.x() * q.axis[0] + n.y() * q.axis[1] + n.z() * q.axis[2];
-        if (cn >= q.sin_R) {  // wholly above: every texel's exact moment
-          for (int c = 0; c < 3; ++c) e[c] += n.x() * q.S[c][0] + n.y() * q.S[c][1] + n.z() * q.S[c][2];
-          continue;
-        }
-        if (cn <= -q.sin_R) continue;  // wholly below
-      }
-      for (size_t t = q.begin; t < q.end; ++t) add_texel(env, n, sorted[t], e);
-    }
-    for (int c = 0; c < 3; ++c) out[size_t(idx) * 3 + size_t(c)] = float(e[c]);
-  });
-  return out;
+  const UnshadowedIrradiance E(env);
+  return cube_of(size, E);
 }
 
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1 && env.texel_count() > 0);
-  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
-  const std::vector<DifTexel> tex = dif_texels(env, texel_moments(env));
-  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
-    const Vector3d n = cube_direction(idx / (size * size), (idx / size) % size, idx % size, size);
-    double e[3] = {0, 0, 0};
-    for (const DifTexel& x : tex) add_texel(env, n, x, e);
-    for (int c = 0; c < 3; ++c) out[size_t(idx) * 3 + size_t(c)] = float(e[c]);
-  });
-  return out;
+  const UnshadowedIrradiance E(env);
+  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); });
 }
 
 Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {

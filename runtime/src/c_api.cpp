@@ -306,4 +306,17 @@ prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const
   });
 }
 
+prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, const float* positions,
+                                      const float* normals, size_t count, int partial, float* out) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr, "scene is null");
+    occluder_at(scene, index);  // checks the index
+    if (count == 0) return;
+    require(positions != nullptr && normals != nullptr && out != nullptr, "null pointer");
+    for (size_t k = 0; k < count; ++k)
+      prt::shade::shade_fiv_member(scene->environment, scene->views.data(), int(scene->views.size()), index,
+                                   positions + 3 * k, normals + 3 * k, partial != 0, out + 3 * k);
+  });
+}
+
 } // extern "C"

@@ -309,6 +309,17 @@ void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float 
   for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, total[c] - occluded[c]);
 }
 
+void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int count, int self, const float p[3],
+                      const float n[3], bool partial, float out[3]) {
+  shade_fiv_self(env_fiv, occluders[self], p, n, out);
+  for (int j = 0; j < count; ++j) {
+    if (j == self) continue;
+    float o[3];
+    occluded_irradiance(occluders[j], p, n, partial, o);
+    for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c] - o[c]);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Overlap pieces and the slow reference
 

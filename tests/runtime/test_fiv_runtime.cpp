@@ -2,8 +2,10 @@
 // face selection), the shell lookup (grid points exact, linear between, φ wrap, poles, radius
 // clamp and 1/ρ² falloff, invalid-sample renormalisation), cases A/B/C, the overlap correction
 // (identical, disjoint, lens area against numerical integration, fast path against the slow
-// reference), self-shadows, validation, and finiteness at extreme inputs.
+// reference), self-shadows, a receiver that is one of several occluders (C++ and C API),
+// validation, and finiteness at extreme inputs.
 #include <prtshade/fiv.h>
+#include <prtshade/prtshade.h>
 
 #include <gtest/gtest.h>
 
@@ -489,6 +491,67 @@ TEST(ShadeFivSelf, EnvironmentMinusOccludedClamped) {
   EXPECT_NEAR(e[0], 1.65f, 4 * FLT_EPSILON * 2.2f);
   EXPECT_NEAR(e[1], 3.3f, 4 * FLT_EPSILON * 4.4f);
   EXPECT_EQ(e[2], 0.0f);
+}
+
+TEST(ShadeFivMember, OwnSelfShadowsMinusTheOtherOccludersShadows) {
+  // A receiver on occluder 0 at the origin, normal +Y, among three others: one wholly above its
+  // horizon (case A), one partly (case B, h = 0.5, R = 1: factor 3/4) and one wholly below (case
+  // C). With constant FIVs, n·F^env_c = 8 (c + 1) and n·F_self = (c + 1), the composition
+  // shade_fiv_self − Σ_others occluded_irradiance is 7 − 2 − ¾·1 − 0 = 4.25 per (c + 1), and
+  // without the partial factor 7 − 2 − 1 = 4. Every term is a small binary fraction and every
+  // dot product has one non-zero product, so float gives these exactly.
+  const float up[3] = {0, 1, 0}, down[3] = {0, -1, 0}, self_f[3] = {0, 1, 0}, a_f[3] = {0, 2, 0};
+  const float c_self[3] = {0, 0, 0}, c_a[3] = {0, 3, 0}, c_b[3] = {5, 0.5f, 0}, c_c[3] = {0, -5, 0};
+  const Shells self = constant_occluder(self_f, 1.0f, c_self), a = constant_occluder(a_f, 1.0f, c_a),
+               b = constant_occluder(self_f, 1.0f, c_b), c = constant_occluder(self_f, 1.0f, c_c);
+  const FivOccluder occ[4] = {self.view(), a.view(), b.view(), c.view()};
+  float env[9] = {};
+  for (int ch = 0; ch < 3; ++ch) env[3 * ch + 1] = 8.0f * float(ch + 1);
+  const float p[3] = {0, 0, 0};
+  float e[3];
+  shade::shade_fiv_member(env, occ, 4, 0, p, up, true, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], 4.25f * float(ch + 1)) << ch;
+  shade::shade_fiv_member(env, occ, 4, 0, p, up, false, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], 4.0f * float(ch + 1)) << ch;
+  // Alone it is shade_fiv_self, bit for bit; facing away from everything, both are 0 (clamped).
+  float s[3];
+  for (const float* n : {up, down}) {
+    shade::shade_fiv_member(env, occ, 1, 0, p, n, true, e);
+    shade::shade_fiv_self(env, occ[0], p, n, s);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], s[ch]);
+  }
+  // The others' shadows clamp at 0 (an occluder never adds light): occluder a hiding 10 (c + 1).
+  const float big_f[3] = {0, 10, 0};
+  const Shells big = constant_occluder(big_f, 1.0f, c_a);
+  const FivOccluder two[2] = {self.view(), big.view()};
+  shade::shade_fiv_member(env, two, 2, 0, p, up, true, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], 0.0f);
+  // The receiver may be any member: on occluder b (index 2) its own term is 7 (c + 1) at
+  // p = centre_b, the others seen from there: a (centre (0, 3, 0), h = 2.5 >= R: case A, the
+  // constant lookup 2 (c + 1)), self and c (h = −0.5 and −5.5 relative to p: case B with factor
+  // ¼ for self (1 (c + 1) · ¼) and case C for c). 7 − 2 − ¼ = 4.75 per (c + 1).
+  shade::shade_fiv_member(env, occ, 4, 2, c_b, up, true, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], 4.75f * float(ch + 1)) << ch;
+
+  // The C API entry computes the same numbers (it copies the occluders into a scene).
+  const std::vector<float> difmap(6 * 1 * 1 * 3, 1.0f);
+  prt_fiv_scene* scene = nullptr;
+  ASSERT_EQ(prt_fiv_scene_create(1, difmap.data(), env, &scene), PRT_OK);
+  for (const FivOccluder& o : occ) {
+    const prt_fiv_occluder_desc d{{o.centre[0], o.centre[1], o.centre[2]}, o.radius, o.n_rho, o.n_theta, o.n_phi,
+                                  o.radii, o.shells, o.valid};
+    int index = -1;
+    ASSERT_EQ(prt_fiv_scene_add_occluder(scene, &d, &index), PRT_OK);
+  }
+  const float points[6] = {0, 0, 0, 5, 0.5f, 0}, normals[6] = {0, 1, 0, 0, 1, 0};
+  float out[6];
+  ASSERT_EQ(prt_fiv_scene_shade_member(scene, 0, points, normals, 2, 1, out), PRT_OK);
+  for (int k = 0; k < 2; ++k) {
+    shade::shade_fiv_member(env, occ, 4, 0, points + 3 * k, normals + 3 * k, true, e);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]);
+  }
+  EXPECT_NE(prt_fiv_scene_shade_member(scene, 4, points, normals, 1, 1, out), PRT_OK);  // no occluder 4
+  prt_fiv_scene_destroy(scene);
 }
 
 TEST(Validate, RejectsBrokenOccludersAndMaps) {

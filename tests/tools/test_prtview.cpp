@@ -143,8 +143,9 @@ TEST(Prtview, BadCameraAndCommandLinesFailWithTheProblemNamed) {
 TEST(Prtview, Band1OfAnOpenPlaneMatchesTheReference) {
   // An unoccluded plane: band-1 shading at the baked normal is the exact irradiance (up to the
   // silhouette integrator's discretisation, ~5e-4 relative at k = 128², bench/RESULTS.md), and the
-  // reference is the exact texel sum with no occluded part (zero noise, horizon term below 1e-4,
-  // bake/render.h). The image is constant, so NRMSE is normalised by |reference|: < 2e-3.
+  // reference is the unshadowed irradiance with no occluded part (zero noise; horizon-cut texels
+  // sub-sampled 4x4, bake/irradiance.h). The image is constant, so NRMSE is normalised by
+  // |reference|: < 2e-3.
   const fs::path h5 = scratch("plane.prt.h5"), out = scratch("plane.png");
   const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
                                          " --report 0 --quiet -o " + h5.string());

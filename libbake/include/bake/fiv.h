@@ -41,14 +41,16 @@ namespace prt::bake {
 
 using Fiv = std::array<double, 9>;  // [RGB][xyz]
 
-// ∫ L ω dω, exact per texel up to its 4×4 sub-sampled ∫_texel ω dω.
+// ∫ L ω dω, exact per texel up to its 4×4 sub-sampled ∫_texel ω dω (texel_moments, bake/irradiance.h).
 Fiv environment_fiv(const EnvMap& env);
 
-// DifMap: [6][S][S][3] float, E_tot(n) per texel direction (see the header comment); texels cut by
-// the horizon of n are integrated with 4×4 sub-samples, the rest with their exact ∫_texel ω dω.
+// DifMap: [6][S][S][3] float, E_tot(n) per texel direction: bake/irradiance.h's
+// UnshadowedIrradiance (texels cut by the horizon of n integrated with 4×4 sub-samples, the rest
+// with their ∫_texel ω dω) at cube_direction, rounded to float.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
-// The same sum texel by texel for every normal (no cell hierarchy): the slow reference of
-// irradiance_cube, equal to it up to summation order. Needs a map with texels.
+// The same sum texel by texel for every normal (UnshadowedIrradiance::reference, no cell
+// hierarchy): the slow reference of irradiance_cube, equal to it up to summation order. Needs a
+// map with texels.
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size);
 Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
 

@@ -51,7 +51,7 @@ public:
   // Number of triangles the ray from p + εn in unit direction d crosses.
   CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
-  // rays of bake/render.h).
+  // rays of the reference renderer, view/reference.h).
   std::optional<RayHit> closest_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear) const;
   double scene_diagonal() const { return diagonal_; }
 

@@ -118,6 +118,15 @@ void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const
 // Self-shadows (eq. 12): E_c = max(0, n·F^env_c − n·F_c(p − centre)), env_fiv = /fiv/environment.
 void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]);
 
+// A receiver that is itself one of several occluders (paper 004 §4.3.2 with eq. 11): a point on
+// occluders[self] (several copies of a baked occluder, or scene objects with FIV shells) gets its
+// own self-shadows (shade_fiv_self) minus what each OTHER occluder j hides,
+// occluded_irradiance(occluders[j], p, n, partial), clamped to >= 0 after each subtraction. No
+// overlap correction (eq. 13–14 pairs occluders against a DifMap; the self term is not one of its
+// I_i). count >= 1, 0 <= self < count.
+void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int count, int self, const float p[3],
+                      const float n[3], bool partial, float out[3]);
+
 // --- pieces and references (tests, mirrors) ----------------------------------------------------
 
 // Area of the intersection (lens) of two planar discs of radii r1, r2 >= 0 whose centres are d >= 0

@@ -121,6 +121,11 @@ prt_status prt_fiv_scene_shade(const prt_fiv_scene* scene, const float* position
 /* Self-shadowed irradiance of `count` receivers lying on occluder `index` (eq. 12). */
 prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const float* positions,
                                     const float* normals, size_t count, float* out);
+/* Irradiance of `count` receivers lying on occluder `index` among the scene's other occluders:
+ * its self-shadows minus the others' shadows (shade_fiv_member; partial: nonzero applies the
+ * case-B factor to the others). */
+prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, const float* positions,
+                                      const float* normals, size_t count, int partial, float* out);
 
 #ifdef __cplusplus
 } /* extern "C" */

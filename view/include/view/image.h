@@ -1,10 +1,10 @@
-// bake/image_io.h — images for people and for numbers: a PNG writer of our own (zlib stream,
-// deflate, CRC-32 and Adler-32 written here), a float OpenEXR writer, tone mapping to 8-bit
-// sRGB, a false-colour error map and the NRMSE figure of paper 004 §5.
+// view/image.h — images for people and for numbers: 8-bit PNG (libpng) and float OpenEXR files,
+// tone mapping to 8-bit sRGB, a false-colour error map and the NRMSE figure of paper 004 §5.
+// Layers: docs/ARCHITECTURE.md, "Layers".
 //
 // Pixels. An Image is LINEAR float RGB, row-major, 3 floats per pixel, row 0 at the TOP of the
 // picture, pixel (x, y) covering [x, x+1) × [y, y+1) with its centre at (x + ½, y + ½) (the
-// convention of bake/render.h). prtview stores the outgoing radiance of a white Lambertian
+// convention of view/camera.h). prtview stores the outgoing radiance of a white Lambertian
 // surface, L_out = E / π (albedo 1), so a constant environment of radiance L renders as L.
 // An Image8 is display-ready 8-bit sRGB, same layout.
 //
@@ -31,11 +31,9 @@
 //
 // Files. write_png / write_exr write "<path>.tmp.<pid>" in the same directory and rename it onto
 // the path, so a failure never leaves a half-written file under the final name; errors throw
-// InputError naming the file. PNG: colour type 2 (RGB, 8 bit), one sRGB chunk (perceptual
-// intent), one IDAT with per-row adaptive filtering (of None/Sub/Up/Average/Paeth, the one with
-// the least sum of |signed bytes|), the zlib stream of RFC 1950 with one deflate block of fixed
-// Huffman codes (RFC 1951 §3.2.6) fed by greedy LZ77 over a 32 KiB window (hash chains of 3-byte
-// prefixes). EXR: channels R, G, B as 32-bit float, ZIP compression, increasing-Y line order.
+// bake::InputError naming the file. PNG (libpng): colour type 2 (RGB, 8 bit), an sRGB chunk
+// (perceptual intent), libpng's default filtering and zlib compression. EXR (OpenEXR): channels
+// R, G, B as 32-bit float, ZIP compression, increasing-Y line order.
 #pragma once
 
 #include <cstdint>
@@ -44,7 +42,7 @@
 #include <span>
 #include <vector>
 
-namespace prt::bake {
+namespace prt::view {
 
 struct Image {
   int width = 0, height = 0;
@@ -62,19 +60,16 @@ struct Image8 {
   Image8(int w, int h, uint8_t fill = 0) : width(w), height(h), rgb(size_t(w) * size_t(h) * 3, fill) {}
 };
 
-// ---- checksums and the zlib stream (exposed for the tests) ----------------------------------
-uint32_t crc32(std::span<const uint8_t> bytes, uint32_t crc = 0);  // ISO-HDLC / PNG CRC; chain by passing the previous value
-uint32_t adler32(std::span<const uint8_t> bytes);
-std::vector<uint8_t> zlib_compress(std::span<const uint8_t> bytes);  // RFC 1950 around RFC 1951
-
 // Calls write_to(tmp) with tmp = "<path>.tmp.<pid>" in the same directory, then renames tmp onto
 // path; on any exception tmp is removed and the exception propagates. Checks the directory first.
 void write_atomically(const std::filesystem::path& path, const std::function<void(const std::filesystem::path&)>& write_to);
 
 // ---- PNG and EXR -------------------------------------------------------------------------------
-std::vector<uint8_t> encode_png(const Image8& image);
 void write_png(const std::filesystem::path& path, const Image8& image);
 void write_exr(const std::filesystem::path& path, const Image& image);
+// Reads an 8-bit RGB PNG written by write_png (other PNGs are converted to 8-bit RGB by libpng).
+// Throws bake::InputError naming the file when it cannot be read.
+Image8 read_png(const std::filesystem::path& path);
 
 // ---- display ------------------------------------------------------------------------------------
 // mask: empty (every pixel) or one byte per pixel, non-zero = use the pixel.
@@ -84,6 +79,8 @@ Image8 false_colour_error(const Image& test, const Image& reference, std::span<c
                           double full_scale);
 // Pictures side by side, top-aligned, separated by `gap` columns of `gap_value` (grey).
 Image8 hstack(std::span<const Image8> parts, int gap = 4, uint8_t gap_value = 255);
+// Linear pictures side by side, top-aligned, no gap (rows below a shorter part are 0).
+Image hstack(std::span<const Image> parts);
 
 // ---- error ----------------------------------------------------------------------------------------
 struct ImageError {
@@ -97,8 +94,8 @@ struct ImageError {
   double nrmse_noise_corrected = 0;  // sqrt(max(0, rmse² − σ_rms²)) / range
 };
 // ref_std_error: empty or an image of per-channel standard errors of `reference`.
-// Throws ContractError when the sizes differ or no pixel is masked.
+// Throws bake::ContractError when the sizes differ or no pixel is masked.
 ImageError compare_images(const Image& test, const Image& reference, std::span<const uint8_t> mask = {},
                           const Image* ref_std_error = nullptr);
 
-} // namespace prt::bake
+} // namespace prt::view

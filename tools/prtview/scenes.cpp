@@ -1,0 +1,252 @@
+// prtview/scenes.cpp — the scenes prtview draws and their runtime pictures (scenes.h).
+#include "scenes.h"
+
+#include "read_file.h"
+
+#include <view/raster.h>
+
+#include <bake/error.h>
+#include <bake/fiv.h>
+#include <bake/irradiance.h>
+#include <prtshade/fiv.h>
+#include <prtshade/shade.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+namespace prt::prtview {
+
+namespace F = prt::formats;
+using Eigen::Vector3d;
+
+namespace {
+
+// The environment's SH coefficients [3][order²] (channel-major, as prtshade wants them).
+std::vector<float> environment_sh(const bake::EnvMap& env, int order, std::string& how) {
+  const size_t n = size_t(order) * size_t(order);
+  std::vector<float> light(3 * n);
+  if (env.info().layout == "latlong" && env.up() == bake::UpAxis::Y) {
+    // The runtime path: the pixels as an engine holds them (after libbake's load policy).
+    const int W = env.info().width, H = env.info().height;
+    std::vector<float> px(size_t(W) * size_t(H) * 3);
+    for (int t = 0; t < W * H; ++t) {
+      const bake::Rgb c = env.texel_value(t);
+      px[3 * size_t(t)] = float(c.r);
+      px[3 * size_t(t) + 1] = float(c.g);
+      px[3 * size_t(t) + 2] = float(c.b);
+    }
+    shade::project_latlong(px.data(), W, H, order, light.data());
+    how = "prt::shade::project_latlong (order " + std::to_string(order) + ") + shade_transfer per vertex, Gouraud";
+  } else {  // cube maps and Z-up scenes: libbake's projection (same quadrature, any layout)
+    const auto L = env.project_sh(order);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t c = 0; c < 3; ++c) light[c * n + i] = float(L[i * 3 + c]);
+    how = "EnvMap::project_sh (order " + std::to_string(order) + ", cube map or Z-up) + prt::shade::shade_transfer, Gouraud";
+  }
+  return light;
+}
+
+// Per-vertex E/pi from diffuse transfer (any environment) or band-1 radiance (the baked one).
+std::vector<float> transfer_colours(const Transfer& t, const bake::EnvMap& env, size_t V, std::string& how) {
+  const std::vector<float> light = environment_sh(env, t.order, how);
+  std::vector<float> colour(3 * V);
+  shade::shade_transfer_vertices(t.coeffs, V, t.order, light.data(), colour.data());
+  return colour;
+}
+std::vector<float> band1_colours(const Band1& b, size_t V, std::string& how) {
+  std::vector<float> colour(3 * V);
+  shade::shade_band1_vertices(b.normals, b.radiance, V, colour.data());
+  for (float& c : colour) c *= float(std::numbers::inv_pi);
+  how = "prt::shade::shade_band1 per vertex (E/pi), Gouraud";
+  return colour;
+}
+
+} // namespace
+
+view::Image render_vertex_file(const F::File& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
+                               const view::Camera& cam, Scene& scene) {
+  scene.mesh = read_mesh(f, file, "");
+  const size_t V = scene.mesh.positions.size();
+  scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
+  const std::vector<float> colour = kind == "transfer" ? transfer_colours(read_transfer(f, file, ""), env, V, scene.how)
+                                                       : band1_colours(read_band1(f, file, "", env), V, scene.how);
+  return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
+}
+
+view::Image render_fiv_file(const F::File& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
+                            const view::Camera& cam, Scene& scene) {
+  const std::string name = choose_occluder(f, file, options.occluder);
+  const BakedOccluder baked = read_occluder(f, file, name, env);
+  const auto& centre = baked.centre;
+  const double R = baked.radius;
+  const float* env_fiv = read_environment_fiv(f, file, env, true);
+  const shade::DifMap difmap = *read_difmap(f, file, env, true);
+  // The occluder's mesh: the one the shells were baked from.
+  const std::string mesh_path = occluder_mesh_path(f, file, options.occluder_mesh);
+  bake::MeshLoadOptions mopt;
+  mopt.use_file_normals = false;
+  const bake::Mesh occ = bake::load_mesh(mesh_path, mopt);
+
+  std::vector<Vector3d> inst = options.instances.empty() ? std::vector<Vector3d>{Vector3d::Zero()} : options.instances;
+  const Vector3d c0(centre[0], centre[1], centre[2]);
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& p : occ.positions) lowest = std::min(lowest, double(p.y()));
+  double min_offset_y = inst[0].y();
+  Vector3d mean = Vector3d::Zero();
+  double spread = 0;
+  for (const auto& t : inst) {
+    min_offset_y = std::min(min_offset_y, t.y());
+    mean += t;
+  }
+  mean /= double(inst.size());
+  for (const auto& t : inst) spread = std::max(spread, Eigen::Vector2d(t.x() - mean.x(), t.z() - mean.z()).norm());
+  const double ground_y = options.ground ? *options.ground : lowest + min_offset_y - 0.01 * R;
+  const double half = options.ground_size ? *options.ground_size : 4 * R + spread;
+
+  std::vector<bake::Mesh> parts = {view::ground_quad(ground_y, c0.x() + mean.x(), c0.z() + mean.z(), half)};
+  std::vector<shade::FivOccluder> occluders;
+  for (size_t k = 0; k < inst.size(); ++k) {
+    parts.push_back(view::translated(occ, inst[k], name + "#" + std::to_string(k)));
+    shade::FivOccluder o = baked.view;
+    for (int c = 0; c < 3; ++c) o.centre[c] = float(centre[size_t(c)] + inst[k][c]);
+    occluders.push_back(o);
+    scene.spheres.push_back({c0 + inst[k], R});
+  }
+  scene.receiver_triangles = parts.front().triangles.size();
+  scene.mesh = bake::merge_meshes(parts, "fiv scene");
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "FIV occluder '%s' (%s, shells %dx%dx%d, R %.4g), %zu cop%s, ground y = %.4g, half-size %.4g",
+                name.c_str(), mesh_path.c_str(), occluders[0].n_phi, occluders[0].n_theta, occluders[0].n_rho, R,
+                inst.size(), inst.size() == 1 ? "y" : "ies", ground_y, half);
+  scene.what = buf;
+  scene.how = std::string("prt::shade::shade_fiv per pixel (overlap correction ") + (options.overlap ? "on" : "off") +
+              ", partial-occluder factor " + (options.partial ? "on" : "off") +
+              "), shade_fiv_member on the occluders (self-shadows minus the other copies' shadows)";
+
+  const shade::FivShadeOptions opts{options.partial, options.overlap};
+  const size_t tri_per_copy = occ.triangles.size();
+  const view::GBuffer g = view::rasterize(scene.mesh, cam);
+  return view::shade_pixels(scene.mesh, g, [&](const view::Fragment& fr, float* out) {
+    const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
+    const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
+    float e[3];
+    if (size_t(fr.triangle) < scene.receiver_triangles) {
+      shade::shade_fiv(difmap, occluders.data(), int(occluders.size()), p, n, opts, e);
+    } else {
+      const size_t k = (size_t(fr.triangle) - scene.receiver_triangles) / tri_per_copy;
+      shade::shade_fiv_member(env_fiv, occluders.data(), int(occluders.size()), int(k), p, n, options.partial, e);
+    }
+    for (int c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi);
+  });
+}
+
+
+view::Image render_scene_file(const F::File& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
+                              Scene& scene) {
+  std::vector<SceneObject> objects = read_scene_objects(f, file, env);
+  // What the runtime has beside the per-vertex data: the DifMap (unshadowed irradiance) and the
+  // environment FIV, when some occluder got shells.
+  const std::optional<shade::DifMap> difmap = read_difmap(f, file, env, false);
+  const float* env_fiv = read_environment_fiv(f, file, env, false);
+  std::optional<bake::UnshadowedIrradiance> exact;  // AO without a DifMap
+  // Flat grey: half the outgoing radiance of a white surface under a uniform sky of the
+  // environment's mean radiance Lbar = L_00 / sqrt(4 pi) (mean over RGB).
+  const auto L00 = env.project_sh(1);
+  const float flat = float(0.5 * (L00[0] + L00[1] + L00[2]) / 3.0 / std::sqrt(4 * std::numbers::pi));
+
+  // Receivers first: the compared region is the triangle range [0, receiver_triangles).
+  std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
+  // Every object with FIV shells is an occluder the runtime knows; those shaded per pixel get their
+  // own self-shadows minus the others' shadows (shade_fiv_member).
+  std::vector<shade::FivOccluder> fiv_occluders;
+  std::vector<int> fiv_index(objects.size(), -1);
+  for (size_t k = 0; k < objects.size(); ++k)
+    if (objects[k].shells) {
+      fiv_index[k] = int(fiv_occluders.size());
+      fiv_occluders.push_back(objects[k].shells->view);
+    }
+  std::vector<std::vector<float>> rgb_of(objects.size());  // E/pi per vertex (white); empty: per pixel
+  std::vector<std::string> how_of(objects.size());
+  for (size_t k = 0; k < objects.size(); ++k) {
+    const SceneObject& o = objects[k];
+    const size_t V = o.mesh.positions.size();
+    const std::string glossy_note = o.glossy_only ? " (glossy: not shaded by the runtime yet)" : "";
+    std::string unused;
+    if (o.band1) {
+      rgb_of[k] = band1_colours(*o.band1, V, unused);
+      how_of[k] = "band-1 radiance (shade_band1)";
+    } else if (o.transfer) {
+      rgb_of[k] = transfer_colours(*o.transfer, env, V, unused);
+      how_of[k] = "diffuse transfer (project_latlong + shade_transfer)";
+    } else if (o.ao) {
+      // AO x the unshadowed irradiance at the vertex normal: the runtime's DifMap when the file has
+      // one (lookup_difmap), else the exact texel sum (bake::UnshadowedIrradiance).
+      if (!difmap && !exact) exact.emplace(env);
+      rgb_of[k].resize(3 * V);
+      for (size_t v = 0; v < V; ++v) {
+        const float n[3] = {o.mesh.normals[v].x(), o.mesh.normals[v].y(), o.mesh.normals[v].z()};
+        float e[3];
+        if (difmap) {
+          shade::lookup_difmap(*difmap, n, e);
+        } else {
+          const bake::Rgb u = (*exact)(o.mesh.normals[v].cast<double>());
+          e[0] = float(u.r), e[1] = float(u.g), e[2] = float(u.b);
+        }
+        for (size_t c = 0; c < 3; ++c) rgb_of[k][3 * v + c] = (*o.ao)[v] * e[c] * float(std::numbers::inv_pi);
+      }
+      how_of[k] = std::string("AO x ") + (difmap ? "DifMap (lookup_difmap)" : "exact unshadowed irradiance") + " / pi" + glossy_note;
+    } else if (o.shells) {
+      how_of[k] = "FIV self-shadows per pixel minus the other FIV occluders' shadows (shade_fiv_member)" + glossy_note;
+    } else {
+      rgb_of[k].assign(3 * V, flat);
+      how_of[k] = "flat grey (no per-vertex products, no FIV shells)" + glossy_note;
+    }
+  }
+
+  std::vector<bake::Mesh> parts;
+  std::vector<float> rgb;
+  std::vector<uint8_t> per_pixel;
+  scene.first_triangle = {0};
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects";
+  scene.how = "per object, times its albedo (white if none):";
+  for (size_t k = 0; k < objects.size(); ++k) {
+    const SceneObject& o = objects[k];
+    const size_t T = o.mesh.triangles.size();
+    for (size_t v = 0; v < o.mesh.positions.size(); ++v)
+      for (size_t c = 0; c < 3; ++c) rgb.push_back(rgb_of[k].empty() ? 0.0f : rgb_of[k][3 * v + c] * o.albedo[c]);
+    per_pixel.insert(per_pixel.end(), T, rgb_of[k].empty() ? 1 : 0);
+    scene.casts_shadow.insert(scene.casts_shadow.end(), T, o.casts_shadow ? 1 : 0);
+    scene.albedo.insert(scene.albedo.end(), T, o.albedo);
+    scene.object_names.push_back(o.name);
+    scene.object_receiver.push_back(o.receiver);
+    scene.first_triangle.push_back(scene.first_triangle.back() + T);
+    if (o.receiver) scene.receiver_triangles += T;
+    if (o.casts_shadow) {
+      view::Sphere sp;
+      bake::bounding_sphere(o.mesh, sp.centre, sp.radius);
+      scene.spheres.push_back(sp);
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s %s (%zu vertices, albedo %.3g %.3g %.3g)", o.name.c_str(), o.role.c_str(),
+                  o.mesh.positions.size(), o.albedo[0], o.albedo[1], o.albedo[2]);
+    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + buf;
+    scene.how += "\n  " + o.name + ": " + how_of[k];
+    parts.push_back(o.mesh);
+  }
+  scene.mesh = bake::merge_meshes(parts, file);
+  const view::GBuffer g = view::rasterize(scene.mesh, cam);
+  return view::shade_mixed(scene.mesh, g, rgb, per_pixel, [&](const view::Fragment& fr, float* out) {
+    const size_t k = size_t(std::upper_bound(scene.first_triangle.begin(), scene.first_triangle.end(), size_t(fr.triangle)) -
+                            scene.first_triangle.begin()) - 1;
+    const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
+    const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
+    float e[3];
+    shade::shade_fiv_member(env_fiv, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
+    for (size_t c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi) * objects[k].albedo[c];
+  });
+}
+
+} // namespace prt::prtview

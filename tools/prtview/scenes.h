@@ -1,0 +1,58 @@
+// prtview/scenes.h — the three kinds of baked file as prtview draws them: the scene both renderers
+// see (a mesh, which triangles are the receiver, what casts shadows) and the runtime picture,
+// shaded by prtshade and rasterized by view/. The data comes from read_file.h; what is drawn is
+// documented in prtview's --help ("WHAT IS DRAWN").
+#pragma once
+
+#include <view/camera.h>
+#include <view/image.h>
+#include <view/reference.h>
+
+#include <bake/envmap.h>
+#include <bake/mesh.h>
+#include <formats/prtfile.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace prt::prtview {
+
+// What a render needs beyond the pictures: the scene both renderers draw and which triangles form
+// the receiver (the ground plane of FIV scenes, the receiver objects of scene files).
+struct Scene {
+  bake::Mesh mesh;
+  size_t receiver_triangles = 0;  // triangles [0, receiver_triangles) are the receiver
+  std::vector<view::Sphere> spheres;
+  std::string what;  // one line: what was drawn
+  std::string how;   // how the runtime shaded it
+  // Scene files: the reference's per-triangle shadow casters and albedos (view::ReferenceOptions),
+  // and the objects' triangle ranges: object k owns [first_triangle[k], first_triangle[k + 1]).
+  std::vector<uint8_t> casts_shadow;
+  std::vector<std::array<float, 3>> albedo;
+  std::vector<std::string> object_names;
+  std::vector<bool> object_receiver;
+  std::vector<size_t> first_triangle;
+};
+
+// Per-vertex files: kind "transfer" or "band1".
+view::Image render_vertex_file(const formats::File& f, const std::string& file, const std::string& kind,
+                               const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
+
+// FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
+struct FivView {
+  std::string occluder, occluder_mesh;
+  std::vector<Eigen::Vector3d> instances;
+  std::optional<double> ground, ground_size;
+  bool overlap = true, partial = true;
+};
+view::Image render_fiv_file(const formats::File& f, const std::string& file, const FivView& options,
+                            const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
+
+// Scene files (prtbake scene, schema v2): every object with what the file holds for it.
+view::Image render_scene_file(const formats::File& f, const std::string& file, const bake::EnvMap& env,
+                              const view::Camera& cam, Scene& scene);
+
+} // namespace prt::prtview

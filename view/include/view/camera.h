@@ -1,0 +1,51 @@
+// view/camera.h — the pinhole camera both renderers share (view/raster.h, view/reference.h) and
+// its text form. Layer and conventions: docs/ARCHITECTURE.md, "Layers" and "Conventions".
+//
+// CAMERA. Right-handed world, look-at: forward f = normalize(at − eye), right r = normalize(f × up),
+// true up u = r × f. fov_y_degrees is the full vertical field of view; aspect = width / height.
+// Pixel (x, y) covers [x, x+1) × [y, y+1), y grows DOWNWARDS, row 0 is the top of the picture and
+// the pixel is sampled at its centre (x + ½, y + ½) by both renderers, so their pictures line up
+// pixel for pixel. Continuous pixel position (sx, sy) ↔ view ray direction
+//   d ∝ f + ((2 sx / W − 1) · aspect · tan(fov/2)) r + ((1 − 2 sy / H) · tan(fov/2)) u.
+// View depth of a point q: z = f · (q − eye). Geometry with z < near is clipped (both renderers:
+// the rasterizer clips triangles against the plane z = near, the ray tracer starts each primary
+// ray at depth near). near = 1e-4 · |at − eye| unless set.
+//
+// Text form: "eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEGREES]" and sizes "WxH". Errors are
+// bake::InputError naming the value ("camera spec '<spec>': <what is wrong>"), never an option of
+// a tool: the tool says where the value came from.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <string_view>
+
+namespace prt::view {
+
+struct Camera {
+  Eigen::Vector3d eye{0, 0, 1}, at{0, 0, 0}, up{0, 1, 0};
+  double fov_y_degrees = 45;
+  int width = 256, height = 256;
+  double near = 0;  // 0: 1e-4 · |at − eye|
+
+  Eigen::Vector3d forward() const;   // f
+  Eigen::Vector3d right() const;     // r
+  Eigen::Vector3d true_up() const;   // u
+  double near_depth() const;
+  // Unit direction of the ray through continuous pixel position (sx, sy) (pixel centres at +½).
+  Eigen::Vector3d ray_direction(double sx, double sy) const;
+  // What is wrong with it, or "" when it is usable: eye == at, up ∥ (at − eye), fov ∉ (0, 180),
+  // non-finite numbers, near < 0 or a size outside [1, 16384]².
+  std::string problem() const;
+  // Throws bake::InputError("camera", problem()) unless problem() is empty.
+  void validate() const;
+};
+
+// "eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEGREES]" (any order, each key at most once; eye and at
+// required). Throws bake::InputError("camera spec '<spec>'", "<what is wrong>").
+Camera parse_camera(std::string_view spec, int width, int height);
+// "WxH", each in [1, 16384]. Throws bake::InputError("image size '<spec>'", "<what is wrong>").
+std::array<int, 2> parse_size(std::string_view spec);
+
+} // namespace prt::view

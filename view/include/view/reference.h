@@ -1,0 +1,127 @@
+// view/reference.h — the Embree ray-traced reference renderer (the brute-force ground truth of
+// paper 004 §5: "the standard rendering formula, Equation (2), with an overall integration of the
+// unoccluded part of the environment map as it is seen from each pixel") and its on-disk cache.
+// It sees the same pixels as the rasterizer (view/camera.h, view/raster.h). Layers:
+// docs/ARCHITECTURE.md, "Layers".
+//
+// REFERENCE (ReferenceRenderer). Per pixel: one primary ray through the pixel centre (Embree
+// closest hit, same near plane) gives p, the shading normal n (the interpolated vertex normals,
+// as the rasterizer) and the geometric normal; the pixel value is the outgoing radiance of a
+// white Lambertian surface, E / π, with the irradiance
+//   E(p, n) = ∫ L(ω) V(p, ω) H(ω, n) (n · ω) dω     (docs/ARCHITECTURE.md, "Conventions"; paper 004 eq. 2)
+// computed as E = E_unocc(n) − ∫ L (1 − V) H (n · ω) dω:
+//   * E_unocc(n) = E_tot(n) of bake/irradiance.h (UnshadowedIrradiance: the same function the
+//     DifMap of FIV files samples), a deterministic sum over every environment texel: no noise
+//     where nothing occludes;
+//   * the occluded part by randomised QMC (bake/sampling.h: a 3D Halton sequence with a
+//     Cranley–Patterson rotation keyed by (seed, pixel index, replicate) — identical bytes for any
+//     thread count), as 8 independent replicates of samples/8 points each: the estimate is their
+//     mean and its standard error the spread of the 8 means / √8 (the honest RQMC error; the iid
+//     sample variance would overstate it because QMC converges faster than 1/√N). Directions
+//     are drawn from a one-sample mixture weighted by the balance heuristic:
+//     cosine-weighted hemisphere around n, the environment's luminance (EnvMap::sample) and,
+//     when `occluder_spheres` are given, a uniform cone around each sphere that p sees from
+//     outside (half-angle asin(R / D)) — the FIV scenes pass their occluders' bounding spheres,
+//     so nearly every shadow ray is spent where occlusion can happen. Weights: ¼ cosine, ¼
+//     environment, ½ shared by the cones; without cones ½ / ½. Every estimator term is
+//     L (n·ω) (1 − V) / p_mixture with p_mixture ≥ w_cos (n·ω)/π, so it is bounded.
+//   * visibility: a shadow ray from p + ε n_g (n_g the geometric normal turned to the side of n,
+//     ε = 1e-5 × the scene's bounding-box diagonal) to infinity; any hit occludes.
+//   * scenes of several objects (ReferenceOptions::casts_shadow / albedo): shadow rays see only
+//     the casting triangles (a separate Embree scene over them), the pixel is albedo · E / π.
+// The per-pixel standard error (of the QMC term, from the replicates) is returned with the
+// picture; compare_images (view/image.h) turns it into the reference's own noise figure.
+#pragma once
+
+#include <view/camera.h>
+#include <view/image.h>
+#include <view/raster.h>
+
+#include <bake/envmap.h>
+#include <bake/irradiance.h>
+#include <bake/mesh.h>
+#include <bake/progress.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace prt::view {
+
+// A sphere the reference may importance-sample (an occluder's bounding sphere).
+struct Sphere {
+  Eigen::Vector3d centre{0, 0, 0};
+  double radius = 0;
+};
+
+struct ReferenceOptions {
+  uint32_t samples = 1024;  // QMC shadow rays per pixel (occluded part); a multiple of 8 (8 replicates)
+  uint64_t seed = 1;
+  std::vector<Sphere> occluder_spheres;
+  // Scenes of several objects (prtview on scene files, roles of bake/scene.h), one entry per
+  // triangle of the rendered mesh; empty vectors keep the single-object behaviour above.
+  //   casts_shadow[t] == 0: triangle t is seen by primary rays but never blocks a shadow ray (an
+  //     object with role "receiver" casts no shadow, not even on itself). When no triangle casts,
+  //     nothing is occluded and E = E_unocc exactly (no shadow rays, standard error 0).
+  //   albedo[t]: diffuse albedo (RGB) of triangle t: the pixel shows albedo · E/π and its standard
+  //     error scales alike. Empty: white (albedo 1), the E/π above.
+  std::vector<uint8_t> casts_shadow;
+  std::vector<std::array<float, 3>> albedo;
+};
+
+struct ReferenceImage {
+  GBuffer gbuffer;   // primary hits
+  Image radiance;    // E / π (white Lambertian), RGB
+  Image std_error;   // standard error of each value (the QMC term)
+  double seconds = 0;
+  uint64_t rays = 0;  // primary + shadow rays cast
+};
+
+class ReferenceRenderer {
+public:
+  // `mesh` and `env` must outlive the renderer. Builds an Embree BVH over the mesh.
+  ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap& env, ReferenceOptions options);
+  ~ReferenceRenderer();
+  ReferenceRenderer(const ReferenceRenderer&) = delete;
+  ReferenceRenderer& operator=(const ReferenceRenderer&) = delete;
+
+  // Primary rays only: the G-buffer of what each pixel centre sees.
+  GBuffer trace_primary(const Camera& camera) const;
+  ReferenceImage render(const Camera& camera, const bake::Monitor& monitor = {}) const;
+
+  // Irradiance E (RGB) at a fragment and its standard error; `index` keys the randomisation.
+  void irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const;
+  std::string description() const;
+  // A key naming everything that determines render(camera) — the mesh, per-triangle casters and
+  // albedos, the camera, the occluder spheres, the environment's SHA-256 and description() — for
+  // the on-disk cache below.
+  std::string cache_key(const Camera& camera) const;
+
+private:
+  // irradiance() with the unshadowed part E_unocc(f.n) already known.
+  void irradiance(const Fragment& f, uint64_t index, const bake::Rgb& unocc, double E[3], double std_error[3]) const;
+  struct Rays;  // bake/raycast.h RayScene over the mesh
+  const bake::Mesh& mesh_;
+  const bake::EnvMap& env_;
+  ReferenceOptions options_;
+  bake::UnshadowedIrradiance unoccluded_;
+  std::unique_ptr<Rays> rt_;
+  double epsilon_ = 0;
+};
+
+// A reference render kept on disk so several runtime renders of one view can be compared against
+// it without tracing it again (prtview --reference-cache). OpenEXR file: channels R, G, B (radiance),
+// se.R, se.G, se.B (standard errors) as float, "triangle" as uint (0xFFFFFFFF = nothing hit), and
+// a string attribute "prt_reference_key" that names what was rendered (the caller builds it from
+// everything that determines the picture). save writes a temporary file and renames it.
+// load returns nothing when the file does not exist or its key differs; a damaged file throws
+// bake::InputError. Only gbuffer.triangle is restored (barycentrics are not kept).
+void save_reference(const std::filesystem::path& path, const ReferenceImage& image, const std::string& key);
+std::optional<ReferenceImage> load_reference(const std::filesystem::path& path, const std::string& key);
+
+} // namespace prt::view

@@ -1,0 +1,354 @@
+// reference.cpp — the Embree reference renderer and its OpenEXR cache (view/reference.h:
+// estimators and conventions).
+#include <view/reference.h>
+
+#include <bake/error.h>
+#include <bake/raycast.h>
+#include <bake/sampling.h>
+#include <bake/sha256.h>
+
+#include <IexBaseExc.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <span>
+#include <sstream>
+#include <utility>
+
+namespace prt::view {
+
+using namespace prt::bake;  // Mesh, EnvMap, Rgb, RayScene, Frame, samplers, errors
+using Eigen::Vector3d;
+
+namespace {
+constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
+}
+
+// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh for
+// primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
+struct ReferenceRenderer::Rays {
+  Topology topology;
+  RayScene scene;
+  Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
+  std::optional<Topology> caster_topology;
+  std::unique_ptr<RayScene> casters;
+  bool any_caster = true;
+  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), scene(mesh, topology) {
+    if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
+    caster_mesh = mesh;
+    caster_mesh.triangles.clear();
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+      if (casts_shadow[t]) caster_mesh.triangles.push_back(mesh.triangles[t]);
+    any_caster = !caster_mesh.triangles.empty();
+    if (!any_caster) return;
+    caster_topology = build_topology(caster_mesh);
+    casters = std::make_unique<RayScene>(caster_mesh, *caster_topology);
+  }
+  bool occluded(const Vector3d& o, const Vector3d& d) const {
+    ShadePoint sp;
+    sp.p = o;  // a free point (welded = -1): the ray starts at o itself
+    return !(casters ? *casters : scene).visible(sp, d);
+  }
+};
+
+ReferenceRenderer::ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap& env, ReferenceOptions options)
+    : mesh_(mesh), env_(env), options_(std::move(options)), unoccluded_(env),
+      rt_(std::make_unique<Rays>(mesh, options_.casts_shadow)) {
+  PRT_CHECK(options_.samples > 0 && (options_.samples % kReplicates == 0 || options_.samples < kReplicates));
+  PRT_CHECK(!mesh.triangles.empty());
+  PRT_CHECK(options_.casts_shadow.empty() || options_.casts_shadow.size() == mesh.triangles.size());
+  PRT_CHECK(options_.albedo.empty() || options_.albedo.size() == mesh.triangles.size());
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& q : mesh.positions) {
+    lo = lo.cwiseMin(q.cast<double>());
+    hi = hi.cwiseMax(q.cast<double>());
+  }
+  epsilon_ = 1e-5 * (hi - lo).norm() + 1e-6 * std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+}
+
+ReferenceRenderer::~ReferenceRenderer() = default;
+
+std::string ReferenceRenderer::description() const {
+  std::ostringstream os;
+  os << "Embree 3 ray tracing: primary ray per pixel centre; E = unshadowed irradiance (the DifMap's texel sum) - "
+        "randomised Halton QMC of the occluded part, "
+     << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
+     << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
+     << "), seed " << options_.seed;
+  if (!options_.casts_shadow.empty()) {
+    const auto n = std::count_if(options_.casts_shadow.begin(), options_.casts_shadow.end(), [](uint8_t c) { return c != 0; });
+    os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
+  }
+  if (!options_.albedo.empty()) os << "; per-object albedo";
+  return os.str();
+}
+
+std::string ReferenceRenderer::cache_key(const Camera& cam) const {
+  std::string bytes;
+  auto put = [&](const void* p, size_t n) { bytes.append(static_cast<const char*>(p), n); };
+  for (const auto& q : mesh_.positions) put(q.data(), 3 * sizeof(float));
+  for (const auto& q : mesh_.normals) put(q.data(), 3 * sizeof(float));
+  for (const auto& t : mesh_.triangles) put(t.data(), 3 * sizeof(uint32_t));
+  put(options_.casts_shadow.data(), options_.casts_shadow.size());
+  for (const auto& c : options_.albedo) put(c.data(), 3 * sizeof(float));
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "|eye %.17g %.17g %.17g at %.17g %.17g %.17g up %.17g %.17g %.17g fov %.17g near %.17g %dx%d",
+                cam.eye.x(), cam.eye.y(), cam.eye.z(), cam.at.x(), cam.at.y(), cam.at.z(), cam.up.x(), cam.up.y(), cam.up.z(),
+                cam.fov_y_degrees, cam.near, cam.width, cam.height);
+  bytes += buf;
+  for (const auto& sp : options_.occluder_spheres) {
+    std::snprintf(buf, sizeof buf, "|sphere %.17g %.17g %.17g %.17g", sp.centre.x(), sp.centre.y(), sp.centre.z(), sp.radius);
+    bytes += buf;
+  }
+  return sha256_bytes(std::as_bytes(std::span<const char>(bytes.data(), bytes.size()))) + " env " + env_.info().sha256 + " " +
+         description();
+}
+
+GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
+  camera.validate();
+  GBuffer g = GBuffer::blank(camera.width, camera.height);
+  const Vector3d f = camera.forward();
+  const double near = camera.near_depth();
+  tbb::parallel_for(0, camera.height, [&](int y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const Vector3d d = camera.ray_direction(x + 0.5, y + 0.5);
+      const double df = d.dot(f);
+      const auto hit = rt_->scene.closest_hit(camera.eye, d, near / df);
+      if (!hit) continue;
+      const size_t i = size_t(y) * size_t(camera.width) + size_t(x);
+      g.triangle[i] = int32_t(hit->triangle);
+      g.bary[i] = {1.0f - hit->u - hit->v, hit->u, hit->v};
+      g.depth[i] = float(double(hit->t) * df);
+    }
+  });
+  return g;
+}
+
+void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const {
+  irradiance(f, index, unoccluded_(f.n), E, std_error);
+}
+
+void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb& unocc, double E[3], double std_error[3]) const {
+  if (!rt_->any_caster) {  // nothing casts a shadow: the exact unshadowed sum, no noise
+    const double un[3] = {unocc.r, unocc.g, unocc.b};
+    for (int c = 0; c < 3; ++c) {
+      E[c] = un[c];
+      std_error[c] = 0;
+    }
+    return;
+  }
+  const Vector3d o = f.p + epsilon_ * f.ng;
+  constexpr double kInvPi = std::numbers::inv_pi;
+  // Cones around the occluder spheres that o sees from outside and that reach above the horizon.
+  struct Cone {
+    Vector3d axis;
+    double cos_a, inv_solid_angle;
+    Frame frame;
+  };
+  std::vector<Cone> cones;
+  for (const Sphere& s : options_.occluder_spheres) {
+    const Vector3d to = s.centre - o;
+    const double D = to.norm();
+    if (!(D > s.radius * (1 + 1e-9))) continue;
+    const double sin_a = s.radius / D, cos_a = std::sqrt(std::max(0.0, 1 - sin_a * sin_a));
+    const Vector3d axis = to / D;
+    if (f.n.dot(axis) <= -sin_a) continue;  // wholly below the horizon: never needed
+    const double one_minus_cos = sin_a * sin_a / (1 + cos_a);
+    cones.push_back({axis, cos_a, 1.0 / (2 * std::numbers::pi * one_minus_cos), Frame(axis)});
+  }
+  const double w_cone_total = cones.empty() ? 0.0 : 0.5;
+  const double w_cos = 0.5 * (1 - w_cone_total), w_env = w_cos;
+  const double w_cone = cones.empty() ? 0.0 : w_cone_total / double(cones.size());
+  const Frame frame(f.n);
+  // Independent replicates (randomised QMC): B rotations of the Halton sequence, N/B points each.
+  // The spread of the replicate means is an honest standard error for the RQMC estimate, which
+  // converges faster than 1/sqrt(N); the iid sample variance would overstate it.
+  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
+  const uint32_t per = std::max<uint32_t>(1, options_.samples / B);
+  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
+  for (uint32_t b = 0; b < B; ++b) {
+    const RotatedHalton3 halton(options_.seed, index * kReplicates + b);
+    double sum[3] = {0, 0, 0};
+    for (uint32_t i = 0; i < per; ++i) {
+      const auto u = halton(i);
+      Vector3d d;
+      if (u[0] < w_cos) {
+        d = frame.to_world(cosine_hemisphere(u[1], u[2]));
+      } else if (u[0] < w_cos + w_env) {
+        d = env_.sample(u[1], u[2], nullptr);
+      } else {
+        const size_t k = std::min(cones.size() - 1, size_t((u[0] - w_cos - w_env) / w_cone));
+        const Cone& c = cones[k];
+        const double z = 1 - u[1] * (1 - c.cos_a), r = std::sqrt(std::max(0.0, 1 - z * z));
+        const double phi = 2 * std::numbers::pi * u[2];
+        d = c.frame.to_world(Vector3d(r * std::cos(phi), r * std::sin(phi), z));
+      }
+      d.normalize();
+      const double cn = f.n.dot(d);
+      if (!(cn > 0) || !rt_->occluded(o, d)) continue;  // contributes 0 to the occluded part
+      double p = w_cos * cn * kInvPi + w_env * env_.pdf(d);
+      for (const Cone& c : cones)
+        if (c.axis.dot(d) >= c.cos_a) p += w_cone * c.inv_solid_angle;
+      const Rgb L = env_.radiance(d);
+      sum[0] += L.r * cn / p;
+      sum[1] += L.g * cn / p;
+      sum[2] += L.b * cn / p;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double m = sum[c] / per;
+      block_sum[c] += m;
+      block_sum2[c] += m * m;
+    }
+  }
+  const double un[3] = {unocc.r, unocc.g, unocc.b};
+  for (int c = 0; c < 3; ++c) {
+    const double mean = block_sum[c] / B;
+    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean * mean) / (double(B) * (B - 1))) : 0.0;
+    E[c] = un[c] - mean;
+    std_error[c] = std::sqrt(var);
+  }
+}
+
+ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monitor& monitor) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  ReferenceImage out;
+  out.gbuffer = trace_primary(camera);
+  out.radiance = Image(camera.width, camera.height);
+  out.std_error = Image(camera.width, camera.height);
+  // E_unocc once per distinct shading normal (every pixel of a plane shares one): the normals of
+  // the covered pixels, sorted and made unique, evaluated in parallel.
+  using Key = std::array<double, 3>;
+  std::vector<Key> normals;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x)
+      if (out.gbuffer.triangle[size_t(y) * size_t(camera.width) + size_t(x)] >= 0) {
+        const Vector3d n = make_fragment(mesh_, out.gbuffer, x, y).n;
+        normals.push_back({n.x(), n.y(), n.z()});
+      }
+  std::sort(normals.begin(), normals.end());
+  normals.erase(std::unique(normals.begin(), normals.end()), normals.end());
+  Task bar(monitor, "reference", uint64_t(normals.size()) + uint64_t(camera.height));
+  std::vector<Rgb> unocc(normals.size());
+  tbb::parallel_for(size_t(0), normals.size(), [&](size_t k) {
+    unocc[k] = unoccluded_(Vector3d(normals[k][0], normals[k][1], normals[k][2]));
+    bar.advance();
+  });
+  std::atomic<uint64_t> pixels{0};
+  tbb::parallel_for(0, camera.height, [&](int y) {
+    uint64_t n = 0;
+    for (int x = 0; x < camera.width; ++x) {
+      const Fragment f = make_fragment(mesh_, out.gbuffer, x, y);
+      if (f.triangle < 0) continue;
+      const Key key{f.n.x(), f.n.y(), f.n.z()};
+      const size_t k = size_t(std::lower_bound(normals.begin(), normals.end(), key) - normals.begin());
+      double E[3], se[3];
+      irradiance(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), unocc[k], E, se);
+      for (int c = 0; c < 3; ++c) {
+        const double albedo = options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(f.triangle)][size_t(c)]);
+        out.radiance.at(x, y)[c] = float(albedo * E[c] * std::numbers::inv_pi);
+        out.std_error.at(x, y)[c] = float(albedo * se[c] * std::numbers::inv_pi);
+      }
+      ++n;
+    }
+    pixels += n;
+    bar.advance();
+  });
+  bar.finish();
+  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
+  out.rays = uint64_t(camera.width) * uint64_t(camera.height) +
+             (rt_->any_caster ? pixels.load() * B * std::max<uint32_t>(1, options_.samples / B) : 0);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (float v : out.radiance.rgb)
+    if (!std::isfinite(v)) throw ContractError("reference render produced a non-finite value");
+  return out;
+}
+
+// ---- reference cache -----------------------------------------------------------------------------------
+
+namespace {
+constexpr const char* kKeyAttr = "prt_reference_key";
+constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;
+} // namespace
+
+void save_reference(const std::filesystem::path& path, const ReferenceImage& image, const std::string& key) {
+  const int W = image.radiance.width, H = image.radiance.height;
+  PRT_CHECK(W > 0 && H > 0 && image.std_error.rgb.size() == image.radiance.rgb.size());
+  PRT_CHECK_OP(image.gbuffer.triangle.size(), ==, size_t(W) * size_t(H));
+  std::vector<uint32_t> tri(image.gbuffer.triangle.size());
+  for (size_t i = 0; i < tri.size(); ++i) tri[i] = image.gbuffer.triangle[i] < 0 ? kNoTriangle : uint32_t(image.gbuffer.triangle[i]);
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    try {
+      Imf::Header header(W, H);
+      header.insert(kKeyAttr, Imf::StringAttribute(key));
+      Imf::FrameBuffer fb;
+      const char* names[6] = {"R", "G", "B", "se.R", "se.G", "se.B"};
+      for (int c = 0; c < 6; ++c) {
+        const Image& src = c < 3 ? image.radiance : image.std_error;
+        header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+        fb.insert(names[c], Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(src.rgb.data() + c % 3)),
+                                       3 * sizeof(float), 3 * sizeof(float) * size_t(W)));
+      }
+      header.channels().insert("triangle", Imf::Channel(Imf::UINT));
+      fb.insert("triangle", Imf::Slice(Imf::UINT, reinterpret_cast<char*>(tri.data()), sizeof(uint32_t), sizeof(uint32_t) * size_t(W)));
+      Imf::OutputFile out(tmp.c_str(), header, 1);
+      out.setFrameBuffer(fb);
+      out.writePixels(H);
+    } catch (const Iex::BaseExc& e) {
+      throw InputError(path.string(), std::string("cannot write the reference: ") + e.what());
+    }
+  });
+}
+
+std::optional<ReferenceImage> load_reference(const std::filesystem::path& path, const std::string& key) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  try {
+    Imf::InputFile in(path.c_str(), 1);
+    const auto* k = in.header().findTypedAttribute<Imf::StringAttribute>(kKeyAttr);
+    if (!k || k->value() != key) return std::nullopt;
+    const Imath::Box2i dw = in.header().dataWindow();
+    const int W = dw.max.x - dw.min.x + 1, H = dw.max.y - dw.min.y + 1;
+    ReferenceImage r;
+    r.radiance = Image(W, H);
+    r.std_error = Image(W, H);
+    std::vector<uint32_t> tri(size_t(W) * size_t(H), kNoTriangle);
+    Imf::FrameBuffer fb;
+    const char* names[6] = {"R", "G", "B", "se.R", "se.G", "se.B"};
+    for (int c = 0; c < 6; ++c) {
+      if (!in.header().channels().findChannel(names[c])) throw InputError(path.string(), std::string("no channel ") + names[c]);
+      Image& dst = c < 3 ? r.radiance : r.std_error;
+      char* base = reinterpret_cast<char*>(dst.rgb.data() + c % 3) -
+                   (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * W) * ptrdiff_t(3 * sizeof(float));
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base, 3 * sizeof(float), 3 * sizeof(float) * size_t(W)));
+    }
+    if (!in.header().channels().findChannel("triangle")) throw InputError(path.string(), "no channel triangle");
+    fb.insert("triangle", Imf::Slice(Imf::UINT,
+                                     reinterpret_cast<char*>(tri.data()) - (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * W) *
+                                                                               ptrdiff_t(sizeof(uint32_t)),
+                                     sizeof(uint32_t), sizeof(uint32_t) * size_t(W)));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    r.gbuffer = GBuffer::blank(W, H);
+    for (size_t i = 0; i < tri.size(); ++i) r.gbuffer.triangle[i] = tri[i] == kNoTriangle ? -1 : int32_t(tri[i]);
+    for (float v : r.radiance.rgb)
+      if (!std::isfinite(v)) throw InputError(path.string(), "non-finite pixel in the cached reference");
+    return r;
+  } catch (const Iex::BaseExc& e) {
+    throw InputError(path.string(), std::string("cannot read the cached reference: ") + e.what());
+  }
+}
+
+} // namespace prt::view
