@@ -63,6 +63,7 @@ using AttrValue =
 struct Attr {
   std::string name;
   AttrValue value;
+  bool operator==(const Attr&) const = default;
 };
 
 using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>>;
@@ -72,6 +73,7 @@ struct Dataset {
   std::vector<uint64_t> shape;   // row-major; data.size() == product(shape)
   DatasetData data;              // float32 / uint32 / uint8 on disk
   std::vector<Attr> attrs;
+  bool operator==(const Dataset&) const = default;
 };
 
 struct File {
