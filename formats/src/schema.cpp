@@ -84,6 +84,18 @@ std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
   return shape_str(idx);
 }
 
+// The dataset paths schema v2 allows, for messages.
+std::string allowed_paths() {
+  std::string s;
+  for (std::string_view p : {N::kPositions, N::kNormals, N::kTriangles, N::kSourcePosition, N::kAo,
+                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1})
+    s += std::string(p) + ", ";
+  return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
+         std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "} and anything under " +
+         std::string(N::kReport) + "/";
+}
+
 class Checker {
 public:
   explicit Checker(const std::filesystem::path& file) : file_(file.string()) {}
@@ -240,11 +252,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     std::string prefix;
     const Kind k = Checker::classify(d.path, &prefix);
     if (k == Kind::unknown)
-      c.fail("unknown dataset path '" + d.path +
-             "' (schema v2 allows /mesh/{positions,normals,triangles,source_position}, /ao, "
-             "/transfer/{diffuse,visibility}, /radiance/band1, the same under /objects/<name>/, "
-             "/fiv/{environment,irradiance_cube}, /fiv/occluders/<name>/{shells,valid} and anything "
-             "under /report/)");
+      c.fail("unknown dataset path '" + d.path + "' (schema v2 allows " + allowed_paths() + ")");
     if (!prefix.empty() && version < 2)
       c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
              std::to_string(version) + ")");
@@ -418,8 +426,8 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   std::set<std::string_view> groups;
   for (const auto& [g, list] : file.group_attrs) {
     if (g.size() < 2 || g[0] != '/' || g.back() == '/')
-      c.fail("group path '" + g + "' must be absolute, like \"/report\" (root attributes go in "
-             "root_attrs)");
+      c.fail("group path '" + g + "' must be absolute, like \"" + std::string(N::kReport) +
+             "\" (root attributes go in root_attrs)");
     const auto parts = split_path(g);
     for (std::string_view part : parts)
       if (!valid_component(part))
@@ -435,9 +443,13 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
                     (object && parts.size() == 3 && product_group("/" + std::string(parts[2]))) ||
                     g == N::kReport || under(N::kReport);
     if (!ok)
-      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on /mesh, "
-             "/transfer, /radiance, /scene, /objects, /objects/<name>[/mesh|/transfer|/radiance], /fiv, "
-             "/fiv/occluders, /fiv/occluders/<name> and /report...)");
+      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on " +
+             std::string(N::kMeshGroup) + ", " + std::string(N::kTransferGroup) + ", " +
+             std::string(N::kRadianceGroup) + ", " + std::string(N::kScene) + ", " + std::string(N::kObjects) +
+             ", " + std::string(N::kObjects) + "/<name>[" + std::string(N::kMeshGroup) + "|" +
+             std::string(N::kTransferGroup) + "|" + std::string(N::kRadianceGroup) + "], " +
+             std::string(N::kFivGroup) + ", " + std::string(N::kOccluders) + ", " + std::string(N::kOccluders) +
+             "/<name> and " + std::string(N::kReport) + "...)");
     if (object && version < 2)
       c.fail("group '" + g + "' is a scene object's, which needs format_version 2");
     if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");

@@ -350,7 +350,7 @@ Json summary_json(const std::string& path, const pf::Inspection& in) {
   const pf::File& f = in.file;
   Json j = Json::object();
   j["file"] = path;
-  j["format_version"] = version_of(f);
+  j[std::string(names::kFormatVersion)] = version_of(f);
   j["schema_valid"] = !in.schema_error;
   j["schema_error"] = in.schema_error ? Json(*in.schema_error) : Json(nullptr);
   j["root_attrs"] = json_attrs(f.root_attrs);
