@@ -1,6 +1,7 @@
 // reader.cpp — read_file: open, check format/format_version, read everything, validate.
 // Hostile input: every HDF5 call is checked, sizes are checked before allocation, link cycles
 // and depth are bounded, and only hard links are followed (never external files).
+#include <formats/names.h>
 #include <formats/prtfile.h>
 
 #include "h5util.h"
@@ -75,11 +76,16 @@ public:
       if (sclass != H5S_SCALAR) fail(what + " is an array of strings (not supported)");
       const htri_t is_var = H5Tis_variable_str(type.get());
       if (is_var < 0) fail("cannot read the type of " + what);
-      if (is_var > 0)
-        fail(what + " is a variable-length string; schema v1 stores strings as fixed-length "
-                    "UTF-8 (variable-length strings are not read: HDF5 cannot read them safely "
-                    "from a damaged file)");
-      {
+      if (is_var > 0) {
+        // Another tool's string (h5py writes str attributes so): read it, never refuse the file.
+        Hid mem = check(detail::type_id(H5Tcopy(H5T_C_S1)), what);
+        if (H5Tset_size(mem.get(), H5T_VARIABLE) < 0 || H5Tset_cset(mem.get(), H5Tget_cset(type.get())) < 0)
+          fail("cannot read the type of " + what);
+        char* text = nullptr;
+        if (H5Aread(a, mem.get(), &text) < 0) fail("cannot read " + what);
+        out.value = std::string(text != nullptr ? text : "");
+        H5free_memory(text);
+      } else {
         const std::size_t size = H5Tget_size(type.get());
         if (size == 0 || !plausible(size, false)) fail(what + " has an invalid string size");
         std::string s(size, '\0');
@@ -228,21 +234,21 @@ File read_file(const std::filesystem::path& path, ReadCheck check) {
       Hid root = r.check(detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT)), "cannot open the root group");
       out.root_attrs = r.read_attrs(root.get(), "the root group");
 
-      const Attr* fmt = find_attr(out.root_attrs, "format");
+      const Attr* fmt = find_attr(out.root_attrs, names::kFormat);
       const auto* fmt_s = fmt ? std::get_if<std::string>(&fmt->value) : nullptr;
-      if (fmt_s == nullptr) throw FormatError(msg_file, "not a prtbake file (no 'format' attribute)");
+      if (fmt_s == nullptr) throw FormatError(msg_file, "not a prtbake file (no '" + std::string(names::kFormat) + "' attribute)");
       if (*fmt_s != kFormatName)
         throw FormatError(msg_file, "not a prtbake file (format = \"" + *fmt_s + "\")");
-      const Attr* ver = find_attr(out.root_attrs, "format_version");
+      const Attr* ver = find_attr(out.root_attrs, names::kFormatVersion);
       const auto* ver_i = ver ? std::get_if<int64_t>(&ver->value) : nullptr;
       if (ver_i == nullptr)
-        throw FormatError(msg_file, "prtbake file without an integer 'format_version' attribute");
+        throw FormatError(msg_file, "prtbake file without an integer '" + std::string(names::kFormatVersion) + "' attribute");
       if (*ver_i > kFormatVersion)
-        throw FormatError(msg_file, "written by a newer prtbake (format_version " +
+        throw FormatError(msg_file, "written by a newer prtbake (" + std::string(names::kFormatVersion) + " " +
                                         std::to_string(*ver_i) + " > " +
                                         std::to_string(kFormatVersion) + "); update prtbake to read it");
       if (*ver_i < 1)
-        throw FormatError(msg_file, "invalid format_version " + std::to_string(*ver_i));
+        throw FormatError(msg_file, "invalid " + std::string(names::kFormatVersion) + " " + std::to_string(*ver_i));
 
       r.read_group(root.get(), "/", 1, out);
       root.close();

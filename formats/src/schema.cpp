@@ -1,5 +1,6 @@
 // schema.cpp — schema v2 (formats/SCHEMA.md) as code: validate() is the single check that the
-// writer applies before writing and the reader applies after reading.
+// writer applies before writing and the reader applies after reading. Names: <formats/names.h>.
+#include <formats/names.h>
 #include <formats/prtfile.h>
 
 #include <array>
@@ -11,15 +12,14 @@
 namespace prt::formats {
 namespace {
 
+namespace N = names;
+
 constexpr std::array<std::string_view, 7> kRequiredRootStrings = {
-    "generator", "created", "command_line", "source", "source_sha256", "up_axis", "sh_convention"};
+    N::kGenerator, N::kCreated, N::kCommandLine, N::kSource, N::kSourceSha256, N::kUpAxis, N::kShConvention};
 
 constexpr int kMaxRank = 32;  // H5S_MAX_RANK
 
-enum class Kind {
-  positions, normals, triangles, source_position, ao, transfer, band1,
-  fiv_environment, fiv_cube, fiv_shells, fiv_valid, report, unknown
-};
+using Kind = DatasetKind;
 
 std::vector<std::string_view> split_path(std::string_view path) {
   std::vector<std::string_view> parts;
@@ -84,6 +84,18 @@ std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
   return shape_str(idx);
 }
 
+// The dataset paths schema v2 allows, for messages.
+std::string allowed_paths() {
+  std::string s;
+  for (std::string_view p : {N::kPositions, N::kNormals, N::kTriangles, N::kSourcePosition, N::kAo,
+                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1})
+    s += std::string(p) + ", ";
+  return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
+         std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "} and anything under " +
+         std::string(N::kReport) + "/";
+}
+
 class Checker {
 public:
   explicit Checker(const std::filesystem::path& file) : file_(file.string()) {}
@@ -122,57 +134,58 @@ public:
 
   void root(const std::vector<Attr>& list) const {
     attrs(list, "the root group");
-    if (const Attr* f = find_attr(list, "format")) {
+    if (const Attr* f = find_attr(list, N::kFormat)) {
       const auto* s = std::get_if<std::string>(&f->value);
       if (s == nullptr || *s != kFormatName)
-        fail("root attribute 'format' must be the string \"prtbake\"");
+        fail("root attribute '" + std::string(N::kFormat) + "' must be the string \"" + std::string(kFormatName) + "\"");
     }
-    if (const Attr* v = find_attr(list, "format_version")) {
+    if (const Attr* v = find_attr(list, N::kFormatVersion)) {
       const auto* i = std::get_if<int64_t>(&v->value);
       if (i == nullptr || *i < 1 || *i > kFormatVersion)
-        fail("root attribute 'format_version' must be an integer in 1.." +
+        fail("root attribute '" + std::string(N::kFormatVersion) + "' must be an integer in 1.." +
              std::to_string(kFormatVersion));
     }
     for (std::string_view name : kRequiredRootStrings) {
       const std::string& s = required_string(list, name, "the root group");
       if (s.empty()) fail("root attribute '" + std::string(name) + "' is empty");
     }
-    const std::string& up = required_string(list, "up_axis", "the root group");
+    const std::string& up = required_string(list, N::kUpAxis, "the root group");
     if (up != "y" && up != "z")
-      fail("root attribute 'up_axis' must be \"y\" or \"z\", not \"" + up + "\"");
-    const std::string& sha = required_string(list, "source_sha256", "the root group");
+      fail("root attribute '" + std::string(N::kUpAxis) + "' must be \"y\" or \"z\", not \"" + up + "\"");
+    const std::string& sha = required_string(list, N::kSourceSha256, "the root group");
     bool hex = sha.size() == 64;
     for (char c : sha) hex = hex && ((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'));
-    if (!hex) fail("root attribute 'source_sha256' must be 64 lowercase hex digits");
+    if (!hex) fail("root attribute '" + std::string(N::kSourceSha256) + "' must be 64 lowercase hex digits");
   }
 
   // The kind of a dataset path; `prefix` receives the vertex set it belongs to: "" for the
   // root layout (one mesh per file), "/objects/<name>" for an object of a scene file (v2).
-  static Kind classify(std::vector<std::string_view> p, std::string* prefix = nullptr) {
+  static Kind classify(std::string_view path, std::string* prefix = nullptr) {
     if (prefix) prefix->clear();
-    if (p[0] == "report") return p.size() >= 2 ? Kind::report : Kind::unknown;
-    const bool object = p[0] == "objects";
+    const auto p = split_path(path);
+    const std::string objects = std::string(N::kObjects) + "/", occluders = std::string(N::kOccluders) + "/";
+    if (path.starts_with(std::string(N::kReport) + "/")) return Kind::report;
+    std::string_view local = path;  // the path inside its vertex set
+    const bool object = path.starts_with(objects);
     if (object) {
       if (p.size() < 3) return Kind::unknown;
-      if (prefix) *prefix = "/objects/" + std::string(p[1]);
-      p.erase(p.begin(), p.begin() + 2);
+      const std::size_t end = objects.size() + p[1].size();
+      if (prefix) *prefix = std::string(path.substr(0, end));
+      local = path.substr(end);
     }
-    if (p.size() == 1 && p[0] == "ao") return Kind::ao;
-    if (p.size() == 2 && p[0] == "mesh") {
-      if (p[1] == "positions") return Kind::positions;
-      if (p[1] == "normals") return Kind::normals;
-      if (p[1] == "triangles") return Kind::triangles;
-      if (p[1] == "source_position") return Kind::source_position;
-    }
-    if (p.size() == 2 && p[0] == "transfer" && (p[1] == "diffuse" || p[1] == "visibility"))
-      return Kind::transfer;
-    if (p.size() == 2 && p[0] == "radiance" && p[1] == "band1") return Kind::band1;
+    static constexpr std::pair<std::string_view, Kind> kVertexSet[] = {
+        {N::kPositions, Kind::positions},           {N::kNormals, Kind::normals},
+        {N::kTriangles, Kind::triangles},           {N::kSourcePosition, Kind::source_position},
+        {N::kAo, Kind::ao},                         {N::kTransferDiffuse, Kind::transfer_diffuse},
+        {N::kTransferVisibility, Kind::transfer_visibility}, {N::kRadianceBand1, Kind::radiance_band1}};
+    for (const auto& [name, kind] : kVertexSet)
+      if (local == name) return kind;
     if (object) return Kind::unknown;
-    if (p.size() == 2 && p[0] == "fiv" && p[1] == "environment") return Kind::fiv_environment;
-    if (p.size() == 2 && p[0] == "fiv" && p[1] == "irradiance_cube") return Kind::fiv_cube;
-    if (p.size() == 4 && p[0] == "fiv" && p[1] == "occluders") {
-      if (p[3] == "shells") return Kind::fiv_shells;
-      if (p[3] == "valid") return Kind::fiv_valid;
+    if (path == N::kFivEnvironment) return Kind::fiv_environment;
+    if (path == N::kIrradianceCube) return Kind::irradiance_cube;
+    if (path.starts_with(occluders) && p.size() == split_path(N::kOccluders).size() + 2) {
+      if (p.back() == N::kShells) return Kind::occluder_shells;
+      if (p.back() == N::kValid) return Kind::occluder_valid;
     }
     return Kind::unknown;
   }
@@ -195,12 +208,16 @@ public:
 
 } // namespace
 
+DatasetKind dataset_kind(std::string_view path) {
+  return path.size() >= 2 && path[0] == '/' ? Checker::classify(path) : Kind::unknown;
+}
+
 bool is_per_vertex_path(std::string_view path) {
   if (path.size() < 2 || path[0] != '/') return false;
   std::string prefix;
-  switch (Checker::classify(split_path(path), &prefix)) {
+  switch (Checker::classify(path, &prefix)) {
   case Kind::positions: case Kind::normals: case Kind::source_position: case Kind::ao:
-  case Kind::transfer: case Kind::band1:
+  case Kind::transfer_diffuse: case Kind::transfer_visibility: case Kind::radiance_band1:
     return true;
   default:
     return false;
@@ -209,7 +226,7 @@ bool is_per_vertex_path(std::string_view path) {
 
 std::string vertex_set_of(std::string_view path) {
   std::string prefix;
-  if (path.size() >= 2 && path[0] == '/') (void)Checker::classify(split_path(path), &prefix);
+  if (path.size() >= 2 && path[0] == '/') (void)Checker::classify(path, &prefix);
   return prefix;
 }
 
@@ -222,24 +239,20 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   std::vector<Kind> kinds;
   std::vector<std::string> prefixes;  // vertex set of each dataset ("" or "/objects/<name>")
   int64_t version = kFormatVersion;
-  if (const Attr* v = find_attr(file.root_attrs, "format_version"))
+  if (const Attr* v = find_attr(file.root_attrs, N::kFormatVersion))
     if (const auto* i = std::get_if<int64_t>(&v->value)) version = *i;
   for (const Dataset& d : file.datasets) {
     if (d.path.size() < 2 || d.path[0] != '/' || d.path.back() == '/')
-      c.fail("dataset path '" + d.path + "' must be absolute, like \"/mesh/positions\"");
+      c.fail("dataset path '" + d.path + "' must be absolute, like \"" + std::string(N::kPositions) + "\"");
     const auto parts = split_path(d.path);
     for (std::string_view part : parts)
       if (!valid_component(part))
         c.fail("dataset path '" + d.path + "' has an invalid component '" + std::string(part) + "'");
     if (!paths.insert(d.path).second) c.fail("dataset '" + d.path + "' is given twice");
     std::string prefix;
-    const Kind k = Checker::classify(parts, &prefix);
+    const Kind k = Checker::classify(d.path, &prefix);
     if (k == Kind::unknown)
-      c.fail("unknown dataset path '" + d.path +
-             "' (schema v2 allows /mesh/{positions,normals,triangles,source_position}, /ao, "
-             "/transfer/{diffuse,visibility}, /radiance/band1, the same under /objects/<name>/, "
-             "/fiv/{environment,irradiance_cube}, /fiv/occluders/<name>/{shells,valid} and anything "
-             "under /report/)");
+      c.fail("unknown dataset path '" + d.path + "' (schema v2 allows " + allowed_paths() + ")");
     if (!prefix.empty() && version < 2)
       c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
              std::to_string(version) + ")");
@@ -284,9 +297,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   };
   auto vertex_set = [&](const std::string& prefix) {
     VertexSet v;
-    v.positions = find_dataset(file, prefix + "/mesh/positions");
+    v.positions = find_dataset(file, prefix + std::string(N::kPositions));
     v.V = v.positions && !v.positions->shape.empty() ? v.positions->shape[0] : 0;
-    v.has_normals = find_dataset(file, prefix + "/mesh/normals") != nullptr;
+    v.has_normals = find_dataset(file, prefix + std::string(N::kNormals)) != nullptr;
     return v;
   };
   std::map<std::string, const Dataset*> shells;  // occluder dir -> shells
@@ -297,7 +310,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     const VertexSet vs = vertex_set(prefix);
     const Dataset* positions = vs.positions;
     const uint64_t V = vs.V;
-    const std::string mesh_positions = prefix + "/mesh/positions";
+    const std::string mesh_positions = prefix + std::string(N::kPositions);
     if (is_per_vertex_path(d.path) && positions == nullptr)
       c.fail("dataset '" + d.path + "' is per-vertex but the file has no " + mesh_positions + " to " +
              "define the vertex count V");
@@ -329,20 +342,22 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.dtype(d, 0);
       c.shape(d, {V}, "[V]");
       break;
-    case Kind::transfer: {
+    case Kind::transfer_diffuse:
+    case Kind::transfer_visibility: {
       c.dtype(d, 0);
-      const Attr* a = find_attr(d.attrs, "sh_order");
+      const std::string sh_order(N::kShOrder);
+      const Attr* a = find_attr(d.attrs, sh_order);
       const auto* L = a ? std::get_if<int64_t>(&a->value) : nullptr;
       if (L == nullptr)
-        c.fail("dataset '" + d.path + "' lacks the integer attribute 'sh_order' (number of bands L)");
+        c.fail("dataset '" + d.path + "' lacks the integer attribute '" + sh_order + "' (number of bands L)");
       if (*L < 1 || *L > 65535)
-        c.fail("dataset '" + d.path + "' has sh_order " + std::to_string(*L) +
+        c.fail("dataset '" + d.path + "' has " + sh_order + " " + std::to_string(*L) +
                "; the number of bands must be in 1..65535");
       const auto L2 = static_cast<uint64_t>(*L) * static_cast<uint64_t>(*L);
-      c.shape(d, {V, L2}, "[V, L*L] with L = sh_order = " + std::to_string(*L));
+      c.shape(d, {V, L2}, "[V, L*L] with L = " + sh_order + " = " + std::to_string(*L));
       break;
     }
-    case Kind::band1:
+    case Kind::radiance_band1:
       c.dtype(d, 0);
       c.shape(d, {V, 3, 3}, "[V, 3 (RGB), 3 (m = -1, 0, 1)]");
       break;
@@ -350,36 +365,36 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.dtype(d, 0);
       c.shape(d, {3, 3}, "[3 (RGB), 3 (xyz)]");
       break;
-    case Kind::fiv_cube:
+    case Kind::irradiance_cube:
       c.dtype(d, 0);
       if (d.shape.size() != 4 || d.shape[0] != 6 || d.shape[1] != d.shape[2] || d.shape[1] == 0 ||
           d.shape[3] != 3)
-        c.fail("dataset '/fiv/irradiance_cube' has shape " + shape_str(d.shape) +
+        c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) +
                "; expected [6, S, S, 3] with S >= 1");
       break;
-    case Kind::fiv_shells: {
+    case Kind::occluder_shells: {
       c.dtype(d, 0);
       if (d.shape.size() != 5 || d.shape[3] != 3 || d.shape[4] != 3 || d.shape[0] == 0 ||
           d.shape[1] == 0 || d.shape[2] == 0)
         c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) +
                "; expected [Nr, Ntheta, Nphi, 3 (RGB), 3 (xyz)] with Nr, Ntheta, Nphi >= 1");
-      const Attr* centre = find_attr(d.attrs, "centre");
+      const Attr* centre = find_attr(d.attrs, N::kCentre);
       const auto* cv = centre ? std::get_if<std::vector<double>>(&centre->value) : nullptr;
       if (cv == nullptr || cv->size() != 3)
-        c.fail("dataset '" + d.path + "' needs attribute 'centre': 3 doubles (bounding-sphere centre)");
-      const Attr* radius = find_attr(d.attrs, "radius");
+        c.fail("dataset '" + d.path + "' needs attribute '" + std::string(N::kCentre) + "': 3 doubles (bounding-sphere centre)");
+      const Attr* radius = find_attr(d.attrs, N::kRadius);
       const auto* r = radius ? std::get_if<double>(&radius->value) : nullptr;
       if (r == nullptr || !(*r > 0))
-        c.fail("dataset '" + d.path + "' needs attribute 'radius': a double > 0 (bounding-sphere radius)");
-      const Attr* radii = find_attr(d.attrs, "radii");
+        c.fail("dataset '" + d.path + "' needs attribute '" + std::string(N::kRadius) + "': a double > 0 (bounding-sphere radius)");
+      const Attr* radii = find_attr(d.attrs, N::kRadii);
       const auto* rv = radii ? std::get_if<std::vector<double>>(&radii->value) : nullptr;
       if (rv == nullptr || rv->size() != d.shape[0])
-        c.fail("dataset '" + d.path + "' needs attribute 'radii': Nr = " +
+        c.fail("dataset '" + d.path + "' needs attribute '" + std::string(N::kRadii) + "': Nr = " +
                std::to_string(d.shape[0]) + " doubles (shell radii)");
-      shells[d.path.substr(0, d.path.size() - 6)] = &d;  // strip "shells"
+      shells[d.path.substr(0, d.path.size() - N::kShells.size())] = &d;  // the occluder's directory + "/"
       break;
     }
-    case Kind::fiv_valid:
+    case Kind::occluder_valid:
     case Kind::report:
     case Kind::unknown:
       break;
@@ -387,11 +402,11 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];
-    if (kinds[i] != Kind::fiv_valid) continue;
+    if (kinds[i] != Kind::occluder_valid) continue;
     c.dtype(d, 2);
-    const auto it = shells.find(d.path.substr(0, d.path.size() - 5));  // strip "valid"
+    const auto it = shells.find(d.path.substr(0, d.path.size() - N::kValid.size()));
     if (it == shells.end())
-      c.fail("dataset '" + d.path + "' has no 'shells' dataset beside it");
+      c.fail("dataset '" + d.path + "' has no '" + std::string(N::kShells) + "' dataset beside it");
     const auto& s = it->second->shape;
     c.shape(d, {s[0], s[1], s[2]}, "[Nr, Ntheta, Nphi] of its shells");
     for (std::size_t j = 0; j < std::get<std::vector<uint8_t>>(d.data).size(); ++j)
@@ -401,33 +416,41 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
                std::to_string(j));
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i)
-    if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer || kinds[i] == Kind::band1) &&
+    if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer_diffuse || kinds[i] == Kind::transfer_visibility ||
+         kinds[i] == Kind::radiance_band1) &&
         !vertex_set(prefixes[i]).has_normals)
-      c.fail("dataset '" + file.datasets[i].path + "' needs " + prefixes[i] +
-             "/mesh/normals (the normals the bake used)");
+      c.fail("dataset '" + file.datasets[i].path + "' needs " + prefixes[i] + std::string(N::kNormals) +
+             " (the normals the bake used)");
 
   // Group attributes: only on schema groups (or anything under /report), each group once.
   std::set<std::string_view> groups;
   for (const auto& [g, list] : file.group_attrs) {
     if (g.size() < 2 || g[0] != '/' || g.back() == '/')
-      c.fail("group path '" + g + "' must be absolute, like \"/report\" (root attributes go in "
-             "root_attrs)");
+      c.fail("group path '" + g + "' must be absolute, like \"" + std::string(N::kReport) +
+             "\" (root attributes go in root_attrs)");
     const auto parts = split_path(g);
     for (std::string_view part : parts)
       if (!valid_component(part))
         c.fail("group path '" + g + "' has an invalid component '" + std::string(part) + "'");
-    auto product_group = [](std::string_view x) { return x == "mesh" || x == "transfer" || x == "radiance"; };
-    const bool ok = (parts.size() == 1 && (product_group(parts[0]) || parts[0] == "fiv" || parts[0] == "scene" ||
-                                           parts[0] == "objects")) ||
-                    g == "/fiv/occluders" || (parts.size() == 3 && g.starts_with("/fiv/occluders/")) ||
-                    (parts[0] == "objects" && parts.size() == 2) ||
-                    (parts[0] == "objects" && parts.size() == 3 && product_group(parts[2])) ||
-                    parts[0] == "report";
+    auto product_group = [](std::string_view x) {
+      return x == N::kMeshGroup || x == N::kTransferGroup || x == N::kRadianceGroup;
+    };
+    auto under = [&g](std::string_view dir) { return g.starts_with(std::string(dir) + "/"); };
+    const bool object = g == N::kObjects || under(N::kObjects);
+    const bool ok = product_group(g) || g == N::kFivGroup || g == N::kScene || g == N::kObjects ||
+                    g == N::kOccluders || (parts.size() == 3 && under(N::kOccluders)) ||
+                    (object && parts.size() == 2) ||
+                    (object && parts.size() == 3 && product_group("/" + std::string(parts[2]))) ||
+                    g == N::kReport || under(N::kReport);
     if (!ok)
-      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on /mesh, "
-             "/transfer, /radiance, /scene, /objects, /objects/<name>[/mesh|/transfer|/radiance], /fiv, "
-             "/fiv/occluders, /fiv/occluders/<name> and /report...)");
-    if (parts[0] == "objects" && version < 2)
+      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on " +
+             std::string(N::kMeshGroup) + ", " + std::string(N::kTransferGroup) + ", " +
+             std::string(N::kRadianceGroup) + ", " + std::string(N::kScene) + ", " + std::string(N::kObjects) +
+             ", " + std::string(N::kObjects) + "/<name>[" + std::string(N::kMeshGroup) + "|" +
+             std::string(N::kTransferGroup) + "|" + std::string(N::kRadianceGroup) + "], " +
+             std::string(N::kFivGroup) + ", " + std::string(N::kOccluders) + ", " + std::string(N::kOccluders) +
+             "/<name> and " + std::string(N::kReport) + "...)");
+    if (object && version < 2)
       c.fail("group '" + g + "' is a scene object's, which needs format_version 2");
     if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");
     if (paths.count(g)) c.fail("group '" + g + "' is also a dataset path");

@@ -1,4 +1,5 @@
 // writer.cpp — write_file: validate, write "<name>.tmp.<pid>" deterministically, rename.
+#include <formats/names.h>
 #include <formats/prtfile.h>
 
 #include <formats/testing.h>
@@ -202,11 +203,11 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
     Hid root = detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT));
     if (!root.valid()) fail("cannot open the root group");
     if (add_format) {
-      w.write_attr(root.get(), {"format", std::string(kFormatName)}, "the root group");
-      w.write_attr(root.get(), {"format_version", int64_t{kFormatVersion}}, "the root group");
+      w.write_attr(root.get(), {std::string(names::kFormat), std::string(kFormatName)}, "the root group");
+      w.write_attr(root.get(), {std::string(names::kFormatVersion), int64_t{kFormatVersion}}, "the root group");
     }
     for (const Attr& a : file.root_attrs)
-      if (!add_format || (a.name != "format" && a.name != "format_version"))  // validated equal
+      if (!add_format || (a.name != names::kFormat && a.name != names::kFormatVersion))  // validated equal
         w.write_attr(root.get(), a, "the root group");
     root.close();
     for (const Dataset& d : file.datasets) w.write_dataset(d);

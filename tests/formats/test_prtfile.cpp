@@ -5,6 +5,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <h5py.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -535,18 +536,11 @@ TEST(Interop, H5dumpListsTheLayout) {
 }
 
 TEST(Interop, H5pyReadsValuesAndAttributes) {
-  // The first Python on PATH may be a private one (pyenv) without h5py; Debian's has it when
-  // python3-h5py is installed.
-  std::string python;
-  for (const char* candidate : {"python3", "/usr/bin/python3"})
-    if (run_command(std::string(candidate) + " -c 'import h5py'").exit_code == 0) {
-      python = candidate;
-      break;
-    }
+  const fs::path dir = scratch("h5py");
+  const std::string python = prt::testing::python_with_h5py(dir);
   if (python.empty())
     GTEST_SKIP() << "h5py is not installed for python3 or /usr/bin/python3 "
                     "(apt-get install python3-h5py to run this test)";
-  const fs::path dir = scratch("h5py");
   write_file(dir / "a.prt.h5", make_file());
   const std::string script =
       "import h5py, sys\n"

@@ -5,6 +5,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <h5py.h>
 #include <run_tool.h>
 
 #include <sys/wait.h>
@@ -186,4 +187,22 @@ TEST(Prtdump, HelpTeachesUsageOptionsAndSections) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* s : {"Usage:", "--vertex I", "--json", "Example:", "Statistics", "Exit status"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "help lacks " << s << ":\n" << r.out;
+}
+
+TEST(Prtdump, ShowsAttributesAnotherToolAdded) {
+  // h5py str attributes are variable-length strings: prtdump shows them and the file stays valid.
+  const fs::path dir = scratch("foreign_attrs");
+  const std::string python = prt::testing::python_with_h5py(dir);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  write_file(dir / "a.prt.h5", make_file());
+  ASSERT_EQ(prt::testing::add_h5py_notes(python, dir / "a.prt.h5", "mesh", "ao"), "");
+  const CmdResult r = prtdump(dir, q(dir / "a.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* s : {"schema   valid", "  note            \"root note \u2713\"", "note = \"dataset note\"",
+                        "  /mesh\n      note = \"group note\""})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << r.out;
+  const CmdResult j = prtdump(dir, "--json " + q(dir / "a.prt.h5"));
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  for (const char* s : {"\"note\": \"root note \u2713\"", "\"note\": \"dataset note\"", "\"/mesh\": {"})
+    EXPECT_NE(j.out.find(s), std::string::npos) << "JSON lacks " << s << ":\n" << j.out;
 }

@@ -8,7 +8,7 @@
 #include <bake/sha256.h>
 #include <bake/scene.h>
 #include <bake/vertex_bake.h>
-#include <formats/prtfile.h>
+#include <formats/asset.h>
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
@@ -366,23 +366,22 @@ std::string human_bytes(uintmax_t b) {
 }
 
 // The root attributes every file carries (formats/SCHEMA.md).
-std::vector<prt::formats::Attr> root_attrs(const Args& a, const std::string& source_sha) {
-  return {
-      {"generator", std::string("prtbake ") + kVersion},
-      {"created", timestamp(a.reproducible)},
-      {"command_line", a.command_line},
-      {"source", a.input},
-      {"source_sha256", source_sha},
-      {"up_axis", std::string(a.up == bake::UpAxis::Y ? "y" : "z")},
-      {"sh_convention", std::string("real orthonormal SH, Condon-Shortley phase, index l*(l+1)+m, order = number of "
-                                    "bands L (L*L coefficients); bands 0-2 equal DirectXMath XMSHEvalDirection; "
-                                    "directions in the mesh frame")},
-  };
+prt::formats::RootInfo root_info(const Args& a, const std::string& source_sha) {
+  prt::formats::RootInfo r;
+  r.generator = std::string("prtbake ") + kVersion;
+  r.created = timestamp(a.reproducible);
+  r.command_line = a.command_line;
+  r.source = a.input;
+  r.source_sha256 = source_sha;
+  r.up_axis = a.up == bake::UpAxis::Y ? "y" : "z";
+  r.sh_convention = "real orthonormal SH, Condon-Shortley phase, index l*(l+1)+m, order = number of bands L (L*L "
+                    "coefficients); bands 0-2 equal DirectXMath XMSHEvalDirection; directions in the mesh frame";
+  return r;
 }
 
-// Writes the file (validated, temp + rename: formats/prtfile.h) and says where and how big.
-void write_file(const Args& a, const prt::formats::File& file) {
-  prt::formats::write_file(a.output, file);
+// Writes the asset (validated, temp + rename: formats/asset.h) and says where and how big.
+void write_file(const Args& a, const prt::formats::Asset& asset) {
+  prt::formats::write_asset(a.output, asset);
   if (!a.quiet) {
     std::error_code ec;
     std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
@@ -477,14 +476,14 @@ int run_vertex(const Args& a) {
 
   // ---- the file (formats/SCHEMA.md) ----
   namespace F = prt::formats;
-  F::File file;
-  file.root_attrs = root_attrs(a, mesh_sha);
-  tool::add_mesh(file, "", mesh);
-  tool::add_products(file, "", result,
-                     {integrator.name(), integrator.description(), a.integrator.samples(), a.integrator.seed, a.transfer,
-                      a.visibility, env ? &*env : nullptr, a.environment});
-  if (report) tool::add_report(file, "/report", *report, result.seconds, mesh.positions.size(), a.reproducible);
-  write_file(a, file);
+  F::Asset asset;
+  asset.root = root_info(a, mesh_sha);
+  tool::set_mesh(asset.vertices, mesh);
+  tool::set_products(asset.vertices, result,
+                     {integrator.name(), integrator.description(), a.integrator.samples(), a.integrator.seed, a.transfer, a.visibility,
+                      env ? &*env : nullptr, a.environment});
+  if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
+  write_file(a, asset);
   return 0;
 }
 
@@ -519,24 +518,23 @@ int run_fiv(const Args& a) {
   }
 
   namespace F = prt::formats;
-  F::File file;
-  file.root_attrs = root_attrs(a, bake::sha256_file(a.input));
-  tool::add_fiv_environment(file, env, a.environment, fenv, cube, a.shells.cube);
+  F::Asset asset;
+  asset.root = root_info(a, bake::sha256_file(a.input));
+  tool::set_fiv_environment(asset, env, a.environment, fenv, cube, a.shells.cube);
   const std::string name = tool::safe_name(fs::path(a.input).stem().string());
-  tool::add_fiv_occluder(file, name, sh, env, a.environment, a.shells.fraction, a.shells.silhouette_k);
+  F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, sh, env, a.environment, a.shells.fraction, a.shells.silhouette_k));
   if (a.integrator.report_points > 0) {
-    // Error against a QMC reference (full-sphere mode) at seeded shell samples.
-    const bake::FivErrorReport r =
-        bake::fiv_error_report(mesh, topo, env, sh, fenv, a.integrator.report_points, a.integrator.seed);
+    // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
+    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, sh, fenv, a.integrator.report_points, a.integrator.seed);
     if (say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
                   bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,
                   r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
-    tool::add_fiv_report(file, name, r, sh, a.reproducible);
+    occluder.report = tool::fiv_report_of(name, r, sh, a.reproducible);
   }
-  write_file(a, file);
+  write_file(a, asset);
   return 0;
 }
 
@@ -595,69 +593,63 @@ int run_scene(const Args& a) {
                 result.environment_seconds);
 
   namespace F = prt::formats;
-  F::File file;
-  file.root_attrs = root_attrs(file_args, bake::sha256_file(a.input));
+  F::Asset asset;
+  asset.root = root_info(file_args, bake::sha256_file(a.input));
   const std::string env_path = env ? scene.environment->string() : std::string();
-  std::vector<F::Attr> scene_attrs = {
-      {"scene_file", a.input},
-      {"integrator", std::string(bake::to_string(scene.integrator.kind))},
-      {"samples", int64_t(scene.integrator.samples())},
-      {"seed", int64_t(scene.integrator.seed)},
-      {"sh_tolerance", scene.sh_tolerance},
-      {"relight", int64_t(scene.relight)}};
+  F::SceneInfo& info = asset.scene.emplace();
+  info.scene_file = a.input;
+  info.integrator = std::string(bake::to_string(scene.integrator.kind));
+  info.samples = int64_t(scene.integrator.samples());
+  info.seed = int64_t(scene.integrator.seed);
+  info.sh_tolerance = scene.sh_tolerance;
+  info.relight = int64_t(scene.relight);
   if (env) {
-    scene_attrs.push_back({"environment", env_path});
-    scene_attrs.push_back({"environment_sha256", env->info().sha256});
+    info.environment = env_path;
+    info.environment_sha256 = env->info().sha256;
   }
-  std::string notes;
-  for (const auto& n : plan.notes) notes += (notes.empty() ? "" : "\n") + n;
-  scene_attrs.push_back({"plan", notes});
-  file.group_attrs.push_back({"/scene", std::move(scene_attrs)});
-  auto join = [](const std::vector<std::string>& lines) {
+  auto join = [](const std::vector<std::string>& lines, const char* none) {
     std::string s;
     for (const auto& l : lines) s += (s.empty() ? "" : "\n") + l;
-    return s.empty() ? std::string("-") : s;
+    return s.empty() ? std::string(none) : s;
   };
+  info.plan = join(plan.notes, "");
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const auto& o = scene.objects[i];
     const auto& p = plan.objects[i];
     const auto& ob = result.objects[i];
-    const std::string prefix = "/objects/" + o.name;
-    std::vector<double> transform(16);
-    for (int k = 0; k < 16; ++k) transform[size_t(k)] = o.transform(k / 4, k % 4);
-    std::vector<F::Attr> attrs = {
-        {"role", std::string(bake::role_name(o.role))},
-        {"mesh", o.mesh.string()},
-        {"mesh_sha256", mesh_sha[i]},
-        {"transform", transform},
-        {"albedo", std::vector<double>(o.material.albedo.begin(), o.material.albedo.end())},
-        {"phong_exponent", o.material.phong_exponent},
-        {"sh_order_diffuse", int64_t(p.transfer_order)},
-        {"sh_order_glossy", int64_t(p.visibility_order)},
-        {"baked", join(p.baked)},
-        {"left_out", join(p.left_out)}};
-    if (o.material.glossy())
-      attrs.push_back({"specular", std::vector<double>(o.material.specular.begin(), o.material.specular.end())});
-    if (ob.values) attrs.push_back({"closed_form_vertices", int64_t(ob.closed_form_vertices)});
-    file.group_attrs.push_back({prefix, std::move(attrs)});
-    tool::add_mesh(file, prefix, meshes[i]);
+    F::SceneObject& obj = asset.objects.emplace_back();
+    obj.name = o.name;
+    obj.role = bake::role_name(o.role);
+    obj.mesh = o.mesh.string();
+    obj.mesh_sha256 = mesh_sha[i];
+    obj.transform.emplace(16);
+    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.transform(k / 4, k % 4);
+    obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
+    obj.phong_exponent = o.material.phong_exponent;
+    obj.sh_order_diffuse = int64_t(p.transfer_order);
+    obj.sh_order_glossy = int64_t(p.visibility_order);
+    obj.baked = join(p.baked, "-");
+    obj.left_out = join(p.left_out, "-");
+    if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());
+    if (ob.values) obj.closed_form_vertices = int64_t(ob.closed_form_vertices);
+    tool::set_mesh(obj.set, meshes[i]);
     if (ob.values) {
-      tool::add_products(file, prefix, *ob.values,
-                         {bake::to_string(scene.integrator.kind), ob.integrator_description,
-                          scene.integrator.samples(), scene.integrator.seed, p.transfer_order, p.visibility_order,
-                          env ? &*env : nullptr, env_path});
+      tool::set_products(obj.set, *ob.values,
+                         {std::string(bake::to_string(scene.integrator.kind)), ob.integrator_description,
+                          scene.integrator.samples(), scene.integrator.seed,
+                          p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
       if (ob.report)
-        tool::add_report(file, "/report/objects/" + o.name, *ob.report, ob.values->seconds, meshes[i].positions.size(),
-                         a.reproducible);
+        obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
     }
     if (ob.fiv) {
-      tool::add_fiv_occluder(file, o.name, *ob.fiv, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k);
-      if (ob.fiv_report) tool::add_fiv_report(file, o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
+      F::Occluder& occluder =
+          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.fiv, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
+      if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
     }
   }
   if (plan.fiv_environment)
-    tool::add_fiv_environment(file, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
-  write_file(a, file);
+    tool::set_fiv_environment(asset, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+  write_file(a, asset);
   return 0;
 }
 

@@ -1,12 +1,22 @@
-// prtdump — inspect a baked file: root attributes, layout, per-dataset statistics, one vertex,
-// or the same as JSON. A thin shell: formats/ reads the file; this file only computes summary
-// statistics and prints.
-#include <formats/prtfile.h>
+// prtdump — inspect a baked file: root attributes, layout, the scene plan, the error report,
+// per-dataset statistics, one vertex, or the same as JSON. A thin shell: formats/ reads the file
+// (formats::inspect_asset: the file as stored, and its typed asset when it passes the schema);
+// this file only computes summary statistics and prints. Command line: CLI11; JSON:
+// nlohmann-json; exit codes: tools/common (docs/ARCHITECTURE.md, "Errors").
+#include <formats/asset.h>
+#include <formats/names.h>
 
+#include "tool_main.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -14,28 +24,22 @@
 #include <string>
 #include <vector>
 
-namespace fmt = prt::formats;
+namespace pf = prt::formats;
+namespace names = prt::formats::names;
+using Json = nlohmann::ordered_json;
 
 namespace {
 
 constexpr std::size_t kMaxColumnsForStats = 16;
 
-const char* const kHelp = R"(prtdump — inspect a prtbake file (HDF5, schema version 1)
+constexpr const char* kUsage = "usage: prtdump [--json] [--vertex I] FILE.prt.h5";
 
-Usage:
+constexpr const char* kDescription = R"(prtdump — inspect a prtbake file (HDF5, formats/SCHEMA.md)
+
   prtdump [--json] FILE.prt.h5               summary: attributes, layout, statistics
-  prtdump [--json] --vertex I FILE.prt.h5    every per-vertex value of vertex I
-  prtdump --help
+  prtdump [--json] --vertex I FILE.prt.h5    every per-vertex value of vertex I)";
 
-Options:
-  --vertex I   print vertex I (0-based) from every per-vertex dataset (/mesh/positions,
-               /mesh/normals, /mesh/source_position, /ao, /transfer/*, /radiance/band1);
-               V, the vertex count, is the number of rows of /mesh/positions.
-  --json       print the same information as one JSON object (for scripts). Numbers are
-               exact (shortest round-trip form); NaN and Inf become null.
-  -h, --help   this text.
-
-Example:
+constexpr const char* kFooter = R"(Example:
   prtbake vertex bunny.obj --transfer 3 -o bunny.prt.h5
   prtdump bunny.prt.h5
   prtdump --vertex 0 bunny.prt.h5
@@ -49,6 +53,7 @@ What the summary shows:
                    command line, the up axis and the SH convention (see formats/SCHEMA.md).
   Layout           each dataset: path, element type, shape and its attributes (e.g. sh_order
                    = L, the number of SH bands, so a transfer vector has L*L coefficients).
+                   Attributes another tool added (e.g. with h5py) are shown with the rest.
   Scene            for scene files (prtbake scene): each object's role and what the bake
                    baked and left out, with the reasons.
   Error report     per product: RMSE and max error against the converged reference, the
@@ -63,8 +68,7 @@ What the summary shows:
                    [V, 3, 3] (radiance/band1) prints one row per channel R, G, B with
                    m = -1, 0, 1.
 
-Exit status: 0 success, 1 bad file or vertex out of range (one line on stderr naming the
-file), 2 usage error.
+Exit status 1 also covers a vertex index out of range.
 )";
 
 // ---- number formatting -------------------------------------------------------------------
@@ -83,146 +87,56 @@ std::string num(float v) {
   return std::string(buf, r.ptr);
 }
 // An element of a dataset: float32 in its own shortest form, integers exactly.
-std::string element(const fmt::DatasetData& data, std::size_t i) {
+std::string element(const pf::DatasetData& data, std::size_t i) {
   if (const auto* f = std::get_if<std::vector<float>>(&data)) return num((*f)[i]);
   if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return std::to_string((*u)[i]);
   return std::to_string(std::get<std::vector<uint8_t>>(data)[i]);
 }
-double element_value(const fmt::DatasetData& data, std::size_t i) {
+double element_value(const pf::DatasetData& data, std::size_t i) {
   return std::visit([i](const auto& v) { return static_cast<double>(v[i]); }, data);
 }
 
-// ---- JSON ----------------------------------------------------------------------------------
+// ---- JSON values ---------------------------------------------------------------------------
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (ch) {
-    case '"': out += "\\\""; break;
-    case '\\': out += "\\\\"; break;
-    case '\b': out += "\\b"; break;
-    case '\f': out += "\\f"; break;
-    case '\n': out += "\\n"; break;
-    case '\r': out += "\\r"; break;
-    case '\t': out += "\\t"; break;
-    default:
-      if (c < 0x20 || c == 0x7F) {
-        char buf[8];
-        std::snprintf(buf, sizeof buf, "\\u%04x", c);
-        out += buf;
-      } else {
-        out += ch;
-      }
-    }
-  }
-  return out + "\"";
+// A float32 value for JSON: the double whose shortest form is the float's own shortest form
+// (0.1f prints as 0.1, not 0.10000000149011612); NaN and Inf become null.
+Json json_float(float v) {
+  if (!std::isfinite(v)) return nullptr;
+  return std::strtod(num(v).c_str(), nullptr);
 }
-std::string json_num(double v) { return std::isfinite(v) ? num(v) : "null"; }
-std::string json_element(const fmt::DatasetData& data, std::size_t i) {
-  if (const auto* f = std::get_if<std::vector<float>>(&data))
-    return std::isfinite((*f)[i]) ? num((*f)[i]) : "null";
-  return element(data, i);
+Json json_double(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json json_element(const pf::DatasetData& data, std::size_t i) {
+  if (const auto* f = std::get_if<std::vector<float>>(&data)) return json_float((*f)[i]);
+  if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return (*u)[i];
+  return std::get<std::vector<uint8_t>>(data)[i];
 }
 
-// A tiny streaming JSON writer: objects/arrays with indentation and comma bookkeeping.
-class Json {
-public:
-  explicit Json(std::ostream& os) : os_(os) {}
-  void begin_object() { open('{'); }
-  void end_object() { close('}'); }
-  void begin_array() { open('['); }
-  // An array of scalars on one line: [1, 2, 3].
-  void begin_inline_array() {
-    item();
-    os_ << '[';
-    first_.push_back(true);
-    inline_.push_back(true);
-  }
-  void end_array() { close(']'); }
-  void key(std::string_view k) {
-    item();
-    os_ << json_string(k) << ": ";
-    after_key_ = true;
-  }
-  void raw(const std::string& v) {  // an already-encoded JSON value
-    item();
-    os_ << v;
-  }
-  void string(std::string_view s) { raw(json_string(s)); }
-  void number(double v) { raw(json_num(v)); }
-  void integer(int64_t v) { raw(std::to_string(v)); }
-  void boolean(bool b) { raw(b ? "true" : "false"); }
-  void null() { raw("null"); }
-
-private:
-  void item() {
-    if (after_key_) {
-      after_key_ = false;
-      return;
-    }
-    if (!first_.empty() && inline_.back()) {
-      if (!first_.back()) os_ << ", ";
-      first_.back() = false;
-    } else if (!first_.empty()) {
-      if (!first_.back()) os_ << ',';
-      first_.back() = false;
-      os_ << '\n' << std::string(2 * first_.size(), ' ');
-    }
-  }
-  void open(char c) {
-    item();
-    os_ << c;
-    first_.push_back(true);
-    inline_.push_back(false);
-  }
-  void close(char c) {
-    const bool empty = first_.back(), was_inline = inline_.back();
-    first_.pop_back();
-    inline_.pop_back();
-    if (!empty && !was_inline) os_ << '\n' << std::string(2 * first_.size(), ' ');
-    os_ << c;
-    if (first_.empty()) os_ << '\n';
-  }
-  std::ostream& os_;
-  std::vector<bool> first_, inline_;
-  bool after_key_ = false;
-};
-
-void json_attr_value(Json& j, const fmt::AttrValue& v) {
-  std::visit(
-      [&j](const auto& x) {
+Json json_attr_value(const pf::AttrValue& v) {
+  return std::visit(
+      [](const auto& x) -> Json {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, std::string>) j.string(x);
-        else if constexpr (std::is_same_v<T, int64_t>) j.integer(x);
-        else if constexpr (std::is_same_v<T, double>) j.number(x);
-        else {
-          j.begin_inline_array();
-          for (const auto& e : x) {
-            if constexpr (std::is_same_v<T, std::vector<double>>) j.number(e);
-            else j.integer(e);
-          }
-          j.end_array();
-        }
+        if constexpr (std::is_same_v<T, double>) return json_double(x);
+        else if constexpr (std::is_same_v<T, std::vector<double>>) {
+          Json a = Json::array();
+          for (double e : x) a.push_back(json_double(e));
+          return a;
+        } else return Json(x);
       },
       v);
 }
-void json_attrs(Json& j, const std::vector<fmt::Attr>& attrs) {
-  j.begin_object();
-  for (const fmt::Attr& a : attrs) {
-    j.key(a.name);
-    json_attr_value(j, a.value);
-  }
-  j.end_object();
+Json json_attrs(const std::vector<pf::Attr>& attrs) {
+  Json o = Json::object();
+  for (const pf::Attr& a : attrs) o[a.name] = json_attr_value(a.value);
+  return o;
 }
 
 // ---- text helpers ------------------------------------------------------------------------
 
-std::string attr_text(const fmt::AttrValue& v) {
+std::string attr_text(const pf::AttrValue& v) {
   return std::visit(
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, std::string>) return json_string(x);
+        if constexpr (std::is_same_v<T, std::string>) return Json(x).dump();
         else if constexpr (std::is_same_v<T, int64_t>) return std::to_string(x);
         else if constexpr (std::is_same_v<T, double>) return num(x);
         else {
@@ -245,6 +159,9 @@ std::string shape_text(const std::vector<uint64_t>& shape) {
 std::string pad(std::string s, std::size_t width) {
   if (s.size() < width) s.append(width - s.size(), ' ');
   return s;
+}
+void attrs_text(std::ostream& os, const std::vector<pf::Attr>& attrs) {
+  for (const pf::Attr& a : attrs) os << "      " << a.name << " = " << attr_text(a.value) << '\n';
 }
 
 // ---- statistics --------------------------------------------------------------------------
@@ -274,9 +191,9 @@ struct DatasetStats {
   std::vector<Stats> columns;  // empty unless rank >= 2 and the last axis is small
 };
 
-DatasetStats compute_stats(const fmt::Dataset& d) {
+DatasetStats compute_stats(const pf::Dataset& d) {
   DatasetStats s;
-  const std::size_t n = fmt::element_count(d.data);
+  const std::size_t n = pf::element_count(d.data);
   const uint64_t last = d.shape.empty() ? 1 : d.shape.back();
   if (d.shape.size() >= 2 && last >= 1 && last <= kMaxColumnsForStats) s.columns.resize(last);
   for (std::size_t i = 0; i < n; ++i) {
@@ -287,133 +204,141 @@ DatasetStats compute_stats(const fmt::Dataset& d) {
   return s;
 }
 
+bool is_float(const pf::Dataset& d) { return std::holds_alternative<std::vector<float>>(d.data); }
+
 // min/max are values of the dataset: print them in the dataset's own precision.
-std::string stat_value(const fmt::Dataset& d, double v) {
-  if (d.data.index() == 0) return num(static_cast<float>(v));
+std::string stat_value(const pf::Dataset& d, double v) {
+  if (is_float(d)) return num(static_cast<float>(v));
   return num(v);
 }
+Json json_stat_value(const pf::Dataset& d, double v) {
+  if (!is_float(d)) return static_cast<int64_t>(v);  // a uint32 or uint8 value, exact in a double
+  return json_double(static_cast<double>(static_cast<float>(v)));
+}
 
-void print_stats_text(std::ostream& os, const fmt::Dataset& d, const Stats& s, const std::string& label) {
+void print_stats_text(std::ostream& os, const pf::Dataset& d, const Stats& s, const std::string& label) {
   os << label;
   if (s.finite == 0) os << "min -  max -  mean -";
   else
     os << "min " << stat_value(d, s.min) << "  max " << stat_value(d, s.max) << "  mean "
        << num(*s.mean());
-  if (d.data.index() == 0) os << "  nan " << s.nan << "  inf " << s.inf;
+  if (is_float(d)) os << "  nan " << s.nan << "  inf " << s.inf;
   os << '\n';
 }
 
-void json_stats(Json& j, const fmt::Dataset& d, const Stats& s, bool counts) {
-  j.begin_object();
-  j.key("min");
-  s.finite ? j.raw(json_num(d.data.index() == 0 ? static_cast<double>(static_cast<float>(s.min)) : s.min)) : j.null();
-  j.key("max");
-  s.finite ? j.raw(json_num(d.data.index() == 0 ? static_cast<double>(static_cast<float>(s.max)) : s.max)) : j.null();
-  j.key("mean");
-  s.finite ? j.number(*s.mean()) : j.null();
+Json json_stats(const pf::Dataset& d, const Stats& s, bool counts) {
+  Json o = Json::object();
+  o["min"] = s.finite ? json_stat_value(d, s.min) : Json(nullptr);
+  o["max"] = s.finite ? json_stat_value(d, s.max) : Json(nullptr);
+  o["mean"] = s.finite ? json_double(*s.mean()) : Json(nullptr);
   if (counts) {
-    j.key("finite");
-    j.integer(static_cast<int64_t>(s.finite));
-    j.key("nan");
-    j.integer(static_cast<int64_t>(s.nan));
-    j.key("inf");
-    j.integer(static_cast<int64_t>(s.inf));
+    o["finite"] = s.finite;
+    o["nan"] = s.nan;
+    o["inf"] = s.inf;
   }
-  j.end_object();
+  return o;
 }
 
 // ---- summary -----------------------------------------------------------------------------
 
-int64_t version_of(const fmt::File& f) {
-  const fmt::Attr* v = fmt::find_attr(f.root_attrs, "format_version");
-  return v ? std::get<int64_t>(v->value) : 0;  // read_file checked it is an int64
+int64_t version_of(const pf::File& f) {
+  const pf::Attr* v = pf::find_attr(f.root_attrs, names::kFormatVersion);
+  return v ? std::get<int64_t>(v->value) : 0;  // inspect_asset checked it is an int64
 }
 
 // The plan of a scene file: each object's role, what was baked and what was left out.
-void scene_text(std::ostream& os, const fmt::File& f) {
-  bool header = false;
-  for (const auto& [g, attrs] : f.group_attrs) {
-    if (!g.starts_with("/objects/")) continue;
-    if (!header) os << "\nScene (objects, what was baked and what was left out)\n";
-    header = true;
-    const fmt::Attr* role = fmt::find_attr(attrs, "role");
-    const auto* role_s = role ? std::get_if<std::string>(&role->value) : nullptr;
-    os << "  " << g.substr(9) << " (" << (role_s ? *role_s : std::string("?")) << ")\n";
-    for (const char* key : {"baked", "left_out"}) {
-      const fmt::Attr* a = fmt::find_attr(attrs, key);
-      const auto* text = a ? std::get_if<std::string>(&a->value) : nullptr;
-      if (text == nullptr || *text == "-") continue;
+void scene_text(std::ostream& os, const pf::Asset& a) {
+  if (a.objects.empty()) return;
+  os << "\nScene (objects, what was baked and what was left out)\n";
+  for (const pf::SceneObject& o : a.objects) {
+    os << "  " << o.name << " (" << o.role.value_or("?") << ")\n";
+    for (const auto& [lines, label] : {std::pair{&o.baked, "baked      "}, std::pair{&o.left_out, "left out   "}}) {
+      if (!*lines || **lines == "-") continue;
+      const std::string& text = **lines;
       std::size_t start = 0;
-      while (start <= text->size()) {
-        const std::size_t end = std::min(text->find('\n', start), text->size());
-        os << "      " << (key[0] == 'b' ? "baked      " : "left out   ") << text->substr(start, end - start) << '\n';
+      while (start <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        os << "      " << label << text.substr(start, end - start) << '\n';
         start = end + 1;
       }
     }
   }
 }
 
-// The error against run time stored under /report: [5] datasets with a 'columns' attribute.
-void report_text(std::ostream& os, const fmt::File& f) {
-  bool header = false;
-  for (const fmt::Dataset& d : f.datasets) {
-    if (!d.path.starts_with("/report/") || d.shape != std::vector<uint64_t>{5} || d.data.index() != 0) continue;
-    if (!header)
-      os << "\nError report (against a converged reference; times are wall seconds)\n"
-         << "  " << pad("product", 40) << pad("RMSE", 12) << pad("max", 12) << pad("ref. RMS", 12)
-         << pad("ref. s.e.", 12) << pad("bake s", 9) << pad("ref. s", 9) << "integrals/s\n";
-    header = true;
-    const auto& v = std::get<std::vector<float>>(d.data);
-    auto num = [](double x, int w) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%-*.3e", w, x);
-      return std::string(buf);
-    };
-    auto attr_num = [&](const char* name) {
-      const fmt::Attr* a = fmt::find_attr(d.attrs, name);
-      const auto* x = a ? std::get_if<double>(&a->value) : nullptr;
-      char buf[32];
-      if (x) std::snprintf(buf, sizeof buf, "%-9.3g", *x);
-      else std::snprintf(buf, sizeof buf, "%-9s", "-");
-      return std::string(buf);
-    };
-    os << "  " << pad(d.path.substr(8), 40) << num(v[0], 12) << num(v[1], 12) << num(v[2], 12) << num(v[4], 12)
-       << attr_num("bake_seconds") << attr_num("reference_seconds") << attr_num("integrals_per_second") << '\n';
-  }
+// Every error-report row of the asset, labelled by its path under /report, in path order.
+std::vector<std::pair<std::string, const pf::ReportRow*>> report_rows(const pf::Asset& a) {
+  std::vector<std::pair<std::string, const pf::ReportRow*>> rows;
+  const std::string report_dir = std::string(names::kReport) + "/";
+  auto relative = [&](std::string_view path) { return std::string(path.substr(report_dir.size())); };
+  for (const pf::ReportRow& r : a.vertices.report.rows) rows.emplace_back(r.product, &r);
+  for (const pf::SceneObject& o : a.objects)
+    for (const pf::ReportRow& r : o.set.report.rows)
+      rows.emplace_back(relative(std::string(names::kReport) + std::string(names::kObjects)) + "/" + o.name + "/" +
+                            r.product,
+                        &r);
+  for (const pf::Occluder& o : a.occluders)
+    if (o.report) rows.emplace_back(relative(names::kReportFiv) + "/" + o.name, &*o.report);
+  std::sort(rows.begin(), rows.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  return rows;
 }
 
-void summary_text(std::ostream& os, const std::string& path, const fmt::File& f,
-                  const std::optional<std::string>& schema_error) {
+// The error against run time stored under /report.
+void report_text(std::ostream& os, const pf::Asset& a) {
+  const auto rows = report_rows(a);
+  if (rows.empty()) return;
+  os << "\nError report (against a converged reference; times are wall seconds)\n"
+     << "  " << pad("product", 40) << pad("RMSE", 12) << pad("max", 12) << pad("ref. RMS", 12) << pad("ref. s.e.", 12)
+     << pad("bake s", 9) << pad("ref. s", 9) << "integrals/s\n";
+  auto sci = [](double x, int w) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%-*.3e", w, x);
+    return std::string(buf);
+  };
+  auto seconds = [](const std::optional<double>& x) {
+    char buf[32];
+    if (x) std::snprintf(buf, sizeof buf, "%-9.3g", *x);
+    else std::snprintf(buf, sizeof buf, "%-9s", "-");
+    return std::string(buf);
+  };
+  for (const auto& [label, r] : rows)
+    os << "  " << pad(label, 40) << sci(r->values[0], 12) << sci(r->values[1], 12) << sci(r->values[2], 12)
+       << sci(r->values[4], 12) << seconds(r->bake_seconds) << seconds(r->reference_seconds)
+       << seconds(r->integrals_per_second) << '\n';
+}
+
+void summary_text(std::ostream& os, const std::string& path, const pf::Inspection& in) {
+  const pf::File& f = in.file;
   os << "file     " << path << '\n';
   os << "format   prtbake, format_version " << version_of(f) << '\n';
   os << "schema   "
-     << (schema_error ? "INVALID: " + *schema_error
-                      : "valid (schema v" + std::to_string(version_of(f)) + ", this prtdump reads 1.." +
-                            std::to_string(fmt::kFormatVersion) + ")")
+     << (in.schema_error ? "INVALID: " + *in.schema_error
+                         : "valid (schema v" + std::to_string(version_of(f)) + ", this prtdump reads 1.." +
+                               std::to_string(pf::kFormatVersion) + ")")
      << "\n\nRoot attributes\n";
   std::size_t w = 0;
-  for (const fmt::Attr& a : f.root_attrs) w = std::max(w, a.name.size());
-  for (const fmt::Attr& a : f.root_attrs) os << "  " << pad(a.name, w + 2) << attr_text(a.value) << '\n';
+  for (const pf::Attr& a : f.root_attrs) w = std::max(w, a.name.size());
+  for (const pf::Attr& a : f.root_attrs) os << "  " << pad(a.name, w + 2) << attr_text(a.value) << '\n';
 
   os << "\nLayout (" << f.datasets.size() << " datasets)\n";
   w = 0;
-  for (const fmt::Dataset& d : f.datasets) w = std::max(w, d.path.size());
-  for (const fmt::Dataset& d : f.datasets) {
-    os << "  " << pad(d.path, w + 2) << pad(std::string(fmt::dtype_name(d.data)), 9)
-       << shape_text(d.shape) << '\n';
-    for (const fmt::Attr& a : d.attrs) os << "      " << a.name << " = " << attr_text(a.value) << '\n';
+  for (const pf::Dataset& d : f.datasets) w = std::max(w, d.path.size());
+  for (const pf::Dataset& d : f.datasets) {
+    os << "  " << pad(d.path, w + 2) << pad(std::string(pf::dtype_name(d.data)), 9) << shape_text(d.shape) << '\n';
+    attrs_text(os, d.attrs);
   }
-  scene_text(os, f);
-  report_text(os, f);
+  if (in.asset) {
+    scene_text(os, *in.asset);
+    report_text(os, *in.asset);
+  }
   if (!f.group_attrs.empty()) {
     os << "\nGroup attributes\n";
     for (const auto& [g, attrs] : f.group_attrs) {
       os << "  " << g << '\n';
-      for (const fmt::Attr& a : attrs) os << "      " << a.name << " = " << attr_text(a.value) << '\n';
+      attrs_text(os, attrs);
     }
   }
   os << "\nStatistics (min, max, mean over finite values; counts of NaN and Inf)\n";
-  for (const fmt::Dataset& d : f.datasets) {
+  for (const pf::Dataset& d : f.datasets) {
     const DatasetStats s = compute_stats(d);
     print_stats_text(os, d, s.all, "  " + pad(d.path, w + 2));
     for (std::size_t c = 0; c < s.columns.size(); ++c)
@@ -421,88 +346,72 @@ void summary_text(std::ostream& os, const std::string& path, const fmt::File& f,
   }
 }
 
-void summary_json(std::ostream& os, const std::string& path, const fmt::File& f,
-                  const std::optional<std::string>& schema_error) {
-  Json j(os);
-  j.begin_object();
-  j.key("file");
-  j.string(path);
-  j.key("format_version");
-  j.integer(version_of(f));
-  j.key("schema_valid");
-  j.boolean(!schema_error);
-  j.key("schema_error");
-  schema_error ? j.string(*schema_error) : j.null();
-  j.key("root_attrs");
-  json_attrs(j, f.root_attrs);
-  j.key("group_attrs");
-  j.begin_object();
-  for (const auto& [g, attrs] : f.group_attrs) {
-    j.key(g);
-    json_attrs(j, attrs);
-  }
-  j.end_object();
-  j.key("datasets");
-  j.begin_array();
-  for (const fmt::Dataset& d : f.datasets) {
+Json summary_json(const std::string& path, const pf::Inspection& in) {
+  const pf::File& f = in.file;
+  Json j = Json::object();
+  j["file"] = path;
+  j[std::string(names::kFormatVersion)] = version_of(f);
+  j["schema_valid"] = !in.schema_error;
+  j["schema_error"] = in.schema_error ? Json(*in.schema_error) : Json(nullptr);
+  j["root_attrs"] = json_attrs(f.root_attrs);
+  Json groups = Json::object();
+  for (const auto& [g, attrs] : f.group_attrs) groups[g] = json_attrs(attrs);
+  j["group_attrs"] = std::move(groups);
+  Json datasets = Json::array();
+  for (const pf::Dataset& d : f.datasets) {
     const DatasetStats s = compute_stats(d);
-    j.begin_object();
-    j.key("path");
-    j.string(d.path);
-    j.key("dtype");
-    j.string(fmt::dtype_name(d.data));
-    j.key("shape");
-    j.begin_inline_array();
-    for (uint64_t x : d.shape) j.integer(static_cast<int64_t>(x));
-    j.end_array();
-    j.key("attrs");
-    json_attrs(j, d.attrs);
-    j.key("stats");
-    json_stats(j, d, s.all, true);
+    Json o = Json::object();
+    o["path"] = d.path;
+    o["dtype"] = pf::dtype_name(d.data);
+    o["shape"] = d.shape;
+    o["attrs"] = json_attrs(d.attrs);
+    o["stats"] = json_stats(d, s.all, true);
     if (!s.columns.empty()) {
-      j.key("columns");
-      j.begin_array();
-      for (const Stats& c : s.columns) json_stats(j, d, c, false);
-      j.end_array();
+      Json columns = Json::array();
+      for (const Stats& c : s.columns) columns.push_back(json_stats(d, c, false));
+      o["columns"] = std::move(columns);
     }
-    j.end_object();
+    datasets.push_back(std::move(o));
   }
-  j.end_array();
-  j.end_object();
+  j["datasets"] = std::move(datasets);
+  return j;
 }
 
 // ---- one vertex --------------------------------------------------------------------------
 
-std::vector<const fmt::Dataset*> vertex_datasets(const fmt::File& f, uint64_t V) {
-  std::vector<const fmt::Dataset*> out;
-  for (const fmt::Dataset& d : f.datasets)
-    if (fmt::is_per_vertex_path(d.path) && !d.shape.empty() && d.shape[0] == V) out.push_back(&d);
+// The per-vertex datasets of the root layout (V rows each), in path order.
+std::vector<const pf::Dataset*> vertex_datasets(const pf::File& f, uint64_t V) {
+  std::vector<const pf::Dataset*> out;
+  for (const pf::Dataset& d : f.datasets)
+    if (pf::is_per_vertex_path(d.path) && pf::vertex_set_of(d.path).empty() && !d.shape.empty() && d.shape[0] == V)
+      out.push_back(&d);
   return out;
 }
 
-std::string row_text(const fmt::Dataset& d, std::size_t begin, std::size_t count) {
+std::string row_text(const pf::Dataset& d, std::size_t begin, std::size_t count) {
   std::string s = "[";
   for (std::size_t i = 0; i < count; ++i) s += (i ? ", " : "") + element(d.data, begin + i);
   return s + "]";
 }
 
-void vertex_text(std::ostream& os, const std::string& path, const fmt::File& f, uint64_t vertex, uint64_t V) {
+std::size_t per_vertex(const pf::Dataset& d) { return pf::shape_product({d.shape.begin() + 1, d.shape.end()}); }
+
+void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, uint64_t vertex, uint64_t V) {
   os << "vertex " << vertex << " of " << V << " (" << path << ")\n";
   const auto list = vertex_datasets(f, V);
   std::size_t w = 0;
   for (const auto* d : list) w = std::max(w, d->path.size());
-  for (const fmt::Dataset* d : list) {
-    const std::size_t per = fmt::shape_product({d->shape.begin() + 1, d->shape.end()});
+  for (const pf::Dataset* d : list) {
+    const std::size_t per = per_vertex(*d);
     const std::size_t base = vertex * per;
     const std::string head = "  " + pad(d->path, w + 2);
     const std::string cont(head.size(), ' ');
-    const fmt::Attr* order = fmt::find_attr(d->attrs, "sh_order");
+    const pf::Attr* order = pf::find_attr(d->attrs, names::kShOrder);
+    const auto* L = order ? std::get_if<int64_t>(&order->value) : nullptr;
     if (d->shape.size() == 1) {
       os << head << element(d->data, base) << '\n';
-    } else if (order && d->shape.size() == 2 && std::holds_alternative<int64_t>(order->value) &&
-               static_cast<uint64_t>(std::get<int64_t>(order->value) * std::get<int64_t>(order->value)) == per) {
-      const auto L = static_cast<std::size_t>(std::get<int64_t>(order->value));
-      for (std::size_t l = 0; l < L; ++l)
+    } else if (L && d->shape.size() == 2 && static_cast<uint64_t>(*L * *L) == per) {
+      for (std::size_t l = 0; l < static_cast<std::size_t>(*L); ++l)
         os << (l ? cont : head) << "l=" << l << "  " << row_text(*d, base + l * l, 2 * l + 1) << '\n';
     } else if (d->shape.size() == 2) {
       os << head << row_text(*d, base, per) << '\n';
@@ -510,9 +419,10 @@ void vertex_text(std::ostream& os, const std::string& path, const fmt::File& f, 
       // Rows of the last axis, labelled by their leading indices (R/G/B for radiance/band1).
       const std::size_t last = d->shape.back();
       const std::vector<uint64_t> lead(d->shape.begin() + 1, d->shape.end() - 1);
+      const bool rgb = pf::dataset_kind(d->path) == pf::DatasetKind::radiance_band1;
       for (std::size_t r = 0; r * last < per; ++r) {
         std::string label;
-        if (d->path == "/radiance/band1") label = std::string(1, "RGB"[r]) + "  ";
+        if (rgb) label = std::string(1, "RGB"[r]) + "  ";
         else {
           std::size_t rem = r;
           std::vector<uint64_t> idx(lead.size());
@@ -525,113 +435,80 @@ void vertex_text(std::ostream& os, const std::string& path, const fmt::File& f, 
   }
 }
 
-void json_nested(Json& j, const fmt::Dataset& d, std::size_t base, std::size_t axis) {
-  if (axis == d.shape.size()) {
-    j.raw(json_element(d.data, base));
-    return;
-  }
-  const std::size_t stride = fmt::shape_product({d.shape.begin() + static_cast<std::ptrdiff_t>(axis) + 1, d.shape.end()});
-  axis + 1 == d.shape.size() ? j.begin_inline_array() : j.begin_array();
-  for (std::size_t i = 0; i < d.shape[axis]; ++i) json_nested(j, d, base + i * stride, axis + 1);
-  j.end_array();
+// The values of one vertex nested by the trailing axes.
+Json json_nested(const pf::Dataset& d, std::size_t base, std::size_t axis) {
+  if (axis == d.shape.size()) return json_element(d.data, base);
+  const std::size_t stride = pf::shape_product({d.shape.begin() + static_cast<std::ptrdiff_t>(axis) + 1, d.shape.end()});
+  Json a = Json::array();
+  for (std::size_t i = 0; i < d.shape[axis]; ++i) a.push_back(json_nested(d, base + i * stride, axis + 1));
+  return a;
 }
 
-void vertex_json(std::ostream& os, const std::string& path, const fmt::File& f, uint64_t vertex, uint64_t V) {
-  Json j(os);
-  j.begin_object();
-  j.key("file");
-  j.string(path);
-  j.key("vertex");
-  j.integer(static_cast<int64_t>(vertex));
-  j.key("vertex_count");
-  j.integer(static_cast<int64_t>(V));
-  j.key("values");
-  j.begin_object();
-  for (const fmt::Dataset* d : vertex_datasets(f, V)) {
-    j.key(d->path);
-    const std::size_t per = fmt::shape_product({d->shape.begin() + 1, d->shape.end()});
-    json_nested(j, *d, vertex * per, 1);
-  }
-  j.end_object();
-  j.end_object();
+Json vertex_json(const std::string& path, const pf::File& f, uint64_t vertex, uint64_t V) {
+  Json j = Json::object();
+  j["file"] = path;
+  j["vertex"] = vertex;
+  j["vertex_count"] = V;
+  Json values = Json::object();
+  for (const pf::Dataset* d : vertex_datasets(f, V)) values[d->path] = json_nested(*d, vertex * per_vertex(*d), 1);
+  j["values"] = std::move(values);
+  return j;
 }
 
-int usage_error(const std::string& msg) {
-  std::cerr << "prtdump: " << msg << "\nusage: prtdump [--json] [--vertex I] FILE.prt.h5 (see prtdump --help)\n";
-  return 2;
+// V of the root layout, from its positions.
+uint64_t root_vertex_count(const pf::File& f, const std::string& file) {
+  for (const pf::Dataset& d : f.datasets)
+    if (pf::dataset_kind(d.path) == pf::DatasetKind::positions && pf::vertex_set_of(d.path).empty() &&
+        !d.shape.empty())
+      return d.shape[0];
+  throw pf::FormatError(file, "--vertex needs " + std::string(names::kPositions) + ", which this file does not have");
+}
+
+int prtdump_main(int argc, char** argv) {
+  CLI::App app(kDescription, "prtdump");
+  app.footer(std::string(kFooter) + "\n" + prt::tool::kExitStatusHelp);
+  app.get_formatter()->column_width(22);
+  bool json = false;
+  uint64_t vertex = 0;
+  std::string file;
+  app.add_flag("--json", json,
+               "print the same information as one JSON object (for scripts). Numbers are exact (shortest "
+               "round-trip form); NaN and Inf become null.");
+  CLI::Option* vertex_opt =
+      app.add_option("--vertex", vertex,
+                     "print vertex I (0-based) from every per-vertex dataset of the root layout (mesh positions, "
+                     "normals and source positions, ao, transfer, radiance band 1); V, the vertex count, is the "
+                     "number of mesh positions.")
+          ->type_name("I");
+  app.add_option("FILE", file, "the .prt.h5 file to inspect")->required()->type_name("FILE.prt.h5");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    throw prt::tool::UsageError(std::string(e.what()) + "; " + kUsage);
+  }
+
+  const pf::Inspection in = pf::inspect_asset(file);
+  std::ostringstream out;
+  if (vertex_opt->count() > 0) {
+    const uint64_t V = root_vertex_count(in.file, file);
+    if (vertex >= V)
+      throw pf::FormatError(file, "vertex " + std::to_string(vertex) + " is out of range (the mesh has " +
+                                      std::to_string(V) + " vertices: 0.." +
+                                      (V ? std::to_string(V - 1) : std::string("none")) + ")");
+    if (json) out << vertex_json(file, in.file, vertex, V).dump(2) << '\n';
+    else vertex_text(out, file, in.file, vertex, V);
+  } else {
+    if (json) out << summary_json(file, in).dump(2) << '\n';
+    else summary_text(out, file, in);
+  }
+  std::cout << out.str();
+  std::cout.flush();
+  if (!std::cout) throw pf::FormatError("standard output", "cannot write");
+  return 0;
 }
 
 } // namespace
 
-int main(int argc, char** argv) {
-  bool json = false;
-  std::optional<uint64_t> vertex;
-  std::optional<std::string> file;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kHelp;
-      return 0;
-    }
-    if (a == "--json") {
-      json = true;
-    } else if (a == "--vertex" || a.starts_with("--vertex=")) {
-      std::string v;
-      if (a == "--vertex") {
-        if (i + 1 >= argc) return usage_error("--vertex needs a vertex index");
-        v = argv[++i];
-      } else {
-        v = a.substr(9);
-      }
-      uint64_t x = 0;
-      const auto r = std::from_chars(v.data(), v.data() + v.size(), x);
-      if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size())
-        return usage_error("--vertex needs a non-negative integer, not '" + v + "'");
-      vertex = x;
-    } else if (a.size() > 1 && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
-    } else if (file) {
-      return usage_error("one file at a time ('" + *file + "' and '" + a + "' given)");
-    } else {
-      file = a;
-    }
-  }
-  if (!file) return usage_error("no file given");
-
-  try {
-    const fmt::File f = fmt::read_file(*file, fmt::ReadCheck::header);
-    std::optional<std::string> schema_error;
-    try {
-      fmt::validate(f, *file);
-    } catch (const fmt::FormatError& e) {
-      schema_error = e.defect();
-    }
-    std::ostringstream out;
-    if (vertex) {
-      const fmt::Dataset* positions = fmt::find_dataset(f, "/mesh/positions");
-      if (positions == nullptr || positions->shape.empty())
-        throw fmt::FormatError(*file, "--vertex needs /mesh/positions, which this file does not have");
-      const uint64_t V = positions->shape[0];
-      if (*vertex >= V)
-        throw fmt::FormatError(*file, "vertex " + std::to_string(*vertex) + " is out of range (the mesh has " +
-                                          std::to_string(V) + " vertices: 0.." +
-                                          (V ? std::to_string(V - 1) : std::string("none")) + ")");
-      json ? vertex_json(out, *file, f, *vertex, V) : vertex_text(out, *file, f, *vertex, V);
-    } else {
-      json ? summary_json(out, *file, f, schema_error) : summary_text(out, *file, f, schema_error);
-    }
-    std::cout << out.str();
-    std::cout.flush();
-    if (!std::cout) {
-      std::cerr << "prtdump: cannot write to standard output\n";
-      return 1;
-    }
-  } catch (const fmt::FormatError& e) {
-    std::cerr << "prtdump: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "prtdump: " << *file << ": " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
-}
+int main(int argc, char** argv) { return prt::tool::run_tool("prtdump", prtdump_main, argc, argv); }

@@ -1,15 +1,18 @@
 // formats/prtfile.h — the baked file (HDF5, schema version 1): the in-memory model, the one
 // writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
 // depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
-// specified in formats/SCHEMA.md; DESIGN.md §3 and §5 are its source.
+// specified in formats/SCHEMA.md (docs/ARCHITECTURE.md, "Schema"); every path and attribute
+// name is in <formats/names.h>. This is the generic layer under the typed asset model
+// (<formats/asset.h>), which is what tools and the runtime loader read and write.
 //
 // Model
 //   A File is a list of root attributes, a list of datasets (each with an absolute path, a
 //   row-major shape, typed data and attributes) and a list of group attributes. Groups are not
 //   listed: they exist because a dataset lies under them or because they carry attributes.
 //   On-disk types: std::vector<float> <-> float32 (IEEE little endian), std::vector<uint32_t>
-//   <-> uint32, std::vector<uint8_t> <-> uint8. Attribute values: std::string <-> variable-length
-//   UTF-8 string, int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
+//   <-> uint32, std::vector<uint8_t> <-> uint8. Attribute values: std::string <-> fixed-length
+//   UTF-8 string (the writer's; variable-length strings that other tools wrote, e.g. h5py's
+//   str attributes, are read too), int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
 //   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
 //
 // Writer contract (write_file)
@@ -60,6 +63,7 @@ using AttrValue =
 struct Attr {
   std::string name;
   AttrValue value;
+  bool operator==(const Attr&) const = default;
 };
 
 using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>>;
@@ -69,6 +73,7 @@ struct Dataset {
   std::vector<uint64_t> shape;   // row-major; data.size() == product(shape)
   DatasetData data;              // float32 / uint32 / uint8 on disk
   std::vector<Attr> attrs;
+  bool operator==(const Dataset&) const = default;
 };
 
 struct File {
@@ -119,6 +124,12 @@ const std::vector<Attr>* find_group_attrs(const File& file, std::string_view gro
 // /transfer/visibility, /radiance/band1, and the same under /objects/<name>/ (schema v2 scene
 // files). /report datasets are never per-vertex.
 bool is_per_vertex_path(std::string_view path);
+// What a dataset path is in the schema (the same rules under /objects/<name>/ for vertex sets).
+enum class DatasetKind {
+  positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
+  radiance_band1, fiv_environment, irradiance_cube, occluder_shells, occluder_valid, report, unknown
+};
+DatasetKind dataset_kind(std::string_view path);
 // The vertex set a dataset path belongs to: "" for the root layout, "/objects/<name>" for a scene
 // object (its V is the rows of "<set>/mesh/positions").
 std::string vertex_set_of(std::string_view path);

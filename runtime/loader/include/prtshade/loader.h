@@ -1,5 +1,5 @@
 // prtshade/loader.h — the optional HDF5 loader of prtshade (target prt::prtshade_hdf5): reads a
-// baked .prt.h5 file (formats/SCHEMA.md, schema v1 and v2) with formats/ and returns plain owning
+// baked .prt.h5 file (formats/SCHEMA.md, schema v1 and v2) with formats::read_asset and returns plain owning
 // arrays in the file's own layout, plus the non-owning views the std-only core shades with
 // (<prtshade/fiv.h> FivOccluder / DifMap). The core never needs HDF5; an engine with its own
 // asset pipeline can skip this library and fill the views itself.
@@ -80,7 +80,7 @@ struct LoadedAsset {
   std::vector<FivOccluder> occluder_views() const;
 };
 
-// Reads `path` (formats::read_file with the full schema check) into a LoadedAsset.
+// Reads `path` (formats::read_asset, with the full schema check) into a LoadedAsset.
 LoadedAsset load_prt(const std::filesystem::path& path);
 
 } // namespace prt::shade

@@ -1,0 +1,223 @@
+// formats/asset.h — the typed asset model: plain structs that describe a baked file (vertex sets
+// and their products, FIV environment data and occluders, the scene and its objects, error
+// reports, the root attributes) and write_asset / read_asset. Every path and attribute name
+// lives in <formats/names.h>; the schema is formats/SCHEMA.md (docs/ARCHITECTURE.md, "Schema").
+//
+// Contract
+//   * write_asset(path, a) converts `a` to the generic File (to_file) and writes it with
+//     write_file: the schema check, temp file + rename and deterministic bytes of prtfile.h.
+//     Datasets are written in a fixed order (root vertex set and its report; then each scene
+//     object with its report, the occluder of the same name and that occluder's report; then
+//     the FIV environment; then the other occluders; then other /report datasets), attributes
+//     in the order of the field tables in asset.cpp followed by the extra attributes.
+//   * read_asset(path) reads with read_file (full schema check) and converts (to_asset).
+//     read_asset(write_asset(a)) == a for every field (std::optional: absent stays absent).
+//   * Extra attributes: any attribute the model does not type (another tool's, e.g. h5py's
+//     `f.attrs["note"] = "..."`, fixed- or variable-length string) is kept in `extra` of its
+//     location (root, /scene, /objects/<name>, each dataset) or, for other groups, in
+//     Asset::group_extras; it is written back (as a fixed-length string) and never makes a file
+//     unreadable. An attribute with a schema name but another type than the model's is kept
+//     there too.
+//   * inspect_asset(path) is for inspectors (prtdump): the file as stored (format and version
+//     checked only) and, when it passes the schema, the asset; else the schema defect.
+// Errors: FormatError "<file>: <defect>" (prtfile.h).
+#pragma once
+
+#include <formats/prtfile.h>
+
+#include <array>
+#include <optional>
+
+namespace prt::formats {
+
+// Attributes at one location that the model does not type: kept, written back, shown.
+using ExtraAttrs = std::vector<Attr>;
+
+// A dataset the model holds as a plain array with no typed attributes.
+template <class T> struct Array {
+  std::vector<T> values;
+  ExtraAttrs extra;
+  bool operator==(const Array&) const = default;
+};
+
+// The root attributes (all required except the extras; format/format_version are the writer's).
+struct RootInfo {
+  int64_t format_version = kFormatVersion;  // as read; write_asset always writes kFormatVersion
+  std::string generator, created, command_line, source, source_sha256, up_axis, sh_convention;
+  ExtraAttrs extra;
+  bool operator==(const RootInfo&) const = default;
+};
+
+// /mesh/normals: the normals the bake used, and where they came from ("file", "angle-weighted").
+struct Normals {
+  std::vector<float> values;  // [V][3]
+  std::optional<std::string> source;
+  ExtraAttrs extra;
+  bool operator==(const Normals&) const = default;
+};
+
+// A baked per-vertex product: /ao [V], /transfer/diffuse and /transfer/visibility [V][L*L]
+// (sh_order = L, required there), /radiance/band1 [V][RGB][m = -1, 0, 1] (environment fields).
+struct Product {
+  std::vector<float> values;
+  std::optional<std::string> integrand;
+  std::optional<int64_t> sh_order;
+  std::optional<std::string> shading, environment, environment_sha256, environment_layout;
+  std::optional<int64_t> negative_pixels_clamped;
+  std::optional<std::string> integrator, integrator_description;
+  std::optional<int64_t> samples, seed;  // samples: rays per vertex (qmc) or k (silhouette)
+  std::optional<std::string> visibility;  // the visibility convention in words
+  ExtraAttrs extra;
+  bool operator==(const Product&) const = default;
+};
+
+// One row of an error report: a [5] float32 dataset (rmse, max_abs, reference_rms,
+// bake_std_error, reference_std_error) named after its product ("ao", "transfer/diffuse", ...).
+struct ReportRow {
+  std::string product;
+  std::array<float, 5> values{};
+  std::optional<std::string> columns;
+  std::optional<int64_t> points;
+  std::optional<std::string> reference;
+  std::optional<double> reference_seconds, bake_seconds, integrals_per_second;
+  ExtraAttrs extra;
+  bool operator==(const ReportRow&) const = default;
+};
+
+// The error report of one vertex set: /report (root layout) or /report/objects/<name>.
+struct Report {
+  std::vector<ReportRow> rows;
+  std::optional<Array<uint32_t>> vertices;  // the seeded vertices compared
+  bool empty() const noexcept { return rows.empty() && !vertices; }
+  bool operator==(const Report&) const = default;
+};
+
+// A vertex set: the root layout or one scene object's /objects/<name>/... (SCHEMA.md).
+struct VertexSet {
+  std::optional<Array<float>> positions;           // [V][3]
+  std::optional<Normals> normals;                  // [V][3]
+  std::optional<Array<uint32_t>> triangles;        // [T][3]
+  std::optional<Array<uint32_t>> source_position;  // [V]
+  std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1;
+  Report report;
+
+  std::size_t vertex_count() const noexcept { return positions ? positions->values.size() / 3 : 0; }
+  bool empty() const noexcept {
+    return !positions && !normals && !triangles && !source_position && !ao && !transfer_diffuse &&
+           !transfer_visibility && !radiance_band1 && report.empty();
+  }
+  bool operator==(const VertexSet&) const = default;
+};
+
+// /fiv/environment: F_env = Int L_c w dw, [RGB][xyz].
+struct FivEnvironment {
+  std::array<float, 9> f_env{};
+  std::optional<std::string> environment, environment_sha256, integrand;
+  ExtraAttrs extra;
+  bool operator==(const FivEnvironment&) const = default;
+};
+
+// /fiv/irradiance_cube: the DifMap E(n), [face][row][col][RGB], S = size.
+struct IrradianceCube {
+  int size = 0;
+  std::vector<float> values;  // [6][S][S][3]
+  std::optional<std::string> environment, environment_sha256, integrand, face_convention;
+  ExtraAttrs extra;
+  bool operator==(const IrradianceCube&) const = default;
+};
+
+// /fiv/occluders/<name>/valid: 1 where the shell sample lies outside the occluder.
+struct OccluderValid {
+  std::vector<uint8_t> values;  // [Nrho][Ntheta][Nphi]
+  std::optional<std::string> meaning;
+  ExtraAttrs extra;
+  bool operator==(const OccluderValid&) const = default;
+};
+
+// /fiv/occluders/<name>: FIVs on shells around an occluder's bounding sphere, and its report.
+struct Occluder {
+  std::string name;
+  int n_rho = 0, n_theta = 0, n_phi = 0;
+  std::vector<float> shells;  // [Nrho][Ntheta][Nphi][RGB][xyz]
+  std::array<double, 3> centre{};
+  double radius = 0;
+  std::vector<double> radii;  // [Nrho]
+  std::optional<std::string> environment, environment_sha256, integrand, angular_convention, grid;
+  std::optional<double> fraction;
+  std::optional<int64_t> samples;  // silhouette k
+  ExtraAttrs extra;                // of the shells dataset
+  std::optional<OccluderValid> valid;
+  std::optional<ReportRow> report;  // /report/fiv/<name> (its product is the name)
+  bool operator==(const Occluder&) const = default;
+};
+
+// /scene: the scene-wide settings of a scene file.
+struct SceneInfo {
+  std::optional<std::string> scene_file, integrator;
+  std::optional<int64_t> samples, seed;
+  std::optional<double> sh_tolerance;
+  std::optional<int64_t> relight;  // 0 / 1
+  std::optional<std::string> environment, environment_sha256;
+  std::optional<std::string> plan;  // scene-wide decisions, one per line
+  ExtraAttrs extra;
+  bool operator==(const SceneInfo&) const = default;
+};
+
+// /objects/<name>: one object of a scene file, its attributes and its vertex set.
+struct SceneObject {
+  std::string name;
+  std::optional<std::string> role;  // "receiver", "occluder", "both"
+  std::optional<std::string> mesh, mesh_sha256;
+  std::optional<std::vector<double>> transform;  // 16 doubles, row-major world_from_object
+  std::optional<std::vector<double>> albedo;     // RGB
+  std::optional<double> phong_exponent;          // 0: none
+  std::optional<int64_t> sh_order_diffuse, sh_order_glossy;  // 0: not baked
+  std::optional<std::string> baked, left_out;    // "product: reason" per line; "-" when none
+  std::optional<std::vector<double>> specular;   // RGB, glossy objects
+  std::optional<int64_t> closed_form_vertices;
+  ExtraAttrs extra;
+  VertexSet set;
+  bool operator==(const SceneObject&) const = default;
+};
+
+struct Asset {
+  RootInfo root;
+  VertexSet vertices;  // the root layout (empty in fiv and scene files)
+  std::optional<SceneInfo> scene;
+  std::vector<SceneObject> objects;  // read back sorted by name
+  std::optional<FivEnvironment> fiv_environment;
+  std::optional<IrradianceCube> irradiance_cube;
+  std::vector<Occluder> occluders;  // read back sorted by name
+  // Datasets under /report the model does not type (/report is free-form in the schema).
+  std::vector<Dataset> other_reports;
+  // Attributes of groups without typed attributes (/mesh, /report, /fiv/occluders/<name>, ...).
+  std::vector<std::pair<std::string, ExtraAttrs>> group_extras;
+
+  const SceneObject* find_object(std::string_view name) const noexcept;
+  const Occluder* find_occluder(std::string_view name) const noexcept;
+  bool operator==(const Asset&) const = default;
+};
+
+// The generic File of `asset` (dataset order and attribute order as write_asset writes them).
+File to_file(const Asset& asset);
+// The asset of a file that passed validate(); messages name `file_for_messages`.
+Asset to_asset(const File& file, const std::filesystem::path& file_for_messages);
+
+// Writes `asset` to `path` (see the contract above). Throws FormatError.
+void write_asset(const std::filesystem::path& path, const Asset& asset);
+// Reads and checks the file at `path` (see the contract above). Throws FormatError.
+Asset read_asset(const std::filesystem::path& path);
+
+// For inspectors: the file as stored and, when it passes the schema, its asset.
+struct Inspection {
+  File file;                          // every dataset and attribute as stored
+  std::optional<Asset> asset;         // set when the file passes the schema
+  std::optional<std::string> schema_error;  // else the first defect (without the file name)
+};
+// Reads `path` checking only format and format_version (FormatError otherwise).
+Inspection inspect_asset(const std::filesystem::path& path);
+
+// The attributes of an occluder's shells dataset, as write_asset writes them.
+std::vector<Attr> shells_attrs(const Occluder& occluder);
+
+} // namespace prt::formats

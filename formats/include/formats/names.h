@@ -1,0 +1,103 @@
+// formats/names.h — every dataset path, group and attribute name of the baked file, spelled once.
+// The schema (formats/SCHEMA.md, docs/ARCHITECTURE.md "Schema") is checked with these names
+// (schema.cpp), the typed asset model is converted with them (asset.cpp), and generic readers
+// that show a file as stored (prtdump) use them instead of literals. Paths of the root layout
+// are absolute; a scene object's vertex set is the same layout under "/objects/<name>".
+#pragma once
+
+#include <string_view>
+
+namespace prt::formats::names {
+
+// ---- groups and path pieces ----
+inline constexpr std::string_view kObjects = "/objects";       // + "/<name>": a scene object
+inline constexpr std::string_view kScene = "/scene";
+inline constexpr std::string_view kReport = "/report";         // + "/<product>", "/objects/<name>/..."
+inline constexpr std::string_view kReportFiv = "/report/fiv";  // + "/<occluder>"
+inline constexpr std::string_view kFivGroup = "/fiv";
+inline constexpr std::string_view kOccluders = "/fiv/occluders";  // + "/<name>/{shells,valid}"
+
+// ---- datasets of a vertex set (relative to its prefix: "" or "/objects/<name>") ----
+inline constexpr std::string_view kMeshGroup = "/mesh";
+inline constexpr std::string_view kPositions = "/mesh/positions";
+inline constexpr std::string_view kNormals = "/mesh/normals";
+inline constexpr std::string_view kTriangles = "/mesh/triangles";
+inline constexpr std::string_view kSourcePosition = "/mesh/source_position";
+inline constexpr std::string_view kAo = "/ao";
+inline constexpr std::string_view kTransferGroup = "/transfer";
+inline constexpr std::string_view kTransferDiffuse = "/transfer/diffuse";
+inline constexpr std::string_view kTransferVisibility = "/transfer/visibility";
+inline constexpr std::string_view kRadianceGroup = "/radiance";
+inline constexpr std::string_view kRadianceBand1 = "/radiance/band1";
+// ---- FIV datasets ----
+inline constexpr std::string_view kFivEnvironment = "/fiv/environment";
+inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";
+inline constexpr std::string_view kShells = "shells";  // leaf under /fiv/occluders/<name>/
+inline constexpr std::string_view kValid = "valid";    // leaf under /fiv/occluders/<name>/
+// ---- report datasets (leaf under a report directory) ----
+inline constexpr std::string_view kReportVertices = "vertices";
+
+// ---- root attributes ----
+inline constexpr std::string_view kFormat = "format";
+inline constexpr std::string_view kFormatVersion = "format_version";
+inline constexpr std::string_view kGenerator = "generator";
+inline constexpr std::string_view kCreated = "created";
+inline constexpr std::string_view kCommandLine = "command_line";
+inline constexpr std::string_view kSource = "source";  // also: /mesh/normals' origin
+inline constexpr std::string_view kSourceSha256 = "source_sha256";
+inline constexpr std::string_view kUpAxis = "up_axis";
+inline constexpr std::string_view kShConvention = "sh_convention";
+
+// ---- product attributes (/ao, /transfer/*, /radiance/band1) ----
+inline constexpr std::string_view kIntegrand = "integrand";
+inline constexpr std::string_view kShOrder = "sh_order";
+inline constexpr std::string_view kShading = "shading";
+inline constexpr std::string_view kEnvironment = "environment";
+inline constexpr std::string_view kEnvironmentSha256 = "environment_sha256";
+inline constexpr std::string_view kEnvironmentLayout = "environment_layout";
+inline constexpr std::string_view kNegativePixelsClamped = "negative_pixels_clamped";
+inline constexpr std::string_view kIntegrator = "integrator";
+inline constexpr std::string_view kIntegratorDescription = "integrator_description";
+inline constexpr std::string_view kSamples = "samples";
+inline constexpr std::string_view kSeed = "seed";
+inline constexpr std::string_view kVisibility = "visibility";
+
+// ---- FIV attributes ----
+inline constexpr std::string_view kFaceConvention = "face_convention";
+inline constexpr std::string_view kCentre = "centre";
+inline constexpr std::string_view kRadius = "radius";
+inline constexpr std::string_view kRadii = "radii";
+inline constexpr std::string_view kAngularConvention = "angular_convention";
+inline constexpr std::string_view kGrid = "grid";
+inline constexpr std::string_view kFraction = "fraction";
+inline constexpr std::string_view kMeaning = "meaning";
+
+// ---- report attributes ----
+inline constexpr std::string_view kColumns = "columns";
+inline constexpr std::string_view kPoints = "points";
+inline constexpr std::string_view kReference = "reference";
+inline constexpr std::string_view kReferenceSeconds = "reference_seconds";
+inline constexpr std::string_view kBakeSeconds = "bake_seconds";
+inline constexpr std::string_view kIntegralsPerSecond = "integrals_per_second";
+
+// ---- /scene attributes ----
+inline constexpr std::string_view kSceneFile = "scene_file";
+inline constexpr std::string_view kShTolerance = "sh_tolerance";
+inline constexpr std::string_view kRelight = "relight";
+inline constexpr std::string_view kPlan = "plan";
+
+// ---- /objects/<name> attributes ----
+inline constexpr std::string_view kRole = "role";
+inline constexpr std::string_view kMesh = "mesh";
+inline constexpr std::string_view kMeshSha256 = "mesh_sha256";
+inline constexpr std::string_view kTransform = "transform";
+inline constexpr std::string_view kAlbedo = "albedo";
+inline constexpr std::string_view kPhongExponent = "phong_exponent";
+inline constexpr std::string_view kSpecular = "specular";
+inline constexpr std::string_view kShOrderDiffuse = "sh_order_diffuse";
+inline constexpr std::string_view kShOrderGlossy = "sh_order_glossy";
+inline constexpr std::string_view kBaked = "baked";
+inline constexpr std::string_view kLeftOut = "left_out";
+inline constexpr std::string_view kClosedFormVertices = "closed_form_vertices";
+
+} // namespace prt::formats::names

@@ -1,0 +1,447 @@
+// asset.cpp — the typed asset model <-> the generic File (see formats/asset.h). Each struct's
+// typed attributes are one field table (name, member); the tables' order is the order in which
+// attributes are written, so a file's bytes do not depend on how the asset was built.
+#include <formats/asset.h>
+#include <formats/names.h>
+
+#include <algorithm>
+#include <span>
+
+namespace prt::formats {
+namespace {
+
+namespace N = names;
+
+// ---- field tables ----------------------------------------------------------------------
+
+template <class S>
+using Member = std::variant<std::optional<std::string> S::*, std::optional<int64_t> S::*,
+                            std::optional<double> S::*, std::optional<std::vector<double>> S::*,
+                            std::string S::*, double S::*, std::vector<double> S::*,
+                            std::array<double, 3> S::*>;
+
+template <class S> struct Field {
+  std::string_view name;
+  Member<S> member;
+};
+
+template <class T> void emit(std::vector<Attr>& out, std::string_view name, const std::optional<T>& v) {
+  if (v) out.push_back({std::string(name), *v});
+}
+template <class T> void emit(std::vector<Attr>& out, std::string_view name, const T& v) {
+  out.push_back({std::string(name), v});
+}
+void emit(std::vector<Attr>& out, std::string_view name, const std::array<double, 3>& v) {
+  out.push_back({std::string(name), std::vector<double>(v.begin(), v.end())});
+}
+
+// Sets `dst` from `v` when the types agree; false leaves the attribute to the extras.
+template <class T> bool assign(std::optional<T>& dst, const AttrValue& v) {
+  const auto* x = std::get_if<T>(&v);
+  if (x) dst = *x;
+  return x != nullptr;
+}
+template <class T> bool assign(T& dst, const AttrValue& v) {
+  const auto* x = std::get_if<T>(&v);
+  if (x) dst = *x;
+  return x != nullptr;
+}
+bool assign(std::array<double, 3>& dst, const AttrValue& v) {
+  const auto* x = std::get_if<std::vector<double>>(&v);
+  if (x == nullptr || x->size() != 3) return false;
+  std::copy(x->begin(), x->end(), dst.begin());
+  return true;
+}
+
+// The typed attributes of `s` in table order, then its extras.
+template <class S>
+std::vector<Attr> attrs_of(const S& s, std::span<const Field<S>> table, const ExtraAttrs& extra) {
+  std::vector<Attr> out;
+  for (const Field<S>& f : table) std::visit([&](auto m) { emit(out, f.name, s.*m); }, f.member);
+  out.insert(out.end(), extra.begin(), extra.end());
+  return out;
+}
+
+// Fills the typed fields of `s` from `attrs`; what the table does not take goes to `extra`.
+template <class S>
+void take_attrs(S& s, std::span<const Field<S>> table, const std::vector<Attr>& attrs, ExtraAttrs& extra) {
+  for (const Attr& a : attrs) {
+    bool used = false;
+    for (const Field<S>& f : table)
+      if (f.name == a.name) std::visit([&](auto m) { used = assign(s.*m, a.value); }, f.member);
+    if (!used) extra.push_back(a);
+  }
+}
+
+constexpr Field<RootInfo> kRootFields[] = {
+    {N::kGenerator, &RootInfo::generator},         {N::kCreated, &RootInfo::created},
+    {N::kCommandLine, &RootInfo::command_line},    {N::kSource, &RootInfo::source},
+    {N::kSourceSha256, &RootInfo::source_sha256},  {N::kUpAxis, &RootInfo::up_axis},
+    {N::kShConvention, &RootInfo::sh_convention}};
+
+constexpr Field<Normals> kNormalsFields[] = {{N::kSource, &Normals::source}};
+
+constexpr Field<Product> kProductFields[] = {
+    {N::kIntegrand, &Product::integrand},
+    {N::kShOrder, &Product::sh_order},
+    {N::kShading, &Product::shading},
+    {N::kEnvironment, &Product::environment},
+    {N::kEnvironmentSha256, &Product::environment_sha256},
+    {N::kEnvironmentLayout, &Product::environment_layout},
+    {N::kNegativePixelsClamped, &Product::negative_pixels_clamped},
+    {N::kIntegrator, &Product::integrator},
+    {N::kIntegratorDescription, &Product::integrator_description},
+    {N::kSamples, &Product::samples},
+    {N::kSeed, &Product::seed},
+    {N::kVisibility, &Product::visibility}};
+
+constexpr Field<ReportRow> kReportFields[] = {
+    {N::kColumns, &ReportRow::columns},
+    {N::kPoints, &ReportRow::points},
+    {N::kReference, &ReportRow::reference},
+    {N::kReferenceSeconds, &ReportRow::reference_seconds},
+    {N::kBakeSeconds, &ReportRow::bake_seconds},
+    {N::kIntegralsPerSecond, &ReportRow::integrals_per_second}};
+
+constexpr Field<FivEnvironment> kFivEnvironmentFields[] = {
+    {N::kEnvironment, &FivEnvironment::environment},
+    {N::kEnvironmentSha256, &FivEnvironment::environment_sha256},
+    {N::kIntegrand, &FivEnvironment::integrand}};
+
+constexpr Field<IrradianceCube> kCubeFields[] = {
+    {N::kEnvironment, &IrradianceCube::environment},
+    {N::kEnvironmentSha256, &IrradianceCube::environment_sha256},
+    {N::kIntegrand, &IrradianceCube::integrand},
+    {N::kFaceConvention, &IrradianceCube::face_convention}};
+
+constexpr Field<Occluder> kShellsFields[] = {
+    {N::kEnvironment, &Occluder::environment},
+    {N::kEnvironmentSha256, &Occluder::environment_sha256},
+    {N::kIntegrand, &Occluder::integrand},
+    {N::kCentre, &Occluder::centre},
+    {N::kRadius, &Occluder::radius},
+    {N::kRadii, &Occluder::radii},
+    {N::kAngularConvention, &Occluder::angular_convention},
+    {N::kFraction, &Occluder::fraction},
+    {N::kSamples, &Occluder::samples},
+    {N::kGrid, &Occluder::grid}};
+
+constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
+
+constexpr Field<SceneInfo> kSceneFields[] = {
+    {N::kSceneFile, &SceneInfo::scene_file},
+    {N::kIntegrator, &SceneInfo::integrator},
+    {N::kSamples, &SceneInfo::samples},
+    {N::kSeed, &SceneInfo::seed},
+    {N::kShTolerance, &SceneInfo::sh_tolerance},
+    {N::kRelight, &SceneInfo::relight},
+    {N::kEnvironment, &SceneInfo::environment},
+    {N::kEnvironmentSha256, &SceneInfo::environment_sha256},
+    {N::kPlan, &SceneInfo::plan}};
+
+constexpr Field<SceneObject> kObjectFields[] = {
+    {N::kRole, &SceneObject::role},
+    {N::kMesh, &SceneObject::mesh},
+    {N::kMeshSha256, &SceneObject::mesh_sha256},
+    {N::kTransform, &SceneObject::transform},
+    {N::kAlbedo, &SceneObject::albedo},
+    {N::kPhongExponent, &SceneObject::phong_exponent},
+    {N::kShOrderDiffuse, &SceneObject::sh_order_diffuse},
+    {N::kShOrderGlossy, &SceneObject::sh_order_glossy},
+    {N::kBaked, &SceneObject::baked},
+    {N::kLeftOut, &SceneObject::left_out},
+    {N::kSpecular, &SceneObject::specular},
+    {N::kClosedFormVertices, &SceneObject::closed_form_vertices}};
+
+// ---- paths -------------------------------------------------------------------------------
+
+std::string cat(std::string_view a, std::string_view b) { return std::string(a) + std::string(b); }
+std::string object_prefix(std::string_view name) { return cat(N::kObjects, "/") + std::string(name); }
+std::string object_report_dir(std::string_view name) { return cat(N::kReport, object_prefix(name)); }
+std::string occluder_dir(std::string_view name) { return cat(N::kOccluders, "/") + std::string(name); }
+std::string fiv_report_path(std::string_view name) { return cat(N::kReportFiv, "/") + std::string(name); }
+
+// ---- Asset -> File -----------------------------------------------------------------------
+
+void add_array(File& f, const std::string& path, std::vector<uint64_t> shape, DatasetData data,
+               std::vector<Attr> attrs) {
+  f.datasets.push_back({path, std::move(shape), std::move(data), std::move(attrs)});
+}
+
+// `trailing`: the shape after the vertex axis ([] for /ao, [L*L] for transfer, [3, 3] for band1).
+void add_product(File& f, const std::string& path, const std::optional<Product>& p, uint64_t V,
+                 const std::vector<uint64_t>& trailing) {
+  if (!p) return;
+  std::vector<uint64_t> shape(1 + trailing.size(), V);
+  std::copy(trailing.begin(), trailing.end(), shape.begin() + 1);
+  add_array(f, path, std::move(shape), p->values, attrs_of<Product>(*p, kProductFields, p->extra));
+}
+
+// The [L*L] trailing shape of a transfer product (L = sh_order; else what its values give).
+std::vector<uint64_t> sh_width(const std::optional<Product>& p, uint64_t V) {
+  if (!p) return {};
+  if (p->sh_order) return {uint64_t(*p->sh_order * *p->sh_order)};
+  return {V ? p->values.size() / V : 0};
+}
+
+std::vector<Attr> row_attrs(const ReportRow& r) { return attrs_of<ReportRow>(r, kReportFields, r.extra); }
+
+void add_row(File& f, const std::string& path, const ReportRow& r) {
+  add_array(f, path, {5}, std::vector<float>(r.values.begin(), r.values.end()), row_attrs(r));
+}
+
+void add_report(File& f, const std::string& dir, const Report& r) {
+  for (const ReportRow& row : r.rows) add_row(f, dir + "/" + row.product, row);
+  if (r.vertices)
+    add_array(f, cat(dir + "/", N::kReportVertices), {r.vertices->values.size()}, r.vertices->values,
+              r.vertices->extra);
+}
+
+void add_vertex_set(File& f, const std::string& prefix, const std::string& report_dir, const VertexSet& s) {
+  const uint64_t V = s.vertex_count();
+  if (s.positions) add_array(f, cat(prefix, N::kPositions), {V, 3}, s.positions->values, s.positions->extra);
+  if (s.normals)
+    add_array(f, cat(prefix, N::kNormals), {s.normals->values.size() / 3, 3}, s.normals->values,
+              attrs_of<Normals>(*s.normals, kNormalsFields, s.normals->extra));
+  if (s.triangles)
+    add_array(f, cat(prefix, N::kTriangles), {s.triangles->values.size() / 3, 3}, s.triangles->values,
+              s.triangles->extra);
+  if (s.source_position)
+    add_array(f, cat(prefix, N::kSourcePosition), {s.source_position->values.size()}, s.source_position->values,
+              s.source_position->extra);
+  add_product(f, cat(prefix, N::kAo), s.ao, V, {});
+  add_product(f, cat(prefix, N::kTransferDiffuse), s.transfer_diffuse, V, sh_width(s.transfer_diffuse, V));
+  add_product(f, cat(prefix, N::kTransferVisibility), s.transfer_visibility, V, sh_width(s.transfer_visibility, V));
+  add_product(f, cat(prefix, N::kRadianceBand1), s.radiance_band1, V, {3, 3});
+  add_report(f, report_dir, s.report);
+}
+
+void add_occluder(File& f, const Occluder& o) {
+  const std::string dir = occluder_dir(o.name) + "/";
+  const std::vector<uint64_t> grid = {uint64_t(o.n_rho), uint64_t(o.n_theta), uint64_t(o.n_phi)};
+  add_array(f, cat(dir, N::kShells), {grid[0], grid[1], grid[2], 3, 3}, o.shells, shells_attrs(o));
+  if (o.valid)
+    add_array(f, cat(dir, N::kValid), grid, o.valid->values,
+              attrs_of<OccluderValid>(*o.valid, kValidFields, o.valid->extra));
+  if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
+}
+
+// ---- File -> Asset -----------------------------------------------------------------------
+
+template <class T> const std::vector<T>& values(const Dataset& d) { return std::get<std::vector<T>>(d.data); }
+
+template <class T> Array<T> array_of(const Dataset& d) { return {values<T>(d), d.attrs}; }
+
+Product product_of(const Dataset& d) {
+  Product p;
+  p.values = values<float>(d);
+  take_attrs<Product>(p, kProductFields, d.attrs, p.extra);
+  return p;
+}
+
+bool is_row(const Dataset& d) { return d.shape == std::vector<uint64_t>{5} && d.data.index() == 0; }
+
+ReportRow row_of(const Dataset& d, std::string product) {
+  ReportRow r;
+  r.product = std::move(product);
+  std::copy_n(values<float>(d).begin(), 5, r.values.begin());
+  take_attrs<ReportRow>(r, kReportFields, d.attrs, r.extra);
+  return r;
+}
+
+// Puts report dataset `d` (its path is `dir` + "/" + `leaf`) into `r` when it has a typed form.
+bool take_report(Report& r, const Dataset& d, std::string_view leaf) {
+  if (leaf == N::kReportVertices && d.shape.size() == 1 && d.data.index() == 1) {
+    r.vertices = array_of<uint32_t>(d);
+    return true;
+  }
+  if (!is_row(d) || leaf.empty()) return false;
+  r.rows.push_back(row_of(d, std::string(leaf)));
+  return true;
+}
+
+template <class T> T* find_named(std::vector<T>& list, std::string_view name) {
+  for (T& x : list)
+    if (x.name == name) return &x;
+  return nullptr;
+}
+template <class T> T& named(std::vector<T>& list, std::string_view name) {
+  if (T* x = find_named(list, name)) return *x;
+  list.emplace_back().name = std::string(name);
+  return list.back();
+}
+
+std::string_view after(std::string_view path, std::string_view prefix) {
+  return path.starts_with(prefix) ? path.substr(prefix.size()) : std::string_view();
+}
+
+void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
+  switch (kind) {
+  case DatasetKind::positions: s.positions = array_of<float>(d); break;
+  case DatasetKind::normals:
+    s.normals.emplace().values = values<float>(d);
+    take_attrs<Normals>(*s.normals, kNormalsFields, d.attrs, s.normals->extra);
+    break;
+  case DatasetKind::triangles: s.triangles = array_of<uint32_t>(d); break;
+  case DatasetKind::source_position: s.source_position = array_of<uint32_t>(d); break;
+  case DatasetKind::ao: s.ao = product_of(d); break;
+  case DatasetKind::transfer_diffuse: s.transfer_diffuse = product_of(d); break;
+  case DatasetKind::transfer_visibility: s.transfer_visibility = product_of(d); break;
+  case DatasetKind::radiance_band1: s.radiance_band1 = product_of(d); break;
+  default: break;
+  }
+}
+
+} // namespace
+
+const SceneObject* Asset::find_object(std::string_view name) const noexcept {
+  for (const SceneObject& o : objects)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+const Occluder* Asset::find_occluder(std::string_view name) const noexcept {
+  for (const Occluder& o : occluders)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+std::vector<Attr> shells_attrs(const Occluder& o) { return attrs_of<Occluder>(o, kShellsFields, o.extra); }
+
+File to_file(const Asset& a) {
+  File f;
+  f.root_attrs = attrs_of<RootInfo>(a.root, kRootFields, a.root.extra);
+  add_vertex_set(f, "", std::string(N::kReport), a.vertices);
+  for (const SceneObject& o : a.objects) {
+    add_vertex_set(f, object_prefix(o.name), object_report_dir(o.name), o.set);
+    if (const Occluder* occ = a.find_occluder(o.name)) add_occluder(f, *occ);
+  }
+  if (a.fiv_environment)
+    add_array(f, std::string(N::kFivEnvironment), {3, 3},
+              std::vector<float>(a.fiv_environment->f_env.begin(), a.fiv_environment->f_env.end()),
+              attrs_of<FivEnvironment>(*a.fiv_environment, kFivEnvironmentFields, a.fiv_environment->extra));
+  if (a.irradiance_cube) {
+    const auto S = uint64_t(a.irradiance_cube->size);
+    add_array(f, std::string(N::kIrradianceCube), {6, S, S, 3}, a.irradiance_cube->values,
+              attrs_of<IrradianceCube>(*a.irradiance_cube, kCubeFields, a.irradiance_cube->extra));
+  }
+  for (const Occluder& occ : a.occluders)
+    if (a.find_object(occ.name) == nullptr) add_occluder(f, occ);
+  f.datasets.insert(f.datasets.end(), a.other_reports.begin(), a.other_reports.end());
+
+  if (a.scene) f.group_attrs.emplace_back(std::string(N::kScene), attrs_of<SceneInfo>(*a.scene, kSceneFields, a.scene->extra));
+  for (const SceneObject& o : a.objects) {
+    std::vector<Attr> attrs = attrs_of<SceneObject>(o, kObjectFields, o.extra);
+    if (!attrs.empty()) f.group_attrs.emplace_back(object_prefix(o.name), std::move(attrs));
+  }
+  f.group_attrs.insert(f.group_attrs.end(), a.group_extras.begin(), a.group_extras.end());
+  return f;
+}
+
+Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
+  Asset a;
+  std::vector<Attr> root;
+  for (const Attr& at : f.root_attrs) {
+    if (at.name == N::kFormatVersion && std::holds_alternative<int64_t>(at.value))
+      a.root.format_version = std::get<int64_t>(at.value);
+    else if (at.name != N::kFormat)
+      root.push_back(at);
+  }
+  take_attrs<RootInfo>(a.root, kRootFields, root, a.root.extra);
+
+  const std::string objects_dir = cat(N::kObjects, "/"), occluders_dir = cat(N::kOccluders, "/");
+  std::vector<const Dataset*> reports;
+  for (const Dataset& d : f.datasets) {
+    const DatasetKind kind = dataset_kind(d.path);
+    switch (kind) {
+    case DatasetKind::fiv_environment: {
+      FivEnvironment& e = a.fiv_environment.emplace();
+      std::copy_n(values<float>(d).begin(), 9, e.f_env.begin());
+      take_attrs<FivEnvironment>(e, kFivEnvironmentFields, d.attrs, e.extra);
+      break;
+    }
+    case DatasetKind::irradiance_cube: {
+      IrradianceCube& c = a.irradiance_cube.emplace();
+      c.size = int(d.shape[1]);
+      c.values = values<float>(d);
+      take_attrs<IrradianceCube>(c, kCubeFields, d.attrs, c.extra);
+      break;
+    }
+    case DatasetKind::occluder_shells:
+    case DatasetKind::occluder_valid: {
+      const std::string_view rest = after(d.path, occluders_dir);
+      Occluder& o = named(a.occluders, rest.substr(0, rest.find('/')));
+      if (kind == DatasetKind::occluder_valid) {
+        o.valid.emplace().values = values<uint8_t>(d);
+        take_attrs<OccluderValid>(*o.valid, kValidFields, d.attrs, o.valid->extra);
+        break;
+      }
+      o.n_rho = int(d.shape[0]), o.n_theta = int(d.shape[1]), o.n_phi = int(d.shape[2]);
+      o.shells = values<float>(d);
+      take_attrs<Occluder>(o, kShellsFields, d.attrs, o.extra);
+      break;
+    }
+    case DatasetKind::report: reports.push_back(&d); break;
+    case DatasetKind::unknown:
+      throw FormatError(file_for_messages.string(), "unknown dataset path '" + d.path + "'");
+    default: {
+      const std::string prefix = vertex_set_of(d.path);
+      VertexSet& s = prefix.empty() ? a.vertices : named(a.objects, after(prefix, objects_dir)).set;
+      take_vertex_dataset(s, kind, d);
+    }
+    }
+  }
+  for (const auto& [group, attrs] : f.group_attrs) {
+    const std::string_view object = after(group, objects_dir);
+    if (group == N::kScene) {
+      SceneInfo& s = a.scene.emplace();
+      take_attrs<SceneInfo>(s, kSceneFields, attrs, s.extra);
+    } else if (!object.empty() && object.find('/') == std::string_view::npos) {
+      SceneObject& o = named(a.objects, object);
+      take_attrs<SceneObject>(o, kObjectFields, attrs, o.extra);
+    } else {
+      a.group_extras.emplace_back(group, attrs);
+    }
+  }
+  // Reports last: they belong to the objects and occluders found above.
+  const std::string report_dir = cat(N::kReport, "/"), object_reports = cat(N::kReport, objects_dir),
+                    fiv_reports = cat(N::kReportFiv, "/");
+  for (const Dataset* d : reports) {
+    const std::string_view object = after(d->path, object_reports);
+    const std::string_view fiv = after(d->path, fiv_reports);
+    const std::size_t slash = object.find('/');
+    SceneObject* o = slash == std::string_view::npos ? nullptr : find_named(a.objects, object.substr(0, slash));
+    Occluder* occ = fiv.find('/') == std::string_view::npos ? find_named(a.occluders, fiv) : nullptr;
+    bool taken = false;
+    if (o != nullptr) taken = take_report(o->set.report, *d, object.substr(slash + 1));
+    else if (occ != nullptr && is_row(*d)) {
+      occ->report = row_of(*d, std::string(fiv));
+      taken = true;
+    } else {
+      taken = take_report(a.vertices.report, *d, after(d->path, report_dir));
+    }
+    if (!taken) a.other_reports.push_back(*d);
+  }
+  auto by_name = [](const auto& x, const auto& y) { return x.name < y.name; };
+  std::sort(a.objects.begin(), a.objects.end(), by_name);
+  std::sort(a.occluders.begin(), a.occluders.end(), by_name);
+  return a;
+}
+
+void write_asset(const std::filesystem::path& path, const Asset& asset) { write_file(path, to_file(asset)); }
+
+Asset read_asset(const std::filesystem::path& path) { return to_asset(read_file(path), path); }
+
+Inspection inspect_asset(const std::filesystem::path& path) {
+  Inspection out;
+  out.file = read_file(path, ReadCheck::header);
+  try {
+    validate(out.file, path);
+    out.asset = to_asset(out.file, path);
+  } catch (const FormatError& e) {
+    out.schema_error = e.defect();
+  }
+  return out;
+}
+
+} // namespace prt::formats

@@ -1,0 +1,311 @@
+// Tests of the typed asset model (formats/asset.h): write_asset -> read_asset gives back every
+// field, an asset's bytes do not depend on the round trip, datasets and attributes land on the
+// schema's paths and names, and attributes another tool added (h5py's variable-length strings on
+// the root, a group and a dataset) are kept, written back and never make the file unreadable.
+#include <formats/asset.h>
+#include <formats/testing.h>
+
+#include <gtest/gtest.h>
+#include <h5py.h>
+
+#include <cmath>
+
+namespace fs = std::filesystem;
+using namespace prt::formats;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "asset" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<float> ramp(std::size_t n, float step) {
+  std::vector<float> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = step * static_cast<float>(i) - 0.5f;
+  return v;
+}
+
+Product product(std::vector<float> values, const std::string& integrand) {
+  Product p;
+  p.values = std::move(values);
+  p.integrand = integrand;
+  p.integrator = "silhouette";
+  p.integrator_description = "semi-analytic";
+  p.samples = 4096;
+  p.seed = 0;  // a seed of 0 is a value, not "absent"
+  p.visibility = "limit from above";
+  return p;
+}
+
+ReportRow row(const std::string& product, float base, bool times) {
+  ReportRow r;
+  r.product = product;
+  r.values = {base, 2 * base, 3 * base, 0, 5 * base};
+  r.columns = "rmse, max_abs, reference_rms, bake_std_error, reference_std_error";
+  r.points = 32;
+  r.reference = "qmc 65536";
+  if (times) {
+    r.reference_seconds = 1.5;
+    r.bake_seconds = 0.25;
+    r.integrals_per_second = 1e6;
+  }
+  return r;
+}
+
+// A vertex set with V = 2 and every dataset the model has.
+VertexSet full_set(float scale) {
+  VertexSet s;
+  s.positions = Array<float>{ramp(6, scale), {{"unit", std::string("m")}}};
+  s.normals = Normals{{0, 0, 1, 0, 1, 0}, "file", {}};
+  s.triangles = Array<uint32_t>{{0, 1, 1}, {}};
+  s.source_position = Array<uint32_t>{{7, 3}, {}};
+  s.ao = product({0.25f, 1}, "A");
+  s.transfer_diffuse = product(ramp(8, 0.125f * scale), "T");
+  s.transfer_diffuse->sh_order = 2;
+  s.transfer_visibility = product(ramp(18, 0.0625f), "U");
+  s.transfer_visibility->sh_order = 3;
+  s.radiance_band1 = product(ramp(18, 0.5f), "R");
+  Product& r = *s.radiance_band1;
+  r.shading = "E = 4pi/3 sum y R";
+  r.environment = "sky.exr";
+  r.environment_sha256 = std::string(64, 'c');
+  r.environment_layout = "lat-long";
+  r.negative_pixels_clamped = 3;
+  r.extra = {{"k", int64_t{12}}};
+  s.report.rows = {row("ao", 1e-3f, true), row("transfer/diffuse", 2e-3f, false)};
+  s.report.vertices = Array<uint32_t>{{0, 1}, {}};
+  return s;
+}
+
+Occluder occluder(const std::string& name, double radius) {
+  Occluder o;
+  o.name = name;
+  o.n_rho = 2, o.n_theta = 2, o.n_phi = 3;
+  o.shells = ramp(2 * 2 * 3 * 9, 0.01f);
+  o.centre = {0.5, -1, 2};
+  o.radius = radius;
+  o.radii = {radius, 2 * radius};
+  o.environment = "sky.exr";
+  o.environment_sha256 = std::string(64, 'd');
+  o.integrand = "F";
+  o.angular_convention = "theta from +Y";
+  o.grid = "theta from +Y, phi from +Z";
+  o.fraction = 1e-3;
+  o.samples = 16384;
+  o.extra = {{"ids", std::vector<int64_t>{-1, 2}}};
+  o.valid = OccluderValid{std::vector<uint8_t>(12, 1), "0: inside", {}};
+  o.valid->values[4] = 0;
+  o.report = row(name, 4e-3f, true);
+  return o;
+}
+
+// An asset with every field of the model set (and extras at every kind of location).
+Asset full_asset() {
+  Asset a;
+  a.root.generator = "test_asset";
+  a.root.created = "2024-01-02T03:04:05Z";
+  a.root.command_line = "prtbake scene s.json -o x";
+  a.root.source = "data/Düsseldorf ✓.json";
+  a.root.source_sha256 = std::string(64, 'a');
+  a.root.up_axis = "z";
+  a.root.sh_convention = "real orthonormal, i = l(l+1)+m";
+  a.root.extra = {{"note", std::string("kept")}};
+  a.vertices = full_set(1);
+  SceneInfo& s = a.scene.emplace();
+  s.scene_file = "s.json";
+  s.integrator = "qmc";
+  s.samples = 1024;
+  s.seed = 7;
+  s.sh_tolerance = 0.01;
+  s.relight = 0;
+  s.environment = "sky.exr";
+  s.environment_sha256 = std::string(64, 'e');
+  s.plan = "one\ntwo";
+  s.extra = {{"version_note", 2.5}};
+  for (const char* name : {"bunny", "ground"}) {
+    SceneObject& o = a.objects.emplace_back();
+    o.name = name;
+    o.role = "both";
+    o.mesh = std::string(name) + ".obj";
+    o.mesh_sha256 = std::string(64, 'f');
+    o.transform = std::vector<double>(16, 0.0);
+    (*o.transform)[0] = (*o.transform)[5] = (*o.transform)[10] = (*o.transform)[15] = 1;
+    o.albedo = std::vector<double>{0.5, 0.25, 1};
+    o.phong_exponent = 24;
+    o.sh_order_diffuse = 0;
+    o.sh_order_glossy = 3;
+    o.baked = "ao: requested\nfiv: it can shadow";
+    o.left_out = "-";
+    o.specular = std::vector<double>{0.1, 0.1, 0.1};
+    o.closed_form_vertices = 1;
+    o.extra = {{"layer", std::string("props")}};
+    o.set = full_set(2);
+  }
+  FivEnvironment& e = a.fiv_environment.emplace();
+  for (std::size_t k = 0; k < 9; ++k) e.f_env[k] = 0.5f * float(k);
+  e.environment = "sky.exr";
+  e.environment_sha256 = std::string(64, 'e');
+  e.integrand = "F_env";
+  IrradianceCube& c = a.irradiance_cube.emplace();
+  c.size = 2;
+  c.values = ramp(6 * 2 * 2 * 3, 0.25f);
+  for (float& x : c.values) x += 10;  // irradiance is positive
+  c.environment = "sky.exr";
+  c.environment_sha256 = std::string(64, 'e');
+  c.integrand = "E";
+  c.face_convention = "+X,-X,+Y,-Y,+Z,-Z";
+  a.occluders = {occluder("bunny", 1.5), occluder("rock", 0.75)};  // bunny is also an object
+  a.other_reports.push_back({"/report/timing", {2}, std::vector<float>{1, 2}, {{"unit", std::string("s")}}});
+  a.group_extras = {{"/fiv/occluders/rock", {{"mesh", std::string("rock.obj")}}},
+                    {"/mesh", {{"note", std::string("on a group")}}},
+                    {"/report", {{"rmse", 1.5e-3}}}};
+  return a;
+}
+
+} // namespace
+
+TEST(Asset, EveryFieldSurvivesWriteRead) {
+  const fs::path dir = scratch("roundtrip");
+  const Asset a = full_asset();
+  write_asset(dir / "a.prt.h5", a);
+  const Asset b = read_asset(dir / "a.prt.h5");
+  // Field by field first, for readable failures; then the whole asset.
+  EXPECT_EQ(b.root, a.root);
+  EXPECT_EQ(b.vertices, a.vertices);
+  EXPECT_EQ(b.scene, a.scene);
+  ASSERT_EQ(b.objects.size(), 2u);
+  EXPECT_EQ(b.objects[0], a.objects[0]);
+  EXPECT_EQ(b.objects[1].set.report, a.objects[1].set.report);
+  EXPECT_EQ(b.fiv_environment, a.fiv_environment);
+  EXPECT_EQ(b.irradiance_cube, a.irradiance_cube);
+  ASSERT_EQ(b.occluders.size(), 2u);
+  EXPECT_EQ(b.occluders[0], a.occluders[0]);
+  EXPECT_EQ(b.occluders[1], a.occluders[1]);
+  ASSERT_EQ(b.other_reports.size(), 1u);
+  EXPECT_EQ(b.other_reports[0].path, "/report/timing");
+  EXPECT_EQ(b.other_reports[0].data, a.other_reports[0].data);
+  EXPECT_EQ(b.group_extras, a.group_extras);
+  EXPECT_EQ(b.root.format_version, kFormatVersion);
+  EXPECT_TRUE(b == a);
+  EXPECT_EQ(b.vertices.vertex_count(), 2u);
+  EXPECT_EQ(*b.find_object("ground")->set.transfer_diffuse->sh_order, 2);
+  EXPECT_EQ(b.find_occluder("nope"), nullptr);
+}
+
+TEST(Asset, AbsentStaysAbsent) {
+  // A file with only a mesh: every optional of the model comes back empty, not defaulted.
+  const fs::path dir = scratch("absent");
+  Asset a = full_asset();
+  a.scene.reset();
+  a.objects.clear();
+  a.fiv_environment.reset();
+  a.irradiance_cube.reset();
+  a.occluders.clear();
+  a.other_reports.clear();
+  a.group_extras.clear();
+  a.vertices = VertexSet{};
+  a.vertices.positions = Array<float>{{0, 0, 0}, {}};
+  write_asset(dir / "a.prt.h5", a);
+  const Asset b = read_asset(dir / "a.prt.h5");
+  EXPECT_TRUE(b == a);
+  EXPECT_FALSE(b.vertices.normals.has_value());
+  EXPECT_FALSE(b.vertices.ao.has_value());
+  EXPECT_TRUE(b.vertices.report.empty());
+  EXPECT_TRUE(b.objects.empty());
+  EXPECT_TRUE(b.occluders.empty());
+}
+
+TEST(Asset, BytesDoNotDependOnTheRoundTrip) {
+  // write(read(write(a))) == write(a): the field tables fix the order of datasets and attributes.
+  const fs::path dir = scratch("bytes");
+  write_asset(dir / "a.prt.h5", full_asset());
+  write_asset(dir / "b.prt.h5", read_asset(dir / "a.prt.h5"));
+  EXPECT_EQ(prt::testing::read_bytes(dir / "a.prt.h5"), prt::testing::read_bytes(dir / "b.prt.h5"));
+}
+
+TEST(Asset, DatasetsAndAttributesAreTheSchemaOnes) {
+  // The generic view of an asset: the paths and names of formats/SCHEMA.md.
+  const File f = to_file(full_asset());
+  for (const char* p : {"/mesh/positions", "/mesh/normals", "/mesh/triangles", "/mesh/source_position", "/ao",
+                        "/transfer/diffuse", "/transfer/visibility", "/radiance/band1", "/report/ao",
+                        "/report/transfer/diffuse", "/report/vertices", "/objects/bunny/mesh/positions",
+                        "/objects/ground/radiance/band1", "/report/objects/ground/ao", "/fiv/environment",
+                        "/fiv/irradiance_cube", "/fiv/occluders/rock/shells", "/fiv/occluders/bunny/valid",
+                        "/report/fiv/rock", "/report/timing"})
+    EXPECT_NE(find_dataset(f, p), nullptr) << p;
+  EXPECT_EQ(find_dataset(f, "/transfer/visibility")->shape, (std::vector<uint64_t>{2, 9}));
+  EXPECT_EQ(find_dataset(f, "/radiance/band1")->shape, (std::vector<uint64_t>{2, 3, 3}));
+  EXPECT_EQ(find_dataset(f, "/fiv/occluders/rock/shells")->shape, (std::vector<uint64_t>{2, 2, 3, 3, 3}));
+  EXPECT_EQ(std::get<int64_t>(find_attr(find_dataset(f, "/transfer/diffuse")->attrs, "sh_order")->value), 2);
+  EXPECT_EQ(std::get<std::vector<double>>(find_attr(find_dataset(f, "/fiv/occluders/rock/shells")->attrs, "radii")->value),
+            (std::vector<double>{0.75, 1.5}));
+  EXPECT_EQ(std::get<std::string>(find_attr(*find_group_attrs(f, "/objects/bunny"), "role")->value), "both");
+  EXPECT_EQ(std::get<int64_t>(find_attr(*find_group_attrs(f, "/scene"), "seed")->value), 7);
+  EXPECT_EQ(std::get<std::string>(find_attr(f.root_attrs, "up_axis")->value), "z");
+  EXPECT_EQ(find_attr(f.root_attrs, "format"), nullptr) << "the writer adds format and format_version";
+  // Scene objects come first with their occluder (same name); the FIV environment before the
+  // occluders of no object (the order prtbake has always written).
+  auto index = [&](std::string_view p) { return find_dataset(f, p) - f.datasets.data(); };
+  EXPECT_LT(index("/report/objects/bunny/vertices"), index("/fiv/occluders/bunny/shells"));
+  EXPECT_LT(index("/fiv/occluders/bunny/shells"), index("/objects/ground/mesh/positions"));
+  EXPECT_LT(index("/fiv/irradiance_cube"), index("/fiv/occluders/rock/shells"));
+}
+
+TEST(Asset, InspectShowsAFileThatFailsTheSchema) {
+  const fs::path dir = scratch("inspect");
+  write_asset(dir / "ok.prt.h5", full_asset());
+  const Inspection ok = inspect_asset(dir / "ok.prt.h5");
+  ASSERT_TRUE(ok.asset.has_value());
+  EXPECT_FALSE(ok.schema_error.has_value());
+  EXPECT_TRUE(*ok.asset == full_asset());
+  EXPECT_THROW((void)inspect_asset(dir / "missing.prt.h5"), FormatError);
+
+  File bad = to_file(full_asset());
+  bad.root_attrs.push_back({"format", std::string("prtbake")});
+  bad.root_attrs.push_back({"format_version", int64_t{2}});
+  for (Dataset& d : bad.datasets)
+    if (d.path == "/ao") std::get<std::vector<float>>(d.data)[1] = std::nanf("");
+  prt::formats::testing::write_file_unvalidated(dir / "nan.prt.h5", bad);
+  const Inspection in = inspect_asset(dir / "nan.prt.h5");
+  EXPECT_FALSE(in.asset.has_value());
+  ASSERT_TRUE(in.schema_error.has_value());
+  EXPECT_EQ(*in.schema_error, "dataset '/ao' has a non-finite value (NaN) at index 1 [1]");
+  EXPECT_EQ(in.file.datasets.size(), bad.datasets.size());
+  EXPECT_THROW((void)read_asset(dir / "nan.prt.h5"), FormatError);
+}
+
+TEST(Asset, AttributesAnotherToolAddedAreKeptAndWrittenBack) {
+  const fs::path dir = scratch("foreign");
+  const std::string python = prt::testing::python_with_h5py(dir);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  Asset a = full_asset();
+  write_asset(dir / "a.prt.h5", a);
+  const std::string failed = prt::testing::add_h5py_notes(python, dir / "a.prt.h5", "objects/ground/mesh", "ao");
+  ASSERT_EQ(failed, "");
+
+  const Asset b = read_asset(dir / "a.prt.h5");  // variable-length strings do not refuse the file
+  const Attr* root_note = find_attr(b.root.extra, "note");
+  ASSERT_NE(root_note, nullptr);
+  EXPECT_EQ(std::get<std::string>(root_note->value), "root note ✓");  // h5py replaced "kept"
+  const Attr* ao_note = find_attr(b.vertices.ao->extra, "note");
+  ASSERT_NE(ao_note, nullptr);
+  EXPECT_EQ(std::get<std::string>(ao_note->value), "dataset note");
+  bool group_note = false;
+  for (const auto& [g, attrs] : b.group_extras)
+    if (g == "/objects/ground/mesh")
+      group_note = find_attr(attrs, "note") && std::get<std::string>(find_attr(attrs, "note")->value) == "group note";
+  EXPECT_TRUE(group_note);
+  // Everything else is as written.
+  Asset expected = a;
+  expected.root.extra = b.root.extra;
+  expected.vertices.ao->extra = b.vertices.ao->extra;
+  expected.group_extras = b.group_extras;
+  EXPECT_TRUE(b == expected);
+
+  // Written back (as fixed-length strings) and read again: the notes stay.
+  write_asset(dir / "b.prt.h5", b);
+  EXPECT_TRUE(read_asset(dir / "b.prt.h5") == b);
+}
