@@ -1,4 +1,5 @@
-// libbake/src/openmesh.h — OpenMesh 9's headers, included once with the warnings they raise under
+// libbake/src/openmesh.h — the OpenMesh 9 headers libbake uses (halfedge meshes and Loop
+// subdivision; mesh files are read by our own readers, see mesh_io.cpp), included once with the warnings they raise under
 // prtbake's flags (-Wshadow, -Woverloaded-virtual, ...) silenced for them alone. Private to libbake.
 #pragma once
 
@@ -10,10 +11,6 @@
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 #pragma GCC diagnostic ignored "-Wcast-align"
 #pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-#include <OpenMesh/Core/IO/IOManager.hh>
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 #include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
 #pragma GCC diagnostic pop
