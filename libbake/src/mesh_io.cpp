@@ -17,9 +17,11 @@
 //   * All: messages go to process-wide streams (omerr/omlog), so reading needed a global lock
 //     and a capture of those streams, and OpenMesh's TriMesh, if used, re-adds non-manifold
 //     ("complex vertex/edge") faces with duplicated vertices.
-// Feeding them from memory does not help: OpenMesh::IO::read_mesh has std::istream overloads
-// (the OBJ, OFF, PLY, STL and OM readers implement read(std::istream&, ...)), but what is lost
-// is lost inside the reader, before any importer sees it. Restoring "every triangle reaches the
+// Feeding them from memory does not help: OpenMesh::IO::read_mesh / IOManager::read have
+// std::istream overloads (all five readers, OBJ, OFF, PLY, STL and OM, implement
+// read(std::istream&, ...); from a stream the OBJ reader cannot find a .mtl and the STL reader
+// must be told ascii or binary), but what is lost is lost inside the reader, before any importer
+// sees it. Restoring "every triangle reaches the
 // baker, in file order" on top of them therefore needs a parse of our own anyway — the second
 // scan this file used to have. So the four readers are ours (mesh_readers.cpp), each a single
 // pass over the bytes, and they were the smallest part to keep: the old scan already validated

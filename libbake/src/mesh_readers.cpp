@@ -317,6 +317,16 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
   auto is_face_list = [](const PlyElement& e, const PlyProperty& p) {
     return e.name == "face" && p.list && (p.name == "vertex_indices" || p.name == "vertex_index");
   };
+  // Every item takes at least this many bytes (binary: its scalars and list counts; ascii: one
+  // character and one separator per property), so a count the file cannot hold is refused
+  // before anything is allocated for it.
+  for (const PlyElement& e : elements) {
+    size_t per_item = 0;
+    for (const PlyProperty& p : e.props) per_item += binary ? static_cast<size_t>(ply_size(p.list ? p.count_type : p.type)) : 2;
+    if (per_item > 0 && e.count > (text.size() - body + 1) / per_item)
+      throw InputError(file.name, "truncated: the header declares " + std::to_string(e.count) + " " + e.name +
+                                      " items, more than the file's " + std::to_string(text.size()) + " bytes can hold");
+  }
   Polygons poly;
   bool has_normals = false;
   for (const PlyElement& e : elements) {
