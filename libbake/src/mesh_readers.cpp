@@ -325,7 +325,8 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
     for (const PlyProperty& p : e.props) per_item += binary ? static_cast<size_t>(ply_size(p.list ? p.count_type : p.type)) : 2;
     if (per_item > 0 && e.count > (text.size() - body + 1) / per_item)
       throw InputError(file.name, "truncated: the header declares " + std::to_string(e.count) + " " + e.name +
-                                      " items, more than the file's " + std::to_string(text.size()) + " bytes can hold");
+                                      " items of at least " + std::to_string(per_item) + " bytes each, but " +
+                                      std::to_string(text.size() - body) + " bytes follow the header");
   }
   Polygons poly;
   bool has_normals = false;
