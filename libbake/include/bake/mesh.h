@@ -80,7 +80,7 @@ struct Mesh {
   std::string source;                                  // path as given
   size_t file_positions = 0, file_faces = 0;           // counts as in the file (faces before triangulation)
   std::vector<std::string> warnings;                   // non-fatal reader messages (e.g. missing .mtl), one line each
-  std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes read; empty for meshes made in memory
+  std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
 };
 
 struct MeshLoadOptions {
@@ -97,7 +97,7 @@ struct Polygons {
   static constexpr uint32_t kNoNormal = 0xffffffffu;
   std::vector<Eigen::Vector3f> positions;   // the file's positions (STL: 3 corners per facet)
   std::vector<Eigen::Vector3f> normals;     // the file's normal values, as written (not normalised)
-  std::vector<uint32_t> offsets{0};         // polygons.size() + 1 entries
+  std::vector<uint32_t> offsets{0};         // polygon_count() + 1 entries, ascending
   std::vector<uint32_t> corner_position;    // per corner: index into positions
   std::vector<uint32_t> corner_normal;      // per corner: index into normals or kNoNormal; empty = none has one
   size_t polygon_count() const { return offsets.size() - 1; }
@@ -137,9 +137,9 @@ std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vecto
 std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                            std::span<const std::array<uint32_t, 3>> triangles);
 
-// Welded, orientation-free incidence for the integrators (docs/ARCHITECTURE.md, "Data path"): the DCF step across an
-// edge counts the faces on each side, so non-manifold edges and inconsistent winding are data,
-// not errors. Welded position ids are assigned in order of first appearance over the output
+// Welded, orientation-free incidence for the integrators (docs/ARCHITECTURE.md, "Data path"):
+// the DCF step across an edge counts the faces on each side, so non-manifold edges and
+// inconsistent winding are data, not errors. Welded position ids are assigned in order of first appearance over the output
 // vertices (so a mesh without duplicate positions has weld[v] == v); positions are equal when
 // their float coordinates are bitwise equal after mapping −0 to +0.
 struct Topology {
