@@ -1,7 +1,8 @@
-// Tests for bake/mesh.h: reading through OpenMesh with our own importer, vertex-order and
-// normal contracts, welded topology, and hostile inputs.
+// Tests for bake/mesh.h: the format readers and build_mesh, vertex-order and normal contracts,
+// the source digest, welded topology, and hostile inputs.
 #include <bake/error.h>
 #include <bake/mesh.h>
+#include <bake/sha256.h>
 
 #include <Eigen/Geometry>
 
@@ -120,12 +121,12 @@ TEST_P(RealMeshes, CountsInEqualCountsOutAndRowsAreTheFilesVertices) {
   ASSERT_EQ(obj.v.size(), expect.positions);
   ASSERT_EQ(obj.triangles, expect.triangles);
 
-  // Without file normals the rows are exactly the file's `v` lines, in order: OpenMesh's
-  // "complex vertex" duplication must not add or shift any.
+  // Without file normals the rows are exactly the file's `v` lines, in order: non-manifold
+  // ("complex") vertices must not be duplicated or shifted, and nothing may be printed.
   testing::internal::CaptureStderr();
   const Mesh plain = prt::bake::load_mesh(path, {.use_file_normals = false});
   const std::string chatter = testing::internal::GetCapturedStderr();
-  EXPECT_EQ(chatter, "") << "OpenMesh's messages must be captured, not printed";
+  EXPECT_EQ(chatter, "") << "reading must not print (libbake is silent)";
   EXPECT_EQ(plain.file_positions, obj.v.size());
   EXPECT_EQ(plain.file_faces, obj.faces.size());
   ASSERT_EQ(plain.positions.size(), obj.v.size()) << "rows must equal the file's v lines";
@@ -467,6 +468,131 @@ TEST(MeshFormats, PlyVertexNormalsAreUsed) {
   EXPECT_LT((plain.normals[2] - Vector3f(0, 0, 1)).norm(), kNormalTolerance);
 }
 
+TEST(MeshFormats, ValidFilesTheOpenMeshReadersRefusedAreRead) {
+  // Each was refused or misread while OpenMesh's readers parsed the files: colours after an OFF
+  // face's indices (read as the next face), integer-typed PLY coordinates (read as 0), a list
+  // property in a PLY vertex element. NOFF normals and big-endian double PLY are read as before.
+  const Prism prism;
+  const Mesh obj = prt::bake::load_mesh(write_file("prism.obj", prism_obj(prism)));
+  auto expect_prism = [&](const Mesh& m) {
+    ASSERT_EQ(m.positions.size(), 10u);
+    for (size_t i = 0; i < 10; ++i) ASSERT_TRUE(bits_equal(m.positions[i], prism.v[i])) << "vertex " << i;
+    EXPECT_EQ(m.triangles, obj.triangles);
+    EXPECT_EQ(m.file_faces, 7u);
+  };
+  std::string off_colours = "OFF\n10 7 0\n", noff = "NOFF\n10 7 0\n";
+  std::string ply_be = "ply\nformat binary_big_endian 1.0\nelement vertex 10\nproperty double x\nproperty double y\n"
+                       "property double z\nelement face 7\nproperty list uchar uint vertex_indices\nend_header\n";
+  auto append_be = [](std::string& s, auto v) {
+    char b[sizeof v];
+    std::memcpy(b, &v, sizeof v);
+    std::reverse(b, b + sizeof v);
+    s.append(b, sizeof v);
+  };
+  for (const auto& v : prism.v) {
+    const std::string xyz = fmt(v.x()) + " " + fmt(v.y()) + " " + fmt(v.z());
+    off_colours += xyz + "\n";
+    noff += xyz + " " + fmt(v.x()) + " 0 " + fmt(v.z()) + "\n";  // radial normals
+    for (int k = 0; k < 3; ++k) append_be(ply_be, double(v[k]));
+  }
+  for (const auto& f : prism.faces) {
+    std::string line = std::to_string(f.size());
+    for (uint32_t i : f) line += " " + std::to_string(i);
+    off_colours += line + " 255 128 0\n";
+    noff += line + "\n";
+    append_be(ply_be, uint8_t(f.size()));
+    for (uint32_t i : f) append_be(ply_be, i);
+  }
+  expect_prism(prt::bake::load_mesh(write_file("prism_colours.off", off_colours)));
+  expect_prism(prt::bake::load_mesh(write_file("prism_be_double.ply", ply_be)));
+  const Mesh n = prt::bake::load_mesh(write_file("prism_normals.off", noff));
+  expect_prism(n);
+  EXPECT_EQ(n.normal_source, Mesh::NormalSource::File);
+  for (size_t i = 0; i < 10; ++i)
+    EXPECT_LT((n.normals[i] - Vector3f(prism.v[i].x(), 0, prism.v[i].z()).normalized()).norm(), kNormalTolerance);
+
+  std::string ints = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty short x\nproperty short y\n"
+                     "property short z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int16_t c : {0, 0, 0, 2, 0, 0, 0, -3, 0}) append_raw(ints, c);
+  append_raw(ints, uint8_t{3});
+  for (int32_t i : {0, 1, 2}) append_raw(ints, i);
+  const Mesh m = prt::bake::load_mesh(write_file("ints.ply", ints));
+  EXPECT_TRUE(m.positions[1] == Vector3f(2, 0, 0));
+  EXPECT_TRUE(m.positions[2] == Vector3f(0, -3, 0));
+  const std::string vlist = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty list uchar float extra\n"
+                            "property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                            "end_header\n0 2 5 5 0 0\n2 0 0 0\n0 1 9 -3 0\n3 0 1 2\n";
+  const Mesh l = prt::bake::load_mesh(write_file("vlist.ply", vlist));
+  EXPECT_TRUE(l.positions == m.positions);
+}
+
+TEST(MeshLoad, SourceSha256IsTheDigestOfTheBytesRead) {
+  const fs::path bunny = fs::path(PRT_DATA_DIR) / "bunny.obj";
+  const Mesh m = prt::bake::load_mesh(bunny);
+  EXPECT_EQ(m.source_sha256, prt::bake::sha256_file(bunny));
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const Mesh t = prt::bake::load_mesh(write_file("sha.obj", tri));
+  EXPECT_EQ(t.source_sha256, prt::bake::sha256_bytes(std::as_bytes(std::span(tri.data(), tri.size()))));
+  EXPECT_EQ(prt::bake::make_mesh(t.positions, t.triangles, "memory").source_sha256, "") << "no file, no digest";
+}
+
+TEST(MeshLoad, MissingMaterialLibraryIsOneWarningNamingIt) {
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib nowhere.mtl\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n";
+  const Mesh m = prt::bake::load_mesh(write_file("mtl.obj", tri));
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_NE(m.warnings[0].find("line 4"), std::string::npos) << m.warnings[0];
+  EXPECT_NE(m.warnings[0].find("nowhere.mtl"), std::string::npos) << m.warnings[0];
+  write_file("present.mtl", "newmtl a\n");
+  const Mesh p = prt::bake::load_mesh(write_file("mtl2.obj", "mtllib present.mtl\n" + tri));
+  EXPECT_EQ(p.warnings.size(), 1u) << "only the missing library is reported";
+}
+
+TEST(MeshBuild, PolygonsToMeshIsTheStepEveryReaderShares) {
+  prt::bake::Polygons p;
+  p.positions = {Vector3f(0, 0, 0), Vector3f(1, 0, 0), Vector3f(1, 1, 0), Vector3f(0, 1, 0)};
+  p.normals = {Vector3f(0, 0, 2), Vector3f(0, 0, -1)};
+  // A quad facing +z, then the triangle (0, 2, 1) with the back normal: its corners split.
+  p.corner_position = {0, 1, 2, 3, 0, 2, 1};
+  p.corner_normal = {0, 0, 0, 0, 1, 1, 1};
+  p.offsets = {0, 4, 7};
+  const Mesh m = prt::bake::build_mesh(p, "generated");
+  EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {0, 2, 3}, {4, 5, 6}}));
+  EXPECT_EQ(m.source_position, (std::vector<uint32_t>{0, 1, 2, 3, 0, 2, 1}));
+  EXPECT_TRUE(m.normals[0] == Vector3f(0, 0, 1)) << "normalised";
+  EXPECT_TRUE(m.normals[4] == Vector3f(0, 0, -1));
+  EXPECT_EQ(m.normal_source, Mesh::NormalSource::File);
+  EXPECT_EQ(m.file_positions, 4u);
+  EXPECT_EQ(m.file_faces, 2u);
+  EXPECT_EQ(m.source, "generated");
+  const Mesh plain = prt::bake::build_mesh(p, "generated", {.use_file_normals = false});
+  EXPECT_EQ(plain.positions.size(), 4u);
+
+  auto expect_defect = [](const prt::bake::Polygons& bad, const std::string& part) {
+    try {
+      (void)prt::bake::build_mesh(bad, "generated");
+      ADD_FAILURE() << "accepted; expected '" << part << "'";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("generated: " + part), std::string::npos) << e.what();
+    }
+  };
+  auto bad = p;
+  bad.corner_position[5] = 9;
+  expect_defect(bad, "face 1: vertex index 9 is out of range [0, 4)");
+  bad = p;
+  bad.corner_normal[6] = 2;
+  expect_defect(bad, "face 1: normal index 2 is out of range [0, 2)");
+  bad = p;
+  bad.offsets = {0, 2, 7};
+  expect_defect(bad, "face 0 has 2 corners, needs at least 3");
+  bad = p;
+  bad.positions[1].y() = std::nanf("");
+  expect_defect(bad, "vertex 1 has a non-finite coordinate");
+  bad = p;
+  bad.normals[1].x() = INFINITY;
+  expect_defect(bad, "vertex 0 has a non-finite normal");
+  expect_defect(prt::bake::Polygons{}, "no faces");
+}
+
 // --- normals --------------------------------------------------------------------------------
 
 std::vector<Vector3f> cube_positions() {
@@ -673,6 +799,16 @@ TEST(MeshErrors, BadInputNamesFileAndDefect) {
   expect_input_error(write_file("cut_ascii.stl", stla.substr(0, stla.size() / 2)), "line ");
   expect_input_error(write_file("garbage.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0\n"), "line 5: 'vertex' needs 3");
   expect_input_error(write_file("empty.stl", stl_binary({})), "no faces");
+}
+
+TEST(MeshErrors, CountsTheFileCannotHoldAreRefusedBeforeAnythingIsAllocated) {
+  // 10^12 vertices would be 12 TB of positions: the answer must be an error naming the defect,
+  // not an allocation failure.
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 0\nproperty list uchar int vertex_indices\n"
+                             "end_header\n";
+  expect_input_error(write_file("huge_count.ply", header + std::string(120, '\0')), "truncated: the header declares 1000000000000 vertex");
+  expect_input_error(write_file("huge_count.off", "OFF\n1000000000000 1 0\n0 0 0\n"), "truncated: the header says 1000000000000 vertices");
 }
 
 TEST(MeshErrors, UnreadableFile) {

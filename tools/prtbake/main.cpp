@@ -398,7 +398,7 @@ int run_vertex(const Args& a) {
   mopt.use_file_normals = a.file_normals;
   const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
-  const std::string mesh_sha = bake::sha256_file(a.input);
+  const std::string mesh_sha = mesh.source_sha256;
   print_warnings(mesh.warnings);
   if (say)
     std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s\n",
@@ -519,7 +519,7 @@ int run_fiv(const Args& a) {
 
   namespace F = prt::formats;
   F::Asset asset;
-  asset.root = root_info(a, bake::sha256_file(a.input));
+  asset.root = root_info(a, mesh.source_sha256);
   tool::set_fiv_environment(asset, env, a.environment, fenv, cube, a.shells.cube);
   const std::string name = tool::safe_name(fs::path(a.input).stem().string());
   F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, sh, env, a.environment, a.shells.fraction, a.shells.silhouette_k));
@@ -556,7 +556,7 @@ int run_scene(const Args& a) {
     } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
       throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.input + ")");
     }
-    mesh_sha.push_back(bake::sha256_file(o.mesh));
+    mesh_sha.push_back(meshes.back().source_sha256);
     print_warnings(meshes.back().warnings);
   }
   std::optional<bake::EnvMap> env;

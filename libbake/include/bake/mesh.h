@@ -1,20 +1,25 @@
-// bake/mesh.h — mesh input and welded topology (DESIGN.md §2, "scene input (OpenMesh), edge/face
-// incidence").
+// bake/mesh.h — mesh input and welded topology (docs/ARCHITECTURE.md, "Data path": scene input,
+// edge/face incidence).
 //
 // A Mesh is the geometry a bake belongs to: its vertex rows are the rows of every per-vertex
 // output (/mesh/positions, /ao, /transfer/...), so they must line up with the vertex buffer an
 // engine builds from the same file. The contracts below are what guarantees that.
 //
-// READING (load_mesh). Files are parsed by OpenMesh's own readers (OBJ, PLY ascii + binary,
-// OFF ascii, STL ascii + binary) into a raw importer of ours (an OpenMesh::IO::BaseImporter), so
-// OpenMesh's TriMesh/PolyMesh never sees the faces: it cannot re-add "complex vertex/edge"
-// (non-manifold) faces with duplicated vertices. Independently of OpenMesh, a cheap structural
-// scan of the file counts positions, faces and Σ(corners − 2) triangles; the two must agree, or
-// load_mesh throws InputError naming the file and both counts. The scan also supplies what
-// OpenMesh 9.0's readers drop on purpose: the OBJ reader removes repeated indices from a face
-// (`f 1 1 2` vanishes, `f 1 2 1 3` becomes a triangle) and the STL reader skips facets with
-// two equal corners. Those faces are restored from the scan, exactly as the file has them:
-// zero-area, needle and repeated-index triangles are all kept, never dropped.
+// READING (load_mesh) happens in two steps with one seam between them:
+//   1. The file's bytes are read once, into memory. Mesh::source_sha256 is the SHA-256 of exactly
+//      those bytes (so a caller never hashes the file again), and ONE reader per format parses
+//      them once into a Polygons: the file's positions and normal values in file order, and its
+//      polygons as corner lists (position index, optional normal index per corner), in file
+//      order, exactly as the file has them (zero-area, needle and repeated-index polygons are
+//      kept). Readers: OBJ, PLY (ascii, binary little/big endian), OFF ([ST][C][N]OFF, ascii),
+//      STL (ascii, binary). Why these readers are ours and not OpenMesh's: see mesh_io.cpp.
+//   2. build_mesh turns any Polygons into the Mesh: vertex rows, hard-edge splits, fan
+//      triangulation, normals and validation, the same for every format.
+// A new format (the next one is glTF) is one more reader: a function that fills a Polygons from
+// the bytes (a glTF primitive's POSITION accessor -> positions, NORMAL -> normals with
+// corner_normal = the corner's vertex index, its indices -> 3-corner polygons, primitives and
+// nodes concatenated in document order) and one line in the extension table in mesh_io.cpp;
+// build_mesh and everything after it stay as they are.
 //
 // OUTPUT VERTEX ORDER (the rule every per-vertex consumer relies on):
 //   * OBJ, PLY, OFF: output vertex i < file_positions IS file position i (the file's `v` lines /
@@ -43,15 +48,13 @@
 // TRIANGLES: file face order; a polygon (c0 … cn−1) becomes the fan (c0, ci, ci+1), i = 1…n−2,
 // in place. Winding is the file's; nothing here assumes it is consistent.
 //
-// ERRORS: bad input throws prt::bake::InputError whose what() is "<path>: <defect>" with a line
-// number where the format has lines: missing/unreadable file, unknown extension, empty mesh,
-// truncated or garbled file (an OBJ line with an unknown keyword is garbage), NaN/Inf or
-// out-of-float-range coordinates, zero / negative / out-of-range face indices, faces with fewer
-// than 3 corners, triangle-count mismatch between the scan and OpenMesh, and any message
-// OpenMesh prints to omerr while reading (its chatter is captured, never printed; messages
-// about a missing or incomplete .mtl material library are not errors and go to Mesh::warnings).
-// Binary OFF is not supported (InputError). Reading holds a process-wide lock while OpenMesh
-// runs (its omerr/omlog streams are global); everything else is re-entrant.
+// ERRORS: bad input throws prt::bake::InputError whose what() is "<path>: <defect>" (one line),
+// with a line number where the format has lines: missing/unreadable/oversized file, unknown
+// extension, empty mesh, truncated or garbled file (an OBJ line with an unknown keyword is
+// garbage), NaN/Inf or out-of-float-range coordinates, zero / negative / out-of-range face
+// indices, faces with fewer than 3 corners. A missing OBJ material library is not an error (a bake
+// does not use materials): it goes to Mesh::warnings. Binary OFF is not supported (InputError).
+// Reading is re-entrant: no global state.
 #pragma once
 
 #include <Eigen/Core>
@@ -77,6 +80,7 @@ struct Mesh {
   std::string source;                                  // path as given
   size_t file_positions = 0, file_faces = 0;           // counts as in the file (faces before triangulation)
   std::vector<std::string> warnings;                   // non-fatal reader messages (e.g. missing .mtl), one line each
+  std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
 };
 
 struct MeshLoadOptions {
@@ -86,6 +90,25 @@ struct MeshLoadOptions {
 // Read OBJ / PLY / OFF / STL (by extension, case-insensitive). See the file comment for the
 // vertex order, normal and error contracts. Throws InputError.
 Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
+
+// The neutral polygon description between a format reader and build_mesh: what the file says,
+// in file order, nothing derived. Corner c of polygon f is c in [offsets[f], offsets[f + 1]).
+struct Polygons {
+  static constexpr uint32_t kNoNormal = 0xffffffffu;
+  std::vector<Eigen::Vector3f> positions;   // the file's positions (STL: 3 corners per facet)
+  std::vector<Eigen::Vector3f> normals;     // the file's normal values, as written (not normalised)
+  std::vector<uint32_t> offsets{0};         // polygon_count() + 1 entries, ascending
+  std::vector<uint32_t> corner_position;    // per corner: index into positions
+  std::vector<uint32_t> corner_normal;      // per corner: index into normals or kNoNormal; empty = none has one
+  size_t polygon_count() const { return offsets.size() - 1; }
+  void end_polygon() { offsets.push_back(static_cast<uint32_t>(corner_position.size())); }
+};
+
+// The one polygon-to-mesh step behind load_mesh (vertex order, hard-edge splits, fans, normals:
+// the contracts in the file comment). Validates what a reader may pass through (finite
+// positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits) and throws
+// InputError(source, defect). Sets source, file_positions, file_faces; not source_sha256 or warnings.
+Mesh build_mesh(const Polygons& polygons, std::string source, const MeshLoadOptions& = {});
 
 // Build a mesh in memory (tests, generated geometry). Output vertex i = positions[i],
 // source_position[i] = i, file_positions = positions.size(), file_faces = triangles.size().
@@ -114,9 +137,9 @@ std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vecto
 std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                            std::span<const std::array<uint32_t, 3>> triangles);
 
-// Welded, orientation-free incidence for the integrators (DESIGN.md §4): the DCF step across an
-// edge counts the faces on each side, so non-manifold edges and inconsistent winding are data,
-// not errors. Welded position ids are assigned in order of first appearance over the output
+// Welded, orientation-free incidence for the integrators (docs/ARCHITECTURE.md, "Data path"):
+// the DCF step across an edge counts the faces on each side, so non-manifold edges and
+// inconsistent winding are data, not errors. Welded position ids are assigned in order of first appearance over the output
 // vertices (so a mesh without duplicate positions has weld[v] == v); positions are equal when
 // their float coordinates are bitwise equal after mapping −0 to +0.
 struct Topology {

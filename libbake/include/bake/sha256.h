@@ -1,31 +1,33 @@
 // bake/sha256.h — SHA-256 (FIPS 180-4) of files and byte buffers, for provenance: the baked
-// file records the digest of every input (mesh, environment map) it was made from.
+// file records the digest of every input (mesh, environment map) it was made from
+// (docs/ARCHITECTURE.md, "Schema"). Computed by OpenSSL's libcrypto (EVP); a mesh's digest comes
+// with the mesh (Mesh::source_sha256, bake/mesh.h), taken from the bytes that were parsed.
 // Digests are returned as 64 lowercase hexadecimal characters.
 #pragma once
 
-#include <array>
 #include <cstddef>
-#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 
 namespace prt::bake {
 
 // Incremental hasher: update() any number of times, then hex_digest() once.
+// Throws SystemError if libcrypto cannot provide SHA-256 (out of memory, a broken install).
 class Sha256 {
 public:
-  Sha256() noexcept;
-  void update(std::span<const std::byte> bytes) noexcept;
+  Sha256();
+  ~Sha256();
+  Sha256(Sha256&&) noexcept;
+  Sha256& operator=(Sha256&&) noexcept;
+  void update(std::span<const std::byte> bytes);
   // Finishes the hash; the object must not be updated afterwards (PRT_CHECK).
   std::string hex_digest();
 
 private:
-  void block(const unsigned char* p) noexcept;
-  std::array<uint32_t, 8> h_;
-  std::array<unsigned char, 64> buf_{};
-  size_t buf_len_ = 0;
-  uint64_t total_bytes_ = 0;
+  struct Context;  // libcrypto's digest context
+  std::unique_ptr<Context> context_;
   bool finished_ = false;
 };
 
