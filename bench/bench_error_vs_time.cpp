@@ -1,5 +1,5 @@
 // bench_error_vs_time — error against run time for the QMC baseline and the silhouette
-// integrator on the same scene and shade points (DESIGN.md §6; paper 001 Figure 10 / Table 1).
+// integrator on the same scene and shade points (docs/ARCHITECTURE.md §6; paper 001 Figure 10 / Table 1).
 //
 // Scene and points: bench_common.h (bunny_ground.obj, AO + order-3 diffuse transfer, seeded
 // vertices). Reference: QMC with R rays per vertex, taken as the mean of two independent

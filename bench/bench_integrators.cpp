@@ -1,6 +1,6 @@
 // bench_integrators — cost of one spherical integral (one shade point, AO + order-3 transfer
 // on the default scene), single-threaded, for the QMC baseline next to the silhouette
-// integrator (DESIGN.md §4, §6; paper 001 Table 1 is the model).
+// integrator (docs/ARCHITECTURE.md §4, §6; paper 001 Table 1 is the model).
 //
 //   BM_Qmc/samples:N                QMC, N rays per integral           (level-0 scene)
 //   BM_Silhouette/isolines:N        silhouette, k = N² samples         (level-0 scene)

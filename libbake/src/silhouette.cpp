@@ -365,7 +365,7 @@ struct SilhouetteIntegrator::Impl {
     return inconsistent;
   }
 
-  // No contour edge in the visible hemisphere (DESIGN.md §5, "no integrator work where no contour
+  // No contour edge in the visible hemisphere (docs/ARCHITECTURE.md §5, "no integrator work where no contour
   // edge is seen"): the depth complexity is then constant over the open upper hemisphere, so one
   // ray along n decides between "enclosed" (W > 0: nothing visible, every product is 0) and
   // "open" (V = H). Open rows are closed forms (bake/zonal.h, Funk–Hecke): AO = 1,

@@ -1,7 +1,7 @@
 // runtime/shaders/fiv.glsl — GLSL 450 mirror of the FIV run-time shading of
 // runtime/include/prtshade/fiv.h (Michael & Chrysanthou, "Fullsphere Irradiance Factorization for
 // Real-Time All-Frequency Illumination for Dynamic Scenes", CGF 2010; paper 004 in
-// ../shared/papers, §4.3 "Run time"). The contract is spec/runtime_api.md; every convention
+// ../shared/papers, §4.3 "Run time"). The contract is <prtshade/fiv.h>; every convention
 // (shell grid, cube faces, cases A/B/C, overlap, self-shadows) is the one in prtshade/fiv.h:
 //
 //   prt_lookup_difmap(n)                 prt::shade::lookup_difmap        E_tot(n), eq. 5 / 11

@@ -1,8 +1,8 @@
 // runtime/shaders/shade.glsl — GLSL 450 mirror of the diffuse-PRT and band-1 shading of
 // runtime/include/prtshade/shade.h (prt::shade::shade_transfer, prt::shade::shade_band1; the
-// contract is spec/runtime_api.md). Include it after defining the bindings you want (below).
+// contract is <prtshade/shade.h>). Include it after defining the bindings you want (below).
 //
-// prt_shade_transfer(first, order) — diffuse PRT, DESIGN.md §3 (Sloan, Kautz, Snyder 2002):
+// prt_shade_transfer(first, order) — diffuse PRT, docs/ARCHITECTURE.md §3 (Sloan, Kautz, Snyder 2002):
 //   out_c = Σ_i T_i · L_{c,i},  i = 0 … order² − 1,
 // T = the vertex's /transfer/diffuse row (it carries the 1/π, so the caller multiplies by the
 // albedo only), L = SH lighting [RGB][order²] channel-major, as prt::shade::project_latlong

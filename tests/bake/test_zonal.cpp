@@ -1,5 +1,5 @@
 // Tests of the zonal closed forms (bake/zonal.h) and of the silhouette integrator's closed-form
-// path for shade points that see no contour edge (DESIGN.md §5).
+// path for shade points that see no contour edge (docs/ARCHITECTURE.md §5).
 #include <bake/envmap.h>
 #include <bake/mesh.h>
 #include <bake/qmc.h>

@@ -182,7 +182,7 @@ TEST(ProjectLatlong, BadInputThrowsNamingTheProblem) {
   EXPECT_THROW(shade::project_latlong(img.data(), 8, 4, 3, nullptr), std::invalid_argument);
 }
 
-// Unoccluded clamped-cosine transfer for n = +z (DESIGN.md §3, T has the 1/π):
+// Unoccluded clamped-cosine transfer for n = +z (docs/ARCHITECTURE.md §3, T has the 1/π):
 // T_0 = 1/(2√π), T_2 = √3/(3√π), T_6 = √5/(8√π), every other coefficient 0.
 std::vector<float> unoccluded_transfer_z(int order) {
   const double rpi = std::sqrt(kPi);

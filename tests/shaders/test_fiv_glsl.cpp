@@ -1,7 +1,7 @@
 // runtime/shaders/fiv.glsl run as a Vulkan compute shader (lavapipe on CI) against the C++ core
 // (prt::shade::lookup_fiv, lookup_difmap, partial_factor, occluded_irradiance, shade_fiv,
 // shade_fiv_self) and against a double-precision transcription of the contract
-// (spec/runtime_api.md), on synthetic occluders: random shells with invalid samples (one cell
+// (<prtshade/fiv.h>), on synthetic occluders: random shells with invalid samples (one cell
 // wholly invalid), several grid sizes including the minimal 1 × 2 × 1, receivers at the poles,
 // across the φ seam, inside the first shell, at ρ = 0 and beyond the last shell.
 //

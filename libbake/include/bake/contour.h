@@ -1,11 +1,11 @@
 // bake/contour.h — contour-edge extraction, the first stage of the silhouette integrator
-// (paper 001 §3.1, eq. 6; DESIGN.md §4).
+// (paper 001 §3.1, eq. 6; docs/ARCHITECTURE.md §4).
 //
 // An undirected welded edge e = (a, b), a < b, with incident faces k (corner c_k not on e) is a
 // contour edge seen from the shade point p when its side sum
 //     S_e = Σ_k σ_k,   σ_k = orient_eps(pos(a), pos(b), pos(c_k), p, n)
 // is non-zero: σ_k tells on which side of the plane through p, a, b the face k lies, evaluated
-// exactly and in the limit p + εn, ε → 0+ (DESIGN.md §3). A path crossing e's projection in
+// exactly and in the limit p + εn, ε → 0+ (docs/ARCHITECTURE.md §3). A path crossing e's projection in
 // direction t changes the depth complexity by sign(m·t)·S_e with m = (a−p)×(b−p): the number of
 // faces on the far side minus those on the near side. Nothing assumes consistent winding or a
 // manifold: boundary edges (1 face) have |S_e| = 1, non-manifold edges any value.

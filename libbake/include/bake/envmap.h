@@ -1,5 +1,5 @@
 // bake/envmap.h — environment maps: loading OpenEXR lat-long and cube maps, radiance lookup,
-// luminance importance sampling and SH projection (DESIGN.md §3 "Environment maps").
+// luminance importance sampling and SH projection (docs/ARCHITECTURE.md §3 "Environment maps").
 //
 // The map is a PIECEWISE-CONSTANT function over the sphere: every texel owns a region and the
 // radiance is the texel value everywhere inside it. radiance(), sample()/pdf() and project_sh()

@@ -1,6 +1,6 @@
 // bake/products.h — what a per-vertex bake computes, and where each value lives in a row.
 //
-// The integrands (DESIGN.md §3; p shade point, n unit normal, V visibility from just above the
+// The integrands (docs/ARCHITECTURE.md §3; p shade point, n unit normal, V visibility from just above the
 // surface, H(ω,n) = [n·ω > 0], y_i the real SH basis of prtshade, index l(l+1)+m, order = number
 // of bands L):
 //   AO                   A     = (1/π) ∫ V H (n·ω) dω                     ∈ [0,1]

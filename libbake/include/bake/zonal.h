@@ -14,7 +14,7 @@
 // Checks: s = 1 gives I = 1/2, 1/3, 1/8, 0, −1/48 … (λ = π, 2π/3, π/4, 0, −π/24: Ramamoorthi &
 // Hanrahan 2001, eq. 8); s = 0 gives ∫_0^1 P_l = 1, 1/2, 0, −1/8 ….
 //
-// Products of an unoccluded shade point (V = H(ω, n), DESIGN.md §3 integrands):
+// Products of an unoccluded shade point (V = H(ω, n), docs/ARCHITECTURE.md §3 integrands):
 //   AO = 1,  T_lm = (1/π) λ_l(1) y_lm(n) = 2 I_l(1) y_lm(n),  U_lm = λ_l(0) y_lm(n) = 2π I_l(0) y_lm(n).
 //
 // Glossy SH order (paper 001 §4 "glossy" after Ramamoorthi & Hanrahan, "Frequency space environment

@@ -3,8 +3,9 @@
 // Scenes", CGF 2010; paper 004 in ../shared/papers, §4.3 "Run time"): DifMap lookup, trilinear
 // lookup of an occluder's baked FIV shells, the three occluder cases A/B/C with the partial-
 // occluder factor, the overlap correction for several occluders (eq. 13–14) and self-shadows
-// (eq. 12). The contract shared with the C API and the GLSL mirrors is spec/runtime_api.md; the
-// baked data and its conventions are libbake/include/bake/fiv.h and formats/SCHEMA.md.
+// (eq. 12). This header is the contract shared with the C API and the GLSL mirrors
+// (docs/ARCHITECTURE.md §2); the baked data and its conventions are libbake/include/bake/fiv.h
+// and formats/SCHEMA.md.
 //
 // Quantities (per RGB channel c; an FIV is [RGB][xyz] = 9 floats, row-major):
 //   environment FIV  F_c^env = ∫ L_c(ω) ω dω                        (/fiv/environment)

@@ -1,6 +1,7 @@
 /* prtshade/prtshade.h — the C API of the prtshade run-time library, for engines that are not C++.
  *
- * It mirrors the C++ core one to one (spec/runtime_api.md): <prtshade/sh.h> (SH rotation),
+ * It mirrors the C++ core one to one (the core's headers are the contract; docs/ARCHITECTURE.md
+ * §2): <prtshade/sh.h> (SH rotation),
  * <prtshade/shade.h> (lat-long projection, transfer · light, band-1 shading) and
  * <prtshade/fiv.h> (paper 004 §4.3 FIV shading). Conventions, units, frames and the papers and
  * equations each function implements are stated in those headers; this one states the C

@@ -1,6 +1,6 @@
 // prtshade/sh.h — THE definition of the spherical-harmonics basis in prtbake: evaluation,
 // index layout and rotation. libbake and every runtime consumer use this file, so baker and
-// runtime cannot disagree on a sign or a normalisation (DESIGN.md §2, §3).
+// runtime cannot disagree on a sign or a normalisation (docs/ARCHITECTURE.md §2, §3).
 //
 // Basis (P.-P. Sloan, "Stupid Spherical Harmonics (SH) Tricks", GDC 2008, §"Definitions";
 // identical to DirectXMath XMSHEvalDirection and to google/spherical-harmonics EvalSH):
@@ -12,7 +12,7 @@
 //   with K_l^m = sqrt((2l+1)/(4π) · (l−m)!/(l+m)!), direction (x, y, z) =
 //   (sin θ cos φ, sin θ sin φ, cos θ): θ is measured from +z, φ from +x towards +y. The basis
 //   is defined on (x, y, z) directly; nothing here knows about "up" (the scene frame is the
-//   caller's business, DESIGN.md §3 "Environment maps").
+//   caller's business, docs/ARCHITECTURE.md §3 "Environment maps").
 //   Bands 0–2 written out (DirectXMath's 6-digit constants):
 //     y00 = 0.282095
 //     y1-1 = −0.488603 y    y10 = 0.488603 z    y11 = −0.488603 x

@@ -1,7 +1,8 @@
 // prtshade/shade.h — run-time diffuse PRT shading with the baked per-vertex data: SH projection
 // of a lighting environment given as pixels, transfer · lighting, and band-1 shading of the
-// baked shadowed radiance. The contract shared with the C API and the GLSL mirrors is
-// spec/runtime_api.md; the conventions are DESIGN.md §3 and formats/SCHEMA.md.
+// baked shadowed radiance. The contract shared with the C API (prtshade/prtshade.h) and the GLSL
+// mirrors (runtime/shaders) is this header; the conventions are docs/ARCHITECTURE.md §3 and
+// formats/SCHEMA.md.
 //
 // SH: the basis of <prtshade/sh.h> (real, orthonormal, Condon–Shortley phase, index l(l+1)+m,
 // "order" L = NUMBER OF BANDS, L² coefficients). Lighting is rotated with prt::sh::Rotation
@@ -23,8 +24,8 @@
 // Pixel policy (as EnvMap::from_latlong): negative values (lossy EXR ringing) are clamped to 0;
 // NaN/Inf is an error naming the pixel.
 //
-// Integrands (DESIGN.md §3; V visibility, H(ω,n) = [n·ω > 0]):
-//   diffuse transfer   T_i = (1/π) ∫ V H (n·ω) y_i dω    (Sloan, Kautz, Snyder 2002; DESIGN.md §3)
+// Integrands (docs/ARCHITECTURE.md §3; V visibility, H(ω,n) = [n·ω > 0]):
+//   diffuse transfer   T_i = (1/π) ∫ V H (n·ω) y_i dω    (Sloan, Kautz, Snyder 2002; docs/ARCHITECTURE.md §3)
 //                      shading: L_out = albedo · Σ_i T_i L_i, L_i = ∫ L_env y_i dω. Because T
 //                      carries the 1/π, a constant environment L with an unoccluded vertex gives
 //                      Σ_i T_i L_i = L (the white furnace returns the albedo).
@@ -49,7 +50,7 @@ namespace prt::shade {
 // double, stored as float (one rounding per coefficient). Throws std::invalid_argument.
 void project_latlong(const float* rgb, int width, int height, int order, float* out);
 
-// Σ_i transfer[i] · light_rgb[c·n + i] for c = 0..2, n = order² (DESIGN.md §3 diffuse transfer;
+// Σ_i transfer[i] · light_rgb[c·n + i] for c = 0..2, n = order² (docs/ARCHITECTURE.md §3 diffuse transfer;
 // the caller multiplies by the albedo). light_rgb is channel-major as project_latlong writes it.
 // Accumulated in float, in index order.
 void shade_transfer(const float* transfer, int order, const float* light_rgb, float out[3]);
