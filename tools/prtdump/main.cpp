@@ -309,7 +309,7 @@ void report_text(std::ostream& os, const pf::Asset& a) {
 void summary_text(std::ostream& os, const std::string& path, const pf::Inspection& in) {
   const pf::File& f = in.file;
   os << "file     " << path << '\n';
-  os << "format   prtbake, format_version " << version_of(f) << '\n';
+  os << "format   prtbake, " << names::kFormatVersion << ' ' << version_of(f) << '\n';
   os << "schema   "
      << (in.schema_error ? "INVALID: " + *in.schema_error
                          : "valid (schema v" + std::to_string(version_of(f)) + ", this prtdump reads 1.." +

@@ -15,7 +15,7 @@
 
 #include <bake/envmap.h>
 #include <bake/error.h>
-#include <formats/prtfile.h>
+#include <formats/asset.h>
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -317,7 +317,7 @@ int run(const Args& a) {
     if (!fs::is_directory(dir, ec)) throw bake::InputError(a.output, "cannot write: directory '" + dir.string() + "' does not exist");
   }
   if (!fs::exists(a.file)) throw bake::InputError(a.file, "no such file");
-  const F::File f = F::read_file(a.file);
+  const F::Asset f = F::read_asset(a.file);
   std::string kind = a.shade;
   if (prtview::is_scene_file(f)) kind = "scene";
   else if (kind.empty()) kind = prtview::has_fiv(f) ? "fiv" : prtview::has_transfer(f) ? "transfer" : "band1";

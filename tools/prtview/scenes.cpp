@@ -66,7 +66,7 @@ std::vector<float> band1_colours(const Band1& b, size_t V, std::string& how) {
 
 } // namespace
 
-view::Image render_vertex_file(const F::File& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
+view::Image render_vertex_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
                                const view::Camera& cam, Scene& scene) {
   scene.mesh = read_mesh(f, file, "");
   const size_t V = scene.mesh.positions.size();
@@ -76,7 +76,7 @@ view::Image render_vertex_file(const F::File& f, const std::string& file, const 
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
 }
 
-view::Image render_fiv_file(const F::File& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
+view::Image render_fiv_file(const F::Asset& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
                             const view::Camera& cam, Scene& scene) {
   const std::string name = choose_occluder(f, file, options.occluder);
   const BakedOccluder baked = read_occluder(f, file, name, env);
@@ -144,7 +144,7 @@ view::Image render_fiv_file(const F::File& f, const std::string& file, const Fiv
 }
 
 
-view::Image render_scene_file(const F::File& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
+view::Image render_scene_file(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
                               Scene& scene) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, env);
   // What the runtime has beside the per-vertex data: the DifMap (unshadowed irradiance) and the

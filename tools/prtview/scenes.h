@@ -10,7 +10,7 @@
 
 #include <bake/envmap.h>
 #include <bake/mesh.h>
-#include <formats/prtfile.h>
+#include <formats/asset.h>
 
 #include <Eigen/Core>
 #include <array>
@@ -38,7 +38,7 @@ struct Scene {
 };
 
 // Per-vertex files: kind "transfer" or "band1".
-view::Image render_vertex_file(const formats::File& f, const std::string& file, const std::string& kind,
+view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
                                const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
@@ -48,11 +48,11 @@ struct FivView {
   std::optional<double> ground, ground_size;
   bool overlap = true, partial = true;
 };
-view::Image render_fiv_file(const formats::File& f, const std::string& file, const FivView& options,
+view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
                             const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
 
 // Scene files (prtbake scene, schema v2): every object with what the file holds for it.
-view::Image render_scene_file(const formats::File& f, const std::string& file, const bake::EnvMap& env,
+view::Image render_scene_file(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
                               const view::Camera& cam, Scene& scene);
 
 } // namespace prt::prtview
