@@ -36,7 +36,7 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
   }
   sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0});
   PRT_CHECK_OP(sh_order_, <=, sh::kMaxOrder);
-  rays_ = std::make_unique<RayScene>(mesh, topology);
+  rays_ = std::make_unique<RayCaster>(mesh, topology);
 }
 
 QmcIntegrator::~QmcIntegrator() = default;

@@ -23,7 +23,7 @@ std::string fmt(const char* f, double a, double b = 0) {
 
 } // namespace
 
-SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
+SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());

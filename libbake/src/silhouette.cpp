@@ -75,7 +75,7 @@ struct SilhouetteIntegrator::Impl {
   ProductLayout layout;
   SilhouetteOptions opt;
   ContourFinder contours;
-  RayScene rays;
+  RayCaster rays;
   oct::Grid grid;
   Eigen::Matrix3d frame_from_world;
   int sh_order = 0;

@@ -543,7 +543,7 @@ int run_scene(const Args& a) {
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  bake::Scene scene = bake::load_scene(a.input);
+  bake::SceneDescription scene = bake::load_scene(a.input);
   if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
@@ -623,7 +623,7 @@ int run_scene(const Args& a) {
     obj.mesh = o.mesh.string();
     obj.mesh_sha256 = mesh_sha[i];
     obj.transform.emplace(16);
-    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.transform(k / 4, k % 4);
+    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
     obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
     obj.phong_exponent = o.material.phong_exponent;
     obj.sh_order_diffuse = int64_t(p.transfer_order);

@@ -30,21 +30,21 @@
 
 namespace prt::view {
 
-using namespace prt::bake;  // Mesh, EnvMap, Rgb, RayScene, Frame, samplers, errors
+using namespace prt::bake;  // Mesh, EnvMap, Rgb, RayCaster, Frame, samplers, errors
 using Eigen::Vector3d;
 
 namespace {
 constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
 }
 
-// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh for
+// The ray queries of the reference: libbake's RayCaster (bake/raycast.h) over the rendered mesh for
 // primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
 struct ReferenceRenderer::Rays {
   Topology topology;
-  RayScene scene;
+  RayCaster scene;
   Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
   std::optional<Topology> caster_topology;
-  std::unique_ptr<RayScene> casters;
+  std::unique_ptr<RayCaster> casters;
   bool any_caster = true;
   Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), scene(mesh, topology) {
     if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
@@ -55,7 +55,7 @@ struct ReferenceRenderer::Rays {
     any_caster = !caster_mesh.triangles.empty();
     if (!any_caster) return;
     caster_topology = build_topology(caster_mesh);
-    casters = std::make_unique<RayScene>(caster_mesh, *caster_topology);
+    casters = std::make_unique<RayCaster>(caster_mesh, *caster_topology);
   }
   bool occluded(const Vector3d& o, const Vector3d& d) const {
     ShadePoint sp;
