@@ -122,12 +122,12 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
     ObjectBake& ob = out.objects[i];
-    ob.fiv = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
-    out.fiv_seconds += ob.fiv->seconds;
+    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
+    out.fiv_seconds += ob.shells->seconds;
     log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
-        "x" + std::to_string(ob.fiv->radii.size()) + " in " + fmt("%.2f s", ob.fiv->seconds));
+        "x" + std::to_string(ob.shells->radii.size()) + " in " + fmt("%.2f s", ob.shells->seconds));
     if (scene.integrator.report_points > 0) {
-      ob.fiv_report = fiv_error_report(m, t, *env, *ob.fiv, out.environment_fiv, scene.integrator.report_points,
+      ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
                                        scene.integrator.seed);
       log("  fiv: " + fmt("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
                           ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));

@@ -139,7 +139,7 @@ struct ObjectBake {
   std::string integrator_description;
   uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
   // Occluders with shells (in world space: centre and radii in scene units).
-  std::optional<FivShells> fiv;
+  std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
 };
 
