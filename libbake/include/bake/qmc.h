@@ -33,7 +33,7 @@
 namespace prt::bake {
 
 struct QmcOptions {
-  uint32_t samples = IntegratorSpec::kDefaultQmcRays;  // rays per shade point
+  uint32_t rays = IntegratorSpec::kDefaultQmcRays;  // per shade point
   uint64_t seed = 1;
 };
 

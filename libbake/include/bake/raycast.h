@@ -54,7 +54,7 @@ public:
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
   // rays of the reference renderer, view/reference.h).
   std::optional<RayHit> closest_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear) const;
-  double scene_diagonal() const { return diagonal_; }
+  double mesh_diagonal() const { return diagonal_; }  // of the mesh's axis-aligned bounds
 
 private:
   struct Embree;
