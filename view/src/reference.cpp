@@ -41,12 +41,12 @@ constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
 // primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
 struct ReferenceRenderer::Rays {
   Topology topology;
-  RayCaster scene;
+  RayCaster every_triangle;  // primary rays; shadow rays too unless `casters` is set
   Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
   std::optional<Topology> caster_topology;
   std::unique_ptr<RayCaster> casters;
   bool any_caster = true;
-  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), scene(mesh, topology) {
+  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), every_triangle(mesh, topology) {
     if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
     caster_mesh = mesh;
     caster_mesh.triangles.clear();
@@ -60,7 +60,7 @@ struct ReferenceRenderer::Rays {
   bool occluded(const Vector3d& o, const Vector3d& d) const {
     ShadePoint sp;
     sp.p = o;  // a free point (welded = -1): the ray starts at o itself
-    return !(casters ? *casters : scene).visible(sp, d);
+    return !(casters ? *casters : every_triangle).visible(sp, d);
   }
 };
 
@@ -126,7 +126,7 @@ GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
     for (int x = 0; x < camera.width; ++x) {
       const Vector3d d = camera.ray_direction(x + 0.5, y + 0.5);
       const double df = d.dot(f);
-      const auto hit = rt_->scene.closest_hit(camera.eye, d, near / df);
+      const auto hit = rt_->every_triangle.closest_hit(camera.eye, d, near / df);
       if (!hit) continue;
       const size_t i = size_t(y) * size_t(camera.width) + size_t(x);
       g.triangle[i] = int32_t(hit->triangle);
