@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     {
       bake::QmcOptions o1, o2;
-      o1.samples = o2.samples = half;
+      o1.rays = o2.rays = half;
       o1.seed = 1001;
       o2.seed = 1002;
       const bake::QmcIntegrator q1(s.mesh, s.topology, req, o1), q2(s.mesh, s.topology, req, o2);
@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
     std::vector<Row> q_rows, s_rows;
     for (long N : qmc) {
       bake::QmcOptions o;
-      o.samples = uint32_t(N);
+      o.rays = uint32_t(N);
       o.seed = 1;
       const bake::QmcIntegrator q(s.mesh, s.topology, req, o);
       Row r;

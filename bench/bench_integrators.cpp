@@ -63,7 +63,7 @@ void qmc_case(benchmark::State& state, int level, uint32_t samples) {
   const bench::Scene& s = bench::scene(level);
   const auto t0 = std::chrono::steady_clock::now();
   bake::QmcOptions opt;
-  opt.samples = samples;
+  opt.rays = samples;
   const bake::QmcIntegrator integ(s.mesh, s.topology, bench::request(), opt);
   state.counters["setup_s"] = since(t0);
   integrate_all(state, s, integ);

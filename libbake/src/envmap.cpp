@@ -6,6 +6,7 @@
 
 #include <prtshade/sh.h>
 
+#include <IexBaseExc.h>
 #include <ImfChannelList.h>
 #include <ImfEnvmap.h>
 #include <ImfFrameBuffer.h>
@@ -170,10 +171,10 @@ EnvMap EnvMap::from_latlong(int width, int height, std::vector<float> rgb, UpAxi
   return from_memory(Layout::LatLong, width, height, std::move(rgb), up, std::move(name));
 }
 
-EnvMap EnvMap::from_cube(int face_size, std::vector<float> rgb, UpAxis up, std::string name) {
+EnvMap EnvMap::from_exr_cube(int face_size, std::vector<float> rgb, UpAxis up, std::string name) {
   PRT_CHECK_OP(face_size, >=, 2);
   PRT_CHECK_OP(int64_t(face_size), <=, int64_t(1) << 13);
-  return from_memory(Layout::Cube, face_size, 6 * face_size, std::move(rgb), up, std::move(name));
+  return from_memory(Layout::ExrCube, face_size, 6 * face_size, std::move(rgb), up, std::move(name));
 }
 
 EnvMap EnvMap::from_memory(Layout layout, int width, int height, std::vector<float> rgb, UpAxis up, std::string name) {
@@ -235,7 +236,7 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
         if (W < 2 || H < 2)
           throw InputError(file, "lat-long environment map of " + shape.str() + " pixels: need at least 2x2");
       } else if (e == Imf::ENVMAP_CUBE) {
-        layout = Layout::Cube;
+        layout = Layout::ExrCube;
         if (int64_t(H) != 6 * int64_t(W) || W < 2)
           throw InputError(file, "cube environment map of " + shape.str() +
                                      " pixels: expected width S >= 2 and height 6*S (faces stacked vertically)");
@@ -245,7 +246,7 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
     } else if (int64_t(W) == 2 * int64_t(H) && H >= 2) {
       layout = Layout::LatLong;
     } else if (int64_t(H) == 6 * int64_t(W) && W >= 2) {
-      layout = Layout::Cube;
+      layout = Layout::ExrCube;
     } else {
       throw InputError(file, "image is " + shape.str() +
                                  " and has no 'envmap' attribute: expected a lat-long map (width == 2*height) "
@@ -310,11 +311,10 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
            << (grey_channel.empty() ? std::string(1, "RGB"[k % 3]) : grey_channel);
         throw InputError(file, os.str());
       }
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    throw InputError(file, "out of memory while reading the image");
-  } catch (const std::exception& e) {  // Iex::BaseExc and anything else from OpenEXR
+  } catch (const Iex::BaseExc& e) {
+    // OpenEXR's own errors: the file is damaged, truncated or not an image OpenEXR can read. Our
+    // InputErrors pass through as they are; std::bad_alloc (the machine) and logic errors (a bug)
+    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6).
     throw InputError(file, "cannot read OpenEXR image: " + one_line(e.what()));
   }
   return build(layout, W, H, std::move(rgb), up, std::move(info));
@@ -326,7 +326,7 @@ EnvMap EnvMap::build(Layout layout, int width, int height, std::vector<float> rg
   m.up_ = up;
   m.width_ = width;
   m.height_ = height;
-  info.layout = layout == Layout::Cube ? "cube" : "latlong";
+  info.layout = layout == Layout::ExrCube ? "cube" : "latlong";
   info.width = width;
   info.height = height;
 

@@ -42,7 +42,7 @@ Fiv environment_fiv(const EnvMap& env) {
   return f;
 }
 
-Eigen::Vector3d cube_direction(int face, int row, int column, int size) {
+Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size) {
   const double s = 2 * (column + 0.5) / size - 1, t = 2 * (row + 0.5) / size - 1;
   Vector3d d;
   switch (face) {
@@ -62,7 +62,7 @@ template <class Irradiance>
 std::vector<float> cube_of(int size, const Irradiance& E) {
   std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
   tbb::parallel_for(0, 6 * size * size, [&](int idx) {
-    const Rgb e = E(cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
+    const Rgb e = E(gl_cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
     out[size_t(idx) * 3] = float(e.r);
     out[size_t(idx) * 3 + 1] = float(e.g);
     out[size_t(idx) * 3 + 2] = float(e.b);
@@ -210,7 +210,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
       progress.advance();
     });
     out.radii.push_back(rho);
-    out.shells.insert(out.shells.end(), shell.begin(), shell.end());
+    out.values.insert(out.values.end(), shell.begin(), shell.end());
     out.valid.insert(out.valid.end(), valid.begin(), valid.end());
     out.integrals += per_shell;
     // Far enough (and outside the bounding sphere, so never inside the occluder): stop.
@@ -221,23 +221,23 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   return out;
 }
 
-FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& sh,
+FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
                                 const Fiv& fenv, size_t points, uint64_t seed) {
   ProductRequest req;
   req.radiance = &env;
   req.visibility_order = 1;
   const QmcIntegrator qmc(occluder, topology, req, {IntegratorSpec::kSilhouetteReferenceRays, mix64(seed ^ 0x66697672656675ull)});
-  const size_t per_shell = size_t(sh.n_theta) * size_t(sh.n_phi), total = sh.radii.size() * per_shell;
+  const size_t per_shell = size_t(shells.n_theta) * size_t(shells.n_phi), total = shells.radii.size() * per_shell;
   const auto picks = seeded_sample(uint32_t(total), points, seed);
   std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);
   const auto r0 = std::chrono::steady_clock::now();
   tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
     const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
-    const int i = int(ij / size_t(sh.n_phi)), j = int(ij % size_t(sh.n_phi));
+    const int i = int(ij / size_t(shells.n_phi)), j = int(ij % size_t(shells.n_phi));
     Fiv se;
-    const Fiv ref = qmc_occluded_fiv(qmc, fenv, sh.centre + sh.radii[k] * shell_direction(i, sh.n_theta, j, sh.n_phi), idx, &se);
+    const Fiv ref = qmc_occluded_fiv(qmc, fenv, shells.centre + shells.radii[k] * shell_direction(i, shells.n_theta, j, shells.n_phi), idx, &se);
     for (size_t x = 0; x < 9; ++x) {
-      const double d = double(sh.shells[idx * 9 + x]) - ref[x];
+      const double d = double(shells.values[idx * 9 + x]) - ref[x];
       err2[q] += d * d;
       se2[q] += se[x] * se[x];
       maxe[q] = std::max(maxe[q], std::abs(d));

@@ -21,7 +21,7 @@ using Eigen::Vector3d;
 QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
                              const QmcOptions& options)
     : mesh_(mesh), topo_(topology), request_(request), layout_(request), options_(options) {
-  PRT_CHECK(options.samples > 0);
+  PRT_CHECK(options.rays > 0);
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
   const bool want_cos = request.ao || request.transfer_order > 0 || request.radiance;
   const bool want_uni = request.visibility_order > 0;
@@ -36,14 +36,14 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
   }
   sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0});
   PRT_CHECK_OP(sh_order_, <=, sh::kMaxOrder);
-  rays_ = std::make_unique<RayScene>(mesh, topology);
+  rays_ = std::make_unique<RayCaster>(mesh, topology);
 }
 
 QmcIntegrator::~QmcIntegrator() = default;
 
 std::string QmcIntegrator::description() const {
   std::ostringstream os;
-  os << "Embree 3 ray casting, randomised Halton QMC, " << options_.samples << " rays/point, seed " << options_.seed
+  os << "Embree 3 ray casting, randomised Halton QMC, " << options_.rays << " rays/point, seed " << options_.seed
      << ", mixture weights cosine " << w_cos_ << " uniform " << w_uni_ << " environment " << w_env_;
   return os.str();
 }
@@ -63,7 +63,7 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
   const Frame frame(point.n);
   const RotatedHalton3 halton(options_.seed, point_index);
   constexpr double kInvPi = std::numbers::inv_pi;
-  const uint32_t N = options_.samples;
+  const uint32_t N = options_.rays;
   for (uint32_t i = 0; i < N; ++i) {
     const auto u = halton(i);
     Vector3d d;

@@ -94,7 +94,7 @@ void embree_error(void* user, RTCError code, const char* str) {
 
 } // namespace
 
-struct RayScene::Embree {
+struct RayCaster::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::string error;
@@ -152,7 +152,7 @@ struct RayScene::Embree {
   }
 };
 
-RayScene::RayScene(const Mesh& mesh, const Topology& topology)
+RayCaster::RayCaster(const Mesh& mesh, const Topology& topology)
     : mesh_(mesh), topo_(topology), rt_(std::make_unique<Embree>(mesh)) {
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
   Eigen::Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -164,7 +164,7 @@ RayScene::RayScene(const Mesh& mesh, const Topology& topology)
   centre_ = mesh.positions.empty() ? Vector3d::Zero() : Vector3d(0.5 * (lo + hi));
 }
 
-RayScene::~RayScene() = default;
+RayCaster::~RayCaster() = default;
 
 namespace {
 RTCRay make_ray(const Vector3d& o, const Vector3d& d) {
@@ -203,7 +203,7 @@ bool collect_near(RTCPointQueryFunctionArguments* args) {
 
 } // namespace
 
-bool RayScene::visible(const ShadePoint& point, const Vector3d& d) const {
+bool RayCaster::visible(const ShadePoint& point, const Vector3d& d) const {
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
     for (uint32_t f : topo_.ring(w)) {
@@ -226,7 +226,7 @@ bool RayScene::visible(const ShadePoint& point, const Vector3d& d) const {
   return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
-std::optional<RayHit> RayScene::closest_hit(const Vector3d& origin, const Vector3d& d, double tnear) const {
+std::optional<RayHit> RayCaster::closest_hit(const Vector3d& origin, const Vector3d& d, double tnear) const {
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);
   ctx.welded = -1;
@@ -241,7 +241,7 @@ std::optional<RayHit> RayScene::closest_hit(const Vector3d& origin, const Vector
   return RayHit{rh.hit.primID, rh.ray.tfar, rh.hit.u, rh.hit.v};
 }
 
-CrossingCount RayScene::count_crossings(const ShadePoint& point, const Vector3d& d) const {
+CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d& d) const {
   CrossingCount out;
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);

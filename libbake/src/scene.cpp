@@ -179,6 +179,7 @@ private:
 
 constexpr double kHuge = 1e30;
 
+// An object's "transform" (translate/rotate/scale or matrix): its world_from_object matrix.
 Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::string& key) {
   r.object(v, key, {"translate", "rotate", "scale", "matrix"});
   Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
@@ -228,11 +229,11 @@ bool valid_name(const std::string& n) {
 
 } // namespace
 
-Scene load_scene(const std::filesystem::path& file) {
+SceneDescription load_scene(const std::filesystem::path& file) {
   const Json root = parse_json_file(file);
   const Reader r(file.string());
   r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
-  Scene sc;
+  SceneDescription sc;
   sc.file = file;
   const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
   auto resolve = [&](const std::string& p) {
@@ -331,7 +332,7 @@ Scene load_scene(const std::filesystem::path& file) {
     else if (rs == "occluder") obj.role = Role::Occluder;
     else if (rs == "both") obj.role = Role::Both;
     else r.fail(key + ".role must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
-    if (const Json* t = find_key(o, "transform")) obj.transform = parse_transform(r, *t, key + ".transform");
+    if (const Json* t = find_key(o, "transform")) obj.world_from_object = parse_transform(r, *t, key + ".transform");
     obj.material.albedo = {0.8, 0.8, 0.8};
     if (const Json* m = find_key(o, "material")) {
       r.object(*m, key + ".material", {"albedo", "phong_exponent", "specular"});
@@ -356,8 +357,8 @@ Scene load_scene(const std::filesystem::path& file) {
 
 Mesh load_scene_mesh(const SceneObject& object) {
   Mesh m = load_mesh(object.mesh);
-  const Eigen::Matrix3d A = object.transform.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = object.transform.topRightCorner<3, 1>();
+  const Eigen::Matrix3d A = object.world_from_object.topLeftCorner<3, 3>();
+  const Eigen::Vector3d t = object.world_from_object.topRightCorner<3, 1>();
   const Eigen::Matrix3d N = A.inverse().transpose();
   for (size_t i = 0; i < m.positions.size(); ++i) {
     const Eigen::Vector3d p = A * m.positions[i].cast<double>() + t;
@@ -374,7 +375,7 @@ Mesh load_scene_mesh(const SceneObject& object) {
   return m;
 }
 
-ScenePlan plan_scene(const Scene& scene, std::span<const Mesh> meshes) {
+ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   ScenePlan plan;
   plan.objects.resize(scene.objects.size());

@@ -15,7 +15,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::string fmt(const char* f, double a, double b = 0) {
+// snprintf of one or two numbers into a string (the log lines).
+std::string printf_string(const char* f, double a, double b = 0) {
   char buf[160];
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
@@ -23,7 +24,7 @@ std::string fmt(const char* f, double a, double b = 0) {
 
 } // namespace
 
-SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
+SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
@@ -95,14 +96,14 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     out.vertex_seconds += ob.values->seconds;
     out.vertices += points.size();
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
-        fmt("%.2f s", ob.values->seconds) +
+        printf_string("%.2f s", ob.values->seconds) +
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref) {
       ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.integrator.report_points,
                                                 scene.integrator.seed);
       for (const auto& e : ob.report->products)
-        log("  " + e.product + ": " + fmt("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
-            fmt("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
+        log("  " + e.product + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
+            printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
                 ob.report->reference_seconds));
     }
   }
@@ -115,21 +116,21 @@ SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const 
     out.irradiance_cube = irradiance_cube(*env, scene.fiv.cube);
     out.environment_seconds = seconds_since(t0);
     log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
-        fmt("%.2f s", out.environment_seconds));
+        printf_string("%.2f s", out.environment_seconds));
   }
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     if (!plan.objects[i].fiv) continue;
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
     ObjectBake& ob = out.objects[i];
-    ob.fiv = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
-    out.fiv_seconds += ob.fiv->seconds;
+    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
+    out.fiv_seconds += ob.shells->seconds;
     log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
-        "x" + std::to_string(ob.fiv->radii.size()) + " in " + fmt("%.2f s", ob.fiv->seconds));
+        "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
     if (scene.integrator.report_points > 0) {
-      ob.fiv_report = fiv_error_report(m, t, *env, *ob.fiv, out.environment_fiv, scene.integrator.report_points,
+      ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
                                        scene.integrator.seed);
-      log("  fiv: " + fmt("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
+      log("  fiv: " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
                           ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
     }
   }

@@ -36,7 +36,7 @@ namespace {
 // The octahedral frame is the world frame turned by a fixed, generic rotation, so that scenes
 // built on the world axes (axis-aligned boxes, ground planes, walls) never put their edges on
 // the octahedral seams or the spine, where crossings would be decided by ties.
-Eigen::Matrix3d frame_rotation() {
+Eigen::Matrix3d octahedral_frame_from_world() {
   return Eigen::AngleAxisd(0.7236, Vector3d(0.3141, 0.5926, 0.7418).normalized()).toRotationMatrix();
 }
 
@@ -75,7 +75,7 @@ struct SilhouetteIntegrator::Impl {
   ProductLayout layout;
   SilhouetteOptions opt;
   ContourFinder contours;
-  RayScene rays;
+  RayCaster rays;
   oct::Grid grid;
   Eigen::Matrix3d frame_from_world;
   int sh_order = 0;
@@ -102,7 +102,7 @@ struct SilhouetteIntegrator::Impl {
 
   Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o)
       : mesh(m), topo(t), req(r), layout(r), opt(o), contours(m, t), rays(m, t), grid(even_isolines(o.isolines)),
-        frame_from_world(frame_rotation()) {
+        frame_from_world(octahedral_frame_from_world()) {
     const int lt = r.transfer_order, lv = r.visibility_order;
     sh_order = std::max({lt, lv, r.radiance ? 2 : 0});
     c_ao = 0;

@@ -45,7 +45,8 @@
 //        GL_EXT_shader_8bit_storage, an optional feature; packing works everywhere.)
 //   PRT_FIV_DIFMAP_BINDING (6)     uvec4 prt_difmap_header; float prt_difmap_texels[];
 //        header.x = face size S, header.yzw unused; texels from byte 16: /fiv/irradiance_cube
-//        [6][S][S][RGB] floats, faces +X, −X, +Y, −Y, +Z, −Z.
+//        [6][S][S][RGB] floats, faces +X, −X, +Y, −Y, +Z, −Z, OpenGL's cube orientation
+//        (prtshade/fiv.h; docs/ARCHITECTURE.md §3 "Two cube conventions").
 // (An engine may prefer a samplerCube for the DifMap; Vulkan cube sampling is seamless and its
 // bilinear weights have only subTexelPrecisionBits (>= 4) bits, so it will not match the C++ core
 // to float precision — this mirror reads the texels itself.)

@@ -133,13 +133,13 @@ EnvMap latlong_from(int w, int h, UpAxis up, F f) {
 }
 template <class F>
 EnvMap cube_from(int s, UpAxis up, F f) {
-  const EnvMap shape = EnvMap::from_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 0.0f), up, "shape");
+  const EnvMap shape = EnvMap::from_exr_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 0.0f), up, "shape");
   std::vector<float> rgb(size_t(3 * 6 * s * s));
   for (int t = 0; t < 6 * s * s; ++t) {
     const Rgb v = f(shape.texel_center(t));
     rgb[size_t(3 * t)] = float(v.r), rgb[size_t(3 * t + 1)] = float(v.g), rgb[size_t(3 * t + 2)] = float(v.b);
   }
-  return EnvMap::from_cube(s, std::move(rgb), up, "synthetic cube");
+  return EnvMap::from_exr_cube(s, std::move(rgb), up, "synthetic cube");
 }
 Rgb grey(double v) { return Rgb{v, v, v}; }
 
@@ -233,7 +233,7 @@ TEST(EnvMapConventions, LatLongCentresMatchOpenEXR) {
 
 TEST(EnvMapConventions, CubeCentresMatchOpenEXR) {
   for (int s : {2, 3, 8}) {
-    const EnvMap m = EnvMap::from_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "cube");
+    const EnvMap m = EnvMap::from_exr_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "cube");
     for (int t = 0; t < 6 * s * s; ++t) {
       const Vector3d exr = EnvMap::openexr_texel_direction("cube", s, 6 * s, t % s, t / s);
       EXPECT_LT((m.texel_center(t) - exr).norm(), 2e-6) << "S " << s << " texel " << t;
@@ -243,7 +243,7 @@ TEST(EnvMapConventions, CubeCentresMatchOpenEXR) {
   // block is centred ON a cube corner (border texels are half, corner texels quarter squares),
   // faces stacked +X, −X, +Y, −Y, +Z, −Z.
   const int s = 4;
-  const EnvMap m = EnvMap::from_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "cube");
+  const EnvMap m = EnvMap::from_exr_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "cube");
   const Vector3d corner = Vector3d(1, 1, -1).normalized();  // +X face, image pixel (0, 0)
   EXPECT_LT((m.texel_center(0) - corner).norm(), 1e-15);
   const double side = 2.0 / (s - 1), half = 0.5 * side;
@@ -262,7 +262,7 @@ TEST(EnvMapConventions, SolidAnglesSumTo4Pi) {
     EXPECT_NEAR(sum_solid_angles(m), kFourPi, kSolidAngleSumTol) << w << "x" << h;
   }
   for (int s : {2, 3, 16, 256}) {
-    const EnvMap m = EnvMap::from_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "c");
+    const EnvMap m = EnvMap::from_exr_cube(s, std::vector<float>(size_t(3 * 6 * s * s), 1.0f), UpAxis::Y, "c");
     EXPECT_NEAR(sum_solid_angles(m), kFourPi, kSolidAngleSumTol) << "S " << s;
   }
 }
@@ -276,7 +276,7 @@ TEST(EnvMapConventions, RadianceIsTheTexelWhoseRegionContainsTheDirection) {
     std::vector<float> ll(3 * 64 * 32), cube(3 * 6 * 9 * 9);
     for (size_t k = 0; k < ll.size(); ++k) ll[k] = float(k / 3);  // value = texel index
     for (size_t k = 0; k < cube.size(); ++k) cube[k] = float(k / 3);
-    const EnvMap maps[2] = {EnvMap::from_latlong(64, 32, ll, up, "ll"), EnvMap::from_cube(9, cube, up, "cube")};
+    const EnvMap maps[2] = {EnvMap::from_latlong(64, 32, ll, up, "ll"), EnvMap::from_exr_cube(9, cube, up, "cube")};
     for (const EnvMap& m : maps) {
       int wrong = 0;
       for (int i = 0; i < 200000; ++i) {
@@ -306,7 +306,7 @@ TEST(EnvMapConventions, TexelWarpIsUniformInSolidAngle) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> U(0.05, 0.95);
   const EnvMap maps[2] = {EnvMap::from_latlong(16, 8, std::vector<float>(3 * 128, 1.0f), UpAxis::Y, "ll"),
-                          EnvMap::from_cube(5, std::vector<float>(3 * 150, 1.0f), UpAxis::Z, "cube")};
+                          EnvMap::from_exr_cube(5, std::vector<float>(3 * 150, 1.0f), UpAxis::Z, "cube")};
   for (const EnvMap& m : maps)
     for (int t = 0; t < m.texel_count(); ++t)
       for (int k = 0; k < 4; ++k) {
@@ -732,7 +732,7 @@ TEST(EnvMapTexels, SampleGridEqualsSampleTexelBitForBit) {
   for (UpAxis up : {UpAxis::Y, UpAxis::Z}) {
     std::vector<float> rgb(size_t(16 * 8 * 3), 1.0f);
     const EnvMap ll = EnvMap::from_latlong(16, 8, rgb, up, "ll");
-    const EnvMap cube = EnvMap::from_cube(4, std::vector<float>(size_t(3 * 6 * 4 * 4), 1.0f), up, "cube");
+    const EnvMap cube = EnvMap::from_exr_cube(4, std::vector<float>(size_t(3 * 6 * 4 * 4), 1.0f), up, "cube");
     for (const EnvMap* m : {&ll, &cube})
       for (int t = 0; t < m->texel_count(); t += 7)
         for (int k : {1, 3, 4}) {

@@ -110,7 +110,7 @@ TEST(Fiv, IrradianceCubeIsExactNotSh9) {
   ASSERT_EQ(cube.size(), size_t(6 * S * S * 3));
   for (int face = 0; face < 6; ++face) {
     const int row = (face * 3) % S, col = (face * 5 + 1) % S;
-    const Vector3d n = cube_direction(face, row, col, S);
+    const Vector3d n = gl_cube_direction(face, row, col, S);
     const auto q = quad(env, [&](const Vector3d& d) { return std::max(0.0, n.dot(d)); });
     for (int c = 0; c < 3; ++c) {
       const float e = cube[size_t(((face * S + row) * S + col) * 3 + c)];
@@ -201,10 +201,10 @@ TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
   ASSERT_EQ(s.radii.size(), 11u) << "stops at the first shell below the fraction";
   for (size_t k = 1; k < s.radii.size(); ++k) EXPECT_GT(s.radii[k], s.radii[k - 1]);
   EXPECT_NEAR(s.radii[0], 0.5 * s.radius, 1e-9);
-  ASSERT_EQ(s.shells.size(), s.radii.size() * 5 * 8 * 9);
+  ASSERT_EQ(s.values.size(), s.radii.size() * 5 * 8 * 9);
   ASSERT_EQ(s.valid.size(), s.radii.size() * 5 * 8);
   // First shell (ρ = 0.707): the equator row θ = π/2 lies inside the plate (|y| = 0 < 0.01).
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 8; ++j) EXPECT_EQ(s.valid[size_t(i * 8 + j)], i == 2 ? 0 : 1) << i << " " << j;
-  for (float x : s.shells) EXPECT_TRUE(std::isfinite(x));
+  for (float x : s.values) EXPECT_TRUE(std::isfinite(x));
 }

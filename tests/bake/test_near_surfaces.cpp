@@ -74,7 +74,7 @@ TEST(NearSurfaces, CoplanarNearDuplicateLayerDoesNotOcclude) {
   ProductRequest req;
   req.ao = true;
   const SilhouetteIntegrator sil(m, topo, req, {64, 1});
-  const RayScene rays(m, topo);
+  const RayCaster rays(m, topo);
   for (uint32_t v = 0; v < m.positions.size(); ++v) {
     const ShadePoint sp = vertex_shade_point(m, topo, v);
     const CrossingCount up = rays.count_crossings(sp, Vector3d(0.3, 0.2, 0.93).normalized());

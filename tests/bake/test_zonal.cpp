@@ -170,7 +170,7 @@ TEST(SilhouetteClosedForm, UnoccludedVerticesSkipTheWalkAndAreExact) {
     for (size_t i = 0; i < 9; ++i) EXPECT_EQ(row[L.radiance + i], b.values[L.radiance + i]) << "same normal, same value";
   }
   QmcOptions q;
-  q.samples = 1 << 16;
+  q.rays = 1 << 16;
   q.seed = 5;
   const QmcIntegrator qmc(m, topo, req, q);
   std::vector<double> ref(L.width), se(L.width);

@@ -292,12 +292,12 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   const F::File f = F::read_file(out);
   EXPECT_EQ(F::find_dataset(f, "/fiv/environment")->shape, (std::vector<uint64_t>{3, 3}));
   EXPECT_EQ(F::find_dataset(f, "/fiv/irradiance_cube")->shape, (std::vector<uint64_t>{6, 2, 2, 3}));
-  const F::Dataset* sh = F::find_dataset(f, "/fiv/occluders/spider/shells");
-  ASSERT_NE(sh, nullptr);
-  ASSERT_EQ(sh->shape.size(), 5u);
-  EXPECT_LE(sh->shape[0], 4u);
-  EXPECT_EQ(sh->shape[1], 5u);
-  EXPECT_EQ(sh->shape[2], 8u);
+  const F::Dataset* shells = F::find_dataset(f, "/fiv/occluders/spider/shells");
+  ASSERT_NE(shells, nullptr);
+  ASSERT_EQ(shells->shape.size(), 5u);
+  EXPECT_LE(shells->shape[0], 4u);
+  EXPECT_EQ(shells->shape[1], 5u);
+  EXPECT_EQ(shells->shape[2], 8u);
   EXPECT_NE(F::find_dataset(f, "/fiv/occluders/spider/valid"), nullptr);
   EXPECT_EQ(F::find_dataset(f, "/mesh/positions"), nullptr) << "no per-vertex data was asked for";
   const F::Dataset* rep = F::find_dataset(f, "/report/fiv/spider");

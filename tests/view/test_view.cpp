@@ -367,7 +367,7 @@ TEST(UnshadowedIrradiance, IsTheDifMapAndBoundsTheFlatSum) {
   for (int face = 0; face < 6; ++face)
     for (int r = 0; r < 3; ++r)
       for (int q = 0; q < 3; ++q) {
-        const Rgb e = E(cube_direction(face, r, q, 3));
+        const Rgb e = E(gl_cube_direction(face, r, q, 3));
         const size_t i = size_t(((face * 3 + r) * 3 + q) * 3);
         EXPECT_EQ(float(e.r), cube[i]);
         EXPECT_EQ(float(e.g), cube[i + 1]);

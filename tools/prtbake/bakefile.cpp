@@ -124,34 +124,34 @@ void set_fiv_environment(F::Asset& asset, const bake::EnvMap& env, const std::st
                       "(1,-t,-s), -X (-1,-t,s), +Y (s,1,t), -Y (s,-1,-t), +Z (s,-t,1), -Z (-s,-t,-1)";
 }
 
-F::Occluder occluder_of(const std::string& name, const bake::FivShells& sh, const bake::EnvMap& env,
-                        const std::string& env_path, double fraction, uint32_t samples) {
+F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, const bake::EnvMap& env,
+                        const std::string& env_path, double fraction, uint32_t silhouette_k) {
   F::Occluder o;
   o.name = name;
-  o.n_rho = int(sh.radii.size());
-  o.n_theta = sh.n_theta;
-  o.n_phi = sh.n_phi;
-  o.shells = sh.shells;
+  o.n_rho = int(shells.radii.size());
+  o.n_theta = shells.n_theta;
+  o.n_phi = shells.n_phi;
+  o.shells = shells.values;
   o.environment = env_path;
   o.environment_sha256 = env.info().sha256;
   o.integrand = "F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]";
-  o.centre = {sh.centre.x(), sh.centre.y(), sh.centre.z()};
-  o.radius = sh.radius;
-  o.radii = sh.radii;
+  o.centre = {shells.centre.x(), shells.centre.y(), shells.centre.z()};
+  o.radius = shells.radius;
+  o.radii = shells.radii;
   o.angular_convention = "s = centre + rho_k d(theta_i, phi_j), theta_i = pi i/(Ntheta-1) from +Y, phi_j = 2 pi "
                          "j/Nphi from +Z towards +X, d = (sin theta sin phi, cos theta, sin theta cos phi)";
   o.fraction = fraction;
-  o.samples = int64_t(samples);
-  o.valid = F::OccluderValid{sh.valid, "0: the offset lies inside the occluder (nothing visible)", {}};
+  o.samples = int64_t(silhouette_k);
+  o.valid = F::OccluderValid{shells.valid, "0: the offset lies inside the occluder (nothing visible)", {}};
   return o;
 }
 
-F::ReportRow fiv_report_of(const std::string& name, const bake::FivErrorReport& r, const bake::FivShells& sh,
+F::ReportRow fiv_report_of(const std::string& name, const bake::FivErrorReport& r, const bake::FivShells& shells,
                            bool reproducible) {
   return report_row(name, {float(r.rmse), float(r.max_abs), float(r.reference_rms), 0.0f, float(r.reference_std_error)},
                     "rmse, max_abs, reference_rms (RMS of F_env components), bake_std_error (0: deterministic), "
                     "reference_std_error",
-                    r.points, r.reference, r.reference_seconds, sh.seconds, double(sh.integrals) / sh.seconds,
+                    r.points, r.reference, r.reference_seconds, shells.seconds, double(shells.integrals) / shells.seconds,
                     reproducible);
 }
 

@@ -41,7 +41,7 @@ void set_fiv_environment(F::Asset& asset, const bake::EnvMap& env, const std::st
                          const std::vector<float>& cube, int cube_size);
 // An occluder's shells and valid mask.
 F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, const bake::EnvMap& env,
-                        const std::string& env_path, double fraction, uint32_t samples);
+                        const std::string& env_path, double fraction, uint32_t silhouette_k);
 // The error report row of an occluder's shells.
 F::ReportRow fiv_report_of(const std::string& name, const bake::FivErrorReport& report, const bake::FivShells& shells,
                            bool reproducible);

@@ -85,9 +85,9 @@ struct Args {
   std::string environment;  // vertex: --radiance ENV; fiv: --env ENV
   bool ao = false;
   int transfer = 0, visibility = 0;  // SH orders (0: not baked)
-  // vertex: the integrator; fiv: seed and report (its k is shells.silhouette_k); scene: --report.
+  // vertex: the integrator; fiv: seed and report (its k is shell_spec.silhouette_k); scene: --report.
   bake::IntegratorSpec integrator;
-  bake::ShellSpec shells;   // fiv
+  bake::ShellSpec shell_spec;  // fiv
   bool report_given = false;  // scene: --report overrides the scene file's
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
@@ -242,17 +242,17 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
   cmd.add_option_function<std::string>(
          "--shells",
          [&a](const std::string& g) {
-           if (!bake::parse_shell_grid(g, a.shells))
+           if (!bake::parse_shell_grid(g, a.shell_spec))
              throw CLI::ValidationError("--shells",
                                         "expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
          },
          "the shell grid: NPHI x NTHETA (poles included) directions on each of\nNRHO shells (default " +
              std::to_string(d.n_phi) + "x" + std::to_string(d.n_theta) + "x" + std::to_string(d.n_rho) + ")")
       ->option_text("NPHIxNTHETAxNRHO");
-  cmd.add_option("--cube", a.shells.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
+  cmd.add_option("--cube", a.shell_spec.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
       ->option_text("S")
       ->check(CLI::Range(1, 1024));
-  cmd.add_option("--fraction", a.shells.fraction,
+  cmd.add_option("--fraction", a.shell_spec.fraction,
                  "stop adding shells once |F| < FRACTION of Int L dw (default 1e-3)")
       ->option_text("FRACTION")
       ->check([](const std::string& s) -> std::string {
@@ -314,7 +314,7 @@ std::optional<Args> parse(int argc, char** argv) {
     throw UsageError("--samples: the silhouette integrator needs k >= " +
                      std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
   if (a.command == "fiv") {
-    a.shells.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
+    a.shell_spec.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
     return a;
   }
   if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
@@ -506,33 +506,34 @@ int run_fiv(const Args& a) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const bake::Fiv fenv = bake::environment_fiv(env);
-  const std::vector<float> cube = bake::irradiance_cube(env, a.shells.cube);
+  const std::vector<float> cube = bake::irradiance_cube(env, a.shell_spec.cube);
   const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const bake::FivShells sh = bake::bake_fiv_shells(mesh, topo, env, a.shells, progress);
+  const bake::FivShells shells = bake::bake_fiv_shells(mesh, topo, env, a.shell_spec, progress);
   if (say) {
-    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.shells.cube, a.shells.cube, env_seconds);
+    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds);
     std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
                 "integrals/s)\n",
-                a.shells.n_phi, a.shells.n_theta, sh.radii.size(), a.shells.n_rho, sh.radii.front(), sh.radii.back(), sh.radius, sh.seconds,
-                double(sh.integrals) / sh.seconds);
+                a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho, shells.radii.front(),
+                shells.radii.back(), shells.radius, shells.seconds,
+                double(shells.integrals) / shells.seconds);
   }
 
   namespace F = prt::formats;
   F::Asset asset;
   asset.root = root_info(a, mesh.source_sha256);
-  tool::set_fiv_environment(asset, env, a.environment, fenv, cube, a.shells.cube);
+  tool::set_fiv_environment(asset, env, a.environment, fenv, cube, a.shell_spec.cube);
   const std::string name = tool::safe_name(fs::path(a.input).stem().string());
-  F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, sh, env, a.environment, a.shells.fraction, a.shells.silhouette_k));
+  F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, shells, env, a.environment, a.shell_spec.fraction, a.shell_spec.silhouette_k));
   if (a.integrator.report_points > 0) {
     // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
-    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, sh, fenv, a.integrator.report_points, a.integrator.seed);
+    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, shells, fenv, a.integrator.report_points, a.integrator.seed);
     if (say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
                   bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,
                   r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
-    occluder.report = tool::fiv_report_of(name, r, sh, a.reproducible);
+    occluder.report = tool::fiv_report_of(name, r, shells, a.reproducible);
   }
   write_file(a, asset);
   return 0;
@@ -543,7 +544,7 @@ int run_scene(const Args& a) {
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  bake::Scene scene = bake::load_scene(a.input);
+  bake::SceneDescription scene = bake::load_scene(a.input);
   if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
@@ -623,7 +624,7 @@ int run_scene(const Args& a) {
     obj.mesh = o.mesh.string();
     obj.mesh_sha256 = mesh_sha[i];
     obj.transform.emplace(16);
-    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.transform(k / 4, k % 4);
+    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
     obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
     obj.phong_exponent = o.material.phong_exponent;
     obj.sh_order_diffuse = int64_t(p.transfer_order);
@@ -641,10 +642,10 @@ int run_scene(const Args& a) {
       if (ob.report)
         obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
     }
-    if (ob.fiv) {
+    if (ob.shells) {
       F::Occluder& occluder =
-          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.fiv, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
-      if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.fiv, a.reproducible);
+          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
+      if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
     }
   }
   if (plan.fiv_environment)

@@ -328,7 +328,7 @@ int run(const Args& a) {
   const std::string env_path = a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
   const bake::EnvMap env = bake::EnvMap::load(env_path, prtview::up_axis(f));
 
-  prtview::Scene scene;
+  prtview::RenderScene scene;
   Timer t_run;
   const view::Image runtime = kind == "scene" ? prtview::render_scene_file(f, a.file, env, cam, scene)
                               : kind == "fiv" ? prtview::render_fiv_file(f, a.file, a.fiv, env, cam, scene)

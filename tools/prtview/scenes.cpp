@@ -67,7 +67,7 @@ std::vector<float> band1_colours(const Band1& b, size_t V, std::string& how) {
 } // namespace
 
 view::Image render_vertex_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
-                               const view::Camera& cam, Scene& scene) {
+                               const view::Camera& cam, RenderScene& scene) {
   scene.mesh = read_mesh(f, file, "");
   const size_t V = scene.mesh.positions.size();
   scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
@@ -77,7 +77,7 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
 }
 
 view::Image render_fiv_file(const F::Asset& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
-                            const view::Camera& cam, Scene& scene) {
+                            const view::Camera& cam, RenderScene& scene) {
   const std::string name = choose_occluder(f, file, options.occluder);
   const BakedOccluder baked = read_occluder(f, file, name, env);
   const auto& centre = baked.centre;
@@ -145,7 +145,7 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
 
 
 view::Image render_scene_file(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
-                              Scene& scene) {
+                              RenderScene& scene) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, env);
   // What the runtime has beside the per-vertex data: the DifMap (unshadowed irradiance) and the
   // environment FIV, when some occluder got shells.

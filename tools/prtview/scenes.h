@@ -22,7 +22,7 @@ namespace prt::prtview {
 
 // What a render needs beyond the pictures: the scene both renderers draw and which triangles form
 // the receiver (the ground plane of FIV scenes, the receiver objects of scene files).
-struct Scene {
+struct RenderScene {
   bake::Mesh mesh;
   size_t receiver_triangles = 0;  // triangles [0, receiver_triangles) are the receiver
   std::vector<view::Sphere> spheres;
@@ -39,7 +39,7 @@ struct Scene {
 
 // Per-vertex files: kind "transfer" or "band1".
 view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
-                               const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
+                               const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
 struct FivView {
@@ -49,10 +49,10 @@ struct FivView {
   bool overlap = true, partial = true;
 };
 view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
-                            const bake::EnvMap& env, const view::Camera& cam, Scene& scene);
+                            const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 
 // Scene files (prtbake scene, schema v2): every object with what the file holds for it.
 view::Image render_scene_file(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
-                              const view::Camera& cam, Scene& scene);
+                              const view::Camera& cam, RenderScene& scene);
 
 } // namespace prt::prtview

@@ -30,23 +30,23 @@
 
 namespace prt::view {
 
-using namespace prt::bake;  // Mesh, EnvMap, Rgb, RayScene, Frame, samplers, errors
+using namespace prt::bake;  // Mesh, EnvMap, Rgb, RayCaster, Frame, samplers, errors
 using Eigen::Vector3d;
 
 namespace {
 constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
 }
 
-// The ray queries of the reference: libbake's RayScene (bake/raycast.h) over the rendered mesh for
+// The ray queries of the reference: libbake's RayCaster (bake/raycast.h) over the rendered mesh for
 // primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
 struct ReferenceRenderer::Rays {
   Topology topology;
-  RayScene scene;
+  RayCaster every_triangle;  // primary rays; shadow rays too unless `casters` is set
   Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
   std::optional<Topology> caster_topology;
-  std::unique_ptr<RayScene> casters;
+  std::unique_ptr<RayCaster> casters;
   bool any_caster = true;
-  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), scene(mesh, topology) {
+  Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), every_triangle(mesh, topology) {
     if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
     caster_mesh = mesh;
     caster_mesh.triangles.clear();
@@ -55,12 +55,12 @@ struct ReferenceRenderer::Rays {
     any_caster = !caster_mesh.triangles.empty();
     if (!any_caster) return;
     caster_topology = build_topology(caster_mesh);
-    casters = std::make_unique<RayScene>(caster_mesh, *caster_topology);
+    casters = std::make_unique<RayCaster>(caster_mesh, *caster_topology);
   }
   bool occluded(const Vector3d& o, const Vector3d& d) const {
     ShadePoint sp;
     sp.p = o;  // a free point (welded = -1): the ray starts at o itself
-    return !(casters ? *casters : scene).visible(sp, d);
+    return !(casters ? *casters : every_triangle).visible(sp, d);
   }
 };
 
@@ -126,7 +126,7 @@ GBuffer ReferenceRenderer::trace_primary(const Camera& camera) const {
     for (int x = 0; x < camera.width; ++x) {
       const Vector3d d = camera.ray_direction(x + 0.5, y + 0.5);
       const double df = d.dot(f);
-      const auto hit = rt_->scene.closest_hit(camera.eye, d, near / df);
+      const auto hit = rt_->every_triangle.closest_hit(camera.eye, d, near / df);
       if (!hit) continue;
       const size_t i = size_t(y) * size_t(camera.width) + size_t(x);
       g.triangle[i] = int32_t(hit->triangle);

@@ -22,8 +22,9 @@
 //     (lon = ±π). Texel (px, py) owns lon/lat band between the half-pixel positions
 //     px ± ½, py ± ½ clipped to [0, W−1] × [0, H−1]: the first/last rows and columns are
 //     half-texels. Solid angle (exact): Δlon · (sin lat_top − sin lat_bottom).
-//   cube (S × 6S, faces stacked top to bottom +X, −X, +Y, −Y, +Z, −Z): the position in a face
-//     (i, j) ∈ [0, S−1]² maps to face-plane coordinates a = 2i/(S−1) − 1, b = 2j/(S−1) − 1,
+//   cube (OpenEXR's cube, not the OpenGL one of the baked DifMap, bake/fiv.h: docs/ARCHITECTURE.md
+//     §3 "Two cube conventions"; S × 6S, faces stacked top to bottom +X, −X, +Y, −Y, +Z, −Z):
+//     the position in a face (i, j) ∈ [0, S−1]² maps to face-plane coordinates a = 2i/(S−1) − 1, b = 2j/(S−1) − 1,
 //     i.e. the centres of the border texels lie ON the cube edges (checked numerically
 //     against OpenEXR 3.1: CubeMap::direction(face, dw, (0,0)) is a cube corner). Face
 //     directions: +X (1, a, b), −X (−1, a, b), +Y (a, 1, b), −Y (a, −1, b), +Z (a, b, 1),
@@ -120,10 +121,10 @@ public:
   // a file). width >= 2, height >= 2, rgb.size() == 3·width·height (PRT_CHECK). Same pixel
   // policy as load(); errors name `name`.
   static EnvMap from_latlong(int width, int height, std::vector<float> rgb, UpAxis up, std::string name);
-  // A cube map from memory: the S × 6S image of a file (faces +X, −X, +Y, −Y, +Z, −Z stacked
+  // An OpenEXR cube map from memory: the S × 6S image of a file (faces +X, −X, +Y, −Y, +Z, −Z stacked
   // top to bottom, each laid out as Imf::CubeMap::pixelPosition). face_size S >= 2,
   // rgb.size() == 3·S·6S (PRT_CHECK). Same pixel policy as load().
-  static EnvMap from_cube(int face_size, std::vector<float> rgb, UpAxis up, std::string name);
+  static EnvMap from_exr_cube(int face_size, std::vector<float> rgb, UpAxis up, std::string name);
 
   // Texel value of the region containing the scene direction (unit; any non-zero length
   // works). Piecewise constant, no filtering.
@@ -168,7 +169,7 @@ public:
   static Eigen::Vector3d openexr_texel_direction(std::string_view layout, int width, int height, int x, int y);
 
 private:
-  enum class Layout { Constant, LatLong, Cube };
+  enum class Layout { Constant, LatLong, ExrCube };  // an OpenEXR cube (docs/ARCHITECTURE.md §3 "Two cube conventions")
   struct Region;  // a texel's region in its parametrisation (envmap.cpp)
 
   EnvMap() = default;

@@ -21,8 +21,9 @@
 //   run out to the last radius: that shadow is real.)
 //   valid = 0 where the offset is inside closed geometry (nothing visible: F = F^env there).
 //
-// Cube map of the DifMap: faces +X, −X, +Y, −Y, +Z, −Z; texel (row r, column q) of size S has
-// s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction (OpenGL's cube-map convention)
+// Cube map of the DifMap, in OpenGL's cube-map convention — not OpenEXR's, which input cube maps
+// use (bake/envmap.h; docs/ARCHITECTURE.md §3 "Two cube conventions"): faces +X, −X, +Y, −Y, +Z,
+// −Z; texel (row r, column q) of size S has s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction
 //   +X (1, −t, −s)   −X (−1, −t, s)   +Y (s, 1, t)   −Y (s, −1, −t)   +Z (s, −t, 1)   −Z (−s, −t, −1).
 #pragma once
 
@@ -46,13 +47,15 @@ Fiv environment_fiv(const EnvMap& env);
 
 // DifMap: [6][S][S][3] float, E_tot(n) per texel direction: bake/irradiance.h's
 // UnshadowedIrradiance (texels cut by the horizon of n integrated with 4×4 sub-samples, the rest
-// with their ∫_texel ω dω) at cube_direction, rounded to float.
+// with their ∫_texel ω dω) at gl_cube_direction, rounded to float.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
 // The same sum texel by texel for every normal (UnshadowedIrradiance::reference, no cell
 // hierarchy): the slow reference of irradiance_cube, equal to it up to summation order. Needs a
 // map with texels.
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size);
-Eigen::Vector3d cube_direction(int face, int row, int column, int size);  // unit
+// The unit direction of DifMap texel (face, row, column) of a size-S face: OpenGL's cube-map
+// convention (header comment), not EnvMap's OpenEXR cube.
+Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size);
 
 // What an FIV bake computes, with its defaults (the same for `prtbake fiv` and scene files).
 struct ShellSpec {
@@ -73,7 +76,7 @@ struct FivShells {
   double radius = 0;
   int n_phi = 0, n_theta = 0;
   std::vector<double> radii;    // the shells baked (≤ n_rho)
-  std::vector<float> shells;    // [Nρ][Nθ][Nφ][RGB][xyz]
+  std::vector<float> values;    // occluded FIV F(s) per grid sample: [Nρ][Nθ][Nφ][RGB][xyz]
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
   double seconds = 0;
   uint64_t integrals = 0;

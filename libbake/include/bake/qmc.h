@@ -33,7 +33,7 @@
 namespace prt::bake {
 
 struct QmcOptions {
-  uint32_t samples = IntegratorSpec::kDefaultQmcRays;  // rays per shade point
+  uint32_t rays = IntegratorSpec::kDefaultQmcRays;  // per shade point
   uint64_t seed = 1;
 };
 
@@ -64,7 +64,7 @@ private:
   QmcOptions options_;
   double w_cos_ = 0, w_uni_ = 0, w_env_ = 0;  // mixture weights, sum to 1
   int sh_order_ = 0;                          // SH order evaluated per sample
-  std::unique_ptr<RayScene> rays_;
+  std::unique_ptr<RayCaster> rays_;
 };
 
 } // namespace prt::bake

@@ -39,12 +39,13 @@ struct RayHit {
   float t, u, v;  // distance along the unit direction; Embree's barycentrics (weights of corners 1, 2)
 };
 
-class RayScene {
+// The ray queries over one mesh (an Embree BVH built once, at construction).
+class RayCaster {
 public:
-  RayScene(const Mesh& mesh, const Topology& topology);  // both must outlive the scene
-  ~RayScene();
-  RayScene(const RayScene&) = delete;
-  RayScene& operator=(const RayScene&) = delete;
+  RayCaster(const Mesh& mesh, const Topology& topology);  // both must outlive the caster
+  ~RayCaster();
+  RayCaster(const RayCaster&) = delete;
+  RayCaster& operator=(const RayCaster&) = delete;
 
   // Visibility of unit direction d from the shade point (limit from above).
   bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
@@ -53,7 +54,7 @@ public:
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
   // rays of the reference renderer, view/reference.h).
   std::optional<RayHit> closest_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear) const;
-  double scene_diagonal() const { return diagonal_; }
+  double mesh_diagonal() const { return diagonal_; }  // of the mesh's axis-aligned bounds
 
 private:
   struct Embree;

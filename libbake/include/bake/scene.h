@@ -79,12 +79,17 @@ struct SceneObject {
   std::string name;
   std::filesystem::path mesh;                     // resolved against the scene file's directory
   Role role = Role::Both;
-  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  // The file's "transform": object space → world space, applied to column vectors
+  // (docs/ARCHITECTURE.md §3 "Frames").
+  Eigen::Matrix4d world_from_object = Eigen::Matrix4d::Identity();
   Material material;
 };
 
-struct Scene {
-  std::filesystem::path file;
+// What a scene file describes (load_scene): the objects, their roles and materials, the
+// environment and the bake settings. Nothing here is rendered or ray-traced (that is prtview's
+// RenderScene and bake/raycast.h's RayCaster).
+struct SceneDescription {
+  std::filesystem::path file;  // the scene file itself
   UpAxis up = UpAxis::Y;
   std::optional<std::filesystem::path> environment;
   bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
@@ -99,9 +104,9 @@ struct Scene {
 };
 
 // Parses and validates a scene file (InputError naming the file and the line and column or the key).
-Scene load_scene(const std::filesystem::path& file);
+SceneDescription load_scene(const std::filesystem::path& file);
 
-// An object's mesh in world space: the transform applied to positions; normals from the file
+// An object's mesh in world space: world_from_object applied to positions; normals from the file
 // transformed by the inverse transpose, angle-weighted normals recomputed on the world positions.
 Mesh load_scene_mesh(const SceneObject& object);
 
@@ -115,7 +120,7 @@ struct ObjectPlan {
 };
 
 struct ScenePlan {
-  std::vector<ObjectPlan> objects;  // parallel to Scene::objects
+  std::vector<ObjectPlan> objects;  // parallel to SceneDescription::objects
   bool fiv_environment = false;     // /fiv/environment and /fiv/irradiance_cube
   std::vector<std::string> notes;   // scene-wide decisions
 };
@@ -123,7 +128,7 @@ struct ScenePlan {
 // Decides what to bake (the rules in the file comment). `meshes` are the world-space meshes of
 // scene.objects (load_scene_mesh), used by the FIV rule. Throws InputError when a material has no
 // SH order within kMaxOrder for the tolerance.
-ScenePlan plan_scene(const Scene& scene, std::span<const Mesh> meshes);
+ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes);
 
 // ---- the bake itself ----
 
@@ -134,12 +139,12 @@ struct ObjectBake {
   std::string integrator_description;
   uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
   // Occluders with shells (in world space: centre and radii in scene units).
-  std::optional<FivShells> fiv;
+  std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
 };
 
 struct SceneBake {
-  std::vector<ObjectBake> objects;  // parallel to Scene::objects
+  std::vector<ObjectBake> objects;  // parallel to SceneDescription::objects
   Fiv environment_fiv{};            // when plan.fiv_environment
   std::vector<float> irradiance_cube;
   double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0;
@@ -150,7 +155,7 @@ struct SceneBake {
 // "both" objects) in world space; a "both" receiver's vertices are shade points of that union
 // (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
-SceneBake bake_scene(const Scene& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
+SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log);
 
 } // namespace prt::bake

@@ -28,8 +28,9 @@
 //   not taken into account"); if the valid neighbours carry no weight (in particular all 8
 //   invalid), the plain trilinear value of the stored samples is used.
 //
-// Cube map (DifMap): faces +X, −X, +Y, −Y, +Z, −Z, OpenGL convention; texel (row r, column q) of
-// a size-S face has s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction
+// Cube map (DifMap): faces +X, −X, +Y, −Y, +Z, −Z in OpenGL's cube-map convention (not OpenEXR's,
+// which input environment cube maps use: docs/ARCHITECTURE.md §3 "Two cube conventions"); texel
+// (row r, column q) of a size-S face has s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction
 //   +X (1, −t, −s)  −X (−1, −t, s)  +Y (s, 1, t)  −Y (s, −1, −t)  +Z (s, −t, 1)  −Z (−s, −t, −1).
 // A direction selects the face of its largest |component| (ties: X before Y before Z); bilinear
 // inside that face, coordinates clamped to the outermost texel centres (no cross-face filtering).
@@ -80,7 +81,8 @@ struct FivOccluder {
   const uint8_t* valid;
 };
 
-// The DifMap /fiv/irradiance_cube [6][size][size][3], faces +X,−X,+Y,−Y,+Z,−Z (header comment).
+// The DifMap /fiv/irradiance_cube [6][size][size][3], faces +X,−X,+Y,−Y,+Z,−Z, OpenGL orientation
+// (header comment).
 struct DifMap {
   int size;
   const float* texels;

@@ -105,7 +105,7 @@ public:
 private:
   // irradiance() with the unshadowed part E_unocc(f.n) already known.
   void irradiance(const Fragment& f, uint64_t index, const bake::Rgb& unocc, double E[3], double std_error[3]) const;
-  struct Rays;  // bake/raycast.h RayScene over the mesh
+  struct Rays;  // bake/raycast.h RayCaster over the mesh
   const bake::Mesh& mesh_;
   const bake::EnvMap& env_;
   ReferenceOptions options_;
