@@ -102,7 +102,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.integrator.report_points,
                                                 scene.integrator.seed);
       for (const auto& e : ob.report->products)
-        log("  " + e.product + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
+        log("  " + std::string(product_label(e.product)) + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
             printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
                 ob.report->reference_seconds));
     }

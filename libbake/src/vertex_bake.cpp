@@ -90,10 +90,10 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
   });
   report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  auto add = [&](const char* name, size_t offset, size_t count) {
+  auto add = [&](Product product, size_t offset, size_t count) {
     if (count == 0) return;
     ProductError e;
-    e.product = name;
+    e.product = product;
     double se2 = 0, bse2 = 0, err2 = 0, r2 = 0;
     for (size_t i = 0; i < K; ++i) {
       const size_t v = report.vertices[i];
@@ -114,11 +114,21 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
     e.bake_std_error = std::sqrt(bse2 / n);
     report.products.push_back(e);
   };
-  add("ao", L.ao, L.ao_count);
-  add("transfer/diffuse", L.transfer, L.transfer_count);
-  add("transfer/visibility", L.visibility, L.visibility_count);
-  add("radiance/band1", L.radiance, L.radiance_count);
+  add(Product::Ao, L.ao, L.ao_count);
+  add(Product::TransferDiffuse, L.transfer, L.transfer_count);
+  add(Product::TransferVisibility, L.visibility, L.visibility_count);
+  add(Product::RadianceBand1, L.radiance, L.radiance_count);
   return report;
+}
+
+const char* product_label(Product product) {
+  switch (product) {
+  case Product::Ao: return "AO";
+  case Product::TransferDiffuse: return "diffuse transfer";
+  case Product::TransferVisibility: return "visibility transfer";
+  case Product::RadianceBand1: return "band-1 radiance";
+  }
+  return "?";
 }
 
 } // namespace prt::bake

@@ -1,10 +1,25 @@
 // bakefile.cpp — see bakefile.h.
 #include "bakefile.h"
 
+#include <formats/names.h>
+
 #include <cctype>
 
 namespace prt::tool {
 namespace {
+
+// A product's report row is named after its dataset: "/report/ao" for "/ao" (SCHEMA.md).
+std::string report_row_name(bake::Product product) {
+  namespace N = prt::formats::names;
+  std::string_view path;
+  switch (product) {
+  case bake::Product::Ao: path = N::kAo; break;
+  case bake::Product::TransferDiffuse: path = N::kTransferDiffuse; break;
+  case bake::Product::TransferVisibility: path = N::kTransferVisibility; break;
+  case bake::Product::RadianceBand1: path = N::kRadianceBand1; break;
+  }
+  return std::string(path.substr(1));
+}
 
 std::vector<float> to_float(std::span<const double> src, size_t stride, size_t offset, size_t count) {
   const size_t rows = stride ? src.size() / stride : 0;
@@ -97,7 +112,7 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible) {
   F::Report out;
   for (const auto& e : report.products)
-    out.rows.push_back(report_row(e.product,
+    out.rows.push_back(report_row(report_row_name(e.product),
                                   {float(e.rmse), float(e.max_abs), float(e.reference_rms), float(e.bake_std_error),
                                    float(e.reference_std_error)},
                                   "rmse, max_abs, reference_rms, bake_std_error, reference_std_error",

@@ -469,7 +469,7 @@ int run_vertex(const Args& a) {
       for (const auto& e : report->products)
         std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (bake's estimated std. error %.3e; "
                     "reference's own %.3e)\n",
-                    e.product.c_str(), e.rmse, e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0,
+                    bake::product_label(e.product), e.rmse, e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0,
                     e.bake_std_error, e.reference_std_error);
     }
   }

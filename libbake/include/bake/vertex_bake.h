@@ -36,8 +36,13 @@ VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& int
                        const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
 // Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md "Data path").
+// The per-vertex products, as libbake knows them; the file names them through formats/ (the
+// baker maps each to its dataset there), libbake only labels them for people.
+enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1 };
+const char* product_label(Product product);  // "AO", "diffuse transfer", ... (for logs)
+
 struct ProductError {
-  std::string product;              // "ao", "transfer/diffuse", "transfer/visibility", "radiance/band1"
+  Product product = Product::Ao;
   size_t values = 0;                // numbers compared
   double rmse = 0, max_abs = 0;     // bake − reference
   double reference_rms = 0;         // RMS of the reference values (for relative errors)
