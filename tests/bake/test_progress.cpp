@@ -13,6 +13,7 @@
 #include <bake/vertex_bake.h>
 
 #include <gtest/gtest.h>
+#include <progress_recorder.h>
 #include <test_scenes.h>
 
 #include <tbb/global_control.h>
@@ -27,6 +28,7 @@
 #include <vector>
 
 using namespace prt::bake;
+using prt::testing::Recorder;
 
 namespace {
 
@@ -72,30 +74,6 @@ private:
   mutable std::set<std::thread::id> threads_;
 };
 
-// Every update a callback saw, and whether two calls ever overlapped.
-struct Recorder {
-  std::vector<ProgressUpdate> updates;  // task views point into the Task's label: compare at once
-  std::vector<std::string> tasks;
-  std::atomic<bool> inside{false};
-  std::atomic<int> overlaps{0};
-  std::function<void(const ProgressUpdate&)> then;  // runs inside the callback (e.g. to cancel)
-  std::chrono::microseconds dwell{200};             // time spent in each call
-
-  Monitor monitor(const CancelToken* cancel = nullptr) {
-    Monitor m;
-    m.cancel = cancel;
-    m.on_progress = [this](const ProgressUpdate& u) {
-      if (inside.exchange(true)) ++overlaps;
-      std::this_thread::sleep_for(dwell);  // widens the window for an overlap
-      updates.push_back(u);
-      tasks.emplace_back(u.task);
-      if (then) then(u);
-      inside.store(false);
-    };
-    return m;
-  }
-};
-
 // Four worker slots even on a two-core machine, so the bake's advances really race.
 template <class F>
 void with_four_threads(F&& f) {
@@ -122,23 +100,8 @@ TEST(Progress, BakeVerticesReportsMonotoneCountsAndOneFinalUpdate) {
   with_four_threads([&] { b = bake_vertices(s.mesh, s.topo, probe, rec.monitor(), "stage under test"); });
   const uint64_t V = s.mesh.positions.size();
   EXPECT_GE(probe.threads(), 2u) << "the bake must run on several threads for this test to mean anything";
-  EXPECT_EQ(rec.overlaps.load(), 0) << "two callbacks ran at the same time";
   ASSERT_GE(rec.updates.size(), 3u) << "expected a first, at least one intermediate and a final update";
-  uint64_t previous = 0;
-  double previous_seconds = 0;
-  for (size_t i = 0; i < rec.updates.size(); ++i) {
-    const ProgressUpdate& u = rec.updates[i];
-    EXPECT_EQ(rec.tasks[i], "stage under test");
-    EXPECT_EQ(u.total, V);
-    EXPECT_LE(u.done, u.total) << "update " << i;
-    EXPECT_GE(u.done, previous) << "update " << i << " went backwards";
-    EXPECT_GE(u.seconds, previous_seconds) << "update " << i;
-    EXPECT_EQ(u.finished, i + 1 == rec.updates.size()) << "exactly one finished update, the last (update " << i << ")";
-    previous = u.done;
-    previous_seconds = u.seconds;
-  }
-  EXPECT_EQ(rec.updates.front().done, 0u);
-  EXPECT_EQ(rec.updates.back().done, V);
+  prt::testing::expect_complete_stage(rec, "stage under test", V);
   EXPECT_EQ(b.values.size(), V * qmc.layout().width);
 }
 
