@@ -21,7 +21,7 @@ double Task::elapsed_seconds() const {
 }
 
 void Task::advance(uint64_t n) {
-  const uint64_t done = done_.fetch_add(n, std::memory_order_relaxed) + n;
+  done_.fetch_add(n, std::memory_order_relaxed);
   if (monitor_.cancelled()) throw Cancelled();
   if (!monitor_.on_progress) return;
   const int64_t now =
@@ -30,7 +30,9 @@ void Task::advance(uint64_t n) {
   if (now < next) return;
   if (!next_report_ns_.compare_exchange_strong(next, now + kReportIntervalNs)) return;  // another thread reports
   std::unique_lock lock(report_mutex_, std::try_to_lock);
-  if (lock.owns_lock() && !finished_) report(done, false);
+  // The count is read under the lock that orders the reports, so they never go backwards (a
+  // thread stalled between winning the exchange and locking must not report an older count).
+  if (lock.owns_lock() && !finished_) report(done_.load(std::memory_order_relaxed), false);
 }
 
 void Task::finish() noexcept {

@@ -1,0 +1,39 @@
+// Ctrl-C in the middle of a bake, end to end: prtbake started as a user would, SIGINT once it has
+// started baking; it must stop with exit 130, say so, and leave nothing in the output directory
+// (tools/common/tool_main.h, bake/progress.h).
+#include <gtest/gtest.h>
+#include <run_tool.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+TEST(PrtbakeCancel, CtrlCDuringABakeExits130AndWritesNothing) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / ("cancel." + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "bunny.h5";
+  // Ambient occlusion with 65536 QMC rays at each of the bunny-on-ground's vertices: minutes of work on two threads,
+  // so the bake is still running when the signal arrives. stderr is a pipe, so progress comes as
+  // plain lines; the first ("baking vertices:   0% ...") is printed as the bake starts.
+  const auto start = std::chrono::steady_clock::now();
+  prt::testing::BackgroundTool bake(PRT_PRTBAKE, {"vertex", std::string(PRT_DATA_DIR) + "/bunny_ground.obj", "-o",
+                                                  out.string(), "--integrator", "qmc", "--samples", "65536", "--ao",
+                                                  "--threads", "2"});
+  ASSERT_TRUE(bake.started());
+  ASSERT_TRUE(bake.wait_for("baking vertices:", std::chrono::seconds(60))) << bake.err();
+  bake.send(SIGINT);
+  const int code = bake.wait();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(code, 130) << bake.err();
+  EXPECT_NE(bake.err().find("prtbake: cancelled; nothing was written\n"), std::string::npos) << bake.err();
+  EXPECT_EQ(bake.err().find("100%"), std::string::npos) << "the bake ran to its end:\n" << bake.err();
+  // Stopping takes at most the blocks of 16 points in flight (16 × 65536 rays per thread).
+  EXPECT_LT(seconds, 30.0);
+  for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
+  fs::remove_all(dir);
+}
