@@ -222,7 +222,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
 }
 
 FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
-                                const Fiv& fenv, size_t points, uint64_t seed) {
+                                const Fiv& fenv, size_t points, uint64_t seed, const Monitor& monitor) {
   ProductRequest req;
   req.radiance = &env;
   req.visibility_order = 1;
@@ -231,6 +231,7 @@ FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, 
   const auto picks = seeded_sample(uint32_t(total), points, seed);
   std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);
   const auto r0 = std::chrono::steady_clock::now();
+  Task progress(monitor, "reference", picks.size());
   tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
     const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
     const int i = int(ij / size_t(shells.n_phi)), j = int(ij % size_t(shells.n_phi));
@@ -242,7 +243,9 @@ FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, 
       se2[q] += se[x] * se[x];
       maxe[q] = std::max(maxe[q], std::abs(d));
     }
+    progress.advance();
   });
+  progress.finish();
   FivErrorReport r;
   r.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
   r.points = picks.size();

@@ -100,7 +100,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref) {
       ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.integrator.report_points,
-                                                scene.integrator.seed);
+                                                scene.integrator.seed, monitor);
       for (const auto& e : ob.report->products)
         log("  " + std::string(product_label(e.product)) + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
             printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
@@ -129,7 +129,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
     if (scene.integrator.report_points > 0) {
       ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
-                                       scene.integrator.seed);
+                                       scene.integrator.seed, monitor);
       log("  fiv: " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
                           ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
     }

@@ -67,12 +67,14 @@ std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {
 }
 
 ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
-                                   const Integrator& reference, size_t n_points, uint64_t seed) {
-  return compare_points_with_reference(vertex_shade_points(mesh, topology), bake, reference, n_points, seed);
+                                   const Integrator& reference, size_t n_points, uint64_t seed,
+                                   const Monitor& monitor) {
+  return compare_points_with_reference(vertex_shade_points(mesh, topology), bake, reference, n_points, seed, monitor);
 }
 
 ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
-                                          const Integrator& reference, size_t n_points, uint64_t seed) {
+                                          const Integrator& reference, size_t n_points, uint64_t seed,
+                                          const Monitor& monitor) {
   const ProductLayout& L = bake.layout;
   PRT_CHECK_OP(reference.layout().width, ==, L.width);
   PRT_CHECK_OP(bake.values.size(), ==, points.size() * L.width);
@@ -82,12 +84,15 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
   const size_t K = report.vertices.size(), W = L.width;
   std::vector<double> ref(K * W), ref_se(K * W);
   const auto t0 = std::chrono::steady_clock::now();
+  Task progress(monitor, "reference", K);
   tbb::parallel_for(size_t(0), K, [&](size_t i) {
     const uint32_t v = report.vertices[i];
     // Index the reference's randomisation apart from the bake's (point index offset by V).
     reference.integrate(points[v], uint64_t(v) + points.size(),
                         std::span(ref).subspan(i * W, W), std::span(ref_se).subspan(i * W, W));
+    progress.advance();
   });
+  progress.finish();
   report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   auto add = [&](Product product, size_t offset, size_t count) {

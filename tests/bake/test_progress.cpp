@@ -143,6 +143,31 @@ TEST(Progress, TokenRequestedBeforeTheCallCancelsAtOnce) {
   EXPECT_THROW(bake_fiv_shells(s.mesh, s.topo, env, spec, silent), Cancelled);
 }
 
+// The error report's reference integration is a stage like the bake: it reports, and a token
+// cancels it (prtbake used to write its file after a Ctrl-C during the report).
+TEST(Progress, TheReferenceStageReportsAndCancels) {
+  const Scene s;
+  const QmcIntegrator qmc(s.mesh, s.topo, s.req, {64, 3});
+  const VertexBake b = bake_vertices(s.mesh, s.topo, qmc);
+  Recorder rec;
+  const ErrorReport r = compare_with_reference(s.mesh, s.topo, b, qmc, 40, 7, rec.monitor());
+  prt::testing::expect_complete_stage(rec, "reference", 40);
+  EXPECT_EQ(r.vertices.size(), 40u);
+
+  CancelToken token;
+  token.request();
+  Monitor cancelled;
+  cancelled.cancel = &token;
+  EXPECT_THROW(compare_with_reference(s.mesh, s.topo, b, qmc, 40, 7, cancelled), Cancelled);
+  const EnvMap env = EnvMap::constant({1, 1, 1});
+  ShellSpec spec;
+  spec.n_phi = 8;
+  spec.n_theta = 5;
+  spec.n_rho = 2;
+  const FivShells shells = bake_fiv_shells(s.mesh, s.topo, env, spec);
+  EXPECT_THROW(fiv_error_report(s.mesh, s.topo, env, shells, environment_fiv(env), 8, 7, cancelled), Cancelled);
+}
+
 TEST(Progress, TokenRequestedFromTheCallbackStopsARunningBake) {
   const Scene s;
   const QmcIntegrator qmc(s.mesh, s.topo, s.req, {64, 3});

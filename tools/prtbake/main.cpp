@@ -381,6 +381,9 @@ prt::formats::RootInfo root_info(const Args& a, const std::string& source_sha) {
 
 // Writes the asset (validated, temp + rename: formats/asset.h) and says where and how big.
 void write_file(const Args& a, const prt::formats::Asset& asset) {
+  // A Ctrl-C during a stage that takes no monitor (loading, setup, the DifMap) is honoured here:
+  // a cancelled bake never writes.
+  if (tool::interrupt_token().requested()) throw bake::Cancelled();
   prt::formats::write_asset(a.output, asset);
   if (!a.quiet) {
     std::error_code ec;
@@ -461,7 +464,8 @@ int run_vertex(const Args& a) {
   std::optional<bake::ErrorReport> report;
   if (a.integrator.report_points > 0) {
     const auto reference = bake::make_reference(a.integrator, mesh, topo, req);
-    report = bake::compare_with_reference(mesh, topo, result, *reference, a.integrator.report_points, a.integrator.seed);
+    report = bake::compare_with_reference(mesh, topo, result, *reference, a.integrator.report_points, a.integrator.seed,
+                                          progress);
     if (say) {
       std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                   "counted in the bake time):\n",
@@ -526,7 +530,8 @@ int run_fiv(const Args& a) {
   F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, shells, env, a.environment, a.shell_spec.fraction, a.shell_spec.silhouette_k));
   if (a.integrator.report_points > 0) {
     // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
-    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, shells, fenv, a.integrator.report_points, a.integrator.seed);
+    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, shells, fenv, a.integrator.report_points,
+                                                          a.integrator.seed, progress);
     if (say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",

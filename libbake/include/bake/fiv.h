@@ -113,7 +113,8 @@ struct FivErrorReport {
   double reference_seconds = 0;    // apart from the bake time
   std::string reference;           // the reference integrator's description
 };
+// The reference integration is a "reference" stage of `monitor` (progress, Cancelled).
 FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
-                                const Fiv& environment, size_t points, uint64_t seed);
+                                const Fiv& environment, size_t points, uint64_t seed, const Monitor& monitor = {});
 
 } // namespace prt::bake

@@ -57,12 +57,15 @@ struct ErrorReport {
 };
 
 // Picks min(n_points, V) distinct vertices with `seed`, integrates them with `reference`, and
-// compares with `bake` (which must have the same layout).
+// compares with `bake` (which must have the same layout). The reference integration is a
+// "reference" stage of `monitor`: it reports progress and throws Cancelled like a bake.
 ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
-                                   const Integrator& reference, size_t n_points, uint64_t seed);
+                                   const Integrator& reference, size_t n_points, uint64_t seed,
+                                   const Monitor& monitor = {});
 
 ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
-                                          const Integrator& reference, size_t n_points, uint64_t seed);
+                                          const Integrator& reference, size_t n_points, uint64_t seed,
+                                          const Monitor& monitor = {});
 
 // The integrator a spec describes (bake/integrator.h). `mesh`, `topology` and the request's
 // environment must outlive it.
