@@ -1,4 +1,4 @@
-# A library that must stay silent (libbake, view: docs/ARCHITECTURE.md, "A silent library") must
+# A library that must stay silent (libbake, view: docs/ARCHITECTURE.md §9) must
 # not reference the C or C++ standard streams or the functions that write to them. Lists the
 # static library's undefined symbols with nm and fails naming each object file and symbol.
 # Writing into buffers (snprintf, std::ostringstream) and into files the caller named

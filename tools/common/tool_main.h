@@ -1,5 +1,5 @@
 // tools/common/tool_main.h — how every prt tool ends: one line on stderr and an exit code that
-// says whose fault it was (docs/ARCHITECTURE.md, "Errors"; each tool's --help lists them).
+// says whose fault it was (docs/ARCHITECTURE.md §6; each tool's --help lists them).
 //
 //   0    success
 //   1    bad input: a file or a value in it (bake::InputError, formats::FormatError); the line

@@ -1,7 +1,7 @@
 // tools/prtbake/bakefile.h — how baked results (libbake, in memory) become the typed asset model
 // (<formats/asset.h>, formats/SCHEMA.md). The one place that joins the two, shared by
 // `prtbake vertex`, `prtbake fiv` and `prtbake scene`, so a product has the same layout and
-// attributes whichever command baked it (docs/ARCHITECTURE.md, "Data path").
+// attributes whichever command baked it (docs/ARCHITECTURE.md §4).
 #pragma once
 
 #include <bake/envmap.h>

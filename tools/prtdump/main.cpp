@@ -2,7 +2,7 @@
 // per-dataset statistics, one vertex, or the same as JSON. A thin shell: formats/ reads the file
 // (formats::inspect_asset: the file as stored, and its typed asset when it passes the schema);
 // this file only computes summary statistics and prints. Command line: CLI11; JSON:
-// nlohmann-json; exit codes: tools/common (docs/ARCHITECTURE.md, "Errors").
+// nlohmann-json; exit codes: tools/common (docs/ARCHITECTURE.md §6).
 #include <formats/asset.h>
 #include <formats/names.h>
 

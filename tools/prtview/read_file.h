@@ -1,6 +1,6 @@
 // prtview/read_file.h — everything prtview takes from a baked file, read as the typed asset
 // (formats::read_asset, <formats/asset.h>; paths and attribute names live in <formats/names.h>,
-// the schema in formats/SCHEMA.md, docs/ARCHITECTURE.md "Schema"). It hands the renderers
+// the schema in formats/SCHEMA.md, docs/ARCHITECTURE.md §5). It hands the renderers
 // (scenes.h) plain meshes, arrays and prtshade views, checked: the environment the data was baked
 // with (SHA-256), the occluder mesh's SHA-256, and what prtshade's validate_* demand (shapes are
 // the schema's, checked by read_asset). Errors are bake::InputError naming the file. Pointers and

@@ -1,7 +1,7 @@
 // formats/asset.h — the typed asset model: plain structs that describe a baked file (vertex sets
 // and their products, FIV environment data and occluders, the scene and its objects, error
 // reports, the root attributes) and write_asset / read_asset. Every path and attribute name
-// lives in <formats/names.h>; the schema is formats/SCHEMA.md (docs/ARCHITECTURE.md, "Schema").
+// lives in <formats/names.h>; the schema is formats/SCHEMA.md (docs/ARCHITECTURE.md §5).
 //
 // Contract
 //   * write_asset(path, a) converts `a` to the generic File (to_file) and writes it with

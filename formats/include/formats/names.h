@@ -1,5 +1,5 @@
 // formats/names.h — every dataset path, group and attribute name of the baked file, spelled once.
-// The schema (formats/SCHEMA.md, docs/ARCHITECTURE.md "Schema") is checked with these names
+// The schema (formats/SCHEMA.md, docs/ARCHITECTURE.md §5) is checked with these names
 // (schema.cpp), the typed asset model is converted with them (asset.cpp), and generic readers
 // that show a file as stored (prtdump) use them instead of literals. Paths of the root layout
 // are absolute; a scene object's vertex set is the same layout under "/objects/<name>".

@@ -1,7 +1,7 @@
 // formats/prtfile.h — the baked file (HDF5, schema version 1): the in-memory model, the one
 // writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
 // depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
-// specified in formats/SCHEMA.md (docs/ARCHITECTURE.md, "Schema"); every path and attribute
+// specified in formats/SCHEMA.md (docs/ARCHITECTURE.md §5); every path and attribute
 // name is in <formats/names.h>. This is the generic layer under the typed asset model
 // (<formats/asset.h>), which is what tools and the runtime loader read and write.
 //

@@ -1,6 +1,6 @@
 // bake/error.h — the three kinds of failure in libbake (after Filament's utils/Panic.h and
 // pbrt's util/error.h); the tools map each to its own exit code (tools/common/tool_main.h,
-// docs/ARCHITECTURE.md "Errors"):
+// docs/ARCHITECTURE.md §6):
 //   * InputError: the user's input is bad (a mesh, an EXR, a scene file, a value in it). what() is
 //     one line that names the file and the defect: "<file>: <what is wrong>". Exit 1. libbake's
 //     messages name files, keys and values, never a tool's command-line flags.

@@ -104,7 +104,7 @@ Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, co
                      uint64_t point_index, Fiv* std_error = nullptr);
 
 // Error of baked shells against the QMC reference (IntegratorSpec::kSilhouetteReferenceRays, full sphere) at `points` shell
-// samples chosen with `seed` (docs/ARCHITECTURE.md "Data path"): RMSE and max over the 9 numbers of each sample.
+// samples chosen with `seed` (docs/ARCHITECTURE.md §6): RMSE and max over the 9 numbers of each sample.
 struct FivErrorReport {
   size_t points = 0;
   double rmse = 0, max_abs = 0;

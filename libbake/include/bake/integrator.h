@@ -15,7 +15,7 @@
 namespace prt::bake {
 
 // A point to integrate at. Visibility is the limit from just above the surface, p + εn, ε → 0+
-// (docs/ARCHITECTURE.md "Conventions"): when `welded` names a welded mesh position (bake/mesh.h Topology), the
+// (docs/ARCHITECTURE.md §3): when `welded` names a welded mesh position (bake/mesh.h Topology), the
 // triangles of its 1-ring occlude exactly as they do in that limit (a concave ring occludes, a
 // flat one does not) with no ε offset; welded = -1 is a free point in space.
 struct ShadePoint {

@@ -19,7 +19,7 @@
 // texel — the same numbers as the texel-by-texel sum (`reference`) up to summation order. A
 // constant environment (no texels) gives π L exactly.
 // Units: radiance × steradian (the environment's radiance times sr). Conventions:
-// docs/ARCHITECTURE.md, "Conventions".
+// docs/ARCHITECTURE.md §3.
 #pragma once
 
 #include <bake/envmap.h>

@@ -1,4 +1,4 @@
-// bake/mesh.h — mesh input and welded topology (docs/ARCHITECTURE.md, "Data path": scene input,
+// bake/mesh.h — mesh input and welded topology (docs/ARCHITECTURE.md §4: scene input,
 // edge/face incidence).
 //
 // A Mesh is the geometry a bake belongs to: its vertex rows are the rows of every per-vertex
@@ -137,7 +137,7 @@ std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vecto
 std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                            std::span<const std::array<uint32_t, 3>> triangles);
 
-// Welded, orientation-free incidence for the integrators (docs/ARCHITECTURE.md, "Data path"):
+// Welded, orientation-free incidence for the integrators (docs/ARCHITECTURE.md §4):
 // the DCF step across an edge counts the faces on each side, so non-manifold edges and
 // inconsistent winding are data, not errors. Welded position ids are assigned in order of first appearance over the output
 // vertices (so a mesh without duplicate positions has weld[v] == v); positions are equal when

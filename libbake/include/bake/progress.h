@@ -1,6 +1,6 @@
 // bake/progress.h — how a long libbake computation reports progress to its caller and how the
 // caller cancels it. libbake never draws anything: it calls back, and the tools draw (the terminal
-// bar lives in tools/common/progress_bar.h). docs/ARCHITECTURE.md, "A silent library".
+// bar lives in tools/common/progress_bar.h). docs/ARCHITECTURE.md §9.
 //
 //   Monitor     what the caller hands to a bake: an optional progress callback and an optional
 //               cancellation token. A default-constructed Monitor is silent and cannot cancel.

@@ -1,5 +1,5 @@
 // bake/scene.h — scene files: several objects, their roles and materials, one environment, and
-// a plan that bakes what the scene needs and nothing else (docs/ARCHITECTURE.md "Data path": only
+// a plan that bakes what the scene needs and nothing else (docs/ARCHITECTURE.md §5: only
 // what was asked for, and what the scene needs, is written).
 //
 // The scene file (JSON, RFC 8259, read with nlohmann-json; documented with an example in

@@ -1,6 +1,6 @@
 // bake/sha256.h — SHA-256 (FIPS 180-4) of files and byte buffers, for provenance: the baked
 // file records the digest of every input (mesh, environment map) it was made from
-// (docs/ARCHITECTURE.md, "Schema"). Computed by OpenSSL's libcrypto (EVP); a mesh's digest comes
+// (docs/ARCHITECTURE.md §5). Computed by OpenSSL's libcrypto (EVP); a mesh's digest comes
 // with the mesh (Mesh::source_sha256, bake/mesh.h), taken from the bytes that were parsed.
 // Digests are returned as 64 lowercase hexadecimal characters.
 #pragma once

@@ -35,7 +35,7 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
                        const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
-// Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md "Data path").
+// Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md §6).
 // The per-vertex products, as libbake knows them; the file names them through formats/ (the
 // baker maps each to its dataset there), libbake only labels them for people.
 enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1 };
@@ -71,7 +71,7 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
 // environment must outlive it.
 std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
                                             const ProductRequest& request);
-// The converged reference of the error reports (docs/ARCHITECTURE.md "Data path"): QMC with
+// The converged reference of the error reports (docs/ARCHITECTURE.md §6): QMC with
 // spec.reference_rays() rays per point, seeded apart from the bake's points.
 std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
                                            const ProductRequest& request);

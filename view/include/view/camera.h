@@ -1,5 +1,5 @@
 // view/camera.h — the pinhole camera both renderers share (view/raster.h, view/reference.h) and
-// its text form. Layer and conventions: docs/ARCHITECTURE.md, "Layers" and "Conventions".
+// its text form. Layer and conventions: docs/ARCHITECTURE.md §2 and "Conventions".
 //
 // CAMERA. Right-handed world, look-at: forward f = normalize(at − eye), right r = normalize(f × up),
 // true up u = r × f. fov_y_degrees is the full vertical field of view; aspect = width / height.

@@ -1,6 +1,6 @@
 // view/image.h — images for people and for numbers: 8-bit PNG (libpng) and float OpenEXR files,
 // tone mapping to 8-bit sRGB, a false-colour error map and the NRMSE figure of paper 004 §5.
-// Layers: docs/ARCHITECTURE.md, "Layers".
+// Layers: docs/ARCHITECTURE.md §2.
 //
 // Pixels. An Image is LINEAR float RGB, row-major, 3 floats per pixel, row 0 at the TOP of the
 // picture, pixel (x, y) covering [x, x+1) × [y, y+1) with its centre at (x + ½, y + ½) (the

@@ -1,7 +1,7 @@
 // view/raster.h — a small software rasterizer: what an engine does with the baked per-vertex
 // and FIV data (prtview's runtime pictures), and the scene pieces the previews add (a ground
 // square, translated copies). Camera and pixel conventions: view/camera.h; layers:
-// docs/ARCHITECTURE.md, "Layers".
+// docs/ARCHITECTURE.md §2.
 //
 // RASTERIZER (rasterize). Every triangle is drawn from both sides (no culling: baked meshes have
 // any winding). Per triangle: vertices to view space, clip against z = near (Sutherland–Hodgman,

@@ -2,13 +2,13 @@
 // paper 004 §5: "the standard rendering formula, Equation (2), with an overall integration of the
 // unoccluded part of the environment map as it is seen from each pixel") and its on-disk cache.
 // It sees the same pixels as the rasterizer (view/camera.h, view/raster.h). Layers:
-// docs/ARCHITECTURE.md, "Layers".
+// docs/ARCHITECTURE.md §2.
 //
 // REFERENCE (ReferenceRenderer). Per pixel: one primary ray through the pixel centre (Embree
 // closest hit, same near plane) gives p, the shading normal n (the interpolated vertex normals,
 // as the rasterizer) and the geometric normal; the pixel value is the outgoing radiance of a
 // white Lambertian surface, E / π, with the irradiance
-//   E(p, n) = ∫ L(ω) V(p, ω) H(ω, n) (n · ω) dω     (docs/ARCHITECTURE.md, "Conventions"; paper 004 eq. 2)
+//   E(p, n) = ∫ L(ω) V(p, ω) H(ω, n) (n · ω) dω     (docs/ARCHITECTURE.md §3; paper 004 eq. 2)
 // computed as E = E_unocc(n) − ∫ L (1 − V) H (n · ω) dω:
 //   * E_unocc(n) = E_tot(n) of bake/irradiance.h (UnshadowedIrradiance: the same function the
 //     DifMap of FIV files samples), a deterministic sum over every environment texel: no noise
