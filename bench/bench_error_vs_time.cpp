@@ -23,9 +23,7 @@
 #include <bench_common.h>
 
 #include <bake/qmc.h>
-#if PRT_BENCH_SILHOUETTE
-#include <bake/silhouette.h>
-#endif
+#include <bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 
@@ -213,36 +211,33 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
 
     std::vector<Row> q_rows, s_rows;
-    for (long N : qmc) {
-      bake::QmcOptions o;
-      o.rays = uint32_t(N);
-      o.seed = 1;
-      const bake::QmcIntegrator q(s.mesh, s.topology, req, o);
+    // One row: the integrator the spec describes, timed on one thread over the points.
+    auto measure = [&](const bake::IntegratorSpec& spec, const char* method, long param, long k) {
+      const std::unique_ptr<bake::Integrator> integ = bake::make_integrator(spec, s.mesh, s.topology, req);
       Row r;
-      r.method = "qmc";
-      r.param = r.k = N;
+      r.method = method;
+      r.param = param;
+      r.k = k;
       double wall = 0, cpu = 0;
-      const auto v = run_serial(s, q, wall, cpu);
+      const auto v = run_serial(s, *integ, wall, cpu);
       r.wall_us = 1e6 * wall / double(n);
       r.cpu_us = 1e6 * cpu / double(n);
       errors(v, ref, L, n, r);
-      q_rows.push_back(r);
+      return r;
+    };
+    for (long N : qmc) {
+      bake::IntegratorSpec spec;
+      spec.kind = bake::IntegratorKind::Qmc;
+      spec.qmc_rays = uint32_t(N);
+      spec.seed = 1;
+      q_rows.push_back(measure(spec, "qmc", N, N));
     }
 #if PRT_BENCH_SILHOUETTE
     for (long N : isolines) {
-      bake::SilhouetteOptions o;
-      o.isolines = int(N);
-      const bake::SilhouetteIntegrator si(s.mesh, s.topology, req, o);
-      Row r;
-      r.method = "silhouette";
-      r.param = N;
-      r.k = N * N;
-      double wall = 0, cpu = 0;
-      const auto v = run_serial(s, si, wall, cpu);
-      r.wall_us = 1e6 * wall / double(n);
-      r.cpu_us = 1e6 * cpu / double(n);
-      errors(v, ref, L, n, r);
-      s_rows.push_back(r);
+      bake::IntegratorSpec spec;
+      spec.kind = bake::IntegratorKind::Silhouette;
+      spec.silhouette_k = uint32_t(N * N);
+      s_rows.push_back(measure(spec, "silhouette", N, N * N));
     }
 #endif
 

@@ -20,15 +20,13 @@
 //   PRT_BENCH_POINTS, PRT_BENCH_SEED (bench_common.h)
 #include <bench_common.h>
 
-#include <bake/qmc.h>
-#if PRT_BENCH_SILHOUETTE
-#include <bake/silhouette.h>
-#endif
+#include <bake/vertex_bake.h>
 
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,27 +57,32 @@ void integrate_all(benchmark::State& state, const bench::Scene& s, const bake::I
   state.counters["points"] = double(n);
 }
 
-void qmc_case(benchmark::State& state, int level, uint32_t samples) {
-  const bench::Scene& s = bench::scene(level);
-  const auto t0 = std::chrono::steady_clock::now();
-  bake::QmcOptions opt;
-  opt.rays = samples;
-  const bake::QmcIntegrator integ(s.mesh, s.topology, bench::request(), opt);
-  state.counters["setup_s"] = since(t0);
-  integrate_all(state, s, integ);
+bake::IntegratorSpec qmc_spec(long rays) {
+  bake::IntegratorSpec spec;
+  spec.kind = bake::IntegratorKind::Qmc;
+  spec.qmc_rays = uint32_t(rays);
+  return spec;
 }
 
-#if PRT_BENCH_SILHOUETTE
-void silhouette_case(benchmark::State& state, int level, int isolines) {
+bake::IntegratorSpec silhouette_spec(long isolines) {
+  bake::IntegratorSpec spec;
+  spec.kind = bake::IntegratorKind::Silhouette;
+  spec.silhouette_k = uint32_t(isolines * isolines);
+  return spec;
+}
+
+// One case: the integrator the spec describes (its setup timed apart), every shade point per
+// iteration, and the integrator's own per-integral statistics (the silhouette integrator's
+// contour and integration split; QMC has none).
+void integrator_case(benchmark::State& state, int level, const bake::IntegratorSpec& spec) {
   const bench::Scene& s = bench::scene(level);
   const auto t0 = std::chrono::steady_clock::now();
-  bake::SilhouetteOptions opt;
-  opt.isolines = isolines;
-  const bake::SilhouetteIntegrator integ(s.mesh, s.topology, bench::request(), opt);
+  const std::unique_ptr<bake::Integrator> integ = bake::make_integrator(spec, s.mesh, s.topology, bench::request());
   state.counters["setup_s"] = since(t0);
-  const bake::IntegratorStats before = integ.stats();
-  integrate_all(state, s, integ);
-  const bake::IntegratorStats after = integ.stats();
+  const bake::IntegratorStats before = integ->stats();
+  integrate_all(state, s, *integ);
+  if (spec.kind != bake::IntegratorKind::Silhouette) return;
+  const bake::IntegratorStats after = integ->stats();
   const double k = double(after.points - before.points);
   if (k > 0) {
     state.counters["contour_us"] = 1e6 * (after.contour_seconds - before.contour_seconds) / k;
@@ -88,9 +91,8 @@ void silhouette_case(benchmark::State& state, int level, int isolines) {
     state.counters["crossings"] = double(after.crossings - before.crossings) / k;
     state.counters["start_rays"] = double(after.start_rays - before.start_rays) / k;
   }
-  state.counters["k"] = double(isolines) * double(isolines);
+  state.counters["k"] = double(spec.silhouette_k);
 }
-#endif
 
 } // namespace
 
@@ -102,12 +104,12 @@ int main(int argc, char** argv) {
     // Baseline next to the optimised method, accuracy knob first, then the triangle sweep.
     for (long n : samples)
       benchmark::RegisterBenchmark(("BM_Qmc/samples:" + std::to_string(n)).c_str(),
-                                   [n](benchmark::State& st) { qmc_case(st, 0, uint32_t(n)); })
+                                   [n](benchmark::State& st) { integrator_case(st, 0, qmc_spec(n)); })
           ->Unit(benchmark::kMillisecond);
 #if PRT_BENCH_SILHOUETTE
     for (long n : isolines)
       benchmark::RegisterBenchmark(("BM_Silhouette/isolines:" + std::to_string(n)).c_str(),
-                                   [n](benchmark::State& st) { silhouette_case(st, 0, int(n)); })
+                                   [n](benchmark::State& st) { integrator_case(st, 0, silhouette_spec(n)); })
           ->Unit(benchmark::kMillisecond);
 #else
     (void)isolines;
@@ -116,11 +118,11 @@ int main(int argc, char** argv) {
 #endif
     for (long l : levels) {
       benchmark::RegisterBenchmark(("BM_QmcTriangles/level:" + std::to_string(l)).c_str(),
-                                   [l](benchmark::State& st) { qmc_case(st, int(l), 1024); })
+                                   [l](benchmark::State& st) { integrator_case(st, int(l), qmc_spec(1024)); })
           ->Unit(benchmark::kMillisecond);
 #if PRT_BENCH_SILHOUETTE
       benchmark::RegisterBenchmark(("BM_SilhouetteTriangles/level:" + std::to_string(l)).c_str(),
-                                   [l](benchmark::State& st) { silhouette_case(st, int(l), 64); })
+                                   [l](benchmark::State& st) { integrator_case(st, int(l), silhouette_spec(64)); })
           ->Unit(benchmark::kMillisecond);
 #endif
     }

@@ -27,6 +27,14 @@ const bake::CancelToken& interrupt_token() { return g_interrupt; }
 
 void install_interrupt_handler() { std::signal(SIGINT, on_sigint); }
 
+namespace {
+// One stderr line "<tool>: <kind><what>" and the exit code that goes with it.
+int fail(const char* tool, const char* kind, const char* what, int code) {
+  std::fprintf(stderr, "%s: %s%s\n", tool, kind, what);
+  return code;
+}
+} // namespace
+
 int run_tool(const char* tool, int (*body)(int, char**), int argc, char** argv) {
   try {
     return body(argc, argv);
@@ -34,26 +42,19 @@ int run_tool(const char* tool, int (*body)(int, char**), int argc, char** argv) 
     std::fprintf(stderr, "%s: %s (try '%s --help')\n", tool, e.what(), tool);
     return kExitUsage;
   } catch (const bake::InputError& e) {
-    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
-    return kExitBadInput;
+    return fail(tool, "error: ", e.what(), kExitBadInput);
   } catch (const formats::FormatError& e) {
-    std::fprintf(stderr, "%s: error: %s\n", tool, e.what());
-    return kExitBadInput;
+    return fail(tool, "error: ", e.what(), kExitBadInput);
   } catch (const bake::Cancelled&) {
-    std::fprintf(stderr, "%s: cancelled; nothing was written\n", tool);
-    return kExitCancelled;
+    return fail(tool, "cancelled; nothing was written", "", kExitCancelled);
   } catch (const bake::SystemError& e) {
-    std::fprintf(stderr, "%s: system error: %s\n", tool, e.what());
-    return kExitSystem;
+    return fail(tool, "system error: ", e.what(), kExitSystem);
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "%s: system error: out of memory\n", tool);
-    return kExitSystem;
+    return fail(tool, "system error: ", "out of memory", kExitSystem);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: internal error: %s\n", tool, e.what());
-    return kExitInternal;
+    return fail(tool, "internal error: ", e.what(), kExitInternal);
   } catch (...) {
-    std::fprintf(stderr, "%s: internal error: unknown exception\n", tool);
-    return kExitInternal;
+    return fail(tool, "internal error: ", "unknown exception", kExitInternal);
   }
 }
 
