@@ -254,4 +254,94 @@ Topology build_topology(const Mesh& mesh) {
   return topo;
 }
 
+size_t WindingFacts::inward_components() const {
+  return size_t(std::count_if(closed.begin(), closed.end(), [](const ClosedComponent& c) { return c.inward; }));
+}
+
+size_t WindingFacts::inward_triangles() const {
+  size_t n = 0;
+  for (const ClosedComponent& c : closed) n += c.inward ? c.triangles : 0;
+  return n;
+}
+
+WindingFacts winding_facts(const Mesh& mesh, const Topology& topo) {
+  const auto n_triangles = static_cast<uint32_t>(mesh.triangles.size());
+  PRT_CHECK_OP(topo.weld.size(), ==, mesh.positions.size());
+  auto welded = [&](uint32_t t) {
+    const auto& v = mesh.triangles[t];
+    return std::array<uint32_t, 3>{topo.weld[v[0]], topo.weld[v[1]], topo.weld[v[2]]};
+  };
+
+  // Components: union-find over triangles joined by each edge's faces.
+  std::vector<uint32_t> parent(n_triangles);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto root = [&](uint32_t t) {
+    while (parent[t] != t) t = parent[t] = parent[parent[t]];
+    return t;
+  };
+  for (uint32_t e = 0; e < topo.edges.size(); ++e) {
+    const auto faces = topo.faces_of_edge(e);
+    for (size_t i = 1; i < faces.size(); ++i) {
+      const uint32_t a = root(faces[0]), b = root(faces[i]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> component(n_triangles), index_of_root(n_triangles, kNone);
+  WindingFacts facts;
+  struct Sums {
+    bool closed = true;
+    double volume = 0, magnitude = 0;
+    Eigen::Vector3d origin;
+  };
+  std::vector<Sums> sums;
+  for (uint32_t t = 0; t < n_triangles; ++t) {
+    uint32_t& c = index_of_root[root(t)];
+    if (c == kNone) {
+      c = static_cast<uint32_t>(facts.closed.size());
+      facts.closed.push_back({t, 0, 0, false});
+      sums.push_back({true, 0, 0, mesh.positions[mesh.triangles[t][0]].cast<double>()});
+    }
+    component[t] = c;
+    ClosedComponent& cc = facts.closed[c];
+    Sums& s = sums[c];
+    ++cc.triangles;
+    const auto w = welded(t);
+    if (w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) s.closed = false;
+    const auto& v = mesh.triangles[t];
+    const Eigen::Vector3d a = mesh.positions[v[0]].cast<double>() - s.origin,
+                          b = mesh.positions[v[1]].cast<double>() - s.origin,
+                          d = mesh.positions[v[2]].cast<double>() - s.origin;
+    const double term = a.dot(b.cross(d));
+    s.volume += term;
+    s.magnitude += std::abs(term);
+  }
+
+  // Closed: every edge has two faces, traversing it in opposite directions.
+  auto forward = [&](uint32_t t, uint32_t a, uint32_t b) {  // does t traverse a -> b?
+    const auto w = welded(t);
+    for (int k = 0; k < 3; ++k)
+      if (w[k] == a && w[(k + 1) % 3] == b) return true;
+    return false;
+  };
+  for (uint32_t e = 0; e < topo.edges.size(); ++e) {
+    const auto faces = topo.faces_of_edge(e);
+    Sums& s = sums[component[faces[0]]];
+    const auto [a, b] = topo.edges[e];
+    if (faces.size() != 2 || forward(faces[0], a, b) == forward(faces[1], a, b)) s.closed = false;
+  }
+
+  facts.components = facts.closed.size();
+  std::vector<ClosedComponent> closed;
+  for (size_t c = 0; c < facts.closed.size(); ++c) {
+    if (!sums[c].closed) continue;
+    ClosedComponent cc = facts.closed[c];
+    cc.signed_volume = sums[c].volume / 6;
+    cc.inward = sums[c].volume < -1e-9 * sums[c].magnitude;
+    closed.push_back(cc);
+  }
+  facts.closed = std::move(closed);
+  return facts;
+}
+
 } // namespace prt::bake

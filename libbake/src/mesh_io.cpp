@@ -187,10 +187,12 @@ Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions&
   }
   if (mesh.positions.size() >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too many vertices for 32-bit indices");
 
-  // Fan triangulation in place.
+  // Fan triangulation in place (each fan triangle reversed when flipping).
+  const int second = options.flip_normals ? 1 : 0;
   for (size_t f = 0; f < poly.polygon_count(); ++f) {
     const uint32_t b = poly.offsets[f], e = poly.offsets[f + 1];
-    for (uint32_t i = b + 1; i + 1 < e; ++i) mesh.triangles.push_back({corner_vertex[b], corner_vertex[i], corner_vertex[i + 1]});
+    for (uint32_t i = b + 1; i + 1 < e; ++i)
+      mesh.triangles.push_back({corner_vertex[b], corner_vertex[i + second], corner_vertex[i + 1 - second]});
   }
 
   // Normals: the file's where usable, else angle-weighted over welded positions.
@@ -201,7 +203,7 @@ Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions&
     const Eigen::Vector3f* n = vertex_file_normal[v];
     const float len = n ? n->norm() : 0.0f;
     if (n && len > 0.0f && std::isfinite(len)) {
-      mesh.normals[v] = *n / len;
+      mesh.normals[v] = (options.flip_normals ? -*n : *n) / len;
       from_file[v] = 1;
       any_file = true;
     } else {

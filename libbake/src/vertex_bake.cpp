@@ -52,6 +52,22 @@ VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integ
   return bake_points(vertex_shade_points(mesh, topology), integrator, monitor, label);
 }
 
+NoSkyCount count_no_sky(const VertexBake& bake) {
+  const ProductLayout& L = bake.layout;
+  const size_t W = L.width;
+  NoSkyCount count;
+  count.total = W ? bake.values.size() / W : 0;
+  // The sky measure's column (see the header), or none for a radiance-only bake.
+  const size_t none = W;
+  const size_t column = L.ao_count ? L.ao : L.transfer_count ? L.transfer : L.visibility_count ? L.visibility : none;
+  for (size_t r = 0; r < count.total; ++r) {
+    const auto row = std::span(bake.values).subspan(r * W, W);
+    const bool dark = column != none ? row[column] == 0.0 : std::all_of(row.begin(), row.end(), [](double x) { return x == 0.0; });
+    count.vertices += dark ? 1 : 0;
+  }
+  return count;
+}
+
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed) {
   std::vector<uint32_t> idx(n);
   std::iota(idx.begin(), idx.end(), 0u);

@@ -92,6 +92,7 @@ struct Args {
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;
+  bool flip_normals = false;  // vertex: reverse every triangle and file normal
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
 };
 
@@ -225,6 +226,11 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                    std::to_string(d.qmc_rays) + "); the error falls like 1/sqrt(N) or faster.");
   cmd.add_flag_callback("--no-file-normals", [&a] { a.file_normals = false; },
                         "ignore normals in the mesh file; use angle-weighted vertex normals.");
+  cmd.add_flag("--flip-normals", a.flip_normals,
+               "reverse every triangle's winding and negate the file's normals (so\n"
+               "file and angle-weighted normals both point the other way): for a\n"
+               "mesh wound inwards, whose vertices would otherwise see no sky.\n"
+               "/mesh/normals' source then ends in ', flipped'.");
   add_report(cmd, a,
              std::to_string(bake::IntegratorSpec::kQmcReferenceFactor) + "x the bake's rays for qmc, " +
                  std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays for silhouette");
@@ -358,6 +364,36 @@ void print_warnings(const std::vector<std::string>& warnings) {
     std::fprintf(stderr, "prtbake: warning: %s%s\n", w.c_str(), n > 1 ? (" (" + std::to_string(n) + " times)").c_str() : "");
 }
 
+// The fix for normals that point inside, as the warnings below say it.
+const char* flip_fix(bool flipped) {
+  return flipped ? "rerun without --flip-normals (this run flipped the mesh)" : "rerun with --flip-normals";
+}
+
+// Closed components wound inwards (bake/mesh.h winding_facts): their vertices will see no sky.
+void warn_inward(const bake::WindingFacts& facts, bool flipped) {
+  const size_t inward = facts.inward_components();
+  if (inward == 0) return;
+  // --flip-normals flips the whole mesh: the fix only when everything in it is inwards.
+  const std::string fix =
+      inward == facts.components
+          ? std::string(flip_fix(flipped))
+          : "fix their winding in the file (--flip-normals would flip all " + std::to_string(facts.components) +
+                " components of the mesh, not only these)";
+  std::fprintf(stderr,
+               "prtbake: warning: %zu of %zu closed components (%zu triangles) are wound inwards: their normals point "
+               "inside, so their vertices see no sky; %s\n",
+               inward, facts.closed.size(), facts.inward_triangles(), fix.c_str());
+}
+
+// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky).
+void warn_no_sky(const bake::NoSkyCount& count, bool flipped) {
+  if (!(count.share() > 0.5)) return;
+  std::fprintf(stderr,
+               "prtbake: warning: %.1f%% of vertices (%zu of %zu) see no sky at all: their normals may point "
+               "inside the mesh; check the mesh's normals and winding, or %s\n",
+               100 * count.share(), count.vertices, count.total, flip_fix(flipped));
+}
+
 std::string human_bytes(uintmax_t b) {
   char buf[32];
   if (b >= (1u << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1 << 20));
@@ -399,14 +435,17 @@ int run_vertex(const Args& a) {
 
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = a.file_normals;
+  mopt.flip_normals = a.flip_normals;
   const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
   const bake::Topology topo = bake::build_topology(mesh);
   const std::string mesh_sha = mesh.source_sha256;
   print_warnings(mesh.warnings);
   if (say)
-    std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s\n",
+    std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s%s\n",
                 a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
-                mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted");
+                mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
+                a.flip_normals ? ", flipped" : "");
+  warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
 
   std::optional<bake::EnvMap> env;
   if (!a.environment.empty()) {
@@ -444,6 +483,7 @@ int run_vertex(const Args& a) {
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
+  warn_no_sky(bake::count_no_sky(result), a.flip_normals);
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
                 mesh.positions.size() / result.seconds);
@@ -483,6 +523,7 @@ int run_vertex(const Args& a) {
   F::Asset asset;
   asset.root = root_info(a, mesh_sha);
   tool::set_mesh(asset.vertices, mesh);
+  if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
   tool::set_products(asset.vertices, result,
                      {integrator.name(), integrator.description(), a.integrator.samples(), a.integrator.seed, a.transfer, a.visibility,
                       env ? &*env : nullptr, a.environment});

@@ -46,7 +46,8 @@
 //     zero-area ones, or exactly cancelling ones) gets +Y = (0, 1, 0), the scene up axis.
 //
 // TRIANGLES: file face order; a polygon (c0 … cn−1) becomes the fan (c0, ci, ci+1), i = 1…n−2,
-// in place. Winding is the file's; nothing here assumes it is consistent.
+// in place. Winding is the file's (each triangle reversed with MeshLoadOptions::flip_normals,
+// which also negates file normals); nothing here assumes it is consistent.
 //
 // ERRORS: bad input throws prt::bake::InputError whose what() is "<path>: <defect>" (one line),
 // with a line number where the format has lines: missing/unreadable/oversized file, unknown
@@ -85,6 +86,10 @@ struct Mesh {
 
 struct MeshLoadOptions {
   bool use_file_normals = true;  // false: ignore the file's normals, rows are exactly the file's positions
+  // true: every triangle's winding is reversed ((c0, c1, c2) -> (c0, c2, c1), after the fan) and
+  // every file normal negated, so file and angle-weighted normals both point the other way. For
+  // meshes wound inwards (winding_facts below). Rows and their order do not change.
+  bool flip_normals = false;
 };
 
 // Read OBJ / PLY / OFF / STL (by extension, case-insensitive). See the file comment for the
@@ -158,5 +163,30 @@ struct Topology {
 // listed once per distinct edge (the triangle (a, a, b) contributes one face to edge {a, b}).
 // Zero-area triangles with distinct corners are ordinary faces here.
 Topology build_topology(const Mesh&);
+
+// Which way the closed parts of a mesh are wound (so a tool can warn before baking a mesh whose
+// normals point inside, where every vertex sees no sky). A COMPONENT is a maximal set of
+// triangles connected through shared welded edges (Topology::edges). It is CLOSED when no
+// triangle repeats a welded corner and every edge of its triangles is shared by exactly two
+// triangles that traverse it in opposite directions (watertight and consistently oriented).
+// Its signed volume is (1/6) Σ_t (a−o)·((b−o)×(c−o)) over its triangles (a, b, c), o its first
+// triangle's first corner (translation-invariant for a closed surface; computed in double). It is
+// positive for outward winding (right-handed face normals, bake/mesh.h, pointing out); a closed
+// component is INWARD when its volume is negative beyond rounding: V < −1e-9 · (1/6) Σ_t |term_t|
+// (so a closed double-sided sheet, V = 0 up to rounding, is not inward). Components that are not
+// closed (open, non-manifold, inconsistently wound) have no inside and are only counted.
+struct ClosedComponent {
+  uint32_t first_triangle = 0;  // its lowest triangle index
+  size_t triangles = 0;
+  double signed_volume = 0;
+  bool inward = false;
+};
+struct WindingFacts {
+  size_t components = 0;                // all components (closed or not)
+  std::vector<ClosedComponent> closed;  // the closed ones, by first triangle
+  size_t inward_components() const;
+  size_t inward_triangles() const;
+};
+WindingFacts winding_facts(const Mesh& mesh, const Topology& topology);
 
 } // namespace prt::bake

@@ -35,6 +35,22 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
                        const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
+// How many rows of a bake see no sky at all (a mesh wound inwards, or a vertex buried inside
+// another object), for a tool's warning. A row sees no sky when its SKY MEASURE is exactly 0; the
+// sky measure is the first of AO, T_0, U_0 the layout holds: each is the integral over the
+// visible part of the hemisphere of a weight > 0 almost everywhere ((n·ω)/π, (n·ω) y_0/π, y_0),
+// so it is 0 exactly when the visible part has measure zero. The silhouette integrator writes
+// exact zeros then (it finds the point enclosed); the QMC estimate is a sum of positive terms, one
+// per ray that escaped, so it is exactly 0 when every ray hit (and a fully visible-but-unlucky
+// vertex cannot reach 0). A radiance-only bake has no such measure: there a row counts when all
+// its values are exactly 0 (no sky, or a sky that is black wherever it is seen).
+struct NoSkyCount {
+  size_t vertices = 0;  // rows that see no sky
+  size_t total = 0;     // rows
+  double share() const { return total ? double(vertices) / double(total) : 0.0; }
+};
+NoSkyCount count_no_sky(const VertexBake& bake);
+
 // Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md §6).
 // The per-vertex products, as libbake knows them; the file names them through formats/ (the
 // baker maps each to its dataset there), libbake only labels them for people.
