@@ -1,0 +1,115 @@
+// prtbake vertex on meshes wound inwards: the warning (numbers and fix) and --flip-normals.
+#include <formats/asset.h>
+
+#include <gtest/gtest.h>
+#include <run_tool.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+
+namespace {
+
+const std::string kBake = PRT_PRTBAKE;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "prtbake_winding";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// The box [0, 1]³ as an OBJ: 8 corners, 6 quads wound outwards (right-handed normals pointing
+// out) or, reversed, inwards.
+fs::path box_obj(const std::string& name, bool inward) {
+  static const int kQuads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+  const fs::path p = scratch(name);
+  std::ofstream out(p);
+  for (int k = 0; k < 8; ++k) out << "v " << (k & 1) << ' ' << ((k >> 1) & 1) << ' ' << ((k >> 2) & 1) << '\n';
+  for (const auto& q : kQuads) {
+    out << 'f';
+    for (int c = 0; c < 4; ++c) out << ' ' << q[inward ? 3 - c : c];
+    out << '\n';
+  }
+  return p;
+}
+
+struct Baked {
+  prt::testing::ToolRun run;
+  F::Asset asset;
+};
+
+Baked bake(const fs::path& mesh, const std::string& extra) {
+  const fs::path out = scratch(mesh.stem().string() + ".prt.h5");
+  fs::remove(out);
+  Baked b{prt::testing::run_tool(kBake, "vertex '" + mesh.string() + "' --ao --report 0 --quiet -o '" + out.string() +
+                                            "' " + extra,
+                                 scratch("capture")),
+          {}};
+  if (b.run.code == 0) b.asset = F::read_asset(out);
+  return b;
+}
+
+const std::string kInwardWarning =
+    "prtbake: warning: 1 of 1 closed components (12 triangles) are wound inwards: their normals point inside, so "
+    "their vertices see no sky; rerun with --flip-normals\n";
+
+TEST(PrtbakeWinding, InwardBoxWarnsAndBakesNoSky) {
+  for (const std::string integrator : {"silhouette", "qmc"}) {
+    SCOPED_TRACE(integrator);
+    const Baked b = bake(box_obj("inward_" + integrator + ".obj", true), "--integrator " + integrator);
+    ASSERT_EQ(b.run.code, 0) << b.run.err;
+    // Before the bake, the winding; after it, the share of vertices that saw no sky.
+    EXPECT_EQ(b.run.err, kInwardWarning +
+                             "prtbake: warning: 100.0% of vertices (8 of 8) see no sky at all: their normals may point "
+                             "inside the mesh; check the mesh's normals and winding, or rerun with --flip-normals\n");
+    ASSERT_TRUE(b.asset.vertices.ao);
+    ASSERT_EQ(b.asset.vertices.ao->values.size(), 8u);
+    // Every vertex's hemisphere is the inside of the box: every ray hits / the point is enclosed.
+    for (float a : b.asset.vertices.ao->values) EXPECT_EQ(a, 0.0f);
+    EXPECT_EQ(b.asset.vertices.normals->source, "angle-weighted");
+  }
+}
+
+TEST(PrtbakeWinding, FlipNormalsBakesTheOutsideWithoutWarning) {
+  const Baked b = bake(box_obj("inward_flipped.obj", true), "--flip-normals");
+  ASSERT_EQ(b.run.code, 0) << b.run.err;
+  EXPECT_EQ(b.run.err, "") << "flipped, the box is wound outwards";
+  // A convex box's corner: its faces lie on the far side of the tangent plane of the averaged
+  // normal, so nothing is above the hemisphere in the limit p + εn: AO = 1 (the silhouette
+  // integrator's closed form for a point with no contour edge in view; float32 in the file).
+  for (float a : b.asset.vertices.ao->values) EXPECT_EQ(a, 1.0f);
+  // Normals point away from the centre (0.5, 0.5, 0.5), and the file says they were flipped.
+  const auto& n = b.asset.vertices.normals->values;
+  const auto& p = b.asset.vertices.positions->values;
+  for (size_t v = 0; v < 8; ++v) {
+    double d = 0;
+    for (size_t k = 0; k < 3; ++k) d += double(n[3 * v + k]) * (p[3 * v + k] - 0.5);
+    EXPECT_GT(d, 0.0) << v;
+  }
+  EXPECT_EQ(b.asset.vertices.normals->source, "angle-weighted, flipped");
+  EXPECT_NE(b.asset.root.command_line.find("--flip-normals"), std::string::npos);
+}
+
+TEST(PrtbakeWinding, OutwardBoxAndOpenMeshDoNotWarn) {
+  const Baked box = bake(box_obj("outward.obj", false), "");
+  ASSERT_EQ(box.run.code, 0) << box.run.err;
+  EXPECT_EQ(box.run.err, "");
+  for (float a : box.asset.vertices.ao->values) EXPECT_EQ(a, 1.0f);
+  const fs::path quad = scratch("quad.obj");
+  std::ofstream(quad) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+  const Baked open = bake(quad, "");
+  ASSERT_EQ(open.run.code, 0) << open.run.err;
+  EXPECT_EQ(open.run.err, "") << "an open mesh has no inside";
+}
+
+TEST(PrtbakeWinding, FlippingAnOutwardBoxSaysToRerunWithout) {
+  const Baked b = bake(box_obj("outward_flipped.obj", false), "--flip-normals");
+  ASSERT_EQ(b.run.code, 0) << b.run.err;
+  EXPECT_NE(b.run.err.find("1 of 1 closed components (12 triangles) are wound inwards"), std::string::npos) << b.run.err;
+  EXPECT_NE(b.run.err.find("rerun without --flip-normals"), std::string::npos) << b.run.err;
+}
+
+} // namespace
