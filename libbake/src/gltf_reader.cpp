@@ -73,7 +73,7 @@ std::string one_line(const std::string& text) {
   return out;
 }
 
-// ---- Accessors (glTF 2.0 §3.6): checked views of buffer bytes. ----
+// ---- Accessors (glTF 2.0 specification, "Accessors"): checked views of buffer bytes. ----
 struct AccessorView {
   const unsigned char* data = nullptr;
   size_t count = 0, stride = 0;
@@ -153,7 +153,7 @@ class Reader {
     return u;
   }
 
-  // ---- Nodes (glTF 2.0 §3.7.3): local transform, matrix or T * R * S, in double. ----
+  // ---- Nodes (glTF 2.0 specification, "Transformations"): local transform, matrix or T * R * S, in double. ----
   Eigen::Matrix4d local_transform(size_t n) const {
     const tinygltf::Node& node = model_.nodes[n];
     const std::string name = "node " + std::to_string(n);
@@ -247,7 +247,7 @@ class Reader {
         sequence.resize(positions.count);
         for (size_t i = 0; i < positions.count; ++i) sequence[i] = static_cast<uint32_t>(i);
       }
-      // Triangles (glTF 2.0 §3.7.2.1): strips alternate winding, fans share the first vertex. A
+      // Triangles (glTF 2.0 specification, "Meshes"): strips alternate winding, fans share the first vertex. A
       // transform with a negative determinant mirrors the primitive; reversing keeps the front face.
       const size_t n = sequence.size();
       auto triangle = [&](uint32_t a, uint32_t b, uint32_t c) {
@@ -278,7 +278,7 @@ class Reader {
     if (static_cast<size_t>(scene_index) >= model_.scenes.size())
       fail("default scene " + std::to_string(scene_index) + " does not exist (" + std::to_string(model_.scenes.size()) + " scenes)");
     // Depth first, iteratively (deep hierarchies must not exhaust the stack). The hierarchy must be
-    // disjoint strict trees (glTF 2.0 §3.5.3): a node reached twice is refused, so the walk is linear.
+    // disjoint strict trees (glTF 2.0 specification, "Nodes and Hierarchy"): a node reached twice is refused, so the walk is linear.
     enum class State : uint8_t { Unseen, OnPath, Done };
     std::vector<State> state(model_.nodes.size(), State::Unseen);
     struct Entry { size_t node; Eigen::Matrix4d parent; bool leave; };

@@ -4,8 +4,8 @@
 // Parsing is tinygltf's (Debian's libtinygltf, a shared library with its own JSON inside, so it
 // cannot meet the nlohmann-json that scene.cpp uses); images are never decoded. What the result
 // holds — rows, normals, transforms, primitive modes, what is refused — is documented in
-// bake/mesh.h (the glTF paragraphs) and follows the glTF 2.0 specification §3.5 (meshes), §3.7
-// (nodes and transforms) and §3.6 (accessors).
+// bake/mesh.h (the glTF paragraphs) and follows the glTF 2.0 specification (Khronos), sections
+// "Nodes and Hierarchy", "Transformations", "Accessors" and "Meshes".
 #pragma once
 
 #include "mesh_readers.h"

@@ -186,7 +186,7 @@ TEST(Gltf, StripAndFanBecomeTrianglesWithConsistentWinding) {
     g.node({{"mesh", g.mesh(fp)}}, true);
     const Mesh m = prt::bake::load_mesh(g.write("strip_fan.gltf"));
     ASSERT_EQ(m.positions.size(), 10u);
-    // glTF 2.0 §3.7.2.1: strip triangle i = (i, i+1+i%2, i+2−i%2); fan triangle i = (i+1, i+2, 0).
+    // glTF 2.0 specification, "Meshes": strip triangle i = (i, i+1+i%2, i+2−i%2); fan triangle i = (i+1, i+2, 0).
     EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {1, 3, 2}, {2, 3, 4}, {6, 7, 5}, {7, 8, 5}, {8, 9, 5}}));
     for (const Tri& t : m.triangles) EXPECT_GT(face_normal(m, t).z(), 0.0f) << "every triangle front-facing +z, as the file's first one";
   }
@@ -213,7 +213,7 @@ TEST(Gltf, MirroringTransformKeepsTheFrontFace) {
   g.node({{"mesh", mesh}, {"scale", {-1.0, 1.0, 1.0}}}, true);
   const Mesh m = prt::bake::load_mesh(g.write("mirror.gltf"));
   ASSERT_EQ(m.triangles.size(), 2u);
-  EXPECT_EQ(m.triangles[1], (Tri{3, 5, 4})) << "negative determinant: winding reversed (glTF 2.0 §3.7.2.1)";
+  EXPECT_EQ(m.triangles[1], (Tri{3, 5, 4})) << "negative determinant: winding reversed (glTF 2.0 specification, 'Meshes')";
   EXPECT_GT(face_normal(m, m.triangles[0]).z(), 0.0f);
   EXPECT_GT(face_normal(m, m.triangles[1]).z(), 0.0f);
 }
