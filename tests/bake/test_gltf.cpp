@@ -5,6 +5,8 @@
 #include <bake/error.h>
 #include <bake/mesh.h>
 
+#include <mesh_files.h>
+
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
@@ -13,7 +15,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -33,20 +34,8 @@ constexpr double kPositionTolerance = 1e-6;
 // Normals: one normalisation in double, one rounding to float and build_mesh's float renormalisation.
 constexpr double kNormalTolerance = 1e-6;
 
-fs::path tmp_dir() {
-  const fs::path dir = fs::path(PRT_TEST_TMP) / "gltf";
-  fs::create_directories(dir);
-  return dir;
-}
-
-fs::path write_file(const std::string& name, const std::string& bytes) {
-  const fs::path p = tmp_dir() / name;
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  EXPECT_TRUE(out.good()) << "could not write " << p;
-  return p;
-}
+fs::path tmp_dir() { return prt::testing::test_dir("gltf"); }
+fs::path write_file(const std::string& name, const std::string& bytes) { return prt::testing::write_test_file(tmp_dir(), name, bytes); }
 
 std::string base64(const std::string& bytes) {
   static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -125,18 +114,7 @@ struct Gltf {
   }
 };
 
-void expect_input_error(const fs::path& path, const std::string& defect_part) {
-  SCOPED_TRACE(path.filename().string());
-  try {
-    prt::bake::load_mesh(path);
-    ADD_FAILURE() << path << " was accepted; expected an error containing '" << defect_part << "'";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(path.string()), std::string::npos) << "what() must name the file: " << what;
-    EXPECT_NE(what.find(defect_part), std::string::npos) << "what() must name the defect: " << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
-  }
-}
+using prt::testing::expect_input_error;
 
 Eigen::Vector3f face_normal(const Mesh& m, const Tri& t) {
   return (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
