@@ -102,7 +102,7 @@ class Reader {
       fail(what + ": accessor " + std::to_string(index) + " does not exist (" + std::to_string(model_.accessors.size()) + " accessors)");
     const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(index)];
     if (a.sparse.isSparse) fail(name + " is sparse; sparse accessors are not supported");
-    if (a.type != type) fail(name + " has the wrong type for its use");
+    if (a.type != type) fail(name + " is not " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR"));
     if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end())
       fail(name + " has unsupported componentType " + std::to_string(a.componentType));
     if (a.normalized && a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) fail(name + " is normalized; not supported");

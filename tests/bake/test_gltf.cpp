@@ -289,6 +289,9 @@ TEST(Gltf, DefectsAreOneLineInputErrorsNamingFileAndDefect) {
     Gltf h = base();
     h.doc["accessors"][0]["componentType"] = 5123;  // UNSIGNED_SHORT positions
     expect_input_error(h.write("short_positions.gltf"), "POSITION (accessor 0) has unsupported componentType 5123");
+    Gltf v = base();
+    v.doc["accessors"][0]["type"] = "VEC2";
+    expect_input_error(v.write("vec2_positions.gltf"), "POSITION (accessor 0) is not VEC3");
   }
   {
     Gltf g = base();
