@@ -31,6 +31,7 @@
 // is reported as an error instead of being re-added. The welded, non-manifold incidence the
 // integrators need (build_topology, mesh.cpp) and the angle-weighted normals are ours: OpenMesh's
 // halfedge structure cannot hold non-manifold edges without duplicating vertices.
+#include "gltf_reader.h"
 #include "mesh_readers.h"
 
 #include <bake/error.h>
@@ -61,6 +62,8 @@ constexpr FormatEntry kFormats[] = {
     {".ply", mesh_readers::read_ply},
     {".off", mesh_readers::read_off},
     {".stl", mesh_readers::read_stl},
+    {".gltf", mesh_readers::read_gltf},
+    {".glb", mesh_readers::read_gltf},
 };
 
 // Larger files are refused before they are read (32-bit indices end well below this anyway).
@@ -229,9 +232,12 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
   const FormatEntry* format = nullptr;
   for (const FormatEntry& f : kFormats)
     if (f.extension == ext) format = &f;
-  if (!format)
+  if (!format) {
+    std::string supported;
+    for (const FormatEntry& f : kFormats) supported += (supported.empty() ? "" : " ") + std::string(f.extension);
     throw InputError(file, "unknown mesh format " + mesh_readers::shown(ext.empty() ? path.filename().string() : ext) +
-                               " (supported: .obj .ply .off .stl)");
+                               " (supported: " + supported + ")");
+  }
   const std::string bytes = read_whole_file(path, file);
   std::vector<std::string> warnings;
   const Polygons polygons = format->read(bytes, {path, file, warnings});

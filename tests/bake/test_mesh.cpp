@@ -4,6 +4,8 @@
 #include <bake/mesh.h>
 #include <bake/sha256.h>
 
+#include <mesh_files.h>
+
 #include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
@@ -36,20 +38,8 @@ constexpr float kUnitTolerance = 1e-6f;
 // Angle-weighted sums are done in double and rounded to float once.
 constexpr float kNormalTolerance = 1e-6f;
 
-fs::path tmp_dir() {
-  const fs::path dir = fs::path(PRT_TEST_TMP) / "mesh";
-  fs::create_directories(dir);
-  return dir;
-}
-
-fs::path write_file(const std::string& name, const std::string& bytes) {
-  const fs::path p = tmp_dir() / name;
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  EXPECT_TRUE(out.good()) << "could not write " << p;
-  return p;
-}
+fs::path tmp_dir() { return prt::testing::test_dir("mesh"); }
+fs::path write_file(const std::string& name, const std::string& bytes) { return prt::testing::write_test_file(tmp_dir(), name, bytes); }
 
 template <class T>
 void append_raw(std::string& s, const T& v) {
@@ -723,18 +713,7 @@ TEST(MeshBuild, MakeAndMergeValidate) {
 
 // --- hostile input ----------------------------------------------------------------------------
 
-void expect_input_error(const fs::path& path, const std::string& defect_part) {
-  SCOPED_TRACE(path.filename().string());
-  try {
-    prt::bake::load_mesh(path);
-    ADD_FAILURE() << path << " was accepted; expected an error containing '" << defect_part << "'";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(path.string()), std::string::npos) << "what() must name the file: " << what;
-    EXPECT_NE(what.find(defect_part), std::string::npos) << "what() must name the defect: " << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
-  }
-}
+using prt::testing::expect_input_error;
 
 TEST(MeshErrors, BadInputNamesFileAndDefect) {
   const Prism prism;

@@ -12,14 +12,15 @@
 //      polygons as corner lists (position index, optional normal index per corner), in file
 //      order, exactly as the file has them (zero-area, needle and repeated-index polygons are
 //      kept). Readers: OBJ, PLY (ascii, binary little/big endian), OFF ([ST][C][N]OFF, ascii),
-//      STL (ascii, binary). Why these readers are ours and not OpenMesh's: see mesh_io.cpp.
+//      STL (ascii, binary), glTF 2.0 (.gltf, .glb; parsed by tinygltf, gltf_reader.cpp). Why the
+//      first four are ours and not OpenMesh's: see mesh_io.cpp. For a .gltf with external
+//      buffers, source_sha256 covers the .gltf's bytes only, not the buffers it refers to.
 //   2. build_mesh turns any Polygons into the Mesh: vertex rows, hard-edge splits, fan
 //      triangulation, normals and validation, the same for every format.
-// A new format (the next one is glTF) is one more reader: a function that fills a Polygons from
-// the bytes (a glTF primitive's POSITION accessor -> positions, NORMAL -> normals with
-// corner_normal = the corner's vertex index, its indices -> 3-corner polygons, primitives and
-// nodes concatenated in document order) and one line in the extension table in mesh_io.cpp;
-// build_mesh and everything after it stay as they are.
+// A new format is one more reader: a function that fills a Polygons from the bytes (as the glTF
+// reader does: a primitive's POSITION accessor -> positions, NORMAL -> normals with
+// corner_normal = the corner's vertex index, its triangles -> 3-corner polygons) and one line in
+// the extension table in mesh_io.cpp; build_mesh and everything after it stay as they are.
 //
 // OUTPUT VERTEX ORDER (the rule every per-vertex consumer relies on):
 //   * OBJ, PLY, OFF: output vertex i < file_positions IS file position i (the file's `v` lines /
@@ -32,10 +33,23 @@
 //     Without file normals (or with use_file_normals = false) the rows are exactly the file's.
 //   * STL has no shared vertices: output vertex 3f+k is corner k of facet f, in file order
 //     (file_positions = 3 × facets). Welding (build_topology) is what connects an STL.
+//   * glTF: the default scene (scene 0 when none is named) is walked depth first, its root nodes
+//     and each node's children in document order; every mesh primitive of every node is an
+//     instance, and the rows are the vertices (POSITION elements) of instance 1 in accessor order,
+//     then instance 2, … — nothing is welded across primitives or instances. A node's transform
+//     (matrix, or translation · rotation · scale) is composed with its ancestors' in double and
+//     applied to positions in double, rounded to float once. TRIANGLES, TRIANGLE_STRIP (triangle i
+//     = (i, i+1+i%2, i+2−i%2)) and TRIANGLE_FAN (triangle i = (i+1, i+2, 0)) become triangles,
+//     indexed or not; under a transform with a negative determinant the winding is reversed (the
+//     front face stays the front face: glTF 2.0 specification, "Meshes"). POINTS and LINE*
+//     primitives give no rows: they are counted in one warning (a file with nothing else is an
+//     InputError). Skins and morph targets are ignored (the rest pose is baked) with a warning.
 //
 // NORMALS (unit, finite, one per output vertex):
 //   * From the file when it has them and MeshLoadOptions::use_file_normals: OBJ `vn` per corner,
 //     PLY nx/ny/nz, NOFF per vertex; normalised. STL facet normals are ignored (often garbage).
+//     glTF NORMAL only when EVERY baked primitive has one (else all are computed), transformed
+//     by the inverse transpose of the node's world transform in double and renormalised.
 //     normal_source = File. A vertex the file gives no normal, or a zero-length one, gets the
 //     computed normal below; a non-finite file normal is an InputError.
 //   * Otherwise angle-weighted ("mean weighted by angle", Thürmer & Wüthrich 1998): for each
@@ -55,6 +69,13 @@
 // garbage), NaN/Inf or out-of-float-range coordinates, zero / negative / out-of-range face
 // indices, faces with fewer than 3 corners. A missing OBJ material library is not an error (a bake
 // does not use materials): it goes to Mesh::warnings. Binary OFF is not supported (InputError).
+// glTF: tinygltf's own parse errors (JSON, GLB container, missing or short buffers), and ours:
+// no scene, a reference to a node / mesh / accessor / buffer view / buffer that does not exist,
+// an accessor past its buffer view or a view past its buffer, an index out of range, a
+// non-finite position, a recursive node graph or a node reached twice (the hierarchy must be
+// disjoint trees), component types other than FLOAT positions/normals and unsigned
+// byte/short/int indices, sparse accessors, TRIANGLES with a count not a multiple of 3, and
+// required compression/quantization extensions. Textures are never decoded.
 // Reading is re-entrant: no global state.
 #pragma once
 
@@ -92,7 +113,7 @@ struct MeshLoadOptions {
   bool flip_normals = false;
 };
 
-// Read OBJ / PLY / OFF / STL (by extension, case-insensitive). See the file comment for the
+// Read OBJ / PLY / OFF / STL / glTF / GLB (by extension, case-insensitive). See the file comment for the
 // vertex order, normal and error contracts. Throws InputError.
 Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
 

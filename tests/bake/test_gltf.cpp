@@ -1,0 +1,365 @@
+// Tests of the glTF 2.0 reader behind load_mesh (bake/mesh.h, libbake/src/gltf_reader.cpp): tiny
+// hand-written glTFs (JSON with base64 data-URI buffers, an external .bin, a .glb) for transforms,
+// strips, fans, non-indexed primitives and normals; each defect the reader refuses; and a walk of
+// Debian's assimp-testmodels glTF2 folder (good and broken public files) plus 2CylinderEngine.glb.
+#include <bake/error.h>
+#include <bake/mesh.h>
+
+#include <mesh_files.h>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using prt::bake::InputError;
+using prt::bake::Mesh;
+using Tri = std::array<uint32_t, 3>;
+
+namespace {
+
+// Positions are transformed in double and rounded to float once: within half a float ulp of the
+// double result, i.e. relative 2^-24 ≈ 6e-8 of the coordinate's magnitude; 1e-6 leaves room for
+// the few ulps by which Eigen's TRS product may differ from the test's own composition.
+constexpr double kPositionTolerance = 1e-6;
+// Normals: one normalisation in double, one rounding to float and build_mesh's float renormalisation.
+constexpr double kNormalTolerance = 1e-6;
+
+fs::path tmp_dir() { return prt::testing::test_dir("gltf"); }
+fs::path write_file(const std::string& name, const std::string& bytes) { return prt::testing::write_test_file(tmp_dir(), name, bytes); }
+
+std::string base64(const std::string& bytes) {
+  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t v = static_cast<uint8_t>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 1]) << 8;
+    if (i + 2 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 2]);
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
+  }
+  return out;
+}
+
+// A glTF under construction: one binary buffer, one buffer view per accessor.
+struct Gltf {
+  json doc = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", json::array()}}}},
+              {"nodes", json::array()}, {"meshes", json::array()}, {"accessors", json::array()},
+              {"bufferViews", json::array()}, {"buffers", json::array()}};
+  std::string bin;
+
+  template <class T>
+  int accessor(const std::vector<T>& values, int component_type, const char* type, size_t count) {
+    while (bin.size() % 4) bin += '\0';
+    const size_t offset = bin.size();
+    bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
+    doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component_type}, {"type", type}, {"count", count}});
+    return static_cast<int>(doc["accessors"].size() - 1);
+  }
+  int vec3(const std::vector<Eigen::Vector3f>& v) {
+    std::vector<float> flat;
+    for (const auto& p : v) flat.insert(flat.end(), {p.x(), p.y(), p.z()});
+    return accessor(flat, 5126, "VEC3", v.size());
+  }
+  int indices(const std::vector<uint16_t>& i) { return accessor(i, 5123, "SCALAR", i.size()); }
+  // A mesh of one primitive; returns its index.
+  int mesh(json primitive) {
+    doc["meshes"].push_back({{"primitives", {std::move(primitive)}}});
+    return static_cast<int>(doc["meshes"].size() - 1);
+  }
+  int node(json n, bool root) {
+    doc["nodes"].push_back(std::move(n));
+    const int index = static_cast<int>(doc["nodes"].size() - 1);
+    if (root) doc["scenes"][0]["nodes"].push_back(index);
+    return index;
+  }
+  // The document with the buffer embedded as a data URI.
+  std::string embedded() const {
+    json d = doc;
+    d["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
+    return d.dump();
+  }
+  fs::path write(const std::string& name) const { return write_file(name, embedded()); }
+  // A .glb: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded).
+  std::string glb() const {
+    json d = doc;
+    d["buffers"] = {{{"byteLength", bin.size()}}};
+    std::string j = d.dump(), b = bin;
+    while (j.size() % 4) j += ' ';
+    while (b.size() % 4) b += '\0';
+    std::string out;
+    auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+    out += "glTF";
+    u32(2);
+    u32(static_cast<uint32_t>(12 + 8 + j.size() + 8 + b.size()));
+    u32(static_cast<uint32_t>(j.size()));
+    out += "JSON";
+    out += j;
+    u32(static_cast<uint32_t>(b.size()));
+    out += std::string("BIN\0", 4);
+    out += b;
+    return out;
+  }
+};
+
+using prt::testing::expect_input_error;
+
+Eigen::Vector3f face_normal(const Mesh& m, const Tri& t) {
+  return (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
+}
+
+const std::vector<Eigen::Vector3f> kTriangle = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+const std::vector<Eigen::Vector3f> kTriangleNormals = {{0, 0, 1}, {0, 0.6f, 0.8f}, {0.6f, 0, 0.8f}};
+
+TEST(Gltf, NodeTransformsComposeInDoubleAndRowsFollowInstances) {
+  Gltf g;
+  const int mesh = g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}, {"NORMAL", g.vec3(kTriangleNormals)}}}});
+  // Parent: T·R·S; child: a matrix (column-major) with a shear, so the inverse transpose differs from the matrix.
+  const std::vector<double> t = {10.0, -2.0, 0.5}, r = {0.0, 0.0, std::sin(0.3), std::cos(0.3)}, s = {2.0, 0.5, 3.0};
+  const std::vector<double> matrix = {1, 0, 0, 0, 0.25, 1, 0, 0, 0, 0, 1, 0, 0.125, 7, -3, 1};
+  const int child = g.node({{"mesh", mesh}, {"matrix", matrix}}, false);
+  g.node({{"mesh", mesh}, {"translation", t}, {"rotation", r}, {"scale", s}, {"children", {child}}}, true);
+  const Mesh m = prt::bake::load_mesh(g.write("two_nodes.gltf"));
+
+  Eigen::Affine3d parent = Eigen::Translation3d(t[0], t[1], t[2]) * Eigen::Quaterniond(r[3], r[0], r[1], r[2]) *
+                           Eigen::Scaling(s[0], s[1], s[2]);
+  const Eigen::Matrix4d child_world = parent.matrix() * Eigen::Map<const Eigen::Matrix4d>(matrix.data());
+  const Eigen::Matrix4d worlds[2] = {parent.matrix(), child_world};  // document order of instances: parent first (depth first)
+  ASSERT_EQ(m.positions.size(), 6u) << "rows: the 3 vertices of each instance";
+  ASSERT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {3, 4, 5}}));
+  EXPECT_EQ(m.normal_source, Mesh::NormalSource::File);
+  for (int instance = 0; instance < 2; ++instance)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d want = (worlds[instance] * kTriangle[k].cast<double>().homogeneous()).head<3>();
+      const Eigen::Vector3f got = m.positions[instance * 3 + k];
+      EXPECT_LT((got.cast<double>() - want).norm(), kPositionTolerance * want.norm()) << instance << " " << k;
+      const Eigen::Vector3d n = (worlds[instance].topLeftCorner<3, 3>().inverse().transpose() * kTriangleNormals[k].cast<double>()).normalized();
+      EXPECT_LT((m.normals[instance * 3 + k].cast<double>() - n).norm(), kNormalTolerance) << instance << " " << k;
+    }
+}
+
+TEST(Gltf, StripAndFanBecomeTrianglesWithConsistentWinding) {
+  // A zig-zag strip and a fan, both in the plane z = 0 and counter-clockwise seen from +z.
+  const std::vector<Eigen::Vector3f> strip = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 2, 0}};
+  const std::vector<Eigen::Vector3f> fan = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {-1, 1, 0}};
+  for (const bool indexed : {true, false}) {
+    SCOPED_TRACE(indexed ? "indexed" : "non-indexed");
+    Gltf g;
+    json sp = {{"attributes", {{"POSITION", g.vec3(strip)}}}, {"mode", 5}};
+    json fp = {{"attributes", {{"POSITION", g.vec3(fan)}}}, {"mode", 6}};
+    if (indexed) sp["indices"] = g.indices({0, 1, 2, 3, 4}), fp["indices"] = g.indices({0, 1, 2, 3, 4});
+    g.node({{"mesh", g.mesh(sp)}}, true);
+    g.node({{"mesh", g.mesh(fp)}}, true);
+    const Mesh m = prt::bake::load_mesh(g.write("strip_fan.gltf"));
+    ASSERT_EQ(m.positions.size(), 10u);
+    // glTF 2.0 specification, "Meshes": strip triangle i = (i, i+1+i%2, i+2−i%2); fan triangle i = (i+1, i+2, 0).
+    EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {1, 3, 2}, {2, 3, 4}, {6, 7, 5}, {7, 8, 5}, {8, 9, 5}}));
+    for (const Tri& t : m.triangles) EXPECT_GT(face_normal(m, t).z(), 0.0f) << "every triangle front-facing +z, as the file's first one";
+  }
+}
+
+TEST(Gltf, NonIndexedTrianglesAndComputedNormalsWhenAPrimitiveHasNone) {
+  Gltf g;
+  const std::vector<Eigen::Vector3f> two = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(two)}}}})}}, true);
+  g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}, {"NORMAL", g.vec3(kTriangleNormals)}}}})},
+          {"translation", {0.0, 0.0, 1.0}}}, true);
+  const Mesh m = prt::bake::load_mesh(g.write("non_indexed.gltf"));
+  ASSERT_EQ(m.positions.size(), 9u) << "no welding: every glTF vertex is a row";
+  EXPECT_EQ(m.triangles, (std::vector<Tri>{{0, 1, 2}, {3, 4, 5}, {6, 7, 8}}));
+  EXPECT_EQ(m.normal_source, Mesh::NormalSource::AngleWeighted) << "one primitive has no NORMAL: all are computed";
+  const auto want = prt::bake::welded_angle_weighted_normals(m.positions, m.triangles);
+  for (size_t v = 0; v < m.normals.size(); ++v) EXPECT_EQ(m.normals[v], want[v]) << v;
+}
+
+TEST(Gltf, MirroringTransformKeepsTheFrontFace) {
+  Gltf g;
+  const int mesh = g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}});
+  g.node({{"mesh", mesh}}, true);
+  g.node({{"mesh", mesh}, {"scale", {-1.0, 1.0, 1.0}}}, true);
+  const Mesh m = prt::bake::load_mesh(g.write("mirror.gltf"));
+  ASSERT_EQ(m.triangles.size(), 2u);
+  EXPECT_EQ(m.triangles[1], (Tri{3, 5, 4})) << "negative determinant: winding reversed (glTF 2.0 specification, 'Meshes')";
+  EXPECT_GT(face_normal(m, m.triangles[0]).z(), 0.0f);
+  EXPECT_GT(face_normal(m, m.triangles[1]).z(), 0.0f);
+}
+
+TEST(Gltf, GlbAndExternalBufferReadTheSameAsEmbedded) {
+  Gltf g;
+  g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}, {"indices", g.indices({0, 1, 2})}})}}, true);
+  const Mesh embedded = prt::bake::load_mesh(g.write("same.gltf"));
+  const Mesh glb = prt::bake::load_mesh(write_file("same.glb", g.glb()));
+  write_file("same_external.bin", g.bin);
+  json d = g.doc;
+  d["buffers"] = {{{"byteLength", g.bin.size()}, {"uri", "same_external.bin"}}};
+  const Mesh external = prt::bake::load_mesh(write_file("same_external.gltf", d.dump()));
+  for (const Mesh* m : {&glb, &external}) {
+    EXPECT_EQ(m->positions, embedded.positions);
+    EXPECT_EQ(m->triangles, embedded.triangles);
+  }
+}
+
+TEST(Gltf, PointAndLinePrimitivesAreSkippedWithACountedWarning) {
+  Gltf g;
+  const int points = g.vec3(kTriangle);
+  g.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", points}}}, {"mode", 0}},
+                                             {{"attributes", {{"POSITION", points}}}, {"mode", 3}},
+                                             {{"attributes", {{"POSITION", points}}}}}}});
+  g.node({{"mesh", 0}}, true);
+  const Mesh m = prt::bake::load_mesh(g.write("lines.gltf"));
+  EXPECT_EQ(m.triangles.size(), 1u);
+  EXPECT_EQ(m.positions.size(), 3u) << "skipped primitives give no rows";
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_NE(m.warnings[0].find("2 point or line primitive"), std::string::npos) << m.warnings[0];
+
+  Gltf only;
+  only.node({{"mesh", only.mesh({{"attributes", {{"POSITION", only.vec3(kTriangle)}}}, {"mode", 1}})}}, true);
+  expect_input_error(only.write("only_lines.gltf"), "no triangles");
+}
+
+TEST(Gltf, DefectsAreOneLineInputErrorsNamingFileAndDefect) {
+  const auto base = [] {
+    Gltf g;
+    g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}, {"indices", g.indices({0, 1, 2})}})}}, true);
+    return g;
+  };
+  {
+    Gltf g = base();
+    g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", 0}}}, {"indices", g.indices({0, 1, 3})}})}}, true);
+    expect_input_error(g.write("index_range.gltf"), "index 2 is 3, out of range [0, 3)");
+  }
+  {
+    Gltf g = base();
+    json d = g.doc;
+    d["buffers"] = {{{"byteLength", g.bin.size()}, {"uri", "no_such_file.bin"}}};
+    expect_input_error(write_file("missing_bin.gltf", d.dump()), "no_such_file.bin");
+    d["buffers"] = {{{"byteLength", g.bin.size() + 4}, {"uri", "data:application/octet-stream;base64," + base64(g.bin)}}};
+    expect_input_error(write_file("short_buffer.gltf", d.dump()), "not a valid glTF");
+    g.doc["bufferViews"][0]["byteLength"] = 1000;
+    expect_input_error(g.write("view_past_buffer.gltf"), "lies past the end of buffer 0");
+  }
+  {
+    Gltf g = base();
+    g.doc["accessors"][0]["byteOffset"] = 4;
+    expect_input_error(g.write("accessor_past_view.gltf"), "lies past the end of buffer view 0");
+  }
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    Gltf g;
+    g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3({{0, 0, 0}, {1, bad, 0}, {0, 1, 0}})}}}})}}, true);
+    expect_input_error(g.write("non_finite.gltf"), "POSITION 1 is not finite");
+  }
+  {
+    Gltf g = base();
+    g.doc["nodes"][0]["children"] = {0};
+    expect_input_error(g.write("self_child.gltf"), "recursive node graph: node 0");
+    g.node({{"children", {0}}}, false);
+    g.doc["nodes"][0]["children"] = {1};
+    expect_input_error(g.write("cycle.gltf"), "recursive node graph");
+    g.doc["nodes"][0]["children"] = json::array();
+    g.doc["scenes"][0]["nodes"] = {1};
+    g.doc["nodes"].push_back({{"children", {0}}});
+    g.doc["nodes"][1]["children"] = {0, 2};
+    expect_input_error(g.write("two_parents.gltf"), "node 0 is reached twice");
+  }
+  {
+    Gltf g = base();
+    g.doc.erase("scenes");
+    g.doc.erase("scene");
+    expect_input_error(g.write("no_scene.gltf"), "no scene");
+    Gltf h = base();
+    h.doc["scene"] = 3;
+    expect_input_error(h.write("bad_default_scene.gltf"), "scene 3 does not exist");
+  }
+  {
+    Gltf g = base();
+    g.doc["accessors"][1]["componentType"] = 5126;  // FLOAT indices
+    expect_input_error(g.write("float_indices.gltf"), "indices (accessor 1) has unsupported componentType 5126");
+    Gltf h = base();
+    h.doc["accessors"][0]["componentType"] = 5123;  // UNSIGNED_SHORT positions
+    expect_input_error(h.write("short_positions.gltf"), "POSITION (accessor 0) has unsupported componentType 5123");
+    Gltf v = base();
+    v.doc["accessors"][0]["type"] = "VEC2";
+    expect_input_error(v.write("vec2_positions.gltf"), "POSITION (accessor 0) is not VEC3");
+  }
+  {
+    Gltf g = base();
+    g.doc["nodes"][0]["mesh"] = 9;
+    expect_input_error(g.write("no_mesh.gltf"), "refers to mesh 9");
+    expect_input_error(write_file("garbage.gltf", "{\"asset\": "), "not a valid glTF");
+    expect_input_error(write_file("garbage.glb", std::string("glTF\x02\0\0\0garbage", 15)), "not a valid glTF");
+  }
+}
+
+// Debian's assimp-testmodels: the public glTF2 test files, good and broken.
+const fs::path kAssimpGltf2 = "/usr/share/assimp/models/glTF2";
+
+TEST(Gltf, EveryAssimpTestFileLoadsOrIsRefusedCleanly) {
+  ASSERT_TRUE(fs::is_directory(kAssimpGltf2)) << kAssimpGltf2 << " is missing: install the Debian package assimp-testmodels (tools/run.sh does)";
+  size_t loaded = 0, refused = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(kAssimpGltf2)) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".gltf" && ext != ".glb")) continue;
+    SCOPED_TRACE(entry.path().string());
+    try {
+      const Mesh m = prt::bake::load_mesh(entry.path());
+      ASSERT_FALSE(m.triangles.empty());
+      for (const auto& p : m.positions) ASSERT_TRUE(p.allFinite());
+      ++loaded;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      EXPECT_NE(what.find(entry.path().string()), std::string::npos) << what;
+      std::printf("refused: %s\n", what.c_str());
+      ++refused;
+    }  // any other exception fails the test
+  }
+  std::printf("assimp-testmodels glTF2: %zu loaded, %zu refused\n", loaded, refused);
+  RecordProperty("loaded", static_cast<int>(loaded));
+  RecordProperty("refused", static_cast<int>(refused));
+  EXPECT_GT(loaded, 0u);
+}
+
+TEST(Gltf, AssetGeneratorTriangleModesGiveTheFrontFacingQuad) {
+  // glTF-Asset-Generator Mesh_PrimitiveMode: a unit quad facing +z (the generator's camera side)
+  // as a strip, a fan and triangles, non-indexed (04–06) and indexed (11–15, the last three with
+  // different index component types). 00–03 and 07–10 are points and lines (refused above).
+  const fs::path dir = kAssimpGltf2 / "glTF-Asset-Generator" / "Mesh_PrimitiveMode";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing: install the Debian package assimp-testmodels (tools/run.sh does)";
+  for (const char* n : {"04", "05", "06", "11", "12", "13", "14", "15"}) {
+    const fs::path path = dir / (std::string("Mesh_PrimitiveMode_") + n + ".gltf");
+    SCOPED_TRACE(path.filename().string());
+    const Mesh m = prt::bake::load_mesh(path);
+    ASSERT_EQ(m.triangles.size(), 2u);
+    float area = 0.0f;
+    for (const Tri& t : m.triangles) {
+      const Eigen::Vector3f fn = face_normal(m, t);
+      EXPECT_GT(fn.z(), 0.0f) << "front face +z";
+      EXPECT_EQ(fn.x(), 0.0f);
+      EXPECT_EQ(fn.y(), 0.0f);
+      area += 0.5f * fn.z();
+    }
+    EXPECT_FLOAT_EQ(area, 1.0f) << "the two triangles cover the unit quad";
+  }
+}
+
+TEST(Gltf, TwoCylinderEngineLoadsCompletely) {
+  const fs::path path = kAssimpGltf2 / "2CylinderEngine-glTF-Binary" / "2CylinderEngine.glb";
+  ASSERT_TRUE(fs::exists(path)) << path << " is missing: install the Debian package assimp-testmodels (tools/run.sh does)";
+  const Mesh m = prt::bake::load_mesh(path);
+  EXPECT_EQ(m.triangles.size(), 121496u);
+  EXPECT_EQ(m.normal_source, Mesh::NormalSource::File);
+}
+
+} // namespace
