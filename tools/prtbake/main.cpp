@@ -153,7 +153,7 @@ void add_run_options(CLI::App& cmd, Args& a) {
                "SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not\n"
                "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).\n"
                "The baked values are identical with or without it.");
-  cmd.add_flag("-q,--quiet", a.quiet, "print nothing but errors.");
+  cmd.add_flag("-q,--quiet", a.quiet, "print nothing but warnings (about the input) and errors.");
 }
 
 // --samples, --seed and --up: what samples the sphere around a shade point.
