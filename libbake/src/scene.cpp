@@ -236,10 +236,10 @@ std::filesystem::path resolve_beside(const std::filesystem::path& file, const st
   return (file.has_parent_path() ? file.parent_path() : std::filesystem::path(".")) / q;
 }
 
-// The file's `version_key` must be 1; `what` names the file's kind ("the scene").
-void check_version(const Reader& r, const Json& root, const char* version_key, const std::string& what) {
+// The file's `version_key` must be 1; `what` names the file ("the scene"), `kind` its kind ("scene-file").
+void check_version(const Reader& r, const Json& root, const char* version_key, const std::string& what, const std::string& kind) {
   const Json* version = find_key(root, version_key);
-  if (version == nullptr) r.fail(what + " lacks \"" + version_key + "\": 1 (the file's version)");
+  if (version == nullptr) r.fail(what + " lacks \"" + version_key + "\": 1 (the " + kind + " version)");
   const int64_t v = r.integer(*version, version_key, 1, 1000);
   if (v != 1) r.fail(std::string(version_key) + " version " + std::to_string(v) + " is newer than this prtbake reads (1)");
 }
@@ -334,7 +334,7 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
   r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
   SceneDescription sc;
   sc.file = file;
-  check_version(r, root, "prtbake_scene", "the scene");
+  check_version(r, root, "prtbake_scene", "the scene", "scene-file");
   parse_settings(r, root, file, sc);
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) r.fail("the scene lacks \"objects\" (an array of one or more objects)");
@@ -391,7 +391,7 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   const Json root = parse_json_file(*options);
   const Reader r(options->string());
   r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "objects"});
-  check_version(r, root, "prtbake_gltf_scene", "the scene options");
+  check_version(r, root, "prtbake_gltf_scene", "the scene options", "options-file");
   parse_settings(r, root, *options, sc);
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) return sc;

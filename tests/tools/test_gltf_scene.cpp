@@ -24,14 +24,13 @@ using prt::testing::json;
 
 namespace {
 
+// An empty scratch directory for one test.
 fs::path dir_for(const std::string& name) {
-  const fs::path d = fs::path(PRT_TEST_TMP) / "gltf_scene" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
+  fs::remove_all(fs::path(PRT_TEST_TMP) / "gltf_scene" / name);
+  return prt::testing::test_dir("gltf_scene/" + name);
 }
 
-void write_text(const fs::path& p, const std::string& s) { std::ofstream(p) << s; }
+void write_text(const fs::path& p, const std::string& s) { prt::testing::write_test_file(p.parent_path(), p.filename().string(), s); }
 
 using Points = std::vector<Eigen::Vector3f>;
 using Triangles = std::vector<uint16_t>;  // 3 per triangle
@@ -153,6 +152,8 @@ TEST(GltfScene, InstancesAreObjectsNamedByNodePathAndBakeAsTheSameJsonScene) {
     const std::vector<float>& want = ao_of(json_scene, json_names[i]);
     ASSERT_EQ(want.size(), rows[i]);
     EXPECT_EQ(o->set.ao->values, want) << "the same geometry in a JSON scene bakes to the same AO";
+    EXPECT_FALSE(o->set.transfer_diffuse) << "the options' bake.products hold only ao";
+    EXPECT_EQ(o->set.positions->values, json_scene.find_object(json_names[i])->set.positions->values) << "the same world positions";
   }
   // Materials: baseColorFactor as albedo; 0.8 grey without a material.
   EXPECT_EQ(gltf.find_object("stack|box#p1")->albedo, (std::vector<double>{0.25, 0.5, 1.0}));

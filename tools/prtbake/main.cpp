@@ -246,7 +246,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
   CLI::App& cmd = *app.add_subcommand("fiv", kFivHelp);
-  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL)")->required()->type_name("");
+  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL, glTF, GLB)")->required()->type_name("");
   add_output(cmd, a);
   cmd.add_option("--env", a.environment, "the HDR environment (OpenEXR lat-long or cube map)")
       ->option_text("ENV")
