@@ -151,7 +151,8 @@ constexpr Field<SceneObject> kObjectFields[] = {
     {N::kBaked, &SceneObject::baked},
     {N::kLeftOut, &SceneObject::left_out},
     {N::kSpecular, &SceneObject::specular},
-    {N::kClosedFormVertices, &SceneObject::closed_form_vertices}};
+    {N::kClosedFormVertices, &SceneObject::closed_form_vertices},
+    {N::kNodePath, &SceneObject::node_path}};
 
 // ---- paths -------------------------------------------------------------------------------
 

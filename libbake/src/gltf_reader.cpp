@@ -19,6 +19,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -181,8 +182,9 @@ class Reader {
     return m;
   }
 
-  // One instance of mesh `mesh_index` under world transform `world`, appended to `out`.
-  void add_mesh(size_t node, const Eigen::Matrix4d& world) {
+  // One instance of the node's mesh under world transform `world`, appended to `out_`; each
+  // primitive with triangles is recorded in `instances_` under the node path `path`.
+  void add_mesh(size_t node, const Eigen::Matrix4d& world, const std::string& path) {
     const int mesh_index = model_.nodes[node].mesh;
     if (static_cast<size_t>(mesh_index) >= model_.meshes.size())
       fail("node " + std::to_string(node) + " refers to mesh " + std::to_string(mesh_index) + ", which does not exist");
@@ -219,6 +221,8 @@ class Reader {
         all_have_normals_ = false;
       }
       const size_t base = out_.positions.size();
+      instances_.push_back({path + (p == 0 ? "" : "#p" + std::to_string(p)), path, prim.material, base, out_.normals.size(),
+                            normals.has_value(), out_.polygon_count(), 0});
       if (base + positions.count >= std::numeric_limits<uint32_t>::max()) fail("too many vertices for 32-bit indices");
       for (size_t i = 0; i < positions.count; ++i) {
         const Eigen::Vector3d local = vec3(positions, i);
@@ -266,10 +270,38 @@ class Reader {
         for (size_t i = 0; i + 2 < n; ++i) triangle(sequence[i + 1], sequence[i + 2], sequence[0]);
       }
       if (out_.corner_position.size() >= std::numeric_limits<uint32_t>::max()) fail("too many triangles for 32-bit indices");
+      instances_.back().polygon_end = out_.polygon_count();
     }
   }
 
-  Polygons read() {
+  // The path segments of `nodes` (siblings, in order): the node's name with '/', '#' and '|'
+  // replaced by '_', or "node<N>" when the name is empty, "." or ".."; a segment already taken by
+  // an earlier sibling gets the first free "~2", "~3", ... (bake/mesh.h "glTF scenes").
+  std::vector<std::string> segments(const std::vector<int>& nodes) const {
+    std::vector<std::string> out;
+    for (int n : nodes) {
+      const std::string* name = n >= 0 && static_cast<size_t>(n) < model_.nodes.size() ? &model_.nodes[static_cast<size_t>(n)].name : nullptr;
+      std::string seg = name ? *name : std::string();
+      for (char& c : seg)
+        if (c == '/' || c == '#' || c == '|') c = '_';
+      if (seg.empty() || seg == "." || seg == "..") seg = "node" + std::to_string(n);
+      out.push_back(std::move(seg));
+    }
+    const std::set<std::string> raw(out.begin(), out.end());
+    std::set<std::string> taken;
+    for (std::string& seg : out) {
+      if (!taken.insert(seg).second) {
+        std::string candidate;
+        for (int k = 2; candidate.empty() || raw.count(candidate) || taken.count(candidate); ++k) candidate = seg + "~" + std::to_string(k);
+        seg = candidate;
+        taken.insert(seg);
+      }
+    }
+    return out;
+  }
+
+  // Walks the default scene into out_ and instances_ and adds the file's warnings.
+  void walk() {
     for (const std::string& ext : model_.extensionsRequired)
       if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" || ext == "KHR_mesh_quantization")
         fail("requires extension " + shown(ext) + ", which is not supported");
@@ -281,16 +313,20 @@ class Reader {
     // disjoint strict trees (glTF 2.0 specification, "Nodes and Hierarchy"): a node reached twice is refused, so the walk is linear.
     enum class State : uint8_t { Unseen, OnPath, Done };
     std::vector<State> state(model_.nodes.size(), State::Unseen);
-    struct Entry { size_t node; Eigen::Matrix4d parent; bool leave; };
+    struct Entry { size_t node; Eigen::Matrix4d parent; bool leave; std::string path; };
     std::vector<Entry> stack;
-    auto push_node = [&](int n, const Eigen::Matrix4d& parent, const std::string& where) {
-      if (n < 0 || static_cast<size_t>(n) >= model_.nodes.size())
-        fail(where + " refers to node " + std::to_string(n) + ", which does not exist (" + std::to_string(model_.nodes.size()) + " nodes)");
-      stack.push_back({static_cast<size_t>(n), parent, false});
+    // Pushes `nodes` (children of `where`, whose path is `parent_path`) so that the first is walked first.
+    auto push_nodes = [&](const std::vector<int>& nodes, const Eigen::Matrix4d& parent, const std::string& where, const std::string& parent_path) {
+      const std::vector<std::string> names = segments(nodes);
+      for (size_t i = nodes.size(); i-- > 0;) {
+        const int n = nodes[i];
+        if (n < 0 || static_cast<size_t>(n) >= model_.nodes.size())
+          fail(where + " refers to node " + std::to_string(n) + ", which does not exist (" + std::to_string(model_.nodes.size()) + " nodes)");
+        stack.push_back({static_cast<size_t>(n), parent, false, parent_path.empty() ? names[i] : parent_path + "/" + names[i]});
+      }
     };
     const tinygltf::Scene& scene = model_.scenes[static_cast<size_t>(scene_index)];
-    for (auto it = scene.nodes.rbegin(); it != scene.nodes.rend(); ++it)
-      push_node(*it, Eigen::Matrix4d::Identity(), "scene " + std::to_string(scene_index));
+    push_nodes(scene.nodes, Eigen::Matrix4d::Identity(), "scene " + std::to_string(scene_index), "");
     while (!stack.empty()) {
       const Entry entry = stack.back();
       stack.pop_back();
@@ -306,10 +342,10 @@ class Reader {
       const Eigen::Matrix4d world = entry.parent * local_transform(entry.node);
       if (node.mesh >= 0) {
         if (node.skin >= 0) ++skinned_instances_;
-        add_mesh(entry.node, world);
+        add_mesh(entry.node, world, entry.path);
       }
-      stack.push_back({entry.node, world, true});
-      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) push_node(*it, world, name);
+      stack.push_back({entry.node, world, true, {}});
+      push_nodes(node.children, world, name, entry.path);
     }
     if (out_.polygon_count() == 0 && skipped_primitives_ > 0)
       fail("no triangles: only " + std::to_string(skipped_primitives_) + " point or line primitive instance(s), nothing to bake");
@@ -320,22 +356,80 @@ class Reader {
       file_.warnings.push_back(file_.name + ": skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
                                " skinned mesh instance(s), " + std::to_string(morphed_primitives_) +
                                " primitive instance(s) with morph targets): the rest pose is baked");
+  }
+
+  Polygons read() {
+    walk();
     if (all_have_normals_ && !out_.normals.empty()) out_.corner_normal = out_.corner_position;
     else out_.normals.clear();
     return std::move(out_);
   }
 
+  std::vector<GltfInstance> read_instances() {
+    walk();
+    std::vector<GltfInstance> result;
+    size_t empty = 0;
+    for (const Instance& in : instances_) {
+      if (in.polygon_end == in.polygon_begin) {
+        ++empty;
+        continue;
+      }
+      GltfInstance& out = result.emplace_back();
+      out.name = in.name;
+      out.node_path = in.node_path;
+      if (in.material >= 0) {
+        if (static_cast<size_t>(in.material) >= model_.materials.size())
+          fail("node " + out.node_path + " refers to material " + std::to_string(in.material) + ", which does not exist (" +
+               std::to_string(model_.materials.size()) + " materials)");
+        const std::vector<double>& f = model_.materials[static_cast<size_t>(in.material)].pbrMetallicRoughness.baseColorFactor;
+        if (f.size() < 3) fail("material " + std::to_string(in.material) + ": baseColorFactor has " + std::to_string(f.size()) + " numbers, needs 4");
+        out.base_color = std::array<double, 3>{f[0], f[1], f[2]};
+      }
+      // The instance's rows, normals and polygons, re-based to its own first row.
+      const size_t first = out_.offsets[in.polygon_begin], last = out_.offsets[in.polygon_end];
+      const auto base = static_cast<uint32_t>(in.position_begin);
+      const size_t rows = next_position_begin(in) - in.position_begin;
+      Polygons& p = out.polygons;
+      p.positions.assign(out_.positions.begin() + std::ptrdiff_t(in.position_begin), out_.positions.begin() + std::ptrdiff_t(in.position_begin + rows));
+      p.corner_position.assign(out_.corner_position.begin() + std::ptrdiff_t(first), out_.corner_position.begin() + std::ptrdiff_t(last));
+      for (uint32_t& c : p.corner_position) c -= base;
+      for (size_t f = in.polygon_begin; f < in.polygon_end; ++f) p.offsets.push_back(out_.offsets[f + 1] - static_cast<uint32_t>(first));
+      if (in.has_normals) {
+        p.normals.assign(out_.normals.begin() + std::ptrdiff_t(in.normal_begin), out_.normals.begin() + std::ptrdiff_t(in.normal_begin + rows));
+        p.corner_normal = p.corner_position;
+      }
+    }
+    if (empty > 0)
+      file_.warnings.push_back(file_.name + ": " + std::to_string(empty) + " triangle primitive instance(s) without a triangle skipped");
+    if (result.empty()) fail("no triangles: no primitive instance has a triangle, nothing to bake");
+    return result;
+  }
+
  private:
+  // A primitive instance of the walk: its name, and where its rows, normals and polygons are in out_.
+  struct Instance {
+    std::string name, node_path;
+    int material;
+    size_t position_begin, normal_begin;
+    bool has_normals;
+    size_t polygon_begin, polygon_end;
+  };
+  // The first row after `in`'s: the next instance's first row, or the end.
+  size_t next_position_begin(const Instance& in) const {
+    const size_t i = static_cast<size_t>(&in - instances_.data());
+    return i + 1 < instances_.size() ? instances_[i + 1].position_begin : out_.positions.size();
+  }
+
   const tinygltf::Model& model_;
   const SourceFile& file_;
   Polygons out_;
+  std::vector<Instance> instances_;
   bool all_have_normals_ = true;
   size_t skipped_primitives_ = 0, skinned_instances_ = 0, morphed_primitives_ = 0;
 };
 
-} // namespace
-
-Polygons read_gltf(std::string_view bytes, const SourceFile& file) {
+// tinygltf's parse of the whole file (buffers resolved, images not decoded).
+tinygltf::Model parse(std::string_view bytes, const SourceFile& file) {
   if (bytes.size() >= std::numeric_limits<unsigned int>::max()) throw InputError(file.name, "too large for the glTF parser");
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_nothing, read_buffer_file, write_nothing, nullptr});
@@ -349,7 +443,17 @@ Polygons read_gltf(std::string_view bytes, const SourceFile& file) {
                          : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
   // tinygltf's warnings concern images and unknown properties, none of which a bake uses.
   if (!ok) throw InputError(file.name, err.empty() ? std::string("is not a valid glTF file") : "not a valid glTF: " + one_line(err));
-  return Reader(model, file).read();
+  return model;
+}
+
+} // namespace
+
+Polygons read_gltf(std::string_view bytes, const SourceFile& file) {
+  return Reader(parse(bytes, file), file).read();
+}
+
+std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file) {
+  return Reader(parse(bytes, file), file).read_instances();
 }
 
 } // namespace prt::bake::mesh_readers

@@ -10,8 +10,22 @@
 
 #include "mesh_readers.h"
 
+#include <array>
+#include <optional>
+
 namespace prt::bake::mesh_readers {
 
+// All primitive instances of the default scene, concatenated (load_mesh, `prtbake vertex`).
 Polygons read_gltf(std::string_view bytes, const SourceFile& file);
+
+// The same walk, each primitive instance that has triangles kept apart (load_mesh_instances,
+// glTF scenes): its name (the rule in bake/mesh.h "glTF scenes"), its base colour, and its own
+// Polygons in world space with its own rows and normals.
+struct GltfInstance {
+  std::string name, node_path;
+  std::optional<std::array<double, 3>> base_color;  // the material's baseColorFactor RGB; none without a material
+  Polygons polygons;
+};
+std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file);
 
 } // namespace prt::bake::mesh_readers

@@ -247,4 +247,28 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
   return mesh;
 }
 
+MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshLoadOptions& options) {
+  const std::string file = path.string();
+  require_file(path, file);
+  const std::string ext = mesh_readers::lowercase(path.extension().string());
+  if (ext != ".gltf" && ext != ".glb") throw InputError(file, "not a glTF file (.gltf or .glb): it has no instances");
+  const std::string bytes = read_whole_file(path, file);
+  MeshInstances result;
+  std::vector<mesh_readers::GltfInstance> instances = mesh_readers::read_gltf_instances(bytes, {path, file, result.warnings});
+  result.source_sha256 = sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
+  for (mesh_readers::GltfInstance& in : instances) {
+    MeshInstance& out = result.instances.emplace_back();
+    try {
+      out.mesh = build_mesh(in.polygons, file, options);
+    } catch (const InputError& e) {
+      throw InputError(file, "node " + in.name + ": " + e.defect());
+    }
+    out.mesh.source_sha256 = result.source_sha256;
+    out.name = std::move(in.name);
+    out.node_path = std::move(in.node_path);
+    out.base_color = in.base_color;
+  }
+  return result;
+}
+
 } // namespace prt::bake

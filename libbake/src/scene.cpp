@@ -220,6 +220,8 @@ Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::strin
   return M;
 }
 
+constexpr std::array<double, 3> kDefaultAlbedo{0.8, 0.8, 0.8};  // an object without a material
+
 bool valid_name(const std::string& n) {
   if (n.empty() || n.size() > 128) return false;
   for (char c : n)
@@ -227,30 +229,29 @@ bool valid_name(const std::string& n) {
   return n != "." && n != "..";
 }
 
-} // namespace
+// A path of the file `file` refers to: relative paths are relative to its directory.
+std::filesystem::path resolve_beside(const std::filesystem::path& file, const std::string& p) {
+  const std::filesystem::path q(p);
+  if (q.is_absolute()) return q;
+  return (file.has_parent_path() ? file.parent_path() : std::filesystem::path(".")) / q;
+}
 
-SceneDescription load_scene(const std::filesystem::path& file) {
-  const Json root = parse_json_file(file);
-  const Reader r(file.string());
-  r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
-  SceneDescription sc;
-  sc.file = file;
-  const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
-  auto resolve = [&](const std::string& p) {
-    const std::filesystem::path q(p);
-    return q.is_absolute() ? q : dir / q;
-  };
-  const Json* version = find_key(root, "prtbake_scene");
-  if (version == nullptr) r.fail("the scene lacks \"prtbake_scene\": 1 (the scene-file version)");
-  if (r.integer(*version, "prtbake_scene", 1, 1000) != 1)
-    r.fail("prtbake_scene version " + std::to_string(r.integer(*version, "prtbake_scene", 1, 1000)) +
-                         " is newer than this prtbake reads (1)");
+// The file's `version_key` must be 1; `what` names the file ("the scene"), `kind` its kind ("scene-file").
+void check_version(const Reader& r, const Json& root, const char* version_key, const std::string& what, const std::string& kind) {
+  const Json* version = find_key(root, version_key);
+  if (version == nullptr) r.fail(what + " lacks \"" + version_key + "\": 1 (the " + kind + " version)");
+  const int64_t v = r.integer(*version, version_key, 1, 1000);
+  if (v != 1) r.fail(std::string(version_key) + " version " + std::to_string(v) + " is newer than this prtbake reads (1)");
+}
+
+// "up", "environment" and "bake" of a scene file or a glTF scene's options (`file`).
+void parse_settings(const Reader& r, const Json& root, const std::filesystem::path& file, SceneDescription& sc) {
   if (const Json* up = find_key(root, "up")) {
     const std::string& u = r.string(*up, "up");
     if (u != "y" && u != "z") r.fail("up must be \"y\" or \"z\", not \"" + u + "\"");
     sc.up = u == "y" ? UpAxis::Y : UpAxis::Z;
   }
-  if (const Json* env = find_key(root, "environment")) sc.environment = resolve(r.string(*env, "environment"));
+  if (const Json* env = find_key(root, "environment")) sc.environment = resolve_beside(file, r.string(*env, "environment"));
   if (const Json* bake = find_key(root, "bake")) {
     r.object(*bake, "bake",
              {"products", "integrator", "samples", "seed", "report", "sh_tolerance", "relight", "fiv"});
@@ -300,6 +301,41 @@ SceneDescription load_scene(const std::filesystem::path& file) {
   // The FIV shells are always baked with the silhouette integrator: at the scene's k for a
   // silhouette scene, at the default k for a qmc one.
   sc.fiv.silhouette_k = sc.integrator.silhouette_k;
+}
+
+Role parse_role(const Reader& r, const Json& v, const std::string& key) {
+  const std::string& rs = r.string(v, key);
+  if (rs == "receiver") return Role::Receiver;
+  if (rs == "occluder") return Role::Occluder;
+  if (rs == "both") return Role::Both;
+  r.fail(key + " must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
+}
+
+// An object's "material" (`key`) for an object of role `role`.
+Material parse_material(const Reader& r, const Json& m, const std::string& key, Role role) {
+  r.object(m, key, {"albedo", "phong_exponent", "specular"});
+  Material material;
+  if (const Json* a = find_key(m, "albedo")) material.albedo = r.vec3(*a, key + ".albedo", 0, 1);
+  if (const Json* x = find_key(m, "phong_exponent")) material.phong_exponent = r.number(*x, key + ".phong_exponent", 0, 1e6);
+  if (const Json* x = find_key(m, "specular")) {
+    material.specular = r.vec3(*x, key + ".specular", 0, 1);
+    if (!material.glossy()) r.fail(key + ".specular needs phong_exponent > 0");
+  } else if (material.glossy()) {
+    material.specular = {1, 1, 1};
+  }
+  if (role != Role::Occluder && !material.diffuse() && !material.glossy())
+    r.fail(key + " has neither a diffuse albedo > 0 nor a phong_exponent > 0: the receiver reflects nothing");
+  return material;
+}
+
+SceneDescription load_json_scene(const std::filesystem::path& file) {
+  const Json root = parse_json_file(file);
+  const Reader r(file.string());
+  r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
+  SceneDescription sc;
+  sc.file = file;
+  check_version(r, root, "prtbake_scene", "the scene", "scene-file");
+  parse_settings(r, root, file, sc);
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) r.fail("the scene lacks \"objects\" (an array of one or more objects)");
   if (!objects->is_array() || objects->empty()) r.fail("objects must be a non-empty array");
@@ -312,7 +348,7 @@ SceneDescription load_scene(const std::filesystem::path& file) {
     const Json* mesh = find_key(o, "mesh");
     if (mesh == nullptr) r.fail(key + " lacks \"mesh\" (the mesh file)");
     const std::string& mesh_path = r.string(*mesh, key + ".mesh");
-    obj.mesh = resolve(mesh_path);
+    obj.mesh = resolve_beside(file, mesh_path);
     if (const Json* n = find_key(o, "name")) {
       obj.name = r.string(*n, key + ".name");
       if (!valid_name(obj.name))
@@ -327,32 +363,115 @@ SceneDescription load_scene(const std::filesystem::path& file) {
       r.fail(key + ": the name \"" + obj.name + "\" is already used by another object (names must be unique; set \"name\")");
     const Json* role = find_key(o, "role");
     if (role == nullptr) r.fail(key + " lacks \"role\": \"receiver\", \"occluder\" or \"both\"");
-    const std::string& rs = r.string(*role, key + ".role");
-    if (rs == "receiver") obj.role = Role::Receiver;
-    else if (rs == "occluder") obj.role = Role::Occluder;
-    else if (rs == "both") obj.role = Role::Both;
-    else r.fail(key + ".role must be \"receiver\", \"occluder\" or \"both\", not \"" + rs + "\"");
+    obj.role = parse_role(r, *role, key + ".role");
     if (const Json* t = find_key(o, "transform")) obj.world_from_object = parse_transform(r, *t, key + ".transform");
-    obj.material.albedo = {0.8, 0.8, 0.8};
-    if (const Json* m = find_key(o, "material")) {
-      r.object(*m, key + ".material", {"albedo", "phong_exponent", "specular"});
-      obj.material.albedo = {0, 0, 0};
-      if (const Json* a = find_key(*m, "albedo")) obj.material.albedo = r.vec3(*a, key + ".material.albedo", 0, 1);
-      if (const Json* s = find_key(*m, "phong_exponent"))
-        obj.material.phong_exponent = r.number(*s, key + ".material.phong_exponent", 0, 1e6);
-      if (const Json* s = find_key(*m, "specular")) {
-        obj.material.specular = r.vec3(*s, key + ".material.specular", 0, 1);
-        if (!obj.material.glossy()) r.fail(key + ".material.specular needs phong_exponent > 0");
-      } else if (obj.material.glossy()) {
-        obj.material.specular = {1, 1, 1};
-      }
-      if (obj.role != Role::Occluder && !obj.material.diffuse() && !obj.material.glossy())
-        r.fail(key + ".material has neither a diffuse albedo > 0 nor a phong_exponent > 0: the receiver reflects "
-                         "nothing");
-    }
+    obj.material.albedo = kDefaultAlbedo;
+    if (const Json* m = find_key(o, "material")) obj.material = parse_material(r, *m, key + ".material", obj.role);
     sc.objects.push_back(std::move(obj));
   }
   return sc;
+}
+
+// A glTF scene (bake/scene.h "glTF scenes"): one object per instance, then the options file.
+SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& options) {
+  SceneDescription sc;
+  sc.file = file;
+  sc.options = options;
+  for (const MeshInstance& in : load_mesh_instances(file).instances) {
+    SceneObject& obj = sc.objects.emplace_back();
+    obj.name = in.name;
+    std::replace(obj.name.begin(), obj.name.end(), '/', '|');
+    obj.node_path = in.name;
+    obj.mesh = file;
+    obj.material.albedo = kDefaultAlbedo;
+    if (in.base_color)
+      for (size_t c = 0; c < 3; ++c) obj.material.albedo[c] = std::clamp((*in.base_color)[c], 0.0, 1.0);
+  }
+  if (!options) return sc;
+  const Json root = parse_json_file(*options);
+  const Reader r(options->string());
+  r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "objects"});
+  check_version(r, root, "prtbake_gltf_scene", "the scene options", "options-file");
+  parse_settings(r, root, *options, sc);
+  const Json* objects = find_key(root, "objects");
+  if (objects == nullptr) return sc;
+  if (!objects->is_object()) r.fail(std::string("objects must be an object {\"<node path>\": {\"role\": ..., \"material\": ...}}, not ") + objects->type_name());
+  // Each entry applies to the instances it names (its own name, or a node path above it); for
+  // each field the most specific (longest) entry that sets it wins.
+  struct Entry {
+    std::string key;
+    std::optional<Role> role;
+    std::optional<Material> material;
+    bool used = false;
+  };
+  std::vector<Entry> entries;
+  for (const auto& [key, value] : objects->items()) {
+    const std::string path = "objects.\"" + key + "\"";
+    r.object(value, path, {"role", "material"});
+    Entry& e = entries.emplace_back();
+    e.key = key;
+    if (const Json* role = find_key(value, "role")) e.role = parse_role(r, *role, path + ".role");
+    if (const Json* m = find_key(value, "material")) e.material = parse_material(r, *m, path + ".material", e.role.value_or(Role::Both));
+  }
+  auto names = [](const std::string& instance, const std::string& key) {
+    return instance.starts_with(key) && (instance.size() == key.size() || instance[key.size()] == '/' || instance[key.size()] == '#');
+  };
+  for (SceneObject& obj : sc.objects) {
+    const Entry* role = nullptr;
+    const Entry* material = nullptr;
+    for (Entry& e : entries) {
+      if (!names(obj.node_path, e.key)) continue;
+      e.used = true;
+      if (e.role && (!role || e.key.size() > role->key.size())) role = &e;
+      if (e.material && (!material || e.key.size() > material->key.size())) material = &e;
+    }
+    if (role) obj.role = *role->role;
+    if (material) obj.material = *material->material;
+  }
+  std::string unknown;
+  for (const Entry& e : entries)
+    if (!e.used) unknown += (unknown.empty() ? "\"" : ", \"") + e.key + "\"";
+  if (!unknown.empty())
+    r.fail("objects: " + unknown + " names no node of " + file.string() + " (keys are node paths or instance names as prtdump shows them, e.g. \"" +
+           sc.objects.front().node_path + "\")");
+  return sc;
+}
+
+bool is_gltf(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".gltf" || ext == ".glb";
+}
+
+} // namespace
+
+SceneDescription load_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& gltf_options) {
+  if (is_gltf(file)) return load_gltf_scene(file, gltf_options);
+  if (gltf_options)
+    throw InputError(gltf_options->string(), "scene options apply to a glTF scene only; " + file.string() + " is a JSON scene file");
+  return load_json_scene(file);
+}
+
+std::vector<Mesh> load_scene_meshes(const SceneDescription& scene, std::vector<std::string>& warnings) {
+  std::vector<Mesh> meshes;
+  if (is_gltf(scene.file)) {
+    MeshInstances file = load_mesh_instances(scene.file);
+    if (file.instances.size() != scene.objects.size())
+      throw InputError(scene.file.string(), "has changed since it was read: " + std::to_string(file.instances.size()) +
+                                                " instances, was " + std::to_string(scene.objects.size()));
+    warnings.insert(warnings.end(), file.warnings.begin(), file.warnings.end());
+    for (MeshInstance& in : file.instances) meshes.push_back(std::move(in.mesh));
+    return meshes;
+  }
+  for (const SceneObject& o : scene.objects) {
+    try {
+      meshes.push_back(load_scene_mesh(o));
+    } catch (const InputError& e) {  // say which object of which scene wanted the mesh
+      throw InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + scene.file.string() + ")");
+    }
+    warnings.insert(warnings.end(), meshes.back().warnings.begin(), meshes.back().warnings.end());
+  }
+  return meshes;
 }
 
 Mesh load_scene_mesh(const SceneObject& object) {

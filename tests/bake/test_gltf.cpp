@@ -5,6 +5,7 @@
 #include <bake/error.h>
 #include <bake/mesh.h>
 
+#include <gltf_builder.h>
 #include <mesh_files.h>
 
 #include <Eigen/Geometry>
@@ -21,6 +22,8 @@
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using prt::testing::Gltf;
+using prt::testing::base64;
 using prt::bake::InputError;
 using prt::bake::Mesh;
 using Tri = std::array<uint32_t, 3>;
@@ -36,83 +39,6 @@ constexpr double kNormalTolerance = 1e-6;
 
 fs::path tmp_dir() { return prt::testing::test_dir("gltf"); }
 fs::path write_file(const std::string& name, const std::string& bytes) { return prt::testing::write_test_file(tmp_dir(), name, bytes); }
-
-std::string base64(const std::string& bytes) {
-  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t v = static_cast<uint8_t>(bytes[i]) << 16;
-    if (i + 1 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 2]);
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[v & 63] : '=';
-  }
-  return out;
-}
-
-// A glTF under construction: one binary buffer, one buffer view per accessor.
-struct Gltf {
-  json doc = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", json::array()}}}},
-              {"nodes", json::array()}, {"meshes", json::array()}, {"accessors", json::array()},
-              {"bufferViews", json::array()}, {"buffers", json::array()}};
-  std::string bin;
-
-  template <class T>
-  int accessor(const std::vector<T>& values, int component_type, const char* type, size_t count) {
-    while (bin.size() % 4) bin += '\0';
-    const size_t offset = bin.size();
-    bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
-    doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component_type}, {"type", type}, {"count", count}});
-    return static_cast<int>(doc["accessors"].size() - 1);
-  }
-  int vec3(const std::vector<Eigen::Vector3f>& v) {
-    std::vector<float> flat;
-    for (const auto& p : v) flat.insert(flat.end(), {p.x(), p.y(), p.z()});
-    return accessor(flat, 5126, "VEC3", v.size());
-  }
-  int indices(const std::vector<uint16_t>& i) { return accessor(i, 5123, "SCALAR", i.size()); }
-  // A mesh of one primitive; returns its index.
-  int mesh(json primitive) {
-    doc["meshes"].push_back({{"primitives", {std::move(primitive)}}});
-    return static_cast<int>(doc["meshes"].size() - 1);
-  }
-  int node(json n, bool root) {
-    doc["nodes"].push_back(std::move(n));
-    const int index = static_cast<int>(doc["nodes"].size() - 1);
-    if (root) doc["scenes"][0]["nodes"].push_back(index);
-    return index;
-  }
-  // The document with the buffer embedded as a data URI.
-  std::string embedded() const {
-    json d = doc;
-    d["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
-    return d.dump();
-  }
-  fs::path write(const std::string& name) const { return write_file(name, embedded()); }
-  // A .glb: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded).
-  std::string glb() const {
-    json d = doc;
-    d["buffers"] = {{{"byteLength", bin.size()}}};
-    std::string j = d.dump(), b = bin;
-    while (j.size() % 4) j += ' ';
-    while (b.size() % 4) b += '\0';
-    std::string out;
-    auto u32 = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
-    out += "glTF";
-    u32(2);
-    u32(static_cast<uint32_t>(12 + 8 + j.size() + 8 + b.size()));
-    u32(static_cast<uint32_t>(j.size()));
-    out += "JSON";
-    out += j;
-    u32(static_cast<uint32_t>(b.size()));
-    out += std::string("BIN\0", 4);
-    out += b;
-    return out;
-  }
-};
 
 using prt::testing::expect_input_error;
 
@@ -352,6 +278,36 @@ TEST(Gltf, AssetGeneratorTriangleModesGiveTheFrontFacingQuad) {
     }
     EXPECT_FLOAT_EQ(area, 1.0f) << "the two triangles cover the unit quad";
   }
+}
+
+TEST(Gltf, InstancesAreNamedByNodePathAndConcatenateToLoadMesh) {
+  Gltf g;
+  const int one = g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}});
+  g.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", g.vec3(kTriangle)}, {"NORMAL", g.vec3(kTriangleNormals)}}}},
+                                             {{"attributes", {{"POSITION", g.vec3(kTriangle)}}}}}}});
+  const int two = static_cast<int>(g.doc["meshes"].size() - 1);
+  // Children of "root": "a/b" ('/' is not a separator inside a name), two "wheel"s and a literal
+  // "wheel~2" (the repeat takes the first free suffix), an unnamed node with a two-primitive mesh.
+  const int ab = g.node({{"name", "a/b"}, {"mesh", one}}, false);
+  const int w1 = g.node({{"name", "wheel"}, {"mesh", one}, {"translation", {1.0, 0.0, 0.0}}}, false);
+  const int w2 = g.node({{"name", "wheel"}, {"mesh", one}, {"translation", {2.0, 0.0, 0.0}}}, false);
+  const int w3 = g.node({{"name", "wheel~2"}, {"mesh", one}}, false);
+  const int unnamed = g.node({{"mesh", two}}, false);
+  g.node({{"name", "root"}, {"children", {ab, w1, w2, w3, unnamed}}}, true);
+  const fs::path path = g.write("named.gltf");
+  const prt::bake::MeshInstances m = prt::bake::load_mesh_instances(path);
+  std::vector<std::string> names;
+  for (const auto& in : m.instances) names.push_back(in.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"root/a_b", "root/wheel", "root/wheel~3", "root/wheel~2", "root/node4", "root/node4#p1"}));
+  EXPECT_EQ(m.instances[4].mesh.normal_source, Mesh::NormalSource::File) << "an instance keeps its own primitive's normals";
+  EXPECT_EQ(m.instances[5].mesh.normal_source, Mesh::NormalSource::AngleWeighted);
+  EXPECT_EQ(m.instances[2].mesh.positions[1], Eigen::Vector3f(3, 0, 0)) << "world space";
+  // load_mesh's rows are the instances' rows, in the same order (the same walk).
+  const Mesh all = prt::bake::load_mesh(path);
+  std::vector<Eigen::Vector3f> rows;
+  for (const auto& in : m.instances) rows.insert(rows.end(), in.mesh.positions.begin(), in.mesh.positions.end());
+  EXPECT_EQ(all.positions, rows);
+  EXPECT_EQ(m.source_sha256, all.source_sha256);
 }
 
 TEST(Gltf, TwoCylinderEngineLoadsCompletely) {

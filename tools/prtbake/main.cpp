@@ -42,8 +42,9 @@ constexpr const char* kVersion = "0.1.0";
 constexpr const char* kDescription = "prtbake — bake precomputed radiance transfer (PRT) data for game geometry";
 
 constexpr const char* kVertexHelp =
-    "Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL) in one pass: the\n"
-    "rays cast from a vertex serve every product at once. Rows follow the file's vertex order;\n"
+    "Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL, glTF, GLB) in one\n"
+    "pass: the rays cast from a vertex serve every product at once. Rows follow the file's vertex\n"
+    "order (glTF: the vertices of each primitive instance of the default scene, in node order);\n"
     "a position with several normals in the file (OBJ v//vn hard edges) gives one row per\n"
     "(position, normal) pair, and /mesh/source_position says which file vertex each row is.\n"
     "Give at least one of the products.";
@@ -66,7 +67,11 @@ constexpr const char* kSceneHelp =
     "no radiance or FIV without an environment; FIV shells only for occluders that can shadow\n"
     "another receiver; vertices that see no contour edge get closed forms. Products, integrator,\n"
     "samples, seed and FIV shells are set in the file's \"bake\" section. Per-object results go\n"
-    "under /objects/<name>/ in the file.";
+    "under /objects/<name>/ in the file.\n"
+    "A glTF (.gltf, .glb) is a scene too: each primitive instance of its default scene is an\n"
+    "object named by its node path (\"root/engine/piston_2\", \"#p1\" for a mesh's 2nd primitive;\n"
+    "stored as /objects/root|engine|piston_2 with the path in node_path), role \"both\", albedo\n"
+    "the material's baseColorFactor (0.8 grey without one). --options sets the rest.";
 
 constexpr const char* kExamples =
     "EXAMPLES\n"
@@ -74,13 +79,15 @@ constexpr const char* kExamples =
     "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
     "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
     "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
 using tool::UsageError;
 
 struct Args {
   std::string command;      // vertex, fiv or scene
-  std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file (scene)
+  std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file or glTF (scene)
+  std::string scene_options;  // scene: a glTF scene's options file (--options)
   std::string output;       // the .prt.h5 file
   std::string environment;  // vertex: --radiance ENV; fiv: --env ENV
   bool ao = false;
@@ -183,7 +190,7 @@ std::string silhouette_k_help() {
 
 void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
   CLI::App& cmd = *app.add_subcommand("vertex", kVertexHelp);
-  cmd.add_option("MESH", a.input, "the mesh (OBJ, PLY, OFF, STL)")->required()->type_name("");
+  cmd.add_option("MESH", a.input, "the mesh (OBJ, PLY, OFF, STL, glTF, GLB; a glTF's primitive\ninstances are concatenated in node order)")->required()->type_name("");
   add_output(cmd, a);
   const std::string products = "Products (at least one)";
   cmd.add_flag("--ao", a.ao, "ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]")->group(products);
@@ -239,7 +246,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
   CLI::App& cmd = *app.add_subcommand("fiv", kFivHelp);
-  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL)")->required()->type_name("");
+  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL, glTF, GLB)")->required()->type_name("");
   add_output(cmd, a);
   cmd.add_option("--env", a.environment, "the HDR environment (OpenEXR lat-long or cube map)")
       ->option_text("ENV")
@@ -274,8 +281,14 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
 
 void add_scene(CLI::App& app, Args& a) {
   CLI::App& cmd = *app.add_subcommand("scene", kSceneHelp);
-  cmd.add_option("SCENE", a.input, "the scene file (JSON)")->required()->type_name("");
+  cmd.add_option("SCENE", a.input, "the scene file (JSON), or a glTF (.gltf, .glb)")->required()->type_name("");
   add_output(cmd, a);
+  cmd.add_option("--options", a.scene_options,
+                 "glTF scenes only: a JSON file {\"prtbake_gltf_scene\": 1, \"up\", \"environment\",\n"
+                 "\"bake\" (as in a scene file), \"objects\": {\"<node path>\": {\"role\": ...,\n"
+                 "\"material\": {...}}}}; a node path covers the nodes below it, the longest\n"
+                 "match wins, a path that names no node is an error (README \"Scene files\").")
+      ->option_text("FILE");
   cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
   add_report(cmd, a, "overrides the scene file's bake.report");
   add_run_options(cmd, a);
@@ -590,22 +603,15 @@ int run_scene(const Args& a) {
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  bake::SceneDescription scene = bake::load_scene(a.input);
+  bake::SceneDescription scene = bake::load_scene(
+      a.input, a.scene_options.empty() ? std::nullopt : std::optional<fs::path>(a.scene_options));
   if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
 
-  std::vector<bake::Mesh> meshes;
-  std::vector<std::string> mesh_sha;
-  for (const auto& o : scene.objects) {
-    try {
-      meshes.push_back(bake::load_scene_mesh(o));
-    } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
-      throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.input + ")");
-    }
-    mesh_sha.push_back(meshes.back().source_sha256);
-    print_warnings(meshes.back().warnings);
-  }
+  std::vector<std::string> warnings;
+  const std::vector<bake::Mesh> meshes = bake::load_scene_meshes(scene, warnings);
+  print_warnings(warnings);
   std::optional<bake::EnvMap> env;
   if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
   const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
@@ -617,8 +623,8 @@ int run_scene(const Args& a) {
                 scene.sh_tolerance);
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const auto& o = scene.objects[i];
-      std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n", o.name.c_str(), bake::role_name(o.role),
-                  o.mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size());
+      std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n", (o.node_path.empty() ? o.name : o.node_path).c_str(),
+                  bake::role_name(o.role), o.mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size());
       for (const auto& b : plan.objects[i].baked) std::printf("      bake       %s\n", b.c_str());
       for (const auto& l : plan.objects[i].left_out) std::printf("      leave out  %s\n", l.c_str());
     }
@@ -668,7 +674,8 @@ int run_scene(const Args& a) {
     obj.name = o.name;
     obj.role = bake::role_name(o.role);
     obj.mesh = o.mesh.string();
-    obj.mesh_sha256 = mesh_sha[i];
+    obj.mesh_sha256 = meshes[i].source_sha256;
+    if (!o.node_path.empty()) obj.node_path = o.node_path;
     obj.transform.emplace(16);
     for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
     obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());

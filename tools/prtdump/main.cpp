@@ -251,7 +251,8 @@ void scene_text(std::ostream& os, const pf::Asset& a) {
   if (a.objects.empty()) return;
   os << "\nScene (objects, what was baked and what was left out)\n";
   for (const pf::SceneObject& o : a.objects) {
-    os << "  " << o.name << " (" << o.role.value_or("?") << ")\n";
+    // A glTF scene's object by its node path (its name is the path with '/' as '|').
+    os << "  " << o.node_path.value_or(o.name) << " (" << o.role.value_or("?") << (o.node_path ? "; /objects/" + o.name : "") << ")\n";
     for (const auto& [lines, label] : {std::pair{&o.baked, "baked      "}, std::pair{&o.left_out, "left out   "}}) {
       if (!*lines || **lines == "-") continue;
       const std::string& text = **lines;

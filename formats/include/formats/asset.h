@@ -175,6 +175,7 @@ struct SceneObject {
   std::optional<std::string> baked, left_out;    // "product: reason" per line; "-" when none
   std::optional<std::vector<double>> specular;   // RGB, glossy objects
   std::optional<int64_t> closed_form_vertices;
+  std::optional<std::string> node_path;          // objects of a glTF scene: the glTF node path
   ExtraAttrs extra;
   VertexSet set;
   bool operator==(const SceneObject&) const = default;

@@ -99,5 +99,6 @@ inline constexpr std::string_view kShOrderGlossy = "sh_order_glossy";
 inline constexpr std::string_view kBaked = "baked";
 inline constexpr std::string_view kLeftOut = "left_out";
 inline constexpr std::string_view kClosedFormVertices = "closed_form_vertices";
+inline constexpr std::string_view kNodePath = "node_path";
 
 } // namespace prt::formats::names

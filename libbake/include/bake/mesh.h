@@ -117,6 +117,32 @@ struct MeshLoadOptions {
 // vertex order, normal and error contracts. Throws InputError.
 Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
 
+// glTF SCENES: the instances of load_mesh's glTF walk kept apart, one Mesh each (a glTF scene's
+// objects, bake/scene.h). Every primitive instance with at least one triangle is an instance, in
+// walk order; its Mesh is build_mesh of that primitive alone, in world space (node transforms as
+// above), rows in its accessor order, with its own NORMAL when it has one (the all-or-nothing rule
+// above is load_mesh's, for the concatenation), source = the file, source_sha256 the file's.
+// NAMES (unique, stable for a given file): the node path is the names of the nodes from the scene
+// root down to the instance's node, joined by '/'. A node's segment is its "name" with '/', '#'
+// and '|' replaced by '_', or "node<N>" (N its index in "nodes") when the name is empty, "." or
+// "..". Among siblings (the scene's root nodes, or one node's children, in document order) a
+// segment already taken gets the first of "~2", "~3", ... that no sibling has. The instance's name
+// is its node path for the mesh's primitive 0 and path + "#p<k>" for primitive k > 0:
+// "root/engine/piston~2#p1". Names never contain '|' (the asset's object names use it for '/').
+struct MeshInstance {
+  std::string name, node_path;
+  std::optional<std::array<double, 3>> base_color;  // the material's pbrMetallicRoughness.baseColorFactor RGB, as in the file; none: no material
+  Mesh mesh;
+};
+struct MeshInstances {
+  std::vector<MeshInstance> instances;
+  std::vector<std::string> warnings;  // the file's (skipped primitives, skins), one line each
+  std::string source_sha256;          // of the file's bytes
+};
+// Throws InputError (as load_mesh; also for a file that is not .gltf / .glb, a material index out of
+// range, and a file without any instance with a triangle).
+MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshLoadOptions& = {});
+
 // The neutral polygon description between a format reader and build_mesh: what the file says,
 // in file order, nothing derived. Corner c of polygon f is c in [offsets[f], offsets[f + 1]).
 struct Polygons {

@@ -28,6 +28,28 @@
 // names the file, and the line and column of a syntax error or the key path of any other
 // ("objects[2].material.albedo[0] must be in [0, 1]").
 //
+// glTF SCENES: a .gltf / .glb file is a scene too (load_scene by extension). Each primitive
+// instance of its default scene (bake/mesh.h "glTF scenes": the walk, the node paths, the
+// names) is one object, in walk order, already in world space (identity transform), with
+//   name      its instance name with '/' replaced by '|' ("root|engine|piston_2#p1"): '/' cannot be
+//             part of an object's name in the file (formats/SCHEMA.md); node_path keeps the name;
+//   role      "both" (everything casts and receives);
+//   material  albedo = the primitive's material's baseColorFactor RGB (linear, as glTF), clamped to
+//             [0, 1]; 0.8 grey, as a scene file's default, when it has no material. No glossy
+//             lobe (roughness has no exact Phong counterpart), metallic is ignored, no texture is
+//             decoded (a base colour texture's colours are not applied).
+// Optional OPTIONS (a JSON file given with the glTF; `prtbake scene --options`), every member too:
+//   {
+//     "prtbake_gltf_scene": 1,                   required: the options-file version
+//     "up", "environment", "bake":               as in a scene file (relative paths: to the options file)
+//     "objects": {"<node path or instance name>": {"role": ..., "material": {...}}}
+//   }
+// An "objects" key names an instance ("root/engine#p1") or a node path, which covers every
+// instance of that node and of the nodes below it ("root/engine"); for each of role and material
+// the most specific (longest) key that sets it wins; a material replaces the default one whole.
+// A key that names no instance is an error (a typo must not silently change a bake); the rest is
+// checked as in a scene file.
+//
 // Roles: a receiver gets per-vertex products; an occluder casts shadows (it is part of every
 // receiver's visibility, and gets FIV shells for dynamic use); "both" does both (self-shadowing).
 // A receiver-only object casts no shadow, not even on itself.
@@ -77,6 +99,7 @@ struct Material {
 
 struct SceneObject {
   std::string name;
+  std::string node_path;                          // glTF scenes: the instance's name (bake/mesh.h); empty in a scene file
   std::filesystem::path mesh;                     // resolved against the scene file's directory
   Role role = Role::Both;
   // The file's "transform": object space → world space, applied to column vectors
@@ -89,7 +112,8 @@ struct SceneObject {
 // environment and the bake settings. Nothing here is rendered or ray-traced (that is prtview's
 // RenderScene and bake/raycast.h's RayCaster).
 struct SceneDescription {
-  std::filesystem::path file;  // the scene file itself
+  std::filesystem::path file;  // the scene file itself (or the glTF)
+  std::optional<std::filesystem::path> options;  // a glTF scene's options file, if any
   UpAxis up = UpAxis::Y;
   std::optional<std::filesystem::path> environment;
   bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
@@ -103,8 +127,16 @@ struct SceneDescription {
   std::vector<SceneObject> objects;
 };
 
-// Parses and validates a scene file (InputError naming the file and the line and column or the key).
-SceneDescription load_scene(const std::filesystem::path& file);
+// Parses and validates a scene file (InputError naming the file and the line and column or the
+// key), or reads a glTF scene and its options file (the "glTF scenes" paragraph above). Options
+// with a scene file are an InputError.
+SceneDescription load_scene(const std::filesystem::path& file,
+                            const std::optional<std::filesystem::path>& gltf_options = std::nullopt);
+
+// The world-space meshes of scene.objects, in order: load_scene_mesh of each object of a scene
+// file (an error names the object and the scene), or the instances of a glTF scene (the file read
+// once). Reader warnings are appended to `warnings`.
+std::vector<Mesh> load_scene_meshes(const SceneDescription& scene, std::vector<std::string>& warnings);
 
 // An object's mesh in world space: world_from_object applied to positions; normals from the file
 // transformed by the inverse transpose, angle-weighted normals recomputed on the world positions.

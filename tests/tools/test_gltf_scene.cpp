@@ -1,0 +1,225 @@
+// `prtbake scene` on a glTF (bake/scene.h "glTF scenes"): every primitive instance is an object
+// named by its node path, baked exactly as the same geometry in a JSON scene; the options file sets
+// roles and materials per node path and refuses a path that names no node; prtdump lists the
+// objects by node path.
+#include <bake/scene.h>
+#include <formats/asset.h>
+
+#include <gltf_builder.h>
+#include <run_tool.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+using prt::testing::Gltf;
+using prt::testing::json;
+
+namespace {
+
+// An empty scratch directory for one test.
+fs::path dir_for(const std::string& name) {
+  fs::remove_all(fs::path(PRT_TEST_TMP) / "gltf_scene" / name);
+  return prt::testing::test_dir("gltf_scene/" + name);
+}
+
+void write_text(const fs::path& p, const std::string& s) { prt::testing::write_test_file(p.parent_path(), p.filename().string(), s); }
+
+using Points = std::vector<Eigen::Vector3f>;
+using Triangles = std::vector<uint16_t>;  // 3 per triangle
+
+// The geometry, in object space. A ground grid 9×9 over [-4, 4]² at y = 0 facing +Y; a closed
+// box [-1, 1] × [0, 2] × [-1, 1] split into two primitives of three quads each; a small quad.
+struct Part {
+  Points points;
+  Triangles triangles;
+};
+Part ground() {
+  Part g;
+  for (int j = 0; j < 9; ++j)
+    for (int i = 0; i < 9; ++i) g.points.emplace_back(float(i - 4), 0.0f, float(j - 4));
+  for (uint16_t j = 0; j < 8; ++j)
+    for (uint16_t i = 0; i < 8; ++i) {
+      const uint16_t a = uint16_t(j * 9 + i), b = uint16_t(a + 1), c = uint16_t(a + 10), e = uint16_t(a + 9);
+      g.triangles.insert(g.triangles.end(), {a, e, c, a, c, b});
+    }
+  return g;
+}
+const Points kBoxPoints = {{-1, 0, -1}, {1, 0, -1}, {-1, 2, -1}, {1, 2, -1}, {-1, 0, 1}, {1, 0, 1}, {-1, 2, 1}, {1, 2, 1}};
+// Outward quads (0-based corners), three per primitive, each as two triangles.
+const Part kBoxLow = {kBoxPoints, {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4}};
+const Part kBoxHigh = {kBoxPoints, {2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5}};
+const Part kQuad = {{{0, 0, 0}, {0.5f, 0, 0}, {0.5f, 0, 0.5f}, {0, 0, 0.5f}}, {0, 2, 1, 0, 3, 2}};
+
+json primitive(Gltf& g, const Part& p) {
+  return {{"attributes", {{"POSITION", g.vec3(p.points)}}},
+          {"indices", g.indices(p.triangles)}};
+}
+
+// Scene root "ground" (mesh: the ground); root "stack" (translation y = 1, no mesh) with children
+// "box" (translation y = 1, the two-primitive box, primitive 1 with a material) and an unnamed
+// node (translation (2, 0, 2), the quad). Instances in walk order: ground, stack/box,
+// stack/box#p1, stack/node2.
+fs::path write_gltf(const fs::path& d) {
+  Gltf g;
+  g.dir = d;
+  g.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {0.25, 0.5, 1.0, 1.0}}}}}};
+  const int ground_mesh = g.mesh(primitive(g, ground()));
+  json high = primitive(g, kBoxHigh);
+  high["material"] = 0;
+  g.doc["meshes"].push_back({{"primitives", {primitive(g, kBoxLow), high}}});
+  const int box_mesh = static_cast<int>(g.doc["meshes"].size() - 1);
+  const int quad_mesh = g.mesh(primitive(g, kQuad));
+  g.node({{"name", "ground"}, {"mesh", ground_mesh}}, true);
+  const int box = g.node({{"name", "box"}, {"mesh", box_mesh}, {"translation", {0.0, 1.0, 0.0}}}, false);
+  const int quad = g.node({{"mesh", quad_mesh}, {"translation", {2.0, 0.0, 2.0}}}, false);
+  g.node({{"name", "stack"}, {"translation", {0.0, 1.0, 0.0}}, {"children", {box, quad}}}, true);
+  EXPECT_EQ(quad, 2) << "the unnamed node's index is in its name";
+  return g.write("stack.gltf");
+}
+
+void write_obj(const fs::path& p, const Part& part) {
+  std::string s;
+  for (const auto& v : part.points) s += "v " + std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z()) + "\n";
+  for (size_t t = 0; t < part.triangles.size(); t += 3)
+    s += "f " + std::to_string(part.triangles[t] + 1) + " " + std::to_string(part.triangles[t + 1] + 1) + " " +
+         std::to_string(part.triangles[t + 2] + 1) + "\n";
+  write_text(p, s);
+}
+
+const std::string kBake = R"("bake": {"products": ["ao"], "samples": 1024, "report": 0})";
+const std::vector<std::string> kNodePaths = {"ground", "stack/box", "stack/box#p1", "stack/node2"};
+const std::vector<std::string> kObjectNames = {"ground", "stack|box", "stack|box#p1", "stack|node2"};
+
+prt::testing::ToolRun bake(const fs::path& d, const std::string& args, const std::string& out = "out.prt.h5") {
+  return prt::testing::run_tool(PRT_PRTBAKE, "scene " + args + " -o '" + (d / out).string() + "'", d);
+}
+
+// `options` written beside the glTF and baked with it.
+F::Asset bake_with_options(const fs::path& d, const std::string& options) {
+  write_text(d / "stack.options.json", options);
+  const auto run = bake(d, "'" + write_gltf(d).string() + "' --options '" + (d / "stack.options.json").string() + "'");
+  EXPECT_EQ(run.code, 0) << run.err;
+  return run.code == 0 ? F::read_asset(d / "out.prt.h5") : F::Asset{};
+}
+
+const std::vector<float>& ao_of(const F::Asset& a, const std::string& object) {
+  static const std::vector<float> kNone;
+  const F::SceneObject* o = a.find_object(object);
+  return o && o->set.ao ? o->set.ao->values : kNone;
+}
+
+} // namespace
+
+TEST(GltfScene, InstancesAreObjectsNamedByNodePathAndBakeAsTheSameJsonScene) {
+  const fs::path d = dir_for("equivalent");
+  const F::Asset gltf = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + "}");
+  ASSERT_EQ(gltf.objects.size(), 4u);
+
+  // The same geometry as a JSON scene: the parts as OBJ files, the composed node translations as
+  // object transforms. Every coordinate is a small binary fraction, so the world positions are the
+  // same floats either way and the AO must be the same bytes.
+  write_obj(d / "ground.obj", ground());
+  write_obj(d / "box_low.obj", kBoxLow);
+  write_obj(d / "box_high.obj", kBoxHigh);
+  write_obj(d / "quad.obj", kQuad);
+  write_text(d / "scene.json", "{\"prtbake_scene\": 1, " + kBake + R"(, "objects": [
+    {"name": "ground", "mesh": "ground.obj", "role": "both"},
+    {"name": "box", "mesh": "box_low.obj", "role": "both", "transform": {"translate": [0, 2, 0]}},
+    {"name": "box_p1", "mesh": "box_high.obj", "role": "both", "transform": {"translate": [0, 2, 0]}},
+    {"name": "quad", "mesh": "quad.obj", "role": "both", "transform": {"translate": [2, 1, 2]}}]})");
+  const auto run = bake(d, "'" + (d / "scene.json").string() + "'", "json.prt.h5");
+  ASSERT_EQ(run.code, 0) << run.err;
+  const F::Asset json_scene = F::read_asset(d / "json.prt.h5");
+  const std::vector<std::string> json_names = {"ground", "box", "box_p1", "quad"};
+  const std::vector<size_t> rows = {81, 8, 8, 4};
+
+  for (size_t i = 0; i < kObjectNames.size(); ++i) {
+    SCOPED_TRACE(kNodePaths[i]);
+    const F::SceneObject* o = gltf.find_object(kObjectNames[i]);
+    ASSERT_NE(o, nullptr) << "object /objects/" << kObjectNames[i];
+    EXPECT_EQ(o->node_path, kNodePaths[i]);
+    EXPECT_EQ(o->role, "both") << "the default role";
+    ASSERT_TRUE(o->set.ao);
+    EXPECT_EQ(o->set.ao->values.size(), rows[i]) << "one row per vertex of the primitive";
+    const std::vector<float>& want = ao_of(json_scene, json_names[i]);
+    ASSERT_EQ(want.size(), rows[i]);
+    EXPECT_EQ(o->set.ao->values, want) << "the same geometry in a JSON scene bakes to the same AO";
+    EXPECT_FALSE(o->set.transfer_diffuse) << "the options' bake.products hold only ao";
+    EXPECT_EQ(o->set.positions->values, json_scene.find_object(json_names[i])->set.positions->values) << "the same world positions";
+  }
+  // Materials: baseColorFactor as albedo; 0.8 grey without a material.
+  EXPECT_EQ(gltf.find_object("stack|box#p1")->albedo, (std::vector<double>{0.25, 0.5, 1.0}));
+  EXPECT_EQ(gltf.find_object("stack|box")->albedo, (std::vector<double>{0.8, 0.8, 0.8}));
+  // The ground under the box is shadowed by it: the objects see each other.
+  EXPECT_LT(ao_of(gltf, "ground")[4 * 9 + 4], 0.9f);
+
+  // prtdump lists the objects by node path.
+  const auto listing = prt::testing::run_tool(PRT_PRTDUMP, "'" + (d / "out.prt.h5").string() + "'", d);
+  ASSERT_EQ(listing.code, 0) << listing.err;
+  for (size_t i = 0; i < kNodePaths.size(); ++i)
+    EXPECT_NE(listing.out.find("  " + kNodePaths[i] + " (both; /objects/" + kObjectNames[i] + ")\n"), std::string::npos)
+        << listing.out;
+}
+
+TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
+  const fs::path d = dir_for("options");
+  const F::Asset base = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + "}");
+  // "stack" covers everything below it; "stack/box#p1" is more specific.
+  const F::Asset a = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + R"(, "objects": {
+      "stack": {"role": "receiver"},
+      "stack/box#p1": {"role": "occluder", "material": {"albedo": [0.1, 0.2, 0.3]}}}})");
+  ASSERT_EQ(a.objects.size(), 4u);
+  EXPECT_EQ(a.find_object("ground")->role, "both");
+  EXPECT_EQ(a.find_object("stack|box")->role, "receiver");
+  EXPECT_EQ(a.find_object("stack|node2")->role, "receiver");
+  EXPECT_EQ(a.find_object("stack|box#p1")->role, "occluder");
+  EXPECT_EQ(a.find_object("stack|box#p1")->albedo, (std::vector<double>{0.1, 0.2, 0.3}));
+  EXPECT_TRUE(ao_of(a, "stack|box#p1").empty()) << "an occluder gets no AO";
+  // The receiver-only box no longer shadows the ground: only its occluder half (the top and two
+  // sides) does, so the ground under it sees more sky than before, and less than without a box.
+  const float before = ao_of(base, "ground")[4 * 9 + 4], after = ao_of(a, "ground")[4 * 9 + 4];
+  EXPECT_GT(after, before + 0.01f) << "role receiver: the box's lower half casts no shadow";
+  EXPECT_LT(after, 0.99f) << "the occluder half still shadows the ground";
+}
+
+TEST(GltfScene, OptionsNamingNoNodeFailWithOneLineNamingTheFileAndTheName) {
+  const fs::path d = dir_for("unknown_node");
+  write_text(d / "stack.options.json", R"({"prtbake_gltf_scene": 1, "objects": {"stack/bx": {"role": "receiver"}}})");
+  const auto run = bake(d, "'" + write_gltf(d).string() + "' --options '" + (d / "stack.options.json").string() + "'");
+  EXPECT_EQ(run.code, 1) << run.out;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  EXPECT_NE(run.err.find((d / "stack.options.json").string() + ": "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("\"stack/bx\""), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
+}
+
+TEST(GltfScene, TwoCylinderEngineInstancesAreNamedObjects) {
+  const fs::path path = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " is missing (Debian package assimp-testmodels)";
+  const prt::bake::SceneDescription scene = prt::bake::load_scene(path);
+  std::vector<std::string> warnings;
+  const std::vector<prt::bake::Mesh> meshes = prt::bake::load_scene_meshes(scene, warnings);
+  ASSERT_EQ(meshes.size(), scene.objects.size());
+  size_t triangles = 0;
+  std::set<std::string> names;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const auto& o = scene.objects[i];
+    triangles += meshes[i].triangles.size();
+    EXPECT_TRUE(names.insert(o.name).second) << "unique: " << o.name;
+    EXPECT_EQ(o.name.find('/'), std::string::npos) << o.name;
+    EXPECT_EQ(o.role, prt::bake::Role::Both);
+  }
+  EXPECT_EQ(triangles, 121496u) << "every triangle of the file is in some object";
+  // Its nodes have no names: paths of node indices, in walk order (node 0 is the root).
+  EXPECT_EQ(scene.objects.size(), 115u);
+  EXPECT_EQ(scene.objects.front().node_path, "node0/node80");
+  EXPECT_EQ(scene.objects[3].name, "node0|node78#p1");
+}
