@@ -5,6 +5,14 @@
 // with opposite winding. Expected values are Lambert's polygon formula on the visible spherical
 // polygon clipped to the hemisphere (tests/common/test_scenes.h polygon_form_factor).
 //
+// The limit, in closed form: an occluder that is locally a convex cone with apex p (a box corner,
+// a slab's edge, a sheet through p) blocks, seen from p + εn as ε → 0, exactly the directions d
+// with n + t d in the cone for some t > 0: the spherical convex hull of the cone's edge rays and
+// −n (the direction in which p itself is seen). A sheet through p blocks the half space behind it;
+// a box corner with p + εn outside it blocks the hull of its three edge directions and −n, which
+// is its octant plus directions that, in these scenes, the floor and walls block anyway — except
+// on the slab's edge, where the test clips the hull explicitly.
+//
 // Tolerances: the silhouette integrator at N = 256 isolines has an O(h²) discretisation error,
 // h = 2/256, bounded by kAnalyticTol = 1e-4 for these polygonal regions (as in
 // test_silhouette.cpp); QMC is compared within 4 of its own standard errors, plus 1e-12 for
@@ -17,6 +25,7 @@
 #include <gtest/gtest.h>
 #include <test_scenes.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -66,11 +75,21 @@ std::vector<Vector3d> clip_to_hemisphere(const std::vector<Vector3d>& poly, cons
   return out;
 }
 
+// The polygon with its interior on the left of each edge seen from outside (reversed if needed;
+// the vertices' mean direction must lie inside it).
+std::vector<Vector3d> oriented(std::vector<Vector3d> poly) {
+  Vector3d c = Vector3d::Zero(), turn = Vector3d::Zero();
+  for (const auto& v : poly) c += v;
+  for (size_t i = 0; i < poly.size(); ++i) turn += poly[i].cross(poly[(i + 1) % poly.size()]);
+  if (turn.dot(c) < 0) std::reverse(poly.begin(), poly.end());
+  return poly;
+}
+
 // AO of a shade point whose visible directions are `seen` minus `blocked` (spherical polygons,
 // `blocked` inside `seen`): Lambert's formula on each, clipped to the hemisphere of n.
 double exact_ao(const Vector3d& n, const std::vector<Vector3d>& seen, const std::vector<Vector3d>& blocked = {}) {
   auto lambert = [&](const std::vector<Vector3d>& poly) {
-    const auto c = clip_to_hemisphere(poly, n);
+    const auto c = clip_to_hemisphere(oriented(poly), n);
     return c.size() < 3 ? 0.0 : prt::testing::polygon_form_factor(Vector3d::Zero(), n, c);
   };
   return lambert(seen) - (blocked.empty() ? 0.0 : lambert(blocked));
@@ -145,9 +164,12 @@ Mesh wall_edge_at_origin() {  // y = 0 over z ≥ 0, facing +y: the origin lies 
   return quad({-10, 0, 0}, {-10, 0, 9}, {13, 0, 9}, {13, 0, 0}, "wall");
 }
 
+// The parts as ONE mesh whose normals are computed over all of it, as load_mesh does for a file
+// holding them all (merge_meshes would keep each part's own normals).
 Mesh merged(std::initializer_list<Mesh> parts) {
   const std::vector<Mesh> v(parts);
-  return merge_meshes(v, "scene");
+  Mesh m = merge_meshes(v, "scene");
+  return make_mesh(std::move(m.positions), std::move(m.triangles), "scene");
 }
 
 } // namespace
@@ -190,6 +212,49 @@ TEST(MessyGeometry, BoxCornerOnTheFloorWallJunction) {
   const double exact = exact_ao(sp.n, {X, Y, -X, Z}, {X, Y, Z});
   expect_exact(ao_at(m, topo, sp, 0), exact, "corner on the floor–wall junction");
   expect_agreement(m, topo, "box in a floor–wall corner");
+}
+
+TEST(MessyGeometry, BoxCornerOnAnEdgeOfAClosedSlab) {
+  // The corner lies on an edge of a closed slab (its top face z = 0 and side face y = 0 meet along
+  // the x axis; no slab vertex there), as a wall's corner sits on a floor slab's edge in an
+  // architectural export. Seen from p + εn the slab's edge through p is the great half circle from
+  // −x through −n to +x; before, the silhouette integrator built its arc from a − p ∥ b − p, a
+  // degenerate great circle, and lost that edge's depth steps (AO 0.53 where the exact value is 0
+  // in data like this). Outside the slab the visible set is the hemisphere minus the slab's
+  // quarter space (y < 0, z < 0) and the box's octant; inside it (the box corner's own normal
+  // points into the slab) nothing is seen.
+  const Mesh slab = prt::testing::box({-5, -5, -1}, {5, 0, 0}, "slab");
+  const Mesh m = merged({unit_box(), slab});
+  const Topology topo = build_topology(m);
+  ShadePoint sp = vertex_shade_point(m, topo, vertex_at(m, {0, 0, 0}));
+  sp.n = Vector3d(-1, 2, 3).normalized();  // p + εn: outside the box (x < 0) and the slab (y, z > 0)
+  // The box's visual cone from n is the hull of its edge rays x, y, z and −n, here the triangle
+  // (y, z, −n) (x lies inside it); the part of it inside the slab's quarter space is clipped off.
+  const Vector3d minus_n = -sp.n;
+  const std::vector<Vector3d> slab_quarter = {X, -Y, -X, -Z}, box_cone = {Y, Z, minus_n};
+  const auto box_in_slab = clip_to_hemisphere(clip_to_hemisphere(oriented(box_cone), -Y), -Z);
+  const double exact = 1 - exact_ao(sp.n, slab_quarter) - (exact_ao(sp.n, box_cone) - exact_ao(sp.n, box_in_slab));
+  expect_exact(ao_at(m, topo, sp, 0), exact, "corner on a slab edge, outside the slab");
+  const ShadePoint own = vertex_shade_point(m, topo, vertex_at(m, {0, 0, 0}));
+  expect_exact(ao_at(m, topo, own, 0), 0.0, "corner on a slab edge, own normal into the slab");
+  expect_agreement(m, topo, "box on a slab edge");
+}
+
+TEST(MessyGeometry, WallCornerOnASlabEdgeAboveABase) {
+  // The configuration of data/regr01-like architectural exports: a wall's bottom corner (vertex
+  // at the origin, own normal (1, −1, −1)/√3) stands on a base slab's top face (no base vertex
+  // there) and on the bottom edge of an upper slab (no slab vertex there either). p + εn lies
+  // inside the base: nothing is seen. The upper slab's edge through p is a contour edge seen from
+  // there; with its arc built from a − p ∥ b − p the silhouette integrator lost its depth steps.
+  const Mesh wall = prt::testing::box({-1, 0, 0}, {0, 1, 3}, "wall");
+  const Mesh upper = prt::testing::box({0, -3, 0}, {5, 3, 2}, "upper slab");
+  const Mesh base = prt::testing::box({-5, -5, -2}, {5, 5, 0}, "base");
+  const Mesh m = merged({wall, upper, base});
+  const Topology topo = build_topology(m);
+  const ShadePoint own = vertex_shade_point(m, topo, vertex_at(m, {0, 0, 0}));
+  EXPECT_NEAR((own.n - Vector3d(1, -1, -1).normalized()).norm(), 0, 1e-7);
+  expect_exact(ao_at(m, topo, own, 0), 0.0, "wall corner inside the base");
+  expect_agreement(m, topo, "wall between a base and an upper slab");
 }
 
 TEST(MessyGeometry, BoxCornerWhereThreePlanesPassThrough) {
