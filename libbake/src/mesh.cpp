@@ -1,4 +1,5 @@
 // mesh.cpp — in-memory meshes, normals and welded topology (contracts in bake/mesh.h).
+#include <bake/contour.h>
 #include <bake/error.h>
 #include <bake/mesh.h>
 
@@ -9,7 +10,9 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -44,27 +47,24 @@ uint32_t weld_positions(std::span<const Eigen::Vector3f> positions, std::vector<
   return static_cast<uint32_t>(ids.size());
 }
 
-// Σ_t α_t(v) n̂_t per index of `corners` (which map triangle corners to accumulator slots).
-std::vector<Eigen::Vector3d> accumulate_angle_weighted(std::span<const Eigen::Vector3f> positions,
-                                                       std::span<const std::array<uint32_t, 3>> triangles,
-                                                       std::span<const uint32_t> slot_of_vertex, size_t slots) {
-  std::vector<Eigen::Vector3d> sum(slots, Eigen::Vector3d::Zero());
-  for (const auto& t : triangles) {
-    for (uint32_t i : t) PRT_CHECK_OP(i, <, positions.size());
-    const Eigen::Vector3d p[3] = {positions[t[0]].cast<double>(), positions[t[1]].cast<double>(),
-                                  positions[t[2]].cast<double>()};
-    const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
-    const double len = n.norm();
-    if (!(len > 0.0) || !std::isfinite(len)) continue;  // zero-area: no direction to contribute
-    const Eigen::Vector3d unit = n / len;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
-      // atan2(|e1×e2|, e1·e2) is accurate for needles, where acos of a normalised dot is not.
-      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
-      sum[slot_of_vertex[t[k]]] += angle * unit;
-    }
+// A triangle's angle-weighted contributions α_k n̂ to the normals at its corners k, in double, or
+// nullopt for a zero-area (or non-finite) triangle, which contributes nothing.
+std::optional<std::array<Eigen::Vector3d, 3>> corner_contributions(std::span<const Eigen::Vector3f> positions,
+                                                                   const std::array<uint32_t, 3>& t) {
+  for (uint32_t i : t) PRT_CHECK_OP(i, <, positions.size());
+  const Eigen::Vector3d p[3] = {positions[t[0]].cast<double>(), positions[t[1]].cast<double>(),
+                                positions[t[2]].cast<double>()};
+  const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+  const double len = n.norm();
+  if (!(len > 0.0) || !std::isfinite(len)) return std::nullopt;
+  const Eigen::Vector3d unit = n / len;
+  std::array<Eigen::Vector3d, 3> c;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+    // atan2(|e1×e2|, e1·e2) is accurate for needles, where acos of a normalised dot is not.
+    c[size_t(k)] = std::atan2(e1.cross(e2).norm(), e1.dot(e2)) * unit;
   }
-  return sum;
+  return c;
 }
 
 Eigen::Vector3f unit_or_up(const Eigen::Vector3d& s) {
@@ -77,23 +77,106 @@ Eigen::Vector3f unit_or_up(const Eigen::Vector3d& s) {
 
 std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                     std::span<const std::array<uint32_t, 3>> triangles) {
-  std::vector<uint32_t> identity(positions.size());
-  std::iota(identity.begin(), identity.end(), 0u);
-  const auto sum = accumulate_angle_weighted(positions, triangles, identity, positions.size());
+  std::vector<Eigen::Vector3d> sum(positions.size(), Eigen::Vector3d::Zero());
+  for (const auto& t : triangles)
+    if (const auto c = corner_contributions(positions, t))
+      for (int k = 0; k < 3; ++k) sum[t[k]] += (*c)[size_t(k)];
   std::vector<Eigen::Vector3f> normals(positions.size());
   for (size_t v = 0; v < positions.size(); ++v) normals[v] = unit_or_up(sum[v]);
   return normals;
 }
 
+namespace {
+
+// Union-find over triangle corners (index 3t + k), by size, with path halving.
+struct CornerSets {
+  std::vector<uint32_t> parent, size;
+  explicit CornerSets(size_t n) : parent(n), size(n, 1) { std::iota(parent.begin(), parent.end(), 0u); }
+  uint32_t find(uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void join(uint32_t a, uint32_t b) {
+    a = find(a), b = find(b);
+    if (a == b) return;
+    if (size[a] < size[b]) std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+  }
+};
+
+// True when triangles t = (a, b, c) and u share the edge {a, b} folded flat onto each other: u's
+// third corner d lies exactly in t's plane on the same side of the edge as c (coincident sheets).
+bool folded(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  if (orient3d_exact(a, b, c, d) != 0) return false;
+  const Eigen::Vector3d e = b - a;
+  return e.cross(c - a).dot(e.cross(d - a)) > 0;
+}
+
+} // namespace
+
 std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                            std::span<const std::array<uint32_t, 3>> triangles) {
   std::vector<uint32_t> weld;
   const uint32_t n_welded = weld_positions(positions, weld);
-  const auto sum = accumulate_angle_weighted(positions, triangles, weld, n_welded);
-  std::vector<Eigen::Vector3f> welded(n_welded);
-  for (uint32_t w = 0; w < n_welded; ++w) welded[w] = unit_or_up(sum[w]);
+  const size_t T = triangles.size();
+  auto pos = [&](uint32_t v) { return Eigen::Vector3d(positions[v].cast<double>()); };
+  std::vector<std::optional<std::array<Eigen::Vector3d, 3>>> contribution(T);
+  for (size_t t = 0; t < T; ++t) contribution[t] = corner_contributions(positions, triangles[t]);
+  // Sheets: the corners at one welded position are joined when they are corners of the same
+  // vertex, or when their triangles share a welded edge that has exactly these two triangles,
+  // traverses it in opposite directions and is not folded flat (bake/mesh.h NORMALS).
+  CornerSets sets(3 * T);
+  std::vector<uint32_t> first_corner(positions.size(), UINT32_MAX);
+  struct EdgeUse {
+    uint32_t lo, hi;   // welded ids, lo < hi
+    uint32_t t, k;     // triangle, and its corner k at the edge's start (k → k+1)
+  };
+  std::vector<EdgeUse> uses;
+  uses.reserve(3 * T);
+  for (uint32_t t = 0; t < T; ++t) {
+    if (!contribution[t]) continue;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const uint32_t v = triangles[t][k];
+      if (first_corner[v] == UINT32_MAX) first_corner[v] = 3 * t + k;
+      else sets.join(first_corner[v], 3 * t + k);
+      const uint32_t wa = weld[v], wb = weld[triangles[t][(k + 1) % 3]];
+      if (wa != wb) uses.push_back({std::min(wa, wb), std::max(wa, wb), t, k});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    return std::tie(x.lo, x.hi, x.t, x.k) < std::tie(y.lo, y.hi, y.t, y.k);
+  });
+  for (size_t i = 0; i < uses.size();) {
+    size_t j = i;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    if (j - i == 2) {
+      const EdgeUse &x = uses[i], &y = uses[i + 1];
+      const auto& tx = triangles[x.t];
+      const auto& ty = triangles[y.t];
+      const uint32_t xa = tx[x.k], xb = tx[(x.k + 1) % 3], xc = tx[(x.k + 2) % 3];
+      const uint32_t ya = ty[y.k], yb = ty[(y.k + 1) % 3], yc = ty[(y.k + 2) % 3];
+      // Opposite directions: y runs from x's end to x's start.
+      if (weld[ya] == weld[xb] && weld[yb] == weld[xa] && !folded(pos(xa), pos(xb), pos(xc), pos(yc))) {
+        sets.join(3 * x.t + x.k, 3 * y.t + (y.k + 1) % 3);  // the corners at x's start
+        sets.join(3 * x.t + (x.k + 1) % 3, 3 * y.t + y.k);  // the corners at x's end
+      }
+    }
+    i = j;
+  }
+  // Angle-weighted sums per sheet (the root of its corner set) and per welded position (the
+  // fallback for a vertex with no corner of non-zero area).
+  std::vector<Eigen::Vector3d> sheet(3 * T, Eigen::Vector3d::Zero()), welded(n_welded, Eigen::Vector3d::Zero());
+  for (uint32_t t = 0; t < T; ++t) {
+    if (!contribution[t]) continue;
+    for (uint32_t k = 0; k < 3; ++k) {
+      sheet[sets.find(3 * t + k)] += (*contribution[t])[k];
+      welded[weld[triangles[t][k]]] += (*contribution[t])[k];
+    }
+  }
   std::vector<Eigen::Vector3f> normals(positions.size());
-  for (size_t v = 0; v < positions.size(); ++v) normals[v] = welded[weld[v]];
+  for (size_t v = 0; v < positions.size(); ++v)
+    normals[v] = unit_or_up(first_corner[v] == UINT32_MAX ? welded[weld[v]] : sheet[sets.find(first_corner[v])]);
   return normals;
 }
 

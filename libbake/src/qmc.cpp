@@ -62,6 +62,7 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
   std::vector<double> y(size_t(sh::num_coeffs(std::max(sh_order_, 1))));
   const Frame frame(point.n);
   const RotatedHalton3 halton(options_.seed, point_index);
+  const NearTriangles near = rays_->near_triangles(point);  // decided exactly, for every ray
   constexpr double kInvPi = std::numbers::inv_pi;
   const uint32_t N = options_.rays;
   for (uint32_t i = 0; i < N; ++i) {
@@ -80,7 +81,7 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
     d.normalize();
     const double c = point.n.dot(d);
     std::fill(x.begin(), x.end(), 0.0);
-    if ((full || c > 0) && visible(point, d)) {
+    if ((full || c > 0) && rays_->visible(point, near, d)) {
       double p = full ? (1.0 - w_env_) * (0.25 * kInvPi) : w_cos_ * c * kInvPi + w_uni_ * (0.5 * kInvPi);
       if (w_env_ > 0) p += w_env_ * request_.radiance->pdf(d);
       const double inv_p = 1.0 / p;  // p ≥ w_cos c/π > 0, w_uni/2π or w_sphere/4π > 0 here

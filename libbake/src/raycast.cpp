@@ -9,6 +9,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <span>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -55,6 +58,7 @@ struct RingContext {
   int64_t welded;
   const uint32_t* weld;  // output vertex -> welded id
   const std::array<uint32_t, 3>* triangles;
+  std::span<const uint32_t> near;  // triangles decided exactly by the caller (ascending): skipped
   Hit* hits = nullptr;   // counted rays only
   unsigned n_hits = 0;
   bool overflow = false;
@@ -72,7 +76,7 @@ void ring_filter(const RTCFilterFunctionNArguments* args) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-    if (in_ring(ctx, prim)) {
+    if (in_ring(ctx, prim) || std::binary_search(ctx->near.begin(), ctx->near.end(), prim)) {
       args->valid[i] = 0;
       continue;
     }
@@ -203,17 +207,85 @@ bool collect_near(RTCPointQueryFunctionArguments* args) {
 
 } // namespace
 
+namespace {
+
+// Corner k of triangle t is the shade point's welded position: the other two corners, in winding
+// order, or nullopt when no corner (or two corners) are the shade point's.
+std::optional<std::pair<Vector3d, Vector3d>> ring_far_corners(const Mesh& mesh, const Topology& topo, uint32_t f,
+                                                              uint32_t w) {
+  const auto& t = mesh.triangles[f];
+  int k = 0;  // rotate the corners so that corner k is the shade point's
+  while (k < 3 && topo.weld[t[k]] != w) ++k;
+  if (k == 3) return std::nullopt;
+  // A triangle with two corners welded to the shade point has no area seen from it.
+  if (topo.weld[t[(k + 1) % 3]] == w || topo.weld[t[(k + 2) % 3]] == w) return std::nullopt;
+  return std::pair{Vector3d(mesh.positions[t[(k + 1) % 3]].cast<double>()),
+                   Vector3d(mesh.positions[t[(k + 2) % 3]].cast<double>())};
+}
+
+// Whether the segment from p + εn (ε → 0+) to r crosses the triangle (a, b, c), decided with
+// exact predicates: Miss, Cross, or Edge when the answer is on a null set (the segment meets an
+// edge or a corner exactly, or r lies in the triangle's plane).
+enum class SegmentCrossing { Miss, Cross, Edge };
+SegmentCrossing crosses_exactly(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& p,
+                                const Vector3d& n, const Vector3d& r) {
+  const int sp = orient_eps(a, b, c, p, n);
+  if (sp == 0) return SegmentCrossing::Miss;  // degenerate triangle (or p + εn in its plane): no area to cross
+  const int sr = orient3d_exact(a, b, c, r);
+  if (sr == 0) return SegmentCrossing::Edge;  // the far end lies in the plane
+  if (sp == sr) return SegmentCrossing::Miss;  // the segment does not reach the plane
+  const int s1 = orient_eps(a, b, r, p, n), s2 = orient_eps(b, c, r, p, n), s3 = orient_eps(c, a, r, p, n);
+  const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
+  if (has_pos && has_neg) return SegmentCrossing::Miss;  // outside the triangle
+  if (s1 == 0 || s2 == 0 || s3 == 0) return SegmentCrossing::Edge;  // through an edge or a corner exactly
+  return SegmentCrossing::Cross;
+}
+
+} // namespace
+
+NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
+  NearTriangles near;
+  near.rho = 2e-4 * std::max(diagonal_, 1e-30) + 2e-6 * point.p.cwiseAbs().maxCoeff();
+  NearQuery query;
+  query.welded = point.welded;
+  query.weld = topo_.weld.data();
+  query.triangles = mesh_.triangles.data();
+  RTCPointQuery q{};
+  q.x = float(point.p.x());
+  q.y = float(point.p.y());
+  q.z = float(point.p.z());
+  q.time = 0;
+  q.radius = float(near.rho);
+  RTCPointQueryContext qctx;
+  rtcInitPointQueryContext(&qctx);
+  rtcPointQuery(rt_->scene, &q, &qctx, collect_near, &query);
+  near.prims.assign(query.prims.begin(), query.prims.end());
+  std::sort(near.prims.begin(), near.prims.end());
+  near.prims.erase(std::unique(near.prims.begin(), near.prims.end()), near.prims.end());
+  return near;
+}
+
+double RayCaster::reach(const ShadePoint& point) const { return 4 * (diagonal_ + (point.p - centre_).norm()) + 1; }
+
 bool RayCaster::visible(const ShadePoint& point, const Vector3d& d) const {
+  return visible(point, near_triangles(point), d);
+}
+
+bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
-    for (uint32_t f : topo_.ring(w)) {
-      const auto& t = mesh_.triangles[f];
-      int k = 0;  // rotate the corners so that corner k is the shade point's
-      while (k < 3 && topo_.weld[t[k]] != w) ++k;
-      if (k == 3) continue;
-      const Vector3d a = mesh_.positions[t[(k + 1) % 3]].cast<double>();
-      const Vector3d b = mesh_.positions[t[(k + 2) % 3]].cast<double>();
-      if (occludes_from_above(point.p, a, b, point.n, d)) return false;
+    for (uint32_t f : topo_.ring(w))
+      if (const auto ab = ring_far_corners(mesh_, topo_, f, w); ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d))
+        return false;
+  }
+  if (!near.prims.empty()) {
+    const Vector3d r = point.p + reach(point) * d;
+    for (const uint32_t prim : near.prims) {
+      const auto& t = mesh_.triangles[prim];
+      // Edge (a null set of directions) does not block: the neighbour across that edge decides.
+      if (crosses_exactly(mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
+                          mesh_.positions[t[2]].cast<double>(), point.p, point.n, r) == SegmentCrossing::Cross)
+        return false;
     }
   }
   RingContext ctx;
@@ -221,6 +293,7 @@ bool RayCaster::visible(const ShadePoint& point, const Vector3d& d) const {
   ctx.welded = point.welded;
   ctx.weld = topo_.weld.data();
   ctx.triangles = mesh_.triangles.data();
+  ctx.near = near.prims;
   RTCRay ray = make_ray(point.p, d);
   rtcOccluded1(rt_->scene, &ctx.base, &ray);
   return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
@@ -245,60 +318,28 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
   CrossingCount out;
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
-    for (uint32_t f : topo_.ring(w)) {
-      const auto& t = mesh_.triangles[f];
-      int k = 0;
-      while (k < 3 && topo_.weld[t[k]] != w) ++k;
-      if (k == 3) continue;
-      // A triangle with two corners welded to the shade point has no area seen from it.
-      if (topo_.weld[t[(k + 1) % 3]] == w || topo_.weld[t[(k + 2) % 3]] == w) continue;
-      const Vector3d a = mesh_.positions[t[(k + 1) % 3]].cast<double>();
-      const Vector3d b = mesh_.positions[t[(k + 2) % 3]].cast<double>();
-      if (occludes_from_above(point.p, a, b, point.n, d, &out.ambiguous)) ++out.count;
-    }
+    for (uint32_t f : topo_.ring(w))
+      if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
+          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, &out.ambiguous))
+        ++out.count;
   }
   // Triangles within ρ of p are decided exactly for the whole ray (below): near p, float hit tests
   // cannot tell which of two adjacent triangles a ray enters — e.g. at a vertex a few ulps from
   // another surface's vertex (near-duplicate shells, T-junctions), where every direction grazes
   // that vertex's fan. Everything farther is left to Embree, with edge grazes flagged ambiguous.
-  const double rho = 2e-4 * std::max(diagonal_, 1e-30) + 2e-6 * point.p.cwiseAbs().maxCoeff();
-  NearQuery near;
-  near.welded = point.welded;
-  near.weld = topo_.weld.data();
-  near.triangles = mesh_.triangles.data();
-  RTCPointQuery q{};
-  q.x = float(point.p.x());
-  q.y = float(point.p.y());
-  q.z = float(point.p.z());
-  q.time = 0;
-  q.radius = float(rho);
-  RTCPointQueryContext qctx;
-  rtcInitPointQueryContext(&qctx);
-  rtcPointQuery(rt_->scene, &q, &qctx, collect_near, &near);
-  std::sort(near.prims.begin(), near.prims.end());
-  near.prims.erase(std::unique(near.prims.begin(), near.prims.end()), near.prims.end());
-
   // The ray is the segment from p + εn to a point r beyond the scene: its exact predicates are
   // those of that segment, whatever rounding r carries.
-  const double reach = 4 * (diagonal_ + (point.p - centre_).norm()) + 1;
-  const Vector3d r = point.p + reach * d;
+  const NearTriangles near = near_triangles(point);
+  const double reach_ = reach(point);
+  const Vector3d r = point.p + reach_ * d;
   for (const unsigned prim : near.prims) {
     const auto& t = mesh_.triangles[prim];
-    const Vector3d a = mesh_.positions[t[0]].cast<double>(), b = mesh_.positions[t[1]].cast<double>(),
-                   c = mesh_.positions[t[2]].cast<double>();
-    const int sp = orient_eps(a, b, c, point.p, point.n), sr = orient3d_exact(a, b, c, r);
-    if (sp == 0) continue;  // degenerate triangle (or p + εn in its plane): no area to cross
-    if (sr == 0) {
-      out.ambiguous = true;  // the far end lies in the plane: choose another direction
-      continue;
+    switch (crosses_exactly(mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
+                            mesh_.positions[t[2]].cast<double>(), point.p, point.n, r)) {
+      case SegmentCrossing::Miss: break;
+      case SegmentCrossing::Edge: out.ambiguous = true; break;  // choose another direction
+      case SegmentCrossing::Cross: ++out.count; break;
     }
-    if (sp == sr) continue;  // the segment does not reach the plane
-    const int s1 = orient_eps(a, b, r, point.p, point.n), s2 = orient_eps(b, c, r, point.p, point.n),
-              s3 = orient_eps(c, a, r, point.p, point.n);
-    const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
-    if (has_pos && has_neg) continue;                   // outside the triangle
-    if (s1 == 0 || s2 == 0 || s3 == 0) out.ambiguous = true;  // through an edge or a corner exactly
-    else ++out.count;
   }
 
   Hit hits[kMaxHits];
@@ -307,17 +348,17 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
   ctx.welded = point.welded;
   ctx.weld = topo_.weld.data();
   ctx.triangles = mesh_.triangles.data();
+  ctx.near = near.prims;
   ctx.hits = hits;
   RTCRayHit rh{};
   rh.ray = make_ray(point.p, d);
-  rh.ray.tfar = float(reach);
+  rh.ray.tfar = float(reach_);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(rt_->scene, &ctx.base, &rh);
   if (ctx.overflow) out.ambiguous = true;
   constexpr float kEdge = 1e-5f;  // barycentric distance to an edge that makes a hit ambiguous
   for (unsigned i = 0; i < ctx.n_hits; ++i) {
-    const Hit& h = hits[i];
-    if (std::binary_search(near.prims.begin(), near.prims.end(), h.prim)) continue;  // decided exactly above
+    const Hit& h = hits[i];  // triangles near p were skipped by the filter: decided exactly above
     const float w0 = 1.0f - h.u - h.v;
     if (h.u < kEdge || h.v < kEdge || w0 < kEdge) out.ambiguous = true;
     ++out.count;

@@ -42,6 +42,15 @@ Eigen::Matrix3d octahedral_frame_from_world() {
 
 inline int sign_of(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
 
+// Exactly whether a, b and p are collinear: coplanar with each of three points spanning space
+// about p (whatever rounding they carry, they are not coplanar with p unless a, b, p are collinear).
+bool collinear_exactly(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Vector3d& p) {
+  const Vector3d A = a.cast<double>(), B = b.cast<double>();
+  for (int k = 0; k < 3; ++k)
+    if (orient3d_exact(A, B, p, p + Vector3d::Unit(k)) != 0) return false;
+  return true;
+}
+
 struct Arc {
   Vector3d a, b, m;  // endpoints (unnormalised, frame coordinates) and m = a × b
   int side_sum;      // S: the step across the arc is sign(m · t) · S for travel direction t
@@ -453,12 +462,29 @@ struct SilhouetteIntegrator::Impl {
         if (point.welded >= 0 && w == uint32_t(point.welded)) return -n;  // seen from p + εn
         return topo.welded_positions[w].cast<double>() - point.p;
       };
-      Arc arc;
-      arc.a = frame_from_world * dir(e[0]);
-      arc.b = frame_from_world * dir(e[1]);
-      arc.m = arc.a.cross(arc.b);
-      arc.side_sum = ce.side_sum;
-      s.arcs.push_back(arc);
+      const Vector3d da = dir(e[0]), db = dir(e[1]);
+      auto push = [&](const Vector3d& a, const Vector3d& b) {
+        Arc arc;
+        arc.a = frame_from_world * a;
+        arc.b = frame_from_world * b;
+        arc.m = arc.a.cross(arc.b);
+        arc.side_sum = ce.side_sum;
+        s.arcs.push_back(arc);
+      };
+      // An edge whose line passes through p (a T-junction: p on another triangle's edge, neither
+      // end welded to it) has a − p ∥ b − p. Seen from p + εn it is the great half circle from a
+      // through −n (where p lies on it) to b, in the plane of (b − a) × n: the limit of m. Both
+      // halves keep that orientation. Collinear with p but not through it, it shrinks to a point
+      // as ε → 0 and is crossed by no path.
+      const bool at_p = point.welded >= 0 && (e[0] == uint32_t(point.welded) || e[1] == uint32_t(point.welded));
+      if (!at_p && da.cross(db).squaredNorm() == 0 && collinear_exactly(topo.welded_positions[e[0]], topo.welded_positions[e[1]], point.p)) {
+        if (da.dot(db) < 0) {
+          push(da, -n);
+          push(-n, db);
+        }
+        continue;
+      }
+      push(da, db);
     }
     if (point.hemisphere) add_horizon(n, s.arcs);
     add_crossings(s);

@@ -15,9 +15,12 @@
 namespace prt::bake {
 
 // A point to integrate at. Visibility is the limit from just above the surface, p + εn, ε → 0+
-// (docs/ARCHITECTURE.md §3): when `welded` names a welded mesh position (bake/mesh.h Topology), the
-// triangles of its 1-ring occlude exactly as they do in that limit (a concave ring occludes, a
-// flat one does not) with no ε offset; welded = -1 is a free point in space.
+// (docs/ARCHITECTURE.md §3), for EVERY triangle, with no ε offset: the triangles of its 1-ring
+// when `welded` names a welded mesh position (bake/mesh.h Topology) occlude exactly as they do in
+// that limit (a concave ring occludes, a flat one does not), and so do triangles that pass
+// through or near p without a corner there (T-junctions: p on another object's edge or face;
+// coplanar overlapping sheets; duplicated faces; bake/raycast.h NearTriangles, bake/contour.h).
+// welded = -1 is a free point in space (no 1-ring; the same limit for every other triangle).
 struct ShadePoint {
   Eigen::Vector3d p{0, 0, 0};
   Eigen::Vector3d n{0, 0, 1};  // unit; defines H(ω,n) = [n·ω > 0]

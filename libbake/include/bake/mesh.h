@@ -52,12 +52,22 @@
 //     by the inverse transpose of the node's world transform in double and renormalised.
 //     normal_source = File. A vertex the file gives no normal, or a zero-length one, gets the
 //     computed normal below; a non-finite file normal is an InputError.
-//   * Otherwise angle-weighted ("mean weighted by angle", Thürmer & Wüthrich 1998): for each
-//     triangle incident to the vertex's WELDED position (bitwise-equal coordinates), the corner
-//     angle times the unit face normal, summed and normalised. Welding first makes an STL soup
-//     or a seam-split OBJ get the same smooth normals as the clean welded mesh. Zero-area
-//     triangles contribute nothing. A vertex whose sum is zero (no incident triangle, only
-//     zero-area ones, or exactly cancelling ones) gets +Y = (0, 1, 0), the scene up axis.
+//   * Otherwise angle-weighted ("mean weighted by angle", Thürmer & Wüthrich 1998) over the
+//     vertex's SHEET: the corner angle times the unit face normal, summed over the sheet's
+//     triangles at the vertex's welded position (bitwise-equal coordinates) and normalised. The
+//     triangle corners at one welded position form sheets by joining (transitively) two corners
+//     when they are corners of the same output vertex, or when their triangles share a welded
+//     edge that has exactly these two triangles, traverse it in opposite directions (consistent
+//     winding) and are not folded flat onto each other (the second triangle's far corner lies
+//     exactly in the first's plane, on the same side of the edge). So an STL soup, a seam-split
+//     OBJ or a per-face-split glTF gets the smooth normals of the clean welded mesh (its fans are
+//     manifold), while a vertex keeps the normal of its own faces where another object or sheet
+//     shares its position: two coincident sheets with opposite winding (a double-sided wall),
+//     a wall standing on a slab, objects touching at a corner (their shared edges have 3+ faces
+//     or fold flat). Zero-area triangles contribute nothing and join nothing. A vertex with no
+//     triangle of non-zero area takes the sum over every triangle at its welded position; a
+//     vertex whose sum is zero (none, or exactly cancelling ones) gets +Y = (0, 1, 0), the scene
+//     up axis.
 //
 // TRIANGLES: file face order; a polygon (c0 … cn−1) becomes the fan (c0, ci, ci+1), i = 1…n−2,
 // in place. Winding is the file's (each triangle reversed with MeshLoadOptions::flip_normals,
@@ -184,8 +194,9 @@ Mesh merge_meshes(std::span<const Mesh> parts, std::string name);
 std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                     std::span<const std::array<uint32_t, 3>> triangles);
 
-// The same sum taken over welded positions (bitwise-equal coordinates) and scattered back to
-// every vertex: what load_mesh and make_mesh use when the file gives no normal.
+// The same sum taken over each vertex's sheet at its welded position (bitwise-equal coordinates;
+// the NORMALS rule in the file comment): what load_mesh and make_mesh use when the file gives no
+// normal. Computed in double; memory O(triangles).
 std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                            std::span<const std::array<uint32_t, 3>> triangles);
 

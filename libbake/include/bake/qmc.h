@@ -18,9 +18,10 @@
 // Patterson rotation from (seed, point index): unbiased, and identical whatever the thread count.
 //
 // Visibility at a mesh vertex is the limit from above (bake/integrator.h): the ray starts at the
-// vertex itself (tnear = 0); Embree's hits on the vertex's own 1-ring are filtered out and the
-// 1-ring is tested analytically instead (occludes_from_above, bake/raycast.h). Hits on any other
-// triangle at any t ≥ 0 occlude.
+// vertex itself (tnear = 0); Embree's hits on the vertex's own 1-ring and on the triangles near it
+// (bake/raycast.h NearTriangles: T-junctions, coplanar overlaps, duplicated and near-duplicate
+// sheets) are filtered out and those triangles are decided exactly in the ε-limit instead
+// (occludes_from_above, orient_eps). Hits on any other triangle at any t ≥ 0 occlude.
 #pragma once
 
 #include <bake/integrator.h>

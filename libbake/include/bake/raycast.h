@@ -5,11 +5,12 @@
 // "minimum W is 0" assumption).
 //
 // The shade point's own 1-ring (every triangle with a corner welded to it) is removed from
-// Embree's answers by a filter and decided analytically (occludes_from_above). In counted rays,
-// hits close to p (triangles whose plane passes through or near p, e.g. a ground plane through
-// the vertex) are decided by the exact ε-limit orientation predicate orient_eps (bake/contour.h),
-// and a hit whose barycentrics put it on a triangle's edge makes the count ambiguous: the caller
-// picks another direction.
+// Embree's answers by a filter and decided analytically (occludes_from_above). So are the
+// triangles near p (NearTriangles: within rho, e.g. a floor or wall passing through the vertex at
+// a T-junction, a coplanar overlapping sheet, a near-duplicate shell), for every ray, visibility
+// and counted alike: they are decided by the exact ε-limit orientation predicate orient_eps
+// (bake/contour.h). In counted rays a far hit whose barycentrics put it on a triangle's edge makes
+// the count ambiguous: the caller picks another direction.
 #pragma once
 
 #include <bake/integrator.h>
@@ -18,6 +19,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace prt::bake {
 
@@ -34,6 +36,17 @@ struct CrossingCount {
   bool ambiguous = false;  // the direction grazes an edge: choose another direction
 };
 
+// The triangles near a shade point that float ray tests cannot be trusted with: every triangle
+// outside the point's welded 1-ring whose bounding box meets the ball of radius rho about p. Rays
+// from the point decide them exactly (the segment from p + εn to a point beyond the scene, with
+// the ε-limit orientation predicates of bake/contour.h); Embree decides the rest. This is what
+// makes T-junctions (p on another object's edge or face), coplanar overlaps, duplicated faces and
+// near-duplicate shells exact for both integrators: the 1-ring alone does not see them.
+struct NearTriangles {
+  std::vector<uint32_t> prims;  // triangle indices, ascending
+  double rho = 0;               // 2e-4 · mesh diagonal + 2e-6 · max|p_i|: well above float hit-test error near p
+};
+
 struct RayHit {
   uint32_t triangle;
   float t, u, v;  // distance along the unit direction; Embree's barycentrics (weights of corners 1, 2)
@@ -47,8 +60,12 @@ public:
   RayCaster(const RayCaster&) = delete;
   RayCaster& operator=(const RayCaster&) = delete;
 
-  // Visibility of unit direction d from the shade point (limit from above).
+  // Visibility of unit direction d from the shade point (limit from above). The second form takes
+  // the point's near_triangles, computed once for all its rays. A direction through an edge or a
+  // corner of a near triangle exactly (a null set) is not blocked by that triangle.
   bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
+  bool visible(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const;
+  NearTriangles near_triangles(const ShadePoint& point) const;
   // Number of triangles the ray from p + εn in unit direction d crosses.
   CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
@@ -58,6 +75,7 @@ public:
 
 private:
   struct Embree;
+  double reach(const ShadePoint& point) const;  // a ray length beyond the whole mesh from p
   const Mesh& mesh_;
   const Topology& topo_;
   std::unique_ptr<Embree> rt_;
