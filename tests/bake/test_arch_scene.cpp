@@ -68,7 +68,7 @@ Contacts contacts(const ArchScene& s) {
 
 bool is_wall(const ArchPart& p) { return p.name.rfind("wall", 0) == 0 || p.name == "lintel"; }
 
-class ArchScene2 : public ::testing::Test {
+class ArchSceneFacts : public ::testing::Test {
 protected:
   static void SetUpTestSuite() {
     scene_ = new ArchScene(architectural_scene(kCellsPerMetre));
@@ -81,8 +81,8 @@ protected:
   static const ArchScene* scene_;
   static const Contacts* contacts_;
 };
-const ArchScene* ArchScene2::scene_ = nullptr;
-const Contacts* ArchScene2::contacts_ = nullptr;
+const ArchScene* ArchSceneFacts::scene_ = nullptr;
+const Contacts* ArchSceneFacts::contacts_ = nullptr;
 
 } // namespace
 
@@ -118,7 +118,7 @@ TEST(PointOnTriangle, ClassifiesExactly) {
   EXPECT_EQ(locate_on_triangle(a, b, Vector3f(2, 0, 0), Vector3f(0.5f, 0, 0)), OnTriangle::Degenerate);
 }
 
-TEST_F(ArchScene2, WallFeetStandOnTheFloorMostlyAsTJunctions) {
+TEST_F(ArchSceneFacts, WallFeetStandOnTheFloorMostlyAsTJunctions) {
   const ArchScene& s = *scene_;
   const size_t floor = size_t(&s.part("floor") - s.parts.data());
   size_t feet = 0, inside = 0, on_edge = 0, at_corner = 0;
@@ -142,7 +142,7 @@ TEST_F(ArchScene2, WallFeetStandOnTheFloorMostlyAsTJunctions) {
   EXPECT_EQ(inside + on_edge + at_corner, feet);
 }
 
-TEST_F(ArchScene2, JunctionCornerLiesOnTheFloorFaceAndOnAWallEdge) {
+TEST_F(ArchSceneFacts, JunctionCornerLiesOnTheFloorFaceAndOnAWallEdge) {
   const ArchScene& s = *scene_;
   const uint32_t v = s.junction_corner;
   EXPECT_TRUE(s.part("cabinet").has_vertex(v));
@@ -155,7 +155,7 @@ TEST_F(ArchScene2, JunctionCornerLiesOnTheFloorFaceAndOnAWallEdge) {
     if (p != floor && p != wall) EXPECT_EQ(c[p], Contact::None) << s.parts[p].name;
 }
 
-TEST_F(ArchScene2, TJunctionCounts) {
+TEST_F(ArchSceneFacts, TJunctionCounts) {
   // Vertices that are a T-junction (inside a face or on an edge's interior) of at least one other
   // part, and of two other parts at once. Golden numbers of this deterministic scene at 2 cells/m:
   // a change to the generator must change them deliberately (lower bounds would let the defects
@@ -183,7 +183,7 @@ TEST_F(ArchScene2, TJunctionCounts) {
   EXPECT_EQ(coincident, 126u);
 }
 
-TEST_F(ArchScene2, RugIsCoplanarWithTheFloorAndOverlapsIt) {
+TEST_F(ArchSceneFacts, RugIsCoplanarWithTheFloorAndOverlapsIt) {
   const ArchScene& s = *scene_;
   const ArchPart& rug = s.part("rug");
   const size_t floor = size_t(&s.part("floor") - s.parts.data());
@@ -200,7 +200,7 @@ TEST_F(ArchScene2, RugIsCoplanarWithTheFloorAndOverlapsIt) {
   }
 }
 
-TEST_F(ArchScene2, DuplicatedFacesRepeatTheTableTop) {
+TEST_F(ArchSceneFacts, DuplicatedFacesRepeatTheTableTop) {
   const ArchScene& s = *scene_;
   const ArchPart& table = s.part("table");
   const ArchPart& copy = s.part("table_top_copy");
@@ -215,7 +215,7 @@ TEST_F(ArchScene2, DuplicatedFacesRepeatTheTableTop) {
   }
 }
 
-TEST_F(ArchScene2, PanelIsTwoCoincidentSheetsWithOppositeWindingAndSeparateVertices) {
+TEST_F(ArchSceneFacts, PanelIsTwoCoincidentSheetsWithOppositeWindingAndSeparateVertices) {
   const ArchScene& s = *scene_;
   const ArchPart& front = s.part("panel_front");
   const ArchPart& back = s.part("panel_back");
