@@ -263,7 +263,7 @@ int main(int argc, char** argv) {
               s.k, silhouette_isolines(s.k), s.rays, s.points, static_cast<unsigned long long>(s.seed),
               tbb::info::default_concurrency(), prt::bench::cpu_model().c_str());
   std::printf("| asset | triangles | vertices compared / total | silhouette ms/vertex | QMC ms/vertex | AO RMSE | AO max "
-              "|diff| | > 4 SE | QMC SE (RMS) | note |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+              "\\|diff\\| | > 4 SE | QMC SE (RMS) | note |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
   std::string worst;
   {
     const std::string engine = "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
