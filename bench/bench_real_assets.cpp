@@ -45,7 +45,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
