@@ -152,7 +152,9 @@ TEST_F(ArchSceneFacts, JunctionCornerLiesOnTheFloorFaceAndOnAWallEdge) {
   EXPECT_EQ(c[floor], Contact::Inside);
   EXPECT_EQ(c[wall], Contact::OnEdge);
   for (size_t p = 0; p < s.parts.size(); ++p)
-    if (p != floor && p != wall) EXPECT_EQ(c[p], Contact::None) << s.parts[p].name;
+    if (p != floor && p != wall) {
+      EXPECT_EQ(c[p], Contact::None) << s.parts[p].name;
+    }
 }
 
 TEST_F(ArchSceneFacts, TJunctionCounts) {
