@@ -95,25 +95,10 @@ void corner_normals_per_vertex(Polygons& poly) { poly.corner_normal = poly.corne
 // plus the `vc` colour extension). Any other keyword makes the line garbage.
 bool obj_ignored_keyword(std::string_view kw) {
   static constexpr std::string_view kKnown[] = {
-      "vp", "vc", "l", "p", "g", "o", "s", "mg", "usemtl", "cstype", "deg", "bmat", "step",
+      "vp", "vc", "l", "p", "g", "o", "s", "mg", "mtllib", "usemtl", "cstype", "deg", "bmat", "step",
       "curv", "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "bevel", "c_interp",
       "d_interp", "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
   return std::find(std::begin(kKnown), std::end(kKnown), kw) != std::end(kKnown);
-}
-
-// A material library only matters to a renderer: a missing one is a warning. The name is the
-// rest of the line (names with spaces exist); if that is not a file, each word is one.
-void check_material_library(const SourceFile& file, std::string_view names, size_t line) {
-  const auto dir = file.path.parent_path();
-  auto missing = [&](std::string_view name) {
-    std::error_code ec;
-    return !std::filesystem::exists(dir / std::string(name), ec);
-  };
-  if (!missing(names)) return;
-  for (std::string_view name : split(names))
-    if (missing(name))
-      file.warnings.push_back(file.name + ": " + at_line(line) + "material library '" + (dir / std::string(name)).string() +
-                              "' not found (a bake does not use materials)");
 }
 
 } // namespace
@@ -192,8 +177,6 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
         poly.corner_normal.push_back(has_normal ? resolve(part[2], poly.normals.size(), 'n') : Polygons::kNoNormal);
       }
       poly.end_polygon();
-    } else if (kw == "mtllib") {
-      check_material_library(file, trim(line.substr(kw.size())), ln);
     } else if (!obj_ignored_keyword(kw)) {
       throw InputError(file.name, at_line(ln) + "not an OBJ statement: " + shown(line));
     }

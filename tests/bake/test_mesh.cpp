@@ -182,14 +182,13 @@ INSTANTIATE_TEST_SUITE_P(Data, RealMeshes,
                            return std::string(p.param.name).substr(0, std::strlen(p.param.name) - 4);
                          });
 
-TEST(MeshLoad, SpiderHardEdgesSplitAndMissingMtlIsAWarning) {
+TEST(MeshLoad, SpiderHardEdgesSplitAndItsMissingMtlIsNotReported) {
   const Mesh m = prt::bake::load_mesh(fs::path(PRT_DATA_DIR) / "spider.obj");
   // 918 distinct (v, vn) pairs over 762 positions (counted with awk over the file).
   EXPECT_EQ(m.positions.size(), 918u);
   EXPECT_EQ(m.file_positions, 762u);
-  const bool mtl = std::any_of(m.warnings.begin(), m.warnings.end(),
-                               [](const std::string& w) { return w.find("spider.mtl") != std::string::npos; });
-  EXPECT_TRUE(mtl) << "the missing spider.mtl must be reported as a warning, not lost";
+  // spider.mtl is missing; materials do not matter to a bake, so nothing is said about it.
+  EXPECT_TRUE(m.warnings.empty()) << m.warnings.front();
 }
 
 // --- one geometry in every format -------------------------------------------------------------
@@ -526,15 +525,13 @@ TEST(MeshLoad, SourceSha256IsTheDigestOfTheBytesRead) {
   EXPECT_EQ(prt::bake::make_mesh(t.positions, t.triangles, "memory").source_sha256, "") << "no file, no digest";
 }
 
-TEST(MeshLoad, MissingMaterialLibraryIsOneWarningNamingIt) {
+TEST(MeshLoad, MaterialLibrariesAreNeitherReadNorReported) {
+  // Reader chatter about materials ("material file not found") is not a prtbake warning: a bake
+  // does not use materials. The geometry is read as usual.
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib nowhere.mtl\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n";
   const Mesh m = prt::bake::load_mesh(write_file("mtl.obj", tri));
-  ASSERT_EQ(m.warnings.size(), 1u);
-  EXPECT_NE(m.warnings[0].find("line 4"), std::string::npos) << m.warnings[0];
-  EXPECT_NE(m.warnings[0].find("nowhere.mtl"), std::string::npos) << m.warnings[0];
-  write_file("present.mtl", "newmtl a\n");
-  const Mesh p = prt::bake::load_mesh(write_file("mtl2.obj", "mtllib present.mtl\n" + tri));
-  EXPECT_EQ(p.warnings.size(), 1u) << "only the missing library is reported";
+  EXPECT_TRUE(m.warnings.empty()) << m.warnings.front();
+  EXPECT_EQ(m.triangles.size(), 2u);
 }
 
 TEST(MeshBuild, PolygonsToMeshIsTheStepEveryReaderShares) {

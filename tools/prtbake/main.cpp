@@ -365,7 +365,7 @@ std::string timestamp(bool reproducible) {
   return buf;
 }
 
-// Prints reader warnings once each, with a count for repeats (a missing .mtl repeats per face).
+// Prints reader warnings once each, with a count for repeats.
 void print_warnings(const std::vector<std::string>& warnings) {
   std::vector<std::pair<std::string, size_t>> seen;
   for (const auto& w : warnings) {

@@ -77,8 +77,9 @@
 // with a line number where the format has lines: missing/unreadable/oversized file, unknown
 // extension, empty mesh, truncated or garbled file (an OBJ line with an unknown keyword is
 // garbage), NaN/Inf or out-of-float-range coordinates, zero / negative / out-of-range face
-// indices, faces with fewer than 3 corners. A missing OBJ material library is not an error (a bake
-// does not use materials): it goes to Mesh::warnings. Binary OFF is not supported (InputError).
+// indices, faces with fewer than 3 corners. An OBJ's material library (`mtllib`) is never
+// opened and a missing one is not reported: a bake does not use materials, and a line about it
+// would be noise (Mesh::warnings holds only what matters to the bake). Binary OFF is not supported (InputError).
 // glTF: tinygltf's own parse errors (JSON, GLB container, missing or short buffers), and ours:
 // no scene, a reference to a node / mesh / accessor / buffer view / buffer that does not exist,
 // an accessor past its buffer view or a view past its buffer, an index out of range, a
