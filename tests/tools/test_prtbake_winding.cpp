@@ -63,8 +63,8 @@ TEST(PrtbakeWinding, InwardBoxWarnsAndBakesNoSky) {
     ASSERT_EQ(b.run.code, 0) << b.run.err;
     // Before the bake, the winding; after it, the share of vertices that saw no sky.
     EXPECT_EQ(b.run.err, kInwardWarning +
-                             "prtbake: warning: 100.0% of vertices (8 of 8) see no sky at all: their normals may point "
-                             "inside the mesh; check the mesh's normals and winding, or rerun with --flip-normals\n");
+                             "prtbake: warning: 100.0% of vertices (8 of 8) see no sky at all: some closed parts are "
+                             "wound inwards (see above)\n");
     ASSERT_TRUE(b.asset.vertices.ao);
     ASSERT_EQ(b.asset.vertices.ao->values.size(), 8u);
     // Every vertex's hemisphere is the inside of the box: every ray hits / the point is enclosed.
@@ -110,6 +110,33 @@ TEST(PrtbakeWinding, FlippingAnOutwardBoxSaysToRerunWithout) {
   ASSERT_EQ(b.run.code, 0) << b.run.err;
   EXPECT_NE(b.run.err.find("1 of 1 closed components (12 triangles) are wound inwards"), std::string::npos) << b.run.err;
   EXPECT_NE(b.run.err.find("rerun without --flip-normals"), std::string::npos) << b.run.err;
+}
+
+TEST(PrtbakeWinding, PartsInsidePartsAreCalledEnclosedNotInwards) {
+  // Two small boxes inside a big one, all wound outwards (an engine's internals under its
+  // housing): 16 of 24 vertices see no sky, and the warning says why instead of suggesting a flip.
+  const fs::path p = scratch("nested.obj");
+  {
+    static const int kQuads[6][4] = {{1, 3, 4, 2}, {5, 6, 8, 7}, {1, 2, 6, 5}, {3, 7, 8, 4}, {1, 5, 7, 3}, {2, 4, 8, 6}};
+    std::ofstream out(p);
+    const double lo[3] = {-4, 0.2, 0.6}, size[3] = {8, 0.2, 0.3};  // the big box, then two small ones
+    for (int b = 0; b < 3; ++b)
+      for (int k = 0; k < 8; ++k)
+        out << "v " << lo[b] + size[b] * (k & 1) << ' ' << lo[b] + size[b] * ((k >> 1) & 1) << ' '
+            << lo[b] + size[b] * ((k >> 2) & 1) << '\n';
+    for (int b = 0; b < 3; ++b)
+      for (const auto& q : kQuads) out << "f " << 8 * b + q[0] << ' ' << 8 * b + q[1] << ' ' << 8 * b + q[2] << ' ' << 8 * b + q[3] << '\n';
+  }
+  for (const std::string integrator : {"silhouette", "qmc"}) {
+    SCOPED_TRACE(integrator);
+    const Baked b = bake(p, "--integrator " + integrator);
+    ASSERT_EQ(b.run.code, 0) << b.run.err;
+    EXPECT_EQ(b.run.err,
+              "prtbake: warning: 66.7% of vertices (16 of 24) see no sky at all: all 3 closed parts are wound outwards, "
+              "so most of these vertices are enclosed by other geometry (parts inside or pushed into other parts); if "
+              "that is not so, check the mesh's normals, or rerun with --flip-normals\n");
+    for (size_t v = 8; v < 24; ++v) EXPECT_EQ(b.asset.vertices.ao->values[v], 0.0f) << v;
+  }
 }
 
 } // namespace

@@ -398,13 +398,25 @@ void warn_inward(const bake::WindingFacts& facts, bool flipped) {
                inward, facts.closed.size(), facts.inward_triangles(), fix.c_str());
 }
 
-// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky).
-void warn_no_sky(const bake::NoSkyCount& count, bool flipped) {
+// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky). The winding
+// facts say which explanation fits: closed parts wound inwards (fixable), or none of that, and then
+// the vertices are enclosed by other geometry (an engine's internals under its housing, parts
+// pushed into each other), which the bake reports as it is.
+void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts, bool flipped) {
   if (!(count.share() > 0.5)) return;
-  std::fprintf(stderr,
-               "prtbake: warning: %.1f%% of vertices (%zu of %zu) see no sky at all: their normals may point "
-               "inside the mesh; check the mesh's normals and winding, or %s\n",
-               100 * count.share(), count.vertices, count.total, flip_fix(flipped));
+  std::string why;
+  if (facts.inward_components() > 0) {
+    why = "some closed parts are wound inwards (see above)";
+  } else if (!facts.closed.empty()) {
+    why = "all " + std::to_string(facts.closed.size()) +
+          " closed parts are wound outwards, so most of these vertices are enclosed by other geometry (parts inside or "
+          "pushed into other parts); if that is not so, check the mesh's normals, or " + flip_fix(flipped);
+  } else {
+    why = "the mesh has no closed part to judge its winding by: its normals may point inside the geometry; check them, or " +
+          std::string(flip_fix(flipped));
+  }
+  std::fprintf(stderr, "prtbake: warning: %.1f%% of vertices (%zu of %zu) see no sky at all: %s\n",
+               100 * count.share(), count.vertices, count.total, why.c_str());
 }
 
 std::string human_bytes(uintmax_t b) {
@@ -458,7 +470,8 @@ int run_vertex(const Args& a) {
                 a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
                 mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
                 a.flip_normals ? ", flipped" : "");
-  warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
+  const bake::WindingFacts winding = bake::winding_facts(mesh, topo);
+  warn_inward(winding, a.flip_normals);
 
   std::optional<bake::EnvMap> env;
   if (!a.environment.empty()) {
@@ -496,7 +509,7 @@ int run_vertex(const Args& a) {
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
-  warn_no_sky(bake::count_no_sky(result), a.flip_normals);
+  warn_no_sky(bake::count_no_sky(result), winding, a.flip_normals);
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
                 mesh.positions.size() / result.seconds);
