@@ -58,16 +58,17 @@ std::string safe_name(const std::string& stem) {
 
 void set_mesh(F::VertexSet& set, const bake::Mesh& mesh) {
   const size_t V = mesh.positions.size(), T = mesh.triangles.size();
-  std::vector<float> pos(3 * V), nrm(3 * V);
+  std::vector<double> pos(3 * V);  // world space: origin + offset in double (float32 on disk when exact)
+  std::vector<float> nrm(3 * V);
   for (size_t i = 0; i < V; ++i)
     for (int k = 0; k < 3; ++k) {
-      pos[3 * i + size_t(k)] = mesh.positions[i][k];
+      pos[3 * i + size_t(k)] = mesh.world_position(i)[k];
       nrm[3 * i + size_t(k)] = mesh.normals[i][k];
     }
   std::vector<uint32_t> tri(3 * T);
   for (size_t i = 0; i < T; ++i)
     for (int k = 0; k < 3; ++k) tri[3 * i + size_t(k)] = mesh.triangles[i][size_t(k)];
-  set.positions = F::Array<float>{std::move(pos), {}};
+  set.positions = F::Array<double>{std::move(pos), {}};
   set.normals = F::Normals{std::move(nrm),
                            mesh.normal_source == bake::Mesh::NormalSource::File ? "file" : "angle-weighted", {}};
   set.triangles = F::Array<uint32_t>{std::move(tri), {}};
