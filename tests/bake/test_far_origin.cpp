@@ -3,6 +3,7 @@
 // original; ordinary meshes keep origin 0 and the floats they always had.
 #include <bake/integrator.h>
 #include <bake/mesh.h>
+#include <bake/scene.h>
 #include <bake/vertex_bake.h>
 
 #include <gtest/gtest.h>
@@ -162,6 +163,32 @@ TEST(FarOrigin, QmcAoFlipsAtMostAFewGrazingRays) {
   EXPECT_LE(differing, a.size() / 100) << "more than 1% of vertices changed";
   EXPECT_LE(worst, 2.0 / 1024 + 1e-6) << "more than two rays flipped at one vertex";
   EXPECT_LE(std::abs(sum_a - sum_b) / double(a.size()), 1e-6 + double(differing) * 2.0 / 1024 / double(a.size()));
+}
+
+// The same bunny moved by a scene transform (translation · scale, applied in double to the
+// file's positions): the same values as the 17-digit file, to the same tolerance and reason.
+TEST(FarOrigin, SceneTransformBakesTheOriginalsAo) {
+  const BunnyPair& p = bunny_pair();
+  prt::bake::SceneObject object;
+  object.name = "bunny";
+  object.mesh = fs::path(PRT_DATA_DIR) / "bunny.obj";
+  object.world_from_object.topLeftCorner<3, 3>() *= kScale;
+  object.world_from_object.topRightCorner<3, 1>() = kShift;
+  const Eigen::Vector3d origin = prt::bake::scene_origin(std::span(&p.near, 1), std::span(&object, 1));
+  EXPECT_NE(origin, Vector3d::Zero());
+  const Mesh placed = prt::bake::place_scene_object(p.near, object, origin);
+  EXPECT_EQ(placed.origin, origin);
+  for (size_t v = 0; v < placed.positions.size(); ++v)
+    ASSERT_LE((placed.world_position(v) - p.far_world[v]).norm(), 1e-10) << v;
+  const auto a = bake_ao(p.near, prt::bake::IntegratorKind::Silhouette);
+  const auto b = bake_ao(placed, prt::bake::IntegratorKind::Silhouette);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t v = 0; v < a.size(); ++v) EXPECT_NEAR(a[v], b[v], 1e-6) << "vertex " << v;
+  // An ordinary scene (identity) keeps origin 0 and the file's floats bit for bit.
+  prt::bake::SceneObject plain = object;
+  plain.world_from_object.setIdentity();
+  EXPECT_EQ(prt::bake::scene_origin(std::span(&p.near, 1), std::span(&plain, 1)), Vector3d::Zero());
+  EXPECT_EQ(prt::bake::place_scene_object(p.near, plain, Vector3d::Zero()).positions, p.near.positions);
 }
 
 // Two vertices a quarter float ulp apart at 1e5 (float32 would merge them): distinct offsets,

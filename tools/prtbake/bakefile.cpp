@@ -151,7 +151,8 @@ F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, 
   o.environment = env_path;
   o.environment_sha256 = env.info().sha256;
   o.integrand = "F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]";
-  o.centre = {shells.centre.x(), shells.centre.y(), shells.centre.z()};
+  const Eigen::Vector3d centre = shells.world_centre();
+  o.centre = {centre.x(), centre.y(), centre.z()};
   o.radius = shells.radius;
   o.radii = shells.radii;
   o.angular_convention = "s = centre + rho_k d(theta_i, phi_j), theta_i = pi i/(Ntheta-1) from +Y, phi_j = 2 pi "

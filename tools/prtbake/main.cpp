@@ -595,17 +595,24 @@ int run_scene(const Args& a) {
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
 
-  std::vector<bake::Mesh> meshes;
-  std::vector<std::string> mesh_sha;
-  for (const auto& o : scene.objects) {
+  // Each object's file, then all of them placed in the scene's one frame (bake/scene.h).
+  auto for_object = [&](const bake::SceneObject& o, auto&& step) {
     try {
-      meshes.push_back(bake::load_scene_mesh(o));
+      step();
     } catch (const bake::InputError& e) {  // say which object of which scene wanted the mesh
       throw bake::InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + a.input + ")");
     }
+  };
+  std::vector<bake::Mesh> meshes;
+  std::vector<std::string> mesh_sha;
+  for (const auto& o : scene.objects) {
+    for_object(o, [&] { meshes.push_back(bake::load_mesh(o.mesh)); });
     mesh_sha.push_back(meshes.back().source_sha256);
     print_warnings(meshes.back().warnings);
   }
+  const Eigen::Vector3d origin = bake::scene_origin(meshes, scene.objects);
+  for (size_t i = 0; i < meshes.size(); ++i)
+    for_object(scene.objects[i], [&] { meshes[i] = bake::place_scene_object(meshes[i], scene.objects[i], origin); });
   std::optional<bake::EnvMap> env;
   if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
   const bake::ScenePlan plan = bake::plan_scene(scene, meshes);

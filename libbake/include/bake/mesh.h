@@ -113,6 +113,12 @@
 
 namespace prt::bake {
 
+// origin + offset in double; with origin 0 the offset as is (so a −0 stays −0: ordinary files
+// keep their bytes).
+inline Eigen::Vector3d add_origin(const Eigen::Vector3d& origin, const Eigen::Vector3d& offset) {
+  return origin == Eigen::Vector3d::Zero() ? offset : Eigen::Vector3d(origin + offset);
+}
+
 struct Mesh {
   std::vector<Eigen::Vector3f> positions;              // one per output vertex, relative to origin (file comment: ORIGIN)
   std::vector<Eigen::Vector3f> normals;                // unit, one per output vertex
@@ -124,7 +130,7 @@ struct Mesh {
   std::vector<std::string> warnings;                   // non-fatal reader messages (e.g. missing .mtl), one line each
   std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();    // world = origin + positions[v], in double (frame_origin)
-  Eigen::Vector3d world_position(size_t v) const { return origin + positions[v].cast<double>(); }
+  Eigen::Vector3d world_position(size_t v) const { return add_origin(origin, positions[v].cast<double>()); }
 };
 
 // The origin rule of the file comment (ORIGIN) for world-space bounds [lo, hi] (lo <= hi).
