@@ -91,4 +91,43 @@ TEST(PrtbakeFar, OrdinaryMeshPositionsStayFloat32) {
   EXPECT_EQ(F::dtype_name(d->data), "float32");
 }
 
+// `prtbake scene` with a ground (receiver) and the bunny on it (both), as given and moved far away
+// by the same transform: the scene's one origin keeps receivers and occluders in one frame, so
+// the ground's and the bunny's AO equal the near scene's within 1e-6 (why that bound:
+// tests/bake/test_far_origin.cpp), and the far positions are float64.
+TEST(PrtbakeFar, FarSceneTransformBakesTheNearScenesAo) {
+  const fs::path data = PRT_DATA_DIR;
+  auto bake_scene = [&](const std::string& name, const std::string& transform) {
+    const fs::path scene = scratch(name + ".json"), out = scratch(name + ".prt.h5");
+    std::ofstream(scene) << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "samples": 1024, "report": 0},
+      "objects": [
+        {"name": "ground", "mesh": ")" << (data / "ground.obj").string() << R"(", "role": "receiver", "transform": )" << transform << R"(},
+        {"name": "bunny", "mesh": ")" << (data / "bunny.obj").string() << R"(", "role": "both", "transform": )" << transform << R"(}]})";
+    fs::remove(out);
+    const auto run = prt::testing::run_tool(PRT_PRTBAKE, "scene '" + scene.string() + "' --quiet -o '" + out.string() + "'",
+                                            scratch("capture"));
+    EXPECT_EQ(run.code, 0) << run.err;
+    return F::read_asset(out);
+  };
+  const F::Asset near = bake_scene("near_scene", R"({"scale": 1})");
+  const F::Asset far = bake_scene("far_scene", R"({"translate": [100000, -200000, 300000], "scale": 0.0001})");
+  ASSERT_EQ(near.objects.size(), 2u);
+  ASSERT_EQ(far.objects.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    SCOPED_TRACE(near.objects[i].name);
+    ASSERT_TRUE(near.objects[i].set.ao && far.objects[i].set.ao);
+    const auto& a = near.objects[i].set.ao->values;
+    const auto& b = far.objects[i].set.ao->values;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t v = 0; v < a.size(); ++v) ASSERT_NEAR(a[v], b[v], 1e-6) << "vertex " << v;
+    // World positions: the near ones moved by the transform, up to the float rounding of the
+    // offsets from the scene origin (at most half the scene's extent, 40 × 1e-4 / 2, times
+    // 2^-24) and the double rounding of the sums (2^-52 × 3e5).
+    const auto& p = near.objects[i].set.positions->values;
+    const auto& q = far.objects[i].set.positions->values;
+    const double shift[3] = {1e5, -2e5, 3e5}, tolerance = 2e-3 * 0x1p-24 + 3e5 * 0x1p-52;
+    for (size_t k = 0; k < p.size(); ++k) ASSERT_NEAR(q[k], shift[k % 3] + 1e-4 * p[k], tolerance) << k;
+  }
+}
+
 } // namespace
