@@ -192,6 +192,17 @@ TEST(FarOrigin, SceneTransformBakesTheOriginalsAo) {
   EXPECT_EQ(prt::bake::place_scene_object(p.near, plain, Vector3d::Zero()).positions, p.near.positions);
 }
 
+// Reading in double never changes the float a coordinate had: the text just above the float
+// midpoint 1 + 2^-24 has that midpoint as its nearest double, which rounds (ties to even) down to
+// 1, while the text's own correctly rounded float is 1 + 2^-23; the reader moves the double one
+// ulp up so the mesh keeps 1 + 2^-23, as when it read floats.
+TEST(FarOrigin, DoubleReadingKeepsTheCorrectlyRoundedFloat) {
+  const std::string obj = "v 0 0 0\nv 1.0000000596046447753906250001 0 0\nv 0 1 0\nf 1 2 3\n";
+  const Mesh m = prt::bake::load_mesh(prt::testing::write_test_file(prt::testing::test_dir("far_origin"), "midpoint.obj", obj));
+  EXPECT_EQ(m.origin, Vector3d::Zero());
+  EXPECT_EQ(m.positions[1].x(), std::nextafter(1.0f, 2.0f));
+}
+
 // Two vertices a quarter float ulp apart at 1e5 (float32 would merge them): distinct offsets,
 // distinct welded positions, distinct world positions.
 TEST(FarOrigin, VerticesCloserThanAFloatUlpStayApart) {
