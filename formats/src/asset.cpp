@@ -198,9 +198,17 @@ void add_report(File& f, const std::string& dir, const Report& r) {
               r.vertices->extra);
 }
 
+// Positions on disk: float32 when every coordinate is a float32 exactly, else float64 (asset.h).
+DatasetData positions_data(const std::vector<double>& values) {
+  const bool all_float = std::all_of(values.begin(), values.end(),
+                                     [](double x) { return static_cast<double>(static_cast<float>(x)) == x; });
+  if (!all_float) return values;
+  return std::vector<float>(values.begin(), values.end());
+}
+
 void add_vertex_set(File& f, const std::string& prefix, const std::string& report_dir, const VertexSet& s) {
   const uint64_t V = s.vertex_count();
-  if (s.positions) add_array(f, cat(prefix, N::kPositions), {V, 3}, s.positions->values, s.positions->extra);
+  if (s.positions) add_array(f, cat(prefix, N::kPositions), {V, 3}, positions_data(s.positions->values), s.positions->extra);
   if (s.normals)
     add_array(f, cat(prefix, N::kNormals), {s.normals->values.size() / 3, 3}, s.normals->values,
               attrs_of<Normals>(*s.normals, kNormalsFields, s.normals->extra));
@@ -278,7 +286,10 @@ std::string_view after(std::string_view path, std::string_view prefix) {
 
 void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
   switch (kind) {
-  case DatasetKind::positions: s.positions = array_of<float>(d); break;
+  case DatasetKind::positions:  // float32 widened exactly, or float64
+    if (const auto* f = std::get_if<std::vector<float>>(&d.data)) s.positions = Array<double>{{f->begin(), f->end()}, d.attrs};
+    else s.positions = array_of<double>(d);
+    break;
   case DatasetKind::normals:
     s.normals.emplace().values = values<float>(d);
     take_attrs<Normals>(*s.normals, kNormalsFields, d.attrs, s.normals->extra);

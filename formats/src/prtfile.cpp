@@ -29,7 +29,8 @@ std::string_view dtype_name(const DatasetData& data) {
   switch (data.index()) {
   case 0: return "float32";
   case 1: return "uint32";
-  default: return "uint8";
+  case 2: return "uint8";
+  default: return "float64";
   }
 }
 

@@ -153,8 +153,11 @@ public:
       } else if (tclass == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_NONE && size == 1) {
         out.data = std::vector<uint8_t>(n);
         buf = std::get<2>(out.data).data(), mem = H5T_NATIVE_UINT8;
+      } else if (tclass == H5T_FLOAT && size == 8) {
+        out.data = std::vector<double>(n);
+        buf = std::get<3>(out.data).data(), mem = H5T_NATIVE_DOUBLE;
       } else {
-        fail(name + " has an unsupported type (schema v1 uses float32, uint32 and uint8)");
+        fail(name + " has an unsupported type (the schema uses float32, float64, uint32 and uint8)");
       }
     } catch (const std::bad_alloc&) {
       fail(name + " is too large to read (" + std::to_string(n) + " values)");

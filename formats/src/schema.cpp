@@ -191,7 +191,7 @@ public:
   }
 
   void dtype(const Dataset& d, std::size_t want) const {
-    static constexpr std::array<std::string_view, 3> names = {"float32", "uint32", "uint8"};
+    static constexpr std::array<std::string_view, 4> names = {"float32", "uint32", "uint8", "float64"};
     if (d.data.index() != want)
       fail("dataset '" + d.path + "' must be " + std::string(names[want]) + ", not " +
            std::string(dtype_name(d.data)));
@@ -279,12 +279,16 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     if (n != element_count(d.data))
       c.fail("dataset '" + d.path + "' has " + std::to_string(element_count(d.data)) +
              " values but shape " + shape_str(d.shape) + " needs " + std::to_string(n));
-    if (const auto* f = std::get_if<std::vector<float>>(&d.data))
-      for (std::size_t i = 0; i < f->size(); ++i)
-        if (!std::isfinite((*f)[i]))
-          c.fail("dataset '" + d.path + "' has a non-finite value (" +
-                 (std::isnan((*f)[i]) ? std::string("NaN") : std::string("Inf")) +
-                 ") at index " + std::to_string(i) + " " + index_str(i, d.shape));
+    std::visit(
+        [&]<class T>(const std::vector<T>& f) {
+          if constexpr (std::is_floating_point_v<T>)
+            for (std::size_t i = 0; i < f.size(); ++i)
+              if (!std::isfinite(f[i]))
+                c.fail("dataset '" + d.path + "' has a non-finite value (" +
+                       (std::isnan(f[i]) ? std::string("NaN") : std::string("Inf")) + ") at index " +
+                       std::to_string(i) + " " + index_str(i, d.shape));
+        },
+        d.data);
     c.attrs(d.attrs, "dataset '" + d.path + "'");
   }
 
@@ -315,7 +319,10 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.fail("dataset '" + d.path + "' is per-vertex but the file has no " + mesh_positions + " to " +
              "define the vertex count V");
     switch (k) {
-    case Kind::positions:
+    case Kind::positions:  // float32, or float64 where float32 would lose precision (SCHEMA.md)
+      if (d.data.index() != 3) c.dtype(d, 0);
+      c.shape(d, {V, 3}, "[V, 3]");
+      break;
     case Kind::normals:
       c.dtype(d, 0);
       c.shape(d, {V, 3}, "[V, 3]");

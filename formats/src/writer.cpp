@@ -105,6 +105,7 @@ public:
     std::visit([&](const auto& v) { buf = v.data(); }, d.data);
     if (d.data.index() == 1) file_type = H5T_STD_U32LE, mem_type = H5T_NATIVE_UINT32;
     if (d.data.index() == 2) file_type = H5T_STD_U8LE, mem_type = H5T_NATIVE_UINT8, elem = 1;
+    if (d.data.index() == 3) file_type = H5T_IEEE_F64LE, mem_type = H5T_NATIVE_DOUBLE, elem = 8;
 
     Hid dcpl = check(detail::plist_id(H5Pcreate(H5P_DATASET_CREATE)), "cannot create properties of " + name);
     check(H5Pset_obj_track_times(dcpl.get(), false), "cannot disable time tracking of " + name);

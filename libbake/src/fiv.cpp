@@ -161,6 +161,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
   FivShells out;
   bounding_sphere(occluder, out.centre, out.radius);
+  out.origin = occluder.origin;
   out.n_phi = spec.n_phi;
   out.n_theta = spec.n_theta;
   ProductRequest req;

@@ -227,8 +227,8 @@ class Reader {
       for (size_t i = 0; i < positions.count; ++i) {
         const Eigen::Vector3d local = vec3(positions, i);
         if (!local.allFinite()) fail(name + " POSITION " + std::to_string(i) + " is not finite (NaN or Inf)");
-        const Eigen::Vector3f world_position = (world * local.homogeneous()).head<3>().cast<float>();
-        if (!world_position.allFinite()) fail(name + " POSITION " + std::to_string(i) + " leaves the float range under node " + std::to_string(node) + "'s transform");
+        const Eigen::Vector3d world_position = (world * local.homogeneous()).head<3>();  // kept in double
+        if (!world_position.cast<float>().allFinite()) fail(name + " POSITION " + std::to_string(i) + " leaves the float range under node " + std::to_string(node) + "'s transform");
         out_.positions.push_back(world_position);
         if (normals) {
           const Eigen::Vector3d n = cofactor * vec3(*normals, i);

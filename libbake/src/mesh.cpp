@@ -75,6 +75,26 @@ Eigen::Vector3f unit_or_up(const Eigen::Vector3d& s) {
 
 } // namespace
 
+Eigen::Vector3d frame_origin(const Eigen::AlignedBox3d& world_bounds) {
+  PRT_CHECK(!world_bounds.isEmpty());
+  const Eigen::Vector3d lo = world_bounds.min(), hi = world_bounds.max();
+  const double reach = lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).maxCoeff();
+  const double extent = (hi - lo).maxCoeff();
+  if (reach <= kNearOrigin * extent) return Eigen::Vector3d::Zero();
+  return lo + (hi - lo) / 2;  // the centre, without overflow
+}
+
+std::vector<Eigen::Vector3f> offsets_from(std::span<const Eigen::Vector3d> world, const Eigen::Vector3d& origin,
+                                          const std::string& source) {
+  std::vector<Eigen::Vector3f> out(world.size());
+  for (size_t v = 0; v < world.size(); ++v) {
+    out[v] = (world[v] - origin).cast<float>();
+    if (!out[v].allFinite())
+      throw InputError(source, "vertex " + std::to_string(v) + " is out of float range relative to the mesh origin");
+  }
+  return out;
+}
+
 std::vector<Eigen::Vector3f> angle_weighted_normals(std::span<const Eigen::Vector3f> positions,
                                                     std::span<const std::array<uint32_t, 3>> triangles) {
   std::vector<Eigen::Vector3d> sum(positions.size(), Eigen::Vector3d::Zero());
@@ -239,6 +259,15 @@ Mesh merge_meshes(std::span<const Mesh> parts, std::string name) {
     n_triangles += m.triangles.size();
   }
   PRT_CHECK_OP(n_vertices, <, size_t{std::numeric_limits<uint32_t>::max()});
+  // One frame for all parts: theirs if they share it, else the rule over their world bounds.
+  const bool same_origin = std::all_of(parts.begin(), parts.end(), [&](const Mesh& m) { return m.origin == parts[0].origin; });
+  out.origin = parts[0].origin;
+  if (!same_origin) {
+    Eigen::AlignedBox3d bounds;
+    for (const Mesh& m : parts)
+      for (size_t v = 0; v < m.positions.size(); ++v) bounds.extend(m.world_position(v));
+    out.origin = bounds.isEmpty() ? Eigen::Vector3d::Zero() : frame_origin(bounds);
+  }
   out.positions.reserve(n_vertices);
   out.normals.reserve(n_vertices);
   out.source_position.reserve(n_vertices);
@@ -247,7 +276,14 @@ Mesh merge_meshes(std::span<const Mesh> parts, std::string name) {
     const auto vertex_offset = static_cast<uint32_t>(out.positions.size());
     const size_t position_offset = out.file_positions;
     PRT_CHECK_OP(position_offset + m.file_positions, <, size_t{std::numeric_limits<uint32_t>::max()});
-    out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
+    if (m.origin == out.origin) {
+      out.positions.insert(out.positions.end(), m.positions.begin(), m.positions.end());
+    } else {
+      std::vector<Eigen::Vector3d> world(m.positions.size());
+      for (size_t v = 0; v < world.size(); ++v) world[v] = m.world_position(v);
+      const auto offsets = offsets_from(world, out.origin, out.source);
+      out.positions.insert(out.positions.end(), offsets.begin(), offsets.end());
+    }
     out.normals.insert(out.normals.end(), m.normals.begin(), m.normals.end());
     for (uint32_t s : m.source_position) out.source_position.push_back(s + static_cast<uint32_t>(position_offset));
     for (const auto& t : m.triangles)

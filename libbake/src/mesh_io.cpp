@@ -122,7 +122,8 @@ void validate(const Polygons& poly, const std::string& source, bool use_normals)
   PRT_CHECK(poly.corner_normal.empty() || poly.corner_normal.size() == poly.corner_position.size());
   if (n_positions >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too large for 32-bit indices");
   for (size_t v = 0; v < n_positions; ++v)
-    if (!poly.positions[v].allFinite()) throw InputError(source, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+    if (!poly.positions[v].allFinite() || !poly.positions[v].cast<float>().allFinite())
+      throw InputError(source, "vertex " + std::to_string(v) + " has a non-finite coordinate (or one out of float range)");
   size_t triangles = 0;
   for (size_t f = 0; f < n_polygons; ++f) {
     const uint32_t b = poly.offsets[f], e = poly.offsets[f + 1];
@@ -163,7 +164,10 @@ Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions&
   std::vector<uint8_t> claimed(n_file, 0);
   std::vector<CornerKey> row_key(n_file);
   std::unordered_map<CornerKey, uint32_t, CornerKeyHash> splits;
-  mesh.positions = poly.positions;
+  Eigen::AlignedBox3d bounds;
+  for (const Eigen::Vector3d& p : poly.positions) bounds.extend(p);
+  mesh.origin = frame_origin(bounds);  // not empty: validate() found a polygon, so a position
+  mesh.positions = offsets_from(poly.positions, mesh.origin, source);
   mesh.source_position.resize(n_file);
   for (uint32_t v = 0; v < n_file; ++v) mesh.source_position[v] = v;
   std::vector<uint32_t> corner_vertex(poly.corner_position.size());
@@ -181,7 +185,8 @@ Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions&
     } else {
       const auto [it, inserted] = splits.try_emplace(key, static_cast<uint32_t>(mesh.positions.size()));
       if (inserted) {
-        mesh.positions.push_back(poly.positions[p]);
+        const Eigen::Vector3f offset = mesh.positions[p];
+        mesh.positions.push_back(offset);
         mesh.source_position.push_back(p);
         vertex_file_normal.push_back(n);
       }

@@ -71,18 +71,36 @@ std::string parse_float(std::string_view tok, float& value) {
   return {};
 }
 
+// A finite coordinate, whole token, in double: the nearest double to the text, except where that
+// double lies exactly halfway between two floats and rounding it to float would not give the
+// correctly rounded float of the text (double rounding); it is then moved one double ulp towards
+// that float. So float(value) is always what parse_float gives: a mesh read in double and
+// rounded to float once (bake/mesh.h, origin 0) has the positions it had when read in float.
+// Range errors are parse_float's (a coordinate must be a finite float).
+std::string parse_coordinate(std::string_view tok, double& value) {
+  float f = 0;
+  if (auto defect = parse_float(tok, f); !defect.empty()) return defect;
+  std::from_chars(tok.data(), tok.data() + tok.size(), value);  // succeeds where the float parse did
+  if (static_cast<float>(value) != f) value = std::nextafter(value, static_cast<double>(f));
+  return {};
+}
+std::string parse_real(std::string_view tok, float& value) { return parse_float(tok, value); }
+std::string parse_real(std::string_view tok, double& value) { return parse_coordinate(tok, value); }
+
 bool parse_int(std::string_view tok, long long& value) {
   const char* end = tok.data() + tok.size();
   auto [ptr, ec] = std::from_chars(tok.data(), end, value);
   return ec == std::errc() && ptr == end;
 }
 
-// Three floats from tokens [first, first + 3), or InputError at `line`.
-Eigen::Vector3f parse_vec3(const SourceFile& file, std::span<const std::string_view> tok, size_t line) {
-  Eigen::Vector3f v;
-  for (int k = 0; k < 3; ++k)
-    if (auto defect = parse_float(tok[static_cast<size_t>(k)], v[k]); !defect.empty())
+// Three values from tokens [first, first + 3), or InputError at `line`: normals in float
+// (parse_float), positions in double (parse_coordinate).
+template <class Vec> Vec parse_vec3(const SourceFile& file, std::span<const std::string_view> tok, size_t line) {
+  Vec v;
+  for (int k = 0; k < 3; ++k) {
+    if (auto defect = parse_real(tok[static_cast<size_t>(k)], v[k]); !defect.empty())
       throw InputError(file.name, at_line(line) + defect);
+  }
   return v;
 }
 
@@ -132,7 +150,9 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
     const std::string_view kw = tok[0];
     if (kw == "v" || kw == "vn") {
       if (tok.size() < 4) throw InputError(file.name, at_line(ln) + "'" + std::string(kw) + "' needs 3 coordinates");
-      (kw == "v" ? poly.positions : poly.normals).push_back(parse_vec3(file, std::span(tok).subspan(1), ln));
+      const auto values = std::span(tok).subspan(1);
+      if (kw == "v") poly.positions.push_back(parse_vec3<Eigen::Vector3d>(file, values, ln));
+      else poly.normals.push_back(parse_vec3<Eigen::Vector3f>(file, values, ln));
     } else if (kw == "vt") {
       float x = 0;
       if (tok.size() < 3) throw InputError(file.name, at_line(ln) + "'vt' needs 2 coordinates");
@@ -217,7 +237,7 @@ int ply_size(PlyType t) {
   return 0;
 }
 
-// One binary PLY value, widened: integers exactly, float64 rounded to float only by the caller.
+// One binary PLY value, widened: integers and floats exactly (normals are rounded to float by the slot).
 struct PlyValue {
   long long integer = 0;
   double real = 0;
@@ -245,7 +265,21 @@ PlyValue ply_binary_value(const char* p, PlyType t, bool big_endian) {
 }
 
 // What the reader does with a vertex property: coordinate k of the position or of the normal.
-struct VertexSlot { Eigen::Vector3f* target = nullptr; int axis = 0; };
+struct VertexSlot {
+  Eigen::Vector3d* position = nullptr;
+  Eigen::Vector3f* normal = nullptr;
+  int axis = 0;
+  explicit operator bool() const { return position || normal; }
+  // Parses the ascii value into the slot; the defect, or empty.
+  std::string parse(std::string_view tok) const {
+    return position ? parse_coordinate(tok, (*position)[axis]) : parse_float(tok, (*normal)[axis]);
+  }
+  // Stores a binary value: positions keep it (float32 widens exactly), normals round to float.
+  void store(double v) const {
+    if (position) (*position)[axis] = v;
+    else (*normal)[axis] = static_cast<float>(v);
+  }
+};
 
 } // namespace
 
@@ -320,7 +354,7 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
           throw InputError(file.name, std::string("PLY vertex element has no '") + axis + "' property");
       has_normals = std::any_of(e.props.begin(), e.props.end(),
                                 [](const PlyProperty& p) { return !p.list && (p.name == "nx" || p.name == "ny" || p.name == "nz"); });
-      poly.positions.assign(e.count, Eigen::Vector3f::Zero());
+      poly.positions.assign(e.count, Eigen::Vector3d::Zero());
       if (has_normals) poly.normals.assign(e.count, Eigen::Vector3f::Zero());
     }
     if (e.name == "face" && e.count > 0 &&
@@ -333,8 +367,8 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
     const std::string_view n = p.name;
     const int axis = n.back() - 'x';
     if (axis < 0 || axis > 2) return {};
-    if (n.size() == 1) return {&poly.positions[item], axis};
-    if (n.size() == 2 && n[0] == 'n') return {&poly.normals[item], axis};
+    if (n.size() == 1) return {&poly.positions[item], nullptr, axis};
+    if (n.size() == 2 && n[0] == 'n') return {nullptr, &poly.normals[item], axis};
     return {};
   };
   auto truncated = [&](const PlyElement& e, size_t item) {
@@ -375,9 +409,10 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
           if (!next_token()) throw truncated(e, item);
           if (!item_line) item_line = tok_line;
           if (!p.list) {
-            // Values are read as float whatever the declared type (one rounding from the text).
-            if (const VertexSlot s = slot_of(e, p, item); s.target)
-              if (auto defect = parse_float(tok, (*s.target)[s.axis]); !defect.empty())
+            // Values are read as their slot's type whatever the declared type (one rounding from
+            // the text): positions in double, normals in float.
+            if (const VertexSlot s = slot_of(e, p, item))
+              if (auto defect = s.parse(tok); !defect.empty())
                 throw InputError(file.name, at_line(tok_line) + defect);
             continue;
           }
@@ -409,7 +444,7 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
         for (const PlyProperty& p : e.props) {
           if (!p.list) {
             const PlyValue v = take(p.type, e, item);
-            if (const VertexSlot s = slot_of(e, p, item); s.target) (*s.target)[s.axis] = static_cast<float>(v.real);
+            if (const VertexSlot s = slot_of(e, p, item)) s.store(v.real);
             continue;
           }
           // Counts are unsigned in practice; a negative signed count is caught as too large.
@@ -474,8 +509,8 @@ Polygons read_off(std::string_view text, const SourceFile& file) {
     if (tok.size() < numbers)
       throw InputError(file.name, at_line(lines.number()) + (has_normals ? "vertex needs 3 coordinates and 3 normal components"
                                                                          : "vertex needs 3 coordinates"));
-    poly.positions.push_back(parse_vec3(file, tok, lines.number()));
-    if (has_normals) poly.normals.push_back(parse_vec3(file, std::span(tok).subspan(3), lines.number()));
+    poly.positions.push_back(parse_vec3<Eigen::Vector3d>(file, tok, lines.number()));
+    if (has_normals) poly.normals.push_back(parse_vec3<Eigen::Vector3f>(file, std::span(tok).subspan(3), lines.number()));
   }
   for (long long f = 0; f < nf; ++f) {
     if (!next_line(tok))
@@ -518,7 +553,7 @@ Polygons read_stl(std::string_view text, const SourceFile& file) {
         std::memcpy(c, rec + 12 + 12 * k, 12);
         const Eigen::Vector3f p(c[0], c[1], c[2]);
         if (!p.allFinite()) throw InputError(file.name, "facet " + std::to_string(f) + " has a non-finite coordinate");
-        poly.positions.push_back(p);
+        poly.positions.push_back(p.cast<double>());  // exact
       }
       add_facet();
     }
@@ -545,7 +580,7 @@ Polygons read_stl(std::string_view text, const SourceFile& file) {
     if (kw == "vertex") {
       if (!in_loop) throw InputError(file.name, at_line(ln) + "'vertex' outside an 'outer loop'");
       if (tok.size() != 4) throw InputError(file.name, at_line(ln) + "'vertex' needs 3 coordinates");
-      poly.positions.push_back(parse_vec3(file, std::span(tok).subspan(1), ln));
+      poly.positions.push_back(parse_vec3<Eigen::Vector3d>(file, std::span(tok).subspan(1), ln));
       if (--in_loop == 0) add_facet();
     } else if (in_loop) {
       throw InputError(file.name, at_line(ln) + "expected 'vertex' (" + std::to_string(in_loop) + " more in the loop from line " +

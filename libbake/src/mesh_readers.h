@@ -2,9 +2,9 @@
 // into a Polygons (bake/mesh.h; why the readers are ours and not OpenMesh's: mesh_io.cpp).
 // Private to libbake.
 //
-// Contract of every reader: `bytes` is the whole file; the result holds the file's positions,
-// normal values and polygons in file order, every polygon exactly as written (repeated indices
-// and zero-area polygons included). A reader throws InputError(file.name, "<defect>") — with
+// Contract of every reader: `bytes` is the whole file; the result holds the file's positions (in
+// double: bake/mesh.h, ORIGIN), normal values and polygons in file order, every polygon exactly
+// as written (repeated indices and zero-area polygons included). A reader throws InputError(file.name, "<defect>") — with
 // "line N: " where the format has lines — for anything it cannot read; build_mesh checks what
 // every format shares (finite positions, index ranges, corner counts, an empty mesh).
 #pragma once

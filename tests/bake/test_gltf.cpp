@@ -3,7 +3,9 @@
 // strips, fans, non-indexed primitives and normals; each defect the reader refuses; and a walk of
 // Debian's assimp-testmodels glTF2 folder (good and broken public files) plus 2CylinderEngine.glb.
 #include <bake/error.h>
+#include <bake/integrator.h>
 #include <bake/mesh.h>
+#include <bake/vertex_bake.h>
 
 #include <gltf_builder.h>
 #include <mesh_files.h>
@@ -316,6 +318,33 @@ TEST(Gltf, TwoCylinderEngineLoadsCompletely) {
   const Mesh m = prt::bake::load_mesh(path);
   EXPECT_EQ(m.triangles.size(), 121496u);
   EXPECT_EQ(m.normal_source, Mesh::NormalSource::File);
+}
+
+// A far glTF node (translation (1e5, −2e5, 3e5), scale 1e-4) over the bunny's positions: kept in
+// double through the node transform and baked relative to the mesh origin, so silhouette AO
+// equals the original's within 1e-6 (the reason: tests/bake/test_far_origin.cpp).
+TEST(Gltf, FarNodeTransformBakesTheOriginalsAo) {
+  const Mesh near = prt::bake::load_mesh(fs::path(PRT_DATA_DIR) / "bunny.obj");
+  ASSERT_LT(near.positions.size(), 65536u);
+  std::vector<uint16_t> idx;
+  for (const Tri& t : near.triangles)
+    for (uint32_t i : t) idx.push_back(static_cast<uint16_t>(i));
+  Gltf g;
+  const int mesh = g.mesh({{"attributes", {{"POSITION", g.vec3(near.positions)}}}, {"indices", g.indices(idx)}});
+  g.node({{"mesh", mesh}, {"translation", {1e5, -2e5, 3e5}}, {"scale", {1e-4, 1e-4, 1e-4}}}, true);
+  const Mesh far = prt::bake::load_mesh(g.write("far_bunny.gltf"));
+  ASSERT_EQ(far.positions.size(), near.positions.size());
+  EXPECT_NE(far.origin, Eigen::Vector3d::Zero());
+  auto ao = [](const Mesh& m) {
+    prt::bake::IntegratorSpec spec;
+    spec.silhouette_k = 1024;
+    prt::bake::ProductRequest request;
+    request.ao = true;
+    const prt::bake::Topology topo = prt::bake::build_topology(m);
+    return prt::bake::bake_vertices(m, topo, *prt::bake::make_integrator(spec, m, topo, request)).values;
+  };
+  const auto a = ao(near), b = ao(far);
+  for (size_t v = 0; v < a.size(); ++v) EXPECT_NEAR(a[v], b[v], 1e-6) << "vertex " << v;
 }
 
 } // namespace

@@ -536,7 +536,7 @@ TEST(MeshLoad, MaterialLibrariesAreNeitherReadNorReported) {
 
 TEST(MeshBuild, PolygonsToMeshIsTheStepEveryReaderShares) {
   prt::bake::Polygons p;
-  p.positions = {Vector3f(0, 0, 0), Vector3f(1, 0, 0), Vector3f(1, 1, 0), Vector3f(0, 1, 0)};
+  p.positions = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(0, 1, 0)};
   p.normals = {Vector3f(0, 0, 2), Vector3f(0, 0, -1)};
   // A quad facing +z, then the triangle (0, 2, 1) with the back normal: its corners split.
   p.corner_position = {0, 1, 2, 3, 0, 2, 1};
@@ -572,7 +572,7 @@ TEST(MeshBuild, PolygonsToMeshIsTheStepEveryReaderShares) {
   bad.offsets = {0, 2, 7};
   expect_defect(bad, "face 0 has 2 corners, needs at least 3");
   bad = p;
-  bad.positions[1].y() = std::nanf("");
+  bad.positions[1].y() = std::nan("");
   expect_defect(bad, "vertex 1 has a non-finite coordinate");
   bad = p;
   bad.normals[1].x() = INFINITY;

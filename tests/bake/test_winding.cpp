@@ -119,7 +119,7 @@ TEST(Winding, DoubleSidedSheetIsClosedButNotInward) {
 Polygons box_polygons(bool with_normals, float sign) {
   const Mesh b = outward_box();
   Polygons poly;
-  poly.positions = b.positions;
+  for (const Vector3f& p : b.positions) poly.positions.push_back(p.cast<double>());
   for (size_t q = 0; q < 6; ++q) {
     const auto& t0 = b.triangles[2 * q];
     const auto& t1 = b.triangles[2 * q + 1];  // (t0[0], t0[2], x): the quad is t0 then x

@@ -58,7 +58,8 @@ ReportRow row(const std::string& product, float base, bool times) {
 // A vertex set with V = 2 and every dataset the model has.
 VertexSet full_set(float scale) {
   VertexSet s;
-  s.positions = Array<float>{ramp(6, scale), {{"unit", std::string("m")}}};
+  const std::vector<float> p = ramp(6, scale);
+  s.positions = Array<double>{{p.begin(), p.end()}, {{"unit", std::string("m")}}};
   s.normals = Normals{{0, 0, 1, 0, 1, 0}, "file", {}};
   s.triangles = Array<uint32_t>{{0, 1, 1}, {}};
   s.source_position = Array<uint32_t>{{7, 3}, {}};
@@ -207,7 +208,7 @@ TEST(Asset, AbsentStaysAbsent) {
   a.other_reports.clear();
   a.group_extras.clear();
   a.vertices = VertexSet{};
-  a.vertices.positions = Array<float>{{0, 0, 0}, {}};
+  a.vertices.positions = Array<double>{{0, 0, 0}, {}};
   write_asset(dir / "a.prt.h5", a);
   const Asset b = read_asset(dir / "a.prt.h5");
   EXPECT_TRUE(b == a);

@@ -58,16 +58,17 @@ std::string safe_name(const std::string& stem) {
 
 void set_mesh(F::VertexSet& set, const bake::Mesh& mesh) {
   const size_t V = mesh.positions.size(), T = mesh.triangles.size();
-  std::vector<float> pos(3 * V), nrm(3 * V);
+  std::vector<double> pos(3 * V);  // world space: origin + offset in double (float32 on disk when exact)
+  std::vector<float> nrm(3 * V);
   for (size_t i = 0; i < V; ++i)
     for (int k = 0; k < 3; ++k) {
-      pos[3 * i + size_t(k)] = mesh.positions[i][k];
+      pos[3 * i + size_t(k)] = mesh.world_position(i)[k];
       nrm[3 * i + size_t(k)] = mesh.normals[i][k];
     }
   std::vector<uint32_t> tri(3 * T);
   for (size_t i = 0; i < T; ++i)
     for (int k = 0; k < 3; ++k) tri[3 * i + size_t(k)] = mesh.triangles[i][size_t(k)];
-  set.positions = F::Array<float>{std::move(pos), {}};
+  set.positions = F::Array<double>{std::move(pos), {}};
   set.normals = F::Normals{std::move(nrm),
                            mesh.normal_source == bake::Mesh::NormalSource::File ? "file" : "angle-weighted", {}};
   set.triangles = F::Array<uint32_t>{std::move(tri), {}};
@@ -150,7 +151,8 @@ F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, 
   o.environment = env_path;
   o.environment_sha256 = env.info().sha256;
   o.integrand = "F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]";
-  o.centre = {shells.centre.x(), shells.centre.y(), shells.centre.z()};
+  const Eigen::Vector3d centre = shells.world_centre();
+  o.centre = {centre.x(), centre.y(), centre.z()};
   o.radius = shells.radius;
   o.radii = shells.radii;
   o.angular_convention = "s = centre + rho_k d(theta_i, phi_j), theta_i = pi i/(Ntheta-1) from +Y, phi_j = 2 pi "

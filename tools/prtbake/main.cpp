@@ -470,6 +470,9 @@ int run_vertex(const Args& a) {
                 a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
                 mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
                 a.flip_normals ? ", flipped" : "");
+  if (say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh.h, ORIGIN)
+    std::printf("mesh: baked relative to its origin (%.17g, %.17g, %.17g); /mesh/positions holds world coordinates\n",
+                mesh.origin.x(), mesh.origin.y(), mesh.origin.z());
   const bake::WindingFacts winding = bake::winding_facts(mesh, topo);
   warn_inward(winding, a.flip_normals);
 

@@ -86,9 +86,10 @@ std::string num(float v) {
   auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
 }
-// An element of a dataset: float32 in its own shortest form, integers exactly.
+// An element of a dataset: float32 and float64 in their own shortest form, integers exactly.
 std::string element(const pf::DatasetData& data, std::size_t i) {
   if (const auto* f = std::get_if<std::vector<float>>(&data)) return num((*f)[i]);
+  if (const auto* f = std::get_if<std::vector<double>>(&data)) return num((*f)[i]);
   if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return std::to_string((*u)[i]);
   return std::to_string(std::get<std::vector<uint8_t>>(data)[i]);
 }
@@ -107,6 +108,7 @@ Json json_float(float v) {
 Json json_double(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json json_element(const pf::DatasetData& data, std::size_t i) {
   if (const auto* f = std::get_if<std::vector<float>>(&data)) return json_float((*f)[i]);
+  if (const auto* f = std::get_if<std::vector<double>>(&data)) return json_double((*f)[i]);
   if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return (*u)[i];
   return std::get<std::vector<uint8_t>>(data)[i];
 }
@@ -204,16 +206,17 @@ DatasetStats compute_stats(const pf::Dataset& d) {
   return s;
 }
 
-bool is_float(const pf::Dataset& d) { return std::holds_alternative<std::vector<float>>(d.data); }
+bool is_float32(const pf::Dataset& d) { return std::holds_alternative<std::vector<float>>(d.data); }
+bool is_float(const pf::Dataset& d) { return is_float32(d) || std::holds_alternative<std::vector<double>>(d.data); }
 
 // min/max are values of the dataset: print them in the dataset's own precision.
 std::string stat_value(const pf::Dataset& d, double v) {
-  if (is_float(d)) return num(static_cast<float>(v));
+  if (is_float32(d)) return num(static_cast<float>(v));
   return num(v);
 }
 Json json_stat_value(const pf::Dataset& d, double v) {
   if (!is_float(d)) return static_cast<int64_t>(v);  // a uint32 or uint8 value, exact in a double
-  return json_double(static_cast<double>(static_cast<float>(v)));
+  return json_double(is_float32(d) ? static_cast<double>(static_cast<float>(v)) : v);
 }
 
 void print_stats_text(std::ostream& os, const pf::Dataset& d, const Stats& s, const std::string& label) {

@@ -84,7 +84,7 @@ bake::Mesh read_mesh(const F::Asset& f, const std::string& file, const std::stri
   const size_t V = pos.size() / 3;
   std::vector<Eigen::Vector3f> P(V), N(V);
   for (size_t i = 0; i < V; ++i) {
-    P[i] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
+    P[i] = Eigen::Vector3d(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]).cast<float>();  // world, rounded to float once
     N[i] = {nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]};
   }
   std::vector<std::array<uint32_t, 3>> T(tri.size() / 3);

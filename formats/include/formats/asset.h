@@ -94,7 +94,11 @@ struct Report {
 
 // A vertex set: the root layout or one scene object's /objects/<name>/... (SCHEMA.md).
 struct VertexSet {
-  std::optional<Array<float>> positions;           // [V][3]
+  // [V][3], world space. Held in double; write_asset stores them as float32 when every
+  // coordinate is exactly a float32 (an ordinary mesh: the bytes of a float32 file) and as
+  // float64 otherwise (a mesh far from the origin, whose float32 rounding would move or merge
+  // vertices). read_asset widens float32 exactly, so read(write(a)) == a either way.
+  std::optional<Array<double>> positions;
   std::optional<Normals> normals;                  // [V][3]
   std::optional<Array<uint32_t>> triangles;        // [T][3]
   std::optional<Array<uint32_t>> source_position;  // [V]

@@ -19,7 +19,7 @@ inline constexpr std::string_view kOccluders = "/fiv/occluders";  // + "/<name>/
 
 // ---- datasets of a vertex set (relative to its prefix: "" or "/objects/<name>") ----
 inline constexpr std::string_view kMeshGroup = "/mesh";
-inline constexpr std::string_view kPositions = "/mesh/positions";
+inline constexpr std::string_view kPositions = "/mesh/positions";  // float32, or float64 where float32 would lose precision (SCHEMA.md)
 inline constexpr std::string_view kNormals = "/mesh/normals";
 inline constexpr std::string_view kTriangles = "/mesh/triangles";
 inline constexpr std::string_view kSourcePosition = "/mesh/source_position";

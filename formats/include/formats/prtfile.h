@@ -66,12 +66,13 @@ struct Attr {
   bool operator==(const Attr&) const = default;
 };
 
-using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>>;
+using DatasetData =
+    std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>, std::vector<double>>;
 
 struct Dataset {
   std::string path;              // absolute, e.g. "/transfer/diffuse"; parent groups are created
   std::vector<uint64_t> shape;   // row-major; data.size() == product(shape)
-  DatasetData data;              // float32 / uint32 / uint8 on disk
+  DatasetData data;              // float32 / uint32 / uint8 / float64 on disk
   std::vector<Attr> attrs;
   bool operator==(const Dataset&) const = default;
 };
@@ -134,7 +135,7 @@ DatasetKind dataset_kind(std::string_view path);
 // object (its V is the rows of "<set>/mesh/positions").
 std::string vertex_set_of(std::string_view path);
 
-// "float32", "uint32" or "uint8".
+// "float32", "uint32", "uint8" or "float64".
 std::string_view dtype_name(const DatasetData& data);
 // Number of elements of `data`.
 std::size_t element_count(const DatasetData& data);

@@ -72,7 +72,9 @@ struct ShellSpec {
 bool parse_shell_grid(std::string_view text, ShellSpec& spec);
 
 struct FivShells {
-  Eigen::Vector3d centre{0, 0, 0};
+  Eigen::Vector3d centre{0, 0, 0};  // in the occluder mesh's frame (Mesh::origin, bake/mesh.h)
+  Eigen::Vector3d origin{0, 0, 0};  // that mesh's origin: what files store is world_centre()
+  Eigen::Vector3d world_centre() const { return add_origin(origin, centre); }
   double radius = 0;
   int n_phi = 0, n_theta = 0;
   std::vector<double> radii;    // the shells baked (≤ n_rho)

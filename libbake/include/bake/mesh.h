@@ -38,18 +38,38 @@
 //     instance, and the rows are the vertices (POSITION elements) of instance 1 in accessor order,
 //     then instance 2, … — nothing is welded across primitives or instances. A node's transform
 //     (matrix, or translation · rotation · scale) is composed with its ancestors' in double and
-//     applied to positions in double, rounded to float once. TRIANGLES, TRIANGLE_STRIP (triangle i
+//     applied to positions in double; they stay double until build_mesh (ORIGIN below). TRIANGLES, TRIANGLE_STRIP (triangle i
 //     = (i, i+1+i%2, i+2−i%2)) and TRIANGLE_FAN (triangle i = (i+1, i+2, 0)) become triangles,
 //     indexed or not; under a transform with a negative determinant the winding is reversed (the
 //     front face stays the front face: glTF 2.0 specification, "Meshes"). POINTS and LINE*
 //     primitives give no rows: they are counted in one warning (a file with nothing else is an
 //     InputError). Skins and morph targets are ignored (the rest pose is baked) with a warning.
 //
+// ORIGIN (positions far from the world origin): readers give positions in double (text parsed to
+// the nearest double — nudged by one double ulp in the rare case where that double is a float
+// midpoint, so that rounding it to float gives the correctly rounded float of the text, the
+// value it had when read in float —; binary float32 widened exactly; PLY float64 kept). A Mesh
+// holds them as Mesh::origin (double) plus float offsets: world position of vertex v =
+// origin + positions[v], summed in double (Mesh::world_position). Everything that bakes (the
+// integrators, Embree, the contour BVH, welding, normals, winding) works on the float offsets,
+// in the object's own frame; everything that is written (mesh/positions, FIV shell centres)
+// adds the origin back in double. The origin is chosen by ONE rule (frame_origin), for a
+// mesh from the bounding box of its world positions, for a scene from that of all its objects:
+//   reach = max over axes of max(|lo|, |hi|), extent = max over axes of (hi − lo);
+//   origin = 0 when reach ≤ kNearOrigin · extent (the box is near the world origin compared to
+//   its size; rounding world coordinates to float then costs at most log2(2·kNearOrigin) = 3
+//   of float's 24 bits over the centred frame), else origin = (lo + hi) / 2 in double.
+// With origin 0 the offsets are the world positions rounded to float once, exactly what the
+// float readers gave: ordinary meshes bake bit for bit as before. With a far origin an object
+// translated by 1e5 and scaled by 1e-4 keeps float's relative precision (2^-24 of its size).
+// Positions must be finite floats (|x| ≤ FLT_MAX) in world space, and so must the offsets.
+//
 // NORMALS (unit, finite, one per output vertex):
 //   * From the file when it has them and MeshLoadOptions::use_file_normals: OBJ `vn` per corner,
 //     PLY nx/ny/nz, NOFF per vertex; normalised. STL facet normals are ignored (often garbage).
 //     glTF NORMAL only when EVERY baked primitive has one (else all are computed), transformed
 //     by the inverse transpose of the node's world transform in double and renormalised.
+//     (Normals and welding do not depend on the origin: both are computed on the float offsets.)
 //     normal_source = File. A vertex the file gives no normal, or a zero-length one, gets the
 //     computed normal below; a non-finite file normal is an InputError.
 //   * Otherwise angle-weighted ("mean weighted by angle", Thürmer & Wüthrich 1998) over the
@@ -104,8 +124,14 @@
 
 namespace prt::bake {
 
+// origin + offset in double; with origin 0 the offset as is (so a −0 stays −0: ordinary files
+// keep their bytes).
+inline Eigen::Vector3d add_origin(const Eigen::Vector3d& origin, const Eigen::Vector3d& offset) {
+  return origin == Eigen::Vector3d::Zero() ? offset : Eigen::Vector3d(origin + offset);
+}
+
 struct Mesh {
-  std::vector<Eigen::Vector3f> positions;              // one per output vertex
+  std::vector<Eigen::Vector3f> positions;              // one per output vertex, relative to origin (file comment: ORIGIN)
   std::vector<Eigen::Vector3f> normals;                // unit, one per output vertex
   std::vector<std::array<uint32_t, 3>> triangles;      // indices into output vertices, file order (polygons fan-triangulated in place)
   std::vector<uint32_t> source_position;               // file position index of each output vertex
@@ -114,7 +140,17 @@ struct Mesh {
   size_t file_positions = 0, file_faces = 0;           // counts as in the file (faces before triangulation)
   std::vector<std::string> warnings;                   // non-fatal reader messages (e.g. missing .mtl), one line each
   std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();    // world = origin + positions[v], in double (frame_origin)
+  Eigen::Vector3d world_position(size_t v) const { return add_origin(origin, positions[v].cast<double>()); }
 };
+
+// The origin rule of the file comment (ORIGIN) for world-space bounds [lo, hi] (lo <= hi).
+inline constexpr double kNearOrigin = 4;
+Eigen::Vector3d frame_origin(const Eigen::AlignedBox3d& world_bounds);
+// Offsets of world positions from `origin`, rounded to float once; InputError(source, ...) if
+// one leaves the float range.
+std::vector<Eigen::Vector3f> offsets_from(std::span<const Eigen::Vector3d> world, const Eigen::Vector3d& origin,
+                                          const std::string& source);
 
 struct MeshLoadOptions {
   bool use_file_normals = true;  // false: ignore the file's normals, rows are exactly the file's positions
@@ -158,7 +194,7 @@ MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshL
 // in file order, nothing derived. Corner c of polygon f is c in [offsets[f], offsets[f + 1]).
 struct Polygons {
   static constexpr uint32_t kNoNormal = 0xffffffffu;
-  std::vector<Eigen::Vector3f> positions;   // the file's positions (STL: 3 corners per facet)
+  std::vector<Eigen::Vector3d> positions;   // the file's positions in double (STL: 3 corners per facet)
   std::vector<Eigen::Vector3f> normals;     // the file's normal values, as written (not normalised)
   std::vector<uint32_t> offsets{0};         // polygon_count() + 1 entries, ascending
   std::vector<uint32_t> corner_position;    // per corner: index into positions
@@ -170,10 +206,11 @@ struct Polygons {
 // The one polygon-to-mesh step behind load_mesh (vertex order, hard-edge splits, fans, normals:
 // the contracts in the file comment). Validates what a reader may pass through (finite
 // positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits) and throws
-// InputError(source, defect). Sets source, file_positions, file_faces; not source_sha256 or warnings.
+// InputError(source, defect). Sets source, file_positions, file_faces and origin (frame_origin of the
+// positions' bounds); not source_sha256 or warnings.
 Mesh build_mesh(const Polygons& polygons, std::string source, const MeshLoadOptions& = {});
 
-// Build a mesh in memory (tests, generated geometry). Output vertex i = positions[i],
+// Build a mesh in memory (tests, generated geometry), origin 0. Output vertex i = positions[i],
 // source_position[i] = i, file_positions = positions.size(), file_faces = triangles.size().
 // Normals: angle-weighted over welded positions (as load_mesh) unless `normals` is given, in which
 // case it must have one finite non-zero vector per position; it is normalised and
@@ -185,7 +222,9 @@ Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<ui
 // Concatenation (e.g. asset + ground plane): vertices and triangles of parts[0], then parts[1]…;
 // triangle indices are offset by the vertex count before each part, source_position by the sum
 // of file_positions before it (so it stays unique across parts). normal_source = File only if
-// every part's is; warnings are concatenated. `parts` must not be empty (contract).
+// every part's is; warnings are concatenated. `parts` must not be empty (contract). Origin: the
+// parts' when they all have the same one (offsets copied); else frame_origin of the union of the
+// parts' world bounds, every offset re-expressed from its world position in double.
 Mesh merge_meshes(std::span<const Mesh> parts, std::string name);
 
 // Angle-weighted vertex normals over the given indexing (no welding): n_v = normalize(Σ_t α_t(v)

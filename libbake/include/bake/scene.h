@@ -81,6 +81,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -138,8 +139,20 @@ SceneDescription load_scene(const std::filesystem::path& file,
 // once). Reader warnings are appended to `warnings`.
 std::vector<Mesh> load_scene_meshes(const SceneDescription& scene, std::vector<std::string>& warnings);
 
-// An object's mesh in world space: world_from_object applied to positions; normals from the file
-// transformed by the inverse transpose, angle-weighted normals recomputed on the world positions.
+// The objects of a scene share one frame (bake/mesh.h, ORIGIN): visibility traces receivers
+// against the union of the occluders. Its origin is frame_origin of the world bounds of every
+// object: world_from_object applied in double to each file mesh's world positions (load_mesh).
+// Ordinary scenes get origin 0, and then the positions below are exactly what they were when
+// the transform was applied to float positions and rounded to float.
+Eigen::Vector3d scene_origin(std::span<const Mesh> file_meshes, std::span<const SceneObject> objects);
+
+// An object's mesh in world space, relative to `origin`: world_from_object applied in double to
+// the file mesh's world positions, offsets from `origin` rounded to float once (Mesh::origin =
+// origin); normals from the file transformed by the inverse transpose, angle-weighted normals
+// recomputed on the offsets. InputError (the mesh file) if a position leaves the float range.
+Mesh place_scene_object(const Mesh& file_mesh, const SceneObject& object, const Eigen::Vector3d& origin);
+
+// One object on its own: load_mesh, then place_scene_object with scene_origin of this object alone.
 Mesh load_scene_mesh(const SceneObject& object);
 
 struct ObjectPlan {

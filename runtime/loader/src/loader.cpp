@@ -24,7 +24,7 @@ int sh_order_of(const formats::Product& p, const std::string& file, const std::s
 LoadedVertexSet vertex_set_of(const formats::VertexSet& s, const std::string& name, const std::string& file) {
   LoadedVertexSet v;
   v.name = name;
-  v.positions = s.positions->values;
+  v.positions.assign(s.positions->values.begin(), s.positions->values.end());  // float64 rounded once
   if (s.normals) v.normals = s.normals->values;
   if (s.triangles) v.triangles = s.triangles->values;
   if (s.ao) v.ao = s.ao->values;

@@ -9,7 +9,9 @@
 //   visibility [V][L²]; radiance_band1 [V][RGB][m = −1, 0, 1];
 //   fiv_environment [RGB][xyz]; irradiance_cube [6][S][S][RGB];
 //   occluder shells [Nρ][Nθ][Nφ][RGB][xyz], valid [Nρ][Nθ][Nφ], radii [Nρ] (the file stores the
-//   radii, centre and radius as float64 attributes; they are rounded once to float here).
+//   radii, centre and radius as float64 attributes; they are rounded once to float here; so are
+//   float64 positions, which a file has for a mesh far from the origin: SCHEMA.md, "Positions
+//   far from the origin" — an engine that needs them exactly reads formats::read_asset).
 // Vertex sets: a v1 file (and the root layout of a v2 file) has one, named ""; a v2 scene file has
 // one per /objects/<name> as well (named "<name>"), root first then by name.
 // Errors: prt::formats::FormatError "<file>: <defect>" for anything unreadable or inconsistent,
