@@ -227,18 +227,38 @@ std::optional<std::pair<Vector3d, Vector3d>> ring_far_corners(const Mesh& mesh, 
 // exact predicates: Miss, Cross, or Edge when the answer is on a null set (the segment meets an
 // edge or a corner exactly, or r lies in the triangle's plane).
 enum class SegmentCrossing { Miss, Cross, Edge };
-SegmentCrossing crosses_exactly(const Vector3d& a, const Vector3d& b, const Vector3d& c, const Vector3d& p,
-                                const Vector3d& n, const Vector3d& r) {
-  const int sp = orient_eps(a, b, c, p, n);
-  if (sp == 0) return SegmentCrossing::Miss;  // degenerate triangle (or p + εn in its plane): no area to cross
-  const int sr = orient3d_exact(a, b, c, r);
-  if (sr == 0) return SegmentCrossing::Edge;  // the far end lies in the plane
-  if (sp == sr) return SegmentCrossing::Miss;  // the segment does not reach the plane
-  const int s1 = orient_eps(a, b, r, p, n), s2 = orient_eps(b, c, r, p, n), s3 = orient_eps(c, a, r, p, n);
+SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const Vector3d& p, const Vector3d& n, const Vector3d& r) {
+  const int sr = orient3d_exact(t.a, t.b, t.c, r);
+  if (sr == 0) return SegmentCrossing::Edge;      // the far end lies in the plane
+  if (t.side == sr) return SegmentCrossing::Miss;  // the segment does not reach the plane
+  const int s1 = orient_eps(t.a, t.b, r, p, n), s2 = orient_eps(t.b, t.c, r, p, n), s3 = orient_eps(t.c, t.a, r, p, n);
   const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
   if (has_pos && has_neg) return SegmentCrossing::Miss;  // outside the triangle
   if (s1 == 0 || s2 == 0 || s3 == 0) return SegmentCrossing::Edge;  // through an edge or a corner exactly
   return SegmentCrossing::Cross;
+}
+
+// Squared distance from p to the triangle (a, b, c) in double (the closest point by regions of
+// the triangle's plane: corners, edges, face).
+double squared_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  const Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
+  const Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
+  const double denom = va + vb + vc;
+  if (!(denom > 0)) return std::min({ap.squaredNorm(), bp.squaredNorm(), cp.squaredNorm()});  // degenerate
+  return (ap - (vb / denom) * ab - (vc / denom) * ac).squaredNorm();
 }
 
 } // namespace
@@ -259,9 +279,22 @@ NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
   RTCPointQueryContext qctx;
   rtcInitPointQueryContext(&qctx);
   rtcPointQuery(rt_->scene, &q, &qctx, collect_near, &query);
-  near.prims.assign(query.prims.begin(), query.prims.end());
-  std::sort(near.prims.begin(), near.prims.end());
-  near.prims.erase(std::unique(near.prims.begin(), near.prims.end()), near.prims.end());
+  std::sort(query.prims.begin(), query.prims.end());
+  query.prims.erase(std::unique(query.prims.begin(), query.prims.end()), query.prims.end());
+  // The point query returns triangles whose bounding boxes meet the ball; keep those within rho
+  // (with a relative margin for the distance's own rounding: a few more is harmless).
+  const double keep = near.rho * near.rho * (1 + 1e-9);
+  for (const unsigned prim : query.prims) {
+    const auto& t = mesh_.triangles[prim];
+    NearTriangles::Test test{mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
+                             mesh_.positions[t[2]].cast<double>(), 0};
+    if (!(squared_distance(point.p, test.a, test.b, test.c) <= keep)) continue;
+    near.prims.push_back(prim);
+    // side 0: a degenerate triangle, or p + εn in its plane: no area to cross, but Embree must
+    // still skip it (it would report it at t = 0).
+    test.side = orient_eps(test.a, test.b, test.c, point.p, point.n);
+    if (test.side != 0) near.tests.push_back(test);
+  }
   return near;
 }
 
@@ -278,15 +311,11 @@ bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, cons
       if (const auto ab = ring_far_corners(mesh_, topo_, f, w); ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d))
         return false;
   }
-  if (!near.prims.empty()) {
+  if (!near.tests.empty()) {
     const Vector3d r = point.p + reach(point) * d;
-    for (const uint32_t prim : near.prims) {
-      const auto& t = mesh_.triangles[prim];
-      // Edge (a null set of directions) does not block: the neighbour across that edge decides.
-      if (crosses_exactly(mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
-                          mesh_.positions[t[2]].cast<double>(), point.p, point.n, r) == SegmentCrossing::Cross)
-        return false;
-    }
+    // Edge (a null set of directions) does not block: the neighbour across that edge decides.
+    for (const NearTriangles::Test& t : near.tests)
+      if (crosses_exactly(t, point.p, point.n, r) == SegmentCrossing::Cross) return false;
   }
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);
@@ -332,10 +361,8 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
   const NearTriangles near = near_triangles(point);
   const double reach_ = reach(point);
   const Vector3d r = point.p + reach_ * d;
-  for (const unsigned prim : near.prims) {
-    const auto& t = mesh_.triangles[prim];
-    switch (crosses_exactly(mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
-                            mesh_.positions[t[2]].cast<double>(), point.p, point.n, r)) {
+  for (const NearTriangles::Test& t : near.tests) {
+    switch (crosses_exactly(t, point.p, point.n, r)) {
       case SegmentCrossing::Miss: break;
       case SegmentCrossing::Edge: out.ambiguous = true; break;  // choose another direction
       case SegmentCrossing::Cross: ++out.count; break;

@@ -37,13 +37,18 @@ struct CrossingCount {
 };
 
 // The triangles near a shade point that float ray tests cannot be trusted with: every triangle
-// outside the point's welded 1-ring whose bounding box meets the ball of radius rho about p. Rays
+// outside the point's welded 1-ring that comes within rho of p (its exact distance, in double). Rays
 // from the point decide them exactly (the segment from p + εn to a point beyond the scene, with
 // the ε-limit orientation predicates of bake/contour.h); Embree decides the rest. This is what
 // makes T-junctions (p on another object's edge or face), coplanar overlaps, duplicated faces and
 // near-duplicate shells exact for both integrators: the 1-ring alone does not see them.
 struct NearTriangles {
-  std::vector<uint32_t> prims;  // triangle indices, ascending
+  struct Test {                 // a near triangle with area as seen from p + εn, decided exactly
+    Eigen::Vector3d a, b, c;
+    int side;                   // orient_eps(a, b, c, p, n): the side of its plane p + εn is on (±1)
+  };
+  std::vector<uint32_t> prims;  // every near triangle, ascending: Embree skips them
+  std::vector<Test> tests;      // those of them that can block (side ≠ 0), in the order of prims
   double rho = 0;               // 2e-4 · mesh diagonal + 2e-6 · max|p_i|: well above float hit-test error near p
 };
 
