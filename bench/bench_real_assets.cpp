@@ -34,6 +34,7 @@
 
 #include <bake/mesh.h>
 #include <bake/qmc.h>
+#include <bake/raycast.h>
 #include <bake/silhouette.h>
 #include <bake/vertex_bake.h>
 
@@ -76,37 +77,6 @@ Asset load_first(const std::string& name, std::initializer_list<std::filesystem:
   return {name, std::nullopt, "not found: " + candidates.begin()->string(), {}};
 }
 
-double point_segment_distance(const Vector3d& q, const Vector3d& a, const Vector3d& b) {
-  const Vector3d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((q - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (q - (a + t * ab)).norm();
-}
-
-// Distance from q to the triangle (a, b, c) (closest point by Voronoi regions; Ericson,
-// "Real-Time Collision Detection", §5.1.5), in double; a zero-area triangle is its three edges.
-double point_triangle_distance(const Vector3d& q, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  if ((b - a).cross(c - a).squaredNorm() == 0)
-    return std::min({point_segment_distance(q, a, b), point_segment_distance(q, b, c), point_segment_distance(q, c, a)});
-  const Vector3d ab = b - a, ac = c - a, ap = q - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.norm();
-  const Vector3d bp = q - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return point_segment_distance(q, a, b);
-  const Vector3d cp = q - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return point_segment_distance(q, a, c);
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return point_segment_distance(q, b, c);
-  const double denom = 1 / (va + vb + vc);
-  return (q - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
-}
-
 struct Diagnosis {
   size_t touch_face = 0, touch_edge = 0, near = 0;
   size_t ring = 0, ring_facing_away = 0, ring_repeated = 0;
@@ -140,7 +110,7 @@ Diagnosis diagnose(const Mesh& m, const Topology& topo, uint32_t v, double near_
   for (uint32_t t = 0; t < m.triangles.size(); ++t) {
     if (std::binary_search(ring.begin(), ring.end(), t)) continue;
     const auto& tri = m.triangles[t];
-    if (!(point_triangle_distance(q, pos(tri[0]), pos(tri[1]), pos(tri[2])) <= near_distance)) continue;
+    if (!(std::sqrt(prt::bake::squared_distance_to_triangle(q, pos(tri[0]), pos(tri[1]), pos(tri[2]))) <= near_distance)) continue;
     ++d.near;
     const auto where = prt::testing::locate_on_triangle(pos(tri[0]), pos(tri[1]), pos(tri[2]), q);
     d.touch_face += where == prt::testing::OnTriangle::Inside;

@@ -44,6 +44,38 @@ bool occludes_from_above(const Vector3d& p, const Vector3d& a, const Vector3d& b
 }
 
 namespace {
+double squared_distance_to_segment(const Vector3d& p, const Vector3d& a, const Vector3d& b) {
+  const Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).squaredNorm();
+}
+} // namespace
+
+double squared_distance_to_triangle(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  if ((b - a).cross(c - a).squaredNorm() == 0)  // zero area: its three edges
+    return std::min({squared_distance_to_segment(p, a, b), squared_distance_to_segment(p, b, c),
+                     squared_distance_to_segment(p, c, a)});
+  const Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return squared_distance_to_segment(p, a, b);
+  const Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return squared_distance_to_segment(p, a, c);
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return squared_distance_to_segment(p, b, c);
+  const double denom = va + vb + vc;
+  return (ap - (vb / denom) * ab - (vc / denom) * ac).squaredNorm();
+}
+
+namespace {
 
 constexpr unsigned kMaxHits = 512;
 struct Hit {
@@ -238,29 +270,6 @@ SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const Vector3d& p,
   return SegmentCrossing::Cross;
 }
 
-// Squared distance from p to the triangle (a, b, c) in double (the closest point by regions of
-// the triangle's plane: corners, edges, face).
-double squared_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  const Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
-  const Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
-  const Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
-  const double denom = va + vb + vc;
-  if (!(denom > 0)) return std::min({ap.squaredNorm(), bp.squaredNorm(), cp.squaredNorm()});  // degenerate
-  return (ap - (vb / denom) * ab - (vc / denom) * ac).squaredNorm();
-}
-
 } // namespace
 
 NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
@@ -288,7 +297,7 @@ NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
     const auto& t = mesh_.triangles[prim];
     NearTriangles::Test test{mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
                              mesh_.positions[t[2]].cast<double>(), 0};
-    if (!(squared_distance(point.p, test.a, test.b, test.c) <= keep)) continue;
+    if (!(squared_distance_to_triangle(point.p, test.a, test.b, test.c) <= keep)) continue;
     near.prims.push_back(prim);
     // side 0: a degenerate triangle, or p + εn in its plane: no area to cross, but Embree must
     // still skip it (it would report it at t = 0).

@@ -113,18 +113,30 @@ struct Both {
   double sil, qmc, qmc_se;
 };
 
+// The two integrators for AO, at the settings the tolerances above are for.
+struct AoIntegrators {
+  static constexpr uint32_t kRays = 4096;
+  ProductRequest req = [] {
+    ProductRequest r;
+    r.ao = true;
+    return r;
+  }();
+  SilhouetteIntegrator sil;
+  QmcIntegrator qmc;
+  AoIntegrators(const Mesh& m, const Topology& topo) : sil(m, topo, req, {256, 1}), qmc(m, topo, req, [] {
+    QmcOptions o;
+    o.rays = kRays;
+    return o;
+  }()) {}
+};
+
 // AO at one shade point with both integrators.
 Both ao_at(const Mesh& m, const Topology& topo, const ShadePoint& sp, uint64_t index) {
-  ProductRequest req;
-  req.ao = true;
-  const SilhouetteIntegrator sil(m, topo, req, {256, 1});
-  QmcOptions qo;
-  qo.rays = 4096;
-  const QmcIntegrator qmc(m, topo, req, qo);
+  const AoIntegrators in(m, topo);
   std::vector<double> a(1), b(1), se(1);
-  sil.integrate(sp, index, a);
-  qmc.integrate(sp, index, b, se);
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  in.sil.integrate(sp, index, a);
+  in.qmc.integrate(sp, index, b, se);
+  EXPECT_EQ(in.sil.stats().inconsistent_loops, 0u);
   return {a[0], b[0], se[0]};
 }
 
@@ -138,17 +150,12 @@ void expect_exact(const Both& got, double exact, const char* what) {
 // an occluder (its standard error is then 0), an occluded set of cosine measure up to 3/N still
 // goes unseen with probability ≥ 5% (the rule of three), e.g. a small box near a vertex's horizon.
 void expect_agreement(const Mesh& m, const Topology& topo, const char* what) {
-  ProductRequest req;
-  req.ao = true;
-  const SilhouetteIntegrator sil(m, topo, req, {256, 1});
-  QmcOptions qo;
-  qo.rays = 4096;
-  const QmcIntegrator qmc(m, topo, req, qo);
-  const VertexBake a = bake_vertices(m, topo, sil), b = bake_vertices(m, topo, qmc);
+  const AoIntegrators in(m, topo);
+  const VertexBake a = bake_vertices(m, topo, in.sil), b = bake_vertices(m, topo, in.qmc);
   for (size_t v = 0; v < m.positions.size(); ++v)
-    EXPECT_NEAR(a.values[v], b.values[v], 4 * b.std_error[v] + kAnalyticTol + 3.0 / qo.rays)
+    EXPECT_NEAR(a.values[v], b.values[v], 4 * b.std_error[v] + kAnalyticTol + 3.0 / AoIntegrators::kRays)
         << what << ": vertex " << v << " at " << m.positions[v].transpose() << " normal " << m.normals[v].transpose();
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u) << what;
+  EXPECT_EQ(in.sil.stats().inconsistent_loops, 0u) << what;
 }
 
 // The unit box [0,1]³ with a corner at the origin, and the big quads through the origin that the

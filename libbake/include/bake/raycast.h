@@ -31,6 +31,12 @@ namespace prt::bake {
 bool occludes_from_above(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                          const Eigen::Vector3d& n, const Eigen::Vector3d& d, bool* ambiguous = nullptr);
 
+// Squared distance from p to the triangle (a, b, c), in double: the closest point by the regions
+// of the triangle's plane (corners, edges, face; Ericson, "Real-Time Collision Detection" §5.1.5);
+// a zero-area triangle is its three edges.
+double squared_distance_to_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c);
+
 struct CrossingCount {
   int count = 0;           // triangles the ray from p + εn crosses (its depth complexity W)
   bool ambiguous = false;  // the direction grazes an edge: choose another direction
