@@ -132,11 +132,23 @@ TEST(PrtbakeWinding, PartsInsidePartsAreCalledEnclosedNotInwards) {
     const Baked b = bake(p, "--integrator " + integrator);
     ASSERT_EQ(b.run.code, 0) << b.run.err;
     EXPECT_EQ(b.run.err,
-              "prtbake: warning: 66.7% of vertices (16 of 24) see no sky at all: all 3 closed parts are wound outwards, "
-              "so most of these vertices are enclosed by other geometry (parts inside or pushed into other parts); if "
-              "that is not so, check the mesh's normals, or rerun with --flip-normals\n");
+              "prtbake: warning: 66.7% of vertices (16 of 24) see no sky at all: 0 of 16 sampled would see sky with the "
+              "opposite normal, so they are enclosed by other geometry (parts inside or pushed into other parts), not "
+              "turned inside out; nothing to fix in the normals\n");
     for (size_t v = 8; v < 24; ++v) EXPECT_EQ(b.asset.vertices.ao->values[v], 0.0f) << v;
   }
+}
+
+TEST(PrtbakeWinding, InwardNormalsOnANonClosedMeshAreToldToFlip) {
+  // The box wound inwards with one face written twice: that face's edges have three triangles,
+  // so no part is closed and the winding cannot be judged by volume; with its normals reversed
+  // every vertex would see the sky, and the flip probe says so.
+  const fs::path p = box_obj("inward_duplicated_face.obj", true);
+  std::ofstream(p, std::ios::app) << "f 2 4 3 1\n";
+  const Baked b = bake(p, "--integrator qmc");
+  ASSERT_EQ(b.run.code, 0) << b.run.err;
+  EXPECT_EQ(b.run.err, "prtbake: warning: 100.0% of vertices (8 of 8) see no sky at all: 8 of 8 sampled would see sky "
+                       "with the opposite normal, so their normals point inside the geometry; rerun with --flip-normals\n");
 }
 
 } // namespace

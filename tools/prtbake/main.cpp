@@ -21,6 +21,7 @@
 #include <tbb/info.h>
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -398,22 +399,25 @@ void warn_inward(const bake::WindingFacts& facts, bool flipped) {
                inward, facts.closed.size(), facts.inward_triangles(), fix.c_str());
 }
 
-// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky). The winding
-// facts say which explanation fits: closed parts wound inwards (fixable), or none of that, and then
-// the vertices are enclosed by other geometry (an engine's internals under its housing, parts
-// pushed into each other), which the bake reports as it is.
-void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts, bool flipped) {
+// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky). Which
+// explanation fits: closed parts wound inwards (said above), or else the flip probe — with their
+// normals reversed, would these vertices see sky (normals pointing inside: flip them) or not
+// (vertices enclosed by other geometry: an engine's internals under its housing, parts pushed
+// into each other; the bake is right and nothing is to be fixed)?
+void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts,
+                 const std::function<bake::FlipProbe()>& probe, bool flipped) {
   if (!(count.share() > 0.5)) return;
   std::string why;
   if (facts.inward_components() > 0) {
     why = "some closed parts are wound inwards (see above)";
-  } else if (!facts.closed.empty()) {
-    why = "all " + std::to_string(facts.closed.size()) +
-          " closed parts are wound outwards, so most of these vertices are enclosed by other geometry (parts inside or "
-          "pushed into other parts); if that is not so, check the mesh's normals, or " + flip_fix(flipped);
   } else {
-    why = "the mesh has no closed part to judge its winding by: its normals may point inside the geometry; check them, or " +
-          std::string(flip_fix(flipped));
+    const bake::FlipProbe p = probe();
+    const std::string tally = std::to_string(p.would_see_sky) + " of " + std::to_string(p.probed) +
+                              " sampled would see sky with the opposite normal";
+    why = 2 * p.would_see_sky > p.probed
+              ? tally + ", so their normals point inside the geometry; " + flip_fix(flipped)
+              : tally + ", so they are enclosed by other geometry (parts inside or pushed into other parts), not "
+                        "turned inside out; nothing to fix in the normals";
   }
   std::fprintf(stderr, "prtbake: warning: %.1f%% of vertices (%zu of %zu) see no sky at all: %s\n",
                100 * count.share(), count.vertices, count.total, why.c_str());
@@ -512,7 +516,8 @@ int run_vertex(const Args& a) {
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
-  warn_no_sky(bake::count_no_sky(result), winding, a.flip_normals);
+  warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
+              a.flip_normals);
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
                 mesh.positions.size() / result.seconds);

@@ -51,6 +51,18 @@ struct NoSkyCount {
 };
 NoSkyCount count_no_sky(const VertexBake& bake);
 
+// Of the rows that saw no sky, how many would see some with the opposite normal: what tells
+// normals that point inside the geometry (most would) from vertices enclosed by other geometry,
+// such as an engine's internals under its housing (none would). Probes a seeded sample of at most
+// `sample` such rows of `mesh` (the mesh `bake` belongs to, one row per vertex), each with `rays`
+// fixed directions over the flipped hemisphere, visibility in the ε-limit (bake/raycast.h).
+struct FlipProbe {
+  size_t probed = 0;         // no-sky rows probed
+  size_t would_see_sky = 0;  // of them, those that see some sky with the opposite normal
+};
+FlipProbe probe_flipped_normals(const Mesh& mesh, const Topology& topology, const VertexBake& bake, size_t sample = 256,
+                                uint32_t rays = 256, uint64_t seed = 1);
+
 // Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md §6).
 // The per-vertex products, as libbake knows them; the file names them through formats/ (the
 // baker maps each to its dataset there), libbake only labels them for people.
