@@ -261,9 +261,18 @@ inline int orient_eps_raw(const double* a, const double* b, const double* c, con
   return -t;
 }
 
-inline int orient_eps_f(const float* a, const float* b, const float* c, const double* p, const double* n) {
+// The second-order tier (bake/contour.h orient_eps): only when D0 = D1 = 0, the ε² coefficient
+// D1 with t in the place of n — orient_eps_raw with t returns exactly that, since D0 = 0.
+inline int orient_eps2_raw(const double* a, const double* b, const double* c, const double* p, const double* n,
+                           const double* t) {
+  const int s = orient_eps_raw(a, b, c, p, n);
+  return s != 0 || t == nullptr ? s : orient_eps_raw(a, b, c, p, t);
+}
+
+inline int orient_eps_f(const float* a, const float* b, const float* c, const double* p, const double* n,
+                        const double* t) {
   const double ad[3] = {a[0], a[1], a[2]}, bd[3] = {b[0], b[1], b[2]}, cd[3] = {c[0], c[1], c[2]};
-  return orient_eps_raw(ad, bd, cd, p, n);
+  return orient_eps2_raw(ad, bd, cd, p, n, t);
 }
 
 // Outward rounding of a double bound to float.
@@ -291,8 +300,8 @@ int orient3d_exact(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
 }
 
 int orient_eps(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-               const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
-  return orient_eps_raw(a.data(), b.data(), c.data(), p.data(), n.data());
+               const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d* t) {
+  return orient_eps2_raw(a.data(), b.data(), c.data(), p.data(), n.data(), t ? t->data() : nullptr);
 }
 
 // ---------------------------------------------------------------- ContourFinder
@@ -575,7 +584,8 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
 size_t ContourFinder::edge_count() const { return topology_->edges.size(); }
 size_t ContourFinder::bvh_node_count() const { return nodes_.size(); }
 
-int ContourFinder::side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
+int ContourFinder::side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
+                                 const Eigen::Vector3d* tie) const {
   const auto& topo = *topology_;
   const auto [ia, ib] = topo.edges[edge];
   const Eigen::Vector3d a = topo.welded_positions[ia].cast<double>(), b = topo.welded_positions[ib].cast<double>();
@@ -585,7 +595,7 @@ int ContourFinder::side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const 
     const uint32_t w0 = topo.weld[t[0]], w1 = topo.weld[t[1]], w2 = topo.weld[t[2]];
     if (w0 == w1 || w1 == w2 || w0 == w2) continue;
     const uint32_t c = (w0 != ia && w0 != ib) ? w0 : (w1 != ia && w1 != ib) ? w1 : w2;
-    sum += orient_eps(a, b, topo.welded_positions[c].cast<double>(), p, n);
+    sum += orient_eps(a, b, topo.welded_positions[c].cast<double>(), p, n, tie);
   }
   return sum;
 }
@@ -594,7 +604,7 @@ void ContourFinder::find_brute_force(const ShadePoint& point, std::vector<Contou
   out.clear();
   const uint32_t E = uint32_t(topology_->edges.size());
   for (uint32_t e = 0; e < E; ++e) {
-    const int s = side_sum_slow(e, point.p, point.n);
+    const int s = side_sum_slow(e, point.p, point.n, tie_break(point));
     if (s != 0) out.push_back({e, s});
   }
 }
@@ -616,8 +626,9 @@ void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out)
   };
   const double p[3] = {point.p.x(), point.p.y(), point.p.z()};
   const double nn[3] = {point.n.x(), point.n.y(), point.n.z()};
+  const double* tt = tie_break(point) ? point.t.data() : nullptr;
   for (const uint32_t e : always_) {
-    const int s = side_sum_slow(e, point.p, point.n);
+    const int s = side_sum_slow(e, point.p, point.n, tie_break(point));
     if (s != 0) emit(e, s);
   }
   if (!nodes_.empty()) {
@@ -657,7 +668,7 @@ void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out)
             s = 2;
           } else {
             const Corners& c = corners_[nd.index + k];
-            s = orient_eps_f(c.a, c.b, c.c1, p, nn) + orient_eps_f(c.a, c.b, c.c2, p, nn);
+            s = orient_eps_f(c.a, c.b, c.c1, p, nn, tt) + orient_eps_f(c.a, c.b, c.c2, p, nn, tt);
           }
           if (s != 0) emit(corners_[nd.index + k].edge, s);
         }

@@ -20,7 +20,7 @@ namespace prt::bake {
 using Eigen::Vector3d;
 
 bool occludes_from_above(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& n,
-                         const Vector3d& d, bool* ambiguous) {
+                         const Vector3d& d, bool* ambiguous, const Vector3d* t) {
   const Vector3d e1 = a - p, e2 = b - p;
   const Vector3d m = e1.cross(e2);
   const double mm = m.squaredNorm();
@@ -31,9 +31,16 @@ bool occludes_from_above(const Vector3d& p, const Vector3d& a, const Vector3d& b
   constexpr double kRel = 1e-9;
   if (ambiguous && std::abs(md) <= kRel * mlen) *ambiguous = true;
   if (md == 0) return false;    // ray parallel to the plane: a set of measure zero
-  const double s = -mn / md;
-  if (!(s > 0)) return false;   // the plane is behind the ray (or through p + εn itself)
-  const Vector3d q = n + s * d; // in the plane of the triangle, up to rounding
+  double s = -mn / md;
+  Vector3d q = n + s * d;       // in the plane of the triangle, up to rounding
+  if (mn == 0 && t) {
+    // p + εn lies in the plane: the ray from p + εn + ε²t meets it at distance ε² (−m·t)/(m·d),
+    // where the point, seen from p, is in direction n (to first order): blocked iff that
+    // distance is positive and n lies in the triangle's cone.
+    s = -m.dot(*t) / md;
+    q = n;
+  }
+  if (!(s > 0)) return false;   // the plane is behind the ray (or through the limit point itself)
   // q = α e1 + β e2 with α = ((q × e2)·m)/|m|², β = ((e1 × q)·m)/|m|²; inside the cone iff α, β ≥ 0.
   const double alpha = q.cross(e2).dot(m), beta = e1.cross(q).dot(m);
   if (ambiguous) {
@@ -259,11 +266,13 @@ std::optional<std::pair<Vector3d, Vector3d>> ring_far_corners(const Mesh& mesh, 
 // exact predicates: Miss, Cross, or Edge when the answer is on a null set (the segment meets an
 // edge or a corner exactly, or r lies in the triangle's plane).
 enum class SegmentCrossing { Miss, Cross, Edge };
-SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const Vector3d& p, const Vector3d& n, const Vector3d& r) {
+SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const ShadePoint& point, const Vector3d& r) {
   const int sr = orient3d_exact(t.a, t.b, t.c, r);
   if (sr == 0) return SegmentCrossing::Edge;      // the far end lies in the plane
   if (t.side == sr) return SegmentCrossing::Miss;  // the segment does not reach the plane
-  const int s1 = orient_eps(t.a, t.b, r, p, n), s2 = orient_eps(t.b, t.c, r, p, n), s3 = orient_eps(t.c, t.a, r, p, n);
+  const Vector3d *tb = tie_break(point);
+  const int s1 = orient_eps(t.a, t.b, r, point.p, point.n, tb), s2 = orient_eps(t.b, t.c, r, point.p, point.n, tb),
+            s3 = orient_eps(t.c, t.a, r, point.p, point.n, tb);
   const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
   if (has_pos && has_neg) return SegmentCrossing::Miss;  // outside the triangle
   if (s1 == 0 || s2 == 0 || s3 == 0) return SegmentCrossing::Edge;  // through an edge or a corner exactly
@@ -301,7 +310,7 @@ NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
     near.prims.push_back(prim);
     // side 0: a degenerate triangle, or p + εn in its plane: no area to cross, but Embree must
     // still skip it (it would report it at t = 0).
-    test.side = orient_eps(test.a, test.b, test.c, point.p, point.n);
+    test.side = orient_eps(test.a, test.b, test.c, point.p, point.n, tie_break(point));
     if (test.side != 0) near.tests.push_back(test);
   }
   return near;
@@ -317,14 +326,14 @@ bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, cons
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
     for (uint32_t f : topo_.ring(w))
-      if (const auto ab = ring_far_corners(mesh_, topo_, f, w); ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d))
+      if (const auto ab = ring_far_corners(mesh_, topo_, f, w); ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, nullptr, tie_break(point)))
         return false;
   }
   if (!near.tests.empty()) {
     const Vector3d r = point.p + reach(point) * d;
     // Edge (a null set of directions) does not block: the neighbour across that edge decides.
     for (const NearTriangles::Test& t : near.tests)
-      if (crosses_exactly(t, point.p, point.n, r) == SegmentCrossing::Cross) return false;
+      if (crosses_exactly(t, point, r) == SegmentCrossing::Cross) return false;
   }
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);
@@ -358,7 +367,7 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
     const auto w = uint32_t(point.welded);
     for (uint32_t f : topo_.ring(w))
       if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
-          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, &out.ambiguous))
+          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, &out.ambiguous, tie_break(point)))
         ++out.count;
   }
   // Triangles within ρ of p are decided exactly for the whole ray (below): near p, float hit tests
@@ -371,7 +380,7 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
   const double reach_ = reach(point);
   const Vector3d r = point.p + reach_ * d;
   for (const NearTriangles::Test& t : near.tests) {
-    switch (crosses_exactly(t, point.p, point.n, r)) {
+    switch (crosses_exactly(t, point, r)) {
       case SegmentCrossing::Miss: break;
       case SegmentCrossing::Edge: out.ambiguous = true; break;  // choose another direction
       case SegmentCrossing::Cross: ++out.count; break;

@@ -18,6 +18,19 @@ ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32
   sp.p = mesh.positions[vertex].cast<double>();
   sp.n = mesh.normals[vertex].cast<double>().normalized();
   sp.welded = topology.weld[vertex];
+  // The tie-break t (bake/integrator.h): from p towards the centroids of the vertex's own
+  // triangles, in its tangent plane — into its own surface.
+  Eigen::Vector3d into = Eigen::Vector3d::Zero();
+  for (const uint32_t f : topology.ring(uint32_t(sp.welded))) {
+    const auto& t = mesh.triangles[f];
+    if (t[0] != vertex && t[1] != vertex && t[2] != vertex) continue;  // another sheet's or object's
+    const Eigen::Vector3d centroid =
+        (mesh.positions[t[0]].cast<double>() + mesh.positions[t[1]].cast<double>() + mesh.positions[t[2]].cast<double>()) / 3;
+    into += centroid - sp.p;
+  }
+  into -= sp.n.dot(into) * sp.n;
+  const double len = into.norm();
+  if (len > 0 && std::isfinite(len)) sp.t = into / len;
   return sp;
 }
 

@@ -316,6 +316,14 @@ TEST(MessyGeometry, CoincidentSheetsKeepTheirOwnNormals) {
     const ShadePoint sp = vertex_shade_point(m, topo, v);
     expect_exact(ao_at(m, topo, sp, v), 0.5, "top corner of a double-sided panel");
   }
+  // The bottom corners stand inside floor faces with a horizontal normal: p + εn lies in the
+  // floor's plane, and the second-order tie-break (bake/integrator.h ShadePoint::t, pointing up
+  // into the panel) puts the limit point on the floor's upper side: the same quarter sphere.
+  for (const uint32_t v : {0u, 1u, 4u, 7u}) {
+    const ShadePoint sp = vertex_shade_point(m, topo, v);
+    EXPECT_NEAR((sp.t - Vector3d(0, sp.p.y() > 0 ? -1 : 1, 1).normalized()).norm(), 0, 1e-12) << v;
+    expect_exact(ao_at(m, topo, sp, v), 0.5, "bottom corner of a double-sided panel on a floor");
+  }
 }
 
 TEST(MessyGeometry, SheetNormalsKeepSmoothNormalsOfSplitManifolds) {

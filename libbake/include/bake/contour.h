@@ -37,8 +37,16 @@ namespace prt::bake {
 // cannot, the determinant is evaluated exactly with floating-point expansions (Shewchuk 1997).
 // Exact for any finite double inputs whose products do not overflow or underflow (always true
 // for float mesh positions and points of comparable magnitude). Thread-safe, no allocation.
+// With a tie-break direction t (ShadePoint::t) the point is p + εn + ε²t: when D0 = D1 = 0 (p + εn
+// itself lies in the plane, e.g. a wall's foot on a floor with a horizontal normal) the sign of the
+// ε² coefficient, −t·((b−a)×(c−a)), decides; without t, or when that is 0 too, the result is 0.
 int orient_eps(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-               const Eigen::Vector3d& p, const Eigen::Vector3d& n);
+               const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d* t = nullptr);
+
+// The shade point's tie-break direction, or nullptr when it has none (t = 0).
+inline const Eigen::Vector3d* tie_break(const ShadePoint& point) {
+  return point.t.isZero(0.0) ? nullptr : &point.t;
+}
 
 // The same determinant without the ε rule: the exact sign of D0 (−1, 0, +1).
 int orient3d_exact(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
@@ -94,7 +102,7 @@ private:
     uint32_t edge;
   };
 
-  int side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n) const;
+  int side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d* tie) const;
 
   const Mesh* mesh_;
   const Topology* topology_;

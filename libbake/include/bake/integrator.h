@@ -24,6 +24,11 @@ namespace prt::bake {
 struct ShadePoint {
   Eigen::Vector3d p{0, 0, 0};
   Eigen::Vector3d n{0, 0, 1};  // unit; defines H(ω,n) = [n·ω > 0]
+  // Second-order tie-break: the limit point is p + εn + ε²t. It decides only triangles whose
+  // plane contains p + εn itself (p in the plane and n parallel to it: a single-sheet wall's foot
+  // on a floor, with a horizontal normal): t points into the point's own surface, so the foot
+  // is on the floor's upper side. 0: none (such triangles then block nothing).
+  Eigen::Vector3d t{0, 0, 0};
   int64_t welded = -1;
   // false: full-sphere mode, H ≡ 1 in every integrand (the FIV products: ∫ V L y_1m dω over the
   // whole sphere). n then only sets the side the limit p + εn is taken from.

@@ -28,8 +28,12 @@ namespace prt::bake {
 // blocked iff s > 0 and n + s d lies in the cone spanned by a-p and b-p. Zero-area: never blocks.
 // `ambiguous` (optional) is set when the answer is within rounding of flipping (d on the cone's
 // boundary or parallel to the plane).
+// With a tie-break t (ShadePoint::t), a triangle whose plane contains p + εn (m·n = 0) blocks d
+// iff −(m·t)/(m·d) > 0 and n lies in the cone: the ray from p + εn + ε²t meets the plane ahead,
+// at a point seen from p in direction n.
 bool occludes_from_above(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& n, const Eigen::Vector3d& d, bool* ambiguous = nullptr);
+                         const Eigen::Vector3d& n, const Eigen::Vector3d& d, bool* ambiguous = nullptr,
+                         const Eigen::Vector3d* t = nullptr);
 
 // Squared distance from p to the triangle (a, b, c), in double: the closest point by the regions
 // of the triangle's plane (corners, edges, face; Ericson, "Real-Time Collision Detection" §5.1.5);
