@@ -244,10 +244,6 @@ bool collect_near(RTCPointQueryFunctionArguments* args) {
   return false;  // the query radius is unchanged
 }
 
-} // namespace
-
-namespace {
-
 // Corner k of triangle t is the shade point's welded position: the other two corners, in winding
 // order, or nullopt when no corner (or two corners) are the shade point's.
 std::optional<std::pair<Vector3d, Vector3d>> ring_far_corners(const Mesh& mesh, const Topology& topo, uint32_t f,
@@ -270,7 +266,7 @@ SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const ShadePoint& 
   const int sr = orient3d_exact(t.a, t.b, t.c, r);
   if (sr == 0) return SegmentCrossing::Edge;      // the far end lies in the plane
   if (t.side == sr) return SegmentCrossing::Miss;  // the segment does not reach the plane
-  const Vector3d *tb = tie_break(point);
+  const Vector3d* tb = tie_break(point);
   const int s1 = orient_eps(t.a, t.b, r, point.p, point.n, tb), s2 = orient_eps(t.b, t.c, r, point.p, point.n, tb),
             s3 = orient_eps(t.c, t.a, r, point.p, point.n, tb);
   const bool has_pos = s1 > 0 || s2 > 0 || s3 > 0, has_neg = s1 < 0 || s2 < 0 || s3 < 0;
@@ -326,7 +322,8 @@ bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, cons
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
     for (uint32_t f : topo_.ring(w))
-      if (const auto ab = ring_far_corners(mesh_, topo_, f, w); ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, nullptr, tie_break(point)))
+      if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
+          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, nullptr, tie_break(point)))
         return false;
   }
   if (!near.tests.empty()) {
