@@ -477,7 +477,8 @@ struct SilhouetteIntegrator::Impl {
       // halves keep that orientation. Collinear with p but not through it, it shrinks to a point
       // as ε → 0 and is crossed by no path.
       const bool at_p = point.welded >= 0 && (e[0] == uint32_t(point.welded) || e[1] == uint32_t(point.welded));
-      if (!at_p && da.cross(db).squaredNorm() == 0 && collinear_exactly(topo.welded_positions[e[0]], topo.welded_positions[e[1]], point.p)) {
+      if (!at_p && da.cross(db).squaredNorm() == 0 &&
+          collinear_exactly(topo.welded_positions[e[0]], topo.welded_positions[e[1]], point.p)) {
         if (da.dot(db) < 0) {
           push(da, -n);
           push(-n, db);

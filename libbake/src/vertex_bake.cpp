@@ -24,9 +24,7 @@ ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32
   for (const uint32_t f : topology.ring(uint32_t(sp.welded))) {
     const auto& t = mesh.triangles[f];
     if (t[0] != vertex && t[1] != vertex && t[2] != vertex) continue;  // another sheet's or object's
-    const Eigen::Vector3d centroid =
-        (mesh.positions[t[0]].cast<double>() + mesh.positions[t[1]].cast<double>() + mesh.positions[t[2]].cast<double>()) / 3;
-    into += centroid - sp.p;
+    for (const uint32_t c : t) into += (mesh.positions[c].cast<double>() - sp.p) / 3;  // centroid − p
   }
   into -= sp.n.dot(into) * sp.n;
   const double len = into.norm();
