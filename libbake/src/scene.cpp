@@ -7,12 +7,14 @@
 #include <prtshade/sh.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <nlohmann/json.hpp>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -215,8 +217,20 @@ Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::strin
     M.topLeftCorner<3, 3>() = R * s.asDiagonal();
     M.topRightCorner<3, 1>() = t;
   }
-  const double det = M.topLeftCorner<3, 3>().determinant();
-  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) r.fail(key + " is singular (determinant " + std::to_string(det) + ")");
+  // Well-conditioned, before any work: normals go through A⁻ᵀ in double, which loses log10(κ) of
+  // double's ~16 digits (κ = σ_max/σ_min); κ ≤ 1e8 keeps 8, more than a float normal holds.
+  // A singular or nearly singular A (a scale of 1e-310 next to 1e30) is refused here, naming the
+  // object, instead of baking and then failing on NaN normals.
+  constexpr double kMaxCondition = 1e8;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M.topLeftCorner<3, 3>());
+  const Eigen::Vector3d sv = svd.singularValues();  // descending
+  const double kappa = sv[2] > 0 ? sv[0] / sv[2] : std::numeric_limits<double>::infinity();
+  if (!sv.allFinite() || !(kappa <= kMaxCondition) || !M.topLeftCorner<3, 3>().inverse().allFinite()) {
+    std::ostringstream os;
+    os << key << " is singular or nearly so (singular values " << sv[0] << ", " << sv[1] << ", " << sv[2]
+       << "; condition number " << kappa << " > " << kMaxCondition << "): it would flatten the object";
+    r.fail(os.str());
+  }
   return M;
 }
 

@@ -277,6 +277,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"singular_transform",
                  scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "transform": {"scale": 0}})"),
                  "objects[0].transform is singular"},
+        // A determinant of 1e-250 passed the old |det| > 1e-300 check; the bake then failed on NaN
+        // normals after all its work. The condition number refuses it up front.
+        BadScene{"nearly_singular_transform",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "transform": {"scale": [1e-310, 1e30, 1e30]}})"),
+                 "objects[0].transform is singular or nearly so (singular values 1e+30, 1e+30, 0; condition number inf > 1e+08)"},
+        BadScene{"ill_conditioned_transform",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "transform": {"scale": [1, 1, 1e-9]}})"),
+                 "condition number 1e+09 > 1e+08"},
         BadScene{"albedo_range",
                  scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "material": {"albedo": [2, 0, 0]}})"),
                  "objects[0].material.albedo[0] must be in [0, 1], got 2"},

@@ -21,6 +21,7 @@
 //       "role": "receiver" | "occluder" | "both",  required
 //       "transform": {"translate": [x,y,z], "rotate": [rx,ry,rz] (degrees, about X then Y then Z),
 //                     "scale": s | [sx,sy,sz]}  or  {"matrix": [16 numbers, row-major, last row 0 0 0 1]},
+//                     its 3×3 part well-conditioned (σ_max/σ_min ≤ 1e8), else refused before any work,
 //       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]}
 //     } ]
 //   }
