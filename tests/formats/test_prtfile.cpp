@@ -10,6 +10,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -346,6 +348,31 @@ TEST(Atomicity, FailedWriteLeavesExistingFileUntouched) {
   EXPECT_THROW(write_file(dir / "a.prt.h5", bad), FormatError);
   EXPECT_EQ(slurp(dir / "a.prt.h5"), before) << "the old file must be untouched";
   EXPECT_EQ(entries(dir), std::vector<std::string>{"a.prt.h5"}) << "no temporary file may remain";
+}
+
+TEST(Atomicity, StaleTemporariesOfKilledBakesAreRemovedLiveOnesKept) {
+  // A bake killed with SIGKILL leaves "<name>.tmp.<host>.<pid>". The next write to that name
+  // removes it when the pid is dead on this machine, and keeps a live pid's (another bake writing
+  // now), another machine's, another name's and anything else.
+  const fs::path dir = scratch("stale_tmp");
+  char host[256] = {};
+  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+  std::string h(host);
+  for (char& c : h)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_')) c = '_';
+  const pid_t dead = ::fork();  // a pid that is surely dead once reaped
+  if (dead == 0) ::_exit(0);
+  ASSERT_GT(dead, 0);
+  ::waitpid(dead, nullptr, 0);
+  const std::string stale = "a.prt.h5.tmp." + h + "." + std::to_string(dead);
+  const std::string live = "a.prt.h5.tmp." + h + "." + std::to_string(::getppid());
+  const std::string other_host = "a.prt.h5.tmp.elsewhere-" + h + "." + std::to_string(dead);
+  const std::string other_name = "b.prt.h5.tmp." + h + "." + std::to_string(dead);
+  for (const std::string& n : {stale, live, other_host, other_name}) std::ofstream(dir / n) << "partial";
+  write_file(dir / "a.prt.h5", make_file());
+  std::vector<std::string> want = {"a.prt.h5", live, other_host, other_name};
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(entries(dir), want);
 }
 
 TEST(Atomicity, MissingDirectoryIsAFormatErrorNamingThePath) {

@@ -20,9 +20,11 @@
 //   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
 //     other required root attribute (generator, created, command_line, source, source_sha256,
 //     up_axis, sh_convention).
-//   * Writes "<dir>/<name>.tmp.<pid>" and renames it onto the final name: on any error the
+//   * Writes "<dir>/<name>.tmp.<host>.<pid>" and renames it onto the final name: on any error the
 //     temporary file is removed, nothing new exists under the final name and a file already
-//     there is untouched.
+//     there is untouched. A temporary of a bake to the same name that was killed (kill -9) on
+//     this machine — its pid no longer alive — is removed first; a live pid's, or another
+//     machine's (a shared disk), is never touched.
 //   * Deterministic: the same File gives the same bytes (no object time stamps, fixed library
 //     format bounds). Datasets are chunked along the first axis (~64 KiB chunks), shuffled,
 //     deflated (level 6) and fletcher32-checksummed.
