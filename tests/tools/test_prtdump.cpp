@@ -148,6 +148,30 @@ TEST(Prtdump, ShowsNaNCountsAndSchemaDefectOfABadFile) {
   EXPECT_NE(j.out.find("\"/ao\": null"), std::string::npos) << "NaN must be null in JSON:\n" << j.out;
 }
 
+TEST(Prtdump, VertexOfAFileThatFailsTheSchemaStaysInBounds) {
+  // Attributes that lie about the shape (issue 11): sh_order = -1 on a [V, 1] transfer (-1² = 1
+  // matched the row width and the band loop ran 2^64 times), sh_order = 3037000500 (its square
+  // overflows), and a band-1 radiance with 4 rows (the R/G/B labels ran off their string). Each
+  // is shown by its shape instead, within the dataset.
+  for (const int64_t order : {int64_t{-1}, int64_t{3037000500}}) {
+    SCOPED_TRACE(order);
+    const fs::path dir = scratch("lying_attrs");
+    File f = make_file();
+    f.root_attrs.push_back({"format", std::string("prtbake")});
+    f.root_attrs.push_back({"format_version", int64_t{2}});
+    f.datasets[4] = {"/transfer/diffuse", {4, 1}, std::vector<float>{0.5f, 1.5f, 2.5f, 3.5f}, {{"sh_order", order}}};
+    std::vector<float> r(48);
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] = static_cast<float>(i);
+    f.datasets[5] = {"/radiance/band1", {4, 4, 3}, r, {}};
+    prt::formats::testing::write_file_unvalidated(dir / "lying.prt.h5", f);
+    const CmdResult v = prtdump(dir, "--vertex 1 " + q(dir / "lying.prt.h5"));
+    ASSERT_EQ(v.exit_code, 0) << v.err;
+    EXPECT_NE(v.out.find("1.5"), std::string::npos) << v.out;       // vertex 1's transfer value
+    EXPECT_NE(v.out.find("[3]  [21, 22, 23]"), std::string::npos) << v.out;  // its 4th radiance row, by index
+    EXPECT_EQ(v.out.find("l=1"), std::string::npos) << "no band loop past the data:\n" << v.out;
+  }
+}
+
 TEST(Prtdump, BadInputsGiveOneLineNamingTheFileAndExitCodes) {
   const fs::path dir = scratch("errors");
   write_file(dir / "a.prt.h5", make_file());

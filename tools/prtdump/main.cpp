@@ -414,7 +414,9 @@ void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, u
     const auto* L = order ? std::get_if<int64_t>(&order->value) : nullptr;
     if (d->shape.size() == 1) {
       os << head << element(d->data, base) << '\n';
-    } else if (L && d->shape.size() == 2 && static_cast<uint64_t>(*L * *L) == per) {
+    } else if (L && *L > 0 && d->shape.size() == 2 && per % uint64_t(*L) == 0 && per / uint64_t(*L) == uint64_t(*L)) {
+      // Bands only when sh_order is positive and its square (computed without overflow) is the
+      // row: prtdump shows files that fail the schema and stays within the data whatever they claim.
       for (std::size_t l = 0; l < static_cast<std::size_t>(*L); ++l)
         os << (l ? cont : head) << "l=" << l << "  " << row_text(*d, base + l * l, 2 * l + 1) << '\n';
     } else if (d->shape.size() == 2) {
@@ -423,7 +425,7 @@ void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, u
       // Rows of the last axis, labelled by their leading indices (R/G/B for radiance/band1).
       const std::size_t last = d->shape.back();
       const std::vector<uint64_t> lead(d->shape.begin() + 1, d->shape.end() - 1);
-      const bool rgb = pf::dataset_kind(d->path) == pf::DatasetKind::radiance_band1;
+      const bool rgb = pf::dataset_kind(d->path) == pf::DatasetKind::radiance_band1 && per == 3 * last;
       for (std::size_t r = 0; r * last < per; ++r) {
         std::string label;
         if (rgb) label = std::string(1, "RGB"[r]) + "  ";
