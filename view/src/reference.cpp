@@ -57,10 +57,18 @@ struct ReferenceRenderer::Rays {
     caster_topology = build_topology(caster_mesh);
     casters = std::make_unique<RayCaster>(caster_mesh, *caster_topology);
   }
-  bool occluded(const Vector3d& o, const Vector3d& d) const {
+  const RayCaster& shadow_caster() const { return casters ? *casters : every_triangle; }
+  // A shading point's shadow rays start at o itself (a free point, welded = -1); the triangles
+  // near o are found once per point, not once per ray (bake/raycast.h NearTriangles).
+  bake::NearTriangles near(const Vector3d& o) const {
     ShadePoint sp;
-    sp.p = o;  // a free point (welded = -1): the ray starts at o itself
-    return !(casters ? *casters : every_triangle).visible(sp, d);
+    sp.p = o;
+    return shadow_caster().near_triangles(sp);
+  }
+  bool occluded(const Vector3d& o, const bake::NearTriangles& near_o, const Vector3d& d) const {
+    ShadePoint sp;
+    sp.p = o;
+    return !shadow_caster().visible(sp, near_o, d);
   }
 };
 
@@ -173,6 +181,7 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
   const double w_cos = 0.5 * (1 - w_cone_total), w_env = w_cos;
   const double w_cone = cones.empty() ? 0.0 : w_cone_total / double(cones.size());
   const Frame frame(f.n);
+  const bake::NearTriangles near_o = rt_->near(o);
   // Independent replicates (randomised QMC): B rotations of the Halton sequence, N/B points each.
   // The spread of the replicate means is an honest standard error for the RQMC estimate, which
   // converges faster than 1/sqrt(N); the iid sample variance would overstate it.
@@ -198,7 +207,7 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
       }
       d.normalize();
       const double cn = f.n.dot(d);
-      if (!(cn > 0) || !rt_->occluded(o, d)) continue;  // contributes 0 to the occluded part
+      if (!(cn > 0) || !rt_->occluded(o, near_o, d)) continue;  // contributes 0 to the occluded part
       double p = w_cos * cn * kInvPi + w_env * env_.pdf(d);
       for (const Cone& c : cones)
         if (c.axis.dot(d) >= c.cos_a) p += w_cone * c.inv_solid_angle;
