@@ -1,12 +1,20 @@
-// reader.cpp — read_file: open, check format/format_version, read everything, validate.
+// reader.cpp — read_file: check the file's HDF5 structures ourselves, open, check
+// format/format_version, read everything, validate.
 // Hostile input: every HDF5 call is checked, sizes are checked before allocation, link cycles
-// and depth are bounded, and only hard links are followed (never external files).
+// and depth are bounded, and only hard links are followed (never external files). HDF5 1.10 does
+// not bounds-check what it parses from unchecksummed metadata, so before HDF5 parses a structure
+// we check from the raw bytes that it is one of the checksummed kinds our writer makes (the policy
+// is in formats/prtfile.h, "Which files the reader opens"; the byte layouts are HDF5's File Format
+// Specification version 3.0, sections II.A (superblock) and IV.A.1.b (version-2 object header)).
 #include <formats/names.h>
 #include <formats/prtfile.h>
 
 #include "h5util.h"
 
 #include <algorithm>
+#include <array>
+#include <cstring>
+#include <fstream>
 #include <limits>
 #include <new>
 
@@ -18,10 +26,90 @@ using detail::Hid;
 constexpr int kMaxDepth = 32;
 constexpr std::size_t kMaxObjects = 1'000'000;
 
+// The file's bytes, read directly, for the structure checks below.
+class RawBytes {
+public:
+  RawBytes(const std::filesystem::path& path, uint64_t size) : in_(path, std::ios::binary), size_(size) {}
+  bool ok() const { return static_cast<bool>(in_); }
+  uint64_t size() const { return size_; }
+  // False when [at, at + n) is not inside the file.
+  bool read(uint64_t at, void* out, std::size_t n) {
+    if (at > size_ || n > size_ - at) return false;
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(at));
+    in_.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
+    return static_cast<std::size_t>(in_.gcount()) == n;
+  }
+
+private:
+  std::ifstream in_;
+  uint64_t size_;
+};
+
+uint64_t little_endian(const unsigned char* p, int bytes) {
+  uint64_t v = 0;
+  for (int k = bytes - 1; k >= 0; --k) v = (v << 8) | p[k];
+  return v;
+}
+
+constexpr unsigned char kSignature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+constexpr uint64_t kUndefinedAddress = ~uint64_t{0};
+
+// The superblock (File Format Specification II.A): HDF5's signature at byte 0, version 2 or 3
+// (checksummed; versions 0 and 1 have no checksum and imply unchecksummed structures below them),
+// 8-byte offsets and lengths, base address 0, and an end-of-file address the file reaches.
+// Returns the root group's object header address and the superblock extension's (or undefined).
+struct SuperblockFacts {
+  uint64_t root = 0, extension = kUndefinedAddress;
+};
+SuperblockFacts check_superblock(RawBytes& raw, const std::string& msg_file) {
+  auto refuse = [&](const std::string& what) { throw FormatError(msg_file, what); };
+  std::array<unsigned char, 48> sb{};  // a version-2/3 superblock with 8-byte offsets: 48 bytes
+  if (!raw.read(0, sb.data(), 8) || std::memcmp(sb.data(), kSignature, 8) != 0) {
+    // HDF5 also looks for its signature after a user block (at 512, 1024, 2048, ...).
+    for (uint64_t at = 512; at < raw.size() && at != 0; at *= 2) {
+      unsigned char sig[8];
+      if (raw.read(at, sig, 8) && std::memcmp(sig, kSignature, 8) == 0)
+        refuse("an HDF5 file with a " + std::to_string(at) + "-byte user block before its data; prtbake files have none");
+    }
+    refuse("not an HDF5 file (or damaged beyond recognition)");
+  }
+  if (!raw.read(0, sb.data(), 9)) refuse("truncated: the file ends inside its HDF5 superblock");
+  const int version = sb[8];
+  if (version < 2)
+    refuse("written in HDF5's oldest file format (superblock version " + std::to_string(version) +
+           ": no checksums), which prtbake does not open (a damaged file of that format can crash "
+           "HDF5 1.10); prtbake writes checksummed files, and `h5repack --latest --filter=FLET IN OUT` "
+           "rewrites another tool's file so");
+  if (version > 3)
+    refuse("HDF5 superblock version " + std::to_string(version) + " is newer than this HDF5 (1.10) reads");
+  if (!raw.read(0, sb.data(), sb.size())) refuse("truncated: the file ends inside its HDF5 superblock");
+  if (sb[9] != 8 || sb[10] != 8)
+    refuse("HDF5 offsets of " + std::to_string(sb[9]) + " and lengths of " + std::to_string(sb[10]) +
+           " bytes (prtbake files use 8 and 8)");
+  const uint64_t base = little_endian(&sb[12], 8), extension = little_endian(&sb[20], 8),
+                 eof = little_endian(&sb[28], 8), root = little_endian(&sb[36], 8);
+  if (base != 0) refuse("HDF5 base address " + std::to_string(base) + " (prtbake files use 0)");
+  if (eof > raw.size())
+    refuse("truncated: " + std::to_string(raw.size()) + " bytes, its HDF5 superblock says " + std::to_string(eof));
+  return {root, extension};
+}
+
+// A version-2 object header starts with "OHDR" and version 2 (File Format Specification
+// IV.A.1.b); HDF5 verifies its checksum when it loads it. A version-1 header has neither.
+void check_object_header(RawBytes& raw, uint64_t address, const std::string& what, const std::string& msg_file) {
+  unsigned char head[5];
+  if (address == kUndefinedAddress || !raw.read(address, head, sizeof head))
+    throw FormatError(msg_file, what + " points outside the file (damaged?)");
+  if (std::memcmp(head, "OHDR", 4) != 0 || head[4] != 2)
+    throw FormatError(msg_file, what + " is not a checksummed (version 2) HDF5 object header: damaged, "
+                                       "or written in an old format that prtbake does not open");
+}
+
 class Reader {
 public:
-  Reader(std::string file_for_messages, uint64_t file_size)
-      : msg_file_(std::move(file_for_messages)), file_size_(file_size) {}
+  Reader(std::string file_for_messages, RawBytes& raw)
+      : msg_file_(std::move(file_for_messages)), file_size_(raw.size()), raw_(raw) {}
 
   // Deflate cannot expand data by more than ~1032:1, so a dataset (attributes are stored
   // uncompressed) claiming more bytes than that is damaged: refuse before allocating.
@@ -121,6 +209,8 @@ public:
     Dataset out;
     out.path = path;
     Hid ds = check(detail::dataset_id(H5Dopen2(parent, link.c_str(), H5P_DEFAULT)), "cannot open " + name);
+    check_structures(ds.get(), name);
+    check_chunk_index(ds.get(), name);
     Hid type = check(detail::type_id(H5Dget_type(ds.get())), "cannot read the type of " + name);
     Hid space = check(detail::space_id(H5Dget_space(ds.get())), "cannot read the shape of " + name);
     const int rank = H5Sget_simple_extent_ndims(space.get());
@@ -188,9 +278,11 @@ public:
       H5L_info_t linfo;
       if (H5Lget_info(group, link.c_str(), &linfo, H5P_DEFAULT) < 0) fail("cannot inspect '" + child + "'");
       if (linfo.type != H5L_TYPE_HARD) fail("'" + child + "' is a soft or external link (not supported)");
+      check_object_header(raw_, linfo.u.address, "'" + child + "'", msg_file_);
       Hid obj = check(detail::object_id(H5Oopen(group, link.c_str(), H5P_DEFAULT)), "cannot open '" + child + "'");
       const H5I_type_t t = H5Iget_type(obj.get());
       if (t == H5I_GROUP) {
+        check_structures(obj.get(), "group '" + child + "'");
         std::vector<Attr> attrs = read_attrs(obj.get(), "group '" + child + "'");
         if (!attrs.empty()) out.group_attrs.emplace_back(child, std::move(attrs));
         read_group(obj.get(), child, depth + 1, out);
@@ -203,9 +295,31 @@ public:
     }
   }
 
+  // What HDF5 cannot be trusted to parse safely, refused from the object header's summary (loaded
+  // and checksummed by now): old-style symbol-table groups (version-1 B-trees and local heaps,
+  // no checksums; our writer's groups keep their links in the header or in checksummed fractal
+  // heaps) and, for datasets, a version-1 B-tree chunk index.
+  void check_structures(hid_t obj, const std::string& what) const {
+    H5O_info_t info;
+    if (H5Oget_info2(obj, &info, H5O_INFO_HDR) < 0) fail("cannot inspect " + what);
+    constexpr unsigned kSymbolTableMessage = 0x11;  // File Format Specification IV.A.2.r
+    if (info.hdr.version != 2 || (info.hdr.mesg.present >> kSymbolTableMessage) & 1u)
+      fail(what + " uses unchecksummed HDF5 structures (an old-style group or object header), "
+                  "which prtbake does not open");
+  }
+  void check_chunk_index(hid_t ds, const std::string& what) const {
+    Hid dcpl = check(detail::plist_id(H5Dget_create_plist(ds)), "cannot read the layout of " + what);
+    if (H5Pget_layout(dcpl.get()) != H5D_CHUNKED) return;
+    H5D_chunk_index_t index;
+    if (H5Dget_chunk_index_type(ds, &index) < 0) fail("cannot read the chunk index of " + what);
+    if (index == H5D_CHUNK_IDX_BTREE)
+      fail(what + " indexes its chunks with an unchecksummed version-1 B-tree, which prtbake does not open");
+  }
+
 private:
   std::string msg_file_;
   uint64_t file_size_;
+  RawBytes& raw_;
   std::size_t objects_ = 0;
 };
 
@@ -222,19 +336,23 @@ File read_file(const std::filesystem::path& path, ReadCheck check) {
   {
     const std::lock_guard lock(detail::hdf5_mutex());
     detail::silence_hdf5_errors();
-    Reader r(msg_file, static_cast<uint64_t>(std::filesystem::file_size(path, ec)));
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) throw FormatError(msg_file, "cannot read the file: " + ec.message());
+    RawBytes raw(path, static_cast<uint64_t>(size));
+    if (!raw.ok()) throw FormatError(msg_file, "cannot open the file for reading");
+    Reader r(msg_file, raw);
     try {
-      const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-      if (is_hdf5 <= 0) {
-        detail::take_hdf5_error();
-        throw FormatError(msg_file, "not an HDF5 file (or damaged beyond recognition)");
-      }
+      const SuperblockFacts sb = check_superblock(raw, msg_file);
+      check_object_header(raw, sb.root, "the root group", msg_file);
+      if (sb.extension != kUndefinedAddress)
+        check_object_header(raw, sb.extension, "the superblock extension", msg_file);
       Hid fapl = detail::plist_id(H5Pcreate(H5P_FILE_ACCESS));
       if (!fapl.valid() || H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0)
         r.fail("cannot create HDF5 file properties");
       Hid f = detail::file_id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get()));
       if (!f.valid()) r.fail("cannot open the HDF5 file (damaged or truncated?)");
       Hid root = r.check(detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT)), "cannot open the root group");
+      r.check_structures(root.get(), "the root group");
       out.root_attrs = r.read_attrs(root.get(), "the root group");
 
       const Attr* fmt = find_attr(out.root_attrs, names::kFormat);

@@ -27,7 +27,8 @@ constexpr unsigned kDeflateLevel = 6;
 
 class Writer {
 public:
-  Writer(std::string file_for_messages, hid_t file) : msg_file_(std::move(file_for_messages)), file_(file) {}
+  Writer(std::string file_for_messages, hid_t file, bool checksum_data)
+      : msg_file_(std::move(file_for_messages)), file_(file), checksum_data_(checksum_data) {}
 
   [[noreturn]] void fail(const std::string& what) const {
     const std::string detail = detail::take_hdf5_error();
@@ -132,7 +133,7 @@ public:
       check(H5Pset_chunk(dcpl.get(), rank, chunk.data()), "cannot set chunking of " + name);
       check(H5Pset_shuffle(dcpl.get()), "cannot set the shuffle filter of " + name);
       check(H5Pset_deflate(dcpl.get(), kDeflateLevel), "cannot set deflate compression of " + name);
-      check(H5Pset_fletcher32(dcpl.get()), "cannot set the fletcher32 checksum of " + name);
+      if (checksum_data_) check(H5Pset_fletcher32(dcpl.get()), "cannot set the fletcher32 checksum of " + name);
     }
     Hid ds = check(detail::dataset_id(H5Dcreate2(file_, d.path.c_str(), file_type, space.get(),
                                                 H5P_DEFAULT, dcpl.get(), H5P_DEFAULT)),
@@ -153,6 +154,7 @@ public:
 private:
   std::string msg_file_;
   hid_t file_;
+  bool checksum_data_;
   std::set<std::string> created_;
 };
 
@@ -199,7 +201,15 @@ void remove_stale_temporaries(const std::filesystem::path& dir, const std::strin
   }
 }
 
-void write_checked(const std::filesystem::path& final_path, const File& file, bool add_format) {
+// The on-disk format: ours (HDF5 1.10 structures, every metadata block checksummed, fletcher32 on
+// data), or, for reader tests only, HDF5's oldest (superblock 0, version-1 object headers,
+// symbol-table groups, version-1 B-tree chunk indexes: no checksum anywhere) — with its own
+// superblock (version 0) or under a checksummed version-2 one (a non-default file-space setting
+// makes HDF5 write that; the objects below it stay unchecksummed).
+enum class OnDisk { current, oldest, oldest_objects };
+
+void write_checked(const std::filesystem::path& final_path, const File& file, bool add_format,
+                   OnDisk on_disk = OnDisk::current) {
   const std::string msg_file = final_path.string();
 
   if (final_path.filename().empty())
@@ -230,7 +240,9 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
     if (!fcpl.valid() || !fapl.valid()) fail("cannot create HDF5 file properties");
     // The root group is created with the file: no time stamps there either.
     if (H5Pset_obj_track_times(fcpl.get(), false) < 0 ||
-        H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V110, H5F_LIBVER_V110) < 0 ||
+        (on_disk == OnDisk::oldest_objects &&
+         H5Pset_file_space_strategy(fcpl.get(), H5F_FSPACE_STRATEGY_FSM_AGGR, 1, 1) < 0) ||
+        (on_disk == OnDisk::current && H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V110, H5F_LIBVER_V110) < 0) ||
         H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0)
       fail("cannot set HDF5 file properties");
     Hid f = detail::file_id(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()));
@@ -238,7 +250,7 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
       fail("cannot create temporary file '" + tmp.string() + "' (is '" + dir.string() +
            "' writable?)");
 
-    Writer w(msg_file, f.get());
+    Writer w(msg_file, f.get(), on_disk == OnDisk::current);
     Hid root = detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT));
     if (!root.valid()) fail("cannot open the root group");
     if (add_format) {
@@ -267,12 +279,24 @@ void write_file(const std::filesystem::path& final_path, const File& file) {
 }
 
 namespace testing {
-void write_file_unvalidated(const std::filesystem::path& final_path, const File& file) {
+namespace {
+void require_memory_safe(const std::filesystem::path& final_path, const File& file) {
   for (const Dataset& d : file.datasets)
     if (d.shape.empty() || d.shape.size() > 32 || d.path.empty() || d.path[0] != '/' ||
         shape_product(d.shape) != element_count(d.data))
       throw FormatError(final_path.string(), "dataset '" + d.path + "' is malformed (rank or size)");
+}
+} // namespace
+
+void write_file_unvalidated(const std::filesystem::path& final_path, const File& file) {
+  require_memory_safe(final_path, file);
   write_checked(final_path, file, false);
+}
+
+void write_file_oldest_format(const std::filesystem::path& final_path, const File& file, OldestFormat which) {
+  require_memory_safe(final_path, file);
+  write_checked(final_path, file, false,
+                which == OldestFormat::everywhere ? OnDisk::oldest : OnDisk::oldest_objects);
 }
 } // namespace testing
 

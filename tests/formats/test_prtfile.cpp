@@ -426,6 +426,43 @@ void expect_read_error(const fs::path& p, const std::string& expected) {
   EXPECT_EQ(err, "") << "HDF5 must not print its error stack";
 }
 
+// Calls `read` on `file` with its byte at each offset `at` XOR-ed by each mask (in place, restored
+// after: rewriting a whole file per flip costs more than the read); returns how many reads threw
+// a FormatError naming the file. Anything else escaping fails the test.
+template <class Offsets>
+int flips_refused(const fs::path& file, const Offsets& offsets, std::initializer_list<unsigned char> masks,
+                  int* tried = nullptr) {
+  std::fstream io(file, std::ios::binary | std::ios::in | std::ios::out);
+  int refused = 0;
+  for (const std::size_t at : offsets)
+    for (const unsigned char mask : masks) {
+      char c;
+      io.seekg(static_cast<std::streamoff>(at));
+      io.get(c);
+      const auto flip = [&](char v) {
+        io.seekp(static_cast<std::streamoff>(at));
+        io.put(v);
+        io.flush();
+      };
+      flip(static_cast<char>(c ^ static_cast<char>(mask)));
+      if (tried != nullptr) ++*tried;
+      try {
+        (void)read_file(file);
+      } catch (const FormatError& e) {
+        ++refused;
+        EXPECT_EQ(e.file(), file.string());
+      }
+      flip(c);
+    }
+  return refused;
+}
+
+std::vector<std::size_t> offsets(std::size_t size, std::size_t dense, std::size_t stride) {
+  std::vector<std::size_t> out;
+  for (std::size_t at = 0; at < size; at += at < dense ? 1 : stride) out.push_back(at);
+  return out;
+}
+
 TEST(Reader, MissingFile) {
   expect_read_error(scratch("missing") / "none.prt.h5", "no such file");
 }
@@ -451,25 +488,13 @@ TEST(Reader, GarbageFileIsAFormatError) {
 }
 
 TEST(Reader, CorruptedBytesGiveFormatErrorNeverACrash) {
-  // Flip one byte in every 7 (offsets cover all metadata structures of the small file): every
+  // Flip every byte (the file is ~9 KB and covers all metadata structures): every
   // outcome must be a clean FormatError or (when the flip hits unused or padding bytes) a
   // successful read; never a crash. Run under the asan preset this also proves no out-of-bounds
-  // access (with stride 1 too: see formats/SCHEMA.md, "Storage").
+  // access (formats/SCHEMA.md, "Storage").
   const fs::path dir = scratch("corrupt");
   write_file(dir / "a.prt.h5", make_file());
-  const std::string bytes = slurp(dir / "a.prt.h5");
-  int errors = 0;
-  for (std::size_t at = 0; at < bytes.size(); at += 7) {
-    std::string b = bytes;
-    b[at] = static_cast<char>(b[at] ^ 0x5A);
-    std::ofstream(dir / "c.prt.h5", std::ios::binary | std::ios::trunc).write(b.data(), static_cast<std::streamsize>(b.size()));
-    try {
-      (void)read_file(dir / "c.prt.h5");
-    } catch (const FormatError& e) {
-      ++errors;
-      EXPECT_EQ(e.file(), (dir / "c.prt.h5").string());
-    }
-  }
+  const int errors = flips_refused(dir / "a.prt.h5", offsets(fs::file_size(dir / "a.prt.h5"), 0, 1), {0x5a});
   EXPECT_GT(errors, 0) << "some flipped bytes must be detected";
 }
 
@@ -531,6 +556,62 @@ TEST(Reader, NonPrtbakeHdf5FileIsRejected) {
   f.root_attrs.push_back({"format", std::string("other")});
   prt::formats::testing::write_file_unvalidated(dir / "other.h5", f);
   expect_read_error(dir / "other.h5", "not a prtbake file (format = \"other\")");
+}
+
+// A prtbake-looking file (format attributes set) in HDF5's oldest on-disk format.
+File with_format_attrs(File f) {
+  f.root_attrs.push_back({"format", std::string("prtbake")});
+  f.root_attrs.push_back({"format_version", int64_t{2}});
+  return f;
+}
+
+TEST(Reader, OldestFormatIsRefusedBeforeHdf5ParsesIt) {
+  // Superblock 0, version-1 object headers, symbol-table groups, no checksums: what crashed
+  // HDF5 1.10 when damaged. Refused from its superblock, whatever its content.
+  const fs::path dir = scratch("oldest");
+  using prt::formats::testing::OldestFormat;
+  prt::formats::testing::write_file_oldest_format(dir / "old.prt.h5", with_format_attrs(make_file()));
+  expect_read_error(dir / "old.prt.h5", "written in HDF5's oldest file format (superblock version 0: no checksums)");
+  // Checksummed superblock, unchecksummed objects below it: refused at the root group's header.
+  prt::formats::testing::write_file_oldest_format(dir / "mixed.prt.h5", with_format_attrs(make_file()),
+                                                  OldestFormat::objects_only);
+  expect_read_error(dir / "mixed.prt.h5", "is not a checksummed (version 2) HDF5 object header");
+  // The message's advice works: h5repack --latest --filter=FLET (rewriting every dataset: a plain
+  // --latest copies object headers as they are) makes it a file the reader opens, with the data.
+  const CmdResult r = run_command("/usr/bin/h5repack --latest --filter=FLET " + (dir / "old.prt.h5").string() + " " +
+                                  (dir / "repacked.prt.h5").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const File got = read_file(dir / "repacked.prt.h5");
+  EXPECT_EQ(std::get<0>(find_dataset(got, "/ao")->data), std::get<0>(find_dataset(make_file(), "/ao")->data));
+}
+
+TEST(Reader, EveryFlippedByteOfAnOldFormatFileIsRefused) {
+  // Byte flips over unchecksummed files (both old kinds): never a crash, never accepted (a flip
+  // cannot make an unchecksummed file a checksummed one: the superblock or header check, or
+  // HDF5's checksum of the structure the flip pretends to be, refuses it). Every byte of the
+  // superblock, then one byte in 5 (the files are ~50 KB); two masks.
+  const fs::path dir = scratch("oldest_flips");
+  using prt::formats::testing::OldestFormat;
+  for (const OldestFormat which : {OldestFormat::everywhere, OldestFormat::objects_only}) {
+    prt::formats::testing::write_file_oldest_format(dir / "old.prt.h5", with_format_attrs(make_file()), which);
+    int tried = 0;
+    const int refused = flips_refused(dir / "old.prt.h5", offsets(fs::file_size(dir / "old.prt.h5"), 64, 5),
+                                      {0x01, 0xff}, &tried);
+    EXPECT_EQ(refused, tried) << "every flip of an unchecksummed file is refused";
+  }
+}
+
+TEST(Reader, UserBlocksAndForeignOffsetSizesAreRefused) {
+  const fs::path dir = scratch("user_block");
+  write_file(dir / "a.prt.h5", make_file());
+  const std::string bytes = slurp(dir / "a.prt.h5");
+  std::ofstream(dir / "ub.prt.h5", std::ios::binary).write((std::string(512, ' ') + bytes).data(),
+                                                           static_cast<std::streamsize>(512 + bytes.size()));
+  expect_read_error(dir / "ub.prt.h5", "an HDF5 file with a 512-byte user block before its data");
+  std::string small = bytes;
+  small[9] = 4;  // 4-byte offsets
+  std::ofstream(dir / "o4.prt.h5", std::ios::binary).write(small.data(), static_cast<std::streamsize>(small.size()));
+  expect_read_error(dir / "o4.prt.h5", "HDF5 offsets of 4 and lengths of 8 bytes (prtbake files use 8 and 8)");
 }
 
 TEST(Reader, FullCheckRejectsNaNHeaderCheckShowsIt) {

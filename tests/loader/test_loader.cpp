@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -149,3 +150,52 @@ TEST(Loader, BrokenOccluderIsRefusedNamingTheFile) {
 }
 
 } // namespace
+
+TEST(Loader, DamagedAndOldFormatFilesAreRefusedNeverACrash) {
+  // What an engine links must not crash on a damaged file (formats/prtfile.h, "Which files the
+  // reader opens"): every third byte of a scene file flipped gives a FormatError naming the file or,
+  // when the flip hits padding, a load; the same file in HDF5's oldest (unchecksummed) format is
+  // refused before HDF5 parses it.
+  const auto path = tmp("loader_flips.prt.h5");
+  prt::formats::write_file(path, make_file(true));
+  const prt::shade::LoadedAsset good = prt::shade::load_prt(path);
+  std::fstream io(path, std::ios::binary | std::ios::in | std::ios::out);
+  const auto size = static_cast<std::size_t>(std::filesystem::file_size(path));
+  int refused = 0, loaded_same = 0, tried = 0;
+  for (std::size_t at = 0; at < size; at += 3) {
+    char c;
+    io.seekg(static_cast<std::streamoff>(at));
+    io.get(c);
+    const auto put = [&](char v) {
+      io.seekp(static_cast<std::streamoff>(at));
+      io.put(v);
+      io.flush();
+    };
+    put(static_cast<char>(c ^ '\xff'));
+    ++tried;
+    try {
+      const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+      // A flip that passes every check landed in bytes that carry nothing (free space, padding).
+      loaded_same += a.vertex_sets.size() == good.vertex_sets.size() && a.vertex_sets[0].ao == good.vertex_sets[0].ao &&
+                     a.occluders.size() == good.occluders.size() && a.occluders[0].shells == good.occluders[0].shells;
+    } catch (const prt::formats::FormatError& e) {
+      ++refused;
+      EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    }
+    put(c);
+  }
+  EXPECT_GT(refused, tried / 2) << "most bytes of a small file are checksummed metadata or data";
+  EXPECT_EQ(refused + loaded_same, tried) << "a damaged file either is refused or loads the same values";
+
+  const auto old = tmp("loader_oldest.prt.h5");
+  File f = make_file(true);
+  f.root_attrs.push_back({"format", std::string("prtbake")});
+  f.root_attrs.push_back({"format_version", int64_t{2}});
+  prt::formats::testing::write_file_oldest_format(old, f);
+  try {
+    prt::shade::load_prt(old);
+    FAIL() << "an unchecksummed file was loaded";
+  } catch (const prt::formats::FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("oldest file format"), std::string::npos) << e.what();
+  }
+}

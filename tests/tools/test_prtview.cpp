@@ -1,5 +1,8 @@
 // End-to-end tests of the prtview binary: bad input fails cleanly (message, exit status, no file
 // left behind), and real renders of small baked files give the numbers their closed forms predict.
+#include <formats/prtfile.h>
+#include <formats/testing.h>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -293,4 +296,44 @@ TEST(PrtviewScene, WrongEnvironmentAndFivOptionsAreRefused) {
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("do not apply to scene files (" + h5.string() + ")"), std::string::npos) << o.err;
   expect_no_output(out);
+}
+
+TEST(Prtview, DamagedAndOldFormatFilesGiveOneLineNeverACrash) {
+  // A baked file with flips spread over it (36 offsets, every metadata structure of a small file
+  // is hit) and the same content in HDF5's oldest unchecksummed format: prtview exits 0 (a flip
+  // in bytes that carry nothing) or 1 with one line naming the file; never a signal, no output
+  // left behind on failure.
+  const fs::path h5 = scratch("flip_src.prt.h5");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
+                                         " --report 0 --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::string bytes = slurp(h5);
+  const fs::path bad = scratch("flipped.prt.h5"), out = scratch("flipped.png");
+  std::vector<std::string> variants;
+  for (int k = 0; k < 36; ++k) {
+    std::string v = bytes;
+    v[v.size() * static_cast<std::size_t>(k) / 36] ^= '\xff';
+    variants.push_back(v);
+  }
+  {
+    prt::formats::File f = prt::formats::read_file(h5);
+    prt::formats::testing::write_file_oldest_format(bad, f);
+    variants.push_back(slurp(bad));
+  }
+  int refused = 0;
+  for (std::size_t k = 0; k < variants.size(); ++k) {
+    std::ofstream(bad, std::ios::binary | std::ios::trunc).write(variants[k].data(), static_cast<std::streamsize>(variants[k].size()));
+    const Outcome r = view(bad.string() + " " + kCamera + " --size 16x12 --samples 8 -o " + out.string());
+    ASSERT_TRUE(r.code == 0 || r.code == 1) << "variant " << k << ": exit " << r.code << "\n" << r.err;
+    if (r.code == 1) {
+      ++refused;
+      EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+      expect_no_output(out);
+    }
+    fs::remove(out);
+  }
+  EXPECT_GT(refused, 18) << "most flips of a small file hit checksummed bytes";
+  const Outcome old = view(bad.string() + " " + kCamera + " -o " + out.string());
+  EXPECT_NE(old.err.find("oldest file format"), std::string::npos) << old.err;
 }

@@ -38,6 +38,25 @@
 //     it then applies validate(), so callers can trust shapes, index ranges and finiteness.
 //   * Damaged, truncated or non-HDF5 files give a FormatError naming the file; never a crash.
 //
+// Which files the reader opens
+//   HDF5 1.10 parses what it reads from a file without bounds checks in several places; a
+//   damaged file can crash it (SIGSEGV, heap overflow, SIGFPE). Its newer on-disk structures carry
+//   checksums that HDF5 verifies before parsing, so the reader opens only files made of those —
+//   what our writer makes — and checks that from the raw bytes BEFORE HDF5 parses a structure:
+//   * the superblock: HDF5's signature at byte 0 (no user block), version 2 or 3 (checksummed),
+//     8-byte offsets and lengths, base address 0, an end-of-file address within the file;
+//   * every object header (the root group, the superblock extension, each hard link's target,
+//     by its address, before it is opened): version 2 ("OHDR", checksummed);
+//   * once a header is loaded: no old-style symbol-table group, no version-1 B-tree chunk index.
+//   Anything else — HDF5's oldest format (superblock 0/1, version-1 object headers, as HDF5 and
+//   h5py write by default), user blocks, soft and external links — is refused with a message
+//   that says so (`h5repack --latest --filter=FLET IN OUT` rewrites another tool's file into
+//   the accepted format; --latest alone copies object headers unchanged). What remains reaches HDF5 only through checksummed metadata: a flipped or truncated
+//   byte is a checksum or bounds error, not a crash. Variable-length strings (h5py `str`
+//   attributes) live in a global heap without a checksum; they are read, and the damaged cases
+//   were tested (docs/RELIABILITY.md). A file crafted on purpose with valid checksums is beyond
+//   what checks of this kind can promise; docs/RELIABILITY.md records what was fuzzed.
+//
 // Errors: every failure is a FormatError whose what() is one line "<file>: <defect>".
 // Threads: serial HDF5 is not thread-safe; write_file/read_file serialise their HDF5 calls with
 // one process-wide mutex, so they may be called from any thread.

@@ -12,4 +12,14 @@ namespace prt::formats::testing {
 // Still refuses what would be memory-unsafe (data size != product(shape), rank outside 1..32).
 void write_file_unvalidated(const std::filesystem::path& final_path, const File& file);
 
+// As write_file_unvalidated, in HDF5's oldest on-disk format, as HDF5 writes by default and as
+// other tools (h5py, h5py-era scripts) do: superblock version 0, version-1 object headers,
+// symbol-table groups, version-1 B-tree chunk indexes, no fletcher32: no checksum anywhere.
+// `objects_only`: the same objects under a checksummed version-2 superblock (HDF5 writes that for
+// a non-default file-space setting), the case a superblock check alone would let through.
+// read_file refuses both (prtfile.h, "Which files the reader opens").
+enum class OldestFormat { everywhere, objects_only };
+void write_file_oldest_format(const std::filesystem::path& final_path, const File& file,
+                              OldestFormat which = OldestFormat::everywhere);
+
 } // namespace prt::formats::testing
