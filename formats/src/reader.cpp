@@ -165,25 +165,22 @@ public:
       const htri_t is_var = H5Tis_variable_str(type.get());
       if (is_var < 0) fail("cannot read the type of " + what);
       if (is_var > 0) {
-        // Another tool's string (h5py writes str attributes so): read it, never refuse the file.
-        Hid mem = check(detail::type_id(H5Tcopy(H5T_C_S1)), what);
-        if (H5Tset_size(mem.get(), H5T_VARIABLE) < 0 || H5Tset_cset(mem.get(), H5Tget_cset(type.get())) < 0)
-          fail("cannot read the type of " + what);
-        char* text = nullptr;
-        if (H5Aread(a, mem.get(), &text) < 0) fail("cannot read " + what);
-        out.value = std::string(text != nullptr ? text : "");
-        H5free_memory(text);
-      } else {
-        const std::size_t size = H5Tget_size(type.get());
-        if (size == 0 || !plausible(size, false)) fail(what + " has an invalid string size");
-        std::string s(size, '\0');
-        Hid mem = check(detail::type_id(H5Tcopy(type.get())), what);
-        if (H5Aread(a, mem.get(), s.data()) < 0) fail("cannot read " + what);
-        s.resize(std::min(s.size(), s.find('\0')));
-        if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD)
-          s.erase(s.find_last_not_of(' ') + 1);
-        out.value = std::move(s);
+        // Its text lives in a global heap, which has no checksum and which HDF5 1.10 parses
+        // without bounds checks: flipping a byte of a heap object's size crashed (SIGSEGV) or hung
+        // HDF5 (docs/RELIABILITY.md). The type is known without touching the heap.
+        fail(what + " is a variable-length string (h5py's default for str), which prtbake does not "
+                    "read: HDF5 reads its unchecksummed heap unsafely; store it fixed-length, e.g. with "
+                    "h5py attrs.create(name, text.encode(), dtype=h5py.string_dtype('utf-8', len(text.encode())))");
       }
+      const std::size_t size = H5Tget_size(type.get());
+      if (size == 0 || !plausible(size, false)) fail(what + " has an invalid string size");
+      std::string s(size, '\0');
+      Hid mem = check(detail::type_id(H5Tcopy(type.get())), what);
+      if (H5Aread(a, mem.get(), s.data()) < 0) fail("cannot read " + what);
+      s.resize(std::min(s.size(), s.find('\0')));
+      if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD)
+        s.erase(s.find_last_not_of(' ') + 1);
+      out.value = std::move(s);
       return out;
     }
     if (tclass != H5T_INTEGER && tclass != H5T_FLOAT) fail(what + " has an unsupported type");

@@ -1,6 +1,6 @@
 // h5py from tests: find a python3 that has it, and add attributes to a file the way another tool
-// would (h5py `str` attributes are variable-length strings), for the tests that check that such
-// attributes are kept and shown (formats/SCHEMA.md, "Extra attributes").
+// would, for the tests that check that such attributes are kept and shown, and that h5py's
+// variable-length strings are refused (formats/SCHEMA.md, "Extra attributes").
 #pragma once
 
 #include <run_tool.h>
@@ -19,22 +19,36 @@ inline std::string python_with_h5py(const std::filesystem::path& capture_dir) {
   return "";
 }
 
-// Adds variable-length string attributes named "note" with h5py: on the root ("root note ✓"),
-// on the group `group` ("group note") and on the dataset `dataset` ("dataset note"). Returns
-// what python printed on failure ("" on success).
+// How add_h5py_notes stores its strings: fixed-length UTF-8 (what prtbake reads), or h5py's
+// default for a Python str, variable-length (what prtbake refuses: formats/prtfile.h, "Which
+// files the reader opens").
+enum class H5pyStrings { fixed_length, variable_length };
+
+// Adds string attributes named "note" with h5py: on the root ("root note ✓"), on the group
+// `group` ("group note") and on the dataset `dataset` ("dataset note"). Returns what python
+// printed on failure ("" on success).
 inline std::string add_h5py_notes(const std::string& python, const std::filesystem::path& file,
-                                  const std::string& group, const std::string& dataset) {
+                                  const std::string& group, const std::string& dataset,
+                                  H5pyStrings kind = H5pyStrings::fixed_length) {
   const std::filesystem::path dir = file.parent_path();
   const std::string script = "import h5py, sys\n"
+                             "fixed = sys.argv[4] == 'fixed'\n"
+                             "def note(obj, text):\n"
+                             "    if fixed:\n"
+                             "        b = text.encode('utf-8')\n"
+                             "        obj.attrs.create('note', b, dtype=h5py.string_dtype('utf-8', len(b)))\n"
+                             "    else:\n"
+                             "        obj.attrs['note'] = text\n"
+                             "    assert (h5py.check_string_dtype(obj.attrs.get_id('note').dtype).length is None) != fixed\n"
                              "f = h5py.File(sys.argv[1], 'r+')\n"
-                             "f.attrs['note'] = 'root note \\u2713'\n"
-                             "f[sys.argv[2]].attrs['note'] = 'group note'\n"
-                             "f[sys.argv[3]].attrs['note'] = 'dataset note'\n"
-                             "assert h5py.check_string_dtype(f.attrs.get_id('note').dtype).length is None\n"
+                             "note(f, 'root note \\u2713')\n"
+                             "note(f[sys.argv[2]], 'group note')\n"
+                             "note(f[sys.argv[3]], 'dataset note')\n"
                              "f.close()\n";
   const std::filesystem::path py = dir / "add_notes.py";
   std::ofstream(py) << script;
-  const ToolRun r = run_tool(python, "'" + py.string() + "' '" + file.string() + "' '" + group + "' '" + dataset + "'",
+  const ToolRun r = run_tool(python, "'" + py.string() + "' '" + file.string() + "' '" + group + "' '" + dataset + "' " +
+                                         (kind == H5pyStrings::fixed_length ? "fixed" : "variable"),
                              dir);
   return r.code == 0 ? std::string() : "python failed (" + std::to_string(r.code) + "): " + r.out + r.err;
 }

@@ -214,7 +214,7 @@ TEST(Prtdump, HelpTeachesUsageOptionsAndSections) {
 }
 
 TEST(Prtdump, ShowsAttributesAnotherToolAdded) {
-  // h5py str attributes are variable-length strings: prtdump shows them and the file stays valid.
+  // Fixed-length string attributes h5py added: prtdump shows them and the file stays valid.
   const fs::path dir = scratch("foreign_attrs");
   const std::string python = prt::testing::python_with_h5py(dir);
   if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";

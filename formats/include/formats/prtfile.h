@@ -11,8 +11,8 @@
 //   listed: they exist because a dataset lies under them or because they carry attributes.
 //   On-disk types: std::vector<float> <-> float32 (IEEE little endian), std::vector<uint32_t>
 //   <-> uint32, std::vector<uint8_t> <-> uint8. Attribute values: std::string <-> fixed-length
-//   UTF-8 string (the writer's; variable-length strings that other tools wrote, e.g. h5py's
-//   str attributes, are read too), int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
+//   UTF-8 string (the writer's; other tools' fixed-length strings are read too, variable-length
+//   ones refused: "Which files the reader opens"), int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
 //   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
 //
 // Writer contract (write_file)
@@ -52,10 +52,11 @@
 //   h5py write by default), user blocks, soft and external links — is refused with a message
 //   that says so (`h5repack --latest --filter=FLET IN OUT` rewrites another tool's file into
 //   the accepted format; --latest alone copies object headers unchanged). What remains reaches HDF5 only through checksummed metadata: a flipped or truncated
-//   byte is a checksum or bounds error, not a crash. Variable-length strings (h5py `str`
-//   attributes) live in a global heap without a checksum; they are read, and the damaged cases
-//   were tested (docs/RELIABILITY.md). A file crafted on purpose with valid checksums is beyond
-//   what checks of this kind can promise; docs/RELIABILITY.md records what was fuzzed.
+//   byte is a checksum or bounds error, not a crash. Variable-length strings (h5py's default
+//   for a str attribute) are refused by their type, before HDF5 reads their text from the
+//   global heap, which has no checksum and which a flipped byte made HDF5 crash or hang on
+//   (docs/RELIABILITY.md). A file crafted on purpose with valid checksums is beyond what checks
+//   of this kind can promise; docs/RELIABILITY.md records what was fuzzed.
 //
 // Errors: every failure is a FormatError whose what() is one line "<file>: <defect>".
 // Threads: serial HDF5 is not thread-safe; write_file/read_file serialise their HDF5 calls with
