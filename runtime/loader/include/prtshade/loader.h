@@ -16,6 +16,16 @@
 // one per /objects/<name> as well (named "<name>"), root first then by name.
 // Errors: prt::formats::FormatError "<file>: <defect>" for anything unreadable or inconsistent,
 // including occluder data the core would refuse (prt::shade::validate_occluder / validate_difmap).
+// What an engine linking this may rely on, for any bytes in the file (a damaged download, a
+// truncated copy, another tool's HDF5 file): load_prt returns the file's data, fully checked
+// against the schema (shapes, index ranges, finiteness), or throws FormatError; it does not
+// crash, hang or allocate more than the file's size allows. HDF5 1.10 itself is not safe on
+// damaged unchecksummed metadata, so the reader hands HDF5 only checksummed structures, checked
+// from the raw bytes first (formats/prtfile.h, "Which files the reader opens"): files in HDF5's
+// oldest format and variable-length strings are refused. Tested by byte flips over whole files
+// (tests/loader) and fuzzed (docs/RELIABILITY.md). Not covered: a file crafted on purpose with
+// valid checksums around malformed HDF5 structures; load untrusted files (user mods, downloads)
+// in a separate process if that matters.
 #pragma once
 
 #include <prtshade/fiv.h>
