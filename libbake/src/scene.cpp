@@ -103,13 +103,22 @@ Json parse_json(const std::string& text, const std::string& file) {
   }
 }
 
+// A scene or options file lists objects and settings: 64 MiB is far beyond any real one. Read up
+// to one byte more, so a pipe or a device (/dev/zero) is refused at the limit, not read forever.
+constexpr size_t kMaxJsonFileBytes = size_t{64} << 20;
+
 Json parse_json_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  std::string text;
+  for (char buffer[65536]; text.size() <= kMaxJsonFileBytes && in;) {
+    in.read(buffer, sizeof buffer);
+    text.append(buffer, static_cast<size_t>(in.gcount()));
+  }
   if (in.bad()) throw InputError(file.string(), "cannot read the file");
-  return parse_json(ss.str(), file.string());
+  if (text.size() > kMaxJsonFileBytes)
+    throw InputError(file.string(), "larger than " + std::to_string(kMaxJsonFileBytes >> 20) + " MiB; a scene file is not that large");
+  return parse_json(text, file.string());
 }
 
 // An object's member, nullptr if absent.
