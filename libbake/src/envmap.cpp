@@ -26,7 +26,9 @@
 #include <numbers>
 #include <filesystem>
 #include <limits>
+#include <new>
 #include <sstream>
+#include <string_view>
 
 namespace prt::bake {
 namespace {
@@ -230,6 +232,10 @@ EnvMap EnvMap::from_memory(Layout layout, int width, int height, std::vector<flo
 
 EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
   const std::string file = exr.string();
+  return reading_file(file, [&] { return read(exr, file, up); });
+}
+
+EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, UpAxis up) {
   std::error_code ec;
   if (!std::filesystem::exists(exr, ec)) throw InputError(file, "no such file");
   EnvMapInfo info;
@@ -353,7 +359,10 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
   } catch (const Iex::BaseExc& e) {
     // OpenEXR's own errors: the file is damaged, truncated or not an image OpenEXR can read. Our
     // InputErrors pass through as they are; std::bad_alloc (the machine) and logic errors (a bug)
-    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6).
+    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6). OpenEXR 3.1 turns
+    // a std::bad_alloc for its scanline buffers into an Iex exception with this message: that is
+    // the machine too.
+    if (std::string_view(e.what()).find("Failed to allocate memory") != std::string_view::npos) throw std::bad_alloc();
     throw InputError(file, "cannot read OpenEXR image: " + one_line(e.what()));
   }
   return build(layout, W, H, std::move(rgb), up, std::move(info));

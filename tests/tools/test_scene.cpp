@@ -243,16 +243,16 @@ struct BadScene {
 
 class SceneErrors : public ::testing::TestWithParam<BadScene> {};
 
-TEST(SceneLimits, FilesLargerThan64MiBAndEndlessStreamsAreRefusedAtTheLimit) {
+TEST(SceneLimits, FilesLargerThan16MiBAndEndlessStreamsAreRefusedAtTheLimit) {
   const fs::path d = dir_for("too_large");
   write_meshes(d);
-  // Valid JSON of 64 MiB + 1 byte (a long string): refused before parsing, naming the limit.
-  write_text(d / "scene.json", "{\"prtbake_scene\": 1, \"x\": \"" + std::string((size_t{64} << 20) - 28, 'a') + "\"}");
-  ASSERT_EQ(fs::file_size(d / "scene.json"), (size_t{64} << 20) + 1);
+  // Valid JSON of 16 MiB + 1 byte (a long string): refused before parsing, naming the limit.
+  write_text(d / "scene.json", "{\"prtbake_scene\": 1, \"x\": \"" + std::string((size_t{16} << 20) - 28, 'a') + "\"}");
+  ASSERT_EQ(fs::file_size(d / "scene.json"), (size_t{16} << 20) + 1);
   for (const fs::path& scene : {d / "scene.json", fs::path("/dev/zero")}) {
     const auto r = prt::testing::run_tool(PRT_PRTBAKE, "scene '" + scene.string() + "' -o '" + (d / "out.prt.h5").string() + "'", d);
     EXPECT_EQ(r.code, 1) << r.err;
-    EXPECT_NE(r.err.find(scene.string() + ": larger than 64 MiB"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(scene.string() + ": larger than 16 MiB"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
   }
   fs::remove(d / "scene.json");
