@@ -469,8 +469,15 @@ uintmax_t preflight(std::string_view text, const SourceFile& file) {
       throw InputError(file.name, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
     return true;
   };
-  const json doc = json::parse(text.begin(), text.end(), depth_limit, /*allow_exceptions=*/false);
-  if (!doc.is_object()) return 0;  // a syntax error, or not a glTF: tinygltf refuses it with its message
+  json doc;
+  try {
+    doc = json::parse(text.begin(), text.end(), depth_limit);
+  } catch (const json::exception& e) {  // "[json.exception.parse_error.101] parse error at line 1, column 11: ..."
+    const std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw InputError(file.name, "not a valid glTF: " + one_line(bracket == std::string::npos ? what : what.substr(bracket + 2)));
+  }
+  if (!doc.is_object()) return 0;  // not a glTF: tinygltf refuses it with its message
   if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
     for (const json& ext : *it)
       if (ext.is_string() && std::find(std::begin(kUnsupportedExtensions), std::end(kUnsupportedExtensions),
