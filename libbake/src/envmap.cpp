@@ -24,15 +24,40 @@
 #include <exception>
 #include <iomanip>
 #include <numbers>
+#include <filesystem>
+#include <limits>
+#include <new>
 #include <sstream>
+#include <string_view>
 
 namespace prt::bake {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInvFourPi = 0.25 * std::numbers::inv_pi;
-// Largest image we accept (pixels): 2^28, e.g. 23k × 11.5k lat-long; ~40 bytes per texel.
+// Largest image we accept (pixels): 2^28, e.g. 23k × 11.5k lat-long, twice the largest common
+// maps (16k × 8k); ~40 bytes per texel once built (the RGB float buffer alone is 3 GiB at the
+// limit). A header's size is also bounded by its file (max_compression_ratio).
 constexpr int64_t kMaxPixels = int64_t(1) << 28;
+
+// The largest ratio of raw channel bytes to file bytes each OpenEXR compression can reach, so a
+// header whose pixels could not fit in its file is refused before a pixel buffer is allocated:
+//   NONE 1; RLE 64 (a run of at most 128 bytes takes 2); B44/B44A 11 (a 4×4 block of halves,
+//   32 bytes, takes at least 3; other types are stored raw); ZIPS/ZIP 1032 and PXR24
+//   1032 × 4/3 (deflate's limit, zlib's "technical details"; PXR24 first packs floats into 24
+//   bits); PIZ 1032 (its Huffman coder spends at least 10 bits on a run of at most 256 16-bit
+//   values: ≤ 410, rounded up to deflate's); DWAA/DWAB: no bound (lossy DCT whose zero runs are
+//   run-length coded and then deflated), only kMaxPixels.
+double max_compression_ratio(Imf::Compression c) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: return 1;
+    case Imf::RLE_COMPRESSION: return 64;
+    case Imf::B44_COMPRESSION: case Imf::B44A_COMPRESSION: return 11;
+    case Imf::ZIPS_COMPRESSION: case Imf::ZIP_COMPRESSION: case Imf::PIZ_COMPRESSION: return 1032;
+    case Imf::PXR24_COMPRESSION: return 1032.0 * 4 / 3;
+    default: return std::numeric_limits<double>::infinity();
+  }
+}
 // Largest double below 1, for remainders that must stay in [0, 1).
 constexpr double kOneMinusEps = 1.0 - 0x1.0p-53;
 
@@ -207,6 +232,10 @@ EnvMap EnvMap::from_memory(Layout layout, int width, int height, std::vector<flo
 
 EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
   const std::string file = exr.string();
+  return reading_file(file, [&] { return read(exr, file, up); });
+}
+
+EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, UpAxis up) {
   std::error_code ec;
   if (!std::filesystem::exists(exr, ec)) throw InputError(file, "no such file");
   EnvMapInfo info;
@@ -265,6 +294,22 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
         throw InputError(file, std::string("channel ") + n + " is subsampled; only full-resolution channels are supported");
 
     if (!in.isComplete()) throw InputError(file, "file is incomplete (truncated?): some pixel data is missing");
+    double raw_bytes = 0;  // of every channel, whose compressed data the file must hold
+    for (auto it = channels.begin(); it != channels.end(); ++it) {
+      const Imf::Channel& c = it.channel();
+      const double samples = std::ceil(double(W) / std::max(1, c.xSampling)) * std::ceil(double(H) / std::max(1, c.ySampling));
+      raw_bytes += samples * (c.type == Imf::HALF ? 2 : 4);
+    }
+    const double ratio = max_compression_ratio(hdr.compression());
+    std::error_code size_ec;
+    const uintmax_t size = std::filesystem::file_size(exr, size_ec);
+    if (size_ec) throw InputError(file, "cannot read: " + size_ec.message());
+    if (raw_bytes > ratio * double(size)) {
+      std::ostringstream os;
+      os << "the header's " << W << "x" << H << " pixels (" << uint64_t(raw_bytes) << " bytes of channel data) cannot fit in "
+         << size << " bytes at the compression's largest ratio (" << ratio << ":1): a damaged or forged header";
+      throw InputError(file, os.str());
+    }
 
     const size_t npix = size_t(W) * size_t(H);
     rgb.assign(3 * npix, 0.0f);
@@ -314,7 +359,10 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
   } catch (const Iex::BaseExc& e) {
     // OpenEXR's own errors: the file is damaged, truncated or not an image OpenEXR can read. Our
     // InputErrors pass through as they are; std::bad_alloc (the machine) and logic errors (a bug)
-    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6).
+    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6). OpenEXR 3.1 turns
+    // a std::bad_alloc for its scanline buffers into an Iex exception with this message: that is
+    // the machine too.
+    if (std::string_view(e.what()).find("Failed to allocate memory") != std::string_view::npos) throw std::bad_alloc();
     throw InputError(file, "cannot read OpenEXR image: " + one_line(e.what()));
   }
   return build(layout, W, H, std::move(rgb), up, std::move(info));

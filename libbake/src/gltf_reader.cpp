@@ -1,8 +1,14 @@
 // gltf_reader.cpp — glTF 2.0 (.gltf, .glb) into a Polygons (contracts: bake/mesh.h, gltf_reader.h).
 //
 // tinygltf parses the JSON / GLB container and resolves buffers (data URIs and external files,
-// read through our file callbacks: no shell expansion of URIs, the same 4 GiB limit as mesh
-// files); images are handed to a loader that does nothing, so no texture is decoded. Everything
+// read through our file callbacks: no shell expansion of URIs); images are handed to a loader
+// that does nothing, so no texture is decoded. Before tinygltf sees the JSON, a preflight parse
+// of ours (nlohmann, iterative) bounds its nesting (kMaxJsonDepth: tinygltf copies `extras` and
+// `extensions` recursively, and a 10^6-deep array crashed it by stack overflow), refuses the
+// compression extensions we cannot decode by name (tinygltf's own message for a Draco file was
+// "accessor[1] invalid bufferView"), and sums the buffers' declared byteLengths: external files
+// are read only up to that total (at most kMaxBufferFileBytes), so a small .gltf cannot make us
+// read a huge file, whether named by a buffer or by an image. Everything
 // tinygltf 2.7 leaves unchecked — every index into another array, accessor extents against their
 // buffer views and buffers, index values, component types, transforms, the node graph — is
 // checked here before a byte is read, so a bad file is a one-line InputError, never a crash.
@@ -11,6 +17,8 @@
 #include <bake/error.h>
 
 #include <tiny_gltf.h>
+
+#include <nlohmann/json.hpp>
 
 #include <Eigen/Geometry>
 
@@ -27,21 +35,38 @@ namespace prt::bake::mesh_readers {
 namespace {
 
 constexpr uintmax_t kMaxBufferFileBytes = uintmax_t{4} << 30;  // as for mesh files (mesh_io.cpp)
+// Deeper JSON is refused before tinygltf parses it; a glTF's own structure is about 8 deep, and
+// scene files have the same limit (scene.cpp).
+constexpr int kMaxJsonDepth = 128;
+// Extensions whose data we cannot decode: a primitive using them has no readable accessors.
+constexpr std::string_view kUnsupportedExtensions[] = {"KHR_draco_mesh_compression", "EXT_meshopt_compression",
+                                                        "KHR_mesh_quantization"};
 
 // ---- tinygltf's file access: plain reads, no wordexp expansion of URIs, no writes. ----
+// The bytes external files may still take (user_data of the callbacks): the buffers' declared total.
+struct ReadBudget {
+  uintmax_t remaining = 0;
+};
 bool file_exists(const std::string& path, void*) {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
 std::string expand_nothing(const std::string& path, void*) { return path; }
-bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user_data) {
+  auto& budget = *static_cast<ReadBudget*>(user_data);
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > budget.remaining) {
+    if (err) *err += "'" + path + "' is " + std::to_string(size) + " bytes, more than the " + std::to_string(budget.remaining) +
+                     " bytes left of what the glTF's buffers declare\n";
+    return false;
+  }
   std::ifstream in(path, std::ios::binary);
-  if (ec || !in || size > kMaxBufferFileBytes) {
+  if (ec || !in) {
     if (err) *err += "cannot read '" + path + "'\n";
     return false;
   }
+  budget.remaining -= size;
   out->resize(static_cast<size_t>(size));
   if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(size))) {
     if (err) *err += "cannot read '" + path + "'\n";
@@ -302,9 +327,6 @@ class Reader {
 
   // Walks the default scene into out_ and instances_ and adds the file's warnings.
   void walk() {
-    for (const std::string& ext : model_.extensionsRequired)
-      if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" || ext == "KHR_mesh_quantization")
-        fail("requires extension " + shown(ext) + ", which is not supported");
     if (model_.scenes.empty()) fail("no scene (nothing says which nodes to bake)");
     const int scene_index = model_.defaultScene < 0 ? 0 : model_.defaultScene;
     if (static_cast<size_t>(scene_index) >= model_.scenes.size())
@@ -428,17 +450,59 @@ class Reader {
   size_t skipped_primitives_ = 0, skinned_instances_ = 0, morphed_primitives_ = 0;
 };
 
+// The JSON of a .gltf, or of a .glb's first chunk where the container is sound (else empty:
+// tinygltf refuses the container before it parses any JSON).
+std::string_view gltf_json(std::string_view bytes, bool binary) {
+  if (!binary) return bytes;
+  if (bytes.size() < 20) return {};
+  uint32_t length = 0;
+  std::memcpy(&length, bytes.data() + 12, 4);  // little endian, as glTF and prtbake's hosts
+  if (bytes.substr(16, 4) != "JSON" || length > bytes.size() - 20) return {};
+  return bytes.substr(20, length);
+}
+
+// What the preflight parse finds: the buffers' declared bytes, at most kMaxBufferFileBytes.
+uintmax_t preflight(std::string_view text, const SourceFile& file) {
+  using nlohmann::json;
+  const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
+    if (depth > kMaxJsonDepth)
+      throw InputError(file.name, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    return true;
+  };
+  json doc;
+  try {
+    doc = json::parse(text.begin(), text.end(), depth_limit);
+  } catch (const json::exception& e) {  // "[json.exception.parse_error.101] parse error at line 1, column 11: ..."
+    const std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw InputError(file.name, "not a valid glTF: " + one_line(bracket == std::string::npos ? what : what.substr(bracket + 2)));
+  }
+  if (!doc.is_object()) return 0;  // not a glTF: tinygltf refuses it with its message
+  if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
+    for (const json& ext : *it)
+      if (ext.is_string() && std::find(std::begin(kUnsupportedExtensions), std::end(kUnsupportedExtensions),
+                                       ext.get_ref<const std::string&>()) != std::end(kUnsupportedExtensions))
+        throw InputError(file.name, "requires extension " + shown(ext.get_ref<const std::string&>()) + ", which is not supported");
+  uintmax_t declared = 0;
+  if (const auto it = doc.find("buffers"); it != doc.end() && it->is_array())
+    for (const json& buffer : *it)
+      if (const auto n = buffer.find("byteLength"); buffer.is_object() && n != buffer.end() && n->is_number_unsigned())
+        declared = std::min(kMaxBufferFileBytes, declared + std::min(kMaxBufferFileBytes, n->get<uintmax_t>()));
+  return declared;
+}
+
 // tinygltf's parse of the whole file (buffers resolved, images not decoded).
 tinygltf::Model parse(std::string_view bytes, const SourceFile& file) {
   if (bytes.size() >= std::numeric_limits<unsigned int>::max()) throw InputError(file.name, "too large for the glTF parser");
+  const bool binary = bytes.substr(0, 4) == "glTF";
+  ReadBudget budget{preflight(gltf_json(bytes, binary), file)};
   tinygltf::TinyGLTF loader;
-  loader.SetFsCallbacks({file_exists, expand_nothing, read_buffer_file, write_nothing, nullptr});
+  loader.SetFsCallbacks({file_exists, expand_nothing, read_buffer_file, write_nothing, &budget});
   loader.SetImageLoader(skip_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   const std::string base_dir = file.path.parent_path().string();
   const auto length = static_cast<unsigned int>(bytes.size());
-  const bool binary = bytes.substr(0, 4) == "glTF";
   const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()), length, base_dir)
                          : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
   // tinygltf's warnings concern images and unknown properties, none of which a bake uses.

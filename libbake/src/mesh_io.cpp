@@ -243,20 +243,20 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
     throw InputError(file, "unknown mesh format " + mesh_readers::shown(ext.empty() ? path.filename().string() : ext) +
                                " (supported: " + supported + ")");
   }
-  const std::string bytes = read_whole_file(path, file);
-  std::vector<std::string> warnings;
-  const Polygons polygons = format->read(bytes, {path, file, warnings});
-  Mesh mesh = build_mesh(polygons, file, options);
-  mesh.warnings = std::move(warnings);
-  mesh.source_sha256 = sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
-  return mesh;
+  return reading_file(file, [&] {
+    const std::string bytes = read_whole_file(path, file);
+    std::vector<std::string> warnings;
+    const Polygons polygons = format->read(bytes, {path, file, warnings});
+    Mesh mesh = build_mesh(polygons, file, options);
+    mesh.warnings = std::move(warnings);
+    mesh.source_sha256 = sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
+    return mesh;
+  });
 }
 
-MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshLoadOptions& options) {
-  const std::string file = path.string();
-  require_file(path, file);
-  const std::string ext = mesh_readers::lowercase(path.extension().string());
-  if (ext != ".gltf" && ext != ".glb") throw InputError(file, "not a glTF file (.gltf or .glb): it has no instances");
+namespace {
+// The instances of a glTF file whose path and format load_mesh_instances has checked.
+MeshInstances read_instances(const std::filesystem::path& path, const std::string& file, const MeshLoadOptions& options) {
   const std::string bytes = read_whole_file(path, file);
   MeshInstances result;
   std::vector<mesh_readers::GltfInstance> instances = mesh_readers::read_gltf_instances(bytes, {path, file, result.warnings});
@@ -275,5 +275,15 @@ MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshL
   }
   return result;
 }
+} // namespace
+
+MeshInstances load_mesh_instances(const std::filesystem::path& path, const MeshLoadOptions& options) {
+  const std::string file = path.string();
+  require_file(path, file);
+  const std::string ext = mesh_readers::lowercase(path.extension().string());
+  if (ext != ".gltf" && ext != ".glb") throw InputError(file, "not a glTF file (.gltf or .glb): it has no instances");
+  return reading_file(file, [&] { return read_instances(path, file, options); });
+}
+
 
 } // namespace prt::bake

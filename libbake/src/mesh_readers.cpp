@@ -187,7 +187,7 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
                                               " so far)");
             return static_cast<uint32_t>(static_cast<long long>(so_far) + i);
           }
-          forward.push_back({i, ln, kind});
+          if (static_cast<unsigned long long>(i) > so_far) forward.push_back({i, ln, kind});  // the rest are in range
           return static_cast<uint32_t>(std::min<long long>(i - 1, std::numeric_limits<uint32_t>::max()));
         };
         if (part[0].empty()) throw InputError(file.name, at_line(ln) + "face corner " + shown(tok[c]) + " has no vertex index");
@@ -305,11 +305,18 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
     const size_t ln = lines.number();
     const auto tok = split(line);
     if (tok.empty() || tok[0] == "comment" || tok[0] == "obj_info") continue;
-    if (tok[0] == "format" && tok.size() >= 2) {
+    if (tok[0] == "format") {
+      // "format <kind> 1.0": the only version of the format (Turk's PLY description).
+      if (tok.size() != 3 || tok[2] != "1.0") throw InputError(file.name, at_line(ln) + "malformed PLY format line " + shown(trim(line)) + " (expected 'format <ascii|binary_little_endian|binary_big_endian> 1.0')");
       format = tok[1];
     } else if (tok[0] == "element" && tok.size() == 3) {
       long long n = 0;
       if (!parse_int(tok[2], n) || n < 0) throw InputError(file.name, at_line(ln) + "bad element count " + shown(tok[2]));
+      // The reader keeps one vertex and one face element: a second would be indexed with the
+      // first one's rows.
+      for (const PlyElement& e : elements)
+        if (e.name == tok[1] && (e.name == "vertex" || e.name == "face"))
+          throw InputError(file.name, at_line(ln) + "a second '" + e.name + "' element");
       elements.push_back({std::string(tok[1]), static_cast<size_t>(n), {}});
     } else if (tok[0] == "property" && !elements.empty()) {
       if (tok.size() == 5 && tok[1] == "list")
@@ -403,6 +410,7 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
       return true;
     };
     for (const PlyElement& e : elements) {
+      if (e.props.empty()) continue;  // items of no bytes (any count): nothing to read
       for (size_t item = 0; item < e.count; ++item) {
         size_t item_line = 0;
         for (const PlyProperty& p : e.props) {
@@ -440,6 +448,7 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
       return v;
     };
     for (const PlyElement& e : elements) {
+      if (e.props.empty()) continue;  // items of no bytes (any count): nothing to read
       for (size_t item = 0; item < e.count; ++item) {
         for (const PlyProperty& p : e.props) {
           if (!p.list) {

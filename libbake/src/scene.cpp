@@ -103,13 +103,29 @@ Json parse_json(const std::string& text, const std::string& file) {
   }
 }
 
-Json parse_json_file(const std::filesystem::path& file) {
+// A scene or options file lists objects and settings: 16 MiB is far beyond any real one (about
+// 200 bytes an object). Read up to one byte more, so a pipe or a device (/dev/zero) is refused at
+// the limit, not read forever. The parsed tree takes at most ~32 bytes per byte of text (a 16-byte
+// value, its heap block and vector growth for "[]," or "0,"): 512 MiB at the limit. Running out of
+// memory inside the JSON library cannot be reported (it allocates while destroying a partial
+// tree, and terminates); this bound is what keeps that away.
+constexpr size_t kMaxJsonFileBytes = size_t{16} << 20;
+
+Json read_json_file(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string(), "cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  std::string text;
+  for (char buffer[65536]; text.size() <= kMaxJsonFileBytes && in;) {
+    in.read(buffer, sizeof buffer);
+    text.append(buffer, static_cast<size_t>(in.gcount()));
+  }
   if (in.bad()) throw InputError(file.string(), "cannot read the file");
-  return parse_json(ss.str(), file.string());
+  if (text.size() > kMaxJsonFileBytes)
+    throw InputError(file.string(), "larger than " + std::to_string(kMaxJsonFileBytes >> 20) + " MiB; a scene file is not that large");
+  return parse_json(text, file.string());
+}
+Json parse_json_file(const std::filesystem::path& file) {
+  return reading_file(file.string(), [&] { return read_json_file(file); });
 }
 
 // An object's member, nullptr if absent.

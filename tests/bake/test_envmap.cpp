@@ -13,6 +13,8 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -73,9 +75,15 @@ void attr(std::string& b, const std::string& name, const std::string& type, cons
   put32(b, uint32_t(value.size()));
   b += value;
 }
+// A forged file: `compression` (OpenEXR's code) in the header, and chunks of `lines` scanlines
+// each holding 4 bytes, whatever the header's size: the offset table is complete and in the file.
+struct ExrForgery {
+  char compression = 0;
+  int lines = 1;
+};
 // envmap: 0 = ENVMAP_LATLONG, 1 = ENVMAP_CUBE, nullopt = no attribute.
 void write_exr(const fs::path& path, int width, int height, std::vector<ExrChannel> channels,
-               std::optional<int> envmap = std::nullopt) {
+               std::optional<int> envmap = std::nullopt, std::optional<ExrForgery> forged = std::nullopt) {
   std::sort(channels.begin(), channels.end(), [](auto& a, auto& b) { return a.name < b.name; });
   std::string b = {'\x76', '\x2f', '\x31', '\x01', '\x02', '\0', '\0', '\0'};
   std::string chl;
@@ -87,7 +95,7 @@ void write_exr(const fs::path& path, int width, int height, std::vector<ExrChann
   }
   chl.push_back('\0');
   attr(b, "channels", "chlist", chl);
-  attr(b, "compression", "compression", std::string(1, '\0'));
+  attr(b, "compression", "compression", std::string(1, forged ? forged->compression : '\0'));
   std::string box;
   put32(box, 0), put32(box, 0), put32(box, uint32_t(width - 1)), put32(box, uint32_t(height - 1));
   attr(b, "dataWindow", "box2i", box);
@@ -103,6 +111,13 @@ void write_exr(const fs::path& path, int width, int height, std::vector<ExrChann
   if (envmap) attr(b, "envmap", "envmap", std::string(1, char(*envmap)));
   b.push_back('\0');
   const size_t table = b.size();
+  if (forged) {
+    const int chunks = (height + forged->lines - 1) / forged->lines;
+    for (int c = 0; c < chunks; ++c) put64(b, table + size_t(chunks) * 8 + size_t(c) * 12);
+    for (int c = 0; c < chunks; ++c) put32(b, uint32_t(c * forged->lines)), put32(b, 4), put32(b, 0);
+    std::ofstream(path, std::ios::binary).write(b.data(), std::streamsize(b.size()));
+    return;
+  }
   const size_t chunk = 8 + channels.size() * size_t(width) * 4;
   for (int y = 0; y < height; ++y) put64(b, table + size_t(height) * 8 + size_t(y) * chunk);
   for (int y = 0; y < height; ++y) {
@@ -663,6 +678,22 @@ void expect_input_error(const fs::path& p, const std::string& needle) {
   } catch (const std::exception& e) {
     ADD_FAILURE() << p << ": wrong exception type: " << e.what();
   }
+}
+
+TEST(EnvMapFiles, HeadersClaimingMorePixelsThanTheFileCanHoldAreRefusedBeforeAllocating) {
+  // Complete offset tables, 4 bytes per chunk: 100 MB of uncompressed floats in a 41 KB file, and
+  // 1.5 GB of ZIP data (16 lines per chunk) in 10 KB; both were allocated before reading failed.
+  rusage before{}, after{};
+  getrusage(RUSAGE_SELF, &before);
+  const std::vector<ExrChannel> rgb = {{"R", {}}, {"G", {}}, {"B", {}}};
+  const fs::path plain = tmp_dir() / "forged_none.exr", zip = tmp_dir() / "forged_zip.exr";
+  write_exr(plain, 4096, 2048, rgb, 0, ExrForgery{0, 1});
+  write_exr(zip, 16384, 8192, rgb, 0, ExrForgery{3, 16});
+  expect_input_error(plain, "bytes at the compression's largest ratio (1:1): a damaged or forged header");
+  expect_input_error(zip, "bytes at the compression's largest ratio (1032:1)");
+  getrusage(RUSAGE_SELF, &after);
+  constexpr long kSlackKiB = 64 << 10;  // allocator noise, far below the 100 MB buffer
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, kSlackKiB) << "peak resident KiB grew";
 }
 
 TEST(EnvMapFiles, BadInputsAreInputErrors) {

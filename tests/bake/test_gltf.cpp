@@ -15,9 +15,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -227,6 +230,58 @@ TEST(Gltf, DefectsAreOneLineInputErrorsNamingFileAndDefect) {
     expect_input_error(g.write("no_mesh.gltf"), "refers to mesh 9");
     expect_input_error(write_file("garbage.gltf", "{\"asset\": "), "not a valid glTF");
     expect_input_error(write_file("garbage.glb", std::string("glTF\x02\0\0\0garbage", 15)), "not a valid glTF");
+  }
+}
+
+// Peak resident memory of this process so far, in bytes (Linux: ru_maxrss is in KiB).
+long long peak_rss_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<long long>(u.ru_maxrss) * 1024;
+}
+
+TEST(Gltf, HostileFilesAreRefusedBeforeTinygltfReadsThem) {
+  const auto triangle = [] {
+    Gltf g;
+    g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}})}}, true);
+    return g;
+  };
+  // Draco: the accessors have no buffer view (the data is in the extension's). tinygltf refused it
+  // with "accessor[1] invalid bufferView"; the extension is named, in .gltf and .glb alike.
+  {
+    Gltf g = triangle();
+    g.doc["accessors"].push_back({{"componentType", 5123}, {"type", "SCALAR"}, {"count", 3}});
+    g.doc["meshes"][0]["primitives"][0]["indices"] = 1;
+    g.doc["meshes"][0]["primitives"][0]["extensions"] = {{"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
+    g.doc["extensionsUsed"] = g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    expect_input_error(g.write("draco.gltf"), "requires extension 'KHR_draco_mesh_compression', which is not supported");
+    expect_input_error(write_file("draco.glb", g.glb()), "requires extension 'KHR_draco_mesh_compression'");
+  }
+  // 10^6 nested arrays in "extras": tinygltf copied them recursively and overflowed the stack.
+  {
+    std::string text = triangle().embedded();
+    text.pop_back();  // the closing '}'
+    text += ",\"extras\": " + std::string(1000000, '[') + std::string(1000000, ']') + "}";
+    expect_input_error(write_file("deep.gltf", text), "JSON nested deeper than 128 levels");
+  }
+  // A 1 GiB file (sparse) named by a 36-byte buffer and by an image: neither is read. The buffer
+  // was read whole before tinygltf compared its size; the image was read and discarded.
+  {
+    const fs::path big = tmp_dir() / "big.bin";
+    std::ofstream(big, std::ios::binary).put('\0');
+    fs::resize_file(big, size_t{1} << 30);
+    const long long rss_before = peak_rss_bytes();
+    Gltf g = triangle();
+    json d = json::parse(g.embedded());
+    d["images"] = {{{"uri", "big.bin"}}};
+    EXPECT_EQ(prt::bake::load_mesh(write_file("big_image.gltf", d.dump())).triangles.size(), 1u);
+    d.erase("images");
+    d["buffers"][0]["uri"] = "big.bin";
+    expect_input_error(write_file("big_buffer.gltf", d.dump()), "is 1073741824 bytes, more than the 36 bytes left of what the glTF's buffers declare");
+    // The bound: what the buffers declare (36 bytes) and the files' own sizes, not the 1 GiB.
+    constexpr long long kSlack = 64ll << 20;  // allocator and page-cache noise, far below 1 GiB
+    EXPECT_LT(peak_rss_bytes() - rss_before, kSlack);
+    fs::remove(big);
   }
 }
 

@@ -787,6 +787,41 @@ TEST(MeshErrors, CountsTheFileCannotHoldAreRefusedBeforeAnythingIsAllocated) {
   expect_input_error(write_file("huge_count.off", "OFF\n1000000000000 1 0\n0 0 0\n"), "truncated: the header says 1000000000000 vertices");
 }
 
+TEST(MeshErrors, PlyHeaderDefectsFailFastNamingTheLine) {
+  const std::string tri = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                          "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  // A version that is not 1.0 (OpenMesh's reader looped forever on this one).
+  expect_input_error(write_file("format_x.ply", "ply\nformat ascii x\n" + tri), "line 2: malformed PLY format line");
+  // 10^18 items of no property take no bytes: nothing to read, at once (it was 10^18 empty
+  // iterations); with a property they are more than the file holds.
+  const std::string junk = "ply\nformat ascii 1.0\nelement junk 1000000000000000000\n";
+  EXPECT_EQ(prt::bake::load_mesh(write_file("junk_empty.ply", junk + tri)).triangles.size(), 1u);
+  expect_input_error(write_file("junk_counted.ply", junk + "property float a\n" + tri),
+                     "truncated: the header declares 1000000000000000000 junk items");
+  // A second vertex element was indexed with the first one's rows: 5 items written into 3 rows.
+  std::string two = "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n" +
+                    tri.substr(0, tri.find("end_header\n") + 11);
+  for (int v = 0; v < 8; ++v) two += "0 0 0\n";
+  expect_input_error(write_file("two_vertex.ply", two + "3 0 1 2\n"),
+                     "line 7: a second 'vertex' element");
+}
+
+TEST(MeshErrors, GarbledColourAndNormalOffAreReadOrRefusedNamingTheLine) {
+  // COFF: the colour columns after x y z are not read (any number of them, any text).
+  const std::string faces = "3 0 1 2\n";
+  const Mesh c = prt::bake::load_mesh(write_file("colours.off", "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 x\n0 1 0\n" + faces));
+  EXPECT_EQ(c.positions.size(), 3u);
+  EXPECT_TRUE(c.positions[1] == Vector3f(1, 0, 0));
+  // NOFF: the three normal columns are required and must be numbers.
+  expect_input_error(write_file("noff_short.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0\n0 1 0 0 0 1\n" + faces),
+                     "line 4: vertex needs 3 coordinates and 3 normal components");
+  expect_input_error(write_file("noff_text.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 zero 1\n0 1 0 0 0 1\n" + faces),
+                     "line 4: malformed number 'zero'");
+  // Garbled counts: refused at the end of the file, never allocated for.
+  expect_input_error(write_file("coff_counts.off", "COFF\n2000000000 2000000000 0\n0 0 0 1 1 1 1\n"),
+                     "truncated: the header says 2000000000 vertices, the file has 1");
+}
+
 TEST(MeshErrors, UnreadableFile) {
   if (geteuid() == 0) GTEST_SKIP() << "root reads files whatever their mode";
   const fs::path p = write_file("unreadable.obj", prism_obj(Prism()));

@@ -243,6 +243,21 @@ struct BadScene {
 
 class SceneErrors : public ::testing::TestWithParam<BadScene> {};
 
+TEST(SceneLimits, FilesLargerThan16MiBAndEndlessStreamsAreRefusedAtTheLimit) {
+  const fs::path d = dir_for("too_large");
+  write_meshes(d);
+  // Valid JSON of 16 MiB + 1 byte (a long string): refused before parsing, naming the limit.
+  write_text(d / "scene.json", "{\"prtbake_scene\": 1, \"x\": \"" + std::string((size_t{16} << 20) - 28, 'a') + "\"}");
+  ASSERT_EQ(fs::file_size(d / "scene.json"), (size_t{16} << 20) + 1);
+  for (const fs::path& scene : {d / "scene.json", fs::path("/dev/zero")}) {
+    const auto r = prt::testing::run_tool(PRT_PRTBAKE, "scene '" + scene.string() + "' -o '" + (d / "out.prt.h5").string() + "'", d);
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find(scene.string() + ": larger than 16 MiB"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
+  }
+  fs::remove(d / "scene.json");
+}
+
 TEST_P(SceneErrors, NameFileLineAndProblemAndWriteNothing) {
   const BadScene& c = GetParam();
   const fs::path d = dir_for(std::string("error_") + c.name);
@@ -267,6 +282,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"duplicate_key", "{\"prtbake_scene\": 1, \"bake\": {\"seed\": 1, \"seed\": 2}, \"objects\": []}",
                  "duplicate key \"seed\" in bake"},
         BadScene{"too_deep", "{\"prtbake_scene\": 1, \"x\": " + std::string(200, '[') + std::string(200, ']') + "}",
+                 "is nested deeper than 128 levels"},
+        // The parser is iterative and stops at the limit: 10^6 levels are refused as 200 are.
+        BadScene{"too_deep_million", "{\"prtbake_scene\": 1, \"x\": " + std::string(1000000, '[') + std::string(1000000, ']') + "}",
                  "is nested deeper than 128 levels"},
         BadScene{"unknown_key", scene_text("", "\"relite\": true", kGround),
                  "unknown key \"relite\" in bake (allowed: products"},

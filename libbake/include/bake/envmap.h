@@ -110,7 +110,9 @@ public:
   // (float slices; alpha and other channels ignored); a luminance-only image (Y) is read as
   // grey; a luminance/chroma image (Y, RY, BY) is converted by Imf::RgbaInputFile.
   // Throws InputError("<exr>: <defect>") for a missing/unreadable/truncated/garbled file, an
-  // unsupported shape or channel set, or a NaN/Inf pixel. No OpenEXR exception escapes.
+  // unsupported shape or channel set, a header whose pixels cannot fit in the file (envmap.cpp,
+  // max_compression_ratio), or a NaN/Inf pixel. No OpenEXR exception escapes. Running out of
+  // memory is a SystemError("<exr>: out of memory while reading the file").
   static EnvMap load(const std::filesystem::path& exr, UpAxis up);
 
   // The same radiance in every direction (white furnace: constant({1, 1, 1})). value must be
@@ -173,6 +175,7 @@ private:
   struct Region;  // a texel's region in its parametrisation (envmap.cpp)
 
   EnvMap() = default;
+  static EnvMap read(const std::filesystem::path& exr, const std::string& file, UpAxis up);  // load, memory aside
   static EnvMap build(Layout layout, int width, int height, std::vector<float> rgb, UpAxis up, EnvMapInfo info);
   static EnvMap from_memory(Layout layout, int width, int height, std::vector<float> rgb, UpAxis up, std::string name);
   Region region(int texel) const;

@@ -12,6 +12,7 @@
 // error codes) are caught at the boundary and rethrown as one of these.
 #pragma once
 
+#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -33,6 +34,18 @@ class SystemError : public std::runtime_error {
 public:
   using std::runtime_error::runtime_error;
 };
+
+// Runs `read` (which reads `file`) and turns running out of memory into a SystemError naming the
+// file: "<file>: out of memory while reading the file". The readers bound what a file can make
+// them allocate (docs/RELIABILITY.md), so this is a machine short of memory for a large input.
+template <class Read>
+auto reading_file(const std::string& file, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const std::bad_alloc&) {
+    throw SystemError(file + ": out of memory while reading the file");
+  }
+}
 
 class ContractError : public std::logic_error {
 public:

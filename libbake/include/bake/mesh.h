@@ -161,7 +161,8 @@ struct MeshLoadOptions {
 };
 
 // Read OBJ / PLY / OFF / STL / glTF / GLB (by extension, case-insensitive). See the file comment for the
-// vertex order, normal and error contracts. Throws InputError.
+// vertex order, normal and error contracts. Throws InputError; running out of memory is a
+// SystemError("<path>: out of memory while reading the file") (load_mesh_instances too).
 Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
 
 // glTF SCENES: the instances of load_mesh's glTF walk kept apart, one Mesh each (a glTF scene's
