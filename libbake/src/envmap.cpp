@@ -35,10 +35,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kInvFourPi = 0.25 * std::numbers::inv_pi;
-// Largest image we accept (pixels): 2^28, e.g. 23k × 11.5k lat-long, twice the largest common
-// maps (16k × 8k); ~40 bytes per texel once built (the RGB float buffer alone is 3 GiB at the
-// limit). A header's size is also bounded by its file (max_compression_ratio).
-constexpr int64_t kMaxPixels = int64_t(1) << 28;
+// Largest image we accept (pixels): 2^27, the largest common maps (16k × 8k lat-long); the RGB
+// float buffer, the largest single allocation, is then 1.5 GiB (docs/RELIABILITY.md: no single
+// allocation over 2 GiB); ~40 bytes per texel once built. A header's size is also bounded by its
+// file (max_compression_ratio).
+constexpr int64_t kMaxPixels = int64_t(1) << 27;
 
 // The largest ratio of raw channel bytes to file bytes each OpenEXR compression can reach, so a
 // header whose pixels could not fit in its file is refused before a pixel buffer is allocated:
