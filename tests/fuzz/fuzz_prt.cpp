@@ -69,6 +69,14 @@ void read(const std::filesystem::path& path) {
 
 } // namespace
 
+// HDF5 keeps freed blocks on its own free lists, so nearly every input ends with fewer frees
+// than mallocs and libFuzzer runs a full leak scan after it (a few inputs per second). Without
+// the lists HDF5 frees what it is done with: the same leak checks, far faster.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  H5set_free_list_limits(0, 0, 0, 0, 0, 0);
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path path = prt::fuzz::write_input("input.prt.h5", prt::fuzz::as_bytes(data, size));
   prt::fuzz::guarded<prt::formats::FormatError>([&] { read(path); });

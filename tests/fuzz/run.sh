@@ -23,7 +23,7 @@ LIMITS=(-timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048)
 # ASan: exit on the first report, symbolized stacks; the uninstrumented system libraries
 # (HDF5, OpenEXR, tinygltf, ...) cannot annotate std::vector containers, so container-overflow
 # checks (which need every library instrumented) are off.
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_container_overflow=0:abort_on_error=1:symbolize=1}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_container_overflow=0:symbolize=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$HERE/lsan.supp:print_suppressions=0}"
 
