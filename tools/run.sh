@@ -4,7 +4,9 @@
 #                       (data/bunny_ground.obj under data/sunset.exr) to out/default.prt.h5,
 #                       show what was baked, then bake data/scene_example.json to out/scene.prt.h5.
 #   tools/run.sh test   install dependencies, build (ci preset: warnings are errors), run every
-#                       test with ctest. This is what CI runs (.ci/run).
+#                       test with ctest, then build the fuzz targets (fuzz preset: clang 14,
+#                       ASan + UBSan) and run each briefly (tests/fuzz/run.sh short: its saved
+#                       regression inputs, then 20 s from its seeds). This is what CI runs (.ci/run).
 #   tools/run.sh deps   only install the Debian packages (apt-get; needs root or sudo).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,7 +14,8 @@ cd "$(dirname "$0")/.."
 PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev hdf5-tools
           libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py
           glslc libvulkan-dev mesa-vulkan-drivers
-          libcli11-dev nlohmann-json3-dev libpng-dev libssl-dev libtinygltf-dev assimp-testmodels)
+          libcli11-dev nlohmann-json3-dev libpng-dev libssl-dev libtinygltf-dev assimp-testmodels
+          clang-14 libclang-rt-14-dev time)
 JOBS=${JOBS:-$(nproc)}
 
 install_deps() {
@@ -50,8 +53,10 @@ case "${1:-}" in
     install_deps
     build ci
     ctest --preset ci
+    build fuzz
+    tests/fuzz/run.sh short
     ;;
   *)
-    sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
     exit 2 ;;
 esac

@@ -442,7 +442,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     auto product_group = [](std::string_view x) {
       return x == N::kMeshGroup || x == N::kTransferGroup || x == N::kRadianceGroup;
     };
-    auto under = [&g](std::string_view dir) { return g.starts_with(std::string(dir) + "/"); };
+    auto under = [&group = g](std::string_view dir) { return group.starts_with(std::string(dir) + "/"); };
     const bool object = g == N::kObjects || under(N::kObjects);
     const bool ok = product_group(g) || g == N::kFivGroup || g == N::kScene || g == N::kObjects ||
                     g == N::kOccluders || (parts.size() == 3 && under(N::kOccluders)) ||

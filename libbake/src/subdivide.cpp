@@ -50,12 +50,12 @@ Mesh loop_subdivide(const Mesh& mesh, int levels) {
                                         tri_name(faces[0]) + ")");
     if (faces.size() == 2) {
       // Direction in which each triangle traverses the edge: +1 for a→b, −1 for b→a.
-      auto direction = [&](uint32_t t) {
+      auto direction = [&, ea = a, eb = b](uint32_t t) {  // (clang 14 cannot capture a structured binding)
         const auto& w = tris[t];
         for (int k = 0; k < 3; ++k) {
           const uint32_t from = w[size_t(k)], to = w[size_t((k + 1) % 3)];
-          if (from == a && to == b) return 1;
-          if (from == b && to == a) return -1;
+          if (from == ea && to == eb) return 1;
+          if (from == eb && to == ea) return -1;
         }
         return 0;
       };
