@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <iomanip>
 #include <numbers>
 #include <filesystem>
@@ -59,6 +60,60 @@ double max_compression_ratio(Imf::Compression c) {
     default: return std::numeric_limits<double>::infinity();
   }
 }
+// The header's attribute list, walked before OpenEXR sees the file (OpenEXR file layout: magic
+// 20000630, a version word whose bit 0x400 allows names of 255 bytes instead of 31 and whose bit
+// 0x1000 makes the file multi-part, then per header attributes "name\0type\0" + int32 size +
+// value, ended by an empty name; a multi-part file's header list ends with an empty header).
+// OpenEXR allocates an attribute's claimed size before it reads it, so a 1 KB file claiming a
+// 1.7 GB attribute cost 1.7 GB and seconds; here every size must fit in the bytes that follow.
+void check_exr_header(const std::filesystem::path& path, const std::string& file) {
+  std::ifstream in(path, std::ios::binary);
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (!in || ec) throw InputError(file, "cannot read the file");
+  uint64_t at = 0;
+  auto bytes = [&](void* out, std::size_t n) {
+    in.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
+    if (static_cast<std::size_t>(in.gcount()) != n) throw InputError(file, "truncated OpenEXR header");
+    at += n;
+  };
+  unsigned char head[8];
+  bytes(head, 8);
+  if (!(head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01))
+    throw InputError(file, "not an OpenEXR image (wrong magic number)");
+  const uint32_t flags = uint32_t(head[5]) << 8 | uint32_t(head[6]) << 16 | uint32_t(head[7]) << 24;
+  const std::size_t max_name = (flags & 0x400u) != 0 ? 255 : 31;
+  const bool multipart = (flags & 0x1000u) != 0;
+  // A name or type: at most max_name bytes, then NUL; "" ends a list.
+  auto word = [&](const char* what) {
+    std::string w;
+    for (char c = 0;;) {
+      bytes(&c, 1);
+      if (c == '\0') return w;
+      if (w.size() == max_name)
+        throw InputError(file, std::string("damaged OpenEXR header: an attribute ") + what + " longer than " +
+                                   std::to_string(max_name) + " bytes");
+      w.push_back(c);
+    }
+  };
+  for (int header = 0;; ++header) {
+    int attributes = 0;
+    for (std::string name = word("name"); !name.empty(); name = word("name"), ++attributes) {
+      word("type");
+      unsigned char n[4];
+      bytes(n, 4);
+      const int32_t value_size = static_cast<int32_t>(uint32_t(n[0]) | uint32_t(n[1]) << 8 | uint32_t(n[2]) << 16 |
+                                                      uint32_t(n[3]) << 24);
+      if (value_size < 0 || uint64_t(value_size) > size - at)
+        throw InputError(file, "damaged OpenEXR header: attribute '" + name + "' claims " + std::to_string(value_size) +
+                                   " bytes, the file has " + std::to_string(size - at) + " left");
+      at += uint64_t(value_size);
+      in.seekg(static_cast<std::streamoff>(at));
+    }
+    if (!multipart || attributes == 0) return;
+  }
+}
+
 // Largest double below 1, for remainders that must stay in [0, 1).
 constexpr double kOneMinusEps = 1.0 - 0x1.0p-53;
 
@@ -242,6 +297,7 @@ EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, U
   EnvMapInfo info;
   info.source = file;
   info.sha256 = sha256_file(exr);  // InputError if unreadable or a directory
+  check_exr_header(exr, file);
 
   Layout layout = Layout::LatLong;
   int W = 0, H = 0;

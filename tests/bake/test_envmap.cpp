@@ -696,6 +696,34 @@ TEST(EnvMapFiles, HeadersClaimingMorePixelsThanTheFileCanHoldAreRefusedBeforeAll
   EXPECT_LT(after.ru_maxrss - before.ru_maxrss, kSlackKiB) << "peak resident KiB grew";
 }
 
+TEST(EnvMapFiles, AttributeClaimingMoreBytesThanTheFileHasIsRefusedBeforeOpenExrAllocatesIt) {
+  // OpenEXR allocates an attribute's claimed size before reading it: a 1 KB file whose
+  // 'compression' attribute claims 1.7 GB cost 1.7 GB and seconds (found by fuzzing; input in
+  // tests/fuzz/regressions/exr). Our walk of the attribute list refuses it first.
+  const fs::path p = tmp_dir() / "huge_attribute.exr";
+  write_exr(p, 8, 4, rgb_channels(8, 4, 1, 1, 1));
+  std::string b(size_t(fs::file_size(p)), '\0');
+  std::ifstream(p, std::ios::binary).read(b.data(), std::streamsize(b.size()));
+  const std::string key = std::string("compression") + '\0' + "compression" + '\0';
+  const size_t at = b.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const uint32_t huge = 1751318528u;
+  for (int k = 0; k < 4; ++k) b[at + key.size() + size_t(k)] = char(huge >> (8 * k));
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(b.data(), std::streamsize(b.size()));
+  rusage before{}, after{};
+  getrusage(RUSAGE_SELF, &before);
+  expect_input_error(p, "damaged OpenEXR header: attribute 'compression' claims 1751318528 bytes, the file has");
+  getrusage(RUSAGE_SELF, &after);
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 64L << 10) << "peak resident KiB grew";
+  // Names longer than the format allows, and a list that runs off the end, are refused too.
+  b[8] = 'x';
+  std::string longname = b.substr(0, 8) + std::string(40, 'n') + b.substr(8);
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(longname.data(), std::streamsize(longname.size()));
+  expect_input_error(p, "an attribute name longer than 31 bytes");
+  std::ofstream(p, std::ios::binary | std::ios::trunc).write(b.data(), 40);
+  expect_input_error(p, "");
+}
+
 TEST(EnvMapFiles, BadInputsAreInputErrors) {
   const fs::path dir = tmp_dir();
   expect_input_error(dir / "does_not_exist.exr", "no such file");
