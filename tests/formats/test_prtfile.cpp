@@ -5,6 +5,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <byte_flips.h>
 #include <h5py.h>
 
 #include <sys/wait.h>
@@ -432,19 +433,9 @@ void expect_read_error(const fs::path& p, const std::string& expected) {
 template <class Offsets>
 int flips_refused(const fs::path& file, const Offsets& offsets, std::initializer_list<unsigned char> masks,
                   int* tried = nullptr) {
-  std::fstream io(file, std::ios::binary | std::ios::in | std::ios::out);
   int refused = 0;
-  for (const std::size_t at : offsets)
-    for (const unsigned char mask : masks) {
-      char c;
-      io.seekg(static_cast<std::streamoff>(at));
-      io.get(c);
-      const auto flip = [&](char v) {
-        io.seekp(static_cast<std::streamoff>(at));
-        io.put(v);
-        io.flush();
-      };
-      flip(static_cast<char>(c ^ static_cast<char>(mask)));
+  for (const unsigned char mask : masks)
+    prt::testing::for_each_flipped_byte(file, offsets, mask, [&](std::size_t) {
       if (tried != nullptr) ++*tried;
       try {
         (void)read_file(file);
@@ -452,8 +443,7 @@ int flips_refused(const fs::path& file, const Offsets& offsets, std::initializer
         ++refused;
         EXPECT_EQ(e.file(), file.string());
       }
-      flip(c);
-    }
+    });
   return refused;
 }
 
