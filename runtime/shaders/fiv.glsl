@@ -270,25 +270,40 @@ mat3 prt_lookup_fiv(uint o, vec3 s) {
   return plain * falloff;
 }
 
+// n / |n|; a zero or non-finite normal is +Y (prtshade/fiv.h "Numerics": only a normal's
+// direction counts).
+vec3 prt_fiv_unit_normal(vec3 n) {
+  float l = length(n);
+  return (l > 0.0 && !isinf(l)) ? n / l : vec3(0.0, 1.0, 0.0);
+}
+
 // h = n·(centre − p): the signed height of the occluder's centre over the receiver's plane.
 float prt_fiv_plane_height(uint o, vec3 p, vec3 n) { return dot(n, prt_fiv_occluders[o].centre_radius.xyz - p); }
 
-// Case C: 0, case A: 1, case B: (h + R)/(2R) (mirrors prt::shade::partial_factor).
-float prt_partial_factor(uint o, vec3 p, vec3 n) {
+// prt_partial_factor for a unit n.
+float prt_partial_factor_unit(uint o, vec3 p, vec3 n) {
   float h = prt_fiv_plane_height(o, p, n), R = prt_fiv_occluders[o].centre_radius.w;
   if (!(h > -R)) return 0.0;
   if (h >= R) return 1.0;
   return clamp((h + R) / (2.0 * R), 0.0, 1.0);
 }
 
-// Per channel max(0, factor · n·F_c(p − centre)); factor = partial_factor, or 1 when `partial`
-// is false (case C stays 0) (mirrors prt::shade::occluded_irradiance).
-vec3 prt_occluded_irradiance(uint o, vec3 p, vec3 n, bool partial) {
-  float factor = partial ? prt_partial_factor(o, p, n)
+// Case C: 0, case A: 1, case B: (h + R)/(2R), n of any length (mirrors prt::shade::partial_factor).
+float prt_partial_factor(uint o, vec3 p, vec3 n) { return prt_partial_factor_unit(o, p, prt_fiv_unit_normal(n)); }
+
+// prt_occluded_irradiance for a unit n.
+vec3 prt_occluded_irradiance_unit(uint o, vec3 p, vec3 n, bool partial) {
+  float factor = partial ? prt_partial_factor_unit(o, p, n)
                          : (prt_fiv_plane_height(o, p, n) > -prt_fiv_occluders[o].centre_radius.w ? 1.0 : 0.0);
   if (factor == 0.0) return vec3(0.0);
   mat3 F = prt_lookup_fiv(o, p - prt_fiv_occluders[o].centre_radius.xyz);
   return max(vec3(0.0), factor * (n * F));
+}
+
+// Per channel max(0, factor · n̂·F_c(p − centre)); factor = partial_factor, or 1 when `partial`
+// is false (case C stays 0) (mirrors prt::shade::occluded_irradiance).
+vec3 prt_occluded_irradiance(uint o, vec3 p, vec3 n, bool partial) {
+  return prt_occluded_irradiance_unit(o, p, prt_fiv_unit_normal(n), partial);
 }
 
 // Area of the lens of two planar discs of radii r1, r2 whose centres are d apart (prt::shade::
@@ -324,12 +339,13 @@ float prt_fiv_overlap(vec4 disc_i, vec4 disc_j) {
 // Irradiance at receiver (p, n) shadowed by occluders first … first + count − 1 (eq. 11, 13, 14;
 // mirrors prt::shade::shade_fiv). Σ_{i<j} O_ij (I_i + I_j) is summed as Σ_i I_i Σ_{j≠i} O_ij over
 // the occluders that hide something.
-vec3 prt_shade_fiv(uint first, uint count, vec3 p, vec3 n, bool partial, bool overlap) {
+vec3 prt_shade_fiv(uint first, uint count, vec3 p, vec3 n_in, bool partial, bool overlap) {
+  vec3 n = prt_fiv_unit_normal(n_in);
   vec3 e = prt_lookup_difmap(n);
   uint hides[PRT_FIV_MASK_WORDS];
   for (int w = 0; w < PRT_FIV_MASK_WORDS; ++w) hides[w] = 0u;
   for (uint i = 0u; i < count; ++i) {
-    vec3 I = prt_occluded_irradiance(first + i, p, n, partial);
+    vec3 I = prt_occluded_irradiance_unit(first + i, p, n, partial);
     if (!any(greaterThan(I, vec3(0.0)))) continue;
     e -= I;
     if (i < uint(PRT_FIV_MAX_OCCLUDERS)) hides[i >> 5u] |= 1u << (i & 31u);
@@ -338,7 +354,7 @@ vec3 prt_shade_fiv(uint first, uint count, vec3 p, vec3 n, bool partial, bool ov
     for (uint i = 0u; i < count; ++i) {
       bool hides_i = i < uint(PRT_FIV_MAX_OCCLUDERS) ? (hides[i >> 5u] & (1u << (i & 31u))) != 0u : true;
       if (!hides_i) continue;
-      vec3 I = prt_occluded_irradiance(first + i, p, n, partial);
+      vec3 I = prt_occluded_irradiance_unit(first + i, p, n, partial);
       if (!any(greaterThan(I, vec3(0.0)))) continue;
       vec4 disc_i = prt_fiv_disc(first + i, p, n);
       float weight = 0.0;  // Σ_{j ≠ i, j hides something} O_ij
@@ -349,7 +365,7 @@ vec3 prt_shade_fiv(uint first, uint count, vec3 p, vec3 n, bool partial, bool ov
         }
         float o = prt_fiv_overlap(disc_i, prt_fiv_disc(first + j, p, n));
         if (o > 0.0 && j >= uint(PRT_FIV_MAX_OCCLUDERS) &&
-            !any(greaterThan(prt_occluded_irradiance(first + j, p, n, partial), vec3(0.0))))
+            !any(greaterThan(prt_occluded_irradiance_unit(first + j, p, n, partial), vec3(0.0))))
           continue;
         weight += o;
       }
@@ -361,7 +377,8 @@ vec3 prt_shade_fiv(uint first, uint count, vec3 p, vec3 n, bool partial, bool ov
 
 // Self-shadows (eq. 12): max(0, n·F^env_c − n·F_c(p − centre)); env_fiv = /fiv/environment
 // [RGB][xyz] (mirrors prt::shade::shade_fiv_self).
-vec3 prt_shade_fiv_self(float env_fiv[9], uint o, vec3 p, vec3 n) {
+vec3 prt_shade_fiv_self(float env_fiv[9], uint o, vec3 p, vec3 n_in) {
+  vec3 n = prt_fiv_unit_normal(n_in);
   mat3 env = mat3(env_fiv[0], env_fiv[1], env_fiv[2], env_fiv[3], env_fiv[4], env_fiv[5], env_fiv[6], env_fiv[7],
                   env_fiv[8]);
   mat3 F = prt_lookup_fiv(o, p - prt_fiv_occluders[o].centre_radius.xyz);

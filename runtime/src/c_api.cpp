@@ -199,7 +199,7 @@ prt_status prt_fiv_scene_create(int difmap_size, const float* difmap_texels, con
   return guarded(__func__, [&] {
     require(difmap_texels != nullptr && environment_fiv != nullptr && out != nullptr, "null pointer");
     prt::shade::validate_difmap({difmap_size, difmap_texels});
-    for (int k = 0; k < 9; ++k) require(std::isfinite(environment_fiv[k]), "environment FIV is not finite");
+    prt::shade::validate_environment_fiv(environment_fiv);
     auto scene = std::make_unique<prt_fiv_scene>();
     scene->difmap_size = difmap_size;
     scene->difmap.assign(difmap_texels, difmap_texels + size_t(6) * size_t(difmap_size) * size_t(difmap_size) * 3);

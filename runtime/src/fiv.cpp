@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -41,9 +42,33 @@ inline void project_fiv(const float f[9], const float n[3], float out[3]) {
   for (int c = 0; c < 3; ++c) out[c] = n[0] * f[3 * c] + n[1] * f[3 * c + 1] + n[2] * f[3 * c + 2];
 }
 
-// Signed distance of the occluder centre above the receiver's tangent plane.
+// The receiver's normal as a unit vector (header "Numerics"): n / |n| with |n| formed in double
+// (no overflow or underflow for any finite float n); a zero or non-finite n is +Y, the direction
+// lookup_difmap gives a zero normal.
+struct UnitNormal {
+  float v[3];
+  explicit UnitNormal(const float n[3]) {
+    const double x = n[0], y = n[1], z = n[2];
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (len > 0 && std::isfinite(len)) {
+      v[0] = float(x / len), v[1] = float(y / len), v[2] = float(z / len);
+    } else {
+      v[0] = 0, v[1] = 1, v[2] = 0;
+    }
+  }
+};
+
+// Offset s = p − centre in double: finite for any finite p and centre.
+inline void offset_from_centre(const FivOccluder& occ, const float p[3], double s[3]) {
+  for (int k = 0; k < 3; ++k) s[k] = double(p[k]) - double(occ.centre[k]);
+}
+
+// Signed distance of the occluder centre above the receiver's tangent plane (n unit), in double:
+// never NaN for finite inputs (in float, centre − p could overflow to ±inf and 0·inf is NaN).
 inline float plane_height(const FivOccluder& occ, const float p[3], const float n[3]) {
-  return n[0] * (occ.centre[0] - p[0]) + n[1] * (occ.centre[1] - p[1]) + n[2] * (occ.centre[2] - p[2]);
+  double s[3];
+  offset_from_centre(occ, p, s);
+  return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
 }
 
 // Occluder i as seen from p for the overlap correction: axis a, angular radius α (radians) and
@@ -81,6 +106,16 @@ inline bool hides_something(const float I[3]) { return I[0] > 0 || I[1] > 0 || I
 // ---------------------------------------------------------------------------------------------
 // Validation
 
+namespace {
+const char* const value_limit_text = ": must be finite with magnitude <= 2^64 (fiv.h \"Numerics\")";
+// A float as the shortest text that reads back to it ("3e+38", not 39 digits).
+std::string value_text(float x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", double(x));
+  return buf;
+}
+} // namespace
+
 void validate_occluder(const FivOccluder& o) {
   PRT_SHADE_REQUIRE(o.radii != nullptr && o.shells != nullptr && o.valid != nullptr, "occluder with a null array");
   PRT_SHADE_REQUIRE(o.n_rho >= 1 && o.n_theta >= 2 && o.n_phi >= 1,
@@ -100,7 +135,8 @@ void validate_occluder(const FivOccluder& o) {
   }
   const size_t n = sample_index(o, o.n_rho, 0, 0) * 9;
   for (size_t i = 0; i < n; ++i)
-    PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]), "shell value " + std::to_string(i) + " is not finite");
+    PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]) && std::fabs(o.shells[i]) <= kFivValueLimit,
+                      "shell value " + std::to_string(i) + " = " + value_text(o.shells[i]) + value_limit_text);
 }
 
 void validate_difmap(const DifMap& map) {
@@ -108,7 +144,15 @@ void validate_difmap(const DifMap& map) {
   PRT_SHADE_REQUIRE(map.size >= 1 && map.size <= (1 << 13), "DifMap face size " + std::to_string(map.size) + " outside [1, 8192]");
   const size_t n = size_t(6) * size_t(map.size) * size_t(map.size) * 3;
   for (size_t i = 0; i < n; ++i)
-    PRT_SHADE_REQUIRE(std::isfinite(map.texels[i]), "DifMap value " + std::to_string(i) + " is not finite");
+    PRT_SHADE_REQUIRE(std::isfinite(map.texels[i]) && std::fabs(map.texels[i]) <= kFivValueLimit,
+                      "DifMap value " + std::to_string(i) + " = " + value_text(map.texels[i]) + value_limit_text);
+}
+
+void validate_environment_fiv(const float env_fiv[9]) {
+  PRT_SHADE_REQUIRE(env_fiv != nullptr, "environment FIV is null");
+  for (int k = 0; k < 9; ++k)
+    PRT_SHADE_REQUIRE(std::isfinite(env_fiv[k]) && std::fabs(env_fiv[k]) <= kFivValueLimit,
+                      "environment FIV value " + std::to_string(k) + " = " + value_text(env_fiv[k]) + value_limit_text);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -156,7 +200,9 @@ void lookup_difmap(const DifMap& map, const float n[3], float out[3]) {
   }
 }
 
-void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
+namespace {
+
+void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
   // Direction and distance, formed in double: |s| never overflows and d is unit to float precision.
   const double sx = s[0], sy = s[1], sz = s[2];
   double rho = std::sqrt(sx * sx + sy * sy + sz * sz);
@@ -222,36 +268,61 @@ void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
   }
 }
 
-// ---------------------------------------------------------------------------------------------
-// Cases A/B/C, shadows, self-shadows
-
-float partial_factor(const FivOccluder& occ, const float p[3], const float n[3]) {
+float partial_factor_unit(const FivOccluder& occ, const float p[3], const float n[3]) {
   const float h = plane_height(occ, p, n), R = occ.radius;
-  if (!(h > -R)) return 0.0f;  // case C (NaN h counts as C: nothing is hidden)
+  if (!(h > -R)) return 0.0f;  // case C
   if (h >= R) return 1.0f;     // case A
   return clamp_nan_safe((h + R) / (2.0f * R), 0.0f, 1.0f);  // case B
 }
 
-void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n[3], bool partial, float out[3]) {
-  float factor;
-  if (partial) {
-    factor = partial_factor(occ, p, n);
-  } else {
-    factor = plane_height(occ, p, n) > -occ.radius ? 1.0f : 0.0f;
-  }
+// occluded_irradiance for a unit n.
+void occluded_irradiance_unit(const FivOccluder& occ, const float p[3], const float n[3], bool partial, float out[3]) {
+  const float factor = partial ? partial_factor_unit(occ, p, n) : (plane_height(occ, p, n) > -occ.radius ? 1.0f : 0.0f);
   if (factor == 0) {
     out[0] = out[1] = out[2] = 0;
     return;
   }
-  const float s[3] = {p[0] - occ.centre[0], p[1] - occ.centre[1], p[2] - occ.centre[2]};
+  double s[3];
+  offset_from_centre(occ, p, s);
   float f[9], e[3];
-  lookup_fiv(occ, s, f);
+  lookup_fiv_at(occ, s, f);
   project_fiv(f, n, e);
   for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, factor * e[c]);
 }
 
-void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n[3],
+// shade_fiv_self for a unit n.
+void shade_fiv_self_unit(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]) {
+  double s[3];
+  offset_from_centre(occ, p, s);
+  float f[9], occluded[3], total[3];
+  lookup_fiv_at(occ, s, f);
+  project_fiv(f, n, occluded);
+  project_fiv(env_fiv, n, total);
+  for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, total[c] - occluded[c]);
+}
+
+} // namespace
+
+void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
+  const double sd[3] = {s[0], s[1], s[2]};
+  lookup_fiv_at(occ, sd, out);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cases A/B/C, shadows, self-shadows
+
+float partial_factor(const FivOccluder& occ, const float p[3], const float n[3]) {
+  return partial_factor_unit(occ, p, UnitNormal(n).v);
+}
+
+void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n[3], bool partial, float out[3]) {
+  occluded_irradiance_unit(occ, p, UnitNormal(n).v, partial, out);
+}
+
+void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n_in[3],
                const FivShadeOptions& options, float out[3]) {
+  const UnitNormal unit(n_in);
+  const float* n = unit.v;
   // Accumulated in double: with hundreds of occluders and pair terms, float sums would drift by
   // ~count·ε·E_tot; the per-occluder work stays in float.
   float tot[3];
@@ -272,7 +343,7 @@ void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const
   int active = 0;  // occluders that hide something are compacted to st[0 .. active)
   for (int i = 0; i < count; ++i) {
     State& s = st[active];
-    occluded_irradiance(occluders[i], p, n, options.partial_occluders, s.I);
+    occluded_irradiance_unit(occluders[i], p, n, options.partial_occluders, s.I);
     if (!hides_something(s.I)) continue;
     for (int c = 0; c < 3; ++c) acc[c] -= s.I[c];
     if (options.overlap_correction) s.disc = disc_view(occluders[i], p, n);
@@ -301,21 +372,18 @@ void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const
 }
 
 void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]) {
-  const float s[3] = {p[0] - occ.centre[0], p[1] - occ.centre[1], p[2] - occ.centre[2]};
-  float f[9], occluded[3], total[3];
-  lookup_fiv(occ, s, f);
-  project_fiv(f, n, occluded);
-  project_fiv(env_fiv, n, total);
-  for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, total[c] - occluded[c]);
+  shade_fiv_self_unit(env_fiv, occ, p, UnitNormal(n).v, out);
 }
 
 void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int count, int self, const float p[3],
-                      const float n[3], bool partial, float out[3]) {
-  shade_fiv_self(env_fiv, occluders[self], p, n, out);
+                      const float n_in[3], bool partial, float out[3]) {
+  const UnitNormal unit(n_in);
+  const float* n = unit.v;
+  shade_fiv_self_unit(env_fiv, occluders[self], p, n, out);
   for (int j = 0; j < count; ++j) {
     if (j == self) continue;
     float o[3];
-    occluded_irradiance(occluders[j], p, n, partial, o);
+    occluded_irradiance_unit(occluders[j], p, n, partial, o);
     for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, out[c] - o[c]);
   }
 }
@@ -342,7 +410,9 @@ double overlap_fraction(double alpha_i, double alpha_j, double gamma) {
 }
 
 void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int count, const float p[3],
-                         const float n[3], const FivShadeOptions& options, float out[3]) {
+                         const float n_in[3], const FivShadeOptions& options, float out[3]) {
+  const UnitNormal unit(n_in);
+  const float* n = unit.v;
   float tot[3];
   lookup_difmap(map, n, tot);
   double e[3] = {tot[0], tot[1], tot[2]};

@@ -173,7 +173,10 @@ void Program::rotation_create() {
   double r[9];
   if (in_.ConsumeBool()) {  // a proper rotation from a quaternion
     double q[4], n = 0;
-    for (double& c : q) n += (c = number()) * c;
+    for (double& c : q) {
+      c = number();
+      n += c * c;
+    }
     n = std::sqrt(n);
     if (!(n > 1e-3) || !std::isfinite(n)) q[0] = 1, q[1] = q[2] = q[3] = 0, n = 1;
     for (double& c : q) c /= n;

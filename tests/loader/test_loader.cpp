@@ -150,6 +150,28 @@ TEST(Loader, BrokenOccluderIsRefusedNamingTheFile) {
   EXPECT_THROW(prt::shade::load_prt(tmp("no_such_file.prt.h5")), prt::formats::FormatError);
 }
 
+TEST(Loader, IrradianceBeyondTheShadingLimitIsRefusedNamingTheDataset) {
+  // prtshade/fiv.h "Numerics": FIV data beyond 2^64 could overflow float in n·F; the schema
+  // accepts any finite value, the loader refuses it for the shading functions.
+  File f = make_file(false);
+  for (Dataset& d : f.datasets)
+    if (d.path == "/fiv/environment") d.data = std::vector<float>{1, 2, 3, 4, 3e38f, 6, 7, 8, 9};
+  f.root_attrs.push_back({"format", std::string("prtbake")});
+  f.root_attrs.push_back({"format_version", int64_t{2}});
+  const auto path = tmp("loader_env_beyond_limit.prt.h5");
+  prt::formats::testing::write_file_unvalidated(path, f);
+  try {
+    prt::shade::load_prt(path);
+    FAIL() << "an environment FIV of 3e38 accepted";
+  } catch (const prt::formats::FormatError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(path.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("/fiv/environment: "), std::string::npos) << what;
+    EXPECT_NE(what.find("environment FIV value 4 = 3.00000001e+38: must be finite with magnitude <= 2^64"), std::string::npos)
+        << what;
+  }
+}
+
 } // namespace
 
 TEST(Loader, DamagedAndOldFormatFilesAreRefusedNeverACrash) {

@@ -480,6 +480,103 @@ TEST(ShadeFiv, ExtremeInputsStayFinite) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(e2[c], e1[c], 1e-5f);
 }
 
+TEST(ShadeFiv, OnlyTheNormalsDirectionCounts) {
+  // fiv.h "Numerics": the shading functions use n/|n|. Scaling n by a power of two scales |n| by
+  // the same power in double, so n/|n| is the same float vector and every result is bit-equal;
+  // a zero or NaN normal is +Y. Before, a non-unit n scaled I = n·F but not E_tot(n̂).
+  std::vector<float> cube = flat_cube(3, 5.0f);
+  for (size_t i = 0; i < cube.size(); ++i) cube[i] += 0.01f * float(i % 17);  // not constant
+  const float f[3] = {0.5f, 1.0f, -0.25f}, c0[3] = {0, 2, 0}, c1[3] = {1.5f, 1, 0.5f};
+  const Shells a = constant_occluder(f, 1.0f, c0), b = constant_occluder(f, 0.5f, c1);
+  const FivOccluder occ[2] = {a.view(), b.view()};
+  const float env[9] = {8, 9, 7, 8.5f, 9.5f, 7.5f, 9, 10, 8};
+  const float p[3] = {0.1f, 0.9f, 0.2f}, n[3] = {0.3f, 0.8f, 0.1f};
+  auto all = [&](const float nn[3], float out[12]) {
+    shade::shade_fiv({3, cube.data()}, occ, 2, p, nn, {}, out);
+    shade::shade_fiv_self(env, occ[0], p, nn, out + 3);
+    shade::shade_fiv_member(env, occ, 2, 0, p, nn, true, out + 6);
+    shade::occluded_irradiance(occ[1], p, nn, true, out + 9);
+  };
+  float ref[12];
+  all(n, ref);
+  for (float k : {0x1p100f, 0x1p-100f, 4.0f}) {
+    const float scaled[3] = {k * n[0], k * n[1], k * n[2]};
+    float got[12];
+    all(scaled, got);
+    for (int e = 0; e < 12; ++e) EXPECT_EQ(got[e], ref[e]) << "k " << k << " output " << e;
+  }
+  const float up[3] = {0, 1, 0}, zero[3] = {0, 0, 0}, nan[3] = {std::nanf(""), 0, 0};
+  float want[12], got_zero[12], got_nan[12];
+  all(up, want);
+  all(zero, got_zero);
+  all(nan, got_nan);
+  for (int e = 0; e < 12; ++e) {
+    EXPECT_EQ(got_zero[e], want[e]) << e;
+    EXPECT_EQ(got_nan[e], want[e]) << e;
+  }
+}
+
+TEST(ShadeFiv, DataAtTheValueLimitGivesFiniteOutputsAndMoreIsRefused) {
+  // The C API fuzz finding (tests/fuzz/regressions/capi/fiv-scene-shade-member-non-finite): an
+  // environment FIV near FLT_MAX and a normal of length 2.6 made n·F^env overflow to +inf, and
+  // prt_fiv_scene_shade_member returned PRT_OK with it. Now data beyond 2^64 is refused and only
+  // n̂ is used: every output is finite at the limit, for positions up to ±3e38.
+  const float L = shade::kFivValueLimit;
+  std::vector<float> cube = flat_cube(2, L);
+  const float f[3] = {L, -L, L}, centre[3] = {-3e38f, 1, 2};
+  Shells o = constant_occluder(f, 1e30f, centre);
+  for (float& x : o.shells) x = (&x - o.shells.data()) % 2 ? -L : L;
+  Shells near = constant_occluder(f, 2.0f, centre);
+  for (int a = 0; a < 3; ++a) near.centre[a] = float(a);
+  for (float& x : near.shells) x = L;
+  EXPECT_NO_THROW(shade::validate_occluder(o.view()));
+  EXPECT_NO_THROW(shade::validate_difmap({2, cube.data()}));
+  const float env[9] = {L, L, L, -L, L, -L, L, L, L};
+  EXPECT_NO_THROW(shade::validate_environment_fiv(env));
+  const FivOccluder occ[3] = {o.view(), near.view(), o.view()};
+  const float points[][3] = {{-0.5625f, -1.1875f, 1.1875f}, {3e38f, -3e38f, 3e38f}, {0, 1, 2}, {-3e38f, 1, 2}};
+  const float normals[][3] = {{2.4375f, 1.0625f, -0.0625f}, {3e38f, 3e38f, -3e38f}, {1e-38f, 0, 0}, {-1, -1, -1}};
+  for (const auto& p : points)
+    for (const auto& n : normals) {
+      float out[12];
+      shade::shade_fiv({2, cube.data()}, occ, 3, p, n, {}, out);
+      shade::shade_fiv_self(env, occ[0], p, n, out + 3);
+      shade::shade_fiv_member(env, occ, 3, 1, p, n, true, out + 6);
+      shade::occluded_irradiance(occ[1], p, n, false, out + 9);
+      for (int e = 0; e < 12; ++e) EXPECT_TRUE(std::isfinite(out[e]) && out[e] >= 0) << p[0] << " " << n[0] << " " << e;
+    }
+  // Refused one float above the limit, through each validator and the C API.
+  const float over = std::nextafter(L, 2 * L);
+  o.shells[7] = over;
+  EXPECT_THROW(shade::validate_occluder(o.view()), std::invalid_argument);
+  cube[5] = -over;
+  EXPECT_THROW(shade::validate_difmap({2, cube.data()}), std::invalid_argument);
+  float env_over[9];
+  std::copy(env, env + 9, env_over);
+  env_over[4] = over;
+  EXPECT_THROW(shade::validate_environment_fiv(env_over), std::invalid_argument);
+  cube[5] = L;
+  prt_fiv_scene* scene = nullptr;
+  EXPECT_EQ(prt_fiv_scene_create(2, cube.data(), env_over, &scene), PRT_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(scene, nullptr);
+  EXPECT_NE(std::string(prt_last_error()).find("environment FIV value 4"), std::string::npos) << prt_last_error();
+}
+
+TEST(ShadeFiv, OffsetsBeyondFloatRangeAreFormedInDouble) {
+  // p − centre = 6e38 overflows float; formed in float it became +inf, was taken for ρ = 0 and
+  // the inner shell's FIV hid the whole environment. In double it is far beyond the last shell:
+  // the 1/ρ² falloff makes the occluded FIV 0 in float, and E is the environment's n·F^env.
+  const float f[3] = {1, 2, 3}, centre[3] = {-3e38f, 0, 0};
+  const Shells o = constant_occluder(f, 1.0f, centre);
+  const float env[9] = {1, 2, 3, 2, 4, 6, 0.5f, 1, 1.5f};
+  const float p[3] = {3e38f, 0, 0}, n[3] = {0, 1, 0};
+  float e[3];
+  shade::shade_fiv_self(env, o.view(), p, n, e);
+  EXPECT_EQ(e[0], 2.0f);
+  EXPECT_EQ(e[1], 4.0f);
+  EXPECT_EQ(e[2], 1.0f);
+}
+
 TEST(ShadeFivSelf, EnvironmentMinusOccludedClamped) {
   const float f[3] = {0.25f, 0.5f, 0.0f}, centre[3] = {0, 0, 0};
   const Shells o = constant_occluder(f, 1.0f, centre);
@@ -575,7 +672,8 @@ TEST(Validate, RejectsBrokenOccludersAndMaps) {
     shade::validate_occluder(o.view());
     FAIL() << "NaN accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("shell value 5 is not finite"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("shell value 5 = "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("must be finite"), std::string::npos) << e.what();
   }
   const std::vector<float> cube = flat_cube(2, 1.0f);
   EXPECT_NO_THROW(shade::validate_difmap({2, cube.data()}));

@@ -518,6 +518,14 @@ TEST_F(FivGlsl, LookupDifMapMatchesCoreAndReference) {
   std::printf("lookup_difmap: worst GLSL-core %.3f x tol\n", worst);
 }
 
+// The normal the shading functions use (prtshade/fiv.h "Numerics"): n/|n|, a zero normal is +Y.
+// The receivers' normals are unit to float rounding, so only the zero normal changes.
+std::array<float, 3> shading_normal(const float n[3]) {
+  const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+  if (!(len > 0)) return {0.0f, 1.0f, 0.0f};
+  return {float(n[0] / len), float(n[1] / len), float(n[2] / len)};
+}
+
 // Partial factor and occluded irradiance. h = n·(c − p) rounds within δh = 8 ε Σ_k |n_k|(|c_k| +
 // |p_k|) on each side, so the factor within δh/(2R) + 4 ε; I_c = max(0, f n·F_c) within
 // δf |n·F_c| + f Σ_k |n_k| tolF_ck + 8 ε f Σ_k |n_k F_ck|; without the partial factor, a receiver
@@ -579,7 +587,8 @@ TEST_F(FivGlsl, PartialFactorAndOccludedIrradianceMatchCore) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const SynthOccluder& o = scene_->occ[rc.info[0]];
-    const IrradianceCheck k = irradiance_check(o, rc.p, rc.n);
+    const std::array<float, 3> sn = shading_normal(rc.n);
+    const IrradianceCheck k = irradiance_check(o, rc.p, sn.data());
     ++cases[k.factor == 0 ? 0 : (k.factor == 1 ? 2 : 1)];
     const float* got = result(r);
     const float core_f = prt::shade::partial_factor(o.view(), rc.p, rc.n);
@@ -611,12 +620,13 @@ TEST_F(FivGlsl, ShadeFivSelfMatchesCore) {
     const Fiv9& tolF = l.tol;
     float core[3];
     prt::shade::shade_fiv_self(scene_->env, o.view(), rc.p, rc.n, core);
+    const std::array<float, 3> sn = shading_normal(rc.n);
     for (std::size_t ch = 0; ch < 3; ++ch) {
       double e = 0, mag = 0, tol = 0;
       for (std::size_t a = 0; a < 3; ++a) {
-        e += rc.n[a] * (scene_->env[3 * ch + a] - F.v[3 * ch + a]);
-        mag += std::abs(rc.n[a] * scene_->env[3 * ch + a]) + std::abs(rc.n[a] * F.v[3 * ch + a]);
-        tol += std::abs(rc.n[a]) * tolF[3 * ch + a];
+        e += sn[a] * (scene_->env[3 * ch + a] - F.v[3 * ch + a]);
+        mag += std::abs(sn[a] * scene_->env[3 * ch + a]) + std::abs(sn[a] * F.v[3 * ch + a]);
+        tol += std::abs(sn[a]) * tolF[3 * ch + a];
       }
       tol += 8 * kFloatEps * mag;
       const double got = result(r)[19 + ch];
@@ -646,6 +656,7 @@ TEST_F(FivGlsl, ShadeFivMatchesCore) {
     for (uint32_t i = 0; i < count; ++i) views.push_back(occ[first + i].view());
     const auto D = difmap_at(scene_->difmap_size, scene_->texels, std::array<double, 3>{rc.n[0], rc.n[1], rc.n[2]}.data());
     const auto tol_D = difmap_tolerance(scene_->difmap_size, scene_->texels, rc.n);
+    const std::array<float, 3> sn = shading_normal(rc.n);
     // Discs in double.
     std::vector<std::array<double, 3>> axis(count);
     std::vector<double> alpha(count), d_alpha(count);
@@ -654,14 +665,14 @@ TEST_F(FivGlsl, ShadeFivMatchesCore) {
       double v[3], D2 = 0;
       for (int a = 0; a < 3; ++a) v[a] = double(o.centre[a]) - rc.p[a], D2 += v[a] * v[a];
       const double Dl = std::sqrt(D2);
-      for (std::size_t a = 0; a < 3; ++a) axis[i][a] = Dl > 0 ? v[a] / Dl : rc.n[a];
+      for (std::size_t a = 0; a < 3; ++a) axis[i][a] = Dl > 0 ? v[a] / Dl : sn[a];
       alpha[i] = Dl > 0 ? std::asin(std::min(1.0, o.radius / Dl)) : kPi / 2;
       d_alpha[i] = 16 * kFloatEps + std::min(4 * kFloatEps / std::max(std::cos(alpha[i]), 1e-300), 4 * std::sqrt(kFloatEps));
     }
     for (int option = 0; option < 4; ++option) {
       const bool partial = option < 2, overlap = option % 2 == 0;
       std::vector<IrradianceCheck> k;
-      for (uint32_t i = 0; i < count; ++i) k.push_back(irradiance_check(occ[first + i], rc.p, rc.n));
+      for (uint32_t i = 0; i < count; ++i) k.push_back(irradiance_check(occ[first + i], rc.p, sn.data()));
       std::array<double, 3> E{}, tol{}, mag{};
       for (std::size_t c = 0; c < 3; ++c) E[c] = D[c], tol[c] = tol_D[c], mag[c] = std::abs(D[c]);
       std::vector<std::array<double, 3>> I(count), tI(count);

@@ -56,10 +56,16 @@
 //   positive hemisphere, so E = max(0, n·F^env − n·F(p − centre)) per channel.
 //
 // Numerics: inputs and outputs are float; shade_fiv sums its terms in double (hundreds of
-// occluders and pair terms would otherwise drift by count·ε·E_tot); |s| and |centre − p| are formed in double (no overflow
-// for any finite float input), the angles in float. Every output is finite for finite inputs,
-// including p at an occluder's centre, ρ far beyond the last shell, normals of any length
-// (a zero normal gives E_tot(+Y) and I = 0) and NaN offsets (treated as ρ = 0).
+// occluders and pair terms would otherwise drift by count·ε·E_tot); s = p − centre, |s| and the
+// plane height n·(centre − p) are formed in double (no overflow for any finite float input), the
+// angles in float. Only the direction of a normal counts: the shading functions use n/|n| (|n| in
+// double), and a zero or non-finite normal is +Y, the direction lookup_difmap gives it.
+// Irradiance data (shell values, DifMap texels, the environment FIV) must be finite with
+// magnitude <= kFivValueLimit = 2^64 (the validate_* functions refuse more; no light reaches it):
+// then every interpolated F and every n·F is below 2·2^64, and every sum, even over 2^30
+// occluders and their pairs, stays far below FLT_MAX (2^128). So every output is finite for
+// finite inputs, including p at an occluder's centre or 10^38 away, ρ far beyond the last shell,
+// normals of any length and NaN offsets given to lookup_fiv (treated as ρ = 0).
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
 // nothing except shade_fiv for more than 128 occluders. Thread-safe (no shared state).
@@ -88,12 +94,18 @@ struct DifMap {
   const float* texels;
 };
 
+// Largest magnitude of a shell value, DifMap texel or environment FIV value (see "Numerics").
+inline constexpr float kFivValueLimit = 0x1p64f;
+
 // Throw std::invalid_argument naming the problem unless: pointers non-null; n_rho >= 1,
 // n_theta >= 2, n_phi >= 1 and n_rho·n_theta·n_phi <= 2^26; centre finite; radius finite and > 0;
-// radii finite, > 0 and strictly increasing; every shell value finite. O(size of the shells).
+// radii finite, > 0 and strictly increasing; every shell value finite, |value| <= kFivValueLimit.
+// O(size of the shells).
 void validate_occluder(const FivOccluder& occ);
-// size in [1, 2^13], texels non-null and finite. O(6 size²).
+// size in [1, 2^13], texels non-null, finite and |texel| <= kFivValueLimit. O(6 size²).
 void validate_difmap(const DifMap& map);
+// /fiv/environment: 9 finite values of magnitude <= kFivValueLimit. O(1).
+void validate_environment_fiv(const float env_fiv[9]);
 
 // Bilinear lookup of E_tot in the face the direction n selects (any length; zero → +Y).
 void lookup_difmap(const DifMap& map, const float n[3], float out[3]);
@@ -102,7 +114,7 @@ void lookup_difmap(const DifMap& map, const float n[3], float out[3]);
 void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]);
 
 // Partial-occluder factor (§4.3.1 "Partial Occluders"): h = n·(centre − p); case C (h <= −R): 0;
-// case A (h >= R): 1; case B: (h + R) / (2R). n unit.
+// case A (h >= R): 1; case B: (h + R) / (2R). n of any length (its direction, see "Numerics").
 float partial_factor(const FivOccluder& occ, const float p[3], const float n[3]);
 
 // Occluded irradiance of one occluder at (p, n): per channel max(0, factor · n·F_c(p − centre)),

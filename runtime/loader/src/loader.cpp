@@ -98,6 +98,11 @@ LoadedAsset load_prt(const std::filesystem::path& path) {
   if (a.fiv_environment) {
     asset.has_fiv_environment = true;
     asset.fiv_environment = a.fiv_environment->f_env;
+    try {
+      validate_environment_fiv(asset.fiv_environment.data());
+    } catch (const std::invalid_argument& e) {
+      throw FormatError(file, "/fiv/environment: " + std::string(e.what()));
+    }
   }
   if (a.irradiance_cube) {
     asset.irradiance_cube_size = a.irradiance_cube->size;
