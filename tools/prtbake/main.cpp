@@ -1,6 +1,7 @@
 // prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments (CLI11:
 // one subcommand per kind of bake, each with only the options that apply to it, into the typed
 // specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
+#include <bake/choose.h>
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <bake/fiv.h>
@@ -12,6 +13,7 @@
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
+#include "choice_text.h"
 #include "progress_bar.h"
 #include "tool_main.h"
 
@@ -101,6 +103,8 @@ struct Args {
   bake::UpAxis up = bake::UpAxis::Y;
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;
   bool flip_normals = false;  // vertex: reverse every triangle and file normal
+  double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
+  bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
 };
 
@@ -227,6 +231,17 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          "qmc: Embree ray casting, importance-sampled randomised Halton QMC, the\n"
          "baseline and the reference.")
       ->option_text("NAME");
+  cmd.add_option("--target-error", a.target_error,
+                 "choose the integrator and its samples for you: the cheapest bake\n"
+                 "whose RMSE is at most E per product (AO, transfer: absolute; band-1\n"
+                 "radiance: relative to its RMS), from a pilot on 128 seeded vertices\n"
+                 "(both integrators timed and their errors measured against a\n"
+                 "512-isoline silhouette reference). E in [1e-4, 0.1], e.g. 1e-3.\n"
+                 "With --integrator, only its samples are chosen; not with --samples.\n"
+                 "The choice is printed; the error report (on 128 vertices unless\n"
+                 "--report says otherwise) then checks E.")
+      ->option_text("E")
+      ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
   add_sampling(cmd, a, samples,
                "silhouette: " + silhouette_k_help() +
@@ -295,6 +310,9 @@ void add_scene(CLI::App& app, Args& a) {
   add_run_options(cmd, a);
 }
 
+// The error report's vertices when --target-error is given and --report is not.
+constexpr uint32_t kTargetReportPoints = 128;
+
 // Parses the command line; nullopt when it asked for help or the version (printed).
 std::optional<Args> parse(int argc, char** argv) {
   Args a;
@@ -328,6 +346,14 @@ std::optional<Args> parse(int argc, char** argv) {
     return a;
   }
   if (a.output.empty()) throw UsageError(a.command + ": no output file given (-o OUT.prt.h5)");
+  if (a.command == "vertex") {
+    a.integrator_given = app.get_subcommand("vertex")->count("--integrator") > 0;
+    if (a.target_error > 0 && samples != 0)
+      throw UsageError("vertex: --target-error and --samples both given: the target chooses the samples (give one)");
+    // Checking a target needs more vertices than the default report's 32 (RMSE over a sample).
+    if (a.target_error > 0 && app.get_subcommand("vertex")->count("--report") == 0)
+      a.integrator.report_points = kTargetReportPoints;
+  }
   if (samples != 0) a.integrator.set_samples(samples);
   if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
       a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
@@ -498,9 +524,21 @@ int run_vertex(const Args& a) {
   req.visibility_order = a.visibility;
   req.radiance = env ? &*env : nullptr;
 
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
+  bake::IntegratorSpec spec = a.integrator;
+  if (a.target_error > 0) {
+    bake::ChooserOptions copt;
+    copt.target = a.target_error;
+    if (a.integrator_given) copt.only = a.integrator.kind;
+    const bake::IntegratorChoice choice =
+        bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req, a.integrator, copt, progress);
+    spec = choice.spec;
+    if (say) tool::print_choice(choice);
+  }
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =
-      bake::make_integrator(a.integrator, mesh, topo, req);
+      bake::make_integrator(spec, mesh, topo, req);
   const bake::Integrator& integrator = *integrator_ptr;
   const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   if (say) {
@@ -513,17 +551,15 @@ int run_vertex(const Args& a) {
                 integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
   }
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
-  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
   warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
               a.flip_normals);
   if (say) {
     std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
                 mesh.positions.size() / result.seconds);
-    if (a.integrator.kind == bake::IntegratorKind::Qmc)
-      std::printf(", %.2f M rays/s", double(mesh.positions.size()) * a.integrator.qmc_rays / result.seconds / 1e6);
-    if (a.integrator.kind == bake::IntegratorKind::Silhouette) {
+    if (spec.kind == bake::IntegratorKind::Qmc)
+      std::printf(", %.2f M rays/s", double(mesh.positions.size()) * spec.qmc_rays / result.seconds / 1e6);
+    if (spec.kind == bake::IntegratorKind::Silhouette) {
       const bake::IntegratorStats st = integrator.stats();
       std::printf("; per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% "
                   "integration",
@@ -536,19 +572,20 @@ int run_vertex(const Args& a) {
   }
 
   std::optional<bake::ErrorReport> report;
-  if (a.integrator.report_points > 0) {
-    const auto reference = bake::make_reference(a.integrator, mesh, topo, req);
-    report = bake::compare_with_reference(mesh, topo, result, *reference, a.integrator.report_points, a.integrator.seed,
+  if (spec.report_points > 0) {
+    const auto reference = bake::make_reference(spec, mesh, topo, req);
+    report = bake::compare_with_reference(mesh, topo, result, *reference, spec.report_points, spec.seed,
                                           progress);
     if (say) {
       std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                   "counted in the bake time):\n",
-                  a.integrator.reference_rays(), report->vertices.size(), report->reference_seconds);
+                  spec.reference_rays(), report->vertices.size(), report->reference_seconds);
       for (const auto& e : report->products)
         std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (bake's estimated std. error %.3e; "
                     "reference's own %.3e)\n",
                     bake::product_label(e.product), e.rmse, e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0,
                     e.bake_std_error, e.reference_std_error);
+      if (a.target_error > 0) tool::print_target_check(*report, a.target_error);
     }
   }
 
@@ -559,7 +596,7 @@ int run_vertex(const Args& a) {
   tool::set_mesh(asset.vertices, mesh);
   if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
   tool::set_products(asset.vertices, result,
-                     {integrator.name(), integrator.description(), a.integrator.samples(), a.integrator.seed, a.transfer, a.visibility,
+                     {integrator.name(), integrator.description(), spec.samples(), spec.seed, a.transfer, a.visibility,
                       env ? &*env : nullptr, a.environment});
   if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
   write_file(a, asset);

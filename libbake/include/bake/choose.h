@@ -1,0 +1,116 @@
+// bake/choose.h — "ask for an error, not a sample count": the integrator and its knob that reach a
+// target RMSE at the lowest cost, chosen from a pilot on the object itself (docs/ARCHITECTURE.md
+// §6 "Error reports"; paper 001 §5 and Table 1: the silhouette integrator wins on small and
+// medium meshes, ray casting on large ones, and where the crossover lies depends on the asset).
+//
+// What the target E means (the same numbers the error report prints, bake/vertex_bake.h):
+//   AO, diffuse transfer T_i, visibility transfer U_i: the RMSE over the values of the product
+//     (every coefficient of every vertex), absolute — these are dimensionless (AO in [0, 1],
+//     |T_i| <= 1/√π, |U_i| <= 2√π);
+//   band-1 radiance R_c,m: the RMSE relative to the RMS of the reference values (its unit is the
+//     environment's, which E cannot know).
+// Every requested product must meet E.
+//
+// The pilot (choose_integrator), on a seeded sample of the bake's shade points:
+//  1. reference: the silhouette integrator at N_ref = 512 u-isolines (k = 2^18), exact up to its
+//     isoline discretisation, which falls as ~N^-1.5..-2 (bench/RESULTS.md, error against time):
+//     ~3e-5 AO RMSE on the bunny at N = 512, a tenth of the smallest E the chooser accepts
+//     (kMinTarget = 1e-4 ... the error report, against QMC, verifies the bake);
+//  2. silhouette at N = 16, 32, 64, 128: the RMSE against the reference per product; the model
+//     RMSE(N) = C N^-a is fitted (least squares in log-log over the levels whose error is above
+//     the reference's own error scale) and solved for the smallest even N with RMSE <= safety·E;
+//  3. QMC at 256, 1024 and 4096 rays: the same against the reference; RMSE(R) = C R^-b with b
+//     fitted from the two largest and clamped to [0.5, 1] (randomised QMC converges between the
+//     Monte Carlo rate 1/2 and 1; ~0.7 on the bunny), solved for the rays, rounded up to a
+//     power of two;
+//     the levels stop early once one misses the goal at a cost per integral above the
+//     silhouette prediction (QMC cannot win then: more rays cost more);
+//  4. costs: the CPU time of every pilot integral (each thread's own CPU clock, so the thread
+//     count does not enter), per point; silhouette cost(N) linear in N through the measured
+//     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays.
+// The cheaper prediction wins. With `only` set (the user named an integrator), only its knob is
+// chosen.
+//
+// Determinism: the knobs are functions of the inputs and the seed (the pilot's values are), but
+// WHICH integrator wins depends on measured CPU time, so two runs whose predicted costs are close
+// may choose differently and then bake different (each correct to E) values. The choice is
+// printed and stored in the file (its integrator and samples); pinning it (--integrator K
+// --samples N) gives the same bytes on any machine. IntegratorChoice::margin says how close it
+// was.
+#pragma once
+
+#include <bake/integrator.h>
+#include <bake/mesh.h>
+#include <bake/products.h>
+#include <bake/progress.h>
+#include <bake/vertex_bake.h>
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace prt::bake {
+
+struct ChooserOptions {
+  static constexpr double kMinTarget = 1e-4;  // below: the pilot reference is not exact enough
+  static constexpr double kMaxTarget = 0.1;
+  double target = 1e-3;                       // E, see the file comment
+  std::optional<IntegratorKind> only;         // choose only this kind's knob
+  uint32_t pilot_points = 128;                // seeded shade points (all of them if fewer)
+  // Aim at safety·E: the pilot's RMSE is itself an estimate from a sample (a few heavy-tailed
+  // vertices dominate it; ~15-20% spread between seeded samples of 128 on the bunny).
+  double safety = 0.7;
+};
+
+// One pilot run: an integrator at one knob on the pilot points.
+struct PilotRun {
+  IntegratorKind kind = IntegratorKind::Silhouette;
+  uint32_t knob = 0;                 // N u-isolines (silhouette) or rays (QMC)
+  std::vector<double> error;         // per product (IntegratorChoice::products): RMSE in E's units
+  double cpu_us_per_point = 0;       // mean CPU time of one integral
+};
+
+// A kind's prediction at the knob the model chose for it.
+struct Prediction {
+  IntegratorKind kind = IntegratorKind::Silhouette;
+  bool reachable = false;            // the model reaches safety·E within the knob's range
+  // QMC only: its pilot stopped at `knob` rays, which missed the goal and already cost more per
+  // integral than the silhouette prediction (more rays cost more): it cannot win. The error and
+  // cost below are those measured there.
+  bool pruned = false;
+  uint32_t knob = 0;                 // N (silhouette) or rays (QMC)
+  double exponent = 0;               // the fitted convergence rate of the worst product
+  double predicted_error = 0;        // of the worst product, in E's units
+  double predicted_us_per_point = 0; // CPU µs per integral
+};
+
+struct IntegratorChoice {
+  IntegratorSpec spec;               // the chosen kind and knob; seed and report from `base`
+  double target = 0;
+  std::vector<Product> products;     // the order of PilotRun::error
+  std::vector<PilotRun> runs;        // the reference's run first (error 0)
+  std::vector<Prediction> predictions;
+  double margin = 0;                 // predicted cost of the other kind / the chosen one's (0: one kind)
+  size_t pilot_points = 0;
+  double pilot_seconds = 0;          // wall time of the whole pilot
+  std::string reason;                // one line: why this integrator
+};
+
+// The pilot and the choice (file comment). `points` are the bake's shade points (their order and
+// count as the bake will see them), `mesh`/`topology` the occluders. Throws InputError when the
+// target is outside [kMinTarget, kMaxTarget] or no integrator is predicted to reach it (naming the
+// best reachable error). A "pilot" stage of `monitor`.
+IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
+                                   const ProductRequest& request, const IntegratorSpec& base,
+                                   const ChooserOptions& options, const Monitor& monitor = {});
+
+// The products a request bakes, in row order (AO, diffuse transfer, visibility transfer, band-1).
+std::vector<Product> requested_products(const ProductRequest& request);
+
+// The report's error of `product` in the target's units (the file comment): RMSE, or RMSE / RMS of
+// the reference for band-1 radiance.
+double error_in_target_units(const ProductError& error);
+
+} // namespace prt::bake

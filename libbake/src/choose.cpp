@@ -1,0 +1,339 @@
+// choose.cpp — the target-error chooser (bake/choose.h): a pilot on seeded shade points, error
+// models fitted per integrator, costs measured, the cheaper prediction chosen.
+#include <bake/choose.h>
+
+#include <bake/error.h>
+#include <bake/qmc.h>
+#include <bake/sampling.h>
+#include <bake/silhouette.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+
+namespace prt::bake {
+namespace {
+
+constexpr int kReferenceIsolines = 512;
+constexpr int kSilhouetteLevels[] = {16, 32, 64, 128};
+constexpr int kMinIsolines = 8, kMaxIsolines = kReferenceIsolines;
+constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
+constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
+constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct ProductSlice {
+  Product product;
+  size_t offset, count;
+};
+
+std::vector<ProductSlice> slices(const ProductLayout& L) {
+  std::vector<ProductSlice> s;
+  if (L.ao_count) s.push_back({Product::Ao, L.ao, L.ao_count});
+  if (L.transfer_count) s.push_back({Product::TransferDiffuse, L.transfer, L.transfer_count});
+  if (L.visibility_count) s.push_back({Product::TransferVisibility, L.visibility, L.visibility_count});
+  if (L.radiance_count) s.push_back({Product::RadianceBand1, L.radiance, L.radiance_count});
+  return s;
+}
+
+// Rows of one integrator at the pilot points, and the mean CPU time per integral.
+struct Rows {
+  std::vector<double> values;
+  double cpu_us_per_point = 0;
+};
+
+Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> points,
+                     const std::vector<uint32_t>& sample, Task& progress) {
+  const size_t W = integrator.layout().width, K = sample.size();
+  Rows rows;
+  rows.values.assign(K * W, 0.0);
+  std::vector<double> seconds(K, 0.0);
+  tbb::parallel_for(size_t(0), K, [&](size_t i) {
+    const double t0 = thread_cpu_seconds();
+    // The bake's own point index: a QMC pilot row is the row the bake would compute.
+    integrator.integrate(points[sample[i]], sample[i], std::span(rows.values).subspan(i * W, W));
+    seconds[i] = thread_cpu_seconds() - t0;
+    progress.advance();
+  });
+  double sum = 0;
+  for (double s : seconds) sum += s;  // in index order: the same sum for any thread count
+  rows.cpu_us_per_point = K ? 1e6 * sum / double(K) : 0.0;
+  return rows;
+}
+
+// Per product: RMSE of `rows` against `ref` in the target's units (bake/choose.h).
+std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
+                                 const std::vector<ProductSlice>& products) {
+  const size_t K = W ? ref.size() / W : 0;
+  std::vector<double> out;
+  for (const ProductSlice& p : products) {
+    double e2 = 0, r2 = 0;
+    for (size_t i = 0; i < K; ++i)
+      for (size_t c = 0; c < p.count; ++c) {
+        const double d = rows[i * W + p.offset + c] - ref[i * W + p.offset + c];
+        e2 += d * d;
+        r2 += ref[i * W + p.offset + c] * ref[i * W + p.offset + c];
+      }
+    const double n = double(std::max<size_t>(K * p.count, 1));
+    double e = std::sqrt(e2 / n);
+    if (p.product == Product::RadianceBand1) e = r2 > 0 ? e / std::sqrt(r2 / n) : 0.0;
+    out.push_back(e);
+  }
+  return out;
+}
+
+// The knob x at which a power law through (x0, e0), (x1, e1) (x0 < x1) reaches `goal`, with its
+// exponent clamped to [lo, hi]; `exponent` receives it. Errors of exactly 0 need no more than x0.
+double solve_power_law(double x0, double e0, double x1, double e1, double goal, double lo, double hi,
+                       double& exponent) {
+  if (!(e1 > 0)) {
+    exponent = hi;
+    return e0 > goal ? x1 : x0;  // e1 = 0: x1 is exact enough
+  }
+  const double a = e0 > 0 ? std::log(e0 / e1) / std::log(x1 / x0) : hi;
+  exponent = std::clamp(std::isfinite(a) ? a : hi, lo, hi);
+  return x1 * std::pow(e1 / goal, 1.0 / exponent);
+}
+
+// Least-squares line t = α + β x through the points.
+void fit_line(const std::vector<double>& x, const std::vector<double>& t, double& alpha, double& beta) {
+  const double n = double(x.size());
+  double sx = 0, st = 0, sxx = 0, sxt = 0;
+  for (size_t i = 0; i < x.size(); ++i) sx += x[i], st += t[i], sxx += x[i] * x[i], sxt += x[i] * t[i];
+  const double d = n * sxx - sx * sx;
+  beta = d > 0 ? (n * sxt - sx * st) / d : 0.0;
+  alpha = (st - beta * sx) / n;
+  if (beta < 0) beta = 0, alpha = st / n;  // noise: cost does not fall with the knob
+}
+
+std::string format(const char* fmt, double a, double b = 0, double c = 0, double d = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
+  return buf;
+}
+
+} // namespace
+
+std::vector<Product> requested_products(const ProductRequest& request) {
+  std::vector<Product> out;
+  for (const ProductSlice& s : slices(ProductLayout(request))) out.push_back(s.product);
+  return out;
+}
+
+double error_in_target_units(const ProductError& e) {
+  if (e.product != Product::RadianceBand1) return e.rmse;
+  return e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0;
+}
+
+IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
+                                   const ProductRequest& request, const IntegratorSpec& base,
+                                   const ChooserOptions& options, const Monitor& monitor) {
+  if (!(options.target >= ChooserOptions::kMinTarget && options.target <= ChooserOptions::kMaxTarget))
+    throw InputError("", format("target error %g outside [%g, %g]", options.target, ChooserOptions::kMinTarget,
+                                ChooserOptions::kMaxTarget));
+  PRT_CHECK(!request.empty());
+  PRT_CHECK(!points.empty());
+  const auto wall0 = std::chrono::steady_clock::now();
+  IntegratorChoice choice;
+  choice.target = options.target;
+  choice.spec = base;
+  const std::vector<ProductSlice> products = slices(ProductLayout(request));
+  for (const ProductSlice& p : products) choice.products.push_back(p.product);
+  const std::vector<uint32_t> sample =
+      seeded_sample(uint32_t(points.size()), options.pilot_points, mix64(base.seed ^ kPilotSalt));
+  choice.pilot_points = sample.size();
+  const size_t W = ProductLayout(request).width;
+  const double goal = options.safety * options.target;
+  const bool want_sil = !options.only || *options.only == IntegratorKind::Silhouette;
+  const bool want_qmc = !options.only || *options.only == IntegratorKind::Qmc;
+  const size_t runs = 1 + (want_sil ? std::size(kSilhouetteLevels) : 0) + (want_qmc ? std::size(kQmcLevels) : 0);
+  Task progress(monitor, "pilot", runs * sample.size());
+
+  // Setup (BVHs, tables) is part of a bake's cost: measured per integrator build, wall time.
+  auto timed_build = [](auto&& make, double& seconds) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto integrator = make();
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return integrator;
+  };
+  auto silhouette = [&](int isolines) {
+    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{isolines, base.seed});
+  };
+  double setup_sil = 0, setup_qmc = 0;
+  const auto reference = timed_build([&] { return silhouette(kReferenceIsolines); }, setup_sil);
+  const Rows ref = integrate_pilot(*reference, points, sample, progress);
+  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(kReferenceIsolines),
+                         std::vector<double>(products.size(), 0.0), ref.cpu_us_per_point});
+
+  const double V = double(points.size());
+  if (want_sil) {
+    std::vector<double> xs, ts;
+    std::vector<std::vector<double>> errors;
+    for (int N : kSilhouetteLevels) {
+      double s = 0;
+      const auto integrator = timed_build([&] { return silhouette(N); }, s);
+      setup_sil = std::max(setup_sil, s);
+      const Rows r = integrate_pilot(*integrator, points, sample, progress);
+      choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(N), pilot_errors(r.values, ref.values, W, products),
+                             r.cpu_us_per_point});
+      xs.push_back(N), ts.push_back(r.cpu_us_per_point), errors.push_back(choice.runs.back().error);
+    }
+    xs.push_back(kReferenceIsolines), ts.push_back(ref.cpu_us_per_point);
+    Prediction pr;
+    pr.kind = IntegratorKind::Silhouette;
+    double need = kMinIsolines;
+    const size_t L = std::size(kSilhouetteLevels);
+    for (size_t p = 0; p < products.size(); ++p) {
+      // The first level that meets the goal, interpolated from the level before it; else the
+      // last two levels extrapolated. Exponent clamped to [0.5, 3].
+      size_t hit = L;
+      for (size_t i = 0; i < L; ++i)
+        if (errors[i][p] <= goal) {
+          hit = i;
+          break;
+        }
+      const size_t i1 = hit == L ? L - 1 : std::max<size_t>(hit, 1), i0 = i1 - 1;
+      double a = 0;
+      double n = solve_power_law(xs[i0], errors[i0][p], xs[i1], errors[i1][p], goal, 0.5, 3.0, a);
+      if (hit == 0 && errors[0][p] <= goal) n = std::min(n, xs[0]);
+      if (n > need) need = n, pr.exponent = a;
+    }
+    pr.reachable = need <= kMaxIsolines;
+    int N = int(std::ceil(std::min<double>(need, kMaxIsolines) - 1e-9));
+    N = std::max(kMinIsolines, N + (N & 1));  // even, as the integrator uses it
+    pr.knob = uint32_t(N);
+    double worst = 0;
+    for (size_t p = 0; p < products.size(); ++p) {
+      // The model at N from the bracketing levels (the exponent per product as solved above).
+      size_t i1 = 1;
+      while (i1 + 1 < L && xs[i1] < N) ++i1;
+      const size_t i0 = i1 - 1;
+      double a = 0;
+      solve_power_law(xs[i0], errors[i0][p], xs[i1], errors[i1][p], goal, 0.5, 3.0, a);
+      const double e = errors[i1][p] * std::pow(xs[i1] / double(N), a);
+      worst = std::max(worst, e);
+    }
+    pr.predicted_error = worst;
+    double alpha = 0, beta = 0;
+    fit_line(xs, ts, alpha, beta);
+    pr.predicted_us_per_point = alpha + beta * N;
+    choice.predictions.push_back(pr);
+  }
+  if (want_qmc) {
+    std::vector<double> xs, ts;
+    std::vector<std::vector<double>> errors;
+    // QMC cannot win once a level that misses the goal already costs more per integral than the
+    // silhouette prediction (more rays cost more): the remaining levels are skipped.
+    const double rival_us = !choice.predictions.empty() && choice.predictions.front().reachable
+                                ? choice.predictions.front().predicted_us_per_point
+                                : 0.0;
+    bool pruned = false;
+    for (uint32_t R : kQmcLevels) {
+      if (!errors.empty() && rival_us > 0) {
+        const bool misses = *std::max_element(errors.back().begin(), errors.back().end()) > goal;
+        if (misses && ts.back() >= rival_us) {
+          pruned = true;
+          break;
+        }
+      }
+      double s = 0;
+      const auto integrator =
+          timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}); }, s);
+      setup_qmc = std::max(setup_qmc, s);
+      const Rows r = integrate_pilot(*integrator, points, sample, progress);
+      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref.values, W, products), r.cpu_us_per_point});
+      xs.push_back(R), ts.push_back(r.cpu_us_per_point), errors.push_back(choice.runs.back().error);
+    }
+    Prediction pr;
+    pr.kind = IntegratorKind::Qmc;
+    if (pruned) {
+      pr.pruned = true;
+      pr.knob = uint32_t(xs.back());
+      pr.predicted_error = *std::max_element(errors.back().begin(), errors.back().end());
+      pr.predicted_us_per_point = ts.back();
+      choice.predictions.push_back(pr);
+      progress.advance(sample.size() * (std::size(kQmcLevels) - xs.size()));
+    }
+  }
+  if (want_qmc && (choice.predictions.empty() || !choice.predictions.back().pruned)) {
+    std::vector<double> xs, ts;
+    std::vector<std::vector<double>> errors;
+    for (const PilotRun& r : choice.runs)
+      if (r.kind == IntegratorKind::Qmc) xs.push_back(r.knob), ts.push_back(r.cpu_us_per_point), errors.push_back(r.error);
+    Prediction pr;
+    pr.kind = IntegratorKind::Qmc;
+    double need = kMinRays, worst = 0;
+    std::vector<double> exponents(products.size());
+    // The rate from the two largest levels (the asymptotic one); below the largest level the
+    // same power law, solved from it.
+    const size_t hi = xs.size() - 1, lo = hi - 1;
+    for (size_t p = 0; p < products.size(); ++p) {
+      const double r = solve_power_law(xs[lo], errors[lo][p], xs[hi], errors[hi][p], goal, 0.5, 1.0, exponents[p]);
+      if (r > need) need = r, pr.exponent = exponents[p];
+    }
+    pr.reachable = need <= kMaxRays;
+    uint32_t R = kMinRays;
+    while (R < kMaxRays && double(R) < need) R *= 2;  // a power of two: whole Sobol blocks
+    pr.knob = R;
+    for (size_t p = 0; p < products.size(); ++p)
+      worst = std::max(worst, errors[hi][p] * std::pow(xs[hi] / double(R), exponents[p]));
+    pr.predicted_error = worst;
+    double alpha = 0, beta = 0;
+    fit_line(xs, ts, alpha, beta);
+    pr.predicted_us_per_point = alpha + beta * R;
+    choice.predictions.push_back(pr);
+  }
+  progress.finish();
+
+  // The cheaper reachable prediction, by CPU seconds for the whole bake (setup + V integrals).
+  auto cost = [&](const Prediction& p) {
+    return (p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) + V * p.predicted_us_per_point * 1e-6;
+  };
+  const Prediction* best = nullptr;
+  for (const Prediction& p : choice.predictions)
+    if (p.reachable && !p.pruned && (!best || cost(p) < cost(*best))) best = &p;
+  if (!best) {
+    double closest = 0;
+    for (const Prediction& p : choice.predictions) closest = closest == 0 ? p.predicted_error : std::min(closest, p.predicted_error);
+    throw InputError("", format("target error %g: no integrator reaches it within its sample range (the closest "
+                                "prediction is %.3g at N = 512 isolines or 2^20 rays)",
+                                options.target, closest));
+  }
+  choice.spec.kind = best->kind;
+  if (best->kind == IntegratorKind::Silhouette)
+    choice.spec.silhouette_k = best->knob * best->knob;
+  else
+    choice.spec.qmc_rays = best->knob;
+  const Prediction* other = nullptr;
+  for (const Prediction& p : choice.predictions)
+    if (&p != best && p.reachable && !p.pruned) other = &p;
+  choice.margin = other ? cost(*other) / std::max(cost(*best), 1e-12) : 0.0;
+  const std::string knob = best->kind == IntegratorKind::Silhouette
+                               ? format("N = %.0f isolines (k = %.0f)", best->knob, double(best->knob) * best->knob)
+                               : format("%.0f rays", best->knob);
+  choice.reason = std::string(to_string(best->kind)) + " at " + knob +
+                  format(": predicted error %.2g (target %g), %.1f µs per integral, %.2f CPU s for the bake", best->predicted_error,
+                         options.target, best->predicted_us_per_point, cost(*best));
+  if (other)
+    choice.reason += format("; %.2fx cheaper than ", choice.margin) + to_string(other->kind) + " at " +
+                     (other->kind == IntegratorKind::Silhouette ? format("N = %.0f", other->knob) : format("%.0f rays", other->knob));
+  else if (!options.only && choice.predictions.size() > 1 && choice.predictions.back().pruned)
+    choice.reason += format("; qmc already costs %.1f µs per integral at %.0f rays, short of the target",
+                            choice.predictions.back().predicted_us_per_point, choice.predictions.back().knob);
+  else if (!options.only)
+    choice.reason += "; the other integrator cannot reach the target within its sample range";
+  choice.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return choice;
+}
+
+} // namespace prt::bake
