@@ -122,6 +122,10 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0, double
   return buf;
 }
 
+std::string knob_text(IntegratorKind kind, uint32_t knob) {
+  return kind == IntegratorKind::Qmc ? std::to_string(knob) + " rays" : "N = " + std::to_string(knob);
+}
+
 } // namespace
 
 std::vector<Product> requested_products(const ProductRequest& request) {
@@ -334,6 +338,59 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     choice.reason += "; the other integrator cannot reach the target within its sample range";
   choice.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return choice;
+}
+
+std::vector<std::string> choice_lines(const IntegratorChoice& c) {
+  std::vector<std::string> out;
+  out.push_back("target error " + format("%g", c.target) + ": pilot on " + std::to_string(c.pilot_points) +
+                " seeded points took " + format("%.2f s", c.pilot_seconds) + "; error per product against a " +
+                std::to_string(c.runs.empty() ? 0u : c.runs.front().knob) + "-isoline silhouette reference:");
+  char buf[512];
+  std::string head;
+  std::snprintf(buf, sizeof buf, "  %-10s %10s %12s", "integrator", "knob", "µs/integral");
+  head = buf;
+  for (Product p : c.products) {
+    std::snprintf(buf, sizeof buf, " %20s", product_label(p));
+    head += buf;
+  }
+  out.push_back(head);
+  for (size_t i = 1; i < c.runs.size(); ++i) {
+    const PilotRun& r = c.runs[i];
+    std::snprintf(buf, sizeof buf, "  %-10s %10s %12.1f", to_string(r.kind), knob_text(r.kind, r.knob).c_str(),
+                  r.cpu_us_per_point);
+    std::string line = buf;
+    for (double e : r.error) {
+      std::snprintf(buf, sizeof buf, " %20.3e", e);
+      line += buf;
+    }
+    out.push_back(line);
+  }
+  for (const Prediction& p : c.predictions) {
+    if (p.pruned)
+      std::snprintf(buf, sizeof buf, "  model: %-10s not competitive: at %s it misses the target and already costs more",
+                    to_string(p.kind), knob_text(p.kind, p.knob).c_str());
+    else
+      std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral%s", to_string(p.kind),
+                    knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point,
+                    p.reachable ? "" : " (cannot reach the target in range)");
+    out.push_back(buf);
+  }
+  out.push_back("chosen: " + c.reason);
+  if (c.margin > 0 && c.margin < 1.25)
+    out.push_back(std::string("  (a close call: another run may time it the other way; pin it with integrator ") +
+                  to_string(c.spec.kind) + ", samples " + std::to_string(c.spec.samples()) + " for the same bytes everywhere)");
+  return out;
+}
+
+std::vector<std::string> target_check_lines(const ErrorReport& report, double target) {
+  std::vector<std::string> out;
+  for (const ProductError& e : report.products) {
+    const double err = error_in_target_units(e);
+    out.push_back(format("  target %g for ", target) + product_label(e.product) + ": " + (err <= target ? "met" : "NOT met") +
+                  format(" (%.3e", err) + (e.product == Product::RadianceBand1 ? " relative" : "") +
+                  format("; the reference's own noise, included, is %.1e)", e.reference_std_error));
+  }
+  return out;
 }
 
 } // namespace prt::bake

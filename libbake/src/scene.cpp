@@ -284,7 +284,7 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
   if (const Json* env = find_key(root, "environment")) sc.environment = resolve_beside(file, r.string(*env, "environment"));
   if (const Json* bake = find_key(root, "bake")) {
     r.object(*bake, "bake",
-             {"products", "integrator", "samples", "seed", "report", "sh_tolerance", "relight", "fiv"});
+             {"products", "integrator", "samples", "seed", "report", "target_error", "sh_tolerance", "relight", "fiv"});
     if (const Json* p = find_key(*bake, "products")) {
       if (!p->is_array()) r.fail("bake.products must be an array of strings");
       sc.want_ao = sc.want_transfer = sc.want_radiance = sc.want_fiv = false;
@@ -302,12 +302,19 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
       const auto kind = parse_integrator_kind(name);
       if (!kind) r.fail("bake.integrator must be \"silhouette\" or \"qmc\", not \"" + name + "\"");
       sc.integrator.kind = *kind;
+      sc.integrator_given = true;
     }
     // The knob of the chosen integrator: k for silhouette, rays for qmc.
     if (const Json* x = find_key(*bake, "samples")) sc.integrator.set_samples(uint32_t(r.integer(*x, "bake.samples", 4, 1 << 24)));
     if (const Json* x = find_key(*bake, "seed")) sc.integrator.seed = uint64_t(r.integer(*x, "bake.seed", 0, int64_t(1) << 52));
     if (const Json* x = find_key(*bake, "report"))
       sc.integrator.report_points = uint32_t(r.integer(*x, "bake.report", 0, 1 << 20));
+    if (const Json* x = find_key(*bake, "target_error")) {
+      sc.target_error = r.number(*x, "bake.target_error", ChooserOptions::kMinTarget, ChooserOptions::kMaxTarget);
+      if (find_key(*bake, "samples"))
+        r.fail("bake.target_error and bake.samples both given: the target chooses the samples (give one)");
+      if (!find_key(*bake, "report")) sc.integrator.report_points = ChooserOptions::kReportPoints;
+    }
     if (const Json* x = find_key(*bake, "sh_tolerance")) {
       sc.sh_tolerance = r.number(*x, "bake.sh_tolerance", 0, 1);
       if (!(sc.sh_tolerance > 0)) r.fail("bake.sh_tolerance must be > 0");

@@ -58,7 +58,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     r.radiance = p.radiance ? env : nullptr;
     return r;
   };
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
+  const bool choose = scene.target_error > 0;  // then one integrator per object, made below
+  for (size_t i = 0; i < scene.objects.size() && !choose; ++i) {
     const ObjectPlan& p = plan.objects[i];
     if (!p.receiver || !p.any_vertex_product()) continue;
     const ProductRequest r = request_of(p);
@@ -77,7 +78,6 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (!p.receiver || !p.any_vertex_product()) continue;
     const Mesh& m = meshes[i];
     const ProductRequest r = request_of(p);
-    const auto& [integ, ref] = integrators.at(Key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr});
     std::vector<ShadePoint> points(m.positions.size());
     for (size_t v = 0; v < points.size(); ++v) {
       if (p.occluder) {
@@ -87,24 +87,47 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         points[v].n = m.normals[v].cast<double>().normalized();
       }
     }
-    const bool silhouette = integ->kind() == IntegratorKind::Silhouette;
-    const uint64_t closed_before = integ->stats().closed_form;
     ObjectBake& ob = out.objects[i];
-    ob.values = bake_points(points, *integ, monitor, "baking " + scene.objects[i].name);
-    ob.integrator_description = integ->description();
-    ob.closed_form_vertices = integ->stats().closed_form - closed_before;
+    ob.integrator = scene.integrator;
+    std::unique_ptr<Integrator> own_integ, own_ref;  // with a target: this object's
+    if (choose) {
+      ChooserOptions copt;
+      copt.target = scene.target_error;
+      if (scene.integrator_given) copt.only = scene.integrator.kind;
+      ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor);
+      ob.integrator = ob.choice->spec;
+      for (const std::string& line : choice_lines(*ob.choice)) log(scene.objects[i].name + ": " + line);
+      own_integ = make_integrator(ob.integrator, occluders, topo, r);
+      if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r);
+    }
+    const Integrator* integ = own_integ.get();
+    const Integrator* ref = own_ref.get();
+    if (!choose) {
+      const auto& shared = integrators.at(Key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr});
+      integ = shared.first.get();
+      ref = shared.second.get();
+    }
+    PRT_CHECK(integ != nullptr);
+    const Integrator& integrator = *integ;
+    const bool silhouette = integrator.kind() == IntegratorKind::Silhouette;
+    const uint64_t closed_before = integrator.stats().closed_form;
+    ob.values = bake_points(points, integrator, monitor, "baking " + scene.objects[i].name);
+    ob.integrator_description = integrator.description();
+    ob.closed_form_vertices = integrator.stats().closed_form - closed_before;
     out.vertex_seconds += ob.values->seconds;
     out.vertices += points.size();
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
         printf_string("%.2f s", ob.values->seconds) +
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref) {
-      ob.report = compare_points_with_reference(points, *ob.values, *ref, scene.integrator.report_points,
-                                                scene.integrator.seed, monitor);
+      ob.report = compare_points_with_reference(points, *ob.values, *ref, ob.integrator.report_points,
+                                                ob.integrator.seed, monitor);
       for (const auto& e : ob.report->products)
         log("  " + std::string(product_label(e.product)) + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
             printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
                 ob.report->reference_seconds));
+      if (choose)
+        for (const std::string& line : target_check_lines(*ob.report, scene.target_error)) log(line);
     }
   }
 

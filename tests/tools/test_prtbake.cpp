@@ -145,6 +145,20 @@ TEST(Prtbake, SameSeedGivesIdenticalBytesWhateverTheThreadCount) {
   EXPECT_FALSE(bake("--seed 6 --threads 2") == x);
 }
 
+TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
+  // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: the
+  // pilot table, the choice and the report's verdict on 128 vertices, and the file names the
+  // integrator and samples that baked it.
+  const fs::path out = scratch("target.prt.h5");
+  const Outcome r =
+      run("vertex " + (kData / "bunny.obj").string() + " --ao --target-error 2e-3 --integrator silhouette -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"target error 0.002: pilot on 128 seeded points", "model: silhouette", "chosen: silhouette at N = ",
+                        "on 128 seeded vertices", "target 0.002 for AO: met"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
+  EXPECT_EQ(r.out.find("model: qmc"), std::string::npos) << "--integrator keeps the kind:\n" << r.out;
+}
+
 TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
   const fs::path out = scratch("talk.prt.h5");
   const Outcome r = run("vertex " + (kData / "bunny.obj").string() + " --ao --samples 32 --report 8 -o " + out.string());
@@ -221,6 +235,8 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
   EXPECT_EQ(run("vertex x.obj --ao -o y --transfer 0").code, 2);
   EXPECT_EQ(run("vertex x.obj --ao -o y --samples lots").code, 2);
   EXPECT_EQ(run("vertex x.obj --ao -o y --frobnicate").code, 2);
+  EXPECT_EQ(run("vertex x.obj --ao -o y.prt.h5 --target-error 1e-3 --samples 64").code, 2) << "target and samples";
+  EXPECT_EQ(run("vertex x.obj --ao -o y.prt.h5 --target-error 1e-6").code, 2) << "target below 1e-4";
   const Outcome h = run("--help");
   EXPECT_EQ(h.code, 0);
   for (const char* s : {"--ao", "--transfer", "--visibility", "--radiance", "--samples", "--seed", "--threads", "--up",

@@ -13,7 +13,6 @@
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
-#include "choice_text.h"
 #include "progress_bar.h"
 #include "tool_main.h"
 
@@ -310,9 +309,6 @@ void add_scene(CLI::App& app, Args& a) {
   add_run_options(cmd, a);
 }
 
-// The error report's vertices when --target-error is given and --report is not.
-constexpr uint32_t kTargetReportPoints = 128;
-
 // Parses the command line; nullopt when it asked for help or the version (printed).
 std::optional<Args> parse(int argc, char** argv) {
   Args a;
@@ -352,7 +348,7 @@ std::optional<Args> parse(int argc, char** argv) {
       throw UsageError("vertex: --target-error and --samples both given: the target chooses the samples (give one)");
     // Checking a target needs more vertices than the default report's 32 (RMSE over a sample).
     if (a.target_error > 0 && app.get_subcommand("vertex")->count("--report") == 0)
-      a.integrator.report_points = kTargetReportPoints;
+      a.integrator.report_points = bake::ChooserOptions::kReportPoints;
   }
   if (samples != 0) a.integrator.set_samples(samples);
   if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
@@ -534,7 +530,8 @@ int run_vertex(const Args& a) {
     const bake::IntegratorChoice choice =
         bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req, a.integrator, copt, progress);
     spec = choice.spec;
-    if (say) tool::print_choice(choice);
+    if (say)
+      for (const std::string& line : bake::choice_lines(choice)) std::printf("%s\n", line.c_str());
   }
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =
@@ -585,7 +582,8 @@ int run_vertex(const Args& a) {
                     "reference's own %.3e)\n",
                     bake::product_label(e.product), e.rmse, e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0,
                     e.bake_std_error, e.reference_std_error);
-      if (a.target_error > 0) tool::print_target_check(*report, a.target_error);
+      if (a.target_error > 0)
+        for (const std::string& line : bake::target_check_lines(*report, a.target_error)) std::printf("%s\n", line.c_str());
     }
   }
 
@@ -747,8 +745,8 @@ int run_scene(const Args& a) {
     tool::set_mesh(obj.set, meshes[i]);
     if (ob.values) {
       tool::set_products(obj.set, *ob.values,
-                         {std::string(bake::to_string(scene.integrator.kind)), ob.integrator_description,
-                          scene.integrator.samples(), scene.integrator.seed,
+                         {std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
+                          ob.integrator.samples(), ob.integrator.seed,
                           p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
       if (ob.report)
         obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);

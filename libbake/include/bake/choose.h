@@ -56,6 +56,9 @@ namespace prt::bake {
 struct ChooserOptions {
   static constexpr double kMinTarget = 1e-4;  // below: the pilot reference is not exact enough
   static constexpr double kMaxTarget = 0.1;
+  // The error report's points when a target is given and the report size is not: an RMSE over
+  // the default 32 is too rough to check a target with.
+  static constexpr uint32_t kReportPoints = 128;
   double target = 1e-3;                       // E, see the file comment
   std::optional<IntegratorKind> only;         // choose only this kind's knob
   uint32_t pilot_points = 128;                // seeded shade points (all of them if fewer)
@@ -105,6 +108,14 @@ struct IntegratorChoice {
 IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                    const ProductRequest& request, const IntegratorSpec& base,
                                    const ChooserOptions& options, const Monitor& monitor = {});
+
+// What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
+// and the choice, one line each, then a hint when the call was close (margin < 1.25).
+std::vector<std::string> choice_lines(const IntegratorChoice& choice);
+
+// After the bake, one line per product: its error in the target's units against the target,
+// "met" or "NOT met", and the reference's own noise (which the measured RMSE includes).
+std::vector<std::string> target_check_lines(const ErrorReport& report, double target);
 
 // The products a request bakes, in row order (AO, diffuse transfer, visibility transfer, band-1).
 std::vector<Product> requested_products(const ProductRequest& request);

@@ -11,6 +11,10 @@
 //     "bake": {                                  optional, every member too:
 //       "products": ["ao", "transfer", "radiance", "fiv"],   what may be baked (default: all four)
 //       "integrator": "silhouette" | "qmc",  "samples": k or rays,  "seed": 1,  "report": 32,
+//       "target_error": 1e-3,                  instead of "samples": per receiver object, the
+//                                              integrator (only its samples when "integrator" is
+//                                              given) chosen to reach this RMSE (bake/choose.h);
+//                                              "report" then defaults to 128
 //       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
 //       "relight": false,                      diffuse receivers also get transfer vectors
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/fiv.h ShellSpec)
@@ -71,6 +75,7 @@
 //   * vertices that see no contour edge get closed forms (bake/silhouette.h, bake/zonal.h).
 #pragma once
 
+#include <bake/choose.h>
 #include <bake/envmap.h>
 #include <bake/fiv.h>
 #include <bake/mesh.h>
@@ -121,6 +126,8 @@ struct SceneDescription {
   bool want_ao = true, want_transfer = true, want_radiance = true, want_fiv = true;
   // "integrator", "samples" (the chosen integrator's knob), "seed" and "report".
   IntegratorSpec integrator;
+  bool integrator_given = false;  // "integrator" was in the file
+  double target_error = 0;        // "target_error" (0: not given; bake/choose.h)
   double sh_tolerance = 0.01;
   bool relight = false;
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
@@ -182,6 +189,8 @@ struct ObjectBake {
   // Receivers: one row per vertex of the object's world mesh, in its layout.
   std::optional<VertexBake> values;
   std::optional<ErrorReport> report;
+  IntegratorSpec integrator;           // what baked the values: the scene's, or the target's choice
+  std::optional<IntegratorChoice> choice;  // with a target error
   std::string integrator_description;
   uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
   // Occluders with shells (in world space: centre and radii in scene units).
