@@ -153,8 +153,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   choice.spec = base;
   const std::vector<ProductSlice> products = slices(ProductLayout(request));
   for (const ProductSlice& p : products) choice.products.push_back(p.product);
-  const std::vector<uint32_t> sample =
-      seeded_sample(uint32_t(points.size()), options.pilot_points, mix64(base.seed ^ kPilotSalt));
+  // A sixteenth of the points, at least 32 and at most pilot_points: on small objects the pilot
+  // must not cost more than the bake it tunes.
+  const size_t pilot = std::clamp<size_t>(points.size() / 16, 32, std::max<size_t>(options.pilot_points, 32));
+  const std::vector<uint32_t> sample = seeded_sample(uint32_t(points.size()), pilot, mix64(base.seed ^ kPilotSalt));
   choice.pilot_points = sample.size();
   const size_t W = ProductLayout(request).width;
   const double goal = options.safety * options.target;

@@ -147,13 +147,12 @@ TEST(Prtbake, SameSeedGivesIdenticalBytesWhateverTheThreadCount) {
 
 TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: the
-  // pilot table, the choice and the report's verdict on 128 vertices, and the file names the
-  // integrator and samples that baked it.
+  // pilot table (on 1839 / 16 = 114 vertices), the choice and the report's verdict on 128.
   const fs::path out = scratch("target.prt.h5");
   const Outcome r =
       run("vertex " + (kData / "bunny.obj").string() + " --ao --target-error 2e-3 --integrator silhouette -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* s : {"target error 0.002: pilot on 128 seeded points", "model: silhouette", "chosen: silhouette at N = ",
+  for (const char* s : {"target error 0.002: pilot on 114 seeded points", "model: silhouette", "chosen: silhouette at N = ",
                         "on 128 seeded vertices", "target 0.002 for AO: met"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
   EXPECT_EQ(r.out.find("model: qmc"), std::string::npos) << "--integrator keeps the kind:\n" << r.out;

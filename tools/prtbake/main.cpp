@@ -233,7 +233,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
   cmd.add_option("--target-error", a.target_error,
                  "choose the integrator and its samples for you: the cheapest bake\n"
                  "whose RMSE is at most E per product (AO, transfer: absolute; band-1\n"
-                 "radiance: relative to its RMS), from a pilot on 128 seeded vertices\n"
+                 "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
                  "(both integrators timed and their errors measured against a\n"
                  "512-isoline silhouette reference). E in [1e-4, 0.1], e.g. 1e-3.\n"
                  "With --integrator, only its samples are chosen; not with --samples.\n"

@@ -11,7 +11,8 @@
 //     environment's, which E cannot know).
 // Every requested product must meet E.
 //
-// The pilot (choose_integrator), on a seeded sample of the bake's shade points:
+// The pilot (choose_integrator), on a seeded sample of the bake's shade points (a sixteenth of
+// them, 32 to 128):
 //  1. reference: the silhouette integrator at N_ref = 512 u-isolines (k = 2^18), exact up to its
 //     isoline discretisation, which falls as ~N^-1.5..-2 (bench/RESULTS.md, error against time):
 //     ~3e-5 AO RMSE on the bunny at N = 512, a tenth of the smallest E the chooser accepts
@@ -61,7 +62,9 @@ struct ChooserOptions {
   static constexpr uint32_t kReportPoints = 128;
   double target = 1e-3;                       // E, see the file comment
   std::optional<IntegratorKind> only;         // choose only this kind's knob
-  uint32_t pilot_points = 128;                // seeded shade points (all of them if fewer)
+  // Seeded shade points of the pilot: a sixteenth of the bake's, at least 32 (all of them if
+  // fewer) and at most this.
+  uint32_t pilot_points = 128;
   // Aim at safety·E: the pilot's RMSE is itself an estimate from a sample (a few heavy-tailed
   // vertices dominate it; ~15-20% spread between seeded samples of 128 on the bunny).
   double safety = 0.7;
