@@ -31,6 +31,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <vector>
 
@@ -474,7 +475,10 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   prt::formats::write_asset(a.output, asset);
   if (!a.quiet) {
     std::error_code ec;
-    std::printf("wrote %s (%s)\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str());
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);  // ru_maxrss: the peak resident set, in KiB on Linux
+    std::printf("wrote %s (%s); peak memory %s\n", a.output.c_str(), human_bytes(fs::file_size(a.output, ec)).c_str(),
+                human_bytes(uintmax_t(usage.ru_maxrss) * 1024).c_str());
   }
 }
 
