@@ -232,14 +232,17 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          "baseline and the reference.")
       ->option_text("NAME");
   cmd.add_option("--target-error", a.target_error,
-                 "choose the integrator and its samples for you: the cheapest bake\n"
+                 "the default (E = 1e-3) unless --samples is given: choose the\n"
+                 "integrator and its samples for you: the cheapest bake\n"
                  "whose RMSE is at most E per product (AO, transfer: absolute; band-1\n"
                  "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
                  "(both integrators timed and their errors measured against a\n"
                  "512-isoline silhouette reference). E in [1e-4, 0.1], e.g. 1e-3.\n"
                  "With --integrator, only its samples are chosen; not with --samples.\n"
-                 "The choice is printed; the error report (on 128 vertices unless\n"
-                 "--report says otherwise) then checks E.")
+                 "The choice is printed; the error report (on 128 vertices when\n"
+                 "--target-error is given, unless --report says otherwise) then\n"
+                 "checks E. Which integrator wins is measured speed: pin the printed\n"
+                 "choice with --integrator and --samples for the same bytes anywhere.")
       ->option_text("E")
       ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
@@ -350,6 +353,9 @@ std::optional<Args> parse(int argc, char** argv) {
     // Checking a target needs more vertices than the default report's 32 (RMSE over a sample).
     if (a.target_error > 0 && app.get_subcommand("vertex")->count("--report") == 0)
       a.integrator.report_points = bake::ChooserOptions::kReportPoints;
+    // Neither samples nor a target: the default target (its report keeps the default 32 points:
+    // checking it on 128 costs a small mesh several times its bake).
+    if (a.target_error == 0 && samples == 0) a.target_error = bake::ChooserOptions{}.target;
   }
   if (samples != 0) a.integrator.set_samples(samples);
   if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
