@@ -225,16 +225,17 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
              throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc)");
            a.integrator.kind = *kind;
          },
-         "silhouette (default): semi-analytic visibility silhouettes (paper 001\n"
-         "§3): contour edges, depth complexity along octahedral u-isolines,\n"
-         "summed-area tables. Deterministic; error falls with k, no noise.\n"
+         "silhouette (the default with --samples): semi-analytic visibility\n"
+         "silhouettes (paper 001 §3): contour edges, depth complexity along\n"
+         "octahedral u-isolines, summed-area tables. Deterministic; error\n"
+         "falls with k, no noise.\n"
          "qmc: Embree ray casting, importance-sampled randomised Halton QMC, the\n"
          "baseline and the reference.")
       ->option_text("NAME");
   cmd.add_option("--target-error", a.target_error,
-                 "the default (E = 1e-3) unless --samples is given: choose the\n"
-                 "integrator and its samples for you: the cheapest bake\n"
-                 "whose RMSE is at most E per product (AO, transfer: absolute; band-1\n"
+                 "the default (E = 1e-3) unless --samples is given: the integrator\n"
+                 "and its samples chosen for you, the cheapest bake whose RMSE is\n"
+                 "at most E per product (AO, transfer: absolute; band-1\n"
                  "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
                  "(both integrators timed and their errors measured against a\n"
                  "512-isoline silhouette reference). E in [1e-4, 0.1], e.g. 1e-3.\n"
