@@ -19,9 +19,12 @@
 namespace prt::bake {
 namespace {
 
-constexpr int kReferenceIsolines = 512;
+// The pilot's reference: 256 isolines for targets >= 5e-4 (its own AO error, ~6e-5 on the bunny,
+// is under a tenth of the aim 0.7·E; its isoline tables take 8 ms to build against 190 ms at 512,
+// bench/RESULTS.md bench_integrators), 512 below.
+int reference_isolines(double target) { return target >= 5e-4 ? 256 : 512; }
 constexpr int kSilhouetteLevels[] = {16, 32, 64, 128};
-constexpr int kMinIsolines = 8, kMaxIsolines = kReferenceIsolines;
+constexpr int kMinIsolines = 8;
 constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
 constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
 constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
@@ -186,9 +189,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{isolines, base.seed});
   };
   double setup_sil = 0, setup_qmc = 0;
-  const auto reference = timed_build([&] { return silhouette(kReferenceIsolines); }, setup_sil);
+  const int ref_isolines = reference_isolines(options.target), max_isolines = ref_isolines;
+  const auto reference = timed_build([&] { return silhouette(ref_isolines); }, setup_sil);
   const Rows ref = integrate_pilot(*reference, points, sample, progress);
-  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(kReferenceIsolines),
+  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(ref_isolines),
                          std::vector<double>(products.size(), 0.0), ref.cpu_us_per_point});
 
   const double V = double(points.size());
@@ -204,7 +208,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                              r.cpu_us_per_point});
       xs.push_back(N), ts.push_back(r.cpu_us_per_point), errors.push_back(choice.runs.back().error);
     }
-    xs.push_back(kReferenceIsolines), ts.push_back(ref.cpu_us_per_point);
+    xs.push_back(ref_isolines), ts.push_back(ref.cpu_us_per_point);
     Prediction pr;
     pr.kind = IntegratorKind::Silhouette;
     double need = kMinIsolines;
@@ -224,8 +228,8 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       if (hit == 0 && errors[0][p] <= goal) n = std::min(n, xs[0]);
       if (n > need) need = n, pr.exponent = a;
     }
-    pr.reachable = need <= kMaxIsolines;
-    int N = int(std::ceil(std::min<double>(need, kMaxIsolines) - 1e-9));
+    pr.reachable = need <= max_isolines;
+    int N = int(std::ceil(std::min<double>(need, max_isolines) - 1e-9));
     N = std::max(kMinIsolines, N + (N & 1));  // even, as the integrator uses it
     pr.knob = uint32_t(N);
     double worst = 0;
@@ -322,7 +326,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     double closest = 0;
     for (const Prediction& p : choice.predictions) closest = closest == 0 ? p.predicted_error : std::min(closest, p.predicted_error);
     throw InputError("", format("target error %g: no integrator reaches it within its sample range (the closest "
-                                "prediction is %.3g at N = 512 isolines or 2^20 rays)",
+                                "prediction is %.3g at N = 256/512 isolines or 2^20 rays)",
                                 options.target, closest));
   }
   choice.spec.kind = best->kind;

@@ -63,8 +63,8 @@ std::vector<double> errors_on(const Asset& a, const ProductRequest& r, const Int
 TEST(Choose, TheChosenBakeMeetsTheTargetOnPointsThePilotNeverSaw) {
   // The target is the tolerance: the chooser promises RMSE <= E per product. Checked on 96 seeded
   // vertices drawn apart from the pilot's (another seed; an overlap of a few is harmless) against
-  // the same 512-isoline reference, whose own error (~3e-5 AO on this asset, bench/RESULTS.md) is
-  // a thirtieth of E.
+  // a 512-isoline reference (finer than the pilot's 256), whose own error (~3e-5 AO on this asset,
+  // bench/RESULTS.md) is a thirtieth of E.
   const Asset& a = bunny_ground();
   ProductRequest r;
   r.ao = true;

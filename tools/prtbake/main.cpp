@@ -238,7 +238,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "at most E per product (AO, transfer: absolute; band-1\n"
                  "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
                  "(both integrators timed and their errors measured against a\n"
-                 "512-isoline silhouette reference). E in [1e-4, 0.1], e.g. 1e-3.\n"
+                 "256- or 512-isoline silhouette reference). E in [1e-4, 0.1].\n"
                  "With --integrator, only its samples are chosen; not with --samples.\n"
                  "The choice is printed; the error report (on 128 vertices when\n"
                  "--target-error is given, unless --report says otherwise) then\n"

@@ -13,10 +13,11 @@
 //
 // The pilot (choose_integrator), on a seeded sample of the bake's shade points (a sixteenth of
 // them, 32 to 128):
-//  1. reference: the silhouette integrator at N_ref = 512 u-isolines (k = 2^18), exact up to its
-//     isoline discretisation, which falls as ~N^-1.5..-2 (bench/RESULTS.md, error against time):
-//     ~3e-5 AO RMSE on the bunny at N = 512, a tenth of the smallest E the chooser accepts
-//     (kMinTarget = 1e-4 ... the error report, against QMC, verifies the bake);
+//  1. reference: the silhouette integrator at N_ref = 256 u-isolines for E >= 5e-4, else 512,
+//     exact up to its isoline discretisation, which falls as ~N^-1.5..-2 (bench/RESULTS.md,
+//     error against time): ~6e-5 AO RMSE on the bunny at 256, ~3e-5 at 512, a tenth or less of
+//     the aim (the error report, against QMC, verifies the bake); the silhouette knob is capped
+//     at N_ref;
 //  2. silhouette at N = 16, 32, 64, 128: the RMSE against the reference per product; the model
 //     RMSE(N) = C N^-a is fitted (least squares in log-log over the levels whose error is above
 //     the reference's own error scale) and solved for the smallest even N with RMSE <= 0.7·E
