@@ -155,6 +155,13 @@ TEST(Choose, SceneFilesTakeATargetInsteadOfSamples) {
   EXPECT_TRUE(q.integrator_given);
   EXPECT_EQ(q.integrator.kind, IntegratorKind::Qmc);
   EXPECT_EQ(q.integrator.report_points, 8u);
+  // Neither samples nor a target: the default target, the default report.
+  const SceneDescription d = load_scene(write("default.json", R"({"integrator": "qmc"})"), std::nullopt);
+  EXPECT_EQ(d.target_error, ChooserOptions{}.target);
+  EXPECT_EQ(d.integrator.report_points, IntegratorSpec{}.report_points);
+  const SceneDescription k = load_scene(write("samples.json", R"({"samples": 4096})"), std::nullopt);
+  EXPECT_EQ(k.target_error, 0.0);
+  EXPECT_EQ(k.integrator.silhouette_k, 4096u);
   for (const char* bad : {R"({"target_error": 0.002, "samples": 1024})", R"({"target_error": 1e-6})",
                           R"({"target_error": "small"})"}) {
     try {

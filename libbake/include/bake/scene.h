@@ -14,7 +14,8 @@
 //       "target_error": 1e-3,                  instead of "samples": per receiver object, the
 //                                              integrator (only its samples when "integrator" is
 //                                              given) chosen to reach this RMSE (bake/choose.h);
-//                                              "report" then defaults to 128
+//                                              "report" then defaults to 128. Without "samples"
+//                                              and "target_error": target 1e-3, report 32
 //       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
 //       "relight": false,                      diffuse receivers also get transfer vectors
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/fiv.h ShellSpec)
