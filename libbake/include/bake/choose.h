@@ -121,7 +121,8 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 std::vector<std::string> choice_lines(const IntegratorChoice& choice);
 
 // After the bake, one line per product: its error in the target's units against the target,
-// "met" or "NOT met", and the reference's own noise (which the measured RMSE includes).
+// "met", "NOT met", or "not verifiable here" when it is above E but the reference's own estimated
+// noise (which the measured RMSE includes, in the same units) is at least E/2.
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target);
 
 // The products a request bakes, in row order (AO, diffuse transfer, visibility transfer, band-1).
