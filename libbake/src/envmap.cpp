@@ -29,6 +29,7 @@
 #include <limits>
 #include <new>
 #include <sstream>
+#include <vector>
 #include <string_view>
 
 namespace prt::bake {
@@ -66,6 +67,49 @@ double max_compression_ratio(Imf::Compression c) {
 // value, ended by an empty name; a multi-part file's header list ends with an empty header).
 // OpenEXR allocates an attribute's claimed size before it reads it, so a 1 KB file claiming a
 // 1.7 GB attribute cost 1.7 GB and seconds; here every size must fit in the bytes that follow.
+// Then the image's size and (single-part scanline images) its chunk table, below.
+// The byte size of OpenEXR's fixed-size attribute types (its standard attribute types), -1 for
+// the others (string, chlist, preview, stringvector and unknown types).
+int fixed_size_of(const std::string& type) {
+  static const std::pair<const char*, int> kSizes[] = {
+      {"box2i", 16},       {"box2f", 16},    {"v2i", 8},      {"v2f", 8},       {"v2d", 16},       {"v3i", 12},
+      {"v3f", 12},         {"v3d", 24},      {"int", 4},      {"float", 4},     {"double", 8},     {"compression", 1},
+      {"lineOrder", 1},    {"envmap", 1},    {"tiledesc", 9}, {"m33f", 36},     {"m44f", 64},      {"m33d", 72},
+      {"m44d", 128},       {"rational", 8},  {"timecode", 8}, {"keycode", 28},  {"chromaticities", 32},
+      {"deepImageState", 1}};
+  for (const auto& [name, bytes] : kSizes)
+    if (type == name) return bytes;
+  return -1;
+}
+
+// Whether a chlist, preview or stringvector value parses to exactly its n bytes (b[n] is a 0
+// sentinel). chlist: entries name\0 (1 to max_name bytes) + 16 bytes (pixel type, pLinear,
+// reserved, x/y sampling), ended by an empty name; preview: uint32 width, height, then
+// width × height RGBA bytes; stringvector: int32 length + bytes, repeated.
+bool typed_value_fits(const std::string& type, const unsigned char* b, size_t n, size_t max_name) {
+  auto u32 = [&](size_t i) { return uint64_t(b[i]) | uint64_t(b[i + 1]) << 8 | uint64_t(b[i + 2]) << 16 | uint64_t(b[i + 3]) << 24; };
+  if (type == "preview") return n >= 8 && u32(0) * u32(4) * 4 == n - 8;
+  size_t i = 0;
+  if (type == "stringvector") {
+    while (i < n) {
+      if (n - i < 4) return false;
+      const uint64_t len = u32(i);
+      i += 4;
+      if (len > n - i) return false;
+      i += size_t(len);
+    }
+    return true;
+  }
+  for (;;) {  // chlist
+    size_t len = 0;
+    while (i + len < n && b[i + len] != 0) ++len;
+    if (i + len >= n) return false;  // no terminating NUL inside the value
+    if (len == 0) return i + 1 == n;
+    if (len > max_name || n - (i + len + 1) < 16) return false;
+    i += len + 1 + 16;
+  }
+}
+
 void check_exr_header(const std::filesystem::path& path, const std::string& file) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
@@ -96,21 +140,95 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
       w.push_back(c);
     }
   };
+  auto int32_at = [](const unsigned char* b) {
+    return static_cast<int32_t>(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
+  };
+  // What the first header says about the pixels' layout (the chunk check below).
+  bool tiled = false, have_window = false;
+  int compression = -1;
+  int32_t window[4] = {0, 0, 0, 0};  // xMin, yMin, xMax, yMax
   for (int header = 0;; ++header) {
     int attributes = 0;
     for (std::string name = word("name"); !name.empty(); name = word("name"), ++attributes) {
-      word("type");
+      const std::string type = word("type");
       unsigned char n[4];
       bytes(n, 4);
-      const int32_t value_size = static_cast<int32_t>(uint32_t(n[0]) | uint32_t(n[1]) << 8 | uint32_t(n[2]) << 16 |
-                                                      uint32_t(n[3]) << 24);
+      const int32_t value_size = int32_at(n);
       if (value_size < 0 || uint64_t(value_size) > size - at)
         throw InputError(file, "damaged OpenEXR header: attribute '" + name + "' claims " + std::to_string(value_size) +
                                    " bytes, the file has " + std::to_string(size - at) + " left");
-      at += uint64_t(value_size);
-      in.seekg(static_cast<std::streamoff>(at));
+      // OpenEXR reads a known fixed-size type's own size whatever the declared one says; a
+      // mismatch would put its reading out of step with ours (as for the parsed types below).
+      const int fixed = fixed_size_of(type);
+      if (fixed >= 0 && value_size != fixed)
+        throw InputError(file, "damaged OpenEXR header: attribute '" + name + "' of type " + type + " claims " +
+                                   std::to_string(value_size) + " bytes, not " + std::to_string(fixed));
+      if (header == 0 && name == "dataWindow" && type == "box2i") {
+        unsigned char v[16];
+        bytes(v, 16);
+        for (int k = 0; k < 4; ++k) window[k] = int32_at(v + 4 * k);
+        have_window = true;
+      } else if (header == 0 && name == "compression" && type == "compression") {
+        unsigned char c = 0;
+        bytes(&c, 1);
+        compression = c;
+      } else if (type == "chlist" || type == "preview" || type == "stringvector") {
+        // Values OpenEXR parses by their own contents, not by the declared size: a channel list
+        // until an empty name, a preview's width × height × 4 bytes, a string vector's lengths.
+        // Unless they fill the declared size exactly, OpenEXR's reading leaves ours and takes a
+        // later garbage word for an attribute size (a 168-byte file claimed 1.7 GB that way).
+        std::vector<unsigned char> v(size_t(value_size) + 1, 0);
+        bytes(v.data(), size_t(value_size));
+        if (!typed_value_fits(type, v.data(), size_t(value_size), max_name))
+          throw InputError(file, "damaged OpenEXR header: attribute '" + name + "' (" + type + ") does not fill its " +
+                                     std::to_string(value_size) + " bytes");
+      } else {
+        tiled |= header == 0 && name == "tiles";
+        at += uint64_t(value_size);
+        in.seekg(static_cast<std::streamoff>(at));
+      }
     }
-    if (!multipart || attributes == 0) return;
+    if (!multipart || attributes == 0) break;
+  }
+  // The image's size, before OpenEXR sizes its line buffers by it.
+  if (have_window) {
+    const int64_t w = int64_t(window[2]) - window[0] + 1, h = int64_t(window[3]) - window[1] + 1;
+    if (w < 1 || h < 1 || w * h > kMaxPixels) {
+      std::ostringstream os;
+      os << "unsupported image size " << w << "x" << h << " (at most " << kMaxPixels << " pixels)";
+      throw InputError(file, os.str());
+    }
+  }
+  // A single-part scanline image: its chunk offset table follows the header, one offset per
+  // chunk of `lines` scanlines (by compression: NONE, RLE, ZIPS 1; ZIP, PXR24 16; PIZ, B44,
+  // B44A, DWAA 32; DWAB 256), and each chunk is int32 y, int32 data size, data. OpenEXR allocates
+  // a chunk's claimed size before reading it, so a 168-byte file claiming a 1.7 GB chunk cost
+  // 1.7 GB of address space (and read as "out of memory" under a memory limit): every offset
+  // and size must fit in the file. (Tiled and multi-part files are left to OpenEXR.)
+  static constexpr int kLinesPerChunk[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+  if (multipart || tiled || !have_window || compression < 0 || compression >= int(std::size(kLinesPerChunk))) return;
+  const int64_t h = int64_t(window[3]) - window[1] + 1;
+  const uint64_t chunks = uint64_t((h + kLinesPerChunk[compression] - 1) / kLinesPerChunk[compression]);
+  if (chunks > (size - at) / 8)
+    throw InputError(file, "truncated OpenEXR file: its " + std::to_string(chunks) + " chunk offsets do not fit in it");
+  std::vector<unsigned char> table(size_t(chunks) * 8);
+  bytes(table.data(), table.size());
+  const uint64_t pixels_start = at;
+  for (uint64_t k = 0; k < chunks; ++k) {
+    uint64_t offset = 0;
+    for (int b = 7; b >= 0; --b) offset = offset << 8 | table[size_t(k) * 8 + size_t(b)];
+    unsigned char chunk[8];
+    if (offset < pixels_start || offset > size - 8) {
+      throw InputError(file, "damaged OpenEXR file: chunk " + std::to_string(k) + " at offset " + std::to_string(offset) +
+                                 " lies outside the file's " + std::to_string(size) + " bytes");
+    }
+    in.seekg(static_cast<std::streamoff>(offset));
+    in.read(reinterpret_cast<char*>(chunk), 8);
+    if (in.gcount() != 8) throw InputError(file, "cannot read the file");
+    const int32_t data_size = int32_at(chunk + 4);
+    if (data_size < 0 || uint64_t(data_size) > size - offset - 8)
+      throw InputError(file, "damaged OpenEXR file: chunk " + std::to_string(k) + " claims " + std::to_string(data_size) +
+                                 " bytes, the file has " + std::to_string(size - offset - 8) + " after it");
   }
 }
 

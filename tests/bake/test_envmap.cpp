@@ -724,6 +724,62 @@ TEST(EnvMapFiles, AttributeClaimingMoreBytesThanTheFileHasIsRefusedBeforeOpenExr
   expect_input_error(p, "");
 }
 
+TEST(EnvMapFiles, ValuesOpenExrParsesItsOwnWayAndChunkSizesMustFitTheFile) {
+  // OpenEXR reads a known fixed-size type's own size and parses a channel list to its empty name,
+  // whatever the declared size; a mismatch puts its reading out of step with ours, and a later
+  // garbage word became a 1.6-1.9 GB allocation (3 fuzz inputs, tests/fuzz/regressions/exr). A
+  // chunk's data size is allocated before it is read too. Each is refused first, as bad input.
+  const fs::path p = tmp_dir() / "damaged_values.exr";
+  write_exr(p, 8, 4, rgb_channels(8, 4, 1, 1, 1), 0);
+  std::string b(size_t(fs::file_size(p)), '\0');
+  std::ifstream(p, std::ios::binary).read(b.data(), std::streamsize(b.size()));
+  auto write = [&](const std::string& bytes) { std::ofstream(p, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size())); };
+  auto patch32 = [](std::string& s, size_t at, uint32_t v) {
+    for (int k = 0; k < 4; ++k) s[at + size_t(k)] = char(v >> (8 * k));
+  };
+  ASSERT_NO_THROW(EnvMap::load(p, UpAxis::Y));
+  {  // dataWindow declared 20 bytes long (4 more zero bytes inserted after it)
+    std::string d = b;
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = d.find(key) + key.size();
+    patch32(d, at, 20);
+    d.insert(at + 4 + 16, 4, '\0');
+    write(d);
+    expect_input_error(p, "damaged OpenEXR header: attribute 'dataWindow' of type box2i claims 20 bytes, not 16");
+  }
+  {  // the channel list declared 2 bytes longer than its entries and terminator
+    std::string d = b;
+    const std::string key = std::string("channels") + '\0' + "chlist" + '\0';
+    const size_t at = d.find(key) + key.size();
+    const uint32_t n = uint32_t(uint8_t(d[at])) | uint32_t(uint8_t(d[at + 1])) << 8;
+    patch32(d, at, n + 2);
+    d.insert(at + 4 + n, 2, 'x');
+    write(d);
+    expect_input_error(p, "damaged OpenEXR header: attribute 'channels' (chlist) does not fill its");
+  }
+  const size_t table = b.find(std::string("envmap") + '\0' + "envmap" + '\0') + 6 + 1 + 6 + 1 + 4 + 1 + 1;
+  {  // chunk 2 claims 1.7 GB
+    std::string d = b;
+    uint64_t offset = 0;
+    for (int k = 7; k >= 0; --k) offset = offset << 8 | uint8_t(d[table + 16 + size_t(k)]);
+    patch32(d, size_t(offset) + 4, 1751318528u);
+    write(d);
+    rusage before{}, after{};
+    getrusage(RUSAGE_SELF, &before);
+    expect_input_error(p, "damaged OpenEXR file: chunk 2 claims 1751318528 bytes, the file has");
+    getrusage(RUSAGE_SELF, &after);
+    EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 64L << 10) << "peak resident KiB grew";
+  }
+  {  // chunk 3's offset beyond the end
+    std::string d = b;
+    patch32(d, table + 24, uint32_t(b.size() + 100));
+    write(d);
+    expect_input_error(p, "damaged OpenEXR file: chunk 3 at offset");
+  }
+  write(b.substr(0, table + 12));  // the offset table cut short
+  expect_input_error(p, "truncated OpenEXR file: its 4 chunk offsets do not fit in it");
+}
+
 TEST(EnvMapFiles, BadInputsAreInputErrors) {
   const fs::path dir = tmp_dir();
   expect_input_error(dir / "does_not_exist.exr", "no such file");
