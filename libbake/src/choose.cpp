@@ -108,6 +108,31 @@ double solve_power_law(double x0, double e0, double x1, double e1, double goal, 
   return x1 * std::pow(e1 / goal, 1.0 / exponent);
 }
 
+// Product p's errors `errors[i][p]` at the measured knobs xs (ascending, at least two): the knob
+// where its power law reaches `goal` — interpolated between the first level that meets it and
+// the level before, extrapolated from the last two when none does (below the first level when
+// the first already meets it) — with the rate clamped to [lo, hi] (`rate` receives it).
+double knob_for(const std::vector<double>& xs, const std::vector<std::vector<double>>& errors, size_t p, double goal,
+                double lo, double hi, double& rate) {
+  const size_t L = xs.size();
+  size_t hit = L;
+  for (size_t i = 0; i < L && hit == L; ++i)
+    if (errors[i][p] <= goal) hit = i;
+  const size_t i1 = hit == L ? L - 1 : std::max<size_t>(hit, 1), i0 = i1 - 1;
+  const double n = solve_power_law(xs[i0], errors[i0][p], xs[i1], errors[i1][p], goal, lo, hi, rate);
+  return hit == 0 ? std::min(n, xs[0]) : n;
+}
+
+// The same model's error of product p at `knob`, from the levels that bracket it.
+double model_error(const std::vector<double>& xs, const std::vector<std::vector<double>>& errors, size_t p, double knob,
+                   double lo, double hi) {
+  size_t i1 = 1;
+  while (i1 + 1 < xs.size() && xs[i1] < knob) ++i1;
+  double rate = 0;
+  solve_power_law(xs[i1 - 1], errors[i1 - 1][p], xs[i1], errors[i1][p], 1.0, lo, hi, rate);
+  return errors[i1][p] * std::pow(xs[i1] / knob, rate);
+}
+
 // Rays for a need of `need`: rounded up to an eighth of an octave (a multiple of 2^(⌊log2 need⌋ −
 // 3), at least 16), so at most 12.5% more than needed. The QMC integrator's randomised Halton
 // points stratify any count; a power of two would cost up to twice the rays.
@@ -212,20 +237,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     Prediction pr;
     pr.kind = IntegratorKind::Silhouette;
     double need = kMinIsolines;
-    const size_t L = std::size(kSilhouetteLevels);
+    const std::vector<double> levels(xs.begin(), xs.end() - 1);  // without the reference
     for (size_t p = 0; p < products.size(); ++p) {
-      // The first level that meets the goal, interpolated from the level before it; else the
-      // last two levels extrapolated. Exponent clamped to [0.5, 3].
-      size_t hit = L;
-      for (size_t i = 0; i < L; ++i)
-        if (errors[i][p] <= goal) {
-          hit = i;
-          break;
-        }
-      const size_t i1 = hit == L ? L - 1 : std::max<size_t>(hit, 1), i0 = i1 - 1;
       double a = 0;
-      double n = solve_power_law(xs[i0], errors[i0][p], xs[i1], errors[i1][p], goal, 0.5, 3.0, a);
-      if (hit == 0 && errors[0][p] <= goal) n = std::min(n, xs[0]);
+      const double n = knob_for(levels, errors, p, goal, 0.5, 3.0, a);  // silhouette: rates 0.5 to 3
       if (n > need) need = n, pr.exponent = a;
     }
     pr.reachable = need <= max_isolines;
@@ -233,16 +248,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     N = std::max(kMinIsolines, N + (N & 1));  // even, as the integrator uses it
     pr.knob = uint32_t(N);
     double worst = 0;
-    for (size_t p = 0; p < products.size(); ++p) {
-      // The model at N from the bracketing levels (the exponent per product as solved above).
-      size_t i1 = 1;
-      while (i1 + 1 < L && xs[i1] < N) ++i1;
-      const size_t i0 = i1 - 1;
-      double a = 0;
-      solve_power_law(xs[i0], errors[i0][p], xs[i1], errors[i1][p], goal, 0.5, 3.0, a);
-      const double e = errors[i1][p] * std::pow(xs[i1] / double(N), a);
-      worst = std::max(worst, e);
-    }
+    for (size_t p = 0; p < products.size(); ++p) worst = std::max(worst, model_error(levels, errors, p, N, 0.5, 3.0));
     pr.predicted_error = worst;
     double alpha = 0, beta = 0;
     fit_line(xs, ts, alpha, beta);
@@ -260,12 +266,13 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                                 : 0.0;
     bool pruned = false;
     for (uint32_t R : kQmcLevels) {
-      if (!errors.empty() && rival_us > 0) {
+      if (!errors.empty()) {
         const bool misses = *std::max_element(errors.back().begin(), errors.back().end()) > goal;
-        if (misses && ts.back() >= rival_us) {
+        if (misses && rival_us > 0 && ts.back() >= rival_us) {
           pruned = true;
           break;
         }
+        if (!misses && errors.size() >= 2) break;  // two levels and the goal met: enough to interpolate
       }
       double s = 0;
       const auto integrator =
@@ -283,8 +290,8 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       pr.predicted_error = *std::max_element(errors.back().begin(), errors.back().end());
       pr.predicted_us_per_point = ts.back();
       choice.predictions.push_back(pr);
-      progress.advance(sample.size() * (std::size(kQmcLevels) - xs.size()));
     }
+    progress.advance(sample.size() * (std::size(kQmcLevels) - xs.size()));  // the levels not run
   }
   if (want_qmc && (choice.predictions.empty() || !choice.predictions.back().pruned)) {
     std::vector<double> xs, ts;
@@ -294,19 +301,15 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     Prediction pr;
     pr.kind = IntegratorKind::Qmc;
     double need = kMinRays, worst = 0;
-    std::vector<double> exponents(products.size());
-    // The rate from the two largest levels (the asymptotic one); below the largest level the
-    // same power law, solved from it.
-    const size_t hi = xs.size() - 1, lo = hi - 1;
     for (size_t p = 0; p < products.size(); ++p) {
-      const double r = solve_power_law(xs[lo], errors[lo][p], xs[hi], errors[hi][p], goal, 0.5, 1.0, exponents[p]);
-      if (r > need) need = r, pr.exponent = exponents[p];
+      double rate = 0;
+      const double r = knob_for(xs, errors, p, goal, 0.5, 1.0, rate);  // QMC: rates 0.5 to 1
+      if (r > need) need = r, pr.exponent = rate;
     }
     pr.reachable = need <= kMaxRays;
     const uint32_t R = round_up_rays(need);
     pr.knob = R;
-    for (size_t p = 0; p < products.size(); ++p)
-      worst = std::max(worst, errors[hi][p] * std::pow(xs[hi] / double(R), exponents[p]));
+    for (size_t p = 0; p < products.size(); ++p) worst = std::max(worst, model_error(xs, errors, p, R, 0.5, 1.0));
     pr.predicted_error = worst;
     double alpha = 0, beta = 0;
     fit_line(xs, ts, alpha, beta);

@@ -19,13 +19,16 @@
 //     the aim (the error report, against QMC, verifies the bake); the silhouette knob is capped
 //     at N_ref;
 //  2. silhouette at N = 16, 32, 64, 128: the RMSE against the reference per product; the model
-//     RMSE(N) = C N^-a is fitted (least squares in log-log over the levels whose error is above
-//     the reference's own error scale) and solved for the smallest even N with RMSE <= 0.7·E
+//     RMSE(N) = C N^-a through the two levels that bracket the goal (the first level that meets
+//     it and the one before; the last two when none does), a clamped to [0.5, 3], solved for
+//     the smallest even N with RMSE <= 0.7·E
 //     (ChooserOptions: the safety factors);
-//  3. QMC at 256, 1024 and 4096 rays: the same against the reference; RMSE(R) = C R^-b with b
-//     fitted from the two largest and clamped to [0.5, 1] (randomised QMC converges between the
-//     Monte Carlo rate 1/2 and 1; ~0.7 on the bunny), solved for the rays, rounded up to an
-//     eighth of an octave (randomised Halton points stratify any count);
+//  3. QMC at 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
+//     goal): the same against the reference; RMSE(R) = C R^-b with b fitted between the levels
+//     that bracket the goal (the last two when none meets it) and clamped to [0.5, 1]
+//     (randomised QMC converges between the Monte Carlo rate 1/2 and 1; ~0.7 on the bunny),
+//     solved for the rays, rounded up to an eighth of an octave (randomised Halton points
+//     stratify any count);
 //     the levels stop early once one misses the goal at a cost per integral above the
 //     silhouette prediction (QMC cannot win then: more rays cost more);
 //  4. costs: the CPU time of every pilot integral (each thread's own CPU clock, so the thread
