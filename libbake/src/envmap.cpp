@@ -144,9 +144,11 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
     return static_cast<int32_t>(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
   };
   // What the first header says about the pixels' layout (the chunk check below).
-  bool tiled = false, have_window = false;
-  int compression = -1;
-  int32_t window[4] = {0, 0, 0, 0};  // xMin, yMin, xMax, yMax
+  // OpenEXR's defaults for what a header leaves out: a 64 × 64 window, ZIP compression.
+  bool tiled = false;
+  int compression = Imf::ZIP_COMPRESSION;
+  int32_t window[4] = {0, 0, 63, 63};  // xMin, yMin, xMax, yMax
+  std::vector<unsigned char> channel_list;  // the first header's chlist value (checked, NUL-ended)
   for (int header = 0;; ++header) {
     int attributes = 0;
     for (std::string name = word("name"); !name.empty(); name = word("name"), ++attributes) {
@@ -167,7 +169,6 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
         unsigned char v[16];
         bytes(v, 16);
         for (int k = 0; k < 4; ++k) window[k] = int32_at(v + 4 * k);
-        have_window = true;
       } else if (header == 0 && name == "compression" && type == "compression") {
         unsigned char c = 0;
         bytes(&c, 1);
@@ -182,6 +183,7 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
         if (!typed_value_fits(type, v.data(), size_t(value_size), max_name))
           throw InputError(file, "damaged OpenEXR header: attribute '" + name + "' (" + type + ") does not fill its " +
                                      std::to_string(value_size) + " bytes");
+        if (header == 0 && name == "channels" && type == "chlist") channel_list = std::move(v);
       } else {
         tiled |= header == 0 && name == "tiles";
         at += uint64_t(value_size);
@@ -190,14 +192,31 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
     }
     if (!multipart || attributes == 0) break;
   }
-  // The image's size, before OpenEXR sizes its line buffers by it.
-  if (have_window) {
-    const int64_t w = int64_t(window[2]) - window[0] + 1, h = int64_t(window[3]) - window[1] + 1;
-    if (w < 1 || h < 1 || w * h > kMaxPixels) {
-      std::ostringstream os;
-      os << "unsupported image size " << w << "x" << h << " (at most " << kMaxPixels << " pixels)";
-      throw InputError(file, os.str());
-    }
+  // The image's size, and its channels' bytes against what the file can hold at the
+  // compression's largest ratio, before OpenEXR sizes its line buffers by them (a 206-byte header
+  // of 8.3M × 8 pixels made it allocate and clear 2 GB).
+  const int64_t w = int64_t(window[2]) - window[0] + 1, h = int64_t(window[3]) - window[1] + 1;
+  if (w < 1 || h < 1 || w * h > kMaxPixels) {
+    std::ostringstream os;
+    os << "unsupported image size " << w << "x" << h << " (at most " << kMaxPixels << " pixels)";
+    throw InputError(file, os.str());
+  }
+  double raw_bytes = 0;  // of every channel, whose compressed data the file must hold
+  for (size_t i = 0; i < channel_list.size() && channel_list[i] != 0;) {  // entries as typed_value_fits checked them
+    while (channel_list[i] != 0) ++i;
+    const unsigned char* e = channel_list.data() + i + 1;
+    const int32_t type = int32_at(e), xs = std::max(1, int32_at(e + 8)), ys = std::max(1, int32_at(e + 12));
+    raw_bytes += std::ceil(double(w) / xs) * std::ceil(double(h) / ys) * (type == Imf::HALF ? 2 : 4);
+    i += 1 + 16;
+  }
+  const double ratio = compression >= 0 && compression < Imf::NUM_COMPRESSION_METHODS
+                           ? max_compression_ratio(Imf::Compression(compression))
+                           : std::numeric_limits<double>::infinity();
+  if (raw_bytes > ratio * double(size)) {
+    std::ostringstream os;
+    os << "the header's " << w << "x" << h << " pixels (" << uint64_t(raw_bytes) << " bytes of channel data) cannot fit in "
+       << size << " bytes at the compression's largest ratio (" << ratio << ":1): a damaged or forged header";
+    throw InputError(file, os.str());
   }
   // A single-part scanline image: its chunk offset table follows the header, one offset per
   // chunk of `lines` scanlines (by compression: NONE, RLE, ZIPS 1; ZIP, PXR24 16; PIZ, B44,
@@ -206,8 +225,7 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
   // 1.7 GB of address space (and read as "out of memory" under a memory limit): every offset
   // and size must fit in the file. (Tiled and multi-part files are left to OpenEXR.)
   static constexpr int kLinesPerChunk[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
-  if (multipart || tiled || !have_window || compression < 0 || compression >= int(std::size(kLinesPerChunk))) return;
-  const int64_t h = int64_t(window[3]) - window[1] + 1;
+  if (multipart || tiled || compression < 0 || compression >= int(std::size(kLinesPerChunk))) return;
   const uint64_t chunks = uint64_t((h + kLinesPerChunk[compression] - 1) / kLinesPerChunk[compression]);
   if (chunks > (size - at) / 8)
     throw InputError(file, "truncated OpenEXR file: its " + std::to_string(chunks) + " chunk offsets do not fit in it");
@@ -469,22 +487,7 @@ EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, U
         throw InputError(file, std::string("channel ") + n + " is subsampled; only full-resolution channels are supported");
 
     if (!in.isComplete()) throw InputError(file, "file is incomplete (truncated?): some pixel data is missing");
-    double raw_bytes = 0;  // of every channel, whose compressed data the file must hold
-    for (auto it = channels.begin(); it != channels.end(); ++it) {
-      const Imf::Channel& c = it.channel();
-      const double samples = std::ceil(double(W) / std::max(1, c.xSampling)) * std::ceil(double(H) / std::max(1, c.ySampling));
-      raw_bytes += samples * (c.type == Imf::HALF ? 2 : 4);
-    }
-    const double ratio = max_compression_ratio(hdr.compression());
-    std::error_code size_ec;
-    const uintmax_t size = std::filesystem::file_size(exr, size_ec);
-    if (size_ec) throw InputError(file, "cannot read: " + size_ec.message());
-    if (raw_bytes > ratio * double(size)) {
-      std::ostringstream os;
-      os << "the header's " << W << "x" << H << " pixels (" << uint64_t(raw_bytes) << " bytes of channel data) cannot fit in "
-         << size << " bytes at the compression's largest ratio (" << ratio << ":1): a damaged or forged header";
-      throw InputError(file, os.str());
-    }
+    // (The pixels' bound by the file's size and compression was checked by check_exr_header.)
 
     const size_t npix = size_t(W) * size_t(H);
     rgb.assign(3 * npix, 0.0f);
