@@ -1,4 +1,4 @@
-// bake/contour.cpp — exact ε-limit orientation and the 4D dual-space BVH of contour candidates
+// bake/contour.cpp — exact ε-limit orientation and the dual-space BVH of contour candidates
 // (paper 001 §3.1). See bake/contour.h for the contract.
 //
 // EXACTNESS.
@@ -18,10 +18,19 @@
 //    point differs from the exact s·π(p)/|N| by at most
 //        δ = 1.01·(η_max + 10u)·(|q|₁ + A)
 //    (η|q|₁ + u|q|₁ from q and n', (η + u + γ₃)A from a' and d', γ₄(|q|₁ + A) for the dot
-//    product or the box bound; the 1.01 covers computing δ itself). So |v| > δ decides the sign
-//    of π exactly; boxes are pruned only when their whole range is beyond ±δ; anything within
-//    δ of zero goes to orient_eps. Faces with η > 1e-6 (slivers, collinear corners) and
-//    repeated welded corners keep their edge out of the BVH, in the always-tested list.
+//    product; the 1.01 covers computing δ itself). So |v| > δ decides the sign of π exactly.
+//    Two evaluations add their own rounding to δ (each bound proven where its coefficient is
+//    set, in the constructor):
+//      - leaves hold ĝ rounded to float and evaluate in float (4 lanes): δ_rec = δ +
+//        1.01·8uf·(|q|₁ + A), uf = 2⁻²⁴; |v| > δ_rec decides, anything within goes to orient_eps;
+//      - a node's bound, the range of n·(q − c) + D over its box (c its centre, D = d + n·c
+//        computed in double and widened by its rounding error before rounding outward to
+//        float), is evaluated in float: δ_node = δ + 1.01·10uf·(|q|₁ + max|c|₁ + max|D|). A node
+//        is pruned only when its whole range is beyond ±δ_node, i.e. when every face of every
+//        edge under it has an exactly known σ that makes S = 0.
+//    Points with |q|₁ ≥ 1e30 (beyond float) take the brute-force path. Faces with η > 1e-6
+//    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
+//    the always-tested list.
 #include <bake/contour.h>
 
 #include <algorithm>
@@ -519,7 +528,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   // ρ ≈ the mean distance of a query point to a node (the frame's unit). Object-median fallback
   // below depth 48 keeps the depth bounded by the query's stack.
   corners_.reserve(recs.size());
-  record_edges_.reserve(recs.size());
+  std::vector<Node> nodes;  // the binary tree, collapsed into wide_ at the end
   size_t max_depth = 0;
   constexpr int kBins = 16;
   // The node's bound in its frame: outward-rounded boxes of the endpoints' normals and of
@@ -565,12 +574,12 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
       box.grow(items[k].lo, items[k].hi);
       keys.grow(items[k].key, items[k].key);
     }
-    const uint32_t self_index = uint32_t(nodes_.size());
-    nodes_.push_back(make_node(begin, end, box));
+    const uint32_t self_index = uint32_t(nodes.size());
+    nodes.push_back(make_node(begin, end, box));
     const uint32_t n = end - begin;
     if (n <= kLeafSize) {
-      nodes_[self_index].index = uint32_t(blocks_.size());
-      nodes_[self_index].count = n;
+      nodes[self_index].index = uint32_t(blocks_.size());
+      nodes[self_index].count = n;
       LeafBlock blk{};
       for (uint32_t j = 0; j < kLeafSize; ++j) {
         if (j < n) {
@@ -580,11 +589,10 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
             blk.g[4 + i][j] = float(d.g2[i]);
           }
           corners_.push_back(crs[items[begin + j].record]);
-          record_edges_.push_back(crs[items[begin + j].record].edge);
+          blk.edge[j] = crs[items[begin + j].record].edge;
         } else {  // padding: both values 1e38, above any tolerance, never undecided
           blk.g[3][j] = blk.g[7][j] = 1e38f;
           corners_.push_back(Corners{});
-          record_edges_.push_back(0);
         }
       }
       blocks_.push_back(blk);
@@ -597,7 +605,13 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
       return std::clamp(int((double(x.key[axis]) - double(keys.lo[axis])) / ext * kBins), 0, kBins - 1);
     };
     if (depth < 48) {
-      for (int axis = 0; axis < 6; ++axis) {
+      // Two candidate axes: the widest of the corner keys and the widest of the normal keys.
+      int widest[2] = {0, 3};
+      for (int i = 1; i < 3; ++i) {
+        if (keys.hi[i] - keys.lo[i] > keys.hi[widest[0]] - keys.lo[widest[0]]) widest[0] = i;
+        if (keys.hi[3 + i] - keys.lo[3 + i] > keys.hi[widest[1]] - keys.lo[widest[1]]) widest[1] = 3 + i;
+      }
+      for (const int axis : widest) {
         if (!(keys.hi[axis] > keys.lo[axis])) continue;
         Box bins[kBins];
         uint32_t counts[kBins] = {};
@@ -647,12 +661,12 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
     }
     self(self, begin, mid, depth + 1);
     const uint32_t right = self(self, mid, end, depth + 1);
-    nodes_[self_index].index = right;
-    nodes_[self_index].count = 0;
+    nodes[self_index].index = right;
+    nodes[self_index].count = 0;
     return self_index;
   };
   if (!items.empty()) build(build, 0, uint32_t(items.size()), 1);
-  collapse_wide();
+  collapse_wide(nodes);
   // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
   // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
   // uf = 2⁻²⁴; 10uf, and δ_node rounded to float upward by the 1.01, cover it.
@@ -669,21 +683,21 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
 // side (one fetch tests them all, and a child that fails is never fetched). A node's children
 // are its binary children, the largest inner one (by records under it) replaced by its own two
 // children while fewer than four; empty slots have D = +∞ and never pass.
-void ContourFinder::collapse_wide() {
-  if (nodes_.empty()) return;
+void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
+  if (binary.empty()) return;
   // Records under each binary node (leaf counts summed), for choosing which child to open.
-  std::vector<uint32_t> under(nodes_.size(), 0);
-  for (size_t i = nodes_.size(); i-- > 0;)
-    under[i] = nodes_[i].count ? nodes_[i].count : under[i + 1] + under[nodes_[i].index];
+  std::vector<uint32_t> under(binary.size(), 0);
+  for (size_t i = binary.size(); i-- > 0;)
+    under[i] = binary[i].count ? binary[i].count : under[i + 1] + under[binary[i].index];
   auto fill = [&](auto&& self, std::vector<uint32_t> slots, uint32_t at) -> void {
     while (slots.size() < 4) {
       int open = -1;
       for (size_t k = 0; k < slots.size(); ++k)
-        if (nodes_[slots[k]].count == 0 && (open < 0 || under[slots[k]] > under[slots[size_t(open)]])) open = int(k);
+        if (binary[slots[k]].count == 0 && (open < 0 || under[slots[k]] > under[slots[size_t(open)]])) open = int(k);
       if (open < 0) break;
       const uint32_t b = slots[size_t(open)];
       slots[size_t(open)] = b + 1;
-      slots.push_back(nodes_[b].index);
+      slots.push_back(binary[b].index);
     }
     for (size_t k = 0; k < 4; ++k) {
       WideNode& w = wide_[at];
@@ -694,7 +708,7 @@ void ContourFinder::collapse_wide() {
         w.count[k] = 1;  // a leaf never entered
         continue;
       }
-      const Node& nd = nodes_[slots[k]];
+      const Node& nd = binary[slots[k]];
       for (int i = 0; i < 3; ++i) {
         w.c[i][k] = nd.c[i];
         w.nlo[i][k] = nd.nlo[i];
@@ -709,17 +723,15 @@ void ContourFinder::collapse_wide() {
         const uint32_t child = uint32_t(wide_.size());
         wide_.emplace_back();
         wide_[at].child[k] = child;
-        self(self, {slots[k] + 1, nodes_[slots[k]].index}, child);
+        self(self, {slots[k] + 1, binary[slots[k]].index}, child);
       }
     }
   };
   wide_.emplace_back();
-  if (nodes_[0].count)
+  if (binary[0].count)
     fill(fill, {0}, 0);
   else
-    fill(fill, {1, nodes_[0].index}, 0);
-  nodes_.clear();
-  nodes_.shrink_to_fit();
+    fill(fill, {1, binary[0].index}, 0);
 }
 
 size_t ContourFinder::edge_count() const { return topology_->edges.size(); }
@@ -805,13 +817,44 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
         float(delta + node_coef_ * ((std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2])) + node_const_));
     const f4 qx = splat(float(q[0])), qy = splat(float(q[1])), qz = splat(float(q[2]));
     const f4 dn = splat(delta_node), dr = splat(delta_rec);
-    uint32_t stack[kMaxStack];
-    int sp = 0;
-    stack[sp++] = 0;
+    // Breadth-first: a FIFO of wide nodes and leaf blocks (bit 31), each prefetched when queued
+    // and read many steps later, so the walk streams memory instead of waiting on each fetch.
+    thread_local std::vector<uint32_t> tl_queue;
+    std::vector<uint32_t>& queue = tl_queue;
+    queue.clear();
+    queue.push_back(0);
     const WideNode* wide = wide_.data();
     const LeafBlock* blocks = blocks_.data();
-    while (sp > 0) {
-      const WideNode& w = wide[stack[--sp]];
+    constexpr uint32_t kLeafBit = 0x80000000u;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const uint32_t item = queue[head];
+      if (item & kLeafBit) {
+        const uint32_t block = item & ~kLeafBit;
+        if constexpr (Count) work.records += kLeafSize;
+        // Both face values of the leaf's four records at once; only undecided ones branch.
+        // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ_rec.
+        const LeafBlock& blk = blocks[block];
+        const f4 v1 = load(blk.g[0]) * qx + load(blk.g[1]) * qy + load(blk.g[2]) * qz + load(blk.g[3]);
+        const f4 v2 = load(blk.g[4]) * qx + load(blk.g[5]) * qy + load(blk.g[6]) * qz + load(blk.g[7]);
+        const i4 same = ((v1 > dr) & (v2 > dr)) | ((v1 < -dr) & (v2 < -dr));
+        for (unsigned live = ~lanes(same) & 0xFu; live != 0; live &= live - 1) {
+          const int j = std::countr_zero(live);
+          const size_t at = size_t(block) * kLeafSize + size_t(j);
+          int s;
+          if (v1[j] > delta_rec && v2[j] < -delta_rec) {
+            s = -2;
+          } else if (v1[j] < -delta_rec && v2[j] > delta_rec) {
+            s = 2;
+          } else {
+            if constexpr (Count) ++work.exact;
+            const Corners& c = corners_[at];
+            s = orient_eps_f(c.a, c.b, c.c1, p, nn, tt) + orient_eps_f(c.a, c.b, c.c2, p, nn, tt);
+          }
+          if (s != 0) emit(blk.edge[j], s);
+        }
+        continue;
+      }
+      const WideNode& w = wide[item];
       if constexpr (Count) work.nodes += 4;
       // Per child: the range of n·(q − c) + D over its box (per axis the smaller / larger
       // product), four children at once.
@@ -828,30 +871,13 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
         const uint32_t child = w.child[k];
         if (w.count[k] == 0) {
           __builtin_prefetch(wide + child);
-          stack[sp++] = child;
-          continue;
-        }
-        if constexpr (Count) work.records += w.count[k];
-        // Both face values of the leaf's four records at once; only undecided ones branch.
-        // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ_rec.
-        const LeafBlock& blk = blocks[child];
-        const f4 v1 = load(blk.g[0]) * qx + load(blk.g[1]) * qy + load(blk.g[2]) * qz + load(blk.g[3]);
-        const f4 v2 = load(blk.g[4]) * qx + load(blk.g[5]) * qy + load(blk.g[6]) * qz + load(blk.g[7]);
-        const i4 same = ((v1 > dr) & (v2 > dr)) | ((v1 < -dr) & (v2 < -dr));
-        for (unsigned live = ~lanes(same) & 0xFu; live != 0; live &= live - 1) {
-          const int j = std::countr_zero(live);
-          const size_t at = size_t(child) * kLeafSize + size_t(j);
-          int s;
-          if (v1[j] > delta_rec && v2[j] < -delta_rec) {
-            s = -2;
-          } else if (v1[j] < -delta_rec && v2[j] > delta_rec) {
-            s = 2;
-          } else {
-            if constexpr (Count) ++work.exact;
-            const Corners& c = corners_[at];
-            s = orient_eps_f(c.a, c.b, c.c1, p, nn, tt) + orient_eps_f(c.a, c.b, c.c2, p, nn, tt);
-          }
-          if (s != 0) emit(record_edges_[at], s);
+          __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + 128);
+          queue.push_back(child);
+        } else {
+          __builtin_prefetch(blocks + child);
+          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 64);
+          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 128);
+          queue.push_back(child | kLeafBit);
         }
       }
     }
