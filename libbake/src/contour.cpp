@@ -32,6 +32,7 @@
 //    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
 //    the always-tested list.
 #include <bake/contour.h>
+#include <bake/error.h>
 
 #include <algorithm>
 #include <array>
@@ -667,6 +668,8 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   };
   if (!items.empty()) build(build, 0, uint32_t(items.size()), 1);
   collapse_wide(nodes);
+  // The walk's queue tags leaf blocks with bit 31.
+  PRT_CHECK(wide_.size() < (size_t(1) << 31) && blocks_.size() < (size_t(1) << 31));
   // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
   // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
   // uf = 2⁻²⁴; 10uf, and δ_node rounded to float upward by the 1.01, cover it.
