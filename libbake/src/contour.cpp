@@ -873,8 +873,8 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
         const int k = std::countr_zero(pass);
         const uint32_t child = w.child[k];
         if (w.count[k] == 0) {
-          __builtin_prefetch(wide + child);
-          __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + 128);
+          for (int line = 0; line < int(sizeof(WideNode)); line += 64)
+            __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + line);
           queue.push_back(child);
         } else {
           __builtin_prefetch(blocks + child);
