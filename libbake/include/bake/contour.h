@@ -84,7 +84,7 @@ struct ContourQueryStats {
   uint64_t nodes = 0;    // child bounds tested (four per wide node fetched)
   uint64_t records = 0;  // leaf lanes whose two face values were evaluated (four per leaf block)
   uint64_t exact = 0;    // of those, edges decided by orient_eps (a value within the tolerance)
-  uint64_t always = 0;   // always-tested edges (side_sum by orient_eps on every query)
+  uint64_t always = 0;   // always-tested edges (their side sums by orient_eps on every query)
 };
 
 class ContourFinder {
@@ -95,7 +95,8 @@ public:
   ContourFinder& operator=(const ContourFinder&) = delete;
 
   // All edges with S_e != 0 at the shade point, sorted by edge index (`out` is cleared first).
-  // Uses the BVH; equals find_brute_force exactly. Thread-safe; allocates only to grow `out`.
+  // Uses the BVH; equals find_brute_force exactly. Thread-safe; allocates only to grow `out` and
+  // its per-thread buffers.
   // Only point.p and point.n are used (the ε-limit is geometric: a shade point at a vertex
   // position gets its 1-ring right whatever point.welded says). With `stats`, the query's work
   // is added to it (the same result; counting costs a few increments).
@@ -108,7 +109,7 @@ public:
   const ContourFinderStats& stats() const { return stats_; }
 
 private:
-  struct Node {  // 52 bytes; the bound in the node's own frame (centre c), rounded outward to float
+  struct Node {  // binary tree node (construction only); the bound in its own frame (centre c), rounded outward
     float c[3];              // centre of the node's corners (finder frame)
     float nlo[3], nhi[3];    // box of the endpoint normals n
     float dlo, dhi;          // range of D = d + n·c over the endpoints (n, d): value n·(q − c) + D
@@ -119,7 +120,7 @@ private:
     float c[3][4], nlo[3][4], nhi[3][4];
     float dlo[4], dhi[4];
     uint32_t child[4];  // leaf: its LeafBlock; inner: wide node index
-    uint32_t count[4];  // leaf: record count (> 0); inner: 0
+    uint32_t count[4];  // leaf: record count (> 0); inner: 0. An empty slot has D = +∞ (never passes)
   };
   struct alignas(16) LeafBlock {  // a leaf's four BVH edges (padded), lane j = edge j: what the leaf test reads
     float g[8][4];     // ĝ_1 (unit normal, offset) then −ĝ_2, finder frame, rounded to float
