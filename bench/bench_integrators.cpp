@@ -11,7 +11,12 @@
 // calling thread; the counter `per_integral` is CPU seconds per integral (per core; printed as e.g. 83.6us).
 // Integrator construction (BVHs, tables) is outside the timed loop and reported as `setup_s`.
 // Silhouette cases also report SilhouetteIntegrator::stats() per integral over the timed loop:
-// contour-search and integration CPU µs, contour edges and isoline crossings.
+// contour-search and integration µs, contour edges and isoline crossings.
+//
+// After the runs, a table of the triangle sweep: per level the contour edges found, contour
+// search µs and CPU µs per integral, and the growth exponents against triangle count (between
+// consecutive levels and a least-squares fit over all levels) of edges, contour time and total
+// time — contour search is output-sensitive when its exponent is no larger than the edges'.
 //
 // Sizes (environment; Google Benchmark's own flags such as --benchmark_filter also work):
 //   PRT_BENCH_QMC_SAMPLES   default 256,1024,4096,16384
@@ -25,7 +30,10 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,10 +46,27 @@ double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The timed loop shared by every case: all shade points once per iteration.
-void integrate_all(benchmark::State& state, const bench::Scene& s, const bake::Integrator& integ) {
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// One row of the triangle-sweep table (the silhouette cases of BM_SilhouetteTriangles).
+struct SweepRow {
+  double triangles = 0, edges = 0, contour_us = 0, total_us = 0;
+};
+std::map<int, SweepRow>& sweep() {
+  static std::map<int, SweepRow> rows;
+  return rows;
+}
+
+// The timed loop shared by every case: all shade points once per iteration. Returns CPU µs
+// per integral (this thread).
+double integrate_all(benchmark::State& state, const bench::Scene& s, const bake::Integrator& integ) {
   std::vector<double> row(integ.layout().width);
   const size_t n = s.points.size();
+  const double c0 = thread_cpu_seconds();
   for (auto _ : state) {
     for (size_t i = 0; i < n; ++i) {
       integ.integrate(s.points[i], s.vertices[i], row);
@@ -55,6 +80,7 @@ void integrate_all(benchmark::State& state, const bench::Scene& s, const bake::I
       benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["triangles"] = double(s.mesh.triangles.size());
   state.counters["points"] = double(n);
+  return 1e6 * (thread_cpu_seconds() - c0) / (double(state.iterations()) * double(n));
 }
 
 bake::IntegratorSpec qmc_spec(long rays) {
@@ -74,13 +100,13 @@ bake::IntegratorSpec silhouette_spec(long isolines) {
 // One case: the integrator the spec describes (its setup timed apart), every shade point per
 // iteration, and the integrator's own per-integral statistics (the silhouette integrator's
 // contour and integration split; QMC has none).
-void integrator_case(benchmark::State& state, int level, const bake::IntegratorSpec& spec) {
+void integrator_case(benchmark::State& state, int level, const bake::IntegratorSpec& spec, bool sweep_row = false) {
   const bench::Scene& s = bench::scene(level);
   const auto t0 = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integ = bake::make_integrator(spec, s.mesh, s.topology, bench::request());
   state.counters["setup_s"] = since(t0);
   const bake::IntegratorStats before = integ->stats();
-  integrate_all(state, s, *integ);
+  const double cpu_us = integrate_all(state, s, *integ);
   if (spec.kind != bake::IntegratorKind::Silhouette) return;
   const bake::IntegratorStats after = integ->stats();
   const double k = double(after.points - before.points);
@@ -90,8 +116,49 @@ void integrator_case(benchmark::State& state, int level, const bake::IntegratorS
     state.counters["contour_edges"] = double(after.contour_edges - before.contour_edges) / k;
     state.counters["crossings"] = double(after.crossings - before.crossings) / k;
     state.counters["start_rays"] = double(after.start_rays - before.start_rays) / k;
+    if (sweep_row)
+      sweep()[level] = {double(s.mesh.triangles.size()), state.counters["contour_edges"], state.counters["contour_us"],
+                        cpu_us};
   }
   state.counters["k"] = double(spec.silhouette_k);
+}
+
+// Slope of log y against log x (least squares); NaN with fewer than two points.
+double loglog_slope(const std::vector<std::pair<double, double>>& xy) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const double n = double(xy.size());
+  for (const auto& [x, y] : xy) {
+    sx += std::log(x);
+    sy += std::log(y);
+    sxx += std::log(x) * std::log(x);
+    sxy += std::log(x) * std::log(y);
+  }
+  return xy.size() < 2 ? std::nan("") : (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+void print_sweep_table() {
+  const auto& rows = sweep();
+  if (rows.empty()) return;
+  std::printf("\nContour search against triangle count (silhouette N = 64; exponents: growth against triangles)\n\n");
+  std::printf("| level | triangles | contour edges | contour µs | CPU µs / integral | edges exp. | contour exp. | total exp. |\n");
+  std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  const SweepRow* prev = nullptr;
+  std::vector<std::pair<double, double>> edges, contour, total;
+  for (const auto& [level, r] : rows) {
+    char exps[96] = "– | – | –";
+    if (prev) {
+      const double lt = std::log(r.triangles / prev->triangles);
+      std::snprintf(exps, sizeof exps, "%.2f | %.2f | %.2f", std::log(r.edges / prev->edges) / lt,
+                    std::log(r.contour_us / prev->contour_us) / lt, std::log(r.total_us / prev->total_us) / lt);
+    }
+    std::printf("| %d | %.0f | %.0f | %.1f | %.1f | %s |\n", level, r.triangles, r.edges, r.contour_us, r.total_us, exps);
+    edges.emplace_back(r.triangles, r.edges);
+    contour.emplace_back(r.triangles, r.contour_us);
+    total.emplace_back(r.triangles, r.total_us);
+    prev = &r;
+  }
+  if (rows.size() >= 2)
+    std::printf("| fit | | | | | %.2f | %.2f | %.2f |\n", loglog_slope(edges), loglog_slope(contour), loglog_slope(total));
 }
 
 } // namespace
@@ -122,7 +189,7 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond);
 #if PRT_BENCH_SILHOUETTE
       benchmark::RegisterBenchmark(("BM_SilhouetteTriangles/level:" + std::to_string(l)).c_str(),
-                                   [l](benchmark::State& st) { integrator_case(st, int(l), silhouette_spec(64)); })
+                                   [l](benchmark::State& st) { integrator_case(st, int(l), silhouette_spec(64), true); })
           ->Unit(benchmark::kMillisecond);
 #endif
     }
@@ -133,6 +200,7 @@ int main(int argc, char** argv) {
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
+    print_sweep_table();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_integrators: %s\n", e.what());
     return 1;

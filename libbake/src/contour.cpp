@@ -1,4 +1,4 @@
-// bake/contour.cpp — exact ε-limit orientation and the 4D dual-space BVH of contour candidates
+// bake/contour.cpp — exact ε-limit orientation and the dual-space BVH of contour candidates
 // (paper 001 §3.1). See bake/contour.h for the contract.
 //
 // EXACTNESS.
@@ -18,16 +18,27 @@
 //    point differs from the exact s·π(p)/|N| by at most
 //        δ = 1.01·(η_max + 10u)·(|q|₁ + A)
 //    (η|q|₁ + u|q|₁ from q and n', (η + u + γ₃)A from a' and d', γ₄(|q|₁ + A) for the dot
-//    product or the box bound; the 1.01 covers computing δ itself). So |v| > δ decides the sign
-//    of π exactly; boxes are pruned only when their whole range is beyond ±δ; anything within
-//    δ of zero goes to orient_eps. Faces with η > 1e-6 (slivers, collinear corners) and
-//    repeated welded corners keep their edge out of the BVH, in the always-tested list.
+//    product; the 1.01 covers computing δ itself). So |v| > δ decides the sign of π exactly.
+//    Two evaluations add their own rounding to δ (each bound proven where its coefficient is
+//    set, in the constructor):
+//      - leaves hold ĝ rounded to float and evaluate in float (4 lanes): δ_rec = δ +
+//        1.01·8uf·(|q|₁ + A), uf = 2⁻²⁴; |v| > δ_rec decides, anything within goes to orient_eps;
+//      - a node's bound, the range of n·(q − c) + D over its box (c its centre, D = d + n·c
+//        computed in double and widened by its rounding error before rounding outward to
+//        float), is evaluated in float: δ_node = δ + 1.01·10uf·(|q|₁ + max|c|₁ + max|D|). A node
+//        is pruned only when its whole range is beyond ±δ_node, i.e. when every face of every
+//        edge under it has an exactly known σ that makes S = 0.
+//    Points with |q|₁ ≥ 1e30 (beyond float) take the brute-force path. Faces with η > 1e-6
+//    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
+//    the always-tested list.
 #include <bake/contour.h>
+#include <bake/error.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -288,8 +299,9 @@ float round_up(double x) {
 }
 
 constexpr double kMaxNormalError = 1e-6;  // faces with a worse normal bound are always tested
-constexpr uint32_t kLeafSize = 4;
-constexpr int kMaxStack = 128;
+constexpr uint32_t kLeafSize = 4;  // records per leaf at most
+static_assert(kLeafSize == 4);  // a leaf is one LeafBlock of four float lanes
+constexpr int kMaxStack = 256;  // ≥ 3 × the wide tree's depth (≤ 48 + 32 + 1) + 1
 
 }  // namespace
 
@@ -342,12 +354,51 @@ FaceDual face_dual(const Eigen::Vector3f& af, const Eigen::Vector3f& bf, const E
   return f;
 }
 
+// Four float lanes (GCC / Clang vector extensions: SSE on x86-64, NEON on ARM, scalar elsewhere).
+typedef float f4 __attribute__((vector_size(16)));
+typedef int32_t i4 __attribute__((vector_size(16)));
+inline f4 load(const float* x) {
+  f4 v;
+  std::memcpy(&v, x, sizeof v);
+  return v;
+}
+inline f4 splat(float x) { return f4{x, x, x, x}; }
+inline unsigned lanes(i4 m) {  // bit k set iff lane k is true
+  return unsigned(m[0] & 1) | unsigned(m[1] & 1) << 1 | unsigned(m[2] & 1) << 2 | unsigned(m[3] & 1) << 3;
+}
+
+// The dual segment of a BVH edge in double: ĝ_1 and −ĝ_2.
+struct DualEdge {
+  double g1[4], g2[4];
+};
+
+// A BVH edge during the build: the box of its four corners (the finder's frame) and of its two
+// endpoint normals (n_1 and −n_2: nearly equal on a smooth surface), with their centres as keys.
 struct BuildItem {
-  float lo[4], hi[4];
-  float centre[4];
+  float lo[6], hi[6];  // x, y, z of the corners; then the normals
+  float key[6];
   uint32_t record;
 };
 
+// A build box over BuildItem's six axes; cost() is the build's estimate of a node's bound width.
+constexpr double kRho = 1.0;
+struct Box {
+  float lo[6], hi[6];
+  void clear() {
+    std::fill(lo, lo + 6, std::numeric_limits<float>::infinity());
+    std::fill(hi, hi + 6, -std::numeric_limits<float>::infinity());
+  }
+  void grow(const float* l, const float* h) {
+    for (int i = 0; i < 6; ++i) {
+      lo[i] = std::min(lo[i], l[i]);
+      hi[i] = std::max(hi[i], h[i]);
+    }
+  }
+  double cost() const {
+    return (double(hi[0]) - lo[0]) + (double(hi[1]) - lo[1]) + (double(hi[2]) - lo[2]) +
+           kRho * ((double(hi[3]) - lo[3]) + (double(hi[4]) - lo[4]) + (double(hi[5]) - lo[5]));
+  }
+};
 }  // namespace
 
 ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_(&mesh), topology_(&topology) {
@@ -373,7 +424,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
 
   std::vector<BuildItem> items;
   items.reserve(E);
-  std::vector<Record> recs;
+  std::vector<DualEdge> recs;
   std::vector<Corners> crs;
   recs.reserve(E);
   crs.reserve(E);
@@ -417,12 +468,26 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
     }
     if (!bvh) {
       always_.push_back(e);
+      for (const uint32_t f : faces) {  // the faces side_sum_slow counts, corners (a, b, c)
+        const auto& t = mesh.triangles[f];
+        const uint32_t w0 = topology.weld[t[0]], w1 = topology.weld[t[1]], w2 = topology.weld[t[2]];
+        if (w0 == w1 || w1 == w2 || w0 == w2) continue;
+        const uint32_t c = (w0 != ia && w0 != ib) ? w0 : (w1 != ia && w1 != ib) ? w1 : w2;
+        AlwaysFace af{};
+        for (int i = 0; i < 3; ++i) {
+          af.a[i] = wp[ia][i];
+          af.b[i] = wp[ib][i];
+          af.c[i] = wp[c][i];
+        }
+        always_faces_.push_back(af);
+      }
+      always_end_.push_back(uint32_t(always_faces_.size()));
       continue;
     }
     eta_max = std::max({eta_max, d1.eta, d2.eta});
     const Eigen::Vector3d ap = (wp[ia].cast<double>() - origin_) * scale_;
     amax = std::max(amax, ap.cwiseAbs().sum());
-    Record r{};
+    DualEdge r{};
     for (int i = 0; i < 4; ++i) {
       r.g1[i] = d1.g[i];
       r.g2[i] = -d2.g[i];
@@ -437,11 +502,15 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
     cr.edge = e;
     crs.push_back(cr);
     BuildItem it{};
-    for (int i = 0; i < 4; ++i) {
-      it.lo[i] = round_down(std::min(r.g1[i], r.g2[i]));
-      it.hi[i] = round_up(std::max(r.g1[i], r.g2[i]));
-      it.centre[i] = float(0.5 * (r.g1[i] + r.g2[i]));
+    for (int i = 0; i < 3; ++i) {
+      const double x[4] = {(wp[ia][i] - origin_[i]) * scale_, (wp[ib][i] - origin_[i]) * scale_,
+                           (wp[corner[0]][i] - origin_[i]) * scale_, (wp[corner[1]][i] - origin_[i]) * scale_};
+      it.lo[i] = float(std::min({x[0], x[1], x[2], x[3]}));
+      it.hi[i] = float(std::max({x[0], x[1], x[2], x[3]}));
+      it.lo[3 + i] = float(std::min(r.g1[i], r.g2[i]));
+      it.hi[3 + i] = float(std::max(r.g1[i], r.g2[i]));
     }
+    for (int i = 0; i < 6; ++i) it.key[i] = 0.5f * (it.lo[i] + it.hi[i]);
     it.record = uint32_t(recs.size());
     recs.push_back(r);
     items.push_back(it);
@@ -453,101 +522,122 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   stats_.bvh_edges = recs.size();
   stats_.always_tested = always_.size();
 
-  // Binned build over the 4D boxes. Cost of a box: the sum of its extents (the mean width, to
-  // which the chance of a hyperplane meeting it is proportional). Object-median fallback keeps
-  // the depth bounded by the stack.
-  records_.reserve(recs.size());
+  // Binned SAH build over the edges' corner boxes and normal boxes. A node is visited when the
+  // query hyperplane comes within its bound's width of it: in the node's own frame (centre c)
+  // that width is about Σ_i |q_i − c_i|·Δn_i + ΔD, ΔD ≈ Δn·radius + the corners' spread along the
+  // normal. The cost of a set is therefore count × (Σ corner extents + ρ·Σ normal extents),
+  // ρ ≈ the mean distance of a query point to a node (the frame's unit). Object-median fallback
+  // below depth 48 keeps the depth bounded by the query's stack.
   corners_.reserve(recs.size());
+  std::vector<Node> nodes;  // the binary tree, collapsed into wide_ at the end
   size_t max_depth = 0;
   constexpr int kBins = 16;
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  auto width = [](const float* lo, const float* hi) {
-    double w = 0;
-    for (int i = 0; i < 4; ++i) w += double(hi[i]) - double(lo[i]);
-    return w;
+  // The node's bound in its frame: outward-rounded boxes of the endpoints' normals and of
+  // D = d + n·c over every endpoint (n, d) of its records (computed in double, then widened by
+  // its rounding bound 5u(|d| + |c|₁) and rounded outward).
+  double c_max = 0, d_max = 0;
+  auto make_node = [&](uint32_t begin, uint32_t end, const Box& box) {
+    Node nd{};
+    for (int i = 0; i < 3; ++i) nd.c[i] = 0.5f * (box.lo[i] + box.hi[i]);
+    const double c[3] = {nd.c[0], nd.c[1], nd.c[2]};
+    const double c1 = std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2]);
+    c_max = std::max(c_max, c1);
+    constexpr double kInfD = std::numeric_limits<double>::infinity();
+    double nlo[3] = {kInfD, kInfD, kInfD}, nhi[3] = {-kInfD, -kInfD, -kInfD}, dlo = kInfD, dhi = -kInfD;
+    for (uint32_t k = begin; k < end; ++k) {
+      const DualEdge& r = recs[items[k].record];
+      for (const double* g : {r.g1, r.g2}) {
+        for (int i = 0; i < 3; ++i) {
+          nlo[i] = std::min(nlo[i], g[i]);
+          nhi[i] = std::max(nhi[i], g[i]);
+        }
+        const double D = g[3] + (g[0] * c[0] + g[1] * c[1] + g[2] * c[2]);
+        const double err = 5 * kU * (std::abs(g[3]) + c1) * (1 + 8 * kU);
+        dlo = std::min(dlo, D - err);
+        dhi = std::max(dhi, D + err);
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      nd.nlo[i] = round_down(nlo[i]);
+      nd.nhi[i] = round_up(nhi[i]);
+    }
+    nd.dlo = round_down(dlo * (1 + (dlo < 0 ? 2 : -2) * kU));
+    nd.dhi = round_up(dhi * (1 + (dhi > 0 ? 2 : -2) * kU));
+    d_max = std::max({d_max, std::abs(double(nd.dlo)), std::abs(double(nd.dhi))});
+    return nd;
   };
-  // Depth-first, so a left child directly follows its parent; depth ≤ 48 + log2(n) (SAH up to
-  // depth 48, object median below), well within the query's fixed stack.
   auto build = [&](auto&& self, uint32_t begin, uint32_t end, uint32_t depth) -> uint32_t {
     max_depth = std::max<size_t>(max_depth, depth);
-    Node nd{};
-    for (int i = 0; i < 4; ++i) {
-      nd.lo[i] = kInf;
-      nd.hi[i] = -kInf;
+    Box box, keys;
+    box.clear();
+    keys.clear();
+    for (uint32_t k = begin; k < end; ++k) {
+      box.grow(items[k].lo, items[k].hi);
+      keys.grow(items[k].key, items[k].key);
     }
-    float clo[4] = {kInf, kInf, kInf, kInf}, chi[4] = {-kInf, -kInf, -kInf, -kInf};
-    for (uint32_t k = begin; k < end; ++k)
-      for (int i = 0; i < 4; ++i) {
-        nd.lo[i] = std::min(nd.lo[i], items[k].lo[i]);
-        nd.hi[i] = std::max(nd.hi[i], items[k].hi[i]);
-        clo[i] = std::min(clo[i], items[k].centre[i]);
-        chi[i] = std::max(chi[i], items[k].centre[i]);
-      }
-    const uint32_t self_index = uint32_t(nodes_.size());
-    nodes_.push_back(nd);
+    const uint32_t self_index = uint32_t(nodes.size());
+    nodes.push_back(make_node(begin, end, box));
     const uint32_t n = end - begin;
     if (n <= kLeafSize) {
-      nodes_[self_index].index = uint32_t(records_.size());
-      nodes_[self_index].count = n;
-      for (uint32_t k = begin; k < end; ++k) {
-        records_.push_back(recs[items[k].record]);
-        corners_.push_back(crs[items[k].record]);
+      nodes[self_index].index = uint32_t(blocks_.size());
+      nodes[self_index].count = n;
+      LeafBlock blk{};
+      for (uint32_t j = 0; j < kLeafSize; ++j) {
+        if (j < n) {
+          const DualEdge& d = recs[items[begin + j].record];
+          for (int i = 0; i < 4; ++i) {
+            blk.g[i][j] = float(d.g1[i]);
+            blk.g[4 + i][j] = float(d.g2[i]);
+          }
+          corners_.push_back(crs[items[begin + j].record]);
+          blk.edge[j] = crs[items[begin + j].record].edge;
+        } else {  // padding: both values 1e38, above any tolerance, never undecided
+          blk.g[3][j] = blk.g[7][j] = 1e38f;
+          corners_.push_back(Corners{});
+        }
       }
+      blocks_.push_back(blk);
       return self_index;
     }
-    // Binned split on every axis, cost = Σ_children (sum of extents) × count.
     double best_cost = std::numeric_limits<double>::infinity();
     int best_axis = -1, best_bin = -1;
     auto bin_of = [&](const BuildItem& x, int axis) {
-      const double ext = double(chi[axis]) - double(clo[axis]);
-      return std::clamp(int((double(x.centre[axis]) - double(clo[axis])) / ext * kBins), 0, kBins - 1);
+      const double ext = double(keys.hi[axis]) - double(keys.lo[axis]);
+      return std::clamp(int((double(x.key[axis]) - double(keys.lo[axis])) / ext * kBins), 0, kBins - 1);
     };
     if (depth < 48) {
-      for (int axis = 0; axis < 4; ++axis) {
-        if (!(chi[axis] > clo[axis])) continue;
-        struct Bin {
-          float lo[4], hi[4];
-          uint32_t count;
-        } bins[kBins];
-        for (auto& b : bins) {
-          b.count = 0;
-          for (int i = 0; i < 4; ++i) {
-            b.lo[i] = kInf;
-            b.hi[i] = -kInf;
-          }
-        }
+      // Two candidate axes: the widest of the corner keys and the widest of the normal keys.
+      int widest[2] = {0, 3};
+      for (int i = 1; i < 3; ++i) {
+        if (keys.hi[i] - keys.lo[i] > keys.hi[widest[0]] - keys.lo[widest[0]]) widest[0] = i;
+        if (keys.hi[3 + i] - keys.lo[3 + i] > keys.hi[widest[1]] - keys.lo[widest[1]]) widest[1] = 3 + i;
+      }
+      for (const int axis : widest) {
+        if (!(keys.hi[axis] > keys.lo[axis])) continue;
+        Box bins[kBins];
+        uint32_t counts[kBins] = {};
+        for (auto& b : bins) b.clear();
         for (uint32_t k = begin; k < end; ++k) {
-          auto& b = bins[bin_of(items[k], axis)];
-          ++b.count;
-          for (int i = 0; i < 4; ++i) {
-            b.lo[i] = std::min(b.lo[i], items[k].lo[i]);
-            b.hi[i] = std::max(b.hi[i], items[k].hi[i]);
-          }
+          const int b = bin_of(items[k], axis);
+          ++counts[b];
+          bins[b].grow(items[k].lo, items[k].hi);
         }
         double right_cost[kBins] = {};
-        float lo[4] = {kInf, kInf, kInf, kInf}, hi[4] = {-kInf, -kInf, -kInf, -kInf};
+        Box acc;
+        acc.clear();
         uint32_t cnt = 0;
         for (int b = kBins - 1; b > 0; --b) {
-          cnt += bins[b].count;
-          for (int i = 0; i < 4; ++i) {
-            lo[i] = std::min(lo[i], bins[b].lo[i]);
-            hi[i] = std::max(hi[i], bins[b].hi[i]);
-          }
-          right_cost[b] = cnt ? width(lo, hi) * cnt : 0;
+          cnt += counts[b];
+          acc.grow(bins[b].lo, bins[b].hi);
+          right_cost[b] = cnt ? acc.cost() * cnt : 0;
         }
-        for (int i = 0; i < 4; ++i) {
-          lo[i] = kInf;
-          hi[i] = -kInf;
-        }
+        acc.clear();
         cnt = 0;
         for (int b = 0; b < kBins - 1; ++b) {
-          cnt += bins[b].count;
-          for (int i = 0; i < 4; ++i) {
-            lo[i] = std::min(lo[i], bins[b].lo[i]);
-            hi[i] = std::max(hi[i], bins[b].hi[i]);
-          }
+          cnt += counts[b];
+          acc.grow(bins[b].lo, bins[b].hi);
           if (cnt == 0 || cnt == n) continue;
-          const double cost = width(lo, hi) * cnt + right_cost[b + 1];
+          const double cost = acc.cost() * cnt + right_cost[b + 1];
           if (cost < best_cost) {
             best_cost = cost;
             best_axis = axis;
@@ -562,27 +652,93 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
                                     [&](const BuildItem& x) { return bin_of(x, best_axis) <= best_bin; }) -
                      items.begin());
     }
-    if (mid == begin || mid == end) {  // object median on the widest centre axis
+    if (mid == begin || mid == end) {  // object median on the widest key axis
       int axis = 0;
-      for (int i = 1; i < 4; ++i)
-        if (chi[i] - clo[i] > chi[axis] - clo[axis]) axis = i;
+      for (int i = 1; i < 6; ++i)
+        if (keys.hi[i] - keys.lo[i] > keys.hi[axis] - keys.lo[axis]) axis = i;
       mid = begin + n / 2;
       std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
-                       [axis](const BuildItem& x, const BuildItem& y) { return x.centre[axis] < y.centre[axis]; });
+                       [axis](const BuildItem& x, const BuildItem& y) { return x.key[axis] < y.key[axis]; });
     }
     self(self, begin, mid, depth + 1);
     const uint32_t right = self(self, mid, end, depth + 1);
-    nodes_[self_index].index = right;
-    nodes_[self_index].count = 0;
+    nodes[self_index].index = right;
+    nodes[self_index].count = 0;
     return self_index;
   };
   if (!items.empty()) build(build, 0, uint32_t(items.size()), 1);
-  stats_.bvh_nodes = nodes_.size();
+  collapse_wide(nodes);
+  // The walk's queue tags leaf blocks with bit 31.
+  PRT_CHECK(wide_.size() < (size_t(1) << 31) && blocks_.size() < (size_t(1) << 31));
+  // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
+  // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
+  // uf = 2⁻²⁴; 10uf, and δ_node rounded to float upward by the 1.01, cover it.
+  node_coef_ = 1.01 * 10 * 0x1p-24;
+  // Leaf values in float: |ĝ_f − ĝ| ≤ uf|ĝ| per component (|n| ≤ 1, |d| ≤ A), q rounded to
+  // float (uf|q_i|), and the float evaluation's γ₄: at most 6.01uf(|q|₁ + A); 8uf covers it.
+  record_coef_ = 1.01 * 8 * 0x1p-24;
+  node_const_ = c_max + d_max;
+  stats_.bvh_nodes = wide_.size();
   stats_.bvh_depth = max_depth;
 }
 
+// The binary tree as a 4-wide one: each wide node holds up to four children's bounds side by
+// side (one fetch tests them all, and a child that fails is never fetched). A node's children
+// are its binary children, the largest inner one (by records under it) replaced by its own two
+// children while fewer than four; empty slots have D = +∞ and never pass.
+void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
+  if (binary.empty()) return;
+  // Records under each binary node (leaf counts summed), for choosing which child to open.
+  std::vector<uint32_t> under(binary.size(), 0);
+  for (size_t i = binary.size(); i-- > 0;)
+    under[i] = binary[i].count ? binary[i].count : under[i + 1] + under[binary[i].index];
+  auto fill = [&](auto&& self, std::vector<uint32_t> slots, uint32_t at) -> void {
+    while (slots.size() < 4) {
+      int open = -1;
+      for (size_t k = 0; k < slots.size(); ++k)
+        if (binary[slots[k]].count == 0 && (open < 0 || under[slots[k]] > under[slots[size_t(open)]])) open = int(k);
+      if (open < 0) break;
+      const uint32_t b = slots[size_t(open)];
+      slots[size_t(open)] = b + 1;
+      slots.push_back(binary[b].index);
+    }
+    for (size_t k = 0; k < 4; ++k) {
+      WideNode& w = wide_[at];
+      if (k >= slots.size()) {
+        for (int i = 0; i < 3; ++i) w.c[i][k] = w.nlo[i][k] = w.nhi[i][k] = 0;
+        w.dlo[k] = w.dhi[k] = std::numeric_limits<float>::infinity();
+        w.child[k] = 0;
+        w.count[k] = 1;  // a leaf never entered
+        continue;
+      }
+      const Node& nd = binary[slots[k]];
+      for (int i = 0; i < 3; ++i) {
+        w.c[i][k] = nd.c[i];
+        w.nlo[i][k] = nd.nlo[i];
+        w.nhi[i][k] = nd.nhi[i];
+      }
+      w.dlo[k] = nd.dlo;
+      w.dhi[k] = nd.dhi;
+      w.count[k] = nd.count;
+      if (nd.count) {
+        w.child[k] = nd.index;
+      } else {
+        const uint32_t child = uint32_t(wide_.size());
+        wide_.emplace_back();
+        wide_[at].child[k] = child;
+        self(self, {slots[k] + 1, binary[slots[k]].index}, child);
+      }
+    }
+  };
+  wide_.emplace_back();
+  if (binary[0].count)
+    fill(fill, {0}, 0);
+  else
+    fill(fill, {1, binary[0].index}, 0);
+}
+
 size_t ContourFinder::edge_count() const { return topology_->edges.size(); }
-size_t ContourFinder::bvh_node_count() const { return nodes_.size(); }
+size_t ContourFinder::bvh_node_count() const { return wide_.size(); }
 
 int ContourFinder::side_sum_slow(uint32_t edge, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
                                  const Eigen::Vector3d* tie) const {
@@ -609,8 +765,25 @@ void ContourFinder::find_brute_force(const ShadePoint& point, std::vector<Contou
   }
 }
 
-void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out) const {
+void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out, ContourQueryStats* stats) const {
+  if (stats)
+    find_impl<true>(point, out, stats);
+  else
+    find_impl<false>(point, out, nullptr);
+}
+
+template <bool Count>
+void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>& out, ContourQueryStats* stats) const {
   out.clear();
+  ContourQueryStats work;
+  if constexpr (Count) work.queries = 1;
+  {  // A point beyond the float bounds' range (or not finite): every edge, the reference way.
+    const Eigen::Vector3d q = (point.p - origin_) * scale_;
+    if (!(std::abs(q.x()) + std::abs(q.y()) + std::abs(q.z()) < 1e30)) {
+      find_brute_force(point, out);
+      return;
+    }
+  }
   // Results go to a per-thread bitmap over the edges (plus their sums) and are read back in edge
   // order: O(K + E/64) instead of sorting K results found in leaf order. The buffers only grow.
   thread_local std::vector<uint64_t> tl_bits;
@@ -627,54 +800,89 @@ void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out)
   const double p[3] = {point.p.x(), point.p.y(), point.p.z()};
   const double nn[3] = {point.n.x(), point.n.y(), point.n.z()};
   const double* tt = tie_break(point) ? point.t.data() : nullptr;
-  for (const uint32_t e : always_) {
-    const int s = side_sum_slow(e, point.p, point.n, tie_break(point));
-    if (s != 0) emit(e, s);
+  if constexpr (Count) work.always = always_.size();
+  for (size_t i = 0, f = 0; i < always_.size(); ++i) {  // side_sum_slow from the stored corners
+    int s = 0;
+    for (; f < always_end_[i]; ++f) {
+      const AlwaysFace& af = always_faces_[f];
+      s += orient_eps_f(af.a, af.b, af.c, p, nn, tt);
+    }
+    if (s != 0) emit(always_[i], s);
   }
-  if (!nodes_.empty()) {
+  if (!wide_.empty()) {
     const double q[4] = {(p[0] - origin_.x()) * scale_, (p[1] - origin_.y()) * scale_, (p[2] - origin_.z()) * scale_,
                          1.0};
     const double delta = delta_coef_ * ((std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2])) + max_a_);
-    // Per axis: which box corner minimises q_i x_i.
-    const bool neg[3] = {q[0] < 0, q[1] < 0, q[2] < 0};
-    uint32_t stack[kMaxStack];
-    int sp = 0;
-    uint32_t ni = 0;
-    const Node* nodes = nodes_.data();
-    const Record* recs = records_.data();
-    for (;;) {
-      const Node& nd = nodes[ni];
-      const double lo0 = neg[0] ? nd.hi[0] : nd.lo[0], hi0 = neg[0] ? nd.lo[0] : nd.hi[0];
-      const double lo1 = neg[1] ? nd.hi[1] : nd.lo[1], hi1 = neg[1] ? nd.lo[1] : nd.hi[1];
-      const double lo2 = neg[2] ? nd.hi[2] : nd.lo[2], hi2 = neg[2] ? nd.lo[2] : nd.hi[2];
-      const double vmin = q[0] * lo0 + q[1] * lo1 + q[2] * lo2 + double(nd.lo[3]);
-      const double vmax = q[0] * hi0 + q[1] * hi1 + q[2] * hi2 + double(nd.hi[3]);
-      if (vmin <= delta && vmax >= -delta) {
-        if (nd.count == 0) {
-          stack[sp++] = nd.index;
-          ni = ni + 1;
-          continue;
-        }
-        const Record* r = recs + nd.index;
-        for (uint32_t k = 0; k < nd.count; ++k, ++r) {
-          const double v1 = r->g1[0] * q[0] + r->g1[1] * q[1] + r->g1[2] * q[2] + r->g1[3];
-          const double v2 = r->g2[0] * q[0] + r->g2[1] * q[1] + r->g2[2] * q[2] + r->g2[3];
-          // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ.
-          if ((v1 > delta && v2 > delta) || (v1 < -delta && v2 < -delta)) continue;
+    const float delta_rec =
+        float(delta + record_coef_ * ((std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2])) + max_a_));
+    // Node bounds in float (see node_coef_).
+    const float delta_node =
+        float(delta + node_coef_ * ((std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2])) + node_const_));
+    const f4 qx = splat(float(q[0])), qy = splat(float(q[1])), qz = splat(float(q[2]));
+    const f4 dn = splat(delta_node), dr = splat(delta_rec);
+    // Breadth-first: a FIFO of wide nodes and leaf blocks (bit 31), each prefetched when queued
+    // and read many steps later, so the walk streams memory instead of waiting on each fetch.
+    thread_local std::vector<uint32_t> tl_queue;
+    std::vector<uint32_t>& queue = tl_queue;
+    queue.clear();
+    queue.push_back(0);
+    const WideNode* wide = wide_.data();
+    const LeafBlock* blocks = blocks_.data();
+    constexpr uint32_t kLeafBit = 0x80000000u;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const uint32_t item = queue[head];
+      if (item & kLeafBit) {
+        const uint32_t block = item & ~kLeafBit;
+        if constexpr (Count) work.records += kLeafSize;
+        // Both face values of the leaf's four records at once; only undecided ones branch.
+        // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ_rec.
+        const LeafBlock& blk = blocks[block];
+        const f4 v1 = load(blk.g[0]) * qx + load(blk.g[1]) * qy + load(blk.g[2]) * qz + load(blk.g[3]);
+        const f4 v2 = load(blk.g[4]) * qx + load(blk.g[5]) * qy + load(blk.g[6]) * qz + load(blk.g[7]);
+        const i4 same = ((v1 > dr) & (v2 > dr)) | ((v1 < -dr) & (v2 < -dr));
+        for (unsigned live = ~lanes(same) & 0xFu; live != 0; live &= live - 1) {
+          const int j = std::countr_zero(live);
+          const size_t at = size_t(block) * kLeafSize + size_t(j);
           int s;
-          if (v1 > delta && v2 < -delta) {
+          if (v1[j] > delta_rec && v2[j] < -delta_rec) {
             s = -2;
-          } else if (v1 < -delta && v2 > delta) {
+          } else if (v1[j] < -delta_rec && v2[j] > delta_rec) {
             s = 2;
           } else {
-            const Corners& c = corners_[nd.index + k];
+            if constexpr (Count) ++work.exact;
+            const Corners& c = corners_[at];
             s = orient_eps_f(c.a, c.b, c.c1, p, nn, tt) + orient_eps_f(c.a, c.b, c.c2, p, nn, tt);
           }
-          if (s != 0) emit(corners_[nd.index + k].edge, s);
+          if (s != 0) emit(blk.edge[j], s);
+        }
+        continue;
+      }
+      const WideNode& w = wide[item];
+      if constexpr (Count) work.nodes += 4;
+      // Per child: the range of n·(q − c) + D over its box (per axis the smaller / larger
+      // product), four children at once.
+      f4 vmin = load(w.dlo), vmax = load(w.dhi);
+      const f4 q3[3] = {qx, qy, qz};
+      for (int i = 0; i < 3; ++i) {
+        const f4 x = q3[i] - load(w.c[i]);
+        const f4 a = x * load(w.nlo[i]), b = x * load(w.nhi[i]);
+        vmin += a < b ? a : b;
+        vmax += a < b ? b : a;
+      }
+      for (unsigned pass = lanes((vmin <= dn) & (vmax >= -dn)); pass != 0; pass &= pass - 1) {
+        const int k = std::countr_zero(pass);
+        const uint32_t child = w.child[k];
+        if (w.count[k] == 0) {
+          for (int line = 0; line < int(sizeof(WideNode)); line += 64)
+            __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + line);
+          queue.push_back(child);
+        } else {
+          __builtin_prefetch(blocks + child);
+          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 64);
+          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 128);
+          queue.push_back(child | kLeafBit);
         }
       }
-      if (sp == 0) break;
-      ni = stack[--sp];
     }
   }
   for (size_t w = 0; w < words; ++w) {
@@ -686,6 +894,13 @@ void ContourFinder::find(const ShadePoint& point, std::vector<ContourEdge>& out)
       out.push_back({e, sums[e]});
       b &= b - 1;
     } while (b != 0);
+  }
+  if constexpr (Count) {
+    stats->queries += work.queries;
+    stats->nodes += work.nodes;
+    stats->records += work.records;
+    stats->exact += work.exact;
+    stats->always += work.always;
   }
 }
 

@@ -3,6 +3,7 @@
 // hand-worked configurations.
 #include <bake/contour.h>
 #include <bake/mesh.h>
+#include <bake/subdivide.h>
 
 #include <gtest/gtest.h>
 
@@ -348,6 +349,55 @@ TEST(ContourFinder, MatchesBruteForceOnBunnyScaled1e4) {
   const Scene b = load("bunny.obj");
   expect_equal_to_brute_force(transformed(b.mesh, 1e-4, 0), 200, 5, "bunny*1e-4");
   expect_equal_to_brute_force(transformed(b.mesh, 1e-4, 1e3), 200, 6, "bunny*1e-4+1e3");
+}
+
+// Points the sampler above does not make, each compared with the brute force: on an edge
+// (midpoint and a point ¼ along it), on a face (centroid) and at a corner, with the face's
+// normal, the reversed normal and a random unit normal; and points so far away that the
+// finder's float bounds cannot hold their coordinates (it must then still be exact).
+void expect_equal_on_edges_faces_and_extremes(const Scene& s, int count, uint64_t seed, const char* what) {
+  const ContourFinder finder(s.mesh, s.topo);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0, 1);
+  const auto& wp = s.topo.welded_positions;
+  std::vector<ContourEdge> fast, slow;
+  auto check = [&](const Vector3d& p, const Vector3d& n) {
+    ShadePoint sp;
+    sp.p = p;
+    sp.n = n;
+    finder.find(sp, fast);
+    finder.find_brute_force(sp, slow);
+    ASSERT_EQ(fast, slow) << what << " at (" << p.transpose() << ") n (" << n.transpose() << ")";
+  };
+  for (int i = 0; i < count; ++i) {
+    const auto& t = s.mesh.triangles[size_t(U(rng) * double(s.mesh.triangles.size())) % s.mesh.triangles.size()];
+    const Vector3d a = s.mesh.positions[t[0]].cast<double>(), b = s.mesh.positions[t[1]].cast<double>(),
+                   c = s.mesh.positions[t[2]].cast<double>();
+    Vector3d fn = (b - a).cross(c - a);
+    fn = fn.norm() > 0 ? Vector3d(fn.normalized()) : Vector3d(0, 0, 1);
+    Vector3d rn(2 * U(rng) - 1, 2 * U(rng) - 1, 2 * U(rng) - 1);
+    rn = rn.norm() > 1e-3 ? Vector3d(rn.normalized()) : Vector3d(1, 0, 0);
+    for (const Vector3d& p : {Vector3d(0.5 * (a + b)), Vector3d(a + 0.25 * (b - a)), Vector3d((a + b + c) / 3.0), a})
+      for (const Vector3d& n : {fn, Vector3d(-fn), rn}) check(p, n);
+  }
+  const Vector3d centre = wp.empty() ? Vector3d(Vector3d::Zero()) : Vector3d(wp[0].cast<double>());
+  for (const double far : {1e20, 1e36, 1e300}) check(centre + Vector3d(far, -0.5 * far, 0.25 * far), Vector3d(0, 1, 0));
+}
+
+TEST(ContourFinder, MatchesBruteForceOnEdgesFacesAndFarPoints) {
+  expect_equal_on_edges_faces_and_extremes(load("bunny_ground.obj"), 60, 11, "bunny_ground");
+  const Scene b = load("bunny.obj");
+  expect_equal_on_edges_faces_and_extremes(transformed(b.mesh, 1, 1e5), 40, 12, "bunny+1e5");
+  expect_equal_on_edges_faces_and_extremes(transformed(b.mesh, 1e-4, 1e3), 40, 13, "bunny*1e-4+1e3");
+}
+
+// A finer mesh (a deeper tree, smaller nodes near the shade point) and the ground's coplanar
+// grid: vertex, off-surface, inside and far points, then edges and faces.
+TEST(ContourFinder, MatchesBruteForceOnSubdividedBunnyOnGround) {
+  Scene s{prt::bake::loop_subdivide(prt::bake::load_mesh(fs::path(PRT_DATA_DIR) / "bunny_ground.obj"), 1), {}};
+  s.topo = prt::bake::build_topology(s.mesh);
+  expect_equal_to_brute_force(s, 60, 14, "bunny_ground (loop x1)");
+  expect_equal_on_edges_faces_and_extremes(s, 15, 15, "bunny_ground (loop x1)");
 }
 
 // ------------------------------------------------------------ known cases
