@@ -154,6 +154,20 @@ void fit_line(const std::vector<double>& x, const std::vector<double>& t, double
   if (beta < 0) beta = 0, alpha = st / n;  // noise: cost does not fall with the knob
 }
 
+// A prediction at `knob`: the worst product's model error (levels/errors, rates in [lo, hi]) and
+// the cost per integral from a least-squares line through the measured (cost_knobs, us).
+void predict_at(Prediction& pr, uint32_t knob, const std::vector<double>& levels,
+                const std::vector<std::vector<double>>& errors, double lo, double hi,
+                const std::vector<double>& cost_knobs, const std::vector<double>& us) {
+  pr.knob = knob;
+  pr.predicted_error = 0;
+  for (size_t p = 0; p < errors.front().size(); ++p)
+    pr.predicted_error = std::max(pr.predicted_error, model_error(levels, errors, p, knob, lo, hi));
+  double alpha = 0, beta = 0;
+  fit_line(cost_knobs, us, alpha, beta);
+  pr.predicted_us_per_point = alpha + beta * knob;
+}
+
 std::string format(const char* fmt, double a, double b = 0, double c = 0, double d = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
@@ -246,13 +260,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     pr.reachable = need <= max_isolines;
     int N = int(std::ceil(std::min<double>(need, max_isolines) - 1e-9));
     N = std::max(kMinIsolines, N + (N & 1));  // even, as the integrator uses it
-    pr.knob = uint32_t(N);
-    double worst = 0;
-    for (size_t p = 0; p < products.size(); ++p) worst = std::max(worst, model_error(levels, errors, p, N, 0.5, 3.0));
-    pr.predicted_error = worst;
-    double alpha = 0, beta = 0;
-    fit_line(xs, ts, alpha, beta);
-    pr.predicted_us_per_point = alpha + beta * N;
+    predict_at(pr, uint32_t(N), levels, errors, 0.5, 3.0, xs, ts);
     choice.predictions.push_back(pr);
   }
   goal = options.safety_qmc * options.target;
@@ -300,20 +308,14 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       if (r.kind == IntegratorKind::Qmc) xs.push_back(r.knob), ts.push_back(r.cpu_us_per_point), errors.push_back(r.error);
     Prediction pr;
     pr.kind = IntegratorKind::Qmc;
-    double need = kMinRays, worst = 0;
+    double need = kMinRays;
     for (size_t p = 0; p < products.size(); ++p) {
       double rate = 0;
       const double r = knob_for(xs, errors, p, goal, 0.5, 1.0, rate);  // QMC: rates 0.5 to 1
       if (r > need) need = r, pr.exponent = rate;
     }
     pr.reachable = need <= kMaxRays;
-    const uint32_t R = round_up_rays(need);
-    pr.knob = R;
-    for (size_t p = 0; p < products.size(); ++p) worst = std::max(worst, model_error(xs, errors, p, R, 0.5, 1.0));
-    pr.predicted_error = worst;
-    double alpha = 0, beta = 0;
-    fit_line(xs, ts, alpha, beta);
-    pr.predicted_us_per_point = alpha + beta * R;
+    predict_at(pr, round_up_rays(need), xs, errors, 0.5, 1.0, xs, ts);
     choice.predictions.push_back(pr);
   }
   progress.finish();
