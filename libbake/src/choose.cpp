@@ -27,6 +27,16 @@ constexpr int kSilhouetteLevels[] = {16, 32, 64, 128};
 constexpr int kMinIsolines = 8;
 constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
 constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
+// Counted costs (ChooserOptions::counted_costs), µs per integral: the silhouette integrator per
+// contour edge (search ~0.045, arcs ~0.038) and per isoline crossing, QMC per ray, and setup in
+// seconds per triangle. Calibrated on this project's 2-core AMD EPYC machine
+// (bench/RESULTS.md: bench_integrators level 0 — contour 24 µs for 528 edges, integration
+// 24 → 156 µs from 99 to 3,187 crossings; bench_target_error's QMC sweeps, 0.49–0.58 µs per ray
+// on every asset; bench_contour's build, 1.5 s at 240k triangles). Large meshes cost the
+// silhouette integrator up to ~2x more per edge (its search is memory-bound there).
+constexpr double kCountedUsPerEdge = 0.083, kCountedUsPerCrossing = 0.043, kCountedUsPerRay = 0.5;
+constexpr double kCountedUsPerPoint = 3.0;
+constexpr double kCountedSetupPerTriangleSilhouette = 6e-6, kCountedSetupPerTriangleQmc = 2e-7;
 constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
 
 double thread_cpu_seconds() {
@@ -72,6 +82,17 @@ Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> p
   for (double s : seconds) sum += s;  // in index order: the same sum for any thread count
   rows.cpu_us_per_point = K ? 1e6 * sum / double(K) : 0.0;
   return rows;
+}
+
+// The cost per integral the choice uses: the measured CPU time, or (counted) the work the
+// integrator reports for the pilot points priced at the constants above.
+double cost_per_point(const Rows& rows, const Integrator& integrator, uint32_t knob, bool counted) {
+  if (!counted) return rows.cpu_us_per_point;
+  if (integrator.kind() == IntegratorKind::Qmc) return kCountedUsPerPoint + kCountedUsPerRay * knob;
+  const IntegratorStats st = integrator.stats();
+  const double n = double(std::max<uint64_t>(st.points, 1));
+  return kCountedUsPerPoint + kCountedUsPerEdge * double(st.contour_edges) / n +
+         kCountedUsPerCrossing * double(st.crossings) / n;
 }
 
 // Per product: RMSE of `rows` against `ref` in the target's units (bake/choose.h).
@@ -231,8 +252,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   const int ref_isolines = reference_isolines(options.target), max_isolines = ref_isolines;
   const auto reference = timed_build([&] { return silhouette(ref_isolines); }, setup_sil);
   const Rows ref = integrate_pilot(*reference, points, sample, progress);
-  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(ref_isolines),
-                         std::vector<double>(products.size(), 0.0), ref.cpu_us_per_point});
+  const bool counted = options.counted_costs;
+  choice.counted_costs = counted;
+  const double ref_us = cost_per_point(ref, *reference, uint32_t(ref_isolines), counted);
+  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(ref_isolines), std::vector<double>(products.size(), 0.0), ref_us});
 
   const double V = double(points.size());
   if (want_sil) {
@@ -244,10 +267,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       setup_sil = std::max(setup_sil, s);
       const Rows r = integrate_pilot(*integrator, points, sample, progress);
       choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(N), pilot_errors(r.values, ref.values, W, products),
-                             r.cpu_us_per_point});
-      xs.push_back(N), ts.push_back(r.cpu_us_per_point), errors.push_back(choice.runs.back().error);
+                             cost_per_point(r, *integrator, uint32_t(N), counted)});
+      xs.push_back(N), ts.push_back(choice.runs.back().cpu_us_per_point), errors.push_back(choice.runs.back().error);
     }
-    xs.push_back(ref_isolines), ts.push_back(ref.cpu_us_per_point);
+    xs.push_back(ref_isolines), ts.push_back(ref_us);
     Prediction pr;
     pr.kind = IntegratorKind::Silhouette;
     double need = kMinIsolines;
@@ -287,8 +310,9 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
           timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}); }, s);
       setup_qmc = std::max(setup_qmc, s);
       const Rows r = integrate_pilot(*integrator, points, sample, progress);
-      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref.values, W, products), r.cpu_us_per_point});
-      xs.push_back(R), ts.push_back(r.cpu_us_per_point), errors.push_back(choice.runs.back().error);
+      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref.values, W, products),
+                             cost_per_point(r, *integrator, R, counted)});
+      xs.push_back(R), ts.push_back(choice.runs.back().cpu_us_per_point), errors.push_back(choice.runs.back().error);
     }
     Prediction pr;
     pr.kind = IntegratorKind::Qmc;
@@ -321,6 +345,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   progress.finish();
 
   // The cheaper reachable prediction, by CPU seconds for the whole bake (setup + V integrals).
+  if (counted) {
+    setup_sil = kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
+    setup_qmc = kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
+  }
   auto cost = [&](const Prediction& p) {
     return (p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) + V * p.predicted_us_per_point * 1e-6;
   };
@@ -368,7 +396,7 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
                 std::to_string(c.runs.empty() ? 0u : c.runs.front().knob) + "-isoline silhouette reference:");
   char buf[512];
   std::string head;
-  std::snprintf(buf, sizeof buf, "  %-10s %10s %12s", "integrator", "knob", "µs/integral");
+  std::snprintf(buf, sizeof buf, "  %-10s %10s %12s", "integrator", "knob", c.counted_costs ? "µs counted" : "µs/integral");
   head = buf;
   for (Product p : c.products) {
     std::snprintf(buf, sizeof buf, " %20s", product_label(p));
@@ -397,7 +425,9 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
     out.push_back(buf);
   }
   out.push_back("chosen: " + c.reason);
-  if (c.margin > 0 && c.margin < 1.25)
+  if (c.counted_costs)
+    out.push_back("  (costs counted from the pilot's work, not timed: the choice is a function of the inputs and the seed)");
+  else if (c.margin > 0 && c.margin < 1.25)
     out.push_back(std::string("  (a close call: another run may time it the other way; pin it with integrator ") +
                   to_string(c.spec.kind) + ", samples " + std::to_string(c.spec.samples()) + " for the same bytes everywhere)");
   return out;

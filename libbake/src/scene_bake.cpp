@@ -94,6 +94,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ChooserOptions copt;
       copt.target = scene.target_error;
       if (scene.integrator_given) copt.only = scene.integrator.kind;
+      copt.counted_costs = scene.counted_costs;
       ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor);
       ob.integrator = ob.choice->spec;
       for (const std::string& line : choice_lines(*ob.choice)) log(scene.objects[i].name + ": " + line);

@@ -125,6 +125,34 @@ TEST(Choose, TighterTargetsAskForMoreSamplesAndTheKnobsAreAFunctionOfTheInputs) 
   EXPECT_EQ(s1.spec.isolines() % 2, 0);
 }
 
+TEST(Choose, CountedCostsMakeTheWholeChoiceAFunctionOfTheInputs) {
+  // With counted costs every number the choice uses is counted work (contour edges, crossings,
+  // rays) priced at fixed constants: two runs agree to the bit, costs included, whatever the
+  // machine's load or thread count.
+  const Asset& a = bunny_ground();
+  ProductRequest r;
+  r.ao = true;
+  ChooserOptions opt;
+  opt.counted_costs = true;
+  const IntegratorChoice c1 = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  const IntegratorChoice c2 = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  EXPECT_TRUE(c1.counted_costs);
+  EXPECT_EQ(c1.spec.kind, c2.spec.kind);
+  EXPECT_EQ(c1.spec.samples(), c2.spec.samples());
+  ASSERT_EQ(c1.runs.size(), c2.runs.size());
+  for (size_t i = 0; i < c1.runs.size(); ++i) {
+    EXPECT_EQ(c1.runs[i].cpu_us_per_point, c2.runs[i].cpu_us_per_point) << i;
+    // QMC's counted cost is 3 µs per point plus 0.5 µs per ray (choose.cpp).
+    if (c1.runs[i].kind == IntegratorKind::Qmc) {
+      EXPECT_EQ(c1.runs[i].cpu_us_per_point, 3.0 + 0.5 * c1.runs[i].knob);
+    }
+  }
+  ASSERT_EQ(c1.predictions.size(), c2.predictions.size());
+  for (size_t i = 0; i < c1.predictions.size(); ++i)
+    EXPECT_EQ(c1.predictions[i].predicted_us_per_point, c2.predictions[i].predicted_us_per_point) << i;
+  EXPECT_EQ(c1.reason, c2.reason);
+}
+
 TEST(Choose, TargetsOutsideTheRangeAreInputErrors) {
   const Asset& a = bunny_ground();
   ProductRequest r;

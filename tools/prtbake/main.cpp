@@ -164,7 +164,10 @@ void add_run_options(CLI::App& cmd, Args& a) {
                "make the file a pure function of the inputs: 'created' is pinned to\n"
                "SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not\n"
                "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).\n"
-               "The baked values are identical with or without it.");
+               "With a target error (the default), the integrator is chosen by the\n"
+               "pilot's counted work instead of its measured time, so the choice,\n"
+               "and the bytes, are the same on any machine. With --samples the\n"
+               "baked values are identical with or without it.");
   cmd.add_flag("-q,--quiet", a.quiet, "print nothing but warnings (about the input) and errors.");
 }
 
@@ -538,6 +541,7 @@ int run_vertex(const Args& a) {
     bake::ChooserOptions copt;
     copt.target = a.target_error;
     if (a.integrator_given) copt.only = a.integrator.kind;
+    copt.counted_costs = a.reproducible;  // the same choice, and bytes, on any machine
     const bake::IntegratorChoice choice =
         bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req, a.integrator, copt, progress);
     spec = choice.spec;
@@ -673,6 +677,7 @@ int run_scene(const Args& a) {
   bake::SceneDescription scene = bake::load_scene(
       a.input, a.scene_options.empty() ? std::nullopt : std::optional<fs::path>(a.scene_options));
   if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
+  scene.counted_costs = a.reproducible;  // a target's choice by counted work: the same on any machine
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
 

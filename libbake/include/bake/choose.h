@@ -42,7 +42,8 @@
 // may choose differently and then bake different (each correct to E) values. The choice is
 // printed and stored in the file (its integrator and samples); pinning it (--integrator K
 // --samples N) gives the same bytes on any machine. IntegratorChoice::margin says how close it
-// was.
+// was. With counted_costs (prtbake --reproducible, SOURCE_DATE_EPOCH) every cost is priced
+// work instead of time and the whole choice is a function of the inputs and the seed.
 #pragma once
 
 #include <bake/integrator.h>
@@ -75,6 +76,12 @@ struct ChooserOptions {
   // sample RMSE: measured on 128 other vertices it came out up to 1.36x the pilot's prediction,
   // bench/RESULTS.md "bench_target_error"); QMC's is noise spread over every vertex (0.9-1.05x).
   double safety_silhouette = 0.7, safety_qmc = 0.8;
+  // Price each integral by counted work (the silhouette integrator's contour edges and
+  // crossings per point, QMC's rays; fixed per-unit costs calibrated on the project's machine,
+  // choose.cpp) instead of measured CPU time, so the whole choice is a function of the inputs
+  // and the seed: same bytes on any machine (prtbake sets it with --reproducible). Within
+  // ~2x of the measured costs (memory-bound searches on large meshes are dearer per edge).
+  bool counted_costs = false;
 };
 
 // One pilot run: an integrator at one knob on the pilot points.
@@ -82,7 +89,7 @@ struct PilotRun {
   IntegratorKind kind = IntegratorKind::Silhouette;
   uint32_t knob = 0;                 // N u-isolines (silhouette) or rays (QMC)
   std::vector<double> error;         // per product (IntegratorChoice::products): RMSE in E's units
-  double cpu_us_per_point = 0;       // mean CPU time of one integral
+  double cpu_us_per_point = 0;       // mean CPU time of one integral (counted: its priced work)
 };
 
 // A kind's prediction at the knob the model chose for it.
@@ -108,6 +115,7 @@ struct IntegratorChoice {
   double margin = 0;                 // predicted cost of the other kind / the chosen one's (0: one kind)
   size_t pilot_points = 0;
   double pilot_seconds = 0;          // wall time of the whole pilot
+  bool counted_costs = false;        // PilotRun::cpu_us_per_point holds counted costs
   std::string reason;                // one line: why this integrator
 };
 

@@ -129,6 +129,7 @@ struct SceneDescription {
   IntegratorSpec integrator;
   bool integrator_given = false;  // "integrator" was in the file
   double target_error = 0;        // "target_error" (0: not given; bake/choose.h)
+  bool counted_costs = false;     // not in the file: the tool's --reproducible (ChooserOptions)
   double sh_tolerance = 0.01;
   bool relight = false;
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
