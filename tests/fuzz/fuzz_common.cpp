@@ -2,7 +2,10 @@
 #include "fuzz_common.h"
 
 #include <cxxabi.h>
+#include <signal.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <cstdio>
 #include <cstdlib>
@@ -28,6 +31,23 @@ void remove_scratch() {
   fs::remove_all(scratch_dir(), ec);
 }
 
+// Scratch directories of dead processes: a finding aborts and a timeout exits without running
+// atexit, so each left its "prt-fuzz.<pid>" behind (30 after one fork-mode campaign).
+void remove_stale_scratch(const fs::path& base) {
+  std::error_code ec;
+  for (fs::directory_iterator it(base, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind("prt-fuzz.", 0) != 0) continue;
+    char* stop = nullptr;
+    const long pid = std::strtol(name.c_str() + 9, &stop, 10);
+    if (pid <= 0 || *stop != '\0' || pid == long(::getpid())) continue;
+    if (::kill(pid_t(pid), 0) != 0 && errno == ESRCH) {
+      std::error_code rm;
+      fs::remove_all(it->path(), rm);
+    }
+  }
+}
+
 std::string type_name(const std::exception& e) {
   int status = 0;
   std::unique_ptr<char, void (*)(void*)> name(abi::__cxa_demangle(typeid(e).name(), nullptr, nullptr, &status), std::free);
@@ -38,6 +58,7 @@ std::string type_name(const std::exception& e) {
 
 const fs::path& scratch_dir() {
   static const fs::path dir = [] {
+    remove_stale_scratch(scratch_base());
     const fs::path d = scratch_base() / ("prt-fuzz." + std::to_string(::getpid()));
     std::error_code ec;
     fs::create_directories(d, ec);

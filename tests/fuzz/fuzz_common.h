@@ -9,7 +9,8 @@
 // sanitizer reports, timeouts and allocations over -malloc_limit_mb are libFuzzer's own findings.
 //
 // Readers that only take a path get the bytes as a file in this process's own scratch directory
-// ($TMPDIR, else /dev/shm, else /tmp: "prt-fuzz.<pid>"), removed when the process exits; the
+// ($TMPDIR, else /dev/shm, else /tmp: "prt-fuzz.<pid>"), removed when the process exits (and, when
+// the next one starts, if the process died without exiting); the
 // same name is reused for every input.
 #pragma once
 
