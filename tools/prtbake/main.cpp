@@ -240,13 +240,15 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "and its samples chosen for you, the cheapest bake whose RMSE is\n"
                  "at most E per product (AO, transfer: absolute; band-1\n"
                  "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
-                 "(both integrators timed and their errors measured against a\n"
-                 "256- or 512-isoline silhouette reference). E in [1e-4, 0.1].\n"
+                 "(both integrators timed, or their work counted with --reproducible,\n"
+                 "and their errors measured against a 256- or 512-isoline silhouette\n"
+                 "reference). E in [1e-4, 0.1].\n"
                  "With --integrator, only its samples are chosen; not with --samples.\n"
                  "The choice is printed; the error report (on 128 vertices when\n"
                  "--target-error is given, unless --report says otherwise) then\n"
                  "checks E. Which integrator wins is measured speed: pin the printed\n"
-                 "choice with --integrator and --samples for the same bytes anywhere.")
+                 "choice with --integrator and --samples, or use --reproducible, for\n"
+                 "the same bytes anywhere.")
       ->option_text("E")
       ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
