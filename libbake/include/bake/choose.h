@@ -24,7 +24,7 @@
 //     the smallest even N with RMSE <= 0.7·E
 //     (ChooserOptions: the safety factors);
 //  3. QMC at 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
-//     goal): the same against the reference; RMSE(R) = C R^-b with b fitted between the levels
+//     goal, 0.8·E for QMC): the same against the reference; RMSE(R) = C R^-b with b fitted between the levels
 //     that bracket the goal (the last two when none meets it) and clamped to [0.5, 1]
 //     (randomised QMC converges between the Monte Carlo rate 1/2 and 1; ~0.7 on the bunny),
 //     solved for the rays, rounded up to an eighth of an octave (randomised Halton points
@@ -33,7 +33,8 @@
 //     silhouette prediction (QMC cannot win then: more rays cost more);
 //  4. costs: the CPU time of every pilot integral (each thread's own CPU clock, so the thread
 //     count does not enter), per point; silhouette cost(N) linear in N through the measured
-//     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays.
+//     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays;
+//     with counted_costs, the pilot's counted work priced at fixed constants instead (below).
 // The cheaper prediction wins. With `only` set (the user named an integrator), only its knob is
 // chosen.
 //
