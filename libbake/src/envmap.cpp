@@ -29,8 +29,8 @@
 #include <limits>
 #include <new>
 #include <sstream>
-#include <vector>
 #include <string_view>
+#include <vector>
 
 namespace prt::bake {
 namespace {
@@ -61,13 +61,16 @@ double max_compression_ratio(Imf::Compression c) {
     default: return std::numeric_limits<double>::infinity();
   }
 }
-// The header's attribute list, walked before OpenEXR sees the file (OpenEXR file layout: magic
-// 20000630, a version word whose bit 0x400 allows names of 255 bytes instead of 31 and whose bit
-// 0x1000 makes the file multi-part, then per header attributes "name\0type\0" + int32 size +
-// value, ended by an empty name; a multi-part file's header list ends with an empty header).
-// OpenEXR allocates an attribute's claimed size before it reads it, so a 1 KB file claiming a
-// 1.7 GB attribute cost 1.7 GB and seconds; here every size must fit in the bytes that follow.
-// Then the image's size and (single-part scanline images) its chunk table, below.
+
+// w × h pixels within [1, kMaxPixels].
+void check_image_size(int64_t w, int64_t h, const std::string& file) {
+  if (w < 1 || h < 1 || w * h > kMaxPixels) {
+    std::ostringstream os;
+    os << "unsupported image size " << w << "x" << h << " (at most " << kMaxPixels << " pixels)";
+    throw InputError(file, os.str());
+  }
+}
+
 // The byte size of OpenEXR's fixed-size attribute types (its standard attribute types), -1 for
 // the others (string, chlist, preview, stringvector and unknown types).
 int fixed_size_of(const std::string& type) {
@@ -110,6 +113,13 @@ bool typed_value_fits(const std::string& type, const unsigned char* b, size_t n,
   }
 }
 
+// The header's attribute list, walked before OpenEXR sees the file (OpenEXR file layout: magic
+// 20000630, a version word whose bit 0x400 allows names of 255 bytes instead of 31 and whose bit
+// 0x1000 makes the file multi-part, then per header attributes "name\0type\0" + int32 size +
+// value, ended by an empty name; a multi-part file's header list ends with an empty header).
+// OpenEXR allocates an attribute's claimed size before it reads it, so a 1 KB file claiming a
+// 1.7 GB attribute cost 1.7 GB and seconds; here every size must fit in the bytes that follow.
+// Then the image's size and (single-part scanline images) its chunk table, below.
 void check_exr_header(const std::filesystem::path& path, const std::string& file) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
@@ -196,11 +206,7 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
   // compression's largest ratio, before OpenEXR sizes its line buffers by them (a 206-byte header
   // of 8.3M × 8 pixels made it allocate and clear 2 GB).
   const int64_t w = int64_t(window[2]) - window[0] + 1, h = int64_t(window[3]) - window[1] + 1;
-  if (w < 1 || h < 1 || w * h > kMaxPixels) {
-    std::ostringstream os;
-    os << "unsupported image size " << w << "x" << h << " (at most " << kMaxPixels << " pixels)";
-    throw InputError(file, os.str());
-  }
+  check_image_size(w, h, file);
   double raw_bytes = 0;  // of every channel, whose compressed data the file must hold
   for (size_t i = 0; i < channel_list.size() && channel_list[i] != 0;) {  // entries as typed_value_fits checked them
     while (channel_list[i] != 0) ++i;
@@ -443,11 +449,7 @@ EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, U
     const Imf::Header& hdr = in.header();
     const Imath::Box2i dw = hdr.dataWindow();
     const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1, h64 = int64_t(dw.max.y) - dw.min.y + 1;
-    if (w64 < 1 || h64 < 1 || w64 * h64 > kMaxPixels) {
-      std::ostringstream os;
-      os << "unsupported image size " << w64 << "x" << h64 << " (at most " << kMaxPixels << " pixels)";
-      throw InputError(file, os.str());
-    }
+    check_image_size(w64, h64, file);  // again: OpenEXR's window is the one read from here on
     W = int(w64), H = int(h64);
     std::ostringstream shape;
     shape << W << "x" << H;
