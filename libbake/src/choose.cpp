@@ -45,20 +45,6 @@ double thread_cpu_seconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
-struct ProductSlice {
-  Product product;
-  size_t offset, count;
-};
-
-std::vector<ProductSlice> slices(const ProductLayout& L) {
-  std::vector<ProductSlice> s;
-  if (L.ao_count) s.push_back({Product::Ao, L.ao, L.ao_count});
-  if (L.transfer_count) s.push_back({Product::TransferDiffuse, L.transfer, L.transfer_count});
-  if (L.visibility_count) s.push_back({Product::TransferVisibility, L.visibility, L.visibility_count});
-  if (L.radiance_count) s.push_back({Product::RadianceBand1, L.radiance, L.radiance_count});
-  return s;
-}
-
 // Rows of one integrator at the pilot points, and the mean CPU time per integral.
 struct Rows {
   std::vector<double> values;
@@ -201,12 +187,6 @@ std::string knob_text(IntegratorKind kind, uint32_t knob) {
 
 } // namespace
 
-std::vector<Product> requested_products(const ProductRequest& request) {
-  std::vector<Product> out;
-  for (const ProductSlice& s : slices(ProductLayout(request))) out.push_back(s.product);
-  return out;
-}
-
 double error_in_target_units(const ProductError& e) {
   if (e.product != Product::RadianceBand1) return e.rmse;
   return e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0;
@@ -224,7 +204,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   IntegratorChoice choice;
   choice.target = options.target;
   choice.spec = base;
-  const std::vector<ProductSlice> products = slices(ProductLayout(request));
+  const std::vector<ProductSlice> products = product_slices(ProductLayout(request));
   for (const ProductSlice& p : products) choice.products.push_back(p.product);
   // A sixteenth of the points, at least 32 and at most pilot_points: on small objects the pilot
   // must not cost more than the bake it tunes.

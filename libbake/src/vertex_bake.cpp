@@ -158,7 +158,6 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
   report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   auto add = [&](Product product, size_t offset, size_t count) {
-    if (count == 0) return;
     ProductError e;
     e.product = product;
     double se2 = 0, bse2 = 0, err2 = 0, r2 = 0;
@@ -181,11 +180,17 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
     e.bake_std_error = std::sqrt(bse2 / n);
     report.products.push_back(e);
   };
-  add(Product::Ao, L.ao, L.ao_count);
-  add(Product::TransferDiffuse, L.transfer, L.transfer_count);
-  add(Product::TransferVisibility, L.visibility, L.visibility_count);
-  add(Product::RadianceBand1, L.radiance, L.radiance_count);
+  for (const ProductSlice& slice : product_slices(L)) add(slice.product, slice.offset, slice.count);
   return report;
+}
+
+std::vector<ProductSlice> product_slices(const ProductLayout& L) {
+  std::vector<ProductSlice> s;
+  if (L.ao_count) s.push_back({Product::Ao, L.ao, L.ao_count});
+  if (L.transfer_count) s.push_back({Product::TransferDiffuse, L.transfer, L.transfer_count});
+  if (L.visibility_count) s.push_back({Product::TransferVisibility, L.visibility, L.visibility_count});
+  if (L.radiance_count) s.push_back({Product::RadianceBand1, L.radiance, L.radiance_count});
+  return s;
 }
 
 const char* product_label(Product product) {

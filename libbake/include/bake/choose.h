@@ -137,9 +137,6 @@ std::vector<std::string> choice_lines(const IntegratorChoice& choice);
 // noise (which the measured RMSE includes, in the same units) is at least E/2.
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target);
 
-// The products a request bakes, in row order (AO, diffuse transfer, visibility transfer, band-1).
-std::vector<Product> requested_products(const ProductRequest& request);
-
 // The report's error of `product` in the target's units (the file comment): RMSE, or RMSE / RMS of
 // the reference for band-1 radiance.
 double error_in_target_units(const ProductError& error);

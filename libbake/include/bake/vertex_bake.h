@@ -69,6 +69,14 @@ FlipProbe probe_flipped_normals(const Mesh& mesh, const Topology& topology, cons
 enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1 };
 const char* product_label(Product product);  // "AO", "diffuse transfer", ... (for logs)
 
+// Where each product a layout holds lies in a row, in row order (AO, diffuse transfer,
+// visibility transfer, band-1 radiance); products the layout does not hold are left out.
+struct ProductSlice {
+  Product product;
+  size_t offset, count;
+};
+std::vector<ProductSlice> product_slices(const ProductLayout& layout);
+
 struct ProductError {
   Product product = Product::Ao;
   size_t values = 0;                // numbers compared
