@@ -153,6 +153,25 @@ TEST(Choose, CountedCostsMakeTheWholeChoiceAFunctionOfTheInputs) {
   EXPECT_EQ(c1.reason, c2.reason);
 }
 
+TEST(Choose, TheTargetCheckSaysMetNotMetOrNotVerifiable) {
+  // E = 1e-3: band-1 is judged relative to the reference's RMS, noise in the same units; a value
+  // above E is "not verifiable here" when the reference's own noise is at least E/2.
+  ErrorReport report;
+  ProductError ao;
+  ao.product = Product::Ao, ao.rmse = 9e-4, ao.reference_std_error = 5e-3;  // met, whatever the noise
+  ProductError t;
+  t.product = Product::TransferDiffuse, t.rmse = 2e-3, t.reference_std_error = 4e-4;  // noise < E/2
+  ProductError r;
+  r.product = Product::RadianceBand1, r.rmse = 3.0, r.reference_rms = 1000, r.reference_std_error = 0.5;  // 3e-3, noise 5e-4
+  report.products = {ao, t, r};
+  const std::vector<std::string> lines = target_check_lines(report, 1e-3);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[0].find("for AO: met (9.000e-04"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find("for diffuse transfer: NOT met (2.000e-03"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find("for band-1 radiance: not verifiable here (3.000e-03 relative"), std::string::npos) << lines[2];
+  EXPECT_NE(lines[2].find("is 5.0e-04: too noisy to tell"), std::string::npos) << lines[2];
+}
+
 TEST(Choose, TargetsOutsideTheRangeAreInputErrors) {
   const Asset& a = bunny_ground();
   ProductRequest r;

@@ -162,7 +162,7 @@ TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
   const fs::path out = scratch("talk.prt.h5");
   const Outcome r = run("vertex " + (kData / "bunny.obj").string() + " --ao --samples 32 --report 8 -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* s : {"1839 vertices", "3674 triangles", "baked 1839 vertices in", "RMSE", "wrote"})
+  for (const char* s : {"1839 vertices", "3674 triangles", "baked 1839 vertices in", "RMSE", "wrote", "; peak memory "})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
 }
 
