@@ -23,7 +23,12 @@ namespace {
 // is under a tenth of the aim 0.7·E; its isoline tables take 8 ms to build against 190 ms at 512,
 // bench/RESULTS.md bench_integrators), 512 below.
 int reference_isolines(double target) { return target >= 5e-4 ? 256 : 512; }
-constexpr int kSilhouetteLevels[] = {16, 32, 64, 128};
+// The silhouette levels: 32 and 64 always; 16 only when some product already meets the goal at
+// 32 (its bracket is then [16, 32]), 128 only when some product still misses it at 64 (its
+// bracket is [64, 128]). Every product's bracket is the one all four levels would give; the
+// levels that bracket nothing are not run (on most assets E = 1e-3 falls between 32 and 64).
+constexpr int kSilhouetteLow = 16, kSilhouetteFirst[] = {32, 64}, kSilhouetteHigh = 128;
+constexpr size_t kSilhouetteMaxLevels = std::size(kSilhouetteFirst) + 2;
 constexpr int kMinIsolines = 8;
 constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
 constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
@@ -215,7 +220,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   double goal = options.safety_silhouette * options.target;
   const bool want_sil = !options.only || *options.only == IntegratorKind::Silhouette;
   const bool want_qmc = !options.only || *options.only == IntegratorKind::Qmc;
-  const size_t runs = 1 + (want_sil ? std::size(kSilhouetteLevels) : 0) + (want_qmc ? std::size(kQmcLevels) : 0);
+  const size_t runs = 1 + (want_sil ? kSilhouetteMaxLevels : 0) + (want_qmc ? std::size(kQmcLevels) : 0);
   Task progress(monitor, "pilot", runs * sample.size());
 
   // Setup (BVHs, tables) is part of a bake's cost: measured per integrator build, wall time.
@@ -239,16 +244,27 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 
   const double V = double(points.size());
   if (want_sil) {
-    std::vector<double> xs, ts;
-    std::vector<std::vector<double>> errors;
-    for (int N : kSilhouetteLevels) {
+    std::vector<PilotRun> levels_run;  // ascending N
+    auto run_level = [&](int N) {
       double s = 0;
       const auto integrator = timed_build([&] { return silhouette(N); }, s);
       setup_sil = std::max(setup_sil, s);
       const Rows r = integrate_pilot(*integrator, points, sample, progress);
-      choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(N), pilot_errors(r.values, ref.values, W, products),
-                             cost_per_point(r, *integrator, uint32_t(N), counted)});
-      xs.push_back(N), ts.push_back(choice.runs.back().cpu_us_per_point), errors.push_back(choice.runs.back().error);
+      PilotRun run{IntegratorKind::Silhouette, uint32_t(N), pilot_errors(r.values, ref.values, W, products),
+                   cost_per_point(r, *integrator, uint32_t(N), counted)};
+      const auto at = std::find_if(levels_run.begin(), levels_run.end(), [&](const PilotRun& x) { return x.knob > run.knob; });
+      levels_run.insert(at, std::move(run));
+    };
+    for (int N : kSilhouetteFirst) run_level(N);
+    auto any_product = [&](const PilotRun& r, auto&& test) { return std::any_of(r.error.begin(), r.error.end(), test); };
+    if (any_product(levels_run.front(), [&](double e) { return e <= goal; })) run_level(kSilhouetteLow);
+    if (any_product(levels_run.back(), [&](double e) { return e > goal; })) run_level(kSilhouetteHigh);
+    progress.advance(sample.size() * (kSilhouetteMaxLevels - levels_run.size()));  // the levels not run
+    std::vector<double> xs, ts;
+    std::vector<std::vector<double>> errors;
+    for (const PilotRun& r : levels_run) {
+      choice.runs.push_back(r);
+      xs.push_back(r.knob), ts.push_back(r.cpu_us_per_point), errors.push_back(r.error);
     }
     xs.push_back(ref_isolines), ts.push_back(ref_us);
     Prediction pr;

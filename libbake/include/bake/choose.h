@@ -18,7 +18,8 @@
 //     error against time): ~6e-5 AO RMSE on the bunny at 256, ~3e-5 at 512, a tenth or less of
 //     the aim (the error report, against QMC, verifies the bake); the silhouette knob is capped
 //     at N_ref;
-//  2. silhouette at N = 16, 32, 64, 128: the RMSE against the reference per product; the model
+//  2. silhouette at N = 32 and 64, then 16 if a product already meets the goal at 32 and 128 if
+//     one still misses it at 64: the RMSE against the reference per product; the model
 //     RMSE(N) = C N^-a through the two levels that bracket the goal (the first level that meets
 //     it and the one before; the last two when none does), a clamped to [0.5, 3], solved for
 //     the smallest even N with RMSE <= 0.7·E
