@@ -199,7 +199,7 @@ double error_in_target_units(const ProductError& e) {
 
 IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                    const ProductRequest& request, const IntegratorSpec& base,
-                                   const ChooserOptions& options, const Monitor& monitor) {
+                                   const ChooserOptions& options, const Monitor& monitor, const MeshAccel* accel) {
   if (!(options.target >= ChooserOptions::kMinTarget && options.target <= ChooserOptions::kMaxTarget))
     throw InputError("", format("target error %g outside [%g, %g]", options.target, ChooserOptions::kMinTarget,
                                 ChooserOptions::kMaxTarget));
@@ -223,15 +223,22 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   const size_t runs = 1 + (want_sil ? kSilhouetteMaxLevels : 0) + (want_qmc ? std::size(kQmcLevels) : 0);
   Task progress(monitor, "pilot", runs * sample.size());
 
-  // Setup (BVHs, tables) is part of a bake's cost: measured per integrator build, wall time.
+  // Setup is part of a bake's cost: measured per integrator build (its tables), wall time. The
+  // trees are built once for every pilot integrator, timed apart: a bake given the same `accel`
+  // reuses them, one without rebuilds them (the silhouette integrator both, QMC the ray scene).
   auto timed_build = [](auto&& make, double& seconds) {
     const auto t0 = std::chrono::steady_clock::now();
-    auto integrator = make();
+    auto result = make();
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return integrator;
+    return result;
   };
+  const MeshAccel own_accel(mesh, topology);
+  const MeshAccel* shared = accel ? accel : &own_accel;
+  double rays_seconds = 0, contours_seconds = 0;
+  timed_build([&] { return shared->rays(); }, rays_seconds);
+  timed_build([&] { return shared->contours(); }, contours_seconds);  // the reference is a silhouette integrator
   auto silhouette = [&](int isolines) {
-    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{isolines, base.seed});
+    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{isolines, base.seed}, shared);
   };
   double setup_sil = 0, setup_qmc = 0;
   const int ref_isolines = reference_isolines(options.target), max_isolines = ref_isolines;
@@ -303,7 +310,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       }
       double s = 0;
       const auto integrator =
-          timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}); }, s);
+          timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}, shared); }, s);
       setup_qmc = std::max(setup_qmc, s);
       const Rows r = integrate_pilot(*integrator, points, sample, progress);
       choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref.values, W, products),
@@ -342,8 +349,12 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 
   // The cheaper reachable prediction, by CPU seconds for the whole bake (setup + V integrals).
   if (counted) {
-    setup_sil = kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
-    setup_qmc = kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
+    // Counted setup is the trees' (calibrated on whole builds): none when the bake reuses them.
+    setup_sil = accel ? 0.0 : kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
+    setup_qmc = accel ? 0.0 : kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
+  } else if (!accel) {
+    setup_sil += rays_seconds + contours_seconds;
+    setup_qmc += rays_seconds;
   }
   auto cost = [&](const Prediction& p) {
     return (p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) + V * p.predicted_us_per_point * 1e-6;

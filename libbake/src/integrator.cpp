@@ -31,19 +31,21 @@ int silhouette_isolines(uint32_t k) { return std::max(2, int(std::lround(std::sq
 uint64_t IntegratorSpec::reference_seed() const { return mix64(seed ^ 0x7265666572656e63ull); }
 
 std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
-                                            const ProductRequest& request) {
+                                            const ProductRequest& request, const MeshAccel* accel) {
   switch (spec.kind) {
-  case IntegratorKind::Qmc: return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.qmc_rays, spec.seed});
+  case IntegratorKind::Qmc:
+    return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.qmc_rays, spec.seed}, accel);
   case IntegratorKind::Silhouette:
-    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{spec.isolines(), spec.seed});
+    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{spec.isolines(), spec.seed}, accel);
   }
   PRT_CHECK(false);
   return nullptr;
 }
 
 std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
-                                           const ProductRequest& request) {
-  return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.reference_rays(), spec.reference_seed()});
+                                           const ProductRequest& request, const MeshAccel* accel) {
+  return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.reference_rays(), spec.reference_seed()},
+                                         accel);
 }
 
 } // namespace prt::bake

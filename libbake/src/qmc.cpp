@@ -19,7 +19,7 @@ using Eigen::Vector3d;
 // ---- integrator ---------------------------------------------------------------------------
 
 QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
-                             const QmcOptions& options)
+                             const QmcOptions& options, const MeshAccel* accel)
     : mesh_(mesh), topo_(topology), request_(request), layout_(request), options_(options) {
   PRT_CHECK(options.rays > 0);
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
@@ -36,7 +36,8 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
   }
   sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0});
   PRT_CHECK_OP(sh_order_, <=, sh::kMaxOrder);
-  rays_ = std::make_unique<RayCaster>(mesh, topology);
+  PRT_CHECK(!accel || accel->of(mesh, topology));
+  rays_ = accel ? accel->rays() : std::make_shared<const RayCaster>(mesh, topology);
 }
 
 QmcIntegrator::~QmcIntegrator() = default;

@@ -46,6 +46,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   if (!parts.empty()) occluders = merge_meshes(parts, "occluders");
   parts.clear();
   const Topology topo = build_topology(occluders);
+  // The union's trees, built once for every integrator, pilot and reference below (bake/accel.h).
+  const MeshAccel accel(occluders, topo);
 
   // One integrator (and one reference) per distinct product request.
   using Key = std::tuple<bool, int, int, bool>;
@@ -65,9 +67,9 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const ProductRequest r = request_of(p);
     const Key key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr};
     if (integrators.count(key)) continue;
-    auto integ = make_integrator(scene.integrator, occluders, topo, r);
+    auto integ = make_integrator(scene.integrator, occluders, topo, r, &accel);
     std::unique_ptr<Integrator> ref;
-    if (scene.integrator.report_points > 0) ref = make_reference(scene.integrator, occluders, topo, r);
+    if (scene.integrator.report_points > 0) ref = make_reference(scene.integrator, occluders, topo, r, &accel);
     integrators.emplace(key, std::make_pair(std::move(integ), std::move(ref)));
   }
   out.setup_seconds = seconds_since(t_setup);
@@ -95,11 +97,11 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       copt.target = scene.target_error;
       if (scene.integrator_given) copt.only = scene.integrator.kind;
       copt.counted_costs = scene.counted_costs;
-      ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor);
+      ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor, &accel);
       ob.integrator = ob.choice->spec;
       for (const std::string& line : choice_lines(*ob.choice)) log(scene.objects[i].name + ": " + line);
-      own_integ = make_integrator(ob.integrator, occluders, topo, r);
-      if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r);
+      own_integ = make_integrator(ob.integrator, occluders, topo, r, &accel);
+      if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r, &accel);
     }
     const Integrator* integ = own_integ.get();
     const Integrator* ref = own_ref.get();

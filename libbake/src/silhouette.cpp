@@ -83,8 +83,10 @@ struct SilhouetteIntegrator::Impl {
   ProductRequest req;
   ProductLayout layout;
   SilhouetteOptions opt;
-  ContourFinder contours;
-  RayCaster rays;
+  std::shared_ptr<const ContourFinder> contours_owned;  // shared with a MeshAccel, or our own
+  std::shared_ptr<const RayCaster> rays_owned;
+  const ContourFinder& contours;
+  const RayCaster& rays;
   oct::Grid grid;
   Eigen::Matrix3d frame_from_world;
   int sh_order = 0;
@@ -109,9 +111,13 @@ struct SilhouetteIntegrator::Impl {
   mutable std::map<std::array<double, 3>, std::array<double, 9>> hemisphere_radiance_cache;
   mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
 
-  Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o)
-      : mesh(m), topo(t), req(r), layout(r), opt(o), contours(m, t), rays(m, t), grid(even_isolines(o.isolines)),
+  Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o, const MeshAccel* accel)
+      : mesh(m), topo(t), req(r), layout(r), opt(o),
+        contours_owned(accel ? accel->contours() : std::make_shared<const ContourFinder>(m, t)),
+        rays_owned(accel ? accel->rays() : std::make_shared<const RayCaster>(m, t)), contours(*contours_owned),
+        rays(*rays_owned), grid(even_isolines(o.isolines)),
         frame_from_world(octahedral_frame_from_world()) {
+    PRT_CHECK(!accel || accel->of(m, t));
     const int lt = r.transfer_order, lv = r.visibility_order;
     sh_order = std::max({lt, lv, r.radiance ? 2 : 0});
     c_ao = 0;
@@ -558,8 +564,8 @@ struct SilhouetteIntegrator::Impl {
 };
 
 SilhouetteIntegrator::SilhouetteIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
-                                           const SilhouetteOptions& options)
-    : impl_(std::make_unique<Impl>(mesh, topology, request, options)) {}
+                                           const SilhouetteOptions& options, const MeshAccel* accel)
+    : impl_(std::make_unique<Impl>(mesh, topology, request, options, accel)) {}
 
 SilhouetteIntegrator::~SilhouetteIntegrator() = default;
 

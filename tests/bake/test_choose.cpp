@@ -131,27 +131,26 @@ TEST(Choose, ThePilotRunsOnlyTheSilhouetteLevelsThatBracketTheGoal) {
   // at 64 (bench/RESULTS.md, error against time), so: E = 1e-3 (aim 7e-4) needs neither extra
   // level and its knob lies in the bracket (32, 64]; E = 1e-2 (aim 7e-3) is met at 32 and adds
   // 16; E = 2e-4 (aim 1.4e-4) is missed at 64 and adds 128.
-  const Asset& a = bunny_ground();
-  ProductRequest r;
-  r.ao = true;
-  ChooserOptions opt;
-  opt.only = IntegratorKind::Silhouette;
+  auto silhouette_ao = [](double target) {
+    const Asset& a = bunny_ground();
+    ProductRequest r;
+    r.ao = true;
+    return choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{},
+                             ChooserOptions{.target = target, .only = IntegratorKind::Silhouette});
+  };
   auto levels = [](const IntegratorChoice& c) {
     std::vector<uint32_t> knobs;
     for (size_t i = 1; i < c.runs.size(); ++i) knobs.push_back(c.runs[i].knob);  // runs[0]: the reference
     return knobs;
   };
-  opt.target = 1e-3;
-  const IntegratorChoice mid = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  const IntegratorChoice mid = silhouette_ao(1e-3);
   EXPECT_EQ(levels(mid), (std::vector<uint32_t>{32, 64}));
   EXPECT_GT(mid.spec.isolines(), 32);
   EXPECT_LE(mid.spec.isolines(), 64);
-  opt.target = 1e-2;
-  const IntegratorChoice loose = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  const IntegratorChoice loose = silhouette_ao(1e-2);
   EXPECT_EQ(levels(loose), (std::vector<uint32_t>{16, 32, 64}));
   EXPECT_LE(loose.spec.isolines(), 32);
-  opt.target = 2e-4;
-  const IntegratorChoice tight = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  const IntegratorChoice tight = silhouette_ao(2e-4);
   EXPECT_EQ(levels(tight), (std::vector<uint32_t>{32, 64, 128}));
   EXPECT_GT(tight.spec.isolines(), 64);
   // A run's error does not depend on which other levels ran (it compares the same points with

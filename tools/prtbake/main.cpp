@@ -539,20 +539,21 @@ int run_vertex(const Args& a) {
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   bake::IntegratorSpec spec = a.integrator;
+  const bake::MeshAccel accel(mesh, topo);  // the mesh's trees, shared by the pilot, the bake and the report
   if (a.target_error > 0) {
     bake::ChooserOptions copt;
     copt.target = a.target_error;
     if (a.integrator_given) copt.only = a.integrator.kind;
     copt.counted_costs = a.reproducible;  // the same choice, and bytes, on any machine
-    const bake::IntegratorChoice choice =
-        bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req, a.integrator, copt, progress);
+    const bake::IntegratorChoice choice = bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req,
+                                                                  a.integrator, copt, progress, &accel);
     spec = choice.spec;
     if (say)
       for (const std::string& line : bake::choice_lines(choice)) std::printf("%s\n", line.c_str());
   }
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =
-      bake::make_integrator(spec, mesh, topo, req);
+      bake::make_integrator(spec, mesh, topo, req, &accel);
   const bake::Integrator& integrator = *integrator_ptr;
   const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
   if (say) {
@@ -587,7 +588,7 @@ int run_vertex(const Args& a) {
 
   std::optional<bake::ErrorReport> report;
   if (spec.report_points > 0) {
-    const auto reference = bake::make_reference(spec, mesh, topo, req);
+    const auto reference = bake::make_reference(spec, mesh, topo, req, &accel);
     report = bake::compare_with_reference(mesh, topo, result, *reference, spec.report_points, spec.seed,
                                           progress);
     if (say) {

@@ -124,10 +124,13 @@ struct IntegratorChoice {
 // The pilot and the choice (file comment). `points` are the bake's shade points (their order and
 // count as the bake will see them), `mesh`/`topology` the occluders. Throws InputError when the
 // target is outside [kMinTarget, kMaxTarget] or no integrator is predicted to reach it (naming the
-// best reachable error). A "pilot" stage of `monitor`.
+// best reachable error). A "pilot" stage of `monitor`. Every pilot integrator shares one set of
+// trees: `accel`'s (bake/accel.h; pass the bake's own, so that the bake reuses them too), else
+// the pilot's own.
 IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                    const ProductRequest& request, const IntegratorSpec& base,
-                                   const ChooserOptions& options, const Monitor& monitor = {});
+                                   const ChooserOptions& options, const Monitor& monitor = {},
+                                   const MeshAccel* accel = nullptr);
 
 // What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
 // and the choice, one line each, then a hint when the call was close (margin < 1.25).

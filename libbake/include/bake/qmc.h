@@ -24,6 +24,7 @@
 // (occludes_from_above, orient_eps). Hits on any other triangle at any t ≥ 0 occlude.
 #pragma once
 
+#include <bake/accel.h>
 #include <bake/integrator.h>
 #include <bake/mesh.h>
 #include <bake/products.h>
@@ -40,9 +41,10 @@ struct QmcOptions {
 
 class QmcIntegrator final : public Integrator {
 public:
-  // `mesh` and `topology` (and the request's environment) must outlive the integrator.
+  // `mesh` and `topology` (and the request's environment) must outlive the integrator. With
+  // `accel` (of the same mesh and topology, bake/accel.h), its ray scene is shared instead of built.
   QmcIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
-                const QmcOptions& options);
+                const QmcOptions& options, const MeshAccel* accel = nullptr);
   ~QmcIntegrator() override;
   QmcIntegrator(const QmcIntegrator&) = delete;
   QmcIntegrator& operator=(const QmcIntegrator&) = delete;
@@ -65,7 +67,7 @@ private:
   QmcOptions options_;
   double w_cos_ = 0, w_uni_ = 0, w_env_ = 0;  // mixture weights, sum to 1
   int sh_order_ = 0;                          // SH order evaluated per sample
-  std::unique_ptr<RayCaster> rays_;
+  std::shared_ptr<const RayCaster> rays_;
 };
 
 } // namespace prt::bake

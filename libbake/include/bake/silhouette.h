@@ -30,6 +30,7 @@
 //    hemisphere and a concave one reaches above the horizon — with no ε offset in the numbers.
 #pragma once
 
+#include <bake/accel.h>
 #include <bake/integrator.h>
 #include <bake/mesh.h>
 #include <bake/products.h>
@@ -46,9 +47,11 @@ struct SilhouetteOptions {
 
 class SilhouetteIntegrator final : public Integrator {
 public:
-  // `mesh`, `topology` and the request's environment must outlive the integrator.
+  // `mesh`, `topology` and the request's environment must outlive the integrator. With `accel`
+  // (of the same mesh and topology, bake/accel.h), its contour tree and ray scene are shared
+  // instead of built: the same results, bit for bit.
   SilhouetteIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
-                       const SilhouetteOptions& options);
+                       const SilhouetteOptions& options, const MeshAccel* accel = nullptr);
   ~SilhouetteIntegrator() override;
   SilhouetteIntegrator(const SilhouetteIntegrator&) = delete;
   SilhouetteIntegrator& operator=(const SilhouetteIntegrator&) = delete;

@@ -4,6 +4,7 @@
 // randomisation is keyed by its index, so any thread count gives the same numbers.
 #pragma once
 
+#include <bake/accel.h>
 #include <bake/integrator.h>
 #include <bake/mesh.h>
 #include <bake/progress.h>
@@ -104,13 +105,13 @@ ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, co
                                           const Monitor& monitor = {});
 
 // The integrator a spec describes (bake/integrator.h). `mesh`, `topology` and the request's
-// environment must outlive it.
+// environment must outlive it. With `accel` (bake/accel.h) its trees are shared, not built.
 std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
-                                            const ProductRequest& request);
+                                            const ProductRequest& request, const MeshAccel* accel = nullptr);
 // The converged reference of the error reports (docs/ARCHITECTURE.md §6): QMC with
 // spec.reference_rays() rays per point, seeded apart from the bake's points.
 std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
-                                           const ProductRequest& request);
+                                           const ProductRequest& request, const MeshAccel* accel = nullptr);
 
 // Distinct indices in [0, n), min(k, n) of them, chosen by seed (partial Fisher–Yates), sorted.
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed);
