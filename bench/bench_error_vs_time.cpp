@@ -50,21 +50,15 @@ struct Row {
   double ao_rmse = 0, ao_max = 0, t_rmse = 0, t_max = 0;
 };
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 // Values [point][width] of one integrator, single-threaded, with wall and thread-CPU time.
 std::vector<double> run_serial(const bench::Scene& s, const bake::Integrator& integ, double& wall, double& cpu) {
   const size_t W = integ.layout().width, n = s.points.size();
   std::vector<double> out(n * W);
-  const double c0 = thread_cpu_seconds();
+  const double c0 = bake::thread_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   for (size_t i = 0; i < n; ++i) integ.integrate(s.points[i], s.vertices[i], std::span<double>(out.data() + i * W, W));
   wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  cpu = thread_cpu_seconds() - c0;
+  cpu = bake::thread_cpu_seconds() - c0;
   return out;
 }
 

@@ -5,9 +5,12 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <numeric>
 
@@ -47,16 +50,27 @@ VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& int
   out.std_error.assign(V * W, 0.0);
   Task progress(monitor, label, V);
   const auto t0 = std::chrono::steady_clock::now();
+  std::atomic<int64_t> cpu_ns{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, V, 16), [&](const tbb::blocked_range<size_t>& r) {
+    const double c0 = thread_cpu_seconds();
     for (size_t v = r.begin(); v != r.end(); ++v)
       integrator.integrate(points[v], v, std::span(out.values).subspan(v * W, W), std::span(out.std_error).subspan(v * W, W));
+    cpu_ns.fetch_add(int64_t(1e9 * (thread_cpu_seconds() - c0)), std::memory_order_relaxed);
     progress.advance(r.size());
   });
   progress.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.cpu_seconds = 1e-9 * double(cpu_ns.load());
+  out.threads = tbb::this_task_arena::max_concurrency();
   for (double x : out.values)
     if (!std::isfinite(x)) throw ContractError("bake_points: non-finite value from integrator " + integrator.name());
   return out;
+}
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,

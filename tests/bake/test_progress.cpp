@@ -105,6 +105,23 @@ TEST(Progress, BakeVerticesReportsMonotoneCountsAndOneFinalUpdate) {
   EXPECT_EQ(b.values.size(), V * qmc.layout().width);
 }
 
+TEST(Progress, TheBakeCountsOnlyTheIntegratorsCpuTime) {
+  // busy_fraction = CPU time inside the integrator / (wall · threads). A probe that sleeps 1 ms per
+  // point does ~30 µs of work in it (64 rays): the sleep is no CPU time, so the fraction stays far
+  // below 1/2; and no thread can spend more CPU than the wall time, so it never exceeds 1.
+  const Scene s;
+  const QmcIntegrator qmc(s.mesh, s.topo, s.req, {64, 3});
+  const Probe probe(qmc, std::chrono::microseconds(1000));
+  VertexBake b;
+  with_four_threads([&] { b = bake_vertices(s.mesh, s.topo, probe); });
+  EXPECT_EQ(b.threads, 4);
+  EXPECT_GT(b.cpu_seconds, 0.0);
+  EXPECT_LT(b.busy_fraction(), 0.5);
+  const VertexBake busy = bake_vertices(s.mesh, s.topo, qmc);
+  EXPECT_GT(busy.cpu_seconds, 0.0);
+  EXPECT_LE(busy.busy_fraction(), 1.0);
+}
+
 TEST(Progress, WatchingABakeDoesNotChangeItsValues) {
   const Scene s;
   const QmcIntegrator qmc(s.mesh, s.topo, s.req, {128, 9});

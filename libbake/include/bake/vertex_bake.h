@@ -21,7 +21,17 @@ struct VertexBake {
   std::vector<double> values;     // [V][layout.width]
   std::vector<double> std_error;  // [V][layout.width], the integrator's per-value standard error
   double seconds = 0;             // wall time of the integration
+  // CPU time spent inside the integrator, summed over the threads (each thread's own clock, so
+  // idle and spinning workers do not count), and the threads that could run: busy_fraction()
+  // = cpu_seconds / (seconds · threads) says whether every core was busy from the first point to
+  // the last (a serial tail or a starved worker shows as less than 1).
+  double cpu_seconds = 0;
+  int threads = 1;
+  double busy_fraction() const { return seconds > 0 ? cpu_seconds / (seconds * threads) : 0.0; }
 };
+
+// The calling thread's CPU time in seconds (CLOCK_THREAD_CPUTIME_ID).
+double thread_cpu_seconds();
 
 ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32_t vertex);
 
