@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # bench/run.sh — build the `release` preset and run every benchmark, writing bench/RESULTS.md
-# (the exact commands, date, machine, and the tables the runs produced).
+# (the exact commands, date, machine, and the tables the runs produced) between its markers;
+# the sections recorded by hand after the end marker are kept.
 #
 #   bench/run.sh                 build (cmake --preset release, -j2) and run everything (~2–10 min)
 #   bench/run.sh --no-build      run what build/release already holds
@@ -162,5 +163,26 @@ PY
     echo
     cat "$tmp/fiv.md"
   fi
-} >"$out"
-echo "wrote $out" >&2
+} >"$tmp/generated.md"
+# Splice: only the block between the markers is replaced; the hand-recorded sections after it
+# (each with the command that produced it) are kept. A file without markers keeps its old
+# content below the new block; a missing file is created.
+python3 - "$tmp/generated.md" "$out" <<'PY'
+import os, sys
+begin = '<!-- bench/run.sh begin: the lines up to "bench/run.sh end" are rewritten by every run; the sections after it are recorded by hand with their commands -->'
+end = '<!-- bench/run.sh end -->'
+generated = open(sys.argv[1]).read().rstrip() + "\n"
+out = sys.argv[2]
+old = open(out).read() if os.path.exists(out) else ""
+rest = ""
+if end in old:
+    rest = old.split(end, 1)[1].lstrip("\n")
+elif old:
+    rest = old
+text = begin + "\n" + generated + "\n" + end + "\n" + ("\n" + rest if rest else "")
+tmp = out + ".tmp"
+with open(tmp, "w") as f:
+    f.write(text)
+os.replace(tmp, out)
+PY
+echo "wrote $out (its hand-recorded sections kept)" >&2
