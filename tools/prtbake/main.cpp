@@ -190,10 +190,12 @@ void add_sampling(CLI::App& cmd, Args& a, uint32_t& samples, const std::string& 
       ->option_text("y|z");
 }
 
-std::string silhouette_k_help() {
+// The fiv command's k has a default; a vertex bake without --samples has its k chosen by the
+// target error instead.
+std::string silhouette_k_help(bool with_default) {
   const bake::IntegratorSpec d;
-  return "k = N, the number of spherical samples\n(sqrt(k) u-isolines, rounded to even; default " +
-         std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2";
+  return "k = N, the number of spherical samples\n(sqrt(k) u-isolines, rounded to even" +
+         (with_default ? "; default " + std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2" : "");
 }
 
 void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
@@ -253,9 +255,10 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
       ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
   add_sampling(cmd, a, samples,
-               "silhouette: " + silhouette_k_help() +
-                   ";\n64^2 to 256^2 converge for HDR environments). qmc: rays per vertex\n(default " +
-                   std::to_string(d.qmc_rays) + "); the error falls like 1/sqrt(N) or faster.");
+               "silhouette: " + silhouette_k_help(false) +
+                   ";\n64^2 to 256^2 converge for HDR environments). qmc: rays per vertex;\n"
+                   "the error falls like 1/sqrt(N) or faster. Without it, --target-error\n"
+                   "chooses N (and the integrator, unless --integrator names one).");
   cmd.add_flag_callback("--no-file-normals", [&a] { a.file_normals = false; },
                         "ignore normals in the mesh file; use angle-weighted vertex normals.");
   cmd.add_flag("--flip-normals", a.flip_normals,
@@ -297,7 +300,7 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
         const double f = std::strtod(s.c_str(), nullptr);
         return f > 0 && f < 1 ? "" : "expects a number in (0, 1), got '" + s + "'";
       });
-  add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help() + ").");
+  add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help(true) + ").");
   add_report(cmd, a,
              std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) +
                  " rays, full sphere, at seeded shell samples");
