@@ -122,11 +122,11 @@ TEST(Prtview, BadCameraAndCommandLinesFailWithTheProblemNamed) {
     std::string args, needle;
     int code;
   } cases[] = {
-      {"--camera eye=0,0,1 -o " + out.string(), "eye=X,Y,Z and at=X,Y,Z are required", 1},
-      {"--camera eye=0,0,1:at=0,0,1 -o " + out.string(), "eye and at are the same point", 1},
-      {"--camera eye=0,x,1:at=0,0,0 -o " + out.string(), "'x' is not a finite number", 1},
-      {"--camera eye=0,0,1:at=0,0,0:zoom=3 -o " + out.string(), "unknown key 'zoom'", 1},
-      {"--camera eye=0,0,1:at=0,0,0:fov=200 -o " + out.string(), "fov must be in (0, 180)", 1},
+      {"--camera eye=0,0,1 -o " + out.string(), "eye=X,Y,Z and at=X,Y,Z are required", 2},
+      {"--camera eye=0,0,1:at=0,0,1 -o " + out.string(), "eye and at are the same point", 2},
+      {"--camera eye=0,x,1:at=0,0,0 -o " + out.string(), "'x' is not a finite number", 2},
+      {"--camera eye=0,0,1:at=0,0,0:zoom=3 -o " + out.string(), "unknown key 'zoom'", 2},
+      {"--camera eye=0,0,1:at=0,0,0:fov=200 -o " + out.string(), "fov must be in (0, 180)", 2},
       {kCamera + " --size 12 -o " + out.string(), "--size", 2},
       {kCamera + " --samples 12 -o " + out.string(), "multiple of 8", 2},
       {kCamera + " -o " + scratch("bad.jpg").string(), "must end in .png or .exr", 2},

@@ -34,7 +34,7 @@ inline constexpr const char* kExitStatusHelp =
     "  1    bad input: one line on stderr names the file and the problem; no output is left behind\n"
     "  2    bad command line\n"
     "  3    the machine failed: out of memory, no Embree device, a failed system call\n"
-    "  4    internal error: a bug in prtbake (please report it with the command line)\n"
+    "  4    internal error: a bug in the prtbake toolkit (please report it with the command line)\n"
     "  130  cancelled with Ctrl-C: nothing was written\n";
 
 // A command-line mistake found after parsing (a missing output, options that do not go together).

@@ -306,8 +306,8 @@ int run(const Args& a) {
   const view::Camera cam = [&] {
     try {
       return view::parse_camera(a.camera, a.width, a.height);
-    } catch (const bake::InputError& e) {  // the value is wrong: say which option gave it
-      throw bake::InputError("--camera", e.what());
+    } catch (const bake::InputError& e) {  // a command-line value is malformed (exit 2, as --size)
+      throw UsageError(std::string("--camera: ") + e.what());
     }
   }();
   {  // fail before the work if the output cannot be written
