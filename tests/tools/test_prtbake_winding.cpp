@@ -152,3 +152,33 @@ TEST(PrtbakeWinding, InwardNormalsOnANonClosedMeshAreToldToFlip) {
 }
 
 } // namespace
+
+namespace {
+
+TEST(PrtbakeWinding, SceneReceiversWoundInwardsWarnNamingTheObject) {
+  // The same two warnings for a scene's receiver that shadows itself ("both"), naming it; a
+  // receiver-only one wound inwards is shaded about inward normals (it casts no shadow, so its
+  // vertices do see sky); an occluder-only box wound inwards is not baked and gets no warning.
+  const fs::path scene = scratch("inward_scene.json");
+  std::ofstream(scene) << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "integrator": "qmc", "samples": 64,
+    "report": 0}, "objects": [
+      {"name": "crate", "mesh": ")" << box_obj("scene_inward.obj", true).string() << R"(", "role": "both"},
+      {"name": "shell", "mesh": ")" << box_obj("scene_inward_receiver.obj", true).string()
+                       << R"(", "role": "receiver", "transform": {"translate": [3, 0, 0]}},
+      {"name": "lid", "mesh": ")" << box_obj("scene_inward_occluder.obj", true).string()
+                       << R"(", "role": "occluder", "transform": {"translate": [0, 3, 0]}}]})";
+  const fs::path out = scratch("inward_scene.prt.h5");
+  fs::remove(out);
+  const prt::testing::ToolRun r =
+      prt::testing::run_tool(kBake, "scene '" + scene.string() + "' --quiet -o '" + out.string() + "'", scratch("capture"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err,
+            "prtbake: warning: crate: 1 of 1 closed components (12 triangles) are wound inwards: their normals point "
+            "inside, so their vertices see no sky; fix their winding in its mesh file\n"
+            "prtbake: warning: shell: 1 of 1 closed components (12 triangles) are wound inwards: their normals point "
+            "inside, so their vertices are shaded as if seen from inside; fix their winding in its mesh file\n"
+            "prtbake: warning: crate: 100.0% of its vertices (8 of 8) see no sky at all: it is enclosed by other "
+            "objects, or its normals point inside (check its winding)\n");
+}
+
+} // namespace

@@ -422,19 +422,24 @@ const char* flip_fix(bool flipped) {
 }
 
 // Closed components wound inwards (bake/mesh.h winding_facts): their vertices will see no sky.
-void warn_inward(const bake::WindingFacts& facts, bool flipped) {
+// `object`: a scene's object ("" for prtbake vertex, whose --flip-normals can fix a whole mesh).
+// `casts`: the mesh shadows itself (a vertex bake, a scene's "both"), so those vertices see no sky;
+// a receiver-only object casts nothing and is shaded about normals that point inside.
+void warn_inward(const bake::WindingFacts& facts, bool flipped, const std::string& object = "", bool casts = true) {
   const size_t inward = facts.inward_components();
   if (inward == 0) return;
   // --flip-normals flips the whole mesh: the fix only when everything in it is inwards.
   const std::string fix =
-      inward == facts.components
+      !object.empty() ? std::string("fix their winding in its mesh file")
+      : inward == facts.components
           ? std::string(flip_fix(flipped))
           : "fix their winding in the file (--flip-normals would flip all " + std::to_string(facts.components) +
                 " components of the mesh, not only these)";
   std::fprintf(stderr,
-               "prtbake: warning: %zu of %zu closed components (%zu triangles) are wound inwards: their normals point "
-               "inside, so their vertices see no sky; %s\n",
-               inward, facts.closed.size(), facts.inward_triangles(), fix.c_str());
+               "prtbake: warning: %s%zu of %zu closed components (%zu triangles) are wound inwards: their normals point "
+               "inside, so their vertices %s; %s\n",
+               object.empty() ? "" : (object + ": ").c_str(), inward, facts.closed.size(), facts.inward_triangles(),
+               casts ? "see no sky" : "are shaded as if seen from inside", fix.c_str());
 }
 
 // More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky). Which
@@ -695,6 +700,11 @@ int run_scene(const Args& a) {
   std::optional<bake::EnvMap> env;
   if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
   const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
+  // Receivers with closed parts wound inwards: their vertices would see no sky.
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (plan.objects[i].receiver && plan.objects[i].any_vertex_product())
+      warn_inward(bake::winding_facts(meshes[i], bake::build_topology(meshes[i])), false, scene.objects[i].name,
+                  plan.objects[i].occluder);
 
   if (say) {
     std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.input.c_str(),
@@ -720,6 +730,16 @@ int run_scene(const Args& a) {
                                                     if (say) std::printf("%s\n", line.c_str());
                                                     std::fflush(stdout);
                                                   });
+  // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (const auto& values = result.objects[i].values) {
+      const bake::NoSkyCount count = bake::count_no_sky(*values);
+      if (count.share() > 0.5)
+        std::fprintf(stderr,
+                     "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
+                     "other objects, or its normals point inside (check its winding)\n",
+                     scene.objects[i].name.c_str(), 100 * count.share(), count.vertices, count.total);
+    }
   if (say)
     std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
                 (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
