@@ -137,7 +137,9 @@ constexpr Field<SceneInfo> kSceneFields[] = {
     {N::kRelight, &SceneInfo::relight},
     {N::kEnvironment, &SceneInfo::environment},
     {N::kEnvironmentSha256, &SceneInfo::environment_sha256},
-    {N::kPlan, &SceneInfo::plan}};
+    {N::kPlan, &SceneInfo::plan},
+    {N::kOptionsFile, &SceneInfo::options_file},
+    {N::kOptionsSha256, &SceneInfo::options_sha256}};
 
 constexpr Field<SceneObject> kObjectFields[] = {
     {N::kRole, &SceneObject::role},

@@ -125,6 +125,8 @@ Asset full_asset() {
   s.environment = "sky.exr";
   s.environment_sha256 = std::string(64, 'e');
   s.plan = "one\ntwo";
+  s.options_file = "engine.options.json";
+  s.options_sha256 = std::string(64, 'c');
   s.extra = {{"version_note", 2.5}};
   for (const char* name : {"bunny", "ground"}) {
     SceneObject& o = a.objects.emplace_back();

@@ -3,6 +3,7 @@
 // roles and materials per node path and refuses a path that names no node; prtdump lists the
 // objects by node path.
 #include <bake/scene.h>
+#include <bake/sha256.h>
 #include <formats/asset.h>
 
 #include <gltf_builder.h>
@@ -122,6 +123,10 @@ TEST(GltfScene, InstancesAreObjectsNamedByNodePathAndBakeAsTheSameJsonScene) {
   const fs::path d = dir_for("equivalent");
   const F::Asset gltf = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + "}");
   ASSERT_EQ(gltf.objects.size(), 4u);
+  // The options file is an input like the glTF: named and hashed in /scene.
+  ASSERT_TRUE(gltf.scene);
+  EXPECT_EQ(gltf.scene->options_file, (d / "stack.options.json").string());
+  EXPECT_EQ(gltf.scene->options_sha256, prt::bake::sha256_file(d / "stack.options.json"));
 
   // The same geometry as a JSON scene: the parts as OBJ files, the composed node translations as
   // object transforms. Every coordinate is a small binary fraction, so the world positions are the

@@ -751,6 +751,10 @@ int run_scene(const Args& a) {
   const std::string env_path = env ? scene.environment->string() : std::string();
   F::SceneInfo& info = asset.scene.emplace();
   info.scene_file = a.input;
+  if (!a.scene_options.empty()) {
+    info.options_file = a.scene_options;
+    info.options_sha256 = bake::sha256_file(a.scene_options);
+  }
   info.integrator = std::string(bake::to_string(scene.integrator.kind));
   info.samples = int64_t(scene.integrator.samples());
   info.seed = int64_t(scene.integrator.seed);

@@ -163,6 +163,7 @@ struct SceneInfo {
   std::optional<int64_t> relight;  // 0 / 1
   std::optional<std::string> environment, environment_sha256;
   std::optional<std::string> plan;  // scene-wide decisions, one per line
+  std::optional<std::string> options_file, options_sha256;  // a glTF scene's options file, when given
   ExtraAttrs extra;
   bool operator==(const SceneInfo&) const = default;
 };

@@ -82,6 +82,8 @@ inline constexpr std::string_view kIntegralsPerSecond = "integrals_per_second";
 
 // ---- /scene attributes ----
 inline constexpr std::string_view kSceneFile = "scene_file";
+inline constexpr std::string_view kOptionsFile = "options_file";
+inline constexpr std::string_view kOptionsSha256 = "options_sha256";
 inline constexpr std::string_view kShTolerance = "sh_tolerance";
 inline constexpr std::string_view kRelight = "relight";
 inline constexpr std::string_view kPlan = "plan";
