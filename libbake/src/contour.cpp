@@ -668,7 +668,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   };
   if (!items.empty()) build(build, 0, uint32_t(items.size()), 1);
   collapse_wide(nodes);
-  // The walk's queue tags leaf blocks with bit 31.
+  // Wide nodes and the walk's queue tag leaf blocks with bit 31 (kLeafBit).
   PRT_CHECK(wide_.size() < (size_t(1) << 31) && blocks_.size() < (size_t(1) << 31));
   // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
   // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
@@ -687,6 +687,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
 // are its binary children, the largest inner one (by records under it) replaced by its own two
 // children while fewer than four; empty slots have D = +∞ and never pass.
 void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
+  static_assert(sizeof(WideNode) == 192);  // three cache lines, prefetched by the walk
   if (binary.empty()) return;
   // Records under each binary node (leaf counts summed), for choosing which child to open.
   std::vector<uint32_t> under(binary.size(), 0);
@@ -707,8 +708,7 @@ void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
       if (k >= slots.size()) {
         for (int i = 0; i < 3; ++i) w.c[i][k] = w.nlo[i][k] = w.nhi[i][k] = 0;
         w.dlo[k] = w.dhi[k] = std::numeric_limits<float>::infinity();
-        w.child[k] = 0;
-        w.count[k] = 1;  // a leaf never entered
+        w.child[k] = kLeafBit;  // a leaf never entered
         continue;
       }
       const Node& nd = binary[slots[k]];
@@ -719,9 +719,8 @@ void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
       }
       w.dlo[k] = nd.dlo;
       w.dhi[k] = nd.dhi;
-      w.count[k] = nd.count;
       if (nd.count) {
-        w.child[k] = nd.index;
+        w.child[k] = nd.index | kLeafBit;
       } else {
         const uint32_t child = uint32_t(wide_.size());
         wide_.emplace_back();
@@ -828,7 +827,6 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
     queue.push_back(0);
     const WideNode* wide = wide_.data();
     const LeafBlock* blocks = blocks_.data();
-    constexpr uint32_t kLeafBit = 0x80000000u;
     for (size_t head = 0; head < queue.size(); ++head) {
       const uint32_t item = queue[head];
       if (item & kLeafBit) {
@@ -872,16 +870,16 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
       for (unsigned pass = lanes((vmin <= dn) & (vmax >= -dn)); pass != 0; pass &= pass - 1) {
         const int k = std::countr_zero(pass);
         const uint32_t child = w.child[k];
-        if (w.count[k] == 0) {
+        if (!(child & kLeafBit)) {
           for (int line = 0; line < int(sizeof(WideNode)); line += 64)
             __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + line);
-          queue.push_back(child);
         } else {
-          __builtin_prefetch(blocks + child);
-          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 64);
-          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 128);
-          queue.push_back(child | kLeafBit);
+          const char* blk = reinterpret_cast<const char*>(blocks + (child & ~kLeafBit));
+          __builtin_prefetch(blk);
+          __builtin_prefetch(blk + 64);
+          __builtin_prefetch(blk + 128);
         }
+        queue.push_back(child);
       }
     }
   }
