@@ -235,7 +235,7 @@ struct SilhouetteIntegrator::Impl {
     double lam[5] = {0, 1, 1, 1, 1};
     int nl = 1;
     for (int c = 0; c < 3; ++c)
-      if (oct::sgn0(arc.a[c]) != oct::sgn0(arc.b[c])) lam[nl++] = arc.a[c] / (arc.a[c] - arc.b[c]);
+      if ((arc.a[c] < 0) != (arc.b[c] < 0)) lam[nl++] = arc.a[c] / (arc.a[c] - arc.b[c]);  // sgn0 differs
     lam[nl++] = 1.0;
     for (int k = 1; k < nl; ++k)  // insertion sort of ≤ 5 values
       for (int j = k; j > 0 && lam[j] < lam[j - 1]; --j) std::swap(lam[j], lam[j - 1]);
