@@ -41,6 +41,9 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace prt::bake {
 
@@ -363,8 +366,31 @@ inline f4 load(const float* x) {
   return v;
 }
 inline f4 splat(float x) { return f4{x, x, x, x}; }
+// The lane-wise helpers of the walk. SSE2: one instruction each (movmskps reads the sign bits
+// of the all-ones / all-zeros comparison lanes; minps / maxps are exactly x < y ? x : y and
+// x > y ? x : y); elsewhere the same values lane by lane.
 inline unsigned lanes(i4 m) {  // bit k set iff lane k is true
+#if defined(__SSE2__)
+  __m128i v;
+  std::memcpy(&v, &m, sizeof v);
+  return unsigned(_mm_movemask_ps(_mm_castsi128_ps(v)));
+#else
   return unsigned(m[0] & 1) | unsigned(m[1] & 1) << 1 | unsigned(m[2] & 1) << 2 | unsigned(m[3] & 1) << 3;
+#endif
+}
+inline f4 min4(f4 x, f4 y) {  // x < y ? x : y
+#if defined(__SSE2__)
+  return f4(_mm_min_ps(__m128(x), __m128(y)));
+#else
+  return x < y ? x : y;
+#endif
+}
+inline f4 max4(f4 x, f4 y) {  // x > y ? x : y
+#if defined(__SSE2__)
+  return f4(_mm_max_ps(__m128(x), __m128(y)));
+#else
+  return x > y ? x : y;
+#endif
 }
 
 // The dual segment of a BVH edge in double: ĝ_1 and −ĝ_2.
@@ -668,7 +694,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   };
   if (!items.empty()) build(build, 0, uint32_t(items.size()), 1);
   collapse_wide(nodes);
-  // The walk's queue tags leaf blocks with bit 31.
+  // Wide nodes and the walk's queue tag leaf blocks with bit 31 (kLeafBit).
   PRT_CHECK(wide_.size() < (size_t(1) << 31) && blocks_.size() < (size_t(1) << 31));
   // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
   // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
@@ -687,6 +713,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
 // are its binary children, the largest inner one (by records under it) replaced by its own two
 // children while fewer than four; empty slots have D = +∞ and never pass.
 void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
+  static_assert(sizeof(WideNode) == 192);  // three cache lines, prefetched by the walk
   if (binary.empty()) return;
   // Records under each binary node (leaf counts summed), for choosing which child to open.
   std::vector<uint32_t> under(binary.size(), 0);
@@ -707,8 +734,7 @@ void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
       if (k >= slots.size()) {
         for (int i = 0; i < 3; ++i) w.c[i][k] = w.nlo[i][k] = w.nhi[i][k] = 0;
         w.dlo[k] = w.dhi[k] = std::numeric_limits<float>::infinity();
-        w.child[k] = 0;
-        w.count[k] = 1;  // a leaf never entered
+        w.child[k] = kLeafBit;  // a leaf never entered
         continue;
       }
       const Node& nd = binary[slots[k]];
@@ -719,9 +745,8 @@ void ContourFinder::collapse_wide(const std::vector<Node>& binary) {
       }
       w.dlo[k] = nd.dlo;
       w.dhi[k] = nd.dhi;
-      w.count[k] = nd.count;
       if (nd.count) {
-        w.child[k] = nd.index;
+        w.child[k] = nd.index | kLeafBit;
       } else {
         const uint32_t child = uint32_t(wide_.size());
         wide_.emplace_back();
@@ -822,14 +847,16 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
     const f4 dn = splat(delta_node), dr = splat(delta_rec);
     // Breadth-first: a FIFO of wide nodes and leaf blocks (bit 31), each prefetched when queued
     // and read many steps later, so the walk streams memory instead of waiting on each fetch.
+    // Besides the root, only slots of fetched wide nodes are queued, and a wide node is queued by
+    // its one parent slot: at most 1 + 4 × (wide nodes) items, the buffer's size before the walk.
     thread_local std::vector<uint32_t> tl_queue;
-    std::vector<uint32_t>& queue = tl_queue;
-    queue.clear();
-    queue.push_back(0);
+    if (tl_queue.size() < 4 * wide_.size() + 1) tl_queue.resize(4 * wide_.size() + 1);
+    uint32_t* const queue = tl_queue.data();
+    size_t tail = 0;
+    queue[tail++] = 0;
     const WideNode* wide = wide_.data();
     const LeafBlock* blocks = blocks_.data();
-    constexpr uint32_t kLeafBit = 0x80000000u;
-    for (size_t head = 0; head < queue.size(); ++head) {
+    for (size_t head = 0; head < tail; ++head) {
       const uint32_t item = queue[head];
       if (item & kLeafBit) {
         const uint32_t block = item & ~kLeafBit;
@@ -866,22 +893,22 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
       for (int i = 0; i < 3; ++i) {
         const f4 x = q3[i] - load(w.c[i]);
         const f4 a = x * load(w.nlo[i]), b = x * load(w.nhi[i]);
-        vmin += a < b ? a : b;
-        vmax += a < b ? b : a;
+        vmin += min4(a, b);
+        vmax += max4(b, a);  // a < b ? b : a
       }
       for (unsigned pass = lanes((vmin <= dn) & (vmax >= -dn)); pass != 0; pass &= pass - 1) {
         const int k = std::countr_zero(pass);
         const uint32_t child = w.child[k];
-        if (w.count[k] == 0) {
+        if (!(child & kLeafBit)) {
           for (int line = 0; line < int(sizeof(WideNode)); line += 64)
             __builtin_prefetch(reinterpret_cast<const char*>(wide + child) + line);
-          queue.push_back(child);
         } else {
-          __builtin_prefetch(blocks + child);
-          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 64);
-          __builtin_prefetch(reinterpret_cast<const char*>(blocks + child) + 128);
-          queue.push_back(child | kLeafBit);
+          const char* blk = reinterpret_cast<const char*>(blocks + (child & ~kLeafBit));
+          __builtin_prefetch(blk);
+          __builtin_prefetch(blk + 64);
+          __builtin_prefetch(blk + 128);
         }
+        queue[tail++] = child;
       }
     }
   }

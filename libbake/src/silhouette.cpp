@@ -241,7 +241,7 @@ struct SilhouetteIntegrator::Impl {
     double lam[5] = {0, 1, 1, 1, 1};
     int nl = 1;
     for (int c = 0; c < 3; ++c)
-      if (oct::sgn0(arc.a[c]) != oct::sgn0(arc.b[c])) lam[nl++] = arc.a[c] / (arc.a[c] - arc.b[c]);
+      if ((arc.a[c] < 0) != (arc.b[c] < 0)) lam[nl++] = arc.a[c] / (arc.a[c] - arc.b[c]);  // sgn0 differs
     lam[nl++] = 1.0;
     for (int k = 1; k < nl; ++k)  // insertion sort of ≤ 5 values
       for (int j = k; j > 0 && lam[j] < lam[j - 1]; --j) std::swap(lam[j], lam[j - 1]);
@@ -252,11 +252,13 @@ struct SilhouetteIntegrator::Impl {
       const Vector3d sg(oct::sgn0(mid.x()), oct::sgn0(mid.y()), oct::sgn0(mid.z()));
       const double da = sg.dot(xa), db = sg.dot(xb);
       if (!(da > 0) || !(db > 0)) continue;  // a piece through the origin (edge through p): no extent
-      const double ua = xa.x() / da, va = xa.y() / da, ub = xb.x() / db, vb = xb.y() / db;
+      const double ua = xa.x() / da, ub = xb.x() / db;
       if (ua == ub) continue;  // parallel to the isolines: crosses none
-      const int sheet = sg.z() > 0 ? 0 : 1;
       const double umin = std::min(ua, ub), umax = std::max(ua, ub);
       const int i0 = std::max(g.first_at_or_after(umin), i_begin), i1 = std::min(g.first_at_or_after(umax), i_end);
+      if (i0 >= i1) continue;  // most pieces of a fine mesh cross no isoline: v only when one does
+      const int sheet = sg.z() > 0 ? 0 : 1;
+      const double va = xa.y() / da, vb = xb.y() / db;
       const double slope = (vb - va) / (ub - ua);
       for (int i = i0; i < i1; ++i) {
         const double l = g.half_length(i);
@@ -279,21 +281,37 @@ struct SilhouetteIntegrator::Impl {
     if (step != 0) out.push_back({u, step});
   }
 
+  // Crossings of one isoline in walk order: by t, then by step (crossings equal in both are
+  // interchangeable, so any sort gives the same walk). Buckets are short: insertion sort, which
+  // moves elements one by one (std::sort's short runs go through memmove).
+  static void sort_along_loop(Crossing* b0, Crossing* b1) {
+    const auto before = [](const Crossing& x, const Crossing& y) { return x.t < y.t || (x.t == y.t && x.step < y.step); };
+    if (b1 - b0 > 32) {
+      std::sort(b0, b1, before);
+      return;
+    }
+    for (Crossing* c = b0 + 1; c < b1; ++c) {
+      const Crossing x = *c;
+      Crossing* j = c;
+      for (; j > b0 && before(x, j[-1]); --j) *j = j[-1];
+      *j = x;
+    }
+  }
+
   // The DCF walk over isolines [i_begin, i_end) of grid g: W at each loop start comes from the
   // sorted spine crossings; runs with W = 0 add C(t_end) − C(t_start) of `tables`.
   template <class Tables>
   static uint64_t walk(const oct::Grid& g, int i_begin, int i_end, const Tables& tables, int W0,
                        const std::vector<SpineCrossing>& spine, std::vector<Crossing>& crossings,
                        std::vector<Crossing>& sorted, std::vector<uint32_t>& start, double* acc, size_t F) {
+    // Counting sort by isoline: counts at start[i + 2], prefix sums, then start[i + 1] as the
+    // fill cursor of isoline i, which leaves isoline i's crossings in [start[i], start[i + 1]).
     const int n = i_end - i_begin;
-    start.assign(size_t(n) + 1, 0);
-    for (const Crossing& c : crossings) ++start[size_t(c.iso - i_begin) + 1];
-    for (int i = 0; i < n; ++i) start[size_t(i) + 1] += start[size_t(i)];
+    start.assign(size_t(n) + 2, 0);
+    for (const Crossing& c : crossings) ++start[size_t(c.iso - i_begin) + 2];
+    for (int i = 0; i < n; ++i) start[size_t(i) + 2] += start[size_t(i) + 1];
     sorted.resize(crossings.size());
-    {
-      std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-      for (const Crossing& c : crossings) sorted[fill[size_t(c.iso - i_begin)]++] = c;
-    }
+    for (const Crossing& c : crossings) sorted[start[size_t(c.iso - i_begin) + 1]++] = c;
     int W = W0;
     size_t sp = 0;
     uint64_t inconsistent = 0;
@@ -305,7 +323,7 @@ struct SilhouetteIntegrator::Impl {
       }
       auto* b0 = sorted.data() + start[size_t(i - i_begin)];
       auto* b1 = sorted.data() + start[size_t(i - i_begin) + 1];
-      std::sort(b0, b1, [](const Crossing& x, const Crossing& y) { return x.t < y.t || (x.t == y.t && x.step < y.step); });
+      sort_along_loop(b0, b1);
       int w = W;
       for (auto* c = b0; c != b1; ++c) {
         const int next = w + c->step;

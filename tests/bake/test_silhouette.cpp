@@ -59,6 +59,23 @@ TEST(Octahedral, JacobianIntegratesToTheSphere) {
   EXPECT_NEAR(oct::jacobian(0.5, 0.5), std::pow(0.5, -1.5), 1e-12);
 }
 
+TEST(Octahedral, CeilIntIsStdCeil) {
+  // The isoline index of a crossing must be the same integer bit for bit: ceil_int against
+  // int(std::ceil(x)) on integers, half-integers, their float neighbours, signed zeros and
+  // seeded values over the range an index takes (|x| ≤ 2²⁰) and far beyond it.
+  std::vector<double> xs = {0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, -2.5, 1e-300, -1e-300, 2147483646.5, -2147483647.5};
+  for (int k = -70; k <= 70; ++k)
+    for (const double x : {double(k), k + 0.5})
+      xs.insert(xs.end(), {x, std::nextafter(x, -1e9), std::nextafter(x, 1e9)});
+  uint64_t state = 12345;
+  for (int r = 0; r < 200000; ++r) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const double unit = double(state >> 11) * 0x1p-53;  // [0, 1)
+    xs.push_back((2 * unit - 1) * (r % 2 ? 0x1p20 : 0x1p30));
+  }
+  for (const double x : xs) ASSERT_EQ(oct::ceil_int(x), int(std::ceil(x))) << x;
+}
+
 TEST(Silhouette, UnoccludedVertexClosedForms) {
   const Mesh m = grid(2, 1.0f);
   const Topology topo = build_topology(m);

@@ -116,12 +116,14 @@ private:
     uint32_t index;  // leaf: first record; inner: right child (left child is this + 1)
     uint32_t count;  // leaf: record count (> 0); inner: 0
   };
-  struct alignas(16) WideNode {  // four children's bounds side by side (SoA, 208 bytes)
+  // Four children's bounds side by side (SoA): 192 bytes, three cache lines on their boundaries.
+  struct alignas(64) WideNode {
     float c[3][4], nlo[3][4], nhi[3][4];
     float dlo[4], dhi[4];
-    uint32_t child[4];  // leaf: its LeafBlock; inner: wide node index
-    uint32_t count[4];  // leaf: record count (> 0); inner: 0. An empty slot has D = +∞ (never passes)
+    uint32_t child[4];  // inner: wide node index; leaf: its LeafBlock | kLeafBit. An empty slot
+                        // is a leaf with D = +∞ (never passes)
   };
+  static constexpr uint32_t kLeafBit = 0x80000000u;
   struct alignas(16) LeafBlock {  // a leaf's four BVH edges (padded), lane j = edge j: what the leaf test reads
     float g[8][4];     // ĝ_1 (unit normal, offset) then −ĝ_2, finder frame, rounded to float
     uint32_t edge[4];  // Topology edge indices (padding: 0, never read)

@@ -22,6 +22,13 @@ namespace prt::bake::oct {
 
 inline double sgn0(double x) noexcept { return x < 0 ? -1.0 : 1.0; }  // sign with sgn0(0) = +1
 
+// int(std::ceil(x)) for |x| < 2³¹, without the rounding sequence std::ceil compiles to on
+// x86-64 without SSE4.1: truncation, then one up when that fell below x.
+inline int ceil_int(double x) noexcept {
+  const int k = int(x);
+  return double(k) < x ? k + 1 : k;
+}
+
 // Unnormalised direction of (u, v) on a sheet (0: z ≥ 0, 1: z < 0).
 inline Eigen::Vector3d dir_from_uv(double u, double v, int sheet) noexcept {
   const double z = 1.0 - std::abs(u) - std::abs(v);
@@ -51,7 +58,7 @@ struct Grid {
                       : Eigen::Vector3d(0, -1, -sgn0(v) * (v == 0 ? 0 : 1));
   }
   // First isoline index with u_i ≥ u.
-  int first_at_or_after(double u) const noexcept { return int(std::ceil((u + 1.0) / h - 0.5)); }
+  int first_at_or_after(double u) const noexcept { return ceil_int((u + 1.0) / h - 0.5); }
 };
 
 // The spine (z = 0, y < 0) as a path in u: q(u) = (u, −(1−|u|), 0); its direction of travel.
