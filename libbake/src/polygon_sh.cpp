@@ -16,7 +16,16 @@
 
 namespace prt::bake {
 
+// One edge of a polygon of unit vertices: ends a, b, unit plane normal u, length θ, and the unit
+// tangents u×a, u×b at its ends (directions of travel).
+struct detail::ShEdge {
+  Eigen::Vector3d a, b, u, ta, tb, a_minus_b;
+  double theta;
+};
+
 namespace {
+
+using Edge = detail::ShEdge;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -35,13 +44,6 @@ std::vector<std::vector<double>> legendre_monomials(int n) {
   }
   return p;
 }
-
-// One edge of a polygon of unit vertices: ends a, b, unit plane normal u, length θ, and the unit
-// tangents u×a, u×b at its ends (directions of travel).
-struct Edge {
-  Eigen::Vector3d a, b, u, ta, tb, a_minus_b;
-  double theta;
-};
 
 } // namespace
 
@@ -76,38 +78,19 @@ PolygonSH::PolygonSH(int order) : order_(order) {
   }
 }
 
-void PolygonSH::project(std::span<const Eigen::Vector3d> vertices, std::span<double> out) const {
-  const int count = sh::num_coeffs(order_);
-  PRT_CHECK(out.size() >= size_t(count));
-  std::fill(out.begin(), out.begin() + count, 0.0);
-  const detail::UnitPolygon unit(vertices);
-  const auto v = unit.span();
-  if (v.size() < 3) return;
+namespace {
 
-  out[0] = detail::solid_angle_unit(v) / std::sqrt(4 * kPi);
-  if (order_ == 1) return;
-  const Eigen::Vector3d phi = 0.5 * detail::twice_vector_irradiance(v);
-  const sh::Band1 b1 = sh::band1_from_direction(phi.x(), phi.y(), phi.z());
-  for (int m = 0; m < 3; ++m) out[size_t(1 + m)] = sh::kBand1Scale * b1.v[m];
-  if (order_ == 2) return;
-
-  // Edges (null edges, a = b, bound nothing and are skipped).
-  constexpr size_t kInline = 32;
-  std::array<Edge, kInline> inline_edges;
-  std::vector<Edge> heap_edges;
-  Edge* edges = inline_edges.data();
-  if (v.size() > kInline) {
-    heap_edges.resize(v.size());
-    edges = heap_edges.data();
-  }
-  size_t n = 0;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const Eigen::Vector3d& a = v[i];
-    const Eigen::Vector3d& b = v[i + 1 == v.size() ? 0 : i + 1];
+// The edges of the arcs arc(0) … arc(n−1) (pairs of unit vectors) into edges[], null arcs
+// (a = b) skipped (they bound nothing); returns the count.
+template <class ArcAt>
+size_t build_edges(size_t n, ArcAt&& arc, Edge* edges) {
+  size_t count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const auto [a, b] = arc(i);
     const Eigen::Vector3d ab = a.cross(b);
     const double s = ab.norm();
     if (s == 0) continue;
-    Edge& e = edges[n++];
+    Edge& e = edges[count++];
     e.a = a;
     e.b = b;
     e.u = ab / s;
@@ -116,7 +99,61 @@ void PolygonSH::project(std::span<const Eigen::Vector3d> vertices, std::span<dou
     e.a_minus_b = a - b;
     e.theta = std::atan2(s, a.dot(b));
   }
+  return count;
+}
 
+// Bands 0 and 1 from Ω and 2Φ.
+void low_bands(int order, double omega, const Eigen::Vector3d& twice_phi, std::span<double> out) {
+  out[0] = omega / std::sqrt(4 * kPi);
+  if (order == 1) return;
+  const sh::Band1 b1 = sh::band1_from_direction(twice_phi.x(), twice_phi.y(), twice_phi.z());
+  for (int m = 0; m < 3; ++m) out[size_t(1 + m)] = 0.5 * sh::kBand1Scale * b1.v[m];
+}
+
+// Small-buffer storage for the edges of one projection.
+class EdgeBuffer {
+public:
+  explicit EdgeBuffer(size_t n) {
+    if (n > inline_.size()) heap_.resize(n);
+  }
+  Edge* data() { return heap_.empty() ? inline_.data() : heap_.data(); }
+
+private:
+  std::array<Edge, 32> inline_;
+  std::vector<Edge> heap_;
+};
+
+} // namespace
+
+void PolygonSH::project(std::span<const Eigen::Vector3d> vertices, std::span<double> out) const {
+  PRT_CHECK(out.size() >= size_t(sh::num_coeffs(order_)));
+  std::fill(out.begin(), out.begin() + sh::num_coeffs(order_), 0.0);
+  const detail::UnitPolygon unit(vertices);
+  const auto v = unit.span();
+  if (v.size() < 3) return;
+  low_bands(order_, detail::solid_angle_unit(v), detail::twice_vector_irradiance(v), out);
+  if (order_ <= 2) return;
+  EdgeBuffer edges(v.size());
+  const size_t n = build_edges(v.size(), [&](size_t i) {
+    return std::pair<const Eigen::Vector3d&, const Eigen::Vector3d&>(v[i], v[i + 1 == v.size() ? 0 : i + 1]);
+  }, edges.data());
+  high_bands({edges.data(), n}, out);
+}
+
+void PolygonSH::project(std::span<const Arc> boundary, std::span<double> out) const {
+  PRT_CHECK(out.size() >= size_t(sh::num_coeffs(order_)));
+  std::fill(out.begin(), out.begin() + sh::num_coeffs(order_), 0.0);
+  if (boundary.empty()) return;
+  low_bands(order_, solid_angle(boundary), 2.0 * vector_irradiance(boundary), out);
+  if (order_ <= 2) return;
+  EdgeBuffer edges(boundary.size());
+  const size_t n = build_edges(boundary.size(), [&](size_t i) {
+    return std::pair<Eigen::Vector3d, Eigen::Vector3d>(boundary[i].a.normalized(), boundary[i].b.normalized());
+  }, edges.data());
+  high_bands({edges.data(), n}, out);
+}
+
+void PolygonSH::high_bands(std::span<const detail::ShEdge> edges, std::span<double> out) const {
   // Q_l(w_k) for every axis and band 2 … order−1.
   const int d = int(axes_.size());
   const int top = order_ - 1;  // highest band; arc moments E_0 … E_{top−1} are needed
@@ -124,8 +161,7 @@ void PolygonSH::project(std::span<const Eigen::Vector3d> vertices, std::span<dou
   std::array<double, kMaxOrder * 4 * kMaxOrder> q{};  // q[(l−2)·D + k]
   for (int k = 0; k < d; ++k) {
     const Eigen::Vector3d& w = axes_[size_t(k)];
-    for (size_t i = 0; i < n; ++i) {
-      const Edge& e = edges[i];
+    for (const Edge& e : edges) {
       const double x0 = w.dot(e.a), x1 = w.dot(e.b), y0 = w.dot(e.ta), y1 = w.dot(e.tb);
       const double r2 = x0 * x0 + y0 * y0;
       moments[0] = e.theta;

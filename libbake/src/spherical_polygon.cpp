@@ -5,16 +5,10 @@
 #include <bake/error.h>
 
 #include <cmath>
-#include <numbers>
 
 namespace prt::bake {
 
 namespace {
-
-// 2π plus the fan's rounding (each of its terms is correct to a few ulps of 2π): a sum above it
-// is the negatively oriented case; a hemisphere (Ω = 2π, a boundary on a great circle) is taken
-// with the orientation of Φ, i.e. as +2π.
-constexpr double kHemisphere = 2 * std::numbers::pi * (1 + 1e-12);
 
 // θ/sin θ − 1 for an edge with s = |a×b| = sin θ and c = a·b (unit a, b), 0 for a null edge.
 // atan2(s, c)/s carries no cancellation for small s (it is 1 + s²/6 + …, with relative error ~u),
@@ -22,13 +16,6 @@ constexpr double kHemisphere = 2 * std::numbers::pi * (1 + 1e-12);
 double arc_excess(double s, double c) {
   if (s == 0) return 0;  // a = b (antipodal ends are excluded by the preconditions)
   return std::atan2(s, c) / s - 1.0;
-}
-
-// Signed solid angle of the spherical triangle (c, a, b), unit vectors (Van Oosterom & Strackee).
-double triangle_solid_angle(const Eigen::Vector3d& c, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double det = c.dot((a - c).cross(b - c));
-  const double den = 1.0 + c.dot(a) + a.dot(b) + b.dot(c);
-  return 2.0 * std::atan2(det, den);
 }
 
 // Error-free product x·y = h + l (FMA; exact unless the product underflows).
@@ -91,15 +78,55 @@ double solid_angle(std::span<const Eigen::Vector3d> vertices) {
 
 double detail::solid_angle_unit(std::span<const Eigen::Vector3d> unit) {
   const size_t n = unit.size();
-  const Eigen::Vector3d phi = twice_vector_irradiance(unit);
-  const double len = phi.norm();
-  if (len == 0) return 0;  // a null chain (e.g. fewer than three distinct vertices)
-  const Eigen::Vector3d c = phi / len;
-  double omega = 0;
-  for (size_t i = 0; i < n; ++i) omega += triangle_solid_angle(c, unit[i], unit[i + 1 == n ? 0 : i + 1]);
-  // The fan counts winding numbers relative to −c: a positively oriented region (around c) gives
-  // Ω ∈ (0, 2π]; a negatively oriented one lies around −c and gives 4π − |Ω| ∈ [2π, 4π).
-  return omega > kHemisphere ? omega - 4 * std::numbers::pi : omega;
+  return fan_solid_angle(twice_vector_irradiance(unit), n, [&](size_t i) {
+    return std::pair<const Eigen::Vector3d&, const Eigen::Vector3d&>(unit[i], unit[i + 1 == n ? 0 : i + 1]);
+  });
+}
+
+Eigen::Vector3d detail::arc_moment(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = a.cross(b);
+  return (1.0 + arc_excess(ab.norm(), a.dot(b))) * ab;
+}
+
+namespace {
+
+// Unit copies of boundary arcs (heap only: a region's boundary is built on the heap anyway).
+std::vector<Arc> unit_arcs(std::span<const Arc> boundary) {
+  std::vector<Arc> out;
+  out.reserve(boundary.size());
+  for (const Arc& arc : boundary) {
+    const double la = arc.a.norm(), lb = arc.b.norm();
+    PRT_CHECK(std::isfinite(la) && la > 0 && std::isfinite(lb) && lb > 0);
+    out.push_back({arc.a / la, arc.b / lb});
+  }
+  return out;
+}
+
+// The closed-polygon form of 2Φ on arcs: Σ (a − o)×(b − o) + Σ (θ/sin θ − 1)(a × b), equal to
+// Σ θ u when the arcs close (every endpoint is as often a start as an end), o = the first start.
+Eigen::Vector3d twice_vector_irradiance_arcs(std::span<const Arc> unit) {
+  if (unit.empty()) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d o = unit[0].a;
+  Eigen::Vector3d area = Eigen::Vector3d::Zero(), bend = Eigen::Vector3d::Zero();
+  for (const Arc& arc : unit) {
+    const Eigen::Vector3d ab = arc.a.cross(arc.b);
+    bend += arc_excess(ab.norm(), arc.a.dot(arc.b)) * ab;
+    area += (arc.a - o).cross(arc.b - o);
+  }
+  return area + bend;
+}
+
+}  // namespace
+
+Eigen::Vector3d vector_irradiance(std::span<const Arc> boundary) {
+  return 0.5 * twice_vector_irradiance_arcs(unit_arcs(boundary));
+}
+
+double solid_angle(std::span<const Arc> boundary) {
+  const std::vector<Arc> unit = unit_arcs(boundary);
+  return detail::fan_solid_angle(twice_vector_irradiance_arcs(unit), unit.size(), [&](size_t i) {
+    return std::pair<const Eigen::Vector3d&, const Eigen::Vector3d&>(unit[i].a, unit[i].b);
+  });
 }
 
 int horizon_side(const Eigen::Vector3d& n, const Eigen::Vector3d& v) {

@@ -31,12 +31,18 @@
 // Cost: O(N · D · order) per polygon of N edges, plus O(order³) to apply the pseudo-inverses.
 #pragma once
 
+#include <bake/spherical_polygon.h>
+
 #include <Eigen/Core>
 
 #include <span>
 #include <vector>
 
 namespace prt::bake {
+
+namespace detail {
+struct ShEdge;
+}
 
 class PolygonSH {
 public:
@@ -50,12 +56,18 @@ public:
   // out[i] = ∫_P y_i(ω) dω for i < order² (out.size() >= order², PRT_CHECK). P is used as given:
   // clip it to the horizon first (bake/spherical_polygon.h) for the visible part above a receiver.
   void project(std::span<const Eigen::Vector3d> vertices, std::span<double> out) const;
+  // The same for a region given by its boundary arcs (bake/spherical_polygon.h Arc; e.g. the
+  // visible part of a light, bake/visible_region.h). Bands 0 and 1 by the per-arc formulas.
+  void project(std::span<const Arc> boundary, std::span<double> out) const;
 
 private:
   int order_;
   std::vector<Eigen::Vector3d> axes_;    // D unit directions w_k
   std::vector<double> solve_;            // bands 2 … order−1: (2l+1) × D row-major blocks
   std::vector<double> derivative_;       // bands 2 … order−1: monomial coefficients of P_l', l each
+
+  // Bands 2 … order−1 from the edges (out already holds bands 0 and 1).
+  void high_bands(std::span<const detail::ShEdge> edges, std::span<double> out) const;
 };
 
 } // namespace prt::bake

@@ -68,6 +68,21 @@ double cosine_integral(std::span<const Eigen::Vector3d> vertices, const Eigen::V
 // Ω(P) in steradians (signed by orientation; see the file comment for the precondition).
 double solid_angle(std::span<const Eigen::Vector3d> vertices);
 
+// An oriented great arc a → b (shorter than π; a, b finite, non-zero, any length): a piece of a
+// region's boundary with the region on its left (bake/visible_region.h builds them). A region
+// given as a set of boundary arcs (a 1-chain: several loops, holes, pieces of edges) integrates
+// by the same edge formulas, summed arc by arc: Φ = ½ Σ θ u in the closed-polygon form above
+// (Σ (a − o)×(b − o) about the first arc's start o, plus the O(θ³) terms), and Ω by the fan about
+// Φ/|Φ| with the same precondition (the region lies in a closed hemisphere). The arcs need not be
+// chained, but the chain should close (each endpoint, bit for bit, as often a start as an end, as
+// visible_region makes it): a gap δ between endpoints changes Φ by ~δ (so a tiny region loses its
+// relative accuracy), the other integrals by O(δ · arc length).
+struct Arc {
+  Eigen::Vector3d a, b;
+};
+Eigen::Vector3d vector_irradiance(std::span<const Arc> boundary);
+double solid_angle(std::span<const Arc> boundary);
+
 // Exact sign (−1, 0, +1) of n·v for finite doubles (no overflow or underflow of the products).
 int horizon_side(const Eigen::Vector3d& n, const Eigen::Vector3d& v);
 
