@@ -3,9 +3,12 @@
 #include <bake/visible_region.h>
 
 #include <bake/contour.h>
+#include <bake/error.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 namespace prt::bake {
 
@@ -181,6 +184,70 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
         }
       }
     }
+  }
+}
+
+ConvexPolyhedron::ConvexPolyhedron(std::vector<V3> vertices, std::vector<std::vector<uint32_t>> faces)
+    : vertices_(std::move(vertices)), faces_(std::move(faces)) {
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> edge_face;
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    const auto& q = faces_[f];
+    PRT_CHECK(q.size() >= 3);
+    for (size_t k = 0; k < q.size(); ++k) {
+      PRT_CHECK(q[k] < vertices_.size());
+      PRT_CHECK(edge_face.emplace(std::pair(q[k], q[(k + 1) % q.size()]), uint32_t(f)).second);
+    }
+  }
+  for (const auto& q : faces_) {
+    twin_face_.emplace_back();
+    for (size_t k = 0; k < q.size(); ++k) {
+      const auto twin = edge_face.find({q[(k + 1) % q.size()], q[k]});
+      PRT_CHECK(twin != edge_face.end());
+      twin_face_.back().push_back(twin->second);
+    }
+  }
+}
+
+bool ConvexPolyhedron::front_facing(size_t face, const V3& p) const {
+  const auto& q = faces_[face];
+  return orient3d_exact(vertices_[q[0]], vertices_[q[1]], vertices_[q[2]], p) < 0;
+}
+
+bool ConvexPolyhedron::silhouette(const V3& p, std::vector<V3>& out) const {
+  out.clear();
+  std::vector<char> front(faces_.size());
+  for (size_t f = 0; f < faces_.size(); ++f) front[f] = front_facing(f, p);
+  // next[v] = u for a silhouette edge (u, v) of a front face, taken reversed.
+  std::vector<int64_t> next(vertices_.size(), -1);
+  int64_t start = -1;
+  size_t edges = 0;
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    if (!front[f]) continue;
+    const auto& q = faces_[f];
+    for (size_t k = 0; k < q.size(); ++k) {
+      if (front[twin_face_[f][k]]) continue;
+      next[q[(k + 1) % q.size()]] = q[k];
+      start = q[k];
+      ++edges;
+    }
+  }
+  if (start < 0) return false;
+  int64_t at = start;
+  do {
+    out.push_back(vertices_[size_t(at)] - p);
+    at = next[size_t(at)];
+    PRT_CHECK(at >= 0 && out.size() <= edges);  // one loop (the body is convex)
+  } while (at != start);
+  return true;
+}
+
+void ConvexPolyhedron::front_triangles(const V3& p, std::vector<std::vector<V3>>& out) const {
+  out.clear();
+  for (size_t f = 0; f < faces_.size(); ++f) {
+    if (!front_facing(f, p)) continue;
+    const auto& q = faces_[f];
+    for (size_t k = 1; k + 1 < q.size(); ++k)
+      out.push_back({vertices_[q[0]] - p, vertices_[q[k + 1]] - p, vertices_[q[k]] - p});
   }
 }
 

@@ -16,7 +16,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <random>
 #include <vector>
 
@@ -174,50 +173,20 @@ Box random_box(std::mt19937_64& rng, double z_lo, double z_hi) {
   return b;
 }
 
-bool front_facing(const Box& b, int f) {
-  const auto& q = b.faces[size_t(f)];
-  const V3 nrm = (b.v[size_t(q[1])] - b.v[size_t(q[0])]).cross(b.v[size_t(q[2])] - b.v[size_t(q[0])]);
-  return nrm.dot(-b.v[size_t(q[0])]) > 0;  // the shade point (origin) on the outer side
+prt::bake::ConvexPolyhedron polyhedron(const Box& b) {
+  std::vector<std::vector<uint32_t>> faces;
+  for (const auto& q : b.faces) faces.push_back({uint32_t(q[0]), uint32_t(q[1]), uint32_t(q[2]), uint32_t(q[3])});
+  return prt::bake::ConvexPolyhedron(std::vector<V3>(b.v.begin(), b.v.end()), faces);
 }
 
-// Front faces as positively oriented spherical polygons (reversed: seen from p they run clockwise
-// in the sphere's outward view), split into triangles: the per-triangle variant.
-std::vector<Poly> front_triangles(const Box& b) {
+// Every triangle of the box's surface (front and back), for ray casting.
+std::vector<Poly> all_triangles(const Box& b) {
   std::vector<Poly> out;
-  for (int f = 0; f < 6; ++f) {
-    if (!front_facing(b, f)) continue;
-    const auto& q = b.faces[size_t(f)];
-    out.push_back({b.v[size_t(q[0])], b.v[size_t(q[2])], b.v[size_t(q[1])]});
-    out.push_back({b.v[size_t(q[0])], b.v[size_t(q[3])], b.v[size_t(q[2])]});
+  for (const auto& q : b.faces) {
+    out.push_back({b.v[size_t(q[0])], b.v[size_t(q[1])], b.v[size_t(q[2])]});
+    out.push_back({b.v[size_t(q[0])], b.v[size_t(q[2])], b.v[size_t(q[3])]});
   }
   return out;
-}
-
-// The silhouette loop: edges between a front and a back face, each taken reversed from its front
-// face (positive orientation), chained.
-Poly silhouette(const Box& b) {
-  std::map<int, int> next;
-  for (int f = 0; f < 6; ++f) {
-    if (!front_facing(b, f)) continue;
-    const auto& q = b.faces[size_t(f)];
-    for (int k = 0; k < 4; ++k) {
-      const int from = q[k], to = q[(k + 1) % 4];
-      bool shared_with_front = false;
-      for (int g = 0; g < 6; ++g) {
-        if (g == f || !front_facing(b, g)) continue;
-        const auto& h = b.faces[size_t(g)];
-        for (int m = 0; m < 4; ++m) shared_with_front |= h[m] == to && h[(m + 1) % 4] == from;
-      }
-      if (!shared_with_front) next[to] = from;
-    }
-  }
-  Poly loop;
-  int start = next.begin()->first, at = start;
-  do {
-    loop.push_back(b.v[size_t(at)]);
-    at = next.at(at);
-  } while (at != start && loop.size() <= 8);
-  return loop;
 }
 
 // Möller–Trumbore: does the ray from the origin along w hit the triangle?
@@ -251,6 +220,33 @@ Scene random_scene(std::mt19937_64& rng, int boxes) {
   return s;
 }
 
+TEST(VisibleRegion, SilhouetteOfABoxFromInsideOutsideAndItsFacePlane) {
+  // The unit box [0, 1]³ seen from inside (no loop: it hides everything), from a corner's
+  // diagonal (6 silhouette vertices), from the front of one face (4) and from the plane of its
+  // bottom face (that face edge-on: not front-facing; the loop agrees with the per-triangle union).
+  Box b;
+  for (int k = 0; k < 8; ++k) b.v[size_t(k)] = V3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+  b.faces = {{{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
+  const auto body = polyhedron(b);
+  Poly loop;
+  EXPECT_FALSE(body.silhouette(V3(0.5, 0.5, 0.5), loop));
+  EXPECT_TRUE(loop.empty());
+  ASSERT_TRUE(body.silhouette(V3(-1, -1, -1), loop));
+  EXPECT_EQ(loop.size(), 6u);
+  ASSERT_TRUE(body.silhouette(V3(0.5, 0.5, -2), loop));
+  EXPECT_EQ(loop.size(), 4u);
+  const V3 p(-1.5, 0.3, 0);  // in the plane z = 0 of the bottom face
+  ASSERT_TRUE(body.silhouette(p, loop));
+  std::vector<Poly> tris;
+  body.front_triangles(p, tris);
+  const Poly light = rect(-1, 3, -2, 3, 2);  // relative to p: above the box
+  Poly light_rel;
+  for (const V3& v : light) light_rel.push_back(v - p);
+  const double e_sil = cosine(visible(light_rel, {loop})), e_tri = cosine(visible(light_rel, tris));
+  EXPECT_NEAR(e_sil, e_tri, kExact);
+  EXPECT_LT(e_sil, cosine(light_rel) - 0.01);  // the box does hide part of the light
+}
+
 TEST(VisibleRegion, SilhouetteAgreesWithPerTriangle) {
   // 1e-10 on 10^4 random convex scenes (issue 13): 3 boxes between p and the light (overlapping
   // each other at random), the light clipped to a tilted horizon; irradiance and order-3 SH.
@@ -262,10 +258,13 @@ TEST(VisibleRegion, SilhouetteAgreesWithPerTriangle) {
   int shadowed = 0, hidden = 0;
   for (int k = 0; k < 10000; ++k) {
     const Scene s = random_scene(rng, 3);
-    std::vector<Poly> sil, tri;
+    std::vector<Poly> sil, tri, front;
     for (const Box& b : s.boxes) {
-      sil.push_back(silhouette(b));
-      for (Poly& t : front_triangles(b)) tri.push_back(std::move(t));
+      const auto body = polyhedron(b);
+      sil.emplace_back();
+      body.silhouette(V3::Zero(), sil.back());
+      body.front_triangles(V3::Zero(), front);
+      for (Poly& t : front) tri.push_back(std::move(t));
     }
     const auto a = visible(s.light, sil), b = visible(s.light, tri);
     EXPECT_TRUE(closes(a)) << k;
@@ -292,15 +291,16 @@ TEST(VisibleRegion, SilhouetteAgreesWithPerTriangle) {
 
 TEST(VisibleRegion, AgreesWithRqmcRayCasting) {
   // E = ∫ V·[ω in light]·(n·ω)⁺ dω by RQMC (32 × 2^11 directions, Möller–Trumbore against every
-  // front-facing triangle; the boxes lie between p and the light, so any hit hides it);
+  // triangle of the boxes; they lie between p and the light, so any hit hides it);
   // tolerance 4 standard errors + 1e-12.
   std::mt19937_64 rng(23);
   for (int k = 0; k < 6; ++k) {
     const Scene s = random_scene(rng, 3);
     std::vector<Poly> sil, tri;
     for (const Box& b : s.boxes) {
-      sil.push_back(silhouette(b));
-      for (Poly& t : front_triangles(b)) tri.push_back(std::move(t));
+      sil.emplace_back();
+      polyhedron(b).silhouette(V3::Zero(), sil.back());
+      for (Poly& t : all_triangles(b)) tri.push_back(std::move(t));
     }
     const auto arcs = visible(s.light, sil);
     const double e = s.n.dot(prt::bake::vector_irradiance(arcs));

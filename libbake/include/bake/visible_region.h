@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -44,5 +45,42 @@ namespace prt::bake {
 // the shade point (points relative to it will do).
 void visible_region(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
                     std::vector<Arc>& out);
+
+// A convex polyhedron (an occluder or a convex emitter) and its silhouette loop seen from a point
+// (paper 003 §3.3, Alg. 2 SphPolySilhouette). Faces are planar, counter-clockwise seen from
+// outside. A face is front-facing from p when det(v0 − p, v1 − p, v2 − p) < 0 (p strictly on its
+// outer side; orient3d_exact, so the decision is exact and a face seen edge-on is not front-facing).
+// The silhouette edges are the edges of front faces whose other face is not front-facing; each is
+// taken against its front face's direction (a front face runs clockwise in this file's positive
+// sense), and they chain into one loop because the body is convex. This replaces Alg. 2's
+// nearest-endpoint ordering in a gnomonic plane by the mesh's adjacency.
+class ConvexPolyhedron {
+public:
+  // Precondition (PRT_CHECK): every face has ≥ 3 vertex indices in range, and every directed edge
+  // (u, v) of a face has exactly one twin (v, u) in another face (a closed, consistently oriented
+  // surface).
+  ConvexPolyhedron(std::vector<Eigen::Vector3d> vertices, std::vector<std::vector<uint32_t>> faces);
+
+  // out = the silhouette loop seen from p, as points relative to p (positively oriented, ready for
+  // visible_region). Returns false, with out empty, when no face is front-facing: p is inside the
+  // closed body or on its surface, and the body hides the whole sphere (E = 0 for every light).
+  // A face whose plane contains p (seen edge-on) is not front-facing and its image is part of the
+  // loop's edges; p ON a face is a degenerate view (that face's image is a great circle) left to
+  // the caller (e.g. decide by the normal: paper 001's ε-limit rule).
+  bool silhouette(const Eigen::Vector3d& p, std::vector<Eigen::Vector3d>& out) const;
+
+  // out = the front-facing faces seen from p, each fanned into triangles relative to p and
+  // positively oriented: the per-triangle variant (paper 003 §4.4).
+  void front_triangles(const Eigen::Vector3d& p, std::vector<std::vector<Eigen::Vector3d>>& out) const;
+
+  const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
+
+private:
+  bool front_facing(size_t face, const Eigen::Vector3d& p) const;
+
+  std::vector<Eigen::Vector3d> vertices_;
+  std::vector<std::vector<uint32_t>> faces_;
+  std::vector<std::vector<uint32_t>> twin_face_;  // [face][k]: the face across edge (k, k+1)
+};
 
 } // namespace prt::bake
