@@ -49,16 +49,19 @@ const std::vector<ShadePoint>& shade_points() {
 
 const std::vector<V3> kQuad{{-0.5, -0.5, 1.5}, {0.5, -0.5, 1.5}, {0.5, 0.5, 1.5}, {-0.5, 0.5, 1.5}};
 
+// The quad light seen from s, clipped to its horizon, into clipped; returns its irradiance.
+double clipped_quad(const ShadePoint& s, std::vector<V3>& rel, std::vector<V3>& clipped) {
+  for (size_t k = 0; k < 4; ++k) rel[k] = kQuad[k] - s.p;
+  prt::bake::clip_to_horizon(rel, s.n, clipped);
+  return prt::bake::cosine_integral(clipped, s.n);
+}
+
 void BM_QuadIrradiance(benchmark::State& state) {
   const auto& points = shade_points();
   std::vector<V3> rel(4), clipped;
   for (auto _ : state) {
     double sum = 0;
-    for (const ShadePoint& s : points) {
-      for (size_t k = 0; k < 4; ++k) rel[k] = kQuad[k] - s.p;
-      prt::bake::clip_to_horizon(rel, s.n, clipped);
-      sum += prt::bake::cosine_integral(clipped, s.n);
-    }
+    for (const ShadePoint& s : points) sum += clipped_quad(s, rel, clipped);
     benchmark::DoNotOptimize(sum);
   }
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(points.size()));
@@ -73,9 +76,7 @@ void BM_QuadIrradianceSH(benchmark::State& state) {
   for (auto _ : state) {
     double sum = 0;
     for (const ShadePoint& s : points) {
-      for (size_t k = 0; k < 4; ++k) rel[k] = kQuad[k] - s.p;
-      prt::bake::clip_to_horizon(rel, s.n, clipped);
-      sum += prt::bake::cosine_integral(clipped, s.n);
+      sum += clipped_quad(s, rel, clipped);
       sh.project(clipped, coeffs);
       sum += coeffs.back();
     }

@@ -53,11 +53,6 @@ double regular_polygon_cosine(int n, double radius, double h) {
   return n * (r / d) * std::atan(r * std::tan(kPi / n) / d);
 }
 
-Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  Eigen::Quaterniond q(g(rng), g(rng), g(rng), g(rng));
-  return q.normalized().toRotationMatrix();
-}
 
 Poly rotated(const Poly& p, const Eigen::Matrix3d& r) {
   Poly out;
@@ -142,7 +137,7 @@ TEST(SphericalPolygon, TinyPolygonKeepsRelativeAccuracy) {
   EXPECT_NEAR(cosine_integral(square, V3::UnitZ()) / cosine, 1, 1e-9);
   std::mt19937_64 rng(7);
   for (int k = 0; k < 20; ++k) {
-    const Eigen::Matrix3d r = random_rotation(rng);
+    const Eigen::Matrix3d r = prt::test::random_rotation(rng);
     EXPECT_NEAR(solid_angle(rotated(square, r)) / omega, 1, 1e-9);
     EXPECT_NEAR(cosine_integral(rotated(square, r), r * V3::UnitZ()) / cosine, 1, 1e-9);
   }
@@ -185,7 +180,7 @@ TEST(SphericalPolygon, AgreesWithRqmc) {
   std::uniform_real_distribution<double> u(0, 1);
   for (int k = 0; k < 12; ++k) {
     const int n = 3 + k % 6;
-    const Eigen::Matrix3d r = random_rotation(rng);
+    const Eigen::Matrix3d r = prt::test::random_rotation(rng);
     const double radius = 0.3 + 2 * u(rng);
     const V3 offset(0.5 * u(rng), 0.5 * u(rng), 0.2 + u(rng));
     Poly p;

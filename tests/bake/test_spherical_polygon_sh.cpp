@@ -40,21 +40,13 @@ Poly hemisphere(const V3& n) {
   return p;
 }
 
-Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
-}
 
-// Legendre P_l(x) by Bonnet's recurrence (the test's own, independent of the library's monomials).
+// Legendre P_l(x) from prtshade's zonal basis function: y_l0 = √((2l+1)/(4π)) P_l(cos θ)
+// (independent of the library's monomial expansion).
 double legendre(int l, double x) {
-  double p0 = 1, p1 = x;
-  if (l == 0) return p0;
-  for (int k = 1; k < l; ++k) {
-    const double p2 = ((2 * k + 1) * x * p1 - k * p0) / (k + 1);
-    p0 = p1;
-    p1 = p2;
-  }
-  return p1;
+  std::vector<double> y(size_t((l + 1) * (l + 1)));
+  prt::sh::eval(l + 1, std::sqrt(1 - x * x), 0.0, x, y);
+  return y[size_t(prt::sh::index(l, 0))] / std::sqrt((2 * l + 1) / (4 * kPi));
 }
 
 TEST(PolygonSH, HemisphereIsTheZonalClosedForm) {
@@ -65,7 +57,7 @@ TEST(PolygonSH, HemisphereIsTheZonalClosedForm) {
     const PolygonSH sh(order);
     const double tol = 1e-13;
     for (int k = 0; k < 10; ++k) {
-      const V3 n = k == 0 ? V3::UnitZ() : V3(random_rotation(rng) * V3::UnitZ());
+      const V3 n = k == 0 ? V3::UnitZ() : V3(prt::test::random_rotation(rng) * V3::UnitZ());
       std::vector<double> expected(size_t(order * order));
       prt::bake::clamped_power_sh(0.0, order, n, expected);
       const auto got = project(sh, hemisphere(n));
@@ -115,7 +107,7 @@ TEST(PolygonSH, RotationEquivariantAndBand1IsLambert) {
   for (int k = 0; k < 20; ++k) {
     Poly p;
     for (int i = 0; i < 5; ++i) p.emplace_back(std::cos(2 * kPi * i / 5) + 0.2 * u(rng), std::sin(2 * kPi * i / 5) + 0.2 * u(rng), 1.5 + 0.3 * u(rng));
-    const Eigen::Matrix3d r = random_rotation(rng);
+    const Eigen::Matrix3d r = prt::test::random_rotation(rng);
     Poly rp;
     for (const V3& v : p) rp.push_back(r * v);
     double rm[3][3];

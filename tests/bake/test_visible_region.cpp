@@ -134,9 +134,8 @@ TEST(VisibleRegion, TinyLightHalfHidden) {
   const double h = 0.5e-5;
   const double expected = cosine(rect(0, h, -h, h));
   std::mt19937_64 rng(9);
-  std::normal_distribution<double> g;
   for (int k = 0; k < 50; ++k) {
-    const Eigen::Matrix3d r = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+    const Eigen::Matrix3d r = prt::test::random_rotation(rng);
     auto rotated = [&](const Poly& p) {
       Poly out;
       for (const V3& v : p) out.push_back(r * v);
@@ -157,8 +156,7 @@ struct Box {
 
 Box random_box(std::mt19937_64& rng, double z_lo, double z_hi) {
   std::uniform_real_distribution<double> u(0, 1);
-  std::normal_distribution<double> g;
-  const Eigen::Matrix3d r = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
+  const Eigen::Matrix3d r = prt::test::random_rotation(rng);
   const V3 half(0.1 + 0.4 * u(rng), 0.1 + 0.4 * u(rng), 0.1 + 0.4 * u(rng));
   const double reach = half.norm();
   const V3 centre(2 * u(rng) - 1, 2 * u(rng) - 1, z_lo + reach + (z_hi - z_lo - 2 * reach) * u(rng));

@@ -2,17 +2,19 @@
 // honest standard error: R independent Cranley–Patterson rotations of the same Halton points
 // (bake/sampling.h) give R i.i.d. unbiased estimates; their mean is the estimate and the standard
 // deviation of the mean (sample std / √R) its standard error (Owen, "Monte Carlo theory, methods
-// and examples", §17.1). Also the inside test of a convex spherical polygon.
+// and examples", §17.1). Also the inside test of a convex spherical polygon and a random rotation.
 #pragma once
 
 #include <bake/sampling.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <random>
 #include <span>
 #include <vector>
 
@@ -56,6 +58,12 @@ inline bool inside_convex(std::span<const Eigen::Vector3d> v, const Eigen::Vecto
   for (size_t i = 0; i < v.size(); ++i)
     if (v[i].cross(v[(i + 1) % v.size()]).dot(w) < 0) return false;
   return true;
+}
+
+// A uniformly random rotation (a normalised Gaussian quaternion).
+inline Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
 }
 
 } // namespace prt::test
