@@ -173,7 +173,7 @@ TEST(SphericalPolygon, ChainsAdd) {
 }
 
 // Random convex planar polygons (a regular polygon of 3–8 vertices, scaled, rotated and moved
-// in front of the receiver) against RQMC: 32 rotations × 2^12 points. Tolerance 4 standard
+// in front of the receiver) against RQMC: 64 rotations × 2^11 points. Tolerance 4 standard
 // errors plus 1e-12 for the closed form's rounding.
 TEST(SphericalPolygon, AgreesWithRqmc) {
   std::mt19937_64 rng(11);
@@ -188,7 +188,7 @@ TEST(SphericalPolygon, AgreesWithRqmc) {
     // Orient positively seen from the origin (the plane's normal through the first three points).
     if ((p[1] - p[0]).cross(p[2] - p[0]).dot(p[0]) < 0) std::reverse(p.begin(), p.end());
     const V3 normal = V3(u(rng) - 0.5, u(rng) - 0.5, 0.3).normalized();
-    const auto est = prt::test::rqmc_sphere(3, 32, 1 << 12, 100 + k, [&](const V3& w, std::span<double> out) {
+    const auto est = prt::test::rqmc_sphere(3, 64, 1 << 11, 100 + k, [&](const V3& w, std::span<double> out) {
       const bool in = prt::test::inside_convex(p, w);
       out[0] = in;
       out[1] = in ? normal.dot(w) : 0;

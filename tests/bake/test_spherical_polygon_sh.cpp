@@ -126,7 +126,7 @@ TEST(PolygonSH, RotationEquivariantAndBand1IsLambert) {
   }
 }
 
-// RQMC (32 rotations × 2^11 = 2^16 points) at order 6 for convex polygons, a horizon-clipped one
+// RQMC (64 rotations × 2^10 = 2^16 points) at order 6 for convex polygons, a horizon-clipped one
 // and a non-convex (L-shaped) one; tolerance 4 standard errors + 1e-12 (closed-form rounding).
 TEST(PolygonSH, AgreesWithRqmc) {
   const int order = 6, count = order * order;
@@ -149,7 +149,7 @@ TEST(PolygonSH, AgreesWithRqmc) {
   };
   uint64_t seed = 40;
   for (const Case& c : cases) {
-    const auto est = prt::test::rqmc_sphere(count, 32, 1 << 11, seed++, [&](const V3& w, std::span<double> out) {
+    const auto est = prt::test::rqmc_sphere(count, 64, 1 << 10, seed++, [&](const V3& w, std::span<double> out) {
       if (c.inside(w)) {
         prt::sh::eval(order, w.x(), w.y(), w.z(), out);
       } else {

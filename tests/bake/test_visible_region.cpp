@@ -288,7 +288,7 @@ TEST(VisibleRegion, SilhouetteAgreesWithPerTriangle) {
 }
 
 TEST(VisibleRegion, AgreesWithRqmcRayCasting) {
-  // E = ∫ V·[ω in light]·(n·ω)⁺ dω by RQMC (32 × 2^11 directions, Möller–Trumbore against every
+  // E = ∫ V·[ω in light]·(n·ω)⁺ dω by RQMC (64 × 2^14 = 2^20 directions, Möller–Trumbore against every
   // triangle of the boxes; they lie between p and the light, so any hit hides it);
   // tolerance 4 standard errors + 1e-12.
   std::mt19937_64 rng(23);
@@ -302,7 +302,7 @@ TEST(VisibleRegion, AgreesWithRqmcRayCasting) {
     }
     const auto arcs = visible(s.light, sil);
     const double e = s.n.dot(prt::bake::vector_irradiance(arcs));
-    const auto est = prt::test::rqmc_sphere(1, 32, 1 << 11, 300 + uint64_t(k), [&](const V3& w, std::span<double> out) {
+    const auto est = prt::test::rqmc_sphere(1, 64, 1 << 14, 300 + uint64_t(k), [&](const V3& w, std::span<double> out) {
       out[0] = 0;
       if (s.n.dot(w) <= 0 || !prt::test::inside_convex(s.light, w)) return;
       for (const Poly& t : tri)

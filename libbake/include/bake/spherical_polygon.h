@@ -11,8 +11,12 @@
 // vertex is finite and non-zero. The polygon is a signed region (a 2-chain): orientation is
 // positive when the vertices run counter-clockwise seen from outside the sphere (right-hand rule
 // about the outward direction of the interior: det(v_0, v_1, v_2) > 0 for a small triangle), and
-// reversing the vertex order negates every integral. Integrals of chains add, so a non-simple or
-// non-convex polygon integrates as the sum of its regions weighted by their winding numbers.
+// reversing the vertex order negates every integral. Seen from p itself a positive polygon runs
+// clockwise: a mesh face counter-clockwise from outside (outward normal) and facing p is
+// negatively oriented here, so lights and occluder faces are passed reversed (visible_region.h's
+// ConvexPolyhedron does this). Φ and the SH projection of chains add, so a non-simple or
+// non-convex polygon integrates as the sum of its regions weighted by their winding numbers (the
+// solid angle needs the hemisphere precondition below).
 //
 // Lambert's edge formula (Arvo, "Applications of Irradiance Tensors to the Simulation of
 // Non-Lambertian Phenomena", SIGGRAPH 1995, §3; paper 003 §2 cites it with Baum et al. 1989):
@@ -40,10 +44,11 @@
 //
 // Horizon clipping (paper 003 §3.4, Alg. 3, as one Sutherland–Hodgman pass against the great
 // circle n·ω = 0): each vertex is classified once by the EXACT sign of n·v (a floating-point
-// filter, then an error-free evaluation), so a vertex on the horizon (n·v = 0 exactly) is kept as
-// it is, never duplicated and never replaced by a computed crossing; an edge whose ends are
-// strictly on opposite sides gets the crossing |n·b|·a + |n·a|·b (a positive combination of its
-// ends, on the horizon up to rounding). Consecutive output vertices are joined by the shorter
+// filter, then an error-free evaluation with FMA products and Shewchuk's expansion sum: the
+// predicate is a dot product with the given normal, which orient3d cannot express), so a vertex
+// on the horizon (n·v = 0 exactly) is kept as it is, never duplicated and never replaced by a
+// computed crossing; an edge whose ends are strictly on opposite sides gets the crossing
+// |n·b̂|·â + |n·â|·b̂ (a positive combination of its ends, on the horizon up to rounding). Consecutive output vertices are joined by the shorter
 // great arc; for a polygon inside an OPEN hemisphere (precondition of clip_to_horizon) every
 // horizon stretch of the clipped boundary is shorter than π, so that arc is the horizon's.
 // (Alg. 3 instead compares dot products with 0 in floating point and adds the horizon edges in a

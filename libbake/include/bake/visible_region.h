@@ -28,7 +28,11 @@
 // vertices give equal parameters exactly, and an ordering error between distinct crossings moves
 // a boundary piece by the crossing points' rounding. Pieces lying on a common great circle of
 // several polygons are kept once, by the polygon listed first (the light, then occluders in order).
-// Cost: O(E²) for E edges in total (every edge against every other polygon's edges).
+// Depth is not looked at: every occluder passed is subtracted, so the caller passes those between
+// p and the light (paper §3.5 GetBetween culls by a frustum); an occluder behind the light must
+// not be passed. Occluders need no horizon clipping (only their parts over the light matter).
+// Cost: O(E²) for E edges in total (every edge against every other polygon's edges); measured by
+// bench/bench_area.cpp (silhouettes ~11× faster than per-triangle for three boxes).
 #pragma once
 
 #include <bake/spherical_polygon.h>
