@@ -208,21 +208,26 @@ void OccluderMesh::add_image(uint32_t triangle, const ShadePoint& point, const L
   }
 }
 
-size_t OccluderMesh::finish(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out, Workspace& ws) const {
-  std::sort(ws.kept.begin(), ws.kept.end());
-  for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
-  visible_region(ws.clipped, std::span<const std::vector<V3>>(ws.images.data(), ws.image_count), out);
-  return ws.kept.size();
-}
-
-size_t OccluderMesh::visible_light(std::span<const V3> light, const ShadePoint& point, std::vector<Arc>& out,
-                                   Workspace& ws) const {
+size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
+                           bool culled) const {
   LightFrame frame;
   if (!prepare(light, point, ws, frame)) {
     out.clear();
     return 0;
   }
-  if (nodes_.empty()) return finish(point, frame, out, ws);
+  if (culled) {
+    cull(ws);
+    std::sort(ws.kept.begin(), ws.kept.end());
+  } else {
+    for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
+  }
+  for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
+  visible_region(ws.clipped, std::span<const std::vector<V3>>(ws.images.data(), ws.image_count), out);
+  return ws.kept.size();
+}
+
+void OccluderMesh::cull(Workspace& ws) const {
+  if (nodes_.empty()) return;
   auto box_outside = [&](const Node& node) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
     for (const auto& plane : ws.planes) {
@@ -246,8 +251,8 @@ size_t OccluderMesh::visible_light(std::span<const V3> light, const ShadePoint& 
   };
   ws.stack.assign(1, 0);
   while (!ws.stack.empty()) {
-    const Node& node = nodes_[ws.stack.back()];
     const uint32_t at = ws.stack.back();
+    const Node& node = nodes_[at];
     ws.stack.pop_back();
     if (box_outside(node)) continue;
     if (node.count == 0) {
@@ -258,18 +263,6 @@ size_t OccluderMesh::visible_light(std::span<const V3> light, const ShadePoint& 
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
       if (!triangle_outside(order_[i])) ws.kept.push_back(order_[i]);
   }
-  return finish(point, frame, out, ws);
-}
-
-size_t OccluderMesh::visible_light_reference(std::span<const V3> light, const ShadePoint& point, std::vector<Arc>& out,
-                                             Workspace& ws) const {
-  LightFrame frame;
-  if (!prepare(light, point, ws, frame)) {
-    out.clear();
-    return 0;
-  }
-  for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
-  return finish(point, frame, out, ws);
 }
 
 } // namespace prt::bake

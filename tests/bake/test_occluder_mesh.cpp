@@ -294,11 +294,7 @@ TEST(OccluderMesh, TinyLightHalfHidden) {
   std::mt19937_64 rng(47);
   for (int k = 0; k < 20; ++k) {
     const Eigen::Matrix3d r = prt::test::random_rotation(rng);
-    auto rotated = [&](const Poly& p) {
-      Poly out;
-      for (const V3& v : p) out.push_back(r * v);
-      return out;
-    };
+    auto rotated = [&](const Poly& p) { return prt::test::rotated(r, p); };
     const ShadePoint s{.p = V3::Zero(), .n = r * V3::UnitZ()};
     const Poly light = rotated(rect(-h, h, -h, h, 1));
     const OccluderMesh sheet(rotated(rect(-1, 0, -1, 1, 0.5)), {{0, 1, 2}, {0, 2, 3}});

@@ -74,11 +74,15 @@ public:
   // Returns the number of triangles kept after culling (those passed to visible_region).
   // Thread-safe (const) with one Workspace per thread.
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
-                       Workspace& ws) const;
+                       Workspace& ws) const {
+    return query(light, point, out, ws, true);
+  }
   // Reference: no tree and no pyramid culling (every triangle goes through the exact depth test
   // and the image rule above). The same arcs' integrals as visible_light.
   size_t visible_light_reference(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
-                                 std::vector<Arc>& out, Workspace& ws) const;
+                                 std::vector<Arc>& out, Workspace& ws) const {
+    return query(light, point, out, ws, false);
+  }
 
   size_t triangle_count() const { return triangles_.size(); }
 
@@ -93,7 +97,9 @@ private:
   uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
   bool prepare(std::span<const Eigen::Vector3d> light, const ShadePoint& point, Workspace& ws, LightFrame& frame) const;
   void add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
-  size_t finish(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out, Workspace& ws) const;
+  size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
+               bool culled) const;
+  void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
