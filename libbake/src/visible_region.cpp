@@ -18,7 +18,13 @@ using V3 = Eigen::Vector3d;
 using Polygon = std::span<const V3>;
 
 // Exact sign of det(c, d, x): the side of x with respect to the great circle through c and d.
-int side(const V3& c, const V3& d, const V3& x) { return orient3d_exact(c, d, x, V3::Zero()); }
+// A shared vertex (x bitwise c or d: adjacent triangles of a mesh, front and back faces of one
+// edge) is 0 at once; the floating-point filter cannot decide an exact zero and would evaluate
+// the expansion.
+int side(const V3& c, const V3& d, const V3& x) {
+  if (x == c || x == d) return 0;
+  return orient3d_exact(c, d, x, V3::Zero());
+}
 
 // A position along the edge being cut: parameter τ ∈ [0, 1] (monotone along the arc) and point.
 struct Bound {

@@ -29,7 +29,10 @@
 // decided by orient3d_exact; unions counted once). Triangles are passed in index order whatever
 // the tree's walk, so the culled query and the reference below make the same decisions on ties.
 // Cost: the walk is output-sensitive; visible_region is O(E²) in the kept edges E (3 per kept
-// triangle), so the cost grows with the square of the triangles inside the light's pyramid.
+// triangle), so the cost grows with the square of the triangles inside the light's pyramid
+// (bench/bench_area.cpp: three boxes as one mesh ≥ 17k shade points/s for 3 lights; the bunny
+// under a quad light, ~280 kept triangles, some 10² shade points/s: a contour-loop variant
+// linear in the silhouette is not built yet).
 #pragma once
 
 #include <bake/integrator.h>

@@ -34,7 +34,9 @@
 // Cost: O(E²) for E edges in total (every edge against every other polygon's edges), each pair
 // first filtered by bounding caps (the edge's and the polygon's, compared by one dot product with
 // a 1e-12 margin; disjoint caps can only give empty cuts, so skipping them changes nothing but
-// spurious cuts of rounding); measured by bench/bench_area.cpp (silhouettes ~11× faster than per-triangle for three boxes).
+// spurious cuts of rounding), and a vertex shared bitwise (adjacent triangles) given side 0
+// without the exact expansion; measured by bench/bench_area.cpp (silhouette loops ~3× faster
+// than per-triangle for three boxes).
 #pragma once
 
 #include <bake/spherical_polygon.h>
