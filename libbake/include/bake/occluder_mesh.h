@@ -55,7 +55,10 @@ public:
   explicit OccluderMesh(const Mesh& mesh);
   OccluderMesh(std::vector<Eigen::Vector3d> positions, std::vector<std::array<uint32_t, 3>> triangles);
 
-  // Per-thread scratch buffers (reused across queries: no allocation once grown).
+  // Per-thread scratch buffers, reused across queries (visible_region still allocates its own).
+  // After a query, `clipped` holds the light as visible_region got it (directions from p,
+  // positively oriented, clipped to the horizon; empty when the query returned no light): its
+  // integrals are the unshadowed values.
   struct Workspace {
     struct Plane {  // kept side: m·(x − o) ≥ −margin
       Eigen::Vector3d m, o;
@@ -75,7 +78,10 @@ public:
   // or nothing of it is above the horizon. Integrate with point.n·vector_irradiance(out) (the
   // irradiance from unit radiance) and PolygonSH::project(out) (bake/polygon_sh.h).
   // Returns the number of triangles kept after culling (those passed to visible_region).
-  // Thread-safe (const) with one Workspace per thread.
+  // Thread-safe (const) with one Workspace per thread. A convex emitter (box, cylinder, sphere as
+  // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
+  // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
+  // dropped by the depth test).
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
     return query(light, point, out, ws, true);
