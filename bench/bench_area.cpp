@@ -12,6 +12,14 @@
 // boxes' silhouettes, then per light the horizon clip, the visible region and its irradiance:
 //   BM_ThreeLightsThreeBoxes/silhouette:1  the boxes as silhouette loops (paper §3.3)
 //   BM_ThreeLightsThreeBoxes/silhouette:0  the boxes as their front-facing triangles (§4.4)
+// and past a triangle mesh (bake/occluder_mesh.h: culling by the light's pyramid and plane, then
+// the per-triangle union of every kept triangle, both facings):
+//   BM_ThreeLightsThreeBoxesMesh/culled:1  the three boxes as one 36-triangle mesh, culled per light
+//   BM_ThreeLightsThreeBoxesMesh/culled:0  the same through the unculled reference
+//   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
+//                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
+#include <bake/mesh.h>
+#include <bake/occluder_mesh.h>
 #include <bake/polygon_sh.h>
 #include <bake/spherical_polygon.h>
 #include <bake/visible_region.h>
@@ -21,6 +29,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <filesystem>
 #include <random>
 #include <vector>
 
@@ -86,24 +95,30 @@ void BM_QuadIrradianceSH(benchmark::State& state) {
 }
 BENCHMARK(BM_QuadIrradianceSH)->Arg(3)->Arg(6)->Unit(benchmark::kMicrosecond);
 
-// A box [lo, hi] with its faces counter-clockwise seen from outside.
-prt::bake::ConvexPolyhedron box(const V3& lo, const V3& hi) {
+// A box [lo, hi]: corner k has bit 0 → hi.x, bit 1 → hi.y, bit 2 → hi.z; faces counter-clockwise
+// seen from outside.
+std::vector<V3> box_corners(const V3& lo, const V3& hi) {
   std::vector<V3> v;
   for (int k = 0; k < 8; ++k) v.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
-  return prt::bake::ConvexPolyhedron(
-      v, {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}});
+  return v;
 }
+const std::vector<std::vector<uint32_t>> kBoxFaces{{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+
+// The three lights and the boxes between them and the floor.
+const std::vector<std::vector<V3>> kLights{{{-1.5, -0.5, 2.5}, {-0.5, -0.5, 2.5}, {-0.5, 0.5, 2.5}, {-1.5, 0.5, 2.5}},
+                                           {{0.5, -1, 3}, {1.5, -1, 3}, {1.5, 0, 3}, {0.5, 0, 3}},
+                                           {{-0.5, 1, 2.8}, {0.5, 1, 2.8}, {0.5, 2, 2.8}, {-0.5, 2, 2.8}}};
+const std::vector<std::pair<V3, V3>> kBoxes{{V3(-1.2, -0.3, 0.8), V3(-0.6, 0.3, 1.4)},
+                                            {V3(0.6, -0.8, 1.2), V3(1.2, -0.2, 1.6)},
+                                            {V3(-0.4, 0.9, 0.5), V3(0.4, 1.5, 1.0)}};
 
 void BM_ThreeLightsThreeBoxes(benchmark::State& state) {
   const bool use_silhouette = state.range(0) != 0;
   const auto& points = shade_points();
-  const std::vector<std::vector<V3>> lights{
-      {{-1.5, -0.5, 2.5}, {-0.5, -0.5, 2.5}, {-0.5, 0.5, 2.5}, {-1.5, 0.5, 2.5}},
-      {{0.5, -1, 3}, {1.5, -1, 3}, {1.5, 0, 3}, {0.5, 0, 3}},
-      {{-0.5, 1, 2.8}, {0.5, 1, 2.8}, {0.5, 2, 2.8}, {-0.5, 2, 2.8}}};
-  const std::vector<prt::bake::ConvexPolyhedron> boxes{box(V3(-1.2, -0.3, 0.8), V3(-0.6, 0.3, 1.4)),
-                                                       box(V3(0.6, -0.8, 1.2), V3(1.2, -0.2, 1.6)),
-                                                       box(V3(-0.4, 0.9, 0.5), V3(0.4, 1.5, 1.0))};
+  const auto& lights = kLights;
+  std::vector<prt::bake::ConvexPolyhedron> boxes;
+  for (const auto& [lo, hi] : kBoxes) boxes.emplace_back(box_corners(lo, hi), kBoxFaces);
   std::vector<std::vector<V3>> occluders, triangles;
   std::vector<V3> rel(4), clipped;
   std::vector<prt::bake::Arc> arcs;
@@ -143,6 +158,74 @@ void BM_ThreeLightsThreeBoxes(benchmark::State& state) {
   state.counters["shadowed_lights"] = double(shadowed) / double(points.size() * lights.size());
 }
 BENCHMARK(BM_ThreeLightsThreeBoxes)->ArgName("silhouette")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+
+// Shade points per CPU second for the given points, one call of shade(point) each; the share of
+// lights the mesh hides part of and the mean number of triangles kept per light as counters.
+template <class Shade>
+void run_mesh_bench(benchmark::State& state, const std::vector<ShadePoint>& points, size_t lights, Shade&& shade) {
+  size_t kept = 0, shadowed = 0;
+  for (const ShadePoint& s : points) shade(s, kept, shadowed);  // untimed: the counters
+  for (auto _ : state) {
+    double sum = 0;
+    size_t k = 0, h = 0;
+    for (const ShadePoint& s : points) sum += shade(s, k, h);
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(points.size()));
+  state.counters["shadowed_lights"] = double(shadowed) / double(points.size() * lights);
+  state.counters["kept_triangles"] = double(kept) / double(points.size() * lights);
+}
+
+// Irradiance at s from the lights past the mesh (culled or reference); adds to kept and shadowed.
+double shade_past_mesh(const prt::bake::OccluderMesh& mesh, const std::vector<std::vector<V3>>& lights, bool culled,
+                       const ShadePoint& s, prt::bake::OccluderMesh::Workspace& ws, std::vector<prt::bake::Arc>& arcs,
+                       size_t& kept, size_t& shadowed) {
+  const prt::bake::ShadePoint point{.p = s.p, .n = s.n};
+  double sum = 0;
+  for (const auto& light : lights) {
+    kept += culled ? mesh.visible_light(light, point, arcs, ws) : mesh.visible_light_reference(light, point, arcs, ws);
+    sum += s.n.dot(prt::bake::vector_irradiance(arcs));
+    shadowed += arcs.size() != ws.clipped.size();
+  }
+  return sum;
+}
+
+void BM_ThreeLightsThreeBoxesMesh(benchmark::State& state) {
+  const bool culled = state.range(0) != 0;
+  std::vector<V3> positions;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  for (const auto& [lo, hi] : kBoxes) {
+    const auto base = uint32_t(positions.size());
+    for (const V3& v : box_corners(lo, hi)) positions.push_back(v);
+    for (const auto& q : kBoxFaces) {
+      triangles.push_back({base + q[0], base + q[1], base + q[2]});
+      triangles.push_back({base + q[0], base + q[2], base + q[3]});
+    }
+  }
+  const prt::bake::OccluderMesh mesh(positions, triangles);
+  prt::bake::OccluderMesh::Workspace ws;
+  std::vector<prt::bake::Arc> arcs;
+  run_mesh_bench(state, shade_points(), kLights.size(), [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
+    return shade_past_mesh(mesh, kLights, culled, s, ws, arcs, kept, shadowed);
+  });
+}
+BENCHMARK(BM_ThreeLightsThreeBoxesMesh)->ArgName("culled")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+
+void BM_BunnyQuad(benchmark::State& state) {
+  const prt::bake::OccluderMesh mesh(prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj"));
+  const std::vector<std::vector<V3>> light{{{-3, 12, -2}, {3, 12, -2}, {3, 12, 2}, {-3, 12, 2}}};
+  std::vector<ShadePoint> points;
+  for (const ShadePoint& s : shade_points()) {  // the floor points mapped to y = 0, normals about +y
+    if (points.size() == 256) break;
+    points.push_back({V3(4 * s.p.x(), 0, 3 * s.p.y()), V3(s.n.x(), s.n.z(), s.n.y())});
+  }
+  prt::bake::OccluderMesh::Workspace ws;
+  std::vector<prt::bake::Arc> arcs;
+  run_mesh_bench(state, points, 1, [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
+    return shade_past_mesh(mesh, light, true, s, ws, arcs, kept, shadowed);
+  });
+}
+BENCHMARK(BM_BunnyQuad)->Unit(benchmark::kMillisecond);
 
 } // namespace
 

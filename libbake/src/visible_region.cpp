@@ -18,7 +18,13 @@ using V3 = Eigen::Vector3d;
 using Polygon = std::span<const V3>;
 
 // Exact sign of det(c, d, x): the side of x with respect to the great circle through c and d.
-int side(const V3& c, const V3& d, const V3& x) { return orient3d_exact(c, d, x, V3::Zero()); }
+// A shared vertex (x bitwise c or d: adjacent triangles of a mesh, front and back faces of one
+// edge) is 0 at once; the floating-point filter cannot decide an exact zero and would evaluate
+// the expansion.
+int side(const V3& c, const V3& d, const V3& x) {
+  if (x == c || x == d) return 0;
+  return orient3d_exact(c, d, x, V3::Zero());
+}
 
 // A position along the edge being cut: parameter τ ∈ [0, 1] (monotone along the arc) and point.
 struct Bound {
@@ -136,6 +142,39 @@ void subtract(std::vector<Interval>& pieces, const Interval& cut) {
   pieces = std::move(out);
 }
 
+// A spherical cap {ω : ω̂·c ≥ cos r} holding a polygon or an arc, enlarged by a margin far above
+// rounding (1e-12 in cos r); all = true when it would reach a hemisphere (then never separates).
+// Two caps with c1·c2 < cos(r1 + r2) − 1e-12 are disjoint, and so are what they hold: the exact
+// predicates could only find empty intervals there, so the pair is skipped (a filter, not a
+// decision: it changes no result beyond dropping empty cuts).
+struct Cap {
+  V3 c = V3::Zero();
+  double cos_r = 0, sin_r = 1;
+  bool all = true;
+};
+
+constexpr double kCapMargin = 1e-12;
+
+Cap cap_of(std::span<const V3> points) {
+  Cap cap;
+  for (const V3& v : points) cap.c += v.normalized();
+  const double len = cap.c.norm();
+  if (!(len > 0)) return cap;
+  cap.c /= len;
+  double lo = 1;
+  for (const V3& v : points) lo = std::min(lo, cap.c.dot(v.normalized()));
+  cap.cos_r = lo - kCapMargin;
+  if (!(cap.cos_r > kCapMargin)) return cap;  // a hemisphere or more: no filtering
+  cap.sin_r = std::sqrt(std::max(0.0, 1 - cap.cos_r * cap.cos_r));
+  cap.all = false;
+  return cap;
+}
+
+bool disjoint(const Cap& x, const Cap& y) {
+  if (x.all || y.all) return false;
+  return x.c.dot(y.c) < x.cos_r * y.cos_r - x.sin_r * y.sin_r - kCapMargin;
+}
+
 }  // namespace
 
 void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> occluders, std::vector<Arc>& out) {
@@ -145,6 +184,8 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
   for (const auto& o : occluders)
     if (o.size() >= 3) polygons.emplace_back(o);
 
+  std::vector<Cap> caps;
+  for (const Polygon poly : polygons) caps.push_back(cap_of(poly));
   std::vector<Interval> pieces;
   for (size_t i = 0; i < polygons.size(); ++i) {
     const Polygon poly = polygons[i];
@@ -155,19 +196,23 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
       // The side of e that may border V: left for the light, right for an occluder.
       const int which = i == 0 ? 0 : 1;
       Interval in[2];
+      const V3 ends[2] = {a, b};
+      const Cap edge_cap = cap_of(ends);
       pieces.assign(1, Interval{{0.0, a}, {1.0, b}, false});
       if (i != 0) {  // an occluder edge borders V only inside the light
+        if (disjoint(edge_cap, caps[0])) continue;
         inside_intervals(a, b, light, false, in);
         if (in[1].empty) continue;
         pieces.assign(1, in[1]);
       }
       for (size_t j = 1; j < polygons.size() && !pieces.empty(); ++j) {
-        if (j == i) continue;
+        if (j == i || disjoint(edge_cap, caps[j])) continue;
         inside_intervals(a, b, polygons[j], i < j, in);
         subtract(pieces, in[which]);
       }
       // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
       for (size_t j = 0; j < i && !pieces.empty(); ++j) {
+        if (disjoint(edge_cap, caps[j])) continue;
         const Polygon other = polygons[j];
         for (size_t f = 0; f < other.size(); ++f) {
           const V3& c = other[f];

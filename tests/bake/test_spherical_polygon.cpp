@@ -54,12 +54,6 @@ double regular_polygon_cosine(int n, double radius, double h) {
 }
 
 
-Poly rotated(const Poly& p, const Eigen::Matrix3d& r) {
-  Poly out;
-  for (const V3& v : p) out.push_back(r * v);
-  return out;
-}
-
 TEST(SphericalPolygon, ParallelRectangleFromCorner) {
   // View factor from a differential area to a parallel rectangle a × b at distance c, the normal
   // through one corner (Howell, "A Catalog of Radiation Heat Transfer Configuration Factors",
@@ -138,8 +132,8 @@ TEST(SphericalPolygon, TinyPolygonKeepsRelativeAccuracy) {
   std::mt19937_64 rng(7);
   for (int k = 0; k < 20; ++k) {
     const Eigen::Matrix3d r = prt::test::random_rotation(rng);
-    EXPECT_NEAR(solid_angle(rotated(square, r)) / omega, 1, 1e-9);
-    EXPECT_NEAR(cosine_integral(rotated(square, r), r * V3::UnitZ()) / cosine, 1, 1e-9);
+    EXPECT_NEAR(solid_angle(prt::test::rotated(r, square)) / omega, 1, 1e-9);
+    EXPECT_NEAR(cosine_integral(prt::test::rotated(r, square), r * V3::UnitZ()) / cosine, 1, 1e-9);
   }
 }
 

@@ -136,11 +136,7 @@ TEST(VisibleRegion, TinyLightHalfHidden) {
   std::mt19937_64 rng(9);
   for (int k = 0; k < 50; ++k) {
     const Eigen::Matrix3d r = prt::test::random_rotation(rng);
-    auto rotated = [&](const Poly& p) {
-      Poly out;
-      for (const V3& v : p) out.push_back(r * v);
-      return out;
-    };
+    auto rotated = [&](const Poly& p) { return prt::test::rotated(r, p); };
     std::vector<Arc> arcs;
     visible_region(rotated(rect(-h, h, -h, h)), std::vector<Poly>{rotated(rect(-1, 0, -1, 1))}, arcs);
     EXPECT_NEAR((r * V3::UnitZ()).dot(prt::bake::vector_irradiance(arcs)) / expected, 1, 1e-9);

@@ -70,4 +70,11 @@ inline Eigen::Matrix3d random_rotation(std::mt19937_64& rng) {
   return Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized().toRotationMatrix();
 }
 
+// r · v for every vertex (a rotated polygon).
+inline std::vector<Eigen::Vector3d> rotated(const Eigen::Matrix3d& r, std::span<const Eigen::Vector3d> poly) {
+  std::vector<Eigen::Vector3d> out;
+  for (const Eigen::Vector3d& v : poly) out.push_back(r * v);
+  return out;
+}
+
 } // namespace prt::test
