@@ -91,6 +91,7 @@ const Scene& scene(int level) {
   const std::vector<uint32_t> base = bake::seeded_sample(uint32_t(file.positions.size()), n_points(), sample_seed());
   if (level == 0) {
     s->mesh = file;
+    s->bunny_vertices = kBunnyVertices;
     s->vertices = base;
   } else {
     bake::Mesh bunny, ground;
@@ -98,7 +99,8 @@ const Scene& scene(int level) {
     const bake::Mesh fine = bake::loop_subdivide(bunny, level);
     const bake::Mesh parts[] = {fine, ground};
     s->mesh = bake::merge_meshes(parts, "bunny_ground.obj, bunny loop x" + std::to_string(level));
-    const uint32_t shift = uint32_t(fine.positions.size()) - kBunnyVertices;
+    s->bunny_vertices = uint32_t(fine.positions.size());
+    const uint32_t shift = s->bunny_vertices - kBunnyVertices;
     for (uint32_t v : base) s->vertices.push_back(v < kBunnyVertices ? v : v + shift);
   }
   s->topology = bake::build_topology(s->mesh);

@@ -30,6 +30,7 @@ struct Scene {
   int level = 0;
   bake::Mesh mesh;
   bake::Topology topology;
+  uint32_t bunny_vertices = 0;            // vertices [0, bunny_vertices) are the bunny's, the rest the ground's
   std::vector<uint32_t> vertices;         // the shade points' vertex indices in `mesh`
   std::vector<bake::ShadePoint> points;   // vertex_shade_point of each
   double build_seconds = 0;               // load + subdivide + topology
