@@ -1,0 +1,60 @@
+// bake/area_bake.h — what a shade point receives from each area light, exactly (paper 003 §3:
+// the light's spherical polygon minus the occluders', clipped to the horizon, integrated in
+// closed form; issue 13). Per shade point and light, at unit radiance (so a light can be dimmed
+// and recoloured at run time by multiplying with its RGB radiance):
+//   E      = ∫_{visible part of the light} max(n·ω, 0) dω        (irradiance; the diffuse
+//            outgoing radiance is albedo/π · Σ_lights radiance · E)
+//   S_i    = ∫_{visible part of the light, above the horizon} y_i(ω) dω,  i < order²
+//            (the SH projection of the visible light, prtshade's basis: glossy receivers shade
+//            with it against their lobe)
+// The visible part comes from bake/occluder_mesh.h (culling, exact depth against each emitting
+// face's plane, the shade point's ε-limit) over the scene's occluder mesh; E from Lambert's vector
+// irradiance and S from the polygon's closed-form SH projection (bake/spherical_polygon.h,
+// bake/polygon_sh.h). A light's faces (bake/lights.h) emit towards their counter-clockwise side
+// (both sides for two_sided planar lights); a face contributes where p is strictly on an emitting
+// side (decided exactly: orient3d_exact against a point surely in front). A convex solid's faces
+// facing p do not overlap as seen from p, so their sum is the solid's image.
+//
+// Frame: the occluder mesh's (Mesh::origin; docs/ARCHITECTURE.md §3 "Frames"): lights are given
+// in world space and moved by −origin once, in double, so that scenes far from the origin keep
+// their digits; shade points are in the mesh's frame, as every integrator's.
+#pragma once
+
+#include <bake/lights.h>
+#include <bake/mesh.h>
+#include <bake/occluder_mesh.h>
+#include <bake/polygon_sh.h>
+
+#include <span>
+#include <vector>
+
+namespace prt::bake {
+
+class AreaLightIntegrator {
+public:
+  // `sh_order` 0: irradiance only. The lights must be valid (validate_light).
+  AreaLightIntegrator(std::span<const AreaLight> lights, const Mesh& occluders, int sh_order);
+
+  size_t lights() const noexcept { return faces_.size(); }
+  int sh_order() const noexcept { return order_; }
+  // Doubles per light in a row: E, then order² SH coefficients.
+  size_t per_light() const noexcept { return 1 + size_t(order_) * size_t(order_); }
+  size_t width() const noexcept { return lights() * per_light(); }
+
+  // out[l·per_light() + 0] = E_l, out[l·per_light() + 1 + i] = S_l,i (file comment). Thread-safe
+  // with one Workspace per thread.
+  void integrate(const ShadePoint& point, std::span<double> out, OccluderMesh::Workspace& ws) const;
+
+private:
+  struct Face {
+    std::vector<Eigen::Vector3d> vertices;  // in the mesh's frame
+    Eigen::Vector3d front;                  // a point surely on the counter-clockwise side
+    bool two_sided = false;
+  };
+  std::vector<std::vector<Face>> faces_;  // per light
+  OccluderMesh occluders_;
+  int order_ = 0;
+  PolygonSH sh_;
+};
+
+} // namespace prt::bake
