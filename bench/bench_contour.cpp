@@ -34,12 +34,6 @@ using namespace prt;
 
 namespace {
 
-double cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 struct Row {
   size_t triangles = 0;
   double us = 0, edges = 0;
@@ -136,10 +130,10 @@ int main() {
     Row prev;
     for (const long level : levels) {
       const bench::Scene& s = bench::scene(int(level));
-      const double b0 = cpu_seconds();
+      const double b0 = prt::bake::thread_cpu_seconds();
       const bake::ContourFinder finder(s.mesh, s.topology);
       Row row;
-      row.build_s = cpu_seconds() - b0;
+      row.build_s = prt::bake::thread_cpu_seconds() - b0;
       row.triangles = s.mesh.triangles.size();
       std::vector<bake::ContourEdge> out, ref;
       size_t found = 0;
@@ -154,11 +148,11 @@ int main() {
           }
         }
       }
-      const double t0 = cpu_seconds();
+      const double t0 = prt::bake::thread_cpu_seconds();
       for (long r = 0; r < repeat; ++r)
         for (const auto& p : s.points) finder.find(p, out);
       const double n = double(s.points.size());
-      row.us = 1e6 * (cpu_seconds() - t0) / (double(repeat) * n);
+      row.us = 1e6 * (prt::bake::thread_cpu_seconds() - t0) / (double(repeat) * n);
       row.edges = double(found) / n;
       const auto per = [n](uint64_t v) { return double(v) / n; };
       char exps[64] = "– | –";

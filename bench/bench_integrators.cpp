@@ -46,12 +46,6 @@ double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
 // One row of the triangle-sweep table (the silhouette cases of BM_SilhouetteTriangles).
 struct SweepRow {
   double triangles = 0, edges = 0, contour_us = 0, total_us = 0;
@@ -66,7 +60,7 @@ std::map<int, SweepRow>& sweep() {
 double integrate_all(benchmark::State& state, const bench::Scene& s, const bake::Integrator& integ) {
   std::vector<double> row(integ.layout().width);
   const size_t n = s.points.size();
-  const double c0 = thread_cpu_seconds();
+  const double c0 = bake::thread_cpu_seconds();
   for (auto _ : state) {
     for (size_t i = 0; i < n; ++i) {
       integ.integrate(s.points[i], s.vertices[i], row);
@@ -80,7 +74,7 @@ double integrate_all(benchmark::State& state, const bench::Scene& s, const bake:
       benchmark::Counter(double(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["triangles"] = double(s.mesh.triangles.size());
   state.counters["points"] = double(n);
-  return 1e6 * (thread_cpu_seconds() - c0) / (double(state.iterations()) * double(n));
+  return 1e6 * (bake::thread_cpu_seconds() - c0) / (double(state.iterations()) * double(n));
 }
 
 bake::IntegratorSpec qmc_spec(long rays) {

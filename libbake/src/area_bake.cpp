@@ -29,26 +29,29 @@ AreaLightIntegrator::AreaLightIntegrator(std::span<const AreaLight> lights, cons
     for (size_t f = 0; f < light.faces.size(); ++f) {
       Face face;
       for (uint32_t i : light.faces[f]) face.vertices.push_back(light.vertices[i] - occluders.origin);
-      face.front = face.vertices[0] + size * light.face_normal(f);
+      face.front_side = orient3d_exact(face.vertices[0], face.vertices[1], face.vertices[2],
+                                       face.vertices[0] + size * light.face_normal(f));
+      PRT_CHECK(face.front_side != 0);
       face.two_sided = light.two_sided;
       faces.push_back(std::move(face));
     }
   }
 }
 
-void AreaLightIntegrator::integrate(const ShadePoint& point, std::span<double> out, OccluderMesh::Workspace& ws) const {
+void AreaLightIntegrator::integrate(const ShadePoint& point, std::span<double> out, Workspace& ws) const {
   PRT_CHECK(out.size() == width());
   std::fill(out.begin(), out.end(), 0.0);
-  std::vector<Arc> arcs;
-  std::vector<double> sh(order_ > 0 ? size_t(order_) * size_t(order_) : 0);
+  std::vector<Arc>& arcs = ws.arcs;
+  std::vector<double>& sh = ws.sh;
+  sh.resize(order_ > 0 ? size_t(order_) * size_t(order_) : 0);
   for (size_t l = 0; l < faces_.size(); ++l) {
     const std::span<double> row = out.subspan(l * per_light(), per_light());
     for (const Face& f : faces_[l]) {
       const std::vector<Eigen::Vector3d>& v = f.vertices;
       const int side = orient3d_exact(v[0], v[1], v[2], point.p);
       if (side == 0) continue;  // p in the face's plane: it subtends no solid angle
-      if (side != orient3d_exact(v[0], v[1], v[2], f.front) && !f.two_sided) continue;  // its back
-      occluders_.visible_light(v, point, arcs, ws);
+      if (side != f.front_side && !f.two_sided) continue;  // its back
+      occluders_.visible_light(v, point, arcs, ws.occluders);
       if (arcs.empty()) continue;
       row[0] += point.n.dot(vector_irradiance(arcs));
       if (order_ > 0) {

@@ -44,7 +44,6 @@ constexpr double kCountedUsPerPoint = 3.0;
 constexpr double kCountedSetupPerTriangleSilhouette = 6e-6, kCountedSetupPerTriangleQmc = 2e-7;
 constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
 
-
 // Rows of one integrator at the pilot points, and the mean CPU time per integral.
 struct Rows {
   std::vector<double> values;

@@ -33,7 +33,7 @@ Mesh nothing() { return prt::testing::grid(1, 0.0f); }
 
 double irradiance_of(const AreaLightIntegrator& a, const ShadePoint& s, size_t light = 0) {
   std::vector<double> row(a.width());
-  OccluderMesh::Workspace ws;
+  AreaLightIntegrator::Workspace ws;
   a.integrate(s, row, ws);
   return row[light * a.per_light()];
 }

@@ -41,14 +41,21 @@ public:
   size_t per_light() const noexcept { return 1 + size_t(order_) * size_t(order_); }
   size_t width() const noexcept { return lights() * per_light(); }
 
+  // Per-thread scratch, reused across shade points.
+  struct Workspace {
+    OccluderMesh::Workspace occluders;
+    std::vector<Arc> arcs;
+    std::vector<double> sh;
+  };
+
   // out[l·per_light() + 0] = E_l, out[l·per_light() + 1 + i] = S_l,i (file comment). Thread-safe
   // with one Workspace per thread.
-  void integrate(const ShadePoint& point, std::span<double> out, OccluderMesh::Workspace& ws) const;
+  void integrate(const ShadePoint& point, std::span<double> out, Workspace& ws) const;
 
 private:
   struct Face {
     std::vector<Eigen::Vector3d> vertices;  // in the mesh's frame
-    Eigen::Vector3d front;                  // a point surely on the counter-clockwise side
+    int front_side = 0;                     // orient3d_exact(v0, v1, v2, ·) on the counter-clockwise side
     bool two_sided = false;
   };
   std::vector<std::vector<Face>> faces_;  // per light
