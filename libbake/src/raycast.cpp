@@ -275,6 +275,22 @@ SegmentCrossing crosses_exactly(const NearTriangles::Test& t, const ShadePoint& 
   return SegmentCrossing::Cross;
 }
 
+// A triangle of the shade point's 1-ring, (p, a, b), against the ray in direction d: the float test
+// (occludes_from_above) decides when it is clear; when it is within its own rounding of flipping
+// (d grazes the cone, the plane nearly contains n, or p + εn lies in the plane and the first-order
+// point sits on the cone's edge: a wall standing on the face along n), the same segment test as
+// the near triangles decides exactly, in the ε and ε² limits (orient_eps). Edge: the direction
+// lies on the triangle's boundary as seen from the limit point (a null set).
+SegmentCrossing ring_crossing(const ShadePoint& point, const Vector3d& a, const Vector3d& b, const Vector3d& d,
+                              double reach) {
+  bool ambiguous = false;
+  const bool blocks = occludes_from_above(point.p, a, b, point.n, d, &ambiguous, tie_break(point));
+  if (!ambiguous) return blocks ? SegmentCrossing::Cross : SegmentCrossing::Miss;
+  const NearTriangles::Test test{point.p, a, b, orient_eps(point.p, a, b, point.p, point.n, tie_break(point))};
+  if (test.side == 0) return SegmentCrossing::Miss;  // no area seen from the limit point
+  return crosses_exactly(test, point, point.p + reach * d);
+}
+
 } // namespace
 
 NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
@@ -321,9 +337,11 @@ bool RayCaster::visible(const ShadePoint& point, const Vector3d& d) const {
 bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
+    const double reach_ = reach(point);
+    // Edge (a null set of directions) does not block, as for the near triangles below.
     for (uint32_t f : topo_.ring(w))
       if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
-          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, nullptr, tie_break(point)))
+          ab && ring_crossing(point, ab->first, ab->second, d, reach_) == SegmentCrossing::Cross)
         return false;
   }
   if (!near.tests.empty()) {
@@ -360,12 +378,18 @@ std::optional<RayHit> RayCaster::closest_hit(const Vector3d& origin, const Vecto
 
 CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d& d) const {
   CrossingCount out;
+  const double reach_ = reach(point);
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
-    for (uint32_t f : topo_.ring(w))
-      if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
-          ab && occludes_from_above(point.p, ab->first, ab->second, point.n, d, &out.ambiguous, tie_break(point)))
-        ++out.count;
+    for (uint32_t f : topo_.ring(w)) {
+      const auto ab = ring_far_corners(mesh_, topo_, f, w);
+      if (!ab) continue;
+      switch (ring_crossing(point, ab->first, ab->second, d, reach_)) {
+        case SegmentCrossing::Miss: break;
+        case SegmentCrossing::Edge: out.ambiguous = true; break;  // choose another direction
+        case SegmentCrossing::Cross: ++out.count; break;
+      }
+    }
   }
   // Triangles within ρ of p are decided exactly for the whole ray (below): near p, float hit tests
   // cannot tell which of two adjacent triangles a ray enters — e.g. at a vertex a few ulps from
@@ -374,7 +398,6 @@ CrossingCount RayCaster::count_crossings(const ShadePoint& point, const Vector3d
   // The ray is the segment from p + εn to a point r beyond the scene: its exact predicates are
   // those of that segment, whatever rounding r carries.
   const NearTriangles near = near_triangles(point);
-  const double reach_ = reach(point);
   const Vector3d r = point.p + reach_ * d;
   for (const NearTriangles::Test& t : near.tests) {
     switch (crosses_exactly(t, point, r)) {

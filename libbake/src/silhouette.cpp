@@ -517,6 +517,20 @@ struct SilhouetteIntegrator::Impl {
         }
         continue;
       }
+      // An edge from p itself along ±n (a wall standing on the face, or hanging under it, from
+      // the vertex: CAD fins): seen from p + εn its far part is at ±n and its near part at −n,
+      // so a − p ∥ b − p. Along −n it is one point. Along +n, from the tie-break's p + εn + ε²t,
+      // the point p + λn is seen in direction (λ − ε)n − ε²t: the great half circle from −n
+      // through −t to +n, the same limit in which the ray counts and contour sides decide
+      // (bake/raycast.h, bake/contour.h). Without a tie-break every face on the edge has side 0
+      // and the edge is no contour edge.
+      if (at_p && da.cross(db).squaredNorm() == 0) {
+        if (tie_break(point) && da.dot(db) < 0) {
+          push(da, -point.t);
+          push(-point.t, db);
+        }
+        continue;
+      }
       push(da, db);
     }
     if (point.hemisphere) add_horizon(n, s.arcs);

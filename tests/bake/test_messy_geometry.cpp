@@ -350,3 +350,79 @@ TEST(MessyGeometry, SheetNormalsKeepSmoothNormalsOfSplitManifolds) {
   EXPECT_LT((touching.normals[a] - Vector3f(1, 1, 1).normalized()).norm(), 1e-6f);
   EXPECT_LT((touching.normals[b] + Vector3f(1, 1, 1).normalized()).norm(), 1e-6f);
 }
+
+namespace {
+
+// A plate z = 0 over x ≥ 0 whose vertex at the origin lies on its edge x = 0, and a single-sheet
+// wall in the plane x = 0 with a corner at the origin: its edge from the origin runs along the
+// plate's normal, up (`up` = +1, a CAD fin standing on the plate) or down (−1, hanging under it),
+// and it spans y from 0 to `side` (±1). Each part keeps its own normals (merge_meshes), as a glTF
+// with per-primitive normals has them: the plate's vertex at the origin has n = +z and the
+// tie-break t = +x (into its own faces), and the wall's faces are in its welded 1-ring.
+Mesh plate_with_fin(float side, float up) {
+  const Mesh plate = make_mesh({{0, 0, 0}, {0, -1, 0}, {1, -1, 0}, {1, 1, 0}, {0, 1, 0}},
+                               {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}}, "plate");
+  const Mesh wall = quad({0, 0, 0}, {0, side, 0}, {0, side, up}, {0, 0, up}, "fin");
+  const std::vector<Mesh> parts = {plate, wall};
+  return merge_meshes(parts, "plate and fin");
+}
+
+} // namespace
+
+TEST(MessyGeometry, FinStandingOnAFaceFromTheVertex) {
+  // Found on 2CylinderEngine.glb (about 2 vertices in 1,000): seen from p + εn the fin's edge from
+  // p runs along n, so p + εn lies in the fin's plane AND on that edge's line; to first order every
+  // direction grazes the fin, and the second-order limit p + εn + ε²t decides. The limit point is
+  // then ε² in front of the fin (t = +x) at its vertical edge, so the fin blocks exactly the
+  // octant {x < 0, y·side > 0, z > 0}: AO = 3/4 whichever side it spans. Before, the ray test
+  // flagged every direction of these points as a graze (no start ray: the bake stopped), and the
+  // edge's arc ran between the antipodes −n and +n (undefined).
+  for (const float side : {1.0f, -1.0f}) {
+    const Mesh m = plate_with_fin(side, 1);
+    const Topology topo = build_topology(m);
+    const ShadePoint sp = vertex_shade_point(m, topo, 0);
+    ASSERT_EQ(sp.n, Vector3d(0, 0, 1));
+    ASSERT_NEAR((sp.t - Vector3d(1, 0, 0)).norm(), 0, 1e-15);
+    expect_exact(ao_at(m, topo, sp, 0), 0.75, side > 0 ? "fin over y > 0" : "fin over y < 0");
+  }
+  // Hanging under the plate, the fin is seen from p + εn in the single direction −n: AO = 1.
+  for (const float side : {1.0f, -1.0f}) {
+    const Mesh m = plate_with_fin(side, -1);
+    const Topology topo = build_topology(m);
+    expect_exact(ao_at(m, topo, vertex_shade_point(m, topo, 0), 0), 1.0, "fin hanging under the plate");
+  }
+}
+
+TEST(MessyGeometry, FinWithANormalOffItsPlaneByRounding) {
+  // The same fins with the plate's normal off the fin's plane by 1e-10 rad (a file normal with
+  // rounding in it; one engine vertex has 6e-11): p + εn is then off the fin's plane at first
+  // order, on the side the tilt says, and the fin blocks the octant on the other side of its
+  // plane, AO = 3/4 (the tilted hemisphere changes AO by O(1e-10)); a hanging fin blocks nothing.
+  // Every ring test here is within the float test's tolerance: the exact predicates decide them.
+  for (const float tilt : {1e-10f, -1e-10f})
+    for (const float side : {1.0f, -1.0f})
+      for (const float up : {1.0f, -1.0f}) {
+        Mesh m = plate_with_fin(side, up);
+        m.normals[0] = Vector3f(tilt, 0, 1);
+        const Topology topo = build_topology(m);
+        const ShadePoint sp = vertex_shade_point(m, topo, 0);
+        ASSERT_NE(sp.n.dot(Vector3d(1, 0, 0)), 0.0);
+        expect_exact(ao_at(m, topo, sp, 0), up > 0 ? 0.75 : 1.0, "fin off the normal by 1e-10 rad");
+      }
+  // A keel hanging under the plate from the vertex, as at engine vertex 913: two faces on the edge
+  // along −n whose planes differ by 6°, so that for every direction one of them has its plane
+  // crossed ahead of the ray near p. The float test could decide no direction (the bake stopped);
+  // the keel is under the plate up to the 1e-10 tilt: AO = 1 (to O(1e-10); its corners on the
+  // horizon leave the silhouette integrator its discretisation error there).
+  for (const float tilt : {1e-10f, -1e-10f}) {
+    const Mesh plate = plate_with_fin(1, 1);
+    const Mesh keel = make_mesh({{0, 0, 0}, {1, -0.05f, 0}, {0, 0, -1}, {-1, -0.05f, 0}}, {{0, 1, 2}, {0, 2, 3}}, "keel");
+    const std::vector<Mesh> parts = {make_mesh({plate.positions.begin(), plate.positions.begin() + 5},
+                                               {plate.triangles.begin(), plate.triangles.begin() + 3}, "plate"),
+                                     keel};
+    Mesh m = merge_meshes(parts, "plate and keel");
+    m.normals[0] = Vector3f(tilt, 0, 1);
+    const Topology topo = build_topology(m);
+    expect_exact(ao_at(m, topo, vertex_shade_point(m, topo, 0), 0), 1.0, "keel under the plate");
+  }
+}

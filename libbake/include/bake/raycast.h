@@ -5,7 +5,9 @@
 // "minimum W is 0" assumption).
 //
 // The shade point's own 1-ring (every triangle with a corner welded to it) is removed from
-// Embree's answers by a filter and decided analytically (occludes_from_above). So are the
+// Embree's answers by a filter and decided analytically: occludes_from_above where its float test
+// is clear, else the exact segment test below (a fin standing on the face from p along n puts
+// every direction within the float test's rounding: docs/RELIABILITY.md). So are the
 // triangles near p (NearTriangles: within rho, e.g. a floor or wall passing through the vertex at
 // a T-junction, a coplanar overlapping sheet, a near-duplicate shell), for every ray, visibility
 // and counted alike: they are decided by the exact ε-limit orientation predicate orient_eps
