@@ -361,6 +361,19 @@ bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, cons
   return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
 }
 
+bool RayCaster::occluded(const Vector3d& origin, const Vector3d& d, double tnear, double tfar) const {
+  RingContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.welded = -1;
+  ctx.weld = topo_.weld.data();
+  ctx.triangles = mesh_.triangles.data();
+  RTCRay ray = make_ray(origin, d);
+  ray.tnear = float(tnear);
+  ray.tfar = float(tfar);
+  rtcOccluded1(rt_->scene, &ctx.base, &ray);
+  return !(ray.tfar >= 0.0f);  // Embree sets tfar = -inf on a hit
+}
+
 std::optional<RayHit> RayCaster::closest_hit(const Vector3d& origin, const Vector3d& d, double tnear) const {
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);

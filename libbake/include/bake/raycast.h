@@ -88,6 +88,10 @@ public:
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
   // rays of the reference renderer, view/reference.h).
   std::optional<RayHit> closest_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear) const;
+  // Whether any triangle meets the segment origin + t d, t in [tnear, tfar] (no 1-ring or near
+  // rules: a free point; Embree's float test): the shadow rays to points on an area light, which
+  // end at the light (view/area_lights.h).
+  bool occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& d, double tnear, double tfar) const;
   double mesh_diagonal() const { return diagonal_; }  // of the mesh's axis-aligned bounds
 
 private:

@@ -1,0 +1,139 @@
+// The per-pixel area-light renders (view/area_lights.h): the analytic one is exact, so the
+// ray-traced reference must agree with it within its own standard error, pixel by pixel, in
+// lit, penumbra and umbra regions alike; an unoccluded pixel equals Lambert's polygon formula; a
+// render is the same bytes for any thread count.
+#include <view/area_lights.h>
+#include <view/camera.h>
+#include <view/raster.h>
+
+#include <bake/lights.h>
+#include <bake/mesh.h>
+
+#include <gtest/gtest.h>
+#include <test_scenes.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace {
+
+using namespace prt;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+// A ground (z = 0, facing +z, [−2, 2]²) with a box standing on it, under a quad light and a
+// two-sided disc: lit ground, the box's soft shadow with umbra and penumbra, the box's own faces.
+struct Scene {
+  bake::Mesh mesh;
+  std::vector<bake::AreaLight> lights;
+  view::Camera camera;
+  Scene() {
+    const bake::Mesh ground = prt::testing::grid(2, 2.0f);
+    const bake::Mesh box = prt::testing::box({-0.4f, -0.3f, 0}, {0.3f, 0.4f, 0.8f});
+    const std::vector<bake::Mesh> parts = {ground, box};
+    mesh = bake::merge_meshes(parts, "ground and box");
+    bake::AreaLight quad = bake::make_quad_light({0.5, 0.2, 2.0}, {1.0, 0, 0}, {0, -0.8, 0});  // emits along u × v = −z
+    quad.name = "quad";
+    quad.radiance = {4, 3, 2};
+    bake::AreaLight disc = bake::make_disc_light({-1.2, -1.0, 1.2}, {1, 1, -1}, 0.3, 24);
+    disc.name = "disc";
+    disc.two_sided = true;
+    disc.radiance = {1, 2, 3};
+    lights = {quad, disc};
+    for (const auto& l : lights) bake::validate_light(l, "test", l.name);
+    camera.eye = {3.0, -4.0, 4.0};
+    camera.at = {0, 0, 0.3};
+    camera.up = {0, 0, 1};
+    camera.fov_y_degrees = 26;
+    camera.width = 48;
+    camera.height = 40;
+  }
+};
+
+TEST(AreaLightRender, TheReferenceAgreesWithTheAnalyticRenderWithinItsStandardError) {
+  const Scene s;
+  ASSERT_LT(s.lights[0].face_normal(0).z(), -0.99) << "the quad light must emit downwards";
+  const view::GBuffer g = view::rasterize(s.mesh, s.camera);
+  ASSERT_GT(g.covered(), 1000u);
+  const view::Image exact = view::render_area_analytic(s.mesh, g, s.lights);
+  view::AreaReferenceOptions ro;
+  ro.samples = 512;
+  const view::AreaReferenceImage ref = view::render_area_reference(s.mesh, g, s.lights, ro);
+  size_t compared = 0, outside = 0, dark = 0, lit = 0;
+  double worst_z = 0, sum_d2 = 0, sum_se2 = 0;
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      if (g.triangle[size_t(y) * size_t(g.width) + size_t(x)] < 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double a = exact.at(x, y)[c], r = ref.radiance.at(x, y)[c], se = ref.std_error.at(x, y)[c];
+        ASSERT_TRUE(std::isfinite(a) && a >= 0) << x << "," << y;
+        ++compared;
+        // 4 standard errors, plus float rounding of the stored values; a pixel whose 512 rays all
+        // agree has standard error 0: there the exact value must be ~0 too or the rays all lit.
+        const double tol = 4 * se + 1e-5 * std::max(a, r) + 1e-7;
+        if (std::abs(a - r) > tol) ++outside;
+        sum_d2 += (a - r) * (a - r);
+        sum_se2 += se * se;
+        if (se > 0) worst_z = std::max(worst_z, std::abs(a - r) / se);
+        if (c == 0 && a < 1e-6) ++dark;
+        if (c == 0 && a > 0.05) ++lit;
+      }
+    }
+  // The standard error comes from 8 replicates, so (exact − ref)/se follows Student's t with 7
+  // degrees of freedom where the exact value is right: |t| > 4 with probability 0.52% (measured
+  // here: 20 of 4146, 0.48%), and E[t²] = 7/5. Asserted: at most 3x that rate beyond 4 se, and
+  // the RMS difference within 1.5x the RMS standard error (expected ~1.2); a bias in any region
+  // of more than a few standard errors breaks both.
+  EXPECT_LE(double(outside), 3 * 0.0052 * double(compared)) << "worst |exact - ref| / se = " << worst_z;
+  EXPECT_LE(std::sqrt(sum_d2 / double(compared)), 1.5 * std::sqrt(sum_se2 / double(compared)));
+  EXPECT_GT(dark, 0u) << "the scene must have pixels in full shadow or facing away";
+  EXPECT_GT(lit, 100u);
+}
+
+TEST(AreaLightRender, AnUnoccludedPixelIsLambertsFormula) {
+  // One ground pixel straight under the quad light, nothing else in the scene: L = radiance/π · π F,
+  // F = Lambert's form factor of the quad from the pixel's shading point.
+  const bake::Mesh ground = prt::testing::grid(1, 2.0f);
+  bake::AreaLight quad = bake::make_quad_light({0.2, 0.1, 1.5}, {1.0, 0, 0}, {0, -0.8, 0});
+  quad.radiance = {2, 2, 2};
+  const std::vector<bake::AreaLight> lights = {quad};
+  view::Camera cam;
+  cam.eye = {0, 0, 5};
+  cam.at = {0, 0, 0};
+  cam.width = cam.height = 9;
+  cam.fov_y_degrees = 10;
+  const view::GBuffer g = view::rasterize(ground, cam);
+  const view::Image img = view::render_area_analytic(ground, g, lights);
+  const view::Fragment f = view::make_fragment(ground, g, 4, 4);
+  ASSERT_GE(f.triangle, 0);
+  const Vector3d p = f.p + view::area_shading_offset(ground) * f.ng;
+  std::vector<Vector3d> corners;
+  for (const auto& v : quad.vertices) corners.push_back(v);
+  const double F = prt::testing::polygon_form_factor(p, {0, 0, 1}, corners);
+  ASSERT_GT(F, 0.05);
+  EXPECT_NEAR(img.at(4, 4)[0], 2 * F, 1e-6 * 2 * F);  // float storage
+}
+
+TEST(AreaLightRender, TheSameBytesForAnyThreadCount) {
+  const Scene s;
+  const view::GBuffer g = view::rasterize(s.mesh, s.camera);
+  view::AreaReferenceOptions ro;
+  ro.samples = 16;
+  view::Image a1, a2;
+  view::AreaReferenceImage r1, r2;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    a1 = view::render_area_analytic(s.mesh, g, s.lights);
+    r1 = view::render_area_reference(s.mesh, g, s.lights, ro);
+  }
+  a2 = view::render_area_analytic(s.mesh, g, s.lights);
+  r2 = view::render_area_reference(s.mesh, g, s.lights, ro);
+  EXPECT_EQ(a1.rgb, a2.rgb);
+  EXPECT_EQ(r1.radiance.rgb, r2.radiance.rgb);
+  EXPECT_EQ(r1.std_error.rgb, r2.std_error.rgb);
+}
+
+} // namespace

@@ -1,0 +1,61 @@
+// view/area_lights.h — direct lighting from area lights, per pixel (issue 13; paper 003 §5, the
+// equal-time comparison against ray tracing): the analytic render with exact soft shadows and its
+// Embree reference, for the same pixels (view/raster.h G-buffers). Layers: docs/ARCHITECTURE.md §2.
+//
+// Both show a Lambertian surface of albedo `albedo` (white by default) lit by the lights only:
+//   L_o(p) = albedo/π · Σ_l radiance_l · E_l(p', n),   E_l = ∫_{visible part of light l} max(n·ω, 0) dω,
+// at the pixel's surface point p moved off its triangle to p' = p + ε n_g (n_g the geometric
+// normal turned to the side of n; ε = 1e-5 × the mesh's diagonal + 1e-6 × its largest coordinate,
+// as the environment reference, view/reference.h), with n the interpolated shading normal, so
+// that both methods see the same point and neither meets its own triangle.
+//   * Analytic (render_area_analytic): E_l from bake/area_bake.h at p' (the light's spherical
+//     polygon minus every triangle's image, clipped to n's horizon, Lambert's closed form): exact,
+//     no noise. Cost grows with the triangles between the point and the light (bake/occluder_mesh.h).
+//   * Reference (render_area_reference): light sampling with shadow rays. Per pixel and light, N
+//     points y uniform over the light's area A (a face by its area, then a uniform point of a
+//     triangle of its fan, from a randomised 3D Halton point: bake/sampling.h RotatedHalton3 keyed by
+//     (seed, pixel, light, replicate)), each contributing
+//       A · max(n·ω, 0) · c_l / r² · [segment p'→y unblocked],  ω = (y − p')/r, r = |y − p'|,
+//     with c_l = −n_f·ω on a face's emitting side (|n_f·ω| for two-sided lights) and 0 behind it:
+//     an unbiased estimate of E_l. With N ≥ 8 (a multiple of 8) the N points form 8 independent
+//     replicates whose spread gives the per-pixel standard error; fewer give no error estimate.
+// Every pixel's value depends only on its own inputs and the seed: the same bytes for any thread
+// count. Uncovered pixels are 0.
+#pragma once
+
+#include <view/image.h>
+#include <view/raster.h>
+
+#include <bake/lights.h>
+#include <bake/mesh.h>
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+namespace prt::view {
+
+struct AreaRenderOptions {
+  std::array<double, 3> albedo{1, 1, 1};
+};
+
+// Exact: E per light from the closed forms (above).
+Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
+                           const AreaRenderOptions& options = {});
+
+struct AreaReferenceOptions {
+  uint32_t samples = 64;  // shadow rays per pixel and light: 1..7, or a multiple of 8 (replicates)
+  uint64_t seed = 1;
+  AreaRenderOptions render;
+};
+struct AreaReferenceImage {
+  Image radiance;
+  Image std_error;  // per channel; all 0 when samples < 8 (no replicates)
+};
+AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
+                                         const AreaReferenceOptions& options);
+
+// The offset ε of the shading points (above) for this mesh.
+double area_shading_offset(const bake::Mesh& mesh);
+
+} // namespace prt::view

@@ -1,0 +1,167 @@
+#include <view/area_lights.h>
+
+#include <bake/area_bake.h>
+#include <bake/error.h>
+#include <bake/raycast.h>
+#include <bake/sampling.h>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+namespace prt::view {
+
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr uint32_t kReplicates = 8;
+
+// The pixel's shading point p' = p + ε n_g and its normal (the file comment).
+bake::ShadePoint shading_point(const Fragment& f, double epsilon) {
+  bake::ShadePoint sp;
+  sp.p = f.p + epsilon * f.ng;
+  sp.n = f.n;
+  return sp;
+}
+
+// A light's surface as triangles (each face's fan) in the mesh's frame, with the cumulative area.
+struct LightSurface {
+  struct Triangle {
+    Vector3d a, ab, ac;  // a + u ab + v ac
+    Vector3d normal;     // unit, towards the emitting side
+  };
+  std::vector<Triangle> triangles;
+  std::vector<double> cdf;  // cumulative area, cdf.back() = the light's area
+  bool two_sided = false;
+
+  LightSurface(const bake::AreaLight& light, const Vector3d& origin) : two_sided(light.two_sided) {
+    double total = 0;
+    for (size_t f = 0; f < light.faces.size(); ++f) {
+      const auto& face = light.faces[f];
+      const Vector3d normal = light.face_normal(f);
+      const Vector3d a = light.vertices[face[0]] - origin;
+      for (size_t k = 1; k + 1 < face.size(); ++k) {
+        const Vector3d b = light.vertices[face[k]] - origin, c = light.vertices[face[k + 1]] - origin;
+        const double area = 0.5 * (b - a).cross(c - a).norm();
+        if (!(area > 0)) continue;
+        triangles.push_back({a, b - a, c - a, normal});
+        total += area;
+        cdf.push_back(total);
+      }
+    }
+    PRT_CHECK(!triangles.empty());
+  }
+  double area() const { return cdf.back(); }
+
+  // A point uniform over the surface from u in [0, 1)³, with its face's normal.
+  const Triangle& pick(double u0, double& rescaled) const {
+    const double target = u0 * area();
+    const size_t i = std::min(size_t(std::upper_bound(cdf.begin(), cdf.end(), target) - cdf.begin()), cdf.size() - 1);
+    const double lo = i ? cdf[i - 1] : 0.0;
+    rescaled = std::clamp((target - lo) / (cdf[i] - lo), 0.0, std::nextafter(1.0, 0.0));
+    return triangles[i];
+  }
+};
+
+void check_lights(std::span<const bake::AreaLight> lights) {
+  PRT_CHECK(!lights.empty());
+  for (const auto& l : lights) PRT_CHECK(!l.faces.empty());
+}
+
+} // namespace
+
+double area_shading_offset(const bake::Mesh& mesh) {
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& q : mesh.positions) {
+    lo = lo.cwiseMin(q.cast<double>());
+    hi = hi.cwiseMax(q.cast<double>());
+  }
+  if (mesh.positions.empty()) return 0;
+  return 1e-5 * (hi - lo).norm() + 1e-6 * std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+}
+
+Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
+                           const AreaRenderOptions& options) {
+  check_lights(lights);
+  const bake::AreaLightIntegrator integrator(lights, mesh, 0);
+  const double epsilon = area_shading_offset(mesh);
+  tbb::enumerable_thread_specific<bake::AreaLightIntegrator::Workspace> workspaces;
+  tbb::enumerable_thread_specific<std::vector<double>> rows([&] { return std::vector<double>(integrator.width()); });
+  return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
+    std::vector<double>& row = rows.local();
+    integrator.integrate(shading_point(f, epsilon), row, workspaces.local());
+    for (size_t c = 0; c < 3; ++c) {
+      double v = 0;
+      for (size_t l = 0; l < lights.size(); ++l) v += lights[l].radiance[c] * row[l * integrator.per_light()];
+      out[c] = float(options.albedo[c] * v * std::numbers::inv_pi);
+    }
+  });
+}
+
+AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
+                                         const AreaReferenceOptions& options) {
+  check_lights(lights);
+  PRT_CHECK(options.samples > 0 && (options.samples < kReplicates || options.samples % kReplicates == 0));
+  const bake::Topology topology = bake::build_topology(mesh);
+  const bake::RayCaster rays(mesh, topology);
+  std::vector<LightSurface> surfaces;
+  for (const auto& l : lights) surfaces.emplace_back(l, mesh.origin);
+  const double epsilon = area_shading_offset(mesh);
+  const uint32_t B = std::min(kReplicates, options.samples), per = options.samples / B;
+
+  AreaReferenceImage out;
+  out.std_error = Image(g.width, g.height);
+  out.radiance = shade_pixels(mesh, g, [&](const Fragment& f, float* rgb) {
+    const bake::ShadePoint sp = shading_point(f, epsilon);
+    const uint64_t pixel = uint64_t(f.y) * uint64_t(g.width) + uint64_t(f.x);
+    std::array<double, kReplicates * 3> means{};
+    for (size_t l = 0; l < lights.size(); ++l) {
+      const LightSurface& s = surfaces[l];
+      for (uint32_t b = 0; b < B; ++b) {
+        const bake::RotatedHalton3 halton(options.seed, (pixel * lights.size() + l) * kReplicates + b);
+        double sum = 0;
+        for (uint32_t i = 0; i < per; ++i) {
+          const std::array<double, 3> u = halton(i);
+          double u0 = 0;
+          const LightSurface::Triangle& t = s.pick(u[0], u0);
+          // Uniform in the triangle: (1 − √u0, √u0 (1 − u2)) weights of ab, ac.
+          const double r0 = std::sqrt(u0);
+          const Vector3d y = t.a + r0 * (1 - u[2]) * t.ab + r0 * u[2] * t.ac;
+          const Vector3d d = y - sp.p;
+          const double r2 = d.squaredNorm(), r = std::sqrt(r2);
+          if (!(r > 0)) continue;
+          const Vector3d w = d / r;
+          const double cos_p = sp.n.dot(w);
+          const double cos_l = s.two_sided ? std::abs(t.normal.dot(w)) : -t.normal.dot(w);
+          if (!(cos_p > 0) || !(cos_l > 0)) continue;
+          if (rays.occluded(sp.p, w, 0.0, r * (1 - 1e-7))) continue;
+          sum += s.area() * cos_p * cos_l / r2;
+        }
+        const double e = sum / per;  // this replicate's estimate of E_l
+        for (size_t c = 0; c < 3; ++c)
+          means[b * 3 + c] += options.render.albedo[c] * lights[l].radiance[c] * e * std::numbers::inv_pi;
+      }
+    }
+    for (size_t c = 0; c < 3; ++c) {
+      double mean = 0;
+      for (uint32_t b = 0; b < B; ++b) mean += means[b * 3 + c];
+      mean /= B;
+      rgb[c] = float(mean);
+      if (B == kReplicates) {
+        double var = 0;
+        for (uint32_t b = 0; b < B; ++b) var += (means[b * 3 + c] - mean) * (means[b * 3 + c] - mean);
+        out.std_error.at(f.x, f.y)[c] = float(std::sqrt(var / (B - 1) / B));
+      }
+    }
+  });
+  return out;
+}
+
+} // namespace prt::view
