@@ -18,6 +18,7 @@
 //   BM_ThreeLightsThreeBoxesMesh/culled:0  the same through the unculled reference
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
+#include <bake/lights.h>
 #include <bake/mesh.h>
 #include <bake/occluder_mesh.h>
 #include <bake/polygon_sh.h>
@@ -226,6 +227,49 @@ void BM_BunnyQuad(benchmark::State& state) {
   });
 }
 BENCHMARK(BM_BunnyQuad)->Unit(benchmark::kMillisecond);
+
+// Cost against the silhouette's size: one quad light (kQuad) and one convex occluder, an N-gon
+// prism (radius 0.3, height 0.2, axis +z, centred at height 1), so that its silhouette from the
+// floor points has ~N + 2 vertices. silhouette:1 subtracts the silhouette loop (paper 003 §3.3),
+// silhouette:0 its front triangles (§4.4: ~2N of them).
+void BM_PrismSilhouette(benchmark::State& state) {
+  const int segments = int(state.range(0));
+  const bool use_silhouette = state.range(1) != 0;
+  const prt::bake::AreaLight prism = prt::bake::make_cylinder_light(
+      V3(0, 0, 1), 0.3, 0.2, segments, Eigen::AngleAxisd(0.5 * 3.141592653589793, V3::UnitX()).toRotationMatrix());
+  const prt::bake::ConvexPolyhedron body(prism.vertices, prism.faces);
+  const auto& points = shade_points();
+  std::vector<std::vector<V3>> occluders;
+  std::vector<V3> rel(4), clipped;
+  std::vector<prt::bake::Arc> arcs;
+  size_t loop_vertices = 0;
+  auto shade = [&](const ShadePoint& s) {
+    occluders.clear();
+    if (use_silhouette) {
+      occluders.emplace_back();
+      if (!body.silhouette(s.p, occluders.back())) return 0.0;
+      loop_vertices += occluders.back().size();
+    } else {
+      body.front_triangles(s.p, occluders);
+    }
+    if (clipped_quad(s, rel, clipped) == 0 || clipped.size() < 3) return 0.0;
+    prt::bake::visible_region(clipped, occluders, arcs);
+    return s.n.dot(prt::bake::vector_irradiance(arcs));
+  };
+  for (const ShadePoint& s : points) shade(s);  // untimed: the loop size
+  const double mean_loop = double(loop_vertices) / double(points.size());
+  for (auto _ : state) {
+    double sum = 0;
+    for (const ShadePoint& s : points) sum += shade(s);
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(points.size()));
+  if (use_silhouette) state.counters["loop_vertices"] = mean_loop;
+}
+BENCHMARK(BM_PrismSilhouette)
+    ->ArgNames({"segments", "silhouette"})
+    ->ArgsProduct({{8, 32, 128, 512}, {1, 0}})
+    ->Unit(benchmark::kMicrosecond);
 
 } // namespace
 
