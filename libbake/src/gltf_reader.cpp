@@ -374,6 +374,12 @@ class Reader {
     if (skipped_primitives_ > 0)
       file_.warnings.push_back(file_.name + ": " + std::to_string(skipped_primitives_) +
                                " point or line primitive instance(s) skipped (only triangles are baked)");
+    // KHR_lights_punctual: points, spots and suns have no area, so nothing of them is baked; the
+    // user must hear it, not find the lights missing in the engine's shading.
+    if (!model_.lights.empty())
+      file_.warnings.push_back(file_.name + ": " + std::to_string(model_.lights.size()) +
+                               " punctual light(s) (KHR_lights_punctual) are not baked: they have no area, and "
+                               "prtbake bakes the environment's light");
     if (skinned_instances_ + morphed_primitives_ > 0)
       file_.warnings.push_back(file_.name + ": skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
                                " skinned mesh instance(s), " + std::to_string(morphed_primitives_) +

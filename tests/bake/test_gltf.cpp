@@ -142,6 +142,21 @@ TEST(Gltf, GlbAndExternalBufferReadTheSameAsEmbedded) {
   }
 }
 
+TEST(Gltf, PunctualLightsAreNotBakedAndSaySo) {
+  Gltf g;
+  const int points = g.vec3(kTriangle);
+  g.doc["meshes"].push_back({{"primitives", {{{"attributes", {{"POSITION", points}}}}}}});
+  g.node({{"mesh", 0}}, true);
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"] = {{"KHR_lights_punctual",
+                          {{"lights", {{{"type", "point"}, {"intensity", 10}}, {{"type", "directional"}}}}}}};
+  const Mesh m = prt::bake::load_mesh(g.write("lights.gltf"));
+  EXPECT_EQ(m.triangles.size(), 1u);
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_NE(m.warnings[0].find("2 punctual light(s) (KHR_lights_punctual) are not baked"), std::string::npos)
+      << m.warnings[0];
+}
+
 TEST(Gltf, PointAndLinePrimitivesAreSkippedWithACountedWarning) {
   Gltf g;
   const int points = g.vec3(kTriangle);
