@@ -20,6 +20,17 @@
 //       "relight": false,                      diffuse receivers also get transfer vectors
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/fiv.h ShellSpec)
 //     },
+//     "lights": [ {                              optional: area lights (bake/lights.h, paper 003)
+//       "name": "key",                           optional: default "light<i>"; unique
+//       "shape": "quad",  "centre", "u", "v"     the rectangle centre ± u/2 ± v/2, emitting towards u × v
+//              | "polygon", "vertices": [[x,y,z], ...]   convex, counter-clockwise seen from its emitting side
+//              | "disc", "centre", "normal", "radius", "segments": 64
+//              | "box", "centre", "size": [sx,sy,sz], "rotate": [rx,ry,rz]
+//              | "cylinder", "centre", "radius", "height", "segments": 64, "rotate"   (axis: its own y)
+//              | "sphere", "centre", "radius", "subdivisions": 3                    (an icosphere)
+//       "radiance": [r,g,b],                     required, ≥ 0, constant over the surface
+//       "two_sided": false                       planar shapes only
+//     } ],                                       (also in a glTF scene's options file)
 //     "objects": [ {                             one or more
 //       "name": "bunny",                         optional: default the mesh file's stem; unique
 //       "mesh": "bunny.obj",                     required; relative paths are relative to the scene file
@@ -79,6 +90,7 @@
 #include <bake/choose.h>
 #include <bake/envmap.h>
 #include <bake/fiv.h>
+#include <bake/lights.h>
 #include <bake/mesh.h>
 #include <bake/progress.h>
 #include <bake/vertex_bake.h>
@@ -135,6 +147,7 @@ struct SceneDescription {
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
+  std::vector<AreaLight> lights;  // "lights", in world space (bake/lights.h), validated
   std::vector<SceneObject> objects;
 };
 
