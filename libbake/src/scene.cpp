@@ -709,6 +709,12 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
       if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
       else p.left_out.push_back("ao: not in bake.products");
       const Material& m = o.material;
+      if (!scene.lights.empty()) {
+        p.area_irradiance = true;
+        p.baked.push_back("area_lights/irradiance: " + std::to_string(scene.lights.size()) +
+                          " area light(s), exact soft shadows (paper 003)");
+        if (!m.glossy()) p.left_out.push_back("area_lights/sh: no glossy lobe (irradiance is exact for a diffuse receiver)");
+      }
       if (m.diffuse()) {
         if (!scene.want_radiance) p.left_out.push_back("radiance/band1: not in bake.products");
         else if (!env) p.left_out.push_back("radiance/band1: the scene has no environment");
@@ -732,6 +738,8 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
       if (m.glossy()) {
         if (!scene.want_transfer) {
           p.left_out.push_back("transfer/visibility: not in bake.products");
+          if (!scene.lights.empty())
+            p.left_out.push_back("area_lights/sh: transfer/visibility is not baked (not in bake.products)");
         } else {
           const int L = clamped_power_order(m.phong_exponent, scene.sh_tolerance, sh::kMaxOrder);
           if (L == 0) {
@@ -748,6 +756,10 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
              << ", the smallest whose lobe energy beyond it (" << pct(clamped_power_energy_beyond(m.phong_exponent, L))
              << ") is <= sh_tolerance " << pct(scene.sh_tolerance);
           p.baked.push_back(os.str());
+          if (!scene.lights.empty()) {
+            p.area_sh_order = L;
+            p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
+          }
         }
       }
     }
