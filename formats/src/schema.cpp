@@ -267,7 +267,10 @@ public:
       const Dataset& indices = *find_dataset(file, g + "/" + std::string(N::kLightFaceIndices));
       if (vertices.shape.empty() || sizes.data.index() != 1 || indices.data.index() != 1) continue;  // the dataset rules say why
       uint64_t total = 0;
-      for (uint32_t size : std::get<std::vector<uint32_t>>(sizes.data)) total += size;
+      for (uint32_t size : std::get<std::vector<uint32_t>>(sizes.data)) {
+        if (size < 3) fail("dataset '" + sizes.path + "' has a face of " + std::to_string(size) + " vertices; a face has >= 3");
+        total += size;
+      }
       if (total != element_count(indices.data))
         fail("dataset '" + indices.path + "' has " + std::to_string(element_count(indices.data)) +
              " indices but the face sizes add up to " + std::to_string(total));
@@ -499,8 +502,6 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.dtype(d, 1);
       if (d.shape.size() != 1 || d.shape[0] == 0)
         c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [F] with F >= 1");
-      for (uint32_t size : std::get<std::vector<uint32_t>>(d.data))
-        if (size < 3) c.fail("dataset '" + d.path + "' has a face of " + std::to_string(size) + " vertices; a face has >= 3");
       break;
     case Kind::light_face_indices:
       c.dtype(d, 1);
