@@ -69,6 +69,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
   Mesh occluders;  // empty when nothing casts shadows: every receiver point is then unoccluded
   if (!parts.empty()) occluders = merge_meshes(parts, "occluders");
+  else if (!meshes.empty()) occluders.origin = meshes[0].origin;  // the scene's frame (scene_origin), for the lights
   parts.clear();
   const Topology topo = build_topology(occluders);
   // The union's trees, built once for every integrator, pilot and reference below (bake/accel.h).

@@ -52,22 +52,29 @@ void write_meshes(const fs::path& d) {
                                   "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
 }
 
-// The quad light [-1, 1]² at y = 4 facing down (u × v = -y), radiance 10.
-const std::string kLight =
-    R"({"name": "key", "shape": "quad", "centre": [0, 4, 0], "u": [2, 0, 0], "v": [0, 0, 2], "radiance": [10, 10, 10]})";
+struct Setup {
+  bool light = true;  // the quad light [-1, 1]² at y = 4 facing down (u × v = -y), radiance 10
+  bool box = true;    // the box as an occluder and the ground "both"; else the ground alone, a receiver
+  double shift = 0;   // everything moved by (shift, 0, shift): far from the origin
+};
 
 // A glossy ground (so area_lights/sh is baked, at the Phong order) casting no shadow of its own
-// beyond its plane, and the box as an occluder.
-std::string scene_text(bool light) {
+// beyond its plane.
+std::string scene_text(const Setup& s) {
+  const std::string at = std::to_string(s.shift);
+  const std::string move = R"(, "transform": {"translate": [)" + at + ", 0, " + at + "]}";
   return std::string(R"({"prtbake_scene": 1, "bake": {"samples": 1024, "report": 0},)") +
-         (light ? R"( "lights": [)" + kLight + "]," : "") +
-         R"( "objects": [{"mesh": "ground.obj", "role": "both", "material": {"albedo": [0.5, 0.5, 0.5], "phong_exponent": 4}},
-                        {"mesh": "box.obj", "role": "occluder"}]})";
+         (s.light ? R"( "lights": [{"name": "key", "shape": "quad", "centre": [)" + at + ", 4, " + at +
+                        R"(], "u": [2, 0, 0], "v": [0, 0, 2], "radiance": [10, 10, 10]}],)"
+                  : "") +
+         R"( "objects": [{"mesh": "ground.obj", "role": ")" + (s.box ? "both" : "receiver") +
+         R"(", "material": {"albedo": [0.5, 0.5, 0.5], "phong_exponent": 4})" +
+         move + "}" + (s.box ? R"(, {"mesh": "box.obj", "role": "occluder")" + move + "}" : "") + "]}";
 }
 
-fs::path bake(const fs::path& d, bool light, int threads) {
+fs::path bake(const fs::path& d, const Setup& setup, int threads = 2) {
   write_meshes(d);
-  std::ofstream(d / "scene.json") << scene_text(light);
+  std::ofstream(d / "scene.json") << scene_text(setup);
   const fs::path out = d / "out.prt.h5";
   const auto r = prt::testing::run_tool(PRT_PRTBAKE,
                                         "scene '" + (d / "scene.json").string() + "' -o '" + out.string() +
@@ -143,7 +150,7 @@ size_t vertex_at(const F::VertexSet& s, const Vector3d& p) {
 
 TEST(SceneAreaLights, IrradianceAndShEqualClosedForms) {
   const fs::path d = fresh_dir("closed");
-  const F::Asset a = F::read_asset(bake(d, true, 2));
+  const F::Asset a = F::read_asset(bake(d, {}));
   ASSERT_EQ(a.lights.size(), 1u);
   const F::Light& key = a.lights[0];
   EXPECT_EQ(key.name, "key");
@@ -185,14 +192,14 @@ TEST(SceneAreaLights, IrradianceAndShEqualClosedForms) {
 
 TEST(SceneAreaLights, OneAndTwoThreadsWriteTheSameBytes) {
   std::string bytes[2];
-  for (int t = 1; t <= 2; ++t) bytes[t - 1] = prt::testing::read_bytes(bake(fresh_dir("threads"), true, t));
+  for (int t = 1; t <= 2; ++t) bytes[t - 1] = prt::testing::read_bytes(bake(fresh_dir("threads"), {}, t));
   EXPECT_FALSE(bytes[0].empty());
   EXPECT_TRUE(bytes[0] == bytes[1]) << "files differ between 1 and 2 threads";
 }
 
 TEST(SceneAreaLights, WithoutLightsNothingOfThemIsWrittenAndTheRestIsTheSame) {
-  const F::File lit = F::read_file(bake(fresh_dir("lit"), true, 2));
-  const F::File dark = F::read_file(bake(fresh_dir("dark"), false, 2));
+  const F::File lit = F::read_file(bake(fresh_dir("lit"), {}));
+  const F::File dark = F::read_file(bake(fresh_dir("dark"), {.light = false}));
   for (const F::Dataset& d : dark.datasets) {
     EXPECT_EQ(d.path.find("light"), std::string::npos) << d.path;
     const F::Dataset* same = F::find_dataset(lit, d.path);
@@ -213,11 +220,27 @@ TEST(SceneAreaLights, WithoutLightsNothingOfThemIsWrittenAndTheRestIsTheSame) {
 
 TEST(SceneAreaLights, PrtdumpShowsTheLightAndWhatEachVertexSetReceives) {
   const fs::path d = fresh_dir("dump");
-  const fs::path out = bake(d, true, 2);
+  const fs::path out = bake(d, {});
   const auto r = prt::testing::run_tool(PRT_PRTDUMP, "'" + out.string() + "'", d);
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* s : {"Area lights", "key  quad, 1 face(s), 4 vertices, radiance [10, 10, 10], one-sided",
                         "/objects/ground (and SH at order", "key  E min 0  max ", "/lights/key/vertices",
                         "/objects/ground/area_lights/irradiance", "lights = \"key\"", "schema   valid"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "prtdump lacks '" << s << "':\n" << r.out;
+}
+
+TEST(SceneAreaLights, FarFromTheOriginTheValuesStay) {
+  // The scene moved by 10^6 in x and z (the scene's frame gets a far origin; the lights move by
+  // it in double): the irradiance is the one near the origin, to float32 rounding; the same
+  // with nothing that casts shadows (the empty occluder union still carries the scene's frame).
+  for (const bool box : {true, false}) {
+    const F::Asset near = F::read_asset(bake(fresh_dir("near"), {.box = box}));
+    const F::Asset far = F::read_asset(bake(fresh_dir("far"), {.box = box, .shift = 1e6}));
+    const std::vector<float>& a = near.find_object("ground")->set.area_irradiance->values;
+    const std::vector<float>& b = far.find_object("ground")->set.area_irradiance->values;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t v = 0; v < a.size(); ++v) EXPECT_NEAR(b[v], a[v], 2e-7 * a[v] + 1e-12) << "vertex " << v << " box " << box;
+    const size_t v = vertex_at(far.find_object("ground")->set, {1e6 + 2, 0, 1e6});
+    EXPECT_NEAR(b[v], closed_form({2, 0, 0}).E, 1e-7 * b[v]) << "box " << box;  // unshadowed either way
+  }
 }
