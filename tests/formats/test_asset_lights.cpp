@@ -19,13 +19,6 @@ using namespace prt::formats;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(PRT_TEST_TMP) / "asset_lights" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 Light quad(const std::string& name, double y, double radiance) {
   Light l;
   l.name = name;
@@ -113,7 +106,8 @@ const std::string kE = "/objects/ground/area_lights/irradiance", kS = "/objects/
 } // namespace
 
 TEST(AssetLights, EveryFieldSurvivesWriteRead) {
-  const fs::path dir = scratch("roundtrip");
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "asset_lights";
+  fs::create_directories(dir);
   const Asset a = lit_asset();
   write_asset(dir / "a.prt.h5", a);
   const Asset b = read_asset(dir / "a.prt.h5");
@@ -148,7 +142,8 @@ TEST(AssetLights, AnAssetWithoutLightsWritesNothingOfThem) {
 }
 
 TEST(AssetLights, Version2FilesReadAndCannotHoldLights) {
-  const fs::path dir = scratch("v2");
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "asset_lights_v2";
+  fs::create_directories(dir);
   Asset a = lit_asset();
   File old = to_file(Asset{a.root, {}, {}, {a.objects[0]}, {}, {}, {}, {}, {}, {}});
   std::erase_if(old.datasets, [](const Dataset& d) { return d.path.find("area_lights") != std::string::npos; });

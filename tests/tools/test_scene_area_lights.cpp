@@ -11,6 +11,7 @@
 #include <formats/asset.h>
 
 #include <gtest/gtest.h>
+#include <mesh_files.h>
 #include <run_tool.h>
 #include <test_scenes.h>
 
@@ -26,12 +27,7 @@ using Eigen::Vector3d;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::path(PRT_TEST_TMP) / "lit_scenes" / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path fresh_dir(const std::string& name) { return prt::testing::test_dir("lit_scenes/" + name); }
 
 // Ground: integer grid [-3, 3]² at y = 0 facing +y (quads, counter-clockwise from above).
 // Box: [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2], outward. Every coordinate is a float exactly, so
