@@ -1,5 +1,6 @@
 // scene_bake.cpp — runs a scene plan (bake/scene.h): the receivers' per-vertex products against
 // the union of the occluders and the area lights' rows, then FIV shells per occluder that needs them.
+#include <bake/area_bake.h>
 #include <bake/error.h>
 #include <bake/scene.h>
 

@@ -94,8 +94,6 @@
 //     (bake/area_bake.h) against the union of the occluders, the same as the other products'.
 #pragma once
 
-#include <bake/area_bake.h>
-
 #include <bake/choose.h>
 #include <bake/envmap.h>
 #include <bake/fiv.h>
