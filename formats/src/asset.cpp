@@ -93,7 +93,8 @@ constexpr Field<Product> kProductFields[] = {
     {N::kIntegratorDescription, &Product::integrator_description},
     {N::kSamples, &Product::samples},
     {N::kSeed, &Product::seed},
-    {N::kVisibility, &Product::visibility}};
+    {N::kVisibility, &Product::visibility},
+    {N::kLightOrder, &Product::lights}};
 
 constexpr Field<ReportRow> kReportFields[] = {
     {N::kColumns, &ReportRow::columns},
@@ -125,6 +126,9 @@ constexpr Field<Occluder> kShellsFields[] = {
     {N::kFraction, &Occluder::fraction},
     {N::kSamples, &Occluder::samples},
     {N::kGrid, &Occluder::grid}};
+
+constexpr Field<Light> kLightFields[] = {
+    {N::kShape, &Light::shape}, {N::kRadiance, &Light::radiance}, {N::kTwoSided, &Light::two_sided}};
 
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
 
@@ -163,6 +167,7 @@ std::string object_prefix(std::string_view name) { return cat(N::kObjects, "/") 
 std::string object_report_dir(std::string_view name) { return cat(N::kReport, object_prefix(name)); }
 std::string occluder_dir(std::string_view name) { return cat(N::kOccluders, "/") + std::string(name); }
 std::string fiv_report_path(std::string_view name) { return cat(N::kReportFiv, "/") + std::string(name); }
+std::string light_dir(std::string_view name) { return cat(N::kLights, "/") + std::string(name); }
 
 // ---- Asset -> File -----------------------------------------------------------------------
 
@@ -180,11 +185,14 @@ void add_product(File& f, const std::string& path, const std::optional<Product>&
   add_array(f, path, std::move(shape), p->values, attrs_of<Product>(*p, kProductFields, p->extra));
 }
 
-// The [L*L] trailing shape of a transfer product (L = sh_order; else what its values give).
-std::vector<uint64_t> sh_width(const std::optional<Product>& p, uint64_t V) {
+// The L*L width of an SH product (L = sh_order; else what its values give for `rows` rows).
+uint64_t sh_width(const std::optional<Product>& p, uint64_t rows) {
+  if (p->sh_order) return uint64_t(*p->sh_order * *p->sh_order);
+  return rows ? p->values.size() / rows : 0;
+}
+std::vector<uint64_t> sh_shape(const std::optional<Product>& p, uint64_t V) {
   if (!p) return {};
-  if (p->sh_order) return {uint64_t(*p->sh_order * *p->sh_order)};
-  return {V ? p->values.size() / V : 0};
+  return {sh_width(p, V)};
 }
 
 std::vector<Attr> row_attrs(const ReportRow& r) { return attrs_of<ReportRow>(r, kReportFields, r.extra); }
@@ -221,9 +229,17 @@ void add_vertex_set(File& f, const std::string& prefix, const std::string& repor
     add_array(f, cat(prefix, N::kSourcePosition), {s.source_position->values.size()}, s.source_position->values,
               s.source_position->extra);
   add_product(f, cat(prefix, N::kAo), s.ao, V, {});
-  add_product(f, cat(prefix, N::kTransferDiffuse), s.transfer_diffuse, V, sh_width(s.transfer_diffuse, V));
-  add_product(f, cat(prefix, N::kTransferVisibility), s.transfer_visibility, V, sh_width(s.transfer_visibility, V));
+  add_product(f, cat(prefix, N::kTransferDiffuse), s.transfer_diffuse, V, sh_shape(s.transfer_diffuse, V));
+  add_product(f, cat(prefix, N::kTransferVisibility), s.transfer_visibility, V, sh_shape(s.transfer_visibility, V));
   add_product(f, cat(prefix, N::kRadianceBand1), s.radiance_band1, V, {3, 3});
+  const auto lights = [](const std::optional<Product>& p) {
+    return p && p->lights ? uint64_t(split_light_list(*p->lights).size()) : uint64_t(0);
+  };
+  add_product(f, cat(prefix, N::kAreaIrradiance), s.area_irradiance, V, {lights(s.area_irradiance)});
+  if (s.area_sh) {
+    const uint64_t L = lights(s.area_sh);
+    add_product(f, cat(prefix, N::kAreaSh), s.area_sh, V, {L, sh_width(s.area_sh, V * L)});
+  }
   add_report(f, report_dir, s.report);
 }
 
@@ -235,6 +251,14 @@ void add_occluder(File& f, const Occluder& o) {
     add_array(f, cat(dir, N::kValid), grid, o.valid->values,
               attrs_of<OccluderValid>(*o.valid, kValidFields, o.valid->extra));
   if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
+}
+
+void add_light(File& f, const Light& l) {
+  const std::string dir = light_dir(l.name) + "/";
+  add_array(f, cat(dir, N::kLightVertices), {l.vertices.values.size() / 3, 3}, l.vertices.values, l.vertices.extra);
+  add_array(f, cat(dir, N::kLightFaceSizes), {l.face_sizes.values.size()}, l.face_sizes.values, l.face_sizes.extra);
+  add_array(f, cat(dir, N::kLightFaceIndices), {l.face_indices.values.size()}, l.face_indices.values,
+            l.face_indices.extra);
 }
 
 // ---- File -> Asset -----------------------------------------------------------------------
@@ -302,6 +326,8 @@ void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
   case DatasetKind::transfer_diffuse: s.transfer_diffuse = product_of(d); break;
   case DatasetKind::transfer_visibility: s.transfer_visibility = product_of(d); break;
   case DatasetKind::radiance_band1: s.radiance_band1 = product_of(d); break;
+  case DatasetKind::area_irradiance: s.area_irradiance = product_of(d); break;
+  case DatasetKind::area_sh: s.area_sh = product_of(d); break;
   default: break;
   }
 }
@@ -317,6 +343,12 @@ const SceneObject* Asset::find_object(std::string_view name) const noexcept {
 const Occluder* Asset::find_occluder(std::string_view name) const noexcept {
   for (const Occluder& o : occluders)
     if (o.name == name) return &o;
+  return nullptr;
+}
+
+const Light* Asset::find_light(std::string_view name) const noexcept {
+  for (const Light& l : lights)
+    if (l.name == name) return &l;
   return nullptr;
 }
 
@@ -341,6 +373,7 @@ File to_file(const Asset& a) {
   }
   for (const Occluder& occ : a.occluders)
     if (a.find_object(occ.name) == nullptr) add_occluder(f, occ);
+  for (const Light& l : a.lights) add_light(f, l);
   f.datasets.insert(f.datasets.end(), a.other_reports.begin(), a.other_reports.end());
 
   if (a.scene) f.group_attrs.emplace_back(std::string(N::kScene), attrs_of<SceneInfo>(*a.scene, kSceneFields, a.scene->extra));
@@ -348,6 +381,7 @@ File to_file(const Asset& a) {
     std::vector<Attr> attrs = attrs_of<SceneObject>(o, kObjectFields, o.extra);
     if (!attrs.empty()) f.group_attrs.emplace_back(object_prefix(o.name), std::move(attrs));
   }
+  for (const Light& l : a.lights) f.group_attrs.emplace_back(light_dir(l.name), attrs_of<Light>(l, kLightFields, l.extra));
   f.group_attrs.insert(f.group_attrs.end(), a.group_extras.begin(), a.group_extras.end());
   return f;
 }
@@ -363,7 +397,8 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
   }
   take_attrs<RootInfo>(a.root, kRootFields, root, a.root.extra);
 
-  const std::string objects_dir = cat(N::kObjects, "/"), occluders_dir = cat(N::kOccluders, "/");
+  const std::string objects_dir = cat(N::kObjects, "/"), occluders_dir = cat(N::kOccluders, "/"),
+                    lights_dir = cat(N::kLights, "/");
   std::vector<const Dataset*> reports;
   for (const Dataset& d : f.datasets) {
     const DatasetKind kind = dataset_kind(d.path);
@@ -395,6 +430,16 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
       take_attrs<Occluder>(o, kShellsFields, d.attrs, o.extra);
       break;
     }
+    case DatasetKind::light_vertices:
+    case DatasetKind::light_face_sizes:
+    case DatasetKind::light_face_indices: {
+      const std::string_view rest = after(d.path, lights_dir);
+      Light& l = named(a.lights, rest.substr(0, rest.find('/')));
+      if (kind == DatasetKind::light_vertices) l.vertices = array_of<double>(d);
+      else if (kind == DatasetKind::light_face_sizes) l.face_sizes = array_of<uint32_t>(d);
+      else l.face_indices = array_of<uint32_t>(d);
+      break;
+    }
     case DatasetKind::report: reports.push_back(&d); break;
     case DatasetKind::unknown:
       throw FormatError(file_for_messages.string(), "unknown dataset path '" + d.path + "'");
@@ -407,12 +452,16 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
   }
   for (const auto& [group, attrs] : f.group_attrs) {
     const std::string_view object = after(group, objects_dir);
+    const std::string_view light = after(group, lights_dir);
     if (group == N::kScene) {
       SceneInfo& s = a.scene.emplace();
       take_attrs<SceneInfo>(s, kSceneFields, attrs, s.extra);
     } else if (!object.empty() && object.find('/') == std::string_view::npos) {
       SceneObject& o = named(a.objects, object);
       take_attrs<SceneObject>(o, kObjectFields, attrs, o.extra);
+    } else if (!light.empty() && light.find('/') == std::string_view::npos) {
+      Light& l = named(a.lights, light);
+      take_attrs<Light>(l, kLightFields, attrs, l.extra);
     } else {
       a.group_extras.emplace_back(group, attrs);
     }
@@ -439,6 +488,7 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
   auto by_name = [](const auto& x, const auto& y) { return x.name < y.name; };
   std::sort(a.objects.begin(), a.objects.end(), by_name);
   std::sort(a.occluders.begin(), a.occluders.end(), by_name);
+  std::sort(a.lights.begin(), a.lights.end(), by_name);
   return a;
 }
 

@@ -1,8 +1,9 @@
-// schema.cpp — schema v2 (formats/SCHEMA.md) as code: validate() is the single check that the
+// schema.cpp — schema v3 (formats/SCHEMA.md) as code: validate() is the single check that the
 // writer applies before writing and the reader applies after reading. Names: <formats/names.h>.
 #include <formats/names.h>
 #include <formats/prtfile.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -84,15 +85,18 @@ std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
   return shape_str(idx);
 }
 
-// The dataset paths schema v2 allows, for messages.
+// The dataset paths schema v3 allows, for messages.
 std::string allowed_paths() {
   std::string s;
   for (std::string_view p : {N::kPositions, N::kNormals, N::kTriangles, N::kSourcePosition, N::kAo,
-                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1})
+                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1, N::kAreaIrradiance,
+                             N::kAreaSh})
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
          std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
-         std::string(N::kShells) + "," + std::string(N::kValid) + "} and anything under " +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "}, " + std::string(N::kLights) + "/<name>/{" +
+         std::string(N::kLightVertices) + "," + std::string(N::kLightFaceSizes) + "," +
+         std::string(N::kLightFaceIndices) + "} and anything under " +
          std::string(N::kReport) + "/";
 }
 
@@ -177,7 +181,8 @@ public:
         {N::kPositions, Kind::positions},           {N::kNormals, Kind::normals},
         {N::kTriangles, Kind::triangles},           {N::kSourcePosition, Kind::source_position},
         {N::kAo, Kind::ao},                         {N::kTransferDiffuse, Kind::transfer_diffuse},
-        {N::kTransferVisibility, Kind::transfer_visibility}, {N::kRadianceBand1, Kind::radiance_band1}};
+        {N::kTransferVisibility, Kind::transfer_visibility}, {N::kRadianceBand1, Kind::radiance_band1},
+        {N::kAreaIrradiance, Kind::area_irradiance}, {N::kAreaSh, Kind::area_sh}};
     for (const auto& [name, kind] : kVertexSet)
       if (local == name) return kind;
     if (object) return Kind::unknown;
@@ -186,6 +191,11 @@ public:
     if (path.starts_with(occluders) && p.size() == split_path(N::kOccluders).size() + 2) {
       if (p.back() == N::kShells) return Kind::occluder_shells;
       if (p.back() == N::kValid) return Kind::occluder_valid;
+    }
+    if (path.starts_with(std::string(N::kLights) + "/") && p.size() == split_path(N::kLights).size() + 2) {
+      if (p.back() == N::kLightVertices) return Kind::light_vertices;
+      if (p.back() == N::kLightFaceSizes) return Kind::light_face_sizes;
+      if (p.back() == N::kLightFaceIndices) return Kind::light_face_indices;
     }
     return Kind::unknown;
   }
@@ -203,10 +213,113 @@ public:
            " = " + shape_str(want));
   }
 
+  // The integer attribute sh_order (number of bands L) of `d`, in 1..65535.
+  uint64_t sh_order(const Dataset& d) const {
+    const std::string sh_order(N::kShOrder);
+    const Attr* a = find_attr(d.attrs, sh_order);
+    const auto* L = a ? std::get_if<int64_t>(&a->value) : nullptr;
+    if (L == nullptr)
+      fail("dataset '" + d.path + "' lacks the integer attribute '" + sh_order + "' (number of bands L)");
+    if (*L < 1 || *L > 65535)
+      fail("dataset '" + d.path + "' has " + sh_order + " " + std::to_string(*L) +
+           "; the number of bands must be in 1..65535");
+    return static_cast<uint64_t>(*L);
+  }
+
+  // The lights an area-light dataset names (its `lights` attribute): at least one, each once,
+  // each one of the file's /lights.
+  std::vector<std::string> light_list(const Dataset& d, const std::set<std::string>& lights) const {
+    const std::string attr(N::kLightOrder);
+    const Attr* a = find_attr(d.attrs, attr);
+    const auto* list = a ? std::get_if<std::string>(&a->value) : nullptr;
+    if (list == nullptr)
+      fail("dataset '" + d.path + "' lacks the string attribute '" + attr + "' (its lights' names, one per line)");
+    const std::vector<std::string> names = split_light_list(*list);
+    if (names.empty()) fail("dataset '" + d.path + "' names no light in its attribute '" + attr + "'");
+    std::set<std::string_view> seen;
+    for (const std::string& name : names) {
+      if (!lights.count(name))
+        fail("dataset '" + d.path + "' names light '" + name + "', which is not in " + std::string(N::kLights));
+      if (!seen.insert(name).second) fail("dataset '" + d.path + "' names light '" + name + "' twice");
+    }
+    return names;
+  }
+
+  // The file's area lights (/lights/<name>): each with its three datasets, faces indexing its
+  // vertices, and its group's shape, radiance and two_sided. Returns their names.
+  std::set<std::string> lights(const File& file, const std::set<std::string_view>& paths, int64_t version) const {
+    std::set<std::string> names;
+    const std::string dir = std::string(N::kLights) + "/";
+    for (const Dataset& d : file.datasets)
+      if (d.path.starts_with(dir)) names.insert(d.path.substr(dir.size(), d.path.find('/', dir.size()) - dir.size()));
+    for (const auto& [g, list] : file.group_attrs)
+      if (g.starts_with(dir) && g.find('/', dir.size()) == std::string::npos && !names.count(g.substr(dir.size())))
+        fail("group '" + g + "' has no '" + std::string(N::kLightVertices) + "' dataset: a light needs its geometry");
+    if (!names.empty() && version < 3)
+      fail("the file has " + std::string(N::kLights) + ", which needs format_version 3");
+    for (const std::string& name : names) {
+      const std::string g = dir + name;
+      for (std::string_view leaf : {N::kLightVertices, N::kLightFaceSizes, N::kLightFaceIndices})
+        if (!paths.count(g + "/" + std::string(leaf)))
+          fail("light '" + g + "' lacks the dataset '" + std::string(leaf) + "'");
+      const Dataset& vertices = *find_dataset(file, g + "/" + std::string(N::kLightVertices));
+      const Dataset& sizes = *find_dataset(file, g + "/" + std::string(N::kLightFaceSizes));
+      const Dataset& indices = *find_dataset(file, g + "/" + std::string(N::kLightFaceIndices));
+      if (vertices.shape.empty() || sizes.data.index() != 1 || indices.data.index() != 1) continue;  // the dataset rules say why
+      uint64_t total = 0;
+      for (uint32_t size : std::get<std::vector<uint32_t>>(sizes.data)) {
+        if (size < 3) fail("dataset '" + sizes.path + "' has a face of " + std::to_string(size) + " vertices; a face has >= 3");
+        total += size;
+      }
+      if (total != element_count(indices.data))
+        fail("dataset '" + indices.path + "' has " + std::to_string(element_count(indices.data)) +
+             " indices but the face sizes add up to " + std::to_string(total));
+      for (uint32_t i : std::get<std::vector<uint32_t>>(indices.data))
+        if (i >= vertices.shape[0])
+          fail("dataset '" + indices.path + "' has vertex index " + std::to_string(i) + " >= N = " +
+               std::to_string(vertices.shape[0]));
+      const std::vector<Attr>* attrs = find_group_attrs(file, g);
+      if (attrs == nullptr) fail("light '" + g + "' lacks its attributes (shape, radiance, two_sided)");
+      if (required_string(*attrs, N::kShape, "group '" + g + "'").empty())
+        fail("attribute '" + std::string(N::kShape) + "' of group '" + g + "' is empty");
+      const Attr* radiance = find_attr(*attrs, N::kRadiance);
+      const auto* rgb = radiance ? std::get_if<std::vector<double>>(&radiance->value) : nullptr;
+      if (rgb == nullptr || rgb->size() != 3 || !std::all_of(rgb->begin(), rgb->end(), [](double x) { return x >= 0; }))
+        fail("group '" + g + "' needs attribute '" + std::string(N::kRadiance) + "': 3 doubles >= 0 (RGB)");
+      const Attr* two = find_attr(*attrs, N::kTwoSided);
+      const auto* t = two ? std::get_if<int64_t>(&two->value) : nullptr;
+      if (t == nullptr || (*t != 0 && *t != 1))
+        fail("group '" + g + "' needs attribute '" + std::string(N::kTwoSided) + "': the integer 0 or 1");
+    }
+    return names;
+  }
+
   const std::string file_;
 };
 
+bool is_area_light_kind(Kind k) {
+  return k == Kind::area_irradiance || k == Kind::area_sh || k == Kind::light_vertices || k == Kind::light_face_sizes ||
+         k == Kind::light_face_indices;
+}
+
 } // namespace
+
+std::vector<std::string> split_light_list(std::string_view list) {
+  std::vector<std::string> out;
+  if (list.empty()) return out;
+  for (std::size_t i = 0;;) {
+    const std::size_t j = list.find('\n', i);
+    out.emplace_back(list.substr(i, j == std::string_view::npos ? std::string_view::npos : j - i));
+    if (j == std::string_view::npos) return out;
+    i = j + 1;
+  }
+}
+
+std::string join_light_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (std::size_t i = 0; i < names.size(); ++i) s += (i ? "\n" : "") + names[i];
+  return s;
+}
 
 DatasetKind dataset_kind(std::string_view path) {
   return path.size() >= 2 && path[0] == '/' ? Checker::classify(path) : Kind::unknown;
@@ -218,6 +331,7 @@ bool is_per_vertex_path(std::string_view path) {
   switch (Checker::classify(path, &prefix)) {
   case Kind::positions: case Kind::normals: case Kind::source_position: case Kind::ao:
   case Kind::transfer_diffuse: case Kind::transfer_visibility: case Kind::radiance_band1:
+  case Kind::area_irradiance: case Kind::area_sh:
     return true;
   default:
     return false;
@@ -255,6 +369,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.fail("unknown dataset path '" + d.path + "' (schema v2 allows " + allowed_paths() + ")");
     if (!prefix.empty() && version < 2)
       c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
+             std::to_string(version) + ")");
+    if (is_area_light_kind(k) && version < 3)
+      c.fail("dataset '" + d.path + "' is an area light's, which needs format_version 3 (the file says " +
              std::to_string(version) + ")");
     kinds.push_back(k);
     prefixes.push_back(std::move(prefix));
@@ -306,6 +423,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     v.has_normals = find_dataset(file, prefix + std::string(N::kNormals)) != nullptr;
     return v;
   };
+  const std::set<std::string> light_names = c.lights(file, paths, version);
   std::map<std::string, const Dataset*> shells;  // occluder dir -> shells
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];
@@ -352,18 +470,43 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     case Kind::transfer_diffuse:
     case Kind::transfer_visibility: {
       c.dtype(d, 0);
-      const std::string sh_order(N::kShOrder);
-      const Attr* a = find_attr(d.attrs, sh_order);
-      const auto* L = a ? std::get_if<int64_t>(&a->value) : nullptr;
-      if (L == nullptr)
-        c.fail("dataset '" + d.path + "' lacks the integer attribute '" + sh_order + "' (number of bands L)");
-      if (*L < 1 || *L > 65535)
-        c.fail("dataset '" + d.path + "' has " + sh_order + " " + std::to_string(*L) +
-               "; the number of bands must be in 1..65535");
-      const auto L2 = static_cast<uint64_t>(*L) * static_cast<uint64_t>(*L);
-      c.shape(d, {V, L2}, "[V, L*L] with L = " + sh_order + " = " + std::to_string(*L));
+      const uint64_t L = c.sh_order(d);
+      c.shape(d, {V, L * L}, "[V, L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
       break;
     }
+    case Kind::area_irradiance:
+    case Kind::area_sh: {
+      c.dtype(d, 0);
+      const auto L = uint64_t(c.light_list(d, light_names).size());
+      if (k == Kind::area_irradiance) {
+        c.shape(d, {V, L}, "[V, L] with L = the lights named in '" + std::string(N::kLightOrder) + "'");
+        break;
+      }
+      const uint64_t n = c.sh_order(d);
+      c.shape(d, {V, L, n * n}, "[V, L, n*n] with L = the lights named in '" + std::string(N::kLightOrder) +
+                                    "' and n = " + std::string(N::kShOrder) + " = " + std::to_string(n));
+      const std::string irradiance = prefix + std::string(N::kAreaIrradiance);
+      const Dataset* e = find_dataset(file, irradiance);
+      const Attr* mine = find_attr(d.attrs, N::kLightOrder);
+      const Attr* its = e ? find_attr(e->attrs, N::kLightOrder) : nullptr;
+      if (its == nullptr || its->value != mine->value)
+        c.fail("dataset '" + d.path + "' needs '" + irradiance + "' beside it, naming the same lights in the same order");
+      break;
+    }
+    case Kind::light_vertices:
+      c.dtype(d, 3);
+      if (d.shape.size() != 2 || d.shape[1] != 3 || d.shape[0] < 3)
+        c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [N, 3] with N >= 3");
+      break;
+    case Kind::light_face_sizes:
+      c.dtype(d, 1);
+      if (d.shape.size() != 1 || d.shape[0] == 0)
+        c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [F] with F >= 1");
+      break;
+    case Kind::light_face_indices:
+      c.dtype(d, 1);
+      if (d.shape.size() != 1) c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [K]");
+      break;
     case Kind::radiance_band1:
       c.dtype(d, 0);
       c.shape(d, {V, 3, 3}, "[V, 3 (RGB), 3 (m = -1, 0, 1)]");
@@ -424,7 +567,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i)
     if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer_diffuse || kinds[i] == Kind::transfer_visibility ||
-         kinds[i] == Kind::radiance_band1) &&
+         kinds[i] == Kind::radiance_band1 || kinds[i] == Kind::area_irradiance || kinds[i] == Kind::area_sh) &&
         !vertex_set(prefixes[i]).has_normals)
       c.fail("dataset '" + file.datasets[i].path + "' needs " + prefixes[i] + std::string(N::kNormals) +
              " (the normals the bake used)");
@@ -440,25 +583,31 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       if (!valid_component(part))
         c.fail("group path '" + g + "' has an invalid component '" + std::string(part) + "'");
     auto product_group = [](std::string_view x) {
-      return x == N::kMeshGroup || x == N::kTransferGroup || x == N::kRadianceGroup;
+      return x == N::kMeshGroup || x == N::kTransferGroup || x == N::kRadianceGroup || x == N::kAreaLightsGroup;
     };
     auto under = [&group = g](std::string_view dir) { return group.starts_with(std::string(dir) + "/"); };
     const bool object = g == N::kObjects || under(N::kObjects);
+    const bool light = g == N::kLights || under(N::kLights);
     const bool ok = product_group(g) || g == N::kFivGroup || g == N::kScene || g == N::kObjects ||
+                    (light && parts.size() <= 2) ||
                     g == N::kOccluders || (parts.size() == 3 && under(N::kOccluders)) ||
                     (object && parts.size() == 2) ||
                     (object && parts.size() == 3 && product_group("/" + std::string(parts[2]))) ||
                     g == N::kReport || under(N::kReport);
     if (!ok)
-      c.fail("attributes on group '" + g + "' are not allowed (schema v2 allows them on " +
+      c.fail("attributes on group '" + g + "' are not allowed (schema v3 allows them on " +
              std::string(N::kMeshGroup) + ", " + std::string(N::kTransferGroup) + ", " +
-             std::string(N::kRadianceGroup) + ", " + std::string(N::kScene) + ", " + std::string(N::kObjects) +
-             ", " + std::string(N::kObjects) + "/<name>[" + std::string(N::kMeshGroup) + "|" +
-             std::string(N::kTransferGroup) + "|" + std::string(N::kRadianceGroup) + "], " +
+             std::string(N::kRadianceGroup) + ", " + std::string(N::kAreaLightsGroup) + ", " + std::string(N::kScene) +
+             ", " + std::string(N::kObjects) + ", " + std::string(N::kObjects) + "/<name>[" +
+             std::string(N::kMeshGroup) + "|" + std::string(N::kTransferGroup) + "|" + std::string(N::kRadianceGroup) +
+             "|" + std::string(N::kAreaLightsGroup) + "], " + std::string(N::kLights) + ", " +
+             std::string(N::kLights) + "/<name>, " +
              std::string(N::kFivGroup) + ", " + std::string(N::kOccluders) + ", " + std::string(N::kOccluders) +
              "/<name> and " + std::string(N::kReport) + "...)");
     if (object && version < 2)
       c.fail("group '" + g + "' is a scene object's, which needs format_version 2");
+    if ((light || g.ends_with(N::kAreaLightsGroup)) && version < 3)
+      c.fail("group '" + g + "' is an area light's, which needs format_version 3");
     if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");
     if (paths.count(g)) c.fail("group '" + g + "' is also a dataset path");
     for (std::size_t slash = g.find('/', 1); slash != std::string::npos;

@@ -197,6 +197,13 @@ private:
 
 constexpr double kHuge = 1e30;
 
+// "rotate": [rx, ry, rz] in radians, about X, then Y, then Z.
+Eigen::Matrix3d rotation_xyz(const Eigen::Vector3d& r) {
+  return (Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
 // An object's "transform" (translate/rotate/scale or matrix): its world_from_object matrix.
 Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::string& key) {
   r.object(v, key, {"translate", "rotate", "scale", "matrix"});
@@ -227,9 +234,7 @@ Eigen::Matrix4d parse_transform(const Reader& r, const Json& v, const std::strin
         s = Eigen::Vector3d(a[0], a[1], a[2]);
       }
     }
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(rot.z(), Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(rot.y(), Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(rot.x(), Eigen::Vector3d::UnitX())).toRotationMatrix();
+    const Eigen::Matrix3d R = rotation_xyz(rot);
     M.topLeftCorner<3, 3>() = R * s.asDiagonal();
     M.topRightCorner<3, 1>() = t;
   }
@@ -369,14 +374,113 @@ Material parse_material(const Reader& r, const Json& m, const std::string& key, 
   return material;
 }
 
+// "lights" (bake/lights.h shapes): every light validated, names unique ("light<i>" by default).
+std::vector<AreaLight> parse_lights(const Reader& r, const Json& v, const std::string& file) {
+  if (!v.is_array()) r.fail("lights must be an array of light objects");
+  std::vector<AreaLight> out;
+  std::set<std::string> names;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const Json& l = v[i];
+    const std::string key = "lights[" + std::to_string(i) + "]";
+    if (!l.is_object()) r.fail(key + " must be an object, not " + l.type_name());
+    const Json* shape = find_key(l, "shape");
+    if (shape == nullptr) r.fail(key + " lacks \"shape\": quad, polygon, disc, box, cylinder or sphere");
+    const std::string& kind = r.string(*shape, key + ".shape");
+    auto need = [&](const char* member) -> const Json& {
+      const Json* x = find_key(l, member);
+      if (x == nullptr) r.fail(key + " (" + kind + ") lacks \"" + member + "\"");
+      return *x;
+    };
+    auto point = [&](const char* member) {
+      const auto a = r.vec3(need(member), key + "." + member, -kHuge, kHuge);
+      return Eigen::Vector3d(a[0], a[1], a[2]);
+    };
+    auto positive = [&](const char* member) {
+      const double x = r.number(need(member), key + "." + member, 0, kHuge);
+      if (!(x > 0)) r.fail(key + "." + member + " must be > 0");
+      return x;
+    };
+    auto count = [&](const char* member, int64_t lo, int64_t hi, int64_t fallback) {
+      const Json* x = find_key(l, member);
+      return x ? int(r.integer(*x, key + "." + member, lo, hi)) : int(fallback);
+    };
+    auto rotation = [&] {
+      Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+      if (const Json* x = find_key(l, "rotate")) {
+        const auto a = r.vec3(*x, key + ".rotate", -36000, 36000);
+        R = rotation_xyz(Eigen::Vector3d(a[0], a[1], a[2]) * (std::numbers::pi / 180));
+      }
+      return R;
+    };
+    const std::initializer_list<std::string_view> common = {"name", "shape", "radiance", "two_sided"};
+    auto allow = [&](std::initializer_list<std::string_view> own) {
+      std::vector<std::string_view> all(common);
+      all.insert(all.end(), own.begin(), own.end());
+      for (const auto& [k, member] : l.items())
+        if (std::find(all.begin(), all.end(), k) == all.end()) {
+          std::string list;
+          for (std::string_view a : all) list += (list.empty() ? "" : ", ") + std::string(a);
+          r.fail("unknown key \"" + k + "\" in " + key + " (a " + kind + " light takes " + list + ")");
+        }
+    };
+    AreaLight light;
+    if (kind == "quad") {
+      allow({"centre", "u", "v"});
+      light = make_quad_light(point("centre"), point("u"), point("v"));
+    } else if (kind == "polygon") {
+      allow({"vertices"});
+      const Json& vs = need("vertices");
+      if (!vs.is_array() || vs.size() < 3 || vs.size() > size_t(kMaxSegments))
+        r.fail(key + ".vertices must be an array of 3 to " + std::to_string(kMaxSegments) + " points [x, y, z]");
+      std::vector<Eigen::Vector3d> corners;
+      for (size_t k = 0; k < vs.size(); ++k) {
+        const auto a = r.vec3(vs[k], key + ".vertices[" + std::to_string(k) + "]", -kHuge, kHuge);
+        corners.emplace_back(a[0], a[1], a[2]);
+      }
+      light = make_polygon_light(std::move(corners));
+    } else if (kind == "disc") {
+      allow({"centre", "normal", "radius", "segments"});
+      const Eigen::Vector3d n = point("normal");
+      if (!(n.norm() > 0)) r.fail(key + ".normal must not be zero");
+      light = make_disc_light(point("centre"), n, positive("radius"), count("segments", kMinSegments, kMaxSegments, 64));
+    } else if (kind == "box") {
+      allow({"centre", "size", "rotate"});
+      const Eigen::Vector3d size = point("size");
+      if (!(size.minCoeff() > 0)) r.fail(key + ".size must be > 0 in every axis");
+      light = make_box_light(point("centre"), size, rotation());
+    } else if (kind == "cylinder") {
+      allow({"centre", "radius", "height", "segments", "rotate"});
+      light = make_cylinder_light(point("centre"), positive("radius"), positive("height"),
+                                  count("segments", kMinSegments, kMaxSegments, 64), rotation());
+    } else if (kind == "sphere") {
+      allow({"centre", "radius", "subdivisions"});
+      light = make_sphere_light(point("centre"), positive("radius"), count("subdivisions", 0, kMaxSphereSubdivisions, 3));
+    } else {
+      r.fail(key + ".shape must be quad, polygon, disc, box, cylinder or sphere, not \"" + kind + "\"");
+    }
+    light.radiance = r.vec3(need("radiance"), key + ".radiance", 0, kHuge);
+    if (const Json* x = find_key(l, "two_sided")) light.two_sided = r.boolean(*x, key + ".two_sided");
+    light.name = "light" + std::to_string(i);
+    if (const Json* n = find_key(l, "name")) {
+      light.name = r.string(*n, key + ".name");
+      if (!valid_name(light.name)) r.fail(key + ".name \"" + light.name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
+    }
+    if (!names.insert(light.name).second) r.fail(key + ": the name \"" + light.name + "\" is already used by another light");
+    validate_light(light, file, key);
+    out.push_back(std::move(light));
+  }
+  return out;
+}
+
 SceneDescription load_json_scene(const std::filesystem::path& file) {
   const Json root = parse_json_file(file);
   const Reader r(file.string());
-  r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "objects"});
+  r.object(root, "the scene", {"prtbake_scene", "up", "environment", "bake", "lights", "objects"});
   SceneDescription sc;
   sc.file = file;
   check_version(r, root, "prtbake_scene", "the scene", "scene-file");
   parse_settings(r, root, file, sc);
+  if (const Json* lights = find_key(root, "lights")) sc.lights = parse_lights(r, *lights, file.string());
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) r.fail("the scene lacks \"objects\" (an array of one or more objects)");
   if (!objects->is_array() || objects->empty()) r.fail("objects must be a non-empty array");
@@ -431,9 +535,10 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   if (!options) return sc;
   const Json root = parse_json_file(*options);
   const Reader r(options->string());
-  r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "objects"});
+  r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "lights", "objects"});
   check_version(r, root, "prtbake_gltf_scene", "the scene options", "options-file");
   parse_settings(r, root, *options, sc);
+  if (const Json* lights = find_key(root, "lights")) sc.lights = parse_lights(r, *lights, options->string());
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) return sc;
   if (!objects->is_object()) r.fail(std::string("objects must be an object {\"<node path>\": {\"role\": ..., \"material\": ...}}, not ") + objects->type_name());
@@ -604,6 +709,12 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
       if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
       else p.left_out.push_back("ao: not in bake.products");
       const Material& m = o.material;
+      if (!scene.lights.empty()) {
+        p.area_irradiance = true;
+        p.baked.push_back("area_lights/irradiance: " + std::to_string(scene.lights.size()) +
+                          " area light(s), exact soft shadows (paper 003)");
+        if (!m.glossy()) p.left_out.push_back("area_lights/sh: no glossy lobe (irradiance is exact for a diffuse receiver)");
+      }
       if (m.diffuse()) {
         if (!scene.want_radiance) p.left_out.push_back("radiance/band1: not in bake.products");
         else if (!env) p.left_out.push_back("radiance/band1: the scene has no environment");
@@ -627,6 +738,8 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
       if (m.glossy()) {
         if (!scene.want_transfer) {
           p.left_out.push_back("transfer/visibility: not in bake.products");
+          if (!scene.lights.empty())
+            p.left_out.push_back("area_lights/sh: transfer/visibility is not baked (not in bake.products)");
         } else {
           const int L = clamped_power_order(m.phong_exponent, scene.sh_tolerance, sh::kMaxOrder);
           if (L == 0) {
@@ -643,6 +756,10 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
              << ", the smallest whose lobe energy beyond it (" << pct(clamped_power_energy_beyond(m.phong_exponent, L))
              << ") is <= sh_tolerance " << pct(scene.sh_tolerance);
           p.baked.push_back(os.str());
+          if (!scene.lights.empty()) {
+            p.area_sh_order = L;
+            p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
+          }
         }
       }
     }

@@ -1,9 +1,15 @@
 // scene_bake.cpp — runs a scene plan (bake/scene.h): the receivers' per-vertex products against
-// the union of the occluders, then FIV shells per occluder that needs them.
+// the union of the occluders and the area lights' rows, then FIV shells per occluder that needs them.
+#include <bake/area_bake.h>
 #include <bake/error.h>
 #include <bake/scene.h>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <tuple>
@@ -20,6 +26,26 @@ std::string printf_string(const char* f, double a, double b = 0) {
   char buf[160];
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
+}
+
+// The area lights' rows of every point ([point][integ.width()]), in parallel; each row depends
+// on its point only, so any thread count gives the same numbers.
+std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const AreaLightIntegrator& integ,
+                                     const Monitor& monitor, const std::string& label) {
+  const size_t W = integ.width();
+  std::vector<double> out(points.size() * W, 0.0);
+  Task progress(monitor, label, points.size());
+  tbb::enumerable_thread_specific<AreaLightIntegrator::Workspace> workspaces;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+    AreaLightIntegrator::Workspace& ws = workspaces.local();
+    for (size_t v = r.begin(); v != r.end(); ++v) integ.integrate(points[v], std::span(out).subspan(v * W, W), ws);
+    progress.advance(r.size());
+  });
+  progress.finish();
+  for (size_t k = 0; k < out.size(); ++k)
+    if (!std::isfinite(out[k]))
+      throw ContractError("bake_area_lights: non-finite value at vertex " + std::to_string(k / W) + " (" + label + ")");
+  return out;
 }
 
 } // namespace
@@ -44,6 +70,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
   Mesh occluders;  // empty when nothing casts shadows: every receiver point is then unoccluded
   if (!parts.empty()) occluders = merge_meshes(parts, "occluders");
+  else if (!meshes.empty()) occluders.origin = meshes[0].origin;  // the scene's frame (scene_origin), for the lights
   parts.clear();
   const Topology topo = build_topology(occluders);
   // The union's trees, built once for every integrator, pilot and reference below (bake/accel.h).
@@ -72,12 +99,18 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (scene.integrator.report_points > 0) ref = make_reference(scene.integrator, occluders, topo, r, &accel);
     integrators.emplace(key, std::make_pair(std::move(integ), std::move(ref)));
   }
+  // One area-light integrator per SH order the receivers need (the lights moved into the
+  // occluders' frame once).
+  std::map<int, std::unique_ptr<AreaLightIntegrator>> area_integrators;
+  for (const ObjectPlan& p : plan.objects)
+    if (p.receiver && p.area_irradiance && !area_integrators.count(p.area_sh_order))
+      area_integrators.emplace(p.area_sh_order, std::make_unique<AreaLightIntegrator>(scene.lights, occluders, p.area_sh_order));
   out.setup_seconds = seconds_since(t_setup);
 
   // ---- receivers ----
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
-    if (!p.receiver || !p.any_vertex_product()) continue;
+    if (!p.receiver || (!p.any_vertex_product() && !p.area_irradiance)) continue;
     const Mesh& m = meshes[i];
     const ProductRequest r = request_of(p);
     std::vector<ShadePoint> points(m.positions.size());
@@ -90,6 +123,17 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       }
     }
     ObjectBake& ob = out.objects[i];
+    if (p.area_irradiance) {
+      const auto t0 = std::chrono::steady_clock::now();
+      ob.area = bake_area_lights(points, *area_integrators.at(p.area_sh_order), monitor,
+                                 "area lights on " + scene.objects[i].name);
+      ob.area_seconds = seconds_since(t0);
+      out.area_seconds += ob.area_seconds;
+      log(scene.objects[i].name + ": " + std::to_string(scene.lights.size()) + " area light(s) at " +
+          std::to_string(points.size()) + " vertices in " + printf_string("%.2f s", ob.area_seconds) +
+          (p.area_sh_order > 0 ? ", SH order " + std::to_string(p.area_sh_order) : std::string()));
+    }
+    if (!p.any_vertex_product()) continue;
     ob.integrator = scene.integrator;
     std::unique_ptr<Integrator> own_integ, own_ref;  // with a target: this object's
     if (choose) {

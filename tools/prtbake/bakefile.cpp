@@ -21,6 +21,9 @@ std::string report_row_name(bake::Product product) {
   return std::string(path.substr(1));
 }
 
+// The visibility convention of every per-vertex product.
+constexpr const char* kVisibilityLimit = "limit from just above the surface (p + eps*n, eps -> 0+)";
+
 std::vector<float> to_float(std::span<const double> src, size_t stride, size_t offset, size_t count) {
   const size_t rows = stride ? src.size() / stride : 0;
   std::vector<float> out(rows * count);
@@ -86,7 +89,7 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
     p.integrator_description = info.integrator_description;
     p.samples = int64_t(info.samples);
     p.seed = int64_t(info.seed);
-    p.visibility = "limit from just above the surface (p + eps*n, eps -> 0+)";
+    p.visibility = kVisibilityLimit;
     return p;
   };
   if (L.ao_count) set.ao = product(L.ao, 1, "A = (1/pi) Int V H (n.w) dw");
@@ -107,6 +110,44 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
     p.environment_sha256 = i.sha256;
     p.environment_layout = i.layout;
     p.negative_pixels_clamped = int64_t(i.negative_pixels_clamped);
+  }
+}
+
+F::Light light_of(const bake::AreaLight& light) {
+  F::Light l;
+  l.name = light.name;
+  l.shape = bake::light_shape_name(light.shape);
+  l.radiance = light.radiance;
+  l.two_sided = int64_t(light.two_sided);
+  for (const Eigen::Vector3d& v : light.vertices) l.vertices.values.insert(l.vertices.values.end(), {v.x(), v.y(), v.z()});
+  for (const auto& face : light.faces) {
+    l.face_sizes.values.push_back(uint32_t(face.size()));
+    l.face_indices.values.insert(l.face_indices.values.end(), face.begin(), face.end());
+  }
+  return l;
+}
+
+void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
+                     int sh_order) {
+  const size_t n2 = size_t(sh_order) * size_t(sh_order), per_light = 1 + n2;
+  std::vector<std::string> names;
+  for (const bake::AreaLight& l : lights) names.push_back(l.name);
+  auto product = [&](size_t offset, size_t count, std::string integrand) {
+    F::Product p;
+    p.values.reserve(rows.size() / per_light * count);
+    for (size_t row = 0; row < rows.size(); row += per_light)
+      for (size_t c = 0; c < count; ++c) p.values.push_back(float(rows[row + offset + c]));
+    p.integrand = std::move(integrand);
+    p.integrator = "area lights: exact visible polygons (paper 003)";
+    p.visibility = kVisibilityLimit;
+    p.lights = F::join_light_list(names);
+    return p;
+  };
+  set.area_irradiance = product(0, 1, "E_l = Int_{visible part of light l} max(n.w, 0) dw at unit radiance; diffuse "
+                                      "outgoing radiance = albedo/pi sum_l radiance_l E_l");
+  if (sh_order > 0) {
+    set.area_sh = product(1, n2, "S_l,i = Int_{visible part of light l above the horizon} y_i(w) dw at unit radiance");
+    set.area_sh->sh_order = sh_order;
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <bake/envmap.h>
 #include <bake/fiv.h>
+#include <bake/lights.h>
 #include <bake/mesh.h>
 #include <bake/vertex_bake.h>
 #include <formats/asset.h>
@@ -30,6 +31,13 @@ struct ProductInfo {
 };
 // ao, transfer_diffuse, transfer_visibility, radiance_band1: whatever the layout holds.
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info);
+
+// An area light as the file stores it (/lights/<name>: world-space faces, radiance, two_sided).
+F::Light light_of(const bake::AreaLight& light);
+// area_lights/irradiance [V][lights] and, when sh_order > 0, area_lights/sh [V][lights][n²] from
+// AreaLightIntegrator rows ([V][lights][1 + n²], bake/area_bake.h); `lights` in column order.
+void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
+                     int sh_order);
 
 // The error report of a vertex bake: one row per product (rmse, max_abs, reference_rms,
 // bake_std_error, reference_std_error) and the vertices compared. Wall times are kept unless

@@ -718,6 +718,9 @@ int run_scene(const Args& a) {
       for (const auto& b : plan.objects[i].baked) std::printf("      bake       %s\n", b.c_str());
       for (const auto& l : plan.objects[i].left_out) std::printf("      leave out  %s\n", l.c_str());
     }
+    for (const auto& l : scene.lights)
+      std::printf("  light %s (%s): %zu face(s), radiance %g %g %g%s\n", l.name.c_str(), bake::light_shape_name(l.shape),
+                  l.faces.size(), l.radiance[0], l.radiance[1], l.radiance[2], l.two_sided ? ", two-sided" : "");
     for (const auto& n : plan.notes) std::printf("  %s\n", n.c_str());
     std::fflush(stdout);
   }
@@ -799,12 +802,14 @@ int run_scene(const Args& a) {
       if (ob.report)
         obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
     }
+    if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
     if (ob.shells) {
       F::Occluder& occluder =
           asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
       if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
     }
   }
+  for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
   if (plan.fiv_environment)
     tool::set_fiv_environment(asset, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
   write_file(a, asset);

@@ -1,5 +1,5 @@
 // prtdump — inspect a baked file: root attributes, layout, the scene plan, the error report,
-// per-dataset statistics, one vertex, or the same as JSON. A thin shell: formats/ reads the file
+// per-dataset statistics, the area lights, one vertex, or the same as JSON. A thin shell: formats/ reads the file
 // (formats::inspect_asset: the file as stored, and its typed asset when it passes the schema);
 // this file only computes summary statistics and prints. Command line: CLI11; JSON:
 // nlohmann-json; exit codes: tools/common (docs/ARCHITECTURE.md §6).
@@ -56,6 +56,10 @@ What the summary shows:
                    Attributes another tool added (e.g. with h5py) are shown with the rest.
   Scene            for scene files (prtbake scene): each object's role and what the bake
                    baked and left out, with the reasons.
+  Area lights      for files with area lights (format_version 3): each light's shape, faces,
+                   radiance and sides, and per vertex set the irradiance E at unit radiance
+                   each light gives (min, max, mean over the vertices; area_lights/irradiance
+                   [V, L], its columns in the order its 'lights' attribute lists).
   Error report     per product: RMSE and max error against the converged reference, the
                    reference's own standard error, bake and reference wall times.
   Group attributes attributes on groups such as /scene and /objects/<name>.
@@ -269,6 +273,33 @@ void scene_text(std::ostream& os, const pf::Asset& a) {
   }
 }
 
+// The area lights, and the irradiance each gives every vertex set that receives them.
+void lights_text(std::ostream& os, const pf::Asset& a) {
+  if (a.lights.empty()) return;
+  os << "\nArea lights (world space; E at unit radiance per vertex set: min, max, mean)\n";
+  std::size_t w = 0;
+  for (const pf::Light& l : a.lights) w = std::max(w, l.name.size());
+  for (const pf::Light& l : a.lights)
+    os << "  " << pad(l.name, w + 2) << l.shape << ", " << l.face_sizes.values.size() << " face(s), "
+       << l.vertices.values.size() / 3 << " vertices, radiance [" << num(l.radiance[0]) << ", " << num(l.radiance[1])
+       << ", " << num(l.radiance[2]) << "], " << (l.two_sided.value_or(0) ? "two-sided" : "one-sided") << '\n';
+  auto set_lines = [&](const std::string& where, const pf::VertexSet& set) {
+    if (!set.area_irradiance || !set.area_irradiance->lights) return;
+    const std::vector<std::string> order = pf::split_light_list(*set.area_irradiance->lights);
+    const std::vector<float>& E = set.area_irradiance->values;
+    os << "  " << where << (set.area_sh ? " (and SH at order " + std::to_string(set.area_sh->sh_order.value_or(0)) + ")" : "")
+       << '\n';
+    for (std::size_t c = 0; c < order.size(); ++c) {
+      Stats st;
+      for (std::size_t i = c; i < E.size(); i += order.size()) st.add(E[i]);
+      os << "      " << pad(order[c], w + 2) << "E min " << num(float(st.min)) << "  max " << num(float(st.max))
+         << "  mean " << (st.mean() ? num(*st.mean()) : std::string("-")) << '\n';
+    }
+  };
+  set_lines("/", a.vertices);
+  for (const pf::SceneObject& o : a.objects) set_lines(std::string(names::kObjects) + "/" + o.name, o.set);
+}
+
 // Every error-report row of the asset, labelled by its path under /report, in path order.
 std::vector<std::pair<std::string, const pf::ReportRow*>> report_rows(const pf::Asset& a) {
   std::vector<std::pair<std::string, const pf::ReportRow*>> rows;
@@ -332,6 +363,7 @@ void summary_text(std::ostream& os, const std::string& path, const pf::Inspectio
   }
   if (in.asset) {
     scene_text(os, *in.asset);
+    lights_text(os, *in.asset);
     report_text(os, *in.asset);
   }
   if (!f.group_attrs.empty()) {

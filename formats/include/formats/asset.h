@@ -1,6 +1,6 @@
 // formats/asset.h — the typed asset model: plain structs that describe a baked file (vertex sets
 // and their products, FIV environment data and occluders, the scene and its objects, error
-// reports, the root attributes) and write_asset / read_asset. Every path and attribute name
+// reports, the area lights, the root attributes) and write_asset / read_asset. Every path and attribute name
 // lives in <formats/names.h>; the schema is formats/SCHEMA.md (docs/ARCHITECTURE.md §5).
 //
 // Contract
@@ -8,7 +8,7 @@
 //     write_file: the schema check, temp file + rename and deterministic bytes of prtfile.h.
 //     Datasets are written in a fixed order (root vertex set and its report; then each scene
 //     object with its report, the occluder of the same name and that occluder's report; then
-//     the FIV environment; then the other occluders; then other /report datasets), attributes
+//     the FIV environment; then the other occluders; then the lights; then other /report datasets), attributes
 //     in the order of the field tables in asset.cpp followed by the extra attributes.
 //   * read_asset(path) reads with read_file (full schema check) and converts (to_asset).
 //     read_asset(write_asset(a)) == a for every field (std::optional: absent stays absent).
@@ -57,7 +57,9 @@ struct Normals {
 };
 
 // A baked per-vertex product: /ao [V], /transfer/diffuse and /transfer/visibility [V][L*L]
-// (sh_order = L, required there), /radiance/band1 [V][RGB][m = -1, 0, 1] (environment fields).
+// (sh_order = L, required there), /radiance/band1 [V][RGB][m = -1, 0, 1] (environment fields),
+// /area_lights/irradiance [V][lights] and /area_lights/sh [V][lights][n*n] (sh_order = n; `lights`
+// required there: the lights' names in column order, join_light_list).
 struct Product {
   std::vector<float> values;
   std::optional<std::string> integrand;
@@ -67,6 +69,7 @@ struct Product {
   std::optional<std::string> integrator, integrator_description;
   std::optional<int64_t> samples, seed;  // samples: rays per vertex (qmc) or k (silhouette)
   std::optional<std::string> visibility;  // the visibility convention in words
+  std::optional<std::string> lights;      // area-light products: names::kLightOrder
   ExtraAttrs extra;
   bool operator==(const Product&) const = default;
 };
@@ -103,12 +106,13 @@ struct VertexSet {
   std::optional<Array<uint32_t>> triangles;        // [T][3]
   std::optional<Array<uint32_t>> source_position;  // [V]
   std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1;
+  std::optional<Product> area_irradiance, area_sh;  // v3
   Report report;
 
   std::size_t vertex_count() const noexcept { return positions ? positions->values.size() / 3 : 0; }
   bool empty() const noexcept {
     return !positions && !normals && !triangles && !source_position && !ao && !transfer_diffuse &&
-           !transfer_visibility && !radiance_band1 && report.empty();
+           !transfer_visibility && !radiance_band1 && !area_irradiance && !area_sh && report.empty();
   }
   bool operator==(const VertexSet&) const = default;
 };
@@ -155,6 +159,22 @@ struct Occluder {
   bool operator==(const Occluder&) const = default;
 };
 
+// /lights/<name> (v3): an area light as the bake saw it, in world space, for a runtime to draw
+// and relight: its convex planar faces, counter-clockwise seen from the side they emit to
+// (solids: outwards), as face_sizes [F] and face_indices [sum of sizes] into vertices [N][3]
+// (float64: far from the origin a light keeps its digits); RGB radiance, constant over the
+// surface; two_sided: planar lights emitting from both sides.
+struct Light {
+  std::string name;
+  std::string shape;  // "quad", "polygon", "disc", "box", "cylinder", "sphere"
+  std::array<double, 3> radiance{};
+  std::optional<int64_t> two_sided;  // 0 / 1; required by the schema
+  Array<double> vertices;            // [N][3]
+  Array<uint32_t> face_sizes, face_indices;
+  ExtraAttrs extra;  // of the group
+  bool operator==(const Light&) const = default;
+};
+
 // /scene: the scene-wide settings of a scene file.
 struct SceneInfo {
   std::optional<std::string> scene_file, integrator;
@@ -194,6 +214,7 @@ struct Asset {
   std::optional<FivEnvironment> fiv_environment;
   std::optional<IrradianceCube> irradiance_cube;
   std::vector<Occluder> occluders;  // read back sorted by name
+  std::vector<Light> lights;        // read back sorted by name (the products name their order)
   // Datasets under /report the model does not type (/report is free-form in the schema).
   std::vector<Dataset> other_reports;
   // Attributes of groups without typed attributes (/mesh, /report, /fiv/occluders/<name>, ...).
@@ -201,6 +222,7 @@ struct Asset {
 
   const SceneObject* find_object(std::string_view name) const noexcept;
   const Occluder* find_occluder(std::string_view name) const noexcept;
+  const Light* find_light(std::string_view name) const noexcept;
   bool operator==(const Asset&) const = default;
 };
 

@@ -16,6 +16,7 @@ inline constexpr std::string_view kReport = "/report";         // + "/<product>"
 inline constexpr std::string_view kReportFiv = "/report/fiv";  // + "/<occluder>"
 inline constexpr std::string_view kFivGroup = "/fiv";
 inline constexpr std::string_view kOccluders = "/fiv/occluders";  // + "/<name>/{shells,valid}"
+inline constexpr std::string_view kLights = "/lights";             // + "/<name>/{vertices,face_sizes,face_indices}" (v3)
 
 // ---- datasets of a vertex set (relative to its prefix: "" or "/objects/<name>") ----
 inline constexpr std::string_view kMeshGroup = "/mesh";
@@ -29,11 +30,18 @@ inline constexpr std::string_view kTransferDiffuse = "/transfer/diffuse";
 inline constexpr std::string_view kTransferVisibility = "/transfer/visibility";
 inline constexpr std::string_view kRadianceGroup = "/radiance";
 inline constexpr std::string_view kRadianceBand1 = "/radiance/band1";
+inline constexpr std::string_view kAreaLightsGroup = "/area_lights";           // v3
+inline constexpr std::string_view kAreaIrradiance = "/area_lights/irradiance";  // [V][L]
+inline constexpr std::string_view kAreaSh = "/area_lights/sh";                  // [V][L][n*n]
 // ---- FIV datasets ----
 inline constexpr std::string_view kFivEnvironment = "/fiv/environment";
 inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";
 inline constexpr std::string_view kShells = "shells";  // leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kValid = "valid";    // leaf under /fiv/occluders/<name>/
+// ---- area-light datasets (leaf under /lights/<name>/) ----
+inline constexpr std::string_view kLightVertices = "vertices";          // float64 [N][3], world space
+inline constexpr std::string_view kLightFaceSizes = "face_sizes";       // uint32 [F]
+inline constexpr std::string_view kLightFaceIndices = "face_indices";   // uint32 [sum of face_sizes]
 // ---- report datasets (leaf under a report directory) ----
 inline constexpr std::string_view kReportVertices = "vertices";
 
@@ -71,6 +79,12 @@ inline constexpr std::string_view kAngularConvention = "angular_convention";
 inline constexpr std::string_view kGrid = "grid";
 inline constexpr std::string_view kFraction = "fraction";
 inline constexpr std::string_view kMeaning = "meaning";
+
+// ---- area-light attributes ----
+inline constexpr std::string_view kShape = "shape";          // /lights/<name>: "quad", "disc", "box", ...
+inline constexpr std::string_view kRadiance = "radiance";    // /lights/<name>: RGB, 3 doubles >= 0
+inline constexpr std::string_view kTwoSided = "two_sided";   // /lights/<name>: 0 / 1
+inline constexpr std::string_view kLightOrder = "lights";    // area_lights/*: the lights' names, one per line, in column order
 
 // ---- report attributes ----
 inline constexpr std::string_view kColumns = "columns";

@@ -1,4 +1,4 @@
-// formats/prtfile.h — the baked file (HDF5, schema version 1): the in-memory model, the one
+// formats/prtfile.h — the baked file (HDF5, schema version 3): the in-memory model, the one
 // writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
 // depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
 // specified in formats/SCHEMA.md (docs/ARCHITECTURE.md §5); every path and attribute
@@ -16,7 +16,7 @@
 //   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
 //
 // Writer contract (write_file)
-//   * Validates the whole File against schema v2 (validate()) before touching the disk.
+//   * Validates the whole File against schema v3 (validate()) before touching the disk.
 //   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
 //     other required root attribute (generator, created, command_line, source, source_sha256,
 //     up_axis, sh_convention).
@@ -75,7 +75,8 @@
 namespace prt::formats {
 
 // Schema version written by this library and the newest one it reads (policy: SCHEMA.md).
-inline constexpr int kFormatVersion = 2;
+// 3 added area lights (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
+inline constexpr int kFormatVersion = 3;
 // Value of the root attribute "format".
 inline constexpr std::string_view kFormatName = "prtbake";
 
@@ -103,7 +104,8 @@ struct File {
   std::vector<Attr> root_attrs;
   std::vector<Dataset> datasets;
   // Attributes of groups, by absolute group path, e.g. {"/report", {{"rmse", 1e-3}, ...}}.
-  // Allowed groups: /mesh, /transfer, /radiance, /fiv, /fiv/occluders, /fiv/occluders/<name>,
+  // Allowed groups: /mesh, /transfer, /radiance, /area_lights, /fiv, /fiv/occluders, /fiv/occluders/<name>,
+  // /lights, /lights/<name> (v3: a light's shape, radiance, two_sided),
   // /report and any group under /report. The root's attributes go in root_attrs, not here.
   std::vector<std::pair<std::string, std::vector<Attr>>> group_attrs;
 };
@@ -125,14 +127,14 @@ private:
 void write_file(const std::filesystem::path& final_path, const File& file);
 
 enum class ReadCheck {
-  full,    // format, format_version and the whole schema v2 (validate())
+  full,    // format, format_version and the whole schema v3 (validate())
   header,  // format and format_version only: for inspectors (prtdump) that show what is wrong
 };
 
 // Reads the whole file at `path` (see the reader contract above). Throws FormatError.
 File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::full);
 
-// Checks `file` against schema v2 exactly as write_file does; messages name `file_for_messages`.
+// Checks `file` against schema v3 exactly as write_file does; messages name `file_for_messages`.
 // Root "format"/"format_version" may be absent (the writer adds them) but, if present, must be
 // "prtbake" / 1..kFormatVersion. Throws FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
@@ -144,18 +146,25 @@ const std::vector<Attr>* find_group_attrs(const File& file, std::string_view gro
 
 // True for the schema's per-vertex datasets (first axis = V = rows of the vertex set's
 // mesh/positions): /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
-// /transfer/visibility, /radiance/band1, and the same under /objects/<name>/ (schema v2 scene
-// files). /report datasets are never per-vertex.
+// /transfer/visibility, /radiance/band1, /area_lights/{irradiance,sh} (v3), and the same under
+// /objects/<name>/ (scene files, v2). /report datasets are never per-vertex.
 bool is_per_vertex_path(std::string_view path);
 // What a dataset path is in the schema (the same rules under /objects/<name>/ for vertex sets).
 enum class DatasetKind {
   positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
-  radiance_band1, fiv_environment, irradiance_cube, occluder_shells, occluder_valid, report, unknown
+  radiance_band1, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
+  light_vertices, light_face_sizes, light_face_indices, report, unknown
 };
 DatasetKind dataset_kind(std::string_view path);
 // The vertex set a dataset path belongs to: "" for the root layout, "/objects/<name>" for a scene
 // object (its V is the rows of "<set>/mesh/positions").
 std::string vertex_set_of(std::string_view path);
+
+// The names of an area-light dataset's `lights` attribute (names::kLightOrder): one per line, in
+// column order. An empty list gives no names.
+std::vector<std::string> split_light_list(std::string_view list);
+// The inverse: names joined with '\n'.
+std::string join_light_list(const std::vector<std::string>& names);
 
 // "float32", "uint32", "uint8" or "float64".
 std::string_view dtype_name(const DatasetData& data);

@@ -20,6 +20,17 @@
 //       "relight": false,                      diffuse receivers also get transfer vectors
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/fiv.h ShellSpec)
 //     },
+//     "lights": [ {                              optional: area lights (bake/lights.h, paper 003)
+//       "name": "key",                           optional: default "light<i>"; unique
+//       "shape": "quad",  "centre", "u", "v"     the rectangle centre ± u/2 ± v/2, emitting towards u × v
+//              | "polygon", "vertices": [[x,y,z], ...]   convex, counter-clockwise seen from its emitting side
+//              | "disc", "centre", "normal", "radius", "segments": 64
+//              | "box", "centre", "size": [sx,sy,sz], "rotate": [rx,ry,rz]
+//              | "cylinder", "centre", "radius", "height", "segments": 64, "rotate"   (axis: its own y)
+//              | "sphere", "centre", "radius", "subdivisions": 3                    (an icosphere)
+//       "radiance": [r,g,b],                     required, ≥ 0, constant over the surface
+//       "two_sided": false                       planar shapes only
+//     } ],                                       (also in a glTF scene's options file)
 //     "objects": [ {                             one or more
 //       "name": "bunny",                         optional: default the mesh file's stem; unique
 //       "mesh": "bunny.obj",                     required; relative paths are relative to the scene file
@@ -73,12 +84,20 @@
 //     reaches above the tangent plane of at least one vertex of another receiver (paper 004 §4.3.1:
 //     case C, wholly below the horizon, occludes nothing);
 //   * the environment's FIV and DifMap only when some occluder gets shells;
-//   * vertices that see no contour edge get closed forms (bake/silhouette.h, bake/zonal.h).
+//   * vertices that see no contour edge get closed forms (bake/silhouette.h, bake/zonal.h);
+//   * area lights ("lights"; none: nothing of them is written): every receiver gets each light's
+//     irradiance at unit radiance, E = ∫ visible light max(n·ω, 0) dω (area_lights/irradiance,
+//     exact diffuse shading for any radiance the runtime gives the light); a receiver that gets
+//     transfer/visibility (a glossy lobe, "transfer" in bake.products) also gets each visible
+//     light's SH projection at that order (area_lights/sh), what its lobe is shaded with. A
+//     diffuse-only receiver gets no SH: E is already exact for it. Soft shadows are exact
+//     (bake/area_bake.h) against the union of the occluders, the same as the other products'.
 #pragma once
 
 #include <bake/choose.h>
 #include <bake/envmap.h>
 #include <bake/fiv.h>
+#include <bake/lights.h>
 #include <bake/mesh.h>
 #include <bake/progress.h>
 #include <bake/vertex_bake.h>
@@ -135,6 +154,7 @@ struct SceneDescription {
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
+  std::vector<AreaLight> lights;  // "lights", in world space (bake/lights.h), validated
   std::vector<SceneObject> objects;
 };
 
@@ -170,7 +190,10 @@ struct ObjectPlan {
   bool ao = false, radiance = false, fiv = false;
   int transfer_order = 0;    // diffuse transfer T (0: none)
   int visibility_order = 0;  // visibility transfer U for the glossy lobe (0: none)
+  bool area_irradiance = false;  // area_lights/irradiance: E of every light, at unit radiance
+  int area_sh_order = 0;         // area_lights/sh: the visible lights' SH at this order (0: none)
   std::vector<std::string> baked, left_out;  // "product: reason", one line each
+  // The products of a vertex integrator (bake/integrator.h); the area lights are not among them.
   bool any_vertex_product() const { return ao || radiance || transfer_order > 0 || visibility_order > 0; }
 };
 
@@ -198,19 +221,24 @@ struct ObjectBake {
   // Occluders with shells (in world space: centre and radii in scene units).
   std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
+  // Receivers with area lights: [V][lights][1 + n²] per vertex and light, E then the SH at
+  // order n = area_sh_order (AreaLightIntegrator's rows).
+  std::optional<std::vector<double>> area;
+  double area_seconds = 0;
 };
 
 struct SceneBake {
   std::vector<ObjectBake> objects;  // parallel to SceneDescription::objects
   Fiv environment_fiv{};            // when plan.fiv_environment
   std::vector<float> irradiance_cube;
-  double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0;
+  double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0, area_seconds = 0;
   uint64_t vertices = 0;  // receiver vertices integrated
 };
 
 // Runs the plan. Visibility for every receiver is the union of the occluders ("occluder" and
 // "both" objects) in world space; a "both" receiver's vertices are shade points of that union
 // (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
+// The area lights' rows are the same for any thread count (each vertex's row is its own).
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log);
