@@ -3,6 +3,7 @@
 // shell: read_file.h reads the file (formats/), scenes.h assembles what is drawn and shades it
 // with prtshade, view/ rasterizes, ray-traces, compares and writes the pictures; this file holds
 // the command line (CLI11) and the report.
+#include "area.h"
 #include "progress_bar.h"
 #include "read_file.h"
 #include "scenes.h"
@@ -65,7 +66,7 @@ WHAT IS DRAWN
     the occluder with prt::shade::shade_fiv_member: its self-shadows (shade_fiv_self, sec. 4.3.2)
     minus the other copies' shadows.
 
-  scene files (/objects/<name>/ and /scene from 'prtbake scene', schema v2): every object, in world
+  scene files (/objects/<name>/ and /scene from 'prtbake scene', schema v2-3): every object, in world
     space, in one z-buffer, each shaded with what the file holds for it, times its diffuse albedo
     (the 'albedo' attribute of /objects/<name>; white if it is zero):
       band1     band-1 radiance when the object has it (shade_band1, E/pi), else
@@ -85,6 +86,17 @@ WHAT IS DRAWN
     apply. The reference renders the same objects: "occluder" and "both" objects cast shadows,
     "receiver" objects do not (not even on themselves: the scene semantics, bake/scene.h), and a
     pixel shows albedo x E/pi.
+
+  area lights of scene files (/lights, schema v3; --shade area or area-exact): only the lights'
+    direct light, no environment: each object's albedo/pi x sum_l radiance_l E_l.
+      area        the baked per-vertex area_lights/irradiance (E_l at unit radiance) x each
+                  light's radiance as /lights/<name> stores it, interpolated (objects without it,
+                  e.g. occluder-only ones, per pixel as below);
+      area-exact  per pixel, exact soft shadows from the stored lights (paper 003: each light's
+                  spherical polygon minus the casting triangles', clipped to the horizon,
+                  Lambert's closed form).
+    The reference samples each light's area with --samples shadow rays per pixel and light
+    (Embree; 8 replicates give the standard error) over the same pixels and casters.
 
   --reference renders the same view by ray tracing (Embree): a primary ray per pixel centre, then
   E = (exact unshadowed irradiance, the function the DifMap samples: bake/irradiance.h) - (QMC
@@ -203,8 +215,8 @@ std::optional<Args> parse(int argc, char** argv) {
   app.add_flag("--triptych", triptych, "write runtime | reference | error side by side and print NRMSE.");
   app.add_option("--shade", a.shade,
                  "transfer | band1 | fiv (default: fiv if the file has /fiv, else transfer if it has "
-                 "/transfer/diffuse, else band1).")
-      ->check(CLI::IsMember({"transfer", "band1", "fiv"}));
+                 "/transfer/diffuse, else band1); scene files with area lights: area | area-exact (see WHAT IS DRAWN).")
+      ->check(CLI::IsMember({"transfer", "band1", "fiv", "area", "area-exact"}));
   app.add_option("--samples", a.samples,
                  "reference: QMC shadow rays per pixel, a multiple of 8: 8 independent randomised-QMC replicates of "
                  "N/8 rays; their spread gives the standard error (default 1024).")
@@ -299,6 +311,50 @@ void write_image(const std::string& path, const view::Image& linear, const view:
   else view::write_png(path, display);
 }
 
+// The environment reference (view/reference.h), read from or written to --reference-cache.
+view::ReferenceImage environment_reference(const Args& a, const prtview::RenderScene& scene, const bake::EnvMap& env,
+                                           const view::Camera& cam, bool say) {
+  view::ReferenceOptions ropt;
+  ropt.samples = a.samples;
+  ropt.seed = a.seed;
+  ropt.occluder_spheres = scene.spheres;
+  ropt.casts_shadow = scene.casts_shadow;
+  ropt.albedo = scene.albedo;
+  const view::ReferenceRenderer rr(scene.mesh, env, ropt);
+  std::optional<view::ReferenceImage> cached;
+  const std::string key = rr.cache_key(cam);
+  if (!a.reference_cache.empty()) cached = view::load_reference(a.reference_cache, key);
+  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  view::ReferenceImage ref = cached ? std::move(*cached) : rr.render(cam, bar.monitor(&tool::interrupt_token()));
+  if (say && cached) std::printf("reference: %s: read from %s\n", rr.description().c_str(), a.reference_cache.c_str());
+  if (say && !cached)
+    std::printf("reference: %s: %.2f s, %.2f M rays/s\n", rr.description().c_str(), ref.seconds,
+                double(ref.rays) / ref.seconds / 1e6);
+  if (!cached && !a.reference_cache.empty()) view::save_reference(a.reference_cache, ref, key);
+  return ref;
+}
+
+// The area lights' reference (view/area_lights.h): light sampling over the rasterized pixels.
+view::ReferenceImage area_reference(const Args& a, const prtview::RenderScene& scene, const std::vector<bake::AreaLight>& lights,
+                                    const view::AreaRenderOptions& options, const view::Camera& cam, bool say) {
+  view::AreaReferenceOptions ro;
+  ro.samples = a.samples;
+  ro.seed = a.seed;
+  ro.render = options;
+  view::ReferenceImage ref;
+  ref.gbuffer = view::rasterize(scene.mesh, cam);
+  Timer t;
+  view::AreaReferenceImage r = view::render_area_reference(scene.mesh, ref.gbuffer, lights, ro);
+  ref.seconds = t.seconds();
+  ref.radiance = std::move(r.radiance);
+  ref.std_error = std::move(r.std_error);
+  ref.rays = uint64_t(ref.gbuffer.covered()) * lights.size() * a.samples;
+  if (say)
+    std::printf("reference: Embree light sampling, %u shadow rays per pixel and light (8 replicates), seed %llu: %.2f s, %.2f M "
+                "rays/s\n", a.samples, (unsigned long long)a.seed, ref.seconds, double(ref.rays) / std::max(ref.seconds, 1e-9) / 1e6);
+  return ref;
+}
+
 int run(const Args& a) {
   const bool say = !a.quiet;
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
@@ -318,26 +374,40 @@ int run(const Args& a) {
   }
   if (!fs::exists(a.file)) throw bake::InputError(a.file, "no such file");
   const F::Asset f = F::read_asset(a.file);
+  const bool area = a.shade == "area" || a.shade == "area-exact";
   std::string kind = a.shade;
-  if (prtview::is_scene_file(f)) kind = "scene";
-  else if (kind.empty()) kind = prtview::has_fiv(f) ? "fiv" : prtview::has_transfer(f) ? "transfer" : "band1";
-  if (kind == "scene" && (!a.shade.empty() || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
-                          !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
-    throw UsageError("--shade, --instance, --occluder(-mesh), --ground(-size), --no-overlap and --no-partial do not apply to "
-                     "scene files (" + a.file + "): each object is shaded with what it holds (see 'prtview --help')");
-  const std::string env_path = a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
-  const bake::EnvMap env = bake::EnvMap::load(env_path, prtview::up_axis(f));
+  if (area) {
+    if (!prtview::is_scene_file(f))
+      throw UsageError("--shade " + a.shade + ": " + a.file + " is not a scene file; area lights are baked by 'prtbake scene'");
+    if (!a.env.empty() || !a.reference_cache.empty())
+      throw UsageError("--env and --reference-cache do not apply to --shade " + a.shade + " (the lights' direct light only)");
+  } else if (prtview::is_scene_file(f)) {
+    kind = "scene";
+  } else if (kind.empty()) {
+    kind = prtview::has_fiv(f) ? "fiv" : prtview::has_transfer(f) ? "transfer" : "band1";
+  }
+  if ((kind == "scene" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
+                                    !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
+    throw UsageError("--shade (except area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
+                     "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
+                     "'prtview --help')");
+  const std::string env_path = area ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
+  const std::optional<bake::EnvMap> env =
+      area ? std::nullopt : std::optional<bake::EnvMap>(bake::EnvMap::load(env_path, prtview::up_axis(f)));
+  const std::vector<bake::AreaLight> lights = area ? prtview::read_area_lights(f, a.file) : std::vector<bake::AreaLight>{};
 
   prtview::RenderScene scene;
+  view::AreaRenderOptions area_options;
   Timer t_run;
-  const view::Image runtime = kind == "scene" ? prtview::render_scene_file(f, a.file, env, cam, scene)
-                              : kind == "fiv" ? prtview::render_fiv_file(f, a.file, a.fiv, env, cam, scene)
-                                              : prtview::render_vertex_file(f, a.file, kind, env, cam, scene);
+  const view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
+                              : kind == "scene" ? prtview::render_scene_file(f, a.file, *env, cam, scene)
+                              : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
+                                                : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();
   if (say) {
-    std::printf("%s: %s\nenvironment: %s (%dx%d %s)\nview: %dx%d, %s\n", a.file.c_str(), scene.what.c_str(),
-                env_path.c_str(), env.info().width, env.info().height, env.info().layout.c_str(), a.width, a.height,
-                a.camera.c_str());
+    std::printf("%s: %s\n", a.file.c_str(), scene.what.c_str());
+    if (env) std::printf("environment: %s (%dx%d %s)\n", env_path.c_str(), env->info().width, env->info().height, env->info().layout.c_str());
+    std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
     std::printf("runtime: %s: %.3f s\n", scene.how.c_str(), runtime_seconds);
     std::fflush(stdout);
   }
@@ -367,27 +437,11 @@ int run(const Args& a) {
     return 0;
   }
 
-  view::ReferenceOptions ropt;
-  ropt.samples = a.samples;
-  ropt.seed = a.seed;
-  ropt.occluder_spheres = scene.spheres;
-  ropt.casts_shadow = scene.casts_shadow;
-  ropt.albedo = scene.albedo;
-  const view::ReferenceRenderer rr(scene.mesh, env, ropt);
-  std::optional<view::ReferenceImage> cached;
-  const std::string key = rr.cache_key(cam);
-  if (!a.reference_cache.empty()) cached = view::load_reference(a.reference_cache, key);
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
-  const view::ReferenceImage ref =
-      cached ? std::move(*cached) : rr.render(cam, bar.monitor(&tool::interrupt_token()));
-  if (say && cached) std::printf("reference: %s: read from %s\n", rr.description().c_str(), a.reference_cache.c_str());
-  if (say && !cached)
-    std::printf("reference: %s: %.2f s, %.2f M rays/s\n", rr.description().c_str(), ref.seconds,
-                double(ref.rays) / ref.seconds / 1e6);
-  if (!cached && !a.reference_cache.empty()) view::save_reference(a.reference_cache, ref, key);
+  const view::ReferenceImage ref = area ? area_reference(a, scene, lights, area_options, cam, say)
+                                        : environment_reference(a, scene, *env, cam, say);
   const view::GBuffer raster = view::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
-  const std::string region = !a.region.empty() ? a.region : kind == "fiv" || kind == "scene" ? "receiver" : "all";
+  const std::string region = !a.region.empty() ? a.region : kind == "fiv" || kind == "scene" || area ? "receiver" : "all";
   const size_t n_px = size_t(a.width) * size_t(a.height);
   std::vector<uint8_t> mask(n_px, 0), covered(n_px, 0);
   for (size_t i = 0; i < n_px; ++i) {

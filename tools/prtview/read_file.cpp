@@ -181,8 +181,8 @@ std::string occluder_mesh_path(const F::Asset& f, const std::string& file, const
   return mesh_path;
 }
 
-std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string& file, const bake::EnvMap& env) {
-  if (f.scene) check_same_environment(*f.scene, std::string(N::kScene), env, file);
+std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string& file, const bake::EnvMap* env) {
+  if (env && f.scene) check_same_environment(*f.scene, std::string(N::kScene), *env, file);
   std::vector<SceneObject> objects;
   for (const F::SceneObject& baked : f.objects) {
     if (!baked.set.positions) continue;  // not a vertex set
@@ -203,10 +203,14 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     const F::VertexSet& s = baked.set;
     o.glossy_only = s.transfer_visibility && !s.radiance_band1 && !s.transfer_diffuse;
     // The per-vertex product the runtime shades it with: the first of band-1 radiance, transfer, AO.
-    if (s.radiance_band1) o.band1 = read_band1(f, file, baked.name, env);
+    if (!env) {
+      objects.push_back(std::move(o));
+      continue;
+    }
+    if (s.radiance_band1) o.band1 = read_band1(f, file, baked.name, *env);
     else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
     else if (s.ao) o.ao = &s.ao->values;
-    if (f.fiv_environment && f.find_occluder(baked.name)) o.shells = read_occluder(f, file, baked.name, env);
+    if (f.fiv_environment && f.find_occluder(baked.name)) o.shells = read_occluder(f, file, baked.name, *env);
     objects.push_back(std::move(o));
   }
   if (objects.empty())

@@ -76,6 +76,8 @@ struct SceneObject {
   std::optional<BakedOccluder> shells;   // read when the file also holds the environment FIV
   bool glossy_only = false;              // visibility transfer only
 };
-std::vector<SceneObject> read_scene_objects(const formats::Asset& f, const std::string& file, const bake::EnvMap& env);
+// `env` null: geometry, roles and albedo only (no product that needs the environment, no check
+// that the file was baked under it): the area-light views.
+std::vector<SceneObject> read_scene_objects(const formats::Asset& f, const std::string& file, const bake::EnvMap* env);
 
 } // namespace prt::prtview

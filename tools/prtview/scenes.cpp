@@ -144,9 +144,20 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
 }
 
 
+void add_object(RenderScene& scene, const SceneObject& o) {
+  const size_t T = o.mesh.triangles.size();
+  if (scene.first_triangle.empty()) scene.first_triangle = {0};
+  scene.casts_shadow.insert(scene.casts_shadow.end(), T, o.casts_shadow ? 1 : 0);
+  scene.albedo.insert(scene.albedo.end(), T, o.albedo);
+  scene.object_names.push_back(o.name);
+  scene.object_receiver.push_back(o.receiver);
+  scene.first_triangle.push_back(scene.first_triangle.back() + T);
+  if (o.receiver) scene.receiver_triangles += T;
+}
+
 view::Image render_scene_file(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
                               RenderScene& scene) {
-  std::vector<SceneObject> objects = read_scene_objects(f, file, env);
+  std::vector<SceneObject> objects = read_scene_objects(f, file, &env);
   // What the runtime has beside the per-vertex data: the DifMap (unshadowed irradiance) and the
   // environment FIV, when some occluder got shells.
   const std::optional<shade::DifMap> difmap = read_difmap(f, file, env, false);
@@ -218,12 +229,7 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
     for (size_t v = 0; v < o.mesh.positions.size(); ++v)
       for (size_t c = 0; c < 3; ++c) rgb.push_back(rgb_of[k].empty() ? 0.0f : rgb_of[k][3 * v + c] * o.albedo[c]);
     per_pixel.insert(per_pixel.end(), T, rgb_of[k].empty() ? 1 : 0);
-    scene.casts_shadow.insert(scene.casts_shadow.end(), T, o.casts_shadow ? 1 : 0);
-    scene.albedo.insert(scene.albedo.end(), T, o.albedo);
-    scene.object_names.push_back(o.name);
-    scene.object_receiver.push_back(o.receiver);
-    scene.first_triangle.push_back(scene.first_triangle.back() + T);
-    if (o.receiver) scene.receiver_triangles += T;
+    add_object(scene, o);
     if (o.casts_shadow) {
       view::Sphere sp;
       bake::bounding_sphere(o.mesh, sp.centre, sp.radius);

@@ -51,6 +51,11 @@ struct FivView {
 view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
                             const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 
+// Appends one scene object's triangles to the scene's per-triangle roles and albedos and its
+// object list (the mesh itself is the caller's to merge, in the same order).
+struct SceneObject;
+void add_object(RenderScene& scene, const SceneObject& o);
+
 // Scene files (prtbake scene, schema v2): every object with what the file holds for it.
 view::Image render_scene_file(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
                               const view::Camera& cam, RenderScene& scene);

@@ -70,9 +70,25 @@ struct LightSurface {
   }
 };
 
-void check_lights(std::span<const bake::AreaLight> lights) {
+void check_inputs(const bake::Mesh& mesh, std::span<const bake::AreaLight> lights, const AreaRenderOptions& o) {
   PRT_CHECK(!lights.empty());
   for (const auto& l : lights) PRT_CHECK(!l.faces.empty());
+  PRT_CHECK(o.casts_shadow.empty() || o.casts_shadow.size() == mesh.triangles.size());
+  PRT_CHECK(o.triangle_albedo.empty() || o.triangle_albedo.size() == mesh.triangles.size());
+}
+
+// The triangles that block light: all of them, or those with casts_shadow set (same positions and frame).
+bake::Mesh casters(const bake::Mesh& mesh, const AreaRenderOptions& o) {
+  bake::Mesh m = mesh;
+  if (o.casts_shadow.empty()) return m;
+  m.triangles.clear();
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (o.casts_shadow[t]) m.triangles.push_back(mesh.triangles[t]);
+  return m;
+}
+
+double albedo_of(const Fragment& f, const AreaRenderOptions& o, size_t c) {
+  return o.triangle_albedo.empty() ? o.albedo[c] : double(o.triangle_albedo[size_t(f.triangle)][c]);
 }
 
 } // namespace
@@ -89,8 +105,8 @@ double area_shading_offset(const bake::Mesh& mesh) {
 
 Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
                            const AreaRenderOptions& options) {
-  check_lights(lights);
-  const bake::AreaLightIntegrator integrator(lights, mesh, 0);
+  check_inputs(mesh, lights, options);
+  const bake::AreaLightIntegrator integrator(lights, casters(mesh, options), 0);
   const double epsilon = area_shading_offset(mesh);
   tbb::enumerable_thread_specific<bake::AreaLightIntegrator::Workspace> workspaces;
   tbb::enumerable_thread_specific<std::vector<double>> rows([&] { return std::vector<double>(integrator.width()); });
@@ -100,17 +116,18 @@ Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<c
     for (size_t c = 0; c < 3; ++c) {
       double v = 0;
       for (size_t l = 0; l < lights.size(); ++l) v += lights[l].radiance[c] * row[l * integrator.per_light()];
-      out[c] = float(options.albedo[c] * v * std::numbers::inv_pi);
+      out[c] = float(albedo_of(f, options, c) * v * std::numbers::inv_pi);
     }
   });
 }
 
 AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
                                          const AreaReferenceOptions& options) {
-  check_lights(lights);
+  check_inputs(mesh, lights, options.render);
   PRT_CHECK(options.samples > 0 && (options.samples < kReplicates || options.samples % kReplicates == 0));
-  const bake::Topology topology = bake::build_topology(mesh);
-  const bake::RayCaster rays(mesh, topology);
+  const bake::Mesh blockers = casters(mesh, options.render);
+  const bake::Topology topology = bake::build_topology(blockers);
+  const bake::RayCaster rays(blockers, topology);
   std::vector<LightSurface> surfaces;
   for (const auto& l : lights) surfaces.emplace_back(l, mesh.origin);
   const double epsilon = area_shading_offset(mesh);
@@ -146,7 +163,7 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
         }
         const double e = sum / per;  // this replicate's estimate of E_l
         for (size_t c = 0; c < 3; ++c)
-          means[b * 3 + c] += options.render.albedo[c] * lights[l].radiance[c] * e * std::numbers::inv_pi;
+          means[b * 3 + c] += albedo_of(f, options.render, c) * lights[l].radiance[c] * e * std::numbers::inv_pi;
       }
     }
     for (size_t c = 0; c < 3; ++c) {

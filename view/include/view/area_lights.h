@@ -32,11 +32,17 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace prt::view {
 
 struct AreaRenderOptions {
   std::array<double, 3> albedo{1, 1, 1};
+  // Scenes of several objects (prtview on scene files), one entry per triangle of the rendered
+  // mesh; empty vectors keep the single-object behaviour. casts_shadow[t] == 0: triangle t is drawn
+  // but blocks no light (a bake's "receiver" objects); triangle_albedo[t] replaces `albedo` there.
+  std::vector<uint8_t> casts_shadow;
+  std::vector<std::array<float, 3>> triangle_albedo;
 };
 
 // Exact: E per light from the closed forms (above).

@@ -1,0 +1,113 @@
+#include "area.h"
+
+#include "read_file.h"
+
+#include <view/raster.h>
+
+#include <bake/error.h>
+#include <formats/names.h>
+#include <formats/prtfile.h>
+
+#include <algorithm>
+#include <numbers>
+#include <string>
+
+namespace prt::prtview {
+
+namespace F = prt::formats;
+namespace N = prt::formats::names;
+using bake::InputError;
+
+namespace {
+
+bake::LightShape shape_of(const F::Light& l, const std::string& file) {
+  for (const auto s : {bake::LightShape::Polygon, bake::LightShape::Quad, bake::LightShape::Disc, bake::LightShape::Box,
+                       bake::LightShape::Cylinder, bake::LightShape::Sphere})
+    if (l.shape == bake::light_shape_name(s)) return s;
+  throw InputError(file, std::string(N::kLights) + "/" + l.name + ": unknown shape '" + l.shape + "'");
+}
+
+} // namespace
+
+std::vector<bake::AreaLight> read_area_lights(const F::Asset& f, const std::string& file) {
+  if (f.lights.empty()) throw InputError(file, "has no area lights (" + std::string(N::kLights) + "): nothing for --shade area to draw");
+  std::vector<bake::AreaLight> out;
+  for (const F::Light& l : f.lights) {  // the schema check has bounded the indices and sizes
+    bake::AreaLight a;
+    a.name = l.name;
+    a.shape = shape_of(l, file);
+    a.radiance = l.radiance;
+    a.two_sided = l.two_sided.value_or(0) != 0;
+    for (size_t i = 0; i + 2 < l.vertices.values.size(); i += 3)
+      a.vertices.emplace_back(l.vertices.values[i], l.vertices.values[i + 1], l.vertices.values[i + 2]);
+    size_t at = 0;
+    for (const uint32_t n : l.face_sizes.values) {
+      a.faces.emplace_back(l.face_indices.values.begin() + std::ptrdiff_t(at), l.face_indices.values.begin() + std::ptrdiff_t(at + n));
+      at += n;
+    }
+    bake::validate_light(a, file, std::string(N::kLights) + "/" + l.name);
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+view::Image render_area_file(const F::Asset& f, const std::string& file, const std::vector<bake::AreaLight>& lights, bool exact,
+                             const view::Camera& cam, RenderScene& scene, view::AreaRenderOptions& options) {
+  std::vector<SceneObject> objects = read_scene_objects(f, file, nullptr);
+  std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
+  std::vector<bake::Mesh> parts;
+  std::vector<float> rgb;
+  std::vector<uint8_t> per_pixel;
+  size_t baked = 0;
+  for (const SceneObject& o : objects) {
+    const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
+    const F::SceneObject* fo = f.find_object(o.name);
+    const F::Product* e = fo && fo->set.area_irradiance ? &*fo->set.area_irradiance : nullptr;
+    if (e && !exact) {
+      // Column l of E is the light named on line l of its `lights` attribute.
+      const std::vector<std::string> names = F::split_light_list(e->lights.value_or(""));
+      std::vector<const bake::AreaLight*> column;
+      for (const std::string& n : names) {
+        const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
+        if (it == lights.end()) throw InputError(file, "object '" + o.name + "': area_lights/irradiance names light '" + n + "', which /lights does not hold");
+        column.push_back(&*it);
+      }
+      const size_t L = column.size();
+      for (size_t v = 0; v < V; ++v)
+        for (size_t c = 0; c < 3; ++c) {
+          double sum = 0;
+          for (size_t l = 0; l < L; ++l) sum += column[l]->radiance[c] * double(e->values[v * L + l]);
+          rgb.push_back(float(double(o.albedo[c]) * sum * std::numbers::inv_pi));
+        }
+      per_pixel.insert(per_pixel.end(), T, 0);
+      ++baked;
+    } else {
+      rgb.insert(rgb.end(), 3 * V, 0.0f);
+      per_pixel.insert(per_pixel.end(), T, 1);
+    }
+    add_object(scene, o);
+    parts.push_back(o.mesh);
+  }
+  if (!exact && baked == 0)
+    throw InputError(file, "holds no " + std::string(N::kAreaLightsGroup) + "/irradiance for any object: use --shade area-exact");
+  scene.mesh = bake::merge_meshes(parts, "scene");
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects, " + std::to_string(lights.size()) + " area light(s), their direct light only";
+  scene.how = exact ? "per pixel: exact soft shadows of the stored lights (render_area_analytic), times the albedo / pi"
+                    : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated (" + std::to_string(baked) +
+                          " objects); objects without it per pixel, exactly";
+  options.casts_shadow = scene.casts_shadow;
+  options.triangle_albedo = scene.albedo;
+
+  const view::GBuffer g = view::rasterize(scene.mesh, cam);
+  const bool any_per_pixel = std::find(per_pixel.begin(), per_pixel.end(), 1) != per_pixel.end();
+  view::Image analytic;
+  if (exact || any_per_pixel) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
+  if (exact) return analytic;
+  view::Image img = view::interpolate_vertices(scene.mesh, g, rgb);
+  for (size_t i = 0; i < g.triangle.size(); ++i)
+    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])])
+      std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+  return img;
+}
+
+} // namespace prt::prtview
