@@ -32,6 +32,11 @@ constexpr size_t kSilhouetteMaxLevels = std::size(kSilhouetteFirst) + 2;
 constexpr int kMinIsolines = 8;
 constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
 constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
+// QMC's levels stop when its best case (above) costs this many times the silhouette prediction.
+// The per-ray cost at a level over-states the cost of more rays by its fixed part per point
+// (~3 µs of ~140 at 256 rays, kCountedUsPerPoint), and a fitted rate above 1 is noise (the fit
+// clamps it to 1): 2 leaves room for both.
+constexpr double kQmcBestCaseMargin = 2.0;
 // Counted costs (ChooserOptions::counted_costs), µs per integral: the silhouette integrator per
 // contour edge (search ~0.045, arcs ~0.038) and per isoline crossing, QMC per ray, and setup in
 // seconds per triangle. Calibrated on this project's 2-core AMD EPYC machine
@@ -205,9 +210,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   choice.spec = base;
   const std::vector<ProductSlice> products = product_slices(ProductLayout(request));
   for (const ProductSlice& p : products) choice.products.push_back(p.product);
-  // A sixteenth of the points, at least 32 and at most pilot_points: on small objects the pilot
-  // must not cost more than the bake it tunes.
-  const size_t pilot = std::clamp<size_t>(points.size() / 16, 32, std::max<size_t>(options.pilot_points, 32));
+  // A 64th of the points, at least 32 and at most pilot_points: the pilot must not cost more than
+  // a small part of the bake it tunes (ChooserOptions::kPilotFraction).
+  const size_t pilot = std::clamp<size_t>(points.size() / ChooserOptions::kPilotFraction, 32,
+                                          std::max<size_t>(options.pilot_points, 32));
   const std::vector<uint32_t> sample = seeded_sample(uint32_t(points.size()), pilot, mix64(base.seed ^ kPilotSalt));
   choice.pilot_points = sample.size();
   const size_t W = ProductLayout(request).width;
@@ -296,7 +302,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     for (uint32_t R : kQmcLevels) {
       if (!errors.empty()) {
         const bool misses = *std::max_element(errors.back().begin(), errors.back().end()) > goal;
-        if (misses && rival_us > 0 && ts.back() >= rival_us) {
+        // Or once even the best case its model allows (rate 1, the top of its clamp: R·e/goal
+        // rays) would cost twice the silhouette prediction at the cost of this level per ray.
+        const double worst = *std::max_element(errors.back().begin(), errors.back().end());
+        if (misses && rival_us > 0 && (ts.back() >= rival_us || ts.back() * (worst / goal) >= kQmcBestCaseMargin * rival_us)) {
           pruned = true;
           break;
         }
