@@ -204,7 +204,7 @@ void run_case(const Case& c, const Settings& s, std::string& notes, std::string&
   const Prediction* pred = nullptr;
   for (const Prediction& p : choice.predictions)
     if (p.kind == choice.spec.kind) pred = &p;
-  std::printf("| %s | %zu | %zu | %s %s %s %u, %.0f µs, %.1e | %.1f + %.1f | %.2f | %.2f | %s |\n", c.name.c_str(),
+  std::printf("| %s | %zu | %zu | %s %s %s %u, %.0f µs, %.1e | %.2f + %.2f | %.2f | %.2f | %s |\n", c.name.c_str(),
               c.mesh.triangles.size(), points.size(), cell(hs, "N =").c_str(), cell(hq, "rays").c_str(), to_string(choice.spec.kind),
               choice.spec.kind == IntegratorKind::Qmc ? choice.spec.qmc_rays : uint32_t(choice.spec.isolines()), chosen.us,
               chosen.rmse, pilot_cpu, chooser_cost - pilot_cpu, (chooser_cost - pilot_cpu) / hand, chooser_cost / hand,

@@ -24,7 +24,7 @@
 //     it and the one before; the last two when none does), a clamped to [0.5, 3], solved for
 //     the smallest even N with RMSE <= 0.7·E
 //     (ChooserOptions: the safety factors);
-//  3. QMC at 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
+//  3. QMC at 64, 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
 //     goal, 0.8·E for QMC): the same against the reference; RMSE(R) = C R^-b with b fitted between the levels
 //     that bracket the goal (the last two when none meets it) and clamped to [0.5, 1]
 //     (randomised QMC converges between the Monte Carlo rate 1/2 and 1; ~0.7 on the bunny),
@@ -72,8 +72,8 @@ struct ChooserOptions {
   double target = 1e-3;                       // E, see the file comment
   std::optional<IntegratorKind> only;         // choose only this kind's knob
   // Seeded shade points of the pilot: a kPilotFraction-th of the bake's, at least 32 (all of
-  // them if fewer) and at most this. A pilot point costs ~4-6 bake integrals (the reference at
-  // 256 isolines ~2, the levels 32 and 64 ~2, QMC at 256 rays ~1.5 on small assets), so a 64th
+  // them if fewer) and at most this. A pilot point costs ~4-5 bake integrals (the reference at
+  // 256 isolines ~2, the levels 32 and 64 ~2, QMC at 64 rays ~0.5 on small assets), so a 64th
   // keeps the pilot under ~10% of the bake from 2,048 shade points up (bench_target_error: a
   // 16th cost 0.1-0.2 CPU s, 24-73% of the bakes of 1.5k-4k vertices); from 8,192 up it is 128.
   static constexpr uint32_t kPilotFraction = 64;
@@ -140,6 +140,9 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 // What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
 // and the choice, one line each, then a hint when the call was close (margin < 1.25).
 std::vector<std::string> choice_lines(const IntegratorChoice& choice);
+// The same in one line: the target, what was chosen and why (IntegratorChoice::reason: its
+// predicted error and µs per integral), and the pilot's size and time.
+std::string choice_summary(const IntegratorChoice& choice);
 
 // After the bake, one line per product: its error in the target's units against the target,
 // "met", "NOT met", or "not verifiable here" when it is above E but the reference's own estimated
