@@ -303,10 +303,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     bool pruned = false;
     for (uint32_t R : kQmcLevels) {
       if (!errors.empty()) {
-        const bool misses = *std::max_element(errors.back().begin(), errors.back().end()) > goal;
-        // Or once even the best case its model allows (rate 1, the top of its clamp: R·e/goal
-        // rays) would cost twice the silhouette prediction at the cost of this level per ray.
         const double worst = *std::max_element(errors.back().begin(), errors.back().end());
+        const bool misses = worst > goal;
+        // Or once even the best case its model allows (rate 1, the top of its clamp: R·worst/goal
+        // rays at this level's cost per ray) costs kQmcBestCaseMargin times the prediction.
         if (misses && rival_us > 0 && (ts.back() >= rival_us || ts.back() * (worst / goal) >= kQmcBestCaseMargin * rival_us)) {
           pruned = true;
           break;
