@@ -19,7 +19,9 @@
 //               contour search dominates and every N costs about the same);
 //   chooser     choose_integrator (the prtbake default pilot), timed as process CPU time, then
 //               its choice measured like a sweep level (RMSE; its µs from the same line as the
-//               sweep's): cost = setup + V × µs, and with the pilot
+//               sweep's): cost = setup + V × µs, and with the pilot; as in prtbake, the pilot
+//               builds the mesh's trees (bake/accel.h) and the bake reuses them, so the bake's
+//               setup is its tables and the trees are counted once, in the pilot
 //               (hand tuning's own runs are not counted: the ratio with the pilot is the harder one).
 // Printed as markdown: one summary row per asset (the ratio chooser / faster hand-tuned, and
 // whether the chooser's RMSE against the reference meets E), the chooser's predictions next to
@@ -179,10 +181,14 @@ void run_case(const Case& c, const Settings& s, std::string& notes, std::string&
 
   ChooserOptions opt;
   opt.target = s.target;
+  // As prtbake runs it: the pilot builds the mesh's trees (its CPU time includes them) and the
+  // bake reuses them (its setup is the integrator's tables only).
+  const MeshAccel accel(c.mesh, topo);
   const double p0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
-  const IntegratorChoice choice = choose_integrator(points, c.mesh, topo, req, IntegratorSpec{}, opt);
+  const IntegratorChoice choice = choose_integrator(points, c.mesh, topo, req, IntegratorSpec{}, opt, {}, &accel);
   const double pilot_cpu = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - p0;
-  const Measured chosen = measure([&] { return make_integrator(choice.spec, c.mesh, topo, req); }, points, rows, &ref.ao);
+  const Measured chosen =
+      measure([&] { return make_integrator(choice.spec, c.mesh, topo, req, &accel); }, points, rows, &ref.ao);
   const bool chose_qmc = choice.spec.kind == IntegratorKind::Qmc;
   const double knob = chose_qmc ? double(choice.spec.qmc_rays) : double(choice.spec.isolines());
   const double chosen_fit_us = chose_qmc ? qa + qb * knob : sa + sb * knob;
@@ -198,7 +204,7 @@ void run_case(const Case& c, const Settings& s, std::string& notes, std::string&
   const Prediction* pred = nullptr;
   for (const Prediction& p : choice.predictions)
     if (p.kind == choice.spec.kind) pred = &p;
-  std::printf("| %s | %zu | %zu | %s %s %s %u, %.0f µs, %.1e | %.1f + %.1f | %.2f | %.2f | %s |\n", c.name.c_str(),
+  std::printf("| %s | %zu | %zu | %s %s %s %u, %.0f µs, %.1e | %.2f + %.2f | %.2f | %.2f | %s |\n", c.name.c_str(),
               c.mesh.triangles.size(), points.size(), cell(hs, "N =").c_str(), cell(hq, "rays").c_str(), to_string(choice.spec.kind),
               choice.spec.kind == IntegratorKind::Qmc ? choice.spec.qmc_rays : uint32_t(choice.spec.isolines()), chosen.us,
               chosen.rmse, pilot_cpu, chooser_cost - pilot_cpu, (chooser_cost - pilot_cpu) / hand, chooser_cost / hand,

@@ -30,8 +30,15 @@ int reference_isolines(double target) { return target >= 5e-4 ? 256 : 512; }
 constexpr int kSilhouetteLow = 16, kSilhouetteFirst[] = {32, 64}, kSilhouetteHigh = 128;
 constexpr size_t kSilhouetteMaxLevels = std::size(kSilhouetteFirst) + 2;
 constexpr int kMinIsolines = 8;
-constexpr uint32_t kQmcLevels[] = {256, 1024, 4096};
+// QMC's levels. 64 first: on the assets the silhouette integrator wins (most), its error there
+// (~1-2e-2 AO) already prices QMC out (kQmcBestCaseMargin) at a quarter of 256 rays' cost.
+constexpr uint32_t kQmcLevels[] = {64, 256, 1024, 4096};
 constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
+// QMC's levels stop when its best case (above) costs this many times the silhouette prediction.
+// The per-ray cost at a level over-states the cost of more rays by its fixed part per point
+// (~3 µs of ~35 at 64 rays, kCountedUsPerPoint), and a fitted rate above 1 is noise (the fit
+// clamps it to 1): 2 leaves room for both.
+constexpr double kQmcBestCaseMargin = 2.0;
 // Counted costs (ChooserOptions::counted_costs), µs per integral: the silhouette integrator per
 // contour edge (search ~0.045, arcs ~0.038) and per isoline crossing, QMC per ray, and setup in
 // seconds per triangle. Calibrated on this project's 2-core AMD EPYC machine
@@ -205,9 +212,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   choice.spec = base;
   const std::vector<ProductSlice> products = product_slices(ProductLayout(request));
   for (const ProductSlice& p : products) choice.products.push_back(p.product);
-  // A sixteenth of the points, at least 32 and at most pilot_points: on small objects the pilot
-  // must not cost more than the bake it tunes.
-  const size_t pilot = std::clamp<size_t>(points.size() / 16, 32, std::max<size_t>(options.pilot_points, 32));
+  // A 64th of the points, at least 32 and at most pilot_points: the pilot must not cost more than
+  // a small part of the bake it tunes (ChooserOptions::kPilotFraction).
+  const size_t pilot = std::clamp<size_t>(points.size() / ChooserOptions::kPilotFraction, 32,
+                                          std::max<size_t>(options.pilot_points, 32));
   const std::vector<uint32_t> sample = seeded_sample(uint32_t(points.size()), pilot, mix64(base.seed ^ kPilotSalt));
   choice.pilot_points = sample.size();
   const size_t W = ProductLayout(request).width;
@@ -295,8 +303,11 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     bool pruned = false;
     for (uint32_t R : kQmcLevels) {
       if (!errors.empty()) {
-        const bool misses = *std::max_element(errors.back().begin(), errors.back().end()) > goal;
-        if (misses && rival_us > 0 && ts.back() >= rival_us) {
+        const double worst = *std::max_element(errors.back().begin(), errors.back().end());
+        const bool misses = worst > goal;
+        // Or once even the best case its model allows (rate 1, the top of its clamp: R·worst/goal
+        // rays at this level's cost per ray) costs kQmcBestCaseMargin times the prediction.
+        if (misses && rival_us > 0 && (ts.back() >= rival_us || ts.back() * (worst / goal) >= kQmcBestCaseMargin * rival_us)) {
           pruned = true;
           break;
         }
@@ -382,8 +393,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     choice.reason += format("; %.2fx cheaper than ", choice.margin) + to_string(other->kind) + " at " +
                      (other->kind == IntegratorKind::Silhouette ? format("N = %.0f", other->knob) : format("%.0f rays", other->knob));
   else if (!options.only && choice.predictions.size() > 1 && choice.predictions.back().pruned)
-    choice.reason += format("; qmc already costs %.1f µs per integral at %.0f rays, short of the target",
-                            choice.predictions.back().predicted_us_per_point, choice.predictions.back().knob);
+    choice.reason += format("; qmc at %.0f rays costs %.1f µs per integral and misses the target by %.1fx: more rays "
+                            "cannot beat it",
+                            choice.predictions.back().knob, choice.predictions.back().predicted_us_per_point,
+                            choice.predictions.back().predicted_error / options.target);
   else if (!options.only)
     choice.reason += "; the other integrator cannot reach the target within its sample range";
   choice.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -417,8 +430,9 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
   }
   for (const Prediction& p : c.predictions) {
     if (p.pruned)
-      std::snprintf(buf, sizeof buf, "  model: %-10s not competitive: at %s it misses the target and already costs more",
-                    to_string(p.kind), knob_text(p.kind, p.knob).c_str());
+      std::snprintf(buf, sizeof buf, "  model: %-10s not competitive: at %s it misses the target (error %.3g) at %.1f "
+                    "µs/integral, and more rays cannot beat the other",
+                    to_string(p.kind), knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.predicted_us_per_point);
     else
       std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral%s", to_string(p.kind),
                     knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point,
@@ -432,6 +446,11 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
     out.push_back(std::string("  (a close call: another run may time it the other way; pin it with integrator ") +
                   to_string(c.spec.kind) + ", samples " + std::to_string(c.spec.samples()) + " for the same bytes everywhere)");
   return out;
+}
+
+std::string choice_summary(const IntegratorChoice& c) {
+  return format("target error %g: chosen ", c.target) + c.reason + " (pilot on " + std::to_string(c.pilot_points) +
+         format(" seeded points, %.2f s)", c.pilot_seconds);
 }
 
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target) {

@@ -27,13 +27,15 @@ struct Asset {
   std::vector<ShadePoint> points;
 };
 
+Asset load_asset(const char* name) {
+  Asset x{load_mesh(fs::path(PRT_DATA_DIR) / name, {.use_file_normals = false}), {}, {}};
+  x.topology = build_topology(x.mesh);
+  x.points = vertex_shade_points(x.mesh, x.topology);
+  return x;
+}
+
 const Asset& bunny_ground() {
-  static const Asset a = [] {
-    Asset x{load_mesh(fs::path(PRT_DATA_DIR) / "bunny_ground.obj", {.use_file_normals = false}), {}, {}};
-    x.topology = build_topology(x.mesh);
-    x.points = vertex_shade_points(x.mesh, x.topology);
-    return x;
-  }();
+  static const Asset a = load_asset("bunny_ground.obj");
   return a;
 }
 
@@ -72,7 +74,7 @@ TEST(Choose, TheChosenBakeMeetsTheTargetOnPointsThePilotNeverSaw) {
   ChooserOptions opt;
   opt.target = 1e-3;
   const IntegratorChoice c = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
-  EXPECT_EQ(c.pilot_points, 128u);
+  EXPECT_EQ(c.pilot_points, 4240u / ChooserOptions::kPilotFraction);  // 66: a 64th of the vertices
   ASSERT_EQ(c.products.size(), 2u);
   // On this asset the silhouette integrator wins by more than 10x (bench/RESULTS.md error against time).
   EXPECT_EQ(c.spec.kind, IntegratorKind::Silhouette);
@@ -185,6 +187,54 @@ TEST(Choose, CountedCostsMakeTheWholeChoiceAFunctionOfTheInputs) {
   for (size_t i = 0; i < c1.predictions.size(); ++i)
     EXPECT_EQ(c1.predictions[i].predicted_us_per_point, c2.predictions[i].predicted_us_per_point) << i;
   EXPECT_EQ(c1.reason, c2.reason);
+}
+
+TEST(Choose, ThePilotScalesWithTheBakeAndStopsQmcWhenItsBestCaseCannotWin) {
+  // wuson (2117 vertices): the pilot runs on a 64th of them, 33, so that it costs a few percent
+  // of the bake. Counted costs make the test a function of the inputs: QMC at 64 rays costs
+  // 3 + 0.5·64 = 35 µs counted.
+  static const Asset w = load_asset("wuson.obj");
+  ProductRequest r;
+  r.ao = true;
+  ChooserOptions opt;
+  opt.counted_costs = true;
+  opt.target = 3e-4;
+  const IntegratorChoice c = choose_integrator(w.points, w.mesh, w.topology, r, IntegratorSpec{}, opt);
+  EXPECT_EQ(c.pilot_points, 2117u / ChooserOptions::kPilotFraction);
+  EXPECT_EQ(c.spec.kind, IntegratorKind::Silhouette) << c.reason;
+  ASSERT_EQ(c.predictions.size(), 2u);
+  const Prediction& sil = c.predictions[0];
+  const Prediction& qmc = c.predictions[1];
+  // QMC stopped after its first level: 64 rays miss the aim 0.8·E by a factor f (AO RMSE ~2e-2
+  // here, f ~ 80), so even at rate 1 it needs 64·f rays, costing ~f times as much: over twice
+  // the silhouette prediction.
+  std::vector<uint32_t> qmc_levels;
+  for (const PilotRun& run : c.runs)
+    if (run.kind == IntegratorKind::Qmc) qmc_levels.push_back(run.knob);
+  EXPECT_EQ(qmc_levels, std::vector<uint32_t>{64});
+  EXPECT_TRUE(qmc.pruned) << c.reason;
+  EXPECT_EQ(qmc.knob, 64u);
+  const double f = qmc.predicted_error / (opt.safety_qmc * opt.target);
+  EXPECT_GE(qmc.predicted_us_per_point * f, 2.0 * sil.predicted_us_per_point);
+  // The silhouette integrator needs N ~ 150 here (~176 µs counted), more than QMC's 64 rays
+  // cost: the rule "a level that misses and costs more than the rival" alone would have run 256
+  // and 1024 rays too. The best case stopped it.
+  EXPECT_LT(qmc.predicted_us_per_point, sil.predicted_us_per_point);
+  EXPECT_NE(c.reason.find("qmc at 64 rays"), std::string::npos) << c.reason;
+}
+
+TEST(Choose, TheOneLineSummarySaysWhatWasChosenAndWhy) {
+  const Asset& a = bunny_ground();
+  ProductRequest r;
+  r.ao = true;
+  const IntegratorChoice c = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{},
+                                               ChooserOptions{.target = 2e-3, .only = IntegratorKind::Silhouette});
+  const std::string line = choice_summary(c);
+  EXPECT_EQ(line.find('\n'), std::string::npos) << line;
+  for (const std::string& s : {std::string("target error 0.002: chosen silhouette at N = ") + std::to_string(c.spec.isolines()),
+                              std::string("predicted error "), std::string(" µs per integral"),
+                              "(pilot on " + std::to_string(c.pilot_points) + " seeded points, "})
+    EXPECT_NE(line.find(s), std::string::npos) << "missing '" << s << "' in " << line;
 }
 
 TEST(Choose, TheTargetCheckSaysMetNotMetOrNotVerifiable) {

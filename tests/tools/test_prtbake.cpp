@@ -146,16 +146,29 @@ TEST(Prtbake, SameSeedGivesIdenticalBytesWhateverTheThreadCount) {
 }
 
 TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
-  // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: the
-  // pilot table (on 1839 / 16 = 114 vertices), the choice and the report's verdict on 128.
+  // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: one
+  // line saying what was chosen and why (the pilot on 1839 / 64 = 28, so at least 32, vertices),
+  // with -v the pilot's table instead, and the report's verdict on 128.
   const fs::path out = scratch("target.prt.h5");
-  const Outcome r =
-      run("vertex " + (kData / "bunny.obj").string() + " --ao --target-error 2e-3 --integrator silhouette -o " + out.string());
+  const std::string bake = "vertex " + (kData / "bunny.obj").string() + " --ao --target-error 2e-3 --integrator silhouette -o " +
+                           out.string();
+  const Outcome r = run(bake);
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const char* s : {"target error 0.002: pilot on 114 seeded points", "model: silhouette", "chosen: silhouette at N = ",
-                        "on 128 seeded vertices", "target 0.002 for AO: met"})
+  for (const char* s : {"target error 0.002: chosen silhouette at N = ", "predicted error ", " µs per integral",
+                        "(pilot on 32 seeded points, ", "on 128 seeded vertices", "target 0.002 for AO: met"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
-  EXPECT_EQ(r.out.find("model: qmc"), std::string::npos) << "--integrator keeps the kind:\n" << r.out;
+  for (const char* s : {"model: ", "chosen: ", "µs/integral"})
+    EXPECT_EQ(r.out.find(s), std::string::npos) << "the table is printed only with -v:\n" << r.out;
+  const Outcome v = run(bake + " -v");
+  ASSERT_EQ(v.code, 0) << v.err;
+  for (const char* s : {"target error 0.002: pilot on 32 seeded points", "model: silhouette", "chosen: silhouette at N = ",
+                        "target 0.002 for AO: met"})
+    EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
+  EXPECT_EQ(v.out.find("model: qmc"), std::string::npos) << "--integrator keeps the kind:\n" << v.out;
+  // -v and --quiet contradict each other: a usage error, nothing baked.
+  fs::remove(out);
+  EXPECT_EQ(run(bake + " -v --quiet").code, 2);
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {

@@ -102,6 +102,7 @@ struct Args {
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;
+  bool verbose = false;  // vertex: the pilot's whole table, not its one-line summary
   bool flip_normals = false;  // vertex: reverse every triangle and file normal
   double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
@@ -109,7 +110,8 @@ struct Args {
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
-// (without --threads, --quiet, --dry-run, --reproducible); "--opt=value" is stored as "--opt value".
+// (without --threads, --quiet, --verbose, --dry-run, --reproducible); "--opt=value" is stored as
+// "--opt value".
 std::string content_command_line(int argc, char** argv) {
   std::string line = "prtbake";
   for (int i = 1; i < argc; ++i) {
@@ -120,7 +122,8 @@ std::string content_command_line(int argc, char** argv) {
       if (eq == std::string::npos) ++i;
       continue;
     }
-    if (s == "--quiet" || s == "-q" || s == "--dry-run" || s == "--reproducible") continue;
+    if (s == "--quiet" || s == "-q" || s == "--verbose" || s == "-v" || s == "--dry-run" || s == "--reproducible")
+      continue;
     line += " " + s;
     if (eq != std::string::npos) line += " " + value;
   }
@@ -246,11 +249,11 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "and their errors measured against a 256- or 512-isoline silhouette\n"
                  "reference). E in [1e-4, 0.1].\n"
                  "With --integrator, only its samples are chosen; not with --samples.\n"
-                 "The choice is printed; the error report (on 128 vertices when\n"
-                 "--target-error is given, unless --report says otherwise) then\n"
-                 "checks E. Which integrator wins is measured speed: pin the printed\n"
-                 "choice with --integrator and --samples, or use --reproducible, for\n"
-                 "the same bytes anywhere.")
+                 "The choice is printed in one line (with -v, the pilot's table);\n"
+                 "the error report (on 128 vertices when --target-error is given,\n"
+                 "unless --report says otherwise) then checks E. Which integrator\n"
+                 "wins is measured speed: pin the printed choice with --integrator\n"
+                 "and --samples, or use --reproducible, for the same bytes anywhere.")
       ->option_text("E")
       ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
@@ -270,6 +273,10 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
              std::to_string(bake::IntegratorSpec::kQmcReferenceFactor) + "x the bake's rays for qmc, " +
                  std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays for silhouette");
   add_run_options(cmd, a);
+  cmd.add_flag("-v,--verbose", a.verbose,
+               "with a target error: print the pilot's table (each run's error and\n"
+               "cost, each integrator's model) instead of one line.")
+      ->excludes("--quiet");
 }
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
@@ -556,8 +563,10 @@ int run_vertex(const Args& a) {
     const bake::IntegratorChoice choice = bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req,
                                                                   a.integrator, copt, progress, &accel);
     spec = choice.spec;
-    if (say)
+    if (say && a.verbose)
       for (const std::string& line : bake::choice_lines(choice)) std::printf("%s\n", line.c_str());
+    else if (say)
+      std::printf("%s\n", bake::choice_summary(choice).c_str());
   }
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =

@@ -11,8 +11,8 @@
 //     environment's, which E cannot know).
 // Every requested product must meet E.
 //
-// The pilot (choose_integrator), on a seeded sample of the bake's shade points (a sixteenth of
-// them, 32 to 128):
+// The pilot (choose_integrator), on a seeded sample of the bake's shade points (a 64th of them,
+// 32 to 128):
 //  1. reference: the silhouette integrator at N_ref = 256 u-isolines for E >= 5e-4, else 512,
 //     exact up to its isoline discretisation, which falls as ~N^-1.5..-2 (bench/RESULTS.md,
 //     error against time): ~6e-5 AO RMSE on the bunny at 256, ~3e-5 at 512, a tenth or less of
@@ -24,14 +24,15 @@
 //     it and the one before; the last two when none does), a clamped to [0.5, 3], solved for
 //     the smallest even N with RMSE <= 0.7·E
 //     (ChooserOptions: the safety factors);
-//  3. QMC at 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
+//  3. QMC at 64, 256, 1024 and 4096 rays (stopping once two levels are run and the last meets the
 //     goal, 0.8·E for QMC): the same against the reference; RMSE(R) = C R^-b with b fitted between the levels
 //     that bracket the goal (the last two when none meets it) and clamped to [0.5, 1]
 //     (randomised QMC converges between the Monte Carlo rate 1/2 and 1; ~0.7 on the bunny),
 //     solved for the rays, rounded up to an eighth of an octave (randomised Halton points
 //     stratify any count);
 //     the levels stop early once one misses the goal at a cost per integral above the
-//     silhouette prediction (QMC cannot win then: more rays cost more);
+//     silhouette prediction (QMC cannot win then: more rays cost more), or when even its best
+//     case (rate 1: R·e/goal rays at this level's cost per ray) costs twice that prediction;
 //  4. costs: the CPU time of every pilot integral (each thread's own CPU clock, so the thread
 //     count does not enter), per point; silhouette cost(N) linear in N through the measured
 //     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays;
@@ -70,8 +71,12 @@ struct ChooserOptions {
   static constexpr uint32_t kReportPoints = 128;
   double target = 1e-3;                       // E, see the file comment
   std::optional<IntegratorKind> only;         // choose only this kind's knob
-  // Seeded shade points of the pilot: a sixteenth of the bake's, at least 32 (all of them if
-  // fewer) and at most this.
+  // Seeded shade points of the pilot: a kPilotFraction-th of the bake's, at least 32 (all of
+  // them if fewer) and at most this. A pilot point costs ~4-5 bake integrals (the reference at
+  // 256 isolines ~2, the levels 32 and 64 ~2, QMC at 64 rays ~0.5 on small assets), so a 64th
+  // keeps the pilot under ~10% of the bake from 2,048 shade points up (bench_target_error: a
+  // 16th cost 0.1-0.2 CPU s, 24-73% of the bakes of 1.5k-4k vertices); from 8,192 up it is 128.
+  static constexpr uint32_t kPilotFraction = 64;
   uint32_t pilot_points = 128;
   // Aim at safety·E: the pilot's RMSE is itself an estimate from a sample. The silhouette
   // integrator's error is a discretisation error concentrated at a few vertices (a heavy-tailed
@@ -135,6 +140,9 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 // What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
 // and the choice, one line each, then a hint when the call was close (margin < 1.25).
 std::vector<std::string> choice_lines(const IntegratorChoice& choice);
+// The same in one line: the target, what was chosen and why (IntegratorChoice::reason: its
+// predicted error and µs per integral), and the pilot's size and time.
+std::string choice_summary(const IntegratorChoice& choice);
 
 // After the bake, one line per product: its error in the target's units against the target,
 // "met", "NOT met", or "not verifiable here" when it is above E but the reference's own estimated
