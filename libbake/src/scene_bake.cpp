@@ -143,7 +143,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       copt.counted_costs = scene.counted_costs;
       ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor, &accel);
       ob.integrator = ob.choice->spec;
-      for (const std::string& line : choice_lines(*ob.choice)) log(scene.objects[i].name + ": " + line);
+      log(scene.objects[i].name + ": " + choice_summary(*ob.choice));
       own_integ = make_integrator(ob.integrator, occluders, topo, r, &accel);
       if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r, &accel);
     }
