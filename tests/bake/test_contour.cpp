@@ -400,6 +400,46 @@ TEST(ContourFinder, MatchesBruteForceOnSubdividedBunnyOnGround) {
   expect_equal_on_edges_faces_and_extremes(s, 15, 15, "bunny_ground (loop x1)");
 }
 
+// The finder stores each edge's record oriented by its face 1's winding, so the tree changes
+// with the windings while the contour sets must not: the bunny with every face's winding chosen
+// at random (seeded), near and far from the origin, against the brute force and against the
+// bunny as wound in the file; then a soup of random triangles over a small vertex pool
+// (inconsistent windings, edges with 1, 2 and 3+ faces, a duplicated position making repeated
+// welded corners, slivers), near and far from the origin.
+TEST(ContourFinder, MatchesBruteForceWithRandomWindings) {
+  const Scene b = load("bunny.obj");
+  std::mt19937_64 rng(16);
+  std::vector<std::array<uint32_t, 3>> tris = b.mesh.triangles;
+  for (auto& t : tris)
+    if (rng() & 1) std::swap(t[1], t[2]);
+  Scene r{prt::bake::make_mesh(b.mesh.positions, tris, "random windings", b.mesh.normals), {}};
+  r.topo = prt::bake::build_topology(r.mesh);
+  ASSERT_EQ(r.topo.edges, b.topo.edges);
+  expect_equal_to_brute_force(r, 100, 17, "bunny, random windings");
+  expect_equal_to_brute_force(transformed(r.mesh, 1, 1e5), 100, 18, "bunny, random windings, +1e5");
+  expect_equal_on_edges_faces_and_extremes(r, 20, 19, "bunny, random windings");
+  const ContourFinder in_file(b.mesh, b.topo), random(r.mesh, r.topo);
+  std::vector<ContourEdge> x, y;
+  for (const auto& sp : sample_points(b.mesh, 60, 20)) {
+    in_file.find(sp, x);
+    random.find(sp, y);
+    EXPECT_EQ(x, y);
+  }
+
+  std::uniform_real_distribution<float> U(-1, 1);
+  std::vector<Vector3f> pool;
+  for (int i = 0; i < 40; ++i) pool.push_back({U(rng), U(rng), U(rng)});
+  pool.push_back(pool[0]);                                             // welds with vertex 0
+  pool.push_back(0.5f * (pool[1] + pool[2]) + Vector3f(1e-7f, 0, 0));  // nearly on the edge 1–2
+  std::vector<std::array<uint32_t, 3>> soup = {{0, 40, 3}, {1, 2, 41}, {2, 1, 41}};
+  for (int i = 0; i < 300; ++i)
+    soup.push_back({uint32_t(rng() % pool.size()), uint32_t(rng() % pool.size()), uint32_t(rng() % pool.size())});
+  Scene s{prt::bake::make_mesh(pool, soup, "soup"), {}};
+  s.topo = prt::bake::build_topology(s.mesh);
+  expect_equal_on_edges_faces_and_extremes(s, 60, 21, "soup");
+  expect_equal_on_edges_faces_and_extremes(transformed(s.mesh, 1, 1e5), 60, 22, "soup+1e5");
+}
+
 // ------------------------------------------------------------ known cases
 
 Scene make(std::vector<Vector3f> pos, std::vector<std::array<uint32_t, 3>> tris) {
