@@ -28,6 +28,8 @@
 //        float), is evaluated in float: δ_node = δ + 1.01·10uf·(|q|₁ + max|c|₁ + max|D|). A node
 //        is pruned only when its whole range is beyond ±δ_node, i.e. when every face of every
 //        edge under it has an exactly known σ that makes S = 0.
+//    A record stored negated (oriented by its face 1's winding) changes none of this: negation
+//    is exact, and the leaf's contour sign is negated back.
 //    Points with |q|₁ ≥ 1e30 (beyond float) take the brute-force path. Faces with η > 1e-6
 //    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
 //    the always-tested list.
@@ -393,9 +395,11 @@ inline f4 max4(f4 x, f4 y) {  // x > y ? x : y
 #endif
 }
 
-// The dual segment of a BVH edge in double: ĝ_1 and −ĝ_2.
+// The dual segment of a BVH edge in double: ĝ_1 and −ĝ_2, both negated when `flipped` (see
+// the constructor: the record is oriented by face 1's winding).
 struct DualEdge {
   double g1[4], g2[4];
+  bool flipped;
 };
 
 // A BVH edge during the build: the box of its four corners (the finder's frame) and of its two
@@ -513,10 +517,22 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
     eta_max = std::max({eta_max, d1.eta, d2.eta});
     const Eigen::Vector3d ap = (wp[ia].cast<double>() - origin_) * scale_;
     amax = std::max(amax, ap.cwiseAbs().sum());
+    // The record's orientation. Negating both ĝ_1 and −ĝ_2 leaves the test unchanged (a record
+    // is skipped iff its two values have the same sign), so each record is stored with face 1's
+    // normal along its winding: N_1 = (b−a)×(c_1−a) follows the edge's index order (a < b), whose
+    // direction relative to the face is arbitrary, so neighbouring edges of a smooth surface
+    // would otherwise sit at ±n at random and a node mixing both could never be pruned. On a
+    // consistently wound surface every record's normal is then the surface normal, and the
+    // build groups neighbours by position without splitting them by sign. The sign is decided
+    // combinatorially (face 1 runs b → a), so nothing about the values changes but their sign.
+    const auto& t1 = mesh.triangles[faces[0]];
+    const uint32_t w1[3] = {topology.weld[t1[0]], topology.weld[t1[1]], topology.weld[t1[2]]};
     DualEdge r{};
+    r.flipped = (w1[0] == ib && w1[1] == ia) || (w1[1] == ib && w1[2] == ia) || (w1[2] == ib && w1[0] == ia);
+    const double orient = r.flipped ? -1.0 : 1.0;
     for (int i = 0; i < 4; ++i) {
-      r.g1[i] = d1.g[i];
-      r.g2[i] = -d2.g[i];
+      r.g1[i] = orient * d1.g[i];
+      r.g2[i] = -orient * d2.g[i];
     }
     Corners cr{};
     for (int i = 0; i < 3; ++i) {
@@ -616,7 +632,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
             blk.g[4 + i][j] = float(d.g2[i]);
           }
           corners_.push_back(crs[items[begin + j].record]);
-          blk.edge[j] = crs[items[begin + j].record].edge;
+          blk.edge[j] = crs[items[begin + j].record].edge | (d.flipped ? kFlipBit : 0u);
         } else {  // padding: both values 1e38, above any tolerance, never undecided
           blk.g[3][j] = blk.g[7][j] = 1e38f;
           corners_.push_back(Corners{});
@@ -696,6 +712,8 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   collapse_wide(nodes);
   // Wide nodes and the walk's queue tag leaf blocks with bit 31 (kLeafBit).
   PRT_CHECK(wide_.size() < (size_t(1) << 31) && blocks_.size() < (size_t(1) << 31));
+  // Leaf blocks tag flipped records with bit 31 of their edge index (kFlipBit).
+  PRT_CHECK(E < (size_t(1) << 31));
   // A node's bound is evaluated in float: q rounded to float (uf|q_i|), x = q − c, the products
   // with box normals ≤ 1 + uf and the sum of four terms: at most 7uf(|q|₁ + |c|₁ + |D|),
   // uf = 2⁻²⁴; 10uf, and δ_node rounded to float upward by the 1.01, cover it.
@@ -862,7 +880,8 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
         const uint32_t block = item & ~kLeafBit;
         if constexpr (Count) work.records += kLeafSize;
         // Both face values of the leaf's four records at once; only undecided ones branch.
-        // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ_rec.
+        // v1 ∝ π_1 (σ_1 = −sign v1), v2 ∝ −π_2 (σ_2 = sign v2) whenever |v| > δ_rec, both
+        // negated for a flipped record.
         const LeafBlock& blk = blocks[block];
         const f4 v1 = load(blk.g[0]) * qx + load(blk.g[1]) * qy + load(blk.g[2]) * qz + load(blk.g[3]);
         const f4 v2 = load(blk.g[4]) * qx + load(blk.g[5]) * qy + load(blk.g[6]) * qz + load(blk.g[7]);
@@ -870,17 +889,19 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
         for (unsigned live = ~lanes(same) & 0xFu; live != 0; live &= live - 1) {
           const int j = std::countr_zero(live);
           const size_t at = size_t(block) * kLeafSize + size_t(j);
+          const uint32_t edge = blk.edge[j] & ~kFlipBit;
+          const int two = (blk.edge[j] & kFlipBit) ? -2 : 2;  // a flipped record's values are negated
           int s;
           if (v1[j] > delta_rec && v2[j] < -delta_rec) {
-            s = -2;
+            s = -two;
           } else if (v1[j] < -delta_rec && v2[j] > delta_rec) {
-            s = 2;
+            s = two;
           } else {
             if constexpr (Count) ++work.exact;
             const Corners& c = corners_[at];
             s = orient_eps_f(c.a, c.b, c.c1, p, nn, tt) + orient_eps_f(c.a, c.b, c.c2, p, nn, tt);
           }
-          if (s != 0) emit(blk.edge[j], s);
+          if (s != 0) emit(edge, s);
         }
         continue;
       }

@@ -400,6 +400,58 @@ TEST(ContourFinder, MatchesBruteForceOnSubdividedBunnyOnGround) {
   expect_equal_on_edges_faces_and_extremes(s, 15, 15, "bunny_ground (loop x1)");
 }
 
+// The scene with the winding of each face i for which flip(i) reversed.
+template <class Flip>
+Scene rewound(const Scene& s, Flip flip, const char* name) {
+  std::vector<std::array<uint32_t, 3>> tris = s.mesh.triangles;
+  for (size_t i = 0; i < tris.size(); ++i)
+    if (flip(i)) std::swap(tris[i][1], tris[i][2]);
+  Scene r{prt::bake::make_mesh(s.mesh.positions, tris, name, s.mesh.normals), {}};
+  r.topo = prt::bake::build_topology(r.mesh);
+  return r;
+}
+
+// find() gives the same contour sets on both scenes (the same positions, other windings).
+void expect_same_contours(const Scene& a, const Scene& b, int count, uint64_t seed) {
+  const ContourFinder fa(a.mesh, a.topo), fb(b.mesh, b.topo);
+  std::vector<ContourEdge> x, y;
+  for (const auto& sp : sample_points(a.mesh, count, seed)) {
+    fa.find(sp, x);
+    fb.find(sp, y);
+    EXPECT_EQ(x, y);
+  }
+}
+
+// The finder stores each edge's record oriented by its face 1's winding, so the tree changes
+// with the windings while the contour sets must not: the bunny with every face's winding chosen
+// at random (seeded), near and far from the origin, against the brute force and against the
+// bunny as wound in the file; then a soup of random triangles over a small vertex pool
+// (inconsistent windings, edges with 1, 2 and 3+ faces, a duplicated position making repeated
+// welded corners, slivers), near and far from the origin.
+TEST(ContourFinder, MatchesBruteForceWithRandomWindings) {
+  const Scene b = load("bunny.obj");
+  std::mt19937_64 rng(16);
+  const Scene r = rewound(b, [&rng](size_t) { return (rng() & 1) != 0; }, "random windings");
+  ASSERT_EQ(r.topo.edges, b.topo.edges);
+  expect_equal_to_brute_force(r, 100, 17, "bunny, random windings");
+  expect_equal_to_brute_force(transformed(r.mesh, 1, 1e5), 100, 18, "bunny, random windings, +1e5");
+  expect_equal_on_edges_faces_and_extremes(r, 20, 19, "bunny, random windings");
+  expect_same_contours(b, r, 60, 20);
+
+  std::uniform_real_distribution<float> U(-1, 1);
+  std::vector<Vector3f> pool;
+  for (int i = 0; i < 40; ++i) pool.push_back({U(rng), U(rng), U(rng)});
+  pool.push_back(pool[0]);                                             // welds with vertex 0
+  pool.push_back(0.5f * (pool[1] + pool[2]) + Vector3f(1e-7f, 0, 0));  // nearly on the edge 1–2
+  std::vector<std::array<uint32_t, 3>> soup = {{0, 40, 3}, {1, 2, 41}, {2, 1, 41}};
+  for (int i = 0; i < 300; ++i)
+    soup.push_back({uint32_t(rng() % pool.size()), uint32_t(rng() % pool.size()), uint32_t(rng() % pool.size())});
+  Scene s{prt::bake::make_mesh(pool, soup, "soup"), {}};
+  s.topo = prt::bake::build_topology(s.mesh);
+  expect_equal_on_edges_faces_and_extremes(s, 60, 21, "soup");
+  expect_equal_on_edges_faces_and_extremes(transformed(s.mesh, 1, 1e5), 60, 22, "soup+1e5");
+}
+
 // ------------------------------------------------------------ known cases
 
 Scene make(std::vector<Vector3f> pos, std::vector<std::array<uint32_t, 3>> tris) {
@@ -548,18 +600,9 @@ TEST(ContourKnown, GroundGridOnlyBoundaryEdges) {
 
 TEST(ContourKnown, RewindingHalfTheFacesChangesNothing) {
   const Scene s = load("bunny.obj");
-  std::vector<std::array<uint32_t, 3>> tris = s.mesh.triangles;
-  for (size_t i = 0; i < tris.size(); i += 2) std::swap(tris[i][1], tris[i][2]);
-  Scene r{prt::bake::make_mesh(s.mesh.positions, tris, "rewound", s.mesh.normals), {}};
-  r.topo = prt::bake::build_topology(r.mesh);
+  const Scene r = rewound(s, [](size_t i) { return i % 2 == 0; }, "rewound");
   ASSERT_EQ(r.topo.edges, s.topo.edges);
-  const ContourFinder fs_(s.mesh, s.topo), fr(r.mesh, r.topo);
-  std::vector<ContourEdge> a, b;
-  for (const auto& sp : sample_points(s.mesh, 60, 9)) {
-    fs_.find(sp, a);
-    fr.find(sp, b);
-    EXPECT_EQ(a, b);
-  }
+  expect_same_contours(s, r, 60, 9);
 }
 
 // Three pages on the edge (0,0,0)–(1,0,0), corners c = (0.5, cos φ, sin φ).

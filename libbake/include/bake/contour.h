@@ -18,12 +18,15 @@
 // miss an edge the exact test reports; every candidate is then decided exactly. Edges with 1 or
 // 3+ faces, or with a degenerate / ill-conditioned face, are always tested.
 //
-// The tree (output-sensitive: its work grows with the contour edges found, not the mesh): the
-// edges are grouped by position and normal (binned SAH over their corners' and normals' boxes),
-// and each node bounds its segments in its own frame — centre c, the box of the endpoints'
-// normals n and the range of D = d + n·c — so the value n·(q − c) + D is bounded by
-// Σ|q_i − c_i|·Δn_i + ΔD: tight for nodes near the shade point, where the hyperplane is
-// tangent to the dual surface. The binary tree is collapsed to a 4-wide one (children's bounds
+// The tree: each edge's dual segment is stored oriented by face 1's winding (negating both
+// endpoints changes no decision, and on a consistently wound surface neighbouring edges then
+// share one normal instead of ±n at random by their index order); the edges are grouped by
+// position and normal (binned SAH over their corners' and normals' boxes; a purely spatial
+// build, a normal-first one and a normal-cone node test were measured and visit more nodes or
+// cost more per node), and each node bounds its segments in its own frame — centre c, the box
+// of the endpoints' normals n and the range of D = d + n·c — so the value n·(q − c) + D is
+// bounded by Σ|q_i − c_i|·Δn_i + ΔD: tight for nodes near the shade point, where the
+// hyperplane is tangent to the dual surface. The binary tree is collapsed to a 4-wide one (children's bounds
 // side by side, tested four at a time in float), leaves are blocks of four edges tested four at
 // a time in float, and the walk is breadth-first with every queued node prefetched.
 #pragma once
@@ -124,9 +127,11 @@ private:
                         // is a leaf with D = +∞ (never passes)
   };
   static constexpr uint32_t kLeafBit = 0x80000000u;
+  static constexpr uint32_t kFlipBit = 0x80000000u;
   struct alignas(16) LeafBlock {  // a leaf's four BVH edges (padded), lane j = edge j: what the leaf test reads
-    float g[8][4];     // ĝ_1 (unit normal, offset) then −ĝ_2, finder frame, rounded to float
-    uint32_t edge[4];  // Topology edge indices (padding: 0, never read)
+    float g[8][4];     // ĝ_1 (unit normal, offset) then −ĝ_2, finder frame, rounded to float; both
+                       // negated when the record is flipped (oriented by face 1's winding)
+    uint32_t edge[4];  // Topology edge indices, | kFlipBit when flipped (padding: 0, never read)
   };
   struct Corners {  // the same edge's positions for the exact test (world frame), same order
     float a[3], b[3], c1[3], c2[3];
