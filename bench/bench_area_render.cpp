@@ -11,10 +11,15 @@
 // as one mesh), a 2 × 1.5 quad light, a second smaller quad tilted towards the boxes and a
 // two-sided disc: soft and hard penumbrae, umbrae, and light grazing the ground.
 //
+// Two shadings, each its own table: diffuse (albedo 1), and diffuse (albedo 0.5) + a GGX layer
+// (α 0.25, F0 0.04, the camera's eye; view/area_lights.h), whose analytic render goes through
+// linearly transformed cosines (prtshade/ltc.h: not exact, within the LTC fit's error) and whose
+// reference weighs each light sample by the BRDF.
+//
 // Usage: bench_area_render [--size WxH] [--converged N] [--images DIR]
 //   DIR (default docs/images of the source tree): area_equal_time.png (analytic | 1 ray | equal
 //   time | converged) and area_equal_time_error.png (|· − converged| false colour, same order
-//   minus the last).
+//   minus the last); area_equal_time_ggx.png and area_equal_time_ggx_error.png for the glossy one.
 #include <view/area_lights.h>
 #include <view/camera.h>
 #include <view/image.h>
@@ -74,6 +79,88 @@ std::vector<bake::AreaLight> scene_lights() {
 
 double cpu_seconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
+constexpr double kGlossyAlpha = 0.25;
+
+// The equal-time comparison for one shading (file comment): prints its table and writes
+// <stem>.png (analytic | 1 ray | equal time | converged) and <stem>_error.png.
+void compare(const bake::Mesh& mesh, const view::GBuffer& g, std::span<const bake::AreaLight> lights,
+             const view::AreaRenderOptions& shading, uint32_t converged, const char* title, const char* analytic_name,
+             const std::filesystem::path& stem) {
+  std::vector<uint8_t> mask(size_t(g.width) * size_t(g.height));
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = g.triangle[i] >= 0;
+  // The converged render first, on every thread.
+  view::AreaReferenceOptions conv;
+  conv.samples = converged;
+  conv.seed = 99;
+  conv.render = shading;
+  const auto w0 = std::chrono::steady_clock::now();
+  const view::AreaReferenceImage truth = view::render_area_reference(mesh, g, lights, conv);
+  const double conv_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+
+  view::Image analytic, one, equal;
+  double t_analytic = 0, t_one = 0, t_equal = 0;
+  uint32_t equal_rays = 1;
+  {
+    const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    double c = cpu_seconds();
+    analytic = view::render_area_analytic(mesh, g, lights, shading);
+    t_analytic = cpu_seconds() - c;
+    view::AreaReferenceOptions ro;
+    ro.samples = 1;
+    ro.seed = 1;
+    ro.render = shading;
+    c = cpu_seconds();
+    one = view::render_area_reference(mesh, g, lights, ro).radiance;
+    t_one = cpu_seconds() - c;
+    // Rays for equal time: a line t = a + b · rays through the 1-ray render and an 8-ray one
+    // (a: the ray tracer's BVH and per-pixel setup), then one correction by the measured ratio.
+    auto rays_for = [](double t) {
+      return t < 8 ? uint32_t(std::max(1.0, std::round(t))) : 8 * uint32_t(std::max(1.0, std::round(t / 8)));
+    };
+    ro.samples = 8;
+    c = cpu_seconds();
+    (void)view::render_area_reference(mesh, g, lights, ro);
+    const double t8 = cpu_seconds() - c;
+    const double b = std::max((t8 - t_one) / 7, 1e-12), a = std::max(t_one - b, 0.0);
+    equal_rays = rays_for((t_analytic - a) / b);
+    for (int pass = 0; pass < 2; ++pass) {
+      ro.samples = equal_rays;
+      c = cpu_seconds();
+      equal = view::render_area_reference(mesh, g, lights, ro).radiance;
+      t_equal = cpu_seconds() - c;
+      if (pass == 0) equal_rays = rays_for(double(equal_rays) * (t_analytic - a) / std::max(t_equal - a, 1e-12));
+    }
+  }
+  const view::ImageError ea = view::compare_images(analytic, truth.radiance, mask, &truth.std_error);
+  const view::ImageError e1 = view::compare_images(one, truth.radiance, mask, &truth.std_error);
+  const view::ImageError ee = view::compare_images(equal, truth.radiance, mask, &truth.std_error);
+
+  std::printf("%s. Converged: %u rays per pixel and light (seed 99), %.1f s wall on all threads; its own noise: %.2e of the range.\n\n", title,
+              converged, conv_wall, ea.ref_noise);
+  std::printf("| render | rays per pixel and light | CPU s | pixels/s | NRMSE vs converged | NRMSE, converged noise removed |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|\n");
+  auto row = [&](const char* what, const std::string& rays, double t, const view::ImageError& e) {
+    std::printf("| %s | %s | %.3f | %.0f | %.2e | %.2e |\n", what, rays.c_str(), t, double(g.covered()) / t, e.nrmse,
+                e.nrmse_noise_corrected);
+  };
+  row(analytic_name, "-", t_analytic, ea);
+  row("Embree, light sampling", "1", t_one, e1);
+  row("Embree, light sampling, equal time", std::to_string(equal_rays), t_equal, ee);
+
+  const double exposure = view::auto_exposure(truth.radiance, mask);
+  const std::vector<view::Image8> strip = {view::tone_map(analytic, exposure), view::tone_map(one, exposure),
+                                           view::tone_map(equal, exposure), view::tone_map(truth.radiance, exposure)};
+  const std::filesystem::path strip_file = stem.string() + ".png", error_file = stem.string() + "_error.png";
+  view::write_png(strip_file, view::hstack(strip));
+  const double range = ea.ref_max - ea.ref_min;
+  const std::vector<view::Image8> errs = {view::false_colour_error(analytic, truth.radiance, mask, range, 0.1),
+                                          view::false_colour_error(one, truth.radiance, mask, range, 0.1),
+                                          view::false_colour_error(equal, truth.radiance, mask, range, 0.1)};
+  view::write_png(error_file, view::hstack(errs));
+  std::printf("\nImages: %s (analytic | 1 ray | equal time | converged), %s (|render - converged|, full scale 10%% of the range)\n",
+              strip_file.c_str(), error_file.c_str());
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -104,79 +191,16 @@ int main(int argc, char** argv) {
   cam.width = W;
   cam.height = H;
   const view::GBuffer g = view::rasterize(mesh, cam);
-  std::vector<uint8_t> mask(size_t(W) * size_t(H));
-  for (size_t i = 0; i < mask.size(); ++i) mask[i] = g.triangle[i] >= 0;
-
-  // The converged render first, on every thread.
-  view::AreaReferenceOptions conv;
-  conv.samples = converged;
-  conv.seed = 99;
-  const auto w0 = std::chrono::steady_clock::now();
-  const view::AreaReferenceImage truth = view::render_area_reference(mesh, g, lights, conv);
-  const double conv_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-
-  view::Image analytic, one, equal;
-  double t_analytic = 0, t_one = 0, t_equal = 0;
-  uint32_t equal_rays = 1;
-  {
-    const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
-    double c = cpu_seconds();
-    analytic = view::render_area_analytic(mesh, g, lights);
-    t_analytic = cpu_seconds() - c;
-    view::AreaReferenceOptions ro;
-    ro.samples = 1;
-    ro.seed = 1;
-    c = cpu_seconds();
-    one = view::render_area_reference(mesh, g, lights, ro).radiance;
-    t_one = cpu_seconds() - c;
-    // Rays for equal time: a line t = a + b · rays through the 1-ray render and an 8-ray one
-    // (a: the ray tracer's BVH and per-pixel setup), then one correction by the measured ratio.
-    auto rays_for = [](double t) {
-      return t < 8 ? uint32_t(std::max(1.0, std::round(t))) : 8 * uint32_t(std::max(1.0, std::round(t / 8)));
-    };
-    ro.samples = 8;
-    c = cpu_seconds();
-    (void)view::render_area_reference(mesh, g, lights, ro);
-    const double t8 = cpu_seconds() - c;
-    const double b = std::max((t8 - t_one) / 7, 1e-12), a = std::max(t_one - b, 0.0);
-    equal_rays = rays_for((t_analytic - a) / b);
-    for (int pass = 0; pass < 2; ++pass) {
-      ro.samples = equal_rays;
-      c = cpu_seconds();
-      equal = view::render_area_reference(mesh, g, lights, ro).radiance;
-      t_equal = cpu_seconds() - c;
-      if (pass == 0) equal_rays = rays_for(double(equal_rays) * (t_analytic - a) / std::max(t_equal - a, 1e-12));
-    }
-  }
-  const view::ImageError ea = view::compare_images(analytic, truth.radiance, mask, &truth.std_error);
-  const view::ImageError e1 = view::compare_images(one, truth.radiance, mask, &truth.std_error);
-  const view::ImageError ee = view::compare_images(equal, truth.radiance, mask, &truth.std_error);
-
-  std::printf("Scene: ground + 3 boxes (%zu triangles), %zu lights (2 quads, a 32-gon disc), %dx%d pixels, %zu covered; one thread.\n",
+  std::printf("Scene: ground + 3 boxes (%zu triangles), %zu lights (2 quads, a 32-gon disc), %dx%d pixels, %zu covered; one thread.\n\n",
               mesh.triangles.size(), lights.size(), W, H, g.covered());
-  std::printf("Converged: %u rays per pixel and light (seed 99), %.1f s wall on all threads; its own noise: %.2e of the range.\n\n",
-              converged, conv_wall, ea.ref_noise);
-  std::printf("| render | rays per pixel and light | CPU s | pixels/s | NRMSE vs converged | NRMSE, converged noise removed |\n");
-  std::printf("|---|---:|---:|---:|---:|---:|\n");
-  auto row = [&](const char* what, const std::string& rays, double t, const view::ImageError& e) {
-    std::printf("| %s | %s | %.3f | %.0f | %.2e | %.2e |\n", what, rays.c_str(), t, double(g.covered()) / t, e.nrmse,
-                e.nrmse_noise_corrected);
-  };
-  row("analytic (exact soft shadows)", "-", t_analytic, ea);
-  row("Embree, light sampling", "1", t_one, e1);
-  row("Embree, light sampling, equal time", std::to_string(equal_rays), t_equal, ee);
-
   std::filesystem::create_directories(images);
-  const double exposure = view::auto_exposure(truth.radiance, mask);
-  const std::vector<view::Image8> strip = {view::tone_map(analytic, exposure), view::tone_map(one, exposure),
-                                           view::tone_map(equal, exposure), view::tone_map(truth.radiance, exposure)};
-  view::write_png(images / "area_equal_time.png", view::hstack(strip));
-  const double range = ea.ref_max - ea.ref_min;
-  const std::vector<view::Image8> errs = {view::false_colour_error(analytic, truth.radiance, mask, range, 0.1),
-                                          view::false_colour_error(one, truth.radiance, mask, range, 0.1),
-                                          view::false_colour_error(equal, truth.radiance, mask, range, 0.1)};
-  view::write_png(images / "area_equal_time_error.png", view::hstack(errs));
-  std::printf("\nImages: %s (analytic | 1 ray | equal time | converged), %s (|render - converged|, full scale 10%% of the range)\n",
-              (images / "area_equal_time.png").c_str(), (images / "area_equal_time_error.png").c_str());
+  view::AreaRenderOptions diffuse;
+  compare(mesh, g, lights, diffuse, converged, "Diffuse (albedo 1)", "analytic (exact soft shadows)", images / "area_equal_time");
+  view::AreaRenderOptions glossy;
+  glossy.albedo = {0.5, 0.5, 0.5};
+  glossy.ggx = view::GgxLayer{kGlossyAlpha, {0.04, 0.04, 0.04}, cam.eye};
+  std::printf("\n");
+  compare(mesh, g, lights, glossy, converged, "Diffuse (albedo 0.5) + GGX (alpha 0.25, F0 0.04)",
+          "analytic (exact soft shadows, GGX by LTC)", images / "area_equal_time_ggx");
   return 0;
 }

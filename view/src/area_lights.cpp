@@ -1,9 +1,14 @@
 #include <view/area_lights.h>
 
 #include <bake/area_bake.h>
+#include <bake/contour.h>
 #include <bake/error.h>
+#include <bake/occluder_mesh.h>
 #include <bake/raycast.h>
 #include <bake/sampling.h>
+#include <bake/spherical_polygon.h>
+
+#include <prtshade/ltc.h>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -91,6 +96,101 @@ double albedo_of(const Fragment& f, const AreaRenderOptions& o, size_t c) {
   return o.triangle_albedo.empty() ? o.albedo[c] : double(o.triangle_albedo[size_t(f.triangle)][c]);
 }
 
+namespace ltc = shade::ltc;
+
+// One light's terms at a shade point, at unit radiance: E and the GGX integral ∫ f cos with
+// F0 = 1 and with F0 = 0 (f is affine in F0: a channel mixes them with its F0).
+struct LightTerms {
+  double e = 0, spec1 = 0, spec0 = 0;
+};
+
+// The light's contribution to channel c (the file comment's sums).
+// `albedo`: the pixel's diffuse albedo in channel c (albedo_of).
+double channel(const bake::AreaLight& light, const LightTerms& t, const AreaRenderOptions& o, double albedo, size_t c) {
+  double v = albedo * light.radiance[c] * t.e * std::numbers::inv_pi;
+  if (o.ggx) v += light.radiance[c] * (o.ggx->f0[c] * t.spec1 + (1 - o.ggx->f0[c]) * t.spec0);
+  return v;
+}
+
+Vector3d view_direction(const GgxLayer& ggx, const Vector3d& p) { return (ggx.eye - p).normalized(); }
+
+// The lights' faces in the mesh's frame with their emitting sides, and the occluder mesh, for the
+// glossy analytic render: the visible arcs of every face facing p (as bake/area_bake.h selects
+// them: the side of p decided exactly against a point surely in front).
+class VisibleFaces {
+public:
+  VisibleFaces(std::span<const bake::AreaLight> lights, const bake::Mesh& mesh) : occluders_(relative_positions(mesh), mesh.triangles) {
+    for (const bake::AreaLight& light : lights) {
+      std::vector<Face>& faces = lights_.emplace_back();
+      Vector3d lo = light.vertices[0], hi = lo;
+      for (const Vector3d& v : light.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      for (size_t f = 0; f < light.faces.size(); ++f) {
+        Face face;
+        for (uint32_t i : light.faces[f]) face.v.push_back(light.vertices[i] - mesh.origin);
+        face.front = bake::orient3d_exact(face.v[0], face.v[1], face.v[2], face.v[0] + (hi - lo).norm() * light.face_normal(f));
+        face.two_sided = light.two_sided;
+        faces.push_back(std::move(face));
+      }
+    }
+  }
+  struct Workspace {
+    bake::OccluderMesh::Workspace occluders;
+    std::vector<bake::Arc> arcs;
+    std::vector<ltc::Arc> ltc_arcs;
+  };
+  // visit(arcs) for every face of light l that p sees from an emitting side, with its visible arcs.
+  template <class Visit>
+  void visit(size_t l, const bake::ShadePoint& sp, Workspace& ws, Visit&& visit) const {
+    for (const Face& f : lights_[l]) {
+      const int side = bake::orient3d_exact(f.v[0], f.v[1], f.v[2], sp.p);
+      if (side == 0 || (side != f.front && !f.two_sided)) continue;
+      occluders_.visible_light(f.v, sp, ws.arcs, ws.occluders);
+      if (!ws.arcs.empty()) visit(ws.arcs);
+    }
+  }
+
+private:
+  struct Face {
+    std::vector<Vector3d> v;
+    int front = 0;
+    bool two_sided = false;
+  };
+  static std::vector<Vector3d> relative_positions(const bake::Mesh& mesh) {
+    std::vector<Vector3d> p;
+    for (const auto& x : mesh.positions) p.push_back(x.cast<double>());
+    return p;
+  }
+  std::vector<std::vector<Face>> lights_;
+  bake::OccluderMesh occluders_;
+};
+
+Image render_glossy_analytic(const bake::Mesh& mesh, const bake::Mesh& blockers, const GBuffer& g,
+                             std::span<const bake::AreaLight> lights, const AreaRenderOptions& options, double epsilon) {
+  const VisibleFaces faces(lights, blockers);
+  const GgxLayer& ggx = *options.ggx;
+  tbb::enumerable_thread_specific<VisibleFaces::Workspace> workspaces;
+  return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
+    VisibleFaces::Workspace& ws = workspaces.local();
+    const bake::ShadePoint sp = shading_point(f, epsilon);
+    const Vector3d v = view_direction(ggx, sp.p);
+    const ltc::Lobe lobe = ltc::ggx_lobe(ltc::ggx_table(), {sp.n.x(), sp.n.y(), sp.n.z()}, {v.x(), v.y(), v.z()}, ggx.alpha);
+    std::array<double, 3> rgb{};
+    for (size_t l = 0; l < lights.size(); ++l) {
+      LightTerms t;
+      faces.visit(l, sp, ws, [&](const std::vector<bake::Arc>& arcs) {
+        t.e += sp.n.dot(bake::vector_irradiance(arcs));
+        ws.ltc_arcs.clear();
+        for (const bake::Arc& a : arcs) ws.ltc_arcs.push_back({{a.a.x(), a.a.y(), a.a.z()}, {a.b.x(), a.b.y(), a.b.z()}});
+        const double integral = ltc::integrate(lobe, ws.ltc_arcs);
+        t.spec1 += lobe.albedo * integral;
+        t.spec0 += lobe.fresnel * integral;
+      });
+      for (size_t c = 0; c < 3; ++c) rgb[c] += channel(lights[l], t, options, albedo_of(f, options, c), c);
+    }
+    for (size_t c = 0; c < 3; ++c) out[c] = float(rgb[c]);
+  });
+}
+
 } // namespace
 
 double area_shading_offset(const bake::Mesh& mesh) {
@@ -106,8 +206,10 @@ double area_shading_offset(const bake::Mesh& mesh) {
 Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
                            const AreaRenderOptions& options) {
   check_inputs(mesh, lights, options);
-  const bake::AreaLightIntegrator integrator(lights, casters(mesh, options), 0);
+  const bake::Mesh blockers = casters(mesh, options);
   const double epsilon = area_shading_offset(mesh);
+  if (options.ggx) return render_glossy_analytic(mesh, blockers, g, lights, options, epsilon);
+  const bake::AreaLightIntegrator integrator(lights, blockers, 0);
   tbb::enumerable_thread_specific<bake::AreaLightIntegrator::Workspace> workspaces;
   tbb::enumerable_thread_specific<std::vector<double>> rows([&] { return std::vector<double>(integrator.width()); });
   return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
@@ -139,11 +241,14 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
     const bake::ShadePoint sp = shading_point(f, epsilon);
     const uint64_t pixel = uint64_t(f.y) * uint64_t(g.width) + uint64_t(f.x);
     std::array<double, kReplicates * 3> means{};
+    const GgxLayer* ggx = options.render.ggx ? &*options.render.ggx : nullptr;
+    const Vector3d v = ggx ? view_direction(*ggx, sp.p) : Vector3d::Zero();
+    const ltc::Vec3 n3 = {sp.n.x(), sp.n.y(), sp.n.z()}, v3 = {v.x(), v.y(), v.z()};
     for (size_t l = 0; l < lights.size(); ++l) {
       const LightSurface& s = surfaces[l];
       for (uint32_t b = 0; b < B; ++b) {
         const bake::RotatedHalton3 halton(options.seed, (pixel * lights.size() + l) * kReplicates + b);
-        double sum = 0;
+        LightTerms sum;
         for (uint32_t i = 0; i < per; ++i) {
           const std::array<double, 3> u = halton(i);
           double u0 = 0;
@@ -159,11 +264,17 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
           const double cos_l = s.two_sided ? std::abs(t.normal.dot(w)) : -t.normal.dot(w);
           if (!(cos_p > 0) || !(cos_l > 0)) continue;
           if (rays.occluded(sp.p, w, 0.0, r * (1 - 1e-7))) continue;
-          sum += s.area() * cos_p * cos_l / r2;
+          const double e = s.area() * cos_p * cos_l / r2;
+          sum.e += e;
+          if (ggx) {
+            const ltc::Vec3 w3 = {w.x(), w.y(), w.z()};
+            sum.spec1 += ltc::ggx_brdf(n3, v3, w3, ggx->alpha, 1.0) * e;
+            sum.spec0 += ltc::ggx_brdf(n3, v3, w3, ggx->alpha, 0.0) * e;
+          }
         }
-        const double e = sum / per;  // this replicate's estimate of E_l
+        const LightTerms estimate = {sum.e / per, sum.spec1 / per, sum.spec0 / per};  // this replicate's
         for (size_t c = 0; c < 3; ++c)
-          means[b * 3 + c] += albedo_of(f, options.render, c) * lights[l].radiance[c] * e * std::numbers::inv_pi;
+          means[b * 3 + c] += channel(lights[l], estimate, options.render, albedo_of(f, options.render, c), c);
       }
     }
     for (size_t c = 0; c < 3; ++c) {

@@ -19,6 +19,15 @@
 //     with c_l = −n_f·ω on a face's emitting side (|n_f·ω| for two-sided lights) and 0 behind it:
 //     an unbiased estimate of E_l. With N ≥ 8 (a multiple of 8) the N points form 8 independent
 //     replicates whose spread gives the per-pixel standard error; fewer give no error estimate.
+// Glossy (AreaRenderOptions::ggx set): a GGX specular layer added to the diffuse one (no energy
+// exchange between the two; prtshade/ltc.h's BRDF: height-correlated Smith masking, Schlick's
+// Fresnel with per-channel F0, roughness α), with v = (eye − p')/|eye − p'| and n as above:
+//   L_o(p) += Σ_l radiance_l · ∫_{visible part of light l} f(v, ω) max(n·ω, 0) dω.
+//   * Analytic: each light face's visible arcs (bake/occluder_mesh.h OccluderMesh::visible_light,
+//     the faces and emitting sides decided as bake/area_bake.h does) integrated through the
+//     linearly transformed cosines of prtshade/ltc.h: (F0·A + (1 − F0)·B) · ∫ D_M; E from the same
+//     arcs. Not exact: within prtshade::ltc::error_bound per light (the fit's measured bound).
+//   * Reference: the same light samples also weigh f(v, ω) (an unbiased estimate of the integral).
 // Every pixel's value depends only on its own inputs and the seed: the same bytes for any thread
 // count. Uncovered pixels are 0.
 #pragma once
@@ -29,15 +38,25 @@
 #include <bake/lights.h>
 #include <bake/mesh.h>
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 namespace prt::view {
 
+struct GgxLayer {
+  double alpha = 0.3;                        // GGX roughness (the LTC table covers [0.01, 1])
+  std::array<double, 3> f0{0.04, 0.04, 0.04};  // Schlick's F0 per channel
+  Eigen::Vector3d eye{0, 0, 1};              // the camera's eye, in the frame of the G-buffer's points
+};
+
 struct AreaRenderOptions {
   std::array<double, 3> albedo{1, 1, 1};
+  std::optional<GgxLayer> ggx;  // unset: diffuse only
   // Scenes of several objects (prtview on scene files), one entry per triangle of the rendered
   // mesh; empty vectors keep the single-object behaviour. casts_shadow[t] == 0: triangle t is drawn
   // but blocks no light (a bake's "receiver" objects); triangle_albedo[t] replaces `albedo` there.
@@ -45,7 +64,7 @@ struct AreaRenderOptions {
   std::vector<std::array<float, 3>> triangle_albedo;
 };
 
-// Exact: E per light from the closed forms (above).
+// Exact: E per light from the closed forms (above); the glossy layer through LTC.
 Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
                            const AreaRenderOptions& options = {});
 
