@@ -9,6 +9,7 @@
 #include <formats/prtfile.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -97,6 +98,12 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
                           " objects); objects without it per pixel, exactly";
   options.casts_shadow = scene.casts_shadow;
   options.triangle_albedo = scene.albedo;
+  if (options.ggx) {
+    options.ggx->eye -= scene.mesh.origin;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " + GGX alpha %.3g, F0 %.3g through LTC", options.ggx->alpha, options.ggx->f0[0]);
+    scene.how += buf;
+  }
 
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   const bool any_per_pixel = std::find(per_pixel.begin(), per_pixel.end(), 1) != per_pixel.end();

@@ -32,7 +32,9 @@ namespace prt::prtview {
 std::vector<bake::AreaLight> read_area_lights(const formats::Asset& f, const std::string& file);
 
 // Fills `scene` (mesh, receivers, casters, albedo, objects) and returns the runtime picture.
-// `exact`: area-exact (above), else area. `options` gets the casters and albedos for the reference.
+// `exact`: area-exact (above), else area. `options` gets the casters and albedos for the reference;
+// a GGX layer already in it (--ggx: area-exact only) has its eye in world space and is moved into
+// the scene mesh's frame here.
 view::Image render_area_file(const formats::Asset& f, const std::string& file, const std::vector<bake::AreaLight>& lights,
                              bool exact, const view::Camera& cam, RenderScene& scene, view::AreaRenderOptions& options);
 

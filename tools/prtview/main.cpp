@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -151,6 +152,7 @@ struct Args {
   std::optional<double> exposure;
   double error_scale = 0.1;
   prtview::FivView fiv;
+  std::string ggx;  // --ggx ALPHA[,F0]
   bool quiet = false;
   int threads = 0;
 };
@@ -217,6 +219,10 @@ std::optional<Args> parse(int argc, char** argv) {
                  "transfer | band1 | fiv (default: fiv if the file has /fiv, else transfer if it has "
                  "/transfer/diffuse, else band1); scene files with area lights: area | area-exact (see WHAT IS DRAWN).")
       ->check(CLI::IsMember({"transfer", "band1", "fiv", "area", "area-exact"}));
+  app.add_option("--ggx", a.ggx,
+                 "ALPHA[,F0]: --shade area-exact only: add a GGX specular layer of roughness ALPHA in [0.01, 1] and "
+                 "Schlick F0 in [0, 1] (default 0.04) over the diffuse albedo, per pixel through linearly transformed "
+                 "cosines (our own fit: prtshade/ltc.h); the reference weights its light samples by the same BRDF.");
   app.add_option("--samples", a.samples,
                  "reference: QMC shadow rays per pixel, a multiple of 8: 8 independent randomised-QMC replicates of "
                  "N/8 rays; their spread gives the standard error (default 1024).")
@@ -398,6 +404,25 @@ int run(const Args& a) {
 
   prtview::RenderScene scene;
   view::AreaRenderOptions area_options;
+  if (!a.ggx.empty()) {
+    if (a.shade != "area-exact") throw UsageError("--ggx applies to --shade area-exact only");
+    view::GgxLayer layer;
+    const size_t comma = a.ggx.find(',');
+    char* end = nullptr;
+    layer.alpha = std::strtod(a.ggx.c_str(), &end);
+    const bool alpha_ok = end == a.ggx.c_str() + (comma == std::string::npos ? a.ggx.size() : comma);
+    double f0 = 0.04;
+    bool f0_ok = true;
+    if (comma != std::string::npos) {
+      f0 = std::strtod(a.ggx.c_str() + comma + 1, &end);
+      f0_ok = comma + 1 < a.ggx.size() && end == a.ggx.c_str() + a.ggx.size();
+    }
+    if (!alpha_ok || !f0_ok || !(layer.alpha >= 0.01 && layer.alpha <= 1) || !(f0 >= 0 && f0 <= 1))
+      throw UsageError("--ggx: expected ALPHA[,F0] with ALPHA in [0.01, 1] and F0 in [0, 1], got '" + a.ggx + "'");
+    layer.f0 = {f0, f0, f0};
+    layer.eye = cam.eye;  // world space: render_area_file moves it into the mesh's frame
+    area_options.ggx = layer;
+  }
   Timer t_run;
   const view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
                               : kind == "scene" ? prtview::render_scene_file(f, a.file, *env, cam, scene)
