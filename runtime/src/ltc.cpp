@@ -78,7 +78,9 @@ double error_bound(const Table& t, double alpha, double cos_theta, double f0) {
 }
 
 std::array<double, Table::kValuesPerNode> lookup(const Table& t, double alpha, double cos_theta) {
-  const auto [i, j, u, w] = locate(t, alpha, cos_theta);
+  const auto cell = locate(t, alpha, cos_theta);
+  const int i = cell.i, j = cell.j;  // not a structured binding: clang 14 cannot capture those
+  const double u = cell.u, w = cell.w;
   std::array<double, Table::kValuesPerNode> out{};
   const auto node = [&](int di, int dj) { return t.values + ((i + di) * t.n_theta + (j + dj)) * Table::kValuesPerNode; };
   for (int k = 0; k < Table::kValuesPerNode; ++k)
