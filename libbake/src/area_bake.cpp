@@ -41,24 +41,17 @@ AreaLightIntegrator::AreaLightIntegrator(std::span<const AreaLight> lights, cons
 void AreaLightIntegrator::integrate(const ShadePoint& point, std::span<double> out, Workspace& ws) const {
   PRT_CHECK(out.size() == width());
   std::fill(out.begin(), out.end(), 0.0);
-  std::vector<Arc>& arcs = ws.arcs;
   std::vector<double>& sh = ws.sh;
   sh.resize(order_ > 0 ? size_t(order_) * size_t(order_) : 0);
   for (size_t l = 0; l < faces_.size(); ++l) {
     const std::span<double> row = out.subspan(l * per_light(), per_light());
-    for (const Face& f : faces_[l]) {
-      const std::vector<Eigen::Vector3d>& v = f.vertices;
-      const int side = orient3d_exact(v[0], v[1], v[2], point.p);
-      if (side == 0) continue;  // p in the face's plane: it subtends no solid angle
-      if (side != f.front_side && !f.two_sided) continue;  // its back
-      occluders_.visible_light(v, point, arcs, ws.occluders);
-      if (arcs.empty()) continue;
+    for_each_visible_face(point, l, ws, [&](const std::vector<Arc>& arcs) {
       row[0] += point.n.dot(vector_irradiance(arcs));
       if (order_ > 0) {
         sh_.project(std::span<const Arc>(arcs), sh);
         for (size_t i = 0; i < sh.size(); ++i) row[1 + i] += sh[i];
       }
-    }
+    });
   }
 }
 

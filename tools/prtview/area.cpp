@@ -70,7 +70,8 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
       std::vector<const bake::AreaLight*> column;
       for (const std::string& n : names) {
         const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
-        if (it == lights.end()) throw InputError(file, "object '" + o.name + "': area_lights/irradiance names light '" + n + "', which /lights does not hold");
+        if (it == lights.end()) throw InputError(file, "object '" + o.name + "': " + std::string(N::kAreaIrradiance).substr(1) + " names light '" + n +
+                                                    "', which " + std::string(N::kLights) + " does not hold");
         column.push_back(&*it);
       }
       const size_t L = column.size();
@@ -90,7 +91,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
     parts.push_back(o.mesh);
   }
   if (!exact && baked == 0)
-    throw InputError(file, "holds no " + std::string(N::kAreaLightsGroup) + "/irradiance for any object: use --shade area-exact");
+    throw InputError(file, "holds no " + std::string(N::kAreaIrradiance) + " for any object: use --shade area-exact");
   scene.mesh = bake::merge_meshes(parts, "scene");
   scene.what = "scene: " + std::to_string(objects.size()) + " objects, " + std::to_string(lights.size()) + " area light(s), their direct light only";
   scene.how = exact ? "per pixel: exact soft shadows of the stored lights (render_area_analytic), times the albedo / pi"

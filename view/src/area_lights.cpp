@@ -114,74 +114,26 @@ double channel(const bake::AreaLight& light, const LightTerms& t, const AreaRend
 
 Vector3d view_direction(const GgxLayer& ggx, const Vector3d& p) { return (ggx.eye - p).normalized(); }
 
-// The lights' faces in the mesh's frame with their emitting sides, and the occluder mesh, for the
-// glossy analytic render: the visible arcs of every face facing p (as bake/area_bake.h selects
-// them: the side of p decided exactly against a point surely in front).
-class VisibleFaces {
-public:
-  VisibleFaces(std::span<const bake::AreaLight> lights, const bake::Mesh& mesh) : occluders_(relative_positions(mesh), mesh.triangles) {
-    for (const bake::AreaLight& light : lights) {
-      std::vector<Face>& faces = lights_.emplace_back();
-      Vector3d lo = light.vertices[0], hi = lo;
-      for (const Vector3d& v : light.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-      for (size_t f = 0; f < light.faces.size(); ++f) {
-        Face face;
-        for (uint32_t i : light.faces[f]) face.v.push_back(light.vertices[i] - mesh.origin);
-        face.front = bake::orient3d_exact(face.v[0], face.v[1], face.v[2], face.v[0] + (hi - lo).norm() * light.face_normal(f));
-        face.two_sided = light.two_sided;
-        faces.push_back(std::move(face));
-      }
-    }
-  }
-  struct Workspace {
-    bake::OccluderMesh::Workspace occluders;
-    std::vector<bake::Arc> arcs;
-    std::vector<ltc::Arc> ltc_arcs;
-  };
-  // visit(arcs) for every face of light l that p sees from an emitting side, with its visible arcs.
-  template <class Visit>
-  void visit(size_t l, const bake::ShadePoint& sp, Workspace& ws, Visit&& visit) const {
-    for (const Face& f : lights_[l]) {
-      const int side = bake::orient3d_exact(f.v[0], f.v[1], f.v[2], sp.p);
-      if (side == 0 || (side != f.front && !f.two_sided)) continue;
-      occluders_.visible_light(f.v, sp, ws.arcs, ws.occluders);
-      if (!ws.arcs.empty()) visit(ws.arcs);
-    }
-  }
-
-private:
-  struct Face {
-    std::vector<Vector3d> v;
-    int front = 0;
-    bool two_sided = false;
-  };
-  static std::vector<Vector3d> relative_positions(const bake::Mesh& mesh) {
-    std::vector<Vector3d> p;
-    for (const auto& x : mesh.positions) p.push_back(x.cast<double>());
-    return p;
-  }
-  std::vector<std::vector<Face>> lights_;
-  bake::OccluderMesh occluders_;
-};
-
 Image render_glossy_analytic(const bake::Mesh& mesh, const bake::Mesh& blockers, const GBuffer& g,
                              std::span<const bake::AreaLight> lights, const AreaRenderOptions& options, double epsilon) {
-  const VisibleFaces faces(lights, blockers);
+  const bake::AreaLightIntegrator faces(lights, blockers, 0);
   const GgxLayer& ggx = *options.ggx;
-  tbb::enumerable_thread_specific<VisibleFaces::Workspace> workspaces;
+  tbb::enumerable_thread_specific<bake::AreaLightIntegrator::Workspace> workspaces;
+  tbb::enumerable_thread_specific<std::vector<ltc::Arc>> ltc_workspaces;
   return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
-    VisibleFaces::Workspace& ws = workspaces.local();
+    bake::AreaLightIntegrator::Workspace& ws = workspaces.local();
+    std::vector<ltc::Arc>& ltc_arcs = ltc_workspaces.local();
     const bake::ShadePoint sp = shading_point(f, epsilon);
     const Vector3d v = view_direction(ggx, sp.p);
     const ltc::Lobe lobe = ltc::ggx_lobe(ltc::ggx_table(), {sp.n.x(), sp.n.y(), sp.n.z()}, {v.x(), v.y(), v.z()}, ggx.alpha);
     std::array<double, 3> rgb{};
     for (size_t l = 0; l < lights.size(); ++l) {
       LightTerms t;
-      faces.visit(l, sp, ws, [&](const std::vector<bake::Arc>& arcs) {
+      faces.for_each_visible_face(sp, l, ws, [&](const std::vector<bake::Arc>& arcs) {
         t.e += sp.n.dot(bake::vector_irradiance(arcs));
-        ws.ltc_arcs.clear();
-        for (const bake::Arc& a : arcs) ws.ltc_arcs.push_back({{a.a.x(), a.a.y(), a.a.z()}, {a.b.x(), a.b.y(), a.b.z()}});
-        const double integral = ltc::integrate(lobe, ws.ltc_arcs);
+        ltc_arcs.clear();
+        for (const bake::Arc& a : arcs) ltc_arcs.push_back({{a.a.x(), a.a.y(), a.a.z()}, {a.b.x(), a.b.y(), a.b.z()}});
+        const double integral = ltc::integrate(lobe, ltc_arcs);
         t.spec1 += lobe.albedo * integral;
         t.spec0 += lobe.fresnel * integral;
       });

@@ -20,12 +20,14 @@
 // their digits; shade points are in the mesh's frame, as every integrator's.
 #pragma once
 
+#include <bake/contour.h>
 #include <bake/lights.h>
 #include <bake/mesh.h>
 #include <bake/occluder_mesh.h>
 #include <bake/polygon_sh.h>
 
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace prt::bake {
@@ -51,6 +53,22 @@ public:
   // out[l·per_light() + 0] = E_l, out[l·per_light() + 1 + i] = S_l,i (file comment). Thread-safe
   // with one Workspace per thread.
   void integrate(const ShadePoint& point, std::span<double> out, Workspace& ws) const;
+
+  // visit(arcs) for every face of light `light` that the point sees from an emitting side, with
+  // the face's visible part (ws.arcs: past the occluders, clipped to the horizon; never empty):
+  // what integrate() sums, for callers that integrate something else over it (view/area_lights.h:
+  // a GGX lobe).
+  template <class Visit>
+  void for_each_visible_face(const ShadePoint& point, size_t light, Workspace& ws, Visit&& visit) const {
+    for (const Face& f : faces_[light]) {
+      const std::vector<Eigen::Vector3d>& v = f.vertices;
+      const int side = orient3d_exact(v[0], v[1], v[2], point.p);
+      if (side == 0) continue;                              // p in the face's plane: no solid angle
+      if (side != f.front_side && !f.two_sided) continue;  // its back
+      occluders_.visible_light(v, point, ws.arcs, ws.occluders);
+      if (!ws.arcs.empty()) visit(std::as_const(ws.arcs));
+    }
+  }
 
 private:
   struct Face {
