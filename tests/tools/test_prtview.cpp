@@ -169,6 +169,35 @@ TEST(Prtview, Band1OfAnOpenPlaneMatchesTheReference) {
   fs::remove(h5);
 }
 
+TEST(Prtview, AoFileNeedsNoCameraAndShowsTheAoUnderAWhiteSky) {
+  // An open plane's AO is exactly 1 (nothing above it; the silhouette integrator finds no contour
+  // edge and uses the closed form). Without --env the sky is a constant white L = 1, so the runtime
+  // shows AO x pi / pi = 1 and the reference is exactly L = 1 (zero noise, as above): the error is
+  // float32 rounding of AO, E and E/pi, a few 1e-8, far below 1e-6.
+  const fs::path h5 = scratch("ao_plane.prt.h5"), out = scratch("ao_plane.png");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --ao --samples 64 --report 0 --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const Outcome r = view(h5.string() + " --size 40x30 --samples 8 --error -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_LT(nrmse(r.out), 1e-6) << r.out;
+  EXPECT_NE(r.out.find("constant white sky"), std::string::npos) << r.out;
+  // No camera: the asset is framed and the camera printed, ready to copy into --camera.
+  const std::string key = "framing the asset: --camera ";
+  const size_t at = r.out.find(key);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string cam = r.out.substr(at + key.size(), r.out.find('\n', at) - at - key.size());
+  const Outcome again = view(h5.string() + " --size 40x30 --camera " + cam + " -o " + out.string());
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{40, 30}));
+  // Asked for a product the file lacks: the message names it and what the file can show.
+  const Outcome w = view(h5.string() + " --shade band1 -o " + scratch("w.png").string());
+  EXPECT_EQ(w.code, 1);
+  EXPECT_NE(w.err.find("no dataset /radiance/band1 (it can be shown with --shade ao)"), std::string::npos) << w.err;
+  expect_no_output(scratch("w.png"));
+  fs::remove(out);
+  fs::remove(h5);
+}
+
 TEST(Prtview, FivTriptychOfACopiedOccluder) {
   // A small cube occluder (fast to bake at coarse shells) shown as two copies on the ground.
   const fs::path cube = scratch("cube.obj"), h5 = scratch("cube.prt.h5"), out = scratch("cube.png");

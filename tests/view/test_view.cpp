@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -211,6 +212,43 @@ TEST(Camera, ParsesAndRejects) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "image size '0x5': width and height must be in [1, 16384]");
   }
+}
+
+TEST(Camera, FrameBoxShowsEveryCornerAndItsTextFormReadsBack) {
+  // frame_box: each of the box's corners projects inside the picture, |x/z| <= aspect tan(fov/2)
+  // and |y/z| <= tan(fov/2) in camera space, and the nearest fit leaves a 5% margin: the widest
+  // corner is at 1/1.05 of the half-width or half-height (to rounding).
+  const Vector3d lo(-3, 0.5, -1), hi(5, 2, 9);
+  for (const Vector3d& up : {Vector3d(0, 1, 0), Vector3d(0, 0, 1)})
+    for (const auto& [W, H] : {std::pair{200, 100}, std::pair{100, 200}, std::pair{64, 64}}) {
+      const Camera c = frame_box(lo, hi, up, W, H);
+      ASSERT_EQ(c.problem(), "");
+      EXPECT_NEAR((c.at - 0.5 * (lo + hi)).norm(), 0, 1e-12);
+      EXPECT_GT(c.true_up().dot(up), 0.5) << "the box's up is the picture's up";
+      EXPECT_LT(c.forward().dot(up), -0.3) << "looking down at it";
+      const double t = std::tan(0.5 * c.fov_y_degrees * pi / 180), aspect = double(W) / H;
+      double widest = 0;
+      for (int k = 0; k < 8; ++k) {
+        const Vector3d q(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+        const Vector3d v = q - c.eye;
+        const double z = v.dot(c.forward());
+        ASSERT_GT(z, c.near_depth());
+        EXPECT_LE(std::abs(v.dot(c.right()) / z), aspect * t) << "corner " << k << " " << W << "x" << H;
+        EXPECT_LE(std::abs(v.dot(c.true_up()) / z), t) << "corner " << k << " " << W << "x" << H;
+        widest = std::max({widest, std::abs(v.dot(c.right()) / z) / (aspect * t), std::abs(v.dot(c.true_up()) / z) / t});
+      }
+      EXPECT_NEAR(widest, 1 / 1.05, 1e-9) << "the nearest distance that shows every corner";
+      // The text form reads back to the same camera (9 significant digits).
+      const Camera back = parse_camera(to_string(c), W, H);
+      EXPECT_LT((back.eye - c.eye).norm(), 1e-8 * c.eye.norm() + 1e-12);
+      EXPECT_LT((back.at - c.at).norm(), 1e-8 * (c.eye - c.at).norm());
+      EXPECT_NEAR(back.fov_y_degrees, c.fov_y_degrees, 1e-12);
+    }
+  // A point: the box of half-size 1 around it.
+  const Camera p = frame_box(Vector3d(1, 2, 3), Vector3d(1, 2, 3), Vector3d(0, 1, 0), 64, 64);
+  EXPECT_EQ(p.problem(), "");
+  EXPECT_NEAR((p.at - Vector3d(1, 2, 3)).norm(), 0, 1e-15);
+  EXPECT_GT((p.eye - p.at).norm(), std::sqrt(3.0)) << "outside the box";
 }
 
 // ---- rasterizer ---------------------------------------------------------------------------------------

@@ -41,8 +41,10 @@ namespace {
 
 constexpr const char* kDescription =
     "prtview - render a baked file shaded by the runtime library, next to ray-traced ground truth\n\n"
-    "  prtview FILE.prt.h5 --camera eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG] -o IMAGE.png|IMAGE.exr\n"
-    "          [--env ENV.exr] [--size WxH] [--reference | --error | --triptych] [OPTIONS]\n";
+    "  prtview FILE.prt.h5 -o IMAGE.png|IMAGE.exr [--camera eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]]\n"
+    "          [--env ENV.exr] [--size WxH] [--reference | --error | --triptych] [OPTIONS]\n\n"
+    "  A first look needs only the file and an image: 'prtview baked.prt.h5 -o look.png' frames the\n"
+    "  whole asset and prints the camera it chose, to copy into --camera and adjust.\n";
 
 constexpr const char* kFooter = R"(
 WHAT IS DRAWN
@@ -50,7 +52,7 @@ WHAT IS DRAWN
   the irradiance; a constant sky of radiance L shows as L (scene files: times each object's
   albedo). Three kinds of file:
 
-  per-vertex files (/mesh + /transfer/diffuse or /radiance/band1, from 'prtbake vertex'):
+  per-vertex files (/mesh + /transfer/diffuse, /radiance/band1 or /ao, from 'prtbake vertex'):
     the mesh is rasterized (software, top-left fill rule, z-buffer, perspective-correct
     interpolation), each vertex is shaded by prtshade and the colours are interpolated across
     triangles (Gouraud), as an engine would:
@@ -59,6 +61,11 @@ WHAT IS DRAWN
                 any environment works: the transfer does not depend on the lighting.
       band1     E = 4pi/3 sum_m y_1m(n) R_m at the baked normal (prt::shade::shade_band1): exact
                 all-frequency shadows under the environment the file was baked with.
+      ao        AO x E_unocc(n)/pi at each vertex, E_unocc the environment's unshadowed
+                irradiance at the baked normal (bake/irradiance.h): the ambient-occlusion
+                approximation. Without --env: a constant white sky (L = 1), so the picture IS
+                the AO (1 = white, 0 = black) and the reference is the true AO of each pixel.
+    The default --shade is the first the file holds of transfer, band1, ao.
   FIV files (/fiv from 'prtbake fiv', paper 004): the occluder mesh (from --occluder-mesh, else
     the file's 'source' attribute; its SHA-256 must match the file's) stands on a square ground
     plane (the receiver), and each pixel is shaded by prtshade: the ground with
@@ -210,15 +217,16 @@ std::optional<Args> parse(int argc, char** argv) {
                  "scene files must be shown under the environment they were baked with (checked by SHA-256).");
   app.add_option("--camera", a.camera,
                  "eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]: eye, at (required), up (default 0,1,0), fov = vertical "
-                 "field of view in degrees (default 45); world units of the mesh.");
+                 "field of view in degrees (default 45); world units of the mesh. Default: a three-quarter view "
+                 "from above the front that frames the whole asset (printed, to copy and adjust).");
   app.add_option("--size", size, "WxH: image size in pixels (default 256x256).");
   app.add_flag("--reference", reference, "write the ray-traced reference instead of the runtime render.");
   app.add_flag("--error", error, "write a false-colour map of |runtime - reference| and print NRMSE.");
   app.add_flag("--triptych", triptych, "write runtime | reference | error side by side and print NRMSE.");
   app.add_option("--shade", a.shade,
-                 "transfer | band1 | fiv (default: fiv if the file has /fiv, else transfer if it has "
-                 "/transfer/diffuse, else band1); scene files with area lights: area | area-exact (see WHAT IS DRAWN).")
-      ->check(CLI::IsMember({"transfer", "band1", "fiv", "area", "area-exact"}));
+                 "transfer | band1 | ao | fiv (default: fiv if the file has /fiv, else the first it holds of "
+                 "transfer, band1, ao); scene files with area lights: area | area-exact (see WHAT IS DRAWN).")
+      ->check(CLI::IsMember({"transfer", "band1", "ao", "fiv", "area", "area-exact"}));
   app.add_option("--ggx", a.ggx,
                  "ALPHA[,F0]: --shade area-exact only: add a GGX specular layer of roughness ALPHA in [0.01, 1] and "
                  "Schlick F0 in [0, 1] (default 0.04) over the diffuse albedo, per pixel through linearly transformed "
@@ -301,7 +309,6 @@ std::optional<Args> parse(int argc, char** argv) {
   if (a.file.empty()) throw UsageError("no FILE.prt.h5 given");
   if (a.output.empty()) throw UsageError("no output given (-o IMAGE.png or IMAGE.exr)");
   if (a.output == "-") throw UsageError("-o -: prtview writes image files, not standard output; give -o IMAGE.png or IMAGE.exr");
-  if (a.camera.empty()) throw UsageError("no camera given (--camera eye=X,Y,Z:at=X,Y,Z)");
   const std::string ext = fs::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr") throw UsageError("-o: '" + a.output + "' must end in .png or .exr");
   return a;
@@ -365,7 +372,8 @@ int run(const Args& a) {
   const bool say = !a.quiet;
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-  const view::Camera cam = [&] {
+  const std::optional<view::Camera> given_camera = [&]() -> std::optional<view::Camera> {
+    if (a.camera.empty()) return std::nullopt;  // framed once the file is read
     try {
       return view::parse_camera(a.camera, a.width, a.height);
     } catch (const bake::InputError& e) {  // a command-line value is malformed (exit 2, as --size)
@@ -390,16 +398,24 @@ int run(const Args& a) {
   } else if (prtview::is_scene_file(f)) {
     kind = "scene";
   } else if (kind.empty()) {
-    kind = prtview::has_fiv(f) ? "fiv" : prtview::has_transfer(f) ? "transfer" : "band1";
+    const std::vector<std::string> kinds = prtview::vertex_kinds(f);
+    kind = prtview::has_fiv(f) ? "fiv" : kinds.empty() ? "band1" : kinds.front();  // band1: its read names what is missing
   }
+  if (kind != "scene" && kind != "fiv" && !area && prtview::has_fiv(f))
+    throw UsageError("--shade " + kind + ": " + a.file + " is an FIV file; it is shown with --shade fiv (the default)");
+  if (kind == "transfer" || kind == "band1" || kind == "ao") prtview::require_vertex_kind(f, a.file, kind);
+  const view::Camera cam = given_camera ? *given_camera : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height);
+  // AO needs an environment only to weigh it: without one (AO files name none), a white sky.
+  const bool white_sky = kind == "ao" && a.env.empty();
   if ((kind == "scene" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
                                     !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
     throw UsageError("--shade (except area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
                      "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
                      "'prtview --help')");
-  const std::string env_path = area ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
-  const std::optional<bake::EnvMap> env =
-      area ? std::nullopt : std::optional<bake::EnvMap>(bake::EnvMap::load(env_path, prtview::up_axis(f)));
+  const std::string env_path = area || white_sky ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
+  const std::optional<bake::EnvMap> env = area        ? std::nullopt
+                                          : white_sky ? std::optional<bake::EnvMap>(bake::EnvMap::constant({1, 1, 1}))
+                                                      : std::optional<bake::EnvMap>(bake::EnvMap::load(env_path, prtview::up_axis(f)));
   const std::vector<bake::AreaLight> lights = area ? prtview::read_area_lights(f, a.file) : std::vector<bake::AreaLight>{};
 
   prtview::RenderScene scene;
@@ -431,8 +447,10 @@ int run(const Args& a) {
   const double runtime_seconds = t_run.seconds();
   if (say) {
     std::printf("%s: %s\n", a.file.c_str(), scene.what.c_str());
-    if (env) std::printf("environment: %s (%dx%d %s)\n", env_path.c_str(), env->info().width, env->info().height, env->info().layout.c_str());
-    std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
+    if (white_sky) std::printf("environment: a constant white sky (L = 1): the picture is the AO itself (--env ENV.exr to light it)\n");
+    else if (env) std::printf("environment: %s (%dx%d %s)\n", env_path.c_str(), env->info().width, env->info().height, env->info().layout.c_str());
+    if (given_camera) std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
+    else std::printf("view: %dx%d, framing the asset: --camera %s\n", a.width, a.height, view::to_string(cam).c_str());
     std::printf("runtime: %s: %.3f s\n", scene.how.c_str(), runtime_seconds);
     std::fflush(stdout);
   }

@@ -45,6 +45,15 @@ void check_same_environment(const Baked& baked, const std::string& where, const 
                                             sha.substr(0, 12) + "...)");
 }
 
+// What a per-vertex file can be shown with instead, for the message of a missing product.
+std::string root_hint(const F::Asset& f) {
+  const std::vector<std::string> kinds = vertex_kinds(f);
+  if (kinds.empty()) return " (it holds no per-vertex product prtview shades: AO, diffuse transfer or band-1 radiance)";
+  std::string hint = " (it can be shown with";
+  for (size_t i = 0; i < kinds.size(); ++i) hint += (i ? i + 1 == kinds.size() ? " or " : ", " : " ") + ("--shade " + kinds[i]);
+  return hint + ")";
+}
+
 // `name` as given, else next to `beside` (a file), when that exists.
 std::string found_beside(const std::string& name, const std::string& beside) {
   if (!fs::exists(name) && fs::exists(fs::path(beside).parent_path() / name)) return (fs::path(beside).parent_path() / name).string();
@@ -56,6 +65,15 @@ std::string found_beside(const std::string& name, const std::string& beside) {
 bool is_scene_file(const F::Asset& f) { return f.scene || !f.objects.empty(); }
 bool has_fiv(const F::Asset& f) { return f.irradiance_cube.has_value(); }
 bool has_transfer(const F::Asset& f) { return f.vertices.transfer_diffuse.has_value(); }
+bool has_band1(const F::Asset& f) { return f.vertices.radiance_band1.has_value(); }
+bool has_ao(const F::Asset& f) { return f.vertices.ao.has_value(); }
+std::vector<std::string> vertex_kinds(const F::Asset& f) {
+  std::vector<std::string> kinds;
+  if (has_transfer(f)) kinds.push_back("transfer");
+  if (has_band1(f)) kinds.push_back("band1");
+  if (has_ao(f)) kinds.push_back("ao");
+  return kinds;
+}
 bake::UpAxis up_axis(const F::Asset& f) { return f.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y; }
 
 std::string baked_environment(const F::Asset& f, const std::string& file) {
@@ -95,15 +113,28 @@ bake::Mesh read_mesh(const F::Asset& f, const std::string& file, const std::stri
 Transfer read_transfer(const F::Asset& f, const std::string& file, const std::string& object) {
   const std::optional<F::Product>& t = vertex_set(f, file, object).transfer_diffuse;
   const std::string path = cat(prefix_of(object), N::kTransferDiffuse);
-  if (!t) throw InputError(file, "no dataset " + path + (object.empty() ? " (try --shade band1)" : ""));
+  if (!t) throw InputError(file, "no dataset " + path + (object.empty() ? root_hint(f) : ""));
   if (!t->sh_order) throw InputError(file, path + " lacks the attribute " + quoted(N::kShOrder));
   return {int(*t->sh_order), t->values.data()};
+}
+
+void require_vertex_kind(const F::Asset& f, const std::string& file, const std::string& kind) {
+  const std::vector<std::string> kinds = vertex_kinds(f);
+  if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) return;
+  const std::string_view path = kind == "transfer" ? N::kTransferDiffuse : kind == "band1" ? N::kRadianceBand1 : N::kAo;
+  throw InputError(file, "no dataset " + std::string(path) + root_hint(f));
+}
+
+const std::vector<float>& read_ao(const F::Asset& f, const std::string& file, const std::string& object) {
+  const std::optional<F::Product>& ao = vertex_set(f, file, object).ao;
+  if (!ao) throw InputError(file, "no dataset " + cat(prefix_of(object), N::kAo) + (object.empty() ? root_hint(f) : ""));
+  return ao->values;
 }
 
 Band1 read_band1(const F::Asset& f, const std::string& file, const std::string& object, const bake::EnvMap& env) {
   const F::VertexSet& s = vertex_set(f, file, object);
   const std::string prefix = prefix_of(object), path = cat(prefix, N::kRadianceBand1);
-  if (!s.radiance_band1) throw InputError(file, "no dataset " + path + (object.empty() ? " (try --shade transfer)" : ""));
+  if (!s.radiance_band1) throw InputError(file, "no dataset " + path + (object.empty() ? root_hint(f) : ""));
   check_same_environment(*s.radiance_band1, path, env, file);
   if (!s.normals) throw InputError(file, "no dataset " + cat(prefix, N::kNormals));
   return {s.normals->values.data(), s.radiance_band1->values.data()};

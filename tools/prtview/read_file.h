@@ -23,6 +23,14 @@ namespace prt::prtview {
 bool is_scene_file(const formats::Asset& f);
 bool has_fiv(const formats::Asset& f);
 bool has_transfer(const formats::Asset& f);
+bool has_band1(const formats::Asset& f);
+bool has_ao(const formats::Asset& f);
+// The --shade kinds a per-vertex file (its root layout) can be shown with, in the default's order
+// of preference (transfer, band1, ao): what a hint names when the asked kind is missing.
+std::vector<std::string> vertex_kinds(const formats::Asset& f);
+// Throws InputError naming the missing dataset and the kinds the file can be shown with, unless
+// the root layout holds `kind`'s product ("transfer", "band1" or "ao").
+void require_vertex_kind(const formats::Asset& f, const std::string& file, const std::string& kind);
 bake::UpAxis up_axis(const formats::Asset& f);
 // The environment the file names (the 'environment' of the scene, of the irradiance cube or of
 // the root band-1 radiance), found as given, next to the file, or next to the scene file. Throws
@@ -37,6 +45,8 @@ struct Transfer {
   const float* coeffs = nullptr;
 };
 Transfer read_transfer(const formats::Asset& f, const std::string& file, const std::string& object);
+// AO [V] of a vertex set.
+const std::vector<float>& read_ao(const formats::Asset& f, const std::string& file, const std::string& object);
 // Band-1 radiance [V][3][3] baked under `env` (checked), with the baked normals [V][3].
 struct Band1 {
   const float* normals = nullptr;

@@ -64,6 +64,28 @@ std::vector<float> band1_colours(const Band1& b, size_t V, std::string& how) {
   return colour;
 }
 
+// AO x the unshadowed irradiance at the vertex normal / pi: the runtime's DifMap when there is one
+// (lookup_difmap), else the exact texel sum (bake::UnshadowedIrradiance) — the ambient-occlusion
+// approximation of E/pi.
+std::vector<float> ao_colours(const std::vector<float>& ao, const bake::Mesh& mesh, const shade::DifMap* difmap,
+                              const bake::UnshadowedIrradiance* exact, std::string& how) {
+  const size_t V = mesh.positions.size();
+  std::vector<float> colour(3 * V);
+  for (size_t v = 0; v < V; ++v) {
+    const float n[3] = {mesh.normals[v].x(), mesh.normals[v].y(), mesh.normals[v].z()};
+    float e[3];
+    if (difmap) {
+      shade::lookup_difmap(*difmap, n, e);
+    } else {
+      const bake::Rgb u = (*exact)(mesh.normals[v].cast<double>());
+      e[0] = float(u.r), e[1] = float(u.g), e[2] = float(u.b);
+    }
+    for (size_t c = 0; c < 3; ++c) colour[3 * v + c] = ao[v] * e[c] * float(std::numbers::inv_pi);
+  }
+  how = std::string("AO x ") + (difmap ? "DifMap (lookup_difmap)" : "exact unshadowed irradiance") + " / pi";
+  return colour;
+}
+
 } // namespace
 
 view::Image render_vertex_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
@@ -71,9 +93,46 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
   scene.mesh = read_mesh(f, file, "");
   const size_t V = scene.mesh.positions.size();
   scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
-  const std::vector<float> colour = kind == "transfer" ? transfer_colours(read_transfer(f, file, ""), env, V, scene.how)
-                                                       : band1_colours(read_band1(f, file, "", env), V, scene.how);
+  std::vector<float> colour;
+  if (kind == "transfer") {
+    colour = transfer_colours(read_transfer(f, file, ""), env, V, scene.how);
+  } else if (kind == "band1") {
+    colour = band1_colours(read_band1(f, file, "", env), V, scene.how);
+  } else {
+    const bake::UnshadowedIrradiance exact(env);
+    colour = ao_colours(read_ao(f, file, ""), scene.mesh, nullptr, &exact, scene.how);
+    scene.how += " per vertex, Gouraud";
+  }
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
+}
+
+view::Camera first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height) {
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  const auto grow = [&](const std::optional<F::Array<double>>& positions) {
+    if (!positions) return;
+    const auto& p = positions->values;
+    for (size_t i = 0; i + 2 < p.size(); i += 3) {
+      const Vector3d q(p[i], p[i + 1], p[i + 2]);
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+  };
+  if (is_scene_file(f)) {
+    for (const F::SceneObject& o : f.objects) grow(o.set.positions);
+  } else if (has_fiv(f)) {
+    const F::Occluder* o = f.find_occluder(choose_occluder(f, file, options.occluder));
+    const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
+    const std::vector<Vector3d> inst = options.instances.empty() ? std::vector<Vector3d>{Vector3d::Zero()} : options.instances;
+    for (const Vector3d& t : inst) {
+      lo = lo.cwiseMin(c + t - Vector3d::Constant(2 * o->radius));
+      hi = hi.cwiseMax(c + t + Vector3d::Constant(2 * o->radius));
+    }
+  } else {
+    grow(f.vertices.positions);
+  }
+  if (!lo.allFinite() || !hi.allFinite()) throw bake::InputError(file, "holds no geometry to look at (no vertex positions)");
+  const Vector3d up = up_axis(f) == bake::UpAxis::Z ? Vector3d::UnitZ() : Vector3d::UnitY();
+  return view::frame_box(lo, hi, up, width, height);
 }
 
 view::Image render_fiv_file(const F::Asset& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
@@ -193,22 +252,9 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       rgb_of[k] = transfer_colours(*o.transfer, env, V, unused);
       how_of[k] = "diffuse transfer (project_latlong + shade_transfer)";
     } else if (o.ao) {
-      // AO x the unshadowed irradiance at the vertex normal: the runtime's DifMap when the file has
-      // one (lookup_difmap), else the exact texel sum (bake::UnshadowedIrradiance).
       if (!difmap && !exact) exact.emplace(env);
-      rgb_of[k].resize(3 * V);
-      for (size_t v = 0; v < V; ++v) {
-        const float n[3] = {o.mesh.normals[v].x(), o.mesh.normals[v].y(), o.mesh.normals[v].z()};
-        float e[3];
-        if (difmap) {
-          shade::lookup_difmap(*difmap, n, e);
-        } else {
-          const bake::Rgb u = (*exact)(o.mesh.normals[v].cast<double>());
-          e[0] = float(u.r), e[1] = float(u.g), e[2] = float(u.b);
-        }
-        for (size_t c = 0; c < 3; ++c) rgb_of[k][3 * v + c] = (*o.ao)[v] * e[c] * float(std::numbers::inv_pi);
-      }
-      how_of[k] = std::string("AO x ") + (difmap ? "DifMap (lookup_difmap)" : "exact unshadowed irradiance") + " / pi" + glossy_note;
+      rgb_of[k] = ao_colours(*o.ao, o.mesh, difmap ? &*difmap : nullptr, exact ? &*exact : nullptr, how_of[k]);
+      how_of[k] += glossy_note;
     } else if (o.shells) {
       how_of[k] = "FIV self-shadows per pixel minus the other FIV occluders' shadows (shade_fiv_member)" + glossy_note;
     } else {

@@ -37,7 +37,7 @@ struct RenderScene {
   std::vector<size_t> first_triangle;
 };
 
-// Per-vertex files: kind "transfer" or "band1".
+// Per-vertex files: kind "transfer", "band1" or "ao".
 view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
                                const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 
@@ -48,6 +48,12 @@ struct FivView {
   std::optional<double> ground, ground_size;
   bool overlap = true, partial = true;
 };
+// The camera of a first look when none is given (view::frame_box): framing every object of a
+// scene file, the mesh of a per-vertex file, or an FIV file's occluder copies (their bounding
+// spheres, widened by R so that their shadows on the ground show).
+view::Camera first_look_camera(const formats::Asset& f, const std::string& file, const FivView& options, int width,
+                               int height);
+
 view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
                             const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 

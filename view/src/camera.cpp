@@ -4,7 +4,9 @@
 #include <bake/error.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <numbers>
 #include <string>
@@ -41,6 +43,42 @@ std::string Camera::problem() const {
 
 void Camera::validate() const {
   if (const std::string p = problem(); !p.empty()) throw InputError("camera", p);
+}
+
+Camera frame_box(const Vector3d& lo, const Vector3d& hi, const Vector3d& up, int width, int height, double fov_y_degrees) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fov_y_degrees = fov_y_degrees;
+  c.up = up.normalized();
+  const Vector3d front = std::abs(c.up.z()) > 0.5 ? Vector3d(0, -1, 0) : Vector3d(0, 0, 1);
+  const Vector3d side = c.up.cross(front);
+  const Vector3d toward_eye = (0.35 * side + 0.5 * c.up + front).normalized();
+  // A point becomes the box of half-size 1 around it.
+  const Vector3d pad = (hi - lo).norm() > 0 ? Vector3d::Zero() : Vector3d::Ones();
+  const Vector3d a = lo - pad, b = hi + pad;
+  c.at = 0.5 * (a + b);
+  // Camera space of the eye c.at + d w: forward −w, right r, true up u; a corner at offset o from
+  // the centre has depth z = d − o·w and is in the picture when |o·r| <= tan(fov_x/2) z and
+  // |o·u| <= tan(fov_y/2) z: the smallest d that holds for every corner, with a 5% margin.
+  c.eye = c.at + toward_eye;
+  const Vector3d r = c.right(), u = c.true_up();
+  const double ty = std::tan(0.5 * fov_y_degrees * std::numbers::pi / 180.0) / 1.05;
+  const double tx = ty * double(width) / double(height);
+  double d = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Vector3d o = Vector3d(k & 1 ? b.x() : a.x(), k & 2 ? b.y() : a.y(), k & 4 ? b.z() : a.z()) - c.at;
+    d = std::max({d, o.dot(toward_eye) + std::abs(o.dot(r)) / tx, o.dot(toward_eye) + std::abs(o.dot(u)) / ty});
+  }
+  c.eye = c.at + d * toward_eye;
+  return c;
+}
+
+std::string to_string(const Camera& c) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "eye=%.9g,%.9g,%.9g:at=%.9g,%.9g,%.9g:up=%.9g,%.9g,%.9g:fov=%.9g", c.eye.x(), c.eye.y(),
+                c.eye.z(), c.at.x(), c.at.y(), c.at.z(), c.up.x(), c.up.y(), c.up.z(), c.fov_y_degrees);
+  return buf;
 }
 
 namespace {

@@ -45,6 +45,18 @@ struct Camera {
 // "eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEGREES]" (any order, each key at most once; eye and at
 // required). Throws bake::InputError("camera spec '<spec>'", "<what is wrong>").
 Camera parse_camera(std::string_view spec, int width, int height);
+// A first look at a box [lo, hi] (world space) whose "up" is the unit axis `up` (+Y or +Z): the
+// camera looks at the box's centre from a three-quarter view above its front — along
+// −(0.35 r̂ + 0.5 û + 1 f̂) where û = up and f̂ the front axis (+Z for Y-up, −Y for Z-up, the
+// conventions of glTF and of Blender), r̂ = û × f̂ — from the nearest distance at which all eight
+// corners are inside the picture with a 5% margin on each side. A degenerate box (a point) becomes
+// the box of half-size 1 around it. lo and hi must be finite.
+Camera frame_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const Eigen::Vector3d& up, int width, int height,
+                 double fov_y_degrees = 45);
+// The text form of `c` for people to copy into --camera ("eye=...:at=...:up=...:fov=..."), each
+// number with 9 significant digits: parse_camera reads back the same camera to 1e-9 relative.
+std::string to_string(const Camera& c);
+
 // "WxH", each in [1, 16384]. Throws bake::InputError("image size '<spec>'", "<what is wrong>").
 std::array<int, 2> parse_size(std::string_view spec);
 
