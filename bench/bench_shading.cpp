@@ -5,6 +5,10 @@
 //
 //   BM_ShadeTransfer/order:L        shade_transfer, 4096 vertices per iteration
 //   BM_ShadeBand1                   shade_band1, 4096 vertices per iteration
+//   BM_ShadeGlossy/order:L          glossy route A (triple product L·U, then the Phong lobe), 4096
+//                                   vertices per iteration, prtshade/glossy.h
+//   BM_ShadeGlossyReference/order:L route A's slow reference (a double Gaunt pass per vertex)
+//   BM_ShadeGlossyRadiance/order:L  glossy route B (the lobe on a baked shadowed radiance S)
 //   BM_ShadeFiv/occluders:N         shade_fiv, 4096 receivers per iteration, both corrections on
 //   BM_ShadeFivReference/occluders:N  the slow reference on the same inputs
 //   BM_ShadeFivNoOverlap/occluders:N  shade_fiv without the overlap correction (its pair-loop share)
@@ -16,6 +20,7 @@
 // 40 × 40 area from 1.5 below to 4 units above a ground plane, receivers on the plane inside it (normal +Y), so
 // occluders are in cases A, B and C and many pairs overlap; a 32² DifMap.
 #include <prtshade/fiv.h>
+#include <prtshade/glossy.h>
 #include <prtshade/shade.h>
 
 #include <benchmark/benchmark.h>
@@ -56,6 +61,68 @@ void BM_ShadeTransfer(benchmark::State& state) {
   per_item(state);
 }
 BENCHMARK(BM_ShadeTransfer)->ArgName("order")->Arg(3)->Arg(6);
+
+// Glossy: per vertex, a fixed eye, normals and positions from the seeded rows, Phong s = 24.
+void BM_ShadeGlossy(benchmark::State& state) {
+  const int order = int(state.range(0)), n = order * order;
+  const prt::shade::TripleProduct tp(order);
+  const std::vector<float> visibility = normal_floats(size_t(kItems) * size_t(n), 1);
+  const std::vector<float> light = normal_floats(size_t(3 * n), 2);
+  std::vector<float> normals = normal_floats(size_t(3 * kItems), 3), positions = normal_floats(size_t(3 * kItems), 4);
+  for (int v = 0; v < kItems; ++v) {
+    float* nv = normals.data() + 3 * v;
+    const float len = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    for (int c = 0; c < 3; ++c) nv[c] /= len;
+  }
+  const float eye[3] = {0, 2, 10};
+  std::vector<float> out(size_t(3 * kItems));
+  const prt::shade::GlossyLight lit(tp, light.data());
+  for (auto _ : state) {
+    prt::shade::shade_glossy_vertices(lit, visibility.data(), normals.data(), positions.data(), kItems, eye, 24.0, out.data());
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+  state.counters["gaunt_entries"] = double(tp.entries().size());
+}
+BENCHMARK(BM_ShadeGlossy)->ArgName("order")->Arg(3)->Arg(5)->Arg(7)->Arg(9)->Arg(11);
+
+// The slow reference of route A (a double Gaunt pass per channel per vertex), same inputs.
+void BM_ShadeGlossyReference(benchmark::State& state) {
+  const int order = int(state.range(0)), n = order * order;
+  const prt::shade::TripleProduct tp(order);
+  const std::vector<float> visibility = normal_floats(size_t(kItems) * size_t(n), 1);
+  const std::vector<float> light = normal_floats(size_t(3 * n), 2);
+  double scales[prt::shade::kMaxGlossyOrder];
+  prt::shade::phong_band_scales(24.0, order, scales);
+  const float r[3] = {0.48f, 0.6f, 0.64f};
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int v = 0; v < kItems; ++v)
+      prt::shade::shade_glossy(tp, light.data(), visibility.data() + size_t(v) * size_t(n), scales, r, out.data() + 3 * v);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+BENCHMARK(BM_ShadeGlossyReference)->ArgName("order")->Arg(3)->Arg(7)->Arg(11);
+
+void BM_ShadeGlossyRadiance(benchmark::State& state) {
+  const int order = int(state.range(0)), n = order * order;
+  const std::vector<float> shadowed = normal_floats(size_t(kItems) * size_t(3 * n), 5);
+  double scales[prt::shade::kMaxGlossyOrder];
+  prt::shade::phong_band_scales(24.0, order, scales);
+  const float r[3] = {0.48f, 0.6f, 0.64f};
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int v = 0; v < kItems; ++v)
+      prt::shade::shade_glossy_radiance(shadowed.data() + size_t(v) * size_t(3 * n), order, scales, r, out.data() + 3 * v);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+BENCHMARK(BM_ShadeGlossyRadiance)->ArgName("order")->Arg(3)->Arg(5)->Arg(7)->Arg(9)->Arg(11);
 
 void BM_ShadeBand1(benchmark::State& state) {
   std::vector<float> normals = normal_floats(size_t(3 * kItems), 3);

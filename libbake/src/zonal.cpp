@@ -2,6 +2,7 @@
 #include <bake/error.h>
 #include <bake/zonal.h>
 
+#include <prtshade/glossy.h>
 #include <prtshade/sh.h>
 
 #include <cmath>
@@ -13,14 +14,7 @@ std::vector<double> clamped_power_moments(double s, int order) {
   PRT_CHECK(s >= 0 && std::isfinite(s));
   PRT_CHECK(order >= 0);
   std::vector<double> I(size_t(order), 0.0);
-  for (int l = 0; l < order; ++l) {
-    if (l == 0) I[0] = 1.0 / (s + 1.0);
-    else if (l == 1) I[1] = 1.0 / (s + 2.0);
-    else {
-      const double k = double(l - 2);
-      I[size_t(l)] = I[size_t(l - 2)] * (s - k) / (s + k + 3.0);
-    }
-  }
+  shade::clamped_power_moments(s, order, I.data());  // the runtime's recurrence: one definition
   return I;
 }
 

@@ -3,6 +3,7 @@
 #include <prtshade/prtshade.h>
 
 #include <prtshade/fiv.h>
+#include <prtshade/glossy.h>
 #include <prtshade/sh.h>
 #include <prtshade/shade.h>
 
@@ -28,6 +29,11 @@ static_assert(sizeof(prt_fiv_occluder_desc) == sizeof(prt::shade::FivOccluder));
 static_assert(offsetof(prt_fiv_occluder_desc, radius) == offsetof(prt::shade::FivOccluder, radius));
 static_assert(offsetof(prt_fiv_occluder_desc, n_phi) == offsetof(prt::shade::FivOccluder, n_phi));
 static_assert(offsetof(prt_fiv_occluder_desc, valid) == offsetof(prt::shade::FivOccluder, valid));
+
+struct prt_glossy {
+  explicit prt_glossy(int order) : table(order) {}
+  prt::shade::TripleProduct table;
+};
 
 struct prt_sh_rotation {
   explicit prt_sh_rotation(const double R[3][3], int order) : rotation(R, order) {}
@@ -192,6 +198,36 @@ prt_status prt_shade_transfer(const float* transfer, size_t vertex_count, int or
 
 prt_status prt_shade_band1(const float* normals, const float* radiance, size_t vertex_count, float* out) {
   return guarded(__func__, [&] { prt::shade::shade_band1_vertices(normals, radiance, vertex_count, out); });
+}
+
+prt_status prt_glossy_create(int order, prt_glossy** out) {
+  return guarded(__func__, [&] {
+    require(out != nullptr, "out is null");
+    *out = new prt_glossy(order);
+  });
+}
+
+void prt_glossy_destroy(prt_glossy* glossy) { delete glossy; }
+
+prt_status prt_shade_glossy(const prt_glossy* glossy, const float* light, const float* visibility, const float* normals,
+                            const float* positions, size_t vertex_count, const float eye[3], double phong_exponent,
+                            float* out) {
+  return guarded(__func__, [&] {
+    require(glossy != nullptr && light != nullptr, "null pointer");
+    const prt::shade::GlossyLight lit(glossy->table, light);
+    prt::shade::shade_glossy_vertices(lit, visibility, normals, positions, vertex_count, eye, phong_exponent, out);
+  });
+}
+
+prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const float r[3], double phong_exponent,
+                                     float out[3]) {
+  return guarded(__func__, [&] {
+    require(shadowed != nullptr && r != nullptr && out != nullptr, "null pointer");
+    require(order >= 1 && order <= prt::shade::kMaxGlossyOrder, "order must be in [1, 16]");
+    double scales[prt::shade::kMaxGlossyOrder];
+    prt::shade::phong_band_scales(phong_exponent, order, scales);
+    prt::shade::shade_glossy_radiance(shadowed, order, scales, r, out);
+  });
 }
 
 prt_status prt_fiv_scene_create(int difmap_size, const float* difmap_texels, const float environment_fiv[9],

@@ -121,6 +121,30 @@ int prt_c_check_shading(char* msg, size_t size) {
   return 0;
 }
 
+/* Glossy shading: the white furnace through both routes. Unoccluded everywhere (U = √(4π) δ_0,
+ * V H ≡ 1) under a white sky (L = √(4π) δ_0): S = √(4π) δ_0 and L_out = λ_0 = 1 for any lobe and
+ * any view — a few float roundings. Route B with the same S; bad arguments refused. */
+int prt_c_check_glossy(char* msg, size_t size) {
+  enum { ORDER = 5, N = ORDER * ORDER };
+  float light[3 * N] = {0}, visibility[N] = {0}, shadowed[3 * N] = {0}, out[3];
+  const float normal[3] = {0, 0, 1}, position[3] = {0, 0, 0}, eye[3] = {3, 1, 2}, r[3] = {0.6f, 0.0f, 0.8f};
+  prt_glossy* g = NULL;
+  int c;
+  for (c = 0; c < 3; ++c) light[c * N] = shadowed[c * N] = (float)sqrt(4 * PI);
+  visibility[0] = (float)sqrt(4 * PI);
+  CHECK_STATUS(prt_glossy_create(0, &g), PRT_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(prt_glossy_create(ORDER, &g), PRT_OK);
+  CHECK_STATUS(prt_shade_glossy(g, light, visibility, normal, position, 1, eye, 24.0, out), PRT_OK);
+  for (c = 0; c < 3; ++c) CHECK_NEAR(out[c], 1.0, 8 * FLT_EPSILON, "glossy white furnace (route A)");
+  CHECK_STATUS(prt_shade_glossy(g, light, visibility, normal, position, 1, eye, -1.0, out), PRT_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(prt_shade_glossy(NULL, light, visibility, normal, position, 1, eye, 4.0, out), PRT_ERROR_INVALID_ARGUMENT);
+  prt_glossy_destroy(g);
+  CHECK_STATUS(prt_shade_glossy_radiance(shadowed, ORDER, r, 128.0, out), PRT_OK);
+  for (c = 0; c < 3; ++c) CHECK_NEAR(out[c], 1.0, 8 * FLT_EPSILON, "glossy white furnace (route B)");
+  CHECK_STATUS(prt_shade_glossy_radiance(shadowed, 17, r, 4.0, out), PRT_ERROR_INVALID_ARGUMENT);
+  return 0;
+}
+
 /* A FIV scene: DifMap + environment FIV + an occluder with constant shells; shading cases. */
 int prt_c_check_fiv(char* msg, size_t size) {
   enum { S = 4, NR = 2, NT = 3, NP = 4 };

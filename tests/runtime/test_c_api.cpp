@@ -7,6 +7,7 @@ extern "C" {
 int prt_c_check_errors(char* msg, size_t size);
 int prt_c_check_shading(char* msg, size_t size);
 int prt_c_check_fiv(char* msg, size_t size);
+int prt_c_check_glossy(char* msg, size_t size);
 }
 
 namespace {
@@ -24,6 +25,11 @@ TEST(CApi, ProjectionTransferBand1Rotation) {
 TEST(CApi, FivSceneShading) {
   char msg[512] = "";
   EXPECT_EQ(prt_c_check_fiv(msg, sizeof msg), 0) << msg;
+}
+
+TEST(CApi, GlossyShadingBothRoutes) {
+  char msg[512] = "";
+  EXPECT_EQ(prt_c_check_glossy(msg, sizeof msg), 0) << msg;
 }
 
 } // namespace

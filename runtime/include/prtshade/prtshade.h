@@ -77,6 +77,25 @@ prt_status prt_shade_transfer(const float* transfer, size_t vertex_count, int or
  * radiance [V][3][3] (/radiance/band1 rows), out [V][3]. */
 prt_status prt_shade_band1(const float* normals, const float* radiance, size_t vertex_count, float* out);
 
+/* ---- glossy shading (<prtshade/glossy.h>) ------------------------------------------------ */
+
+/* The triple-product (Gaunt) table of one order in [1, 16]; immutable, shareable between threads. */
+typedef struct prt_glossy prt_glossy;
+prt_status prt_glossy_create(int order, prt_glossy** out);
+void prt_glossy_destroy(prt_glossy* glossy);
+/* Route A (relightable): out[v][c] = ∫ L_c V H k_s(r_v·ω) dω through S = P_L(L_c · U_v), for
+ * vertex_count vertices: light [3][order²] (channel-major, as prt_project_latlong writes it),
+ * visibility [V][order²] (/transfer/visibility rows at the table's order), normals and positions
+ * [V][3], eye [3]; r_v reflects normalize(eye − p_v) about n_v; k_s the normalised Phong lobe of
+ * exponent phong_exponent >= 0; out [V][3] (times the specular colour by the caller). */
+prt_status prt_shade_glossy(const prt_glossy* glossy, const float* light, const float* visibility, const float* normals,
+                            const float* positions, size_t vertex_count, const float eye[3], double phong_exponent,
+                            float* out);
+/* Route B (fixed environment): out[c] = Σ_l λ_l Σ_m S[c][lm] y_lm(r) for one shadowed-radiance
+ * vector S [3][order²] and a unit reflection direction r; λ_l the lobe's band scales. */
+prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const float r[3], double phong_exponent,
+                                     float out[3]);
+
 /* ---- FIV shading (<prtshade/fiv.h>, paper 004 §4.3) -------------------------------------- */
 
 /* One baked occluder, laid out as /fiv/occluders/<name>: shells [n_rho][n_theta][n_phi][3][3],
