@@ -462,6 +462,48 @@ TEST(Reference, UnoccludedPlaneUnderConstantSkyIsPiL) {
   }
 }
 
+TEST(Reference, GlossyLobeUnderACapShapedOccluderMatchesItsClosedForm) {
+  // Glossy mode at a ground point p = 0 with n = +y and the eye straight above (r = n): under a
+  // constant sky L the integral is L ∫_visible k_s(n·ω) dω. With nothing above, the lobe lies in the
+  // upper hemisphere: L exactly in expectation. Under an occluding disk at height 1 of angular
+  // radius α about +y: L (1 − (1 − cos^{s+1} α)) = L cos^{s+1} α (∫_cap k_s = 1 − cos^{s+1} α). The
+  // disk is a 512-gon inscribed in the circle: the missing sliver is < (2π²/3)/512² ≈ 3e-5 of
+  // the cap's solid angle and k_s ≤ (s+1)/(2π) there, so the value moves by < 3e-5 · 2π(1 − cos α)
+  // · (s+1)/(2π) < 2e-4 L. Tolerance: 4 standard errors of the replicates plus that.
+  const double s = 4, alpha = 30 * pi / 180, L = 0.75;
+  const EnvMap env = EnvMap::constant({L, L, L});
+  Mesh disk;
+  const int N = 512;
+  const double R = std::tan(alpha);
+  disk.positions.push_back(Vector3f(0, 1, 0));
+  for (int k = 0; k < N; ++k)
+    disk.positions.push_back(Vector3f(float(R * std::cos(2 * pi * k / N)), 1.0f, float(R * std::sin(2 * pi * k / N))));
+  for (uint32_t k = 0; k < uint32_t(N); ++k) disk.triangles.push_back({0, 1 + k, 1 + (k + 1) % uint32_t(N)});
+  disk = make_mesh(disk.positions, disk.triangles, "disk");
+  const Mesh ground = ground_quad(0.0, 0.0, 0.0, 5.0);
+  const std::vector<Mesh> parts = {ground, disk};
+  const Mesh scene = merge_meshes(parts, "glossy");
+  Fragment f;
+  f.triangle = 0;
+  f.p = {0, 0, 0};
+  for (bool occluded : {false, true}) {
+    ReferenceOptions opt;
+    opt.samples = 4096;
+    opt.casts_shadow.assign(scene.triangles.size(), occluded ? 1 : 0);
+    for (size_t t = 0; t < ground.triangles.size(); ++t) opt.casts_shadow[t] = 0;
+    opt.glossy = ReferenceOptions::Glossy{Vector3d(0, 5, 0), std::vector<double>(scene.triangles.size(), s),
+                                          std::vector<std::array<float, 3>>(scene.triangles.size(), {1, 1, 1})};
+    const ReferenceRenderer rr(scene, env, opt);
+    double G[3], se[3];
+    rr.glossy(f, 7, s, G, se);
+    const double expect = occluded ? L * std::pow(std::cos(alpha), s + 1) : L;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(G[c], expect, 4 * se[c] + 2e-4 * L) << (occluded ? "under the disk" : "open sky");
+      EXPECT_LT(se[c], 0.01 * L) << "the lobe half of the mixture keeps the estimate tight";
+    }
+  }
+}
+
 TEST(Reference, SquareOccluderMatchesLambertFormFactor) {
   // A 2 × 2 square at height 1 over a ground plane, constant sky L: at a ground point, E = π L (1 − F)
   // with F the square's form factor (Lambert's polygon formula, tests/common/test_scenes.h).

@@ -82,8 +82,8 @@ WHAT IS DRAWN
       AO        AO x E_unocc(n)/pi at each vertex, E_unocc the unshadowed irradiance from the
                 file's DifMap (lookup_difmap; the exact texel sum if the file has none) - the
                 ambient-occlusion approximation. Glossy-only objects (transfer/visibility only)
-                land here: glossy shading is not in the runtime (prtshade) yet, so they show
-                their AO-shaded diffuse response, not their highlights.
+                land here with their AO-shaded diffuse response; their highlights are drawn by
+                --shade glossy (below).
       FIV self  objects without per-vertex products (occluder-only) that have FIV shells
                 (/fiv/occluders/<name>) and /fiv/environment: per pixel with shade_fiv_member
                 (self-shadows, eq. 12, minus the shadows of the other objects that have FIV
@@ -94,6 +94,16 @@ WHAT IS DRAWN
     apply. The reference renders the same objects: "occluder" and "both" objects cast shadows,
     "receiver" objects do not (not even on themselves: the scene semantics, bake/scene.h), and a
     pixel shows albedo x E/pi.
+
+  glossy objects of scene files (--shade glossy; objects with a phong_exponent, whose
+    /objects/<name>/transfer/visibility the scene plan baked at the lobe's order): their specular
+    lobes only, other objects black (they still cast shadows by their roles): per vertex
+    specular x int L V H k_s(r.w) dw, k_s the normalised Phong lobe (s+1)/2pi max(t,0)^s about the
+    reflection r of the direction to the eye, by prt::shade::shade_glossy_vertices: the
+    environment's SH at the object's order times the visibility transfer by the SH triple product,
+    then the lobe band by band (prtshade/glossy.h); Gouraud. --phong S swaps every lobe's exponent
+    at run time (U does not depend on it; the order stays the baked one). The reference traces the
+    same lobe per pixel (Embree, mixture of the lobe and the environment, --samples rays).
 
   area lights of scene files (/lights, schema v3; --shade area or area-exact): only the lights'
     direct light, no environment: each object's albedo/pi x sum_l radiance_l E_l.
@@ -143,6 +153,7 @@ EXAMPLES
   prtview default.prt.h5 --env data/sunset.exr --camera eye=0,14,26:at=0,3,0 --triptych -o t.png
   prtbake scene data/scene_example.json -o scene.prt.h5
   prtview scene.prt.h5 --camera eye=0,18,34:at=0,2,0 --size 320x240 --triptych -o scene.png
+  prtview scene.prt.h5 --shade glossy --phong 128 --triptych -o statue.png
 
 )";
 
@@ -160,6 +171,7 @@ struct Args {
   double error_scale = 0.1;
   prtview::FivView fiv;
   std::string ggx;  // --ggx ALPHA[,F0]
+  std::optional<double> phong;  // --phong S (--shade glossy)
   bool quiet = false;
   int threads = 0;
 };
@@ -207,6 +219,7 @@ std::optional<Args> parse(int argc, char** argv) {
   app.get_formatter()->column_width(28);
   app.allow_extras();  // reported below as "unknown option" / "unexpected argument"
   std::string size, shade_kind, region;
+  double phong_value = 0;
   std::vector<std::string> instances;
   bool reference = false, error = false, triptych = false, no_overlap = false, no_partial = false;
   double exposure = 0, ground = 0, ground_size = 0;
@@ -225,8 +238,12 @@ std::optional<Args> parse(int argc, char** argv) {
   app.add_flag("--triptych", triptych, "write runtime | reference | error side by side and print NRMSE.");
   app.add_option("--shade", a.shade,
                  "transfer | band1 | ao | fiv (default: fiv if the file has /fiv, else the first it holds of "
-                 "transfer, band1, ao); scene files with area lights: area | area-exact (see WHAT IS DRAWN).")
-      ->check(CLI::IsMember({"transfer", "band1", "ao", "fiv", "area", "area-exact"}));
+                 "transfer, band1, ao); scene files: glossy (the glossy objects' specular lobes), and with area "
+                 "lights area | area-exact (see WHAT IS DRAWN).")
+      ->check(CLI::IsMember({"transfer", "band1", "ao", "fiv", "glossy", "area", "area-exact"}));
+  CLI::Option* phong_opt = app.add_option("--phong", phong_value,
+                                          "S > 0: --shade glossy only: shade every glossy object with the Phong exponent S "
+                                          "instead of its own (the baked visibility transfer does not depend on it).");
   app.add_option("--ggx", a.ggx,
                  "ALPHA[,F0]: --shade area-exact only: add a GGX specular layer of roughness ALPHA in [0.01, 1] and "
                  "Schlick F0 in [0, 1] (default 0.04) over the diffuse albedo, per pixel through linearly transformed "
@@ -304,6 +321,11 @@ std::optional<Args> parse(int argc, char** argv) {
     if (!(ground_size > 0 && std::isfinite(ground_size))) throw UsageError("--ground-size must be > 0");
     a.fiv.ground_size = ground_size;
   }
+  if (phong_opt->count()) {
+    if (a.shade != "glossy") throw UsageError("--phong applies to --shade glossy only");
+    if (!(phong_value > 0 && std::isfinite(phong_value))) throw UsageError("--phong must be a finite number > 0");
+    a.phong = phong_value;
+  }
   a.fiv.overlap = !no_overlap;
   a.fiv.partial = !no_partial;
   if (a.file.empty()) throw UsageError("no FILE.prt.h5 given");
@@ -333,6 +355,7 @@ view::ReferenceImage environment_reference(const Args& a, const prtview::RenderS
   ropt.occluder_spheres = scene.spheres;
   ropt.casts_shadow = scene.casts_shadow;
   ropt.albedo = scene.albedo;
+  if (!scene.phong.empty()) ropt.glossy = view::ReferenceOptions::Glossy{cam.eye - scene.mesh.origin, scene.phong, scene.specular};
   const view::ReferenceRenderer rr(scene.mesh, env, ropt);
   std::optional<view::ReferenceImage> cached;
   const std::string key = rr.cache_key(cam);
@@ -396,20 +419,22 @@ int run(const Args& a) {
     if (!a.env.empty() || !a.reference_cache.empty())
       throw UsageError("--env and --reference-cache do not apply to --shade " + a.shade + " (the lights' direct light only)");
   } else if (prtview::is_scene_file(f)) {
-    kind = "scene";
+    kind = a.shade == "glossy" ? "glossy" : "scene";
+  } else if (a.shade == "glossy") {
+    throw UsageError("--shade glossy: " + a.file + " is not a scene file; glossy objects are baked by 'prtbake scene'");
   } else if (kind.empty()) {
     const std::vector<std::string> kinds = prtview::vertex_kinds(f);
     kind = prtview::has_fiv(f) ? "fiv" : kinds.empty() ? "band1" : kinds.front();  // band1: its read names what is missing
   }
-  if (kind != "scene" && kind != "fiv" && !area && prtview::has_fiv(f))
+  if (kind != "scene" && kind != "glossy" && kind != "fiv" && !area && prtview::has_fiv(f))
     throw UsageError("--shade " + kind + ": " + a.file + " is an FIV file; it is shown with --shade fiv (the default)");
   if (kind == "transfer" || kind == "band1" || kind == "ao") prtview::require_vertex_kind(f, a.file, kind);
-  const view::Camera cam = given_camera ? *given_camera : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height);
+  const view::Camera cam = given_camera ? *given_camera : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height, kind == "glossy");
   // AO needs an environment only to weigh it: without one (AO files name none), a white sky.
   const bool white_sky = kind == "ao" && a.env.empty();
-  if ((kind == "scene" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
+  if ((kind == "scene" || kind == "glossy" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
                                     !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
-    throw UsageError("--shade (except area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
+    throw UsageError("--shade (except glossy, area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
                      "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
                      "'prtview --help')");
   const std::string env_path = area || white_sky ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
@@ -442,6 +467,7 @@ int run(const Args& a) {
   Timer t_run;
   const view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
                               : kind == "scene" ? prtview::render_scene_file(f, a.file, *env, cam, scene)
+                              : kind == "glossy" ? prtview::render_glossy_scene(f, a.file, *env, cam, a.phong, scene)
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();
@@ -484,7 +510,8 @@ int run(const Args& a) {
                                         : environment_reference(a, scene, *env, cam, say);
   const view::GBuffer raster = view::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
-  const std::string region = !a.region.empty() ? a.region : kind == "fiv" || kind == "scene" || area ? "receiver" : "all";
+  const std::string region =
+      !a.region.empty() ? a.region : kind == "fiv" || kind == "scene" || kind == "glossy" || area ? "receiver" : "all";
   const size_t n_px = size_t(a.width) * size_t(a.height);
   std::vector<uint8_t> mask(n_px, 0), covered(n_px, 0);
   for (size_t i = 0; i < n_px; ++i) {

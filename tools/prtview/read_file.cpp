@@ -241,6 +241,16 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     if (s.radiance_band1) o.band1 = read_band1(f, file, baked.name, *env);
     else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
     else if (s.ao) o.ao = &s.ao->values;
+    if (baked.phong_exponent.value_or(0) > 0 && s.transfer_visibility) {
+      const std::string path = cat(prefix, N::kTransferVisibility);
+      if (!s.transfer_visibility->sh_order) throw InputError(file, path + " lacks the attribute " + quoted(N::kShOrder));
+      o.visibility = Transfer{int(*s.transfer_visibility->sh_order), s.transfer_visibility->values.data()};
+      o.phong = *baked.phong_exponent;
+      if (const auto& c = baked.specular) {
+        if (c->size() != 3) throw InputError(file, prefix + ": " + quoted(N::kSpecular) + " must be 3 numbers");
+        for (size_t k = 0; k < 3; ++k) o.specular[k] = float(std::max(0.0, (*c)[k]));
+      }
+    }
     if (f.fiv_environment && f.find_occluder(baked.name)) o.shells = read_occluder(f, file, baked.name, *env);
     objects.push_back(std::move(o));
   }

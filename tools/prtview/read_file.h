@@ -85,6 +85,10 @@ struct SceneObject {
   const std::vector<float>* ao = nullptr;
   std::optional<BakedOccluder> shells;   // read when the file also holds the environment FIV
   bool glossy_only = false;              // visibility transfer only
+  // Glossy objects (a phong_exponent > 0 and /transfer/visibility): the lobe and its colour.
+  std::optional<Transfer> visibility;
+  double phong = 0;
+  std::array<float, 3> specular{1, 1, 1};  // white when the file names none
 };
 // `env` null: geometry, roles and albedo only (no product that needs the environment, no check
 // that the file was baked under it): the area-light views.

@@ -9,12 +9,16 @@
 #include <bake/fiv.h>
 #include <bake/irradiance.h>
 #include <prtshade/fiv.h>
+#include <formats/names.h>
+#include <prtshade/glossy.h>
 #include <prtshade/shade.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <memory>
 #include <numbers>
 
 namespace prt::prtview {
@@ -106,7 +110,8 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
 }
 
-view::Camera first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height) {
+view::Camera first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height,
+                               bool glossy) {
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   const auto grow = [&](const std::optional<F::Array<double>>& positions) {
     if (!positions) return;
@@ -118,7 +123,8 @@ view::Camera first_look_camera(const F::Asset& f, const std::string& file, const
     }
   };
   if (is_scene_file(f)) {
-    for (const F::SceneObject& o : f.objects) grow(o.set.positions);
+    for (const F::SceneObject& o : f.objects)
+      if (!glossy || (o.phong_exponent.value_or(0) > 0 && o.set.transfer_visibility)) grow(o.set.positions);
   } else if (has_fiv(f)) {
     const F::Occluder* o = f.find_occluder(choose_occluder(f, file, options.occluder));
     const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
@@ -243,7 +249,7 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
   for (size_t k = 0; k < objects.size(); ++k) {
     const SceneObject& o = objects[k];
     const size_t V = o.mesh.positions.size();
-    const std::string glossy_note = o.glossy_only ? " (glossy: not shaded by the runtime yet)" : "";
+    const std::string glossy_note = o.glossy_only ? " (glossy: its lobe with --shade glossy)" : "";
     std::string unused;
     if (o.band1) {
       rgb_of[k] = band1_colours(*o.band1, V, unused);
@@ -299,6 +305,60 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
     shade::shade_fiv_member(env_fiv, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
     for (size_t c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi) * objects[k].albedo[c];
   });
+}
+
+view::Image render_glossy_scene(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
+                                std::optional<double> phong, RenderScene& scene) {
+  std::vector<SceneObject> objects = read_scene_objects(f, file, &env);
+  for (SceneObject& o : objects) o.receiver = o.visibility.has_value();
+  if (std::none_of(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; }))
+    throw bake::InputError(file, "has no glossy object (one with a phong_exponent and " +
+                                     std::string(F::names::kObjects) + "/<name>" + std::string(F::names::kTransferVisibility) +
+                                     "): nothing to show with --shade glossy");
+  std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
+  std::map<int, std::unique_ptr<shade::TripleProduct>> tables;  // one Gaunt table per order
+  std::vector<bake::Mesh> parts;
+  std::vector<float> rgb;
+  scene.first_triangle = {0};
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects, glossy lobes only";
+  scene.how = "prt::shade::shade_glossy_vertices (route A: environment SH x /transfer/visibility by the triple product, "
+              "normalised Phong lobe about the reflected view direction), times the specular colour, Gouraud:";
+  for (const SceneObject& o : objects) {
+    const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
+    std::vector<float> colour(3 * V, 0.0f);
+    const double s = o.visibility ? phong.value_or(o.phong) : 0.0;
+    if (o.visibility) {
+      const int order = o.visibility->order;
+      if (order < 1 || order > shade::kMaxGlossyOrder)
+        throw bake::InputError(file, "object '" + o.name + "': visibility transfer of order " + std::to_string(order) +
+                                         " (glossy shading takes orders 1 to " + std::to_string(shade::kMaxGlossyOrder) + ")");
+      auto& tp = tables[order];
+      if (!tp) tp = std::make_unique<shade::TripleProduct>(order);
+      std::string unused;
+      const std::vector<float> light = environment_sh(env, order, unused);
+      const shade::GlossyLight lit(*tp, light.data());
+      std::vector<float> pos(3 * V), nrm(3 * V);
+      for (size_t v = 0; v < V; ++v)
+        for (int c = 0; c < 3; ++c) pos[3 * v + size_t(c)] = o.mesh.positions[v][c], nrm[3 * v + size_t(c)] = o.mesh.normals[v][c];
+      const Vector3d eye_local = cam.eye - o.mesh.origin;
+      const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
+      shade::shade_glossy_vertices(lit, o.visibility->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+      for (size_t v = 0; v < V; ++v)
+        for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "\n  %s: order %d, Phong %.4g%s, specular %.3g %.3g %.3g", o.name.c_str(), order, s,
+                    phong ? " (--phong)" : "", o.specular[0], o.specular[1], o.specular[2]);
+      scene.how += buf;
+    }
+    rgb.insert(rgb.end(), colour.begin(), colour.end());
+    scene.phong.insert(scene.phong.end(), T, s);
+    scene.specular.insert(scene.specular.end(), T, o.visibility ? o.specular : std::array<float, 3>{0, 0, 0});
+    add_object(scene, o);
+    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + o.name + (o.visibility ? " (glossy)" : "");
+    parts.push_back(o.mesh);
+  }
+  scene.mesh = bake::merge_meshes(parts, file);
+  return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), rgb);
 }
 
 } // namespace prt::prtview

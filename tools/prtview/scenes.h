@@ -35,6 +35,10 @@ struct RenderScene {
   std::vector<std::string> object_names;
   std::vector<bool> object_receiver;
   std::vector<size_t> first_triangle;
+  // --shade glossy: per triangle, the Phong exponent (0: not glossy) and specular colour the
+  // reference's glossy mode (view::ReferenceOptions::glossy) uses; empty otherwise.
+  std::vector<double> phong;
+  std::vector<std::array<float, 3>> specular;
 };
 
 // Per-vertex files: kind "transfer", "band1" or "ao".
@@ -50,9 +54,10 @@ struct FivView {
 };
 // The camera of a first look when none is given (view::frame_box): framing every object of a
 // scene file, the mesh of a per-vertex file, or an FIV file's occluder copies (their bounding
-// spheres, widened by R so that their shadows on the ground show).
+// spheres, widened by R so that their shadows on the ground show). `glossy`: frame only a scene
+// file's glossy objects (--shade glossy).
 view::Camera first_look_camera(const formats::Asset& f, const std::string& file, const FivView& options, int width,
-                               int height);
+                               int height, bool glossy = false);
 
 view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
                             const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
@@ -65,5 +70,14 @@ void add_object(RenderScene& scene, const SceneObject& o);
 // Scene files (prtbake scene, schema v2): every object with what the file holds for it.
 view::Image render_scene_file(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
                               const view::Camera& cam, RenderScene& scene);
+
+// Scene files, --shade glossy: the glossy objects' specular lobes only (prtshade/glossy.h route A:
+// the environment's SH at the object's visibility order, the triple product with each vertex's
+// /transfer/visibility row, the normalised Phong lobe about the reflected view direction from
+// cam.eye, times the specular colour; Gouraud). The glossy objects are the compared receivers;
+// the others are drawn black and cast shadows by their roles. `phong`: an exponent that replaces
+// every glossy object's own (the lobe may change at run time: the baked U does not depend on it).
+view::Image render_glossy_scene(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
+                                const view::Camera& cam, std::optional<double> phong, RenderScene& scene);
 
 } // namespace prt::prtview

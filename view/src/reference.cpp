@@ -79,6 +79,8 @@ ReferenceRenderer::ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap&
   PRT_CHECK(!mesh.triangles.empty());
   PRT_CHECK(options_.casts_shadow.empty() || options_.casts_shadow.size() == mesh.triangles.size());
   PRT_CHECK(options_.albedo.empty() || options_.albedo.size() == mesh.triangles.size());
+  PRT_CHECK(!options_.glossy ||
+            (options_.glossy->phong.size() == mesh.triangles.size() && options_.glossy->specular.size() == mesh.triangles.size()));
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const auto& q : mesh.positions) {
     lo = lo.cwiseMin(q.cast<double>());
@@ -91,16 +93,21 @@ ReferenceRenderer::~ReferenceRenderer() = default;
 
 std::string ReferenceRenderer::description() const {
   std::ostringstream os;
-  os << "Embree 3 ray tracing: primary ray per pixel centre; E = unshadowed irradiance (the DifMap's texel sum) - "
-        "randomised Halton QMC of the occluded part, "
-     << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
-     << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
-     << "), seed " << options_.seed;
+  os << "Embree 3 ray tracing: primary ray per pixel centre; ";
+  if (options_.glossy)
+    os << "GLOSSY: specular x the normalised Phong lobe about the reflected view direction, randomised Halton QMC, "
+       << options_.samples << " rays/pixel (mixture: lobe, environment)";
+  else
+    os << "E = unshadowed irradiance (the DifMap's texel sum) - randomised Halton QMC of the occluded part, "
+       << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
+       << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
+       << ")";
+  os << ", seed " << options_.seed;
   if (!options_.casts_shadow.empty()) {
     const auto n = std::count_if(options_.casts_shadow.begin(), options_.casts_shadow.end(), [](uint8_t c) { return c != 0; });
     os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
   }
-  if (!options_.albedo.empty()) os << "; per-object albedo";
+  if (!options_.albedo.empty() && !options_.glossy) os << "; per-object albedo";
   return os.str();
 }
 
@@ -117,6 +124,11 @@ std::string ReferenceRenderer::cache_key(const Camera& cam) const {
                 cam.eye.x(), cam.eye.y(), cam.eye.z(), cam.at.x(), cam.at.y(), cam.at.z(), cam.up.x(), cam.up.y(), cam.up.z(),
                 cam.fov_y_degrees, cam.near, cam.width, cam.height);
   bytes += buf;
+  if (options_.glossy) {
+    put(options_.glossy->phong.data(), options_.glossy->phong.size() * sizeof(double));
+    for (const auto& c : options_.glossy->specular) put(c.data(), 3 * sizeof(float));
+    put(options_.glossy->eye.data(), 3 * sizeof(double));
+  }
   for (const auto& sp : options_.occluder_spheres) {
     std::snprintf(buf, sizeof buf, "|sphere %.17g %.17g %.17g %.17g", sp.centre.x(), sp.centre.y(), sp.centre.z(), sp.radius);
     bytes += buf;
@@ -231,6 +243,55 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
   }
 }
 
+void ReferenceRenderer::glossy(const Fragment& f, uint64_t index, double s, double out[3], double std_error[3]) const {
+  PRT_CHECK(options_.glossy.has_value() && s >= 0);
+  const Vector3d v = (options_.glossy->eye - f.p).normalized();
+  Vector3d r = 2 * f.n.dot(v) * f.n - v;
+  r = r.norm() > 0 ? Vector3d(r.normalized()) : f.n;
+  const Vector3d o = f.p + epsilon_ * f.ng;
+  const Frame lobe(r);
+  const double k_norm = (s + 1) / (2 * std::numbers::pi);
+  const auto k_s = [&](const Vector3d& d) { const double c = r.dot(d); return c > 0 ? k_norm * std::pow(c, s) : 0.0; };
+  const bake::NearTriangles near_o = rt_->near(o);
+  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
+  const uint32_t per = std::max<uint32_t>(1, options_.samples / B);
+  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
+  for (uint32_t b = 0; b < B; ++b) {
+    const RotatedHalton3 halton(options_.seed, index * kReplicates + b);
+    double sum[3] = {0, 0, 0};
+    for (uint32_t i = 0; i < per; ++i) {
+      const auto u = halton(i);
+      Vector3d d;
+      if (u[0] < 0.5) {  // the lobe: cos θ = u^(1/(s+1)) about r
+        const double z = std::pow(std::max(u[1], 1e-300), 1 / (s + 1)), rho = std::sqrt(std::max(0.0, 1 - z * z));
+        const double phi = 2 * std::numbers::pi * u[2];
+        d = lobe.to_world(Vector3d(rho * std::cos(phi), rho * std::sin(phi), z));
+      } else {
+        d = env_.sample(u[1], u[2], nullptr);
+      }
+      d.normalize();
+      const double k = k_s(d);
+      if (!(f.n.dot(d) > 0) || !(k > 0) || (rt_->any_caster && rt_->occluded(o, near_o, d))) continue;
+      const double p = 0.5 * k + 0.5 * env_.pdf(d);
+      const Rgb L = env_.radiance(d);
+      sum[0] += L.r * k / p;
+      sum[1] += L.g * k / p;
+      sum[2] += L.b * k / p;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const double m = sum[c] / per;
+      block_sum[c] += m;
+      block_sum2[c] += m * m;
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const double mean = block_sum[c] / B;
+    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean * mean) / (double(B) * (B - 1))) : 0.0;
+    out[c] = mean;
+    std_error[c] = std::sqrt(var);
+  }
+}
+
 ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monitor& monitor) const {
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceImage out;
@@ -241,7 +302,7 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monit
   // the covered pixels, sorted and made unique, evaluated in parallel.
   using Key = std::array<double, 3>;
   std::vector<Key> normals;
-  for (int y = 0; y < camera.height; ++y)
+  for (int y = 0; y < camera.height && !options_.glossy; ++y)  // glossy mode needs no E_unocc
     for (int x = 0; x < camera.width; ++x)
       if (out.gbuffer.triangle[size_t(y) * size_t(camera.width) + size_t(x)] >= 0) {
         const Vector3d n = make_fragment(mesh_, out.gbuffer, x, y).n;
@@ -261,6 +322,19 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monit
     for (int x = 0; x < camera.width; ++x) {
       const Fragment f = make_fragment(mesh_, out.gbuffer, x, y);
       if (f.triangle < 0) continue;
+      if (options_.glossy) {
+        const size_t t = size_t(f.triangle);
+        const double s = options_.glossy->phong[t];
+        double G[3] = {0, 0, 0}, se[3] = {0, 0, 0};
+        if (s > 0) glossy(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), s, G, se);
+        for (int c = 0; c < 3; ++c) {
+          const double spec = double(options_.glossy->specular[t][size_t(c)]);
+          out.radiance.at(x, y)[c] = float(spec * G[c]);
+          out.std_error.at(x, y)[c] = float(spec * se[c]);
+        }
+        ++n;
+        continue;
+      }
       const Key key{f.n.x(), f.n.y(), f.n.z()};
       const size_t k = size_t(std::lower_bound(normals.begin(), normals.end(), key) - normals.begin());
       double E[3], se[3];

@@ -72,6 +72,19 @@ struct ReferenceOptions {
   //     error scales alike. Empty: white (albedo 1), the E/π above.
   std::vector<uint8_t> casts_shadow;
   std::vector<std::array<float, 3>> albedo;
+  // GLOSSY mode (prtview --shade glossy; prtshade/glossy.h's integral): instead of albedo · E/π,
+  // pixel = specular[t] · ∫ L(ω) V(p, ω) H(ω, n) k_s(r·ω) dω with the normalised Phong lobe
+  // k_s(t) = (s+1)/(2π) max(t, 0)^s, s = phong[t] (0 where phong[t] <= 0: the pixel is 0),
+  // r = 2(n·v)n − v, v = normalize(eye − p). Estimated by randomised QMC (the same replicates and
+  // visibility as above) from a one-sample mixture, balance heuristic: ½ the lobe itself (pdf k_s)
+  // and ½ the environment's luminance; each term L V H k_s / p is bounded by 2 L k_s / k_s or by
+  // 2 L k_s / p_env, finite for any environment. One entry per triangle.
+  struct Glossy {
+    Eigen::Vector3d eye{0, 0, 0};
+    std::vector<double> phong;
+    std::vector<std::array<float, 3>> specular;
+  };
+  std::optional<Glossy> glossy;
 };
 
 struct ReferenceImage {
@@ -94,6 +107,9 @@ public:
   GBuffer trace_primary(const Camera& camera) const;
   ReferenceImage render(const Camera& camera, const bake::Monitor& monitor = {}) const;
 
+  // The glossy integral (ReferenceOptions::glossy, without the specular colour) at a fragment for
+  // exponent s and its standard error; `index` keys the randomisation.
+  void glossy(const Fragment& f, uint64_t index, double s, double out[3], double std_error[3]) const;
   // Irradiance E (RGB) at a fragment and its standard error; `index` keys the randomisation.
   void irradiance(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const;
   std::string description() const;
