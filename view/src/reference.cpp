@@ -35,7 +35,35 @@ using Eigen::Vector3d;
 
 namespace {
 constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
+
+// Independent replicates (randomised QMC): B = min(8, samples) rotations of the Halton sequence
+// keyed by (seed, index, replicate), samples/B points each; estimate(u, sum) adds one point's
+// RGB terms to sum. The mean of the replicate means and its standard error, the spread of the
+// means / √B: an honest error for the RQMC estimate, which converges faster than 1/√N (the iid
+// sample variance would overstate it).
+template <class Estimate>
+void replicate_mean(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& estimate, double mean[3], double se[3]) {
+  const uint32_t B = std::min<uint32_t>(kReplicates, samples);
+  const uint32_t per = std::max<uint32_t>(1, samples / B);
+  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
+  for (uint32_t b = 0; b < B; ++b) {
+    const RotatedHalton3 halton(seed, index * kReplicates + b);
+    double sum[3] = {0, 0, 0};
+    for (uint32_t i = 0; i < per; ++i) estimate(halton(i), sum);
+    for (int c = 0; c < 3; ++c) {
+      const double m = sum[c] / per;
+      block_sum[c] += m;
+      block_sum2[c] += m * m;
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    mean[c] = block_sum[c] / B;
+    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean[c] * mean[c]) / (double(B) * (B - 1))) : 0.0;
+    se[c] = std::sqrt(var);
+  }
 }
+
+} // namespace
 
 // The ray queries of the reference: libbake's RayCaster (bake/raycast.h) over the rendered mesh for
 // primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
@@ -194,17 +222,8 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
   const double w_cone = cones.empty() ? 0.0 : w_cone_total / double(cones.size());
   const Frame frame(f.n);
   const bake::NearTriangles near_o = rt_->near(o);
-  // Independent replicates (randomised QMC): B rotations of the Halton sequence, N/B points each.
-  // The spread of the replicate means is an honest standard error for the RQMC estimate, which
-  // converges faster than 1/sqrt(N); the iid sample variance would overstate it.
-  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
-  const uint32_t per = std::max<uint32_t>(1, options_.samples / B);
-  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
-  for (uint32_t b = 0; b < B; ++b) {
-    const RotatedHalton3 halton(options_.seed, index * kReplicates + b);
-    double sum[3] = {0, 0, 0};
-    for (uint32_t i = 0; i < per; ++i) {
-      const auto u = halton(i);
+  double occluded[3];
+  replicate_mean(options_.samples, options_.seed, index, [&](const std::array<double, 3>& u, double sum[3]) {
       Vector3d d;
       if (u[0] < w_cos) {
         d = frame.to_world(cosine_hemisphere(u[1], u[2]));
@@ -219,7 +238,7 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
       }
       d.normalize();
       const double cn = f.n.dot(d);
-      if (!(cn > 0) || !rt_->occluded(o, near_o, d)) continue;  // contributes 0 to the occluded part
+      if (!(cn > 0) || !rt_->occluded(o, near_o, d)) return;  // contributes 0 to the occluded part
       double p = w_cos * cn * kInvPi + w_env * env_.pdf(d);
       for (const Cone& c : cones)
         if (c.axis.dot(d) >= c.cos_a) p += w_cone * c.inv_solid_angle;
@@ -227,20 +246,9 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
       sum[0] += L.r * cn / p;
       sum[1] += L.g * cn / p;
       sum[2] += L.b * cn / p;
-    }
-    for (int c = 0; c < 3; ++c) {
-      const double m = sum[c] / per;
-      block_sum[c] += m;
-      block_sum2[c] += m * m;
-    }
-  }
+    }, occluded, std_error);
   const double un[3] = {unocc.r, unocc.g, unocc.b};
-  for (int c = 0; c < 3; ++c) {
-    const double mean = block_sum[c] / B;
-    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean * mean) / (double(B) * (B - 1))) : 0.0;
-    E[c] = un[c] - mean;
-    std_error[c] = std::sqrt(var);
-  }
+  for (int c = 0; c < 3; ++c) E[c] = un[c] - occluded[c];
 }
 
 void ReferenceRenderer::glossy(const Fragment& f, uint64_t index, double s, double out[3], double std_error[3]) const {
@@ -253,14 +261,7 @@ void ReferenceRenderer::glossy(const Fragment& f, uint64_t index, double s, doub
   const double k_norm = (s + 1) / (2 * std::numbers::pi);
   const auto k_s = [&](const Vector3d& d) { const double c = r.dot(d); return c > 0 ? k_norm * std::pow(c, s) : 0.0; };
   const bake::NearTriangles near_o = rt_->near(o);
-  const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
-  const uint32_t per = std::max<uint32_t>(1, options_.samples / B);
-  double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
-  for (uint32_t b = 0; b < B; ++b) {
-    const RotatedHalton3 halton(options_.seed, index * kReplicates + b);
-    double sum[3] = {0, 0, 0};
-    for (uint32_t i = 0; i < per; ++i) {
-      const auto u = halton(i);
+  replicate_mean(options_.samples, options_.seed, index, [&](const std::array<double, 3>& u, double sum[3]) {
       Vector3d d;
       if (u[0] < 0.5) {  // the lobe: cos θ = u^(1/(s+1)) about r
         const double z = std::pow(std::max(u[1], 1e-300), 1 / (s + 1)), rho = std::sqrt(std::max(0.0, 1 - z * z));
@@ -271,25 +272,13 @@ void ReferenceRenderer::glossy(const Fragment& f, uint64_t index, double s, doub
       }
       d.normalize();
       const double k = k_s(d);
-      if (!(f.n.dot(d) > 0) || !(k > 0) || (rt_->any_caster && rt_->occluded(o, near_o, d))) continue;
+      if (!(f.n.dot(d) > 0) || !(k > 0) || (rt_->any_caster && rt_->occluded(o, near_o, d))) return;
       const double p = 0.5 * k + 0.5 * env_.pdf(d);
       const Rgb L = env_.radiance(d);
       sum[0] += L.r * k / p;
       sum[1] += L.g * k / p;
       sum[2] += L.b * k / p;
-    }
-    for (int c = 0; c < 3; ++c) {
-      const double m = sum[c] / per;
-      block_sum[c] += m;
-      block_sum2[c] += m * m;
-    }
-  }
-  for (int c = 0; c < 3; ++c) {
-    const double mean = block_sum[c] / B;
-    const double var = B > 1 ? std::max(0.0, (block_sum2[c] - B * mean * mean) / (double(B) * (B - 1))) : 0.0;
-    out[c] = mean;
-    std_error[c] = std::sqrt(var);
-  }
+    }, out, std_error);
 }
 
 ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monitor& monitor) const {
