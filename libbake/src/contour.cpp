@@ -306,7 +306,6 @@ float round_up(double x) {
 constexpr double kMaxNormalError = 1e-6;  // faces with a worse normal bound are always tested
 constexpr uint32_t kLeafSize = 4;  // records per leaf at most
 static_assert(kLeafSize == 4);  // a leaf is one LeafBlock of four float lanes
-constexpr int kMaxStack = 256;  // ≥ 3 × the wide tree's depth (≤ 48 + 32 + 1) + 1
 
 }  // namespace
 
@@ -569,7 +568,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   // that width is about Σ_i |q_i − c_i|·Δn_i + ΔD, ΔD ≈ Δn·radius + the corners' spread along the
   // normal. The cost of a set is therefore count × (Σ corner extents + ρ·Σ normal extents),
   // ρ ≈ the mean distance of a query point to a node (the frame's unit). Object-median fallback
-  // below depth 48 keeps the depth bounded by the query's stack.
+  // below depth 48 keeps the depth bounded.
   corners_.reserve(recs.size());
   std::vector<Node> nodes;  // the binary tree, collapsed into wide_ at the end
   size_t max_depth = 0;

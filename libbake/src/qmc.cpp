@@ -20,7 +20,7 @@ using Eigen::Vector3d;
 
 QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
                              const QmcOptions& options, const MeshAccel* accel)
-    : mesh_(mesh), topo_(topology), request_(request), layout_(request), options_(options) {
+    : request_(request), layout_(request), options_(options) {
   PRT_CHECK(options.rays > 0);
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
   const bool want_cos = request.ao || request.transfer_order > 0 || request.radiance;

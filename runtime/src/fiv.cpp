@@ -22,8 +22,6 @@ constexpr float kTwoPiF = 6.28318530717958647692f;
 // it is always defined.
 inline float clamp_nan_safe(float x, float lo, float hi) { return std::fmin(std::fmax(x, lo), hi); }
 
-inline float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 // Bilinear coordinate of one face axis: texel centres at 2(q + ½)/S − 1, clamped to the outer ones.
 inline void face_coordinate(float s, int size, int& q0, int& q1, float& f) {
   const float q = clamp_nan_safe((s + 1.0f) * 0.5f * float(size) - 0.5f, 0.0f, float(size - 1));

@@ -60,8 +60,6 @@ public:
   const QmcOptions& options() const { return options_; }
 
 private:
-  const Mesh& mesh_;
-  const Topology& topo_;
   ProductRequest request_;
   ProductLayout layout_;
   QmcOptions options_;
