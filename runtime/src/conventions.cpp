@@ -30,7 +30,7 @@ Mat3 engine_from_file(Engine engine, UpAxis up) noexcept {
   // Z-up files turn Y-up first: (x, y, z) ↦ (x, z, −y).
   Mat3 m = up == UpAxis::Z ? Mat3{{{1, 0, 0}, {0, 0, 1}, {0, -1, 0}}} : Mat3{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   if (engine == Engine::Unity)
-    for (double& v : m[0]) v = -v;  // left-handed: mirror X
+    for (double& v : m[0]) v = 0.0 - v;  // left-handed: mirror X (0 − 0 = +0)
   return m;
 }
 
