@@ -1,12 +1,6 @@
 // Engine SH conventions (prtshade/conventions.h): known lighting cases evaluated with each
-// engine's OWN formula, written out here from the engines' published shader code:
-//   Unity     UnityCG.cginc ShadeSH9 = SHEvalLinearL0L1 + SHEvalLinearL2 on unity_SHAr..unity_SHC,
-//             packed from SphericalHarmonicsL2 sh[rgb, i] as Unity's own Hybrid Renderer packs them
-//             (SHA = (sh3, sh1, sh2, sh0 − sh6), SHB = (sh4, sh5, 3·sh6, sh7), SHC = sh8);
-//   Godot 4   scene_forward_clustered.glsl, lightmap capture: Ramamoorthi–Hanrahan eq. 13 with
-//             c1..c5 = 0.429043, 0.511664, 0.743125, 0.886227, 0.247708 on the probe's sh[9];
-//   Filament  Irradiance_SphericalHarmonics: Σ sh[i] · (1, y, z, x, yx, yz, 3z²−1, zx, x²−y²).
-// Each returns the diffuse lighting E/π. The expected values are closed forms (no SH):
+// engine's OWN formula (tests/common/engine_sh.h, written out from the engines' shader code).
+// Each formula returns the diffuse lighting E/π. The expected values are closed forms (no SH):
 //   * a uniform sky of radiance 1 over the hemisphere around axis a: E(n)/π = (1 + n·a)/2;
 //   * radiance (ω·b)²: E(n)/π = (1 + (n·b)²)/4 (Funk–Hecke: λ0 = π, λ2 = π/4);
 //   * an unoccluded vertex with its own hemisphere of sky, from its band-1 radiance: E/π = 1.
@@ -14,6 +8,7 @@
 // Tolerance 1e-5: Godot's constants have 6 digits (relative 1e-6); everything else is double.
 #include <prtshade/conventions.h>
 
+#include <engine_sh.h>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -22,7 +17,7 @@
 namespace {
 
 using namespace prt::conventions;
-using V3 = std::array<double, 3>;
+using namespace prt::testing;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTol = 1e-5;
@@ -32,47 +27,10 @@ constexpr std::array<double, 9> kK = {0.28209479177387814, -0.48860251190291992,
                                       -0.48860251190291992, 1.0925484305920792, -1.0925484305920792,
                                       0.31539156525252005, -1.0925484305920792, 0.54627421529603959};
 
-// p_i(d): the basis polynomials.
-std::array<double, 9> poly(const V3& d) {
-  const double x = d[0], y = d[1], z = d[2];
-  return {1, y, z, x, x * y, y * z, 3 * z * z - 1, x * z, x * x - y * y};
-}
-
 double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 V3 unit(V3 v) {
   const double n = std::sqrt(dot(v, v));
   return {v[0] / n, v[1] / n, v[2] / n};
-}
-
-// ---- the engines' formulas (channel c) ----
-double unity_shade_sh9(const EngineSh& sh, int c, const V3& n) {
-  auto at = [&](int i) { return sh[size_t(c * 9 + i)]; };  // SphericalHarmonicsL2[rgb, i]
-  const double SHA[4] = {at(3), at(1), at(2), at(0) - at(6)};
-  const double SHB[4] = {at(4), at(5), 3 * at(6), at(7)};
-  const double SHC = at(8);
-  const double l0l1 = SHA[0] * n[0] + SHA[1] * n[1] + SHA[2] * n[2] + SHA[3] * 1.0;  // dot(SHAr, half4(n, 1))
-  const double vB[4] = {n[0] * n[1], n[1] * n[2], n[2] * n[2], n[2] * n[0]};        // normal.xyzz * normal.yzzx
-  const double l2 = SHB[0] * vB[0] + SHB[1] * vB[1] + SHB[2] * vB[2] + SHB[3] * vB[3] + SHC * (n[0] * n[0] - n[1] * n[1]);
-  return l0l1 + l2;
-}
-
-double godot_capture(const EngineSh& sh, int c, const V3& w) {
-  auto s = [&](int i) { return sh[size_t(i * 3 + c)]; };  // probe sh[i].rgb
-  const double c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
-  return c1 * s(8) * (w[0] * w[0] - w[1] * w[1]) + c3 * s(6) * w[2] * w[2] + c4 * s(0) - c5 * s(6) +
-         2 * c1 * s(4) * w[0] * w[1] + 2 * c1 * s(7) * w[0] * w[2] + 2 * c1 * s(5) * w[1] * w[2] +
-         2 * c2 * s(3) * w[0] + 2 * c2 * s(1) * w[1] + 2 * c2 * s(2) * w[2];
-}
-
-double filament_irradiance(const EngineSh& sh, int c, const V3& n) {
-  const auto p = poly(n);
-  double e = 0;
-  for (int i = 0; i < 9; ++i) e += sh[size_t(i * 3 + c)] * p[size_t(i)];  // float3 iblSH[9]
-  return e;
-}
-
-double evaluate(Engine e, const EngineSh& sh, int c, const V3& n) {
-  return e == Engine::Unity ? unity_shade_sh9(sh, c, n) : e == Engine::Godot ? godot_capture(sh, c, n) : filament_irradiance(sh, c, n);
 }
 
 // A direction of the file, seen in the engine's frame (by hand, not with engine_from_file).
