@@ -16,15 +16,20 @@
 // constants k_i = y_i / p_i = (0.282095, −0.488603, 0.488603, −0.488603, 1.092548, −1.092548,
 // 0.315392, −1.092548, 0.546274) (the minus signs are the Condon–Shortley phase):
 //
-// | engine   | frame (from a file with up_axis y)         | stored coefficient c_i            | evaluation of E(n)/π                          | layout   |
-// |----------|--------------------------------------------|-----------------------------------|-----------------------------------------------|----------|
-// | ours     | right-handed, +Y up                        | L_i (radiance, CS phase)          | Σ_i Â_l/π · L_i y_i(n)                        | [RGB][9] |
-// | Unity    | LEFT-handed, +Y up: x_unity = −x (as its    | Â_l/π · k_i · L_i: the polynomial | ShadeSH9: SHA = (c3, c1, c2, c0 − c6),        | [RGB][9] (SphericalHarmonicsL2[rgb, i]) |
-// |          | glTF and FBX importers mirror X)           | coefficients, no CS phase left    | SHB = (c4, c5, 3c6, c7), SHC = c8; Σ c_i p_i(n) |          |
-// | Godot 4  | right-handed, +Y up (= ours)               | s_i · L_i / π (radiance/π, basis  | R&H eq. 13: c4·c0 + 2c2(c3 x + c1 y + c2 z) +  | [9][RGB] (probe data: 9 colours) |
-// |          |                                            | without CS phase, s_i = sign k_i) | c3·c6 z² − c5·c6 + c1·c8(x²−y²) + 2c1(c4 xy + c7 xz + c5 yz) |  |
-// | Filament | right-handed, +Y up (= ours)               | Â_l/π · k_i · L_i (cmgen's        | Σ c_i p_i(n) (Irradiance_SphericalHarmonics)  | [9][RGB] (float3 sh[9]) |
-// |          |                                            | "pre-scaled" irradiance SH)       |                                               |          |
+//   ours      frame: right-handed, +Y up (a file with up_axis y). c_i = L_i (radiance, CS phase).
+//             E(n)/π = Σ_i Â_l/π · L_i y_i(n). Layout [RGB][9].
+//   Unity     frame: LEFT-handed, +Y up: x ↦ −x (what its glTF and FBX importers do).
+//             SphericalHarmonicsL2 c_i = Â_l/π · k_i · L_i: the coefficients of the polynomials
+//             p_i, pre-scaled, no CS phase left. ShadeSH9 on SHA = (c3, c1, c2, c0 − c6),
+//             SHB = (c4, c5, 3c6, c7), SHC = c8 gives Σ_i c_i p_i(n). Layout [rgb][9] (sh[rgb, i]).
+//   Godot 4   frame: right-handed, +Y up (identity). LightmapGI probe c_i = sign(k_i) · L_i / π:
+//             radiance/π in the orthonormal basis WITHOUT the CS phase (Ramamoorthi–Hanrahan's);
+//             its shader applies R&H eq. 13: 0.886227 c0 − 0.247708 c6 + 0.743125 c6 z²
+//             + 1.023328 (c3 x + c1 y + c2 z) + 0.858086 (c4 xy + c7 xz + c5 yz)
+//             + 0.429043 c8 (x² − y²). Layout [9][rgb] (a probe's 9 colours).
+//   Filament  frame: right-handed, +Y up (identity). IndirectLight::irradiance(3, sh): cmgen's
+//             pre-scaled irradiance SH, c_i = Â_l/π · k_i · L_i (as Unity's numbers);
+//             Irradiance_SphericalHarmonics gives Σ_i c_i p_i(n). Layout [9][rgb] (float3 sh[9]).
 //
 // A file with up_axis "z" (Blender) is first turned Y-up as glTF exporters do: (x, y, z) ↦
 // (x, z, −y), then mapped as above. Re-expressing a function in a mirrored or rotated frame
@@ -36,7 +41,8 @@
 // 001 app. A). An engine convolves band 1 with Â_1 = 2π/3, half of that, so the probe of a
 // vertex is the radiance SH (0; 2R; 0): every engine's formula then returns exactly the baked
 // E/π at the baked normal (and the linear "vector irradiance" n · F/π at other normals).
-// Errors: none (every input is valid; NaN in, NaN out).
+// Errors: change_frame throws std::invalid_argument (from sh::Rotation) for a matrix that is not
+// orthogonal; to_engine never throws (its matrices are exact); NaN in, NaN out.
 #pragma once
 
 #include <array>
