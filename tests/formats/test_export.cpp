@@ -14,6 +14,7 @@
 #include <engine_sh.h>
 #include <gtest/gtest.h>
 #include <run_tool.h>
+#include <scratch.h>
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
@@ -28,21 +29,8 @@ using namespace prt::formats;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-const fs::path kTmp = fs::path(PRT_TEST_TMP) / "export";
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = kTmp / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
+fs::path fresh_dir(const std::string& name) { return prt::testing::fresh_dir("export", name); }
+using prt::testing::listing;
 
 // Deterministic values with every bit in use (not round numbers).
 std::vector<float> values(size_t n, double seed) {

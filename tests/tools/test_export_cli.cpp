@@ -3,6 +3,7 @@
 // directory); a bad --to is a command-line error (exit 2).
 #include <gtest/gtest.h>
 #include <run_tool.h>
+#include <scratch.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -14,12 +15,7 @@ namespace {
 
 const fs::path kDir = fs::path(PRT_TEST_TMP) / "export_cli";
 
-std::vector<std::string> listing(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
+using prt::testing::listing;
 
 // An AO-only bake of the ground mesh, made once.
 const fs::path& ao_bake() {
@@ -33,12 +29,7 @@ const fs::path& ao_bake() {
   return file;
 }
 
-fs::path fresh(const std::string& name) {
-  const fs::path d = kDir / name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path fresh(const std::string& name) { return prt::testing::fresh_dir("export_cli", name); }
 
 std::string export_args(const fs::path& in, const std::string& to, const fs::path& out) {
   return "export '" + in.string() + "' --to " + to + " -o '" + out.string() + "'";
