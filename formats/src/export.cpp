@@ -25,9 +25,9 @@ std::string relative(std::string_view path) { return std::string(path.substr(1))
 
 std::vector<SetRef> vertex_sets(const Asset& asset) {
   std::vector<SetRef> sets;
-  if (asset.vertices.positions) sets.push_back({"root", "", &asset.vertices});
+  if (asset.vertices.vertex_count() > 0) sets.push_back({"root", "", &asset.vertices});
   for (const SceneObject& o : asset.objects)
-    if (o.set.positions)
+    if (o.set.vertex_count() > 0)
       sets.push_back({o.node_path ? *o.node_path : o.name, relative(names::kObjects) + "/" + o.name, &o.set});
   return sets;
 }
@@ -128,7 +128,7 @@ const char* to_string(ExportFormat format) noexcept {
 void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
                   const std::filesystem::path& out) {
   if (exporting::vertex_sets(asset).empty())
-    throw FormatError(source.string(), "has no vertex set with /mesh/positions to export (an FIV-only file?)");
+    throw FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");
   switch (format) {
   case ExportFormat::Gltf:
   case ExportFormat::Glb: exporting::export_gltf(asset, out, format == ExportFormat::Glb); return;

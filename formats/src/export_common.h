@@ -19,7 +19,7 @@ struct SetRef {
   std::string prefix;  // "" or "objects/<name>" (no leading or trailing '/')
   const VertexSet* set = nullptr;
 };
-// Every vertex set with positions, the root layout first, then the objects in the asset's order.
+// Every vertex set with at least one vertex, the root layout first, then the objects in the asset's order.
 std::vector<SetRef> vertex_sets(const Asset& asset);
 
 // A baked per-vertex product of a set: its dataset name ("ao", "transfer/diffuse", ...) relative

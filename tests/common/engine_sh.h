@@ -13,6 +13,7 @@
 #include <prtshade/conventions.h>
 
 #include <array>
+#include <cstddef>
 
 namespace prt::testing {
 
@@ -27,7 +28,7 @@ inline std::array<double, 9> poly(const V3& d) {
 }
 
 inline double unity_shade_sh9(const EngineSh& sh, int c, const V3& n) {
-  auto at = [&](int i) { return sh[size_t(c * 9 + i)]; };  // SphericalHarmonicsL2[rgb, i]
+  auto at = [&](int i) { return sh[std::size_t(c * 9 + i)]; };  // SphericalHarmonicsL2[rgb, i]
   const double SHA[4] = {at(3), at(1), at(2), at(0) - at(6)};
   const double SHB[4] = {at(4), at(5), 3 * at(6), at(7)};
   const double SHC = at(8);
@@ -38,7 +39,7 @@ inline double unity_shade_sh9(const EngineSh& sh, int c, const V3& n) {
 }
 
 inline double godot_capture(const EngineSh& sh, int c, const V3& w) {
-  auto s = [&](int i) { return sh[size_t(i * 3 + c)]; };  // probe sh[i].rgb
+  auto s = [&](int i) { return sh[std::size_t(i * 3 + c)]; };  // probe sh[i].rgb
   const double c1 = 0.429043, c2 = 0.511664, c3 = 0.743125, c4 = 0.886227, c5 = 0.247708;
   return c1 * s(8) * (w[0] * w[0] - w[1] * w[1]) + c3 * s(6) * w[2] * w[2] + c4 * s(0) - c5 * s(6) +
          2 * c1 * s(4) * w[0] * w[1] + 2 * c1 * s(7) * w[0] * w[2] + 2 * c1 * s(5) * w[1] * w[2] +
@@ -48,7 +49,7 @@ inline double godot_capture(const EngineSh& sh, int c, const V3& w) {
 inline double filament_irradiance(const EngineSh& sh, int c, const V3& n) {
   const auto p = poly(n);
   double e = 0;
-  for (int i = 0; i < 9; ++i) e += sh[size_t(i * 3 + c)] * p[size_t(i)];  // float3 iblSH[9]
+  for (int i = 0; i < 9; ++i) e += sh[std::size_t(i * 3 + c)] * p[std::size_t(i)];  // float3 iblSH[9]
   return e;
 }
 

@@ -5,9 +5,10 @@
 // prtshade/conventions.h.
 //
 // Contract
-//   * Every vertex set with positions is exported: the root layout, then each scene object (by
-//     name). Values are the file's, unchanged (float32); positions are float32 or float64 as in
-//     the file (glTF: float32 relative to a node translation, see SCHEMA.md).
+//   * Every vertex set with at least one vertex is exported: the root layout, then each scene
+//     object in the asset's order (read_asset: by name). Values are the file's, unchanged
+//     (float32); positions are float32 or float64 as in the file (glTF: float32 relative to a
+//     node translation, see SCHEMA.md).
 //   * Outputs are written to a staging directory beside `out` and renamed into place: on any
 //     error nothing exists under the final name(s) and files already there are untouched.
 //     glTF (.gltf) writes two files: `out` and its buffer `<stem>.bin` beside it.
