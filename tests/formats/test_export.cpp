@@ -6,9 +6,10 @@
 //     attributes via asset.extras.prtbake: values equal bit for bit (no arithmetic on them).
 //   * PRTBIN: tests/formats/prtbin_reader.py, written from SCHEMA.md with Python's struct/json,
 //     checks the layout and returns every array: values equal bit for bit.
-//   * Probes: the Unity file's SH evaluated with ShadeSH9 (tests/common/engine_sh.h) at each
-//     vertex's normal (in Unity's mirrored frame) equals the baked E/π of SCHEMA.md's
-//     (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 relative (float data, double arithmetic).
+//   * Probes: each engine file's SH evaluated with that engine's formula (tests/common/engine_sh.h:
+//     Unity's ShadeSH9, Godot's capture formula, Filament's) at each vertex's normal in the
+//     engine's frame equals the baked E/π of SCHEMA.md's (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 of
+//     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
 #include <formats/export.h>
 
 #include <engine_sh.h>
@@ -22,6 +23,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <tuple>
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
@@ -304,35 +306,43 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
 
 // ---- engine probes ----
 
-TEST(ExportProbes, UnityShadeSH9AtEachVertexNormalIsTheBakedIrradiance) {
+TEST(ExportProbes, EachEnginesFormulaAtEachVertexNormalIsTheBakedIrradiance) {
+  using prt::conventions::Engine;
   const fs::path dir = fresh_dir("probes");
-  for (const Asset& a : {vertex_asset(), scene_asset()}) {
-    export_asset(a, "in.prt.h5", ExportFormat::Unity, dir / "p.json");
-    const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "p.json"));
-    EXPECT_EQ(j["engine"], "unity");
-    const VertexSet& s = a.objects.empty() ? a.vertices : a.objects[1].set;  // the scene's "lit"
-    ASSERT_EQ(j["sets"].size(), 1u);  // only sets with band-1 radiance
-    const auto& set = j["sets"][0];
-    const std::vector<double> sh = set["sh"], normals = set["normals"], positions = set["positions"];
-    const size_t V = s.vertex_count();
-    ASSERT_EQ(sh.size(), 27 * V);
-    const double k1 = 0.48860251190291992;
-    for (size_t v = 0; v < V; ++v) {
-      const double nx = s.normals->values[3 * v], ny = s.normals->values[3 * v + 1], nz = s.normals->values[3 * v + 2];
-      // Unity's frame by hand: mirror X after turning a Z-up file Y-up.
-      const prt::testing::V3 n_u = a.root.up_axis == "z" ? prt::testing::V3{-nx, nz, -ny} : prt::testing::V3{-nx, ny, nz};
-      for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(normals[3 * v + c], n_u[c], 1e-7);
-      const double py = s.positions->values[3 * v + 1], pz = s.positions->values[3 * v + 2];
-      EXPECT_EQ(positions[3 * v + 1], a.root.up_axis == "z" ? pz : py);
-      prt::conventions::EngineSh probe;
-      std::copy_n(sh.begin() + long(27 * v), 27, probe.begin());
-      for (int c = 0; c < 3; ++c) {
-        const float* R = &s.radiance_band1->values[9 * v + 3 * size_t(c)];
-        const double E = 4 * kPi / 3 * k1 * (-ny * R[0] + nz * R[1] - nx * R[2]);  // SCHEMA.md
-        EXPECT_NEAR(prt::testing::unity_shade_sh9(probe, c, n_u), E / kPi, 1e-5 * (std::abs(E) + 1e-3));
+  for (const auto& [format, engine, name] : {std::tuple{ExportFormat::Unity, Engine::Unity, "unity"},
+                                             std::tuple{ExportFormat::Godot, Engine::Godot, "godot"},
+                                             std::tuple{ExportFormat::Filament, Engine::Filament, "filament"}})
+    for (const Asset& a : {vertex_asset(), scene_asset()}) {
+      SCOPED_TRACE(std::string(name) + ", up " + a.root.up_axis);
+      export_asset(a, "in.prt.h5", format, dir / "p.json");
+      const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "p.json"));
+      EXPECT_EQ(j["engine"], name);
+      const VertexSet& s = a.objects.empty() ? a.vertices : a.objects[1].set;  // the scene's "lit"
+      ASSERT_EQ(j["sets"].size(), 1u);  // only sets with band-1 radiance
+      const auto& set = j["sets"][0];
+      const std::vector<double> sh = set["sh"], normals = set["normals"], positions = set["positions"];
+      const size_t V = s.vertex_count();
+      ASSERT_EQ(sh.size(), 27 * V);
+      const double k1 = 0.48860251190291992;
+      for (size_t v = 0; v < V; ++v) {
+        const double nx = s.normals->values[3 * v], ny = s.normals->values[3 * v + 1], nz = s.normals->values[3 * v + 2];
+        // The engine's frame by hand: a Z-up file turned Y-up, then Unity mirrors X.
+        prt::testing::V3 n_e = a.root.up_axis == "z" ? prt::testing::V3{nx, nz, -ny} : prt::testing::V3{nx, ny, nz};
+        if (engine == Engine::Unity) n_e[0] = -n_e[0];
+        for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(normals[3 * v + c], n_e[c], 1e-7);
+        const double py = s.positions->values[3 * v + 1], pz = s.positions->values[3 * v + 2];
+        EXPECT_EQ(positions[3 * v + 1], a.root.up_axis == "z" ? pz : py);
+        prt::conventions::EngineSh probe;
+        std::copy_n(sh.begin() + long(27 * v), 27, probe.begin());
+        for (int c = 0; c < 3; ++c) {
+          const float* R = &s.radiance_band1->values[9 * v + 3 * size_t(c)];
+          const double E = 4 * kPi / 3 * k1 * (-ny * R[0] + nz * R[1] - nx * R[2]);  // SCHEMA.md
+          // Godot's constants have 6 digits: 1e-5 of the terms' magnitude.
+          const double scale = 4 * kPi / 3 * k1 * (std::abs(R[0]) + std::abs(R[1]) + std::abs(R[2])) / kPi;
+          EXPECT_NEAR(prt::testing::evaluate(engine, probe, c, n_e), E / kPi, 1e-5 * scale + 1e-12);
+        }
       }
     }
-  }
 }
 
 TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
