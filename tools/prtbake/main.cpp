@@ -13,6 +13,7 @@
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
+#include "export.h"
 #include "progress_bar.h"
 #include "tool_main.h"
 
@@ -107,6 +108,7 @@ struct Args {
   double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
+  tool::ExportArgs exported;  // export: a baked file in another format (export.h)
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
@@ -341,6 +343,7 @@ std::optional<Args> parse(int argc, char** argv) {
   add_vertex(app, a, samples);
   add_fiv(app, a, samples);
   add_scene(app, a);
+  tool::add_export(app, a.exported);
   for (CLI::App* cmd : app.get_subcommands({})) cmd->footer(app.get_footer());
   try {
     app.parse(argc, argv);
@@ -354,6 +357,7 @@ std::optional<Args> parse(int argc, char** argv) {
     throw UsageError(e.what());
   }
   a.command = app.get_subcommands().front()->get_name();
+  if (a.command == "export") return a;
   a.command_line = content_command_line(argc, argv);
   if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
   if (a.command == "scene") {
@@ -830,6 +834,7 @@ int prtbake_main(int argc, char** argv) {
   if (!parsed) return 0;  // --help or --version
   const Args& a = *parsed;
   tool::install_interrupt_handler();
+  if (a.command == "export") return tool::run_export(a.exported);
   return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
 }
 

@@ -1,0 +1,42 @@
+// formats/export.h — a baked asset for consumers that read neither HDF5 nor our schema: glTF 2.0
+// with the baked per-vertex data as vertex attributes, a plain binary file with a JSON header,
+// and per-vertex light probes in the SH conventions of Unity, Godot and Filament. The layouts
+// are formats/SCHEMA.md "Exports" (docs/ARCHITECTURE.md "Schema"); the engine conventions are
+// prtshade/conventions.h.
+//
+// Contract
+//   * Every vertex set with at least one vertex is exported: the root layout, then each scene
+//     object in the asset's order (read_asset: by name). Values are the file's, unchanged
+//     (float32); positions are float32 or float64 as in the file (glTF: float32 relative to a
+//     node translation, see SCHEMA.md).
+//   * Outputs are written to a staging directory beside `out` and renamed into place: on any
+//     error nothing exists under the final name(s) and files already there are untouched.
+//     glTF (.gltf) writes two files: `out` and its buffer `<stem>.bin` beside it.
+//   * The engine formats need /radiance/band1 in some vertex set (the only baked product that is
+//     lighting; see SCHEMA.md "Exports" for why the others are not probes).
+// Errors: FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
+#pragma once
+
+#include <formats/asset.h>
+
+#include <filesystem>
+#include <optional>
+#include <string_view>
+
+namespace prt::formats {
+
+enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament };
+
+// "gltf", "glb", "bin", "unity", "godot", "filament" (nullopt for anything else).
+std::optional<ExportFormat> parse_export_format(std::string_view name);
+const char* to_string(ExportFormat format) noexcept;
+
+// Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`.
+void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                  const std::filesystem::path& out);
+
+// The binary format's magic (8 bytes) and version (SCHEMA.md "Exports").
+inline constexpr char kBinaryMagic[8] = {'P', 'R', 'T', 'B', 'I', 'N', '\0', '\0'};
+inline constexpr uint32_t kBinaryVersion = 1;
+
+} // namespace prt::formats

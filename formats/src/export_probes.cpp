@@ -1,0 +1,107 @@
+// export_probes.cpp — per-vertex light probes in engine SH conventions (JSON), from the baked
+// band-1 radiance: the probe of a vertex is the radiance SH (0; 2R; 0), which every engine's own
+// formula evaluates to exactly the baked E/π at the baked normal (prtshade/conventions.h; layout:
+// formats/SCHEMA.md "Exports"). Positions and normals are given in the engine's frame.
+#include "export_common.h"
+
+#include <formats/names.h>
+
+#include <prtshade/conventions.h>
+
+#include <nlohmann/json.hpp>
+
+namespace prt::formats::exporting {
+namespace {
+
+namespace C = prt::conventions;
+
+struct EngineInfo {
+  ExportFormat format;
+  C::Engine engine;
+  const char* name;
+  const char* layout;
+  const char* coefficients;
+  const char* evaluation;
+};
+
+constexpr EngineInfo kEngines[] = {
+    {ExportFormat::Unity, C::Engine::Unity, "unity", "[vertex][rgb][9]: SphericalHarmonicsL2 sh[rgb, i]",
+     "c_i = A_l/pi * k_i * L_i: coefficients of the polynomials (1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2), "
+     "pre-scaled as ShadeSH9 expects (no Condon-Shortley phase left)",
+     "ShadeSH9 with unity_SHAr = (c3, c1, c2, c0 - c6), unity_SHBr = (c4, c5, 3 c6, c7), unity_SHC.r = c8 "
+     "gives E(n)/pi, the diffuse lighting Unity multiplies by the albedo"},
+    {ExportFormat::Godot, C::Engine::Godot, "godot", "[vertex][9][rgb]: a LightmapGI probe's 9 colours",
+     "c_i = s_i * L_i / pi: radiance over pi in the basis without the Condon-Shortley phase (s_i = sign of k_i)",
+     "the lightmap-capture formula (Ramamoorthi-Hanrahan eq. 13, c1..c5 = 0.429043, 0.511664, 0.743125, 0.886227, "
+     "0.247708) gives E(n)/pi"},
+    {ExportFormat::Filament, C::Engine::Filament, "filament", "[vertex][9][rgb]: IndirectLight::irradiance(3, float3 sh[9])",
+     "c_i = A_l/pi * k_i * L_i: cmgen's pre-scaled irradiance SH",
+     "Irradiance_SphericalHarmonics: sum_i c_i * (1, y, z, x, yx, yz, 3z^2-1, zx, x^2-y^2)_i gives E(n)/pi"},
+};
+
+const EngineInfo& info_of(ExportFormat format) {
+  for (const EngineInfo& e : kEngines)
+    if (e.format == format) return e;
+  return kEngines[0];
+}
+
+nlohmann::json in_frame(const std::vector<double>& xyz, const C::Mat3& M) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t v = 0; v + 2 < xyz.size(); v += 3)
+    for (size_t r = 0; r < 3; ++r) out.push_back(M[r][0] * xyz[v] + M[r][1] * xyz[v + 1] + M[r][2] * xyz[v + 2]);
+  return out;
+}
+
+} // namespace
+
+void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                   const std::filesystem::path& out) {
+  const EngineInfo& e = info_of(format);
+  const C::UpAxis up = asset.root.up_axis == "z" ? C::UpAxis::Z : C::UpAxis::Y;
+  const C::Mat3 M = C::engine_from_file(e.engine, up);
+
+  nlohmann::json sets = nlohmann::json::array();
+  for (const SetRef& ref : vertex_sets(asset)) {
+    const VertexSet& s = *ref.set;
+    if (!s.radiance_band1) continue;
+    const size_t V = s.vertex_count();
+    nlohmann::json sh = nlohmann::json::array();
+    for (size_t v = 0; v < V; ++v) {
+      std::array<float, 9> R{};
+      std::copy_n(s.radiance_band1->values.begin() + std::ptrdiff_t(9 * v), 9, R.begin());
+      for (double c : C::to_engine(e.engine, up, C::radiance_from_band1(R))) sh.push_back(c);
+    }
+    nlohmann::json set = {{"name", ref.name},
+                          {"dataset", join(ref.prefix, std::string(names::kRadianceBand1.substr(1)))},
+                          {"vertices", V},
+                          {"positions", in_frame(s.positions->values, M)},
+                          {"sh", std::move(sh)}};
+    if (s.normals) set["normals"] = in_frame(std::vector<double>(s.normals->values.begin(), s.normals->values.end()), M);
+    sets.push_back(std::move(set));
+  }
+  if (sets.empty())
+    throw FormatError(source.string(),
+                      std::string("has no /radiance/band1, the only baked product that is lighting: a ") + e.name +
+                          " probe needs it (bake with prtbake vertex --radiance ENV, or a scene with an environment)");
+
+  nlohmann::json j;
+  j["format"] = "prtbake-probes";
+  j["version"] = 1;
+  j["engine"] = e.name;
+  j["source"] = asset.root.source;
+  j["source_sha256"] = asset.root.source_sha256;
+  j["up_axis"] = asset.root.up_axis;
+  j["engine_from_file"] = {M[0], M[1], M[2]};
+  j["layout"] = e.layout;
+  j["coefficients"] = e.coefficients;
+  j["evaluation"] = e.evaluation;
+  j["probe"] = "per vertex, from /radiance/band1 R: the radiance SH (0; 2R; 0), exact E/pi at the baked normal "
+               "(formats/SCHEMA.md, Exports)";
+  j["sets"] = std::move(sets);
+
+  Staging staging(out);
+  write_bytes(staging.stage(out), j.dump() + "\n", out);
+  staging.commit();
+}
+
+} // namespace prt::formats::exporting

@@ -1,0 +1,371 @@
+// Exports (formats/export.h), each re-read by a second, independent reader:
+//   * glTF / GLB: tinygltf loads what we wrote; the test checks the structure glTF 2.0 requires
+//     (buffer views inside the buffer, accessors inside their views, 4-byte alignment, POSITION
+//     min/max equal to the data's bounds, application-specific attributes named "_…" with float
+//     SCALAR..VEC4 accessors, indices < vertex count) and reassembles every product from its
+//     attributes via asset.extras.prtbake: values equal bit for bit (no arithmetic on them).
+//   * PRTBIN: tests/formats/prtbin_reader.py, written from SCHEMA.md with Python's struct/json,
+//     checks the layout and returns every array: values equal bit for bit.
+//   * Probes: each engine file's SH evaluated with that engine's formula (tests/common/engine_sh.h:
+//     Unity's ShadeSH9, Godot's capture formula, Filament's) at each vertex's normal in the
+//     engine's frame equals the baked E/π of SCHEMA.md's (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 of
+//     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
+#include <formats/export.h>
+
+#include <engine_sh.h>
+#include <gtest/gtest.h>
+#include <run_tool.h>
+#include <scratch.h>
+
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <tuple>
+
+namespace fs = std::filesystem;
+using namespace prt::formats;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+fs::path fresh_dir(const std::string& name) { return prt::testing::fresh_dir("export", name); }
+using prt::testing::listing;
+
+// Deterministic values with every bit in use (not round numbers).
+std::vector<float> values(size_t n, double seed) {
+  std::vector<float> v(n);
+  for (size_t i = 0; i < n; ++i) v[i] = float(std::sin(seed + 0.731 * double(i)) * 0.9);
+  return v;
+}
+
+Product product(std::vector<float> v, std::optional<int64_t> sh_order = std::nullopt) {
+  Product p;
+  p.values = std::move(v);
+  p.sh_order = sh_order;
+  return p;
+}
+
+// A mesh of V vertices on a bumpy strip, `offset` added to its positions; unit normals.
+void fill_mesh(VertexSet& s, size_t V, double offset) {
+  s.positions.emplace();
+  s.normals.emplace();
+  s.triangles.emplace();
+  for (size_t v = 0; v < V; ++v) {
+    const double x = double(v) * 0.37, z = std::sin(double(v)) * 0.3;
+    for (double c : {x + offset, 0.25 * double(v % 2) + offset, z + offset}) s.positions->values.push_back(c);
+    const double nx = std::sin(double(v) + 1), ny = 1.0, nz = std::cos(double(v) * 2), len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    for (double c : {nx / len, ny / len, nz / len}) s.normals->values.push_back(float(c));
+  }
+  for (uint32_t v = 0; v + 2 < V; ++v) s.triangles->values.insert(s.triangles->values.end(), {v, v + 1, v + 2});
+  s.source_position.emplace();
+  for (uint32_t v = 0; v < V; ++v) s.source_position->values.push_back(v / 2);
+}
+
+RootInfo root(const std::string& up) {
+  RootInfo r;
+  r.generator = "test_export";
+  r.created = "2024-05-01T12:00:00Z";
+  r.command_line = "prtbake vertex x.obj";
+  r.source = "x.obj";
+  r.source_sha256 = std::string(64, 'b');
+  r.up_axis = up;
+  r.sh_convention = "ours";
+  return r;
+}
+
+// The root layout: AO, order-3 diffuse and order-2 visibility transfer, band-1 radiance.
+Asset vertex_asset() {
+  Asset a;
+  a.root = root("y");
+  const size_t V = 7;
+  fill_mesh(a.vertices, V, 0.0);
+  a.vertices.ao = product(values(V, 0.1));
+  for (float& x : a.vertices.ao->values) x = std::abs(x);
+  a.vertices.transfer_diffuse = product(values(V * 9, 0.2), 3);
+  a.vertices.transfer_visibility = product(values(V * 4, 0.3), 2);
+  a.vertices.radiance_band1 = product(values(V * 9, 0.4));
+  return a;
+}
+
+// A Z-up scene: one object far from the origin with order-5 transfer (25 = 6 VEC4 + a SCALAR),
+// one with area-light data (2 lights, SH order 2: [V][2][4]) and band-1 radiance.
+Asset scene_asset() {
+  Asset a;
+  a.root = root("z");
+  a.scene.emplace();
+  SceneObject& far = a.objects.emplace_back();
+  far.name = "far";
+  far.node_path = "root/far";
+  fill_mesh(far.set, 5, 1e5 + 1e-4);
+  far.set.transfer_diffuse = product(values(5 * 25, 0.5), 5);
+  SceneObject& lit = a.objects.emplace_back();
+  lit.name = "lit";
+  fill_mesh(lit.set, 6, 0.0);
+  lit.set.area_irradiance = product(values(6 * 2, 0.6));
+  lit.set.area_irradiance->lights = "key\nfill";
+  lit.set.area_sh = product(values(6 * 2 * 4, 0.7), 2);
+  lit.set.area_sh->lights = "key\nfill";
+  lit.set.radiance_band1 = product(values(6 * 9, 0.8));
+  return a;
+}
+
+// ---- glTF: structure checks and reading accessors ----
+
+size_t component_count(int type) {
+  switch (type) {
+  case TINYGLTF_TYPE_SCALAR: return 1;
+  case TINYGLTF_TYPE_VEC2: return 2;
+  case TINYGLTF_TYPE_VEC3: return 3;
+  case TINYGLTF_TYPE_VEC4: return 4;
+  default: return 0;
+  }
+}
+
+// The elements of accessor `index` (float or uint32 components), after checking its bounds.
+template <class T> std::vector<T> read_accessor(const tinygltf::Model& m, int index) {
+  const tinygltf::Accessor& acc = m.accessors.at(size_t(index));
+  const tinygltf::BufferView& view = m.bufferViews.at(size_t(acc.bufferView));
+  const tinygltf::Buffer& buffer = m.buffers.at(size_t(view.buffer));
+  const size_t comps = component_count(acc.type);
+  EXPECT_GT(comps, 0u);
+  EXPECT_EQ(view.byteOffset % 4, 0u);
+  EXPECT_EQ(acc.byteOffset % sizeof(T), 0u);
+  EXPECT_LE(view.byteOffset + view.byteLength, buffer.data.size());
+  const size_t stride = view.byteStride ? view.byteStride : comps * sizeof(T);
+  EXPECT_LE(acc.byteOffset + (acc.count - 1) * stride + comps * sizeof(T), view.byteLength);
+  std::vector<T> out(acc.count * comps);
+  for (size_t e = 0; e < acc.count; ++e)
+    std::memcpy(out.data() + e * comps, buffer.data.data() + view.byteOffset + acc.byteOffset + e * stride, comps * sizeof(T));
+  return out;
+}
+
+tinygltf::Model load(const fs::path& file, bool glb) {
+  tinygltf::TinyGLTF loader;
+  tinygltf::Model m;
+  std::string err, warn;
+  const bool ok = glb ? loader.LoadBinaryFromFile(&m, &err, &warn, file.string())
+                      : loader.LoadASCIIFromFile(&m, &err, &warn, file.string());
+  EXPECT_TRUE(ok) << err;
+  EXPECT_EQ(warn, "");
+  return m;
+}
+
+// Checks every mesh of `m` against the vertex sets of `a` and the glTF rules above.
+void check_gltf(const tinygltf::Model& m, const Asset& a) {
+  ASSERT_EQ(m.asset.version, "2.0");
+  const tinygltf::Value& info = m.asset.extras.Get("prtbake");
+  ASSERT_TRUE(info.IsObject());
+  EXPECT_EQ(info.Get("up_axis").Get<std::string>(), a.root.up_axis);
+  const tinygltf::Value& sets = info.Get("sets");
+  ASSERT_EQ(sets.ArrayLen(), a.objects.empty() ? 1u : a.objects.size());
+  for (size_t si = 0; si < sets.ArrayLen(); ++si) {
+    const tinygltf::Value& entry = sets.Get(int(si));
+    const VertexSet& s = a.objects.empty() ? a.vertices : a.objects[si].set;
+    const size_t V = s.vertex_count();
+    SCOPED_TRACE("set " + entry.Get("name").Get<std::string>());
+    const tinygltf::Mesh& mesh = m.meshes.at(size_t(entry.Get("mesh").Get<int>()));
+    const tinygltf::Node& node = m.nodes.at(size_t(entry.Get("node").Get<int>()));
+    ASSERT_EQ(mesh.primitives.size(), 1u);
+    const tinygltf::Primitive& prim = mesh.primitives[0];
+    for (const auto& [name, index] : prim.attributes) {
+      const tinygltf::Accessor& acc = m.accessors.at(size_t(index));
+      EXPECT_EQ(acc.count, V) << name;
+      EXPECT_TRUE(name == "POSITION" || name == "NORMAL" || name == "COLOR_0" || name[0] == '_') << name;
+      EXPECT_EQ(acc.componentType, TINYGLTF_COMPONENT_TYPE_FLOAT) << name;
+      EXPECT_GT(component_count(acc.type), 0u) << name;
+      EXPECT_EQ(m.bufferViews.at(size_t(acc.bufferView)).target, TINYGLTF_TARGET_ARRAY_BUFFER) << name;
+    }
+    // POSITION: float32 + the node's translation; min/max are the data's bounds (required).
+    const std::vector<float> pos = read_accessor<float>(m, prim.attributes.at("POSITION"));
+    const tinygltf::Accessor& pacc = m.accessors.at(size_t(prim.attributes.at("POSITION")));
+    ASSERT_EQ(pacc.minValues.size(), 3u);
+    ASSERT_EQ(pacc.maxValues.size(), 3u);
+    for (size_t c = 0; c < 3; ++c) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (size_t v = 0; v < V; ++v) lo = std::min(lo, double(pos[3 * v + c])), hi = std::max(hi, double(pos[3 * v + c]));
+      EXPECT_EQ(pacc.minValues[c], lo);
+      EXPECT_EQ(pacc.maxValues[c], hi);
+    }
+    for (size_t i = 0; i < 3 * V; ++i) {
+      const double t = node.translation.empty() ? 0.0 : node.translation[i % 3];
+      const double want = s.positions->values[i];
+      if (t == 0.0) EXPECT_EQ(double(pos[i]), want);  // the file's float32 positions, unchanged
+      else EXPECT_NEAR(double(pos[i]) + t, want, std::abs(want - t) * 1e-7 + 1e-12);  // one float32 rounding of p − t
+    }
+    EXPECT_EQ(read_accessor<float>(m, prim.attributes.at("NORMAL")), s.normals->values);
+    // Indices.
+    ASSERT_EQ(prim.mode, TINYGLTF_MODE_TRIANGLES);
+    const tinygltf::Accessor& iacc = m.accessors.at(size_t(prim.indices));
+    EXPECT_EQ(iacc.componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+    EXPECT_EQ(iacc.type, TINYGLTF_TYPE_SCALAR);
+    EXPECT_EQ(m.bufferViews.at(size_t(iacc.bufferView)).target, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    const std::vector<uint32_t> idx = read_accessor<uint32_t>(m, prim.indices);
+    EXPECT_EQ(idx, s.triangles->values);
+    for (uint32_t i : idx) EXPECT_LT(i, V);
+    // Products: concatenate the listed attributes per vertex, in order.
+    std::map<std::string, const Product*> want;
+    for (auto [name, p] : {std::pair<std::string, const std::optional<Product>*>{"ao", &s.ao},
+                           {"transfer/diffuse", &s.transfer_diffuse}, {"transfer/visibility", &s.transfer_visibility},
+                           {"radiance/band1", &s.radiance_band1}, {"area_lights/irradiance", &s.area_irradiance},
+                           {"area_lights/sh", &s.area_sh}})
+      if (*p) want[name] = &**p;
+    const tinygltf::Value& products = entry.Get("products");
+    ASSERT_EQ(products.ArrayLen(), want.size());
+    for (size_t k = 0; k < products.ArrayLen(); ++k) {
+      const tinygltf::Value& pe = products.Get(int(k));
+      const std::string dataset = pe.Get("dataset").Get<std::string>();
+      ASSERT_TRUE(want.count(dataset)) << dataset;
+      std::vector<std::vector<float>> groups;
+      size_t width = 0;
+      for (size_t g = 0; g < pe.Get("attributes").ArrayLen(); ++g) {
+        const std::string attr = pe.Get("attributes").Get(int(g)).Get<std::string>();
+        EXPECT_EQ(attr[0], '_');
+        groups.push_back(read_accessor<float>(m, prim.attributes.at(attr)));
+        width += groups.back().size() / V;
+      }
+      std::vector<float> rows;
+      for (size_t v = 0; v < V; ++v)
+        for (const auto& g : groups) rows.insert(rows.end(), g.begin() + long(v * g.size() / V), g.begin() + long((v + 1) * g.size() / V));
+      EXPECT_EQ(rows, want[dataset]->values) << dataset;
+      EXPECT_EQ(width * V, want[dataset]->values.size()) << dataset;
+    }
+    if (s.ao) {  // COLOR_0: the same AO, grey
+      const std::vector<float> grey = read_accessor<float>(m, prim.attributes.at("COLOR_0"));
+      for (size_t v = 0; v < V; ++v)
+        for (size_t c = 0; c < 3; ++c) EXPECT_EQ(grey[3 * v + c], s.ao->values[v]);
+    }
+  }
+}
+
+TEST(ExportGltf, TinygltfReadsBackEveryValueAndTheStructureIsValid) {
+  for (const Asset& a : {vertex_asset(), scene_asset()}) {
+    const fs::path dir = fresh_dir("gltf");
+    export_asset(a, "in.prt.h5", ExportFormat::Gltf, dir / "asset.gltf");
+    EXPECT_EQ(listing(dir), (std::vector<std::string>{"asset.bin", "asset.gltf"}));  // no staging left
+    check_gltf(load(dir / "asset.gltf", false), a);
+    export_asset(a, "in.prt.h5", ExportFormat::Glb, dir / "asset.glb");
+    check_gltf(load(dir / "asset.glb", true), a);
+  }
+}
+
+TEST(ExportGltf, ZUpBakesHangUnderANodeTurningZToY) {
+  const fs::path dir = fresh_dir("gltf_z");
+  export_asset(scene_asset(), "in.prt.h5", ExportFormat::Glb, dir / "s.glb");
+  const tinygltf::Model m = load(dir / "s.glb", true);
+  ASSERT_EQ(m.scenes.at(0).nodes.size(), 1u);
+  const tinygltf::Node& up = m.nodes.at(size_t(m.scenes[0].nodes[0]));
+  ASSERT_EQ(up.rotation.size(), 4u);  // −90° about X: (x, y, z) ↦ (x, z, −y)
+  EXPECT_NEAR(up.rotation[0], -std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(up.rotation[3], std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(up.children.size(), 2u);
+}
+
+// ---- PRTBIN through the Python reader ----
+
+TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
+  const fs::path dir = fresh_dir("bin");
+  if (prt::testing::run_tool("python3", "-c 'import json, struct'", dir).code != 0) GTEST_SKIP() << "no python3";
+  for (const Asset& a : {vertex_asset(), scene_asset()}) {
+    export_asset(a, "in.prt.h5", ExportFormat::Binary, dir / "a.prtbin");
+    const auto run = prt::testing::run_tool("python3", std::string(PRT_SOURCE_TESTS) + "/formats/prtbin_reader.py '" +
+                                                           (dir / "a.prtbin").string() + "' '" + (dir / "a.json").string() + "'",
+                                            dir);
+    ASSERT_EQ(run.code, 0) << run.err;
+    const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "a.json"));
+    std::map<std::string, std::pair<std::vector<double>, std::string>> want;  // name -> values, dtype
+    auto add = [&](const std::string& prefix, const VertexSet& s) {
+      auto name = [&](const std::string& d) { return prefix.empty() ? d : prefix + "/" + d; };
+      const bool f32 = std::all_of(s.positions->values.begin(), s.positions->values.end(), [](double x) { return double(float(x)) == x; });
+      want[name("mesh/positions")] = {s.positions->values, f32 ? "float32" : "float64"};
+      want[name("mesh/normals")] = {{s.normals->values.begin(), s.normals->values.end()}, "float32"};
+      want[name("mesh/triangles")] = {{s.triangles->values.begin(), s.triangles->values.end()}, "uint32"};
+      want[name("mesh/source_position")] = {{s.source_position->values.begin(), s.source_position->values.end()}, "uint32"};
+      for (auto [d, p] : {std::pair<std::string, const std::optional<Product>*>{"ao", &s.ao},
+                          {"transfer/diffuse", &s.transfer_diffuse}, {"transfer/visibility", &s.transfer_visibility},
+                          {"radiance/band1", &s.radiance_band1}, {"area_lights/irradiance", &s.area_irradiance},
+                          {"area_lights/sh", &s.area_sh}})
+        if (*p) want[name(d)] = {{(*p)->values.begin(), (*p)->values.end()}, "float32"};
+    };
+    if (a.objects.empty()) add("", a.vertices);
+    for (const SceneObject& o : a.objects) add("objects/" + o.name, o.set);
+    ASSERT_EQ(j["header"]["arrays"].size(), want.size());
+    for (const auto& h : j["header"]["arrays"]) {
+      const std::string name = h["name"];
+      ASSERT_TRUE(want.count(name)) << name;
+      EXPECT_EQ(h["dtype"], want[name].second) << name;
+      EXPECT_EQ(j["arrays"][name].get<std::vector<double>>(), want[name].first) << name;
+    }
+    const auto& sh = *std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
+                                   [&](const auto& h) { return h["name"] == (a.objects.empty() ? "transfer/diffuse" : "objects/far/transfer/diffuse"); });
+    EXPECT_EQ(sh["attrs"]["sh_order"], a.objects.empty() ? 3 : 5);
+  }
+}
+
+// ---- engine probes ----
+
+TEST(ExportProbes, EachEnginesFormulaAtEachVertexNormalIsTheBakedIrradiance) {
+  using prt::conventions::Engine;
+  const fs::path dir = fresh_dir("probes");
+  for (const auto& [format, engine, name] : {std::tuple{ExportFormat::Unity, Engine::Unity, "unity"},
+                                             std::tuple{ExportFormat::Godot, Engine::Godot, "godot"},
+                                             std::tuple{ExportFormat::Filament, Engine::Filament, "filament"}})
+    for (const Asset& a : {vertex_asset(), scene_asset()}) {
+      SCOPED_TRACE(std::string(name) + ", up " + a.root.up_axis);
+      export_asset(a, "in.prt.h5", format, dir / "p.json");
+      const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "p.json"));
+      EXPECT_EQ(j["engine"], name);
+      const VertexSet& s = a.objects.empty() ? a.vertices : a.objects[1].set;  // the scene's "lit"
+      ASSERT_EQ(j["sets"].size(), 1u);  // only sets with band-1 radiance
+      const auto& set = j["sets"][0];
+      const std::vector<double> sh = set["sh"], normals = set["normals"], positions = set["positions"];
+      const size_t V = s.vertex_count();
+      ASSERT_EQ(sh.size(), 27 * V);
+      const double k1 = 0.48860251190291992;
+      for (size_t v = 0; v < V; ++v) {
+        const double nx = s.normals->values[3 * v], ny = s.normals->values[3 * v + 1], nz = s.normals->values[3 * v + 2];
+        // The engine's frame by hand: a Z-up file turned Y-up, then Unity mirrors X.
+        prt::testing::V3 n_e = a.root.up_axis == "z" ? prt::testing::V3{nx, nz, -ny} : prt::testing::V3{nx, ny, nz};
+        if (engine == Engine::Unity) n_e[0] = -n_e[0];
+        for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(normals[3 * v + c], n_e[c], 1e-7);
+        const double py = s.positions->values[3 * v + 1], pz = s.positions->values[3 * v + 2];
+        EXPECT_EQ(positions[3 * v + 1], a.root.up_axis == "z" ? pz : py);
+        prt::conventions::EngineSh probe;
+        std::copy_n(sh.begin() + long(27 * v), 27, probe.begin());
+        for (int c = 0; c < 3; ++c) {
+          const float* R = &s.radiance_band1->values[9 * v + 3 * size_t(c)];
+          const double E = 4 * kPi / 3 * k1 * (-ny * R[0] + nz * R[1] - nx * R[2]);  // SCHEMA.md
+          // Godot's constants have 6 digits: 1e-5 of the terms' magnitude.
+          const double scale = 4 * kPi / 3 * k1 * (std::abs(R[0]) + std::abs(R[1]) + std::abs(R[2])) / kPi;
+          EXPECT_NEAR(prt::testing::evaluate(engine, probe, c, n_e), E / kPi, 1e-5 * scale + 1e-12);
+        }
+      }
+    }
+}
+
+TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
+  const fs::path dir = fresh_dir("probes_none");
+  Asset a = vertex_asset();
+  a.vertices.radiance_band1.reset();
+  for (ExportFormat f : {ExportFormat::Unity, ExportFormat::Godot, ExportFormat::Filament}) {
+    try {
+      export_asset(a, "ao_only.prt.h5", f, dir / "p.json");
+      ADD_FAILURE() << "no error";
+    } catch (const FormatError& e) {
+      EXPECT_EQ(e.file(), "ao_only.prt.h5");
+      EXPECT_NE(e.defect().find("/radiance/band1"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(listing(dir).empty());
+  }
+}
+
+TEST(Export, FormatNamesRoundTrip) {
+  for (ExportFormat f : {ExportFormat::Gltf, ExportFormat::Glb, ExportFormat::Binary, ExportFormat::Unity,
+                         ExportFormat::Godot, ExportFormat::Filament})
+    EXPECT_EQ(parse_export_format(to_string(f)), f);
+  EXPECT_EQ(parse_export_format("fbx"), std::nullopt);
+}
+
+} // namespace

@@ -1,0 +1,21 @@
+// tools/prtbake/export.h — `prtbake export`: a baked file in formats engines load without HDF5
+// (glTF, a plain binary + JSON header, per-vertex light probes in Unity / Godot / Filament SH
+// conventions). The command line only; the formats are formats/export.h and SCHEMA.md "Exports".
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace prt::tool {
+
+struct ExportArgs {
+  std::string input, output, format;
+};
+
+// Adds the `export` subcommand to `app`, parsing into `args`.
+void add_export(CLI::App& app, ExportArgs& args);
+// Runs it: reads the input (FormatError: exit 1), writes the output whole or not at all.
+int run_export(const ExportArgs& args);
+
+} // namespace prt::tool
