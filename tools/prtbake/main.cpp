@@ -14,6 +14,7 @@
 
 #include "bakefile.h"
 #include "progress_bar.h"
+#include "shards.h"
 #include "tool_main.h"
 
 #include <CLI/CLI.hpp>
@@ -107,19 +108,21 @@ struct Args {
   double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
+  tool::ShardOptions shard;  // vertex: sharded and resumable bakes (shards.h)
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
-// (without --threads, --quiet, --verbose, --dry-run, --reproducible); "--opt=value" is stored as
-// "--opt value".
+// (without --threads, --quiet, --verbose, --dry-run, --reproducible and the sharding options);
+// "--opt=value" is stored as "--opt value".
 std::string content_command_line(int argc, char** argv) {
   std::string line = "prtbake";
   for (int i = 1; i < argc; ++i) {
     std::string s = argv[i], value;
     const size_t eq = s.rfind("--", 0) == 0 ? s.find('=') : std::string::npos;
     if (eq != std::string::npos) value = s.substr(eq + 1), s.resize(eq);
-    if (s == "--threads") {
-      if (eq == std::string::npos) ++i;
+    bool takes_value = false;
+    if (s == "--threads" || tool::is_shard_option(s, takes_value)) {
+      if ((s == "--threads" || takes_value) && eq == std::string::npos) ++i;
       continue;
     }
     if (s == "--quiet" || s == "-q" || s == "--verbose" || s == "-v" || s == "--dry-run" || s == "--reproducible")
@@ -277,6 +280,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                "with a target error: print the pilot's table (each run's error and\n"
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
+  tool::add_shard_options(cmd, a.shard);
 }
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
@@ -330,7 +334,7 @@ void add_scene(CLI::App& app, Args& a) {
 }
 
 // Parses the command line; nullopt when it asked for help or the version (printed).
-std::optional<Args> parse(int argc, char** argv) {
+std::optional<Args> parse(int argc, char** argv, bool under_mpirun) {
   Args a;
   uint32_t samples = 0;  // --samples: 0 if not given
   CLI::App app(kDescription, "prtbake");
@@ -356,6 +360,10 @@ std::optional<Args> parse(int argc, char** argv) {
   a.command = app.get_subcommands().front()->get_name();
   a.command_line = content_command_line(argc, argv);
   if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
+  if (under_mpirun && a.command != "vertex")
+    throw UsageError(a.command + ": under mpirun only vertex bakes are sharded; run it as one process");
+  // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
+  if (a.shard.given() || under_mpirun) a.reproducible = true;
   if (a.command == "scene") {
     a.report_given = app.get_subcommand("scene")->count("--report") > 0;
     if (a.output.empty() && !a.dry_run) throw UsageError("scene: no output file given (-o OUT.prt.h5)");
@@ -509,8 +517,8 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   }
 }
 
-int run_vertex(const Args& a) {
-  const bool say = !a.quiet;
+int run_vertex(const Args& a, const tool::MpiSession& mpi) {
+  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
   check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -551,7 +559,7 @@ int run_vertex(const Args& a) {
   req.visibility_order = a.visibility;
   req.radiance = env ? &*env : nullptr;
 
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   bake::IntegratorSpec spec = a.integrator;
   const bake::MeshAccel accel(mesh, topo);  // the mesh's trees, shared by the pilot, the bake and the report
@@ -583,7 +591,28 @@ int run_vertex(const Args& a) {
                 integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
   }
-  const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
+  const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(mesh, topo);
+  std::optional<tool::ShardedRows> shards;
+  bake::VertexBake result;
+  if (a.shard.given() || mpi.active()) {
+    const tool::Worker worker = tool::resolve_worker(a.shard, mpi);
+    const std::string manifest = tool::manifest_of(
+        {"vertex", kVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment",
+         integrator.description(), bake::to_string(spec.kind), std::to_string(spec.samples()),
+         std::to_string(spec.seed), std::to_string(integrator.layout().width), std::to_string(a.shard.chunk_rows)});
+    shards.emplace(worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
+                   std::vector<uint32_t>{uint32_t(integrator.layout().width)}, a.quiet);
+    const bool merges = shards->run([&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& closed_form) {
+      const uint64_t before = integrator.stats().closed_form;
+      bake::VertexBake rows = bake::bake_point_rows(points, r.begin, r.end, integrator, monitor);
+      closed_form = integrator.stats().closed_form - before;
+      return rows;
+    });
+    if (!merges) return 0;
+    result = shards->merge(0, integrator.layout());
+  } else {
+    result = bake::bake_points(points, integrator, progress);
+  }
   warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
               a.flip_normals);
   if (say) {
@@ -635,6 +664,7 @@ int run_vertex(const Args& a) {
                       env ? &*env : nullptr, a.environment});
   if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
   write_file(a, asset);
+  if (shards) shards->finish();
   return 0;
 }
 
@@ -826,11 +856,12 @@ int run_scene(const Args& a) {
 }
 
 int prtbake_main(int argc, char** argv) {
-  const std::optional<Args> parsed = parse(argc, argv);
+  const tool::MpiSession mpi(argc, argv);  // under mpirun: ranks are shard workers (shards.h)
+  const std::optional<Args> parsed = parse(argc, argv, mpi.active());
   if (!parsed) return 0;  // --help or --version
   const Args& a = *parsed;
   tool::install_interrupt_handler();
-  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
+  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a, mpi);
 }
 
 } // namespace
