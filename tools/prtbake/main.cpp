@@ -108,7 +108,7 @@ struct Args {
   double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
-  tool::ShardOptions shard;  // vertex: sharded and resumable bakes (shards.h)
+  tool::ShardOptions shard;  // vertex, scene: sharded and resumable bakes (shards.h)
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
@@ -331,6 +331,7 @@ void add_scene(CLI::App& app, Args& a) {
   cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
   add_report(cmd, a, "overrides the scene file's bake.report");
   add_run_options(cmd, a);
+  tool::add_shard_options(cmd, a.shard);
 }
 
 // Parses the command line; nullopt when it asked for help or the version (printed).
@@ -360,8 +361,8 @@ std::optional<Args> parse(int argc, char** argv, bool under_mpirun) {
   a.command = app.get_subcommands().front()->get_name();
   a.command_line = content_command_line(argc, argv);
   if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
-  if (under_mpirun && a.command != "vertex")
-    throw UsageError(a.command + ": under mpirun only vertex bakes are sharded; run it as one process");
+  if (under_mpirun && a.command == "fiv")
+    throw UsageError("fiv: under mpirun only vertex and scene bakes are sharded; run it as one process");
   // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
   if (a.shard.given() || under_mpirun) a.reproducible = true;
   if (a.command == "scene") {
@@ -602,11 +603,10 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
          std::to_string(spec.seed), std::to_string(integrator.layout().width), std::to_string(a.shard.chunk_rows)});
     shards.emplace(worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
                    std::vector<uint32_t>{uint32_t(integrator.layout().width)}, a.quiet);
-    const bool merges = shards->run([&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& closed_form) {
-      const uint64_t before = integrator.stats().closed_form;
-      bake::VertexBake rows = bake::bake_point_rows(points, r.begin, r.end, integrator, monitor);
-      closed_form = integrator.stats().closed_form - before;
-      return rows;
+    const bool merges = shards->run([&] {
+      shards->work([&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& closed_form) {
+        return tool::bake_chunk(points, r, integrator, monitor, closed_form);
+      });
     });
     if (!merges) return 0;
     result = shards->merge(0, integrator.layout());
@@ -721,8 +721,8 @@ int run_fiv(const Args& a) {
   return 0;
 }
 
-int run_scene(const Args& a) {
-  const bool say = !a.quiet;
+int run_scene(const Args& a, const tool::MpiSession& mpi) {
+  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -765,13 +765,57 @@ int run_scene(const Args& a) {
   }
   if (a.dry_run) return 0;
 
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
+  // Sharded: the receivers' rows in chunks (every worker), then the rest of the bake on the
+  // merging process, its rows read back from the chunks (shards.h).
+  std::optional<tool::ShardedRows> shards;
+  bake::SceneRows merged_rows;
+  if (a.shard.given() || mpi.active()) {
+    const tool::Worker worker = tool::resolve_worker(a.shard, mpi);
+    std::vector<uint64_t> set_rows;
+    std::vector<uint32_t> widths;
+    std::vector<std::string> lines = {"scene", kVersion, a.command_line, bake::sha256_file(a.input),
+                                      a.scene_options.empty() ? "" : bake::sha256_file(a.scene_options),
+                                      env ? env->info().sha256 : "no environment", std::to_string(a.shard.chunk_rows)};
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const bake::ObjectPlan& p = plan.objects[i];
+      if (!p.receiver || !p.any_vertex_product()) continue;
+      bake::ProductRequest r;
+      r.ao = p.ao, r.transfer_order = p.transfer_order, r.visibility_order = p.visibility_order;
+      r.radiance = p.radiance && env ? &*env : nullptr;
+      set_rows.push_back(meshes[i].positions.size());
+      widths.push_back(uint32_t(bake::ProductLayout(r).width));
+      lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
+    }
+    shards.emplace(worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
+    const bool merges = shards->run([&] {
+      bake::SceneRows work;
+      work.rows_only = true;
+      work.rows = [&](size_t set, std::span<const bake::ShadePoint> points, const bake::Integrator& integrator,
+                      const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+        shards->work(
+            [&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& count) {
+              return tool::bake_chunk(points, r, integrator, monitor, count);
+            },
+            uint32_t(set));
+        closed_form = 0;
+        return bake::VertexBake{};
+      };
+      bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress, [](const std::string&) {}, work);
+    });
+    if (!merges) return 0;
+    merged_rows.rows = [&](size_t set, std::span<const bake::ShadePoint>, const bake::Integrator& integrator,
+                           const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+      return shards->merge(uint32_t(set), integrator.layout(), &closed_form);
+    };
+  }
   const bake::SceneBake result = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
                                                   [&](const std::string& line) {
                                                     if (say) std::printf("%s\n", line.c_str());
                                                     std::fflush(stdout);
-                                                  });
+                                                  },
+                                                  merged_rows);
   // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (const auto& values = result.objects[i].values) {
@@ -852,6 +896,7 @@ int run_scene(const Args& a) {
   if (plan.fiv_environment)
     tool::set_fiv_environment(asset, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
   write_file(a, asset);
+  if (shards) shards->finish();
   return 0;
 }
 
@@ -861,7 +906,7 @@ int prtbake_main(int argc, char** argv) {
   if (!parsed) return 0;  // --help or --version
   const Args& a = *parsed;
   tool::install_interrupt_handler();
-  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a, mpi);
+  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a, mpi) : run_vertex(a, mpi);
 }
 
 } // namespace

@@ -222,6 +222,14 @@ Worker resolve_worker(const ShardOptions& o, const MpiSession& mpi) {
   return w;
 }
 
+bake::VertexBake bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
+                            const bake::Integrator& integrator, const bake::Monitor& monitor, uint64_t& closed_form) {
+  const uint64_t before = integrator.stats().closed_form;  // chunks run one at a time in a process
+  bake::VertexBake rows = bake::bake_point_rows(points, range.begin, range.end, integrator, monitor);
+  closed_form = integrator.stats().closed_form - before;
+  return rows;
+}
+
 std::string manifest_of(const std::vector<std::string>& lines) {
   std::string text = "prtbake chunk manifest 1\n";
   for (const std::string& l : lines) text += l + "\n";
@@ -236,6 +244,10 @@ struct ShardedRows::State {
   bake::ChunkStore store;
   std::vector<uint32_t> widths;
   bool quiet = false;
+  // This run's counts, for the progress and summary lines.
+  size_t before = 0, computed = 0, rows = 0;
+  double busy = 0, cpu = 0;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 
 namespace {
@@ -255,72 +267,73 @@ ShardedRows::ShardedRows(const Worker& worker, const MpiSession& mpi, const Shar
 
 ShardedRows::~ShardedRows() = default;
 
-bool ShardedRows::run(const Compute& compute) {
+bool ShardedRows::run(const std::function<void()>& body) {
   State& s = *s_;
   const Worker& w = s.worker;
-  const auto& chunks = s.store.chunks();
-  const size_t total = chunks.size();
-  const bool say = !s.quiet && w.index == 0;
-  bool ok = true;
   std::exception_ptr error;
   try {
     if (w.computes) {
-      const size_t before = s.store.committed_count();
+      s.before = s.store.committed_count();
       s.mpi->all(true);  // every rank counted before any commits
-      if (say)
+      if (!s.quiet && w.index == 0)
         std::printf("chunks: %zu in %s; %zu committed before this run (reused), %zu to compute by %d worker(s), %s "
                     "claiming\n",
-                    total, s.store.dir().string().c_str(), before, total - before, w.count,
-                    w.claim == Claim::Static ? "static" : "dynamic");
+                    s.store.chunks().size(), s.store.dir().string().c_str(), s.before, s.store.chunks().size() - s.before,
+                    w.count, w.claim == Claim::Static ? "static" : "dynamic");
       std::fflush(stdout);
-      const bake::Monitor cancel{{}, &interrupt_token()};
-      const auto t0 = std::chrono::steady_clock::now();
-      size_t computed = 0, rows = 0;
-      double busy = 0, cpu = 0;
-      for (size_t i = 0; i < total; ++i) {
-        const bool mine = w.claim == Claim::Static ? int(i % size_t(w.count)) == w.index : true;
-        if (!mine) continue;
-        if (s.store.committed(i)) {
-          // A foreign or corrupt chunk is refused now, before hours of work (static: this worker's
-          // own; dynamic: the first worker checks them all).
-          if (w.claim == Claim::Static || w.index == 0) s.store.read(i, s.widths.at(chunks[i].set));
-          continue;
-        }
-        if (w.claim == Claim::Dynamic && !s.store.claim(i, w.run_id)) continue;
-        uint64_t closed_form = 0;
-        const bake::VertexBake b = compute(chunks[i], cancel, closed_form);
-        bake::ChunkData d;
-        d.range = chunks[i];
-        d.width = uint32_t(b.layout.width);
-        d.values = b.values;
-        d.std_error = b.std_error;
-        d.closed_form = closed_form;
-        d.cpu_seconds = b.cpu_seconds;
-        d.seconds = b.seconds;
-        s.store.commit(i, d);
-        ++computed, rows += chunks[i].rows(), busy += b.seconds, cpu += b.cpu_seconds;
-        if (say) {
-          const size_t now = s.store.committed_count();
-          const double elapsed = seconds_since(t0);
-          const double eta = now > before ? elapsed * double(total - now) / double(now - before) : 0.0;
-          std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %.0f s\n", i, now, total,
-                      elapsed, eta);
-          std::fflush(stdout);
-        }
-      }
-      if (!s.quiet)
-        std::printf("worker %d/%d (%s): computed %zu chunks (%zu rows), busy %.2f s (%.2f CPU s)\n", w.index, w.count,
-                    w.launcher.c_str(), computed, rows, busy, cpu);
-      std::fflush(stdout);
+      s.start = std::chrono::steady_clock::now();
+      body();
     }
+    if (w.computes && !s.quiet)
+      std::printf("worker %d/%d (%s): computed %zu chunks (%zu rows), busy %.2f s (%.2f CPU s)\n", w.index, w.count,
+                  w.launcher.c_str(), s.computed, s.rows, s.busy, s.cpu);
+    std::fflush(stdout);
   } catch (...) {
-    ok = false;
     error = std::current_exception();
   }
-  const bool every = s.mpi->all(ok);  // under mpirun: the barrier before rank 0 merges
+  const bool every = s.mpi->all(!error);  // under mpirun: the barrier before rank 0 merges
   if (error) std::rethrow_exception(error);
-  if (!every && w.merges) throw bake::InputError(s.store.dir().string(), "another worker failed (its message is above); nothing merged");
+  if (!every && w.merges)
+    throw bake::InputError(s.store.dir().string(), "another worker failed (its message is above); nothing merged");
   return w.merges;
+}
+
+void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set) {
+  State& s = *s_;
+  const Worker& w = s.worker;
+  if (!w.computes) return;
+  const auto& chunks = s.store.chunks();
+  const size_t total = chunks.size();
+  const bool say = !s.quiet && w.index == 0;
+  const bake::Monitor cancel{{}, &interrupt_token()};
+  for (size_t i = 0; i < total; ++i) {
+    if (set && chunks[i].set != *set) continue;
+    if (w.claim == Claim::Static && int(i % size_t(w.count)) != w.index) continue;
+    if (s.store.committed(i)) {
+      // A foreign or corrupt chunk is refused now, before hours of work (static: this worker's
+      // own; dynamic: the first worker checks them all).
+      if (w.claim == Claim::Static || w.index == 0) s.store.read(i, s.widths.at(chunks[i].set));
+      continue;
+    }
+    if (w.claim == Claim::Dynamic && !s.store.claim(i, w.run_id)) continue;
+    bake::ChunkData d;
+    const bake::VertexBake b = compute(chunks[i], cancel, d.closed_form);
+    d.range = chunks[i];
+    d.width = uint32_t(b.layout.width);
+    d.values = b.values;
+    d.std_error = b.std_error;
+    d.cpu_seconds = b.cpu_seconds;
+    d.seconds = b.seconds;
+    s.store.commit(i, d);
+    ++s.computed, s.rows += chunks[i].rows(), s.busy += b.seconds, s.cpu += b.cpu_seconds;
+    if (say) {
+      const size_t now = s.store.committed_count();
+      const double elapsed = seconds_since(s.start);
+      const double eta = now > s.before ? elapsed * double(total - now) / double(now - s.before) : 0.0;
+      std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %.0f s\n", i, now, total, elapsed, eta);
+      std::fflush(stdout);
+    }
+  }
 }
 
 bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form) const {

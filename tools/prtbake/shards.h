@@ -29,6 +29,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -94,12 +95,15 @@ public:
               const std::string& manifest, const std::vector<uint64_t>& set_rows, std::vector<uint32_t> set_widths,
               bool quiet);
   ~ShardedRows();
-  // Computes this worker's uncommitted chunks with `compute` (rows [range.begin, range.end) of set
-  // range.set; `monitor` cancels on Ctrl-C) and commits each; then waits for the other ranks under
-  // mpirun. Returns whether this process merges.
+  // Rows [range.begin, range.end) of set range.set (`monitor` cancels on Ctrl-C) and their
+  // IntegratorStats::closed_form.
   using Compute = std::function<bake::VertexBake(const bake::ChunkRange&, const bake::Monitor& monitor,
                                                  uint64_t& closed_form)>;
-  bool run(const Compute& compute);
+  // Runs `body`, which calls work() for the rows (not with --merge), then, under mpirun, waits
+  // for every rank (an error in any rank stops the merge). Returns whether this process merges.
+  bool run(const std::function<void()>& body);
+  // Computes and commits this worker's uncommitted chunks (of set `set` only, when given).
+  void work(const Compute& compute, std::optional<uint32_t> set = std::nullopt);
   // Every chunk of set `set`, verified (InputError naming a missing, corrupt or foreign chunk),
   // joined into one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
   bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
@@ -110,6 +114,10 @@ private:
   struct State;
   std::unique_ptr<State> s_;
 };
+
+// Rows [range.begin, range.end) of `points` (bake_point_rows) and their closed-form count.
+bake::VertexBake bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
+                            const bake::Integrator& integrator, const bake::Monitor& monitor, uint64_t& closed_form);
 
 // The SHA-256 of the lines that determine a bake's rows (inputs' digests, options, integrator,
 // seed, chunk size).
