@@ -186,9 +186,13 @@ std::optional<ChunkData> ChunkStore::read(size_t index, uint32_t width) const {
   return d;
 }
 
+bool valid_run_id(std::string_view id) {
+  return !id.empty() && id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.") ==
+                            std::string_view::npos;
+}
+
 bool ChunkStore::claim(size_t index, const std::string& run_id) const {
-  PRT_CHECK(!run_id.empty() && run_id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.") ==
-                                   std::string::npos);
+  PRT_CHECK(valid_run_id(run_id));
   const fs::path path = chunk_path(index).string() + ".claim." + run_id;
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {

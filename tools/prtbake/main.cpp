@@ -84,6 +84,8 @@ constexpr const char* kExamples =
     "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
     "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
     "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
+    "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
+    "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
 using tool::UsageError;

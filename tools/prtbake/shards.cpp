@@ -115,12 +115,7 @@ void add_shard_options(CLI::App& cmd, ShardOptions& o) {
                  "its workers; mpirun and SLURM arrays name theirs). A rerun with another\n"
                  "id ignores the claims of the dead one.")
       ->option_text("ID")
-      ->check([](const std::string& s) -> std::string {
-        return !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.") ==
-                                 std::string::npos
-                   ? ""
-                   : "expects letters, digits, '-', '_' or '.'";
-      })
+      ->check([](const std::string& s) { return bake::valid_run_id(s) ? "" : std::string("expects letters, digits, '-', '_' or '.'"); })
       ->group(group);
 }
 

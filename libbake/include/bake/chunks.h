@@ -26,6 +26,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace prt::bake {
@@ -48,6 +49,9 @@ struct ChunkData {
   double cpu_seconds = 0, seconds = 0;    // integrator CPU time and wall time of the chunk
 };
 
+// Whether `id` can name a run in claim file names: letters, digits, '-', '_', '.' (not empty).
+bool valid_run_id(std::string_view id);
+
 // One bake's chunk directory.
 class ChunkStore {
 public:
@@ -67,8 +71,7 @@ public:
   // Chunk `index`, verified; nullopt if it was never committed. InputError naming the file if it
   // is corrupt, of another bake or of another range.
   std::optional<ChunkData> read(size_t index, uint32_t width) const;
-  // Claims chunk `index` for run `run_id` (letters, digits, '-', '_', '.'); false if a worker of
-  // the same run holds it.
+  // Claims chunk `index` for run `run_id` (valid_run_id); false if a worker of the same run holds it.
   bool claim(size_t index, const std::string& run_id) const;
   // Removes this store's chunk files, claims and temporaries, then the directory if empty.
   void remove() const;
