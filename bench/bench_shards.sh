@@ -7,6 +7,7 @@
 #
 #   bench/bench_shards.sh                 bunny_ground, all four products, qmc 2048 rays
 #   PRT_SHARDS_SAMPLES=512 PRT_SHARDS_INTEGRATOR=silhouette bench/bench_shards.sh
+#   PRT_SHARDS_REPORT=0 bench/bench_shards.sh   no error report: the merge's own cost
 #   PRT_BENCH_BUILD_DIR=build/ci bench/bench_shards.sh   another build tree (default build/release)
 # Times: wall (elapsed) and CPU (user + system) from /usr/bin/time; "busy" is the time a worker
 # spent integrating its chunks (its "worker ..." line). On a shared machine, compare CPU and busy
@@ -18,11 +19,12 @@ prtbake="$build/tools/prtbake"
 samples="${PRT_SHARDS_SAMPLES:-2048}"
 integrator="${PRT_SHARDS_INTEGRATOR:-qmc}"
 rows="${PRT_SHARDS_CHUNK_ROWS:-256}"
+report="${PRT_SHARDS_REPORT:-32}"  # the error report's points, integrated by the merge
 [[ -x "$prtbake" ]] || { echo "bench_shards.sh: no $prtbake (build the release preset)" >&2; exit 2; }
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 args=(vertex "$root/data/bunny_ground.obj" --ao --transfer 3 --visibility 3 --radiance "$root/data/sunset.exr"
-      --integrator "$integrator" --samples "$samples" --chunk-rows "$rows" -o out.prt.h5)
+      --integrator "$integrator" --samples "$samples" --chunk-rows "$rows" --report "$report" -o out.prt.h5)
 
 # run NAME DIR ARGS...: runs prtbake in DIR, its stdout in DIR/NAME.log, "wall cpu" in DIR/NAME.time.
 run() {
