@@ -520,8 +520,15 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   }
 }
 
+// Who this process is in a sharded bake (nullopt: not sharded), before any long step.
+std::optional<tool::Worker> shard_worker(const Args& a, const tool::MpiSession& mpi) {
+  if (!a.shard.given() && !mpi.active()) return std::nullopt;
+  return tool::resolve_worker(a.shard, mpi);
+}
+
 int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
+  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
   check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -597,13 +604,12 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(mesh, topo);
   std::optional<tool::ShardedRows> shards;
   bake::VertexBake result;
-  if (a.shard.given() || mpi.active()) {
-    const tool::Worker worker = tool::resolve_worker(a.shard, mpi);
+  if (worker) {
     const std::string manifest = tool::manifest_of(
         {"vertex", kVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment",
          integrator.description(), bake::to_string(spec.kind), std::to_string(spec.samples()),
          std::to_string(spec.seed), std::to_string(integrator.layout().width), std::to_string(a.shard.chunk_rows)});
-    shards.emplace(worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
+    shards.emplace(*worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
                    std::vector<uint32_t>{uint32_t(integrator.layout().width)}, a.quiet);
     const bool merges = shards->run([&] {
       shards->work([&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& closed_form) {
@@ -725,6 +731,7 @@ int run_fiv(const Args& a) {
 
 int run_scene(const Args& a, const tool::MpiSession& mpi) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
+  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -773,8 +780,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
   // merging process, its rows read back from the chunks (shards.h).
   std::optional<tool::ShardedRows> shards;
   bake::SceneRows merged_rows;
-  if (a.shard.given() || mpi.active()) {
-    const tool::Worker worker = tool::resolve_worker(a.shard, mpi);
+  if (worker) {
     std::vector<uint64_t> set_rows;
     std::vector<uint32_t> widths;
     std::vector<std::string> lines = {"scene", kVersion, a.command_line, bake::sha256_file(a.input),
@@ -790,7 +796,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
       widths.push_back(uint32_t(bake::ProductLayout(r).width));
       lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
     }
-    shards.emplace(worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
+    shards.emplace(*worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
     const bool merges = shards->run([&] {
       bake::SceneRows work;
       work.rows_only = true;
