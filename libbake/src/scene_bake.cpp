@@ -51,7 +51,7 @@ std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const A
 } // namespace
 
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     const Monitor& monitor, const std::function<void(const std::string&)>& log) {
+                     const Monitor& monitor, const std::function<void(const std::string&)>& log, const SceneRows& rows) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
   SceneBake out;
@@ -108,6 +108,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   out.setup_seconds = seconds_since(t_setup);
 
   // ---- receivers ----
+  size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
     if (!p.receiver || (!p.any_vertex_product() && !p.area_irradiance)) continue;
@@ -123,7 +124,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       }
     }
     ObjectBake& ob = out.objects[i];
-    if (p.area_irradiance) {
+    if (p.area_irradiance && !rows.rows_only) {
       const auto t0 = std::chrono::steady_clock::now();
       ob.area = bake_area_lights(points, *area_integrators.at(p.area_sh_order), monitor,
                                  "area lights on " + scene.objects[i].name);
@@ -157,10 +158,16 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     PRT_CHECK(integ != nullptr);
     const Integrator& integrator = *integ;
     const bool silhouette = integrator.kind() == IntegratorKind::Silhouette;
-    const uint64_t closed_before = integrator.stats().closed_form;
-    ob.values = bake_points(points, integrator, monitor, "baking " + scene.objects[i].name);
+    const std::string label = "baking " + scene.objects[i].name;
+    if (rows.rows) {
+      ob.values = rows.rows(set++, points, integrator, monitor, label, ob.closed_form_vertices);
+      if (rows.rows_only) continue;
+    } else {
+      const uint64_t closed_before = integrator.stats().closed_form;
+      ob.values = bake_points(points, integrator, monitor, label);
+      ob.closed_form_vertices = integrator.stats().closed_form - closed_before;
+    }
     ob.integrator_description = integrator.description();
-    ob.closed_form_vertices = integrator.stats().closed_form - closed_before;
     out.vertex_seconds += ob.values->seconds;
     out.vertices += points.size();
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
@@ -179,6 +186,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   }
 
   // ---- FIV ----
+  if (rows.rows_only) return out;
   if (plan.fiv_environment) {
     PRT_CHECK(env != nullptr);
     const auto t0 = std::chrono::steady_clock::now();

@@ -43,18 +43,25 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator, const Monitor& monitor,
                        const std::string& label) {
+  return bake_point_rows(points, 0, points.size(), integrator, monitor, label);
+}
+
+VertexBake bake_point_rows(std::span<const ShadePoint> points, size_t begin, size_t end, const Integrator& integrator,
+                           const Monitor& monitor, const std::string& label) {
+  PRT_CHECK(begin <= end && end <= points.size());
   VertexBake out;
   out.layout = integrator.layout();
-  const size_t V = points.size(), W = out.layout.width;
+  const size_t V = end - begin, W = out.layout.width;
   out.values.assign(V * W, 0.0);
   out.std_error.assign(V * W, 0.0);
   Task progress(monitor, label, V);
   const auto t0 = std::chrono::steady_clock::now();
   std::atomic<int64_t> cpu_ns{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, V, 16), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 16), [&](const tbb::blocked_range<size_t>& r) {
     const double c0 = thread_cpu_seconds();
     for (size_t v = r.begin(); v != r.end(); ++v)
-      integrator.integrate(points[v], v, std::span(out.values).subspan(v * W, W), std::span(out.std_error).subspan(v * W, W));
+      integrator.integrate(points[v], v, std::span(out.values).subspan((v - begin) * W, W),
+                           std::span(out.std_error).subspan((v - begin) * W, W));
     cpu_ns.fetch_add(int64_t(1e9 * (thread_cpu_seconds() - c0)), std::memory_order_relaxed);
     progress.advance(r.size());
   });

@@ -15,6 +15,7 @@
 #include "bakefile.h"
 #include "export.h"
 #include "progress_bar.h"
+#include "shards.h"
 #include "tool_main.h"
 
 #include <CLI/CLI.hpp>
@@ -84,12 +85,15 @@ constexpr const char* kExamples =
     "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
     "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
     "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
+    "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
+    "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
+    "  prtbake export bunny.prt.h5 --to glb -o bunny.glb   # for engines without HDF5 (also gltf, bin, unity, godot, filament)\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
 using tool::UsageError;
 
 struct Args {
-  std::string command;      // vertex, fiv or scene
+  std::string command;      // vertex, fiv, scene or export
   std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file or glTF (scene)
   std::string scene_options;  // scene: a glTF scene's options file (--options)
   std::string output;       // the .prt.h5 file
@@ -109,19 +113,21 @@ struct Args {
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
   tool::ExportArgs exported;  // export: a baked file in another format (export.h)
+  tool::ShardOptions shard;   // vertex, scene: sharded and resumable bakes (shards.h)
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
-// (without --threads, --quiet, --verbose, --dry-run, --reproducible); "--opt=value" is stored as
-// "--opt value".
+// (without --threads, --quiet, --verbose, --dry-run, --reproducible and the sharding options);
+// "--opt=value" is stored as "--opt value".
 std::string content_command_line(int argc, char** argv) {
   std::string line = "prtbake";
   for (int i = 1; i < argc; ++i) {
     std::string s = argv[i], value;
     const size_t eq = s.rfind("--", 0) == 0 ? s.find('=') : std::string::npos;
     if (eq != std::string::npos) value = s.substr(eq + 1), s.resize(eq);
-    if (s == "--threads") {
-      if (eq == std::string::npos) ++i;
+    bool takes_value = false;
+    if (s == "--threads" || tool::is_shard_option(s, takes_value)) {
+      if ((s == "--threads" || takes_value) && eq == std::string::npos) ++i;
       continue;
     }
     if (s == "--quiet" || s == "-q" || s == "--verbose" || s == "-v" || s == "--dry-run" || s == "--reproducible")
@@ -279,6 +285,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                "with a target error: print the pilot's table (each run's error and\n"
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
+  tool::add_shard_options(cmd, a.shard);
 }
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
@@ -329,10 +336,11 @@ void add_scene(CLI::App& app, Args& a) {
   cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
   add_report(cmd, a, "overrides the scene file's bake.report");
   add_run_options(cmd, a);
+  tool::add_shard_options(cmd, a.shard);
 }
 
 // Parses the command line; nullopt when it asked for help or the version (printed).
-std::optional<Args> parse(int argc, char** argv) {
+std::optional<Args> parse(int argc, char** argv, bool under_mpirun) {
   Args a;
   uint32_t samples = 0;  // --samples: 0 if not given
   CLI::App app(kDescription, "prtbake");
@@ -357,9 +365,16 @@ std::optional<Args> parse(int argc, char** argv) {
     throw UsageError(e.what());
   }
   a.command = app.get_subcommands().front()->get_name();
-  if (a.command == "export") return a;
+  if (a.command == "export") {
+    if (under_mpirun) throw UsageError("export: run it as one process, not under mpirun");
+    return a;
+  }
   a.command_line = content_command_line(argc, argv);
   if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
+  if (under_mpirun && a.command == "fiv")
+    throw UsageError("fiv: under mpirun only vertex and scene bakes are sharded; run it as one process");
+  // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
+  if (a.shard.given() || under_mpirun) a.reproducible = true;
   if (a.command == "scene") {
     a.report_given = app.get_subcommand("scene")->count("--report") > 0;
     if (a.output.empty() && !a.dry_run) throw UsageError("scene: no output file given (-o OUT.prt.h5)");
@@ -513,8 +528,15 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   }
 }
 
-int run_vertex(const Args& a) {
-  const bool say = !a.quiet;
+// Who this process is in a sharded bake (nullopt: not sharded), before any long step.
+std::optional<tool::Worker> shard_worker(const Args& a, const tool::MpiSession& mpi) {
+  if (!a.shard.given() && !mpi.active()) return std::nullopt;
+  return tool::resolve_worker(a.shard, mpi);
+}
+
+int run_vertex(const Args& a, const tool::MpiSession& mpi) {
+  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
+  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
   check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -555,7 +577,7 @@ int run_vertex(const Args& a) {
   req.visibility_order = a.visibility;
   req.radiance = env ? &*env : nullptr;
 
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   bake::IntegratorSpec spec = a.integrator;
   const bake::MeshAccel accel(mesh, topo);  // the mesh's trees, shared by the pilot, the bake and the report
@@ -587,7 +609,26 @@ int run_vertex(const Args& a) {
                 integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
   }
-  const bake::VertexBake result = bake::bake_vertices(mesh, topo, integrator, progress);
+  const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(mesh, topo);
+  std::optional<tool::ShardedRows> shards;
+  bake::VertexBake result;
+  if (worker) {
+    const std::string manifest = tool::manifest_of(
+        {"vertex", kVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment",
+         integrator.description(), bake::to_string(spec.kind), std::to_string(spec.samples()),
+         std::to_string(spec.seed), std::to_string(integrator.layout().width), std::to_string(a.shard.chunk_rows)});
+    shards.emplace(*worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
+                   std::vector<uint32_t>{uint32_t(integrator.layout().width)}, a.quiet);
+    const bool merges = shards->run([&] {
+      shards->work([&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& closed_form) {
+        return tool::bake_chunk(points, r, integrator, monitor, closed_form);
+      });
+    });
+    if (!merges) return 0;
+    result = shards->merge(0, integrator.layout());
+  } else {
+    result = bake::bake_points(points, integrator, progress);
+  }
   warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
               a.flip_normals);
   if (say) {
@@ -639,6 +680,7 @@ int run_vertex(const Args& a) {
                       env ? &*env : nullptr, a.environment});
   if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
   write_file(a, asset);
+  if (shards) shards->finish();
   return 0;
 }
 
@@ -695,8 +737,9 @@ int run_fiv(const Args& a) {
   return 0;
 }
 
-int run_scene(const Args& a) {
-  const bool say = !a.quiet;
+int run_scene(const Args& a, const tool::MpiSession& mpi) {
+  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
+  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -739,13 +782,56 @@ int run_scene(const Args& a) {
   }
   if (a.dry_run) return 0;
 
-  const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
+  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
+  // Sharded: the receivers' rows in chunks (every worker), then the rest of the bake on the
+  // merging process, its rows read back from the chunks (shards.h).
+  std::optional<tool::ShardedRows> shards;
+  bake::SceneRows merged_rows;
+  if (worker) {
+    std::vector<uint64_t> set_rows;
+    std::vector<uint32_t> widths;
+    std::vector<std::string> lines = {"scene", kVersion, a.command_line, bake::sha256_file(a.input),
+                                      a.scene_options.empty() ? "" : bake::sha256_file(a.scene_options),
+                                      env ? env->info().sha256 : "no environment", std::to_string(a.shard.chunk_rows)};
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const bake::ObjectPlan& p = plan.objects[i];
+      if (!p.receiver || !p.any_vertex_product()) continue;
+      bake::ProductRequest r;
+      r.ao = p.ao, r.transfer_order = p.transfer_order, r.visibility_order = p.visibility_order;
+      r.radiance = p.radiance && env ? &*env : nullptr;
+      set_rows.push_back(meshes[i].positions.size());
+      widths.push_back(uint32_t(bake::ProductLayout(r).width));
+      lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
+    }
+    shards.emplace(*worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
+    const bool merges = shards->run([&] {
+      bake::SceneRows work;
+      work.rows_only = true;
+      work.rows = [&](size_t set, std::span<const bake::ShadePoint> points, const bake::Integrator& integrator,
+                      const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+        shards->work(
+            [&](const bake::ChunkRange& r, const bake::Monitor& monitor, uint64_t& count) {
+              return tool::bake_chunk(points, r, integrator, monitor, count);
+            },
+            uint32_t(set));
+        closed_form = 0;
+        return bake::VertexBake{};
+      };
+      bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress, [](const std::string&) {}, work);
+    });
+    if (!merges) return 0;
+    merged_rows.rows = [&](size_t set, std::span<const bake::ShadePoint>, const bake::Integrator& integrator,
+                           const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+      return shards->merge(uint32_t(set), integrator.layout(), &closed_form);
+    };
+  }
   const bake::SceneBake result = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
                                                   [&](const std::string& line) {
                                                     if (say) std::printf("%s\n", line.c_str());
                                                     std::fflush(stdout);
-                                                  });
+                                                  },
+                                                  merged_rows);
   // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (const auto& values = result.objects[i].values) {
@@ -826,16 +912,18 @@ int run_scene(const Args& a) {
   if (plan.fiv_environment)
     tool::set_fiv_environment(asset, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
   write_file(a, asset);
+  if (shards) shards->finish();
   return 0;
 }
 
 int prtbake_main(int argc, char** argv) {
-  const std::optional<Args> parsed = parse(argc, argv);
+  const tool::MpiSession mpi(argc, argv);  // under mpirun: ranks are shard workers (shards.h)
+  const std::optional<Args> parsed = parse(argc, argv, mpi.active());
   if (!parsed) return 0;  // --help or --version
   const Args& a = *parsed;
   tool::install_interrupt_handler();
   if (a.command == "export") return tool::run_export(a.exported);
-  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a) : run_vertex(a);
+  return a.command == "fiv" ? run_fiv(a) : a.command == "scene" ? run_scene(a, mpi) : run_vertex(a, mpi);
 }
 
 } // namespace

@@ -240,7 +240,20 @@ struct SceneBake {
 // (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
 // The area lights' rows are the same for any thread count (each vertex's row is its own).
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
+// How bake_scene integrates receiver rows, for sharded bakes (bake/chunks.h). `rows` replaces
+// bake_points for every receiver with per-vertex products: `set` numbers those receivers in object
+// order; it returns the rows of all of `points` (or none, with rows_only) and sets `closed_form` to
+// their IntegratorStats::closed_form. With rows_only, bake_scene stops there: no area lights, error
+// reports, FIV or environment (what a worker that only computes chunks needs).
+struct SceneRows {
+  std::function<VertexBake(size_t set, std::span<const ShadePoint> points, const Integrator& integrator,
+                           const Monitor& monitor, const std::string& label, uint64_t& closed_form)>
+      rows;
+  bool rows_only = false;
+};
+
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     const Monitor& monitor, const std::function<void(const std::string&)>& log);
+                     const Monitor& monitor, const std::function<void(const std::string&)>& log,
+                     const SceneRows& rows = {});
 
 } // namespace prt::bake

@@ -45,6 +45,11 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
 // occluders, bake/scene.h); row i belongs to points[i], randomised by the index i.
 VertexBake bake_points(std::span<const ShadePoint> points, const Integrator& integrator,
                        const Monitor& monitor = {}, const std::string& label = "baking vertices");
+// Rows [begin, end) of bake_points(points, ...), each randomised by its index in `points` (the
+// whole set), so the rows of any cut into ranges equal those of one bake_points call; the result
+// holds end − begin rows. The form sharded bakes use (bake/chunks.h).
+VertexBake bake_point_rows(std::span<const ShadePoint> points, size_t begin, size_t end, const Integrator& integrator,
+                           const Monitor& monitor = {}, const std::string& label = "baking vertices");
 
 // How many rows of a bake see no sky at all (a mesh wound inwards, or a vertex buried inside
 // another object), for a tool's warning. A row sees no sky when its SKY MEASURE is exactly 0; the

@@ -1,0 +1,220 @@
+// chunks.cpp — chunk files of sharded bakes (bake/chunks.h): layout, atomic commit, verification,
+// claims.
+#include <bake/chunks.h>
+#include <bake/error.h>
+#include <bake/sha256.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace prt::bake {
+namespace {
+
+// File layout: kMagic, manifest (64 hex), index u64, set u32, begin u64, end u64, width u32,
+// closed_form u64, cpu_seconds f64, seconds f64, values f64[rows·width], std_error f64[rows·width],
+// then the SHA-256 (64 hex) of every byte before it.
+constexpr char kMagic[8] = {'P', 'R', 'T', 'C', 'H', 'N', 'K', '1'};
+constexpr size_t kDigest = 64;
+constexpr size_t kHeader = sizeof kMagic + kDigest + 8 + 4 + 8 + 8 + 4 + 8 + 8 + 8;
+
+template <class T>
+void put(std::string& out, const T& x) {
+  out.append(reinterpret_cast<const char*>(&x), sizeof x);
+}
+template <class T>
+T get(const std::string& in, size_t& at) {
+  T x;
+  std::memcpy(&x, in.data() + at, sizeof x);
+  at += sizeof x;
+  return x;
+}
+
+std::string digest_of(const std::string& bytes, size_t n) {
+  return sha256_bytes(std::span(reinterpret_cast<const std::byte*>(bytes.data()), n));
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+// Writes all of `bytes` to `fd`; false on a failed write.
+bool write_all(int fd, const std::string& bytes) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
+  }
+  return true;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (gethostname(buf, sizeof buf - 1) != 0) return "host";
+  return buf;
+}
+
+} // namespace
+
+std::vector<ChunkRange> row_chunks(std::span<const uint64_t> set_rows, uint64_t rows_per_chunk) {
+  PRT_CHECK(rows_per_chunk > 0);
+  std::vector<ChunkRange> out;
+  for (size_t s = 0; s < set_rows.size(); ++s)
+    for (uint64_t b = 0; b < set_rows[s]; b += rows_per_chunk)
+      out.push_back({uint32_t(s), b, std::min(set_rows[s], b + rows_per_chunk)});
+  return out;
+}
+
+ChunkStore::ChunkStore(fs::path dir, std::string manifest, std::vector<ChunkRange> chunks)
+    : dir_(std::move(dir)), manifest_(std::move(manifest)), chunks_(std::move(chunks)) {
+  PRT_CHECK_OP(manifest_.size(), ==, kDigest);
+  std::error_code ec;
+  fs::create_directories(dir_, ec);
+  if (!fs::is_directory(dir_)) throw InputError(dir_.string(), "cannot create the chunk directory: " + ec.message());
+}
+
+fs::path ChunkStore::chunk_path(size_t index) const {
+  char name[32];
+  std::snprintf(name, sizeof name, "c%06zu.chunk", index);
+  return dir_ / name;
+}
+
+bool ChunkStore::committed(size_t index) const {
+  std::error_code ec;
+  return fs::is_regular_file(chunk_path(index), ec);
+}
+
+size_t ChunkStore::committed_count() const {
+  size_t n = 0;
+  for (size_t i = 0; i < chunks_.size(); ++i) n += committed(i) ? 1 : 0;
+  return n;
+}
+
+void ChunkStore::commit(size_t index, const ChunkData& d) const {
+  PRT_CHECK(index < chunks_.size() && d.range == chunks_[index]);
+  PRT_CHECK_OP(d.values.size(), ==, d.range.rows() * d.width);
+  PRT_CHECK_OP(d.std_error.size(), ==, d.values.size());
+  std::string bytes;
+  bytes.reserve(kHeader + 16 * d.values.size() + kDigest);
+  bytes.append(kMagic, sizeof kMagic);
+  bytes += manifest_;
+  put(bytes, uint64_t(index));
+  put(bytes, d.range.set);
+  put(bytes, d.range.begin);
+  put(bytes, d.range.end);
+  put(bytes, d.width);
+  put(bytes, d.closed_form);
+  put(bytes, d.cpu_seconds);
+  put(bytes, d.seconds);
+  for (const auto* column : {&d.values, &d.std_error})
+    bytes.append(reinterpret_cast<const char*>(column->data()), column->size() * sizeof(double));
+  bytes += digest_of(bytes, bytes.size());
+
+  const fs::path final_path = chunk_path(index);
+  const fs::path temp = final_path.string() + ".tmp." + host_name() + "." + std::to_string(getpid());
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw SystemError(temp.string() + ": cannot create: " + errno_text());
+  const bool ok = write_all(fd, bytes) && ::fsync(fd) == 0;
+  const std::string why = errno_text();
+  ::close(fd);
+  if (!ok || ::rename(temp.c_str(), final_path.c_str()) != 0) {
+    const std::string problem = ok ? errno_text() : why;
+    ::unlink(temp.c_str());
+    throw SystemError(final_path.string() + ": cannot commit the chunk: " + problem);
+  }
+  // The rename itself is durable once the directory is.
+  const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+std::optional<ChunkData> ChunkStore::read(size_t index, uint32_t width) const {
+  PRT_CHECK(index < chunks_.size());
+  const fs::path path = chunk_path(index);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return std::nullopt;
+  std::string bytes(size_t(std::max<std::streamoff>(in.tellg(), 0)), '\0');
+  in.seekg(0);
+  if (!in.read(bytes.data(), std::streamsize(bytes.size())))
+    throw InputError(path.string(), "cannot read the chunk file");
+  const std::string file = path.string();
+  if (bytes.size() < kHeader + kDigest || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw InputError(file, "not a chunk file (truncated or wrong format); remove it and rerun the bake to recompute it");
+  const size_t body = bytes.size() - kDigest;
+  if (digest_of(bytes, body) != bytes.substr(body))
+    throw InputError(file, "corrupt chunk: its SHA-256 does not match its contents; remove it and rerun the bake to "
+                           "recompute it");
+  if (bytes.compare(sizeof kMagic, kDigest, manifest_) != 0)
+    throw InputError(file, "chunk of another bake (other inputs, options, integrator or seed: manifest " +
+                               bytes.substr(sizeof kMagic, 12) + "... is not this bake's " + manifest_.substr(0, 12) +
+                               "...); remove the chunk directory or rerun with the same inputs and options");
+  size_t at = sizeof kMagic + kDigest;
+  ChunkData d;
+  const uint64_t stored_index = get<uint64_t>(bytes, at);
+  d.range.set = get<uint32_t>(bytes, at);
+  d.range.begin = get<uint64_t>(bytes, at);
+  d.range.end = get<uint64_t>(bytes, at);
+  d.width = get<uint32_t>(bytes, at);
+  d.closed_form = get<uint64_t>(bytes, at);
+  d.cpu_seconds = get<double>(bytes, at);
+  d.seconds = get<double>(bytes, at);
+  const ChunkRange& want = chunks_[index];
+  if (stored_index != index || !(d.range == want) || d.width != width)
+    throw InputError(file, "chunk " + std::to_string(stored_index) + " of set " + std::to_string(d.range.set) +
+                               ", rows " + std::to_string(d.range.begin) + "-" + std::to_string(d.range.end) +
+                               ", width " + std::to_string(d.width) + " is not this bake's chunk " +
+                               std::to_string(index) + " (set " + std::to_string(want.set) + ", rows " +
+                               std::to_string(want.begin) + "-" + std::to_string(want.end) + ", width " +
+                               std::to_string(width) + ")");
+  const size_t n = size_t(d.range.rows()) * width;
+  if (body != kHeader + 2 * n * sizeof(double))
+    throw InputError(file, "chunk holds " + std::to_string(body) + " bytes where its rows need " +
+                               std::to_string(kHeader + 2 * n * sizeof(double)));
+  for (auto* column : {&d.values, &d.std_error}) {
+    column->resize(n);
+    std::memcpy(column->data(), bytes.data() + at, n * sizeof(double));
+    at += n * sizeof(double);
+  }
+  return d;
+}
+
+bool valid_run_id(std::string_view id) {
+  return !id.empty() && id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.") ==
+                            std::string_view::npos;
+}
+
+bool ChunkStore::claim(size_t index, const std::string& run_id) const {
+  PRT_CHECK(valid_run_id(run_id));
+  const fs::path path = chunk_path(index).string() + ".claim." + run_id;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    if (errno == EEXIST) return false;
+    throw SystemError(path.string() + ": cannot create the claim: " + errno_text());
+  }
+  write_all(fd, host_name() + " " + std::to_string(getpid()) + "\n");
+  ::close(fd);
+  return true;
+}
+
+void ChunkStore::remove() const {
+  std::error_code ec;
+  for (size_t i = 0; i < chunks_.size(); ++i) fs::remove(chunk_path(i), ec);
+  // Claims and temporaries: "<chunk>.claim.*", "<chunk>.tmp.*" of this store's chunk names.
+  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() > 13 && name[0] == 'c' && name.compare(7, 6, ".chunk") == 0 &&
+        (name.find(".chunk.claim.") == 7 || name.find(".chunk.tmp.") == 7))
+      fs::remove(entry.path(), ec);
+  }
+  fs::remove(dir_, ec);  // only if empty
+}
+
+} // namespace prt::bake

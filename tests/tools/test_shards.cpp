@@ -1,0 +1,287 @@
+// Sharded and resumable bakes (tools/prtbake/shards.h): every launcher's file is cmp-identical to
+// the single-process --reproducible bake; kill -9 and rerun resumes; bad chunks are refused.
+// The mpirun cases are compiled when prtbake is linked with MPI (CMake PRT_MPI; ON in the ci
+// preset), and then fail — not skip — if mpirun cannot run.
+#include "run_tool.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+using prt::testing::read_bytes;
+using prt::testing::run_tool;
+
+namespace {
+
+const std::string kData = PRT_DATA_DIR;
+// All four products of bunny_ground (4240 vertices) at few samples, one thread per process;
+// chunks of 512 rows: 9 chunks.
+std::string products(const std::string& integrator) {
+  return "vertex " + kData + "/bunny_ground.obj --ao --transfer 3 --visibility 3 --radiance " + kData +
+         "/sunset.exr --integrator " + integrator + " --samples 64 --threads 1 --chunk-rows 512";
+}
+constexpr size_t kChunks = 9;
+
+fs::path dir_for(const std::string& name) {
+  const fs::path d = fs::path(PRT_TEST_TMP) / ("shards_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+prt::testing::ToolRun prtbake(const std::string& args, const fs::path& dir, const std::string& env = "") {
+  return run_tool(PRT_PRTBAKE, args, dir / "capture", env);
+}
+
+// The single-process --reproducible bake of `args` written to `out` (the command line stored in
+// the file names the output, so every variant writes the same name), moved to OUT.ref.
+std::string reference(const std::string& args, const fs::path& out) {
+  const auto r = prtbake(args + " --reproducible -q -o " + out.string(), out.parent_path());
+  EXPECT_EQ(r.code, 0) << r.err;
+  const std::string bytes = read_bytes(out);
+  fs::remove(out);
+  EXPECT_FALSE(bytes.empty());
+  return bytes;
+}
+
+// Files left next to the output besides it and the capture directory (temporaries, chunks).
+std::vector<std::string> leftovers(const fs::path& dir, const fs::path& out) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path() != out && e.path().filename() != "capture") names.push_back(e.path().filename().string());
+  return names;
+}
+
+size_t committed_chunks(const fs::path& chunks) {
+  size_t n = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(chunks, ec)) n += e.path().extension() == ".chunk" ? 1 : 0;
+  return n;
+}
+
+// "N committed before this run (reused), M to compute" and "computed K chunks" from stdout.
+struct Resumed {
+  int reused = -1, to_compute = -1, computed = -1;
+};
+Resumed resumed_of(const std::string& out) {
+  Resumed r;
+  std::smatch m;
+  if (std::regex_search(out, m, std::regex(R"((\d+) committed before this run \(reused\), (\d+) to compute)")))
+    r.reused = std::stoi(m[1]), r.to_compute = std::stoi(m[2]);
+  if (std::regex_search(out, m, std::regex(R"(computed (\d+) chunks)"))) r.computed = std::stoi(m[1]);
+  return r;
+}
+
+void flip_byte(const fs::path& p, size_t at) {
+  std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekg(std::streamoff(at));
+  char c = 0;
+  f.read(&c, 1);
+  c = char(c ^ 0x10);
+  f.seekp(std::streamoff(at));
+  f.write(&c, 1);
+}
+
+// The one stderr line of a failed merge, and that nothing was written.
+void expect_refused(const prt::testing::ToolRun& r, const fs::path& out, const std::string& names, const std::string& says) {
+  EXPECT_EQ(r.code, 1) << r.out << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+} // namespace
+
+TEST(Shards, ResumeFlagAloneGivesTheReproducibleBytes) {
+  const fs::path dir = dir_for("resume"), out = dir / "out.prt.h5";
+  const std::string ref = reference(products("qmc"), out);
+  const auto r = prtbake(products("qmc") + " --resume -o " + out.string(), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(read_bytes(out) == ref);
+  EXPECT_EQ(resumed_of(r.out).computed, int(kChunks));
+  EXPECT_TRUE(leftovers(dir, out).empty());  // OUT.chunks/ removed after the merge
+}
+
+// --shard I/N workers (here one after another, as a scheduler may run them) and a --merge step;
+// static and dynamic claiming; a SLURM array's variables with --shard auto.
+TEST(Shards, ShardWorkersThenMerge) {
+  const fs::path dir = dir_for("shard_merge"), out = dir / "out.prt.h5";
+  const std::string ref = reference(products("silhouette"), out);
+  // Static: three separate workers, each its own chunks.
+  for (int i = 0; i < 3; ++i) {
+    const auto w = prtbake(products("silhouette") + " --shard " + std::to_string(i) + "/3 -o " + out.string(), dir);
+    ASSERT_EQ(w.code, 0) << w.err;
+    EXPECT_EQ(resumed_of(w.out).computed, 3) << w.out;
+    EXPECT_FALSE(fs::exists(out));  // workers never write the file
+  }
+  auto m = prtbake(products("silhouette") + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "static --shard I/3 + --merge";
+  EXPECT_TRUE(leftovers(dir, out).empty());
+  fs::remove(out);
+
+  // Dynamic: two workers at once claim chunks through claim files; together they do each once.
+  const std::string worker = std::string("'") + PRT_PRTBAKE + "' " + products("silhouette") + " -o " + out.string();
+  const std::string both = "(" + worker + " --shard 0/2 --claim dynamic --run-id t1 > " + (dir / "w0").string() +
+                           " & " + worker + " --shard 1/2 --claim dynamic --run-id t1 > " + (dir / "w1").string() +
+                           " & wait) 2>&1";
+  ASSERT_EQ(std::system(both.c_str()), 0);
+  const int c0 = resumed_of(read_bytes(dir / "w0")).computed, c1 = resumed_of(read_bytes(dir / "w1")).computed;
+  EXPECT_EQ(c0 + c1, int(kChunks)) << c0 << " + " << c1;
+  fs::remove(dir / "w0"), fs::remove(dir / "w1");
+  m = prtbake(products("silhouette") + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "dynamic --shard I/2 + --merge";
+  fs::remove(out);
+
+  // A SLURM array (--array=5-7): tasks 5, 6, 7 of 3 with --shard auto.
+  for (int id = 5; id <= 7; ++id) {
+    const auto w = prtbake(products("silhouette") + " --shard auto -o " + out.string(), dir,
+                           "SLURM_ARRAY_JOB_ID=42 SLURM_ARRAY_TASK_MIN=5 SLURM_ARRAY_TASK_COUNT=3 SLURM_ARRAY_TASK_ID=" +
+                               std::to_string(id));
+    ASSERT_EQ(w.code, 0) << w.err;
+    EXPECT_NE(w.out.find("SLURM array task " + std::to_string(id)), std::string::npos) << w.out;
+  }
+  m = prtbake(products("silhouette") + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "SLURM array + --merge";
+  EXPECT_TRUE(leftovers(dir, out).empty());
+}
+
+// A flipped byte, a chunk of another bake, a missing chunk: one line naming it, exit 1, no file.
+TEST(Shards, MergeRefusesBadChunks) {
+  const fs::path dir = dir_for("refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
+  const std::string ref = reference(products("qmc"), out);
+  const std::string args = products("qmc") + " -o " + out.string();
+  ASSERT_EQ(prtbake(args + " --shard 0/1", dir).code, 0);
+  ASSERT_EQ(committed_chunks(chunks), kChunks);
+  // Another bake's chunks (another seed) in a directory of their own.
+  ASSERT_EQ(prtbake(args + " --seed 7 --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
+  const fs::path c2 = chunks / "c000002.chunk";
+
+  flip_byte(c2, fs::file_size(c2) / 2);
+  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "corrupt");
+  // A worker refuses it too, before computing anything.
+  expect_refused(prtbake(args + " --shard 0/1", dir), out, "c000002.chunk", "corrupt");
+
+  fs::copy_file(dir / "other" / "c000002.chunk", c2, fs::copy_options::overwrite_existing);
+  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "another bake");
+
+  fs::remove(c2);
+  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "missing");
+
+  // Rerunning the worker recomputes exactly the missing chunk; the merge then succeeds.
+  const auto w = prtbake(args + " --shard 0/1", dir);
+  ASSERT_EQ(w.code, 0) << w.err;
+  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
+  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
+  EXPECT_TRUE(read_bytes(out) == ref);
+}
+
+// kill -9 at random moments, then the same command again: the same bytes, only the chunks that
+// were not committed recomputed, no temporary left.
+TEST(Shards, KillNineAndRerunResumes) {
+  const fs::path dir = dir_for("kill"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
+  // More samples and smaller chunks than above: a bake of ~1-2 s in 17 chunks, room to land kills.
+  const std::string bake = "vertex " + kData + "/bunny_ground.obj --ao --transfer 3 --visibility 3 --radiance " +
+                           kData + "/sunset.exr --integrator qmc --samples 256 --threads 1 --chunk-rows 256";
+  const std::string args = bake + " --resume";
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string ref = reference(bake, out);
+  const double full = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::mt19937 rng(std::random_device{}());
+  std::uniform_real_distribution<double> moment(0.1 * full, 0.9 * full);
+  std::vector<std::string> argv;
+  {
+    std::istringstream words(args + " -o " + out.string());
+    for (std::string w; words >> w;) argv.push_back(w);
+  }
+  int kills = 0;
+  std::string moments;  // for the messages
+  for (int trial = 0; trial < 12 && kills < 6; ++trial) {
+    // Two kills in a row (the second one of a resumed run), then a run to the end.
+    for (int k = 0; k < 2; ++k) {
+      prt::testing::BackgroundTool tool(PRT_PRTBAKE, argv);
+      ASSERT_TRUE(tool.started());
+      const double at = moment(rng);
+      std::this_thread::sleep_for(std::chrono::duration<double>(at));
+      tool.send(SIGKILL);
+      const bool killed = tool.wait() == -1;
+      kills += killed ? 1 : 0;
+      moments += (killed ? " killed at " : " finished before ") + std::to_string(at) + " s;";
+    }
+    SCOPED_TRACE("trial " + std::to_string(trial) + " of a " + std::to_string(full) + " s bake:" + moments);
+    const size_t committed = committed_chunks(chunks);
+    if (fs::exists(out)) {  // the second run finished before its kill: start the next trial afresh
+      fs::remove(out);
+      continue;
+    }
+    const auto r = prtbake(args + " -o " + out.string(), dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Resumed re = resumed_of(r.out);
+    EXPECT_EQ(re.reused, int(committed)) << r.out;
+    EXPECT_EQ(re.computed, 17 - int(committed)) << r.out;  // recomputed: only the uncommitted chunks
+    EXPECT_TRUE(read_bytes(out) == ref);
+    EXPECT_TRUE(leftovers(dir, out).empty()) << "stray files after the resumed bake";
+    fs::remove(out);
+  }
+  EXPECT_GE(kills, 5);
+}
+
+#ifdef PRT_MPIRUN
+// mpirun -n 1..4, both integrators, static and dynamic claiming: cmp-identical to the
+// single-process --reproducible bake.
+TEST(Shards, MpirunMatrixIsByteIdentical) {
+  const fs::path dir = dir_for("mpirun"), out = dir / "out.prt.h5";
+  const std::string mpirun = std::string("OMPI_MCA_btl_vader_single_copy_mechanism=none '") + PRT_MPIRUN +
+                             "' --allow-run-as-root --oversubscribe -n ";
+  for (const std::string integrator : {"qmc", "silhouette"}) {
+    const std::string ref = reference(products(integrator), out);
+    for (int n = 1; n <= 4; ++n)
+      for (const std::string claim : {"static", "dynamic"}) {
+        const std::string cmd = mpirun + std::to_string(n) + " '" + PRT_PRTBAKE + "' " + products(integrator) +
+                                " --claim " + claim + " -o " + out.string() + " > " + (dir / "log").string() + " 2>&1";
+        const int status = std::system(cmd.c_str());
+        const std::string log = read_bytes(dir / "log");
+        ASSERT_EQ(status, 0) << cmd << "\n" << log;
+        EXPECT_TRUE(read_bytes(out) == ref) << integrator << ", mpirun -n " << n << ", " << claim << " claiming\n" << log;
+        for (int r = 0; r < n; ++r)
+          EXPECT_NE(log.find("worker " + std::to_string(r) + "/" + std::to_string(n) + " (mpirun rank"), std::string::npos)
+              << log;
+        fs::remove(out);
+        fs::remove(dir / "log");
+        EXPECT_TRUE(leftovers(dir, out).empty());
+      }
+  }
+}
+
+// scene_example.json (three receivers, FIV shells, reports): the receivers' rows sharded under
+// mpirun -n 2 (static claiming) and -n 4 (dynamic); the vertex matrix above covers 1-4 each way.
+TEST(Shards, MpirunSceneIsByteIdentical) {
+  const fs::path dir = dir_for("mpirun_scene"), out = dir / "out.prt.h5";
+  const std::string args = "scene " + kData + "/scene_example.json --report 4 --threads 1 --chunk-rows 400";
+  const std::string ref = reference(args, out);
+  for (const int n : {2, 4}) {
+    const std::string claim = n == 2 ? "static" : "dynamic";
+    const std::string cmd = std::string("OMPI_MCA_btl_vader_single_copy_mechanism=none '") + PRT_MPIRUN +
+                            "' --allow-run-as-root --oversubscribe -n " + std::to_string(n) + " '" + PRT_PRTBAKE + "' " +
+                            args + " --claim " + claim + " -o " + out.string() + " > " + (dir / "log").string() + " 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << "\n" << read_bytes(dir / "log");
+    EXPECT_TRUE(read_bytes(out) == ref) << "scene, mpirun -n " << n << ", " << claim << " claiming\n" << read_bytes(dir / "log");
+    fs::remove(out);
+    fs::remove(dir / "log");
+    EXPECT_TRUE(leftovers(dir, out).empty());
+  }
+}
+#endif

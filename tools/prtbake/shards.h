@@ -1,0 +1,126 @@
+// tools/prtbake/shards.h — sharded and resumable bakes (docs/ARCHITECTURE.md "Data path"): who
+// this process is among the workers, which fixed chunks of rows it computes, and the merge that
+// joins them into the one file a single-process --reproducible bake writes, byte for byte.
+//
+// Launchers (the engines, not a protocol of ours):
+//   mpirun -n N prtbake ...     with MPI linked (PRT_MPI): rank r is worker r of N; the ranks
+//                               agree after their chunks (MPI_Allreduce) and rank 0 merges.
+//   prtbake ... --shard auto    a SLURM array task (SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN of
+//                               SLURM_ARRAY_TASK_COUNT), else OMPI_COMM_WORLD_RANK/SIZE, else
+//                               PMI_RANK/PMI_SIZE; computes its chunks only.
+//   prtbake ... --shard I/N     worker I (0-based) of N; computes its chunks only.
+//   prtbake ... --merge         verifies every chunk and writes the file (a dependent job).
+//   prtbake ... --resume        one process: its chunks, then the merge.
+// Chunks live in OUT.chunks/ (--chunks DIR), are removed after a successful merge, and are reused
+// by a rerun of the same command (bake/chunks.h: checksummed, tagged with the bake's manifest).
+// Static claiming gives worker i the chunks i, i + N, ...; dynamic claiming lets each worker take
+// the next unclaimed chunk (claim files of this run, bake/chunks.h). A run is one launch: mpirun
+// (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
+// another run are stale by definition, so a rerun recomputes what a dead run claimed.
+// Sharded bakes are always reproducible (--reproducible is implied): the merged file cannot hold
+// one wall time of many workers, and a target error's choice must be the same on every worker.
+#pragma once
+
+#include <bake/chunks.h>
+#include <bake/progress.h>
+#include <bake/vertex_bake.h>
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace prt::tool {
+
+enum class Claim { Static, Dynamic };
+
+struct ShardOptions {
+  bool resume = false;  // --resume
+  std::string shard;    // --shard I/N or auto ("": not given)
+  bool merge = false;   // --merge
+  Claim claim = Claim::Static;
+  uint64_t chunk_rows = 2048;
+  std::string chunks_dir;  // "": OUT.chunks
+  std::string run_id;      // --run-id
+  bool given() const { return resume || !shard.empty() || merge; }
+};
+
+// --resume, --shard, --merge, --claim, --chunk-rows, --chunks, --run-id on a subcommand.
+void add_shard_options(CLI::App& cmd, ShardOptions& options);
+// The options above that take a value (the stored command line leaves them out: they do not
+// change the file).
+bool is_shard_option(const std::string& name, bool& takes_value);
+
+// MPI for the lifetime of the process when it was started by mpirun and prtbake is linked with
+// MPI; otherwise inactive. Finalised on normal exit; when an error unwinds, left unfinalised so
+// that mpirun ends the other ranks instead of leaving them waiting.
+class MpiSession {
+public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  bool active() const { return active_; }
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // true when every rank passes true (an inactive session returns `ok`).
+  bool all(bool ok) const;
+  std::string broadcast(const std::string& text) const;  // rank 0's text, on every rank
+
+private:
+  bool active_ = false;
+  int rank_ = 0, size_ = 1;
+};
+
+struct Worker {
+  int index = 0, count = 1;
+  bool computes = true;  // false for --merge
+  bool merges = true;    // writes the file after the chunks
+  Claim claim = Claim::Static;
+  std::string run_id;
+  std::string launcher;  // how it was started, for its log lines
+};
+// Throws UsageError when the options do not say who this process is.
+Worker resolve_worker(const ShardOptions& options, const MpiSession& mpi);
+
+// One sharded bake's rows: row sets of `set_rows` rows, cut into chunks of options.chunk_rows.
+class ShardedRows {
+public:
+  // `manifest`: manifest_of(...) of everything the rows depend on; set s has set_rows[s] rows of
+  // set_widths[s] values.
+  ShardedRows(const Worker& worker, const MpiSession& mpi, const ShardOptions& options, const std::string& output,
+              const std::string& manifest, const std::vector<uint64_t>& set_rows, std::vector<uint32_t> set_widths,
+              bool quiet);
+  ~ShardedRows();
+  // Rows [range.begin, range.end) of set range.set (`monitor` cancels on Ctrl-C) and their
+  // IntegratorStats::closed_form.
+  using Compute = std::function<bake::VertexBake(const bake::ChunkRange&, const bake::Monitor& monitor,
+                                                 uint64_t& closed_form)>;
+  // Runs `body`, which calls work() for the rows (not with --merge), then, under mpirun, waits
+  // for every rank (an error in any rank stops the merge). Returns whether this process merges.
+  bool run(const std::function<void()>& body);
+  // Computes and commits this worker's uncommitted chunks (of set `set` only, when given).
+  void work(const Compute& compute, std::optional<uint32_t> set = std::nullopt);
+  // Every chunk of set `set`, verified (InputError naming a missing, corrupt or foreign chunk),
+  // joined into one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
+  bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
+  // After the file is written: removes the chunk directory.
+  void finish() const;
+
+private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+// Rows [range.begin, range.end) of `points` (bake_point_rows) and their closed-form count.
+bake::VertexBake bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
+                            const bake::Integrator& integrator, const bake::Monitor& monitor, uint64_t& closed_form);
+
+// The SHA-256 of the lines that determine a bake's rows (inputs' digests, options, integrator,
+// seed, chunk size).
+std::string manifest_of(const std::vector<std::string>& lines);
+
+} // namespace prt::tool
