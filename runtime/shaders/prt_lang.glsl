@@ -10,6 +10,7 @@
 //   PRT_CONST                 a file-scope constant (GLSL const, HLSL static const)
 //   PRT_MAT3_ZERO             the zero 3×3 matrix
 //   PRT_MAT3_DOTS(v, m)       (dot(v, m[0]), dot(v, m[1]), dot(v, m[2]))
+//   PRT_ANY_POSITIVE(v)       whether a component of the vec3 v is > 0
 #ifndef PRT_LANG
 #define PRT_LANG
 #define PRT_GLSL 1
@@ -21,4 +22,5 @@
 #define PRT_CONST const
 #define PRT_MAT3_ZERO mat3(0.0)
 #define PRT_MAT3_DOTS(v, m) ((v) * (m))
+#define PRT_ANY_POSITIVE(v) any(greaterThan((v), vec3(0.0)))
 #endif  // PRT_LANG

@@ -14,4 +14,5 @@
 #define PRT_CONST static const
 #define PRT_MAT3_ZERO ((float3x3)0)
 #define PRT_MAT3_DOTS(v, m) mul((m), (v))
+#define PRT_ANY_POSITIVE(v) any((v) > 0.0)
 #endif  // PRT_LANG
