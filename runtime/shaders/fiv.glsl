@@ -46,18 +46,6 @@
 #include "prt_lang.glsl"
 #include "fiv_bindings.inc"
 
-layout(std430, set = PRT_FIV_SET, binding = PRT_FIV_OCCLUDERS_BINDING) readonly buffer PrtFivOccluders {
-  PrtFivOccluder prt_fiv_occluders[];
-};
-layout(std430, set = PRT_FIV_SET, binding = PRT_FIV_RADII_BINDING) readonly buffer PrtFivRadii {
-  float prt_fiv_radii[];
-};
-layout(std430, set = PRT_FIV_SET, binding = PRT_FIV_SHELLS_BINDING) readonly buffer PrtFivShells {
-  float prt_fiv_shells[];
-};
-layout(std430, set = PRT_FIV_SET, binding = PRT_FIV_VALID_BINDING) readonly buffer PrtFivValid {
-  uint prt_fiv_valid[];
-};
 layout(std430, set = PRT_FIV_SET, binding = PRT_FIV_DIFMAP_BINDING) readonly buffer PrtFivDifMap {
   uvec4 prt_difmap_header;
   float prt_difmap_texels[];

@@ -35,10 +35,6 @@
 #include "prt_lang.hlsl"
 #include "fiv_bindings.inc"
 
-[[vk::binding(PRT_FIV_OCCLUDERS_BINDING, PRT_FIV_SET)]] StructuredBuffer<PrtFivOccluder> prt_fiv_occluders;
-[[vk::binding(PRT_FIV_RADII_BINDING, PRT_FIV_SET)]] StructuredBuffer<float> prt_fiv_radii;
-[[vk::binding(PRT_FIV_SHELLS_BINDING, PRT_FIV_SET)]] StructuredBuffer<float> prt_fiv_shells;
-[[vk::binding(PRT_FIV_VALID_BINDING, PRT_FIV_SET)]] StructuredBuffer<uint> prt_fiv_valid;
 [[vk::binding(PRT_FIV_DIFMAP_BINDING, PRT_FIV_SET)]] StructuredBuffer<float> prt_fiv_difmap;
 #define PRT_FIV_DIFMAP_SIZE int(asuint(prt_fiv_difmap[0]))
 #define PRT_FIV_DIFMAP_TEXEL(i) prt_fiv_difmap[4u + (i)]

@@ -29,38 +29,6 @@
 
 #include "sh.glsl"
 
-#ifndef PRT_GLOSSY_SET
-#define PRT_GLOSSY_SET 0
-#endif
-#ifndef PRT_GLOSSY_MATRICES_BINDING
-#define PRT_GLOSSY_MATRICES_BINDING 7
-#endif
-#ifndef PRT_VISIBILITY_BINDING
-#define PRT_VISIBILITY_BINDING 8
-#endif
-#ifndef PRT_SHADOWED_BINDING
-#define PRT_SHADOWED_BINDING 9
-#endif
-
-#ifndef PRT_GLOSSY_MATRIX
-layout(std430, set = PRT_GLOSSY_SET, binding = PRT_GLOSSY_MATRICES_BINDING) readonly buffer PrtGlossyMatrices {
-  float prt_glossy_matrices[];
-};
-#define PRT_GLOSSY_MATRIX(i) prt_glossy_matrices[(i)]
-#endif
-#ifndef PRT_VISIBILITY
-layout(std430, set = PRT_GLOSSY_SET, binding = PRT_VISIBILITY_BINDING) readonly buffer PrtVisibility {
-  float prt_visibility[];
-};
-#define PRT_VISIBILITY(i) prt_visibility[(i)]
-#endif
-#ifndef PRT_SHADOWED
-layout(std430, set = PRT_GLOSSY_SET, binding = PRT_SHADOWED_BINDING) readonly buffer PrtShadowed {
-  float prt_shadowed[];
-};
-#define PRT_SHADOWED(i) prt_shadowed[(i)]
-#endif
-
 #include "glossy.inc"
 
 #endif  // PRT_GLOSSY_GLSL

@@ -30,32 +30,6 @@
 
 #include "sh.hlsl"
 
-#ifndef PRT_GLOSSY_SET
-#define PRT_GLOSSY_SET 0
-#endif
-#ifndef PRT_GLOSSY_MATRICES_BINDING
-#define PRT_GLOSSY_MATRICES_BINDING 7
-#endif
-#ifndef PRT_VISIBILITY_BINDING
-#define PRT_VISIBILITY_BINDING 8
-#endif
-#ifndef PRT_SHADOWED_BINDING
-#define PRT_SHADOWED_BINDING 9
-#endif
-
-#ifndef PRT_GLOSSY_MATRIX
-[[vk::binding(PRT_GLOSSY_MATRICES_BINDING, PRT_GLOSSY_SET)]] StructuredBuffer<float> prt_glossy_matrices;
-#define PRT_GLOSSY_MATRIX(i) prt_glossy_matrices[(i)]
-#endif
-#ifndef PRT_VISIBILITY
-[[vk::binding(PRT_VISIBILITY_BINDING, PRT_GLOSSY_SET)]] StructuredBuffer<float> prt_visibility;
-#define PRT_VISIBILITY(i) prt_visibility[(i)]
-#endif
-#ifndef PRT_SHADOWED
-[[vk::binding(PRT_SHADOWED_BINDING, PRT_GLOSSY_SET)]] StructuredBuffer<float> prt_shadowed;
-#define PRT_SHADOWED(i) prt_shadowed[(i)]
-#endif
-
 #include "glossy.inc"
 
 #endif  // PRT_GLOSSY_HLSL

@@ -20,29 +20,6 @@
 
 #include "sh.glsl"
 
-#ifndef PRT_SHADE_SET
-#define PRT_SHADE_SET 0
-#endif
-#ifndef PRT_TRANSFER_BINDING
-#define PRT_TRANSFER_BINDING 0
-#endif
-#ifndef PRT_LIGHT_BINDING
-#define PRT_LIGHT_BINDING 1
-#endif
-
-#ifndef PRT_TRANSFER
-layout(std430, set = PRT_SHADE_SET, binding = PRT_TRANSFER_BINDING) readonly buffer PrtTransfer {
-  float prt_transfer[];
-};
-#define PRT_TRANSFER(i) prt_transfer[(i)]
-#endif
-#ifndef PRT_LIGHT
-layout(std430, set = PRT_SHADE_SET, binding = PRT_LIGHT_BINDING) readonly buffer PrtLight {
-  float prt_light[];
-};
-#define PRT_LIGHT(i) prt_light[(i)]
-#endif
-
 #include "shade.inc"
 
 #endif  // PRT_SHADE_GLSL

@@ -21,25 +21,6 @@
 
 #include "sh.hlsl"
 
-#ifndef PRT_SHADE_SET
-#define PRT_SHADE_SET 0
-#endif
-#ifndef PRT_TRANSFER_BINDING
-#define PRT_TRANSFER_BINDING 0
-#endif
-#ifndef PRT_LIGHT_BINDING
-#define PRT_LIGHT_BINDING 1
-#endif
-
-#ifndef PRT_TRANSFER
-[[vk::binding(PRT_TRANSFER_BINDING, PRT_SHADE_SET)]] StructuredBuffer<float> prt_transfer;
-#define PRT_TRANSFER(i) prt_transfer[(i)]
-#endif
-#ifndef PRT_LIGHT
-[[vk::binding(PRT_LIGHT_BINDING, PRT_SHADE_SET)]] StructuredBuffer<float> prt_light;
-#define PRT_LIGHT(i) prt_light[(i)]
-#endif
-
 #include "shade.inc"
 
 #endif  // PRT_SHADE_HLSL

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <initializer_list>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,6 +40,9 @@ constexpr double kFloatEps = 1.0 / 16777216.0;  // 2^-24
 }
 
 enum class ShaderLanguage { glsl, hlsl };
+
+// gtest prints the parameter in the test listing as this name.
+inline void PrintTo(ShaderLanguage language, std::ostream* os) { *os << (language == ShaderLanguage::hlsl ? "hlsl" : "glsl"); }
 
 // The compiled kernel of tests/shaders/<name>.comp (GLSL) or <name>.hlsl (tests/shaders/CMakeLists.txt
 // names the HLSL module <name>_hlsl).
