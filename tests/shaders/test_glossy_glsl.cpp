@@ -94,7 +94,9 @@ void random_sh(std::mt19937& rng, int order, std::size_t rows, std::vector<float
   const int n = order * order;
   out.resize(rows * static_cast<std::size_t>(n));
   for (std::size_t r = 0; r < rows; ++r)
-    for (int i = 0; i < n; ++i) out[r * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] = uni(rng) / (1.0f + std::floor(std::sqrt(float(i))));
+    for (int i = 0; i < n; ++i)
+      out[r * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] =
+          uni(rng) / (1.0f + std::floor(std::sqrt(float(i))));
 }
 
 // Random unit normals and positions around the origin; the last vertex sits on the eye (r = n).
@@ -160,7 +162,8 @@ std::array<double, 3> glossy_tolerance(int order, const std::vector<double>& lam
       const double yhat = std::abs(y[k]) + dy;
       const double s = std::abs(S[c * n + k]);
       if (!sums.empty()) tol[c] += 2.0 * (double(n) + 2.0) * kFloatEps * lam * yhat * sums[c * n + k];
-      tol[c] += lam * s * dy + (8.0 + 5.0 * l) * kFloatEps * lam * yhat * s + (double(n) + 2.0) * kFloatEps * lam * yhat * s;
+      tol[c] += lam * s * dy + (8.0 + 5.0 * l) * kFloatEps * lam * yhat * s +
+                (double(n) + 2.0) * kFloatEps * lam * yhat * s;
     }
   std::array<double, 3> sensitivity{};
   for (int corner = 0; corner < 8; ++corner) {
@@ -174,6 +177,17 @@ std::array<double, 3> glossy_tolerance(int order, const std::vector<double>& lam
   return tol;
 }
 
+// One route's shader result against the core's and the double formula's within `tol`.
+void check_route(const char* route, const std::array<float, 3>& got, const float* core,
+                 const std::array<double, 3>& formula, const std::array<double, 3>& tol, double& worst) {
+  for (std::size_t c = 0; c < 3; ++c) {
+    const double g = got[c];
+    worst = std::max(worst, std::abs(g - core[c]) / tol[c]);
+    ASSERT_LE(std::abs(g - core[c]), tol[c]) << "route " << route << " vs core, channel " << c;
+    ASSERT_LE(std::abs(g - formula[c]), tol[c]) << "route " << route << " vs formula, channel " << c;
+  }
+}
+
 // Both routes at orders 3, 7, 11 for Phong exponents 0 (λ_0 only is 1; the lobe is the
 // hemisphere), 4, 24, 128 (the issue's) and 7.25 (a recurrence that never hits zero), against the
 // core and the double formula (the tolerance of the file comment).
@@ -181,6 +195,7 @@ TEST_P(GlossyMirror, RoutesMatchCore) {
   constexpr uint32_t kCount = 96;
   double worst_a = 0, worst_b = 0, worst_r = 0;
   for (int order : {3, 7, 11}) {
+    SCOPED_TRACE(testing::Message() << "order " << order);
     const Scene sc = make_scene(order, kCount, 900u + uint32_t(order));
     const prt::shade::TripleProduct tp(order);
     const prt::shade::GlossyLight light(tp, sc.light.data());
@@ -192,6 +207,7 @@ TEST_P(GlossyMirror, RoutesMatchCore) {
         positions3.push_back(sc.positions[4 * v + a]);
       }
     for (double s : {0.0, 4.0, 24.0, 128.0, 7.25}) {
+      SCOPED_TRACE(testing::Message() << "Phong exponent " << s);
       std::vector<Result> got;
       ASSERT_TRUE(run_glossy(kernel("glossy_eval"), sc, light, s, got));
       std::vector<float> core_a(3 * kCount);
@@ -201,10 +217,11 @@ TEST_P(GlossyMirror, RoutesMatchCore) {
       prt::shade::phong_band_scales(s, order, lambda.data());
       const std::vector<float>& m = light.matrices();
       for (uint32_t v = 0; v < kCount; ++v) {
+        SCOPED_TRACE(testing::Message() << "vertex " << v);
         const std::array<float, 3> r = core_reflection(&normals3[3 * v], &positions3[3 * v], sc.eye);
         for (std::size_t a = 0; a < 3; ++a) {
           worst_r = std::max(worst_r, std::abs(double(got[v].r[a]) - r[a]) / kDirectionTolerance);
-          ASSERT_LE(std::abs(double(got[v].r[a]) - r[a]), kDirectionTolerance) << "order " << order << " vertex " << v;
+          ASSERT_LE(std::abs(double(got[v].r[a]) - r[a]), kDirectionTolerance) << "r component " << a;
         }
         // Route A: S = M U in double from the float M and U, and A_k = Σ_j |M[j][k] U_j|.
         const float* u = &sc.visibility[v * n];
@@ -218,28 +235,21 @@ TEST_P(GlossyMirror, RoutesMatchCore) {
             }
         std::array<double, 3> formula{};
         auto tol = glossy_tolerance(order, lambda, S, sums, r, formula);
-        for (std::size_t c = 0; c < 3; ++c) {
-          const double g = got[v].route_a[c], core = core_a[3 * v + c];
-          worst_a = std::max(worst_a, std::abs(g - core) / tol[c]);
-          ASSERT_LE(std::abs(g - core), tol[c]) << "route A order " << order << " s " << s << " vertex " << v << " channel " << c;
-          ASSERT_LE(std::abs(g - formula[c]), tol[c]) << "route A vs formula, order " << order << " s " << s << " vertex " << v;
-        }
+        check_route("A", got[v].route_a, &core_a[3 * v], formula, tol, worst_a);
+        if (HasFatalFailure()) return;
         // Route B on the vertex's shadowed-radiance row.
         const float* row = &sc.shadowed[3 * n * v];
         std::vector<double> Sb(row, row + 3 * n);
         tol = glossy_tolerance(order, lambda, Sb, {}, r, formula);
         float core_b[3];
         prt::shade::shade_glossy_radiance(row, order, lambda.data(), r.data(), core_b);
-        for (std::size_t c = 0; c < 3; ++c) {
-          const double g = got[v].route_b[c];
-          worst_b = std::max(worst_b, std::abs(g - core_b[c]) / tol[c]);
-          ASSERT_LE(std::abs(g - core_b[c]), tol[c]) << "route B order " << order << " s " << s << " vertex " << v << " channel " << c;
-          ASSERT_LE(std::abs(g - formula[c]), tol[c]) << "route B vs formula, order " << order << " s " << s << " vertex " << v;
-        }
+        check_route("B", got[v].route_b, core_b, formula, tol, worst_b);
+        if (HasFatalFailure()) return;
       }
     }
   }
-  std::printf("%s glossy vs prt::shade, orders 3/7/11: worst route A %.3f x tol, route B %.3f x tol, r %.3f x %.0f eps\n",
+  std::printf("%s glossy vs prt::shade, orders 3/7/11: worst route A %.3f x tol, route B %.3f x tol, "
+              "r %.3f x %.0f eps\n",
               language(), worst_a, worst_b, worst_r, kDirectionTolerance / kFloatEps);
 }
 
