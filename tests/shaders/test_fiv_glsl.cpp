@@ -1,4 +1,5 @@
-// runtime/shaders/fiv.glsl run as a Vulkan compute shader (lavapipe on CI) against the C++ core
+// runtime/shaders/fiv.glsl and fiv.hlsl run as Vulkan compute shaders (lavapipe on CI; every test
+// once per language, fiv_eval.comp and fiv_eval.hlsl, the same tolerances) against the C++ core
 // (prt::shade::lookup_fiv, lookup_difmap, partial_factor, occluded_irradiance, shade_fiv,
 // shade_fiv_self) and against a double-precision transcription of the contract
 // (<prtshade/fiv.h>), on synthetic occluders: random shells with invalid samples (one cell
@@ -6,7 +7,7 @@
 // across the φ seam, inside the first shell, at ρ = 0 and beyond the last shell.
 //
 // Tolerances. Both implementations round the same float inputs; their results differ through
-// (a) the grid coordinates (θ, φ, ρ) they compute — GLSL: A&S atan2 + float rounding, within
+// (a) the grid coordinates (θ, φ, ρ) they compute — shaders: A&S atan2 + float rounding, within
 //     16 ulps of π in θ and of 2π in φ and 8 ulps of ρ; C++: the same bounds plus acos(d_y) near
 //     the poles, whose error is min(2ε/sin θ, 2√ε) (ε = 2^-24: d_y is rounded to float and
 //     acos' = −1/sin θ) — and
@@ -192,7 +193,7 @@ Coords coords_of(const SynthOccluder& o, const float s[3]) {
 struct Budget {
   double theta, phi, rho;
 };
-Budget glsl_budget(const Coords& c) { return {16 * kFloatEps * kPi, 16 * kFloatEps * 2 * kPi, 8 * kFloatEps * c.rho}; }
+Budget shader_budget(const Coords& c) { return {16 * kFloatEps * kPi, 16 * kFloatEps * 2 * kPi, 8 * kFloatEps * c.rho}; }
 Budget core_budget(const Coords& c) {
   const double pole = std::min(2 * kFloatEps / std::max(std::sin(c.theta), 1e-300), 2 * std::sqrt(kFloatEps));
   return {16 * kFloatEps * kPi + pole, 16 * kFloatEps * 2 * kPi, 4 * kFloatEps * c.rho};
@@ -390,42 +391,51 @@ std::vector<Receiver> make_receivers(const Scene& sc) {
 
 // ---------------------------------------------------------------------------------------------
 
-class FivGlsl : public ::testing::Test {
+class FivMirror : public prt::test::ShaderMirror {
 protected:
   static void SetUpTestSuite() {
     scene_ = new Scene(make_scene());
     receivers_ = new std::vector<Receiver>(make_receivers(*scene_));
-    GpuScene g = pack(scene_->occ, scene_->difmap_size, scene_->texels);
-    auto in = prt::test::to_bytes(*receivers_);
-    std::vector<std::byte> res(receivers_->size() * 36 * sizeof(float));
-    PushBlock push{uint32_t(receivers_->size()), {}};
-    std::copy_n(scene_->env, 9, push.env);
-    ran_ = prt::test::run_kernel("fiv_eval", {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res},
-                                 prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
-    results_ = new std::vector<float>(prt::test::from_bytes<float>(res));
   }
   static void TearDownTestSuite() {
     delete scene_;
     delete receivers_;
-    delete results_;
+    for (std::vector<float>*& r : results_) {
+      delete r;
+      r = nullptr;
+    }
   }
-  void SetUp() override { ASSERT_TRUE(ran_) << "the fiv_eval kernel did not run (see the failure above)"; }
+  // The language's kernel runs once, on its first test; its results serve the others.
+  void SetUp() override {
+    std::vector<float>*& results = results_[static_cast<std::size_t>(GetParam())];
+    if (!results) {
+      GpuScene g = pack(scene_->occ, scene_->difmap_size, scene_->texels);
+      auto in = prt::test::to_bytes(*receivers_);
+      std::vector<std::byte> res(receivers_->size() * 36 * sizeof(float));
+      PushBlock push{uint32_t(receivers_->size()), {}};
+      std::copy_n(scene_->env, 9, push.env);
+      const bool ran = prt::test::run_kernel(kernel("fiv_eval"),
+                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res},
+                                             prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
+      results = new std::vector<float>(ran ? prt::test::from_bytes<float>(res) : std::vector<float>{});
+    }
+    ASSERT_FALSE(results->empty()) << "the " << language() << " fiv_eval kernel did not run (see the failure above)";
+  }
 
-  static const float* result(std::size_t r) { return &(*results_)[36 * r]; }
+  static const float* result(std::size_t r) { return &(*results_[static_cast<std::size_t>(GetParam())])[36 * r]; }
   static prt::shade::DifMap difmap() { return {scene_->difmap_size, scene_->texels.data()}; }
 
   static Scene* scene_;
   static std::vector<Receiver>* receivers_;
-  static std::vector<float>* results_;
-  static bool ran_;
+  static std::array<std::vector<float>*, 2> results_;  // per prt::test::ShaderLanguage
 };
-Scene* FivGlsl::scene_ = nullptr;
-std::vector<Receiver>* FivGlsl::receivers_ = nullptr;
-std::vector<float>* FivGlsl::results_ = nullptr;
-bool FivGlsl::ran_ = false;
+Scene* FivMirror::scene_ = nullptr;
+std::vector<Receiver>* FivMirror::receivers_ = nullptr;
+std::array<std::vector<float>*, 2> FivMirror::results_ = {nullptr, nullptr};
+PRT_SHADER_MIRROR_LANGUAGES(FivMirror);
 
 // One lookup of occluder o from receiver point p: the offset as both implementations form it
-// (float subtraction), its coordinates, the reference value and the GLSL-vs-core tolerance.
+// (float subtraction), its coordinates, the reference value and the shader-vs-core tolerance.
 struct Lookup {
   float s[3];
   Coords c;
@@ -437,13 +447,13 @@ Lookup lookup_case(const SynthOccluder& o, const float p[3]) {
   for (int k = 0; k < 3; ++k) l.s[k] = p[k] - o.centre[k];
   l.c = coords_of(o, l.s);
   l.ref = fiv_at(o, l.c.t, l.c.u, l.c.rho);
-  l.tol = fiv_tolerance(o, l.s, glsl_budget(l.c) + core_budget(l.c));
+  l.tol = fiv_tolerance(o, l.s, shader_budget(l.c) + core_budget(l.c));
   return l;
 }
 
-// lookup_fiv: GLSL vs the C++ core and vs the double transcription; the C++ core vs the
+// lookup_fiv: the shader vs the C++ core and vs the double transcription; the C++ core vs the
 // transcription too (so a disagreement names the side that is off).
-TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
+TEST_P(FivMirror, LookupFivMatchesCoreAndReference) {
   double worst_core = 0, worst_ref = 0;
   std::size_t checked = 0, ill_conditioned = 0, plain = 0, beyond = 0;
   std::vector<double> rel_tols;
@@ -455,7 +465,7 @@ TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
     const Coords& c = l.c;
     const FivRef& ref = l.ref;
     const Fiv9& tol_core = l.tol;
-    const Fiv9 tol_ref = fiv_tolerance(o, s, glsl_budget(c));
+    const Fiv9 tol_ref = fiv_tolerance(o, s, shader_budget(c));
     const Fiv9 tol_core_ref = fiv_tolerance(o, s, core_budget(c));
     plain += ref.plain ? 1 : 0;
     beyond += c.rho > o.radii.back() ? 1 : 0;
@@ -467,7 +477,7 @@ TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
       const double err_core = std::abs(got[e] - core[e]), err_ref = std::abs(got[e] - ref.v[e]);
       worst_core = std::max(worst_core, err_core / tol_core[e]);
       worst_ref = std::max(worst_ref, err_ref / tol_ref[e]);
-      // Strength of the GLSL check on the random receivers (the special ones sit on purpose at
+      // Strength of the shader check on the random receivers (the special ones sit on purpose at
       // the poles, where an invalid pole sample makes the lookup jump): its tolerance against the
       // reference relative to the samples.
       if (rc.info[3] == 1) {
@@ -484,9 +494,9 @@ TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
     }
   }
   std::sort(rel_tols.begin(), rel_tols.end());
-  std::printf("lookup_fiv: %zu values; worst GLSL-core %.3f x tol, GLSL-reference %.3f x tol; tolerance / largest "
-              "sample: median %.2g, 99%% %.2g; %zu values ill-conditioned (tol > 1e-3 x samples)\n",
-              checked, worst_core, worst_ref, rel_tols[rel_tols.size() / 2], rel_tols[rel_tols.size() * 99 / 100],
+  std::printf("%s lookup_fiv: %zu values; worst shader-core %.3f x tol, shader-reference %.3f x tol; tolerance / "
+              "largest sample: median %.2g, 99%% %.2g; %zu values ill-conditioned (tol > 1e-3 x samples)\n",
+              language(), checked, worst_core, worst_ref, rel_tols[rel_tols.size() / 2], rel_tols[rel_tols.size() * 99 / 100],
               ill_conditioned);
   // The bound must stay a float bound for nearly all samples, or the test proves little: only
   // lookups renormalised over nearly weightless valid samples may be ill-conditioned (the
@@ -498,7 +508,7 @@ TEST_F(FivGlsl, LookupFivMatchesCoreAndReference) {
   EXPECT_GT(beyond, 500u);
 }
 
-TEST_F(FivGlsl, LookupDifMapMatchesCoreAndReference) {
+TEST_P(FivMirror, LookupDifMapMatchesCoreAndReference) {
   double worst = 0;
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
@@ -515,7 +525,7 @@ TEST_F(FivGlsl, LookupDifMapMatchesCoreAndReference) {
       ASSERT_LE(std::abs(got - ref[c]), tol[c]) << "receiver " << r;
     }
   }
-  std::printf("lookup_difmap: worst GLSL-core %.3f x tol\n", worst);
+  std::printf("%s lookup_difmap: worst shader-core %.3f x tol\n", language(), worst);
 }
 
 // The normal the shading functions use (prtshade/fiv.h "Numerics"): n/|n|, a zero normal is +Y.
@@ -582,7 +592,7 @@ IrradianceCheck irradiance_check(const SynthOccluder& o, const float p[3], const
   return k;
 }
 
-TEST_F(FivGlsl, PartialFactorAndOccludedIrradianceMatchCore) {
+TEST_P(FivMirror, PartialFactorAndOccludedIrradianceMatchCore) {
   int cases[3] = {0, 0, 0};  // C, B, A
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
@@ -611,7 +621,7 @@ TEST_F(FivGlsl, PartialFactorAndOccludedIrradianceMatchCore) {
 }
 
 // Self-shadows: E_c = max(0, n·F^env_c − n·F_c) within Σ_k |n_k| tolF_ck + 8 ε (|n·F^env_c| terms + |n F_c| terms).
-TEST_F(FivGlsl, ShadeFivSelfMatchesCore) {
+TEST_P(FivMirror, ShadeFivSelfMatchesCore) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const SynthOccluder& o = scene_->occ[rc.info[0]];
@@ -640,12 +650,12 @@ TEST_F(FivGlsl, ShadeFivSelfMatchesCore) {
 // combinations, vs the C++ core. Tolerance, composed through E = D − Σ I_i + Σ_{i<j} O_ij (I_i + I_j):
 //   tol_D + Σ_i tol_I_i (1 + Σ_j O_ij) + Σ_{i<j} tol_O_ij (I_i + I_j)
 //   + Σ over pairs whose "hides something" test is within tolerance of flipping: O_ij (I_i + I_j + tol)
-//   + 16 ε (count + 2) (|D| + Σ_i I_i (1 + Σ_j O_ij))   (summation order differs: GLSL sums
+//   + 16 ε (count + 2) (|D| + Σ_i I_i (1 + Σ_j O_ij))   (summation order differs: the shader sums
 //     I_i Σ_j O_ij, the core O_ij (I_i + I_j)),
 // tol_O_ij = twice the largest change of O over the box α ± δα, γ ± δγ plus 64 ε (the float lens
 // formula), δα = 16 ε + min(4 ε/cos α, 4 √ε) (asin near α = π/2), δγ = 32 ε π + min(4 ε/sin γ, 4 √ε)
 // (the core's cosine test for disjoint discs resolves γ only to ε/sin γ).
-TEST_F(FivGlsl, ShadeFivMatchesCore) {
+TEST_P(FivMirror, ShadeFivMatchesCore) {
   const std::vector<SynthOccluder>& occ = scene_->occ;
   double worst = 0;
   int pairs_overlapping = 0;
@@ -733,7 +743,8 @@ TEST_F(FivGlsl, ShadeFivMatchesCore) {
       }
     }
   }
-  std::printf("shade_fiv: worst GLSL-core %.3f x tol; %d overlapping pairs seen\n", worst, pairs_overlapping);
+  std::printf("%s shade_fiv: worst shader-core %.3f x tol; %d overlapping pairs seen\n", language(), worst,
+              pairs_overlapping);
   EXPECT_GT(pairs_overlapping, 100);  // the overlap correction was exercised
 }
 

@@ -1,4 +1,5 @@
-// runtime/shaders/sh.glsl run as a Vulkan compute shader (lavapipe on CI) against prt::sh::eval.
+// runtime/shaders/sh.glsl and sh.hlsl run as Vulkan compute shaders (lavapipe on CI) against
+// prt::sh::eval: every test once per language (sh_eval.comp, sh_eval.hlsl), the same tolerances.
 #include "shader_test.h"
 
 #include <prtshade/sh.h>
@@ -11,7 +12,7 @@ namespace {
 
 using prt::test::kFloatEps;
 
-constexpr int kOrders = 16;  // PRT_SH_MAX_ORDER of sh_eval.comp: the limit sh.glsl allows
+constexpr int kOrders = 16;  // PRT_SH_MAX_ORDER of the sh_eval kernels: the limit sh.inc allows
 constexpr int kCoeffs = kOrders * kOrders;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -58,7 +59,10 @@ std::vector<Dir> test_directions(int random_count, uint32_t seed) {
 // band l in l steps, each a handful of operations of ≤ 2.5 ulps each under Vulkan's precision
 // rules (division 2.5 ulp, sqrt as 1/inversesqrt) on coefficients of size O(1), so the error
 // grows at most linearly in l with a per-step constant well under 16 ulps.
-TEST(ShGlsl, EvalMatchesCoreAllOrders) {
+class ShMirror : public prt::test::ShaderMirror {};
+PRT_SHADER_MIRROR_LANGUAGES(ShMirror);
+
+TEST_P(ShMirror, EvalMatchesCoreAllOrders) {
   const std::vector<Dir> dirs = test_directions(600, 20261123u);
   const auto per_order = static_cast<uint32_t>(dirs.size());
   const uint32_t count = per_order * kOrders;
@@ -73,7 +77,7 @@ TEST(ShGlsl, EvalMatchesCoreAllOrders) {
     }
   auto in_bytes = prt::test::to_bytes(in);
   std::vector<std::byte> out_bytes(static_cast<std::size_t>(count) * kCoeffs * sizeof(float));
-  ASSERT_TRUE(prt::test::run_kernel("sh_eval", {&in_bytes, &out_bytes}, prt::test::push_bytes(count), count));
+  ASSERT_TRUE(prt::test::run_kernel(kernel("sh_eval"), {&in_bytes, &out_bytes}, prt::test::push_bytes(count), count));
   const auto out = prt::test::from_bytes<float>(out_bytes);
 
   double worst_ratio = 0;  // max |error| / tolerance over everything checked
@@ -96,20 +100,20 @@ TEST(ShGlsl, EvalMatchesCoreAllOrders) {
       // Entries beyond order² are left untouched (the kernel filled them with −12345).
       for (int c = order * order; c < kCoeffs; ++c) ASSERT_EQ(got[c], -12345.0f) << "order " << order << " wrote " << c;
     }
-  std::printf("sh.glsl vs prt::sh::eval, orders 1..%d, %u directions: worst |error| = %.3f x tolerance\n", kOrders,
-              per_order, worst_ratio);
+  std::printf("%s sh vs prt::sh::eval, orders 1..%d, %u directions: worst |error| = %.3f x tolerance\n", language(),
+              kOrders, per_order, worst_ratio);
 }
 
 // Condon–Shortley signs and normalisation spelled out (sh.h bands 0–2 at 6 digits, DirectXMath):
 // a sign error in the shader would flip these whole values, far beyond the 1e-6 of the constants.
-TEST(ShGlsl, BandsZeroToTwoClosedForm) {
+TEST_P(ShMirror, BandsZeroToTwoClosedForm) {
   const std::vector<Dir> dirs = test_directions(64, 7u);
   const auto count = static_cast<uint32_t>(dirs.size());
   std::vector<float> in;
   for (const Dir& d : dirs) in.insert(in.end(), {d.x, d.y, d.z, 3.0f});
   auto in_bytes = prt::test::to_bytes(in);
   std::vector<std::byte> out_bytes(static_cast<std::size_t>(count) * kCoeffs * sizeof(float));
-  ASSERT_TRUE(prt::test::run_kernel("sh_eval", {&in_bytes, &out_bytes}, prt::test::push_bytes(count), count));
+  ASSERT_TRUE(prt::test::run_kernel(kernel("sh_eval"), {&in_bytes, &out_bytes}, prt::test::push_bytes(count), count));
   const auto out = prt::test::from_bytes<float>(out_bytes);
   for (uint32_t i = 0; i < count; ++i) {
     const double x = dirs[i].x, y = dirs[i].y, z = dirs[i].z;

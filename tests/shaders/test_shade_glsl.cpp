@@ -1,5 +1,6 @@
-// runtime/shaders/shade.glsl run as a Vulkan compute shader against prt::shade::shade_transfer and
-// prt::shade::shade_band1 (and against the formulas in double, built on prt::sh::eval).
+// runtime/shaders/shade.glsl and shade.hlsl run as Vulkan compute shaders against
+// prt::shade::shade_transfer and prt::shade::shade_band1 (and against the formulas in double, built
+// on prt::sh::eval): every test once per language (shade_eval.comp, shade_eval.hlsl).
 #include "shader_test.h"
 
 #include <prtshade/sh.h>
@@ -22,7 +23,10 @@ struct Push {
 // Per vertex: a random transfer row and band-1 row, random unit normal; one lighting vector.
 // Values span several magnitudes (×10^[-2, 2]) so the summation bound is exercised with
 // cancellation, as real transfer rows have.
-TEST(ShadeGlsl, TransferAndBand1MatchCore) {
+class ShadeMirror : public prt::test::ShaderMirror {};
+PRT_SHADER_MIRROR_LANGUAGES(ShadeMirror);
+
+TEST_P(ShadeMirror, TransferAndBand1MatchCore) {
   std::mt19937 rng(5u);
   std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
   std::uniform_real_distribution<float> expo(-2.0f, 2.0f);
@@ -44,7 +48,7 @@ TEST(ShadeGlsl, TransferAndBand1MatchCore) {
     auto b_transfer = prt::test::to_bytes(transfer), b_light = prt::test::to_bytes(light);
     auto b_normals = prt::test::to_bytes(normals), b_band1 = prt::test::to_bytes(band1);
     std::vector<std::byte> b_out(kCount * 8 * sizeof(float));
-    ASSERT_TRUE(prt::test::run_kernel("shade_eval", {&b_transfer, &b_light, &b_normals, &b_band1, &b_out},
+    ASSERT_TRUE(prt::test::run_kernel(kernel("shade_eval"), {&b_transfer, &b_light, &b_normals, &b_band1, &b_out},
                                       prt::test::push_bytes(Push{kCount, order}), kCount));
     const auto out = prt::test::from_bytes<float>(b_out);
     double y1[4];
@@ -88,15 +92,15 @@ TEST(ShadeGlsl, TransferAndBand1MatchCore) {
       }
     }
   }
-  std::printf("shade.glsl vs prt::shade: worst transfer error %.3f x tol, band-1 %.3f x tol\n", worst_transfer,
-              worst_band1);
+  std::printf("%s shade vs prt::shade: worst transfer error %.3f x tol, band-1 %.3f x tol\n", language(),
+              worst_transfer, worst_band1);
 }
 
 // The white furnace through the shader: an unoccluded vertex's transfer under constant radiance
 // L returns L. With T_00 = y_00 · ∫_H (n·ω)/π dω = y_00 (and bands 1, 2 of the clamped cosine,
 // which meet zero lighting coefficients) and L_00 = L · √(4π): Σ T L = L · y_00 · √(4π) = L, to
 // a few float ulps (four roundings of at most 2^-24 each: y_00, √(4π), L·√(4π), the product).
-TEST(ShadeGlsl, WhiteFurnaceTransferReturnsRadiance) {
+TEST_P(ShadeMirror, WhiteFurnaceTransferReturnsRadiance) {
   const int order = 3;
   std::vector<float> transfer(9, 0.0f), light(27, 0.0f);
   transfer[0] = 0.28209479177387814f;              // y_00
@@ -108,7 +112,7 @@ TEST(ShadeGlsl, WhiteFurnaceTransferReturnsRadiance) {
   auto b_transfer = prt::test::to_bytes(transfer), b_light = prt::test::to_bytes(light);
   auto b_normals = prt::test::to_bytes(normals), b_band1 = prt::test::to_bytes(band1);
   std::vector<std::byte> b_out(8 * sizeof(float));
-  ASSERT_TRUE(prt::test::run_kernel("shade_eval", {&b_transfer, &b_light, &b_normals, &b_band1, &b_out},
+  ASSERT_TRUE(prt::test::run_kernel(kernel("shade_eval"), {&b_transfer, &b_light, &b_normals, &b_band1, &b_out},
                                     prt::test::push_bytes(Push{1, order}), 1));
   const auto out = prt::test::from_bytes<float>(b_out);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[static_cast<std::size_t>(c)], L[c], 5 * kFloatEps * L[c]);
