@@ -12,6 +12,7 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 namespace prt::bake {
 
@@ -24,6 +25,9 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kMinNormalCos = 0.9063077870366499;  // cos 25°: neighbours' normals within 25° of n
 constexpr double kMaxPlaneSlope = 0.3;                // |(q − p)·n| ≤ 0.3 |q − p|: no depth discontinuity
 constexpr int kSpacingNeighbours = 6;                 // local vertex spacing: mean distance to 6 nearest
+constexpr double kContactSpacings = 0.5;             // an own ray blocked nearer than d/2: contact
+// Directions probed per cell for contact: the centre and four points near the corners.
+constexpr std::pair<double, double> kCellProbes[] = {{0.5, 0.5}, {0.02, 0.02}, {0.02, 0.98}, {0.98, 0.02}, {0.98, 0.98}};
 constexpr uint64_t kFallbackSalt = 0x66616c6c6261636bull;
 
 // Gauss–Legendre nodes and weights on [a, b] (Newton on P_n from the Chebyshev-like guess).
@@ -316,16 +320,18 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
   std::array<bool, C> brute;
   brute.fill(true);
 
+  std::optional<NearTriangles> near;  // computed when needed
   const Prepared* prep = prepared_.get();
   const bool prepared = prep && point_index < prep->points.size() && prep->points[point_index].p == p &&
                         prep->points[point_index].n == n;
   if (!prepared) unprepared_.fetch_add(1, std::memory_order_relaxed);
-  if (prepared && options_.radius_factor > 0) {
+  const bool filtering = prepared && options_.radius_factor > 0;
+  if (filtering) {
     brute.fill(false);
     // Neighbours (bake/filter.h): within radius_factor · d, similar normal, no depth discontinuity.
-    const double d = spacing(point_index);
+    const double d = spacing(point_index), search = options_.radius_factor * d;
     std::vector<uint32_t> neighbours;
-    prep->tree.within(p, options_.radius_factor * d, [&](uint32_t q) {
+    prep->tree.within(p, search, [&](uint32_t q) {
       const ShadePoint& sq = prep->points[q];
       const Vector3d e = sq.p - p;
       if (q == point_index || (sq.n.dot(n) >= kMinNormalCos && std::abs(e.dot(n)) <= kMaxPlaneSlope * e.norm()))
@@ -356,6 +362,20 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
         zmin[c] = std::min(zmin[c], z);
         zmax[c] = std::max(zmax[c], z);
       }
+    // A receiver whose own rays met an occluder at distance ~0 (its 1-ring or a near triangle: a
+    // crease, a contact, a face lying on it) sits where its neighbours' rays cannot speak for it:
+    // every cell in which those triangles block the centre or a corner direction is brute-forced.
+    bool contact = false;
+    for (const Sample& s : pass1(point_index)) contact = contact || double(s.t) < kContactSpacings * d;
+    if (contact) {
+      near = rays_->near_triangles(point);
+      for (int c = 0; c < C; ++c)
+        for (const auto& [u0, u1] : kCellProbes)
+          if (rays_->blocked_nearby(point, *near, frame.to_world(HemisphereCells::direction(c, u0, u1)).normalized())) {
+            zmin[size_t(c)] = 0;
+            break;
+          }
+    }
     // Eq. 8 (Ω_pix = 0.5/d): the spatial radius; eq. 9: the mid depth (harmonic mean); §3.3: too
     // close an occluder (Ω_v / z_min > Ω_pix) brute-forces the cell.
     const double omega_pix = d > 0 ? 0.5 / d : kInf;
@@ -412,7 +432,6 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
 
   // Brute-forced cells (§5): fallback_rays stratified rays in the cell, distributed as (n·ω).
   uint64_t n_brute = 0;
-  std::optional<NearTriangles> near;
   for (int c = 0; c < C; ++c) {
     if (!brute[size_t(c)]) continue;
     ++n_brute;
@@ -425,6 +444,16 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
       cell.add(1.0, rays_->visible(point, *near, v), f);
     }
   }
+  // When filtering, the receiver's own pass-1 rays that fell in a brute-forced cell are samples of
+  // it too (unbiased: the receiver's own rays need no filter): they join the cell's fallback rays.
+  if (filtering)
+    for (const Sample& s : pass1(point_index)) {
+      const Vector3d v(s.d[0], s.d[1], s.d[2]);
+      const int c = HemisphereCells::cell_of(Vector3d(frame.t.dot(v), frame.b.dot(v), n.dot(v)));
+      if (!brute[size_t(c)]) continue;
+      cells_.integrands(n, v, y, f);
+      sums[size_t(c)].add(1.0, !std::isfinite(s.t), f);
+    }
 
   // ∫_c V f ≈ ν_c F_c + Ω_c (mean(V f) − ν_c mean(f)) (bake/filter.h), Σ_c ν_c F_c rotated once.
   std::vector<double> local(W, 0.0), world(W, 0.0);

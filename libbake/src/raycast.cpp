@@ -372,7 +372,7 @@ RingContext ring_context(const ShadePoint& point, const NearTriangles& near, con
 } // namespace
 
 bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
-  if (exact_blocker(point, near, d, true) < std::numeric_limits<double>::infinity()) return false;
+  if (blocked_nearby(point, near, d)) return false;
   RingContext ctx = ring_context(point, near, topo_.weld.data(), mesh_.triangles.data());
   RTCRay ray = make_ray(point.p, d);
   rtcOccluded1(rt_->scene, &ctx.base, &ray);

@@ -57,8 +57,8 @@ VertexBake bake_filter(const Scene& s, const ProductRequest& r, FilterOptions o)
   return bake_points(s.points, f);
 }
 
-// AO of rows `rows` by QMC with `rays` (the converged reference at 16384: standard error
-// ≤ 0.5/128 ≈ 4e-3 per vertex, far below the tolerances below).
+// AO of rows `rows` by QMC with `rays` (the reference at 4096 rays: standard error ≤ 0.5/64 ≈
+// 8e-3 per vertex, and Halton QMC does better; well below the tolerances below).
 std::vector<double> qmc_ao(const Scene& s, const std::vector<uint32_t>& rows, uint32_t rays) {
   ProductRequest r;
   r.ao = true;
@@ -87,6 +87,10 @@ std::vector<uint32_t> all_rows(const Scene& s) {
   for (uint32_t i = 0; i < r.size(); ++i) r[i] = i;
   return r;
 }
+
+// The stiff cases' bounds are about twice the errors measured at the default seed (the filter is
+// deterministic: its error is a fixed function of the seed; the margin admits Embree's rounding
+// on another machine) and far below the AO a leak or a missed occluder changes (0.2-0.5).
 
 // A ground grid with a box standing on it (the box's vertices are receivers too).
 Scene ground_and_box() { return Scene(merged({grid(12, 1.0f), box({-0.3f, -0.3f, 0.0f}, {0.3f, 0.3f, 0.5f})})); }
@@ -199,11 +203,10 @@ TEST(Filter, LayersFacingAwayDoNotLeak) {
   for (size_t v = n; v < 2 * n; ++v) EXPECT_NEAR(b.values[v * W], 1.0, 1e-12) << v;
   std::vector<uint32_t> rows;
   for (uint32_t v = 0; v < n; ++v) rows.push_back(v);
-  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 16384));
-  // The upper sheet under the box: the filter's error (over-blur at the box's shadow edge,
-  // 17×17 vertices, 16 rays each) stays well below the 0.2-0.5 AO drop the box causes.
-  EXPECT_LT(e.rmse, 0.05);
-  EXPECT_LT(e.max, 0.2);
+  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
+  // The upper sheet under the box (measured: RMSE 0.017, max 0.058).
+  EXPECT_LT(e.rmse, 0.035);
+  EXPECT_LT(e.max, 0.12);
 }
 
 TEST(Filter, ThinSlats) {
@@ -218,10 +221,10 @@ TEST(Filter, ThinSlats) {
   ProductRequest r;
   r.ao = true;
   const VertexBake b = bake_filter(s, r, {});
-  const std::vector<uint32_t> rows = all_rows(s);
-  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 16384));
-  EXPECT_LT(e.rmse, 0.05);
-  EXPECT_LT(e.max, 0.25);
+  const std::vector<uint32_t> rows = seeded_sample(uint32_t(s.points.size()), 600, 3);
+  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
+  EXPECT_LT(e.rmse, 0.04);  // measured: RMSE 0.020, max 0.063
+  EXPECT_LT(e.max, 0.13);
 }
 
 TEST(Filter, CubeEdgeCrease) {
@@ -234,25 +237,29 @@ TEST(Filter, CubeEdgeCrease) {
   r.ao = true;
   const VertexBake b = bake_filter(s, r, {});
   const std::vector<uint32_t> rows = all_rows(s);
-  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 16384));
-  EXPECT_LT(e.rmse, 0.03);
-  EXPECT_LT(e.max, 0.12);
+  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
+  EXPECT_LT(e.rmse, 0.025);  // measured: RMSE 0.012, max 0.079 (the crease's own vertices: exact ring)
+  EXPECT_LT(e.max, 0.15);
 }
 
 TEST(Filter, ErrorFallsWithPassOneRays) {
-  const Scene s = ground_and_box();
+  // A ground grid under a floating box (an overhang: soft shadows, no contact).
+  const Scene s(merged({grid(12, 1.0f), box({-0.3f, -0.3f, 0.15f}, {0.3f, 0.3f, 0.5f})}));
   ProductRequest r;
   r.ao = true;
   const std::vector<uint32_t> rows = all_rows(s);
-  const std::vector<double> ref = qmc_ao(s, rows, 16384);
-  double previous = 1;
+  const std::vector<double> ref = qmc_ao(s, rows, 4096);
+  // Measured: 0.0198, 0.0186, 0.0177, 0.0163 (deterministic at the default seed).
+  double previous = 1, first = 0;
   for (uint32_t rays : {4u, 8u, 16u, 32u}) {
     FilterOptions o;
     o.rays = rays;
     const double e = ao_errors(bake_filter(s, r, o), rows, ref).rmse;
     EXPECT_LT(e, previous) << rays << " rays";
+    if (rays == 4) first = e;
     previous = e;
   }
+  EXPECT_LT(previous, 0.9 * first);
 }
 
 TEST(Filter, BunnyContactShadow) {
@@ -263,14 +270,14 @@ TEST(Filter, BunnyContactShadow) {
   // Ground vertices within the bunny's contact shadow: the lowest vertices of the scene whose AO
   // the reference puts below 0.8.
   const std::vector<uint32_t> sample = seeded_sample(uint32_t(s.points.size()), 400, 5);
-  const std::vector<double> ref = qmc_ao(s, sample, 16384);
+  const std::vector<double> ref = qmc_ao(s, sample, 4096);
   std::vector<uint32_t> rows;
   std::vector<double> shadow;
   for (size_t i = 0; i < sample.size(); ++i)
     if (ref[i] < 0.8) rows.push_back(sample[i]), shadow.push_back(ref[i]);
   ASSERT_GT(rows.size(), 20u);
   const Errors e = ao_errors(b, rows, shadow);
-  EXPECT_LT(e.rmse, 0.05);
+  EXPECT_LT(e.rmse, 0.05);  // measured: RMSE 0.024, max 0.118
   EXPECT_LT(e.max, 0.2);
 }
 

@@ -88,6 +88,11 @@ public:
   // plane's distance, in double; any other at Embree's closest hit). The sparse rays of the
   // filter integrator (bake/filter.h), which need the occluder's depth.
   std::optional<double> first_hit(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const;
+  // Whether the point's 1-ring or one of its near triangles blocks d (the exact part of visible();
+  // Embree is not asked): occluders at distance ~0, a crease or a contact.
+  bool blocked_nearby(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const {
+    return exact_blocker(point, near, d, true) == 0.0;
+  }
   // Number of triangles the ray from p + εn in unit direction d crosses.
   CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
