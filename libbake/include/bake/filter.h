@@ -33,8 +33,14 @@
 //     the target; x is the distance from p to where the sample's ray meets the plane through p
 //     perpendicular to v; its weight is (1 − (x/r)²)² for x < r (our choice of a smooth compact
 //     filter: the paper leaves ComputeFilterWeight open);
+//   - a receiver whose own pass-1 rays met an occluder nearer than d/2 (a crease, a contact: its
+//     1-ring or near triangles) brute-forces every cell in which those triangles, decided exactly
+//     (RayCaster::blocked_nearby), block the cell's centre or a corner direction: its neighbours'
+//     rays start on the other side of that occluder (the floor beside a wall) and cannot speak
+//     for it;
 //   - cells with total weight below 2 (§5: "approximately 2 samples") are brute-forced too:
-//     `fallback_rays` stratified rays inside the cell (the paper shot one).
+//     `fallback_rays` stratified rays inside the cell (the paper shot one), joined by the
+//     receiver's own pass-1 rays that fell in the cell (they need no filter).
 //
 // The estimate per cell c (solid angle Ω_c, integrand f of a product: (n·ω)/π for AO, (n·ω) y_i/π
 // for diffuse transfer, y_i for visibility transfer) uses the weighted visible fraction ν_c, the
@@ -43,7 +49,8 @@
 //     ∫_c V f dω ≈ ν_c F_c + Ω_c (mean(V f) − ν_c mean(f)).
 // So a receiver whose samples all escape gets exactly the closed form (bake/zonal.h), one whose
 // samples all hit gets exactly 0, and a cell with one ray gets V(ray)·F_c (the stratified
-// estimator). F_c is integrated once in the frame of the cell (Gauss–Legendre in θ and φ, exact
+// estimator: with radius_factor 0 the whole result is Σ_c V(d_c) F_c, one fallback ray per
+// cell). F_c is integrated once in the frame of the cell (Gauss–Legendre in θ and φ, exact
 // to rounding) and rotated to the receiver's frame with prtshade's SH rotation (Σ_c ν_c F_c is
 // linear: one rotation per receiver). Each sample carries its own effective direction, so the
 // cells only bin and normalise: any transfer / visibility order the SH code supports is carried,
@@ -52,14 +59,22 @@
 // Band-1 radiance: the filter assumes the lighting · BRDF response is band-limited (Ω_v, §3.2);
 // an HDR environment with a sun (10^4-10^5 × its mean) is not, so radiance is always routed to the
 // QMC integrator (bake/qmc.h, environment importance sampling, `radiance_rays` rays per point) and
-// the description says so. Full-sphere points (ShadePoint::hemisphere false) are not filtered:
-// the constructor is for hemisphere products only (the FIV shells use the silhouette integrator).
+// the description says so. Full-sphere points (ShadePoint::hemisphere false) are a contract
+// error: hemisphere products only (the FIV shells use the silhouette integrator).
+//
+// Where it loses (measured, bench/bench_filter.cpp): its error is mostly the noise of a few
+// binary samples per cell plus the 1-ray brute-forced cells, so at ≤ 32 rays per point it beats
+// QMC at the same rays but not QMC at 256; on dense foliage most cells are brute-forced (the
+// occluders are within 4d) and it is slower than QMC at equal error. Receivers enclosed by an
+// occluder that stands on their own surface, farther than d/2 (ground vertices inside a box
+// standing on the ground) take light from neighbours outside it within the search radius.
 //
 // prepare(points) must be given every point of the bake before integrate(); integrate() with an
 // index that prepare() did not see, or a point that differs from the prepared one, is integrated
 // by brute force over every cell (fallback_rays per cell: the plain stratified estimator).
-// The per-value standard error is reported as 0: the filter's error is mostly bias (over-blur),
-// which only a reference can measure (the error report).
+// The per-value standard error is reported as 0: the filter has no per-point variance estimate
+// (its samples are its neighbours', shared between points); the error report measures its error
+// against the QMC reference. Products and integrands: docs/ARCHITECTURE.md ("Conventions").
 #pragma once
 
 #include <bake/accel.h>
