@@ -14,6 +14,11 @@
 //                                    latter below 400k triangles only: its contour setup grows
 //                                    too slow) a seeded sample of 512 (their cost per vertex does
 //                                    not depend on the others), scaled to all receivers.
+//   bench_filter grille [bars]       a grille of round bars (radius 2 mm, 16 sides × 128 segments:
+//                                    4,096 triangles each; default 256 bars = 1M triangles, half
+//                                    along x at 30 cm, half along y just above) over the same ground,
+//                                    receivers and runs as grass: occluders far from the receivers
+//                                    (the filter's case) but every bar edge a contour edge.
 //
 // Errors are over the reference's vertices; "rays/pt" counts pass-1 and brute-force rays (the
 // filter) or rays (QMC); CPU seconds are the process's (every thread), including the filter's
@@ -161,12 +166,9 @@ void assets(std::vector<std::string> names) {
   }
 }
 
-// Grass: `blades` blades, each a bent strip of 2 quads (4 triangles) 4-12 mm wide at the base and
-// 8-20 cm tall, leaning randomly, on a 2 m × 2 m ground grid of kGround² quads (its vertices first).
+// The 2 m × 2 m ground grid of kGround² quads at z = 0, its vertices first.
 constexpr int kGround = 512;
-Mesh grass(uint32_t blades) {
-  std::vector<Vector3f> p;
-  std::vector<std::array<uint32_t, 3>> t;
+void ground(std::vector<Vector3f>& p, std::vector<std::array<uint32_t, 3>>& t) {
   const int G = kGround;
   for (int j = 0; j <= G; ++j)
     for (int i = 0; i <= G; ++i) p.emplace_back(-1.0f + 2.0f * float(i) / G, -1.0f + 2.0f * float(j) / G, 0.0f);
@@ -176,6 +178,14 @@ Mesh grass(uint32_t blades) {
       t.push_back({a, b, c});
       t.push_back({a, c, d});
     }
+}
+
+// Grass: `blades` blades, each a bent strip of 2 quads (4 triangles) 4-12 mm wide at the base and
+// 8-20 cm tall, leaning randomly, on the ground grid.
+Mesh grass(uint32_t blades) {
+  std::vector<Vector3f> p;
+  std::vector<std::array<uint32_t, 3>> t;
+  ground(p, t);
   for (uint32_t k = 0; k < blades; ++k) {
     auto u = [&](uint64_t salt) { return float(to_unit(mix64(uint64_t(k) * 8 + salt))); };
     const Vector3f base(-0.98f + 1.96f * u(1), -0.98f + 1.96f * u(2), 0.0f);
@@ -197,12 +207,42 @@ Mesh grass(uint32_t blades) {
   return make_mesh(std::move(p), std::move(t), "grass");
 }
 
-void grass_scene(uint32_t blades) {
-  const double c0 = process_cpu_seconds();
-  Asset a(grass(blades));
+// A grille: `bars` round bars (radius 2 mm, 16 sides, 128 segments) across the ground, the first
+// half along x at z = 0.3, the rest along y at z = 0.306, evenly spaced over [-0.9, 0.9].
+Mesh grille(uint32_t bars) {
+  std::vector<Vector3f> p;
+  std::vector<std::array<uint32_t, 3>> t;
+  ground(p, t);
+  constexpr int kSides = 16, kSegments = 128;
+  constexpr float kRadius = 0.002f;
+  const uint32_t half = std::max(bars / 2, 1u);
+  for (uint32_t k = 0; k < bars; ++k) {
+    const bool along_x = k < half;
+    const uint32_t i = along_x ? k : k - half, count = along_x ? half : bars - half;
+    const float offset = -0.9f + 1.8f * (float(i) + 0.5f) / float(count), z = along_x ? 0.3f : 0.306f;
+    const uint32_t first = uint32_t(p.size());
+    for (int s = 0; s <= kSegments; ++s)
+      for (int a = 0; a < kSides; ++a) {
+        const float along = -1.0f + 2.0f * float(s) / kSegments, ang = 6.2831853f * float(a) / kSides;
+        const float u = kRadius * std::cos(ang), w = kRadius * std::sin(ang);
+        p.push_back(along_x ? Vector3f(along, offset + u, z + w) : Vector3f(offset + u, along, z + w));
+      }
+    for (uint32_t s = 0; s < uint32_t(kSegments); ++s)
+      for (uint32_t a = 0; a < uint32_t(kSides); ++a) {
+        const uint32_t a1 = (a + 1) % kSides, r0 = first + s * kSides, r1 = r0 + kSides;
+        t.push_back({r0 + a, r0 + a1, r1 + a1});
+        t.push_back({r0 + a, r1 + a1, r1 + a});
+      }
+  }
+  return make_mesh(std::move(p), std::move(t), "grille");
+}
+
+// The ground's receivers under `mesh`: filter, QMC and (below 400k triangles) silhouette.
+void ground_scene(const char* name, Mesh mesh, double build_seconds) {
+  Asset a(std::move(mesh));
   a.points.resize(size_t(kGround + 1) * size_t(kGround + 1));  // the ground's vertices receive
-  std::printf("grass: %u blades, %zu triangles, %zu ground vertices receive (built in %.1f CPU s); AO\n", blades,
-              a.mesh.triangles.size(), a.points.size(), process_cpu_seconds() - c0);
+  std::printf("%s: %zu triangles, %zu ground vertices receive (built in %.1f CPU s); AO\n", name,
+              a.mesh.triangles.size(), a.points.size(), build_seconds);
   ProductRequest req;
   req.ao = true;
   const std::vector<uint32_t> rows = seeded_sample(uint32_t(a.points.size()), 512, 11);
@@ -231,10 +271,14 @@ int main(int argc, char** argv) {
   const std::string what = argc > 1 ? argv[1] : "assets";
   if (what == "assets") {
     assets(std::vector<std::string>(argv + std::min(argc, 2), argv + argc));
-  } else if (what == "grass") {
-    grass_scene(argc > 2 ? uint32_t(std::stoul(argv[2])) : 250000u);
+  } else if (what == "grass" || what == "grille") {
+    const bool g = what == "grass";
+    const uint32_t n = argc > 2 ? uint32_t(std::stoul(argv[2])) : g ? 250000u : 256u;
+    const double c0 = process_cpu_seconds();
+    Mesh mesh = g ? grass(n) : grille(n);
+    ground_scene(what.c_str(), std::move(mesh), process_cpu_seconds() - c0);
   } else {
-    std::fprintf(stderr, "usage: bench_filter assets [names...] | grass [blades]\n");
+    std::fprintf(stderr, "usage: bench_filter assets [names...] | grass [blades] | grille [bars]\n");
     return 2;
   }
   return 0;
