@@ -206,6 +206,9 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                                 ChooserOptions::kMaxTarget));
   PRT_CHECK(!request.empty());
   PRT_CHECK(!points.empty());
+  if (options.only == IntegratorKind::Filter)
+    throw InputError("", "the target-error chooser has no model of the filter integrator: give its pass-1 rays "
+                         "(--samples N)");
   const auto wall0 = std::chrono::steady_clock::now();
   IntegratorChoice choice;
   choice.target = options.target;

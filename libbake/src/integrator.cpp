@@ -1,6 +1,7 @@
 // integrator.cpp — the integrator kinds' names and the defaults' rules (bake/integrator.h), and
 // the integrators built from a spec (bake/vertex_bake.h).
 #include <bake/error.h>
+#include <bake/filter.h>
 #include <bake/integrator.h>
 #include <bake/qmc.h>
 #include <bake/sampling.h>
@@ -16,12 +17,13 @@ const char* to_string(IntegratorKind kind) {
   switch (kind) {
   case IntegratorKind::Silhouette: return "silhouette";
   case IntegratorKind::Qmc: return "qmc";
+  case IntegratorKind::Filter: return "filter";
   }
   return "?";
 }
 
 std::optional<IntegratorKind> parse_integrator_kind(std::string_view name) {
-  for (IntegratorKind k : {IntegratorKind::Silhouette, IntegratorKind::Qmc})
+  for (IntegratorKind k : {IntegratorKind::Silhouette, IntegratorKind::Qmc, IntegratorKind::Filter})
     if (name == to_string(k)) return k;
   return std::nullopt;
 }
@@ -35,6 +37,12 @@ std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Me
   switch (spec.kind) {
   case IntegratorKind::Qmc:
     return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{spec.qmc_rays, spec.seed}, accel);
+  case IntegratorKind::Filter: {
+    FilterOptions options;
+    options.rays = spec.filter_rays;
+    options.seed = spec.seed;
+    return std::make_unique<FilterIntegrator>(mesh, topology, request, options, accel);
+  }
   case IntegratorKind::Silhouette:
     return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{spec.isolines(), spec.seed}, accel);
   }

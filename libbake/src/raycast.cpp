@@ -334,7 +334,7 @@ bool RayCaster::visible(const ShadePoint& point, const Vector3d& d) const {
   return visible(point, near_triangles(point), d);
 }
 
-bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
+double RayCaster::exact_blocker(const ShadePoint& point, const NearTriangles& near, const Vector3d& d, bool any) const {
   if (point.welded >= 0) {
     const auto w = uint32_t(point.welded);
     const double reach_ = reach(point);
@@ -342,23 +342,55 @@ bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, cons
     for (uint32_t f : topo_.ring(w))
       if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
           ab && ring_crossing(point, ab->first, ab->second, d, reach_) == SegmentCrossing::Cross)
-        return false;
+        return 0.0;  // through p itself
   }
+  double first = std::numeric_limits<double>::infinity();
   if (!near.tests.empty()) {
     const Vector3d r = point.p + reach(point) * d;
     // Edge (a null set of directions) does not block: the neighbour across that edge decides.
     for (const NearTriangles::Test& t : near.tests)
-      if (crosses_exactly(t, point, r) == SegmentCrossing::Cross) return false;
+      if (crosses_exactly(t, point, r) == SegmentCrossing::Cross) {
+        if (any) return 0.0;
+        const Vector3d m = (t.b - t.a).cross(t.c - t.a);
+        first = std::min(first, std::max(0.0, m.dot(t.a - point.p) / m.dot(d)));  // m·d ≠ 0: it is crossed
+      }
   }
+  return first;
+}
+
+namespace {
+RingContext ring_context(const ShadePoint& point, const NearTriangles& near, const uint32_t* weld,
+                         const std::array<uint32_t, 3>* triangles) {
   RingContext ctx;
   rtcInitIntersectContext(&ctx.base);
   ctx.welded = point.welded;
-  ctx.weld = topo_.weld.data();
-  ctx.triangles = mesh_.triangles.data();
+  ctx.weld = weld;
+  ctx.triangles = triangles;
   ctx.near = near.prims;
+  return ctx;
+}
+} // namespace
+
+bool RayCaster::visible(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
+  if (blocked_nearby(point, near, d)) return false;
+  RingContext ctx = ring_context(point, near, topo_.weld.data(), mesh_.triangles.data());
   RTCRay ray = make_ray(point.p, d);
   rtcOccluded1(rt_->scene, &ctx.base, &ray);
   return ray.tfar >= 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+std::optional<double> RayCaster::first_hit(const ShadePoint& point, const NearTriangles& near, const Vector3d& d) const {
+  double first = exact_blocker(point, near, d, false);
+  if (first == 0.0) return first;
+  RingContext ctx = ring_context(point, near, topo_.weld.data(), mesh_.triangles.data());
+  RTCRayHit rh{};
+  rh.ray = make_ray(point.p, d);
+  if (first < std::numeric_limits<double>::infinity()) rh.ray.tfar = float(first);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rt_->scene, &ctx.base, &rh);
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) first = std::min(first, double(rh.ray.tfar));
+  if (first == std::numeric_limits<double>::infinity()) return std::nullopt;
+  return first;
 }
 
 bool RayCaster::occluded(const Vector3d& origin, const Vector3d& d, double tnear, double tfar) const {

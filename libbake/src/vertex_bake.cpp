@@ -56,6 +56,7 @@ VertexBake bake_point_rows(std::span<const ShadePoint> points, size_t begin, siz
   out.std_error.assign(V * W, 0.0);
   Task progress(monitor, label, V);
   const auto t0 = std::chrono::steady_clock::now();
+  integrator.prepare(points);
   std::atomic<int64_t> cpu_ns{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(begin, end, 16), [&](const tbb::blocked_range<size_t>& r) {
     const double c0 = thread_cpu_seconds();

@@ -238,7 +238,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          [&a](const std::string& name) {
            const auto kind = bake::parse_integrator_kind(name);
            if (!kind)
-             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc)");
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc, filter)");
            a.integrator.kind = *kind;
          },
          "silhouette (the default with --samples): semi-analytic visibility\n"
@@ -246,7 +246,9 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          "octahedral u-isolines, summed-area tables. Deterministic; error\n"
          "falls with k, no noise.\n"
          "qmc: Embree ray casting, importance-sampled randomised Halton QMC, the\n"
-         "baseline and the reference.")
+         "baseline and the reference.\n"
+         "filter: a few rays per vertex reused by its neighbours through the\n"
+         "sheared filter (paper 002); --samples is its pass-1 rays (4-32).")
       ->option_text("NAME");
   cmd.add_option("--target-error", a.target_error,
                  "the default (E = 1e-3) unless --samples is given: the integrator\n"

@@ -38,7 +38,9 @@
 //     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays;
 //     with counted_costs, the pilot's counted work priced at fixed constants instead (below).
 // The cheaper prediction wins. With `only` set (the user named an integrator), only its knob is
-// chosen.
+// chosen. The filter integrator (bake/filter.h) is not modelled: its error depends on the
+// neighbours' rays, which a pilot on scattered vertices does not see; only = Filter is an
+// InputError (give its rays), and the unrestricted choice is between the other two.
 //
 // Determinism: the knobs are functions of the inputs and the seed (the pilot's values are), but
 // WHICH integrator wins depends on measured CPU time, so two runs whose predicted costs are close

@@ -1,6 +1,6 @@
 // bake/integrator.h — the interface every spherical integrator implements, so products can be
-// baked by either the QMC baseline (bake/qmc.h) or the silhouette integrator (paper 001 §3, next)
-// and compared value by value — and the typed configuration that chooses one (IntegratorSpec).
+// baked by the QMC baseline (bake/qmc.h), the silhouette integrator (paper 001 §3) or the
+// sheared-filter integrator (paper 002, bake/filter.h) and compared value by value — and the typed configuration that chooses one (IntegratorSpec).
 #pragma once
 
 #include <bake/products.h>
@@ -35,9 +35,9 @@ struct ShadePoint {
   bool hemisphere = true;
 };
 
-enum class IntegratorKind { Silhouette, Qmc };
+enum class IntegratorKind { Silhouette, Qmc, Filter };
 
-// The names files and tools use ("silhouette", "qmc"): the one place they are spelled.
+// The names files and tools use ("silhouette", "qmc", "filter"): the one place they are spelled.
 const char* to_string(IntegratorKind kind);
 std::optional<IntegratorKind> parse_integrator_kind(std::string_view name);  // nullopt for another name
 
@@ -51,6 +51,7 @@ int silhouette_isolines(uint32_t k);
 struct IntegratorSpec {
   static constexpr uint32_t kDefaultSilhouetteK = 16384;  // 128² spherical samples
   static constexpr uint32_t kDefaultQmcRays = 1024;
+  static constexpr uint32_t kDefaultFilterRays = 16;     // pass-1 rays (paper 002 §5: 4-32)
   static constexpr uint32_t kMinSilhouetteK = 4;          // 2 u-isolines
   // The converged reference of a silhouette bake (and of FIV shells, bake/fiv.h): QMC rays per point.
   static constexpr uint32_t kSilhouetteReferenceRays = 65536;
@@ -59,11 +60,21 @@ struct IntegratorSpec {
   IntegratorKind kind = IntegratorKind::Silhouette;
   uint32_t silhouette_k = kDefaultSilhouetteK;  // silhouette: k spherical samples (silhouette_isolines(k))
   uint32_t qmc_rays = kDefaultQmcRays;          // qmc: rays per shade point
+  uint32_t filter_rays = kDefaultFilterRays;    // filter: pass-1 rays per shade point
   uint64_t seed = 1;
   uint32_t report_points = 32;                  // error report: seeded points re-integrated (0: none)
 
-  uint32_t samples() const { return kind == IntegratorKind::Qmc ? qmc_rays : silhouette_k; }
-  void set_samples(uint32_t n) { (kind == IntegratorKind::Qmc ? qmc_rays : silhouette_k) = n; }
+  // The chosen kind's knob.
+  static uint32_t IntegratorSpec::*knob(IntegratorKind k) {
+    switch (k) {
+    case IntegratorKind::Qmc: return &IntegratorSpec::qmc_rays;
+    case IntegratorKind::Filter: return &IntegratorSpec::filter_rays;
+    case IntegratorKind::Silhouette: break;
+    }
+    return &IntegratorSpec::silhouette_k;
+  }
+  uint32_t samples() const { return this->*knob(kind); }
+  void set_samples(uint32_t n) { this->*knob(kind) = n; }
   int isolines() const { return silhouette_isolines(silhouette_k); }
   // Rays per point of the QMC reference the error report compares with.
   uint32_t reference_rays() const {
@@ -71,6 +82,7 @@ struct IntegratorSpec {
   }
   // The reference's randomisation seed, apart from the bake's points.
   uint64_t reference_seed() const;
+
 };
 
 // Work counters, summed over all integrate() calls. A counter an integrator does not keep stays
@@ -82,6 +94,12 @@ struct IntegratorStats {
   // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
   uint64_t closed_form = 0, enclosed = 0;
   double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
+  // The filter integrator (bake/filter.h): pass-1 rays cast (once per point), rays of brute-forced
+  // cells, hemisphere cells integrated and how many of them by brute force, and points integrated
+  // by brute force because prepare() had not seen them.
+  uint64_t pass1_rays = 0, fallback_rays = 0, cells = 0, brute_cells = 0, unprepared = 0;
+  double brute_fraction() const { return cells ? double(brute_cells) / double(cells) : 0.0; }
+  double rays_per_point() const { return points ? double(pass1_rays + fallback_rays) / double(points) : 0.0; }
 };
 
 class Integrator {
@@ -91,6 +109,11 @@ public:
   std::string name() const { return to_string(kind()); }
   virtual std::string description() const = 0;     // one line: method and its parameters
   virtual const ProductLayout& layout() const = 0;
+  // Called once before a bake's integrate() calls with ALL its points (bake_points: row i is
+  // points[i]), never concurrently with integrate(); integrate(points[i], i) may then use the other
+  // points (the filter integrator reuses its neighbours' rays). A later call replaces the earlier
+  // set. Default: nothing to prepare.
+  virtual void prepare(std::span<const ShadePoint> points) const { (void)points; }
   // Writes one row of estimates (layout().width doubles) for the shade point. `point_index`
   // identifies the point for deterministic per-point randomisation. `std_error` (optional, same
   // width) receives each value's estimated standard error (0 for a deterministic integrator).

@@ -83,6 +83,16 @@ public:
   bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
   bool visible(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const;
   NearTriangles near_triangles(const ShadePoint& point) const;
+  // The same visibility with the distance to the first blocking triangle: nullopt when d is
+  // visible, else the distance along d (a 1-ring triangle blocks at 0; a near triangle at its
+  // plane's distance, in double; any other at Embree's closest hit). The sparse rays of the
+  // filter integrator (bake/filter.h), which need the occluder's depth.
+  std::optional<double> first_hit(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const;
+  // Whether the point's 1-ring or one of its near triangles blocks d (the exact part of visible();
+  // Embree is not asked): occluders at distance ~0, a crease or a contact.
+  bool blocked_nearby(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const {
+    return exact_blocker(point, near, d, true) == 0.0;
+  }
   // Number of triangles the ray from p + εn in unit direction d crosses.
   CrossingCount count_crossings(const ShadePoint& point, const Eigen::Vector3d& d) const;
   // Closest triangle hit by the ray origin + t d, t in [tnear, ∞) (no 1-ring filtering; primary
@@ -97,6 +107,10 @@ public:
 private:
   struct Embree;
   double reach(const ShadePoint& point) const;  // a ray length beyond the whole mesh from p
+  // The first blocker among the 1-ring and the near triangles (decided exactly): its distance
+  // along d (0 for the 1-ring), +inf when none blocks. With `any`, the first blocker found ends
+  // the search (its distance then need not be the least).
+  double exact_blocker(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d, bool any) const;
   const Mesh& mesh_;
   const Topology& topo_;
   std::unique_ptr<Embree> rt_;
