@@ -244,6 +244,12 @@ std::string FilterIntegrator::description() const {
 }
 
 void FilterIntegrator::prepare(std::span<const ShadePoint> points) const {
+  // The same points again (a sharded bake prepares once per chunk of rows, bake/vertex_bake.h
+  // bake_point_rows): keep the tree and the pass-1 rays already traced.
+  const auto same = [](const ShadePoint& a, const ShadePoint& b) {
+    return a.p == b.p && a.n == b.n && a.t == b.t && a.welded == b.welded && a.hemisphere == b.hemisphere;
+  };
+  if (prepared_ && std::equal(points.begin(), points.end(), prepared_->points.begin(), prepared_->points.end(), same)) return;
   auto p = std::make_unique<Prepared>();
   p->points.assign(points.begin(), points.end());
   std::vector<Vector3d> positions(points.size());

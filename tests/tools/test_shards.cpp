@@ -159,6 +159,24 @@ TEST(Shards, ShardWorkersThenMerge) {
   EXPECT_TRUE(leftovers(dir, out).empty());
 }
 
+// The filter integrator (paper 002) shares rays between neighbouring rows, across chunk borders:
+// each row's pass-1 rays are a function of (seed, row), so workers that each trace their
+// neighbours' rays again give the single-process bytes.
+TEST(Shards, FilterIntegratorAcrossChunkBorders) {
+  const fs::path dir = dir_for("filter"), out = dir / "out.prt.h5";
+  const std::string args = "vertex " + kData + "/bunny_ground.obj --ao --transfer 3 --integrator filter --samples 8 "
+                           "--threads 1 --chunk-rows 512 --report 4";
+  const std::string ref = reference(args, out);
+  for (int i = 0; i < 2; ++i) {
+    const auto w = prtbake(args + " --shard " + std::to_string(i) + "/2 -o " + out.string(), dir);
+    ASSERT_EQ(w.code, 0) << w.err;
+  }
+  const auto m = prtbake(args + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "--integrator filter, --shard I/2 + --merge";
+  EXPECT_TRUE(leftovers(dir, out).empty());
+}
+
 // A flipped byte, a chunk of another bake, a missing chunk: one line naming it, exit 1, no file.
 TEST(Shards, MergeRefusesBadChunks) {
   const fs::path dir = dir_for("refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";

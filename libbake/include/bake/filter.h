@@ -72,6 +72,8 @@
 // prepare(points) must be given every point of the bake before integrate(); integrate() with an
 // index that prepare() did not see, or a point that differs from the prepared one, is integrated
 // by brute force over every cell (fallback_rays per cell: the plain stratified estimator).
+// prepare() with the points it already holds keeps them and the pass-1 rays traced so far (a
+// sharded bake calls it once per chunk of rows); other points replace them.
 // The per-value standard error is reported as 0: the filter has no per-point variance estimate
 // (its samples are its neighbours', shared between points); the error report measures its error
 // against the QMC reference. Products and integrands: docs/ARCHITECTURE.md ("Conventions").
