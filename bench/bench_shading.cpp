@@ -87,40 +87,39 @@ void BM_ShadeGlossy(benchmark::State& state) {
 }
 BENCHMARK(BM_ShadeGlossy)->ArgName("order")->Arg(3)->Arg(5)->Arg(7)->Arg(9)->Arg(11);
 
+// One vertex at a time with a fixed reflection direction and Phong 24: shade(v, scales, r, out_v).
+template <class Shade>
+void per_vertex_glossy(benchmark::State& state, int order, Shade&& shade) {
+  double scales[prt::shade::kMaxGlossyOrder];
+  prt::shade::phong_band_scales(24.0, order, scales);
+  const float r[3] = {0.48f, 0.6f, 0.64f};
+  std::vector<float> out(size_t(3 * kItems));
+  for (auto _ : state) {
+    for (int v = 0; v < kItems; ++v) shade(size_t(v), scales, r, out.data() + 3 * v);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  per_item(state);
+}
+
 // The slow reference of route A (a double Gaunt pass per channel per vertex), same inputs.
 void BM_ShadeGlossyReference(benchmark::State& state) {
   const int order = int(state.range(0)), n = order * order;
   const prt::shade::TripleProduct tp(order);
   const std::vector<float> visibility = normal_floats(size_t(kItems) * size_t(n), 1);
   const std::vector<float> light = normal_floats(size_t(3 * n), 2);
-  double scales[prt::shade::kMaxGlossyOrder];
-  prt::shade::phong_band_scales(24.0, order, scales);
-  const float r[3] = {0.48f, 0.6f, 0.64f};
-  std::vector<float> out(size_t(3 * kItems));
-  for (auto _ : state) {
-    for (int v = 0; v < kItems; ++v)
-      prt::shade::shade_glossy(tp, light.data(), visibility.data() + size_t(v) * size_t(n), scales, r, out.data() + 3 * v);
-    benchmark::DoNotOptimize(out.data());
-    benchmark::ClobberMemory();
-  }
-  per_item(state);
+  per_vertex_glossy(state, order, [&](size_t v, const double* scales, const float* r, float* out) {
+    prt::shade::shade_glossy(tp, light.data(), visibility.data() + v * size_t(n), scales, r, out);
+  });
 }
 BENCHMARK(BM_ShadeGlossyReference)->ArgName("order")->Arg(3)->Arg(7)->Arg(11);
 
 void BM_ShadeGlossyRadiance(benchmark::State& state) {
   const int order = int(state.range(0)), n = order * order;
   const std::vector<float> shadowed = normal_floats(size_t(kItems) * size_t(3 * n), 5);
-  double scales[prt::shade::kMaxGlossyOrder];
-  prt::shade::phong_band_scales(24.0, order, scales);
-  const float r[3] = {0.48f, 0.6f, 0.64f};
-  std::vector<float> out(size_t(3 * kItems));
-  for (auto _ : state) {
-    for (int v = 0; v < kItems; ++v)
-      prt::shade::shade_glossy_radiance(shadowed.data() + size_t(v) * size_t(3 * n), order, scales, r, out.data() + 3 * v);
-    benchmark::DoNotOptimize(out.data());
-    benchmark::ClobberMemory();
-  }
-  per_item(state);
+  per_vertex_glossy(state, order, [&](size_t v, const double* scales, const float* r, float* out) {
+    prt::shade::shade_glossy_radiance(shadowed.data() + v * size_t(3 * n), order, scales, r, out);
+  });
 }
 BENCHMARK(BM_ShadeGlossyRadiance)->ArgName("order")->Arg(3)->Arg(5)->Arg(7)->Arg(9)->Arg(11);
 

@@ -4,6 +4,7 @@
 #include <bake/qmc.h>
 #include <bake/zonal.h>
 
+#include <prtshade/quadrature.h>
 #include <prtshade/sh.h>
 
 #include <algorithm>
@@ -29,29 +30,6 @@ constexpr double kContactSpacings = 0.5;             // an own ray blocked neare
 // Directions probed per cell for contact: the centre and four points near the corners.
 constexpr std::pair<double, double> kCellProbes[] = {{0.5, 0.5}, {0.02, 0.02}, {0.02, 0.98}, {0.98, 0.02}, {0.98, 0.98}};
 constexpr uint64_t kFallbackSalt = 0x66616c6c6261636bull;
-
-// Gauss–Legendre nodes and weights on [a, b] (Newton on P_n from the Chebyshev-like guess).
-void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w) {
-  x.assign(size_t(n), 0.0);
-  w.assign(size_t(n), 0.0);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double step = p1 / dp;
-      z -= step;
-      if (std::abs(step) < 1e-16) break;
-    }
-    x[size_t(i)] = 0.5 * (a + b) - 0.5 * (b - a) * z;
-    w[size_t(i)] = (b - a) / ((1 - z * z) * dp * dp);
-  }
-}
 
 // ---- a k-d tree over the prepared points (implicit: the median of each range splits it) ------
 class PointTree {
@@ -161,9 +139,9 @@ CellIntegrals::CellIntegrals(const ProductLayout& layout) : layout_(layout) {
   std::vector<double> tx, tw, px, pw, y(size_t(sh::num_coeffs(std::max(sh_order_, 1)))), f(width_);
   for (int c = 0; c < HemisphereCells::kCount; ++c) {
     const int ring = c / HemisphereCells::kSectors, sector = c % HemisphereCells::kSectors;
-    gauss_legendre(kNodes, std::asin(std::sqrt(double(ring) / HemisphereCells::kRings)),
+    shade::gauss_legendre(kNodes, std::asin(std::sqrt(double(ring) / HemisphereCells::kRings)),
                    std::asin(std::sqrt(double(ring + 1) / HemisphereCells::kRings)), tx, tw);
-    gauss_legendre(kNodes, 2 * kPi * sector / HemisphereCells::kSectors,
+    shade::gauss_legendre(kNodes, 2 * kPi * sector / HemisphereCells::kSectors,
                    2 * kPi * (sector + 1) / HemisphereCells::kSectors, px, pw);
     const std::span<double> cell = std::span(values_).subspan(size_t(c) * width_, width_);
     for (int i = 0; i < kNodes; ++i)

@@ -1,5 +1,6 @@
 // glossy.cpp — glossy shading from visibility transfer or shadowed radiance (prtshade/glossy.h).
 #include <prtshade/glossy.h>
+#include <prtshade/quadrature.h>
 #include <prtshade/sh.h>
 
 #include "check.h"
@@ -13,30 +14,6 @@
 namespace prt::shade {
 
 namespace {
-
-// Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_n from the Chebyshev guess; the
-// three-term recurrence for P_n and its derivative), converged to a few ulps.
-void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.assign(size_t(n), 0.0);
-  w.assign(size_t(n), 0.0);
-  for (int i = 0; i < n; ++i) {
-    double t = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5)), dp = 1;
-    for (int iter = 0; iter < 100; ++iter) {
-      double p0 = 1, p1 = t;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (t * p1 - p0) / (t * t - 1);  // p1 = P_n(t), p0 = P_{n−1}(t)
-      const double step = p1 / dp;
-      t -= step;
-      if (std::abs(step) < 1e-16) break;
-    }
-    x[size_t(i)] = t;
-    w[size_t(i)] = 2 / ((1 - t * t) * dp * dp);
-  }
-}
 
 int band_of(int i) { return int(std::sqrt(double(i))); }
 
@@ -72,7 +49,7 @@ TripleProduct::TripleProduct(int order) : order_(order) {
   const int n = order * order;
   const int nt = (3 * order - 1) / 2, np = 3 * order - 2;  // ⌈(3L−2)/2⌉ and 3L−2 nodes
   std::vector<double> ct, wt;
-  gauss_legendre(nt, ct, wt);
+  gauss_legendre(nt, -1.0, 1.0, ct, wt);
   const size_t nodes = size_t(nt) * size_t(np);
   std::vector<double> Y(nodes * size_t(n)), W(nodes);
   for (int a = 0; a < nt; ++a)
