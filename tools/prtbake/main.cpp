@@ -804,8 +804,9 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
       r.radiance = p.radiance && env ? &*env : nullptr;
       set_rows.push_back(meshes[i].positions.size());
       widths.push_back(uint32_t(bake::ProductLayout(r).width));
-      lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
     }
+    // Every object's mesh, occluders included: they shape the receivers' values.
+    for (size_t i = 0; i < scene.objects.size(); ++i) lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
     shards.emplace(*worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
     const bool merges = shards->run([&] {
       bake::SceneRows work;
