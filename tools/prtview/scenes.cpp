@@ -125,6 +125,8 @@ view::Camera first_look_camera(const F::Asset& f, const std::string& file, const
   if (is_scene_file(f)) {
     for (const F::SceneObject& o : f.objects)
       if (!glossy || (o.phong_exponent.value_or(0) > 0 && o.set.transfer_visibility)) grow(o.set.positions);
+    if (glossy && !lo.allFinite())  // no glossy object: frame them all (the render says what is missing)
+      for (const F::SceneObject& o : f.objects) grow(o.set.positions);
   } else if (has_fiv(f)) {
     const F::Occluder* o = f.find_occluder(choose_occluder(f, file, options.occluder));
     const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
