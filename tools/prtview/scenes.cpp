@@ -318,7 +318,8 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
                                      std::string(F::names::kObjects) + "/<name>" + std::string(F::names::kTransferVisibility) +
                                      "): nothing to show with --shade glossy");
   std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
-  std::map<int, std::unique_ptr<shade::TripleProduct>> tables;  // one Gaunt table per order
+  // One Gaunt table and one lit product matrix per order, shared by the objects of that order.
+  std::map<int, std::unique_ptr<shade::GlossyLight>> lit_of;
   std::vector<bake::Mesh> parts;
   std::vector<float> rgb;
   scene.first_triangle = {0};
@@ -334,17 +335,18 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
       if (order < 1 || order > shade::kMaxGlossyOrder)
         throw bake::InputError(file, "object '" + o.name + "': visibility transfer of order " + std::to_string(order) +
                                          " (glossy shading takes orders 1 to " + std::to_string(shade::kMaxGlossyOrder) + ")");
-      auto& tp = tables[order];
-      if (!tp) tp = std::make_unique<shade::TripleProduct>(order);
-      std::string unused;
-      const std::vector<float> light = environment_sh(env, order, unused);
-      const shade::GlossyLight lit(*tp, light.data());
+      auto& lit = lit_of[order];
+      if (!lit) {
+        std::string unused;
+        const std::vector<float> light = environment_sh(env, order, unused);
+        lit = std::make_unique<shade::GlossyLight>(shade::TripleProduct(order), light.data());
+      }
       std::vector<float> pos(3 * V), nrm(3 * V);
       for (size_t v = 0; v < V; ++v)
         for (int c = 0; c < 3; ++c) pos[3 * v + size_t(c)] = o.mesh.positions[v][c], nrm[3 * v + size_t(c)] = o.mesh.normals[v][c];
       const Vector3d eye_local = cam.eye - o.mesh.origin;
       const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
-      shade::shade_glossy_vertices(lit, o.visibility->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+      shade::shade_glossy_vertices(*lit, o.visibility->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
       for (size_t v = 0; v < V; ++v)
         for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
       char buf[200];
