@@ -15,6 +15,7 @@
 #include "gltf_reader.h"
 
 #include <bake/error.h>
+#include <bake/sha256.h>
 
 #include <tiny_gltf.h>
 
@@ -44,8 +45,14 @@ constexpr std::string_view kUnsupportedExtensions[] = {"KHR_draco_mesh_compressi
 
 // ---- tinygltf's file access: plain reads, no wordexp expansion of URIs, no writes. ----
 // The bytes external files may still take (user_data of the callbacks): the buffers' declared total.
+// What the file system callbacks may read: the external buffers the JSON declares, in its order
+// (tinygltf reads buffers before anything else, its "3. Parse Buffer"), at most their declared bytes.
+// Reads after the last buffer are images, which a bake never uses: refused, so tinygltf keeps their
+// uri with a warning and no texture is read or hashed.
 struct ReadBudget {
   uintmax_t remaining = 0;
+  size_t buffer_files = 0;                      // buffers whose uri is not a data URI
+  std::vector<std::string>* digests = nullptr;  // SourceFile::referenced_sha256, one per buffer file read
 };
 bool file_exists(const std::string& path, void*) {
   std::error_code ec;
@@ -54,6 +61,10 @@ bool file_exists(const std::string& path, void*) {
 std::string expand_nothing(const std::string& path, void*) { return path; }
 bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user_data) {
   auto& budget = *static_cast<ReadBudget*>(user_data);
+  if (budget.buffer_files == 0) {
+    if (err) *err += "'" + path + "' is not a buffer (images are not read)\n";
+    return false;
+  }
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (!ec && size > budget.remaining) {
@@ -72,6 +83,8 @@ bool read_buffer_file(std::vector<unsigned char>* out, std::string* err, const s
     if (err) *err += "cannot read '" + path + "'\n";
     return false;
   }
+  --budget.buffer_files;
+  if (budget.digests) budget.digests->push_back(sha256_bytes(std::as_bytes(std::span(out->data(), out->size()))));
   return true;
 }
 bool write_nothing(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
@@ -467,8 +480,9 @@ std::string_view gltf_json(std::string_view bytes, bool binary) {
   return bytes.substr(20, length);
 }
 
-// What the preflight parse finds: the buffers' declared bytes, at most kMaxBufferFileBytes.
-uintmax_t preflight(std::string_view text, const SourceFile& file) {
+// What the preflight parse finds: the buffers' declared bytes (at most kMaxBufferFileBytes) and how
+// many of them are external files.
+ReadBudget preflight(std::string_view text, const SourceFile& file) {
   using nlohmann::json;
   const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
     if (depth > kMaxJsonDepth)
@@ -483,25 +497,31 @@ uintmax_t preflight(std::string_view text, const SourceFile& file) {
     const size_t bracket = what.find("] ");
     throw InputError(file.name, "not a valid glTF: " + one_line(bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
-  if (!doc.is_object()) return 0;  // not a glTF: tinygltf refuses it with its message
+  if (!doc.is_object()) return {};  // not a glTF: tinygltf refuses it with its message
   if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
     for (const json& ext : *it)
       if (ext.is_string() && std::find(std::begin(kUnsupportedExtensions), std::end(kUnsupportedExtensions),
                                        ext.get_ref<const std::string&>()) != std::end(kUnsupportedExtensions))
         throw InputError(file.name, "requires extension " + shown(ext.get_ref<const std::string&>()) + ", which is not supported");
-  uintmax_t declared = 0;
+  ReadBudget budget;
+  budget.digests = file.referenced_sha256;
   if (const auto it = doc.find("buffers"); it != doc.end() && it->is_array())
-    for (const json& buffer : *it)
-      if (const auto n = buffer.find("byteLength"); buffer.is_object() && n != buffer.end() && n->is_number_unsigned())
-        declared = std::min(kMaxBufferFileBytes, declared + std::min(kMaxBufferFileBytes, n->get<uintmax_t>()));
-  return declared;
+    for (const json& buffer : *it) {
+      if (!buffer.is_object()) continue;
+      if (const auto n = buffer.find("byteLength"); n != buffer.end() && n->is_number_unsigned())
+        budget.remaining = std::min(kMaxBufferFileBytes, budget.remaining + std::min(kMaxBufferFileBytes, n->get<uintmax_t>()));
+      if (const auto uri = buffer.find("uri"); uri != buffer.end() && uri->is_string() &&
+                                                uri->get_ref<const std::string&>().rfind("data:", 0) != 0)
+        ++budget.buffer_files;
+    }
+  return budget;
 }
 
 // tinygltf's parse of the whole file (buffers resolved, images not decoded).
 tinygltf::Model parse(std::string_view bytes, const SourceFile& file) {
   if (bytes.size() >= std::numeric_limits<unsigned int>::max()) throw InputError(file.name, "too large for the glTF parser");
   const bool binary = bytes.substr(0, 4) == "glTF";
-  ReadBudget budget{preflight(gltf_json(bytes, binary), file)};
+  ReadBudget budget = preflight(gltf_json(bytes, binary), file);
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_nothing, read_buffer_file, write_nothing, &budget});
   loader.SetImageLoader(skip_image, nullptr);

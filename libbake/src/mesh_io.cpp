@@ -146,6 +146,16 @@ void validate(const Polygons& poly, const std::string& source, bool use_normals)
   if (triangles >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too large for 32-bit indices");
 }
 
+// Mesh::source_sha256 (bake/mesh.h): the file's digest when it refers to no other file, else the
+// digest of its bytes followed by each referenced file's hex digest in the order it was read.
+std::string source_digest(const std::string& bytes, const std::vector<std::string>& referenced) {
+  if (referenced.empty()) return sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
+  Sha256 h;
+  h.update(std::as_bytes(std::span(bytes.data(), bytes.size())));
+  for (const std::string& digest : referenced) h.update(std::as_bytes(std::span(digest.data(), digest.size())));
+  return h.hex_digest();
+}
+
 } // namespace
 
 Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions& options) {
@@ -245,11 +255,11 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
   }
   return reading_file(file, [&] {
     const std::string bytes = read_whole_file(path, file);
-    std::vector<std::string> warnings;
-    const Polygons polygons = format->read(bytes, {path, file, warnings});
+    std::vector<std::string> warnings, referenced;
+    const Polygons polygons = format->read(bytes, {path, file, warnings, &referenced});
     Mesh mesh = build_mesh(polygons, file, options);
     mesh.warnings = std::move(warnings);
-    mesh.source_sha256 = sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
+    mesh.source_sha256 = source_digest(bytes, referenced);
     return mesh;
   });
 }
@@ -259,8 +269,10 @@ namespace {
 MeshInstances read_instances(const std::filesystem::path& path, const std::string& file, const MeshLoadOptions& options) {
   const std::string bytes = read_whole_file(path, file);
   MeshInstances result;
-  std::vector<mesh_readers::GltfInstance> instances = mesh_readers::read_gltf_instances(bytes, {path, file, result.warnings});
-  result.source_sha256 = sha256_bytes(std::as_bytes(std::span(bytes.data(), bytes.size())));
+  std::vector<std::string> referenced;
+  std::vector<mesh_readers::GltfInstance> instances =
+      mesh_readers::read_gltf_instances(bytes, {path, file, result.warnings, &referenced});
+  result.source_sha256 = source_digest(bytes, referenced);
   for (mesh_readers::GltfInstance& in : instances) {
     MeshInstance& out = result.instances.emplace_back();
     try {

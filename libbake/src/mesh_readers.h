@@ -22,6 +22,9 @@ struct SourceFile {
   const std::filesystem::path& path;   // for files the format refers to (an OBJ's mtllib)
   const std::string& name;             // for messages: the path as given
   std::vector<std::string>& warnings;  // non-fatal findings, one line each
+  // SHA-256 (hex) of every other file whose bytes the parse used (a .gltf's external buffers), in
+  // the order they were read; load_mesh folds them into Mesh::source_sha256 (bake/mesh.h).
+  std::vector<std::string>* referenced_sha256 = nullptr;
 };
 
 // Shared by the readers and load_mesh's messages.

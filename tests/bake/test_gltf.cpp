@@ -5,6 +5,7 @@
 #include <bake/error.h>
 #include <bake/integrator.h>
 #include <bake/mesh.h>
+#include <bake/sha256.h>
 #include <bake/vertex_bake.h>
 
 #include <gltf_builder.h>
@@ -140,6 +141,47 @@ TEST(Gltf, GlbAndExternalBufferReadTheSameAsEmbedded) {
     EXPECT_EQ(m->positions, embedded.positions);
     EXPECT_EQ(m->triangles, embedded.triangles);
   }
+}
+
+// A .gltf and its external buffer are one input: a changed .bin must change the source digest
+// (a resumed sharded bake compares it), and the digest is defined (bake/mesh.h) as the .gltf's
+// bytes followed by each buffer file's hex digest. Images are neither read nor hashed.
+TEST(Gltf, SourceDigestCoversExternalBuffersNotImages) {
+  Gltf g;
+  g.node({{"mesh", g.mesh({{"attributes", {{"POSITION", g.vec3(kTriangle)}}}, {"indices", g.indices({0, 1, 2})}})}}, true);
+  const auto bytes_of = [](const std::string& s) { return std::as_bytes(std::span(s.data(), s.size())); };
+  json d = g.doc;
+  d["buffers"] = {{{"byteLength", g.bin.size()}, {"uri", "digest_buffer.bin"}}};
+  d["images"] = {{{"uri", "digest_texture.png"}}};
+  const std::string text = d.dump();
+  const fs::path gltf = write_file("digest.gltf", text);
+  write_file("digest_buffer.bin", g.bin);
+  write_file("digest_texture.png", "not a png");
+
+  const std::string want = [&] {
+    prt::bake::Sha256 h;
+    h.update(bytes_of(text));
+    const std::string bin_digest = prt::bake::sha256_bytes(bytes_of(g.bin));
+    h.update(bytes_of(bin_digest));
+    return h.hex_digest();
+  }();
+  const Mesh first = prt::bake::load_mesh(gltf);
+  EXPECT_EQ(first.source_sha256, want);
+  EXPECT_NE(first.source_sha256, prt::bake::sha256_bytes(bytes_of(text))) << "the buffer is part of the input";
+  EXPECT_EQ(prt::bake::load_mesh_instances(gltf).source_sha256, want) << "scene instances: the same digest";
+
+  write_file("digest_texture.png", "another texture, same geometry");
+  EXPECT_EQ(prt::bake::load_mesh(gltf).source_sha256, want) << "images are not part of a bake's input";
+
+  std::string changed = g.bin;
+  changed[0] = static_cast<char>(changed[0] ^ 1);  // the first position's lowest mantissa bit
+  write_file("digest_buffer.bin", changed);
+  const Mesh second = prt::bake::load_mesh(gltf);
+  EXPECT_NE(second.source_sha256, want) << "a changed buffer changes the digest";
+  EXPECT_NE(second.positions[0], first.positions[0]);
+
+  const Mesh embedded = prt::bake::load_mesh(g.write("digest_embedded.gltf"));
+  EXPECT_EQ(embedded.source_sha256, prt::bake::sha256_file(tmp_dir() / "digest_embedded.gltf")) << "one file: as sha256sum";
 }
 
 TEST(Gltf, PunctualLightsAreNotBakedAndSaySo) {

@@ -13,8 +13,12 @@
 //      order, exactly as the file has them (zero-area, needle and repeated-index polygons are
 //      kept). Readers: OBJ, PLY (ascii, binary little/big endian), OFF ([ST][C][N]OFF, ascii),
 //      STL (ascii, binary), glTF 2.0 (.gltf, .glb; parsed by tinygltf, gltf_reader.cpp). Why the
-//      first four are ours and not OpenMesh's: see mesh_io.cpp. For a .gltf with external
-//      buffers, source_sha256 covers the .gltf's bytes only, not the buffers it refers to.
+//      first four are ours and not OpenMesh's: see mesh_io.cpp. A .gltf with external
+//      buffers is the one input made of several files: its source_sha256 is the SHA-256 of the
+//      .gltf's bytes followed by the 64 hex digits of each external buffer file's SHA-256, in the
+//      order of its "buffers" array (so a changed .bin changes the digest, and a resumed sharded
+//      bake refuses chunks of the old one). Image files are never read or hashed: a bake uses no
+//      texture. Every other file's source_sha256 is the SHA-256 of its bytes, as `sha256sum`.
 //   2. build_mesh turns any Polygons into the Mesh: vertex rows, hard-edge splits, fan
 //      triangulation, normals and validation, the same for every format.
 // A new format is one more reader: a function that fills a Polygons from the bytes (as the glTF
