@@ -4,10 +4,10 @@
 #include <formats/names.h>
 
 #include "export_common.h"
+#include "temporaries.h"
 
 #include <algorithm>
 #include <fstream>
-#include <unistd.h>
 
 namespace prt::formats {
 namespace exporting {
@@ -74,7 +74,9 @@ Staging::Staging(const std::filesystem::path& out) : out_(out) {
   if (!std::filesystem::is_directory(parent, ec))
     throw FormatError(msg, "output directory '" + parent.string() + "' does not exist");
   if (std::filesystem::is_directory(out, ec)) throw FormatError(msg, "the output path is an existing directory");
-  dir_ = parent / ("." + out.filename().string() + ".export." + std::to_string(::getpid()));
+  const std::string prefix = "." + out.filename().string() + ".export." + detail::host_tag() + ".";
+  detail::remove_stale_temporaries(parent, prefix);
+  dir_ = parent / detail::temporary_name(prefix);
   std::filesystem::remove_all(dir_, ec);
   if (!std::filesystem::create_directory(dir_, ec))
     throw FormatError(msg, "cannot create the staging directory '" + dir_.string() + "': " + ec.message());

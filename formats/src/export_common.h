@@ -38,8 +38,10 @@ bool exactly_float(const std::vector<double>& values) noexcept;
 // "<prefix>/<dataset>" or "<dataset>" for the root layout.
 std::string join(const std::string& prefix, const std::string& dataset);
 
-// Staged outputs: files are written under a hidden directory beside the final output and renamed
-// into place by commit(); the destructor removes the directory and anything left in it.
+// Staged outputs: files are written under a hidden directory beside the final output
+// (".<name>.export.<host>.<pid>") and renamed into place by commit(); the destructor removes the
+// directory and anything left in it. The constructor first removes the staging directories that
+// killed exports to the same name on this machine left (temporaries.h).
 class Staging {
 public:
   // Checks that `out` can be written (its directory exists, it is not a directory); FormatError.

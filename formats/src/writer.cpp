@@ -6,13 +6,10 @@
 #include <formats/testing.h>
 
 #include "h5util.h"
+#include "temporaries.h"
 
-#include <signal.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
-#include <cerrno>
 #include <string>
 #include <set>
 #include <system_error>
@@ -170,37 +167,6 @@ struct TempGuard {
   }
 };
 
-// This machine's name as it goes into temporary file names: [A-Za-z0-9._-] only ("host" if none).
-std::string host_tag() {
-  char buf[256] = {};
-  if (::gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "host";
-  std::string h(buf);
-  for (char& c : h)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_')) c = '_';
-  return h;
-}
-
-// Removes "<name>.tmp.<host>.<pid>" files that a bake on THIS machine left when it was killed
-// (kill -9, power loss): their pid is not alive. A live pid (or one we may not signal) is
-// another bake writing now and is left alone; so are other machines' files (a shared disk) and
-// anything else in the directory. Best effort: an entry that cannot be removed stays.
-void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& final_name, const std::string& host) {
-  const std::string prefix = final_name + ".tmp." + host + ".";
-  std::error_code ec;
-  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string digits = name.substr(prefix.size());
-    if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      continue;
-    const pid_t pid = static_cast<pid_t>(std::stol(digits));
-    if (pid <= 0 || pid == ::getpid()) continue;
-    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
-    std::error_code rm;
-    std::filesystem::remove(it->path(), rm);
-  }
-}
-
 // The on-disk format: ours (HDF5 1.10 structures, every metadata block checksummed, fletcher32 on
 // data), or, for reader tests only, HDF5's oldest (superblock 0, version-1 object headers,
 // symbol-table groups, version-1 B-tree chunk indexes: no checksum anywhere) — with its own
@@ -222,10 +188,9 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
   if (std::filesystem::is_directory(final_path, ec))
     throw FormatError(msg_file, "the output path is an existing directory");
 
-  const std::string host = host_tag();
-  const std::filesystem::path tmp =
-      dir / (final_path.filename().string() + ".tmp." + host + "." + std::to_string(::getpid()));
-  remove_stale_temporaries(dir, final_path.filename().string(), host);
+  const std::string prefix = final_path.filename().string() + ".tmp." + detail::host_tag() + ".";
+  const std::filesystem::path tmp = dir / detail::temporary_name(prefix);
+  detail::remove_stale_temporaries(dir, prefix);
 
   const std::lock_guard lock(detail::hdf5_mutex());
   detail::silence_hdf5_errors();

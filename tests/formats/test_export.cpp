@@ -12,6 +12,8 @@
 //     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
 #include <formats/export.h>
 
+#include "temporaries.h"
+
 #include <engine_sh.h>
 #include <gtest/gtest.h>
 #include <run_tool.h>
@@ -24,6 +26,12 @@
 #include <cstring>
 #include <map>
 #include <tuple>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
@@ -249,6 +257,30 @@ TEST(ExportGltf, TinygltfReadsBackEveryValueAndTheStructureIsValid) {
     export_asset(a, "in.prt.h5", ExportFormat::Glb, dir / "asset.glb");
     check_gltf(load(dir / "asset.glb", true), a);
   }
+}
+
+TEST(Export, StagingLeftByAKilledExportIsRemovedLiveAndOtherHostsKept) {
+  // An export killed with SIGKILL leaves ".<name>.export.<host>.<pid>/" with partial files. The
+  // next export to that name removes it when the pid is dead on this machine, and keeps a live
+  // pid's (an export writing now), another machine's and another name's.
+  const fs::path dir = fresh_dir("stale_staging");
+  const pid_t dead = ::fork();  // a pid that is surely dead once reaped
+  if (dead == 0) ::_exit(0);
+  ASSERT_GT(dead, 0);
+  ::waitpid(dead, nullptr, 0);
+  const std::string h = prt::formats::detail::host_tag();
+  const std::string stale = ".a.glb.export." + h + "." + std::to_string(dead);
+  const std::string live = ".a.glb.export." + h + "." + std::to_string(::getppid());
+  const std::string other_host = ".a.glb.export.elsewhere-" + h + "." + std::to_string(dead);
+  const std::string other_name = ".b.glb.export." + h + "." + std::to_string(dead);
+  for (const std::string& n : {stale, live, other_host, other_name}) {
+    fs::create_directory(dir / n);
+    std::ofstream(dir / n / "a.glb") << "partial";
+  }
+  export_asset(vertex_asset(), "in.prt.h5", ExportFormat::Glb, dir / "a.glb");
+  std::vector<std::string> want = {"a.glb", live, other_host, other_name};
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(listing(dir), want);
 }
 
 TEST(ExportGltf, ZUpBakesHangUnderANodeTurningZToY) {

@@ -2,6 +2,8 @@
 // rule, atomic writes (no half files, no stray temp files), hostile inputs for the reader, and
 // interoperability with h5dump and h5py.
 #include <formats/prtfile.h>
+
+#include "temporaries.h"
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
@@ -12,7 +14,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -356,11 +357,7 @@ TEST(Atomicity, StaleTemporariesOfKilledBakesAreRemovedLiveOnesKept) {
   // removes it when the pid is dead on this machine, and keeps a live pid's (another bake writing
   // now), another machine's, another name's and anything else.
   const fs::path dir = scratch("stale_tmp");
-  char host[256] = {};
-  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
-  std::string h(host);
-  for (char& c : h)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_')) c = '_';
+  const std::string h = prt::formats::detail::host_tag();
   const pid_t dead = ::fork();  // a pid that is surely dead once reaped
   if (dead == 0) ::_exit(0);
   ASSERT_GT(dead, 0);
