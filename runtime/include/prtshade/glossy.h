@@ -58,6 +58,31 @@ void clamped_power_moments(double s, int order, double* out);
 // The Phong lobe's per-band scales λ_l = (s+1) I_l(s), l = 0 … order−1 (out[order]).
 void phong_band_scales(double s, int order, double* out);
 
+// GGX (Trowbridge–Reitz; Walter et al. 2007), and how it maps onto the zonal lobe above. With the
+// microfacet distribution D(h) = α² / (π ((n·h)²(α² − 1) + 1)²) (∫ D (n·h) dω_h = 1), the
+// distribution of the reflected direction ω = 2(v·h)h − v is p_v(ω) = D(h)(n·h) / (4(v·h)) — the
+// lobe without G, F and the cosine, normalised like k_s above. At normal incidence (v = n, so
+// r = n) p_n is ZONAL about r: θ_ω = 2θ_h, and its Funk–Hecke band scales are
+//   λ_l(α) = ∫ p_n(ω) P_l(cos θ_ω) dω = ∫_0^1 P_l(2μ(ξ) − 1) dξ,  μ(ξ) = (1 − ξ)/(1 − (1 − α²)ξ),
+// the expectation of P_l(cos θ_ω) under GGX's own sampling map (cos²θ_h = μ(ξ), ξ uniform), so
+// λ_0 = 1 and |λ_l| ≤ 1. Route A and route B then shade GGX with these scales in place of Phong's:
+// exact at normal incidence for a lighting of at most `order` bands. Away from normal incidence the
+// true lobe stretches along the plane of v and n (it is not zonal), which a per-band scale cannot
+// carry: the error of the zonal model against the true lobe, as a function of the view angle, is
+// measured in tests/runtime/test_glossy.cpp and bench/RESULTS.md "Glossy shading".
+// The integral is a composite 24-point Gauss–Legendre rule in u = 1 − ξ on a mesh graded
+// geometrically towards u = 0 (μ has a pole at u = −α²/(1 − α²), just beyond the interval): every
+// piece lies at least its own length from the pole, so each converges geometrically; the tests
+// check λ_0 = 1 and λ_1's closed form to 1e-14 for α in [1e-4, 1].
+// The Phong exponent with the same mean cosine λ_1 (the usual single-number mapping) is
+// s = (2λ_1 − 1)/(1 − λ_1) (from λ_1 = (s + 1)/(s + 2)); it matches band 1 only — GGX's long tail
+// keeps its band 2 and up above Phong's (the tests: band 2 for every α, bands 2–15 for α ≤ 0.1),
+// so a Phong stand-in loses GGX's glow around highlights. Where GGX is wider than the widest Phong
+// lobe (λ_1 < ½, α > 0.4421), ggx_equivalent_phong_exponent returns 0, the clamped cosine.
+// α in [1e-4, 1]; throws std::invalid_argument otherwise.
+void ggx_band_scales(double alpha, int order, double* out);
+double ggx_equivalent_phong_exponent(double alpha);
+
 // The real Gaunt coefficients of one order, as a sparse list.
 class TripleProduct {
 public:
