@@ -498,6 +498,14 @@ ReadBudget preflight(std::string_view text, const SourceFile& file) {
     throw InputError(file.name, "not a valid glTF: " + one_line(bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
   if (!doc.is_object()) return {};  // not a glTF: tinygltf refuses it with its message
+  // glTF 1.0 (asset.version "1.0", "1.0.2", or the number 1 in some exporters) has another schema:
+  // say so rather than let its missing 2.0 properties speak.
+  if (const auto asset = doc.find("asset"); asset != doc.end() && asset->is_object())
+    if (const auto v = asset->find("version"); v != asset->end()) {
+      const std::string version = v->is_string() ? v->get<std::string>() : v->is_number() ? v->dump() : std::string();
+      if (version == "1" || version.starts_with("1."))
+        throw InputError(file.name, "is glTF " + version + " (asset.version): only glTF 2.0 is read; convert it to 2.0");
+    }
   if (const auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
     for (const json& ext : *it)
       if (ext.is_string() && std::find(std::begin(kUnsupportedExtensions), std::end(kUnsupportedExtensions),
@@ -521,6 +529,8 @@ ReadBudget preflight(std::string_view text, const SourceFile& file) {
 tinygltf::Model parse(std::string_view bytes, const SourceFile& file) {
   if (bytes.size() >= std::numeric_limits<unsigned int>::max()) throw InputError(file.name, "too large for the glTF parser");
   const bool binary = bytes.substr(0, 4) == "glTF";
+  if (binary && bytes.size() >= 8 && bytes.substr(4, 4) == std::string_view("\x01\0\0\0", 4))
+    throw InputError(file.name, "is a glTF 1.0 binary (.glb container version 1): only glTF 2.0 is read; convert it to 2.0");
   ReadBudget budget = preflight(gltf_json(bytes, binary), file);
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({file_exists, expand_nothing, read_buffer_file, write_nothing, &budget});

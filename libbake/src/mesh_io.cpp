@@ -56,15 +56,28 @@ using ReadFormat = Polygons (*)(std::string_view bytes, const mesh_readers::Sour
 struct FormatEntry {
   std::string_view extension;
   ReadFormat read;
+  bool text;  // begins with text (PLY's header, binary or not); STL and GLB may begin with any bytes
 };
 constexpr FormatEntry kFormats[] = {
-    {".obj", mesh_readers::read_obj},
-    {".ply", mesh_readers::read_ply},
-    {".off", mesh_readers::read_off},
-    {".stl", mesh_readers::read_stl},
-    {".gltf", mesh_readers::read_gltf},
-    {".glb", mesh_readers::read_gltf},
+    {".obj", mesh_readers::read_obj, true},
+    {".ply", mesh_readers::read_ply, true},
+    {".off", mesh_readers::read_off, true},
+    {".stl", mesh_readers::read_stl, false},
+    {".gltf", mesh_readers::read_gltf, true},
+    {".glb", mesh_readers::read_gltf, false},
 };
+
+// What a text format's reader parses: the bytes after a UTF-8 byte-order mark (Windows editors and
+// exporters write one; it is not part of the text), or InputError for UTF-16/32 text, which no
+// reader decodes. Binary formats get their bytes as they are.
+std::string_view reader_bytes(std::string_view bytes, const FormatEntry& format, const std::string& file) {
+  if (!format.text) return bytes;
+  if (bytes.starts_with("\xEF\xBB\xBF")) return bytes.substr(3);
+  if (bytes.starts_with("\xFE\xFF") || bytes.starts_with("\xFF\xFE"))
+    throw InputError(file, std::string("is UTF-16 or UTF-32 text (byte-order mark ") +
+                               (bytes[0] == '\xFE' ? "FE FF" : "FF FE") + "): save it as UTF-8 or ASCII");
+  return bytes;
+}
 
 // Larger files are refused before they are read (32-bit indices end well below this anyway).
 constexpr uintmax_t kMaxMeshFileBytes = uintmax_t{4} << 30;
@@ -256,7 +269,7 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
   return reading_file(file, [&] {
     const std::string bytes = read_whole_file(path, file);
     std::vector<std::string> warnings, referenced;
-    const Polygons polygons = format->read(bytes, {path, file, warnings, &referenced});
+    const Polygons polygons = format->read(reader_bytes(bytes, *format, file), {path, file, warnings, &referenced});
     Mesh mesh = build_mesh(polygons, file, options);
     mesh.warnings = std::move(warnings);
     mesh.source_sha256 = source_digest(bytes, referenced);
@@ -270,8 +283,9 @@ MeshInstances read_instances(const std::filesystem::path& path, const std::strin
   const std::string bytes = read_whole_file(path, file);
   MeshInstances result;
   std::vector<std::string> referenced;
+  const FormatEntry gltf{".gltf", mesh_readers::read_gltf, bytes.substr(0, 4) != "glTF"};
   std::vector<mesh_readers::GltfInstance> instances =
-      mesh_readers::read_gltf_instances(bytes, {path, file, result.warnings, &referenced});
+      mesh_readers::read_gltf_instances(reader_bytes(bytes, gltf, file), {path, file, result.warnings, &referenced});
   result.source_sha256 = source_digest(bytes, referenced);
   for (mesh_readers::GltfInstance& in : instances) {
     MeshInstance& out = result.instances.emplace_back();

@@ -62,9 +62,15 @@ std::string at_line(size_t line) { return "line " + std::to_string(line) + ": ";
 
 // A finite float, whole token (correctly rounded, as the C library's strtof). Returns an empty
 // string on success, else the defect.
+// A leading '+' is accepted (C's strtof and many exporters write it; std::from_chars does not).
+std::string_view without_plus(std::string_view tok) {
+  return tok.size() > 1 && tok[0] == '+' && tok[1] != '-' && tok[1] != '+' ? tok.substr(1) : tok;
+}
+
 std::string parse_float(std::string_view tok, float& value) {
-  const char* end = tok.data() + tok.size();
-  auto [ptr, ec] = std::from_chars(tok.data(), end, value);
+  const std::string_view digits = without_plus(tok);
+  const char* end = digits.data() + digits.size();
+  auto [ptr, ec] = std::from_chars(digits.data(), end, value);
   if (ec == std::errc::result_out_of_range) return "coordinate " + shown(tok) + " is out of float range";
   if (ec != std::errc() || ptr != end) return "malformed number " + shown(tok);
   if (!std::isfinite(value)) return "non-finite coordinate " + shown(tok);
@@ -80,7 +86,8 @@ std::string parse_float(std::string_view tok, float& value) {
 std::string parse_coordinate(std::string_view tok, double& value) {
   float f = 0;
   if (auto defect = parse_float(tok, f); !defect.empty()) return defect;
-  std::from_chars(tok.data(), tok.data() + tok.size(), value);  // succeeds where the float parse did
+  const std::string_view digits = without_plus(tok);
+  std::from_chars(digits.data(), digits.data() + digits.size(), value);  // succeeds where the float parse did
   if (static_cast<float>(value) != f) value = std::nextafter(value, static_cast<double>(f));
   return {};
 }
@@ -301,6 +308,8 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
   std::string_view line;
   size_t body = std::string_view::npos;
   if (!lines.next(line) || trim(line) != "ply") throw InputError(file.name, "not a PLY file (first line is not 'ply')");
+  size_t keywordless = 0;
+  std::string first_keywordless;
   while (lines.next(line)) {
     const size_t ln = lines.number();
     const auto tok = split(line);
@@ -328,11 +337,20 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
     } else if (tok[0] == "end_header") {
       body = static_cast<size_t>(line.data() + line.size() - text.data()) + 1;
       break;
-    } else {
+    } else if (tok[0] == "format" || tok[0] == "element" || tok[0] == "property") {
       throw InputError(file.name, at_line(ln) + "malformed PLY header line " + shown(line));
+    } else {
+      // A line with no keyword: Blender 2.4x wrote "Created by Blender3D …" without "comment".
+      // Nothing in it describes the data, so it is read as a comment, and said (the first one by
+      // line, the rest counted).
+      if (keywordless++ == 0) first_keywordless = at_line(ln) + "PLY header line " + shown(trim(line));
     }
   }
   if (body == std::string_view::npos) throw InputError(file.name, "PLY header has no 'end_header' (truncated?)");
+  if (keywordless > 0)
+    file.warnings.push_back(first_keywordless + " has no keyword" +
+                            (keywordless > 1 ? " (and " + std::to_string(keywordless - 1) + " more header lines)" : "") +
+                            "; read as a comment");
   if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
     throw InputError(file.name, "unknown PLY format " + shown(format));
   const bool binary = format != "ascii", big_endian = format == "binary_big_endian";

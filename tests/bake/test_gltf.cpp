@@ -288,6 +288,17 @@ TEST(Gltf, DefectsAreOneLineInputErrorsNamingFileAndDefect) {
     expect_input_error(write_file("garbage.gltf", "{\"asset\": "), "not a valid glTF");
     expect_input_error(write_file("garbage.glb", std::string("glTF\x02\0\0\0garbage", 15)), "not a valid glTF");
   }
+  {
+    // glTF 1.0 (Debian's assimp test models hold several): named, not "no scene".
+    Gltf g = base();
+    g.doc["asset"] = {{"version", "1.0.2"}};
+    expect_input_error(g.write("v1.gltf"), "is glTF 1.0.2 (asset.version): only glTF 2.0 is read");
+    g.doc["asset"] = {{"version", 1}};
+    expect_input_error(g.write("v1_number.gltf"), "is glTF 1 (asset.version)");
+    std::string glb1 = base().glb();
+    glb1[4] = '\x01';
+    expect_input_error(write_file("v1.glb", glb1), "is a glTF 1.0 binary (.glb container version 1)");
+  }
 }
 
 // Peak resident memory of this process so far, in bytes (Linux: ru_maxrss is in KiB).

@@ -515,6 +515,39 @@ TEST(MeshFormats, ValidFilesTheOpenMeshReadersRefusedAreRead) {
   EXPECT_TRUE(l.positions == m.positions);
 }
 
+TEST(MeshFormats, WhatRealExportersWriteIsReadAndSaid) {
+  // Found in real files (Debian's assimp test models): numbers with a leading '+' (C's strtof
+  // reads them), a UTF-8 byte-order mark before an OBJ or PLY (Windows tools), and a PLY header
+  // line without a keyword (Blender 2.47's "Created by Blender3D ..."), read as a comment with a
+  // warning naming the line. UTF-16 text is refused naming the encoding.
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const Mesh plain = prt::bake::load_mesh(write_file("plain.obj", tri));
+  const Mesh plus = prt::bake::load_mesh(write_file("plus.obj", "v +0 +0. 0\nv +1 0 +0e0\nv 0 +1.0e+0 0\nf 1 2 3\n"));
+  EXPECT_TRUE(plus.positions == plain.positions);
+  prt::testing::expect_input_error(write_file("plusminus.obj", "v +-1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "line 1: malformed number '+-1'");
+  prt::testing::expect_input_error(write_file("plusplus.obj", "v ++1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "line 1: malformed number '++1'");
+  prt::testing::expect_input_error(write_file("exponent.obj", "v 3.1+e2 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "line 1: malformed number '3.1+e2'");
+
+  const Mesh bom = prt::bake::load_mesh(write_file("bom.obj", "\xEF\xBB\xBF" + tri));
+  EXPECT_TRUE(bom.positions == plain.positions);
+  EXPECT_EQ(bom.triangles, plain.triangles);
+  const std::string ply = "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org\nelement vertex 3\n"
+                          "property float x\nproperty float y\nproperty float z\nNot a keyword either\nelement face 1\n"
+                          "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const Mesh blender = prt::bake::load_mesh(write_file("blender247.ply", "\xEF\xBB\xBF" + ply));
+  EXPECT_TRUE(blender.positions == plain.positions);
+  ASSERT_EQ(blender.warnings.size(), 1u);
+  EXPECT_EQ(blender.warnings[0], "line 3: PLY header line 'Created by Blender3D 247 - www.blender.o...' has no keyword "
+                                 "(and 1 more header lines); read as a comment");
+  prt::testing::expect_input_error(write_file("badelement.ply", "ply\nformat ascii 1.0\nelement vertex\nend_header\n"),
+                     "line 3: malformed PLY header line");
+
+  std::string utf16 = "\xFE\xFF";
+  for (char c : tri) utf16 += std::string(1, '\0') + c;
+  prt::testing::expect_input_error(write_file("utf16.obj", utf16), "UTF-16 or UTF-32 text (byte-order mark FE FF)");
+  prt::testing::expect_input_error(write_file("utf16.ply", "\xFF\xFE" + ply), "byte-order mark FF FE");
+}
+
 TEST(MeshLoad, SourceSha256IsTheDigestOfTheBytesRead) {
   const fs::path bunny = fs::path(PRT_DATA_DIR) / "bunny.obj";
   const Mesh m = prt::bake::load_mesh(bunny);

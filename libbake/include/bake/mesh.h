@@ -19,6 +19,9 @@
 //      order of its "buffers" array (so a changed .bin changes the digest, and a resumed sharded
 //      bake refuses chunks of the old one). Image files are never read or hashed: a bake uses no
 //      texture. Every other file's source_sha256 is the SHA-256 of its bytes, as `sha256sum`.
+//      Text formats (OBJ, PLY's header, OFF, .gltf) may begin with a UTF-8 byte-order mark, which
+//      is skipped; UTF-16/32 text and glTF 1.0 are refused naming them. Numbers may carry a
+//      leading '+'. A PLY header line without a keyword is read as a comment, with a warning.
 //   2. build_mesh turns any Polygons into the Mesh: vertex rows, hard-edge splits, fan
 //      triangulation, normals and validation, the same for every format.
 // A new format is one more reader: a function that fills a Polygons from the bytes (as the glTF
