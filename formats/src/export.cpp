@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <stdexcept>
 
 namespace prt::formats {
 namespace exporting {
@@ -128,8 +129,10 @@ const char* to_string(ExportFormat format) noexcept {
 }
 
 void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                  const std::filesystem::path& out) {
-  if (exporting::vertex_sets(asset).empty())
+                  const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
+  const bool probe = format == ExportFormat::Unity || format == ExportFormat::Godot || format == ExportFormat::Filament;
+  if (environment && !probe) throw std::invalid_argument("an environment probe is written by the probe formats only");
+  if (exporting::vertex_sets(asset).empty() && !(probe && environment))
     throw FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");
   switch (format) {
   case ExportFormat::Gltf:
@@ -137,7 +140,7 @@ void export_asset(const Asset& asset, const std::filesystem::path& source, Expor
   case ExportFormat::Binary: exporting::export_binary(asset, out); return;
   case ExportFormat::Unity:
   case ExportFormat::Godot:
-  case ExportFormat::Filament: exporting::export_probes(asset, source, format, out); return;
+  case ExportFormat::Filament: exporting::export_probes(asset, source, format, out, environment); return;
   }
 }
 

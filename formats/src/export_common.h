@@ -68,6 +68,6 @@ void write_bytes(const std::filesystem::path& path, const std::string& bytes, co
 void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb);
 void export_binary(const Asset& asset, const std::filesystem::path& out);
 void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat engine,
-                   const std::filesystem::path& out);
+                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment);
 
 } // namespace prt::formats::exporting

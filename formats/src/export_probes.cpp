@@ -55,7 +55,7 @@ nlohmann::json in_frame(const std::vector<double>& xyz, const C::Mat3& M) {
 } // namespace
 
 void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                   const std::filesystem::path& out) {
+                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
   const EngineInfo& e = info_of(format);
   const C::UpAxis up = asset.root.up_axis == "z" ? C::UpAxis::Z : C::UpAxis::Y;
   const C::Mat3 M = C::engine_from_file(e.engine, up);
@@ -79,10 +79,11 @@ void export_probes(const Asset& asset, const std::filesystem::path& source, Expo
     if (s.normals) set["normals"] = in_frame(std::vector<double>(s.normals->values.begin(), s.normals->values.end()), M);
     sets.push_back(std::move(set));
   }
-  if (sets.empty())
+  if (sets.empty() && !environment)
     throw FormatError(source.string(),
                       std::string("has no /radiance/band1, the only baked product that is lighting: a ") + e.name +
-                          " probe needs it (bake with prtbake vertex --radiance ENV, or a scene with an environment)");
+                          " probe needs it (bake with prtbake vertex --radiance ENV, or a scene with an environment), "
+                          "or give --env ENV for the environment's probe alone");
 
   nlohmann::json j;
   j["format"] = "prtbake-probes";
@@ -98,6 +99,17 @@ void export_probes(const Asset& asset, const std::filesystem::path& source, Expo
   j["probe"] = "per vertex, from /radiance/band1 R: the radiance SH (0; 2R; 0), exact E/pi at the baked normal "
                "(formats/SCHEMA.md, Exports)";
   j["sets"] = std::move(sets);
+  if (environment) {
+    C::RgbSh9 radiance{};
+    for (size_t c = 0; c < 3; ++c) std::copy(environment->radiance[c].begin(), environment->radiance[c].end(), radiance[c].begin());
+    nlohmann::json sh = nlohmann::json::array();
+    for (double x : C::to_engine(e.engine, up, radiance)) sh.push_back(x);
+    j["environment"] = {{"name", environment->name},
+                        {"sha256", environment->sha256},
+                        {"probe", "the environment's radiance SH (order 3, no shadowing): E/pi of the unoccluded sky "
+                                  "at any normal, up to its band-2 truncation (formats/SCHEMA.md, Exports)"},
+                        {"sh", std::move(sh)}};
+  }
 
   Staging staging(out);
   write_bytes(staging.stage(out), j.dump() + "\n", out);

@@ -377,6 +377,53 @@ TEST(ExportProbes, EachEnginesFormulaAtEachVertexNormalIsTheBakedIrradiance) {
     }
 }
 
+TEST(ExportProbes, TheEnvironmentProbeIsItsIrradianceInEachEnginesFormula) {
+  // A full order-3 radiance SH (every coefficient non-zero, distinct per channel): each engine's
+  // own formula at normals in its frame must give our E(n)/π at the same direction in the file's
+  // frame (conventions::irradiance_over_pi), for both up axes; alone (an AO-only file, which
+  // without the environment is refused) and beside the per-vertex probes.
+  using prt::conventions::Engine;
+  EnvironmentProbe env;
+  for (size_t c = 0; c < 3; ++c)
+    for (size_t i = 0; i < 9; ++i) env.radiance[c][i] = (i == 0 ? 2.0 : 0.3 * std::sin(1.7 * double(i) + double(c)));
+  env.name = "sky.exr";
+  env.sha256 = std::string(64, 'e');
+  const fs::path dir = fresh_dir("env_probe");
+  for (const auto& [format, engine] : {std::pair{ExportFormat::Unity, Engine::Unity}, std::pair{ExportFormat::Godot, Engine::Godot},
+                                       std::pair{ExportFormat::Filament, Engine::Filament}})
+    for (const std::string up : {"y", "z"}) {
+      Asset ao_only = vertex_asset();
+      ao_only.root.up_axis = up;
+      ao_only.vertices.radiance_band1.reset();
+      EXPECT_THROW(export_asset(ao_only, "in.prt.h5", format, dir / "p.json"), FormatError);
+      export_asset(ao_only, "in.prt.h5", format, dir / "p.json", env);
+      const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "p.json"));
+      EXPECT_TRUE(j["sets"].empty());
+      EXPECT_EQ(j["environment"]["sha256"], env.sha256);
+      const std::vector<double> sh = j["environment"]["sh"];
+      ASSERT_EQ(sh.size(), 27u);
+      prt::conventions::EngineSh probe;
+      std::copy(sh.begin(), sh.end(), probe.begin());
+      for (int k = 0; k < 40; ++k) {
+        const double z = 1 - 2 * (k + 0.5) / 40, r = std::sqrt(1 - z * z), phi = 2.39996 * k;
+        const double nx = r * std::cos(phi), ny = r * std::sin(phi), nz = z;
+        prt::testing::V3 n_e = up == "z" ? prt::testing::V3{nx, nz, -ny} : prt::testing::V3{nx, ny, nz};
+        if (engine == Engine::Unity) n_e[0] = -n_e[0];
+        for (int c = 0; c < 3; ++c) {
+          const double want = prt::conventions::irradiance_over_pi(env.radiance[size_t(c)], nx, ny, nz);
+          // Godot's constants have 6 digits: 1e-5 of the coefficients' magnitude.
+          EXPECT_NEAR(prt::testing::evaluate(engine, probe, c, n_e), want, 1e-5 * 4) << "up " << up << " k " << k;
+        }
+      }
+    }
+  Asset both = vertex_asset();
+  export_asset(both, "in.prt.h5", ExportFormat::Unity, dir / "both.json", env);
+  const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(dir / "both.json"));
+  EXPECT_EQ(j["sets"].size(), 1u);
+  EXPECT_EQ(j["environment"]["sh"].size(), 27u);
+  EXPECT_THROW(export_asset(both, "in.prt.h5", ExportFormat::Glb, dir / "x.glb", env), std::invalid_argument);
+}
+
 TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
   const fs::path dir = fresh_dir("probes_none");
   Asset a = vertex_asset();

@@ -5,6 +5,8 @@
 #include <run_tool.h>
 #include <scratch.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <filesystem>
 
@@ -67,6 +69,36 @@ TEST(ExportCli, BadInputIsOneLineExitOneAndNoOutput) {
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
   EXPECT_EQ(listing(d), (std::vector<std::string>{"not.prt.h5"}));
+}
+
+TEST(ExportCli, EnvironmentProbeMustBeTheBakesEnvironment) {
+  const fs::path d = fresh("env");
+  const std::string data = PRT_DATA_DIR;
+  const fs::path lit = d / "ground_sunset.prt.h5";
+  auto r = run_tool(PRT_PRTBAKE, "vertex '" + data + "/ground.obj' --radiance '" + data + "/sunset.exr' --integrator qmc "
+                    "--samples 16 --report 0 -q -o '" + lit.string() + "'", d);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The map the file was baked with: per-vertex probes and the environment's.
+  r = run_tool(PRT_PRTBAKE, export_args(lit, "unity", d / "lit.json") + " --env '" + data + "/sunset.exr'", d);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(prt::testing::read_bytes(d / "lit.json"));
+  EXPECT_EQ(j["sets"].size(), 1u);
+  EXPECT_EQ(j["environment"]["sh"].size(), 27u);
+  // Another map: one line naming it, exit 1, nothing written.
+  r = run_tool(PRT_PRTBAKE, export_args(lit, "godot", d / "wrong.json") + " --env '" + data + "/forest.exr'", d);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("forest.exr: is not the environment"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "wrong.json"));
+  // An AO-only file records no environment: the probe of any map, alone.
+  r = run_tool(PRT_PRTBAKE, export_args(ao_bake(), "filament", d / "sky.json") + " --env '" + data + "/forest.exr'", d);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(prt::testing::read_bytes(d / "sky.json"))["sets"].empty());
+  // Not a probe format: a command-line error.
+  r = run_tool(PRT_PRTBAKE, export_args(ao_bake(), "glb", d / "x.glb") + " --env '" + data + "/forest.exr'", d);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("--env writes an environment probe"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "x.glb"));
 }
 
 TEST(ExportCli, UnknownFormatIsACommandLineError) {

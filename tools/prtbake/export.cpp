@@ -1,9 +1,14 @@
 // tools/prtbake/export.cpp — `prtbake export` (contract: export.h).
 #include "export.h"
 
+#include "tool_main.h"
+
+#include <bake/envmap.h>
+#include <bake/error.h>
 #include <formats/export.h>
 
 #include <cstdio>
+#include <set>
 
 namespace prt::tool {
 namespace {
@@ -24,7 +29,10 @@ constexpr const char* kExportHelp =
     "  godot     the same as Godot 4 LightmapGI probe SH ([9][rgb], radiance/pi, no CS phase).\n"
     "  filament  the same as Filament/cmgen pre-scaled irradiance SH ([9][rgb]).\n"
     "The probe formats evaluate, in each engine's own formula, to the baked irradiance/pi at the\n"
-    "baked normal; they need a file baked with --radiance (or a scene with an environment).";
+    "baked normal; they need a file baked with --radiance (or a scene with an environment), or\n"
+    "--env ENV: the environment's own probe (its order-3 radiance SH, unshadowed), the ambient\n"
+    "probe for dynamic objects, consistent with the bake. Example:\n"
+    "  prtbake export bunny.prt.h5 --to unity --env data/sunset.exr -o bunny_probes.json";
 
 } // namespace
 
@@ -42,12 +50,57 @@ void add_export(CLI::App& app, ExportArgs& args) {
                  "staging directory first and renamed, so OUT is never half-written.")
       ->option_text("OUT")
       ->required();
+  cmd.add_option("--env", args.env,
+                 "unity, godot, filament: also write the probe of this environment map (OpenEXR\n"
+                 "lat-long or cube, read in the file's up axis) as \"environment\"; it must be the\n"
+                 "map the file's lighting was baked with, when the file names one.")
+      ->option_text("ENV");
 }
+
+namespace {
+
+// Every environment SHA-256 the file records: band-1 radiance products and the scene's.
+std::set<std::string> recorded_environments(const formats::Asset& asset) {
+  std::set<std::string> out;
+  auto add = [&](const std::optional<formats::Product>& p) {
+    if (p && p->environment_sha256) out.insert(*p->environment_sha256);
+  };
+  add(asset.vertices.radiance_band1);
+  for (const formats::SceneObject& o : asset.objects) add(o.set.radiance_band1);
+  if (asset.scene && asset.scene->environment_sha256) out.insert(*asset.scene->environment_sha256);
+  return out;
+}
+
+// The environment probe of `path`, read in the file's up axis, after checking it is the map the
+// file's lighting was baked with (when the file records one).
+formats::EnvironmentProbe environment_probe(const std::string& path, const formats::Asset& asset, const std::string& input) {
+  const bake::UpAxis up = asset.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y;
+  const bake::EnvMap env = bake::EnvMap::load(path, up);
+  const std::set<std::string> recorded = recorded_environments(asset);
+  if (!recorded.empty() && !recorded.count(env.info().sha256))
+    throw bake::InputError(path, "is not the environment " + input + " was baked with (its SHA-256 is " + env.info().sha256 +
+                                     ", the file records " + *recorded.begin() + ")");
+  formats::EnvironmentProbe probe;
+  const std::vector<double> sh = env.project_sh(3);  // [i*3 + c]
+  for (size_t c = 0; c < 3; ++c)
+    for (size_t i = 0; i < 9; ++i) probe.radiance[c][i] = sh[i * 3 + c];
+  probe.name = path;
+  probe.sha256 = env.info().sha256;
+  return probe;
+}
+
+} // namespace
 
 int run_export(const ExportArgs& args) {
   const formats::ExportFormat format = *formats::parse_export_format(args.format);
+  const bool probe = format == formats::ExportFormat::Unity || format == formats::ExportFormat::Godot ||
+                     format == formats::ExportFormat::Filament;
+  if (!args.env.empty() && !probe)
+    throw UsageError("--env writes an environment probe: it needs --to unity, godot or filament, not " + args.format);
   const formats::Asset asset = formats::read_asset(args.input);
-  formats::export_asset(asset, args.input, format, args.output);
+  std::optional<formats::EnvironmentProbe> environment;
+  if (!args.env.empty()) environment = environment_probe(args.env, asset, args.input);
+  formats::export_asset(asset, args.input, format, args.output, environment);
   std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), formats::to_string(format));
   return 0;
 }

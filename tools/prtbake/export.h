@@ -10,7 +10,7 @@
 namespace prt::tool {
 
 struct ExportArgs {
-  std::string input, output, format;
+  std::string input, output, format, env;  // env: an environment map for the probe formats' sky probe
 };
 
 // Adds the `export` subcommand to `app`, parsing into `args`.

@@ -13,14 +13,16 @@
 //     error nothing exists under the final name(s) and files already there are untouched.
 //     glTF (.gltf) writes two files: `out` and its buffer `<stem>.bin` beside it.
 //   * The engine formats need /radiance/band1 in some vertex set (the only baked product that is
-//     lighting; see SCHEMA.md "Exports" for why the others are not probes).
+//     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe.
 // Errors: FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
 #pragma once
 
 #include <formats/asset.h>
 
+#include <array>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace prt::formats {
@@ -31,9 +33,19 @@ enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament };
 std::optional<ExportFormat> parse_export_format(std::string_view name);
 const char* to_string(ExportFormat format) noexcept;
 
-// Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`.
+// The sky as a light probe (the probe formats only): the radiance SH of order 3 of an environment
+// map, in our convention and the file's frame ([RGB][i], index l(l+1)+m), with the map's name and
+// SHA-256. Written as the export's "environment" probe in the engine's convention — the ambient
+// probe for what the bake does not cover (dynamic objects), consistent with the baked lighting.
+struct EnvironmentProbe {
+  std::array<std::array<double, 9>, 3> radiance{};
+  std::string name, sha256;
+};
+
+// Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
+// `environment` adds the environment probe (probe formats only; std::invalid_argument otherwise).
 void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                  const std::filesystem::path& out);
+                  const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment = std::nullopt);
 
 // The binary format's magic (8 bytes) and version (SCHEMA.md "Exports").
 inline constexpr char kBinaryMagic[8] = {'P', 'R', 'T', 'B', 'I', 'N', '\0', '\0'};
