@@ -159,6 +159,12 @@ void validate(const Polygons& poly, const std::string& source, bool use_normals)
   if (triangles >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too large for 32-bit indices");
 }
 
+// Reader warnings as load_mesh returns them: "<file>: <finding>" (bake/mesh.h).
+std::vector<std::string> named(const std::string& file, std::vector<std::string> warnings) {
+  for (std::string& w : warnings) w = file + ": " + w;
+  return warnings;
+}
+
 // Mesh::source_sha256 (bake/mesh.h): the file's digest when it refers to no other file, else the
 // digest of its bytes followed by each referenced file's hex digest in the order it was read.
 std::string source_digest(const std::string& bytes, const std::vector<std::string>& referenced) {
@@ -271,7 +277,7 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& options
     std::vector<std::string> warnings, referenced;
     const Polygons polygons = format->read(reader_bytes(bytes, *format, file), {path, file, warnings, &referenced});
     Mesh mesh = build_mesh(polygons, file, options);
-    mesh.warnings = std::move(warnings);
+    mesh.warnings = named(file, std::move(warnings));
     mesh.source_sha256 = source_digest(bytes, referenced);
     return mesh;
   });
@@ -287,6 +293,7 @@ MeshInstances read_instances(const std::filesystem::path& path, const std::strin
   std::vector<mesh_readers::GltfInstance> instances =
       mesh_readers::read_gltf_instances(reader_bytes(bytes, gltf, file), {path, file, result.warnings, &referenced});
   result.source_sha256 = source_digest(bytes, referenced);
+  result.warnings = named(file, std::move(result.warnings));
   for (mesh_readers::GltfInstance& in : instances) {
     MeshInstance& out = result.instances.emplace_back();
     try {

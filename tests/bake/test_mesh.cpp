@@ -537,7 +537,7 @@ TEST(MeshFormats, WhatRealExportersWriteIsReadAndSaid) {
   const Mesh blender = prt::bake::load_mesh(write_file("blender247.ply", "\xEF\xBB\xBF" + ply));
   EXPECT_TRUE(blender.positions == plain.positions);
   ASSERT_EQ(blender.warnings.size(), 1u);
-  EXPECT_EQ(blender.warnings[0], "line 3: PLY header line 'Created by Blender3D 247 - www.blender.o...' has no keyword "
+  EXPECT_EQ(blender.warnings[0], (tmp_dir() / "blender247.ply").string() + ": line 3: PLY header line 'Created by Blender3D 247 - www.blender.o...' has no keyword "
                                  "(and 1 more header lines); read as a comment");
   prt::testing::expect_input_error(write_file("badelement.ply", "ply\nformat ascii 1.0\nelement vertex\nend_header\n"),
                      "line 3: malformed PLY header line");

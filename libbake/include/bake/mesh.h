@@ -145,7 +145,7 @@ struct Mesh {
   enum class NormalSource { File, AngleWeighted } normal_source = NormalSource::AngleWeighted;
   std::string source;                                  // path as given
   size_t file_positions = 0, file_faces = 0;           // counts as in the file (faces before triangulation)
-  std::vector<std::string> warnings;                   // non-fatal reader messages (e.g. missing .mtl), one line each
+  std::vector<std::string> warnings;                   // non-fatal reader messages, one line each, "<file>: <finding>"
   std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();    // world = origin + positions[v], in double (frame_origin)
   Eigen::Vector3d world_position(size_t v) const { return add_origin(origin, positions[v].cast<double>()); }
@@ -191,7 +191,7 @@ struct MeshInstance {
 };
 struct MeshInstances {
   std::vector<MeshInstance> instances;
-  std::vector<std::string> warnings;  // the file's (skipped primitives, skins), one line each
+  std::vector<std::string> warnings;  // the file's (skipped primitives, skins), one line each, "<file>: <finding>"
   std::string source_sha256;          // of the file's bytes
 };
 // Throws InputError (as load_mesh; also for a file that is not .gltf / .glb, a material index out of
