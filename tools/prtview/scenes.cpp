@@ -366,9 +366,9 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
       for (size_t v = 0; v < V; ++v)
         for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
       char buf[240];
-      std::snprintf(buf, sizeof buf, "\n  %s: route %s, order %d, Phong %.4g%s, specular %.3g %.3g %.3g", o.name.c_str(),
-                    route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)", order, s, phong ? " (--phong)" : "",
-                    o.specular[0], o.specular[1], o.specular[2]);
+      std::snprintf(buf, sizeof buf, "\n  %s: order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s", o.name.c_str(),
+                    order, s, phong ? " (--phong)" : "", o.specular[0], o.specular[1], o.specular[2],
+                    route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)");
       scene.how += buf;
     }
     rgb.insert(rgb.end(), colour.begin(), colour.end());
