@@ -4,6 +4,7 @@
 // single-process one; a scene's glossy receiver under the environment gets it at the Phong order
 // (and keeps transfer/visibility for relighting), and none without "radiance" in bake.products.
 #include "run_tool.h"
+#include "scratch.h"
 
 #include <formats/prtfile.h>
 
@@ -22,12 +23,7 @@ namespace {
 
 const std::string kData = PRT_DATA_DIR;
 
-fs::path dir_for(const std::string& name) {
-  const fs::path d = fs::path(PRT_TEST_TMP) / ("shadowed_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path dir_for(const std::string& name) { return prt::testing::fresh_dir("shadowed", name); }
 
 const std::vector<float>& values(const F::File& f, const std::string& path) {
   const F::Dataset* d = F::find_dataset(f, path);
