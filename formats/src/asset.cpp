@@ -232,6 +232,8 @@ void add_vertex_set(File& f, const std::string& prefix, const std::string& repor
   add_product(f, cat(prefix, N::kTransferDiffuse), s.transfer_diffuse, V, sh_shape(s.transfer_diffuse, V));
   add_product(f, cat(prefix, N::kTransferVisibility), s.transfer_visibility, V, sh_shape(s.transfer_visibility, V));
   add_product(f, cat(prefix, N::kRadianceBand1), s.radiance_band1, V, {3, 3});
+  if (s.radiance_shadowed)
+    add_product(f, cat(prefix, N::kRadianceShadowed), s.radiance_shadowed, V, {3, sh_width(s.radiance_shadowed, 3 * V)});
   const auto lights = [](const std::optional<Product>& p) {
     return p && p->lights ? uint64_t(split_light_list(*p->lights).size()) : uint64_t(0);
   };
@@ -326,6 +328,7 @@ void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
   case DatasetKind::transfer_diffuse: s.transfer_diffuse = product_of(d); break;
   case DatasetKind::transfer_visibility: s.transfer_visibility = product_of(d); break;
   case DatasetKind::radiance_band1: s.radiance_band1 = product_of(d); break;
+  case DatasetKind::radiance_shadowed: s.radiance_shadowed = product_of(d); break;
   case DatasetKind::area_irradiance: s.area_irradiance = product_of(d); break;
   case DatasetKind::area_sh: s.area_sh = product_of(d); break;
   default: break;

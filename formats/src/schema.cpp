@@ -85,11 +85,11 @@ std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
   return shape_str(idx);
 }
 
-// The dataset paths schema v3 allows, for messages.
+// The dataset paths schema v4 allows, for messages.
 std::string allowed_paths() {
   std::string s;
   for (std::string_view p : {N::kPositions, N::kNormals, N::kTriangles, N::kSourcePosition, N::kAo,
-                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1, N::kAreaIrradiance,
+                             N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1, N::kRadianceShadowed, N::kAreaIrradiance,
                              N::kAreaSh})
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
@@ -182,6 +182,7 @@ public:
         {N::kTriangles, Kind::triangles},           {N::kSourcePosition, Kind::source_position},
         {N::kAo, Kind::ao},                         {N::kTransferDiffuse, Kind::transfer_diffuse},
         {N::kTransferVisibility, Kind::transfer_visibility}, {N::kRadianceBand1, Kind::radiance_band1},
+        {N::kRadianceShadowed, Kind::radiance_shadowed},
         {N::kAreaIrradiance, Kind::area_irradiance}, {N::kAreaSh, Kind::area_sh}};
     for (const auto& [name, kind] : kVertexSet)
       if (local == name) return kind;
@@ -331,7 +332,7 @@ bool is_per_vertex_path(std::string_view path) {
   switch (Checker::classify(path, &prefix)) {
   case Kind::positions: case Kind::normals: case Kind::source_position: case Kind::ao:
   case Kind::transfer_diffuse: case Kind::transfer_visibility: case Kind::radiance_band1:
-  case Kind::area_irradiance: case Kind::area_sh:
+  case Kind::radiance_shadowed: case Kind::area_irradiance: case Kind::area_sh:
     return true;
   default:
     return false;
@@ -366,12 +367,15 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     std::string prefix;
     const Kind k = Checker::classify(d.path, &prefix);
     if (k == Kind::unknown)
-      c.fail("unknown dataset path '" + d.path + "' (schema v2 allows " + allowed_paths() + ")");
+      c.fail("unknown dataset path '" + d.path + "' (schema v4 allows " + allowed_paths() + ")");
     if (!prefix.empty() && version < 2)
       c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
              std::to_string(version) + ")");
     if (is_area_light_kind(k) && version < 3)
       c.fail("dataset '" + d.path + "' is an area light's, which needs format_version 3 (the file says " +
+             std::to_string(version) + ")");
+    if (k == Kind::radiance_shadowed && version < 4)
+      c.fail("dataset '" + d.path + "' is shadowed radiance, which needs format_version 4 (the file says " +
              std::to_string(version) + ")");
     kinds.push_back(k);
     prefixes.push_back(std::move(prefix));
@@ -511,6 +515,12 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.dtype(d, 0);
       c.shape(d, {V, 3, 3}, "[V, 3 (RGB), 3 (m = -1, 0, 1)]");
       break;
+    case Kind::radiance_shadowed: {
+      c.dtype(d, 0);
+      const uint64_t L = c.sh_order(d);
+      c.shape(d, {V, 3, L * L}, "[V, 3 (RGB), L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
+      break;
+    }
     case Kind::fiv_environment:
       c.dtype(d, 0);
       c.shape(d, {3, 3}, "[3 (RGB), 3 (xyz)]");
@@ -567,7 +577,8 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i)
     if ((kinds[i] == Kind::ao || kinds[i] == Kind::transfer_diffuse || kinds[i] == Kind::transfer_visibility ||
-         kinds[i] == Kind::radiance_band1 || kinds[i] == Kind::area_irradiance || kinds[i] == Kind::area_sh) &&
+         kinds[i] == Kind::radiance_band1 || kinds[i] == Kind::radiance_shadowed || kinds[i] == Kind::area_irradiance ||
+         kinds[i] == Kind::area_sh) &&
         !vertex_set(prefixes[i]).has_normals)
       c.fail("dataset '" + file.datasets[i].path + "' needs " + prefixes[i] + std::string(N::kNormals) +
              " (the normals the bake used)");

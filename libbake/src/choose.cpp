@@ -19,6 +19,9 @@
 namespace prt::bake {
 namespace {
 
+// Radiance products (R, S) carry the environment's HDR scale: their errors are relative to their RMS.
+bool is_radiance(Product p) { return p == Product::RadianceBand1 || p == Product::RadianceShadowed; }
+
 // The pilot's reference: 256 isolines for targets >= 5e-4 (its own AO error, ~6e-5 on the bunny,
 // is under a tenth of the aim 0.7·E; its isoline tables take 8 ms to build against 190 ms at 512,
 // bench/RESULTS.md bench_integrators), 512 below.
@@ -102,7 +105,7 @@ std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vec
       }
     const double n = double(std::max<size_t>(K * p.count, 1));
     double e = std::sqrt(e2 / n);
-    if (p.product == Product::RadianceBand1) e = r2 > 0 ? e / std::sqrt(r2 / n) : 0.0;
+    if (is_radiance(p.product)) e = r2 > 0 ? e / std::sqrt(r2 / n) : 0.0;
     out.push_back(e);
   }
   return out;
@@ -194,7 +197,7 @@ std::string knob_text(IntegratorKind kind, uint32_t knob) {
 } // namespace
 
 double error_in_target_units(const ProductError& e) {
-  if (e.product != Product::RadianceBand1) return e.rmse;
+  if (!is_radiance(e.product)) return e.rmse;
   return e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0;
 }
 
@@ -462,11 +465,11 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
     const double err = error_in_target_units(e);
     // The reference's own noise in the same units (its estimated standard error; QMC's actual
     // error is often well below it): an RMSE above E with noise that large says nothing.
-    const double noise = e.product == Product::RadianceBand1 ? (e.reference_rms > 0 ? e.reference_std_error / e.reference_rms : 0.0)
+    const double noise = is_radiance(e.product) ? (e.reference_rms > 0 ? e.reference_std_error / e.reference_rms : 0.0)
                                                              : e.reference_std_error;
     const char* verdict = err <= target ? "met" : noise >= 0.5 * target ? "not verifiable here" : "NOT met";
     out.push_back(format("  target %g for ", target) + product_label(e.product) + ": " + verdict + format(" (%.3e", err) +
-                  (e.product == Product::RadianceBand1 ? " relative" : "") +
+                  (is_radiance(e.product) ? " relative" : "") +
                   format("; the reference's own estimated noise, included in it, is %.1e", noise) +
                   (err > target && noise >= 0.5 * target ? ": too noisy to tell)" : ")"));
   }

@@ -203,9 +203,11 @@ FilterIntegrator::FilterIntegrator(const Mesh& mesh, const Topology& topology, c
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
   PRT_CHECK(!accel || accel->of(mesh, topology));
   rays_ = accel ? accel->rays() : std::make_shared<const RayCaster>(mesh, topology);
-  if (request.radiance) {
+  if (request.radiance || request.shadowed_order > 0) {  // R and S: [R | S] as in layout_
     ProductRequest r;
     r.radiance = request.radiance;
+    r.shadowed = request.shadowed;
+    r.shadowed_order = request.shadowed_order;
     radiance_ = std::make_unique<QmcIntegrator>(mesh, topology, r, QmcOptions{options.radiance_rays, options.seed}, accel);
   }
 }
@@ -217,7 +219,9 @@ std::string FilterIntegrator::description() const {
   os << "sheared-filter sparse ray tracing (Egan et al. 2011), " << options_.rays << " pass-1 rays/point, seed "
      << options_.seed << ", search radius " << options_.radius_factor << " vertex spacings, 8x8 cells, "
      << options_.fallback_rays << " ray(s) per brute-forced cell";
-  if (radiance_) os << "; band-1 radiance by QMC, " << options_.radiance_rays << " rays/point (HDR environments break the filter's band limit)";
+  if (radiance_)
+    os << "; " << (!layout_.shadowed_count ? "band-1" : layout_.radiance_count ? "band-1 and shadowed" : "shadowed")
+       << " radiance by QMC, " << options_.radiance_rays << " rays/point (HDR environments break the filter's band limit)";
   return os.str();
 }
 
@@ -455,9 +459,9 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
   }
   std::copy(world.begin(), world.end(), out.begin());
   if (radiance_) {
-    double rad[9];
+    std::vector<double> rad(radiance_->layout().width);
     radiance_->integrate(point, point_index, rad);
-    std::copy_n(rad, 9, out.begin() + ptrdiff_t(layout_.radiance));
+    std::copy(rad.begin(), rad.end(), out.begin() + ptrdiff_t(layout_.radiance));
   }
   if (!std_error.empty()) std::fill_n(std_error.begin(), layout_.width, 0.0);
   points_.fetch_add(1, std::memory_order_relaxed);

@@ -23,9 +23,11 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
     : request_(request), layout_(request), options_(options) {
   PRT_CHECK(options.rays > 0);
   PRT_CHECK_OP(topology.weld.size(), ==, mesh.positions.size());
+  PRT_CHECK(request.consistent());
   const bool want_cos = request.ao || request.transfer_order > 0 || request.radiance;
-  const bool want_uni = request.visibility_order > 0;
-  w_env_ = request.radiance ? 0.5 : 0.0;
+  const bool want_uni = request.visibility_order > 0 || request.shadowed_order > 0;
+  env_ = request.environment();
+  w_env_ = env_ ? 0.5 : 0.0;
   const double rest = 1.0 - w_env_;
   const int n_hemi = int(want_cos) + int(want_uni);
   if (n_hemi > 0) {
@@ -34,7 +36,7 @@ QmcIntegrator::QmcIntegrator(const Mesh& mesh, const Topology& topology, const P
   } else {
     w_env_ = 1.0;
   }
-  sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0});
+  sh_order_ = std::max({request.transfer_order, request.visibility_order, request.radiance ? 2 : 0, request.shadowed_order});
   PRT_CHECK_OP(sh_order_, <=, sh::kMaxOrder);
   PRT_CHECK(!accel || accel->of(mesh, topology));
   rays_ = accel ? accel->rays() : std::make_shared<const RayCaster>(mesh, topology);
@@ -71,7 +73,7 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
     Vector3d d;
     if (u[0] < w_env_) {
       double pdf_unused;
-      d = request_.radiance->sample(u[1], u[2], &pdf_unused);
+      d = env_->sample(u[1], u[2], &pdf_unused);
     } else if (full) {
       d = uniform_sphere(u[1], u[2]);
     } else if (u[0] < w_env_ + w_cos_) {
@@ -84,17 +86,21 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
     std::fill(x.begin(), x.end(), 0.0);
     if ((full || c > 0) && rays_->visible(point, near, d)) {
       double p = full ? (1.0 - w_env_) * (0.25 * kInvPi) : w_cos_ * c * kInvPi + w_uni_ * (0.5 * kInvPi);
-      if (w_env_ > 0) p += w_env_ * request_.radiance->pdf(d);
+      if (w_env_ > 0) p += w_env_ * env_->pdf(d);
       const double inv_p = 1.0 / p;  // p ≥ w_cos c/π > 0, w_uni/2π or w_sphere/4π > 0 here
       if (sh_order_ > 0) sh::eval(sh_order_, d.x(), d.y(), d.z(), y);
       if (layout_.ao_count) x[layout_.ao] = c * kInvPi * inv_p;
       for (size_t k = 0; k < layout_.transfer_count; ++k) x[layout_.transfer + k] = c * kInvPi * y[k] * inv_p;
       for (size_t k = 0; k < layout_.visibility_count; ++k) x[layout_.visibility + k] = y[k] * inv_p;
-      if (layout_.radiance_count) {
-        const Rgb L = request_.radiance->radiance(d);
+      if (env_) {
+        const Rgb L = env_->radiance(d);
         const double rgb[3] = {L.r, L.g, L.b};
+        if (layout_.radiance_count)
+          for (int ch = 0; ch < 3; ++ch)
+            for (int m = 0; m < 3; ++m) x[layout_.radiance + size_t(3 * ch + m)] = rgb[ch] * y[size_t(1 + m)] * inv_p;
+        const size_t ns = layout_.shadowed_count / 3;
         for (int ch = 0; ch < 3; ++ch)
-          for (int m = 0; m < 3; ++m) x[layout_.radiance + size_t(3 * ch + m)] = rgb[ch] * y[size_t(1 + m)] * inv_p;
+          for (size_t k = 0; k < ns; ++k) x[layout_.shadowed + size_t(ch) * ns + k] = rgb[ch] * y[k] * inv_p;
       }
     }
     for (size_t k = 0; k < W; ++k) {

@@ -736,11 +736,15 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
         p.left_out.push_back("radiance/band1, transfer/diffuse: the material has no diffuse albedo");
       }
       if (m.glossy()) {
+        const bool shadowed = scene.want_radiance && env;
+        if (!scene.want_radiance) p.left_out.push_back("radiance/shadowed: not in bake.products");
+        else if (!env) p.left_out.push_back("radiance/shadowed: the scene has no environment");
         if (!scene.want_transfer) {
           p.left_out.push_back("transfer/visibility: not in bake.products");
           if (!scene.lights.empty())
             p.left_out.push_back("area_lights/sh: transfer/visibility is not baked (not in bake.products)");
-        } else {
+        }
+        if (scene.want_transfer || shadowed) {
           const int L = clamped_power_order(m.phong_exponent, scene.sh_tolerance, sh::kMaxOrder);
           if (L == 0) {
             std::ostringstream os;
@@ -750,15 +754,30 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
                << " at order " << sh::kMaxOrder << "); lower the exponent or raise bake.sh_tolerance";
             throw InputError(scene.file.string(), os.str());
           }
-          p.visibility_order = L;
           std::ostringstream os;
-          os << "transfer/visibility: order " << L << " for the Phong exponent " << m.phong_exponent
+          os << "order " << L << " for the Phong exponent " << m.phong_exponent
              << ", the smallest whose lobe energy beyond it (" << pct(clamped_power_energy_beyond(m.phong_exponent, L))
              << ") is <= sh_tolerance " << pct(scene.sh_tolerance);
-          p.baked.push_back(os.str());
-          if (!scene.lights.empty()) {
-            p.area_sh_order = L;
-            p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
+          // S for the scene's own environment (exact shadows, any lobe at run time); U besides it
+          // whenever transfer is asked for: it is what relights or rotates the lighting (route A),
+          // at a third of S's size, and a scene that wants the fixed environment only leaves
+          // "transfer" out of bake.products.
+          if (shadowed) {
+            p.shadowed_order = L;
+            p.baked.push_back("radiance/shadowed: " + os.str() + ", under " + env_name +
+                              ": the shadowed incident radiance, the lobe applied at run time (paper 001 §4, "
+                              "material editing)");
+          }
+          if (scene.want_transfer) {
+            p.visibility_order = L;
+            p.baked.push_back("transfer/visibility: " + os.str() +
+                              (shadowed ? " (relightable: the lighting may change or rotate; radiance/shadowed "
+                                          "serves the fixed environment)"
+                                        : ""));
+            if (!scene.lights.empty()) {
+              p.area_sh_order = L;
+              p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
+            }
           }
         }
       }

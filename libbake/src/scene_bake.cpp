@@ -77,22 +77,18 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   const MeshAccel accel(occluders, topo);
 
   // One integrator (and one reference) per distinct product request.
-  using Key = std::tuple<bool, int, int, bool>;
-  std::map<Key, std::pair<std::unique_ptr<Integrator>, std::unique_ptr<Integrator>>> integrators;
-  auto request_of = [&](const ObjectPlan& p) {
-    ProductRequest r;
-    r.ao = p.ao;
-    r.transfer_order = p.transfer_order;
-    r.visibility_order = p.visibility_order;
-    r.radiance = p.radiance ? env : nullptr;
-    return r;
+  using Key = std::tuple<bool, int, int, bool, int>;
+  auto key_of = [](const ProductRequest& r) {
+    return Key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr, r.shadowed_order};
   };
+  std::map<Key, std::pair<std::unique_ptr<Integrator>, std::unique_ptr<Integrator>>> integrators;
+  auto request_of = [&](const ObjectPlan& p) { return product_request(p, env); };
   const bool choose = scene.target_error > 0;  // then one integrator per object, made below
   for (size_t i = 0; i < scene.objects.size() && !choose; ++i) {
     const ObjectPlan& p = plan.objects[i];
     if (!p.receiver || !p.any_vertex_product()) continue;
     const ProductRequest r = request_of(p);
-    const Key key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr};
+    const Key key = key_of(r);
     if (integrators.count(key)) continue;
     auto integ = make_integrator(scene.integrator, occluders, topo, r, &accel);
     std::unique_ptr<Integrator> ref;
@@ -151,7 +147,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const Integrator* integ = own_integ.get();
     const Integrator* ref = own_ref.get();
     if (!choose) {
-      const auto& shared = integrators.at(Key{r.ao, r.transfer_order, r.visibility_order, r.radiance != nullptr});
+      const auto& shared = integrators.at(key_of(r));
       integ = shared.first.get();
       ref = shared.second.get();
     }
@@ -213,6 +209,16 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
   }
   return out;
+}
+
+ProductRequest product_request(const ObjectPlan& p, const EnvMap* env) {
+  ProductRequest r;
+  r.ao = p.ao;
+  r.transfer_order = p.transfer_order;
+  r.visibility_order = p.visibility_order;
+  r.radiance = p.radiance ? env : nullptr;
+  if (p.shadowed_order > 0 && env) r.shadowed = env, r.shadowed_order = p.shadowed_order;
+  return r;
 }
 
 } // namespace prt::bake

@@ -90,7 +90,12 @@ struct SilhouetteIntegrator::Impl {
   oct::Grid grid;
   Eigen::Matrix3d frame_from_world;
   int sh_order = 0;
-  size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, F = 0;
+  // Columns of the tables: [AO n-moments (3) | T (3·Lt²) | U (Lv²) | R (9) | S (3·Ls²)]. The
+  // environment's columns R and S are the last n_env = F − c_r: the hot texels' tables hold
+  // exactly those, and the closed form's horizon-only walk yields them.
+  size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, c_s = 0, F = 0, n_env = 0;
+  const EnvMap* envmap = nullptr;  // of R and S
+  int env_order = 0;            // SH order the environment's columns need
   int subsamples = 1;
   std::unique_ptr<IsolineTables> tables;
   // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
@@ -105,10 +110,10 @@ struct SilhouetteIntegrator::Impl {
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
       n_closed_form{0}, n_enclosed{0};
-  // Band-1 radiance of the unoccluded hemisphere about n, per distinct normal (bit pattern): the one
-  // environment-dependent part of the closed form (see closed_form()).
+  // R and S of the unoccluded hemisphere about n (the n_env environment columns), per distinct
+  // normal (bit pattern): the one environment-dependent part of the closed form (see closed_form()).
   mutable std::mutex hemisphere_mutex;
-  mutable std::map<std::array<double, 3>, std::array<double, 9>> hemisphere_radiance_cache;
+  mutable std::map<std::array<double, 3>, std::vector<double>> hemisphere_radiance_cache;
   mutable std::atomic<int64_t> contour_ns{0}, integrate_ns{0};
 
   Impl(const Mesh& m, const Topology& t, const ProductRequest& r, const SilhouetteOptions& o, const MeshAccel* accel)
@@ -118,24 +123,29 @@ struct SilhouetteIntegrator::Impl {
         rays(*rays_owned), grid(even_isolines(o.isolines)),
         frame_from_world(octahedral_frame_from_world()) {
     PRT_CHECK(!accel || accel->of(m, t));
-    const int lt = r.transfer_order, lv = r.visibility_order;
-    sh_order = std::max({lt, lv, r.radiance ? 2 : 0});
+    PRT_CHECK(r.consistent());
+    const int lt = r.transfer_order, lv = r.visibility_order, ls = r.shadowed_order;
+    envmap = r.environment();
+    env_order = std::max(r.radiance ? 2 : 0, ls);
+    sh_order = std::max({lt, lv, env_order});
     c_ao = 0;
     c_t = c_ao + (r.ao ? 3 : 0);
     c_u = c_t + size_t(3 * lt * lt);
     c_r = c_u + size_t(lv * lv);
-    F = c_r + (r.radiance ? 9 : 0);
+    c_s = c_r + (r.radiance ? 9 : 0);
+    F = c_s + size_t(3 * ls * ls);
+    n_env = F - c_r;
     PRT_CHECK(F > 0);
-    if (r.radiance) {
+    if (envmap) {
       // Box-filter the environment over each cell: ~2 sub-samples per texel width.
-      const double texel = std::sqrt(4 * std::numbers::pi / double(std::max<size_t>(r.radiance->texel_count(), 1)));
+      const double texel = std::sqrt(4 * std::numbers::pi / double(std::max<size_t>(envmap->texel_count(), 1)));
       subsamples = std::clamp(int(std::ceil(2.0 * grid.h / texel)), 1, 8);
     }
     const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
     std::vector<Vector3d> hot_samples;
     int n_fine = 0;
-    if (r.radiance && r.radiance->texel_count() > 0) {
-      const EnvMap& env = *r.radiance;
+    if (envmap && envmap->texel_count() > 0) {
+      const EnvMap& env = *envmap;
       const int T = env.texel_count();
       std::vector<double> lum(static_cast<size_t>(T));
       for (int tx = 0; tx < T; ++tx) lum[size_t(tx)] = luminance(env.texel_value(tx));
@@ -164,19 +174,35 @@ struct SilhouetteIntegrator::Impl {
     }
     auto is_hot = [&](const Vector3d& w) {
       if (hot_mask.empty()) return false;
-      const int tx = req.radiance->texel_of(w);
+      const int tx = envmap->texel_of(w);
       return tx >= 0 && hot_mask[size_t(tx)] != 0;
+    };
+    // The SH basis at w up to `order` in `small` (orders ≤ 16) or `big`.
+    auto eval_sh = [](int order, const Vector3d& w, std::span<double> small, std::vector<double>& big) -> double* {
+      double* yp = small.data();
+      if (size_t(sh::num_coeffs(order)) > small.size()) {
+        big.resize(size_t(sh::num_coeffs(order)));
+        yp = big.data();
+      }
+      if (order > 0) sh::eval(order, w.x(), w.y(), w.z(), std::span(yp, size_t(sh::num_coeffs(order))));
+      return yp;
+    };
+    // The environment's columns (n_env of them, R then S) for radiance L at w, basis yp.
+    auto env_columns = [&](const Rgb& L, const double* yp, double* out) {
+      const double rgb[3] = {L.r, L.g, L.b};
+      if (r.radiance)
+        for (int c = 0; c < 3; ++c)
+          for (int mm = 0; mm < 3; ++mm) out[size_t(3 * c + mm)] = rgb[c] * yp[1 + mm];
+      const size_t ns = size_t(ls * ls);
+      double* s_out = out + (c_s - c_r);
+      for (int c = 0; c < 3; ++c)
+        for (size_t i = 0; i < ns; ++i) s_out[size_t(c) * ns + i] = rgb[c] * yp[i];
     };
     tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
       const Vector3d w = world_from_frame * w_frame;
       double y[sh::num_coeffs(16)];
       std::vector<double> ybig;
-      double* yp = y;
-      if (sh_order > 16) {
-        ybig.resize(size_t(sh::num_coeffs(sh_order)));
-        yp = ybig.data();
-      }
-      if (sh_order > 0) sh::eval(sh_order, w.x(), w.y(), w.z(), std::span(yp, size_t(sh::num_coeffs(sh_order))));
+      const double* yp = eval_sh(sh_order, w, y, ybig);
       constexpr double kInvPi = std::numbers::inv_pi;
       if (req.ao)
         for (int a = 0; a < 3; ++a) out[c_ao + size_t(a)] = w[a] * kInvPi;
@@ -184,26 +210,18 @@ struct SilhouetteIntegrator::Impl {
       for (int a = 0; a < 3; ++a)
         for (size_t i = 0; i < nt; ++i) out[c_t + size_t(a) * nt + i] = w[a] * yp[i] * kInvPi;
       for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
-      if (req.radiance) {
-        const Rgb L = is_hot(w) ? Rgb{} : req.radiance->radiance(w);  // hot texels: the fine grid's part
-        const double rgb[3] = {L.r, L.g, L.b};
-        for (int c = 0; c < 3; ++c)
-          for (int mm = 0; mm < 3; ++mm) out[c_r + size_t(3 * c + mm)] = rgb[c] * yp[1 + mm];
-      }
+      if (envmap) env_columns(is_hot(w) ? Rgb{} : envmap->radiance(w), yp, &out[c_r]);  // hot texels: the fine grid's part
     });
     if (!hot_samples.empty()) {
       hot = std::make_unique<SparseIsolineTables>(
-          oct::Grid(n_fine), 9, 2,
+          oct::Grid(n_fine), int(n_env), 2,
           [&](const Vector3d& w_frame, std::span<double> out) {
             const Vector3d w = world_from_frame * w_frame;
             std::fill(out.begin(), out.end(), 0.0);
             if (!is_hot(w)) return;
-            const Rgb L = req.radiance->radiance(w);
-            double y[4];
-            sh::eval(2, w.x(), w.y(), w.z(), std::span(y, 4));
-            const double rgb[3] = {L.r, L.g, L.b};
-            for (int c = 0; c < 3; ++c)
-              for (int mm = 0; mm < 3; ++mm) out[size_t(3 * c + mm)] = rgb[c] * y[1 + mm];
+            double y[sh::num_coeffs(16)];
+            std::vector<double> ybig;
+            env_columns(envmap->radiance(w), eval_sh(env_order, w, y, ybig), out.data());
           },
           hot_samples);
     }
@@ -222,10 +240,11 @@ struct SilhouetteIntegrator::Impl {
       for (int i = hot->first_isoline(); i < hot->last_isoline(); ++i)
         if (hot->has(i)) {
           const double* total = hot->loop_total(i);
-          for (size_t c = 0; c < 9; ++c) acc[c_r + c] += total[c] * hot->grid().h;
+          for (size_t c = 0; c < n_env; ++c) acc[c_r + c] += total[c] * hot->grid().h;
         }
     for (size_t k = 0; k < layout.visibility_count; ++k) row[layout.visibility + k] = acc[c_u + k];
     for (size_t k = 0; k < layout.radiance_count; ++k) row[layout.radiance + k] = acc[c_r + k];
+    for (size_t k = 0; k < layout.shadowed_count; ++k) row[layout.shadowed + k] = acc[c_s + k];
     return row;
   }
 
@@ -388,13 +407,13 @@ struct SilhouetteIntegrator::Impl {
     double* acc = s.acc.data();
     uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
     if (hot) {
-      s.hot_acc.assign(9, 0.0);
+      s.hot_acc.assign(n_env, 0.0);
       inconsistent += walk(hot->grid(), hot->first_isoline(), hot->last_isoline(), *hot, W0, s.spine, s.hot_crossings,
-                           s.sorted, s.bucket_start, s.hot_acc.data(), 9);
+                           s.sorted, s.bucket_start, s.hot_acc.data(), n_env);
     }
     for (size_t c = 0; c < F; ++c) acc[c] *= grid.h;
     if (hot)
-      for (size_t c = 0; c < 9; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
+      for (size_t c = 0; c < n_env; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
     return inconsistent;
   }
 
@@ -434,14 +453,17 @@ struct SilhouetteIntegrator::Impl {
       for (size_t k = 0; k < L.transfer_count; ++k) out[L.transfer + k] *= std::numbers::inv_pi;
     }
     if (L.visibility_count) clamped_power_sh(0.0, req.visibility_order, point.n, out.subspan(L.visibility, L.visibility_count));
-    if (L.radiance_count) {
-      const std::array<double, 9> r = hemisphere_radiance(point.n);
-      std::copy(r.begin(), r.end(), out.begin() + std::ptrdiff_t(L.radiance));
+    if (n_env) {
+      const std::vector<double>& r = hemisphere_radiance(point.n);
+      for (size_t k = 0; k < L.radiance_count; ++k) out[L.radiance + k] = r[k];
+      for (size_t k = 0; k < L.shadowed_count; ++k) out[L.shadowed + k] = r[c_s - c_r + k];
     }
     return true;
   }
 
-  std::array<double, 9> hemisphere_radiance(const Vector3d& n) const {
+  // The n_env environment columns (R, S) of the open hemisphere about n; the reference stays valid
+  // (std::map nodes do not move).
+  const std::vector<double>& hemisphere_radiance(const Vector3d& n) const {
     const std::array<double, 3> key = {n.x(), n.y(), n.z()};
     {
       const std::lock_guard lock(hemisphere_mutex);
@@ -457,8 +479,7 @@ struct SilhouetteIntegrator::Impl {
     double hz = n.dot(s0_world);
     if (hz == 0) hz = n.dot(frame_from_world.transpose() * Vector3d(-1, 0, -1e-9).normalized());
     (void)walk_all(s, hz < 0 ? 1 : 0);
-    std::array<double, 9> r{};
-    for (size_t c = 0; c < 9; ++c) r[c] = s.acc[c_r + c];
+    std::vector<double> r(s.acc.begin() + std::ptrdiff_t(c_r), s.acc.end());
     const std::lock_guard lock(hemisphere_mutex);
     return hemisphere_radiance_cache.emplace(key, r).first->second;
   }
@@ -584,6 +605,7 @@ struct SilhouetteIntegrator::Impl {
     }
     for (size_t k = 0; k < L.visibility_count; ++k) out[L.visibility + k] = acc[c_u + k];
     for (size_t k = 0; k < L.radiance_count; ++k) out[L.radiance + k] = acc[c_r + k];
+    for (size_t k = 0; k < L.shadowed_count; ++k) out[L.shadowed + k] = acc[c_s + k];
 
     const auto t2 = clock::now();
     n_points.fetch_add(1, std::memory_order_relaxed);

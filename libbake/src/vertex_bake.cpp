@@ -212,6 +212,7 @@ std::vector<ProductSlice> product_slices(const ProductLayout& L) {
   if (L.transfer_count) s.push_back({Product::TransferDiffuse, L.transfer, L.transfer_count});
   if (L.visibility_count) s.push_back({Product::TransferVisibility, L.visibility, L.visibility_count});
   if (L.radiance_count) s.push_back({Product::RadianceBand1, L.radiance, L.radiance_count});
+  if (L.shadowed_count) s.push_back({Product::RadianceShadowed, L.shadowed, L.shadowed_count});
   return s;
 }
 
@@ -221,6 +222,7 @@ const char* product_label(Product product) {
   case Product::TransferDiffuse: return "diffuse transfer";
   case Product::TransferVisibility: return "visibility transfer";
   case Product::RadianceBand1: return "band-1 radiance";
+  case Product::RadianceShadowed: return "shadowed radiance";
   }
   return "?";
 }

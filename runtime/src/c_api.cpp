@@ -223,8 +223,8 @@ prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const flo
                                      float out[3]) {
   return guarded(__func__, [&] {
     require(shadowed != nullptr && r != nullptr && out != nullptr, "null pointer");
-    require(order >= 1 && order <= prt::shade::kMaxGlossyOrder, "order must be in [1, 16]");
-    double scales[prt::shade::kMaxGlossyOrder];
+    require(order >= 1 && order <= prt::shade::kMaxShadowedOrder, "order must be in [1, 64]");
+    double scales[prt::shade::kMaxShadowedOrder];
     prt::shade::phong_band_scales(phong_exponent, order, scales);
     prt::shade::shade_glossy_radiance(shadowed, order, scales, r, out);
   });

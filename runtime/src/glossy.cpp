@@ -10,12 +10,15 @@
 #include <cstdlib>
 #include <numbers>
 #include <span>
+#include <string>
 
 namespace prt::shade {
 
 namespace {
 
 int band_of(int i) { return int(std::sqrt(double(i))); }
+
+static_assert(kMaxShadowedOrder == sh::kMaxOrder, "route B takes every order of the SH basis");
 
 // Whether real SH of orders m_i, m_j (signed) can give a non-zero Gaunt coefficient with m_k:
 // |m_k| ∈ {|m_i| + |m_j|, ||m_i| − |m_j||} and the sign rule of the real basis (sin·sin and
@@ -125,7 +128,7 @@ void TripleProduct::multiply(const float* a, const float* b, float* out) const {
 }
 
 void shade_glossy_radiance(const float* shadowed, int order, const double* scales, const float r[3], float out[3]) {
-  float y[kMaxGlossyOrder * kMaxGlossyOrder];
+  float y[kMaxShadowedOrder * kMaxShadowedOrder];
   const int n = order * order;
   sh::eval(order, r[0], r[1], r[2], std::span<float>(y, size_t(n)));
   for (int c = 0; c < 3; ++c) {
@@ -177,6 +180,21 @@ void reflect(const float n[3], const float v[3], float r[3]) {
   for (int c = 0; c < 3; ++c) r[c] = d * n[c] - v[c];
 }
 
+namespace {
+
+// The unit reflection of the direction from p to the eye about the unit normal n (n itself when
+// the eye is on the vertex).
+void view_reflection(const float n[3], const float p[3], const float eye[3], float r[3]) {
+  float to_eye[3] = {eye[0] - p[0], eye[1] - p[1], eye[2] - p[2]};
+  const float len = std::sqrt(to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
+  for (float& c : to_eye) c = len > 0 ? c / len : 0.0f;
+  reflect(n, to_eye, r);
+  const float rl = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  for (int c = 0; c < 3; ++c) r[c] = rl > 0 ? r[c] / rl : n[c];  // n: the eye on the vertex
+}
+
+} // namespace
+
 void shade_glossy_vertices(const GlossyLight& light, const float* visibility, const float* normals,
                            const float* positions, std::size_t count, const float eye[3], double phong_exponent,
                            float* out) {
@@ -187,17 +205,26 @@ void shade_glossy_vertices(const GlossyLight& light, const float* visibility, co
   const size_t n = size_t(light.order()) * size_t(light.order());
   float S[3 * kMaxGlossyOrder * kMaxGlossyOrder];
   for (size_t v = 0; v < count; ++v) {
-    const float* p = positions + 3 * v;
-    float to_eye[3] = {eye[0] - p[0], eye[1] - p[1], eye[2] - p[2]};
-    const float len = std::sqrt(to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
-    for (float& c : to_eye) c = len > 0 ? c / len : 0.0f;
     float r[3];
-    reflect(normals + 3 * v, to_eye, r);
-    const float rl = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    if (rl > 0) for (float& c : r) c /= rl;
-    else r[0] = normals[3 * v], r[1] = normals[3 * v + 1], r[2] = normals[3 * v + 2];  // the eye on the vertex
+    view_reflection(normals + 3 * v, positions + 3 * v, eye, r);
     light.shadowed_radiance(visibility + n * v, S);
     shade_glossy_radiance(S, light.order(), scales, r, out + 3 * v);
+  }
+}
+
+void shade_glossy_radiance_vertices(const float* shadowed, int order, const float* normals, const float* positions,
+                                    std::size_t count, const float eye[3], double phong_exponent, float* out) {
+  PRT_SHADE_REQUIRE(count == 0 || (shadowed && normals && positions && eye && out), "null pointer");
+  PRT_SHADE_REQUIRE(order >= 1 && order <= kMaxShadowedOrder,
+                    "order must be in [1, " + std::to_string(kMaxShadowedOrder) + "]");
+  PRT_SHADE_REQUIRE(phong_exponent >= 0 && std::isfinite(phong_exponent), "the Phong exponent must be finite and >= 0");
+  double scales[kMaxShadowedOrder];
+  phong_band_scales(phong_exponent, order, scales);
+  const size_t row = 3 * size_t(order) * size_t(order);
+  for (size_t v = 0; v < count; ++v) {
+    float r[3];
+    view_reflection(normals + 3 * v, positions + 3 * v, eye, r);
+    shade_glossy_radiance(shadowed + row * v, order, scales, r, out + 3 * v);
   }
 }
 

@@ -111,7 +111,7 @@ TEST(AssetLights, EveryFieldSurvivesWriteRead) {
   const Asset a = lit_asset();
   write_asset(dir / "a.prt.h5", a);
   const Asset b = read_asset(dir / "a.prt.h5");
-  EXPECT_EQ(b.root.format_version, 3);
+  EXPECT_EQ(b.root.format_version, kFormatVersion);
   ASSERT_EQ(b.lights.size(), 2u);
   EXPECT_EQ(b.lights[1], a.lights[1]);
   EXPECT_EQ(b.lights[0], a.lights[0]);  // with the extras of its group and its vertices dataset

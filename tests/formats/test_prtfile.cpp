@@ -280,8 +280,8 @@ INSTANTIATE_TEST_SUITE_P(
                "'up_axis' must be \"y\" or \"z\""},
         Defect{"bad_sha", [](File& f) { drop_root(f, "source_sha256"); f.root_attrs.push_back({"source_sha256", std::string("abc")}); },
                "'source_sha256' must be 64 lowercase hex digits"},
-        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{4}}); },
-               "'format_version' must be an integer in 1..3"},
+        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{5}}); },
+               "'format_version' must be an integer in 1..4"},
         Defect{"object_in_v1_file",
                [](File& f) {
                  f.root_attrs.push_back({"format_version", int64_t{1}});
@@ -489,9 +489,9 @@ TEST(Reader, NewerVersionIsRejectedClearly) {
   const fs::path dir = scratch("newer");
   File f = make_file();
   f.root_attrs.push_back({"format", std::string("prtbake")});
-  f.root_attrs.push_back({"format_version", int64_t{4}});
-  prt::formats::testing::write_file_unvalidated(dir / "v4.prt.h5", f);
-  expect_read_error(dir / "v4.prt.h5", "written by a newer prtbake (format_version 4 > 3)");
+  f.root_attrs.push_back({"format_version", int64_t{5}});
+  prt::formats::testing::write_file_unvalidated(dir / "v5.prt.h5", f);
+  expect_read_error(dir / "v5.prt.h5", "written by a newer prtbake (format_version 5 > 4)");
 }
 
 TEST(Reader, Version1FilesStayReadable) {
@@ -643,7 +643,7 @@ TEST(Interop, H5pyReadsValuesAndAttributes) {
       "a = f.attrs\n"
       "s = lambda v: v.decode('utf-8')  # fixed-length strings come back as bytes\n"
       "assert s(a['format']) == 'prtbake', a['format']\n"
-      "assert int(a['format_version']) == 3\n"
+      "assert int(a['format_version']) == 4\n"
       "assert s(a['source']) == 'data/D\\u00fcsseldorf \\u2713.obj', a['source']\n"
       "assert f['ao'][2] == 0.75\n"
       "assert f['mesh/triangles'][1, 2] == 3 and f['mesh/triangles'].dtype == 'uint32'\n"

@@ -72,7 +72,7 @@ TEST(Prtdump, SummaryListsLayoutAttributesAndExactStatistics) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   for (const char* s : {"/mesh/positions", "/mesh/normals", "/mesh/triangles", "/ao", "/transfer/diffuse",
-                        "/radiance/band1", "format_version 3", "schema   valid", "sh_order = 2",
+                        "/radiance/band1", "format_version 4", "schema   valid", "sh_order = 2",
                         "rmse = 0.0625", "up_axis", "\"z\"", "float32  [4, 3]", "uint32   [4, 3]"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << r.out;
   // /ao = {0.25, 0.5, 0.75, 1}: min 0.25, max 1, mean 0.625, no NaN or Inf.
@@ -105,7 +105,7 @@ TEST(Prtdump, JsonHasTheKeyFieldsAndParses) {
   write_file(dir / "a.prt.h5", make_file());
   const CmdResult r = prtdump(dir, "--json " + q(dir / "a.prt.h5"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* s : {"\"format_version\": 3", "\"schema_valid\": true", "\"path\": \"/ao\"",
+  for (const char* s : {"\"format_version\": 4", "\"schema_valid\": true", "\"path\": \"/ao\"",
                         "\"dtype\": \"uint32\"", "\"sh_order\": 2", "\"min\": 0.25", "\"mean\": 0.625",
                         "\"nan\": 0", "\"/report\": {", "\"rmse\": 0.0625",
                         "\"command_line\": \"prtbake vertex \\\"q.obj\\\"\\t-o x\""})

@@ -17,6 +17,7 @@ std::string report_row_name(bake::Product product) {
   case bake::Product::TransferDiffuse: path = N::kTransferDiffuse; break;
   case bake::Product::TransferVisibility: path = N::kTransferVisibility; break;
   case bake::Product::RadianceBand1: path = N::kRadianceBand1; break;
+  case bake::Product::RadianceShadowed: path = N::kRadianceShadowed; break;
   }
   return std::string(path.substr(1));
 }
@@ -101,15 +102,25 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
     set.transfer_visibility = product(L.visibility, L.visibility_count, "U_i = Int V H y_i dw");
     set.transfer_visibility->sh_order = info.visibility_order;
   }
-  if (L.radiance_count) {
+  auto environment = [&](F::Product& p) {
     const auto& i = info.env->info();
-    F::Product& p = set.radiance_band1.emplace(
-        product(L.radiance, 9, "R_c,m = Int L_c V H y_1m dw, layout [vertex][RGB][m=-1,0,1]"));
-    p.shading = "E_c = (4 pi / 3) sum_m y_1m(n) R_c,m";
     p.environment = info.env_path;
     p.environment_sha256 = i.sha256;
     p.environment_layout = i.layout;
     p.negative_pixels_clamped = int64_t(i.negative_pixels_clamped);
+  };
+  if (L.radiance_count) {
+    F::Product& p = set.radiance_band1.emplace(
+        product(L.radiance, 9, "R_c,m = Int L_c V H y_1m dw, layout [vertex][RGB][m=-1,0,1]"));
+    p.shading = "E_c = (4 pi / 3) sum_m y_1m(n) R_c,m";
+    environment(p);
+  }
+  if (L.shadowed_count) {
+    F::Product& p = set.radiance_shadowed.emplace(
+        product(L.shadowed, L.shadowed_count, "S_c,i = Int L_c V H y_i dw, layout [vertex][RGB][i=l(l+1)+m]"));
+    p.sh_order = L.shadowed_order;
+    p.shading = "L_out = sum_l lambda_l sum_m S_c,lm y_lm(r), lambda_l = (s+1) Int_0^1 t^s P_l(t) dt (Phong s)";
+    environment(p);
   }
 }
 

@@ -100,6 +100,7 @@ struct Args {
   std::string environment;  // vertex: --radiance ENV; fiv: --env ENV
   bool ao = false;
   int transfer = 0, visibility = 0;  // SH orders (0: not baked)
+  int shadowed = 0;                  // vertex: --shadowed L, S under the --radiance environment
   // vertex: the integrator; fiv: seed and report (its k is shell_spec.silhouette_k); scene: --report.
   bake::IntegratorSpec integrator;
   bake::ShellSpec shell_spec;  // fiv
@@ -232,6 +233,13 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "diffuse shadows with 3 coefficients per channel. Irradiance at the\n"
                  "baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m.")
       ->option_text("ENV")
+      ->group(products);
+  cmd.add_option("--shadowed", a.shadowed,
+                 "shadowed radiance S_c,i = Int L_c V H y_i dw at SH order L under the\n"
+                 "--radiance environment (paper 001 sec. 4, material editing: glossy\n"
+                 "lobes chosen at run time; band 1 of S is R)")
+      ->option_text("L")
+      ->check(CLI::Range(1, sh::kMaxOrder))
       ->group(products);
   cmd.add_option_function<std::string>(
          "--integrator",
@@ -405,6 +413,7 @@ std::optional<Args> parse(int argc, char** argv, bool under_mpirun) {
   }
   if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
     throw UsageError("vertex: nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV");
+  if (a.shadowed && a.environment.empty()) throw UsageError("--shadowed L needs --radiance ENV (the environment it is baked under)");
   return a;
 }
 
@@ -578,6 +587,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   req.transfer_order = a.transfer;
   req.visibility_order = a.visibility;
   req.radiance = env ? &*env : nullptr;
+  if (a.shadowed) req.shadowed = req.radiance, req.shadowed_order = a.shadowed;
 
   const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
@@ -607,6 +617,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
     if (a.transfer) std::printf(" transfer/diffuse (order %d, %d coefficients)", a.transfer, a.transfer * a.transfer);
     if (a.visibility) std::printf(" transfer/visibility (order %d, %d coefficients)", a.visibility, a.visibility * a.visibility);
     if (env) std::printf(" radiance/band1 (3x3)");
+    if (a.shadowed) std::printf(" radiance/shadowed (order %d, 3x%d)", a.shadowed, a.shadowed * a.shadowed);
     std::printf("\nintegrator: %s; %d threads; setup (ray/contour BVHs, tables) %.2f s\n",
                 integrator.description().c_str(), threads, setup_seconds);
     std::fflush(stdout);
@@ -799,11 +810,8 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const bake::ObjectPlan& p = plan.objects[i];
       if (!p.receiver || !p.any_vertex_product()) continue;
-      bake::ProductRequest r;
-      r.ao = p.ao, r.transfer_order = p.transfer_order, r.visibility_order = p.visibility_order;
-      r.radiance = p.radiance && env ? &*env : nullptr;
       set_rows.push_back(meshes[i].positions.size());
-      widths.push_back(uint32_t(bake::ProductLayout(r).width));
+      widths.push_back(uint32_t(bake::ProductLayout(bake::product_request(p, env ? &*env : nullptr)).width));
     }
     // Every object's mesh, occluders included: they shape the receivers' values.
     for (size_t i = 0; i < scene.objects.size(); ++i) lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
@@ -890,7 +898,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
     obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
     obj.phong_exponent = o.material.phong_exponent;
     obj.sh_order_diffuse = int64_t(p.transfer_order);
-    obj.sh_order_glossy = int64_t(p.visibility_order);
+    obj.sh_order_glossy = int64_t(std::max(p.visibility_order, p.shadowed_order));
     obj.baked = join(p.baked, "-");
     obj.left_out = join(p.left_out, "-");
     if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());

@@ -70,7 +70,8 @@ What the summary shows:
   --vertex         values are laid out by the trailing axes: [V, 3] prints one [x, y, z] row;
                    [V, L*L] prints one row per SH band l (index l*(l+1)+m, m = -l..l);
                    [V, 3, 3] (radiance/band1) prints one row per channel R, G, B with
-                   m = -1, 0, 1.
+                   m = -1, 0, 1; [V, 3, L*L] (radiance/shadowed, the shadowed radiance S of
+                   format_version 4) one row per channel and band l.
 
 Exit status 1 also covers a vertex index out of range.
 )";
@@ -444,13 +445,20 @@ void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, u
     const std::string cont(head.size(), ' ');
     const pf::Attr* order = pf::find_attr(d->attrs, names::kShOrder);
     const auto* L = order ? std::get_if<int64_t>(&order->value) : nullptr;
+    // Bands only when sh_order is positive and its square (computed without overflow) is the
+    // row (per channel): prtdump shows files that fail the schema and stays within the data
+    // whatever they claim.
+    const std::size_t channels = pf::dataset_kind(d->path) == pf::DatasetKind::radiance_shadowed ? 3 : 1;
+    const bool bands = L && *L > 0 && d->shape.size() == channels + 1 && per % channels == 0 &&
+                       (per / channels) % uint64_t(*L) == 0 && per / channels / uint64_t(*L) == uint64_t(*L);
     if (d->shape.size() == 1) {
       os << head << element(d->data, base) << '\n';
-    } else if (L && *L > 0 && d->shape.size() == 2 && per % uint64_t(*L) == 0 && per / uint64_t(*L) == uint64_t(*L)) {
-      // Bands only when sh_order is positive and its square (computed without overflow) is the
-      // row: prtdump shows files that fail the schema and stays within the data whatever they claim.
-      for (std::size_t l = 0; l < static_cast<std::size_t>(*L); ++l)
-        os << (l ? cont : head) << "l=" << l << "  " << row_text(*d, base + l * l, 2 * l + 1) << '\n';
+    } else if (bands) {
+      const std::size_t n = per / channels;
+      for (std::size_t c = 0; c < channels; ++c)
+        for (std::size_t l = 0; l < static_cast<std::size_t>(*L); ++l)
+          os << (c + l ? cont : head) << (channels > 1 ? std::string(1, "RGB"[c]) + " " : std::string()) << "l=" << l
+             << "  " << row_text(*d, base + c * n + l * l, 2 * l + 1) << '\n';
     } else if (d->shape.size() == 2) {
       os << head << row_text(*d, base, per) << '\n';
     } else {

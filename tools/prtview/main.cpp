@@ -96,14 +96,19 @@ WHAT IS DRAWN
     pixel shows albedo x E/pi.
 
   glossy objects of scene files (--shade glossy; objects with a phong_exponent, whose
-    /objects/<name>/transfer/visibility the scene plan baked at the lobe's order): their specular
-    lobes only, other objects black (they still cast shadows by their roles): per vertex
-    specular x int L V H k_s(r.w) dw, k_s the normalised Phong lobe (s+1)/2pi max(t,0)^s about the
-    reflection r of the direction to the eye, by prt::shade::shade_glossy_vertices: the
-    environment's SH at the object's order times the visibility transfer by the SH triple product,
-    then the lobe band by band (prtshade/glossy.h); Gouraud. --phong S swaps every lobe's exponent
-    at run time (U does not depend on it; the order stays the baked one). The reference traces the
-    same lobe per pixel (Embree, mixture of the lobe and the environment, --samples rays).
+    /objects/<name>/radiance/shadowed or transfer/visibility the scene plan baked at the lobe's
+    order): their specular lobes only, other objects black (they still cast shadows by their
+    roles): per vertex specular x int L V H k_s(r.w) dw, k_s the normalised Phong lobe
+    (s+1)/2pi max(t,0)^s about the reflection r of the direction to the eye, then the lobe band by
+    band (prtshade/glossy.h); Gouraud. Two routes, the one used printed per object:
+      B  (when the object has radiance/shadowed; format_version 4) the baked shadowed radiance
+         S = int L V H y dw (paper 001 sec. 4, material editing): exact shadows under the baked
+         environment, any order (prt::shade::shade_glossy_radiance_vertices);
+      A  otherwise: the environment's SH at the object's order times the visibility transfer by
+         the SH triple product (prt::shade::shade_glossy_vertices; orders up to 16).
+    --glossy-route a|b forces one. --phong S swaps every lobe's exponent at run time (neither S
+    nor U depends on it; the order stays the baked one). The reference traces the same lobe per
+    pixel (Embree, mixture of the lobe and the environment, --samples rays).
 
   area lights of scene files (/lights, schema v3; --shade area or area-exact): only the lights'
     direct light, no environment: each object's albedo/pi x sum_l radiance_l E_l.
@@ -172,6 +177,7 @@ struct Args {
   prtview::FivView fiv;
   std::string ggx;  // --ggx ALPHA[,F0]
   std::optional<double> phong;  // --phong S (--shade glossy)
+  std::string glossy_route;     // --glossy-route a|b (--shade glossy; empty: B where the file has S)
   bool quiet = false;
   int threads = 0;
 };
@@ -244,6 +250,10 @@ std::optional<Args> parse(int argc, char** argv) {
   CLI::Option* phong_opt = app.add_option("--phong", phong_value,
                                           "S > 0: --shade glossy only: shade every glossy object with the Phong exponent S "
                                           "instead of its own (the baked visibility transfer does not depend on it).");
+  app.add_option("--glossy-route", a.glossy_route,
+                 "a | b: --shade glossy only: force route A (triple product of the environment and "
+                 "transfer/visibility) or B (the baked radiance/shadowed); default B where the file holds it.")
+      ->check(CLI::IsMember({"a", "b"}));
   app.add_option("--ggx", a.ggx,
                  "ALPHA[,F0]: --shade area-exact only: add a GGX specular layer of roughness ALPHA in [0.01, 1] and "
                  "Schlick F0 in [0, 1] (default 0.04) over the diffuse albedo, per pixel through linearly transformed "
@@ -321,6 +331,7 @@ std::optional<Args> parse(int argc, char** argv) {
     if (!(ground_size > 0 && std::isfinite(ground_size))) throw UsageError("--ground-size must be > 0");
     a.fiv.ground_size = ground_size;
   }
+  if (!a.glossy_route.empty() && a.shade != "glossy") throw UsageError("--glossy-route applies to --shade glossy only");
   if (phong_opt->count()) {
     if (a.shade != "glossy") throw UsageError("--phong applies to --shade glossy only");
     if (!(phong_value > 0 && std::isfinite(phong_value))) throw UsageError("--phong must be a finite number > 0");
@@ -467,7 +478,11 @@ int run(const Args& a) {
   Timer t_run;
   const view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
                               : kind == "scene" ? prtview::render_scene_file(f, a.file, *env, cam, scene)
-                              : kind == "glossy" ? prtview::render_glossy_scene(f, a.file, *env, cam, a.phong, scene)
+                              : kind == "glossy" ? prtview::render_glossy_scene(f, a.file, *env, cam, a.phong,
+                                                                                  a.glossy_route == "a"   ? prtview::GlossyRoute::A
+                                                                                  : a.glossy_route == "b" ? prtview::GlossyRoute::B
+                                                                                                          : prtview::GlossyRoute::Auto,
+                                                                                  scene)
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();

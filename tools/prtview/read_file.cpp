@@ -241,10 +241,16 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     if (s.radiance_band1) o.band1 = read_band1(f, file, baked.name, *env);
     else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
     else if (s.ao) o.ao = &s.ao->values;
-    if (baked.phong_exponent.value_or(0) > 0 && s.transfer_visibility) {
-      const std::string path = cat(prefix, N::kTransferVisibility);
-      if (!s.transfer_visibility->sh_order) throw InputError(file, path + " lacks the attribute " + quoted(N::kShOrder));
-      o.visibility = Transfer{int(*s.transfer_visibility->sh_order), s.transfer_visibility->values.data()};
+    if (baked.phong_exponent.value_or(0) > 0 && (s.transfer_visibility || s.radiance_shadowed)) {
+      auto sh_product = [&](const F::Product& p, std::string_view name) {
+        if (!p.sh_order) throw InputError(file, cat(prefix, name) + " lacks the attribute " + quoted(N::kShOrder));
+        return Transfer{int(*p.sh_order), p.values.data()};
+      };
+      if (s.transfer_visibility) o.visibility = sh_product(*s.transfer_visibility, N::kTransferVisibility);
+      if (s.radiance_shadowed) {
+        check_same_environment(*s.radiance_shadowed, cat(prefix, N::kRadianceShadowed), *env, file);
+        o.shadowed = sh_product(*s.radiance_shadowed, N::kRadianceShadowed);
+      }
       o.phong = *baked.phong_exponent;
       if (const auto& c = baked.specular) {
         if (c->size() != 3) throw InputError(file, prefix + ": " + quoted(N::kSpecular) + " must be 3 numbers");

@@ -85,8 +85,11 @@ struct SceneObject {
   const std::vector<float>* ao = nullptr;
   std::optional<BakedOccluder> shells;   // read when the file also holds the environment FIV
   bool glossy_only = false;              // visibility transfer only
-  // Glossy objects (a phong_exponent > 0 and /transfer/visibility): the lobe and its colour.
+  // Glossy objects (a phong_exponent > 0 and /transfer/visibility or /radiance/shadowed): the
+  // lobe and its colour, and what shades it: U (route A) and S [V][3][L*L] baked under `env`
+  // (checked; route B), whichever the file holds.
   std::optional<Transfer> visibility;
+  std::optional<Transfer> shadowed;
   double phong = 0;
   std::array<float, 3> specular{1, 1, 1};  // white when the file names none
 };

@@ -124,7 +124,8 @@ view::Camera first_look_camera(const F::Asset& f, const std::string& file, const
   };
   if (is_scene_file(f)) {
     for (const F::SceneObject& o : f.objects)
-      if (!glossy || (o.phong_exponent.value_or(0) > 0 && o.set.transfer_visibility)) grow(o.set.positions);
+      if (!glossy || (o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed)))
+        grow(o.set.positions);
     if (glossy && !lo.allFinite())  // no glossy object: frame them all (the render says what is missing)
       for (const F::SceneObject& o : f.objects) grow(o.set.positions);
   } else if (has_fiv(f)) {
@@ -310,12 +311,13 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
 }
 
 view::Image render_glossy_scene(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
-                                std::optional<double> phong, RenderScene& scene) {
+                                std::optional<double> phong, GlossyRoute route, RenderScene& scene) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, &env);
-  for (SceneObject& o : objects) o.receiver = o.visibility.has_value();
+  for (SceneObject& o : objects) o.receiver = o.visibility || o.shadowed;
   if (std::none_of(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; }))
     throw bake::InputError(file, "has no glossy object (one with a phong_exponent and " +
                                      std::string(F::names::kObjects) + "/<name>" + std::string(F::names::kTransferVisibility) +
+                                     " or " + std::string(F::names::kRadianceShadowed.substr(1)) +
                                      "): nothing to show with --shade glossy");
   std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
   // One Gaunt table and one lit product matrix per order, shared by the objects of that order.
@@ -324,41 +326,56 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
   std::vector<float> rgb;
   scene.first_triangle = {0};
   scene.what = "scene: " + std::to_string(objects.size()) + " objects, glossy lobes only";
-  scene.how = "prt::shade::shade_glossy_vertices (route A: environment SH x /transfer/visibility by the triple product, "
-              "normalised Phong lobe about the reflected view direction), times the specular colour, Gouraud:";
+  scene.how = "specular lobes by route A (prt::shade::shade_glossy_vertices: environment SH x /transfer/visibility by the "
+              "triple product) or route B (prt::shade::shade_glossy_radiance_vertices: the baked /radiance/shadowed, paper "
+              "001 §4 material editing), normalised Phong lobe about the reflected view direction, times the specular "
+              "colour, Gouraud:";
   for (const SceneObject& o : objects) {
     const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
     std::vector<float> colour(3 * V, 0.0f);
-    const double s = o.visibility ? phong.value_or(o.phong) : 0.0;
-    if (o.visibility) {
-      const int order = o.visibility->order;
-      if (order < 1 || order > shade::kMaxGlossyOrder)
-        throw bake::InputError(file, "object '" + o.name + "': visibility transfer of order " + std::to_string(order) +
-                                         " (glossy shading takes orders 1 to " + std::to_string(shade::kMaxGlossyOrder) + ")");
-      auto& lit = lit_of[order];
-      if (!lit) {
-        std::string unused;
-        const std::vector<float> light = environment_sh(env, order, unused);
-        lit = std::make_unique<shade::GlossyLight>(shade::TripleProduct(order), light.data());
-      }
+    const double s = o.receiver ? phong.value_or(o.phong) : 0.0;
+    if (o.receiver) {
+      // Route B when the file holds S (unless --glossy-route a), else route A.
+      const bool route_b = route == GlossyRoute::B || (route == GlossyRoute::Auto && o.shadowed);
+      const std::optional<Transfer>& data = route_b ? o.shadowed : o.visibility;
+      if (!data)
+        throw bake::InputError(file, "object '" + o.name + "' has no " +
+                                         std::string((route_b ? F::names::kRadianceShadowed : F::names::kTransferVisibility).substr(1)) +
+                                         " for --glossy-route " + (route_b ? "b" : "a"));
+      const int order = data->order, max_order = route_b ? shade::kMaxShadowedOrder : shade::kMaxGlossyOrder;
+      if (order < 1 || order > max_order)
+        throw bake::InputError(file, "object '" + o.name + "': " + (route_b ? "shadowed radiance" : "visibility transfer") +
+                                         " of order " + std::to_string(order) + " (glossy shading takes orders 1 to " +
+                                         std::to_string(max_order) + ")");
       std::vector<float> pos(3 * V), nrm(3 * V);
       for (size_t v = 0; v < V; ++v)
         for (int c = 0; c < 3; ++c) pos[3 * v + size_t(c)] = o.mesh.positions[v][c], nrm[3 * v + size_t(c)] = o.mesh.normals[v][c];
       const Vector3d eye_local = cam.eye - o.mesh.origin;
       const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
-      shade::shade_glossy_vertices(*lit, o.visibility->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+      if (route_b) {
+        shade::shade_glossy_radiance_vertices(data->coeffs, order, nrm.data(), pos.data(), V, eye, s, colour.data());
+      } else {
+        auto& lit = lit_of[order];
+        if (!lit) {
+          std::string unused;
+          const std::vector<float> light = environment_sh(env, order, unused);
+          lit = std::make_unique<shade::GlossyLight>(shade::TripleProduct(order), light.data());
+        }
+        shade::shade_glossy_vertices(*lit, data->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+      }
       for (size_t v = 0; v < V; ++v)
         for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
-      char buf[200];
-      std::snprintf(buf, sizeof buf, "\n  %s: order %d, Phong %.4g%s, specular %.3g %.3g %.3g", o.name.c_str(), order, s,
-                    phong ? " (--phong)" : "", o.specular[0], o.specular[1], o.specular[2]);
+      char buf[240];
+      std::snprintf(buf, sizeof buf, "\n  %s: order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s", o.name.c_str(),
+                    order, s, phong ? " (--phong)" : "", o.specular[0], o.specular[1], o.specular[2],
+                    route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)");
       scene.how += buf;
     }
     rgb.insert(rgb.end(), colour.begin(), colour.end());
     scene.phong.insert(scene.phong.end(), T, s);
-    scene.specular.insert(scene.specular.end(), T, o.visibility ? o.specular : std::array<float, 3>{0, 0, 0});
+    scene.specular.insert(scene.specular.end(), T, o.receiver ? o.specular : std::array<float, 3>{0, 0, 0});
     add_object(scene, o);
-    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + o.name + (o.visibility ? " (glossy)" : "");
+    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + o.name + (o.receiver ? " (glossy)" : "");
     parts.push_back(o.mesh);
   }
   scene.mesh = bake::merge_meshes(parts, file);

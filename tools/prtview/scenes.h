@@ -71,13 +71,19 @@ void add_object(RenderScene& scene, const SceneObject& o);
 view::Image render_scene_file(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
                               const view::Camera& cam, RenderScene& scene);
 
-// Scene files, --shade glossy: the glossy objects' specular lobes only (prtshade/glossy.h route A:
-// the environment's SH at the object's visibility order, the triple product with each vertex's
-// /transfer/visibility row, the normalised Phong lobe about the reflected view direction from
-// cam.eye, times the specular colour; Gouraud). The glossy objects are the compared receivers;
-// the others are drawn black and cast shadows by their roles. `phong`: an exponent that replaces
-// every glossy object's own (the lobe may change at run time: the baked U does not depend on it).
+// Scene files, --shade glossy: the glossy objects' specular lobes only, the normalised Phong lobe
+// about the reflected view direction from cam.eye times the specular colour, Gouraud, by one of
+// prtshade/glossy.h's routes per object: B (shade_glossy_radiance_vertices on the baked
+// /radiance/shadowed, paper 001 §4 "material editing": shadows exact under the baked environment,
+// any order) when the object has S, else A (the environment's SH at the object's visibility order,
+// the triple product with each vertex's /transfer/visibility row). GlossyRoute::A or ::B forces
+// one (an object without its data is an InputError). The glossy objects are the compared
+// receivers; the others are drawn black and cast shadows by their roles. `phong`: an exponent that
+// replaces every glossy object's own (the lobe may change at run time: neither U nor S depends on
+// it; the order stays the baked one).
+enum class GlossyRoute { Auto, A, B };
 view::Image render_glossy_scene(const formats::Asset& f, const std::string& file, const bake::EnvMap& env,
-                                const view::Camera& cam, std::optional<double> phong, RenderScene& scene);
+                                const view::Camera& cam, std::optional<double> phong, GlossyRoute route,
+                                RenderScene& scene);
 
 } // namespace prt::prtview

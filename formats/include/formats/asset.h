@@ -58,6 +58,7 @@ struct Normals {
 
 // A baked per-vertex product: /ao [V], /transfer/diffuse and /transfer/visibility [V][L*L]
 // (sh_order = L, required there), /radiance/band1 [V][RGB][m = -1, 0, 1] (environment fields),
+// /radiance/shadowed [V][RGB][L*L] (v4; sh_order = L required, environment fields),
 // /area_lights/irradiance [V][lights] and /area_lights/sh [V][lights][n*n] (sh_order = n; `lights`
 // required there: the lights' names in column order, join_light_list).
 struct Product {
@@ -107,12 +108,14 @@ struct VertexSet {
   std::optional<Array<uint32_t>> source_position;  // [V]
   std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1;
   std::optional<Product> area_irradiance, area_sh;  // v3
+  std::optional<Product> radiance_shadowed;         // v4
   Report report;
 
   std::size_t vertex_count() const noexcept { return positions ? positions->values.size() / 3 : 0; }
   bool empty() const noexcept {
     return !positions && !normals && !triangles && !source_position && !ao && !transfer_diffuse &&
-           !transfer_visibility && !radiance_band1 && !area_irradiance && !area_sh && report.empty();
+           !transfer_visibility && !radiance_band1 && !area_irradiance && !area_sh && !radiance_shadowed &&
+           report.empty();
   }
   bool operator==(const VertexSet&) const = default;
 };

@@ -30,6 +30,7 @@ inline constexpr std::string_view kTransferDiffuse = "/transfer/diffuse";
 inline constexpr std::string_view kTransferVisibility = "/transfer/visibility";
 inline constexpr std::string_view kRadianceGroup = "/radiance";
 inline constexpr std::string_view kRadianceBand1 = "/radiance/band1";
+inline constexpr std::string_view kRadianceShadowed = "/radiance/shadowed";  // v4: [V][RGB][L*L]
 inline constexpr std::string_view kAreaLightsGroup = "/area_lights";           // v3
 inline constexpr std::string_view kAreaIrradiance = "/area_lights/irradiance";  // [V][L]
 inline constexpr std::string_view kAreaSh = "/area_lights/sh";                  // [V][L][n*n]

@@ -76,7 +76,7 @@ namespace prt::formats {
 
 // Schema version written by this library and the newest one it reads (policy: SCHEMA.md).
 // 3 added area lights (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 3;
+inline constexpr int kFormatVersion = 4;
 // Value of the root attribute "format".
 inline constexpr std::string_view kFormatName = "prtbake";
 
@@ -127,14 +127,14 @@ private:
 void write_file(const std::filesystem::path& final_path, const File& file);
 
 enum class ReadCheck {
-  full,    // format, format_version and the whole schema v3 (validate())
+  full,    // format, format_version and the whole schema v4 (validate())
   header,  // format and format_version only: for inspectors (prtdump) that show what is wrong
 };
 
 // Reads the whole file at `path` (see the reader contract above). Throws FormatError.
 File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::full);
 
-// Checks `file` against schema v3 exactly as write_file does; messages name `file_for_messages`.
+// Checks `file` against schema v4 exactly as write_file does; messages name `file_for_messages`.
 // Root "format"/"format_version" may be absent (the writer adds them) but, if present, must be
 // "prtbake" / 1..kFormatVersion. Throws FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
@@ -146,13 +146,14 @@ const std::vector<Attr>* find_group_attrs(const File& file, std::string_view gro
 
 // True for the schema's per-vertex datasets (first axis = V = rows of the vertex set's
 // mesh/positions): /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
-// /transfer/visibility, /radiance/band1, /area_lights/{irradiance,sh} (v3), and the same under
+// /transfer/visibility, /radiance/band1, /radiance/shadowed (v4), /area_lights/{irradiance,sh} (v3),
+// and the same under
 // /objects/<name>/ (scene files, v2). /report datasets are never per-vertex.
 bool is_per_vertex_path(std::string_view path);
 // What a dataset path is in the schema (the same rules under /objects/<name>/ for vertex sets).
 enum class DatasetKind {
   positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
-  radiance_band1, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
+  radiance_band1, radiance_shadowed, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
   light_vertices, light_face_sizes, light_face_indices, report, unknown
 };
 DatasetKind dataset_kind(std::string_view path);

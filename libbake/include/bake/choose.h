@@ -7,8 +7,8 @@
 //   AO, diffuse transfer T_i, visibility transfer U_i: the RMSE over the values of the product
 //     (every coefficient of every vertex), absolute — these are dimensionless (AO in [0, 1],
 //     |T_i| <= 1/√π, |U_i| <= 2√π);
-//   band-1 radiance R_c,m: the RMSE relative to the RMS of the reference values (its unit is the
-//     environment's, which E cannot know).
+//   band-1 radiance R_c,m and shadowed radiance S_c,i: the RMSE relative to the RMS of the
+//     reference values (their unit is the environment's, which E cannot know).
 // Every requested product must meet E.
 //
 // The pilot (choose_integrator), on a seeded sample of the bake's shade points (a 64th of them,

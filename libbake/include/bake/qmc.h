@@ -9,10 +9,18 @@
 //   cosine-weighted hemisphere  p = cos θ / π     — AO, diffuse transfer, radiance
 //   uniform hemisphere          p = 1 / 2π        — visibility transfer (∫ V H y_i dω has
 //                                                   infinite variance under cosine sampling)
-//   environment luminance       p = EnvMap::pdf   — band-1 radiance (suns of 10^4-10^5 × mean)
-// Weights: 1/2 to the environment when radiance is baked; the rest shared equally by the
+//   environment luminance       p = EnvMap::pdf   — band-1 radiance R and shadowed radiance S
+//                                                   (suns of 10^4-10^5 × mean)
+// Weights: 1/2 to the environment when R or S is baked; the rest shared equally by the
 // hemisphere strategies in use. Every estimator f·V/p is then bounded, so the per-point
-// standard error is finite and reported.
+// standard error is finite and reported. S_c,i = ∫ L_c V H y_i dω (bake/products.h; paper 001
+// §4 "Material Editing") has no cosine, like U: under cosine sampling alone L y_i / (cos θ/π)
+// grows without bound at the horizon wherever the environment's pdf is small against a channel
+// (a dim, saturated horizon), so S brings in the uniform hemisphere like U does; with it
+// |f/p| ≤ |y_i| L_c / max(w_env pdf_env, w_uni/2π) everywhere. The environment strategy
+// carries the variance of bright texels (L_c / pdf_env is at most the channel's share of the
+// luminance over its mean), the uniform one that of dim sky near the horizon. R alone keeps the
+// mixture it had (its numbers do not change).
 //
 // Points are a 3D Halton sequence (u0 picks the strategy, u1,u2 warp) with a per-point Cranley–
 // Patterson rotation from (seed, point index): unbiased, and identical whatever the thread count.
@@ -65,6 +73,7 @@ private:
   QmcOptions options_;
   double w_cos_ = 0, w_uni_ = 0, w_env_ = 0;  // mixture weights, sum to 1
   int sh_order_ = 0;                          // SH order evaluated per sample
+  const EnvMap* env_ = nullptr;               // of R and S (ProductRequest::environment())
   std::shared_ptr<const RayCaster> rays_;
 };
 

@@ -77,8 +77,13 @@
 //     diffuse shading with 3 coefficients per channel (paper 001 §4) — and no higher order; diffuse
 //     transfer (relightable) only without an environment or with "relight", at the smallest order
 //     whose clamped-cosine energy beyond it is ≤ sh_tolerance (order 3 for 1%, bake/zonal.h);
-//   * glossy lobe (phong_exponent s): visibility transfer at the smallest order whose Phong-lobe
-//     energy beyond it is ≤ sh_tolerance (Ramamoorthi & Hanrahan 2002; paper 001 §4 glossy);
+//   * glossy lobe (phong_exponent s): one order L, the smallest whose Phong-lobe energy beyond it
+//     is ≤ sh_tolerance (Ramamoorthi & Hanrahan 2002; paper 001 §4 glossy), for both of: the
+//     shadowed radiance S ("radiance" in bake.products and an environment: paper 001 §4 "material
+//     editing", exact shadows under the scene's environment, the lobe applied at run time) and
+//     the visibility transfer U ("transfer" in bake.products; kept beside S, with or without
+//     "relight": it is what shades under a changed or rotated lighting, at a third of S's size,
+//     and scenes baked before S keep it — leave "transfer" out for S alone);
 //   * no radiance and no FIV without an environment;
 //   * FIV shells only for an occluder that can shadow some other receiver: its bounding sphere
 //     reaches above the tangent plane of at least one vertex of another receiver (paper 004 §4.3.1:
@@ -190,12 +195,18 @@ struct ObjectPlan {
   bool ao = false, radiance = false, fiv = false;
   int transfer_order = 0;    // diffuse transfer T (0: none)
   int visibility_order = 0;  // visibility transfer U for the glossy lobe (0: none)
+  int shadowed_order = 0;    // shadowed radiance S for the glossy lobe under the environment (0: none)
   bool area_irradiance = false;  // area_lights/irradiance: E of every light, at unit radiance
   int area_sh_order = 0;         // area_lights/sh: the visible lights' SH at this order (0: none)
   std::vector<std::string> baked, left_out;  // "product: reason", one line each
   // The products of a vertex integrator (bake/integrator.h); the area lights are not among them.
-  bool any_vertex_product() const { return ao || radiance || transfer_order > 0 || visibility_order > 0; }
+  bool any_vertex_product() const {
+    return ao || radiance || transfer_order > 0 || visibility_order > 0 || shadowed_order > 0;
+  }
 };
+
+// The vertex integrator's request for an object's plan under the scene's environment `env`.
+ProductRequest product_request(const ObjectPlan& plan, const EnvMap* env);
 
 struct ScenePlan {
   std::vector<ObjectPlan> objects;  // parallel to SceneDescription::objects

@@ -23,7 +23,8 @@
 //    edge with step +1 into the lower hemisphere (paper §4: clamping is part of visibility), so
 //    integrands never carry H and the tables are shared by all shade points.
 //  * A hemisphere point with no contour edge in view takes closed forms (bake/zonal.h) after one
-//    ray decides enclosed / open; its band-1 radiance is the horizon-only walk, once per normal.
+//    ray decides enclosed / open; its band-1 and shadowed radiance (R, S) are the horizon-only
+//    walk, once per normal.
 //  * Visibility is the limit from p + εn, ε → 0+: every orientation predicate at p is evaluated
 //    symbolically at p + εn (sign of the value, else of its ε-derivative), and the shade point's
 //    own vertex is seen in direction −n. A flat 1-ring therefore covers exactly the lower

@@ -82,11 +82,11 @@ FlipProbe probe_flipped_normals(const Mesh& mesh, const Topology& topology, cons
 // Error against a converged reference on a seeded sample of vertices (docs/ARCHITECTURE.md §6).
 // The per-vertex products, as libbake knows them; the file names them through formats/ (the
 // baker maps each to its dataset there), libbake only labels them for people.
-enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1 };
+enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1, RadianceShadowed };
 const char* product_label(Product product);  // "AO", "diffuse transfer", ... (for logs)
 
 // Where each product a layout holds lies in a row, in row order (AO, diffuse transfer,
-// visibility transfer, band-1 radiance); products the layout does not hold are left out.
+// visibility transfer, band-1 radiance, shadowed radiance); products the layout does not hold are left out.
 struct ProductSlice {
   Product product;
   size_t offset, count;

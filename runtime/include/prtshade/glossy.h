@@ -50,6 +50,9 @@
 namespace prt::shade {
 
 inline constexpr int kMaxGlossyOrder = 16;  // bands of the triple product (256 coefficients)
+// Bands of route B (no triple product: any order of the SH basis, prtshade/sh.h kMaxOrder). A
+// Phong exponent of 128 wants ~25 bands at 1% of the lobe's energy (bake/zonal.h).
+inline constexpr int kMaxShadowedOrder = 64;
 
 // I_l(s) = ∫_0^1 t^s P_l(t) dt for l = 0 … order−1 (out[order]); s ≥ 0 finite. Throws
 // std::invalid_argument otherwise.
@@ -103,7 +106,8 @@ private:
 };
 
 // Route B: L_out = Σ_l λ_l Σ_m S_{c,lm} y_lm(r) for c = 0..2. `shadowed` is [3][order²]
-// channel-major, `scales` the order band scales of phong_band_scales, r a unit direction.
+// channel-major (a vertex's /radiance/shadowed row), order in [1, kMaxShadowedOrder], `scales`
+// the order band scales of phong_band_scales, r a unit direction.
 void shade_glossy_radiance(const float* shadowed, int order, const double* scales, const float r[3], float out[3]);
 
 // Route A, the slow reference: S_c = P_L(L_c · U) by one pass over the Gaunt table per channel
@@ -145,5 +149,12 @@ void reflect(const float n[3], const float v[3], float r[3]);
 void shade_glossy_vertices(const GlossyLight& light, const float* visibility, const float* normals,
                            const float* positions, std::size_t count, const float eye[3], double phong_exponent,
                            float* out);
+
+// Route B over `count` vertices (shade_glossy_radiance about each vertex's reflected view
+// direction, as shade_glossy_vertices): shadowed [count][3][order²] (/radiance/shadowed), order in
+// [1, kMaxShadowedOrder]; the rest as shade_glossy_vertices. Throws std::invalid_argument on null
+// pointers (count > 0), an order out of range or a negative or non-finite exponent.
+void shade_glossy_radiance_vertices(const float* shadowed, int order, const float* normals, const float* positions,
+                                    std::size_t count, const float eye[3], double phong_exponent, float* out);
 
 } // namespace prt::shade

@@ -92,7 +92,8 @@ prt_status prt_shade_glossy(const prt_glossy* glossy, const float* light, const 
                             const float* positions, size_t vertex_count, const float eye[3], double phong_exponent,
                             float* out);
 /* Route B (fixed environment): out[c] = Σ_l λ_l Σ_m S[c][lm] y_lm(r) for one shadowed-radiance
- * vector S [3][order²] and a unit reflection direction r; λ_l the lobe's band scales. */
+ * vector S [3][order²] (a /radiance/shadowed row), order in [1, 64], and a unit reflection
+ * direction r; λ_l the lobe's band scales. */
 prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const float r[3], double phong_exponent,
                                      float out[3]);
 
