@@ -50,6 +50,10 @@ std::vector<ProductRef> products(const VertexSet& set) {
   add(names::kTransferDiffuse, set.transfer_diffuse, {width(set.transfer_diffuse)});
   add(names::kTransferVisibility, set.transfer_visibility, {width(set.transfer_visibility)});
   add(names::kRadianceBand1, set.radiance_band1, {3, 3});
+  if (set.radiance_shadowed) {
+    const uint64_t n2 = uint64_t(set.radiance_shadowed->sh_order.value_or(0) * set.radiance_shadowed->sh_order.value_or(0));
+    add(names::kRadianceShadowed, set.radiance_shadowed, {3, n2});
+  }
   add(names::kAreaIrradiance, set.area_irradiance, {width(set.area_irradiance)});
   if (set.area_sh) {
     const uint64_t n2 = uint64_t(set.area_sh->sh_order.value_or(0) * set.area_sh->sh_order.value_or(0));

@@ -95,6 +95,7 @@ Asset vertex_asset() {
   a.vertices.transfer_diffuse = product(values(V * 9, 0.2), 3);
   a.vertices.transfer_visibility = product(values(V * 4, 0.3), 2);
   a.vertices.radiance_band1 = product(values(V * 9, 0.4));
+  a.vertices.radiance_shadowed = product(values(V * 3 * 4, 0.45), 2);  // [RGB][4]: three VEC4 attributes
   return a;
 }
 
@@ -118,6 +119,17 @@ Asset scene_asset() {
   lit.set.area_sh->lights = "key\nfill";
   lit.set.radiance_band1 = product(values(6 * 9, 0.8));
   return a;
+}
+
+// Every per-vertex product an export carries, by its dataset name relative to the set.
+std::vector<std::pair<std::string, const std::optional<Product>*>> exported_products(const VertexSet& s) {
+  return {{"ao", &s.ao},
+          {"transfer/diffuse", &s.transfer_diffuse},
+          {"transfer/visibility", &s.transfer_visibility},
+          {"radiance/band1", &s.radiance_band1},
+          {"radiance/shadowed", &s.radiance_shadowed},
+          {"area_lights/irradiance", &s.area_irradiance},
+          {"area_lights/sh", &s.area_sh}};
 }
 
 // ---- glTF: structure checks and reading accessors ----
@@ -215,10 +227,7 @@ void check_gltf(const tinygltf::Model& m, const Asset& a) {
     for (uint32_t i : idx) EXPECT_LT(i, V);
     // Products: concatenate the listed attributes per vertex, in order.
     std::map<std::string, const Product*> want;
-    for (auto [name, p] : {std::pair<std::string, const std::optional<Product>*>{"ao", &s.ao},
-                           {"transfer/diffuse", &s.transfer_diffuse}, {"transfer/visibility", &s.transfer_visibility},
-                           {"radiance/band1", &s.radiance_band1}, {"area_lights/irradiance", &s.area_irradiance},
-                           {"area_lights/sh", &s.area_sh}})
+    for (auto [name, p] : exported_products(s))
       if (*p) want[name] = &**p;
     const tinygltf::Value& products = entry.Get("products");
     ASSERT_EQ(products.ArrayLen(), want.size());
@@ -315,10 +324,7 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
       want[name("mesh/normals")] = {{s.normals->values.begin(), s.normals->values.end()}, "float32"};
       want[name("mesh/triangles")] = {{s.triangles->values.begin(), s.triangles->values.end()}, "uint32"};
       want[name("mesh/source_position")] = {{s.source_position->values.begin(), s.source_position->values.end()}, "uint32"};
-      for (auto [d, p] : {std::pair<std::string, const std::optional<Product>*>{"ao", &s.ao},
-                          {"transfer/diffuse", &s.transfer_diffuse}, {"transfer/visibility", &s.transfer_visibility},
-                          {"radiance/band1", &s.radiance_band1}, {"area_lights/irradiance", &s.area_irradiance},
-                          {"area_lights/sh", &s.area_sh}})
+      for (auto [d, p] : exported_products(s))
         if (*p) want[name(d)] = {{(*p)->values.begin(), (*p)->values.end()}, "float32"};
     };
     if (a.objects.empty()) add("", a.vertices);
