@@ -31,6 +31,9 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <optional>
 #include <string>
 #include <sys/resource.h>
@@ -977,7 +980,21 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
   return 0;
 }
 
+// prtbake allocates and frees buffers of megabytes one after another (the environment's pixels
+// and tables, chunk rows, the datasets written). glibc serves each from a fresh mmap and unmaps it
+// when freed, so every buffer pays its page faults again; keeping freed memory in the heap for
+// the next one makes a merge ~15% cheaper in CPU time (bench/bench_shards.sh). Peak memory is
+// unchanged: only memory already freed is kept.
+void reuse_freed_memory() {
+#ifdef __GLIBC__
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  mallopt(M_TOP_PAD, 16 << 20);
+#endif
+}
+
 int prtbake_main(int argc, char** argv) {
+  reuse_freed_memory();
   const tool::MpiSession mpi(argc, argv);  // under mpirun: ranks are shard workers (shards.h)
   const std::optional<Args> parsed = parse(argc, argv, mpi.active());
   if (!parsed) return 0;  // --help or --version
