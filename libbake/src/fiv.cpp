@@ -57,30 +57,37 @@ Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size) {
 }
 
 namespace {
-// The DifMap [6][S][S][3]: E(n) at every cube texel direction, as float.
+// Texels [begin, end) of the DifMap [6][S][S][3]: E(n) at each cube texel direction, as float.
 template <class Irradiance>
-std::vector<float> cube_of(int size, const Irradiance& E) {
-  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
-  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
+std::vector<float> cube_of(int size, const Irradiance& E, size_t begin, size_t end) {
+  PRT_CHECK(size >= 1 && begin <= end && end <= size_t(6) * size_t(size) * size_t(size));
+  std::vector<float> out((end - begin) * 3, 0.0f);
+  tbb::parallel_for(begin, end, [&](size_t t) {
+    const int idx = int(t);
     const Rgb e = E(gl_cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
-    out[size_t(idx) * 3] = float(e.r);
-    out[size_t(idx) * 3 + 1] = float(e.g);
-    out[size_t(idx) * 3 + 2] = float(e.b);
+    out[(t - begin) * 3] = float(e.r);
+    out[(t - begin) * 3 + 1] = float(e.g);
+    out[(t - begin) * 3 + 2] = float(e.b);
   });
   return out;
 }
+size_t cube_texels(int size) { return size_t(6) * size_t(size) * size_t(size); }
 } // namespace
 
 std::vector<float> irradiance_cube(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1);
   const UnshadowedIrradiance E(env);
-  return cube_of(size, E);
+  return cube_of(size, E, 0, cube_texels(size));
+}
+
+std::vector<float> irradiance_cube_texels(const UnshadowedIrradiance& irradiance, int size, size_t begin, size_t end) {
+  return cube_of(size, irradiance, begin, end);
 }
 
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1 && env.texel_count() > 0);
   const UnshadowedIrradiance E(env);
-  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); });
+  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); }, 0, cube_texels(size));
 }
 
 Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {

@@ -303,14 +303,15 @@ std::string speck_mesh() {
   return path.string();
 }
 
-// That occluder under studio.exr: 24x13 = 312 samples per shell in slabs of 80 (4 chunks a
-// shell); the rule ends the bake at shell kFivShells of 16.
+// That occluder under studio.exr: the 2x2x6 DifMap's 24 texels in one chunk, then 24x13 = 312
+// samples per shell in slabs of 80 (4 chunks a shell); the rule ends the bake at shell kFivShells
+// of 16.
 std::string fiv_bake(int samples = 256) {
   return "fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 24x13x16 --fraction 0.01 --cube 2 --samples " +
          std::to_string(samples) + " --threads 1 --chunk-rows 80 --report 4";
 }
 constexpr int kFivShells = 7;
-constexpr int kFivChunks = 4 * kFivShells;
+constexpr int kFivChunks = 1 + 4 * kFivShells;
 
 // The shells a FIV bake printed it used ("shells: 24x13xK (of 16 ...").
 int shells_used(const std::string& out) {
@@ -389,11 +390,11 @@ TEST(ShardsFiv, MergeRefusesBadChunks) {
   EXPECT_TRUE(read_bytes(out) == ref);
 }
 
-// A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell).
+// A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell, 1 for the DifMap).
 TEST(ShardsFiv, KillNineAndRerunResumes) {
   kill_nine_and_rerun("fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 40x21x16 --fraction 0.01 --cube 2 "
                       "--samples 1024 --threads 1 --chunk-rows 210 --report 0",
-                      dir_for("fiv_kill"), 4 * 13);
+                      dir_for("fiv_kill"), 1 + 4 * 13);
 }
 
 #ifdef PRT_MPIRUN

@@ -5,6 +5,7 @@
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <bake/fiv.h>
+#include <bake/irradiance.h>
 #include <bake/mesh.h>
 #include <bake/sha256.h>
 #include <bake/scene.h>
@@ -688,55 +689,72 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   return 0;
 }
 
-// The FIV shells of a sharded bake (shards.h): every worker takes slabs of shell rows, shell
-// after shell, and stops past the first complete shell that meets the stopping rule; the merging
-// process joins the shells up to that one. nullopt: this process does not merge.
-// `shards` is emplaced here; the caller removes the chunks (finish()) once the file is written.
-std::optional<bake::FivShells> sharded_fiv_shells(const Args& a, const tool::Worker& worker, const tool::MpiSession& mpi,
-                                                  const bake::Mesh& mesh, const bake::Topology& topo,
-                                                  const bake::EnvMap& env, std::optional<tool::ShardedRows>& sharded) {
+// The DifMap and the FIV shells of a sharded bake (shards.h): row set 0 is the DifMap's texels,
+// row set 1 + k shell k's samples. Every worker takes slabs of rows set after set and stops past
+// the first complete shell that meets the stopping rule; the merging process joins the DifMap
+// and the shells up to that one. nullopt: this process does not merge. `sharded` is emplaced
+// here; the caller removes the chunks (finish()) once the file is written.
+struct ShardedFiv {
+  std::vector<float> cube;
+  bake::FivShells shells;
+};
+std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker, const tool::MpiSession& mpi,
+                                      const bake::Mesh& mesh, const bake::Topology& topo, const bake::EnvMap& env,
+                                      std::optional<tool::ShardedRows>& sharded) {
   const bake::ShellSpec& sp = a.shell_spec;
   const bake::FivShellRows baker(mesh, topo, env, sp, worker.computes);
-  const size_t per_shell = baker.rows_per_shell(), width = bake::FivShellRows::kRowWidth;
-  char spec[160];
-  std::snprintf(spec, sizeof spec, "%dx%dx%d inner %.17g fraction %.17g k %u", sp.n_phi, sp.n_theta, sp.n_rho, sp.inner,
-                sp.fraction, unsigned(sp.silhouette_k));
+  const size_t width = bake::FivShellRows::kRowWidth;
+  char spec[192];
+  std::snprintf(spec, sizeof spec, "%dx%dx%d inner %.17g fraction %.17g k %u cube %d", sp.n_phi, sp.n_theta, sp.n_rho,
+                sp.inner, sp.fraction, unsigned(sp.silhouette_k), sp.cube);
   const std::string manifest = tool::manifest_of({"fiv", kVersion, a.command_line, mesh.source_sha256, env.info().sha256,
                                                   spec, std::to_string(width), std::to_string(a.shard.chunk_rows)});
-  tool::ShardedRows& shards =
-      sharded.emplace(worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>(size_t(baker.shell_count()), per_shell),
-                      std::vector<uint32_t>(size_t(baker.shell_count()), uint32_t(width)), a.quiet);
-  // The first shell, in order, that is complete in the chunk directory and meets the rule.
+  std::vector<uint64_t> set_rows = {uint64_t(6) * uint64_t(sp.cube) * uint64_t(sp.cube)};
+  std::vector<uint32_t> widths = {3};
+  for (int k = 0; k < baker.shell_count(); ++k) set_rows.push_back(baker.rows_per_shell()), widths.push_back(uint32_t(width));
+  tool::ShardedRows& shards = sharded.emplace(worker, mpi, a.shard, a.output, manifest, set_rows, widths, a.quiet);
+  // The set of the first shell, in order, that is complete in the chunk directory and meets the rule.
   int checked = 0;
-  const auto last_shell = [&]() -> std::optional<uint32_t> {
-    for (; checked < baker.shell_count() && shards.complete(uint32_t(checked)); ++checked)
-      if (baker.may_stop_after(checked) && baker.stops_after(checked, shards.join(uint32_t(checked)).values))
-        return uint32_t(checked);
+  const auto last_set = [&]() -> std::optional<uint32_t> {
+    for (; checked < baker.shell_count() && shards.complete(uint32_t(1 + checked)); ++checked)
+      if (baker.may_stop_after(checked) && baker.stops_after(checked, shards.join(uint32_t(1 + checked)).values))
+        return uint32_t(1 + checked);
     return std::nullopt;
   };
+  std::optional<bake::UnshadowedIrradiance> irradiance;  // built for this worker's first DifMap chunk
   const bool merges = shards.run([&] {
     shards.work(
         [&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
           bake::ChunkData d;
-          bake::Task task(monitor, "FIV shell rows", r.rows());
+          bake::Task task(monitor, r.set == 0 ? "DifMap texels" : "FIV shell rows", r.rows());
           const double cpu0 = tool::process_cpu_seconds();
-          d.values = baker.rows(int(r.set), r.begin, r.end, &task);
+          if (r.set == 0) {
+            if (!irradiance) irradiance.emplace(env);
+            const std::vector<float> texels = bake::irradiance_cube_texels(*irradiance, sp.cube, r.begin, r.end);
+            d.values.assign(texels.begin(), texels.end());
+            task.advance(r.rows());
+          } else {
+            d.values = baker.rows(int(r.set - 1), r.begin, r.end, &task);
+          }
           task.finish();
           d.seconds = task.elapsed_seconds();
           d.cpu_seconds = tool::process_cpu_seconds() - cpu0;
           return d;
         },
-        std::nullopt, last_shell);
+        std::nullopt, last_set);
   });
   if (!merges) return std::nullopt;
-  bake::FivShells shells = baker.empty_shells();
+  ShardedFiv out;
+  const bake::ChunkData cube = shards.join(0);
+  out.cube.assign(cube.values.begin(), cube.values.end());
+  out.shells = baker.empty_shells();
   for (int k = 0; k < baker.shell_count(); ++k) {
-    const bake::ChunkData d = shards.join(uint32_t(k));
-    baker.append(shells, k, d.values);
-    shells.seconds += d.seconds;
+    const bake::ChunkData d = shards.join(uint32_t(1 + k));
+    baker.append(out.shells, k, d.values);
+    out.shells.seconds += d.seconds;
     if (baker.stops_after(k, d.values)) break;
   }
-  return shells;
+  return out;
 }
 
 int run_fiv(const Args& a, const tool::MpiSession& mpi) {
@@ -758,18 +776,20 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
                 a.environment.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
 
   std::optional<tool::ShardedRows> shards;
-  std::optional<bake::FivShells> sharded;
+  std::optional<ShardedFiv> sharded;
   if (worker) {
-    sharded = sharded_fiv_shells(a, *worker, mpi, mesh, topo, env, shards);
+    sharded = sharded_fiv(a, *worker, mpi, mesh, topo, env, shards);
     if (!sharded) return 0;
   }
   const auto t0 = std::chrono::steady_clock::now();
   const bake::Fiv fenv = bake::environment_fiv(env);
-  const std::vector<float> cube = bake::irradiance_cube(env, a.shell_spec.cube);
+  const std::vector<float> cube = sharded ? std::move(sharded->cube) : bake::irradiance_cube(env, a.shell_spec.cube);
   const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const bake::FivShells shells = sharded ? std::move(*sharded) : bake::bake_fiv_shells(mesh, topo, env, a.shell_spec, progress);
+  const bake::FivShells shells =
+      sharded ? std::move(sharded->shells) : bake::bake_fiv_shells(mesh, topo, env, a.shell_spec, progress);
   if (say) {
-    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds);
+    std::printf("environment FIV and %dx%dx6 DifMap in %.2f s%s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds,
+                sharded ? " (the DifMap's texels in the chunks)" : "");
     std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
                 "integrals/s)\n",
                 a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho, shells.radii.front(),

@@ -51,6 +51,11 @@ Fiv environment_fiv(const EnvMap& env);
 // UnshadowedIrradiance (texels cut by the horizon of n integrated with 4×4 sub-samples, the rest
 // with their ∫_texel ω dω) at gl_cube_direction, rounded to float.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
+// Texels [begin, end) of irradiance_cube(env, size) (texel (face·S + row)·S + column), [end −
+// begin][3], from `irradiance`, an UnshadowedIrradiance of env: the same floats, for a DifMap cut
+// into chunks.
+class UnshadowedIrradiance;
+std::vector<float> irradiance_cube_texels(const UnshadowedIrradiance& irradiance, int size, size_t begin, size_t end);
 // The same sum texel by texel for every normal (UnshadowedIrradiance::reference, no cell
 // hierarchy): the slow reference of irradiance_cube, equal to it up to summation order. Needs a
 // map with texels.
