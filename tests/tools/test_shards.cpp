@@ -178,6 +178,32 @@ TEST(Shards, FilterIntegratorAcrossChunkBorders) {
   EXPECT_TRUE(leftovers(dir, out).empty());
 }
 
+namespace {
+// Chunk `name` of the bake `args` (which writes dir/out.prt.h5; its chunks committed in
+// dir/out.prt.h5.chunks, another bake's in dir/other) flipped, then replaced by the other bake's,
+// then removed: each refused by the merge in one line naming it, nothing written. A rerun of the
+// worker then recomputes exactly that chunk, and the merge gives `ref`.
+void expect_bad_chunk_refused(const std::string& args, const fs::path& dir, const std::string& name, const std::string& ref) {
+  const fs::path out = dir / "out.prt.h5", chunk = dir / "out.prt.h5.chunks" / name;
+  flip_byte(chunk, fs::file_size(chunk) / 2);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "corrupt");
+  // A worker refuses it too, before computing anything.
+  expect_refused(prtbake(args + " --shard 0/1", dir), out, name, "corrupt");
+
+  fs::copy_file(dir / "other" / name, chunk, fs::copy_options::overwrite_existing);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "another bake");
+
+  fs::remove(chunk);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "missing");
+
+  const auto w = prtbake(args + " --shard 0/1", dir);
+  ASSERT_EQ(w.code, 0) << w.err;
+  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
+  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
+  EXPECT_TRUE(read_bytes(out) == ref);
+}
+} // namespace
+
 // A flipped byte, a chunk of another bake, a missing chunk: one line naming it, exit 1, no file.
 TEST(Shards, MergeRefusesBadChunks) {
   const fs::path dir = dir_for("refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
@@ -187,25 +213,7 @@ TEST(Shards, MergeRefusesBadChunks) {
   ASSERT_EQ(committed_chunks(chunks), kChunks);
   // Another bake's chunks (another seed) in a directory of their own.
   ASSERT_EQ(prtbake(args + " --seed 7 --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
-  const fs::path c2 = chunks / "c000002.chunk";
-
-  flip_byte(c2, fs::file_size(c2) / 2);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "corrupt");
-  // A worker refuses it too, before computing anything.
-  expect_refused(prtbake(args + " --shard 0/1", dir), out, "c000002.chunk", "corrupt");
-
-  fs::copy_file(dir / "other" / "c000002.chunk", c2, fs::copy_options::overwrite_existing);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "another bake");
-
-  fs::remove(c2);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "missing");
-
-  // Rerunning the worker recomputes exactly the missing chunk; the merge then succeeds.
-  const auto w = prtbake(args + " --shard 0/1", dir);
-  ASSERT_EQ(w.code, 0) << w.err;
-  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
-  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
-  EXPECT_TRUE(read_bytes(out) == ref);
+  expect_bad_chunk_refused(args, dir, "c000002.chunk", ref);
 }
 
 namespace {
@@ -376,18 +384,7 @@ TEST(ShardsFiv, MergeRefusesBadChunks) {
   ASSERT_EQ(committed_chunks(chunks), size_t(kFivChunks));
   // Another bake's chunks (another k) in a directory of their own.
   ASSERT_EQ(prtbake(fiv_bake(144) + " -o " + out.string() + " --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
-  const fs::path c5 = chunks / "c000005.chunk";
-  flip_byte(c5, fs::file_size(c5) / 2);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000005.chunk", "corrupt");
-  fs::copy_file(dir / "other" / "c000005.chunk", c5, fs::copy_options::overwrite_existing);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000005.chunk", "another bake");
-  fs::remove(c5);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000005.chunk", "missing");
-  const auto w = prtbake(args + " --shard 0/1", dir);
-  ASSERT_EQ(w.code, 0) << w.err;
-  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
-  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
-  EXPECT_TRUE(read_bytes(out) == ref);
+  expect_bad_chunk_refused(args, dir, "c000005.chunk", ref);  // shell 1's first slab
 }
 
 // A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell, 1 for the DifMap).

@@ -17,8 +17,8 @@
 // the next unclaimed chunk (claim files of this run, bake/chunks.h). A run is one launch: mpirun
 // (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
 // another run are stale by definition, so a rerun recomputes what a dead run claimed.
-// FIV bakes: a row set is a shell, cut into slabs of sample rows. Where the shells stop depends
-// on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
+// FIV bakes: row set 0 is the DifMap's texels, row set 1 + k shell k's samples, each cut into
+// slabs of rows. Where the shells stop depends on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
 // after shell without waiting for each other and read the stopping rule from committed chunks:
 // once a complete shell meets it, no worker starts a chunk beyond it. A worker ahead of the
 // others may compute chunks past the last shell while that shell is not complete (about one
