@@ -9,6 +9,9 @@
 #   PRT_SHARDS_SAMPLES=512 PRT_SHARDS_INTEGRATOR=silhouette bench/bench_shards.sh
 #   PRT_SHARDS_REPORT=0 bench/bench_shards.sh   no error report: the merge's own cost
 #   PRT_BENCH_BUILD_DIR=build/ci bench/bench_shards.sh   another build tree (default build/release)
+#   PRT_SHARDS_BAKE=fiv bench/bench_shards.sh   a FIV bake instead: bunny under forest.exr, shells
+#       PRT_SHARDS_SHELLS (default 64x33x30), k = PRT_SHARDS_SAMPLES (default 1024), slabs of
+#       PRT_SHARDS_CHUNK_ROWS (default 264) samples
 # Times: wall (elapsed) and CPU (user + system) from /usr/bin/time; "busy" is the time a worker
 # spent integrating its chunks (its "worker ..." line). On a shared machine, compare CPU and busy
 # times rather than wall times.
@@ -16,15 +19,23 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$(cd "${PRT_BENCH_BUILD_DIR:-$root/build/release}" && pwd)"
 prtbake="$build/tools/prtbake"
-samples="${PRT_SHARDS_SAMPLES:-2048}"
-integrator="${PRT_SHARDS_INTEGRATOR:-qmc}"
-rows="${PRT_SHARDS_CHUNK_ROWS:-256}"
+bake="${PRT_SHARDS_BAKE:-vertex}"
 report="${PRT_SHARDS_REPORT:-32}"  # the error report's points, integrated by the merge
 [[ -x "$prtbake" ]] || { echo "bench_shards.sh: no $prtbake (build the release preset)" >&2; exit 2; }
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-args=(vertex "$root/data/bunny_ground.obj" --ao --transfer 3 --visibility 3 --radiance "$root/data/sunset.exr"
-      --integrator "$integrator" --samples "$samples" --chunk-rows "$rows" --report "$report" -o out.prt.h5)
+if [[ "$bake" == fiv ]]; then
+  samples="${PRT_SHARDS_SAMPLES:-1024}"
+  rows="${PRT_SHARDS_CHUNK_ROWS:-264}"
+  args=(fiv "$root/data/bunny.obj" --env "$root/data/forest.exr" --shells "${PRT_SHARDS_SHELLS:-64x33x30}"
+        --samples "$samples" --chunk-rows "$rows" --report "$report" -o out.prt.h5)
+else
+  samples="${PRT_SHARDS_SAMPLES:-2048}"
+  rows="${PRT_SHARDS_CHUNK_ROWS:-256}"
+  args=(vertex "$root/data/bunny_ground.obj" --ao --transfer 3 --visibility 3 --radiance "$root/data/sunset.exr"
+        --integrator "${PRT_SHARDS_INTEGRATOR:-qmc}" --samples "$samples" --chunk-rows "$rows" --report "$report"
+        -o out.prt.h5)
+fi
 
 # run NAME DIR ARGS...: runs prtbake in DIR, its stdout in DIR/NAME.log, "wall cpu" in DIR/NAME.time.
 run() {

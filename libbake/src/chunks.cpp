@@ -18,11 +18,12 @@ namespace prt::bake {
 namespace {
 
 // File layout: kMagic, manifest (64 hex), index u64, set u32, begin u64, end u64, width u32,
-// closed_form u64, cpu_seconds f64, seconds f64, values f64[rows·width], std_error f64[rows·width],
-// then the SHA-256 (64 hex) of every byte before it.
-constexpr char kMagic[8] = {'P', 'R', 'T', 'C', 'H', 'N', 'K', '1'};
+// columns u32 (1: values, 2: values and std_error), closed_form u64, cpu_seconds f64, seconds f64,
+// values f64[rows·width], std_error f64[rows·width] (when 2 columns), then the SHA-256 (64 hex) of
+// every byte before it.
+constexpr char kMagic[8] = {'P', 'R', 'T', 'C', 'H', 'N', 'K', '2'};
 constexpr size_t kDigest = 64;
-constexpr size_t kHeader = sizeof kMagic + kDigest + 8 + 4 + 8 + 8 + 4 + 8 + 8 + 8;
+constexpr size_t kHeader = sizeof kMagic + kDigest + 8 + 4 + 8 + 8 + 4 + 4 + 8 + 8 + 8;
 
 template <class T>
 void put(std::string& out, const T& x) {
@@ -99,9 +100,10 @@ size_t ChunkStore::committed_count() const {
 void ChunkStore::commit(size_t index, const ChunkData& d) const {
   PRT_CHECK(index < chunks_.size() && d.range == chunks_[index]);
   PRT_CHECK_OP(d.values.size(), ==, d.range.rows() * d.width);
-  PRT_CHECK_OP(d.std_error.size(), ==, d.values.size());
+  PRT_CHECK(d.std_error.empty() || d.std_error.size() == d.values.size());
+  const uint32_t columns = d.std_error.empty() ? 1 : 2;
   std::string bytes;
-  bytes.reserve(kHeader + 16 * d.values.size() + kDigest);
+  bytes.reserve(kHeader + 8 * columns * d.values.size() + kDigest);
   bytes.append(kMagic, sizeof kMagic);
   bytes += manifest_;
   put(bytes, uint64_t(index));
@@ -109,6 +111,7 @@ void ChunkStore::commit(size_t index, const ChunkData& d) const {
   put(bytes, d.range.begin);
   put(bytes, d.range.end);
   put(bytes, d.width);
+  put(bytes, columns);
   put(bytes, d.closed_form);
   put(bytes, d.cpu_seconds);
   put(bytes, d.seconds);
@@ -163,6 +166,7 @@ std::optional<ChunkData> ChunkStore::read(size_t index, uint32_t width) const {
   d.range.begin = get<uint64_t>(bytes, at);
   d.range.end = get<uint64_t>(bytes, at);
   d.width = get<uint32_t>(bytes, at);
+  const uint32_t columns = get<uint32_t>(bytes, at);
   d.closed_form = get<uint64_t>(bytes, at);
   d.cpu_seconds = get<double>(bytes, at);
   d.seconds = get<double>(bytes, at);
@@ -175,10 +179,12 @@ std::optional<ChunkData> ChunkStore::read(size_t index, uint32_t width) const {
                                std::to_string(want.begin) + "-" + std::to_string(want.end) + ", width " +
                                std::to_string(width) + ")");
   const size_t n = size_t(d.range.rows()) * width;
-  if (body != kHeader + 2 * n * sizeof(double))
-    throw InputError(file, "chunk holds " + std::to_string(body) + " bytes where its rows need " +
-                               std::to_string(kHeader + 2 * n * sizeof(double)));
+  if ((columns != 1 && columns != 2) || body != kHeader + columns * n * sizeof(double))
+    throw InputError(file, "chunk holds " + std::to_string(body) + " bytes in " + std::to_string(columns) +
+                               " column(s) where its rows need " + std::to_string(kHeader + 2 * n * sizeof(double)) +
+                               " in 2 or " + std::to_string(kHeader + n * sizeof(double)) + " in 1");
   for (auto* column : {&d.values, &d.std_error}) {
+    if (column == &d.std_error && columns == 1) break;
     column->resize(n);
     std::memcpy(column->data(), bytes.data() + at, n * sizeof(double));
     at += n * sizeof(double);

@@ -573,14 +573,20 @@ EnvMap EnvMap::build(Layout layout, int width, int height, std::vector<float> rg
   info.min_value_seen = min_seen;
   m.rgb_ = std::move(rgb);
 
-  // Exact texel solid angles.
+  // Exact texel solid angles. A lat-long texel's is ds(column) · dt(row): each factor once per
+  // column or row, not per texel (the same products as region(t).ds * region(t).dt).
   const int n = m.texel_count();
   m.solid_angle_.resize(size_t(n));
-  for (int t = 0; t < n; ++t) {
-    const Region r = m.region(t);
-    if (r.face < 0) {
-      m.solid_angle_[size_t(t)] = r.ds * r.dt;
-    } else {
+  if (layout == Layout::LatLong) {
+    std::vector<double> ds(static_cast<size_t>(width));
+    for (int x = 0; x < width; ++x) ds[size_t(x)] = m.region(x).ds;
+    for (int y = 0; y < height; ++y) {
+      const double dt = m.region(y * width).dt;
+      for (int x = 0; x < width; ++x) m.solid_angle_[size_t(y) * size_t(width) + size_t(x)] = ds[size_t(x)] * dt;
+    }
+  } else {
+    for (int t = 0; t < n; ++t) {
+      const Region r = m.region(t);
       m.solid_angle_[size_t(t)] = rect_solid_angle(r.s0, r.s1, r.t0, r.t1);
     }
   }

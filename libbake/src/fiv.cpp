@@ -57,30 +57,37 @@ Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size) {
 }
 
 namespace {
-// The DifMap [6][S][S][3]: E(n) at every cube texel direction, as float.
+// Texels [begin, end) of the DifMap [6][S][S][3]: E(n) at each cube texel direction, as float.
 template <class Irradiance>
-std::vector<float> cube_of(int size, const Irradiance& E) {
-  std::vector<float> out(size_t(6) * size_t(size) * size_t(size) * 3, 0.0f);
-  tbb::parallel_for(0, 6 * size * size, [&](int idx) {
+std::vector<float> cube_of(int size, const Irradiance& E, size_t begin, size_t end) {
+  PRT_CHECK(size >= 1 && begin <= end && end <= size_t(6) * size_t(size) * size_t(size));
+  std::vector<float> out((end - begin) * 3, 0.0f);
+  tbb::parallel_for(begin, end, [&](size_t t) {
+    const int idx = int(t);
     const Rgb e = E(gl_cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
-    out[size_t(idx) * 3] = float(e.r);
-    out[size_t(idx) * 3 + 1] = float(e.g);
-    out[size_t(idx) * 3 + 2] = float(e.b);
+    out[(t - begin) * 3] = float(e.r);
+    out[(t - begin) * 3 + 1] = float(e.g);
+    out[(t - begin) * 3 + 2] = float(e.b);
   });
   return out;
 }
+size_t cube_texels(int size) { return size_t(6) * size_t(size) * size_t(size); }
 } // namespace
 
 std::vector<float> irradiance_cube(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1);
   const UnshadowedIrradiance E(env);
-  return cube_of(size, E);
+  return cube_of(size, E, 0, cube_texels(size));
+}
+
+std::vector<float> irradiance_cube_texels(const UnshadowedIrradiance& irradiance, int size, size_t begin, size_t end) {
+  return cube_of(size, irradiance, begin, end);
 }
 
 std::vector<float> irradiance_cube_reference(const EnvMap& env, int size) {
   PRT_CHECK(size >= 1 && env.texel_count() > 0);
   const UnshadowedIrradiance E(env);
-  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); });
+  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); }, 0, cube_texels(size));
 }
 
 Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {
@@ -156,66 +163,109 @@ bool parse_shell_grid(std::string_view text, ShellSpec& spec) {
   return true;
 }
 
-FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
-                          const Monitor& monitor) {
-  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
-  FivShells out;
-  bounding_sphere(occluder, out.centre, out.radius);
-  out.origin = occluder.origin;
-  out.n_phi = spec.n_phi;
-  out.n_theta = spec.n_theta;
+namespace {
+ProductRequest band1_radiance(const EnvMap& env) {
   ProductRequest req;
   req.radiance = &env;
   req.visibility_order = 1;
-  const SilhouetteIntegrator integrator(occluder, topology, req, {silhouette_isolines(spec.silhouette_k), 1});
+  return req;
+}
+} // namespace
+
+FivShellRows::FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                           bool integrate)
+    : spec_(spec) {
+  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
+  if (integrate)
+    integrator_ = std::make_unique<const SilhouetteIntegrator>(occluder, topology, band1_radiance(env),
+                                                               SilhouetteOptions{silhouette_isolines(spec.silhouette_k), 1});
+  bounding_sphere(occluder, frame_.centre, frame_.radius);
+  frame_.origin = occluder.origin;
+  frame_.n_phi = spec.n_phi;
+  frame_.n_theta = spec.n_theta;
   // The scale the occluded FIV is compared with: ∫ L_c dω, the full-sphere irradiance. (|F^env|
   // itself cancels to 0 for a uniform sky, so a fraction of it is ill-posed.)
-  double env_norm[3] = {0, 0, 0};
   if (env.texel_count() == 0) {
     const Rgb L = env.radiance(Vector3d::UnitY());
-    env_norm[0] = 4 * std::numbers::pi * L.r;
-    env_norm[1] = 4 * std::numbers::pi * L.g;
-    env_norm[2] = 4 * std::numbers::pi * L.b;
+    env_norm_[0] = 4 * std::numbers::pi * L.r;
+    env_norm_[1] = 4 * std::numbers::pi * L.g;
+    env_norm_[2] = 4 * std::numbers::pi * L.b;
   }
   for (int t = 0; t < env.texel_count(); ++t) {
     const Rgb L = env.texel_value(t);
     const double w = env.texel_solid_angle(t);
-    env_norm[0] += L.r * w;
-    env_norm[1] += L.g * w;
-    env_norm[2] += L.b * w;
+    env_norm_[0] += L.r * w;
+    env_norm_[1] += L.g * w;
+    env_norm_[2] += L.b * w;
   }
-  const double R = std::max(out.radius, 1e-30);
+  const double R = std::max(frame_.radius, 1e-30);
   const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
   const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
-  const size_t per_shell = size_t(spec.n_theta) * size_t(spec.n_phi);
+  for (int k = 0; k < spec.n_rho; ++k) radii_.push_back(rho0 * std::pow(g, k));
+}
+
+FivShellRows::~FivShellRows() = default;
+
+size_t FivShellRows::rows_per_shell() const { return size_t(spec_.n_theta) * size_t(spec_.n_phi); }
+
+FivShells FivShellRows::empty_shells() const { return frame_; }
+
+std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task* task) const {
+  PRT_CHECK(integrator_ && begin <= end && end <= rows_per_shell());
+  std::vector<double> out((end - begin) * kRowWidth, 0.0);
+  const double rho = radius(shell);
+  tbb::parallel_for(begin, end, [&](size_t idx) {
+    const int i = int(idx / size_t(spec_.n_phi)), j = int(idx % size_t(spec_.n_phi));
+    bool inside = false;
+    const Fiv f = occluded_fiv(*integrator_, frame_.centre + rho * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside);
+    double r = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
+                                  f[size_t(3 * c + 2)] * f[size_t(3 * c + 2)]);
+      if (env_norm_[c] > 0) r = std::max(r, nf / env_norm_[c]);
+    }
+    double* row = out.data() + (idx - begin) * kRowWidth;
+    for (int q = 0; q < 9; ++q) row[q] = double(float(f[size_t(q)]));
+    row[9] = inside ? 0.0 : 1.0;
+    row[10] = inside ? 0.0 : r;  // offsets inside the geometry say nothing about distance
+    if (task) task->advance();
+  });
+  return out;
+}
+
+// Far enough (and outside the bounding sphere, so never inside the occluder).
+bool FivShellRows::may_stop_after(int shell) const { return radius(shell) >= std::max(frame_.radius, 1e-30); }
+
+bool FivShellRows::stops_after(int shell, std::span<const double> rows) const {
+  PRT_CHECK_OP(rows.size(), ==, rows_per_shell() * kRowWidth);
+  if (!may_stop_after(shell)) return false;
+  double worst = 0;
+  for (size_t idx = 0; idx < rows_per_shell(); ++idx) worst = std::max(worst, rows[idx * kRowWidth + 10]);
+  return worst < spec_.fraction;
+}
+
+void FivShellRows::append(FivShells& shells, int shell, std::span<const double> rows) const {
+  PRT_CHECK(rows.size() == rows_per_shell() * kRowWidth && shells.radii.size() == size_t(shell));
+  shells.radii.push_back(radius(shell));
+  for (size_t idx = 0; idx < rows_per_shell(); ++idx) {
+    const double* row = rows.data() + idx * kRowWidth;
+    for (int q = 0; q < 9; ++q) shells.values.push_back(float(row[q]));
+    shells.valid.push_back(row[9] != 0.0 ? 1 : 0);
+  }
+  shells.integrals += rows_per_shell();
+}
+
+FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                          const Monitor& monitor) {
+  const FivShellRows baker(occluder, topology, env, spec);
+  FivShells out = baker.empty_shells();
+  const size_t per_shell = baker.rows_per_shell();
   Task progress(monitor, "baking FIV shells", uint64_t(spec.n_rho) * per_shell);
   const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < spec.n_rho; ++k) {
-    const double rho = rho0 * std::pow(g, k);
-    std::vector<float> shell(per_shell * 9);
-    std::vector<uint8_t> valid(per_shell);
-    std::vector<double> ratio(per_shell, 0.0);
-    tbb::parallel_for(size_t(0), per_shell, [&](size_t idx) {
-      const int i = int(idx / size_t(spec.n_phi)), j = int(idx % size_t(spec.n_phi));
-      bool inside = false;
-      const Fiv f = occluded_fiv(integrator, out.centre + rho * shell_direction(i, spec.n_theta, j, spec.n_phi), &inside);
-      double r = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
-                                    f[size_t(3 * c + 2)] * f[size_t(3 * c + 2)]);
-        if (env_norm[c] > 0) r = std::max(r, nf / env_norm[c]);
-      }
-      ratio[idx] = inside ? 0.0 : r;  // offsets inside the geometry say nothing about distance
-      for (int q = 0; q < 9; ++q) shell[idx * 9 + size_t(q)] = float(f[size_t(q)]);
-      valid[idx] = inside ? 0 : 1;
-      progress.advance();
-    });
-    out.radii.push_back(rho);
-    out.values.insert(out.values.end(), shell.begin(), shell.end());
-    out.valid.insert(out.valid.end(), valid.begin(), valid.end());
-    out.integrals += per_shell;
-    // Far enough (and outside the bounding sphere, so never inside the occluder): stop.
-    if (rho >= R && *std::max_element(ratio.begin(), ratio.end()) < spec.fraction) break;
+  for (int k = 0; k < baker.shell_count(); ++k) {
+    const std::vector<double> rows = baker.rows(k, 0, per_shell, &progress);
+    baker.append(out, k, rows);
+    if (baker.stops_after(k, rows)) break;
   }
   progress.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -67,6 +67,25 @@ TEST(Chunks, CommitThenReadGivesTheSameRows) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
+// A bake without standard errors (FIV shell rows) commits values only: read back without them.
+TEST(Chunks, ValuesOnlyChunkReadsBackWithoutStandardErrors) {
+  const fs::path dir = fresh_dir("values_only");
+  const ChunkStore store(dir, kManifest, row_chunks(std::vector<uint64_t>{5}, 5));
+  ChunkData d = sample_chunk(store.chunks()[0], 2);
+  const ChunkData with_errors = d;
+  d.std_error.clear();
+  store.commit(0, d);
+  const auto back = store.read(0, 2);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->values, d.values);
+  EXPECT_TRUE(back->std_error.empty());
+  // Half the bytes of the rows: the errors are not stored as zeros.
+  const uintmax_t values_only = fs::file_size(store.chunk_path(0));
+  store.commit(0, with_errors);
+  EXPECT_EQ(fs::file_size(store.chunk_path(0)) - values_only, 10 * sizeof(double));
+  store.remove();
+}
+
 TEST(Chunks, EveryFlippedByteIsRefused) {
   const fs::path dir = fresh_dir("flip");
   const ChunkStore store(dir, kManifest, row_chunks(std::vector<uint64_t>{4}, 4));

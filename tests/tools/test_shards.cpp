@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -177,6 +178,32 @@ TEST(Shards, FilterIntegratorAcrossChunkBorders) {
   EXPECT_TRUE(leftovers(dir, out).empty());
 }
 
+namespace {
+// Chunk `name` of the bake `args` (which writes dir/out.prt.h5; its chunks committed in
+// dir/out.prt.h5.chunks, another bake's in dir/other) flipped, then replaced by the other bake's,
+// then removed: each refused by the merge in one line naming it, nothing written. A rerun of the
+// worker then recomputes exactly that chunk, and the merge gives `ref`.
+void expect_bad_chunk_refused(const std::string& args, const fs::path& dir, const std::string& name, const std::string& ref) {
+  const fs::path out = dir / "out.prt.h5", chunk = dir / "out.prt.h5.chunks" / name;
+  flip_byte(chunk, fs::file_size(chunk) / 2);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "corrupt");
+  // A worker refuses it too, before computing anything.
+  expect_refused(prtbake(args + " --shard 0/1", dir), out, name, "corrupt");
+
+  fs::copy_file(dir / "other" / name, chunk, fs::copy_options::overwrite_existing);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "another bake");
+
+  fs::remove(chunk);
+  expect_refused(prtbake(args + " --merge", dir), out, name, "missing");
+
+  const auto w = prtbake(args + " --shard 0/1", dir);
+  ASSERT_EQ(w.code, 0) << w.err;
+  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
+  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
+  EXPECT_TRUE(read_bytes(out) == ref);
+}
+} // namespace
+
 // A flipped byte, a chunk of another bake, a missing chunk: one line naming it, exit 1, no file.
 TEST(Shards, MergeRefusesBadChunks) {
   const fs::path dir = dir_for("refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
@@ -186,34 +213,15 @@ TEST(Shards, MergeRefusesBadChunks) {
   ASSERT_EQ(committed_chunks(chunks), kChunks);
   // Another bake's chunks (another seed) in a directory of their own.
   ASSERT_EQ(prtbake(args + " --seed 7 --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
-  const fs::path c2 = chunks / "c000002.chunk";
-
-  flip_byte(c2, fs::file_size(c2) / 2);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "corrupt");
-  // A worker refuses it too, before computing anything.
-  expect_refused(prtbake(args + " --shard 0/1", dir), out, "c000002.chunk", "corrupt");
-
-  fs::copy_file(dir / "other" / "c000002.chunk", c2, fs::copy_options::overwrite_existing);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "another bake");
-
-  fs::remove(c2);
-  expect_refused(prtbake(args + " --merge", dir), out, "c000002.chunk", "missing");
-
-  // Rerunning the worker recomputes exactly the missing chunk; the merge then succeeds.
-  const auto w = prtbake(args + " --shard 0/1", dir);
-  ASSERT_EQ(w.code, 0) << w.err;
-  EXPECT_EQ(resumed_of(w.out).computed, 1) << w.out;
-  ASSERT_EQ(prtbake(args + " --merge", dir).code, 0);
-  EXPECT_TRUE(read_bytes(out) == ref);
+  expect_bad_chunk_refused(args, dir, "c000002.chunk", ref);
 }
 
-// kill -9 at random moments, then the same command again: the same bytes, only the chunks that
-// were not committed recomputed, no temporary left.
-TEST(Shards, KillNineAndRerunResumes) {
-  const fs::path dir = dir_for("kill"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
-  // More samples and smaller chunks than above: a bake of ~1-2 s in 17 chunks, room to land kills.
-  const std::string bake = "vertex " + kData + "/bunny_ground.obj --ao --transfer 3 --visibility 3 --radiance " +
-                           kData + "/sunset.exr --integrator qmc --samples 256 --threads 1 --chunk-rows 256";
+namespace {
+// kill -9 at random moments of `bake` --resume (at least 5 kills), then the same command again:
+// the bytes of `bake` --reproducible, only the chunks that were not committed recomputed (the
+// bake needs `needed` chunks), no temporary left.
+void kill_nine_and_rerun(const std::string& bake, const fs::path& dir, int needed) {
+  const fs::path out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
   const std::string args = bake + " --resume";
   const auto t0 = std::chrono::steady_clock::now();
   const std::string ref = reference(bake, out);
@@ -249,57 +257,191 @@ TEST(Shards, KillNineAndRerunResumes) {
     ASSERT_EQ(r.code, 0) << r.err;
     const Resumed re = resumed_of(r.out);
     EXPECT_EQ(re.reused, int(committed)) << r.out;
-    EXPECT_EQ(re.computed, 17 - int(committed)) << r.out;  // recomputed: only the uncommitted chunks
+    EXPECT_EQ(re.computed, needed - int(committed)) << r.out;  // recomputed: only the uncommitted chunks
     EXPECT_TRUE(read_bytes(out) == ref);
     EXPECT_TRUE(leftovers(dir, out).empty()) << "stray files after the resumed bake";
     fs::remove(out);
   }
   EXPECT_GE(kills, 5);
 }
+} // namespace
+
+// kill -9 at random moments, then the same command again: the same bytes, only the chunks that
+// were not committed recomputed, no temporary left.
+TEST(Shards, KillNineAndRerunResumes) {
+  // More samples and smaller chunks than above: a bake of ~1-2 s in 17 chunks, room to land kills.
+  kill_nine_and_rerun("vertex " + kData + "/bunny_ground.obj --ao --transfer 3 --visibility 3 --radiance " + kData +
+                          "/sunset.exr --integrator qmc --samples 256 --threads 1 --chunk-rows 256",
+                      dir_for("kill"), 17);
+}
+
+// ---- FIV bakes: each shell's samples cut into slabs; the shells stop where the rule says ----
+
+namespace {
+// An occluder much smaller than its bounding sphere, so that the stopping rule ends the shells
+// well before the last radius: the spider scaled by 1/1000 (radius ~0.12) and a 0.01-sized
+// triangle 2 away. Written once (temporary name and rename: test processes run in parallel).
+std::string speck_mesh() {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "shards_fiv_mesh", path = dir / "spider_and_speck.obj";
+  if (fs::exists(path)) return path.string();
+  fs::create_directories(dir);
+  std::istringstream in(read_bytes(kData + "/spider.obj"));
+  std::ostringstream out;
+  out.precision(9);
+  size_t vertices = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string tag;
+    words >> tag;
+    if (tag == "v") {
+      double x = 0, y = 0, z = 0;
+      words >> x >> y >> z;
+      out << "v " << 1e-3 * x << " " << 1e-3 * y << " " << 1e-3 * z << "\n";
+      ++vertices;
+    } else if (tag == "f") {
+      out << "f";
+      for (std::string corner; words >> corner;) out << " " << corner.substr(0, corner.find('/'));
+      out << "\n";
+    }
+  }
+  out << "v 2 0 0\nv 2.01 0 0\nv 2 0.01 0\nf " << vertices + 1 << " " << vertices + 2 << " " << vertices + 3 << "\n";
+  const fs::path temp = path.string() + ".tmp." + std::to_string(::getpid());
+  std::ofstream(temp) << out.str();
+  fs::rename(temp, path);
+  return path.string();
+}
+
+// That occluder under studio.exr: the 2x2x6 DifMap's 24 texels in one chunk, then 24x13 = 312
+// samples per shell in slabs of 80 (4 chunks a shell); the rule ends the bake at shell kFivShells
+// of 16.
+std::string fiv_bake(int samples = 256) {
+  return "fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 24x13x16 --fraction 0.01 --cube 2 --samples " +
+         std::to_string(samples) + " --threads 1 --chunk-rows 80 --report 4";
+}
+constexpr int kFivShells = 7;
+constexpr int kFivChunks = 1 + 4 * kFivShells;
+
+// The shells a FIV bake printed it used ("shells: 24x13xK (of 16 ...").
+int shells_used(const std::string& out) {
+  std::smatch m;
+  return std::regex_search(out, m, std::regex(R"(shells: \d+x\d+x(\d+) \(of)")) ? std::stoi(m[1]) : -1;
+}
+} // namespace
+
+TEST(ShardsFiv, ResumeShardWorkersAndMergeGiveTheSingleProcessBytes) {
+  const fs::path dir = dir_for("fiv"), out = dir / "out.prt.h5";
+  const auto single = prtbake(fiv_bake() + " --reproducible -o " + out.string(), dir);
+  ASSERT_EQ(single.code, 0) << single.err;
+  ASSERT_EQ(shells_used(single.out), kFivShells) << single.out;  // the rule stops it before the last radius
+  const std::string ref = read_bytes(out);
+  fs::remove(out);
+
+  const auto r = prtbake(fiv_bake() + " --resume -o " + out.string(), dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "--resume";
+  EXPECT_EQ(resumed_of(r.out).computed, kFivChunks) << r.out;  // one process stops where the rule does
+  EXPECT_EQ(shells_used(r.out), kFivShells) << r.out;
+  EXPECT_TRUE(leftovers(dir, out).empty());
+  fs::remove(out);
+
+  // Static: three workers one after another (the first cannot see the others' shells, so it
+  // computes its chunks of every shell); the merge ignores the shells past the rule's.
+  for (int i = 0; i < 3; ++i) {
+    const auto w = prtbake(fiv_bake() + " --shard " + std::to_string(i) + "/3 -o " + out.string(), dir);
+    ASSERT_EQ(w.code, 0) << w.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  auto m = prtbake(fiv_bake() + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "static --shard I/3 + --merge";
+  EXPECT_TRUE(leftovers(dir, out).empty());
+  fs::remove(out);
+
+  // Dynamic: two workers at once; together they compute every needed chunk once, and stop within
+  // a chunk each of the last shell.
+  const std::string worker = std::string("'") + PRT_PRTBAKE + "' " + fiv_bake() + " -o " + out.string();
+  const std::string both = "(" + worker + " --shard 0/2 --claim dynamic --run-id f1 > " + (dir / "w0").string() +
+                           " & " + worker + " --shard 1/2 --claim dynamic --run-id f1 > " + (dir / "w1").string() +
+                           " & wait) 2>&1";
+  ASSERT_EQ(std::system(both.c_str()), 0);
+  const int c0 = resumed_of(read_bytes(dir / "w0")).computed, c1 = resumed_of(read_bytes(dir / "w1")).computed;
+  EXPECT_GE(c0 + c1, kFivChunks) << c0 << " + " << c1;
+  EXPECT_LE(c0 + c1, kFivChunks + 2) << c0 << " + " << c1;
+  fs::remove(dir / "w0"), fs::remove(dir / "w1");
+  m = prtbake(fiv_bake() + " --merge -o " + out.string(), dir);
+  ASSERT_EQ(m.code, 0) << m.err;
+  EXPECT_TRUE(read_bytes(out) == ref) << "dynamic --shard I/2 + --merge";
+  EXPECT_TRUE(leftovers(dir, out).empty());
+}
+
+// A flipped byte, a chunk of another bake, a missing chunk of a used shell: one line naming it,
+// exit 1, no file.
+TEST(ShardsFiv, MergeRefusesBadChunks) {
+  const fs::path dir = dir_for("fiv_refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
+  const std::string ref = reference(fiv_bake(), out);
+  const std::string args = fiv_bake() + " -o " + out.string();
+  ASSERT_EQ(prtbake(args + " --shard 0/1", dir).code, 0);
+  ASSERT_EQ(committed_chunks(chunks), size_t(kFivChunks));
+  // Another bake's chunks (another k) in a directory of their own.
+  ASSERT_EQ(prtbake(fiv_bake(144) + " -o " + out.string() + " --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
+  expect_bad_chunk_refused(args, dir, "c000005.chunk", ref);  // shell 1's first slab
+}
+
+// A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell, 1 for the DifMap).
+TEST(ShardsFiv, KillNineAndRerunResumes) {
+  kill_nine_and_rerun("fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 40x21x16 --fraction 0.01 --cube 2 "
+                      "--samples 1024 --threads 1 --chunk-rows 210 --report 0",
+                      dir_for("fiv_kill"), 1 + 4 * 13);
+}
 
 #ifdef PRT_MPIRUN
+namespace {
+// `mpirun -n N prtbake ARGS --claim CLAIM -o OUT` in `dir`: its bytes equal `ref`, every rank
+// said it was a worker, nothing left next to the file.
+void expect_mpirun_bytes(const std::string& args, const std::string& ref, int n, const std::string& claim,
+                         const fs::path& dir) {
+  const fs::path out = dir / "out.prt.h5";
+  const std::string cmd = std::string("OMPI_MCA_btl_vader_single_copy_mechanism=none '") + PRT_MPIRUN +
+                          "' --allow-run-as-root --oversubscribe -n " + std::to_string(n) + " '" + PRT_PRTBAKE + "' " +
+                          args + " --claim " + claim + " -o " + out.string() + " > " + (dir / "log").string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string log = read_bytes(dir / "log");
+  ASSERT_EQ(status, 0) << cmd << "\n" << log;
+  EXPECT_TRUE(read_bytes(out) == ref) << args << ", mpirun -n " << n << ", " << claim << " claiming\n" << log;
+  for (int r = 0; r < n; ++r)
+    EXPECT_NE(log.find("worker " + std::to_string(r) + "/" + std::to_string(n) + " (mpirun rank"), std::string::npos)
+        << log;
+  fs::remove(out);
+  fs::remove(dir / "log");
+  EXPECT_TRUE(leftovers(dir, out).empty());
+}
+} // namespace
+
 // mpirun -n 1..4, both integrators, static and dynamic claiming: cmp-identical to the
 // single-process --reproducible bake.
 TEST(Shards, MpirunMatrixIsByteIdentical) {
   const fs::path dir = dir_for("mpirun"), out = dir / "out.prt.h5";
-  const std::string mpirun = std::string("OMPI_MCA_btl_vader_single_copy_mechanism=none '") + PRT_MPIRUN +
-                             "' --allow-run-as-root --oversubscribe -n ";
   for (const std::string integrator : {"qmc", "silhouette"}) {
     const std::string ref = reference(products(integrator), out);
     for (int n = 1; n <= 4; ++n)
-      for (const std::string claim : {"static", "dynamic"}) {
-        const std::string cmd = mpirun + std::to_string(n) + " '" + PRT_PRTBAKE + "' " + products(integrator) +
-                                " --claim " + claim + " -o " + out.string() + " > " + (dir / "log").string() + " 2>&1";
-        const int status = std::system(cmd.c_str());
-        const std::string log = read_bytes(dir / "log");
-        ASSERT_EQ(status, 0) << cmd << "\n" << log;
-        EXPECT_TRUE(read_bytes(out) == ref) << integrator << ", mpirun -n " << n << ", " << claim << " claiming\n" << log;
-        for (int r = 0; r < n; ++r)
-          EXPECT_NE(log.find("worker " + std::to_string(r) + "/" + std::to_string(n) + " (mpirun rank"), std::string::npos)
-              << log;
-        fs::remove(out);
-        fs::remove(dir / "log");
-        EXPECT_TRUE(leftovers(dir, out).empty());
-      }
+      for (const std::string claim : {"static", "dynamic"}) expect_mpirun_bytes(products(integrator), ref, n, claim, dir);
   }
 }
 
 // scene_example.json (three receivers, FIV shells, reports): the receivers' rows sharded under
 // mpirun -n 2 (static claiming) and -n 4 (dynamic); the vertex matrix above covers 1-4 each way.
+// A FIV bake under mpirun -n 1..4, static and dynamic claiming.
+TEST(ShardsFiv, MpirunMatrixIsByteIdentical) {
+  const fs::path dir = dir_for("fiv_mpirun");
+  const std::string ref = reference(fiv_bake(), dir / "out.prt.h5");
+  for (int n = 1; n <= 4; ++n)
+    for (const std::string claim : {"static", "dynamic"}) expect_mpirun_bytes(fiv_bake(), ref, n, claim, dir);
+}
+
 TEST(Shards, MpirunSceneIsByteIdentical) {
   const fs::path dir = dir_for("mpirun_scene"), out = dir / "out.prt.h5";
   const std::string args = "scene " + kData + "/scene_example.json --report 4 --threads 1 --chunk-rows 400";
   const std::string ref = reference(args, out);
-  for (const int n : {2, 4}) {
-    const std::string claim = n == 2 ? "static" : "dynamic";
-    const std::string cmd = std::string("OMPI_MCA_btl_vader_single_copy_mechanism=none '") + PRT_MPIRUN +
-                            "' --allow-run-as-root --oversubscribe -n " + std::to_string(n) + " '" + PRT_PRTBAKE + "' " +
-                            args + " --claim " + claim + " -o " + out.string() + " > " + (dir / "log").string() + " 2>&1";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << "\n" << read_bytes(dir / "log");
-    EXPECT_TRUE(read_bytes(out) == ref) << "scene, mpirun -n " << n << ", " << claim << " claiming\n" << read_bytes(dir / "log");
-    fs::remove(out);
-    fs::remove(dir / "log");
-    EXPECT_TRUE(leftovers(dir, out).empty());
-  }
+  for (const int n : {2, 4}) expect_mpirun_bytes(args, ref, n, n == 2 ? "static" : "dynamic", dir);
 }
 #endif

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <exception>
 #include <random>
+#include <time.h>
 #include <unistd.h>
 
 #ifdef PRT_HAVE_MPI
@@ -102,8 +103,8 @@ void add_shard_options(CLI::App& cmd, ShardOptions& o) {
       ->option_text("static|dynamic")
       ->group(group);
   cmd.add_option("--chunk-rows", o.chunk_rows,
-                 "rows (vertices) per chunk (default " + std::to_string(ShardOptions{}.chunk_rows) +
-                     "); the same for every worker of\na bake, whatever their number.")
+                 "rows per chunk: vertices, or a FIV shell's samples (default " +
+                     std::to_string(ShardOptions{}.chunk_rows) + ");\nthe same for every worker of a bake, whatever their number.")
       ->option_text("R")
       ->check(CLI::Range(uint64_t(1), uint64_t(1) << 30))
       ->group(group);
@@ -217,12 +218,23 @@ Worker resolve_worker(const ShardOptions& o, const MpiSession& mpi) {
   return w;
 }
 
-bake::VertexBake bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
-                            const bake::Integrator& integrator, const bake::Monitor& monitor, uint64_t& closed_form) {
+bake::ChunkData bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
+                           const bake::Integrator& integrator, const bake::Monitor& monitor) {
   const uint64_t before = integrator.stats().closed_form;  // chunks run one at a time in a process
   bake::VertexBake rows = bake::bake_point_rows(points, range.begin, range.end, integrator, monitor);
-  closed_form = integrator.stats().closed_form - before;
-  return rows;
+  bake::ChunkData d;
+  d.closed_form = integrator.stats().closed_form - before;
+  d.values = std::move(rows.values);
+  d.std_error = std::move(rows.std_error);
+  d.cpu_seconds = rows.cpu_seconds;
+  d.seconds = rows.seconds;
+  return d;
+}
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 std::string manifest_of(const std::vector<std::string>& lines) {
@@ -293,16 +305,18 @@ bool ShardedRows::run(const std::function<void()>& body) {
   return w.merges;
 }
 
-void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set) {
+void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set, const LastSet& last_set) {
   State& s = *s_;
   const Worker& w = s.worker;
   if (!w.computes) return;
   const auto& chunks = s.store.chunks();
-  const size_t total = chunks.size();
   const bool say = !s.quiet && w.index == 0;
   const bake::Monitor cancel{{}, &interrupt_token()};
-  for (size_t i = 0; i < total; ++i) {
+  std::optional<uint32_t> last;
+  for (size_t i = 0; i < chunks.size(); ++i) {
     if (set && chunks[i].set != *set) continue;
+    if (last_set && !last) last = last_set();
+    if (last && chunks[i].set > *last) break;  // chunks run set after set
     if (w.claim == Claim::Static && int(i % size_t(w.count)) != w.index) continue;
     if (s.store.committed(i)) {
       // A foreign or corrupt chunk is refused now, before hours of work (static: this worker's
@@ -311,39 +325,48 @@ void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set) {
       continue;
     }
     if (w.claim == Claim::Dynamic && !s.store.claim(i, w.run_id)) continue;
-    bake::ChunkData d;
-    const bake::VertexBake b = compute(chunks[i], cancel, d.closed_form);
+    bake::ChunkData d = compute(chunks[i], cancel);
     d.range = chunks[i];
-    d.width = uint32_t(b.layout.width);
-    d.values = b.values;
-    d.std_error = b.std_error;
-    d.cpu_seconds = b.cpu_seconds;
-    d.seconds = b.seconds;
+    d.width = s.widths.at(chunks[i].set);
     s.store.commit(i, d);
-    ++s.computed, s.rows += chunks[i].rows(), s.busy += b.seconds, s.cpu += b.cpu_seconds;
+    ++s.computed, s.rows += chunks[i].rows(), s.busy += d.seconds, s.cpu += d.cpu_seconds;
     if (say) {
-      const size_t now = s.store.committed_count();
+      // Every worker's committed chunks (the files), against all chunks the bake may need: the
+      // progress and ETA of the whole bake. Until the last set is known (FIV shells), the total
+      // counts every set, and the ETA is an upper bound.
+      size_t now = 0, total = 0;
+      for (size_t c = 0; c < chunks.size(); ++c)
+        if (!last || chunks[c].set <= *last) {
+          ++total;
+          now += s.store.committed(c) ? 1 : 0;
+        }
+      const size_t before = std::min(s.before, now);
       const double elapsed = seconds_since(s.start);
-      const double eta = now > s.before ? elapsed * double(total - now) / double(now - s.before) : 0.0;
-      std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %.0f s\n", i, now, total, elapsed, eta);
+      const double eta = now > before ? elapsed * double(total - now) / double(now - before) : 0.0;
+      std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %s%.0f s\n", i, now, total, elapsed,
+                  last_set && !last ? "at most " : "", eta);
       std::fflush(stdout);
     }
   }
 }
 
-bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form) const {
+bool ShardedRows::complete(uint32_t set) const {
+  const auto& chunks = s_->store.chunks();
+  for (size_t i = 0; i < chunks.size(); ++i)
+    if (chunks[i].set == set && !s_->store.committed(i)) return false;
+  return true;
+}
+
+bake::ChunkData ShardedRows::join(uint32_t set) const {
   const State& s = *s_;
   const auto& chunks = s.store.chunks();
-  const size_t W = layout.width;
-  PRT_CHECK_OP(s.widths.at(set), ==, W);
-  bake::VertexBake out;
-  out.layout = layout;
-  uint64_t rows = 0;
+  const size_t W = s.widths.at(set);
+  bake::ChunkData out;
+  out.width = uint32_t(W);
+  out.range.set = set;
   for (const bake::ChunkRange& c : chunks)
-    if (c.set == set) rows = std::max(rows, c.end);
-  out.values.assign(rows * W, 0.0);
-  out.std_error.assign(rows * W, 0.0);
-  if (closed_form) *closed_form = 0;
+    if (c.set == set) out.range.end = std::max(out.range.end, c.end);
+  out.values.assign(out.range.end * W, 0.0);
   for (size_t i = 0; i < chunks.size(); ++i) {
     if (chunks[i].set != set) continue;
     const std::optional<bake::ChunkData> d = s.store.read(i, uint32_t(W));
@@ -352,11 +375,28 @@ bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& lay
                              "missing chunk " + std::to_string(i) + " (rows " + std::to_string(chunks[i].begin) + "-" +
                                  std::to_string(chunks[i].end) + "): no worker committed it; rerun the bake to compute it");
     std::copy(d->values.begin(), d->values.end(), out.values.begin() + ptrdiff_t(chunks[i].begin * W));
-    std::copy(d->std_error.begin(), d->std_error.end(), out.std_error.begin() + ptrdiff_t(chunks[i].begin * W));
+    if (!d->std_error.empty()) {
+      out.std_error.resize(out.values.size());
+      std::copy(d->std_error.begin(), d->std_error.end(), out.std_error.begin() + ptrdiff_t(chunks[i].begin * W));
+    }
     out.seconds += d->seconds;
     out.cpu_seconds += d->cpu_seconds;
-    if (closed_form) *closed_form += d->closed_form;
+    out.closed_form += d->closed_form;
   }
+  return out;
+}
+
+bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form) const {
+  PRT_CHECK_OP(s_->widths.at(set), ==, layout.width);
+  bake::ChunkData d = join(set);
+  bake::VertexBake out;
+  out.layout = layout;
+  out.values = std::move(d.values);
+  out.std_error = std::move(d.std_error);
+  out.std_error.resize(out.values.size());  // a vertex bake's chunks all hold them
+  out.seconds = d.seconds;
+  out.cpu_seconds = d.cpu_seconds;
+  if (closed_form) *closed_form = d.closed_form;
   return out;
 }
 

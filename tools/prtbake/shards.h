@@ -17,6 +17,13 @@
 // the next unclaimed chunk (claim files of this run, bake/chunks.h). A run is one launch: mpirun
 // (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
 // another run are stale by definition, so a rerun recomputes what a dead run claimed.
+// FIV bakes: row set 0 is the DifMap's texels, row set 1 + k shell k's samples, each cut into
+// slabs of rows. Where the shells stop depends on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
+// after shell without waiting for each other and read the stopping rule from committed chunks:
+// once a complete shell meets it, no worker starts a chunk beyond it. A worker ahead of the
+// others may compute chunks past the last shell while that shell is not complete (about one
+// chunk per worker when they keep pace); the merge evaluates the rule shell by shell from the
+// chunks, as the single-process bake does, and ignores those.
 // Sharded bakes are always reproducible (--reproducible is implied): the merged file cannot hold
 // one wall time of many workers, and a target error's choice must be the same on every worker.
 #pragma once
@@ -95,17 +102,25 @@ public:
               const std::string& manifest, const std::vector<uint64_t>& set_rows, std::vector<uint32_t> set_widths,
               bool quiet);
   ~ShardedRows();
-  // Rows [range.begin, range.end) of set range.set (`monitor` cancels on Ctrl-C) and their
-  // IntegratorStats::closed_form.
-  using Compute = std::function<bake::VertexBake(const bake::ChunkRange&, const bake::Monitor& monitor,
-                                                 uint64_t& closed_form)>;
+  // The rows [range.begin, range.end) of set range.set (`monitor` cancels on Ctrl-C): values,
+  // standard errors (or none), counters and times; work() fills in the range and the width.
+  using Compute = std::function<bake::ChunkData(const bake::ChunkRange&, const bake::Monitor& monitor)>;
+  // The last row set the bake needs, once known (FIV shells: the first shell that meets the
+  // stopping rule, read from committed chunks); nullopt while every set may be needed.
+  using LastSet = std::function<std::optional<uint32_t>()>;
   // Runs `body`, which calls work() for the rows (not with --merge), then, under mpirun, waits
   // for every rank (an error in any rank stops the merge). Returns whether this process merges.
   bool run(const std::function<void()>& body);
-  // Computes and commits this worker's uncommitted chunks (of set `set` only, when given).
-  void work(const Compute& compute, std::optional<uint32_t> set = std::nullopt);
+  // Computes and commits this worker's uncommitted chunks (of set `set` only, when given; of the
+  // sets up to last_set() only, asked before each chunk, when given).
+  void work(const Compute& compute, std::optional<uint32_t> set = std::nullopt, const LastSet& last_set = {});
+  // Whether every chunk of set `set` has been committed (not verified).
+  bool complete(uint32_t set) const;
   // Every chunk of set `set`, verified (InputError naming a missing, corrupt or foreign chunk),
-  // joined into one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
+  // joined in row order: values (and standard errors when the chunks hold them), counters and
+  // times summed.
+  bake::ChunkData join(uint32_t set) const;
+  // join() as one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
   bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
   // After the file is written: removes the chunk directory.
   void finish() const;
@@ -115,9 +130,12 @@ private:
   std::unique_ptr<State> s_;
 };
 
-// Rows [range.begin, range.end) of `points` (bake_point_rows) and their closed-form count.
-bake::VertexBake bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
-                            const bake::Integrator& integrator, const bake::Monitor& monitor, uint64_t& closed_form);
+// Rows [range.begin, range.end) of `points` (bake_point_rows) with their closed-form count.
+bake::ChunkData bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
+                           const bake::Integrator& integrator, const bake::Monitor& monitor);
+
+// This process's CPU time in seconds, all threads (CLOCK_PROCESS_CPUTIME_ID).
+double process_cpu_seconds();
 
 // The SHA-256 of the lines that determine a bake's rows (inputs' digests, options, integrator,
 // seed, chunk size).

@@ -8,7 +8,8 @@
 //   order, set after set; chunk i is the i-th range. Every row is a pure function of the inputs,
 //   the seed and its global index (bake/vertex_bake.h bake_point_rows), so any assignment of
 //   chunks to workers gives the same numbers.
-// - A chunk file holds the range, the rows ([rows][width] values and standard errors), the
+// - A chunk file holds the range, the rows ([rows][width] values and, when the bake has them,
+//   standard errors), the
 //   integrator's work counters over them and the bake's MANIFEST (a SHA-256 of everything the
 //   rows depend on, computed by the caller), and ends with the SHA-256 of the bytes before it.
 //   It is written under a temporary name, fsync'd and renamed (then the directory fsync'd): a
@@ -44,7 +45,8 @@ std::vector<ChunkRange> row_chunks(std::span<const uint64_t> set_rows, uint64_t 
 struct ChunkData {
   ChunkRange range;
   uint32_t width = 0;
-  std::vector<double> values, std_error;  // [rows][width]
+  std::vector<double> values;             // [rows][width]
+  std::vector<double> std_error;          // [rows][width], or empty (a bake without errors)
   uint64_t closed_form = 0;               // IntegratorStats::closed_form over these rows
   double cpu_seconds = 0, seconds = 0;    // integrator CPU time and wall time of the chunk
 };

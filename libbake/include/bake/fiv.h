@@ -34,6 +34,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -49,6 +51,11 @@ Fiv environment_fiv(const EnvMap& env);
 // UnshadowedIrradiance (texels cut by the horizon of n integrated with 4×4 sub-samples, the rest
 // with their ∫_texel ω dω) at gl_cube_direction, rounded to float.
 std::vector<float> irradiance_cube(const EnvMap& env, int size);
+// Texels [begin, end) of irradiance_cube(env, size) (texel (face·S + row)·S + column), [end −
+// begin][3], from `irradiance`, an UnshadowedIrradiance of env: the same floats, for a DifMap cut
+// into chunks.
+class UnshadowedIrradiance;
+std::vector<float> irradiance_cube_texels(const UnshadowedIrradiance& irradiance, int size, size_t begin, size_t end);
 // The same sum texel by texel for every normal (UnshadowedIrradiance::reference, no cell
 // hierarchy): the slow reference of irradiance_cube, equal to it up to summation order. Needs a
 // map with texels.
@@ -92,6 +99,41 @@ void bounding_sphere(const Mesh& mesh, Eigen::Vector3d& centre, double& radius);
 
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
                           const Monitor& monitor = {});
+
+// The shell bake as rows, for bakes cut into chunks (sharded and resumable bakes): bake_fiv_shells
+// is this class's rows shell after shell, stopping where stops_after() says, so any cut of the
+// shells' rows gives the same numbers. Row r of shell k is grid sample r = i·Nφ + j, kRowWidth
+// doubles: the occluded FIV rounded to float (9), valid (0 or 1) and the sample's stopping
+// ratio max_c |F_c| / ∫ L_c dω (0 inside the geometry).
+class FivShellRows {
+public:
+  static constexpr size_t kRowWidth = 11;
+  // integrate = false: the frame, radii and stopping rule only (a merge of committed rows), no
+  // integrator built; rows() is then a contract error.
+  FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+               bool integrate = true);
+  ~FivShellRows();
+  int shell_count() const { return int(radii_.size()); }  // spec.n_rho: the most the bake can use
+  size_t rows_per_shell() const;
+  double radius(int shell) const { return radii_.at(size_t(shell)); }
+  // Rows [begin, end) of shell `shell`, [end − begin][kRowWidth]; one task->advance() per row
+  // when given (Cancelled on a cancel request).
+  std::vector<double> rows(int shell, size_t begin, size_t end, Task* task = nullptr) const;
+  // Whether the bake ends with shell `shell`, whose rows (all of them) are `rows`: outside the
+  // bounding sphere (may_stop_after) and every sample's ratio below spec.fraction.
+  bool may_stop_after(int shell) const;
+  bool stops_after(int shell, std::span<const double> rows) const;
+  // Appends shell `shell` (all its rows) to `shells`, which starts as empty_shells().
+  void append(FivShells& shells, int shell, std::span<const double> rows) const;
+  FivShells empty_shells() const;  // the frame (centre, radius, grid) without shells
+
+private:
+  ShellSpec spec_;
+  FivShells frame_;
+  std::vector<double> radii_;
+  double env_norm_[3] = {0, 0, 0};
+  std::unique_ptr<const SilhouetteIntegrator> integrator_;
+};
 
 // The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1}
 // in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
