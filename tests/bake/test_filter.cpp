@@ -204,9 +204,28 @@ TEST(Filter, LayersFacingAwayDoNotLeak) {
   std::vector<uint32_t> rows;
   for (uint32_t v = 0; v < n; ++v) rows.push_back(v);
   const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
-  // The upper sheet under the box (measured: RMSE 0.017, max 0.058).
+  // The upper sheet under the box (measured: RMSE 0.015, max 0.045).
   EXPECT_LT(e.rmse, 0.035);
   EXPECT_LT(e.max, 0.12);
+}
+
+TEST(Filter, SlotDoesNotTakeTheSkyOfNeighboursOutside) {
+  // A slab 3 cm above a ground grid (spacing 1/12) covers x < 0: a ground vertex 3+ grid steps
+  // inside the slot sees the sky only below ~7° towards +x, while its neighbours within the search
+  // radius (3 spacings) outside the slot see most of it. Sparse rays leave most of its cells
+  // without an occluder sample; those cells must not take the outside neighbours' sky.
+  const Mesh ground = grid(12, 1.0f);
+  const Scene s(merged({ground, box({-1.2f, -1.2f, 0.03f}, {0.0f, 1.2f, 0.1f})}));
+  ProductRequest r;
+  r.ao = true;
+  const VertexBake b = bake_filter(s, r, {});
+  std::vector<uint32_t> rows;
+  for (uint32_t v = 0; v < ground.positions.size(); ++v)
+    if (s.points[v].p.x() <= -0.25 && std::abs(s.points[v].p.y()) < 0.8) rows.push_back(v);
+  const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
+  // Measured: RMSE 0.0050, max 0.017 (0.017 and 0.090 when those cells took the outside sky).
+  EXPECT_LT(e.rmse, 0.01);
+  EXPECT_LT(e.max, 0.035);
 }
 
 TEST(Filter, ThinSlats) {
@@ -223,7 +242,7 @@ TEST(Filter, ThinSlats) {
   const VertexBake b = bake_filter(s, r, {});
   const std::vector<uint32_t> rows = seeded_sample(uint32_t(s.points.size()), 600, 3);
   const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
-  EXPECT_LT(e.rmse, 0.04);  // measured: RMSE 0.020, max 0.063
+  EXPECT_LT(e.rmse, 0.04);  // measured: RMSE 0.019, max 0.051
   EXPECT_LT(e.max, 0.13);
 }
 
@@ -238,7 +257,7 @@ TEST(Filter, CubeEdgeCrease) {
   const VertexBake b = bake_filter(s, r, {});
   const std::vector<uint32_t> rows = all_rows(s);
   const Errors e = ao_errors(b, rows, qmc_ao(s, rows, 4096));
-  EXPECT_LT(e.rmse, 0.025);  // measured: RMSE 0.012, max 0.079 (the crease's own vertices: exact ring)
+  EXPECT_LT(e.rmse, 0.025);  // measured: RMSE 0.010, max 0.047 (the crease's own vertices: exact ring)
   EXPECT_LT(e.max, 0.15);
 }
 
@@ -249,7 +268,7 @@ TEST(Filter, ErrorFallsWithPassOneRays) {
   r.ao = true;
   const std::vector<uint32_t> rows = all_rows(s);
   const std::vector<double> ref = qmc_ao(s, rows, 4096);
-  // Measured: 0.0198, 0.0186, 0.0177, 0.0163 (deterministic at the default seed).
+  // Measured: 0.0175, 0.0172, 0.0165, 0.0149 (deterministic at the default seed).
   double previous = 1, first = 0;
   for (uint32_t rays : {4u, 8u, 16u, 32u}) {
     FilterOptions o;
@@ -277,7 +296,7 @@ TEST(Filter, BunnyContactShadow) {
     if (ref[i] < 0.8) rows.push_back(sample[i]), shadow.push_back(ref[i]);
   ASSERT_GT(rows.size(), 20u);
   const Errors e = ao_errors(b, rows, shadow);
-  EXPECT_LT(e.rmse, 0.05);  // measured: RMSE 0.024, max 0.118
+  EXPECT_LT(e.rmse, 0.05);  // measured: RMSE 0.019, max 0.063
   EXPECT_LT(e.max, 0.2);
 }
 
