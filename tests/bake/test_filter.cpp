@@ -162,6 +162,26 @@ TEST(Filter, ZeroRadiusIsTheStratifiedEstimatorBitForBit) {
   EXPECT_EQ(cold.stats().unprepared, 1u);
 }
 
+TEST(Filter, StatsCountNeighboursAndFilteredSamples) {
+  const Scene s = ground_and_box();
+  const FilterIntegrator f(s.mesh, s.topo, ao_t3_u3(), {});
+  bake_points(s.points, f);
+  const IntegratorStats st = f.stats();
+  EXPECT_EQ(st.points, s.points.size());
+  EXPECT_GE(st.neighbours, st.points);  // every receiver counts itself
+  // A filtered cell holds filter weight ≥ min_weight (2) and each sample weighs at most 1.
+  EXPECT_GT(st.cells, st.brute_cells);
+  EXPECT_GE(st.samples_per_filtered_cell(), 2.0);
+  EXPECT_NE(f.work_summary().find("brute-forced"), std::string::npos);
+  FilterOptions o;
+  o.radius_factor = 0;  // no filtering: no neighbours, no filtered cell
+  const FilterIntegrator g(s.mesh, s.topo, ao_t3_u3(), o);
+  bake_points(s.points, g);
+  EXPECT_EQ(g.stats().neighbours, 0u);
+  EXPECT_EQ(g.stats().filtered_samples, 0u);
+  EXPECT_EQ(g.stats().samples_per_filtered_cell(), 0.0);
+}
+
 TEST(Filter, EnclosedVertexIsExactlyDark) {
   // A small grid inside a closed box: every ray hits.
   const Scene s(merged({grid(3, 0.3f), box({-1, -1, -1}, {1, 1, 1})}));
