@@ -6,6 +6,11 @@
 //                                    bunny_ground wuson spider): filter at 8-32 pass-1 rays, QMC at
 //                                    32-256 rays, each against a converged reference (QMC, 2^16
 //                                    rays per vertex on 256 seeded vertices).
+//   bench_filter diagnose [names...] the filter's error split into bias and noise over 6 seeds
+//                                    (default: bunny_ground), with its neighbours and samples per
+//                                    filtered cell, next to the same with every brute-forced cell
+//                                    at 256 rays (its share of the error; PRT_DIAGNOSE_QUICK=1
+//                                    skips it and QMC) and QMC at 32 and 256 rays.
 //   bench_filter grass [blades]      the paper's use case: a generated field of grass blades (4
 //                                    triangles each; default 250,000 blades = 1M triangles) on a
 //                                    2 m ground grid of 512² quads, AO of the ground's 263,169
@@ -84,6 +89,8 @@ FilterOptions tuned() {
 
 struct Result {
   double ao_rmse = 0, ao_max = 0, t_rmse = 0, cpu = 0, rays = 0, brute = 0;
+  double neighbours = 0, cell_samples = 0;  // the filter's: per point, per filtered cell
+  std::vector<double> values;               // [rows][W]
 };
 
 // Errors of rows (values: [rows][W]) against the reference (same layout; AO first, then T).
@@ -102,8 +109,7 @@ void errors(const std::vector<double>& values, const std::vector<double>& ref, s
 
 // The filter bakes every vertex (it needs the neighbours' rays); errors on `rows`.
 Result run_filter(const Asset& a, const ProductRequest& req, uint32_t rays, const std::vector<uint32_t>& rows,
-                  const std::vector<double>& ref) {
-  FilterOptions o = tuned();
+                  const std::vector<double>& ref, FilterOptions o = tuned()) {
   o.rays = rays;
   const double c0 = process_cpu_seconds();
   const FilterIntegrator f(a.mesh, a.topo, req, o);
@@ -124,6 +130,9 @@ Result run_filter(const Asset& a, const ProductRequest& req, uint32_t rays, cons
   const IntegratorStats s = f.stats();
   r.rays = s.rays_per_point();
   r.brute = s.brute_fraction();
+  r.neighbours = s.neighbours_per_point();
+  r.cell_samples = s.samples_per_filtered_cell();
+  r.values = std::move(values);
   return r;
 }
 
@@ -137,6 +146,7 @@ Result run_rows(const Asset& a, const Integrator& integ, const std::vector<uint3
   r.cpu = (process_cpu_seconds() - c0) * double(a.points.size()) / double(rows.size());
   errors(v, ref, integ.layout().width, transfer, r);
   r.rays = rays;
+  r.values = v;
   return r;
 }
 
@@ -162,6 +172,82 @@ void assets(std::vector<std::string> names) {
     for (uint32_t rays : {32u, 64u, 128u, 256u}) {
       const QmcIntegrator q(a.mesh, a.topo, req, {rays, 1});
       print("qmc", std::to_string(rays), run_rows(a, q, rows, ref, true, rays));
+    }
+  }
+}
+
+// The error of `runs` (one per seed) split into bias and noise, per vertex of the reference: the
+// mean over seeds m_i and the spread s_i² (unbiased); noise = √mean s_i², bias = √(mean (m_i −
+// ref_i)² − noise²/S) (the mean's own noise removed). AO column 0 and the transfer columns.
+void split(const char* name, const std::string& knob, const std::vector<Result>& runs, const std::vector<double>& ref,
+           size_t W) {
+  const size_t n = ref.size() / W, S = runs.size();
+  double bias2[2] = {0, 0}, noise2[2] = {0, 0}, rmse[2] = {0, 0}, mean_ao = 0;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t k = 0; k < W; ++k) {
+      double m = 0, e2 = 0;
+      for (const Result& r : runs) m += r.values[i * W + k] / double(S);
+      double v = 0;
+      for (const Result& r : runs) {
+        v += (r.values[i * W + k] - m) * (r.values[i * W + k] - m) / double(S - 1);
+        e2 += (r.values[i * W + k] - ref[i * W + k]) * (r.values[i * W + k] - ref[i * W + k]) / double(S);
+      }
+      const size_t j = k == 0 ? 0 : 1;
+      if (k == 0) mean_ao += (m - ref[i * W]) / double(n);
+      bias2[j] += (m - ref[i * W + k]) * (m - ref[i * W + k]) - v / double(S);
+      noise2[j] += v;
+      rmse[j] += e2;
+    }
+  const double na = double(n), nt = double(n * (W - 1));
+  double rays = 0, brute = 0, nb = 0, cs = 0;
+  for (const Result& r : runs) rays += r.rays / double(S), brute += r.brute / double(S), nb += r.neighbours / double(S),
+                               cs += r.cell_samples / double(S);
+  std::printf("  %-10s %-22s rays/pt %6.1f brute %4.1f%% nbrs %5.1f smp/cell %5.1f | AO rmse %.4f bias %.4f noise "
+              "%.4f mean %+.4f | T rmse %.4f bias %.4f noise %.4f\n",
+              name, knob.c_str(), rays, 100 * brute, nb, cs, std::sqrt(rmse[0] / na), std::sqrt(std::max(0.0, bias2[0] / na)),
+              std::sqrt(noise2[0] / na), mean_ao, std::sqrt(rmse[1] / nt), std::sqrt(std::max(0.0, bias2[1] / nt)),
+              std::sqrt(noise2[1] / nt));
+  std::fflush(stdout);
+}
+
+// Bias and noise of the filter (and QMC) over 6 seeds; variants from the environment as in tuned().
+void diagnose(std::vector<std::string> names) {
+  if (names.empty()) names = {"bunny_ground"};
+  ProductRequest req;
+  req.ao = true;
+  req.transfer_order = 3;
+  constexpr uint64_t kSeeds = 6;
+  for (const std::string& name : names) {
+    const Asset a(load_mesh(std::filesystem::path(PRT_DATA_DIR) / (name + ".obj")));
+    const std::vector<uint32_t> rows = seeded_sample(uint32_t(a.points.size()), 256, 11);
+    const QmcIntegrator reference(a.mesh, a.topo, req, {65536, 12345});
+    const std::vector<double> ref = integrate_rows(a, reference, rows, 1u << 30);
+    const size_t W = reference.layout().width;
+    std::printf("%s: %zu vertices; %llu seeds\n", name.c_str(), a.points.size(), (unsigned long long)kSeeds);
+    const auto variant = [&](const std::string& label, uint32_t rays, FilterOptions o) {
+      std::vector<Result> runs;
+      for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+        o.seed = seed;
+        runs.push_back(run_filter(a, req, rays, rows, ref, o));
+      }
+      split("filter", std::to_string(rays) + " " + label, runs, ref, W);
+    };
+    const bool exact_cells = !std::getenv("PRT_DIAGNOSE_QUICK");  // brute cells at 256 rays: slow
+    for (uint32_t rays : {8u, 16u, 32u}) {
+      variant("", rays, tuned());
+      if (!exact_cells) continue;
+      FilterOptions exact = tuned();
+      exact.fallback_rays = 256;
+      variant("brute@256", rays, exact);
+    }
+    for (uint32_t rays : {32u, 256u}) {
+      if (!exact_cells) break;
+      std::vector<Result> runs;
+      for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+        const QmcIntegrator q(a.mesh, a.topo, req, {rays, seed});
+        runs.push_back(run_rows(a, q, rows, ref, true, rays));
+      }
+      split("qmc", std::to_string(rays), runs, ref, W);
     }
   }
 }
@@ -271,6 +357,8 @@ int main(int argc, char** argv) {
   const std::string what = argc > 1 ? argv[1] : "assets";
   if (what == "assets") {
     assets(std::vector<std::string>(argv + std::min(argc, 2), argv + argc));
+  } else if (what == "diagnose") {
+    diagnose(std::vector<std::string>(argv + std::min(argc, 2), argv + argc));
   } else if (what == "grass" || what == "grille") {
     const bool g = what == "grass";
     const uint32_t n = argc > 2 ? uint32_t(std::stoul(argv[2])) : g ? 250000u : 256u;
@@ -278,7 +366,7 @@ int main(int argc, char** argv) {
     Mesh mesh = g ? grass(n) : grille(n);
     ground_scene(what.c_str(), std::move(mesh), process_cpu_seconds() - c0);
   } else {
-    std::fprintf(stderr, "usage: bench_filter assets [names...] | grass [blades] | grille [bars]\n");
+    std::fprintf(stderr, "usage: bench_filter assets|diagnose [names...] | grass [blades] | grille [bars]\n");
     return 2;
   }
   return 0;

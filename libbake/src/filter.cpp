@@ -29,6 +29,9 @@ constexpr int kSpacingNeighbours = 6;                 // local vertex spacing: m
 constexpr double kContactSpacings = 0.5;             // an own ray blocked nearer than d/2: contact
 // Directions probed per cell for contact: the centre and four points near the corners.
 constexpr std::pair<double, double> kCellProbes[] = {{0.5, 0.5}, {0.02, 0.02}, {0.02, 0.98}, {0.98, 0.02}, {0.98, 0.98}};
+// A brute-forced cell in which the neighbours' samples saw both sky and occluder holds a visibility
+// edge: it gets this many times the fallback rays (one binary ray there is most of the noise).
+constexpr uint32_t kEdgeFallbackFactor = 4;
 constexpr uint64_t kFallbackSalt = 0x66616c6c6261636bull;
 
 // ---- a k-d tree over the prepared points (implicit: the median of each range splits it) ------
@@ -307,6 +310,9 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
   }
   std::array<bool, C> brute;
   brute.fill(true);
+  std::array<uint32_t, C> counts{};  // samples with a non-zero filter weight per cell
+  std::array<uint8_t, C> seen{};     // per cell: 1 a sample escaped, 2 a sample met an occluder
+  uint64_t n_neighbours = 0;
 
   std::optional<NearTriangles> near;  // computed when needed
   const Prepared* prep = prepared_.get();
@@ -325,6 +331,7 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
       if (q == point_index || (sq.n.dot(n) >= kMinNormalCos && std::abs(e.dot(n)) <= kMaxPlaneSlope * e.norm()))
         neighbours.push_back(q);
     });
+    n_neighbours = neighbours.size();
     auto local_cell = [&](const Vector3d& v) {
       return HemisphereCells::cell_of(Vector3d(frame.t.dot(v), frame.b.dot(v), n.dot(v)));
     };
@@ -350,12 +357,15 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
         zmin[c] = std::min(zmin[c], z);
         zmax[c] = std::max(zmax[c], z);
       }
+    // The nearest occluder p's own rays met: a cell in which no sample met an occluder may still
+    // hold one that near (a vertex in a slot sees the far wall with its own rays; its neighbours
+    // outside the slot see the sky), so that cell's radius is eq. 8 for [z_near, ∞] (below).
+    double z_near = kInf;
+    for (const Sample& s : pass1(point_index)) z_near = std::min(z_near, double(s.t));
     // A receiver whose own rays met an occluder at distance ~0 (its 1-ring or a near triangle: a
     // crease, a contact, a face lying on it) sits where its neighbours' rays cannot speak for it:
     // every cell in which those triangles block the centre or a corner direction is brute-forced.
-    bool contact = false;
-    for (const Sample& s : pass1(point_index)) contact = contact || double(s.t) < kContactSpacings * d;
-    if (contact) {
+    if (z_near < kContactSpacings * d) {
       near = rays_->near_triangles(point);
       for (int c = 0; c < C; ++c)
         for (const auto& [u0, u1] : kCellProbes)
@@ -368,8 +378,11 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
     // close an occluder (Ω_v / z_min > Ω_pix) brute-forces the cell.
     const double omega_pix = d > 0 ? 0.5 / d : kInf;
     for (size_t c = 0; c < size_t(C); ++c) {
-      radius_c[c] = mid[c] = kInf;  // no occluder seen: one depth, at infinity
-      if (zmin[c] == kInf) continue;
+      radius_c[c] = mid[c] = kInf;  // no occluder seen: its escaped rays at infinity
+      if (zmin[c] == kInf) {
+        radius_c[c] = z_near / options_.omega_v;
+        continue;
+      }
       brute[c] = options_.omega_v / zmin[c] > omega_pix;
       const double spread = 1 / zmin[c] - 1 / zmax[c];
       if (spread > 0) radius_c[c] = 1 / (options_.omega_v * spread);
@@ -407,26 +420,34 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
           x = (o - (o.dot(v) / dv) * dir).norm();
         }
         const size_t c = size_t(local_cell(v));
+        seen[c] |= occluded ? 2 : 1;
         if (brute[c]) continue;
         const double r = x / radius_c[c];
         if (!(r < 1)) continue;
         const double w = (1 - r * r) * (1 - r * r);
         cells_.integrands(n, v, y, f);
         sums[c].add(w, !occluded, f);
+        ++counts[c];
       }
     }
     for (size_t c = 0; c < size_t(C); ++c) brute[c] = brute[c] || sums[c].w < options_.min_weight;
   }
 
-  // Brute-forced cells (§5): fallback_rays stratified rays in the cell, distributed as (n·ω).
-  uint64_t n_brute = 0;
+  // Brute-forced cells (§5): fallback_rays stratified rays in the cell, distributed as (n·ω), or
+  // kEdgeFallbackFactor times as many where the neighbours' samples saw a visibility edge.
+  uint64_t n_brute = 0, n_filtered = 0, n_fallback = 0;
   for (int c = 0; c < C; ++c) {
-    if (!brute[size_t(c)]) continue;
+    if (!brute[size_t(c)]) {
+      n_filtered += counts[size_t(c)];
+      continue;
+    }
     ++n_brute;
     if (!near) near = rays_->near_triangles(point);
     CellSums& cell = sums[size_t(c)];
     cell.clear();
-    for (uint32_t i = 0; i < options_.fallback_rays; ++i) {
+    const uint32_t m = seen[size_t(c)] == 3 ? kEdgeFallbackFactor * options_.fallback_rays : options_.fallback_rays;
+    n_fallback += m;
+    for (uint32_t i = 0; i < m; ++i) {
       const Vector3d v = frame.to_world(fallback_direction(point_index, c, i)).normalized();
       cells_.integrands(n, v, y, f);
       cell.add(1.0, rays_->visible(point, *near, v), f);
@@ -467,7 +488,9 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
   points_.fetch_add(1, std::memory_order_relaxed);
   cells_total_.fetch_add(C, std::memory_order_relaxed);
   brute_cells_.fetch_add(n_brute, std::memory_order_relaxed);
-  fallback_rays_.fetch_add(n_brute * options_.fallback_rays, std::memory_order_relaxed);
+  fallback_rays_.fetch_add(n_fallback, std::memory_order_relaxed);
+  neighbours_.fetch_add(n_neighbours, std::memory_order_relaxed);
+  filtered_samples_.fetch_add(n_filtered, std::memory_order_relaxed);
 }
 
 IntegratorStats FilterIntegrator::stats() const {
@@ -478,7 +501,23 @@ IntegratorStats FilterIntegrator::stats() const {
   s.cells = cells_total_.load();
   s.brute_cells = brute_cells_.load();
   s.unprepared = unprepared_.load();
+  s.neighbours = neighbours_.load();
+  s.filtered_samples = filtered_samples_.load();
   return s;
+}
+
+std::string FilterIntegrator::work_summary() const {
+  const IntegratorStats s = stats();
+  const double points = double(std::max<uint64_t>(s.points, 1));
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(1);
+  os << "per point " << s.rays_per_point() << " rays (" << double(s.pass1_rays) / points << " pass-1 + "
+     << double(s.fallback_rays) / points << " fallback); " << 100 * s.brute_fraction()
+     << "% of cells brute-forced; " << s.neighbours_per_point() << " neighbours, " << s.samples_per_filtered_cell()
+     << " samples per filtered cell";
+  if (s.unprepared) os << "; " << s.unprepared << " points unprepared";
+  return os.str();
 }
 
 } // namespace prt::bake

@@ -662,6 +662,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
                   100 * st.integrate_seconds / std::max(1e-12, st.contour_seconds + st.integrate_seconds));
     }
     std::printf(")\n");
+    if (const std::string work = integrator.work_summary(); !work.empty()) std::printf("%s\n", work.c_str());
     std::printf("threads busy %.0f%% of the bake (%.2f CPU s in the integrator over %.2f s on %d threads)\n",
                 100 * result.busy_fraction(), result.cpu_seconds, result.seconds, result.threads);
   }

@@ -22,9 +22,12 @@
 //     (Algorithm 1 lines 1-10: hit points in p's hemisphere, binned by the effective direction
 //     from p to the hit);
 //   - per cell, eq. 8 with Ω_pix = 0.5/d (§3.3) gives the spatial radius
-//     r = d · primalScale = [Ω_v (1/z_min − 1/z_max)]⁻¹ (unbounded when the cell saw one depth or
-//     none: the search radius bounds it), and eq. 9 the mid depth, the harmonic mean of z_min and
-//     z_max (§5). A cell with Ω_v / z_min > Ω_pix (occluders closer than 4d for Ω_v = 2: contact
+//     r = d · primalScale = [Ω_v (1/z_min − 1/z_max)]⁻¹ (unbounded when the cell saw one depth:
+//     the search radius bounds it; a cell where no sample met an occluder gets eq. 8 for
+//     [z_near, ∞], r = z_near / Ω_v, z_near the nearest hit of the receiver's own pass-1 rays:
+//     sparse rays miss occluders, and a vertex in a slot whose own rays meet the far wall must not
+//     take the sky its neighbours outside the slot see), and eq. 9 the mid depth, the harmonic
+//     mean of z_min and z_max (§5). A cell with Ω_v / z_min > Ω_pix (occluders closer than 4d for Ω_v = 2: contact
 //     shadows, creases) is brute-forced (§3.3);
 //   - every neighbour sample gets a target point (§4, Fig. 6): its hit point, or for a ray that
 //     escaped, its crossing of the plane at the mid depth of the cell its direction falls in,
@@ -39,8 +42,10 @@
 //     rays start on the other side of that occluder (the floor beside a wall) and cannot speak
 //     for it;
 //   - cells with total weight below 2 (§5: "approximately 2 samples") are brute-forced too:
-//     `fallback_rays` stratified rays inside the cell (the paper shot one), joined by the
-//     receiver's own pass-1 rays that fell in the cell (they need no filter).
+//     `fallback_rays` stratified rays inside the cell (the paper shot one), four times as many in
+//     a cell where the neighbours' samples (whatever their weight) saw both sky and an occluder
+//     (a visibility edge: one binary ray there is most of the noise), joined by the receiver's
+//     own pass-1 rays that fell in the cell (they need no filter).
 //
 // The estimate per cell c (solid angle Ω_c, integrand f of a product: (n·ω)/π for AO, (n·ω) y_i/π
 // for diffuse transfer, y_i for visibility transfer) uses the weighted visible fraction ν_c, the
@@ -62,12 +67,15 @@
 // the description says so. Full-sphere points (ShadePoint::hemisphere false) are a contract
 // error: hemisphere products only (the FIV shells use the silhouette integrator).
 //
-// Where it loses (measured, bench/bench_filter.cpp): its error is mostly the noise of a few
-// binary samples per cell plus the 1-ray brute-forced cells, so at ≤ 32 rays per point it beats
-// QMC at the same rays but not QMC at 256; on dense foliage most cells are brute-forced (the
-// occluders are within 4d) and it is slower than QMC at equal error. Receivers enclosed by an
-// occluder that stands on their own surface, farther than d/2 (ground vertices inside a box
-// standing on the ground) take light from neighbours outside it within the search radius.
+// Where it loses (measured, bench/bench_filter.cpp `diagnose`: bias and noise over 6 seeds): on
+// coarse meshes (a few thousand vertices: ~28 neighbours on the bunny, 8 on wuson, 4 on spider)
+// every occluder within 4d brute-forces its cell, and a 1-ray cell is binary noise (on the bunny
+// at 16 pass-1 rays, 60% of the error variance); the filtered cells carry a blur bias that grows
+// with the search radius (0.003 at 1.5 d, 0.008 at 3 d, 0.010 at 6 d AO RMSE on the bunny). So at
+// ≤ 32 rays per point it beats QMC at the same rays but not QMC at 256 there, and on wuson and
+// spider (80-90% of cells brute-forced) it is a 64-cell stratified estimator. On dense foliage
+// most cells are brute-forced too (the occluders are within 4d) and it is slower than QMC at
+// equal error. It wins where occluders are far from dense receivers (a grille over a ground).
 //
 // prepare(points) must be given every point of the bake before integrate(); integrate() with an
 // index that prepare() did not see, or a point that differs from the prepared one, is integrated
@@ -155,8 +163,12 @@ public:
   void prepare(std::span<const ShadePoint> points) const override;
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                  std::span<double> std_error = {}) const override;
-  // points, pass1_rays, fallback_rays, cells, brute_cells, unprepared (bake/integrator.h).
+  // points, pass1_rays, fallback_rays, cells, brute_cells, unprepared, neighbours, filtered_samples
+  // (bake/integrator.h).
   IntegratorStats stats() const override;
+  // Rays per point (pass-1 + fallback), the brute-forced cell fraction, neighbours
+  // and samples per filtered cell.
+  std::string work_summary() const override;
   const FilterOptions& options() const { return options_; }
   const CellIntegrals& cell_integrals() const { return cells_; }
   // Brute-force ray i of cell c at the point of index point_index, in the local frame (+z = n;
@@ -179,7 +191,7 @@ private:
   std::unique_ptr<QmcIntegrator> radiance_;  // band-1 radiance, routed to QMC
   mutable std::unique_ptr<Prepared> prepared_;
   mutable std::atomic<uint64_t> points_{0}, pass1_rays_{0}, fallback_rays_{0}, cells_total_{0}, brute_cells_{0},
-      unprepared_{0};
+      unprepared_{0}, neighbours_{0}, filtered_samples_{0};
 };
 
 } // namespace prt::bake

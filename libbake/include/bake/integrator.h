@@ -98,7 +98,14 @@ struct IntegratorStats {
   // cells, hemisphere cells integrated and how many of them by brute force, and points integrated
   // by brute force because prepare() had not seen them.
   uint64_t pass1_rays = 0, fallback_rays = 0, cells = 0, brute_cells = 0, unprepared = 0;
+  // Its neighbours kept (the receiver included) and the samples with a non-zero filter weight in
+  // the cells it filtered, summed over points.
+  uint64_t neighbours = 0, filtered_samples = 0;
   double brute_fraction() const { return cells ? double(brute_cells) / double(cells) : 0.0; }
+  double neighbours_per_point() const { return points ? double(neighbours) / double(points) : 0.0; }
+  double samples_per_filtered_cell() const {
+    return cells > brute_cells ? double(filtered_samples) / double(cells - brute_cells) : 0.0;
+  }
   double rays_per_point() const { return points ? double(pass1_rays + fallback_rays) / double(points) : 0.0; }
 };
 
@@ -121,6 +128,9 @@ public:
   virtual void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                          std::span<double> std_error = {}) const = 0;
   virtual IntegratorStats stats() const { return {}; }
+  // One line on the work done so far, from stats(), for a tool to print after a bake; empty when
+  // the integrator has nothing to add to its rays and time.
+  virtual std::string work_summary() const { return {}; }
 };
 
 } // namespace prt::bake
