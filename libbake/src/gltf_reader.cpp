@@ -44,8 +44,7 @@ constexpr std::string_view kUnsupportedExtensions[] = {"KHR_draco_mesh_compressi
                                                         "KHR_mesh_quantization"};
 
 // ---- tinygltf's file access: plain reads, no wordexp expansion of URIs, no writes. ----
-// The bytes external files may still take (user_data of the callbacks): the buffers' declared total.
-// What the file system callbacks may read: the external buffers the JSON declares, in its order
+// What the file system callbacks may read (their user_data): the external buffers the JSON declares, in its order
 // (tinygltf reads buffers before anything else, its "3. Parse Buffer"), at most their declared bytes.
 // Reads after the last buffer are images, which a bake never uses: refused, so tinygltf keeps their
 // uri with a warning and no texture is read or hashed.
