@@ -134,7 +134,7 @@ const char* to_string(ExportFormat format) noexcept {
 
 void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
-  const bool probe = format == ExportFormat::Unity || format == ExportFormat::Godot || format == ExportFormat::Filament;
+  const bool probe = is_probe_format(format);
   if (environment && !probe) throw std::invalid_argument("an environment probe is written by the probe formats only");
   if (exporting::vertex_sets(asset).empty() && !(probe && environment))
     throw FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");

@@ -93,8 +93,7 @@ formats::EnvironmentProbe environment_probe(const std::string& path, const forma
 
 int run_export(const ExportArgs& args) {
   const formats::ExportFormat format = *formats::parse_export_format(args.format);
-  const bool probe = format == formats::ExportFormat::Unity || format == formats::ExportFormat::Godot ||
-                     format == formats::ExportFormat::Filament;
+  const bool probe = formats::is_probe_format(format);
   if (!args.env.empty() && !probe)
     throw UsageError("--env writes an environment probe: it needs --to unity, godot or filament, not " + args.format);
   const formats::Asset asset = formats::read_asset(args.input);

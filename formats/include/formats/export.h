@@ -32,6 +32,10 @@ enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament };
 // "gltf", "glb", "bin", "unity", "godot", "filament" (nullopt for anything else).
 std::optional<ExportFormat> parse_export_format(std::string_view name);
 const char* to_string(ExportFormat format) noexcept;
+// Unity, Godot, Filament: the light-probe formats (the ones an EnvironmentProbe may join).
+constexpr bool is_probe_format(ExportFormat f) noexcept {
+  return f == ExportFormat::Unity || f == ExportFormat::Godot || f == ExportFormat::Filament;
+}
 
 // The sky as a light probe (the probe formats only): the radiance SH of order 3 of an environment
 // map, in our convention and the file's frame ([RGB][i], index l(l+1)+m), with the map's name and
