@@ -14,7 +14,8 @@ cd "$(dirname "$0")/.."
 PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev hdf5-tools
           libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py
           glslc libvulkan-dev mesa-vulkan-drivers
-          libcli11-dev nlohmann-json3-dev libpng-dev libssl-dev libtinygltf-dev assimp-testmodels
+          libcli11-dev nlohmann-json3-dev libpng-dev libssl-dev libtinygltf-dev libdeflate-dev zlib1g-dev
+          assimp-testmodels
           openmpi-bin libopenmpi-dev blender python3-numpy
           clang-14 libclang-rt-14-dev time)
 JOBS=${JOBS:-$(nproc)}

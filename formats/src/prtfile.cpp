@@ -52,6 +52,11 @@ namespace detail {
 
 std::mutex& hdf5_mutex() {
   static std::mutex m;
+  // Before HDF5's first call here: no library shutdown at exit. A file whose close failed (a full
+  // disk under a direct chunk write) stays half-open in HDF5 1.10, and its exit handler crashes
+  // on it after our one-line error; we close every file we open ourselves, or report why not.
+  static const bool no_exit_handler = H5dont_atexit() >= 0;
+  (void)no_exit_handler;
   return m;
 }
 

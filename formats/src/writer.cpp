@@ -5,11 +5,19 @@
 
 #include <formats/testing.h>
 
+#include "chunk_filters.h"
 #include "h5util.h"
 #include "temporaries.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstring>
+#include <memory>
 #include <string>
 #include <set>
 #include <system_error>
@@ -20,12 +28,59 @@ namespace {
 using detail::Hid;
 
 constexpr uint64_t kChunkBytes = 64 * 1024;
-constexpr unsigned kDeflateLevel = 6;
+constexpr unsigned kDeflateLevel = 6;  // recorded in the deflate filter's parameters; libdeflate's scale
+// Chunks encoded at once (in parallel) before they are written in order: bounds the memory held.
+constexpr std::size_t kChunkBatch = 256;
+// Direct chunk writes store the array's memory bytes as the file's: both little-endian.
+static_assert(std::endian::native == std::endian::little, "the writer stores native bytes as little-endian");
+
+// Who filters the chunks: we do (chunk_filters.h; parallel, libdeflate) or, for the tests' reference
+// writer, HDF5's own pipeline (H5Dwrite, zlib).
+enum class Filters { ours, library };
+
+// One chunk of a dataset: its first element (HDF5's chunk offset) and the flat range of the
+// row-major array it holds. The writer's chunk shapes make every chunk one contiguous range: all
+// dimensions after `split` whole, the ones before it 1 (Writer::write_dataset).
+struct ChunkSpan {
+  std::vector<hsize_t> offset;
+  uint64_t first = 0, count = 0;
+};
+
+std::vector<ChunkSpan> chunk_spans(const std::vector<hsize_t>& dims, const std::vector<hsize_t>& chunk) {
+  const int rank = int(dims.size());
+  int split = rank - 1;  // the last dimension not taken whole (-1: the chunk is the whole array)
+  while (split >= 0 && chunk[size_t(split)] == dims[size_t(split)]) --split;
+  uint64_t inner = 1;
+  for (int k = split + 1; k < rank; ++k) inner *= dims[size_t(k)];
+  uint64_t outer = 1;
+  for (int k = 0; k < split; ++k) {
+    if (chunk[size_t(k)] != 1) throw FormatError("", "internal error: a chunk shape that is not one contiguous range");
+    outer *= dims[size_t(k)];
+  }
+  std::vector<ChunkSpan> out;
+  if (split < 0) {
+    out.push_back({std::vector<hsize_t>(dims.size(), 0), 0, inner});
+    return out;
+  }
+  const hsize_t along = dims[size_t(split)], step = chunk[size_t(split)];
+  for (uint64_t o = 0; o < outer; ++o)
+    for (hsize_t a = 0; a < along; a += step) {
+      ChunkSpan c{std::vector<hsize_t>(dims.size(), 0), (o * along + a) * inner, std::min(step, along - a) * inner};
+      uint64_t rest = o;  // o unravelled over the dimensions before `split`
+      for (int k = split - 1; k >= 0; --k) {
+        c.offset[size_t(k)] = rest % dims[size_t(k)];
+        rest /= dims[size_t(k)];
+      }
+      c.offset[size_t(split)] = a;
+      out.push_back(std::move(c));
+    }
+  return out;
+}
 
 class Writer {
 public:
-  Writer(std::string file_for_messages, hid_t file, bool checksum_data)
-      : msg_file_(std::move(file_for_messages)), file_(file), checksum_data_(checksum_data) {}
+  Writer(std::string file_for_messages, hid_t file, bool checksum_data, Filters filters)
+      : msg_file_(std::move(file_for_messages)), file_(file), checksum_data_(checksum_data), filters_(filters) {}
 
   [[noreturn]] void fail(const std::string& what) const {
     const std::string detail = detail::take_hdf5_error();
@@ -113,10 +168,11 @@ public:
     Hid dcpl = check(detail::plist_id(H5Pcreate(H5P_DATASET_CREATE)), "cannot create properties of " + name);
     check(H5Pset_obj_track_times(dcpl.get(), false), "cannot disable time tracking of " + name);
     const bool empty = std::find(dims.begin(), dims.end(), hsize_t{0}) != dims.end();
+    std::vector<hsize_t> chunk(dims.size(), 1);
     if (!empty) {
       // Chunks of ~kChunkBytes: whole trailing dimensions while they fit, then a run of the
-      // first dimension that does not fit (for [V, ...] that is a block of vertices).
-      std::vector<hsize_t> chunk(dims.size(), 1);
+      // first dimension that does not fit (for [V, ...] that is a block of vertices); the ones
+      // before it are 1, so that a chunk is one contiguous range of the array (chunk_spans).
       uint64_t inner = elem;
       for (int k = rank - 1; k >= 0; --k) {
         if (inner * dims[k] <= kChunkBytes) {
@@ -135,8 +191,10 @@ public:
     Hid ds = check(detail::dataset_id(H5Dcreate2(file_, d.path.c_str(), file_type, space.get(),
                                                 H5P_DEFAULT, dcpl.get(), H5P_DEFAULT)),
                    "cannot create " + name);
-    if (!empty)
+    if (!empty && filters_ == Filters::library)
       check(H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf), "cannot write " + name);
+    else if (!empty)
+      write_chunks(ds.get(), dims, chunk, elem, static_cast<const std::byte*>(buf), name);
     for (const Attr& a : d.attrs) write_attr(ds.get(), a, name);
     check(ds.close(), "cannot close " + name);
   }
@@ -149,9 +207,46 @@ public:
   }
 
 private:
+  // The chunks of one dataset, filtered here in parallel (chunk_filters.h) a batch at a time and
+  // written whole, in row-major chunk order: the same bytes whatever the thread count. Chunks
+  // past the array's end are padded with zeros, HDF5's default fill value, as H5Dwrite pads them.
+  void write_chunks(hid_t ds, const std::vector<hsize_t>& dims, const std::vector<hsize_t>& chunk, std::size_t elem,
+                    const std::byte* bytes, const std::string& name) const {
+    const std::vector<ChunkSpan> spans = chunk_spans(dims, chunk);
+    uint64_t chunk_elements = 1;
+    for (const hsize_t c : chunk) chunk_elements *= c;
+    tbb::enumerable_thread_specific<std::unique_ptr<detail::ChunkEncoder>> encoders;
+    std::vector<std::vector<std::byte>> encoded(std::min(kChunkBatch, spans.size()));
+    for (std::size_t b = 0; b < spans.size(); b += kChunkBatch) {
+      const std::size_t n = std::min(kChunkBatch, spans.size() - b);
+      // Isolated: a thread waiting here must not pick up outer work that may take the HDF5 lock.
+      tbb::this_task_arena::isolate([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+          std::unique_ptr<detail::ChunkEncoder>& encoder = encoders.local();
+          if (!encoder) encoder = std::make_unique<detail::ChunkEncoder>(int(kDeflateLevel), checksum_data_);
+          std::vector<std::byte> padded;
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const ChunkSpan& c = spans[b + i];
+            std::span<const std::byte> whole(bytes + c.first * elem, c.count * elem);
+            if (c.count != chunk_elements) {
+              padded.assign(chunk_elements * elem, std::byte{0});
+              std::memcpy(padded.data(), whole.data(), whole.size());
+              whole = padded;
+            }
+            encoded[i] = encoder->encode(whole, elem);
+          }
+        });
+      });
+      for (std::size_t i = 0; i < n; ++i)
+        check(H5Dwrite_chunk(ds, H5P_DEFAULT, 0, spans[b + i].offset.data(), encoded[i].size(), encoded[i].data()),
+              "cannot write " + name);
+    }
+  }
+
   std::string msg_file_;
   hid_t file_;
   bool checksum_data_;
+  Filters filters_;
   std::set<std::string> created_;
 };
 
@@ -175,7 +270,7 @@ struct TempGuard {
 enum class OnDisk { current, oldest, oldest_objects };
 
 void write_checked(const std::filesystem::path& final_path, const File& file, bool add_format,
-                   OnDisk on_disk = OnDisk::current) {
+                   OnDisk on_disk = OnDisk::current, Filters filters = Filters::ours) {
   const std::string msg_file = final_path.string();
 
   if (final_path.filename().empty())
@@ -215,7 +310,7 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
       fail("cannot create temporary file '" + tmp.string() + "' (is '" + dir.string() +
            "' writable?)");
 
-    Writer w(msg_file, f.get(), on_disk == OnDisk::current);
+    Writer w(msg_file, f.get(), on_disk == OnDisk::current, filters);
     Hid root = detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT));
     if (!root.valid()) fail("cannot open the root group");
     if (add_format) {
@@ -262,6 +357,11 @@ void write_file_oldest_format(const std::filesystem::path& final_path, const Fil
   require_memory_safe(final_path, file);
   write_checked(final_path, file, false,
                 which == OldestFormat::everywhere ? OnDisk::oldest : OnDisk::oldest_objects);
+}
+
+void write_file_library_filters(const std::filesystem::path& final_path, const File& file) {
+  require_memory_safe(final_path, file);
+  write_checked(final_path, file, false, OnDisk::current, Filters::library);
 }
 } // namespace testing
 

@@ -26,8 +26,9 @@
 //     this machine — its pid no longer alive — is removed first; a live pid's, or another
 //     machine's (a shared disk), is never touched.
 //   * Deterministic: the same File gives the same bytes (no object time stamps, fixed library
-//     format bounds). Datasets are chunked along the first axis (~64 KiB chunks), shuffled,
-//     deflated (level 6) and fletcher32-checksummed.
+//     format bounds), whatever the thread count. Datasets are chunked along the first axis
+//     (~64 KiB chunks), shuffled, deflated (libdeflate, level 6) and fletcher32-checksummed, by
+//     the writer itself, chunks in parallel (oneTBB; formats/src/chunk_filters.h).
 //
 // Reader contract (read_file)
 //   * Reads every dataset and every attribute of the root, of each group and of each dataset.

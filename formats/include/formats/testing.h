@@ -1,5 +1,6 @@
-// formats/testing.h — for tests of readers only (hostile-input tests of read_file, the runtime
-// loader, prtdump): write files that the real writer refuses to write. Never use in tools.
+// formats/testing.h — for tests only: files that the real writer refuses to write (hostile-input
+// tests of read_file, the runtime loader, prtdump), and the writer's slow reference (HDF5's own
+// filters). Never use in tools.
 #pragma once
 
 #include <formats/prtfile.h>
@@ -21,5 +22,11 @@ void write_file_unvalidated(const std::filesystem::path& final_path, const File&
 enum class OldestFormat { everywhere, objects_only };
 void write_file_oldest_format(const std::filesystem::path& final_path, const File& file,
                               OldestFormat which = OldestFormat::everywhere);
+
+// The reference for the writer's own filtering (parallel shuffle → deflate → Fletcher-32 with direct
+// chunk writes): write_file_unvalidated's file, with the same layout, but each chunk filtered by
+// HDF5's built-in pipeline (H5Dwrite, zlib). The datasets read back the same; the deflate streams
+// differ.
+void write_file_library_filters(const std::filesystem::path& final_path, const File& file);
 
 } // namespace prt::formats::testing
