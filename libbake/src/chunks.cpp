@@ -4,11 +4,11 @@
 #include <bake/error.h>
 #include <bake/sha256.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
-#include <fstream>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -30,9 +30,9 @@ void put(std::string& out, const T& x) {
   out.append(reinterpret_cast<const char*>(&x), sizeof x);
 }
 template <class T>
-T get(const std::string& in, size_t& at) {
+T get(const char* in, size_t& at) {
   T x;
-  std::memcpy(&x, in.data() + at, sizeof x);
+  std::memcpy(&x, in + at, sizeof x);
   at += sizeof x;
   return x;
 }
@@ -54,6 +54,24 @@ bool write_all(int fd, const std::string& bytes) {
   }
   return true;
 }
+
+// Reads exactly `n` bytes from `fd` into `to`; false on a failed or short read.
+bool read_all(int fd, void* to, size_t n) {
+  size_t done = 0;
+  while (done < n) {
+    const ssize_t got = ::read(fd, static_cast<char*>(to) + done, n - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) return false;
+    done += size_t(got);
+  }
+  return true;
+}
+
+// Closes a file descriptor at the end of its scope.
+struct Fd {
+  int fd;
+  ~Fd() { ::close(fd); }
+};
 
 std::string host_name() {
   char buf[256] = {};
@@ -141,55 +159,95 @@ void ChunkStore::commit(size_t index, const ChunkData& d) const {
 
 std::optional<ChunkData> ChunkStore::read(size_t index, uint32_t width) const {
   PRT_CHECK(index < chunks_.size());
+  ChunkData d;
+  d.range = chunks_[index];
+  d.width = width;
+  d.values.resize(size_t(d.range.rows()) * width);
+  if (!read_into(index, width, d)) return std::nullopt;
+  return d;
+}
+
+bool ChunkStore::read_into(size_t index, uint32_t width, ChunkData& out) const {
+  PRT_CHECK(index < chunks_.size());
+  const ChunkRange& want = chunks_[index];
+  const size_t n = size_t(want.rows()) * width;  // values in each column
+  PRT_CHECK(out.range.begin <= want.begin && size_t(want.end - out.range.begin) * width <= out.values.size());
   const fs::path path = chunk_path(index);
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return std::nullopt;
-  std::string bytes(size_t(std::max<std::streamoff>(in.tellg(), 0)), '\0');
-  in.seekg(0);
-  if (!in.read(bytes.data(), std::streamsize(bytes.size())))
-    throw InputError(path.string(), "cannot read the chunk file");
   const std::string file = path.string();
-  if (bytes.size() < kHeader + kDigest || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT) return false;
+    throw InputError(file, "cannot read the chunk file: " + errno_text());
+  }
+  const Fd closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw InputError(file, "cannot read the chunk file: " + errno_text());
+  const size_t size = size_t(std::max<off_t>(st.st_size, 0));
+  char header[kHeader];
+  if (size < kHeader + kDigest || !read_all(fd, header, kHeader) || std::memcmp(header, kMagic, sizeof kMagic) != 0)
     throw InputError(file, "not a chunk file (truncated or wrong format); remove it and rerun the bake to recompute it");
-  const size_t body = bytes.size() - kDigest;
-  if (digest_of(bytes, body) != bytes.substr(body))
+  size_t at = sizeof kMagic + kDigest;
+  const uint64_t stored_index = get<uint64_t>(header, at);
+  ChunkRange range;
+  range.set = get<uint32_t>(header, at);
+  range.begin = get<uint64_t>(header, at);
+  range.end = get<uint64_t>(header, at);
+  const uint32_t stored_width = get<uint32_t>(header, at);
+  const uint32_t columns = get<uint32_t>(header, at);
+  const uint64_t closed_form = get<uint64_t>(header, at);
+  const double cpu_seconds = get<double>(header, at), seconds = get<double>(header, at);
+  const bool same_chunk = stored_index == index && range == want && stored_width == width;
+  const size_t body = size - kDigest;
+  const bool fits = same_chunk && (columns == 1 || columns == 2) && body == kHeader + columns * n * sizeof(double);
+
+  // The digest covers every byte before it: the header, then the rows, read into their place
+  // when the header says where that is, else only hashed (a damaged header reads as corrupt).
+  Sha256 hash;
+  hash.update(std::as_bytes(std::span(header)));
+  bool complete = true;
+  if (fits) {
+    const size_t offset = size_t(want.begin - out.range.begin) * width;
+    if (columns == 2 && out.std_error.size() < out.values.size()) out.std_error.resize(out.values.size());
+    for (std::vector<double>* column : {&out.values, &out.std_error}) {
+      if (column == &out.std_error && columns == 1) break;
+      const std::span<double> rows(column->data() + offset, n);
+      complete = complete && read_all(fd, rows.data(), rows.size_bytes());
+      hash.update(std::as_bytes(rows));
+    }
+  } else {
+    std::vector<char> buffer(std::min<size_t>(body - kHeader, size_t(1) << 16));
+    for (size_t left = body - kHeader; left > 0 && complete;) {
+      const size_t piece = std::min(left, buffer.size());
+      complete = read_all(fd, buffer.data(), piece);
+      hash.update(std::as_bytes(std::span(buffer.data(), piece)));
+      left -= piece;
+    }
+  }
+  char digest[kDigest];
+  if (!complete || !read_all(fd, digest, kDigest)) throw InputError(file, "cannot read the chunk file");
+  if (hash.hex_digest() != std::string_view(digest, kDigest))
     throw InputError(file, "corrupt chunk: its SHA-256 does not match its contents; remove it and rerun the bake to "
                            "recompute it");
-  if (bytes.compare(sizeof kMagic, kDigest, manifest_) != 0)
-    throw InputError(file, "chunk of another bake (other inputs, options, integrator or seed: manifest " +
-                               bytes.substr(sizeof kMagic, 12) + "... is not this bake's " + manifest_.substr(0, 12) +
-                               "...); remove the chunk directory or rerun with the same inputs and options");
-  size_t at = sizeof kMagic + kDigest;
-  ChunkData d;
-  const uint64_t stored_index = get<uint64_t>(bytes, at);
-  d.range.set = get<uint32_t>(bytes, at);
-  d.range.begin = get<uint64_t>(bytes, at);
-  d.range.end = get<uint64_t>(bytes, at);
-  d.width = get<uint32_t>(bytes, at);
-  const uint32_t columns = get<uint32_t>(bytes, at);
-  d.closed_form = get<uint64_t>(bytes, at);
-  d.cpu_seconds = get<double>(bytes, at);
-  d.seconds = get<double>(bytes, at);
-  const ChunkRange& want = chunks_[index];
-  if (stored_index != index || !(d.range == want) || d.width != width)
-    throw InputError(file, "chunk " + std::to_string(stored_index) + " of set " + std::to_string(d.range.set) +
-                               ", rows " + std::to_string(d.range.begin) + "-" + std::to_string(d.range.end) +
-                               ", width " + std::to_string(d.width) + " is not this bake's chunk " +
-                               std::to_string(index) + " (set " + std::to_string(want.set) + ", rows " +
-                               std::to_string(want.begin) + "-" + std::to_string(want.end) + ", width " +
-                               std::to_string(width) + ")");
-  const size_t n = size_t(d.range.rows()) * width;
-  if ((columns != 1 && columns != 2) || body != kHeader + columns * n * sizeof(double))
+  const std::string_view stored_manifest(header + sizeof kMagic, kDigest);
+  if (stored_manifest != manifest_)
+    throw InputError(file, "chunk of another bake (other inputs, options, integrator, seed or chunk layout: manifest " +
+                               std::string(stored_manifest.substr(0, 12)) + "... is not this bake's " +
+                               manifest_.substr(0, 12) + "...); remove the chunk directory or rerun with the same "
+                               "inputs and options");
+  if (!same_chunk)
+    throw InputError(file, "chunk " + std::to_string(stored_index) + " of set " + std::to_string(range.set) + ", rows " +
+                               std::to_string(range.begin) + "-" + std::to_string(range.end) + ", width " +
+                               std::to_string(stored_width) + " is not this bake's chunk " + std::to_string(index) +
+                               " (set " + std::to_string(want.set) + ", rows " + std::to_string(want.begin) + "-" +
+                               std::to_string(want.end) + ", width " + std::to_string(width) + ")");
+  if (!fits)
     throw InputError(file, "chunk holds " + std::to_string(body) + " bytes in " + std::to_string(columns) +
                                " column(s) where its rows need " + std::to_string(kHeader + 2 * n * sizeof(double)) +
                                " in 2 or " + std::to_string(kHeader + n * sizeof(double)) + " in 1");
-  for (auto* column : {&d.values, &d.std_error}) {
-    if (column == &d.std_error && columns == 1) break;
-    column->resize(n);
-    std::memcpy(column->data(), bytes.data() + at, n * sizeof(double));
-    at += n * sizeof(double);
-  }
-  return d;
+  out.closed_form += closed_form;
+  out.cpu_seconds += cpu_seconds;
+  out.seconds += seconds;
+  return true;
 }
 
 bool valid_run_id(std::string_view id) {

@@ -433,14 +433,82 @@ EnvMap EnvMap::load(const std::filesystem::path& exr, UpAxis up) {
   return reading_file(file, [&] { return read(exr, file, up); });
 }
 
-EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, UpAxis up) {
+namespace {
+// What load() and identify() know of the file before its pixels: it exists, its SHA-256, and
+// check_exr_header's checks.
+EnvMapInfo file_identity(const std::filesystem::path& exr, const std::string& file) {
   std::error_code ec;
   if (!std::filesystem::exists(exr, ec)) throw InputError(file, "no such file");
   EnvMapInfo info;
   info.source = file;
   info.sha256 = sha256_file(exr);  // InputError if unreadable or a directory
   check_exr_header(exr, file);
+  return info;
+}
 
+// The image's layout and size from its OpenEXR header (the envmap attribute, else its shape).
+struct ExrShape {
+  bool cube = false;
+  int width = 0, height = 0;
+};
+ExrShape exr_shape(const Imf::Header& hdr, const std::string& file) {
+  const Imath::Box2i dw = hdr.dataWindow();
+  const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1, h64 = int64_t(dw.max.y) - dw.min.y + 1;
+  check_image_size(w64, h64, file);  // again: OpenEXR's window is the one read from here on
+  const int W = int(w64), H = int(h64);
+  std::ostringstream shape;
+  shape << W << "x" << H;
+  if (Imf::hasEnvmap(hdr)) {
+    const Imf::Envmap e = Imf::envmap(hdr);
+    if (e == Imf::ENVMAP_LATLONG) {
+      if (W < 2 || H < 2) throw InputError(file, "lat-long environment map of " + shape.str() + " pixels: need at least 2x2");
+      return {false, W, H};
+    }
+    if (e == Imf::ENVMAP_CUBE) {
+      if (int64_t(H) != 6 * int64_t(W) || W < 2)
+        throw InputError(file, "cube environment map of " + shape.str() +
+                                   " pixels: expected width S >= 2 and height 6*S (faces stacked vertically)");
+      return {true, W, H};
+    }
+    throw InputError(file, "unknown 'envmap' attribute value " + std::to_string(int(e)));
+  }
+  if (int64_t(W) == 2 * int64_t(H) && H >= 2) return {false, W, H};
+  if (int64_t(H) == 6 * int64_t(W) && W >= 2) return {true, W, H};
+  throw InputError(file, "image is " + shape.str() +
+                             " and has no 'envmap' attribute: expected a lat-long map (width == 2*height) "
+                             "or a cube map (height == 6*width)");
+}
+
+// OpenEXR's own errors: the file is damaged, truncated or not an image OpenEXR can read. Our
+// InputErrors pass through as they are; std::bad_alloc (the machine) and logic errors (a bug)
+// are not the file's fault and pass through too (docs/ARCHITECTURE.md §6). OpenEXR 3.1 turns a
+// std::bad_alloc for its scanline buffers into an Iex exception with this message: that is the
+// machine too.
+[[noreturn]] void openexr_failure(const Iex::BaseExc& e, const std::string& file) {
+  if (std::string_view(e.what()).find("Failed to allocate memory") != std::string_view::npos) throw std::bad_alloc();
+  throw InputError(file, "cannot read OpenEXR image: " + one_line(e.what()));
+}
+} // namespace
+
+EnvMapInfo EnvMap::identify(const std::filesystem::path& exr) {
+  const std::string file = exr.string();
+  return reading_file(file, [&] {
+    EnvMapInfo info = file_identity(exr, file);
+    try {
+      const Imf::InputFile in(file.c_str());
+      const ExrShape shape = exr_shape(in.header(), file);
+      info.layout = shape.cube ? "cube" : "latlong";
+      info.width = shape.width;
+      info.height = shape.height;
+    } catch (const Iex::BaseExc& e) {
+      openexr_failure(e, file);
+    }
+    return info;
+  });
+}
+
+EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, UpAxis up) {
+  EnvMapInfo info = file_identity(exr, file);
   Layout layout = Layout::LatLong;
   int W = 0, H = 0;
   std::vector<float> rgb;
@@ -448,34 +516,9 @@ EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, U
     Imf::InputFile in(file.c_str());
     const Imf::Header& hdr = in.header();
     const Imath::Box2i dw = hdr.dataWindow();
-    const int64_t w64 = int64_t(dw.max.x) - dw.min.x + 1, h64 = int64_t(dw.max.y) - dw.min.y + 1;
-    check_image_size(w64, h64, file);  // again: OpenEXR's window is the one read from here on
-    W = int(w64), H = int(h64);
-    std::ostringstream shape;
-    shape << W << "x" << H;
-    if (Imf::hasEnvmap(hdr)) {
-      const Imf::Envmap e = Imf::envmap(hdr);
-      if (e == Imf::ENVMAP_LATLONG) {
-        layout = Layout::LatLong;
-        if (W < 2 || H < 2)
-          throw InputError(file, "lat-long environment map of " + shape.str() + " pixels: need at least 2x2");
-      } else if (e == Imf::ENVMAP_CUBE) {
-        layout = Layout::ExrCube;
-        if (int64_t(H) != 6 * int64_t(W) || W < 2)
-          throw InputError(file, "cube environment map of " + shape.str() +
-                                     " pixels: expected width S >= 2 and height 6*S (faces stacked vertically)");
-      } else {
-        throw InputError(file, "unknown 'envmap' attribute value " + std::to_string(int(e)));
-      }
-    } else if (int64_t(W) == 2 * int64_t(H) && H >= 2) {
-      layout = Layout::LatLong;
-    } else if (int64_t(H) == 6 * int64_t(W) && W >= 2) {
-      layout = Layout::ExrCube;
-    } else {
-      throw InputError(file, "image is " + shape.str() +
-                                 " and has no 'envmap' attribute: expected a lat-long map (width == 2*height) "
-                                 "or a cube map (height == 6*width)");
-    }
+    const ExrShape shape = exr_shape(hdr, file);
+    layout = shape.cube ? Layout::ExrCube : Layout::LatLong;
+    W = shape.width, H = shape.height;
 
     const Imf::ChannelList& channels = hdr.channels();
     auto has = [&](const char* n) { return channels.findChannel(n) != nullptr; };
@@ -537,13 +580,7 @@ EnvMap EnvMap::read(const std::filesystem::path& exr, const std::string& file, U
         throw InputError(file, os.str());
       }
   } catch (const Iex::BaseExc& e) {
-    // OpenEXR's own errors: the file is damaged, truncated or not an image OpenEXR can read. Our
-    // InputErrors pass through as they are; std::bad_alloc (the machine) and logic errors (a bug)
-    // are not the file's fault and pass through too (docs/ARCHITECTURE.md §6). OpenEXR 3.1 turns
-    // a std::bad_alloc for its scanline buffers into an Iex exception with this message: that is
-    // the machine too.
-    if (std::string_view(e.what()).find("Failed to allocate memory") != std::string_view::npos) throw std::bad_alloc();
-    throw InputError(file, "cannot read OpenEXR image: " + one_line(e.what()));
+    openexr_failure(e, file);
   }
   return build(layout, W, H, std::move(rgb), up, std::move(info));
 }

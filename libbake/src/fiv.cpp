@@ -172,17 +172,10 @@ ProductRequest band1_radiance(const EnvMap& env) {
 }
 } // namespace
 
-FivShellRows::FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
-                           bool integrate)
-    : spec_(spec) {
-  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
-  if (integrate)
-    integrator_ = std::make_unique<const SilhouetteIntegrator>(occluder, topology, band1_radiance(env),
-                                                               SilhouetteOptions{silhouette_isolines(spec.silhouette_k), 1});
-  bounding_sphere(occluder, frame_.centre, frame_.radius);
-  frame_.origin = occluder.origin;
-  frame_.n_phi = spec.n_phi;
-  frame_.n_theta = spec.n_theta;
+FivShellRows::FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec)
+    : FivShellRows(occluder, spec) {
+  integrator_ = std::make_unique<const SilhouetteIntegrator>(occluder, topology, band1_radiance(env),
+                                                             SilhouetteOptions{silhouette_isolines(spec.silhouette_k), 1});
   // The scale the occluded FIV is compared with: ∫ L_c dω, the full-sphere irradiance. (|F^env|
   // itself cancels to 0 for a uniform sky, so a fraction of it is ill-posed.)
   if (env.texel_count() == 0) {
@@ -198,6 +191,14 @@ FivShellRows::FivShellRows(const Mesh& occluder, const Topology& topology, const
     env_norm_[1] += L.g * w;
     env_norm_[2] += L.b * w;
   }
+}
+
+FivShellRows::FivShellRows(const Mesh& occluder, const ShellSpec& spec) : spec_(spec) {
+  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
+  bounding_sphere(occluder, frame_.centre, frame_.radius);
+  frame_.origin = occluder.origin;
+  frame_.n_phi = spec.n_phi;
+  frame_.n_theta = spec.n_theta;
   const double R = std::max(frame_.radius, 1e-30);
   const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
   const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
@@ -208,7 +209,14 @@ FivShellRows::~FivShellRows() = default;
 
 size_t FivShellRows::rows_per_shell() const { return size_t(spec_.n_theta) * size_t(spec_.n_phi); }
 
-FivShells FivShellRows::empty_shells() const { return frame_; }
+FivShells FivShellRows::empty_shells() const {
+  // Room for every shell the bake may use, so that append() never moves what it appended (the
+  // pages of shells never appended are never touched).
+  FivShells out = frame_;
+  out.values.reserve(size_t(shell_count()) * rows_per_shell() * 9);
+  out.valid.reserve(size_t(shell_count()) * rows_per_shell());
+  return out;
+}
 
 std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task* task) const {
   PRT_CHECK(integrator_ && begin <= end && end <= rows_per_shell());
@@ -247,6 +255,7 @@ bool FivShellRows::stops_after(int shell, std::span<const double> rows) const {
 void FivShellRows::append(FivShells& shells, int shell, std::span<const double> rows) const {
   PRT_CHECK(rows.size() == rows_per_shell() * kRowWidth && shells.radii.size() == size_t(shell));
   shells.radii.push_back(radius(shell));
+  // Into the room empty_shells() reserved: no reallocation, and no zeroing pass before the values.
   for (size_t idx = 0; idx < rows_per_shell(); ++idx) {
     const double* row = rows.data() + idx * kRowWidth;
     for (int q = 0; q < 9; ++q) shells.values.push_back(float(row[q]));

@@ -86,6 +86,42 @@ TEST(Chunks, ValuesOnlyChunkReadsBackWithoutStandardErrors) {
   store.remove();
 }
 
+// read_into places each chunk's rows at their rows of a buffer of the whole set and adds its
+// counters: chunk after chunk into one buffer gives the set, as the chunks hold it.
+TEST(Chunks, ReadIntoPlacesTheRowsOfEachChunk) {
+  const fs::path dir = fresh_dir("read_into");
+  const ChunkStore store(dir, kManifest, row_chunks(std::vector<uint64_t>{7}, 3));
+  ChunkData out;
+  out.range = {0, 0, 7};
+  out.values.assign(7 * 2, -1.0);
+  EXPECT_FALSE(store.read_into(2, 2, out));  // never committed: out unchanged
+  EXPECT_EQ(out.values, std::vector<double>(7 * 2, -1.0));
+  EXPECT_TRUE(out.std_error.empty());
+  std::vector<double> values, std_error;
+  for (size_t i : {size_t(2), size_t(0), size_t(1)}) store.commit(i, sample_chunk(store.chunks()[i], 2));
+  for (size_t i = 0; i < 3; ++i) {
+    const ChunkData d = sample_chunk(store.chunks()[i], 2);
+    values.insert(values.end(), d.values.begin(), d.values.end());
+    std_error.insert(std_error.end(), d.std_error.begin(), d.std_error.end());
+  }
+  for (size_t i : {size_t(1), size_t(2), size_t(0)}) ASSERT_TRUE(store.read_into(i, 2, out));  // any order
+  EXPECT_EQ(out.values, values);
+  EXPECT_EQ(out.std_error, std_error);
+  EXPECT_EQ(out.closed_form, 3u * 3u);
+  EXPECT_EQ(out.cpu_seconds, 3 * 0.5);
+  // A buffer that starts at the chunk's own first row: read() is read_into() of such a buffer.
+  ChunkData one;
+  one.range = store.chunks()[1];
+  one.values.resize(3 * 2);
+  ASSERT_TRUE(store.read_into(1, 2, one));
+  EXPECT_EQ(one.values, store.read(1, 2)->values);
+  // A buffer too small for the chunk's rows is the caller's bug.
+  ChunkData small;
+  small.values.resize(5 * 2);
+  EXPECT_THROW(store.read_into(2, 2, small), ContractError);
+  store.remove();
+}
+
 TEST(Chunks, EveryFlippedByteIsRefused) {
   const fs::path dir = fresh_dir("flip");
   const ChunkStore store(dir, kManifest, row_chunks(std::vector<uint64_t>{4}, 4));

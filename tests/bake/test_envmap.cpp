@@ -31,6 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using prt::bake::EnvMap;
+using prt::bake::EnvMapInfo;
 using prt::bake::InputError;
 using prt::bake::Rgb;
 using prt::bake::UpAxis;
@@ -654,6 +655,39 @@ TEST(EnvMapFiles, WrittenLatLongAndCubeFilesRoundTrip) {
   // The attribute wins over the shape rule: a 6x4 lat-long map is fine when declared.
   write_exr(ll, 6, 4, rgb_channels(6, 4, 1, 1, 1), 0);
   EXPECT_EQ(EnvMap::load(ll, UpAxis::Y).info().layout, "latlong");
+}
+
+// identify(): load()'s identity of the file (source, SHA-256, layout, size) without its pixels,
+// and load()'s errors for a file it cannot use.
+TEST(EnvMapFiles, IdentifyGivesLoadsIdentityWithoutThePixels) {
+  const fs::path cube = tmp_dir() / "identify_cube_4.exr", bad = tmp_dir() / "identify_not_exr.exr";
+  write_exr(cube, 4, 24, rgb_channels(4, 24, 1, 2, 3));
+  std::ofstream(bad, std::ios::binary) << "not an OpenEXR file at all";
+  for (const fs::path& p : {data("forest.exr"), cube}) {
+    const EnvMapInfo loaded = EnvMap::load(p, UpAxis::Z).info(), identified = EnvMap::identify(p);
+    EXPECT_EQ(identified.source, loaded.source);
+    EXPECT_EQ(identified.sha256, loaded.sha256);
+    EXPECT_EQ(identified.layout, loaded.layout);
+    EXPECT_EQ(identified.width, loaded.width);
+    EXPECT_EQ(identified.height, loaded.height);
+    EXPECT_EQ(identified.mean_luminance, 0.0) << "no pixels read";
+  }
+  EXPECT_EQ(EnvMap::identify(cube).layout, "cube");
+  for (const fs::path& p : {tmp_dir() / "identify_missing.exr", bad}) {
+    std::string loaded, identified;
+    try {
+      (void)EnvMap::load(p, UpAxis::Y);
+    } catch (const InputError& e) {
+      loaded = e.what();
+    }
+    try {
+      (void)EnvMap::identify(p);
+    } catch (const InputError& e) {
+      identified = e.what();
+    }
+    EXPECT_FALSE(loaded.empty()) << p;
+    EXPECT_EQ(identified, loaded) << p;
+  }
 }
 
 TEST(EnvMapFiles, LuminanceOnlyImageIsGrey) {

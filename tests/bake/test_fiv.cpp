@@ -1,5 +1,6 @@
 // FIV products (bake/fiv.h, paper 004 §3–4.2) against quadrature, QMC and closed forms.
 #include <bake/envmap.h>
+#include <bake/error.h>
 #include <bake/fiv.h>
 #include <bake/mesh.h>
 #include <bake/qmc.h>
@@ -182,21 +183,30 @@ TEST(Fiv, InsideClosedGeometryIsInvalidAndFullyOccluded) {
   EXPECT_FALSE(inside);
 }
 
+namespace {
+// A thin 2 × 0.02 × 2 plate (R = 1.4143) under a uniform grey sky, an 8x5x12 grid, fraction 0.02.
+struct PlateUnderGreySky {
+  EnvMap env = EnvMap::from_latlong(16, 8, std::vector<float>(16 * 8 * 3, 1.0f), UpAxis::Y, "grey");
+  Mesh m = box({-1, -0.01f, -1}, {1, 0.01f, 1});
+  Topology topo = build_topology(m);
+  ShellSpec spec = [] {
+    ShellSpec s;
+    s.n_phi = 8;
+    s.n_theta = 5;
+    s.n_rho = 12;
+    s.silhouette_k = 64 * 64;  // 64 u-isolines
+    s.fraction = 0.02;
+    return s;
+  }();
+};
+} // namespace
+
 TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
-  // A thin 2 × 0.02 × 2 plate (R = 1.4143) under a uniform grey sky, fraction 0.02: radii run
-  // geometrically from 0.707 to R / (2√0.02) = 5.0 over 12 shells (… 2.94, 3.51, 4.19, 5.0).
-  // Face-on, the plate subtends Ω = 4 atan(1 / (ρ √(2 + ρ²))) and |F| ≈ Ω of ∫ L = 4π:
-  // 0.0237 at ρ = 3.51 (go on), 0.0170 at ρ = 4.19 (stop) — 11 shells.
-  const EnvMap env = EnvMap::from_latlong(16, 8, std::vector<float>(16 * 8 * 3, 1.0f), UpAxis::Y, "grey");
-  const Mesh m = box({-1, -0.01f, -1}, {1, 0.01f, 1});
-  const Topology topo = build_topology(m);
-  ShellSpec spec;
-  spec.n_phi = 8;
-  spec.n_theta = 5;
-  spec.n_rho = 12;
-  spec.silhouette_k = 64 * 64;  // 64 u-isolines
-  spec.fraction = 0.02;
-  const FivShells s = bake_fiv_shells(m, topo, env, spec);
+  // The plate: radii run geometrically from 0.707 to R / (2√0.02) = 5.0 over 12 shells (… 2.94,
+  // 3.51, 4.19, 5.0). Face-on, the plate subtends Ω = 4 atan(1 / (ρ √(2 + ρ²))) and |F| ≈ Ω of
+  // ∫ L = 4π: 0.0237 at ρ = 3.51 (go on), 0.0170 at ρ = 4.19 (stop) — 11 shells.
+  const PlateUnderGreySky p;
+  const FivShells s = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
   EXPECT_NEAR(s.radius, std::sqrt(2.0001), 1e-6);
   ASSERT_EQ(s.radii.size(), 11u) << "stops at the first shell below the fraction";
   for (size_t k = 1; k < s.radii.size(); ++k) EXPECT_GT(s.radii[k], s.radii[k - 1]);
@@ -207,4 +217,30 @@ TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 8; ++j) EXPECT_EQ(s.valid[size_t(i * 8 + j)], i == 2 ? 0 : 1) << i << " " << j;
   for (float x : s.values) EXPECT_TRUE(std::isfinite(x));
+}
+
+// A merge's FivShellRows (the mesh and the spec only: no environment, no integrator) has the
+// integrating one's frame, radii and stopping rule, and appends the same shells from its rows.
+TEST(Fiv, FrameOnlyShellRowsAgreeWithTheIntegratingOnes) {
+  const PlateUnderGreySky p;
+  const FivShellRows baker(p.m, p.topo, p.env, p.spec), frame(p.m, p.spec);
+  ASSERT_EQ(frame.shell_count(), baker.shell_count());
+  ASSERT_EQ(frame.rows_per_shell(), baker.rows_per_shell());
+  FivShells a = baker.empty_shells(), b = frame.empty_shells();
+  EXPECT_EQ(a.centre, b.centre);
+  EXPECT_EQ(a.radius, b.radius);
+  for (int k = 0; k < baker.shell_count(); ++k) {
+    EXPECT_EQ(frame.radius(k), baker.radius(k));
+    const std::vector<double> rows = baker.rows(k, 0, baker.rows_per_shell());
+    baker.append(a, k, rows);
+    frame.append(b, k, rows);
+    ASSERT_EQ(frame.stops_after(k, rows), baker.stops_after(k, rows)) << "shell " << k;
+    if (baker.stops_after(k, rows)) break;
+  }
+  const FivShells whole = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
+  EXPECT_EQ(b.radii, whole.radii);
+  EXPECT_EQ(b.values, whole.values);
+  EXPECT_EQ(b.valid, whole.valid);
+  EXPECT_EQ(a.values, whole.values);
+  EXPECT_THROW((void)frame.rows(0, 0, 1), ContractError);  // nothing to integrate with
 }

@@ -311,15 +311,16 @@ std::string speck_mesh() {
   return path.string();
 }
 
-// That occluder under studio.exr: the 2x2x6 DifMap's 24 texels in one chunk, then 24x13 = 312
-// samples per shell in slabs of 80 (4 chunks a shell); the rule ends the bake at shell kFivShells
-// of 16.
-std::string fiv_bake(int samples = 256) {
+// That occluder under studio.exr: the 2x2x6 DifMap's 24 texels in one chunk, the environment FIV
+// in one, then 24x13 = 312 samples per shell in slabs of 80 (4 chunks a shell); the rule ends the
+// bake at shell kFivShells of 16. An error report of `report` points (a merge without one reads
+// the environment's identity only, not its pixels).
+std::string fiv_bake(int samples = 256, int report = 4) {
   return "fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 24x13x16 --fraction 0.01 --cube 2 --samples " +
-         std::to_string(samples) + " --threads 1 --chunk-rows 80 --report 4";
+         std::to_string(samples) + " --threads 1 --chunk-rows 80 --report " + std::to_string(report);
 }
 constexpr int kFivShells = 7;
-constexpr int kFivChunks = 1 + 4 * kFivShells;
+constexpr int kFivChunks = 2 + 4 * kFivShells;
 
 // The shells a FIV bake printed it used ("shells: 24x13xK (of 16 ...").
 int shells_used(const std::string& out) {
@@ -374,24 +375,41 @@ TEST(ShardsFiv, ResumeShardWorkersAndMergeGiveTheSingleProcessBytes) {
   EXPECT_TRUE(leftovers(dir, out).empty());
 }
 
-// A flipped byte, a chunk of another bake, a missing chunk of a used shell: one line naming it,
-// exit 1, no file.
-TEST(ShardsFiv, MergeRefusesBadChunks) {
-  const fs::path dir = dir_for("fiv_refuse"), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
-  const std::string ref = reference(fiv_bake(), out);
-  const std::string args = fiv_bake() + " -o " + out.string();
+namespace {
+// expect_bad_chunk_refused on chunk `name` of fiv_bake(256, report), committed by one worker in
+// dir_for(`test`).
+void expect_bad_fiv_chunk_refused(const std::string& test, const std::string& name, int report) {
+  const fs::path dir = dir_for(test), out = dir / "out.prt.h5", chunks = dir / "out.prt.h5.chunks";
+  const std::string ref = reference(fiv_bake(256, report), out);
+  const std::string args = fiv_bake(256, report) + " -o " + out.string();
   ASSERT_EQ(prtbake(args + " --shard 0/1", dir).code, 0);
   ASSERT_EQ(committed_chunks(chunks), size_t(kFivChunks));
   // Another bake's chunks (another k) in a directory of their own.
-  ASSERT_EQ(prtbake(fiv_bake(144) + " -o " + out.string() + " --shard 0/1 --chunks " + (dir / "other").string(), dir).code, 0);
-  expect_bad_chunk_refused(args, dir, "c000005.chunk", ref);  // shell 1's first slab
+  ASSERT_EQ(prtbake(fiv_bake(144, report) + " -o " + out.string() + " --shard 0/1 --chunks " + (dir / "other").string(), dir).code,
+            0);
+  expect_bad_chunk_refused(args, dir, name, ref);
+}
+} // namespace
+
+// A flipped byte, a chunk of another bake, a missing chunk of a used shell: one line naming it,
+// exit 1, no file.
+TEST(ShardsFiv, MergeRefusesBadChunks) {
+  expect_bad_fiv_chunk_refused("fiv_refuse", "c000006.chunk", 4);  // shell 1's first slab
 }
 
-// A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell, 1 for the DifMap).
+// The environment FIV is a chunk of its own, computed by a worker: flipped, foreign or missing it
+// is refused like any other, and recomputed alone it gives the same bytes. Without an error
+// report, the merge reads no pixels of the environment.
+TEST(ShardsFiv, EnvironmentFivChunkIsVerifiedAndRecomputed) {
+  expect_bad_fiv_chunk_refused("fiv_environment", "c000001.chunk", 0);
+}
+
+// A longer FIV bake (40x21 samples, 13 of 16 shells, k = 1024; 4 chunks a shell, 1 for the DifMap,
+// 1 for the environment FIV).
 TEST(ShardsFiv, KillNineAndRerunResumes) {
   kill_nine_and_rerun("fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 40x21x16 --fraction 0.01 --cube 2 "
                       "--samples 1024 --threads 1 --chunk-rows 210 --report 0",
-                      dir_for("fiv_kill"), 1 + 4 * 13);
+                      dir_for("fiv_kill"), 2 + 4 * 13);
 }
 
 #ifdef PRT_MPIRUN

@@ -175,33 +175,33 @@ F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t
   return out;
 }
 
-void set_fiv_environment(F::Asset& asset, const bake::EnvMap& env, const std::string& env_path, const bake::Fiv& fenv,
+void set_fiv_environment(F::Asset& asset, const bake::EnvMapInfo& env, const std::string& env_path, const bake::Fiv& fenv,
                          const std::vector<float>& cube, int cube_size) {
   F::FivEnvironment& e = asset.fiv_environment.emplace();
   for (size_t k = 0; k < 9; ++k) e.f_env[k] = float(fenv[k]);
   e.environment = env_path;
-  e.environment_sha256 = env.info().sha256;
+  e.environment_sha256 = env.sha256;
   e.integrand = "F_c = Int L_c(w) w dw, layout [RGB][xyz]";
   F::IrradianceCube& c = asset.irradiance_cube.emplace();
   c.size = cube_size;
   c.values = cube;
   c.environment = env_path;
-  c.environment_sha256 = env.info().sha256;
+  c.environment_sha256 = env.sha256;
   c.integrand = "E_c(n) = Int L_c H(w,n) (n.w) dw, exact per texel";
   c.face_convention = "faces +X,-X,+Y,-Y,+Z,-Z; texel (row r, column q): s = 2(q+0.5)/S-1, t = 2(r+0.5)/S-1; +X "
                       "(1,-t,-s), -X (-1,-t,s), +Y (s,1,t), -Y (s,-1,-t), +Z (s,-t,1), -Z (-s,-t,-1)";
 }
 
-F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, const bake::EnvMap& env,
+F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const bake::EnvMapInfo& env,
                         const std::string& env_path, double fraction, uint32_t silhouette_k) {
   F::Occluder o;
   o.name = name;
   o.n_rho = int(shells.radii.size());
   o.n_theta = shells.n_theta;
   o.n_phi = shells.n_phi;
-  o.shells = shells.values;
+  o.shells = std::move(shells.values);
   o.environment = env_path;
-  o.environment_sha256 = env.info().sha256;
+  o.environment_sha256 = env.sha256;
   o.integrand = "F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]";
   const Eigen::Vector3d centre = shells.world_centre();
   o.centre = {centre.x(), centre.y(), centre.z()};
@@ -211,7 +211,7 @@ F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, 
                          "j/Nphi from +Z towards +X, d = (sin theta sin phi, cos theta, sin theta cos phi)";
   o.fraction = fraction;
   o.samples = int64_t(silhouette_k);
-  o.valid = F::OccluderValid{shells.valid, "0: the offset lies inside the occluder (nothing visible)", {}};
+  o.valid = F::OccluderValid{std::move(shells.valid), "0: the offset lies inside the occluder (nothing visible)", {}};
   return o;
 }
 

@@ -44,11 +44,11 @@ void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const s
 // `reproducible`.
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible);
 
-// F_env and the irradiance cube (DifMap) of the asset.
-void set_fiv_environment(F::Asset& asset, const bake::EnvMap& env, const std::string& env_path, const bake::Fiv& fenv,
+// F_env and the irradiance cube (DifMap) of the asset, from the environment `env` (its SHA-256).
+void set_fiv_environment(F::Asset& asset, const bake::EnvMapInfo& env, const std::string& env_path, const bake::Fiv& fenv,
                          const std::vector<float>& cube, int cube_size);
-// An occluder's shells and valid mask.
-F::Occluder occluder_of(const std::string& name, const bake::FivShells& shells, const bake::EnvMap& env,
+// An occluder's shells and valid mask (moved from `shells`).
+F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const bake::EnvMapInfo& env,
                         const std::string& env_path, double fraction, uint32_t silhouette_k);
 // The error report row of an occluder's shells.
 F::ReportRow fiv_report_of(const std::string& name, const bake::FivErrorReport& report, const bake::FivShells& shells,

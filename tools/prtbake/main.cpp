@@ -701,36 +701,51 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   return 0;
 }
 
-// The DifMap and the FIV shells of a sharded bake (shards.h): row set 0 is the DifMap's texels,
-// row set 1 + k shell k's samples. Every worker takes slabs of rows set after set and stops past
-// the first complete shell that meets the stopping rule; the merging process joins the DifMap
-// and the shells up to that one. nullopt: this process does not merge. `sharded` is emplaced
-// here; the caller removes the chunks (finish()) once the file is written.
+// The row sets of a sharded FIV bake (shards.h): the DifMap's texels (3 values each), the
+// environment FIV (one row of its 9 values), then shell k's samples (FivShellRows::kRowWidth
+// values each) in set kFirstShellSet + k.
+constexpr uint32_t kDifMapSet = 0, kEnvironmentFivSet = 1, kFirstShellSet = 2;
+
+// The DifMap, the environment FIV and the FIV shells of a sharded bake. Every worker takes slabs
+// of rows set after set and stops past the first complete shell that meets the stopping rule; the
+// merging process joins the DifMap, the environment FIV and the shells up to that one. nullopt:
+// this process does not merge. `topo` and `env` are needed by a process that computes rows only
+// (a merge joins committed rows: the environment's identity `env_info` is all it needs). `sharded`
+// is emplaced here; the caller removes the chunks (finish()) once the file is written.
 struct ShardedFiv {
   std::vector<float> cube;
+  bake::Fiv environment{};
   bake::FivShells shells;
 };
 std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker, const tool::MpiSession& mpi,
-                                      const bake::Mesh& mesh, const bake::Topology& topo, const bake::EnvMap& env,
-                                      std::optional<tool::ShardedRows>& sharded) {
+                                      const bake::Mesh& mesh, const bake::Topology* topo, const bake::EnvMap* env,
+                                      const bake::EnvMapInfo& env_info, std::optional<tool::ShardedRows>& sharded) {
+  PRT_CHECK(!worker.computes || (topo && env));
   const bake::ShellSpec& sp = a.shell_spec;
-  const bake::FivShellRows baker(mesh, topo, env, sp, worker.computes);
-  const size_t width = bake::FivShellRows::kRowWidth;
+  const bake::FivShellRows baker =
+      worker.computes ? bake::FivShellRows(mesh, *topo, *env, sp) : bake::FivShellRows(mesh, sp);
+  std::vector<uint64_t> set_rows = {uint64_t(6) * uint64_t(sp.cube) * uint64_t(sp.cube), 1};
+  std::vector<uint32_t> widths = {3, uint32_t(std::tuple_size_v<bake::Fiv>)};
+  for (int k = 0; k < baker.shell_count(); ++k)
+    set_rows.push_back(baker.rows_per_shell()), widths.push_back(uint32_t(bake::FivShellRows::kRowWidth));
+  // What each set holds, its rows and width: chunks of another layout belong to another bake.
+  std::string layout = "sets: DifMap texels, environment FIV, shell samples:";
+  for (size_t s = 0; s < set_rows.size(); ++s) layout += " " + std::to_string(set_rows[s]) + "x" + std::to_string(widths[s]);
   char spec[192];
   std::snprintf(spec, sizeof spec, "%dx%dx%d inner %.17g fraction %.17g k %u cube %d", sp.n_phi, sp.n_theta, sp.n_rho,
                 sp.inner, sp.fraction, unsigned(sp.silhouette_k), sp.cube);
-  const std::string manifest = tool::manifest_of({"fiv", kVersion, a.command_line, mesh.source_sha256, env.info().sha256,
-                                                  spec, std::to_string(width), std::to_string(a.shard.chunk_rows)});
-  std::vector<uint64_t> set_rows = {uint64_t(6) * uint64_t(sp.cube) * uint64_t(sp.cube)};
-  std::vector<uint32_t> widths = {3};
-  for (int k = 0; k < baker.shell_count(); ++k) set_rows.push_back(baker.rows_per_shell()), widths.push_back(uint32_t(width));
+  const std::string manifest = tool::manifest_of({"fiv", kVersion, a.command_line, mesh.source_sha256, env_info.sha256,
+                                                  spec, layout, std::to_string(a.shard.chunk_rows)});
   tool::ShardedRows& shards = sharded.emplace(worker, mpi, a.shard, a.output, manifest, set_rows, widths, a.quiet);
   // The set of the first shell, in order, that is complete in the chunk directory and meets the rule.
   int checked = 0;
+  bake::ChunkData rows;  // one buffer for every set read back
   const auto last_set = [&]() -> std::optional<uint32_t> {
-    for (; checked < baker.shell_count() && shards.complete(uint32_t(1 + checked)); ++checked)
-      if (baker.may_stop_after(checked) && baker.stops_after(checked, shards.join(uint32_t(1 + checked)).values))
-        return uint32_t(1 + checked);
+    for (; checked < baker.shell_count() && shards.complete(kFirstShellSet + uint32_t(checked)); ++checked)
+      if (baker.may_stop_after(checked)) {
+        shards.join(kFirstShellSet + uint32_t(checked), rows);
+        if (baker.stops_after(checked, rows.values)) return kFirstShellSet + uint32_t(checked);
+      }
     return std::nullopt;
   };
   std::optional<bake::UnshadowedIrradiance> irradiance;  // built for this worker's first DifMap chunk
@@ -738,15 +753,19 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
     shards.work(
         [&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
           bake::ChunkData d;
-          bake::Task task(monitor, r.set == 0 ? "DifMap texels" : "FIV shell rows", r.rows());
+          bake::Task task(monitor, r.set < kFirstShellSet ? "environment FIV and DifMap" : "FIV shell rows", r.rows());
           const double cpu0 = tool::process_cpu_seconds();
-          if (r.set == 0) {
-            if (!irradiance) irradiance.emplace(env);
+          if (r.set == kDifMapSet) {
+            if (!irradiance) irradiance.emplace(*env);
             const std::vector<float> texels = bake::irradiance_cube_texels(*irradiance, sp.cube, r.begin, r.end);
             d.values.assign(texels.begin(), texels.end());
             task.advance(r.rows());
+          } else if (r.set == kEnvironmentFivSet) {
+            const bake::Fiv f = bake::environment_fiv(*env);
+            d.values.assign(f.begin(), f.end());
+            task.advance(r.rows());
           } else {
-            d.values = baker.rows(int(r.set - 1), r.begin, r.end, &task);
+            d.values = baker.rows(int(r.set - kFirstShellSet), r.begin, r.end, &task);
           }
           task.finish();
           d.seconds = task.elapsed_seconds();
@@ -757,14 +776,16 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
   });
   if (!merges) return std::nullopt;
   ShardedFiv out;
-  const bake::ChunkData cube = shards.join(0);
-  out.cube.assign(cube.values.begin(), cube.values.end());
+  shards.join(kDifMapSet, rows);
+  out.cube.assign(rows.values.begin(), rows.values.end());
+  shards.join(kEnvironmentFivSet, rows);
+  std::copy(rows.values.begin(), rows.values.end(), out.environment.begin());
   out.shells = baker.empty_shells();
   for (int k = 0; k < baker.shell_count(); ++k) {
-    const bake::ChunkData d = shards.join(uint32_t(1 + k));
-    baker.append(out.shells, k, d.values);
-    out.shells.seconds += d.seconds;
-    if (baker.stops_after(k, d.values)) break;
+    shards.join(kFirstShellSet + uint32_t(k), rows);
+    baker.append(out.shells, k, rows.values);
+    out.shells.seconds += rows.seconds;
+    if (baker.stops_after(k, rows.values)) break;
   }
   return out;
 }
@@ -778,30 +799,40 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = false;  // an occluder's normals play no part in its FIVs
   const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
-  const bake::Topology topo = bake::build_topology(mesh);
   print_warnings(mesh.warnings);
-  const bake::EnvMap env = bake::EnvMap::load(a.environment, a.up);
+  // A merge (--merge) joins committed rows: it needs the environment's identity (its SHA-256, in
+  // the manifest and the file) but not its pixels, nor the mesh's topology, unless its error
+  // report integrates a reference. The workers loaded the same bytes (the manifest holds their
+  // SHA-256) and checked the pixels.
+  const bool integrates = !worker || worker->computes || a.integrator.report_points > 0;
+  std::optional<bake::Topology> topo;
+  std::optional<bake::EnvMap> env;
+  if (integrates) {
+    topo = bake::build_topology(mesh);
+    env = bake::EnvMap::load(a.environment, a.up);
+  }
+  const bake::EnvMapInfo env_info = env ? env->info() : bake::EnvMap::identify(a.environment);
   const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   if (say)
     std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.input.c_str(), mesh.triangles.size(),
-                a.environment.c_str(), env.info().width, env.info().height, env.info().layout.c_str());
+                a.environment.c_str(), env_info.width, env_info.height, env_info.layout.c_str());
 
   std::optional<tool::ShardedRows> shards;
   std::optional<ShardedFiv> sharded;
   if (worker) {
-    sharded = sharded_fiv(a, *worker, mpi, mesh, topo, env, shards);
+    sharded = sharded_fiv(a, *worker, mpi, mesh, topo ? &*topo : nullptr, env ? &*env : nullptr, env_info, shards);
     if (!sharded) return 0;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const bake::Fiv fenv = bake::environment_fiv(env);
-  const std::vector<float> cube = sharded ? std::move(sharded->cube) : bake::irradiance_cube(env, a.shell_spec.cube);
+  const bake::Fiv fenv = sharded ? sharded->environment : bake::environment_fiv(*env);
+  const std::vector<float> cube = sharded ? std::move(sharded->cube) : bake::irradiance_cube(*env, a.shell_spec.cube);
   const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const bake::FivShells shells =
-      sharded ? std::move(sharded->shells) : bake::bake_fiv_shells(mesh, topo, env, a.shell_spec, progress);
+  bake::FivShells shells =
+      sharded ? std::move(sharded->shells) : bake::bake_fiv_shells(mesh, *topo, *env, a.shell_spec, progress);
   if (say) {
     std::printf("environment FIV and %dx%dx6 DifMap in %.2f s%s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds,
-                sharded ? " (the DifMap's texels in the chunks)" : "");
+                sharded ? " (both in the chunks)" : "");
     std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
                 "integrals/s)\n",
                 a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho, shells.radii.front(),
@@ -812,12 +843,12 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
   namespace F = prt::formats;
   F::Asset asset;
   asset.root = root_info(a, mesh.source_sha256);
-  tool::set_fiv_environment(asset, env, a.environment, fenv, cube, a.shell_spec.cube);
+  tool::set_fiv_environment(asset, env_info, a.environment, fenv, cube, a.shell_spec.cube);
   const std::string name = tool::safe_name(fs::path(a.input).stem().string());
-  F::Occluder& occluder = asset.occluders.emplace_back(tool::occluder_of(name, shells, env, a.environment, a.shell_spec.fraction, a.shell_spec.silhouette_k));
+  std::optional<F::ReportRow> report;
   if (a.integrator.report_points > 0) {
     // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
-    const bake::FivErrorReport r = bake::fiv_error_report(mesh, topo, env, shells, fenv, a.integrator.report_points,
+    const bake::FivErrorReport r = bake::fiv_error_report(mesh, *topo, *env, shells, fenv, a.integrator.report_points,
                                                           a.integrator.seed, progress);
     if (say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
@@ -825,8 +856,12 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
                   bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,
                   r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
-    occluder.report = tool::fiv_report_of(name, r, shells, a.reproducible);
+    report = tool::fiv_report_of(name, r, shells, a.reproducible);
   }
+  // The shells move into the file's occluder (the report above was their last reader).
+  asset.occluders.push_back(tool::occluder_of(name, std::move(shells), env_info, a.environment, a.shell_spec.fraction,
+                                              a.shell_spec.silhouette_k));
+  asset.occluders.back().report = std::move(report);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;
@@ -997,13 +1032,13 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
     if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
     if (ob.shells) {
       F::Occluder& occluder =
-          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, *env, env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
+          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
       if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
     }
   }
   for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
   if (plan.fiv_environment)
-    tool::set_fiv_environment(asset, *env, env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+    tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;

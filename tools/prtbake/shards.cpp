@@ -358,32 +358,28 @@ bool ShardedRows::complete(uint32_t set) const {
 }
 
 bake::ChunkData ShardedRows::join(uint32_t set) const {
+  bake::ChunkData out;
+  join(set, out);
+  return out;
+}
+
+void ShardedRows::join(uint32_t set, bake::ChunkData& out) const {
   const State& s = *s_;
   const auto& chunks = s.store.chunks();
-  const size_t W = s.widths.at(set);
-  bake::ChunkData out;
-  out.width = uint32_t(W);
-  out.range.set = set;
+  const uint32_t W = s.widths.at(set);
+  out.width = W;
+  out.range = {set, 0, 0};
   for (const bake::ChunkRange& c : chunks)
     if (c.set == set) out.range.end = std::max(out.range.end, c.end);
-  out.values.assign(out.range.end * W, 0.0);
-  for (size_t i = 0; i < chunks.size(); ++i) {
-    if (chunks[i].set != set) continue;
-    const std::optional<bake::ChunkData> d = s.store.read(i, uint32_t(W));
-    if (!d)
+  out.values.resize(out.range.end * W);  // every row is read into place below
+  out.std_error.clear();
+  out.closed_form = 0;
+  out.seconds = out.cpu_seconds = 0;
+  for (size_t i = 0; i < chunks.size(); ++i)
+    if (chunks[i].set == set && !s.store.read_into(i, W, out))
       throw bake::InputError(s.store.chunk_path(i).string(),
                              "missing chunk " + std::to_string(i) + " (rows " + std::to_string(chunks[i].begin) + "-" +
                                  std::to_string(chunks[i].end) + "): no worker committed it; rerun the bake to compute it");
-    std::copy(d->values.begin(), d->values.end(), out.values.begin() + ptrdiff_t(chunks[i].begin * W));
-    if (!d->std_error.empty()) {
-      out.std_error.resize(out.values.size());
-      std::copy(d->std_error.begin(), d->std_error.end(), out.std_error.begin() + ptrdiff_t(chunks[i].begin * W));
-    }
-    out.seconds += d->seconds;
-    out.cpu_seconds += d->cpu_seconds;
-    out.closed_form += d->closed_form;
-  }
-  return out;
 }
 
 bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form) const {

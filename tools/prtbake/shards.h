@@ -17,8 +17,8 @@
 // the next unclaimed chunk (claim files of this run, bake/chunks.h). A run is one launch: mpirun
 // (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
 // another run are stale by definition, so a rerun recomputes what a dead run claimed.
-// FIV bakes: row set 0 is the DifMap's texels, row set 1 + k shell k's samples, each cut into
-// slabs of rows. Where the shells stop depends on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
+// FIV bakes: row set 0 is the DifMap's texels, row set 1 the environment FIV (one row), row set
+// 2 + k shell k's samples, each cut into slabs of rows. Where the shells stop depends on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
 // after shell without waiting for each other and read the stopping rule from committed chunks:
 // once a complete shell meets it, no worker starts a chunk beyond it. A worker ahead of the
 // others may compute chunks past the last shell while that shell is not complete (about one
@@ -120,6 +120,9 @@ public:
   // joined in row order: values (and standard errors when the chunks hold them), counters and
   // times summed.
   bake::ChunkData join(uint32_t set) const;
+  // join() into `out`, its memory reused (set after set into one ChunkData: no new allocation
+  // for sets of the same size); each chunk's rows are read from its file straight into place.
+  void join(uint32_t set, bake::ChunkData& out) const;
   // join() as one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
   bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
   // After the file is written: removes the chunk directory.

@@ -73,6 +73,13 @@ public:
   // Chunk `index`, verified; nullopt if it was never committed. InputError naming the file if it
   // is corrupt, of another bake or of another range.
   std::optional<ChunkData> read(size_t index, uint32_t width) const;
+  // read() into `out`, which holds rows of `width` values from row out.range.begin of the chunk's
+  // set (out.values sized by the caller to hold this chunk's rows): the chunk's values go from
+  // the file straight into their rows of out.values and, when it holds standard errors, into
+  // out.std_error (sized like out.values first when smaller), with no copy on the way; its
+  // counters and times are added to out's. false (out unchanged) if the chunk was never
+  // committed; InputError as read(), and then this chunk's rows of `out` are unspecified.
+  bool read_into(size_t index, uint32_t width, ChunkData& out) const;
   // Claims chunk `index` for run `run_id` (valid_run_id); false if a worker of the same run holds it.
   bool claim(size_t index, const std::string& run_id) const;
   // Removes this store's chunk files, claims and temporaries, then the directory if empty.

@@ -114,6 +114,11 @@ public:
   // max_compression_ratio), or a NaN/Inf pixel. No OpenEXR exception escapes. Running out of
   // memory is a SystemError("<exr>: out of memory while reading the file").
   static EnvMap load(const std::filesystem::path& exr, UpAxis up);
+  // What load() would say of the file without reading its pixels: info()'s source, sha256,
+  // layout, width and height (the pixel statistics stay 0), after the same checks of the file
+  // and its header (the same InputErrors; a bad pixel is not found). For a process that needs
+  // the map's identity only (a merge of committed rows).
+  static EnvMapInfo identify(const std::filesystem::path& exr);
 
   // The same radiance in every direction (white furnace: constant({1, 1, 1})). value must be
   // finite and >= 0 (PRT_CHECK).

@@ -108,10 +108,10 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
 class FivShellRows {
 public:
   static constexpr size_t kRowWidth = 11;
-  // integrate = false: the frame, radii and stopping rule only (a merge of committed rows), no
-  // integrator built; rows() is then a contract error.
-  FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
-               bool integrate = true);
+  FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec);
+  // The frame, radii and stopping rule only (a merge of committed rows): no integrator, no
+  // environment; rows() is then a contract error.
+  FivShellRows(const Mesh& occluder, const ShellSpec& spec);
   ~FivShellRows();
   int shell_count() const { return int(radii_.size()); }  // spec.n_rho: the most the bake can use
   size_t rows_per_shell() const;
