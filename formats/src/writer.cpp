@@ -212,6 +212,16 @@ private:
   // past the array's end are padded with zeros, HDF5's default fill value, as H5Dwrite pads them.
   void write_chunks(hid_t ds, const std::vector<hsize_t>& dims, const std::vector<hsize_t>& chunk, std::size_t elem,
                     const std::byte* bytes, const std::string& name) const {
+    try {
+      write_chunks_of(ds, dims, chunk, elem, bytes, name);
+    } catch (const FormatError& e) {  // the encoder's errors do not know the file or the dataset
+      if (!e.file().empty()) throw;
+      fail("cannot write " + name + ": " + e.defect());
+    }
+  }
+
+  void write_chunks_of(hid_t ds, const std::vector<hsize_t>& dims, const std::vector<hsize_t>& chunk,
+                       std::size_t elem, const std::byte* bytes, const std::string& name) const {
     const std::vector<ChunkSpan> spans = chunk_spans(dims, chunk);
     uint64_t chunk_elements = 1;
     for (const hsize_t c : chunk) chunk_elements *= c;
