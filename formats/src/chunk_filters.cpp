@@ -33,9 +33,10 @@ uint32_t fletcher32(std::span<const std::byte> bytes) {
 }
 
 void shuffle_bytes(std::span<const std::byte> in, std::size_t element_size, std::span<std::byte> out) {
-  std::memcpy(out.data(), in.data(), in.size());  // the tail past the last whole element stays
-  if (element_size <= 1) return;
-  const std::size_t n = in.size() / element_size;
+  const std::size_t n = element_size <= 1 ? 0 : in.size() / element_size;
+  // Bytes past the last whole element (all of them for single-byte elements) stay where they are.
+  std::memcpy(out.data() + n * element_size, in.data() + n * element_size, in.size() - n * element_size);
+  if (n == 0) return;
   for (std::size_t j = 0; j < element_size; ++j) {
     std::byte* to = out.data() + j * n;
     const std::byte* from = in.data() + j;
