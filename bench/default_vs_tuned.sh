@@ -41,7 +41,8 @@
 #   the cap, so its ratio is a lower bound), TARGET (1e-3), HDRI_ONCE (below), SMALL_TRIANGLES
 #   (32) and SMALL_HDRIS (city, sunrise: the issue's sun cases): a mesh of fewer triangles (a
 #   plane, a box: little or nothing occludes) is baked under those HDRIs only; WORK (a directory
-#   to keep the cases' logs and rows in; default a temporary one, removed).
+#   to keep the cases' logs and rows in; default a temporary one, removed), NO_AO=1 (leave out
+#   the AO-only cases).
 #   bench/default_vs_tuned.sh --table DIR   prints the table of DIR/rows.tsv (a WORK directory,
 #   e.g. of a run stopped early) without baking.
 set -uo pipefail
@@ -67,15 +68,18 @@ fi
 small_tris=${SMALL_TRIANGLES:-32}
 read -r -a small_hdris <<< "${SMALL_HDRIS:-$world/city.exr $world/sunrise.exr}"
 [ -x "$prtbake" ] && [ -x "$refprog" ] || { echo "build $prtbake and $refprog first" >&2; exit 2; }
-if [ -n "${WORK:-}" ]; then
+table_only=0
+if [ "${1:-}" = --table ]; then
+  table_only=1
+  work=$2
+elif [ -n "${WORK:-}" ]; then
   work=$WORK
   mkdir -p "$work"
 else
   work=$(mktemp -d)
-  trap 'rm -rf "$work"' EXIT
+  tmp_work=$work
+  trap 'rm -rf "$tmp_work"' EXIT
 fi
-table_only=0
-if [ "${1:-}" = --table ]; then table_only=1; work=$2; fi
 sweep_start=$(date +%s.%N)
 
 if [ $table_only = 0 ]; then
@@ -177,7 +181,8 @@ n_case=0
 for entry in "${accepted[@]}"; do
   IFS='|' read -r mesh tris verts <<< "$entry"
   name=${mesh#"$models"/}
-  sets=("ao|")
+  sets=()
+  [ "${NO_AO:-0}" = 1 ] || sets+=("ao|")
   if [ -n "${also_as[$name]:-}" ]; then
     ao_only+=("$name: AO only; under the HDRIs as ${also_as[$name]}")
   elif [ "$tris" -lt "$small_tris" ]; then
@@ -215,7 +220,7 @@ for entry in "${accepted[@]}"; do
       fi
     else
       d_plan="exit $d_rc: $(grep -v '^\(mesh\|environment\|pilot\|baking\|reference\)' "$case_dir/default.log" | head -1 | cut -c1-160)"
-      [ "$d_rc" = 124 ] && d_plan="**runaway**: killed after $default_cap s; $(grep -m1 '^target error' "$case_dir/default.log" | cut -c1-160)"
+      [ "$d_rc" = 124 ] && d_plan="**runaway** (killed after $default_cap s): $(grep -m1 -o 'chosen [a-z]* at [^:]*' "$case_dir/default.log")"
       d_errs="-"; d_worst=nan; d_bake=nan
       [ "$d_rc" = 124 ] && d_bake=$default_cap
       # the reference still has to exist for the ladders
@@ -276,7 +281,7 @@ fi
 # shellcheck disable=SC1091
 . "$work/lists.sh"
 if [ -f "$work/seconds" ]; then sweep_secs=$(cat "$work/seconds")
-else sweep_secs="$(echo "$(date +%s.%N) - $(cat "$work/start")" | bc -l | xargs printf '%.0f') so far (stopped or still running)"; fi
+else sweep_secs="$(echo "$(date +%s.%N) - $(cat "$work/start" 2>/dev/null || date +%s)" | bc -l | xargs printf '%.0f') so far (stopped or still running)"; fi
 
 rows="$work/rows.tsv"
 # ---- the table ----
@@ -285,7 +290,9 @@ echo "|---|---:|---|---|---|---:|---|---:|---:|---|---|---|"
 while IFS=$'\t' read -r name tris hname label dplan dbake dwall bplan bt ratio derrs dworst dverd refinfo nr; do
   per=$(echo "$derrs" | tr ' ' '\n' | awk -F= -v E="$E" 'NF==2{printf "%s%s %.2f", (n++?", ":""), $1, ($2=="nan"?1e30:$2/E)}')
   [ -z "$per" ] && per="—"
-  if [ "$dworst" = nan ]; then verdict="default did not bake"
+  [[ $dplan == \*\*runaway* ]] && [ "$ratio" != nan ] && ratio="≥ $ratio"
+  if [[ $dplan == \*\*runaway* ]]; then verdict="runaway: killed, no file to check"
+  elif [ "$dworst" = nan ]; then verdict="default did not bake"
   elif awk -v w="$dworst" 'BEGIN{exit !(w <= 1)}'; then verdict="within E"
   else verdict="**above E** ($(echo "$derrs" | tr ' ' '\n' | awk -F= -v E="$E" 'NF==2 && $2/E>1{printf "%s%s", (n++?", ":""), $1}'))"; fi
   [ "$dverd" != - ] && verdict="$verdict; report: $dverd"
