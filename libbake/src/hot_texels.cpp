@@ -4,6 +4,7 @@
 
 #include <bake/error.h>
 #include <bake/polygon_sh.h>
+#include <bake/spherical_polygon.h>
 
 #include <prtshade/quadrature.h>
 #include <prtshade/sh.h>
@@ -28,14 +29,14 @@ inline int sign_of(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
 inline double cross2(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 inline double orient2(const Vector2d& a, const Vector2d& b, const Vector2d& c) { return cross2(b - a, c - a); }
 
-// A straight segment of a texel's gnomonic chart: a texel edge (step 0, toggles "inside") or a
-// piece of a W arc, whose line is g(x, y) = g0 + gx·x + gy·y = m·(c + x e1 + y e2) (W steps by
-// sign(Δg)·side_sum when crossed).
+// A piece of a W arc in a texel's gnomonic chart: a straight segment on the line
+// g(x, y) = g0 + gx·x + gy·y = m·(c + x e1 + y e2) (W steps by sign(Δg)·side_sum when crossed).
 struct Segment {
-  Vector2d p, q;
-  bool edge = false;
+  Vector2d p, q;  // p.x < q.x
   double gx = 0, gy = 0;
   int side_sum = 0;
+  bool spans = false;  // an arc piece that crosses the whole box (both ends cut by its sides)
+  size_t arc = 0;      // its arc
   double y_at(double x) const {
     if (x <= std::min(p.x(), q.x())) return p.x() < q.x() ? p.y() : q.y();
     if (x >= std::max(p.x(), q.x())) return p.x() > q.x() ? p.y() : q.y();
@@ -43,8 +44,45 @@ struct Segment {
   }
 };
 
+// A bounding cap of an arc or a path: centre and half-angle (cos, sin); cos_h = −1: the sphere.
+struct Cap {
+  Vector3d mid = Vector3d::UnitZ();
+  double cos_h = -1, sin_h = 0;
+};
+Cap cap_of(const Vector3d& a, const Vector3d& b) {
+  const Vector3d ah = a.normalized(), bh = b.normalized(), sum = ah + bh;
+  Cap c;
+  const double n = sum.norm();
+  if (!(n > 1e-6)) return c;  // (nearly) antipodal ends: no useful bound
+  c.mid = sum / n;
+  c.cos_h = std::min(1.0, c.mid.dot(ah));
+  c.sin_h = std::sqrt(std::max(0.0, 1 - c.cos_h * c.cos_h));
+  return c;
+}
+// Whether two caps can meet: the angle between their centres is at most the sum of their half
+// angles (cos of the sum from the parts; with a margin of 1e-9 for rounding, so it only passes more).
+bool caps_meet(const Cap& a, const Cap& b) {
+  if (a.cos_h <= -1 || b.cos_h <= -1) return true;
+  const double cos_sum = a.cos_h * b.cos_h - a.sin_h * b.sin_h;
+  if (a.sin_h * b.cos_h + a.cos_h * b.sin_h >= 0 && cos_sum <= -1 + 1e-9) return true;  // sum ≥ π
+  return a.mid.dot(b.mid) >= cos_sum - 1e-9;
+}
+
+// Per arc of a call: its bounding cap and unit ends and normal (for the exact cap test).
+struct ArcInfo {
+  Cap cap;
+  Vector3d ah, bh, mh;  // mh = 0: a degenerate arc
+};
+
 struct Scratch {
   std::vector<Segment> segments;
+  std::vector<double> strips;
+  std::vector<std::pair<double, size_t>> active;
+  std::vector<Vector2d> band, clip_tmp;
+  std::vector<Vector3d> world;
+  std::vector<ArcInfo> info;  // per arc of the current call
+  std::vector<std::vector<size_t>> node_arcs;  // per depth of the cluster tree
+  std::vector<Vector3d> clipped;
   std::vector<double> xs;
   std::vector<std::pair<double, size_t>> order;
   std::vector<size_t> cluster_arcs, texel_arcs;
@@ -77,6 +115,7 @@ struct HotTexels::Impl {
     int index = 0;
     Vector3d c, e1, e2;
     std::vector<Vector2d> polygon;  // counter-clockwise in the chart
+    std::vector<Vector3d> polygon_world;  // the same vertices, unit, world frame
     Vector2d lo, hi;                // the chart box every local arc is clipped to (polygon box + margin)
     // The point W is carried from (chart ref2, direction ref): off the centre by odd fractions of
     // the box, so that no arc of an axis-aligned scene passes through it by symmetry (a W path
@@ -101,29 +140,102 @@ struct HotTexels::Impl {
   std::vector<uint8_t> hot_mask;
   std::vector<Texel> texels;
   std::vector<Cluster> clusters;
+  // A binary tree of bounding caps over the clusters (node 0 the root): a call finds each arc's
+  // clusters by descending it, and carries W from a node's reference point (its first cluster's)
+  // to its children's, testing only the arcs that meet the node's cap.
+  struct Node {
+    Vector3d c = Vector3d::UnitZ(), ref = Vector3d::UnitZ();
+    double cos_r = -1, sin_r = 0;  // cos_r = −1: wider than 60°, no cap (its parent's arcs pass)
+    int left = -1, right = -1;     // children; a leaf holds cluster `cluster`
+    int cluster = -1;
+  };
+  std::vector<Node> nodes;
+  int depth = 0;
+
+  int build_node(std::vector<int>& ids, size_t begin, size_t end, int level) {
+    depth = std::max(depth, level + 1);
+    const int index = int(nodes.size());
+    nodes.emplace_back();
+    Vector3d c = Vector3d::Zero();
+    for (size_t k = begin; k < end; ++k) c += clusters[size_t(ids[k])].c;
+    Node n;
+    n.ref = clusters[size_t(ids[begin])].ref;
+    if (c.norm() > 1e-9) {
+      n.c = c.normalized();
+      double r = 0;
+      for (size_t k = begin; k < end; ++k) {
+        const Cluster& cl = clusters[size_t(ids[k])];
+        r = std::max(r, std::atan2(n.c.cross(cl.c).norm(), n.c.dot(cl.c)) + std::atan2(cl.sin_r, cl.cos_r));
+      }
+      if (r < 1.0) n.cos_r = std::cos(r), n.sin_r = std::sin(r);
+    }
+    if (end - begin == 1) {
+      n.cluster = ids[begin];
+      n.cos_r = clusters[size_t(ids[begin])].cos_r, n.sin_r = clusters[size_t(ids[begin])].sin_r;
+      n.c = clusters[size_t(ids[begin])].c;
+    } else {
+      // Split at the median along the axis where the centres spread most.
+      Vector3d lo = Vector3d::Constant(2), hi = Vector3d::Constant(-2);
+      for (size_t k = begin; k < end; ++k) lo = lo.cwiseMin(clusters[size_t(ids[k])].c), hi = hi.cwiseMax(clusters[size_t(ids[k])].c);
+      int axis = 0;
+      (hi - lo).maxCoeff(&axis);
+      const size_t mid = begin + (end - begin) / 2;
+      std::nth_element(ids.begin() + std::ptrdiff_t(begin), ids.begin() + std::ptrdiff_t(mid), ids.begin() + std::ptrdiff_t(end),
+                       [&](int a, int b) {
+                         const double ka = clusters[size_t(a)].c[axis], kb = clusters[size_t(b)].c[axis];
+                         return ka < kb || (ka == kb && a < b);
+                       });
+      n.ref = clusters[size_t(ids[begin])].ref;  // the first cluster after the split: the left child's ref
+      n.left = build_node(ids, begin, mid, level + 1);
+      n.right = build_node(ids, mid, end, level + 1);
+      n.ref = nodes[size_t(n.left)].ref;
+    }
+    nodes[size_t(index)] = n;
+    return index;
+  }
+
+  // Descends from node `index`, whose cap the arcs `list` may meet and where W = W_node.
+  void descend(int index, std::span<const DcfArc> arcs, const std::vector<size_t>& list, int W_node, double* out,
+               Scratch& s, int level) const {
+    const Node& n = nodes[size_t(index)];
+    if (n.cluster >= 0) {
+      const Cluster& cl = clusters[size_t(n.cluster)];
+      s.cluster_arcs.clear();
+      for (size_t j : list)
+        if (meets_cap(s.info[j], cl.c, cl.cos_r, cl.sin_r)) s.cluster_arcs.push_back(j);
+      if (s.cluster_arcs.empty()) {
+        if (W_node == 0)
+          for (size_t i = 0; i < cl.total.size(); ++i) out[i] += cl.total[i];
+        return;
+      }
+      texel_range(cl, arcs, s.cluster_arcs, W_node, out, s);  // visible() leaves cluster_arcs alone
+      return;
+    }
+    for (const int child : {n.left, n.right}) {
+      const Node& ch = nodes[size_t(child)];
+      // The leg n.ref → ch.ref lies in n's cap (or its nearest capped ancestor's): `list` holds
+      // every arc that can cross it.
+      const int W_child = W_node + steps_between(arcs, s.info, n.ref, ch.ref, &list);
+      std::vector<size_t>& sub = s.node_arcs[size_t(level + 1)];
+      sub.clear();
+      Cap cap;
+      cap.mid = ch.c, cap.cos_h = ch.cos_r, cap.sin_h = ch.sin_r;
+      for (size_t j : list)
+        if (ch.cos_r <= -1 || caps_meet(s.info[j].cap, cap)) sub.push_back(j);
+      descend(child, arcs, sub, W_child, out, s, level + 1);
+    }
+  }
   std::vector<double> unoccluded;
   mutable std::atomic<uint64_t> texels_cut{0};
 
   // ∫ y_i dω (i < order²) over the chart trapezoid x ∈ [x0, x1] between the lines through
   // (x0, ylo0)–(x1, ylo1) and (x0, yhi0)–(x1, yhi1), added to out.
-  void trapezoid(const Texel& t, double x0, double x1, double ylo0, double ylo1, double yhi0, double yhi1,
-                 double* out, Scratch& s) const {
-    // Heights below 0 come from rounding where two segments meet at a slab's end: none there.
-    yhi0 = std::max(yhi0, ylo0), yhi1 = std::max(yhi1, ylo1);
-    if (!(x1 > x0) || !(yhi0 > ylo0 || yhi1 > ylo1)) return;
-    // A sliver of (nearly) no area: its vertices are (nearly) on one great circle, where the
-    // closed form's solid angle cannot tell the sliver from a hemisphere. Leaving out slivers
-    // under 1e-13 of the texel's chart box costs at most that per sliver.
-    const Vector2d box = t.hi - t.lo;
-    if (0.5 * (x1 - x0) * ((yhi0 - ylo0) + (yhi1 - ylo1)) <= 1e-13 * box.x() * box.y()) return;
+  // ∫ y_i over the chart trapezoid x ∈ [x0, x1] between the lines through (x0, ylo0)–(x1, ylo1)
+  // and (x0, yhi0)–(x1, yhi1), added to out, by Gauss–Legendre (orders above PolygonSH's).
+  void gauss_trapezoid(const Texel& t, double x0, double x1, double ylo0, double ylo1, double yhi0, double yhi1,
+                       double* out, Scratch& s) const {
+    if (!(x1 > x0)) return;
     auto world = [&](double x, double y) { return Vector3d(world_from_frame * (t.c + x * t.e1 + y * t.e2)); };
-    if (polygon_sh) {
-      const Vector3d v[4] = {world(x0, ylo0), world(x1, ylo1), world(x1, yhi1), world(x0, yhi0)};
-      s.moments.assign(n2, 0.0);
-      polygon_sh->project(std::span<const Vector3d>(v, 4), s.moments);
-      for (size_t i = 0; i < n2; ++i) out[i] += s.moments[i];
-      return;
-    }
     // Above PolygonSH's orders: Gauss–Legendre in the chart. y_i varies on the angular scale
     // 1/order and the chart is within ~1% of isometric over a texel, so with n ≥ order·size/2 + 6
     // points per axis the rule's error (~(order·size/4)^(2n) / (2n)!) is far below 1e-12.
@@ -147,25 +259,67 @@ struct HotTexels::Impl {
     }
   }
 
+  // ∫ y_i over a polygon of t's chart (counter-clockwise, vertices in `poly`), added to out:
+  // PolygonSH's closed form on its world vertices, or above its orders the polygon's trapezoids
+  // (slabs between its vertices, inside by the parity of its edges) by Gauss–Legendre. A sliver
+  // of (nearly) no area is left out: its vertices are (nearly) on one great circle, where the
+  // closed form's solid angle cannot tell it from a hemisphere; below 1e-13 of the texel's chart
+  // box, that costs at most as much.
+  void polygon_moments(const Texel& t, const std::vector<Vector2d>& poly, double* out, Scratch& s) const {
+    const size_t nv = poly.size();
+    if (nv < 3) return;
+    double area2 = 0;
+    for (size_t k = 0; k < nv; ++k) area2 += cross2(poly[k], poly[(k + 1) % nv]);
+    const Vector2d box = t.hi - t.lo;
+    if (0.5 * area2 <= 1e-13 * box.x() * box.y()) return;
+    if (polygon_sh) {
+      s.world.clear();
+      for (const Vector2d& v : poly) s.world.push_back(world_from_frame * (t.c + v.x() * t.e1 + v.y() * t.e2));
+      s.moments.assign(n2, 0.0);
+      polygon_sh->project(s.world, s.moments);
+      for (size_t i = 0; i < n2; ++i) out[i] += s.moments[i];
+      return;
+    }
+    s.xs.clear();
+    for (const Vector2d& v : poly) s.xs.push_back(v.x());
+    std::sort(s.xs.begin(), s.xs.end());
+    s.xs.erase(std::unique(s.xs.begin(), s.xs.end()), s.xs.end());
+    for (size_t k = 0; k + 1 < s.xs.size(); ++k) {
+      const double x0 = s.xs[k], x1 = s.xs[k + 1], xm = 0.5 * (x0 + x1);
+      s.order.clear();
+      for (size_t e = 0; e < nv; ++e) {
+        const Vector2d &p = poly[e], &q = poly[(e + 1) % nv];
+        if (p.x() == q.x() || xm < std::min(p.x(), q.x()) || xm > std::max(p.x(), q.x())) continue;
+        s.order.emplace_back(p.y() + (xm - p.x()) * (q.y() - p.y()) / (q.x() - p.x()), e);
+      }
+      std::sort(s.order.begin(), s.order.end());
+      auto y_at = [&](size_t e, double x) {
+        const Vector2d &p = poly[e], &q = poly[(e + 1) % nv];
+        return p.y() + (x - p.x()) * (q.y() - p.y()) / (q.x() - p.x());
+      };
+      for (size_t r = 0; r + 1 < s.order.size(); r += 2) {  // inside between edges 2r and 2r + 1
+        const size_t lo = s.order[r].second, hi = s.order[r + 1].second;
+        gauss_trapezoid(t, x0, x1, y_at(lo, x0), y_at(lo, x1), y_at(hi, x0), y_at(hi, x1), out, s);
+      }
+    }
+  }
+
   // The moments of the part of texel t where W = 0, given W at t.ref and the arcs `local`
   // (indices into arcs) that may meet its box; added to out (order² values, unit radiance).
+  // In the chart: the arcs' pieces in the box are segments. Strips between every segment end
+  // and every crossing of two segments; in a strip the segments do not cross, so they cut it into
+  // bands, each with one W; each band with W = 0 is the texel's polygon clipped by the strip's
+  // sides and the band's two segment lines (straight lines: great circles), integrated exactly.
   void visible(const Texel& t, std::span<const DcfArc> arcs, std::span<const size_t> local, int W_ref,
                double* out, Scratch& s) const {
     s.segments.clear();
-    const size_t nv = t.polygon.size();
-    for (size_t k = 0; k < nv; ++k) {
-      Segment e;
-      e.p = t.polygon[k];
-      e.q = t.polygon[(k + 1) % nv];
-      e.edge = true;
-      if (e.p != e.q) s.segments.push_back(e);
-    }
     for (size_t j : local) {
       const DcfArc& arc = arcs[j];
       // The part of the arc inside the box's pyramid: x ≥ lo.x ⇔ (e1 − lo.x c)·ω ≥ 0 and so on,
       // and c·ω ≥ 0; each is linear in the chord parameter λ of ω = a + λ(b − a), which runs
       // over the same directions as the arc.
       double l0 = 0, l1 = 1;
+      bool cut0 = false, cut1 = false;
       const Vector3d planes[5] = {t.c, t.e1 - t.lo.x() * t.c, t.hi.x() * t.c - t.e1, t.e2 - t.lo.y() * t.c,
                                   t.hi.y() * t.c - t.e2};
       const Vector3d d = arc.b - arc.a;
@@ -176,8 +330,8 @@ struct HotTexels::Impl {
           continue;
         }
         const double root = -fa / fd;
-        if (fd > 0) l0 = std::max(l0, root);
-        else l1 = std::min(l1, root);
+        if (fd > 0 && root >= l0) l0 = root, cut0 = true;
+        else if (fd < 0 && root <= l1) l1 = root, cut1 = true;
       }
       if (!(l1 > l0)) continue;
       auto chart = [&](double l) {
@@ -188,91 +342,161 @@ struct HotTexels::Impl {
       Segment g;
       g.p = chart(l0);
       g.q = chart(l1);
-      if (!(g.p.allFinite() && g.q.allFinite())) continue;
+      if (!(g.p.allFinite() && g.q.allFinite()) || g.p.x() == g.q.x()) continue;  // vertical: a strip side
+      if (g.p.x() > g.q.x()) std::swap(g.p, g.q);
       g.gx = arc.m.dot(t.e1);
       g.gy = arc.m.dot(t.e2);
       g.side_sum = arc.side_sum;
+      g.spans = cut0 && cut1;
+      g.arc = j;
       s.segments.push_back(g);
     }
-    // Slab boundaries: every end and every proper crossing inside the polygon's x-range.
+    const size_t ns = s.segments.size();
+    if (ns == 0) {  // nothing crosses the box: W is W_ref throughout
+      if (W_ref == 0)
+        for (size_t i = 0; i < n2; ++i) out[i] += t.moments[i];
+      return;
+    }
+    // One arc across the whole box: the texel on one side of its great circle (or all, or
+    // nothing), clipped in 3D (bake/spherical_polygon.h) and projected once.
+    if (ns == 1 && s.segments[0].spans && polygon_sh) {
+      const DcfArc& arc = arcs[s.segments[0].arc];
+      const double g_ref = arc.m.dot(t.ref);
+      if (g_ref != 0) {
+        const int W_other = W_ref + (g_ref < 0 ? 1 : -1) * arc.side_sum;
+        if (W_ref != 0 && W_other != 0) return;
+        // Keep the side where W = 0: sign(m·ω) = sign(g_ref) when that is ref's side.
+        const Vector3d keep = world_from_frame * ((W_ref == 0) == (g_ref > 0) ? arc.m : Vector3d(-arc.m));
+        clip_to_horizon(t.polygon_world, keep, s.clipped);
+        if (s.clipped.size() >= 3) {
+          s.moments.assign(n2, 0.0);
+          polygon_sh->project(s.clipped, s.moments);
+          for (size_t i = 0; i < n2; ++i) out[i] += s.moments[i];
+        }
+        return;
+      }
+    }
     double xmin = t.polygon[0].x(), xmax = xmin;
     for (const Vector2d& v : t.polygon) xmin = std::min(xmin, v.x()), xmax = std::max(xmax, v.x());
-    s.xs.clear();
-    s.xs.push_back(xmin);
-    s.xs.push_back(xmax);
-    const size_t ns = s.segments.size();
+    s.strips.clear();
+    s.strips.push_back(xmin);
+    s.strips.push_back(xmax);
     for (size_t i = 0; i < ns; ++i) {
       const Segment& a = s.segments[i];
-      s.xs.push_back(a.p.x());
-      s.xs.push_back(a.q.x());
+      s.strips.push_back(a.p.x());
+      s.strips.push_back(a.q.x());
       for (size_t j = i + 1; j < ns; ++j) {
         const Segment& b = s.segments[j];
-        if (a.edge && b.edge) continue;  // the polygon's own edges meet at its vertices only
         const double d1 = orient2(a.p, a.q, b.p), d2 = orient2(a.p, a.q, b.q);
         const double d3 = orient2(b.p, b.q, a.p), d4 = orient2(b.p, b.q, a.q);
         if (!((d1 > 0) != (d2 > 0) && d1 != 0 && d2 != 0 && (d3 > 0) != (d4 > 0) && d3 != 0 && d4 != 0)) continue;
         const double f = d1 / (d1 - d2);
-        s.xs.push_back(b.p.x() + f * (b.q.x() - b.p.x()));
+        s.strips.push_back(b.p.x() + f * (b.q.x() - b.p.x()));
       }
     }
-    std::sort(s.xs.begin(), s.xs.end());
-    s.xs.erase(std::unique(s.xs.begin(), s.xs.end()), s.xs.end());
-    for (size_t k = 0; k + 1 < s.xs.size(); ++k) {
-      const double x0 = s.xs[k], x1 = s.xs[k + 1];
+    std::sort(s.strips.begin(), s.strips.end());
+    s.strips.erase(std::unique(s.strips.begin(), s.strips.end()), s.strips.end());
+    for (size_t k = 0; k + 1 < s.strips.size(); ++k) {
+      const double x0 = s.strips[k], x1 = s.strips[k + 1];
       if (x0 < xmin || x1 > xmax || !(x1 > x0)) continue;
       const double xm = 0.5 * (x0 + x1);
-      s.order.clear();
+      s.active.clear();
       for (size_t i = 0; i < ns; ++i) {
         const Segment& g = s.segments[i];
-        if (g.p.x() == g.q.x() || xm < std::min(g.p.x(), g.q.x()) || xm > std::max(g.p.x(), g.q.x())) continue;
-        s.order.emplace_back(g.y_at(xm), i);
+        if (xm >= g.p.x() && xm <= g.q.x()) s.active.emplace_back(g.y_at(xm), i);
       }
-      std::sort(s.order.begin(), s.order.end());
-      // W below every segment of the slab. The slab's ends are events, so every segment either
-      // spans x = xm or misses it: the middle of the widest gap between the heights at xm (box
-      // sides included) is off every segment, and the path from ref2 to it decides W there by
-      // strict orientation tests; the segments below it are then stepped back over.
+      std::sort(s.active.begin(), s.active.end());
+      // W in the lowest band. The strip's sides are events, so every segment spans x = xm or
+      // misses it: the middle of the widest gap between the heights at xm (box sides included)
+      // is off every segment, and the straight chart path (a great arc) from ref2 to it decides
+      // W there by strict orientation tests; the segments below it are then stepped back over.
       size_t below = 0;
       double gap = -1, yB = 0;
-      for (size_t r = 0; r <= s.order.size(); ++r) {
-        const double ya = r == 0 ? t.lo.y() : s.order[r - 1].first, yb = r == s.order.size() ? t.hi.y() : s.order[r].first;
+      for (size_t r = 0; r <= s.active.size(); ++r) {
+        const double ya = r == 0 ? t.lo.y() : s.active[r - 1].first, yb = r == s.active.size() ? t.hi.y() : s.active[r].first;
         if (yb - ya > gap) gap = yb - ya, yB = 0.5 * (ya + yb), below = r;
       }
-      const Vector2d A = t.ref2, B(xm, yB), d = B - A;
+      const Vector2d A = t.ref2, B(xm, yB), dAB = B - A;
       int W = W_ref;
       for (const Segment& g : s.segments) {
-        if (g.edge) continue;
         const double d1 = orient2(A, B, g.p), d2 = orient2(A, B, g.q);
         const double d3 = orient2(g.p, g.q, A), d4 = orient2(g.p, g.q, B);
         if ((d1 > 0) != (d2 > 0) && d1 != 0 && d2 != 0 && (d3 > 0) != (d4 > 0) && d3 != 0 && d4 != 0)
-          W += sign_of(d.x() * g.gx + d.y() * g.gy) * g.side_sum;
+          W += sign_of(dAB.x() * g.gx + dAB.y() * g.gy) * g.side_sum;
       }
-      for (size_t r = 0; r < below; ++r)
-        if (const Segment& g = s.segments[s.order[r].second]; !g.edge) W -= sign_of(g.gy) * g.side_sum;
-      bool inside = false;
-      for (size_t r = 0; r < s.order.size(); ++r) {
-        const Segment& g = s.segments[s.order[r].second];
-        if (g.edge) inside = !inside;
-        else W += sign_of(g.gy) * g.side_sum;  // travelling +y
-        if (r + 1 < s.order.size() && inside && W == 0) {
-          const Segment& h = s.segments[s.order[r + 1].second];
-          trapezoid(t, x0, x1, g.y_at(x0), g.y_at(x1), h.y_at(x0), h.y_at(x1), out, s);
+      for (size_t r = 0; r < below; ++r) W -= sign_of(s.segments[s.active[r].second].gy) * s.segments[s.active[r].second].side_sum;
+      // Bands from the bottom: band r lies above active segment r − 1 and below segment r.
+      for (size_t r = 0; r <= s.active.size(); ++r) {
+        if (r > 0) W += sign_of(s.segments[s.active[r - 1].second].gy) * s.segments[s.active[r - 1].second].side_sum;
+        if (W != 0) continue;
+        s.band = t.polygon;
+        clip_half_plane(s.band, Vector2d(x0, 0), Vector2d(0, -1), s);  // x ≥ x0: left of downward
+        clip_half_plane(s.band, Vector2d(x1, 0), Vector2d(0, 1), s);   // x ≤ x1: left of upward
+        if (r > 0) {
+          const Segment& g = s.segments[s.active[r - 1].second];
+          clip_half_plane(s.band, g.p, g.q - g.p, s);  // above it: left of p → q (p.x < q.x)
         }
+        if (r < s.active.size()) {
+          const Segment& g = s.segments[s.active[r].second];
+          clip_half_plane(s.band, g.q, g.p - g.q, s);  // below it: left of q → p
+        }
+        polygon_moments(t, s.band, out, s);
       }
     }
   }
 
+  // Sutherland–Hodgman: keeps the part of `poly` left of the directed line through `a` along `d`.
+  static void clip_half_plane(std::vector<Vector2d>& poly, const Vector2d& a, const Vector2d& d, Scratch& s) {
+    s.clip_tmp.clear();
+    const size_t n = poly.size();
+    for (size_t k = 0; k < n; ++k) {
+      const Vector2d &p = poly[k], &q = poly[(k + 1) % n];
+      const double fp = cross2(d, p - a), fq = cross2(d, q - a);
+      if (fp >= 0) s.clip_tmp.push_back(p);
+      if ((fp > 0 && fq < 0) || (fp < 0 && fq > 0)) s.clip_tmp.push_back(p + (fp / (fp - fq)) * (q - p));
+    }
+    poly.swap(s.clip_tmp);
+  }
+
   // Whether the arc comes within the cap (c, r) (r < π/2): its nearest point to c is an end or the
   // foot of c on its great circle.
-  static bool meets_cap(const DcfArc& arc, const Vector3d& c, double cos_r, double sin_r) {
-    const double na = arc.a.norm(), nb = arc.b.norm();
-    if (c.dot(arc.a) >= cos_r * na || c.dot(arc.b) >= cos_r * nb) return true;
+  static bool meets_cap(const ArcInfo& arc, const Vector3d& c, double cos_r, double sin_r) {
+    if (c.dot(arc.ah) >= cos_r || c.dot(arc.bh) >= cos_r) return true;
+    const double s = c.dot(arc.mh);
+    if (arc.mh.squaredNorm() == 0 || std::abs(s) > sin_r) return false;
+    const Vector3d foot = c - s * arc.mh;
+    return arc.ah.cross(foot).dot(arc.mh) >= 0 && foot.cross(arc.bh).dot(arc.mh) >= 0 && foot.dot(arc.ah + arc.bh) > 0;
+  }
+  static ArcInfo info_of(const DcfArc& arc) {
+    ArcInfo i;
+    i.cap = cap_of(arc.a, arc.b);
+    i.ah = arc.a.normalized(), i.bh = arc.b.normalized();
     const double nm = arc.m.norm();
-    if (!(nm > 0)) return false;
-    const double s = c.dot(arc.m) / nm;
-    if (std::abs(s) > sin_r) return false;
-    const Vector3d foot = c - (s / nm) * arc.m;
-    return arc.a.cross(foot).dot(arc.m) >= 0 && foot.cross(arc.b).dot(arc.m) >= 0 && foot.dot(arc.a + arc.b) > 0;
+    i.mh = nm > 0 ? Vector3d(arc.m / nm) : Vector3d::Zero();
+    return i;
+  }
+
+  // The steps of the arcs crossed on the way from `from` to `to` (via a waypoint when the two are
+  // nearly opposite), testing only the arcs whose caps meet the leg's.
+  // (`subset`: the arcs that may cross it, indices into arcs; empty: all of them.)
+  static int steps_between(std::span<const DcfArc> arcs, std::span<const ArcInfo> info, const Vector3d& from,
+                           const Vector3d& to, const std::vector<size_t>* subset = nullptr) {
+    if (from.dot(to) <= -0.5 * from.norm() * to.norm()) {
+      const Vector3d any = std::abs(from.x()) < 0.9 * from.norm() ? Vector3d::UnitX() : Vector3d::UnitY();
+      const Vector3d mid = from.cross(any).normalized();
+      return steps_between(arcs, info, from, mid, subset) + steps_between(arcs, info, mid, to, subset);
+    }
+    if (from == to) return 0;
+    const Cap leg = cap_of(from, to);
+    int w = 0;
+    auto test = [&](size_t j) {
+      if (caps_meet(info[j].cap, leg)) w += dcf_path_steps(arcs.subspan(j, 1), from, to);
+    };
+    if (subset)
+      for (size_t j : *subset) test(j);
+    else
+      for (size_t j = 0; j < arcs.size(); ++j) test(j);
+    return w;
   }
 
   // W at the frame direction to, from W0 at s0 (via a waypoint when the two are nearly opposite).
@@ -292,7 +516,7 @@ struct HotTexels::Impl {
       const Texel& t = texels[k];
       s.texel_arcs.clear();
       for (size_t j : local)
-        if (meets_cap(arcs[j], t.c, t.cos_r, t.sin_r)) s.texel_arcs.push_back(j);
+        if (meets_cap(s.info[j], t.c, t.cos_r, t.sin_r)) s.texel_arcs.push_back(j);
       // The short arc from the cluster's reference point to the texel's stays in the cluster's
       // cap: only its local arcs can cross it.
       int W = Wc;
@@ -359,6 +583,7 @@ HotTexels::HotTexels(const EnvMap& env, const Eigen::Matrix3d& frame_from_world,
       const double z = t.c.dot(v);
       PRT_CHECK(z > 0);
       t.polygon.emplace_back(t.e1.dot(v) / z, t.e2.dot(v) / z);
+      t.polygon_world.push_back(I.world_from_frame * v);
     }
     t.lo = t.hi = t.polygon[0];
     for (const Vector2d& v : t.polygon) t.lo = t.lo.cwiseMin(v), t.hi = t.hi.cwiseMax(v);
@@ -374,7 +599,7 @@ HotTexels::HotTexels(const EnvMap& env, const Eigen::Matrix3d& frame_from_world,
     const Rgb L = env.texel_value(tx);
     t.rgb[0] = L.r, t.rgb[1] = L.g, t.rgb[2] = L.b;
     t.moments.assign(I.n2, 0.0);
-    I.visible(t, {}, {}, 0, t.moments.data(), s);
+    I.polygon_moments(t, t.polygon, t.moments.data(), s);
     return t;
   };
   for (auto& [key, members] : tiles) {
@@ -413,6 +638,12 @@ HotTexels::HotTexels(const EnvMap& env, const Eigen::Matrix3d& frame_from_world,
         for (size_t i = 0; i < I.n2; ++i) cl.total[size_t(c) * I.n2 + i] += I.texels[k].rgb[c] * I.texels[k].moments[i];
     for (size_t i = 0; i < cl.total.size(); ++i) I.unoccluded[i] += cl.total[i];
   }
+  if (!I.clusters.empty()) {
+    std::vector<int> ids(I.clusters.size());
+    std::iota(ids.begin(), ids.end(), 0);
+    I.nodes.reserve(2 * ids.size());
+    I.build_node(ids, 0, ids.size(), 0);
+  }
 }
 
 HotTexels::~HotTexels() = default;
@@ -427,19 +658,23 @@ const std::vector<double>& HotTexels::unoccluded() const noexcept { return impl_
 
 void HotTexels::accumulate(std::span<const DcfArc> arcs, const Vector3d& s0, int W0, double* out) const {
   const Impl& I = *impl_;
+  if (I.nodes.empty()) return;
   Scratch& s = tl_scratch;
-  for (const Impl::Cluster& cl : I.clusters) {
-    s.cluster_arcs.clear();
-    for (size_t j = 0; j < arcs.size(); ++j)
-      if (arcs[j].side_sum != 0 && Impl::meets_cap(arcs[j], cl.c, cl.cos_r, cl.sin_r)) s.cluster_arcs.push_back(j);
-    const int Wc = Impl::W_at(arcs, s0, W0, cl.ref);
-    if (s.cluster_arcs.empty()) {
-      if (Wc == 0)
-        for (size_t i = 0; i < cl.total.size(); ++i) out[i] += cl.total[i];
-      continue;
-    }
-    I.texel_range(cl, arcs, s.cluster_arcs, Wc, out, s);  // visible() leaves cluster_arcs alone
+  s.info.resize(arcs.size());
+  s.node_arcs.resize(size_t(I.depth) + 1);
+  std::vector<size_t>& root = s.node_arcs[0];
+  root.clear();
+  for (size_t j = 0; j < arcs.size(); ++j) {
+    s.info[j] = Impl::info_of(arcs[j]);
+    if (arcs[j].side_sum == 0) continue;
+    const Impl::Node& n = I.nodes[0];
+    Cap cap;
+    cap.mid = n.c, cap.cos_h = n.cos_r, cap.sin_h = n.sin_r;
+    if (n.cos_r <= -1 || caps_meet(s.info[j].cap, cap)) root.push_back(j);
   }
+  // W at the root's reference point from s0: a long path, every arc tested (by its cap first).
+  const int W_root = W0 + Impl::steps_between(arcs, s.info, s0, I.nodes[0].ref);
+  I.descend(0, arcs, root, W_root, out, s, 0);
 }
 
 std::vector<double> HotTexels::texel_moments(int texel, std::span<const DcfArc> arcs, const Vector3d& s0, int W0) const {
@@ -447,9 +682,12 @@ std::vector<double> HotTexels::texel_moments(int texel, std::span<const DcfArc> 
   std::vector<double> out(I.n2, 0.0);
   for (const Impl::Texel& t : I.texels) {
     if (t.index != texel) continue;
+    Scratch& s = tl_scratch;
+    s.info.resize(arcs.size());
+    for (size_t j = 0; j < arcs.size(); ++j) s.info[j] = Impl::info_of(arcs[j]);
     std::vector<size_t> local;
     for (size_t j = 0; j < arcs.size(); ++j)
-      if (arcs[j].side_sum != 0 && Impl::meets_cap(arcs[j], t.c, t.cos_r, t.sin_r)) local.push_back(j);
+      if (arcs[j].side_sum != 0 && Impl::meets_cap(s.info[j], t.c, t.cos_r, t.sin_r)) local.push_back(j);
     const int W = Impl::W_at(arcs, s0, W0, t.ref);
     if (local.empty()) {
       if (W == 0) out = t.moments;

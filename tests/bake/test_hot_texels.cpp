@@ -124,6 +124,57 @@ TEST(HotTexels, VisiblePartPastAGreatCircleMatchesTheClippedPolygon) {
   EXPECT_GT(cut, 100);  // most trials cut their texel (the plane passes within 0.03 of its centre)
 }
 
+TEST(HotTexels, TriangleCornerInsideATexelMatchesTheClippedPolygon) {
+  // A silhouette vertex inside the texel: an occluder triangle (W = 1 inside: side_sum +1 on its
+  // counter-clockwise arcs) with one corner near the texel's centre and the others ~2 texels away,
+  // so two arcs end inside the texel and the slab decomposition decides. Closed form: the texel
+  // minus its part inside the triangle (the texel clipped by the triangle's three great circles).
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> U(-1, 1);
+  const Vector3d s0(-1, 0, 0);
+  for (const bool cube : {false, true}) {
+    std::vector<int> all;
+    const int count = cube ? 16 * 16 * 6 : 64 * 32;
+    for (int t = 0; t < count; ++t) all.push_back(t);
+    const EnvMap env = cube ? lit_cube(16, all, 1) : lit_latlong(64, 32, all, 1);
+    const Eigen::Matrix3d frame = Eigen::AngleAxisd(0.7236, Vector3d(0.3141, 0.5926, 0.7418).normalized()).toRotationMatrix();
+    const HotTexels hot(env, frame, 3, 0.0, size_t(count));
+    for (int trial = 0; trial < 100; ++trial) {
+      const int t = int(std::uniform_int_distribution<int>(0, count - 1)(rng));
+      const std::vector<Vector3d> poly = env.texel_polygon(t);
+      Vector3d c = Vector3d::Zero();
+      for (const Vector3d& v : poly) c += v;
+      c.normalize();
+      const double size = std::sqrt(env.texel_solid_angle(t));
+      const Vector3d e1 = c.cross(Vector3d(U(rng), U(rng), U(rng))).normalized(), e2 = c.cross(e1);
+      const Vector3d v0 = (c + 0.2 * size * (U(rng) * e1 + U(rng) * e2)).normalized();
+      const double a1 = 3.2 * U(rng), a2 = a1 + 0.6 + 1.5 * (U(rng) + 1);  // an angle < π at v0
+      Vector3d v1 = (v0 + 2 * size * (std::cos(a1) * e1 + std::sin(a1) * e2)).normalized();
+      Vector3d v2 = (v0 + 2 * size * (std::cos(a2) * e1 + std::sin(a2) * e2)).normalized();
+      if (v0.cross(v1).dot(v2) < 0) std::swap(v1, v2);  // counter-clockwise from outside
+      const Vector3d tri[3] = {v0, v1, v2};
+      std::vector<DcfArc> arcs;
+      for (int k = 0; k < 3; ++k) {
+        const Vector3d a = frame * tri[k], b = frame * tri[(k + 1) % 3];
+        arcs.push_back({a, b, a.cross(b), +1});
+      }
+      const int W0 = 0;  // s0 is far from every small triangle
+      const std::vector<double> got = hot.texel_moments(t, arcs, s0, W0);
+      std::vector<Vector3d> inside = poly, next;
+      for (int k = 0; k < 3 && inside.size() >= 3; ++k) {
+        clip_to_horizon(inside, tri[k].cross(tri[(k + 1) % 3]), next);
+        inside.swap(next);
+      }
+      std::vector<double> full(9, 0.0), hidden(9, 0.0);
+      PolygonSH(3).project(poly, full);
+      if (inside.size() >= 3) PolygonSH(3).project(inside, hidden);
+      for (size_t i = 0; i < 9; ++i)
+        ASSERT_NEAR(got[i], full[i] - hidden[i], 1e-12 * env.texel_solid_angle(t))
+            << (cube ? "cube" : "lat-long") << " texel " << t << " trial " << trial << " i " << i;
+    }
+  }
+}
+
 TEST(HotTexels, GaussLegendreAboveOrderTwelveAgreesWithTheClosedForm) {
   // Order 14 takes the Gauss–Legendre path; its first 144 moments must equal PolygonSH's order 12
   // on the same visible parts to 1e-12 of the texel's solid angle (the rule's bound, header).
