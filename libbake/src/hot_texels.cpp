@@ -86,6 +86,8 @@ struct Scratch {
   std::vector<double> xs;
   std::vector<std::pair<double, size_t>> order;
   std::vector<size_t> cluster_arcs, texel_arcs;
+  std::vector<uint8_t> spanning;  // per cluster-local arc: it crosses the whole cap
+  std::vector<int> side_ref;      // its side at the cluster's reference point
   std::vector<double> moments;
   std::vector<double> gx, gw, gy, gwy;
 };
@@ -476,14 +478,23 @@ struct HotTexels::Impl {
     return i;
   }
 
+  // A point a quarter turn from `from`, off every axis plane: the arcs of an axis-aligned scene and
+  // the horizon's quarter arcs (whose ends lie in the frame's axis planes for some normals) must
+  // not pass through a W path's corner by symmetry.
+  static Vector3d waypoint(const Vector3d& from) {
+    const Vector3d generic(0.5466, -0.3719, 0.7503);
+    Vector3d m = from.cross(generic);
+    if (m.squaredNorm() < 1e-6 * from.squaredNorm()) m = from.cross(Vector3d(-0.2377, 0.8716, 0.4288));
+    return m.normalized();
+  }
+
   // The steps of the arcs crossed on the way from `from` to `to` (via a waypoint when the two are
   // nearly opposite), testing only the arcs whose caps meet the leg's.
   // (`subset`: the arcs that may cross it, indices into arcs; empty: all of them.)
   static int steps_between(std::span<const DcfArc> arcs, std::span<const ArcInfo> info, const Vector3d& from,
                            const Vector3d& to, const std::vector<size_t>* subset = nullptr) {
     if (from.dot(to) <= -0.5 * from.norm() * to.norm()) {
-      const Vector3d any = std::abs(from.x()) < 0.9 * from.norm() ? Vector3d::UnitX() : Vector3d::UnitY();
-      const Vector3d mid = from.cross(any).normalized();
+      const Vector3d mid = waypoint(from);
       return steps_between(arcs, info, from, mid, subset) + steps_between(arcs, info, mid, to, subset);
     }
     if (from == to) return 0;
@@ -502,8 +513,7 @@ struct HotTexels::Impl {
   // W at the frame direction to, from W0 at s0 (via a waypoint when the two are nearly opposite).
   static int W_at(std::span<const DcfArc> arcs, const Vector3d& s0, int W0, const Vector3d& to) {
     if (s0.dot(to) > -0.5 * s0.norm() * to.norm()) return W0 + dcf_path_steps(arcs, s0, to);
-    const Vector3d any = std::abs(s0.x()) < 0.9 * s0.norm() ? Vector3d::UnitX() : Vector3d::UnitY();
-    const Vector3d mid = s0.cross(any).normalized();
+    const Vector3d mid = waypoint(s0);
     return W0 + dcf_path_steps(arcs, s0, mid) + dcf_path_steps(arcs, mid, to);
   }
 
@@ -511,16 +521,38 @@ struct HotTexels::Impl {
   // centre is Wc, its local arcs `local`).
   void texel_range(const Cluster& cl, std::span<const DcfArc> arcs, std::span<const size_t> local, int Wc, double* out,
                    Scratch& s) const {
+    // A local arc with both ends outside the cluster's cap covers its great circle's whole chord
+    // of the cap (the cap is convex): there, crossing it is changing sides of that great circle,
+    // and meeting a texel's cap is coming within its radius of the circle. Only the arcs that end
+    // inside the cap need the path test.
+    s.spanning.assign(local.size(), 0);
+    s.side_ref.assign(local.size(), 0);
+    for (size_t q = 0; q < local.size(); ++q) {
+      const ArcInfo& a = s.info[local[q]];
+      if (a.mh.squaredNorm() > 0 && cl.c.dot(a.ah) < cl.cos_r && cl.c.dot(a.bh) < cl.cos_r) {
+        s.spanning[q] = 1;
+        s.side_ref[q] = sign_of(arcs[local[q]].m.dot(cl.ref));
+      }
+    }
     std::vector<double> m;
     for (size_t k = cl.begin; k < cl.end; ++k) {
       const Texel& t = texels[k];
       s.texel_arcs.clear();
-      for (size_t j : local)
-        if (meets_cap(s.info[j], t.c, t.cos_r, t.sin_r)) s.texel_arcs.push_back(j);
       // The short arc from the cluster's reference point to the texel's stays in the cluster's
       // cap: only its local arcs can cross it.
       int W = Wc;
-      for (size_t j : local) W += dcf_path_steps(arcs.subspan(j, 1), cl.ref, t.ref);
+      for (size_t q = 0; q < local.size(); ++q) {
+        const size_t j = local[q];
+        const ArcInfo& a = s.info[j];
+        if (s.spanning[q]) {
+          if (std::abs(t.c.dot(a.mh)) <= t.sin_r) s.texel_arcs.push_back(j);
+          const int side = sign_of(arcs[j].m.dot(t.ref));
+          if (side != 0 && s.side_ref[q] != 0 && side != s.side_ref[q]) W += side * arcs[j].side_sum;
+        } else {
+          if (meets_cap(a, t.c, t.cos_r, t.sin_r)) s.texel_arcs.push_back(j);
+          W += dcf_path_steps(arcs.subspan(j, 1), cl.ref, t.ref);
+        }
+      }
       const double* mom = nullptr;
       if (s.texel_arcs.empty()) {
         if (W != 0) continue;
@@ -535,6 +567,7 @@ struct HotTexels::Impl {
         for (size_t i = 0; i < n2; ++i) out[size_t(c) * n2 + i] += t.rgb[c] * mom[i];
     }
   }
+
 };
 
 HotTexels::HotTexels(const EnvMap& env, const Eigen::Matrix3d& frame_from_world, int order, double hot_factor,
