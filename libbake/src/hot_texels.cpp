@@ -4,7 +4,6 @@
 
 #include <bake/error.h>
 #include <bake/polygon_sh.h>
-#include <bake/spherical_polygon.h>
 
 #include <prtshade/quadrature.h>
 #include <prtshade/sh.h>
@@ -82,7 +81,6 @@ struct Scratch {
   std::vector<Vector3d> world;
   std::vector<ArcInfo> info;  // per arc of the current call
   std::vector<std::vector<size_t>> node_arcs;  // per depth of the cluster tree
-  std::vector<Vector3d> clipped;
   std::vector<double> xs;
   std::vector<std::pair<double, size_t>> order;
   std::vector<size_t> cluster_arcs, texel_arcs;
@@ -117,7 +115,6 @@ struct HotTexels::Impl {
     int index = 0;
     Vector3d c, e1, e2;
     std::vector<Vector2d> polygon;  // counter-clockwise in the chart
-    std::vector<Vector3d> polygon_world;  // the same vertices, unit, world frame
     Vector2d lo, hi;                // the chart box every local arc is clipped to (polygon box + margin)
     // The point W is carried from (chart ref2, direction ref): off the centre by odd fractions of
     // the box, so that no arc of an axis-aligned scene passes through it by symmetry (a W path
@@ -360,20 +357,18 @@ struct HotTexels::Impl {
       return;
     }
     // One arc across the whole box: the texel on one side of its great circle (or all, or
-    // nothing), clipped in 3D (bake/spherical_polygon.h) and projected once.
-    if (ns == 1 && s.segments[0].spans && polygon_sh) {
-      const DcfArc& arc = arcs[s.segments[0].arc];
-      const double g_ref = arc.m.dot(t.ref);
-      if (g_ref != 0) {
-        const int W_other = W_ref + (g_ref < 0 ? 1 : -1) * arc.side_sum;
-        if (W_ref != 0 && W_other != 0) return;
-        // Keep the side where W = 0: sign(m·ω) = sign(g_ref) when that is ref's side.
-        const Vector3d keep = world_from_frame * ((W_ref == 0) == (g_ref > 0) ? arc.m : Vector3d(-arc.m));
-        clip_to_horizon(t.polygon_world, keep, s.clipped);
-        if (s.clipped.size() >= 3) {
-          s.moments.assign(n2, 0.0);
-          polygon_sh->project(s.clipped, s.moments);
-          for (size_t i = 0; i < n2; ++i) out[i] += s.moments[i];
+    // nothing): the polygon clipped once by the segment's line and projected once.
+    if (ns == 1 && s.segments[0].spans) {
+      const Segment& g = s.segments[0];
+      const double side = orient2(g.p, g.q, t.ref2);  // > 0: ref2 above the line (left of p → q)
+      if (side != 0) {
+        const int step_up = sign_of(g.gy) * g.side_sum;  // W's step crossing the line upwards
+        const int W_above = side > 0 ? W_ref : W_ref + step_up, W_below = W_above - step_up;
+        if (W_above == 0 || W_below == 0) {
+          s.band = t.polygon;
+          if (W_above == 0) clip_half_plane(s.band, g.p, g.q - g.p, s);
+          else clip_half_plane(s.band, g.q, g.p - g.q, s);
+          polygon_moments(t, s.band, out, s);
         }
         return;
       }
@@ -616,7 +611,6 @@ HotTexels::HotTexels(const EnvMap& env, const Eigen::Matrix3d& frame_from_world,
       const double z = t.c.dot(v);
       PRT_CHECK(z > 0);
       t.polygon.emplace_back(t.e1.dot(v) / z, t.e2.dot(v) / z);
-      t.polygon_world.push_back(I.world_from_frame * v);
     }
     t.lo = t.hi = t.polygon[0];
     for (const Vector2d& v : t.polygon) t.lo = t.lo.cwiseMin(v), t.hi = t.hi.cwiseMax(v);
