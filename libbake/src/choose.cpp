@@ -714,9 +714,18 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                             choice.predictions.back().predicted_error / E);
   else if (!options.only && choice.predictions.size() > 1)
     choice.reason += "; the other integrator cannot reach the target within its bound";
+  if (pick.checked && !pick.switched) {
+    const Prediction& alt = choice.predictions[pick.checked_index];
+    choice.reason += "; the sanity check measured " + std::string(to_string(alt.kind)) + " at " +
+                     knob_text(alt.kind, alt.knob) +
+                     format(" (%.1fx cheaper): %.3g, not taken", cost(best) / std::max(cost(alt), 1e-12), pick.checked_error);
+  }
   if (!choice.reaches) {
     // A default never refuses: the best plan within the bounds, the error it expects, and the way on.
-    choice.reason += format("; the target is NOT reached: expected error %.2g", choice.expected_error) + " (" +
+    choice.reason += format("; the target is NOT reached: expected error %.2g against the aim %.2g (the target times "
+                            "its safety factor)",
+                            choice.expected_error, best.kind == IntegratorKind::Silhouette ? goal_sil : goal_qmc) +
+                     " (" +
                      knob_text(best.kind, best.knob) + " is at its bound: " + best.bound_reason + ")";
     std::string f;
     for (const Prediction& p : choice.predictions) {
@@ -805,7 +814,7 @@ std::string choice_summary(const IntegratorChoice& c) {
 
 ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                     const ProductRequest& request, const IntegratorSpec& spec, double target,
-                                    const Monitor& monitor, const MeshAccel* accel) {
+                                    const Monitor& monitor, const MeshAccel* accel, uint64_t ray_budget) {
   PRT_CHECK(target > 0);
   PRT_CHECK(!request.empty());
   ReferencePlan plan;
@@ -846,7 +855,8 @@ ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Me
     plan.rays_needed.push_back(uint64_t(std::ceil(std::min(r, 1e18))));
     need = std::max(need, r);
   }
-  const uint64_t cap = std::max<uint64_t>(floor_rays, ReferencePlan::kReportRayBudget / plan.points);
+  plan.ray_budget = ray_budget ? ray_budget : ReferencePlan::kReportRayBudget;
+  const uint64_t cap = std::max<uint64_t>(floor_rays, plan.ray_budget / plan.points);
   uint32_t rays = round_up_rays(need);
   if (rays > cap) rays = uint32_t(std::min<uint64_t>(cap, kMaxRays));
   plan.rays = std::max(rays, floor_rays);
@@ -880,7 +890,7 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
           if (plan->products[p] == e.product && plan->rays_needed[p] > plan->rays)
             why += format("; E/3 would need %.3g rays per point, %.3g in all, over the report's budget of %.3g rays",
                           double(plan->rays_needed[p]), double(plan->rays_needed[p]) * double(plan->points),
-                          double(ReferencePlan::kReportRayBudget));
+                          double(plan->ray_budget ? plan->ray_budget : ReferencePlan::kReportRayBudget));
     }
     out.push_back(format("  target %g for ", target) + product_label(e.product) + ": " + verdict + format(" (%.3e", err) +
                   (is_radiance(e.product) ? " relative" : "") +

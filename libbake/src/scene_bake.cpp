@@ -105,6 +105,9 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   out.setup_seconds = seconds_since(t_setup);
 
   // ---- receivers ----
+  uint64_t receiver_vertices = 0;  // of the receivers with per-vertex products (the report's budget)
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (plan.objects[i].receiver && plan.objects[i].any_vertex_product()) receiver_vertices += meshes[i].positions.size();
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -143,8 +146,11 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ob.integrator = ob.choice->spec;
       // The report's reference: its noise within E/3 (or the plan says why not), bake/choose.h.
       if (ob.integrator.report_points > 0 && !rows.rows_only) {
-        ob.reference_plan =
-            plan_report_reference(points, occluders, topo, r, ob.integrator, scene.target_error, monitor, &accel);
+        // The report's ray budget is the scene's, shared by the receivers' vertices.
+        const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(points.size()) /
+                                         double(std::max<uint64_t>(receiver_vertices, 1)));
+        ob.reference_plan = plan_report_reference(points, occluders, topo, r, ob.integrator, scene.target_error, monitor,
+                                                  &accel, std::max<uint64_t>(budget, 1));
         ob.integrator.report_rays = ob.reference_plan->rays;
       }
       if (on_choice)

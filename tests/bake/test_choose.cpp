@@ -380,6 +380,34 @@ TEST(Choose, APlanMoreThanFourTimesTheCostOfANearEqualAlternativeIsNeverTakenUnc
   EXPECT_EQ(pick_plan(tie, E, never).index, 0u);
 }
 
+TEST(Choose, EndToEndTheSanityCheckMeasuresTheCheapNearEqualPlan) {
+  // The situation built on the bunny's AO with counted costs (a function of the inputs): the
+  // silhouette knob bounded by memory at N = 48, whose prediction (~7e-4) misses the aim 0.7·E
+  // but lies within 2·E for E = 5e-4, while QMC's plan (~4e-4 at 65,536 rays) costs hundreds of
+  // times more. The QMC plan is not taken unchecked: the silhouette plan is measured on the pilot
+  // (there, at the reference level, its error is the reference's estimate ~1.6e-3, so it is not
+  // taken) and the choice says so.
+  const Asset& a = bunny_ground();
+  ProductRequest r;
+  r.ao = true;
+  ChooserOptions opt{.target = 5e-4};
+  opt.counted_costs = true;
+  opt.memory_budget_bytes = isoline_table_bytes(r, 48);
+  const IntegratorChoice c = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
+  ASSERT_EQ(c.predictions.size(), 2u);
+  const Prediction& sil = c.predictions[0];
+  const Prediction& qmc = c.predictions[1];
+  ASSERT_FALSE(sil.reachable) << c.reason;
+  ASSERT_LE(sil.predicted_error, ChooserOptions::kSanityErrorFactor * opt.target) << c.reason;
+  ASSERT_FALSE(qmc.pruned) << c.reason;
+  ASSERT_EQ(c.spec.kind, IntegratorKind::Qmc) << c.reason;  // the pick before the check, and after it here
+  ASSERT_GT(qmc.predicted_us_per_point, ChooserOptions::kSanityCostRatio * sil.predicted_us_per_point) << c.reason;
+  EXPECT_NE(c.sanity.find("sanity check: silhouette at N = 48"), std::string::npos) << c.sanity;
+  EXPECT_NE(c.reason.find("sanity check"), std::string::npos) << c.reason;
+  const std::vector<std::string> lines = choice_lines(c);
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("  sanity check: ") == 0; }));
+}
+
 TEST(Choose, AnUnreachableTargetBakesTheBestPlanAndSaysTheErrorItExpects) {
   // The silhouette knob bounded by memory at N = 48 (the tables' budget given), E = kMinTarget:
   // no plan reaches it. The chooser does not throw: it bakes the best plan in its bounds, states

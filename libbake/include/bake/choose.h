@@ -85,7 +85,8 @@
 // noise is d/sqrt(1 + 1/4) and the reference's at R rays that times sqrt(4096/R). (The estimator,
 // an i.i.d. variance, overstates QMC's actual error many times over: 5.5e-4 on AO at 2M rays on
 // sphereWithHole.stl where the bake agreed with the reference to 2.5e-5.) Never fewer than the
-// spec's default reference rays, at most kReportRayBudget rays in all; when the budget binds, the
+// spec's default reference rays, at most kReportRayBudget rays in all (a scene shares it among its
+// receivers by their vertices); when the budget binds, the
 // plan says per product what it would need, and target_check_lines says why it cannot verify.
 //
 // Determinism: the knobs are functions of the inputs and the seed (the pilot's values are), but
@@ -277,6 +278,7 @@ struct ReferencePlan {
   std::vector<double> noise;           // measured, scaled to `rays` (E's units)
   std::vector<double> estimator_noise; // QMC's own standard-error estimate at `rays` (an upper bound)
   std::vector<uint64_t> rays_needed;   // for noise <= E/3
+  uint64_t ray_budget = 0;             // the rays in all it could spend
   bool budget_bound = false;           // the budget kept some product above E/3
   double probe_seconds = 0;
 };
@@ -284,9 +286,12 @@ struct ReferencePlan {
 // (compare_points_with_reference with spec.report_points and spec.seed) and sizes the reference:
 // at least spec.reference_rays() (its default), rounded up like the chooser's rays. Deterministic
 // (seeded QMC). Set spec.report_rays = plan.rays for make_reference.
+// `ray_budget`: the rays in all it may spend (0: kReportRayBudget); a scene shares
+// kReportRayBudget among its receivers by their vertices.
 ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                     const ProductRequest& request, const IntegratorSpec& spec, double target,
-                                    const Monitor& monitor = {}, const MeshAccel* accel = nullptr);
+                                    const Monitor& monitor = {}, const MeshAccel* accel = nullptr,
+                                    uint64_t ray_budget = 0);
 
 // What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
 // and the choice, one line each, then a hint when the call was close (margin < 1.25).
