@@ -402,13 +402,19 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   };
 
   // ---- 1. the reference, and its own error ----
-  const size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes : default_table_memory_budget();
+  // With counted costs the whole choice is a function of the inputs: the memory bound too (a fixed
+  // budget instead of the machine's share).
+  const size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes
+                        : options.counted_costs      ? ChooserOptions::kCountedTableMemoryBudget
+                                                     : default_table_memory_budget();
   const int mem_max = max_isolines_for_memory(request, budget);
   choice.max_isolines = mem_max;
   choice.max_isolines_reason =
       format("memory: the isoline tables of N = %.0f take %.0f MiB of a %.0f MiB budget", mem_max,
              double(isoline_table_bytes(request, mem_max)) / (1 << 20), double(budget) / (1 << 20)) +
-      (options.memory_budget_bytes ? std::string(" (given)") : format(" (%.3g of physical memory)", ChooserOptions::kTableMemoryShare));
+      (options.memory_budget_bytes ? std::string(" (given)")
+       : options.counted_costs     ? std::string(" (fixed with counted costs)")
+                                   : format(" (%.3g of physical memory)", ChooserOptions::kTableMemoryShare));
   int ref_top = mem_max;
   if (options.max_reference_isolines) ref_top = std::min(ref_top, int(options.max_reference_isolines));
   int N_ref = options.reference_isolines ? int(options.reference_isolines) : reference_isolines(E);

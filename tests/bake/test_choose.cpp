@@ -179,6 +179,8 @@ TEST(Choose, CountedCostsMakeTheWholeChoiceAFunctionOfTheInputs) {
   const IntegratorChoice c1 = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
   const IntegratorChoice c2 = choose_integrator(a.points, a.mesh, a.topology, r, IntegratorSpec{}, opt);
   EXPECT_TRUE(c1.counted_costs);
+  // The memory bound too is fixed, not the machine's share of its memory.
+  EXPECT_EQ(c1.max_isolines, max_isolines_for_memory(r, ChooserOptions::kCountedTableMemoryBudget));
   EXPECT_EQ(c1.spec.kind, c2.spec.kind);
   EXPECT_EQ(c1.spec.samples(), c2.spec.samples());
   ASSERT_EQ(c1.runs.size(), c2.runs.size());

@@ -95,9 +95,10 @@
 // printed and stored in the file (its integrator and samples); pinning it (--integrator K
 // --samples N) gives the same bytes on any machine. IntegratorChoice::margin says how close it
 // was. With counted_costs (prtbake --reproducible, SOURCE_DATE_EPOCH) every cost is priced
-// work instead of time and the whole choice is a function of the inputs and the seed. The
-// memory bound depends on the machine's physical memory only when it binds (N in the
-// thousands); ChooserOptions::memory_budget_bytes pins it. The report's reference rays are a
+// work instead of time and the memory bound a fixed budget (kCountedTableMemoryBudget), so the
+// whole choice is a function of the inputs and the seed. Otherwise the memory bound depends on
+// the machine's physical memory when it binds (N in the thousands);
+// ChooserOptions::memory_budget_bytes pins it. The report's reference rays are a
 // function of the inputs, the seed and E.
 #pragma once
 
@@ -134,6 +135,9 @@ struct ChooserOptions {
   // The isoline tables of one silhouette integrator may take this share of physical memory (the
   // pilot holds two: its reference and a level; the bake's reference is QMC).
   static constexpr double kTableMemoryShare = 0.125;
+  // The tables' budget with counted_costs (a function of the inputs, not of the machine): 2 GiB,
+  // the share above of a 16 GiB machine.
+  static constexpr size_t kCountedTableMemoryBudget = size_t(2) << 30;
   double target = 1e-3;                       // E, see the file comment
   std::optional<IntegratorKind> only;         // choose only this kind's knob
   // Seeded shade points of the pilot: a kPilotFraction-th of the bake's, at least 32 (all of
