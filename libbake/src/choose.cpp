@@ -458,7 +458,14 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       e_qmc[p] = std::sqrt(std::max(0.0, D[p] * D[p] - null));
     }
   };
-  if (request.environment()) {
+  // (Nothing to check where the reference's radiance is 0 at every pilot point: an enclosed
+  // receiver, whose relative errors are 0 by definition.)
+  bool any_radiance = false;
+  for (const ProductSlice& sl : products)
+    if (is_radiance(sl.product))
+      for (size_t i = 0; i < K && !any_radiance; ++i)
+        for (size_t k = 0; k < sl.count; ++k) any_radiance = any_radiance || ref[i * W + sl.offset + k] != 0.0;
+  if (request.environment() && any_radiance) {
     // Under an environment the hot texels are integrated apart from the isolines (bake/
     // silhouette.h), so their error need not shrink with N and Richardson cannot see it. Two
     // independent QMC runs f, c (kCheckRays and a quarter of it): their noises are independent of
