@@ -1,7 +1,7 @@
 // `prtbake scene` on a glTF (bake/scene.h "glTF scenes"): every primitive instance is an object
 // named by its node path, baked exactly as the same geometry in a JSON scene; the options file sets
 // roles and materials per node path and refuses a path that names no node; prtdump lists the
-// objects by node path.
+// objects by node path; unnamed nodes take their mesh's name.
 #include <bake/scene.h>
 #include <bake/sha256.h>
 #include <formats/asset.h>
@@ -174,6 +174,38 @@ TEST(GltfScene, InstancesAreObjectsNamedByNodePathAndBakeAsTheSameJsonScene) {
         << listing.out;
 }
 
+TEST(GltfScene, UnnamedNodesAreNamedAfterTheirMeshes) {
+  // CAD exports name meshes, not nodes (2CylinderEngine.glb: "Piston_123-844_0_Parts_1"): an
+  // unnamed node's segment is its mesh's name (bake/mesh.h NAMES), made unique among siblings;
+  // a node's own name wins; neither: node<N>.
+  const fs::path d = dir_for("mesh_names");
+  Gltf g;
+  g.dir = d;
+  auto named_mesh = [&](const char* name) {
+    const int m = g.mesh(primitive(g, kQuad));
+    if (name) g.doc["meshes"][size_t(m)]["name"] = name;
+    return m;
+  };
+  const int piston = named_mesh("Piston_123-844_0_Parts_1"), odd = named_mesh("a/b#c|d"), anonymous = named_mesh(nullptr),
+            dots = named_mesh("..");
+  std::vector<int> children;
+  for (const json& n : {json{{"mesh", piston}}, json{{"mesh", piston}}, json{{"name", "rod"}, {"mesh", piston}},
+                        json{{"mesh", odd}}, json{{"mesh", anonymous}}, json{{"mesh", dots}}})
+    children.push_back(g.node(n, false));
+  const int root = g.node({{"children", children}}, true);
+  ASSERT_EQ(root, 6);
+  const prt::bake::SceneDescription scene = prt::bake::load_scene(g.write("parts.gltf"));
+  std::vector<std::string> paths, names;
+  for (const auto& o : scene.objects) paths.push_back(o.node_path), names.push_back(o.name);
+  EXPECT_EQ(paths, (std::vector<std::string>{"node6/Piston_123-844_0_Parts_1", "node6/Piston_123-844_0_Parts_1~2",
+                                             "node6/rod", "node6/a_b_c_d", "node6/node4", "node6/node5"}));
+  EXPECT_EQ(names[1], "node6|Piston_123-844_0_Parts_1~2") << "stored with '|' for '/'";
+  // Stable: the same file names the same objects again.
+  std::vector<std::string> again;
+  for (const auto& o : prt::bake::load_scene(d / "parts.gltf").objects) again.push_back(o.node_path);
+  EXPECT_EQ(again, paths);
+}
+
 TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
   const fs::path d = dir_for("options");
   const F::Asset base = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + "}");
@@ -223,8 +255,13 @@ TEST(GltfScene, TwoCylinderEngineInstancesAreNamedObjects) {
     EXPECT_EQ(o.role, prt::bake::Role::Both);
   }
   EXPECT_EQ(triangles, 121496u) << "every triangle of the file is in some object";
-  // Its nodes have no names: paths of node indices, in walk order (node 0 is the root).
+  // Its nodes have no names, its meshes have: paths of the mesh names, group nodes by index, in
+  // walk order (node 0 is the root; nodes 80 and 79 both show mesh "body").
   EXPECT_EQ(scene.objects.size(), 115u);
-  EXPECT_EQ(scene.objects.front().node_path, "node0/node80");
-  EXPECT_EQ(scene.objects[3].name, "node0|node78#p1");
+  EXPECT_EQ(scene.objects[0].node_path, "node0/body");
+  EXPECT_EQ(scene.objects[1].node_path, "node0/body~2");
+  EXPECT_EQ(scene.objects[3].name, "node0|Lifter_123-923_0_Parts_1#p1");
+  EXPECT_TRUE(std::any_of(scene.objects.begin(), scene.objects.end(), [](const auto& o) {
+    return o.node_path == "node0/node1/Piston_123-844_0_Parts_1";
+  })) << "the piston of issue 29 by its mesh's name";
 }
