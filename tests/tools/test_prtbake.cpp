@@ -1,5 +1,6 @@
 // End-to-end tests of the prtbake binary: what a user runs, what lands on disk, what a bad input
 // does. Values are checked through the formats reader (the same one prtdump uses).
+#include <formats/asset.h>
 #include <formats/prtfile.h>
 
 #include <gtest/gtest.h>
@@ -179,6 +180,11 @@ TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
   for (const char* s : {"model: ", "chosen: ", "µs/integral"})
     EXPECT_EQ(r.out.find(s), std::string::npos) << "the table is printed only with -v:\n" << r.out;
+  // The target asked for is recorded (/report target_error, SCHEMA.md "Error reports") and shown.
+  EXPECT_EQ(F::read_asset(out).target_error, 2e-3);
+  const auto dump = prt::testing::run_tool(PRT_PRTDUMP, "--json " + out.string(), out.parent_path());
+  ASSERT_EQ(dump.code, 0) << dump.err;
+  EXPECT_NE(dump.out.find("\"target_error\": 0.002,"), std::string::npos) << dump.out;
   const Outcome v = run(bake + " -v");
   ASSERT_EQ(v.code, 0) << v.err;
   for (const char* s : {"target error 0.002: pilot on 32 seeded points", "model: silhouette", "chosen: silhouette at N = ",
@@ -203,6 +209,7 @@ TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* s : {"1839 vertices", "3674 triangles", "baked 1839 vertices in", "RMSE", "wrote", "; peak memory "})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
+  EXPECT_FALSE(F::read_asset(out).target_error.has_value()) << "samples given: no target to record";
 }
 
 struct BadInput {

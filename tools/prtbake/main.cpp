@@ -730,6 +730,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
                      {integrator.name(), integrator.description(), spec.samples(), spec.seed, a.transfer, a.visibility,
                       env ? &*env : nullptr, a.environment});
   if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
+  tool::set_target_error(asset, a.target_error);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;
@@ -1087,6 +1088,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
   for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
   if (plan.fiv_environment)
     tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+  tool::set_target_error(asset, scene.target_error);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;
