@@ -181,8 +181,35 @@ double solve_power_law(double x0, double e0, double x1, double e1, double goal, 
   }
   const double a = e0 > 0 ? std::log(e0 / e1) / std::log(x1 / x0) : hi;
   exponent = std::clamp(std::isfinite(a) ? a : hi, lo, hi);
+  // Faster than the clamp allows (a > hi): the clamped law runs through the lower level, the
+  // conservative end (through the upper one it would promise the goal at a knob where the
+  // bracket's own line still misses it); model_error() anchors the same way.
+  if (std::isfinite(a) && a > hi) return x0 * std::pow(e0 / goal, 1.0 / exponent);
   return x1 * std::pow(e1 / goal, 1.0 / exponent);
 }
+
+// The power law's error at `knob` through (x0, e0), (x1, e1), as solve_power_law fits it.
+double power_law_error(double x0, double e0, double x1, double e1, double knob, double lo, double hi) {
+  double rate = 0;
+  solve_power_law(x0, e0, x1, e1, 1.0, lo, hi, rate);
+  const double a = e0 > 0 && e1 > 0 ? std::log(e0 / e1) / std::log(x1 / x0) : 0.0;
+  if (std::isfinite(a) && a > hi) return e0 * std::pow(x0 / knob, rate);
+  return e1 * std::pow(x1 / knob, rate);
+}
+
+} // namespace
+
+namespace detail {
+double power_law_knob(double x0, double e0, double x1, double e1, double goal, double lo, double hi) {
+  double rate = 0;
+  return solve_power_law(x0, e0, x1, e1, goal, lo, hi, rate);
+}
+double power_law_error_at(double x0, double e0, double x1, double e1, double knob, double lo, double hi) {
+  return power_law_error(x0, e0, x1, e1, knob, lo, hi);
+}
+} // namespace detail
+
+namespace {
 
 // Product p's errors `errors[i][p]` at the measured knobs xs (ascending, at least two): the knob
 // where its power law reaches `goal` — interpolated between the first level that meets it and
@@ -204,9 +231,7 @@ double model_error(const std::vector<double>& xs, const std::vector<std::vector<
                    double lo, double hi) {
   size_t i1 = 1;
   while (i1 + 1 < xs.size() && xs[i1] < knob) ++i1;
-  double rate = 0;
-  solve_power_law(xs[i1 - 1], errors[i1 - 1][p], xs[i1], errors[i1][p], 1.0, lo, hi, rate);
-  return errors[i1][p] * std::pow(xs[i1] / knob, rate);
+  return power_law_error(xs[i1 - 1], errors[i1 - 1][p], xs[i1], errors[i1][p], knob, lo, hi);
 }
 
 // Rays for a need of `need`: rounded up to an eighth of an octave (a multiple of 2^(⌊log2 need⌋ −

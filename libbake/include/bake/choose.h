@@ -318,4 +318,12 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
 // the reference for band-1 radiance.
 double error_in_target_units(const ProductError& error);
 
+namespace detail {
+// The chooser's power law through two measured levels (x0, e0), (x1, e1), x0 < x1, its rate
+// clamped to [lo, hi] (choose.cpp): the knob where it reaches `goal`, and its error at `knob`.
+// The two agree (the error at the knob is the goal), also when the measured rate exceeds hi.
+double power_law_knob(double x0, double e0, double x1, double e1, double goal, double lo, double hi);
+double power_law_error_at(double x0, double e0, double x1, double e1, double knob, double lo, double hi);
+} // namespace detail
+
 } // namespace prt::bake
