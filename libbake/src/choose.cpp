@@ -127,18 +127,21 @@ double cost_per_point(const Rows& rows, const Integrator& integrator, uint32_t k
          kCountedUsPerCrossing * double(st.crossings) / n;
 }
 
-// Per product: RMSE of `rows` against `ref` in the target's units (bake/choose.h).
-std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
-                                 const std::vector<ProductSlice>& products) {
+// Per product: the RMS of value(k) over the product's values k of every row, in the target's
+// units (relative to the RMS of `ref` there for the radiance products, bake/choose.h).
+template <class Value>
+std::vector<double> per_product_rms(const std::vector<double>& ref, size_t W, const std::vector<ProductSlice>& products,
+                                    Value value) {
   const size_t K = W ? ref.size() / W : 0;
   std::vector<double> out;
   for (const ProductSlice& p : products) {
     double e2 = 0, r2 = 0;
     for (size_t i = 0; i < K; ++i)
       for (size_t c = 0; c < p.count; ++c) {
-        const double d = rows[i * W + p.offset + c] - ref[i * W + p.offset + c];
+        const size_t k = i * W + p.offset + c;
+        const double d = value(k);
         e2 += d * d;
-        r2 += ref[i * W + p.offset + c] * ref[i * W + p.offset + c];
+        r2 += ref[k] * ref[k];
       }
     const double n = double(std::max<size_t>(K * p.count, 1));
     double e = std::sqrt(e2 / n);
@@ -148,25 +151,16 @@ std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vec
   return out;
 }
 
-// Per product: the RMS of `std_error` in the target's units (relative to the RMS of `ref` for
-// the radiance products, like pilot_errors).
+// Per product: RMSE of `rows` against `ref` in the target's units.
+std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
+                                 const std::vector<ProductSlice>& products) {
+  return per_product_rms(ref, W, products, [&](size_t k) { return rows[k] - ref[k]; });
+}
+
+// Per product: the RMS of `std_error` in the target's units (like pilot_errors).
 std::vector<double> pilot_noise(const std::vector<double>& std_error, const std::vector<double>& ref, size_t W,
                                 const std::vector<ProductSlice>& products) {
-  const size_t K = W ? ref.size() / W : 0;
-  std::vector<double> out;
-  for (const ProductSlice& p : products) {
-    double s2 = 0, r2 = 0;
-    for (size_t i = 0; i < K; ++i)
-      for (size_t c = 0; c < p.count; ++c) {
-        s2 += std_error[i * W + p.offset + c] * std_error[i * W + p.offset + c];
-        r2 += ref[i * W + p.offset + c] * ref[i * W + p.offset + c];
-      }
-    const double n = double(std::max<size_t>(K * p.count, 1));
-    double e = std::sqrt(s2 / n);
-    if (is_radiance(p.product)) e = r2 > 0 ? e / std::sqrt(r2 / n) : 0.0;
-    out.push_back(e);
-  }
-  return out;
+  return per_product_rms(ref, W, products, [&](size_t k) { return std_error[k]; });
 }
 
 double worst_of(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
