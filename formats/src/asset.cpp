@@ -355,6 +355,24 @@ const Light* Asset::find_light(std::string_view name) const noexcept {
   return nullptr;
 }
 
+const SceneObject* Asset::find_object_by_label(std::string_view name) const noexcept {
+  for (const SceneObject& o : objects)
+    if (names_object(name, o.name, o.node_path)) return &o;
+  return nullptr;
+}
+
+std::string object_label(std::string_view stored_name, const std::optional<std::string>& node_path) {
+  return node_path && !node_path->empty() ? *node_path : std::string(stored_name);
+}
+
+bool names_object(std::string_view query, std::string_view stored_name, const std::optional<std::string>& node_path) {
+  if (query == stored_name || (node_path && query == *node_path)) return true;
+  if (query.find('/') == std::string_view::npos || query.size() != stored_name.size()) return false;
+  for (std::size_t i = 0; i < query.size(); ++i)
+    if ((query[i] == '/' ? '|' : query[i]) != stored_name[i]) return false;
+  return true;
+}
+
 std::vector<Attr> shells_attrs(const Occluder& o) { return attrs_of<Occluder>(o, kShellsFields, o.extra); }
 
 File to_file(const Asset& a) {
@@ -386,6 +404,12 @@ File to_file(const Asset& a) {
   }
   for (const Light& l : a.lights) f.group_attrs.emplace_back(light_dir(l.name), attrs_of<Light>(l, kLightFields, l.extra));
   f.group_attrs.insert(f.group_attrs.end(), a.group_extras.begin(), a.group_extras.end());
+  if (a.target_error) {  // /report's one typed attribute, first, before its extras (if any)
+    const Attr target{std::string(N::kTargetError), *a.target_error};
+    auto it = std::find_if(f.group_attrs.begin(), f.group_attrs.end(), [](const auto& g) { return g.first == N::kReport; });
+    if (it == f.group_attrs.end()) f.group_attrs.emplace_back(std::string(N::kReport), std::vector<Attr>{target});
+    else it->second.insert(it->second.begin(), target);
+  }
   return f;
 }
 
@@ -465,6 +489,12 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
     } else if (!light.empty() && light.find('/') == std::string_view::npos) {
       Light& l = named(a.lights, light);
       take_attrs<Light>(l, kLightFields, attrs, l.extra);
+    } else if (group == N::kReport) {
+      ExtraAttrs rest;
+      for (const Attr& at : attrs)
+        if (at.name == N::kTargetError && std::holds_alternative<double>(at.value)) a.target_error = std::get<double>(at.value);
+        else rest.push_back(at);
+      if (!rest.empty()) a.group_extras.emplace_back(group, std::move(rest));
     } else {
       a.group_extras.emplace_back(group, attrs);
     }

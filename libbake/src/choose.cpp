@@ -1,8 +1,11 @@
-// choose.cpp — the target-error chooser (bake/choose.h): a pilot on seeded shade points, error
-// models fitted per integrator, costs measured, the cheaper prediction chosen.
+// choose.cpp — the target-error chooser (bake/choose.h): a pilot on seeded shade points against a
+// reference whose own error is estimated, error models fitted per integrator within stated
+// bounds, costs measured, the cheaper prediction chosen and checked; and the error report's
+// reference sized for the target.
 #include <bake/choose.h>
 
 #include <bake/error.h>
+#include <bake/octahedral.h>
 #include <bake/qmc.h>
 #include <bake/sampling.h>
 #include <bake/silhouette.h>
@@ -14,7 +17,11 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <limits>
+#include <map>
 #include <memory>
+
+#include <unistd.h>
 
 namespace prt::bake {
 namespace {
@@ -22,21 +29,46 @@ namespace {
 // Radiance products (R, S) carry the environment's HDR scale: their errors are relative to their RMS.
 bool is_radiance(Product p) { return p == Product::RadianceBand1 || p == Product::RadianceShadowed; }
 
-// The pilot's reference: 256 isolines for targets >= 5e-4 (its own AO error, ~6e-5 on the bunny,
-// is under a tenth of the aim 0.7·E; its isoline tables take 8 ms to build against 190 ms at 512,
-// bench/RESULTS.md bench_integrators), 512 below.
+// The pilot's reference starts at 256 isolines for targets >= 5e-4 (its own AO error, ~6e-5 on
+// the bunny, is under a tenth of the aim 0.7·E; its isoline tables take 8 ms to build against
+// 190 ms at 512, bench/RESULTS.md bench_integrators), 512 below; it doubles from there while its
+// estimated error exceeds E/3 (bake/choose.h step 1).
 int reference_isolines(double target) { return target >= 5e-4 ? 256 : 512; }
+// Richardson's order, clamped: at least first order (what the integrator shows under HDR suns,
+// the slowest it converges), at most second (a ratio of two sampled RMS differences can promise
+// more than the integrator delivers).
+constexpr double kRichardsonOrderMin = 1.0, kRichardsonOrderMax = 2.0;
+// The QMC check (bake/choose.h step 1): over n values with standard errors σ, the mean squared
+// difference from an exact reference is σ² with a spread of ~σ²·sqrt(2/n) (Gaussian errors); a
+// bias shows only beyond kQmcCheckSigmas of that spread.
+constexpr double kQmcCheckSigmas = 3.0;
+// The check's rays under an environment: 16,384 (and 4,096) per pilot point, ~0.01 CPU s each; at
+// 128 points ~1.3 CPU s. The two runs differed by 5.5e-3 relative on band-1 under a sun of
+// 3·10^4× the mean (sphereWithHole.stl, city.exr, 32 points × 9 values), so a bias from ~1.6e-3
+// up shows.
+constexpr uint32_t kCheckRays = 16384;
+constexpr uint64_t kCheckSalt = 0x636865636b736565ull;
 // The silhouette levels: 32 and 64 always; 16 only when some product already meets the goal at
-// 32 (its bracket is then [16, 32]), 128 only when some product still misses it at 64 (its
-// bracket is [64, 128]). Every product's bracket is the one all four levels would give; the
-// levels that bracket nothing are not run (on most assets E = 1e-3 falls between 32 and 64).
-constexpr int kSilhouetteLow = 16, kSilhouetteFirst[] = {32, 64}, kSilhouetteHigh = 128;
-constexpr size_t kSilhouetteMaxLevels = std::size(kSilhouetteFirst) + 2;
+// 32 (its bracket is then [16, 32]); doubling levels while some product still misses it (their
+// bracket lies above), below the reference level. N_ref/4 and N_ref/2 always run (Richardson).
+constexpr int kSilhouetteLow = 16, kSilhouetteFirst[] = {32, 64};
 constexpr int kMinIsolines = 8;
+// An upper bound on N whatever the memory: N² + N rows must fit size_t arithmetic comfortably
+// and int indices in the tables (65,536² ≈ 4.3e9 rows · 8 bytes is 34 GB per component anyway).
+constexpr int kMaxIsolinesAbsolute = 65536;
 // QMC's levels. 64 first: on the assets the silhouette integrator wins (most), its error there
 // (~1-2e-2 AO) already prices QMC out (kQmcBestCaseMargin) at a quarter of 256 rays' cost.
+// Beyond 4096 the levels go on by factors of 4 while the goal is missed, as long as the pilot's
+// rays (points × rays of the level) stay within kPilotRayBudget: 2^22 rays, ~2-3 CPU s at
+// 0.5-0.75 µs per ray — the most a pilot may spend on one level to learn QMC's rate (at 32
+// points up to 131,072 rays a level, at 128 points 32,768; the model extrapolates 4× beyond).
 constexpr uint32_t kQmcLevels[] = {64, 256, 1024, 4096};
-constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 20;
+constexpr uint32_t kQmcLevelFactor = 4;
+constexpr uint64_t kPilotRayBudget = uint64_t(1) << 22;
+// kMaxRays: rays per point of any QMC plan. 2^26 (67M; ~34 CPU s per point at ~0.5 µs per ray)
+// is no practical bound — the extrapolation limit (4× the last measured level) and the report's
+// ray budget bind first; it keeps R·points and the rounding inside 64-bit and 32-bit arithmetic.
+constexpr uint32_t kMinRays = 16, kMaxRays = 1u << 26;
 // QMC's levels stop when its best case (above) costs this many times the silhouette prediction.
 // The per-ray cost at a level over-states the cost of more rays by its fixed part per point
 // (~3 µs of ~35 at 64 rays, kCountedUsPerPoint), and a fitted rate above 1 is noise (the fit
@@ -53,23 +85,28 @@ constexpr double kCountedUsPerEdge = 0.083, kCountedUsPerCrossing = 0.043, kCoun
 constexpr double kCountedUsPerPoint = 3.0;
 constexpr double kCountedSetupPerTriangleSilhouette = 6e-6, kCountedSetupPerTriangleQmc = 2e-7;
 constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
+constexpr uint64_t kProbeSalt = 0x70726f6265736565ull;  // the report probe's coarse run, apart from the reference
 
 // Rows of one integrator at the pilot points, and the mean CPU time per integral.
 struct Rows {
   std::vector<double> values;
+  std::vector<double> std_error;  // the integrator's estimated standard errors (0: deterministic)
   double cpu_us_per_point = 0;
 };
 
 Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> points,
-                     const std::vector<uint32_t>& sample, Task& progress) {
+                     const std::vector<uint32_t>& sample, Task& progress, uint64_t index_offset = 0) {
   const size_t W = integrator.layout().width, K = sample.size();
   Rows rows;
   rows.values.assign(K * W, 0.0);
+  rows.std_error.assign(K * W, 0.0);
   std::vector<double> seconds(K, 0.0);
   tbb::parallel_for(size_t(0), K, [&](size_t i) {
     const double t0 = thread_cpu_seconds();
-    // The bake's own point index: a QMC pilot row is the row the bake would compute.
-    integrator.integrate(points[sample[i]], sample[i], std::span(rows.values).subspan(i * W, W));
+    // The bake's own point index: a QMC pilot row is the row the bake would compute (the report's
+    // reference offsets it, compare_points_with_reference).
+    integrator.integrate(points[sample[i]], sample[i] + index_offset, std::span(rows.values).subspan(i * W, W),
+                         std::span(rows.std_error).subspan(i * W, W));
     seconds[i] = thread_cpu_seconds() - t0;
     progress.advance();
   });
@@ -90,18 +127,21 @@ double cost_per_point(const Rows& rows, const Integrator& integrator, uint32_t k
          kCountedUsPerCrossing * double(st.crossings) / n;
 }
 
-// Per product: RMSE of `rows` against `ref` in the target's units (bake/choose.h).
-std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
-                                 const std::vector<ProductSlice>& products) {
+// Per product: the RMS of value(k) over the product's values k of every row, in the target's
+// units (relative to the RMS of `ref` there for the radiance products, bake/choose.h).
+template <class Value>
+std::vector<double> per_product_rms(const std::vector<double>& ref, size_t W, const std::vector<ProductSlice>& products,
+                                    Value value) {
   const size_t K = W ? ref.size() / W : 0;
   std::vector<double> out;
   for (const ProductSlice& p : products) {
     double e2 = 0, r2 = 0;
     for (size_t i = 0; i < K; ++i)
       for (size_t c = 0; c < p.count; ++c) {
-        const double d = rows[i * W + p.offset + c] - ref[i * W + p.offset + c];
+        const size_t k = i * W + p.offset + c;
+        const double d = value(k);
         e2 += d * d;
-        r2 += ref[i * W + p.offset + c] * ref[i * W + p.offset + c];
+        r2 += ref[k] * ref[k];
       }
     const double n = double(std::max<size_t>(K * p.count, 1));
     double e = std::sqrt(e2 / n);
@@ -110,6 +150,20 @@ std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vec
   }
   return out;
 }
+
+// Per product: RMSE of `rows` against `ref` in the target's units.
+std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
+                                 const std::vector<ProductSlice>& products) {
+  return per_product_rms(ref, W, products, [&](size_t k) { return rows[k] - ref[k]; });
+}
+
+// Per product: the RMS of `std_error` in the target's units (like pilot_errors).
+std::vector<double> pilot_noise(const std::vector<double>& std_error, const std::vector<double>& ref, size_t W,
+                                const std::vector<ProductSlice>& products) {
+  return per_product_rms(ref, W, products, [&](size_t k) { return std_error[k]; });
+}
+
+double worst_of(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
 
 // The knob x at which a power law through (x0, e0), (x1, e1) (x0 < x1) reaches `goal`, with its
 // exponent clamped to [lo, hi]; `exponent` receives it. Errors of exactly 0 need no more than x0.
@@ -121,8 +175,35 @@ double solve_power_law(double x0, double e0, double x1, double e1, double goal, 
   }
   const double a = e0 > 0 ? std::log(e0 / e1) / std::log(x1 / x0) : hi;
   exponent = std::clamp(std::isfinite(a) ? a : hi, lo, hi);
+  // Faster than the clamp allows (a > hi): the clamped law runs through the lower level, the
+  // conservative end (through the upper one it would promise the goal at a knob where the
+  // bracket's own line still misses it); model_error() anchors the same way.
+  if (std::isfinite(a) && a > hi) return x0 * std::pow(e0 / goal, 1.0 / exponent);
   return x1 * std::pow(e1 / goal, 1.0 / exponent);
 }
+
+// The power law's error at `knob` through (x0, e0), (x1, e1), as solve_power_law fits it.
+double power_law_error(double x0, double e0, double x1, double e1, double knob, double lo, double hi) {
+  double rate = 0;
+  solve_power_law(x0, e0, x1, e1, 1.0, lo, hi, rate);
+  const double a = e0 > 0 && e1 > 0 ? std::log(e0 / e1) / std::log(x1 / x0) : 0.0;
+  if (std::isfinite(a) && a > hi) return e0 * std::pow(x0 / knob, rate);
+  return e1 * std::pow(x1 / knob, rate);
+}
+
+} // namespace
+
+namespace detail {
+double power_law_knob(double x0, double e0, double x1, double e1, double goal, double lo, double hi) {
+  double rate = 0;
+  return solve_power_law(x0, e0, x1, e1, goal, lo, hi, rate);
+}
+double power_law_error_at(double x0, double e0, double x1, double e1, double knob, double lo, double hi) {
+  return power_law_error(x0, e0, x1, e1, knob, lo, hi);
+}
+} // namespace detail
+
+namespace {
 
 // Product p's errors `errors[i][p]` at the measured knobs xs (ascending, at least two): the knob
 // where its power law reaches `goal` — interpolated between the first level that meets it and
@@ -144,9 +225,7 @@ double model_error(const std::vector<double>& xs, const std::vector<std::vector<
                    double lo, double hi) {
   size_t i1 = 1;
   while (i1 + 1 < xs.size() && xs[i1] < knob) ++i1;
-  double rate = 0;
-  solve_power_law(xs[i1 - 1], errors[i1 - 1][p], xs[i1], errors[i1][p], 1.0, lo, hi, rate);
-  return errors[i1][p] * std::pow(xs[i1] / knob, rate);
+  return power_law_error(xs[i1 - 1], errors[i1 - 1][p], xs[i1], errors[i1][p], knob, lo, hi);
 }
 
 // Rays for a need of `need`: rounded up to an eighth of an octave (a multiple of 2^(⌊log2 need⌋ −
@@ -174,11 +253,13 @@ void fit_line(const std::vector<double>& x, const std::vector<double>& t, double
 // the cost per integral from a least-squares line through the measured (cost_knobs, us).
 void predict_at(Prediction& pr, uint32_t knob, const std::vector<double>& levels,
                 const std::vector<std::vector<double>>& errors, double lo, double hi,
-                const std::vector<double>& cost_knobs, const std::vector<double>& us) {
+                const std::vector<double>& cost_knobs, const std::vector<double>& us,
+                const std::vector<double>& offset = {}) {
   pr.knob = knob;
   pr.predicted_error = 0;
   for (size_t p = 0; p < errors.front().size(); ++p)
-    pr.predicted_error = std::max(pr.predicted_error, model_error(levels, errors, p, knob, lo, hi));
+    pr.predicted_error = std::max(pr.predicted_error, model_error(levels, errors, p, knob, lo, hi) +
+                                                          (offset.empty() ? 0.0 : offset[p]));
   double alpha = 0, beta = 0;
   fit_line(cost_knobs, us, alpha, beta);
   pr.predicted_us_per_point = alpha + beta * knob;
@@ -201,6 +282,74 @@ double error_in_target_units(const ProductError& e) {
   return e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0;
 }
 
+size_t isoline_table_bytes(const ProductRequest& r, int isolines) {
+  const int n = std::max(2, isolines + (isolines & 1));
+  const oct::Grid grid(n);
+  size_t rows = 0;
+  for (int i = 0; i < n; ++i) rows += size_t(2 * grid.cells_per_sheet(i) + 1);
+  const size_t lt = size_t(r.transfer_order), lv = size_t(r.visibility_order), ls = size_t(r.shadowed_order);
+  const size_t F = (r.ao ? 3 : 0) + 3 * lt * lt + lv * lv + (r.radiance ? 9 : 0) + 3 * ls * ls;
+  return std::max<size_t>(F, 1) * rows * sizeof(double);
+}
+
+size_t default_table_memory_budget() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  const double physical = pages > 0 && page > 0 ? double(pages) * double(page) : 32.0 * (1ull << 30);
+  return size_t(ChooserOptions::kTableMemoryShare * physical);
+}
+
+int max_isolines_for_memory(const ProductRequest& r, size_t budget_bytes) {
+  const size_t budget = budget_bytes ? budget_bytes : default_table_memory_budget();
+  // rows = N² + N: start from the root and step down to the largest even N that fits.
+  const double per_row = double(isoline_table_bytes(r, 2)) / 6.0;  // N = 2: 6 rows
+  int n = int(std::min<double>(kMaxIsolinesAbsolute, std::floor(std::sqrt(double(budget) / per_row))));
+  n -= n & 1;
+  while (n > kMinIsolines && isoline_table_bytes(r, n) > budget) n -= 2;
+  return std::max(n, kMinIsolines);
+}
+
+PlanPick pick_plan(std::span<const PlanCandidate> c, double target,
+                   const std::function<double(const PlanCandidate&)>& measure) {
+  PRT_CHECK(!c.empty());
+  constexpr size_t none = SIZE_MAX;
+  PlanPick pick;
+  size_t best = none;
+  for (size_t i = 0; i < c.size(); ++i)
+    if (c[i].predicted_error <= c[i].aim && (best == none || c[i].cost_seconds < c[best].cost_seconds)) best = i;
+  pick.reaches = best != none;
+  if (!pick.reaches)  // the lowest predicted error, the cheaper on a tie
+    for (size_t i = 0; i < c.size(); ++i)
+      if (best == none || c[i].predicted_error < c[best].predicted_error ||
+          (c[i].predicted_error == c[best].predicted_error && c[i].cost_seconds < c[best].cost_seconds))
+        best = i;
+  pick.index = best;
+  pick.expected_error = c[best].predicted_error;
+  // The sanity check: the cheapest plan of another kind that costs less than 1/kSanityCostRatio
+  // of the pick and predicts an error within kSanityErrorFactor·E is measured.
+  size_t alt = none;
+  for (size_t i = 0; i < c.size(); ++i)
+    if (i != best && c[i].kind != c[best].kind &&
+        c[i].cost_seconds * ChooserOptions::kSanityCostRatio < c[best].cost_seconds &&
+        c[i].predicted_error <= ChooserOptions::kSanityErrorFactor * target &&
+        (alt == none || c[i].cost_seconds < c[alt].cost_seconds))
+      alt = i;
+  if (alt != none && measure) {
+    pick.checked = true;
+    pick.checked_index = alt;
+    pick.checked_error = measure(c[alt]);
+    // Taken if it meets its aim, or is no worse than what the pick predicts for itself (at under
+    // a quarter of the cost).
+    // It reaches if it meets its aim, or if the pick reached and it is no worse than the pick.
+    if (pick.checked_error <= c[alt].aim || pick.checked_error <= c[best].predicted_error) {
+      pick.switched = true;
+      pick.index = alt;
+      pick.expected_error = pick.checked_error;
+      pick.reaches = pick.checked_error <= c[alt].aim || (pick.reaches && pick.checked_error <= c[best].predicted_error);
+    }
+  }
+  return pick;
+}
+
 IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                    const ProductRequest& request, const IntegratorSpec& base,
                                    const ChooserOptions& options, const Monitor& monitor, const MeshAccel* accel) {
@@ -213,23 +362,26 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     throw InputError("", "the target-error chooser has no model of the filter integrator: give its pass-1 rays "
                          "(--samples N)");
   const auto wall0 = std::chrono::steady_clock::now();
+  const double E = options.target;
   IntegratorChoice choice;
-  choice.target = options.target;
+  choice.target = E;
   choice.spec = base;
   const std::vector<ProductSlice> products = product_slices(ProductLayout(request));
   for (const ProductSlice& p : products) choice.products.push_back(p.product);
+  const size_t P = products.size();
   // A 64th of the points, at least 32 and at most pilot_points: the pilot must not cost more than
   // a small part of the bake it tunes (ChooserOptions::kPilotFraction).
   const size_t pilot = std::clamp<size_t>(points.size() / ChooserOptions::kPilotFraction, 32,
                                           std::max<size_t>(options.pilot_points, 32));
   const std::vector<uint32_t> sample = seeded_sample(uint32_t(points.size()), pilot, mix64(base.seed ^ kPilotSalt));
   choice.pilot_points = sample.size();
+  const size_t K = sample.size();
   const size_t W = ProductLayout(request).width;
-  double goal = options.safety_silhouette * options.target;
+  const double goal_sil = options.safety_silhouette * E, goal_qmc = options.safety_qmc * E;
   const bool want_sil = !options.only || *options.only == IntegratorKind::Silhouette;
   const bool want_qmc = !options.only || *options.only == IntegratorKind::Qmc;
-  const size_t runs = 1 + (want_sil ? kSilhouetteMaxLevels : 0) + (want_qmc ? std::size(kQmcLevels) : 0);
-  Task progress(monitor, "pilot", runs * sample.size());
+  // Progress: the runs are not known in advance; ~10 is typical (the bar clamps at its total).
+  Task progress(monitor, "pilot", 10 * K);
 
   // Setup is part of a bake's cost: measured per integrator build (its tables), wall time. The
   // trees are built once for every pilot integrator, timed apart: a bake given the same `accel`
@@ -245,59 +397,182 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   double rays_seconds = 0, contours_seconds = 0;
   timed_build([&] { return shared->rays(); }, rays_seconds);
   timed_build([&] { return shared->contours(); }, contours_seconds);  // the reference is a silhouette integrator
-  auto silhouette = [&](int isolines) {
-    return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{isolines, base.seed}, shared);
-  };
-  double setup_sil = 0, setup_qmc = 0;
-  const int ref_isolines = reference_isolines(options.target), max_isolines = ref_isolines;
-  const auto reference = timed_build([&] { return silhouette(ref_isolines); }, setup_sil);
-  const Rows ref = integrate_pilot(*reference, points, sample, progress);
   const bool counted = options.counted_costs;
   choice.counted_costs = counted;
-  const double ref_us = cost_per_point(ref, *reference, uint32_t(ref_isolines), counted);
-  choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(ref_isolines), std::vector<double>(products.size(), 0.0), ref_us});
+  double setup_sil = 0, setup_qmc = 0;
 
+  // Silhouette rows per level, computed once (the reference's levels are also model levels).
+  struct SilRun {
+    Rows rows;
+    double cost = 0;
+  };
+  std::map<int, SilRun> sil;
+  auto run_sil = [&](int N) -> const SilRun& {
+    if (const auto it = sil.find(N); it != sil.end()) return it->second;
+    double s = 0;
+    const auto integrator = timed_build(
+        [&] { return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{N, base.seed}, shared); },
+        s);
+    setup_sil = std::max(setup_sil, s);
+    SilRun run;
+    run.rows = integrate_pilot(*integrator, points, sample, progress);
+    run.cost = cost_per_point(run.rows, *integrator, uint32_t(N), counted);
+    return sil.emplace(N, std::move(run)).first->second;
+  };
+
+  // ---- 1. the reference, and its own error ----
+  // With counted costs the whole choice is a function of the inputs: the memory bound too (a fixed
+  // budget instead of the machine's share).
+  const size_t budget = options.memory_budget_bytes ? options.memory_budget_bytes
+                        : options.counted_costs      ? ChooserOptions::kCountedTableMemoryBudget
+                                                     : default_table_memory_budget();
+  const int mem_max = max_isolines_for_memory(request, budget);
+  choice.max_isolines = mem_max;
+  choice.max_isolines_reason =
+      format("memory: the isoline tables of N = %.0f take %.0f MiB of a %.0f MiB budget", mem_max,
+             double(isoline_table_bytes(request, mem_max)) / (1 << 20), double(budget) / (1 << 20)) +
+      (options.memory_budget_bytes ? std::string(" (given)")
+       : options.counted_costs     ? std::string(" (fixed with counted costs)")
+                                   : format(" (%.3g of physical memory)", ChooserOptions::kTableMemoryShare));
+  int ref_top = mem_max;
+  if (options.max_reference_isolines) ref_top = std::min(ref_top, int(options.max_reference_isolines));
+  int N_ref = options.reference_isolines ? int(options.reference_isolines) : reference_isolines(E);
+  N_ref = std::max(4 * kMinIsolines, std::min(N_ref + (N_ref & 1), ref_top - (ref_top & 1)));
+  std::vector<double> e_ref(P, 0.0), orders(P, kRichardsonOrderMin);
+  for (;;) {
+    const std::vector<double>& ref = run_sil(N_ref).rows.values;
+    const std::vector<double>& half = run_sil(N_ref / 2).rows.values;
+    const std::vector<double>& quarter = run_sil(N_ref / 4).rows.values;
+    const std::vector<double> d = pilot_errors(half, ref, W, products), d2 = pilot_errors(quarter, half, W, products);
+    for (size_t p = 0; p < P; ++p) {
+      const double a = d[p] > 0 && d2[p] > 0 ? std::log2(d2[p] / d[p]) : kRichardsonOrderMin;
+      orders[p] = std::clamp(std::isfinite(a) ? a : kRichardsonOrderMin, kRichardsonOrderMin, kRichardsonOrderMax);
+      e_ref[p] = d[p] / (std::exp2(orders[p]) - 1.0);
+    }
+    if (worst_of(e_ref) <= ChooserOptions::kReferenceShare * E || 2 * N_ref > ref_top) break;
+    N_ref *= 2;
+  }
+  choice.reference_isolines = uint32_t(N_ref);
+  const SilRun& ref_run = run_sil(N_ref);
+  const std::vector<double>& ref = ref_run.rows.values;
+  size_t worst_p = 0;
+  for (size_t p = 0; p < P; ++p)
+    if (e_ref[p] > e_ref[worst_p]) worst_p = p;
+  choice.reference_richardson_order = orders[worst_p];
+  const bool ref_capped = worst_of(e_ref) > ChooserOptions::kReferenceShare * E;
+  std::string ref_bound;
+  if (ref_capped)
+    ref_bound = 2 * N_ref > mem_max ? format("N = %.0f would exceed the ", 2 * N_ref) + choice.max_isolines_reason
+                                    : format("the reference was held at most at N = %.0f (ChooserOptions)", ref_top);
+
+  // The reference's independent check (bake/choose.h step 1): QMC against it. D² ≈ e_ref² + σ²;
+  // an exact reference leaves D² − σ² within kQmcCheckSigmas of its spread σ²·sqrt(2/n).
+  std::vector<double> e_qmc(P, 0.0);
+  uint32_t qmc_check_rays = 0;
+  auto check = [&](const std::vector<double>& qmc_rows, const std::vector<double>& sigma) {
+    const std::vector<double> D = pilot_errors(qmc_rows, ref, W, products);
+    for (size_t p = 0; p < P; ++p) {
+      const double n = double(K * products[p].count);
+      const double null = sigma[p] * sigma[p] * (1.0 + kQmcCheckSigmas * std::sqrt(2.0 / n));
+      e_qmc[p] = std::sqrt(std::max(0.0, D[p] * D[p] - null));
+    }
+  };
+  // (Nothing to check where the reference's radiance is 0 at every pilot point: an enclosed
+  // receiver, whose relative errors are 0 by definition.)
+  bool any_radiance = false;
+  for (const ProductSlice& sl : products)
+    if (is_radiance(sl.product))
+      for (size_t i = 0; i < K && !any_radiance; ++i)
+        for (size_t k = 0; k < sl.count; ++k) any_radiance = any_radiance || ref[i * W + sl.offset + k] != 0.0;
+  if (request.environment() && any_radiance) {
+    // Under an environment the hot texels are integrated apart from the isolines (bake/
+    // silhouette.h), so their error need not shrink with N and Richardson cannot see it. Two
+    // independent QMC runs f, c (kCheckRays and a quarter of it): their noises are independent of
+    // each other and of the reference's error b, so the mean of (f − ref)(c − ref) over the n
+    // values is b² with a spread of at most σ_f σ_c / sqrt(n) ≤ d² / (2 sqrt(n)), d = RMS(f − c)
+    // — no convergence rate assumed. The bound: b² ≥ that mean − kQmcCheckSigmas spreads.
+    const QmcIntegrator fine(mesh, topology, request, QmcOptions{kCheckRays, mix64(base.seed ^ kCheckSalt)}, shared);
+    const QmcIntegrator coarse(mesh, topology, request, QmcOptions{kCheckRays / 4, mix64(base.seed ^ kCheckSalt ^ 1)},
+                               shared);
+    const Rows f = integrate_pilot(fine, points, sample, progress);
+    const Rows c = integrate_pilot(coarse, points, sample, progress);
+    for (size_t p = 0; p < P; ++p) {
+      const ProductSlice& sl = products[p];
+      double cross = 0, d2 = 0, r2 = 0;
+      for (size_t i = 0; i < K; ++i)
+        for (size_t k = 0; k < sl.count; ++k) {
+          const size_t j = i * W + sl.offset + k;
+          cross += (f.values[j] - ref[j]) * (c.values[j] - ref[j]);
+          d2 += (f.values[j] - c.values[j]) * (f.values[j] - c.values[j]);
+          r2 += ref[j] * ref[j];
+        }
+      const double n = double(std::max<size_t>(K * sl.count, 1));
+      cross /= n, d2 /= n, r2 /= n;
+      if (is_radiance(sl.product)) {  // relative, like pilot_errors
+        cross = r2 > 0 ? cross / r2 : 0.0;
+        d2 = r2 > 0 ? d2 / r2 : 0.0;
+      }
+      e_qmc[p] = std::sqrt(std::max(0.0, cross - kQmcCheckSigmas * d2 / (2.0 * std::sqrt(n))));
+    }
+    qmc_check_rays = kCheckRays;
+  }
+  // A bias the check sees is stated (reference_ok, reference_note), not chased: finer isolines do
+  // not remove it, and the QMC reference and the silhouette integrator may differ in how they
+  // reconstruct the environment between texels as well as in error; the predictions stay those
+  // against the silhouette reference, known only to within it.
+
+  // ---- 2. silhouette levels ----
   const double V = double(points.size());
+  std::vector<int> sil_levels;  // ascending, below N_ref
   if (want_sil) {
-    std::vector<PilotRun> levels_run;  // ascending N
-    auto run_level = [&](int N) {
-      double s = 0;
-      const auto integrator = timed_build([&] { return silhouette(N); }, s);
-      setup_sil = std::max(setup_sil, s);
-      const Rows r = integrate_pilot(*integrator, points, sample, progress);
-      PilotRun run{IntegratorKind::Silhouette, uint32_t(N), pilot_errors(r.values, ref.values, W, products),
-                   cost_per_point(r, *integrator, uint32_t(N), counted)};
-      const auto at = std::find_if(levels_run.begin(), levels_run.end(), [&](const PilotRun& x) { return x.knob > run.knob; });
-      levels_run.insert(at, std::move(run));
+    auto level_errors = [&](int N) { return pilot_errors(run_sil(N).rows.values, ref, W, products); };
+    auto misses = [&](int N) { return worst_of(level_errors(N)) > goal_sil; };
+    auto meets_any = [&](int N) {
+      const std::vector<double> e = level_errors(N);
+      return std::any_of(e.begin(), e.end(), [&](double x) { return x <= goal_sil; });
     };
-    for (int N : kSilhouetteFirst) run_level(N);
-    auto any_product = [&](const PilotRun& r, auto&& test) { return std::any_of(r.error.begin(), r.error.end(), test); };
-    if (any_product(levels_run.front(), [&](double e) { return e <= goal; })) run_level(kSilhouetteLow);
-    if (any_product(levels_run.back(), [&](double e) { return e > goal; })) run_level(kSilhouetteHigh);
-    progress.advance(sample.size() * (kSilhouetteMaxLevels - levels_run.size()));  // the levels not run
+    for (int N : kSilhouetteFirst)
+      if (N < N_ref) run_sil(N);
+    if (N_ref > kSilhouetteLow * 2 && meets_any(std::min(kSilhouetteFirst[0], N_ref / 2))) run_sil(kSilhouetteLow);
+    for (int N = kSilhouetteFirst[1]; 2 * N < N_ref && misses(N); N *= 2) run_sil(2 * N);
+    for (const auto& [N, run] : sil)
+      if (N < N_ref) sil_levels.push_back(N);
     std::vector<double> xs, ts;
     std::vector<std::vector<double>> errors;
-    for (const PilotRun& r : levels_run) {
-      choice.runs.push_back(r);
-      xs.push_back(r.knob), ts.push_back(r.cpu_us_per_point), errors.push_back(r.error);
+    for (int N : sil_levels) {
+      choice.runs.push_back({IntegratorKind::Silhouette, uint32_t(N), level_errors(N), sil.at(N).cost});
+      xs.push_back(N), ts.push_back(sil.at(N).cost), errors.push_back(choice.runs.back().error);
     }
-    xs.push_back(ref_isolines), ts.push_back(ref_us);
     Prediction pr;
     pr.kind = IntegratorKind::Silhouette;
+    pr.last_measured = uint32_t(xs.back());
+    const int extrap = int(ChooserOptions::kMaxExtrapolation * xs.back());
+    const int bound = std::min({N_ref, mem_max, extrap});
+    pr.bound = uint32_t(bound);
+    pr.bound_reason = bound == N_ref ? (ref_capped ? "the reference level (" + ref_bound + ")"
+                                                    : std::string("the reference level, whose error is within E/3"))
+                      : bound == mem_max ? choice.max_isolines_reason
+                                         : format("the extrapolation limit, %.0fx the last measured level",
+                                                  ChooserOptions::kMaxExtrapolation);
     double need = kMinIsolines;
-    const std::vector<double> levels(xs.begin(), xs.end() - 1);  // without the reference
-    for (size_t p = 0; p < products.size(); ++p) {
+    for (size_t p = 0; p < P; ++p) {
       double a = 0;
-      const double n = knob_for(levels, errors, p, goal, 0.5, 3.0, a);  // silhouette: rates 0.5 to 3
+      const double n = knob_for(xs, errors, p, goal_sil, 0.5, 3.0, a);  // silhouette: rates 0.5 to 3
       if (n > need) need = n, pr.exponent = a;
     }
-    pr.reachable = need <= max_isolines;
-    int N = int(std::ceil(std::min<double>(need, max_isolines) - 1e-9));
+    pr.reachable = need <= bound;
+    if (!pr.reachable) pr.knob_for_target = uint32_t(std::min<double>(need, kMaxIsolinesAbsolute));
+    int N = int(std::ceil(std::min<double>(need, bound) - 1e-9));
     N = std::max(kMinIsolines, N + (N & 1));  // even, as the integrator uses it
-    predict_at(pr, uint32_t(N), levels, errors, 0.5, 3.0, xs, ts);
+    N = std::min(N, bound - (bound & 1));
+    xs.push_back(N_ref), ts.push_back(ref_run.cost);  // costs: the reference is a measured level too
+    predict_at(pr, uint32_t(N), std::vector<double>(xs.begin(), xs.end() - 1), errors, 0.5, 3.0, xs, ts);
+    pr.extrapolated = pr.knob > pr.last_measured;
     choice.predictions.push_back(pr);
   }
-  goal = options.safety_qmc * options.target;
+
+  // ---- 3. QMC levels ----
+  Rows finest_qmc;  // the finest QMC level's rows, for the reference's independent check
   if (want_qmc) {
     std::vector<double> xs, ts;
     std::vector<std::vector<double>> errors;
@@ -307,58 +582,96 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                                 ? choice.predictions.front().predicted_us_per_point
                                 : 0.0;
     bool pruned = false;
-    for (uint32_t R : kQmcLevels) {
+    std::vector<uint32_t> levels(std::begin(kQmcLevels), std::end(kQmcLevels));
+    for (size_t li = 0; li < levels.size(); ++li) {
+      const uint32_t R = levels[li];
       if (!errors.empty()) {
-        const double worst = *std::max_element(errors.back().begin(), errors.back().end());
-        const bool misses = worst > goal;
+        const double worst = worst_of(errors.back());
+        const bool misses = worst > goal_qmc;
         // Or once even the best case its model allows (rate 1, the top of its clamp: R·worst/goal
         // rays at this level's cost per ray) costs kQmcBestCaseMargin times the prediction.
-        if (misses && rival_us > 0 && (ts.back() >= rival_us || ts.back() * (worst / goal) >= kQmcBestCaseMargin * rival_us)) {
+        if (misses && rival_us > 0 && (ts.back() >= rival_us || ts.back() * (worst / goal_qmc) >= kQmcBestCaseMargin * rival_us)) {
           pruned = true;
           break;
         }
         if (!misses && errors.size() >= 2) break;  // two levels and the goal met: enough to interpolate
       }
+      if (double(K) * R > double(kPilotRayBudget) && !errors.empty()) break;
       double s = 0;
       const auto integrator =
           timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}, shared); }, s);
       setup_qmc = std::max(setup_qmc, s);
-      const Rows r = integrate_pilot(*integrator, points, sample, progress);
-      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref.values, W, products),
+      Rows r = integrate_pilot(*integrator, points, sample, progress);
+      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref, W, products),
                              cost_per_point(r, *integrator, R, counted)});
       xs.push_back(R), ts.push_back(choice.runs.back().cpu_us_per_point), errors.push_back(choice.runs.back().error);
+      finest_qmc = std::move(r);
+      // On past the fixed levels by factors of 4 while the goal is missed (the loop's checks stop it).
+      if (li + 1 == levels.size() && uint64_t(R) * kQmcLevelFactor <= kMaxRays) levels.push_back(R * kQmcLevelFactor);
     }
     Prediction pr;
     pr.kind = IntegratorKind::Qmc;
+    pr.last_measured = uint32_t(xs.back());
     if (pruned) {
       pr.pruned = true;
       pr.knob = uint32_t(xs.back());
-      pr.predicted_error = *std::max_element(errors.back().begin(), errors.back().end());
+      pr.predicted_error = worst_of(errors.back());
       pr.predicted_us_per_point = ts.back();
-      choice.predictions.push_back(pr);
+      pr.bound = pr.knob;
+    } else if (xs.size() < 2) {  // one level only (the pilot's ray budget): its own numbers
+      pr.knob = uint32_t(xs.back());
+      pr.predicted_error = worst_of(errors.back());
+      pr.predicted_us_per_point = ts.back();
+      pr.bound = pr.knob;
+      pr.bound_reason = "the pilot's ray budget (one level measured)";
+      pr.reachable = pr.predicted_error <= goal_qmc;
+    } else {
+      const double bound = std::min<double>(kMaxRays, ChooserOptions::kMaxExtrapolation * xs.back());
+      pr.bound = uint32_t(bound);
+      pr.bound_reason = bound == kMaxRays ? std::string("the ray bound 2^26")
+                                          : format("the extrapolation limit, %.0fx the last measured level (the pilot's "
+                                                   "ray budget stopped its levels)",
+                                                   ChooserOptions::kMaxExtrapolation);
+      double need = kMinRays;
+      for (size_t p = 0; p < P; ++p) {
+        double rate = 0;
+        const double r = knob_for(xs, errors, p, goal_qmc, 0.5, 1.0, rate);  // QMC: rates 0.5 to 1
+        if (r > need) need = r, pr.exponent = rate;
+      }
+      pr.reachable = need <= bound;
+      if (!pr.reachable) pr.knob_for_target = uint32_t(std::min<double>(need, 4294967040.0));
+      predict_at(pr, std::min(round_up_rays(std::min(need, bound)), uint32_t(bound)), xs, errors, 0.5, 1.0, xs, ts);
     }
-    progress.advance(sample.size() * (std::size(kQmcLevels) - xs.size()));  // the levels not run
-  }
-  if (want_qmc && (choice.predictions.empty() || !choice.predictions.back().pruned)) {
-    std::vector<double> xs, ts;
-    std::vector<std::vector<double>> errors;
-    for (const PilotRun& r : choice.runs)
-      if (r.kind == IntegratorKind::Qmc) xs.push_back(r.knob), ts.push_back(r.cpu_us_per_point), errors.push_back(r.error);
-    Prediction pr;
-    pr.kind = IntegratorKind::Qmc;
-    double need = kMinRays;
-    for (size_t p = 0; p < products.size(); ++p) {
-      double rate = 0;
-      const double r = knob_for(xs, errors, p, goal, 0.5, 1.0, rate);  // QMC: rates 0.5 to 1
-      if (r > need) need = r, pr.exponent = rate;
-    }
-    pr.reachable = need <= kMaxRays;
-    predict_at(pr, round_up_rays(need), xs, errors, 0.5, 1.0, xs, ts);
+    pr.extrapolated = pr.knob > pr.last_measured;
     choice.predictions.push_back(pr);
   }
-  progress.finish();
 
-  // The cheaper reachable prediction, by CPU seconds for the whole bake (setup + V integrals).
+  if (qmc_check_rays == 0 && !finest_qmc.values.empty()) {
+    // Without one, the pilot's finest QMC level with its estimated standard errors (which
+    // overstate QMC's noise: a check that sees only gross biases, at no extra cost).
+    for (const PilotRun& r : choice.runs)
+      if (r.kind == IntegratorKind::Qmc) qmc_check_rays = std::max(qmc_check_rays, r.knob);
+    check(finest_qmc.values, pilot_noise(finest_qmc.std_error, ref, W, products));
+  }
+  choice.reference_error.resize(P);
+  for (size_t p = 0; p < P; ++p) choice.reference_error[p] = std::max(e_ref[p], e_qmc[p]);
+  choice.reference_ok = worst_of(choice.reference_error) <= ChooserOptions::kReferenceShare * E;
+  choice.runs.insert(choice.runs.begin(),
+                     PilotRun{IntegratorKind::Silhouette, uint32_t(N_ref), choice.reference_error, ref_run.cost});
+  choice.reference_note =
+      format("estimated error %.2e (Richardson from N = %.0f, order %.2f", worst_of(choice.reference_error), N_ref / 2,
+             choice.reference_richardson_order) +
+      (qmc_check_rays ? format("; QMC check at %.0f rays: %.2e", qmc_check_rays, worst_of(e_qmc)) : std::string()) + ")" +
+      (choice.reference_ok ? format(", within E/3 = %.2e", ChooserOptions::kReferenceShare * E)
+                           : format(", ABOVE E/3 = %.2e: ", ChooserOptions::kReferenceShare * E) +
+                                 (worst_of(e_qmc) > worst_of(e_ref)
+                                      ? std::string("the QMC check disagrees with the reference by more than finer "
+                                                    "isolines would change (a bias, or another reconstruction of the "
+                                                    "environment between texels)")
+                                      : ref_bound) +
+                                 "; the pilot's errors are known only to within it");
+
+  // ---- 5. the pick ----
   if (counted) {
     // Counted setup is the trees' (calibrated on whole builds): none when the bake reuses them.
     setup_sil = accel ? 0.0 : kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
@@ -370,41 +683,97 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   auto cost = [&](const Prediction& p) {
     return (p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) + V * p.predicted_us_per_point * 1e-6;
   };
-  const Prediction* best = nullptr;
+  std::vector<PlanCandidate> candidates;
   for (const Prediction& p : choice.predictions)
-    if (p.reachable && !p.pruned && (!best || cost(p) < cost(*best))) best = &p;
-  if (!best) {
-    double closest = 0;
-    for (const Prediction& p : choice.predictions) closest = closest == 0 ? p.predicted_error : std::min(closest, p.predicted_error);
-    throw InputError("", format("target error %g: no integrator reaches it within its sample range (the closest "
-                                "prediction is %.3g at N = 256/512 isolines or 2^20 rays)",
-                                options.target, closest));
-  }
-  choice.spec.kind = best->kind;
-  if (best->kind == IntegratorKind::Silhouette)
-    choice.spec.silhouette_k = best->knob * best->knob;
+    candidates.push_back({p.kind, p.knob, p.predicted_error,
+                          p.kind == IntegratorKind::Silhouette ? goal_sil : goal_qmc, cost(p)});
+  // The sanity check's measurement: a plan's error against the reference on the pilot points; at
+  // or above the reference level a silhouette plan is compared with itself, so its error is the
+  // reference's own estimate.
+  auto measure = [&](const PlanCandidate& c) {
+    if (c.kind == IntegratorKind::Silhouette) {
+      std::vector<double> e = pilot_errors(run_sil(int(c.knob)).rows.values, ref, W, products);
+      if (int(c.knob) >= N_ref)
+        for (size_t p = 0; p < P; ++p) e[p] = std::max(e[p], e_ref[p]);
+      return worst_of(e);
+    }
+    for (const PilotRun& r : choice.runs)
+      if (r.kind == IntegratorKind::Qmc && r.knob == c.knob) return worst_of(r.error);
+    const QmcIntegrator integrator(mesh, topology, request, QmcOptions{c.knob, base.seed}, shared);
+    return worst_of(pilot_errors(integrate_pilot(integrator, points, sample, progress).values, ref, W, products));
+  };
+  const PlanPick pick = pick_plan(candidates, E, measure);
+  progress.finish();
+  const Prediction& best = choice.predictions[pick.index];
+  choice.spec.kind = best.kind;
+  if (best.kind == IntegratorKind::Silhouette)
+    choice.spec.silhouette_k = best.knob * best.knob;
   else
-    choice.spec.qmc_rays = best->knob;
+    choice.spec.qmc_rays = best.knob;
+  choice.reaches = pick.reaches;
+  choice.expected_error = pick.expected_error;
   const Prediction* other = nullptr;
   for (const Prediction& p : choice.predictions)
-    if (&p != best && p.reachable && !p.pruned) other = &p;
-  choice.margin = other ? cost(*other) / std::max(cost(*best), 1e-12) : 0.0;
-  const std::string knob = best->kind == IntegratorKind::Silhouette
-                               ? format("N = %.0f isolines (k = %.0f)", best->knob, double(best->knob) * best->knob)
-                               : format("%.0f rays", best->knob);
-  choice.reason = std::string(to_string(best->kind)) + " at " + knob +
-                  format(": predicted error %.2g (target %g), %.1f µs per integral, %.2f CPU s for the bake", best->predicted_error,
-                         options.target, best->predicted_us_per_point, cost(*best));
-  if (other)
+    if (&p != &best && p.reachable && !p.pruned) other = &p;
+  choice.margin = other ? cost(*other) / std::max(cost(best), 1e-12) : 0.0;
+  if (pick.checked) {
+    const Prediction& alt = choice.predictions[pick.checked_index];
+    const Prediction& first = choice.predictions[pick.switched ? 1 - pick.checked_index : pick.index];
+    choice.sanity_switched = pick.switched;
+    choice.sanity = "sanity check: " + std::string(to_string(alt.kind)) + " at " + knob_text(alt.kind, alt.knob) +
+                    format(" costs %.2f CPU s against %.2f for ", cost(alt), cost(first)) + to_string(first.kind) +
+                    " at " + knob_text(first.kind, first.knob) +
+                    format(" and predicts %.3g; measured on the pilot: %.3g, ", alt.predicted_error, pick.checked_error) +
+                    (pick.switched ? "taken" : "not taken (it misses its aim and the other's prediction)");
+  }
+  const std::string knob = best.kind == IntegratorKind::Silhouette
+                               ? format("N = %.0f isolines (k = %.0f)", best.knob, double(best.knob) * best.knob)
+                               : format("%.0f rays", best.knob);
+  choice.reason = std::string(to_string(best.kind)) + " at " + knob + ": " +
+                  (pick.switched ? "measured" : "predicted") +
+                  format(" error %.2g (target %g), %.1f µs per integral, %.2f CPU s for the bake", pick.expected_error, E,
+                         best.predicted_us_per_point, cost(best));
+  if (pick.switched)
+    choice.reason += "; taken by the sanity check over the " + std::string(to_string(choice.predictions[1 - pick.index].kind)) +
+                     format(" plan (%.1fx its cost)", cost(choice.predictions[1 - pick.index]) / std::max(cost(best), 1e-12));
+  else if (other)
     choice.reason += format("; %.2fx cheaper than ", choice.margin) + to_string(other->kind) + " at " +
                      (other->kind == IntegratorKind::Silhouette ? format("N = %.0f", other->knob) : format("%.0f rays", other->knob));
   else if (!options.only && choice.predictions.size() > 1 && choice.predictions.back().pruned)
     choice.reason += format("; qmc at %.0f rays costs %.1f µs per integral and misses the target by %.1fx: more rays "
                             "cannot beat it",
                             choice.predictions.back().knob, choice.predictions.back().predicted_us_per_point,
-                            choice.predictions.back().predicted_error / options.target);
-  else if (!options.only)
-    choice.reason += "; the other integrator cannot reach the target within its sample range";
+                            choice.predictions.back().predicted_error / E);
+  else if (!options.only && choice.predictions.size() > 1)
+    choice.reason += "; the other integrator cannot reach the target within its bound";
+  if (pick.checked && !pick.switched) {
+    const Prediction& alt = choice.predictions[pick.checked_index];
+    choice.reason += "; the sanity check measured " + std::string(to_string(alt.kind)) + " at " +
+                     knob_text(alt.kind, alt.knob) +
+                     format(" (%.1fx cheaper): %.3g, not taken", cost(best) / std::max(cost(alt), 1e-12), pick.checked_error);
+  }
+  if (!choice.reaches) {
+    // A default never refuses: the best plan within the bounds, the error it expects, and the way on.
+    choice.reason += format("; the target is NOT reached: expected error %.2g against the aim %.2g (the target times "
+                            "its safety factor)",
+                            choice.expected_error, best.kind == IntegratorKind::Silhouette ? goal_sil : goal_qmc) +
+                     " (" +
+                     knob_text(best.kind, best.knob) + " is at its bound: " + best.bound_reason + ")";
+    std::string f;
+    for (const Prediction& p : choice.predictions) {
+      if (p.pruned || !p.knob_for_target) continue;
+      if (!f.empty()) f += ", or ";
+      if (p.kind == IntegratorKind::Qmc)
+        f += format("integrator qmc with samples %.0f (the model's extrapolation to the aim: ~%.0f CPU s)",
+                    p.knob_for_target, V * (p.predicted_us_per_point / std::max(1.0, double(p.knob))) * p.knob_for_target * 1e-6);
+      else
+        f += format("integrator silhouette at N = %.0f (samples %.0f; its tables would take %.0f MiB)", p.knob_for_target,
+                    double(p.knob_for_target) * p.knob_for_target,
+                    double(isoline_table_bytes(request, int(p.knob_for_target))) / (1 << 20));
+    }
+    if (!f.empty()) f += ", or ";
+    choice.further = "to go further: " + f + format("a target error of %.2g or more", std::max(E, 1.05 * choice.expected_error));
+  }
   choice.pilot_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return choice;
 }
@@ -413,7 +782,8 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
   std::vector<std::string> out;
   out.push_back("target error " + format("%g", c.target) + ": pilot on " + std::to_string(c.pilot_points) +
                 " seeded points took " + format("%.2f s", c.pilot_seconds) + "; error per product against a " +
-                std::to_string(c.runs.empty() ? 0u : c.runs.front().knob) + "-isoline silhouette reference:");
+                std::to_string(c.reference_isolines) + "-isoline silhouette reference:");
+  out.push_back("  reference N = " + std::to_string(c.reference_isolines) + ": " + c.reference_note);
   char buf[512];
   std::string head;
   std::snprintf(buf, sizeof buf, "  %-10s %10s %12s", "integrator", "knob", c.counted_costs ? "µs counted" : "µs/integral");
@@ -423,15 +793,16 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
     head += buf;
   }
   out.push_back(head);
-  for (size_t i = 1; i < c.runs.size(); ++i) {
+  for (size_t i = 0; i < c.runs.size(); ++i) {
     const PilotRun& r = c.runs[i];
-    std::snprintf(buf, sizeof buf, "  %-10s %10s %12.1f", to_string(r.kind), knob_text(r.kind, r.knob).c_str(),
-                  r.cpu_us_per_point);
+    std::snprintf(buf, sizeof buf, "  %-10s %10s %12.1f", i == 0 ? "reference" : to_string(r.kind),
+                  knob_text(r.kind, r.knob).c_str(), r.cpu_us_per_point);
     std::string line = buf;
     for (double e : r.error) {
       std::snprintf(buf, sizeof buf, " %20.3e", e);
       line += buf;
     }
+    if (i == 0) line += "  (its estimated own error)";
     out.push_back(line);
   }
   for (const Prediction& p : c.predictions) {
@@ -439,13 +810,25 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
       std::snprintf(buf, sizeof buf, "  model: %-10s not competitive: at %s it misses the target (error %.3g) at %.1f "
                     "µs/integral, and more rays cannot beat the other",
                     to_string(p.kind), knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.predicted_us_per_point);
-    else
-      std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral%s", to_string(p.kind),
-                    knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point,
-                    p.reachable ? "" : " (cannot reach the target in range)");
+    else {
+      std::string note;
+      if (p.extrapolated) note += "; extrapolated beyond the last measured " + knob_text(p.kind, p.last_measured);
+      if (!p.reachable)
+        note += "; cannot reach the target within its bound " + knob_text(p.kind, p.bound) + ": " + p.bound_reason;
+      std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral", to_string(p.kind),
+                    knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point);
+      out.push_back(buf + note);
+      continue;
+    }
     out.push_back(buf);
   }
+  if (!c.sanity.empty()) out.push_back("  " + c.sanity);
   out.push_back("chosen: " + c.reason);
+  if (!c.further.empty()) out.push_back("  " + c.further);
+  if (!c.reference_ok)
+    out.push_back(format("  (the pilot's reference is not within E/3: its estimated error is %.2e, so the errors above "
+                         "are only known to within it)",
+                         c.reference_error.empty() ? 0.0 : *std::max_element(c.reference_error.begin(), c.reference_error.end())));
   if (c.counted_costs)
     out.push_back("  (costs counted from the pilot's work, not timed: the choice is a function of the inputs and the seed)");
   else if (c.margin > 0 && c.margin < 1.25)
@@ -455,23 +838,95 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
 }
 
 std::string choice_summary(const IntegratorChoice& c) {
-  return format("target error %g: chosen ", c.target) + c.reason + " (pilot on " + std::to_string(c.pilot_points) +
-         format(" seeded points, %.2f s)", c.pilot_seconds);
+  std::string line = format("target error %g: chosen ", c.target) + c.reason;
+  if (!c.further.empty()) line += "; " + c.further;
+  if (!c.reference_ok) line += "; the pilot's reference N = " + std::to_string(c.reference_isolines) + " is not within E/3";
+  return line + " (pilot on " + std::to_string(c.pilot_points) + format(" seeded points, %.2f s)", c.pilot_seconds);
 }
 
-std::vector<std::string> target_check_lines(const ErrorReport& report, double target) {
+ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
+                                    const ProductRequest& request, const IntegratorSpec& spec, double target,
+                                    const Monitor& monitor, const MeshAccel* accel, uint64_t ray_budget) {
+  PRT_CHECK(target > 0);
+  PRT_CHECK(!request.empty());
+  ReferencePlan plan;
+  plan.target = target;
+  IntegratorSpec base = spec;
+  base.report_rays = 0;
+  const uint32_t floor_rays = base.reference_rays();  // never fewer than the default reference
+  // The report's own points (compare_points_with_reference), their first kReportProbePoints.
+  const std::vector<uint32_t> vertices = seeded_sample(uint32_t(points.size()), spec.report_points, spec.seed);
+  plan.points = vertices.size();
+  plan.rays = floor_rays;
+  if (vertices.empty()) return plan;
+  const std::vector<uint32_t> probe(vertices.begin(),
+                                    vertices.begin() + std::min<size_t>(vertices.size(), ReferencePlan::kReportProbePoints));
+  const auto t0 = std::chrono::steady_clock::now();
+  constexpr uint32_t R1 = ReferencePlan::kReportProbeRays, R2 = ReferencePlan::kReportProbeRaysFine;
+  const QmcIntegrator coarse(mesh, topology, request, QmcOptions{R1, mix64(spec.reference_seed() ^ kProbeSalt)}, accel);
+  const QmcIntegrator fine(mesh, topology, request, QmcOptions{R2, spec.reference_seed()}, accel);
+  Task progress(monitor, "reference probe", 2 * probe.size());
+  // The report's point indices (offset by the point count: the reference's randomisation).
+  const Rows a = integrate_pilot(coarse, points, probe, progress, points.size());
+  const Rows b = integrate_pilot(fine, points, probe, progress, points.size());
+  progress.finish();
+  plan.probe_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::vector<ProductSlice> products = product_slices(ProductLayout(request));
+  const size_t W = coarse.layout().width;
+  // d² = σ1² + σ2² with σ ∝ rays^-1/2: σ1² = d² / (1 + R1/R2).
+  const std::vector<double> d = pilot_errors(a.values, b.values, W, products);
+  const std::vector<double> est = pilot_noise(b.std_error, b.values, W, products);
+  const double aim = ChooserOptions::kReferenceShare * target;
+  std::vector<double> sigma1(products.size());
+  double need = floor_rays;
+  for (size_t p = 0; p < products.size(); ++p) {
+    plan.products.push_back(products[p].product);
+    sigma1[p] = d[p] / std::sqrt(1.0 + double(R1) / double(R2));
+    // σ(R) = σ1·sqrt(R1/R) ≤ aim  ⇔  R ≥ R1·(σ1/aim)².
+    const double r = double(R1) * (sigma1[p] / aim) * (sigma1[p] / aim);
+    plan.rays_needed.push_back(uint64_t(std::ceil(std::min(r, 1e18))));
+    need = std::max(need, r);
+  }
+  plan.ray_budget = ray_budget ? ray_budget : ReferencePlan::kReportRayBudget;
+  const uint64_t cap = std::max<uint64_t>(floor_rays, plan.ray_budget / plan.points);
+  uint32_t rays = round_up_rays(need);
+  if (rays > cap) rays = uint32_t(std::min<uint64_t>(cap, kMaxRays));
+  plan.rays = std::max(rays, floor_rays);
+  for (size_t p = 0; p < products.size(); ++p) {
+    plan.noise.push_back(sigma1[p] * std::sqrt(double(R1) / double(plan.rays)));
+    plan.estimator_noise.push_back(est[p] * std::sqrt(double(R2) / double(plan.rays)));
+    if (plan.noise.back() > aim) plan.budget_bound = true;
+  }
+  return plan;
+}
+
+std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
   std::vector<std::string> out;
   for (const ProductError& e : report.products) {
     const double err = error_in_target_units(e);
     // The reference's own noise in the same units (its estimated standard error; QMC's actual
     // error is often well below it): an RMSE above E with noise that large says nothing.
-    const double noise = is_radiance(e.product) ? (e.reference_rms > 0 ? e.reference_std_error / e.reference_rms : 0.0)
-                                                             : e.reference_std_error;
-    const char* verdict = err <= target ? "met" : noise >= 0.5 * target ? "not verifiable here" : "NOT met";
+    double noise = is_radiance(e.product) ? (e.reference_rms > 0 ? e.reference_std_error / e.reference_rms : 0.0)
+                                                       : e.reference_std_error;
+    const char* noise_kind = "estimated";
+    if (plan)
+      for (size_t p = 0; p < plan->products.size(); ++p)
+        if (plan->products[p] == e.product && p < plan->noise.size()) noise = plan->noise[p], noise_kind = "measured";
+    const bool unverifiable = err > target && noise >= 0.5 * target;
+    const char* verdict = err <= target ? "met" : unverifiable ? "not verifiable here" : "NOT met";
+    std::string why;
+    if (unverifiable) {
+      why = ": too noisy to tell";
+      if (plan)
+        for (size_t p = 0; p < plan->products.size(); ++p)
+          if (plan->products[p] == e.product && plan->rays_needed[p] > plan->rays)
+            why += format("; E/3 would need %.3g rays per point, %.3g in all, over the report's budget of %.3g rays",
+                          double(plan->rays_needed[p]), double(plan->rays_needed[p]) * double(plan->points),
+                          double(plan->ray_budget ? plan->ray_budget : ReferencePlan::kReportRayBudget));
+    }
     out.push_back(format("  target %g for ", target) + product_label(e.product) + ": " + verdict + format(" (%.3e", err) +
                   (is_radiance(e.product) ? " relative" : "") +
-                  format("; the reference's own estimated noise, included in it, is %.1e", noise) +
-                  (err > target && noise >= 0.5 * target ? ": too noisy to tell)" : ")"));
+                  "; the reference's own " + noise_kind + format(" noise, included in it, is %.1e", noise) + why + ")");
   }
   return out;
 }

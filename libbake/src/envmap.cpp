@@ -6,6 +6,8 @@
 
 #include <prtshade/sh.h>
 
+#include <Eigen/Geometry>
+
 #include <IexBaseExc.h>
 #include <ImfChannelList.h>
 #include <ImfEnvmap.h>
@@ -772,6 +774,54 @@ Rgb EnvMap::radiance(const Eigen::Vector3d& dir_scene) const {
   if (layout_ == Layout::Constant) return constant_;
   const float* p = &rgb_[size_t(texel_of_map(map_from_scene(dir_scene, up_))) * 3];
   return Rgb{double(p[0]), double(p[1]), double(p[2])};
+}
+
+std::vector<Eigen::Vector3d> EnvMap::texel_polygon(int texel, double max_relative_area_error) const {
+  PRT_CHECK(texel >= 0 && texel < texel_count());
+  PRT_CHECK(max_relative_area_error > 0);
+  const Region r = region(texel);
+  std::vector<Eigen::Vector3d> poly;
+  if (r.face >= 0) {
+    for (const auto& [a, b] : {std::pair{r.s0, r.t0}, {r.s1, r.t0}, {r.s1, r.t1}, {r.s0, r.t1}})
+      poly.push_back(cube_dir(r.face, a, b).normalized());
+    // (a, b) runs counter-clockwise about the outward direction on half the faces.
+    if ((poly[1] - poly[0]).cross(poly[2] - poly[0]).dot(poly[0]) < 0) std::reverse(poly.begin(), poly.end());
+  } else {
+    const int x = texel % width_, y = texel / width_;
+    double xlo, xhi, ylo, yhi;
+    half_pixel_bounds(x, width_, xlo, xhi);
+    half_pixel_bounds(y, height_, ylo, yhi);
+    const double lon0 = longitude_of(xhi, width_), lon1 = longitude_of(xlo, width_);  // lon0 < lon1
+    const double lat_top = latitude_of(ylo, height_), lat_bottom = latitude_of(yhi, height_);
+    // Chords per parallel from the sliver bound (header): k chords over a parallel of length
+    // ℓ_0 = Δλ cos β and geodesic curvature |tan β| leave ℓ_0³ |tan β| / (12 k²), at most
+    // max_relative_area_error × the smaller texel of the column on either side of the parallel
+    // (a function of the parallel and the column alone, so both texels split it alike).
+    auto row_area = [&](int row) {  // solid angle of this column's texel in `row` (0 outside the map)
+      if (row < 0 || row >= height_) return 0.0;
+      double lo, hi;
+      half_pixel_bounds(row, height_, lo, hi);
+      return (lon1 - lon0) * (std::sin(latitude_of(lo, height_)) - std::sin(latitude_of(hi, height_)));
+    };
+    auto chords = [&](double lat, int row_above) {
+      if (std::abs(lat) >= 0.5 * kPi) return 0;  // a pole: one vertex
+      const double a0 = row_area(row_above), a1 = row_area(row_above + 1);
+      const double area = a0 > 0 && a1 > 0 ? std::min(a0, a1) : std::max(a0, a1);
+      const double len = (lon1 - lon0) * std::cos(lat);
+      const double k = std::sqrt(len * len * len * std::abs(std::tan(lat)) / (12.0 * max_relative_area_error * area));
+      return std::clamp(int(std::ceil(k)), 1, 1 << 12);
+    };
+    // Counter-clockwise seen from outside: along the bottom parallel eastwards (longitude
+    // increasing), then back along the top one. (With lon the angle from +z towards +x, the east
+    // direction ∂d/∂lon and north ∂d/∂lat satisfy east × north = d: outward.)
+    const int kb = chords(lat_bottom, y), kt = chords(lat_top, y - 1);
+    if (kb == 0) poly.push_back(latlong_dir(lat_bottom, 0.0));
+    for (int j = 0; j <= kb && kb > 0; ++j) poly.push_back(latlong_dir(lat_bottom, lon0 + (lon1 - lon0) * j / kb));
+    if (kt == 0) poly.push_back(latlong_dir(lat_top, 0.0));
+    for (int j = kt; j >= 0 && kt > 0; --j) poly.push_back(latlong_dir(lat_top, lon0 + (lon1 - lon0) * j / kt));
+  }
+  for (Eigen::Vector3d& v : poly) v = scene_from_map(v, up_);
+  return poly;
 }
 
 Eigen::Vector3d EnvMap::sample_texel(int texel, double u0, double u1) const {

@@ -311,17 +311,26 @@ class Reader {
     }
   }
 
-  // The path segments of `nodes` (siblings, in order): the node's name with '/', '#' and '|'
-  // replaced by '_', or "node<N>" when the name is empty, "." or ".."; a segment already taken by
-  // an earlier sibling gets the first free "~2", "~3", ... (bake/mesh.h "glTF scenes").
+  // The path segments of `nodes` (siblings, in order): the node's name, or when it has none (empty,
+  // "." or "..") the name of its mesh, with '/', '#' and '|' replaced by '_'; "node<N>" when
+  // neither has one; a segment already taken by an earlier sibling gets the first free "~2",
+  // "~3", ... (bake/mesh.h NAMES).
   std::vector<std::string> segments(const std::vector<int>& nodes) const {
+    auto usable = [](std::string s) {
+      for (char& c : s)
+        if (c == '/' || c == '#' || c == '|') c = '_';
+      return s == "." || s == ".." ? std::string() : s;
+    };
     std::vector<std::string> out;
     for (int n : nodes) {
-      const std::string* name = n >= 0 && static_cast<size_t>(n) < model_.nodes.size() ? &model_.nodes[static_cast<size_t>(n)].name : nullptr;
-      std::string seg = name ? *name : std::string();
-      for (char& c : seg)
-        if (c == '/' || c == '#' || c == '|') c = '_';
-      if (seg.empty() || seg == "." || seg == "..") seg = "node" + std::to_string(n);
+      std::string seg;
+      if (n >= 0 && static_cast<size_t>(n) < model_.nodes.size()) {
+        const tinygltf::Node& node = model_.nodes[static_cast<size_t>(n)];
+        seg = usable(node.name);
+        if (seg.empty() && node.mesh >= 0 && static_cast<size_t>(node.mesh) < model_.meshes.size())
+          seg = usable(model_.meshes[static_cast<size_t>(node.mesh)].name);
+      }
+      if (seg.empty()) seg = "node" + std::to_string(n);
       out.push_back(std::move(seg));
     }
     const std::set<std::string> raw(out.begin(), out.end());

@@ -51,7 +51,8 @@ std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const A
 } // namespace
 
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     const Monitor& monitor, const std::function<void(const std::string&)>& log, const SceneRows& rows) {
+                     const Monitor& monitor, const std::function<void(const std::string&)>& log, const SceneRows& rows,
+                     const OnChoice& on_choice) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
   SceneBake out;
@@ -104,6 +105,9 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   out.setup_seconds = seconds_since(t_setup);
 
   // ---- receivers ----
+  uint64_t receiver_vertices = 0;  // of the receivers with per-vertex products (the report's budget)
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (plan.objects[i].receiver && plan.objects[i].any_vertex_product()) receiver_vertices += meshes[i].positions.size();
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -140,7 +144,19 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       copt.counted_costs = scene.counted_costs;
       ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor, &accel);
       ob.integrator = ob.choice->spec;
-      log(scene.objects[i].name + ": " + choice_summary(*ob.choice));
+      // The report's reference: its noise within E/3 (or the plan says why not), bake/choose.h.
+      if (ob.integrator.report_points > 0 && !rows.rows_only) {
+        // The report's ray budget is the scene's, shared by the receivers' vertices.
+        const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(points.size()) /
+                                         double(std::max<uint64_t>(receiver_vertices, 1)));
+        ob.reference_plan = plan_report_reference(points, occluders, topo, r, ob.integrator, scene.target_error, monitor,
+                                                  &accel, std::max<uint64_t>(budget, 1));
+        ob.integrator.report_rays = ob.reference_plan->rays;
+      }
+      if (on_choice)
+        on_choice(scene.objects[i].name, *ob.choice, ob.reference_plan ? &*ob.reference_plan : nullptr);
+      else
+        log(scene.objects[i].name + ": " + choice_summary(*ob.choice));
       own_integ = make_integrator(ob.integrator, occluders, topo, r, &accel);
       if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r, &accel);
     }
@@ -177,7 +193,9 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
             printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
                 ob.report->reference_seconds));
       if (choose)
-        for (const std::string& line : target_check_lines(*ob.report, scene.target_error)) log(line);
+        for (const std::string& line :
+             target_check_lines(*ob.report, scene.target_error, ob.reference_plan ? &*ob.reference_plan : nullptr))
+          log(line);
     }
   }
 

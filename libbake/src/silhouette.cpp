@@ -5,6 +5,7 @@
 #include <bake/contour.h>
 #include <bake/envmap.h>
 #include <bake/error.h>
+#include <bake/hot_texels.h>
 #include <bake/isoline_tables.h>
 #include <bake/octahedral.h>
 #include <bake/raycast.h>
@@ -51,10 +52,9 @@ bool collinear_exactly(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const
   return true;
 }
 
-struct Arc {
-  Vector3d a, b, m;  // endpoints (unnormalised, frame coordinates) and m = a × b
-  int side_sum;      // S: the step across the arc is sign(m · t) · S for travel direction t
-};
+// Endpoints (unnormalised, frame coordinates), m = a × b, and S = side_sum: the step across the
+// arc is sign(m · t) · S for travel direction t (bake/hot_texels.h).
+using Arc = DcfArc;
 struct Crossing {
   int iso;
   double t;
@@ -68,10 +68,10 @@ struct SpineCrossing {
 struct Scratch {
   std::vector<ContourEdge> edges;
   std::vector<Arc> arcs;
-  std::vector<Crossing> crossings, hot_crossings, sorted;
+  std::vector<Crossing> crossings, sorted;
   std::vector<SpineCrossing> spine;
   std::vector<uint32_t> bucket_start;
-  std::vector<double> acc, hot_acc;
+  std::vector<double> acc, hot_moments;
 };
 thread_local Scratch tl_scratch;
 
@@ -91,21 +91,19 @@ struct SilhouetteIntegrator::Impl {
   Eigen::Matrix3d frame_from_world;
   int sh_order = 0;
   // Columns of the tables: [AO n-moments (3) | T (3·Lt²) | U (Lv²) | R (9) | S (3·Ls²)]. The
-  // environment's columns R and S are the last n_env = F − c_r: the hot texels' tables hold
-  // exactly those, and the closed form's horizon-only walk yields them.
+  // environment's columns R and S are the last n_env = F − c_r: the hot texels add to exactly
+  // those, and the closed form's horizon-only walk yields them.
   size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, c_s = 0, F = 0, n_env = 0;
   const EnvMap* envmap = nullptr;  // of R and S
   int env_order = 0;            // SH order the environment's columns need
   int subsamples = 1;
   std::unique_ptr<IsolineTables> tables;
   // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
-  // integrated on a fine isoline grid of their own (a quarter texel apart) so that suns cut by a
-  // shadow edge or by the horizon are resolved below texel size, not smeared over a strip.
+  // left out of the tables and integrated exactly over their visible part (bake/hot_texels.h), so
+  // that suns cut by a shadow edge or by the horizon carry no discretisation error at any N.
   static constexpr double kHotFactor = 64;
   static constexpr size_t kMaxHot = 4096;
-  std::vector<uint8_t> hot_mask;  // per texel
-  size_t hot_texels = 0;
-  std::unique_ptr<SparseIsolineTables> hot;
+  std::unique_ptr<HotTexels> hot;
   std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
@@ -142,41 +140,11 @@ struct SilhouetteIntegrator::Impl {
       subsamples = std::clamp(int(std::ceil(2.0 * grid.h / texel)), 1, 8);
     }
     const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
-    std::vector<Vector3d> hot_samples;
-    int n_fine = 0;
-    if (envmap && envmap->texel_count() > 0) {
-      const EnvMap& env = *envmap;
-      const int T = env.texel_count();
-      std::vector<double> lum(static_cast<size_t>(T));
-      for (int tx = 0; tx < T; ++tx) lum[size_t(tx)] = luminance(env.texel_value(tx));
-      double threshold = kHotFactor * env.info().mean_luminance;
-      if (size_t(T) > kMaxHot) {
-        std::vector<double> sorted_lum = lum;
-        std::nth_element(sorted_lum.begin(), sorted_lum.begin() + (kMaxHot - 1), sorted_lum.end(), std::greater<>());
-        threshold = std::max(threshold, std::nextafter(sorted_lum[kMaxHot - 1], std::numeric_limits<double>::infinity()));
-      }
-      hot_mask.assign(size_t(T), 0);
-      const double texel = std::sqrt(4 * std::numbers::pi / double(T));
-      // A quarter texel apart, and at least 4× finer than the base grid.
-      n_fine = std::max(4 * grid.n, even_isolines(int(std::ceil(2.0 / (texel / 4)))));
-      // Support samples dense enough that every fine strip and cell a hot texel touches gets one
-      // (a texel spans about texel / (2 / n_fine) strips; octahedral u moves at most ~1.4× faster
-      // than the angle).
-      const int kS = std::clamp(int(std::ceil(3.0 * texel / (2.0 / n_fine))), 6, 96);
-      for (int tx = 0; tx < T; ++tx)
-        if (lum[size_t(tx)] > threshold && lum[size_t(tx)] > 0) {
-          hot_mask[size_t(tx)] = 1;
-          ++hot_texels;
-          for (int a = 0; a < kS; ++a)
-            for (int b = 0; b < kS; ++b)
-              hot_samples.push_back(frame_from_world * env.sample_texel(tx, (a + 0.5) / kS, (b + 0.5) / kS));
-        }
+    if (envmap && envmap->texel_count() > 0 && env_order > 0) {
+      hot = std::make_unique<HotTexels>(*envmap, frame_from_world, env_order, kHotFactor, kMaxHot);
+      if (hot->empty()) hot.reset();
     }
-    auto is_hot = [&](const Vector3d& w) {
-      if (hot_mask.empty()) return false;
-      const int tx = envmap->texel_of(w);
-      return tx >= 0 && hot_mask[size_t(tx)] != 0;
-    };
+    auto is_hot = [&](const Vector3d& w) { return hot && hot->is_hot(envmap->texel_of(w)); };
     // The SH basis at w up to `order` in `small` (orders ≤ 16) or `big`.
     auto eval_sh = [](int order, const Vector3d& w, std::span<double> small, std::vector<double>& big) -> double* {
       double* yp = small.data();
@@ -210,21 +178,8 @@ struct SilhouetteIntegrator::Impl {
       for (int a = 0; a < 3; ++a)
         for (size_t i = 0; i < nt; ++i) out[c_t + size_t(a) * nt + i] = w[a] * yp[i] * kInvPi;
       for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
-      if (envmap) env_columns(is_hot(w) ? Rgb{} : envmap->radiance(w), yp, &out[c_r]);  // hot texels: the fine grid's part
+      if (envmap) env_columns(is_hot(w) ? Rgb{} : envmap->radiance(w), yp, &out[c_r]);  // hot texels: exact, apart
     });
-    if (!hot_samples.empty()) {
-      hot = std::make_unique<SparseIsolineTables>(
-          oct::Grid(n_fine), int(n_env), 2,
-          [&](const Vector3d& w_frame, std::span<double> out) {
-            const Vector3d w = world_from_frame * w_frame;
-            std::fill(out.begin(), out.end(), 0.0);
-            if (!is_hot(w)) return;
-            double y[sh::num_coeffs(16)];
-            std::vector<double> ybig;
-            env_columns(envmap->radiance(w), eval_sh(env_order, w, y, ybig), out.data());
-          },
-          hot_samples);
-    }
     unoccluded_row = unoccluded_totals();
   }
 
@@ -236,12 +191,7 @@ struct SilhouetteIntegrator::Impl {
       const double* total = tables->loop_total(i);
       for (size_t c = 0; c < F; ++c) acc[c] += total[c] * grid.h;
     }
-    if (hot)
-      for (int i = hot->first_isoline(); i < hot->last_isoline(); ++i)
-        if (hot->has(i)) {
-          const double* total = hot->loop_total(i);
-          for (size_t c = 0; c < n_env; ++c) acc[c_r + c] += total[c] * hot->grid().h;
-        }
+    if (hot) add_hot_moments(hot->unoccluded().data(), acc.data());
     for (size_t k = 0; k < layout.visibility_count; ++k) row[layout.visibility + k] = acc[c_u + k];
     for (size_t k = 0; k < layout.radiance_count; ++k) row[layout.radiance + k] = acc[c_r + k];
     for (size_t k = 0; k < layout.shadowed_count; ++k) row[layout.shadowed + k] = acc[c_s + k];
@@ -362,18 +312,7 @@ struct SilhouetteIntegrator::Impl {
   // Change of W along the great-circle arc from P to Q (frame coordinates): the sum of the steps
   // of every arc it crosses.
   static int path_steps(const std::vector<Arc>& arcs, const Vector3d& P, const Vector3d& Q) {
-    const Vector3d m2 = P.cross(Q);
-    int w = 0;
-    for (const Arc& arc : arcs) {
-      const Vector3d dir = arc.m.cross(m2);
-      if (dir.squaredNorm() == 0) continue;
-      for (const Vector3d& c : {dir, Vector3d(-dir)}) {
-        if (arc.a.cross(c).dot(arc.m) >= 0 && c.cross(arc.b).dot(arc.m) >= 0 && P.cross(c).dot(m2) >= 0 &&
-            c.cross(Q).dot(m2) >= 0)
-          w += sign_of(arc.m.dot(m2.cross(c))) * arc.side_sum;
-      }
-    }
-    return w;
+    return dcf_path_steps(arcs, P, Q);
   }
 
   // The horizon of n as a virtual occluder boundary (four quarter arcs): +1 when crossing into n·ω < 0.
@@ -388,32 +327,39 @@ struct SilhouetteIntegrator::Impl {
   // Isoline crossings and spine crossings of every arc in s.arcs.
   void add_crossings(Scratch& s) const {
     s.crossings.clear();
-    s.hot_crossings.clear();
     s.spine.clear();
     for (const Arc& arc : s.arcs) {
       add_arc(arc, grid, 0, grid.n, s.crossings);
       add_spine(arc, s.spine);
-      if (hot) add_arc(arc, hot->grid(), hot->first_isoline(), hot->last_isoline(), s.hot_crossings);
     }
   }
 
-  // DCF walks from W0 at the spine start: the base tables on the isoline grid, the hot texels on
-  // their fine grid. Leaves the F integrals (in the tables' column layout) in s.acc; returns the
+  // The hot texels' moments (HotTexels::width(): per colour, order² SH integrals) into the
+  // environment's columns R and S of `acc` (the tables' layout): both are linear in y_i.
+  void add_hot_moments(const double* mom, double* acc) const {
+    const size_t n2 = size_t(env_order * env_order), ns = size_t(req.shadowed_order * req.shadowed_order);
+    if (req.radiance)
+      for (size_t c = 0; c < 3; ++c)
+        for (size_t mm = 0; mm < 3; ++mm) acc[c_r + 3 * c + mm] += mom[c * n2 + 1 + mm];
+    for (size_t c = 0; c < 3; ++c)
+      for (size_t i = 0; i < ns; ++i) acc[c_s + c * ns + i] += mom[c * n2 + i];
+  }
+
+  // DCF walk from W0 at the spine start over the isoline tables, then the hot texels' visible
+  // parts exactly. Leaves the F integrals (in the tables' column layout) in s.acc; returns the
   // number of inconsistent loops.
   uint64_t walk_all(Scratch& s, int W0) const {
     std::sort(s.spine.begin(), s.spine.end(),
               [](const SpineCrossing& x, const SpineCrossing& y) { return x.u < y.u || (x.u == y.u && x.step < y.step); });
     s.acc.assign(F, 0.0);
     double* acc = s.acc.data();
-    uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
-    if (hot) {
-      s.hot_acc.assign(n_env, 0.0);
-      inconsistent += walk(hot->grid(), hot->first_isoline(), hot->last_isoline(), *hot, W0, s.spine, s.hot_crossings,
-                           s.sorted, s.bucket_start, s.hot_acc.data(), n_env);
-    }
+    const uint64_t inconsistent = walk(grid, 0, grid.n, *tables, W0, s.spine, s.crossings, s.sorted, s.bucket_start, acc, F);
     for (size_t c = 0; c < F; ++c) acc[c] *= grid.h;
-    if (hot)
-      for (size_t c = 0; c < n_env; ++c) acc[c_r + c] += s.hot_acc[c] * hot->grid().h;
+    if (hot) {
+      s.hot_moments.assign(hot->width(), 0.0);
+      hot->accumulate(s.arcs, Vector3d(-1, 0, 0), W0, s.hot_moments.data());
+      add_hot_moments(s.hot_moments.data(), acc);
+    }
     return inconsistent;
   }
 
@@ -629,9 +575,8 @@ std::string SilhouetteIntegrator::description() const {
      << impl_->F << " integrand components in " << (impl_->tables->bytes() >> 20) << " MiB of isoline tables, "
      << impl_->subsamples << "x" << impl_->subsamples << " sub-samples per cell";
   if (impl_->hot)
-    os << "; " << impl_->hot_texels << " hot environment texels (>= " << Impl::kHotFactor
-       << "x mean luminance) on " << impl_->hot->grid().n << " fine isolines ("
-       << (impl_->hot->bytes() >> 10) << " KiB)";
+    os << "; " << impl_->hot->texels() << " hot environment texels (>= " << Impl::kHotFactor
+       << "x mean luminance) in " << impl_->hot->clusters() << " clusters, integrated exactly over their visible parts";
   return os.str();
 }
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <h5py.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace fs = std::filesystem;
@@ -165,6 +166,7 @@ Asset full_asset() {
   a.group_extras = {{"/fiv/occluders/rock", {{"mesh", std::string("rock.obj")}}},
                     {"/mesh", {{"note", std::string("on a group")}}},
                     {"/report", {{"rmse", 1.5e-3}}}};
+  a.target_error = 2.5e-3;  // typed, on /report beside the extra above
   return a;
 }
 
@@ -209,6 +211,7 @@ TEST(Asset, AbsentStaysAbsent) {
   a.occluders.clear();
   a.other_reports.clear();
   a.group_extras.clear();
+  a.target_error.reset();
   a.vertices = VertexSet{};
   a.vertices.positions = Array<double>{{0, 0, 0}, {}};
   write_asset(dir / "a.prt.h5", a);
@@ -219,6 +222,62 @@ TEST(Asset, AbsentStaysAbsent) {
   EXPECT_TRUE(b.vertices.report.empty());
   EXPECT_TRUE(b.objects.empty());
   EXPECT_TRUE(b.occluders.empty());
+  EXPECT_FALSE(b.target_error.has_value());
+  EXPECT_EQ(find_group_attrs(read_file(dir / "a.prt.h5"), "/report"), nullptr) << "no /report attributes without a target";
+}
+
+TEST(Asset, TargetErrorIsAnOptionalDoubleOnTheReportGroup) {
+  // SCHEMA.md "Error reports": /report's target_error, float64, beside any extra attribute there.
+  const fs::path dir = scratch("target_error");
+  Asset a = full_asset();
+  const File f = to_file(a);
+  const std::vector<Attr>* report = find_group_attrs(f, "/report");
+  ASSERT_NE(report, nullptr);
+  ASSERT_NE(find_attr(*report, "target_error"), nullptr);
+  EXPECT_EQ(std::get<double>(find_attr(*report, "target_error")->value), 2.5e-3);
+  EXPECT_EQ(std::get<double>(find_attr(*report, "rmse")->value), 1.5e-3) << "the extra stays on the same group";
+  EXPECT_EQ(std::count_if(f.group_attrs.begin(), f.group_attrs.end(), [](const auto& g) { return g.first == "/report"; }), 1)
+      << "one /report group";
+  write_asset(dir / "a.prt.h5", a);
+  EXPECT_EQ(read_asset(dir / "a.prt.h5").target_error, 2.5e-3);
+
+  // A target alone, with no report rows (--report 0): the group holds just the attribute.
+  Asset alone = a;
+  alone.group_extras.clear();
+  alone.vertices.report = Report{};
+  write_asset(dir / "alone.prt.h5", alone);
+  const Asset b = read_asset(dir / "alone.prt.h5");
+  EXPECT_EQ(b.target_error, 2.5e-3);
+  EXPECT_TRUE(b.group_extras.empty()) << "target_error is typed, not an extra";
+
+  // Not a double (another tool's string): kept as an extra, not misread as a target.
+  File g = to_file(alone);
+  for (auto& [group, attrs] : g.group_attrs)
+    if (group == "/report") attrs = {{"target_error", std::string("1e-3")}};
+  write_file(dir / "string.prt.h5", g);
+  const Asset c = read_asset(dir / "string.prt.h5");
+  EXPECT_FALSE(c.target_error.has_value());
+  ASSERT_EQ(c.group_extras.size(), 1u);
+  EXPECT_EQ(c.group_extras[0].first, "/report");
+}
+
+TEST(Asset, ObjectsAreFoundByTheirNodePathOrTheirStoredName) {
+  // One spelling for people (asset.h): the node path; the file's name has '|' for '/'.
+  Asset a;
+  a.objects.resize(2);
+  a.objects[0].name = "node0|node13|node71";
+  a.objects[0].node_path = "node0/node13/node71";
+  a.objects[1].name = "bunny";
+  EXPECT_EQ(object_label(a.objects[0]), "node0/node13/node71");
+  EXPECT_EQ(object_label(a.objects[1]), "bunny");
+  EXPECT_EQ(a.find_object_by_label("node0/node13/node71"), &a.objects[0]);
+  EXPECT_EQ(a.find_object_by_label("node0|node13|node71"), &a.objects[0]);
+  EXPECT_EQ(a.find_object_by_label("bunny"), &a.objects[1]);
+  EXPECT_EQ(a.find_object_by_label("node0/node13"), nullptr) << "a prefix is not the object";
+  EXPECT_EQ(a.find_object_by_label("node0/node13/node7"), nullptr);
+  // Without its node_path attribute (a file that lost it) the '/' spelling still finds it.
+  a.objects[0].node_path.reset();
+  EXPECT_EQ(a.find_object_by_label("node0/node13/node71"), &a.objects[0]);
 }
 
 TEST(Asset, BytesDoNotDependOnTheRoundTrip) {

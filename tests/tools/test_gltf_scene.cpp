@@ -1,7 +1,7 @@
 // `prtbake scene` on a glTF (bake/scene.h "glTF scenes"): every primitive instance is an object
 // named by its node path, baked exactly as the same geometry in a JSON scene; the options file sets
 // roles and materials per node path and refuses a path that names no node; prtdump lists the
-// objects by node path.
+// objects by node path and dumps one object's vertex by it; unnamed nodes take their mesh's name.
 #include <bake/scene.h>
 #include <bake/sha256.h>
 #include <formats/asset.h>
@@ -12,9 +12,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -166,12 +168,116 @@ TEST(GltfScene, InstancesAreObjectsNamedByNodePathAndBakeAsTheSameJsonScene) {
   // The ground under the box is shadowed by it: the objects see each other.
   EXPECT_LT(ao_of(gltf, "ground")[4 * 9 + 4], 0.9f);
 
-  // prtdump lists the objects by node path.
+  // prtdump lists the objects by node path, saying where the file stores them when that differs.
   const auto listing = prt::testing::run_tool(PRT_PRTDUMP, "'" + (d / "out.prt.h5").string() + "'", d);
   ASSERT_EQ(listing.code, 0) << listing.err;
   for (size_t i = 0; i < kNodePaths.size(); ++i)
-    EXPECT_NE(listing.out.find("  " + kNodePaths[i] + " (both; /objects/" + kObjectNames[i] + ")\n"), std::string::npos)
+    EXPECT_NE(listing.out.find("  " + kNodePaths[i] + " (both" +
+                               (kNodePaths[i] == kObjectNames[i] ? "" : "; stored as /objects/" + kObjectNames[i]) + ")\n"),
+              std::string::npos)
         << listing.out;
+  // One spelling in every section: the stored name ('|') only where it is labelled as such.
+  std::istringstream lines(listing.out);
+  size_t stored_lines = 0;
+  for (std::string line; std::getline(lines, line);)
+    if (line.find('|') != std::string::npos) {
+      EXPECT_NE(line.find("stored as /objects/"), std::string::npos) << "a name spelled with '|': " << line;
+      ++stored_lines;
+    }
+  EXPECT_GE(stored_lines, 3u) << "the three objects under 'stack' say where they are stored:\n" << listing.out;
+}
+
+TEST(GltfScene, PrtdumpPrintsOneObjectsVertexByNodePathOrStoredName) {
+  // Issue 29: `--vertex I` on a scene file needs `--object NAME`, the node path the Scene section
+  // prints (or the stored name); the values printed are the file's for that object's vertex I.
+  const fs::path d = dir_for("dump_object");
+  const F::Asset a = bake_with_options(d, "{\"prtbake_gltf_scene\": 1, " + kBake + "}");
+  const F::SceneObject* box = a.find_object("stack|box");
+  ASSERT_NE(box, nullptr);
+  ASSERT_TRUE(box->set.ao && box->set.positions);
+  ASSERT_GT(box->set.ao->values.size(), 5u);
+  auto shortest = [](float v) {  // prtdump prints float32 values in their shortest round-trip form
+    char buf[32];
+    return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+  };
+  const std::string ao = shortest(box->set.ao->values[5]);
+  const std::string position = "[" + shortest(float(box->set.positions->values[15])) + ", " +
+                               shortest(float(box->set.positions->values[16])) + ", " +
+                               shortest(float(box->set.positions->values[17])) + "]";
+  const std::string file = "'" + (d / "out.prt.h5").string() + "'";
+  std::string first;
+  for (const std::string& name : {std::string("stack/box"), std::string("stack|box")}) {
+    SCOPED_TRACE(name);
+    const auto v = prt::testing::run_tool(PRT_PRTDUMP, "--vertex 5 --object '" + name + "' " + file, d);
+    ASSERT_EQ(v.code, 0) << v.err;
+    EXPECT_NE(v.out.find("vertex 5 of 8 ("), std::string::npos) << v.out;
+    EXPECT_NE(v.out.find(", object stack/box)\n"), std::string::npos) << v.out;
+    std::istringstream lines(v.out);
+    bool ao_line = false, position_line = false;
+    for (std::string line; std::getline(lines, line);) {
+      if (line.starts_with("  /ao ")) ao_line = line.ends_with(" " + ao);
+      if (line.starts_with("  /mesh/positions ")) position_line = line.ends_with(" " + position);
+    }
+    EXPECT_TRUE(ao_line) << "AO of stack/box vertex 5 is " << ao << ":\n" << v.out;
+    EXPECT_TRUE(position_line) << "its position is " << position << ":\n" << v.out;
+    if (first.empty()) first = v.out;
+    else EXPECT_EQ(v.out, first) << "both spellings name the same object";
+  }
+  // JSON: the object by its node path, the values by their path within the object.
+  const auto j = prt::testing::run_tool(PRT_PRTDUMP, "--json --vertex 5 --object stack/box " + file, d);
+  ASSERT_EQ(j.code, 0) << j.err;
+  EXPECT_NE(j.out.find("\"object\": \"stack/box\""), std::string::npos) << j.out;
+  const size_t at = j.out.find("\"/ao\": " + ao);
+  ASSERT_NE(at, std::string::npos) << j.out;
+  const char after = j.out[at + 7 + ao.size()];
+  EXPECT_TRUE(after == ',' || after == '\n') << "the whole number: " << j.out.substr(at, 40);
+
+  // Without --object, or with a name that is no object: one line naming the file and the objects.
+  for (const std::string& args : {"--vertex 0 " + file, "--vertex 0 --object stack/bx " + file}) {
+    SCOPED_TRACE(args);
+    const auto r = prt::testing::run_tool(PRT_PRTDUMP, args, d);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find((d / "out.prt.h5").string() + ": "), std::string::npos) << r.err;
+    for (const std::string& path : kNodePaths) EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('|'), std::string::npos) << "objects by node path: " << r.err;
+    EXPECT_EQ(r.err.find("needs /mesh/positions"), std::string::npos) << r.err;
+  }
+  // --object means nothing without --vertex: a command-line error.
+  EXPECT_EQ(prt::testing::run_tool(PRT_PRTDUMP, "--object stack/box " + file, d).code, 2);
+}
+
+TEST(GltfScene, UnnamedNodesAreNamedAfterTheirMeshes) {
+  // CAD exports name meshes, not nodes (2CylinderEngine.glb: "Piston_123-844_0_Parts_1"): an
+  // unnamed node's segment is its mesh's name (bake/mesh.h NAMES), made unique among siblings;
+  // a node's own name wins; neither: node<N>.
+  const fs::path d = dir_for("mesh_names");
+  Gltf g;
+  g.dir = d;
+  auto named_mesh = [&](const char* name) {
+    const int m = g.mesh(primitive(g, kQuad));
+    if (name) g.doc["meshes"][size_t(m)]["name"] = name;
+    return m;
+  };
+  const int piston = named_mesh("Piston_123-844_0_Parts_1"), odd = named_mesh("a/b#c|d"), anonymous = named_mesh(nullptr),
+            dots = named_mesh("..");
+  std::vector<int> children;
+  for (const json& n : {json{{"mesh", piston}}, json{{"mesh", piston}}, json{{"name", "rod"}, {"mesh", piston}},
+                        json{{"mesh", odd}}, json{{"mesh", anonymous}}, json{{"mesh", dots}}})
+    children.push_back(g.node(n, false));
+  const int root = g.node({{"children", children}}, true);
+  ASSERT_EQ(root, 6);
+  const prt::bake::SceneDescription scene = prt::bake::load_scene(g.write("parts.gltf"));
+  std::vector<std::string> paths, names;
+  for (const auto& o : scene.objects) paths.push_back(o.node_path), names.push_back(o.name);
+  EXPECT_EQ(paths, (std::vector<std::string>{"node6/Piston_123-844_0_Parts_1", "node6/Piston_123-844_0_Parts_1~2",
+                                             "node6/rod", "node6/a_b_c_d", "node6/node4", "node6/node5"}));
+  EXPECT_EQ(names[1], "node6|Piston_123-844_0_Parts_1~2") << "stored with '|' for '/'";
+  // Stable: the same file names the same objects again.
+  std::vector<std::string> again;
+  for (const auto& o : prt::bake::load_scene(d / "parts.gltf").objects) again.push_back(o.node_path);
+  EXPECT_EQ(again, paths);
 }
 
 TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
@@ -223,8 +329,13 @@ TEST(GltfScene, TwoCylinderEngineInstancesAreNamedObjects) {
     EXPECT_EQ(o.role, prt::bake::Role::Both);
   }
   EXPECT_EQ(triangles, 121496u) << "every triangle of the file is in some object";
-  // Its nodes have no names: paths of node indices, in walk order (node 0 is the root).
+  // Its nodes have no names, its meshes have: paths of the mesh names, group nodes by index, in
+  // walk order (node 0 is the root; nodes 80 and 79 both show mesh "body").
   EXPECT_EQ(scene.objects.size(), 115u);
-  EXPECT_EQ(scene.objects.front().node_path, "node0/node80");
-  EXPECT_EQ(scene.objects[3].name, "node0|node78#p1");
+  EXPECT_EQ(scene.objects[0].node_path, "node0/body");
+  EXPECT_EQ(scene.objects[1].node_path, "node0/body~2");
+  EXPECT_EQ(scene.objects[3].name, "node0|Lifter_123-923_0_Parts_1#p1");
+  EXPECT_TRUE(std::any_of(scene.objects.begin(), scene.objects.end(), [](const auto& o) {
+    return o.node_path == "node0/node1/Piston_123-844_0_Parts_1";
+  })) << "the piston of issue 29 by its mesh's name";
 }

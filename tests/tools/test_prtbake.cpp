@@ -1,5 +1,6 @@
 // End-to-end tests of the prtbake binary: what a user runs, what lands on disk, what a bad input
 // does. Values are checked through the formats reader (the same one prtdump uses).
+#include <formats/asset.h>
 #include <formats/prtfile.h>
 
 #include <gtest/gtest.h>
@@ -145,6 +146,26 @@ TEST(Prtbake, SameSeedGivesIdenticalBytesWhateverTheThreadCount) {
   EXPECT_FALSE(bake("--seed 6 --threads 2") == x);
 }
 
+TEST(Prtbake, SceneBakesPrintThePilotTableWithVerbose) {
+  // A scene's receivers are chosen for like a vertex bake: one line each, the pilot's table with -v.
+  const fs::path dir = scratch("scene_verbose");
+  fs::create_directories(dir);
+  const fs::path scene = dir / "s.json";
+  std::ofstream(scene) << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "target_error": 0.003, "report": 8},
+    "objects": [{"name": "bunny", "mesh": ")" << (kData / "bunny.obj").string() << R"(", "role": "both"}]})";
+  const std::string bake = "scene " + scene.string() + " -o " + (dir / "s.prt.h5").string();
+  const Outcome r = run(bake);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("bunny: target error 0.003: chosen "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("model: "), std::string::npos) << "the table is printed only with -v:\n" << r.out;
+  const Outcome v = run(bake + " -v");
+  ASSERT_EQ(v.code, 0) << v.err;
+  for (const char* s : {"bunny: the target-error pilot:", "target error 0.003: pilot on 32 seeded points",
+                        "reference N = 256: estimated error ", "model: silhouette", "chosen: ", "report reference: QMC at ",
+                        "target 0.003 for AO: met"})
+    EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
+}
+
 TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: one
   // line saying what was chosen and why (the pilot on 1839 / 64 = 28, so at least 32, vertices),
@@ -159,12 +180,23 @@ TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
   for (const char* s : {"model: ", "chosen: ", "µs/integral"})
     EXPECT_EQ(r.out.find(s), std::string::npos) << "the table is printed only with -v:\n" << r.out;
+  // The target asked for is recorded (/report target_error, SCHEMA.md "Error reports") and shown.
+  EXPECT_EQ(F::read_asset(out).target_error, 2e-3);
+  const auto dump = prt::testing::run_tool(PRT_PRTDUMP, "--json " + out.string(), out.parent_path());
+  ASSERT_EQ(dump.code, 0) << dump.err;
+  EXPECT_NE(dump.out.find("\"target_error\": 0.002,"), std::string::npos) << dump.out;
   const Outcome v = run(bake + " -v");
   ASSERT_EQ(v.code, 0) << v.err;
   for (const char* s : {"target error 0.002: pilot on 32 seeded points", "model: silhouette", "chosen: silhouette at N = ",
                         "target 0.002 for AO: met"})
     EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
   EXPECT_EQ(v.out.find("model: qmc"), std::string::npos) << "--integrator keeps the kind:\n" << v.out;
+  // The reference's own error is stated, and the report's reference is sized for E/3 (its noise
+  // measured, not QMC's estimator): the check line says which noise it used.
+  for (const char* s : {"reference N = 256: estimated error ", "within E/3 = 6.67e-04", "report reference: QMC at ",
+                        "the reference's own measured noise"})
+    EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
+  EXPECT_EQ(v.out.find("not verifiable"), std::string::npos) << v.out;
   // -v and --quiet contradict each other: a usage error, nothing baked.
   fs::remove(out);
   EXPECT_EQ(run(bake + " -v --quiet").code, 2);
@@ -177,6 +209,7 @@ TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* s : {"1839 vertices", "3674 triangles", "baked 1839 vertices in", "RMSE", "wrote", "; peak memory "})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
+  EXPECT_FALSE(F::read_asset(out).target_error.has_value()) << "samples given: no target to record";
 }
 
 struct BadInput {

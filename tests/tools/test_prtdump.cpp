@@ -1,6 +1,7 @@
 // Tests of the prtdump binary (PRT_PRTDUMP): summary, statistics, one vertex, JSON, help, and
 // one-line errors with the right exit codes. Files are made with formats/ so every expected
 // number is known exactly.
+#include <formats/asset.h>
 #include <formats/prtfile.h>
 #include <formats/testing.h>
 
@@ -10,9 +11,11 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
@@ -63,7 +66,207 @@ File make_file() {
   return f;
 }
 
+// A scene file as prtbake writes one (formats' asset model): a glTF object stored as
+// "node0|node10|node11" (node path node0/node10/node11) and an object whose name is 120
+// characters long, each with V = 2, AO and an error report whose numbers print exactly (against
+// a reference of its own: the long-named object's has 4096 rays); the target error asked for is
+// 0.002.
+const std::string kLongName = "a_very_long_object_name_" + std::string(96, 'x');  // 120 characters
+const std::string kStored = "node0|node10|node11", kNodePath = "node0/node10/node11";
+
+Asset make_scene_asset() {
+  Asset a;
+  a.root = {kFormatVersion, "prtbake test", "2024-01-02T03:04:05Z", "prtbake scene s.json -o s.prt.h5", "s.json",
+            std::string(64, '0'), "y", "real, l(l+1)+m, Condon-Shortley", {}};
+  a.scene.emplace().integrator = "silhouette";
+  auto object = [&](const std::string& name, std::optional<std::string> node_path, float ao0, float rmse,
+                    const std::string& reference) {
+    SceneObject& o = a.objects.emplace_back();
+    o.name = name;
+    o.node_path = std::move(node_path);
+    o.role = "both";
+    o.set.positions = Array<double>{{0, 0, 0, 1, 0.5, 0}, {}};
+    o.set.normals = Normals{{0, 1, 0, 0, 1, 0}, "file", {}};
+    o.set.ao.emplace().values = {ao0, 0.5f};
+    ReportRow r;
+    r.product = "ao";
+    r.values = {rmse, 0.5f, 0.25f, 0.03125f, 0.0625f};
+    r.columns = "rmse, max_abs, reference_rms, bake_std_error, reference_std_error";
+    r.points = 32;
+    r.reference = reference;
+    r.reference_seconds = 1.5;
+    r.bake_seconds = 0.5;
+    r.integrals_per_second = 1000;
+    o.set.report.rows.push_back(r);
+    r.product = "transfer/diffuse";
+    r.values[0] = rmse / 2;
+    o.set.report.rows.push_back(r);
+  };
+  object(kStored, kNodePath, 0.75f, 0.125f, "qmc 65536 rays");
+  object(kLongName, std::nullopt, 0.25f, 0.375f, "qmc 4096 rays");
+  a.target_error = 2e-3;
+  return a;
+}
+
+// The lines of the "Error report" section of a summary.
+std::vector<std::string> report_section(const std::string& out) {
+  std::vector<std::string> lines;
+  std::istringstream in(out.substr(std::min(out.find("\nError report"), out.size())));
+  std::string line;
+  std::getline(in, line);  // the empty line before the heading
+  while (std::getline(in, line) && !line.empty()) lines.push_back(line);
+  return lines;
+}
+
 } // namespace
+
+TEST(Prtdump, ReportTableKeepsItsColumnsForA120CharacterName) {
+  // Issue 29: "objects/node0|node10|node11/radiance/band15.225e-02" ran the name into the
+  // number. Every value must start exactly under its column's heading, names spelled as the
+  // Scene section spells them, and a name longer than the column on a line of its own.
+  const fs::path dir = scratch("report_table");
+  write_asset(dir / "s.prt.h5", make_scene_asset());
+  const CmdResult r = prtdump(dir, q(dir / "s.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> lines = report_section(r.out);
+  ASSERT_GE(lines.size(), 8u) << r.out;
+  EXPECT_EQ(lines[0], "Error report (against a converged reference; times are wall seconds)");
+  EXPECT_EQ(lines[1], "  target error asked for: RMSE 0.002");
+  // Two references: numbered, each row naming its own in the "ref." column.
+  EXPECT_EQ(lines[2], "  reference 1: qmc 4096 rays");
+  EXPECT_EQ(lines[3], "  reference 2: qmc 65536 rays");
+  const std::string& head = lines[4];
+  ASSERT_TRUE(head.starts_with("  object ")) << head;
+  const std::size_t product = head.find("product"), ref = head.find("ref."), rmse = head.find("RMSE"),
+                    max = head.find("max"), ref_rms = head.find("ref. RMS"), ref_se = head.find("ref. s.e."),
+                    bake_s = head.find("bake s"), ips = head.find("integrals/s");
+  ASSERT_TRUE(product < ref && ref < rmse && rmse < max && max < ref_rms && ref_rms < ref_se && ref_se < bake_s &&
+              bake_s < ips)
+      << head;
+  // Rows by object: the long name's ao and transfer/diffuse (the name on its own line first),
+  // then node0/node10/node11's; an object's name in the first of its rows only.
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {"", "ao"}, {"", "transfer/diffuse"}, {kNodePath, "ao"}, {"", "transfer/diffuse"}};
+  const std::vector<std::string> want_rmse = {"3.750e-01", "1.875e-01", "1.250e-01", "6.250e-02"};
+  std::size_t row = 0, long_lines = 0;
+  for (std::size_t i = 5; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    if (line == "  " + kLongName) {  // the long name alone; the rows under it are its
+      EXPECT_EQ(row, 0u) << "before its rows";
+      ++long_lines;
+      continue;
+    }
+    ASSERT_LT(row, want.size()) << line;
+    SCOPED_TRACE(line);
+    ASSERT_GE(line.size(), ips + 1);
+    if (!want[row].first.empty()) EXPECT_EQ(line.substr(2, kNodePath.size() + 1), kNodePath + " ");
+    else EXPECT_EQ(line.find_first_not_of(' '), product) << "the object's cell is empty";
+    EXPECT_EQ(line.substr(product, want[row].second.size() + 1), want[row].second + " ");
+    EXPECT_EQ(line.substr(ref, 2), row < 2 ? "1 " : "2 ");
+    EXPECT_EQ(line[rmse - 1], ' ');
+    EXPECT_EQ(line.substr(rmse, 10), want_rmse[row] + " ");
+    EXPECT_EQ(line.substr(max, 10), "5.000e-01 ");
+    EXPECT_EQ(line.substr(ref_rms, 10), "2.500e-01 ");
+    EXPECT_EQ(line.substr(ref_se, 10), "6.250e-02 ");
+    EXPECT_EQ(line.substr(bake_s, 4), "0.5 ");
+    EXPECT_EQ(line.substr(ips), "1e+03");
+    ++row;
+  }
+  EXPECT_EQ(row, want.size());
+  EXPECT_EQ(long_lines, 1u) << "the 120-character name once, on its own line";
+  EXPECT_LE(head.size(), 120u) << "the columns do not grow with the long name";
+}
+
+TEST(Prtdump, JsonCarriesTheWholeReportAndTheTarget) {
+  // Issue 29: --json had only a 'columns' string and min/max/mean of each 5-number row.
+  const fs::path dir = scratch("report_json");
+  write_asset(dir / "s.prt.h5", make_scene_asset());
+  const CmdResult r = prtdump(dir, "--json " + q(dir / "s.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  write_file(dir / "old.prt.h5", make_file());  // no report rows, no target: an older file
+  const CmdResult old = prtdump(dir, "--json " + q(dir / "old.prt.h5"));
+  ASSERT_EQ(old.exit_code, 0) << old.err;
+  EXPECT_NE(r.out.find("\"target_error\": 0.002"), std::string::npos) << r.out;
+  EXPECT_NE(old.out.find("\"target_error\": null"), std::string::npos) << old.out;
+
+  if (std::system("python3 -c 'import json' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3 not available: JSON checked by string search only";
+  std::ofstream(dir / "s.json") << r.out;
+  std::ofstream(dir / "old.json") << old.out;
+  // Every column of every row by name (float32 values exactly), its attributes and times, the
+  // object spelled as the Scene section spells it, in the rows, the objects and the datasets.
+  const std::string check =
+      "python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); o=json.load(open(sys.argv[2])); "
+      "R=s[\"report\"]; assert R[\"target_error\"] == 0.002, R; rows=R[\"rows\"]; assert len(rows) == 4, rows; "
+      "x=[r for r in rows if r[\"object\"] == \"node0/node10/node11\" and r[\"product\"] == \"transfer/diffuse\"]; "
+      "assert len(x) == 1, rows; x=x[0]; "
+      "assert (x[\"rmse\"], x[\"max_abs\"], x[\"reference_rms\"], x[\"bake_std_error\"], x[\"reference_std_error\"]) "
+      "== (0.0625, 0.5, 0.25, 0.03125, 0.0625), x; "
+      "assert x[\"points\"] == 32 and x[\"reference\"] == \"qmc 65536 rays\", x; "
+      "assert (x[\"bake_seconds\"], x[\"reference_seconds\"], x[\"integrals_per_second\"]) == (0.5, 1.5, 1000), x; "
+      "assert x[\"path\"] == \"/report/objects/node0|node10|node11/transfer/diffuse\", x; "
+      "assert x[\"columns\"].startswith(\"rmse, max_abs\"), x; "
+      "L=[r for r in rows if r[\"object\"] == \"" + kLongName + "\" and r[\"product\"] == \"ao\"]; "
+      "assert len(L) == 1 and L[0][\"rmse\"] == 0.375, rows; "
+      "assert [b[\"name\"] for b in s[\"objects\"]] == [\"" + kLongName + "\", \"node0/node10/node11\"], s[\"objects\"]; "
+      "d={b[\"path\"]: b for b in s[\"datasets\"]}; "
+      "assert d[\"/objects/node0|node10|node11/ao\"][\"object\"] == \"node0/node10/node11\"; "
+      "assert d[\"/report/objects/node0|node10|node11/ao\"][\"object\"] == \"node0/node10/node11\"; "
+      "assert o[\"report\"] == {\"target_error\": None, \"rows\": []}, o[\"report\"]' " +
+      q(dir / "s.json") + " " + q(dir / "old.json");
+  EXPECT_EQ(std::system(check.c_str()), 0) << "python3 json rejected or disagreed:\n" << r.out;
+}
+
+TEST(Prtdump, SceneObjectsByNodePathInEverySectionAndVertexByEitherSpelling) {
+  const fs::path dir = scratch("objects");
+  write_asset(dir / "s.prt.h5", make_scene_asset());
+  const CmdResult r = prtdump(dir, q(dir / "s.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The stored name only where it is labelled as such; the node path everywhere else.
+  std::istringstream lines(r.out);
+  std::size_t headings = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find('|') != std::string::npos) {
+      EXPECT_NE(line.find("stored as /objects/node0|node10|node11"), std::string::npos) << line;
+    }
+    headings += line == "  object node0/node10/node11 (stored as /objects/node0|node10|node11)";
+  }
+  EXPECT_EQ(headings, 3u) << "its datasets in Layout and Statistics, its group in Group attributes:\n" << r.out;
+  EXPECT_NE(r.out.find("\n  node0/node10/node11 (both; stored as /objects/node0|node10|node11)\n"), std::string::npos)
+      << r.out;
+
+  for (const std::string& name : {kNodePath, kStored}) {
+    const CmdResult v = prtdump(dir, "--vertex 1 --object '" + name + "' " + q(dir / "s.prt.h5"));
+    ASSERT_EQ(v.exit_code, 0) << v.err;
+    EXPECT_NE(v.out.find("vertex 1 of 2 (" + (dir / "s.prt.h5").string() + ", object node0/node10/node11)\n"),
+              std::string::npos) << v.out;
+    EXPECT_NE(v.out.find("  /mesh/positions  [1, 0.5, 0]\n"), std::string::npos) << v.out;
+    EXPECT_NE(v.out.find("  /ao              0.5\n"), std::string::npos) << v.out;
+  }
+  const CmdResult first = prtdump(dir, "--vertex 0 --object " + kLongName + " " + q(dir / "s.prt.h5"));
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_NE(first.out.find("0.25\n"), std::string::npos) << "the long-named object's AO[0]:\n" << first.out;
+
+  struct Case {
+    std::string args, message;
+  };
+  const fs::path plain = dir / "plain.prt.h5";
+  write_file(plain, make_file());
+  for (const Case& c : std::vector<Case>{
+           {"--vertex 0 " + q(dir / "s.prt.h5"), "is a scene file: its vertices belong to its 2 objects; give --vertex "
+                                                  "with --object NAME, one of: " + kLongName + ", node0/node10/node11"},
+           {"--vertex 0 --object node0/node10 " + q(dir / "s.prt.h5"), "has no object 'node0/node10'; its 2 objects are: "},
+           {"--vertex 2 --object node0/node10/node11 " + q(dir / "s.prt.h5"),
+            "vertex 2 is out of range (object node0/node10/node11 has 2 vertices: 0..1)"},
+           {"--vertex 0 --object x " + q(plain), "has no scene objects"}}) {
+    SCOPED_TRACE(c.args);
+    const CmdResult e = prtdump(dir, c.args);
+    EXPECT_EQ(e.exit_code, 1);
+    EXPECT_EQ(e.out, "");
+    EXPECT_NE(e.err.find(c.message), std::string::npos) << e.err;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
+  }
+}
 
 TEST(Prtdump, SummaryListsLayoutAttributesAndExactStatistics) {
   const fs::path dir = scratch("summary");

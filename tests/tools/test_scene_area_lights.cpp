@@ -220,8 +220,8 @@ TEST(SceneAreaLights, PrtdumpShowsTheLightAndWhatEachVertexSetReceives) {
   const auto r = prt::testing::run_tool(PRT_PRTDUMP, "'" + out.string() + "'", d);
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* s : {"Area lights", "key  quad, 1 face(s), 4 vertices, radiance [10, 10, 10], one-sided",
-                        "/objects/ground (and SH at order", "key  E min 0  max ", "/lights/key/vertices",
-                        "/objects/ground/area_lights/irradiance", "lights = \"key\"", "schema   valid"})
+                        "  object ground (and SH at order", "key  E min 0  max ", "/lights/key/vertices",
+                        "\n  object ground\n", "\n    area_lights/irradiance  float32  [49, 1]\n", "lights = \"key\"", "schema   valid"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "prtdump lacks '" << s << "':\n" << r.out;
 }
 

@@ -175,6 +175,10 @@ F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t
   return out;
 }
 
+void set_target_error(F::Asset& asset, double target) {
+  if (target > 0) asset.target_error = target;
+}
+
 void set_fiv_environment(F::Asset& asset, const bake::EnvMapInfo& env, const std::string& env_path, const bake::Fiv& fenv,
                          const std::vector<float>& cube, int cube_size) {
   F::FivEnvironment& e = asset.fiv_environment.emplace();

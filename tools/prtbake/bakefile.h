@@ -44,6 +44,10 @@ void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const s
 // `reproducible`.
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible);
 
+// Records the target error the bake was asked to reach (/report's target_error; SCHEMA.md) when
+// it had one: `target` > 0 (bake/choose.h; the default target counts), else nothing.
+void set_target_error(F::Asset& asset, double target);
+
 // F_env and the irradiance cube (DifMap) of the asset, from the environment `env` (its SHA-256).
 void set_fiv_environment(F::Asset& asset, const bake::EnvMapInfo& env, const std::string& env_path, const bake::Fiv& fenv,
                          const std::vector<float>& cube, int cube_size);

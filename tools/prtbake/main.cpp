@@ -351,6 +351,11 @@ void add_scene(CLI::App& app, Args& a) {
   cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
   add_report(cmd, a, "overrides the scene file's bake.report");
   add_run_options(cmd, a);
+  cmd.add_flag("-v,--verbose", a.verbose,
+               "with a target error: print each receiver's pilot table (each run's\n"
+               "error and cost, each integrator's model) instead of one line, and the\n"
+               "error report's reference plan.")
+      ->excludes("--quiet");
   tool::add_shard_options(cmd, a.shard);
 }
 
@@ -506,6 +511,27 @@ void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts,
                100 * count.share(), count.vertices, count.total, why.c_str());
 }
 
+// A target the chooser could not reach within its bounds: it baked the best plan it had
+// (bake/choose.h, step 5); say so on stderr, with the options that go further.
+void warn_unreached(const bake::IntegratorChoice& choice, const std::string& object) {
+  if (choice.reaches) return;
+  std::fprintf(stderr,
+               "prtbake: warning: %starget error %g is not reached within the chooser's bounds: baking %s at %u samples, "
+               "expected error %.2g; %s (--integrator, --samples, --target-error)\n",
+               object.empty() ? "" : (object + ": ").c_str(), choice.target, bake::to_string(choice.spec.kind),
+               choice.spec.samples(), choice.expected_error, choice.further.c_str());
+}
+
+// The error report's reference for a target (bake/choose.h plan_report_reference), with -v.
+void print_reference_plan(const bake::ReferencePlan& plan) {
+  std::printf("report reference: QMC at %u rays per point on %zu points (probe at %u rays, %.2f s); expected noise",
+              plan.rays, plan.points, bake::ReferencePlan::kReportProbeRays, plan.probe_seconds);
+  for (size_t p = 0; p < plan.products.size(); ++p)
+    std::printf("%s %s %.1e", p ? "," : "", bake::product_label(plan.products[p]), plan.noise[p]);
+  std::printf(" (E/3 = %.1e%s)\n", plan.target / 3,
+              plan.budget_bound ? "; the report's ray budget keeps some product above it" : "");
+}
+
 std::string human_bytes(uintmax_t b) {
   char buf[32];
   if (b >= (1u << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1 << 20));
@@ -608,6 +634,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
       for (const std::string& line : bake::choice_lines(choice)) std::printf("%s\n", line.c_str());
     else if (say)
       std::printf("%s\n", bake::choice_summary(choice).c_str());
+    warn_unreached(choice, "");
   }
   const auto setup_start = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integrator_ptr =
@@ -668,7 +695,13 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
   }
 
   std::optional<bake::ErrorReport> report;
+  std::optional<bake::ReferencePlan> reference_plan;
   if (spec.report_points > 0) {
+    if (a.target_error > 0) {  // a reference whose own noise is within E/3, or a budget that says why not
+      reference_plan = bake::plan_report_reference(points, mesh, topo, req, spec, a.target_error, progress, &accel);
+      spec.report_rays = reference_plan->rays;
+      if (say && a.verbose) print_reference_plan(*reference_plan);
+    }
     const auto reference = bake::make_reference(spec, mesh, topo, req, &accel);
     report = bake::compare_with_reference(mesh, topo, result, *reference, spec.report_points, spec.seed,
                                           progress);
@@ -682,7 +715,8 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
                     bake::product_label(e.product), e.rmse, e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0,
                     e.bake_std_error, e.reference_std_error);
       if (a.target_error > 0)
-        for (const std::string& line : bake::target_check_lines(*report, a.target_error)) std::printf("%s\n", line.c_str());
+        for (const std::string& line : bake::target_check_lines(*report, a.target_error, reference_plan ? &*reference_plan : nullptr))
+          std::printf("%s\n", line.c_str());
     }
   }
 
@@ -696,6 +730,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
                      {integrator.name(), integrator.description(), spec.samples(), spec.seed, a.transfer, a.visibility,
                       env ? &*env : nullptr, a.environment});
   if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
+  tool::set_target_error(asset, a.target_error);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;
@@ -959,7 +994,21 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
                                                     if (say) std::printf("%s\n", line.c_str());
                                                     std::fflush(stdout);
                                                   },
-                                                  merged_rows);
+                                                  merged_rows,
+                                                  [&](const std::string& object, const bake::IntegratorChoice& choice,
+                                                      const bake::ReferencePlan* reference_plan) {
+                                                    if (say && a.verbose) {
+                                                      std::printf("%s: the target-error pilot:\n", object.c_str());
+                                                      for (const std::string& l : bake::choice_lines(choice))
+                                                        std::printf("%s\n", l.c_str());
+                                                      if (reference_plan) print_reference_plan(*reference_plan);
+                                                    } else if (say) {
+                                                      std::printf("%s: %s\n", object.c_str(),
+                                                                  bake::choice_summary(choice).c_str());
+                                                    }
+                                                    std::fflush(stdout);
+                                                    warn_unreached(choice, object);
+                                                  });
   // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (const auto& values = result.objects[i].values) {
@@ -1039,6 +1088,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
   for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
   if (plan.fiv_environment)
     tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+  tool::set_target_error(asset, scene.target_error);
   write_file(a, asset);
   if (shards) shards->finish();
   return 0;

@@ -17,11 +17,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace pf = prt::formats;
@@ -32,18 +34,27 @@ namespace {
 
 constexpr std::size_t kMaxColumnsForStats = 16;
 
-constexpr const char* kUsage = "usage: prtdump [--json] [--vertex I] FILE.prt.h5";
+constexpr const char* kUsage = "usage: prtdump [--json] [--vertex I [--object NAME]] FILE.prt.h5";
 
 constexpr const char* kDescription = R"(prtdump — inspect a prtbake file (HDF5, formats/SCHEMA.md)
 
   prtdump [--json] FILE.prt.h5               summary: attributes, layout, statistics
-  prtdump [--json] --vertex I FILE.prt.h5    every per-vertex value of vertex I)";
+  prtdump [--json] --vertex I FILE.prt.h5    every per-vertex value of vertex I
+  prtdump [--json] --vertex I --object NAME SCENE.prt.h5
+                                             the same for vertex I of a scene object)";
 
 constexpr const char* kFooter = R"(Example:
   prtbake vertex bunny.obj --transfer 3 -o bunny.prt.h5
   prtdump bunny.prt.h5
   prtdump --vertex 0 bunny.prt.h5
   prtdump --json bunny.prt.h5 | python3 -m json.tool
+  prtbake scene data/scene_example.json -o scene.prt.h5
+  prtdump scene.prt.h5 --vertex 0 --object bunny
+
+Object names: a scene object is named as the Scene section prints it: a glTF object by its
+node path (node0/node13/node71, or Piston_123-844_0_Parts_1 where the asset names it), which
+the file stores as /objects/node0|node13|node71 (an HDF5 name cannot hold '/'). Every section
+and the JSON use the node path; --object takes either spelling.
 
 What the summary shows:
   format / schema  the format version and whether the file passes the schema check
@@ -54,15 +65,19 @@ What the summary shows:
   Layout           each dataset: path, element type, shape and its attributes (e.g. sh_order
                    = L, the number of SH bands, so a transfer vector has L*L coefficients).
                    Attributes another tool added (e.g. with h5py) are shown with the rest.
+                   A scene object's datasets are listed under its name, by their path within
+                   it (mesh/positions, ao, report/ao, fiv/shells); Statistics likewise.
   Scene            for scene files (prtbake scene): each object's role and what the bake
                    baked and left out, with the reasons.
   Area lights      for files with area lights (format_version 3): each light's shape, faces,
                    radiance and sides, and per vertex set the irradiance E at unit radiance
                    each light gives (min, max, mean over the vertices; area_lights/irradiance
                    [V, L], its columns in the order its 'lights' attribute lists).
-  Error report     per product: RMSE and max error against the converged reference, the
-                   reference's own standard error, bake and reference wall times.
-  Group attributes attributes on groups such as /scene and /objects/<name>.
+  Error report     the target error the bake was asked to reach (when it had one), the
+                   reference, and per object and product: RMSE and max error against the
+                   converged reference, the reference's RMS and own standard error, bake and
+                   reference wall times. --json carries every column of every row by name.
+  Group attributes attributes on groups such as /scene and each scene object's.
   Statistics       per dataset: min, max and mean over the finite values, and the number of
                    NaN and Inf values (a valid file has none). For a dataset whose last axis is
                    small (<= 16, e.g. xyz, RGB or SH coefficients) also per-column min/max/mean,
@@ -73,7 +88,8 @@ What the summary shows:
                    m = -1, 0, 1; [V, 3, L*L] (radiance/shadowed, the shadowed radiance S of
                    format_version 4) one row per channel and band l.
 
-Exit status 1 also covers a vertex index out of range.
+Exit status 1 also covers a vertex index out of range, an unknown --object, and --vertex on a
+scene file without --object (the message lists the objects).
 )";
 
 // ---- number formatting -------------------------------------------------------------------
@@ -247,6 +263,96 @@ Json json_stats(const pf::Dataset& d, const Stats& s, bool counts) {
   return o;
 }
 
+// ---- scene objects: one spelling for people ------------------------------------------------
+
+// The scene objects of a file as stored (a file that fails the schema has no asset): each
+// object's stored name and, for a glTF scene's, its node path. Object names are printed as
+// formats::object_label gives them (the node path, "node0/node13/node71"), never as the HDF5
+// name ("node0|node13|node71"), which appears only where it is labelled as one.
+struct FileObject {
+  std::string name;                      // as stored: /objects/<name>
+  std::optional<std::string> node_path;  // the group's node_path attribute, when it is a string
+  std::string label() const { return pf::object_label(name, node_path); }
+};
+
+std::vector<FileObject> file_objects(const pf::File& f) {
+  const std::string dir = std::string(names::kObjects) + "/";
+  std::vector<FileObject> out;
+  auto add = [&](std::string_view prefix) -> FileObject* {
+    if (!prefix.starts_with(dir)) return nullptr;
+    const std::string_view name = prefix.substr(dir.size());
+    if (name.empty() || name.find('/') != std::string_view::npos) return nullptr;
+    for (FileObject& o : out)
+      if (o.name == name) return &o;
+    return &out.emplace_back(FileObject{std::string(name), std::nullopt});
+  };
+  for (const pf::Dataset& d : f.datasets) add(pf::vertex_set_of(d.path));
+  for (const auto& [g, attrs] : f.group_attrs)
+    if (FileObject* o = add(g))
+      if (const pf::Attr* a = pf::find_attr(attrs, names::kNodePath))
+        if (const auto* s = std::get_if<std::string>(&a->value)) o->node_path = *s;
+  std::sort(out.begin(), out.end(), [](const FileObject& x, const FileObject& y) { return x.name < y.name; });
+  return out;
+}
+
+const FileObject* find_file_object(const std::vector<FileObject>& objects, std::string_view name) {
+  for (const FileObject& o : objects)
+    if (o.name == name) return &o;
+  return nullptr;
+}
+
+// A dataset path that belongs to scene object `object` (its vertex set, its report, its FIV
+// shells), and the path within it as printed under the object: "mesh/positions", "report/ao",
+// "fiv/shells", "report/fiv".
+struct ObjectPath {
+  const FileObject* object = nullptr;
+  std::string rest;
+};
+ObjectPath object_path(const std::vector<FileObject>& objects, std::string_view path) {
+  const std::string objects_dir = std::string(names::kObjects) + "/";
+  const std::pair<std::string, std::string> dirs[] = {
+      {objects_dir, ""},
+      {std::string(names::kReport) + objects_dir, "report/"},
+      {std::string(names::kOccluders) + "/", "fiv/"},
+      {std::string(names::kReportFiv) + "/", "report/fiv"}};
+  for (const auto& [dir, shown] : dirs) {
+    if (!path.starts_with(dir)) continue;
+    const std::string_view tail = path.substr(dir.size());
+    const std::size_t slash = tail.find('/');
+    const FileObject* o = find_file_object(objects, tail.substr(0, slash));
+    if (o == nullptr) continue;
+    if (slash == std::string_view::npos) return {o, shown.ends_with('/') ? shown.substr(0, shown.size() - 1) : shown};
+    return {o, shown + std::string(tail.substr(slash + 1))};
+  }
+  return {};
+}
+
+// "object node0/node13/node71 (HDF5 name node0|node13|node71)": the heading of an object's lines.
+std::string object_heading(const FileObject& o) {
+  const std::string label = o.label();
+  return "object " + label + (label != o.name ? " (stored as " + std::string(names::kObjects) + "/" + o.name + ")" : "");
+}
+
+// Datasets in the order printed: the ones of no object first (file order), then each object's.
+struct DatasetGroups {
+  std::vector<const pf::Dataset*> loose;
+  std::vector<std::pair<const FileObject*, std::vector<std::pair<const pf::Dataset*, std::string>>>> objects;
+};
+DatasetGroups group_datasets(const pf::File& f, const std::vector<FileObject>& objects) {
+  DatasetGroups g;
+  for (const FileObject& o : objects) g.objects.push_back({&o, {}});
+  for (const pf::Dataset& d : f.datasets) {
+    const ObjectPath op = object_path(objects, d.path);
+    if (op.object == nullptr) {
+      g.loose.push_back(&d);
+      continue;
+    }
+    for (auto& [o, list] : g.objects)
+      if (o == op.object) list.emplace_back(&d, op.rest);
+  }
+  return g;
+}
+
 // ---- summary -----------------------------------------------------------------------------
 
 int64_t version_of(const pf::File& f) {
@@ -259,8 +365,10 @@ void scene_text(std::ostream& os, const pf::Asset& a) {
   if (a.objects.empty()) return;
   os << "\nScene (objects, what was baked and what was left out)\n";
   for (const pf::SceneObject& o : a.objects) {
-    // A glTF scene's object by its node path (its name is the path with '/' as '|').
-    os << "  " << o.node_path.value_or(o.name) << " (" << o.role.value_or("?") << (o.node_path ? "; /objects/" + o.name : "") << ")\n";
+    // A glTF scene's object by its node path; where the file stores it when that differs.
+    const std::string shown = pf::object_label(o);
+    os << "  " << shown << " (" << o.role.value_or("?")
+       << (shown != o.name ? "; stored as " + std::string(names::kObjects) + "/" + o.name : "") << ")\n";
     for (const auto& [lines, label] : {std::pair{&o.baked, "baked      "}, std::pair{&o.left_out, "left out   "}}) {
       if (!*lines || **lines == "-") continue;
       const std::string& text = **lines;
@@ -298,48 +406,103 @@ void lights_text(std::ostream& os, const pf::Asset& a) {
     }
   };
   set_lines("/", a.vertices);
-  for (const pf::SceneObject& o : a.objects) set_lines(std::string(names::kObjects) + "/" + o.name, o.set);
+  for (const pf::SceneObject& o : a.objects) set_lines("object " + pf::object_label(o), o.set);
 }
 
-// Every error-report row of the asset, labelled by its path under /report, in path order.
-std::vector<std::pair<std::string, const pf::ReportRow*>> report_rows(const pf::Asset& a) {
-  std::vector<std::pair<std::string, const pf::ReportRow*>> rows;
-  const std::string report_dir = std::string(names::kReport) + "/";
-  auto relative = [&](std::string_view path) { return std::string(path.substr(report_dir.size())); };
-  for (const pf::ReportRow& r : a.vertices.report.rows) rows.emplace_back(r.product, &r);
+// One error-report row of the asset: whose it is (an object's label, an FIV occluder's name, or
+// empty for the root layout), which product ("ao", "radiance/band1", "fiv shells") and the row.
+struct ReportLine {
+  std::string object, product, hdf5_path;
+  const pf::ReportRow* row = nullptr;
+};
+
+// Every error-report row of the asset: the root layout's first, then by object and product.
+std::vector<ReportLine> report_lines(const pf::Asset& a) {
+  std::vector<ReportLine> lines;
+  const std::string report = std::string(names::kReport) + "/";
+  for (const pf::ReportRow& r : a.vertices.report.rows) lines.push_back({"", r.product, report + r.product, &r});
   for (const pf::SceneObject& o : a.objects)
     for (const pf::ReportRow& r : o.set.report.rows)
-      rows.emplace_back(relative(std::string(names::kReport) + std::string(names::kObjects)) + "/" + o.name + "/" +
-                            r.product,
-                        &r);
-  for (const pf::Occluder& o : a.occluders)
-    if (o.report) rows.emplace_back(relative(names::kReportFiv) + "/" + o.name, &*o.report);
-  std::sort(rows.begin(), rows.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  return rows;
+      lines.push_back({pf::object_label(o), r.product,
+                       std::string(names::kReport) + std::string(names::kObjects) + "/" + o.name + "/" + r.product, &r});
+  for (const pf::Occluder& o : a.occluders) {
+    if (!o.report) continue;
+    const pf::SceneObject* object = a.find_object(o.name);
+    lines.push_back({object ? pf::object_label(*object) : o.name, "fiv shells",
+                     std::string(names::kReportFiv) + "/" + o.name, &*o.report});
+  }
+  std::stable_sort(lines.begin(), lines.end(), [](const ReportLine& x, const ReportLine& y) {
+    return std::tie(x.object, x.product) < std::tie(y.object, y.product);
+  });
+  return lines;
 }
 
-// The error against run time stored under /report.
+// The report's object column is at most this wide; a longer name gets a line of its own above
+// its row, so the numbers stay in their columns whatever the names.
+constexpr std::size_t kMaxNameColumn = 40;
+
+// The error against run time stored under /report: a table whose columns are as wide as their
+// content (names longer than kMaxNameColumn on their own line), and the target asked for.
 void report_text(std::ostream& os, const pf::Asset& a) {
-  const auto rows = report_rows(a);
-  if (rows.empty()) return;
-  os << "\nError report (against a converged reference; times are wall seconds)\n"
-     << "  " << pad("product", 40) << pad("RMSE", 12) << pad("max", 12) << pad("ref. RMS", 12) << pad("ref. s.e.", 12)
-     << pad("bake s", 9) << pad("ref. s", 9) << "integrals/s\n";
-  auto sci = [](double x, int w) {
+  const std::vector<ReportLine> lines = report_lines(a);
+  if (lines.empty() && !a.target_error) return;
+  os << "\nError report (against a converged reference; times are wall seconds)\n";
+  if (a.target_error) os << "  target error asked for: RMSE " << num(*a.target_error) << '\n';
+  if (lines.empty()) return;
+  std::vector<std::string> references;
+  for (const ReportLine& l : lines)
+    if (l.row->reference && std::find(references.begin(), references.end(), *l.row->reference) == references.end())
+      references.push_back(*l.row->reference);
+  // One reference: said once. Several (a scene's AO, FIV shells, glossy objects): numbered, and
+  // each row says which in its "ref." column.
+  const bool numbered = references.size() > 1;
+  for (std::size_t i = 0; i < references.size(); ++i)
+    os << "  reference" << (numbered ? " " + std::to_string(i + 1) : std::string()) << ": " << references[i] << '\n';
+  auto reference_number = [&](const pf::ReportRow& r) {
+    if (!r.reference) return std::string("-");
+    return std::to_string(std::find(references.begin(), references.end(), *r.reference) - references.begin() + 1);
+  };
+
+  auto sci = [](double x) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%-*.3e", w, x);
+    std::snprintf(buf, sizeof buf, "%.3e", x);
     return std::string(buf);
   };
   auto seconds = [](const std::optional<double>& x) {
     char buf[32];
-    if (x) std::snprintf(buf, sizeof buf, "%-9.3g", *x);
-    else std::snprintf(buf, sizeof buf, "%-9s", "-");
+    if (!x) return std::string("-");
+    std::snprintf(buf, sizeof buf, "%.3g", *x);
     return std::string(buf);
   };
-  for (const auto& [label, r] : rows)
-    os << "  " << pad(label, 40) << sci(r->values[0], 12) << sci(r->values[1], 12) << sci(r->values[2], 12)
-       << sci(r->values[4], 12) << seconds(r->bake_seconds) << seconds(r->reference_seconds)
-       << seconds(r->integrals_per_second) << '\n';
+  const bool objects = std::any_of(lines.begin(), lines.end(), [](const ReportLine& l) { return !l.object.empty(); });
+  std::vector<std::vector<std::string>> rows;  // cells; the object's cell first, empty below its first row
+  rows.push_back({"object", "product", "ref.", "RMSE", "max", "ref. RMS", "ref. s.e.", "bake s", "ref. s", "integrals/s"});
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const ReportLine& l = lines[i];
+    const pf::ReportRow& r = *l.row;
+    const bool same = i > 0 && lines[i - 1].object == l.object;
+    rows.push_back({same ? std::string() : l.object.empty() ? std::string("-") : l.object, l.product, reference_number(r),
+                    sci(r.values[0]),
+                    sci(r.values[1]), sci(r.values[2]), sci(r.values[4]), seconds(r.bake_seconds),
+                    seconds(r.reference_seconds), seconds(r.integrals_per_second)});
+  }
+  std::vector<std::size_t> width(rows[0].size(), 0);
+  for (const auto& row : rows)
+    for (std::size_t c = 0; c < row.size(); ++c)
+      if (c != 0 || row[c].size() <= kMaxNameColumn) width[c] = std::max(width[c], row[c].size());
+  for (const auto& row : rows) {
+    std::string line = "  ";
+    for (std::size_t c = objects ? 0 : 1; c < row.size(); ++c) {
+      if (c == 2 && !numbered) continue;  // the "ref." column only with several references
+      std::string cell = row[c];
+      if (c == 0 && cell.size() > width[0]) {  // a long name: its own line, the row below it
+        os << "  " << cell << '\n';
+        cell.clear();
+      }
+      line += c + 1 < row.size() ? pad(cell, width[c] + 2) : cell;
+    }
+    os << line << '\n';
+  }
 }
 
 void summary_text(std::ostream& os, const std::string& path, const pf::Inspection& in) {
@@ -355,13 +518,27 @@ void summary_text(std::ostream& os, const std::string& path, const pf::Inspectio
   for (const pf::Attr& a : f.root_attrs) w = std::max(w, a.name.size());
   for (const pf::Attr& a : f.root_attrs) os << "  " << pad(a.name, w + 2) << attr_text(a.value) << '\n';
 
-  os << "\nLayout (" << f.datasets.size() << " datasets)\n";
+  // Datasets of no scene object by their path; each object's under a heading with its name,
+  // by their path within it (the HDF5 path is the heading's group + that path).
+  const std::vector<FileObject> objects = file_objects(f);
+  const DatasetGroups groups = group_datasets(f, objects);
   w = 0;
-  for (const pf::Dataset& d : f.datasets) w = std::max(w, d.path.size());
-  for (const pf::Dataset& d : f.datasets) {
-    os << "  " << pad(d.path, w + 2) << pad(std::string(pf::dtype_name(d.data)), 9) << shape_text(d.shape) << '\n';
+  for (const pf::Dataset* d : groups.loose) w = std::max(w, d->path.size());
+  for (const auto& [o, list] : groups.objects)
+    for (const auto& [d, rest] : list) w = std::max(w, rest.size() + 2);
+  auto each_dataset = [&](const std::function<void(const pf::Dataset&, const std::string&)>& line) {
+    for (const pf::Dataset* d : groups.loose) line(*d, "  " + pad(d->path, w + 2));
+    for (const auto& [o, list] : groups.objects) {
+      if (list.empty()) continue;
+      os << "  " << object_heading(*o) << '\n';
+      for (const auto& [d, rest] : list) line(*d, "    " + pad(rest, w));
+    }
+  };
+  os << "\nLayout (" << f.datasets.size() << " datasets)\n";
+  each_dataset([&](const pf::Dataset& d, const std::string& head) {
+    os << head << pad(std::string(pf::dtype_name(d.data)), 9) << shape_text(d.shape) << '\n';
     attrs_text(os, d.attrs);
-  }
+  });
   if (in.asset) {
     scene_text(os, *in.asset);
     lights_text(os, *in.asset);
@@ -370,17 +547,51 @@ void summary_text(std::ostream& os, const std::string& path, const pf::Inspectio
   if (!f.group_attrs.empty()) {
     os << "\nGroup attributes\n";
     for (const auto& [g, attrs] : f.group_attrs) {
-      os << "  " << g << '\n';
+      // An object's group by the object's name (and where it is stored).
+      const ObjectPath op = object_path(objects, g);
+      if (op.object) os << "  " << object_heading(*op.object) << (op.rest.empty() ? "" : ": " + op.rest) << '\n';
+      else os << "  " << g << '\n';
       attrs_text(os, attrs);
     }
   }
   os << "\nStatistics (min, max, mean over finite values; counts of NaN and Inf)\n";
-  for (const pf::Dataset& d : f.datasets) {
+  each_dataset([&](const pf::Dataset& d, const std::string& head) {
     const DatasetStats s = compute_stats(d);
-    print_stats_text(os, d, s.all, "  " + pad(d.path, w + 2));
+    print_stats_text(os, d, s.all, head);
     for (std::size_t c = 0; c < s.columns.size(); ++c)
       print_stats_text(os, d, s.columns[c], "      [..., " + std::to_string(c) + "]  ");
+  });
+}
+
+// The whole error report: the target asked for, and every /report row with its five columns
+// by name, its attributes and whose it is (object as the Scene section names it; null: the
+// root layout). null for the JSON of a file without a report.
+Json report_json(const pf::Asset& a) {
+  const std::vector<ReportLine> lines = report_lines(a);
+  Json r = Json::object();
+  r["target_error"] = a.target_error ? json_double(*a.target_error) : Json(nullptr);
+  Json rows = Json::array();
+  // asset.h ReportRow: the five columns of every row, in this order.
+  static constexpr const char* kColumnNames[5] = {"rmse", "max_abs", "reference_rms", "bake_std_error",
+                                                  "reference_std_error"};
+  for (const ReportLine& l : lines) {
+    const pf::ReportRow& row = *l.row;
+    Json x = Json::object();
+    x["object"] = l.object.empty() ? Json(nullptr) : Json(l.object);
+    x["product"] = l.product;
+    x["path"] = l.hdf5_path;
+    for (std::size_t c = 0; c < 5; ++c) x[kColumnNames[c]] = json_float(row.values[c]);
+    x["columns"] = row.columns ? Json(*row.columns) : Json(nullptr);
+    x["points"] = row.points ? Json(*row.points) : Json(nullptr);
+    x["reference"] = row.reference ? Json(*row.reference) : Json(nullptr);
+    x["reference_seconds"] = row.reference_seconds ? json_double(*row.reference_seconds) : Json(nullptr);
+    x["bake_seconds"] = row.bake_seconds ? json_double(*row.bake_seconds) : Json(nullptr);
+    x["integrals_per_second"] = row.integrals_per_second ? json_double(*row.integrals_per_second) : Json(nullptr);
+    if (!row.extra.empty()) x["attrs"] = json_attrs(row.extra);
+    rows.push_back(std::move(x));
   }
+  r["rows"] = std::move(rows);
+  return r;
 }
 
 Json summary_json(const std::string& path, const pf::Inspection& in) {
@@ -394,11 +605,30 @@ Json summary_json(const std::string& path, const pf::Inspection& in) {
   Json groups = Json::object();
   for (const auto& [g, attrs] : f.group_attrs) groups[g] = json_attrs(attrs);
   j["group_attrs"] = std::move(groups);
+  // Scene objects by the name people read ("name": the node path of a glTF scene's object) and
+  // the group the file stores them in; every "object" below spells the name the same way.
+  const std::vector<FileObject> objects = file_objects(f);
+  Json jobjects = Json::array();
+  for (const FileObject& o : objects) {
+    Json x = Json::object();
+    x["name"] = o.label();
+    x["group"] = std::string(names::kObjects) + "/" + o.name;
+    if (in.asset)
+      if (const pf::SceneObject* so = in.asset->find_object(o.name)) {
+        x["role"] = so->role ? Json(*so->role) : Json(nullptr);
+        x["baked"] = so->baked ? Json(*so->baked) : Json(nullptr);
+        x["left_out"] = so->left_out ? Json(*so->left_out) : Json(nullptr);
+      }
+    jobjects.push_back(std::move(x));
+  }
+  j["objects"] = std::move(jobjects);
+  j["report"] = in.asset ? report_json(*in.asset) : Json(nullptr);
   Json datasets = Json::array();
   for (const pf::Dataset& d : f.datasets) {
     const DatasetStats s = compute_stats(d);
     Json o = Json::object();
     o["path"] = d.path;
+    if (const ObjectPath op = object_path(objects, d.path); op.object) o["object"] = op.object->label();
     o["dtype"] = pf::dtype_name(d.data);
     o["shape"] = d.shape;
     o["attrs"] = json_attrs(d.attrs);
@@ -416,12 +646,21 @@ Json summary_json(const std::string& path, const pf::Inspection& in) {
 
 // ---- one vertex --------------------------------------------------------------------------
 
-// The per-vertex datasets of the root layout (V rows each), in path order.
-std::vector<const pf::Dataset*> vertex_datasets(const pf::File& f, uint64_t V) {
-  std::vector<const pf::Dataset*> out;
+// The vertex set --vertex prints: the root layout (prefix "") or a scene object's
+// ("/objects/<name>", shown as its label).
+struct VertexSetRef {
+  std::string prefix;
+  std::string label;  // empty for the root layout
+};
+
+// The per-vertex datasets of the vertex set (V rows each), in path order, each with its path
+// within the set ("/ao", "/mesh/positions": the same keys for the root layout and an object).
+std::vector<std::pair<const pf::Dataset*, std::string>> vertex_datasets(const pf::File& f, const VertexSetRef& set,
+                                                                        uint64_t V) {
+  std::vector<std::pair<const pf::Dataset*, std::string>> out;
   for (const pf::Dataset& d : f.datasets)
-    if (pf::is_per_vertex_path(d.path) && pf::vertex_set_of(d.path).empty() && !d.shape.empty() && d.shape[0] == V)
-      out.push_back(&d);
+    if (pf::is_per_vertex_path(d.path) && pf::vertex_set_of(d.path) == set.prefix && !d.shape.empty() && d.shape[0] == V)
+      out.emplace_back(&d, d.path.substr(set.prefix.size()));
   return out;
 }
 
@@ -433,15 +672,17 @@ std::string row_text(const pf::Dataset& d, std::size_t begin, std::size_t count)
 
 std::size_t per_vertex(const pf::Dataset& d) { return pf::shape_product({d.shape.begin() + 1, d.shape.end()}); }
 
-void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, uint64_t vertex, uint64_t V) {
-  os << "vertex " << vertex << " of " << V << " (" << path << ")\n";
-  const auto list = vertex_datasets(f, V);
+void vertex_text(std::ostream& os, const std::string& path, const pf::File& f, const VertexSetRef& set, uint64_t vertex,
+                 uint64_t V) {
+  os << "vertex " << vertex << " of " << V << " (" << path << (set.label.empty() ? "" : ", object " + set.label)
+     << ")\n";
+  const auto list = vertex_datasets(f, set, V);
   std::size_t w = 0;
-  for (const auto* d : list) w = std::max(w, d->path.size());
-  for (const pf::Dataset* d : list) {
+  for (const auto& [d, shown] : list) w = std::max(w, shown.size());
+  for (const auto& [d, shown] : list) {
     const std::size_t per = per_vertex(*d);
     const std::size_t base = vertex * per;
-    const std::string head = "  " + pad(d->path, w + 2);
+    const std::string head = "  " + pad(shown, w + 2);
     const std::string cont(head.size(), ' ');
     const pf::Attr* order = pf::find_attr(d->attrs, names::kShOrder);
     const auto* L = order ? std::get_if<int64_t>(&order->value) : nullptr;
@@ -490,24 +731,61 @@ Json json_nested(const pf::Dataset& d, std::size_t base, std::size_t axis) {
   return a;
 }
 
-Json vertex_json(const std::string& path, const pf::File& f, uint64_t vertex, uint64_t V) {
+Json vertex_json(const std::string& path, const pf::File& f, const VertexSetRef& set, uint64_t vertex, uint64_t V) {
   Json j = Json::object();
   j["file"] = path;
+  j["object"] = set.label.empty() ? Json(nullptr) : Json(set.label);  // null: the root layout
+  j["group"] = set.prefix.empty() ? Json("/") : Json(set.prefix);
   j["vertex"] = vertex;
   j["vertex_count"] = V;
   Json values = Json::object();
-  for (const pf::Dataset* d : vertex_datasets(f, V)) values[d->path] = json_nested(*d, vertex * per_vertex(*d), 1);
+  for (const auto& [d, shown] : vertex_datasets(f, set, V)) values[shown] = json_nested(*d, vertex * per_vertex(*d), 1);
   j["values"] = std::move(values);
   return j;
 }
 
-// V of the root layout, from its positions.
-uint64_t root_vertex_count(const pf::File& f, const std::string& file) {
+// "a, b, c" for the first names of a list, "... and N more" past kMaxListed (a glTF scene has
+// hundreds of objects: the Scene section of `prtdump FILE` lists them all).
+std::string name_list(const std::vector<FileObject>& objects) {
+  constexpr std::size_t kMaxListed = 12;
+  std::string s;
+  for (std::size_t i = 0; i < objects.size() && i < kMaxListed; ++i) s += (i ? ", " : "") + objects[i].label();
+  if (objects.size() > kMaxListed)
+    s += ", ... and " + std::to_string(objects.size() - kMaxListed) + " more ('prtdump FILE' lists them all)";
+  return s;
+}
+
+// The vertex set --vertex reads: the root layout, or with --object the scene object it names (by
+// its node path or its stored name). One line naming the file for every mistake.
+VertexSetRef vertex_set(const pf::File& f, const std::string& file, const std::optional<std::string>& object) {
+  const std::vector<FileObject> objects = file_objects(f);
+  if (!object) {
+    if (!objects.empty() && std::none_of(f.datasets.begin(), f.datasets.end(), [](const pf::Dataset& d) {
+          return pf::dataset_kind(d.path) == pf::DatasetKind::positions && pf::vertex_set_of(d.path).empty();
+        }))
+      throw pf::FormatError(file, "is a scene file: its vertices belong to its " + std::to_string(objects.size()) +
+                                      " objects; give --vertex with --object NAME, one of: " + name_list(objects));
+    return {};
+  }
+  if (objects.empty())
+    throw pf::FormatError(file, "has no scene objects (it is not a scene file): --vertex reads its root layout "
+                                "without --object");
+  for (const FileObject& o : objects)
+    if (pf::names_object(*object, o.name, o.node_path))
+      return {std::string(names::kObjects) + "/" + o.name, o.label()};
+  throw pf::FormatError(file, "has no object '" + *object + "'; its " + std::to_string(objects.size()) +
+                                  " objects are: " + name_list(objects));
+}
+
+// V of a vertex set, from its positions.
+uint64_t vertex_count(const pf::File& f, const std::string& file, const VertexSetRef& set) {
   for (const pf::Dataset& d : f.datasets)
-    if (pf::dataset_kind(d.path) == pf::DatasetKind::positions && pf::vertex_set_of(d.path).empty() &&
+    if (pf::dataset_kind(d.path) == pf::DatasetKind::positions && pf::vertex_set_of(d.path) == set.prefix &&
         !d.shape.empty())
       return d.shape[0];
-  throw pf::FormatError(file, "--vertex needs " + std::string(names::kPositions) + ", which this file does not have");
+  throw pf::FormatError(file, "--vertex needs " + set.prefix + std::string(names::kPositions) +
+                                  (set.label.empty() ? "" : " (object " + set.label + ")") +
+                                  ", which this file does not have");
 }
 
 int prtdump_main(int argc, char** argv) {
@@ -522,10 +800,18 @@ int prtdump_main(int argc, char** argv) {
                "round-trip form); NaN and Inf become null.");
   CLI::Option* vertex_opt =
       app.add_option("--vertex", vertex,
-                     "print vertex I (0-based) from every per-vertex dataset of the root layout (mesh positions, "
-                     "normals and source positions, ao, transfer, radiance band 1); V, the vertex count, is the "
-                     "number of mesh positions.")
+                     "print vertex I (0-based) from every per-vertex dataset of the root layout, or of the scene "
+                     "object --object names (mesh positions, normals and source positions, ao, transfer, radiance, "
+                     "area lights); V, the vertex count, is the number of its mesh positions.")
           ->type_name("I");
+  std::string object;
+  CLI::Option* object_opt =
+      app.add_option("--object", object,
+                     "with --vertex, in a scene file: the object whose vertex to print, by the name the Scene "
+                     "section shows (a glTF object's node path, e.g. node0/node13/node71) or as stored "
+                     "(node0|node13|node71).")
+          ->type_name("NAME")
+          ->needs(vertex_opt);
   app.add_option("FILE", file, "the .prt.h5 file to inspect")->required()->type_name("FILE.prt.h5");
   try {
     app.parse(argc, argv);
@@ -538,13 +824,16 @@ int prtdump_main(int argc, char** argv) {
   const pf::Inspection in = pf::inspect_asset(file);
   std::ostringstream out;
   if (vertex_opt->count() > 0) {
-    const uint64_t V = root_vertex_count(in.file, file);
+    const VertexSetRef set =
+        vertex_set(in.file, file, object_opt->count() > 0 ? std::optional<std::string>(object) : std::nullopt);
+    const uint64_t V = vertex_count(in.file, file, set);
     if (vertex >= V)
-      throw pf::FormatError(file, "vertex " + std::to_string(vertex) + " is out of range (the mesh has " +
+      throw pf::FormatError(file, "vertex " + std::to_string(vertex) + " is out of range (" +
+                                      (set.label.empty() ? std::string("the mesh") : "object " + set.label) + " has " +
                                       std::to_string(V) + " vertices: 0.." +
                                       (V ? std::to_string(V - 1) : std::string("none")) + ")");
-    if (json) out << vertex_json(file, in.file, vertex, V).dump(2) << '\n';
-    else vertex_text(out, file, in.file, vertex, V);
+    if (json) out << vertex_json(file, in.file, set, vertex, V).dump(2) << '\n';
+    else vertex_text(out, file, in.file, set, vertex, V);
   } else {
     if (json) out << summary_json(file, in).dump(2) << '\n';
     else summary_text(out, file, in);

@@ -218,6 +218,10 @@ struct Asset {
   std::optional<IrradianceCube> irradiance_cube;
   std::vector<Occluder> occluders;  // read back sorted by name
   std::vector<Light> lights;        // read back sorted by name (the products name their order)
+  // /report's target_error: the RMSE the bake was asked to reach (bake/choose.h; the default
+  // target when neither samples nor a target was given), when it had one. Optional: older files
+  // have none.
+  std::optional<double> target_error;
   // Datasets under /report the model does not type (/report is free-form in the schema).
   std::vector<Dataset> other_reports;
   // Attributes of groups without typed attributes (/mesh, /report, /fiv/occluders/<name>, ...).
@@ -226,8 +230,22 @@ struct Asset {
   const SceneObject* find_object(std::string_view name) const noexcept;
   const Occluder* find_occluder(std::string_view name) const noexcept;
   const Light* find_light(std::string_view name) const noexcept;
+  // The scene object named `name` as the file stores it ("node0|node13") or as people read it:
+  // its node path ("node0/node13", object_label); nullptr when there is none.
+  const SceneObject* find_object_by_label(std::string_view name) const noexcept;
   bool operator==(const Asset&) const = default;
 };
+
+// Object names, one spelling for people. The name people read for a scene object is its glTF
+// node path when it has one ("node0/node13/node71"), else its name. The file stores a glTF
+// object under the node path with '/' written as '|' ("/objects/node0|node13|node71": an HDF5
+// link name cannot hold '/'; bake/mesh.h NAMES keeps '|' out of node paths, so the two are one to
+// one). Tools print the label and accept either spelling (Asset::find_object_by_label).
+std::string object_label(std::string_view stored_name, const std::optional<std::string>& node_path);
+inline std::string object_label(const SceneObject& object) { return object_label(object.name, object.node_path); }
+// True when `query` names the object stored as `stored_name`: that name, its node path, or
+// the stored name with '|' read as '/'.
+bool names_object(std::string_view query, std::string_view stored_name, const std::optional<std::string>& node_path);
 
 // The generic File of `asset` (dataset order and attribute order as write_asset writes them).
 File to_file(const Asset& asset);

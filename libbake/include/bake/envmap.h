@@ -164,6 +164,15 @@ public:
   // A scene direction uniformly distributed in solid angle over the texel's region, from
   // (u0, u1) ∈ [0, 1)² (the warp sample() uses inside the chosen texel).
   Eigen::Vector3d sample_texel(int texel, double u0, double u1) const;
+  // The texel's region as a spherical polygon (scene space, unit vertices, counter-clockwise
+  // seen from outside: bake/spherical_polygon.h's positive orientation; edges are great arcs).
+  // A cube texel is exactly the great-arc quad of its four corners. A lat-long texel is bounded
+  // by two meridians (great arcs) and two parallels (small circles): each parallel is split into
+  // the fewest great-arc chords whose slivers leave the polygon's solid angle within
+  // `max_relative_area_error` of the texel's (the chord of length ℓ at latitude β leaves a sliver
+  // of ~ℓ³|tan β|/12; a pole is one vertex). Shared parallels split alike in both texels, so the
+  // polygons of neighbouring texels tile without gaps or overlaps.
+  std::vector<Eigen::Vector3d> texel_polygon(int texel, double max_relative_area_error = 1e-6) const;
   // The k × k stratified sub-samples sample_texel(texel, (a + ½)/k, (b + ½)/k) into out[a·k + b]
   // (1 ≤ k ≤ 16), the same values bit for bit; lat-long texels share the k latitudes and k
   // longitudes (2k transcendental pairs instead of k²).

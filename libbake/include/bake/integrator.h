@@ -63,6 +63,9 @@ struct IntegratorSpec {
   uint32_t filter_rays = kDefaultFilterRays;    // filter: pass-1 rays per shade point
   uint64_t seed = 1;
   uint32_t report_points = 32;                  // error report: seeded points re-integrated (0: none)
+  // error report: the QMC reference's rays per point, sized for a target error
+  // (bake/choose.h plan_report_reference); 0: the defaults below.
+  uint32_t report_rays = 0;
 
   // The chosen kind's knob.
   static uint32_t IntegratorSpec::*knob(IntegratorKind k) {
@@ -78,6 +81,7 @@ struct IntegratorSpec {
   int isolines() const { return silhouette_isolines(silhouette_k); }
   // Rays per point of the QMC reference the error report compares with.
   uint32_t reference_rays() const {
+    if (report_rays > 0) return report_rays;
     return kind == IntegratorKind::Qmc ? qmc_rays * kQmcReferenceFactor : kSilhouetteReferenceRays;
   }
   // The reference's randomisation seed, apart from the bake's points.

@@ -48,37 +48,3 @@ private:
 };
 
 } // namespace prt::bake
-
-namespace prt::bake {
-
-// The same tables for an integrand with small support (the "hot" texels of an HDR environment:
-// suns, lamps), on a finer isoline grid, stored only over the cells the support touches, with
-// the same s × s box filter. (Point-sampling u instead was tried: on a 2×2-texel sun cut by the
-// horizon it erred −1.7% against +0.9% for the box filter at the same grid.) The
-// support is given by sample directions inside it; each isoline keeps one cell range [j_lo, j_hi]
-// (plus one cell of margin for the sub-sample box filter). Outside its range C_i is 0 before and
-// the range's total after, so accumulate() keeps the dense tables' meaning for any t.
-class SparseIsolineTables {
-public:
-  SparseIsolineTables(const oct::Grid& grid, int components, int subsamples, const IsolineTables::Integrand& f,
-                      std::span<const Eigen::Vector3d> support_samples);
-
-  const oct::Grid& grid() const noexcept { return grid_; }
-  int components() const noexcept { return components_; }
-  int first_isoline() const noexcept { return i_lo_; }  // isolines with a range: [first, last)
-  int last_isoline() const noexcept { return i_hi_; }
-  bool has(int i) const noexcept { return i >= i_lo_ && i < i_hi_ && range_[size_t(i - i_lo_)].first >= 0; }
-  size_t bytes() const noexcept { return table_.size() * sizeof(double); }
-  void accumulate(int i, double t, double weight, double* acc) const noexcept;
-  const double* loop_total(int i) const noexcept;
-
-private:
-  oct::Grid grid_;
-  int components_;
-  int i_lo_ = 0, i_hi_ = 0;
-  std::vector<std::pair<int, int>> range_;  // per isoline in [i_lo, i_hi): cells [first, second], first < 0: none
-  std::vector<size_t> offset_;             // first row of each isoline's range
-  std::vector<double> table_;
-};
-
-} // namespace prt::bake

@@ -178,10 +178,12 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
 // above), rows in its accessor order, with its own NORMAL when it has one (the all-or-nothing rule
 // above is load_mesh's, for the concatenation), source = the file, source_sha256 the file's.
 // NAMES (unique, stable for a given file): the node path is the names of the nodes from the scene
-// root down to the instance's node, joined by '/'. A node's segment is its "name" with '/', '#'
-// and '|' replaced by '_', or "node<N>" (N its index in "nodes") when the name is empty, "." or
-// "..". Among siblings (the scene's root nodes, or one node's children, in document order) a
-// segment already taken gets the first of "~2", "~3", ... that no sibling has. The instance's name
+// root down to the instance's node, joined by '/'. A node's segment is the name the asset gives
+// it: the node's "name", or when that is empty, "." or ".." the "name" of the node's mesh (CAD
+// exports name meshes, not nodes: 2CylinderEngine.glb's "Piston_123-844_0_Parts_1"), with '/',
+// '#' and '|' replaced by '_'; "node<N>" (N its index in "nodes") when neither has one. Among
+// siblings (the scene's root nodes, or one node's children, in document order) a segment already
+// taken gets the first of "~2", "~3", ... that no sibling has. The instance's name
 // is its node path for the mesh's primitive 0 and path + "#p<k>" for primitive k > 0:
 // "root/engine/piston~2#p1". Names never contain '|' (the asset's object names use it for '/').
 struct MeshInstance {

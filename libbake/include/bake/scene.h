@@ -227,6 +227,7 @@ struct ObjectBake {
   std::optional<ErrorReport> report;
   IntegratorSpec integrator;           // what baked the values: the scene's, or the target's choice
   std::optional<IntegratorChoice> choice;  // with a target error
+  std::optional<ReferencePlan> reference_plan;  // with a target error and a report (bake/choose.h)
   std::string integrator_description;
   uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
   // Occluders with shells (in world space: centre and radii in scene units).
@@ -263,8 +264,12 @@ struct SceneRows {
   bool rows_only = false;
 };
 
+// With a target error, `on_choice` receives each receiver's choice (its object name, the choice,
+// and the error report's reference plan when a report is made) as soon as it is made, before
+// the receiver is baked; without it, `log` receives choice_summary.
+using OnChoice = std::function<void(const std::string& object, const IntegratorChoice& choice, const ReferencePlan* plan)>;
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log,
-                     const SceneRows& rows = {});
+                     const SceneRows& rows = {}, const OnChoice& on_choice = {});
 
 } // namespace prt::bake
