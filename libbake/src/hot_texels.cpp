@@ -1,5 +1,6 @@
 // hot_texels.cpp — the environment's hot texels integrated exactly over their visible part
-// (bake/hot_texels.h: clusters, W by paths, the slab decomposition in each texel's gnomonic chart).
+// (bake/hot_texels.h: the cluster tree, W by paths, bands between arc segments in each texel's
+// gnomonic chart).
 #include <bake/hot_texels.h>
 
 #include <bake/error.h>
@@ -63,7 +64,8 @@ Cap cap_of(const Vector3d& a, const Vector3d& b) {
 bool caps_meet(const Cap& a, const Cap& b) {
   if (a.cos_h <= -1 || b.cos_h <= -1) return true;
   const double cos_sum = a.cos_h * b.cos_h - a.sin_h * b.sin_h;
-  if (a.sin_h * b.cos_h + a.cos_h * b.sin_h >= 0 && cos_sum <= -1 + 1e-9) return true;  // sum ≥ π
+  const double sin_sum = a.sin_h * b.cos_h + a.cos_h * b.sin_h;
+  if (sin_sum < 0 || cos_sum <= -1 + 1e-9) return true;  // the half angles add up to π or more
   return a.mid.dot(b.mid) >= cos_sum - 1e-9;
 }
 

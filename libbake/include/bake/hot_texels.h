@@ -17,25 +17,33 @@
 // How, per shade point (the arcs and W0, the depth complexity at the spine start s0, come from the
 // silhouette integrator's own walk, so both see the same occluders):
 //  * Hot texels (≥ hot_factor × the mean luminance, at most max_texels of the brightest) are
-//    grouped in clusters (8 × 8 image tiles) with a bounding cap; an arc is local to a cap when
-//    its great arc comes within the cap's radius of the centre (exact test: the nearest point of
-//    the arc is an end or the foot of the centre on its great circle).
-//  * W at a cluster's centre is W0 plus the steps of the arcs crossed by the great arc from s0
-//    (dcf_path_steps); W at a texel's centre adds the steps of the cluster's local arcs along the
-//    short arc from the cluster's centre. A texel that no local arc meets is wholly visible
-//    (W = 0: its precomputed integral) or wholly hidden.
+//    grouped in clusters (8 × 8 image tiles) with a bounding cap, and the clusters in a binary
+//    tree of caps. An arc is local to a cap when its great arc comes within the cap's radius of
+//    the centre (exact test: the nearest point of the arc is an end or the foot of the centre on
+//    its great circle), after a cheaper test of the two caps.
+//  * W at the root's reference point is W0 plus the steps of the arcs crossed by the great arc
+//    from s0 (dcf_path_steps); down the tree, W is carried from a node's reference point to its
+//    children's along short arcs inside the node's cap, testing only the arcs that meet it; in a
+//    cluster, an arc that crosses the whole cap steps W where a texel's reference point lies on
+//    the other side of its great circle, the others by paths. Reference points sit off centre by
+//    odd fractions, and waypoints off the axis planes, so that no arc of an axis-aligned scene
+//    (nor the horizon's quarter arcs) passes through a path's end by symmetry. A texel that no
+//    local arc meets is wholly visible (W = 0: its precomputed integral) or wholly hidden.
 //  * A texel cut by arcs is decomposed in its gnomonic chart (centred on the texel, where great
-//    arcs are straight segments): vertical slabs between every vertex and crossing abscissa, in
-//    each slab the segments sorted by height, the parity of the texel's edges and W (from the
-//    texel's centre along a straight path, i.e. a great arc) walked upwards; each run with W = 0
-//    inside the texel is a trapezoid whose sides are great arcs: a spherical quadrilateral,
-//    integrated by PolygonSH's closed form (orders ≤ 12, bake/polygon_sh.h), or above order 12
-//    by an n × n Gauss–Legendre rule over the trapezoid in the chart (dω = (1 + x² + y²)^(−3/2)
-//    dx dy; n grows with order × size so that the rule's error is below 1e-12 relative).
+//    arcs are straight segments): strips between every segment end and every crossing of two
+//    segments; in a strip the segments cut it into bands of one W each (W below them from a
+//    straight path, i.e. a great arc, from the reference point); each band with W = 0 is the
+//    texel's polygon clipped by the strip's sides and the band's segment lines, integrated by
+//    PolygonSH's closed form (orders ≤ 12, bake/polygon_sh.h), or above order 12 as its
+//    trapezoids by an n × n Gauss–Legendre rule (dω = (1 + x² + y²)^(−3/2) dx dy; n grows with
+//    order × size so that the rule's error is below 1e-12 relative). One arc across the whole
+//    texel is one clip. Slivers under 1e-13 of the texel's chart box are left out (their
+//    vertices lie on one great circle, where the closed form cannot tell a sliver from a
+//    hemisphere).
 //  * A lat-long texel's parallels are small circles: EnvMap::texel_polygon splits them into
 //    great-arc chords within 1e-6 of the texel's solid angle; cube texels are exact.
-// The only approximations left are that chord bound and rounding: the result does not depend on
-// the isoline count N at all.
+// The only approximations left are that chord bound, the sliver cut and rounding: the result does
+// not depend on the isoline count N at all.
 #pragma once
 
 #include <bake/envmap.h>
