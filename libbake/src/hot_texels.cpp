@@ -10,7 +10,6 @@
 #include <prtshade/sh.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -88,7 +87,7 @@ struct Scratch {
   std::vector<size_t> cluster_arcs, texel_arcs;
   std::vector<uint8_t> spanning;  // per cluster-local arc: it crosses the whole cap
   std::vector<int> side_ref;      // its side at the cluster's reference point
-  std::vector<double> moments;
+  std::vector<double> moments, texel;  // one projection; one cut texel's moments
   std::vector<double> gx, gw, gy, gwy;
 };
 thread_local Scratch tl_scratch;
@@ -227,7 +226,6 @@ struct HotTexels::Impl {
     }
   }
   std::vector<double> unoccluded;
-  mutable std::atomic<uint64_t> texels_cut{0};
 
   // ∫ y_i dω (i < order²) over the chart trapezoid x ∈ [x0, x1] between the lines through
   // (x0, ylo0)–(x1, ylo1) and (x0, yhi0)–(x1, yhi1), added to out.
@@ -531,7 +529,6 @@ struct HotTexels::Impl {
         s.side_ref[q] = sign_of(arcs[local[q]].m.dot(cl.ref));
       }
     }
-    std::vector<double> m;
     for (size_t k = cl.begin; k < cl.end; ++k) {
       const Texel& t = texels[k];
       s.texel_arcs.clear();
@@ -555,10 +552,9 @@ struct HotTexels::Impl {
         if (W != 0) continue;
         mom = t.moments.data();
       } else {
-        texels_cut.fetch_add(1, std::memory_order_relaxed);
-        m.assign(n2, 0.0);
-        visible(t, arcs, s.texel_arcs, W, m.data(), s);  // visible() leaves texel_arcs alone
-        mom = m.data();
+        s.texel.assign(n2, 0.0);
+        visible(t, arcs, s.texel_arcs, W, s.texel.data(), s);  // visible() leaves texel_arcs alone
+        mom = s.texel.data();
       }
       for (int c = 0; c < 3; ++c)
         for (size_t i = 0; i < n2; ++i) out[size_t(c) * n2 + i] += t.rgb[c] * mom[i];
@@ -729,6 +725,5 @@ std::vector<double> HotTexels::texel_moments(int texel, std::span<const DcfArc> 
   return out;
 }
 
-HotTexels::Stats HotTexels::stats() const { return {impl_->texels_cut.load()}; }
 
 } // namespace prt::bake

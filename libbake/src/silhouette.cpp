@@ -309,11 +309,6 @@ struct SilhouetteIntegrator::Impl {
     return inconsistent;
   }
 
-  // Change of W along the great-circle arc from P to Q (frame coordinates): the sum of the steps
-  // of every arc it crosses.
-  static int path_steps(const std::vector<Arc>& arcs, const Vector3d& P, const Vector3d& Q) {
-    return dcf_path_steps(arcs, P, Q);
-  }
 
   // The horizon of n as a virtual occluder boundary (four quarter arcs): +1 when crossing into n·ω < 0.
   void add_horizon(const Vector3d& n, std::vector<Arc>& arcs) const {
@@ -527,7 +522,7 @@ struct SilhouetteIntegrator::Impl {
         w += hz < 0 ? 1 : 0;
       }
       if (attempt > 0) {
-        w += path_steps(s.arcs, frame_from_world * wr, s0);
+        w += dcf_path_steps(s.arcs, frame_from_world * wr, s0);  // bake/hot_texels.h
         n_retries.fetch_add(1, std::memory_order_relaxed);
       }
       W0 = w;

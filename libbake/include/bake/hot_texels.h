@@ -98,14 +98,9 @@ public:
   // the horizon).
   void accumulate(std::span<const DcfArc> arcs, const Eigen::Vector3d& s0, int W0, double* out) const;
 
-  // The same moments of one texel's part where W = 0 (tests): W at the texel's chart centre is
-  // W0 + steps from s0, as in accumulate().
+  // The same moments of one texel's part where W = 0 (tests): W at the texel's reference point
+  // from W0 at s0 directly, not down the cluster tree as in accumulate().
   std::vector<double> texel_moments(int texel, std::span<const DcfArc> arcs, const Eigen::Vector3d& s0, int W0) const;
-
-  struct Stats {
-    uint64_t texels_cut = 0;  // texels decomposed because an arc met them
-  };
-  Stats stats() const;
 
 private:
   struct Impl;
