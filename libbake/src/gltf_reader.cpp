@@ -221,7 +221,7 @@ class Reader {
 
   // One instance of the node's mesh under world transform `world`, appended to `out_`; each
   // primitive with triangles is recorded in `instances_` under the node path `path`.
-  void add_mesh(size_t node, const Eigen::Matrix4d& world, const std::string& path) {
+  void add_mesh(size_t node, const Eigen::Matrix4d& world, const std::string& path, bool animated) {
     const int mesh_index = model_.nodes[node].mesh;
     if (static_cast<size_t>(mesh_index) >= model_.meshes.size())
       fail("node " + std::to_string(node) + " refers to mesh " + std::to_string(mesh_index) + ", which does not exist");
@@ -259,7 +259,7 @@ class Reader {
       }
       const size_t base = out_.positions.size();
       instances_.push_back({path + (p == 0 ? "" : "#p" + std::to_string(p)), path, prim.material, base, out_.normals.size(),
-                            normals.has_value(), out_.polygon_count(), 0});
+                            normals.has_value(), out_.polygon_count(), 0, animated});
       if (base + positions.count >= std::numeric_limits<uint32_t>::max()) fail("too many vertices for 32-bit indices");
       for (size_t i = 0; i < positions.count; ++i) {
         const Eigen::Vector3d local = vec3(positions, i);
@@ -356,20 +356,29 @@ class Reader {
     // disjoint strict trees (glTF 2.0 specification, "Nodes and Hierarchy"): a node reached twice is refused, so the walk is linear.
     enum class State : uint8_t { Unseen, OnPath, Done };
     std::vector<State> state(model_.nodes.size(), State::Unseen);
-    struct Entry { size_t node; Eigen::Matrix4d parent; bool leave; std::string path; };
+    struct Entry { size_t node; Eigen::Matrix4d parent; bool leave; std::string path; bool animated; };
+    // Nodes an animation channel moves (translation, rotation or scale; "weights" animates morph
+    // targets, which are ignored): their subtrees move at run time (glTF 2.0, "Animations").
+    std::vector<bool> moved(model_.nodes.size(), false);
+    for (const tinygltf::Animation& a : model_.animations)
+      for (const tinygltf::AnimationChannel& c : a.channels)
+        if (c.target_node >= 0 && static_cast<size_t>(c.target_node) < moved.size() && c.target_path != "weights")
+          moved[static_cast<size_t>(c.target_node)] = true;
     std::vector<Entry> stack;
     // Pushes `nodes` (children of `where`, whose path is `parent_path`) so that the first is walked first.
-    auto push_nodes = [&](const std::vector<int>& nodes, const Eigen::Matrix4d& parent, const std::string& where, const std::string& parent_path) {
+    auto push_nodes = [&](const std::vector<int>& nodes, const Eigen::Matrix4d& parent, const std::string& where, const std::string& parent_path,
+                          bool parent_animated) {
       const std::vector<std::string> names = segments(nodes);
       for (size_t i = nodes.size(); i-- > 0;) {
         const int n = nodes[i];
         if (n < 0 || static_cast<size_t>(n) >= model_.nodes.size())
           fail(where + " refers to node " + std::to_string(n) + ", which does not exist (" + std::to_string(model_.nodes.size()) + " nodes)");
-        stack.push_back({static_cast<size_t>(n), parent, false, parent_path.empty() ? names[i] : parent_path + "/" + names[i]});
+        stack.push_back({static_cast<size_t>(n), parent, false, parent_path.empty() ? names[i] : parent_path + "/" + names[i],
+                         parent_animated || moved[static_cast<size_t>(n)]});
       }
     };
     const tinygltf::Scene& scene = model_.scenes[static_cast<size_t>(scene_index)];
-    push_nodes(scene.nodes, Eigen::Matrix4d::Identity(), "scene " + std::to_string(scene_index), "");
+    push_nodes(scene.nodes, Eigen::Matrix4d::Identity(), "scene " + std::to_string(scene_index), "", false);
     while (!stack.empty()) {
       const Entry entry = stack.back();
       stack.pop_back();
@@ -385,10 +394,10 @@ class Reader {
       const Eigen::Matrix4d world = entry.parent * local_transform(entry.node);
       if (node.mesh >= 0) {
         if (node.skin >= 0) ++skinned_instances_;
-        add_mesh(entry.node, world, entry.path);
+        add_mesh(entry.node, world, entry.path, entry.animated);
       }
-      stack.push_back({entry.node, world, true, {}});
-      push_nodes(node.children, world, name, entry.path);
+      stack.push_back({entry.node, world, true, {}, false});
+      push_nodes(node.children, world, name, entry.path, entry.animated);
     }
     if (out_.polygon_count() == 0 && skipped_primitives_ > 0)
       fail("no triangles: only " + std::to_string(skipped_primitives_) + " point or line primitive instance(s), nothing to bake");
@@ -426,6 +435,7 @@ class Reader {
       GltfInstance& out = result.emplace_back();
       out.name = in.name;
       out.node_path = in.node_path;
+      out.animated = in.animated;
       if (in.material >= 0) {
         if (static_cast<size_t>(in.material) >= model_.materials.size())
           fail("node " + out.node_path + " refers to material " + std::to_string(in.material) + ", which does not exist (" +
@@ -462,6 +472,7 @@ class Reader {
     size_t position_begin, normal_begin;
     bool has_normals;
     size_t polygon_begin, polygon_end;
+    bool animated;  // an animation channel moves its node or an ancestor
   };
   // The first row after `in`'s: the next instance's first row, or the end.
   size_t next_position_begin(const Instance& in) const {

@@ -24,6 +24,7 @@ Polygons read_gltf(std::string_view bytes, const SourceFile& file);
 struct GltfInstance {
   std::string name, node_path;
   std::optional<std::array<double, 3>> base_color;  // the material's baseColorFactor RGB; none without a material
+  bool animated = false;  // an animation channel (translation, rotation, scale) targets its node or an ancestor
   Polygons polygons;
 };
 std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file);

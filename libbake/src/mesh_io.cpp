@@ -305,6 +305,7 @@ MeshInstances read_instances(const std::filesystem::path& path, const std::strin
     out.name = std::move(in.name);
     out.node_path = std::move(in.node_path);
     out.base_color = in.base_color;
+    out.animated = in.animated;
   }
   return result;
 }

@@ -488,7 +488,7 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
   for (size_t i = 0; i < objects->size(); ++i) {
     const Json& o = (*objects)[i];
     const std::string key = "objects[" + std::to_string(i) + "]";
-    r.object(o, key, {"name", "mesh", "role", "transform", "material"});
+    r.object(o, key, {"name", "mesh", "role", "transform", "material", "moves"});
     SceneObject obj;
     const Json* mesh = find_key(o, "mesh");
     if (mesh == nullptr) r.fail(key + " lacks \"mesh\" (the mesh file)");
@@ -512,6 +512,10 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
     if (const Json* t = find_key(o, "transform")) obj.world_from_object = parse_transform(r, *t, key + ".transform");
     obj.material.albedo = kDefaultAlbedo;
     if (const Json* m = find_key(o, "material")) obj.material = parse_material(r, *m, key + ".material", obj.role);
+    if (const Json* mv = find_key(o, "moves")) {
+      obj.moves = r.boolean(*mv, key + ".moves");
+      obj.moves_reason = std::string("\"moves\": ") + (obj.moves ? "true" : "false") + " in the scene file";
+    }
     sc.objects.push_back(std::move(obj));
   }
   return sc;
@@ -528,6 +532,8 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
     std::replace(obj.name.begin(), obj.name.end(), '/', '|');
     obj.node_path = in.name;
     obj.mesh = file;
+    obj.moves = in.animated;
+    obj.moves_reason = in.animated ? "an animation moves its node" : "no animation moves its node";
     obj.material.albedo = kDefaultAlbedo;
     if (in.base_color)
       for (size_t c = 0; c < 3; ++c) obj.material.albedo[c] = std::clamp((*in.base_color)[c], 0.0, 1.0);
@@ -548,16 +554,18 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
     std::string key;
     std::optional<Role> role;
     std::optional<Material> material;
+    std::optional<bool> moves;
     bool used = false;
   };
   std::vector<Entry> entries;
   for (const auto& [key, value] : objects->items()) {
     const std::string path = "objects.\"" + key + "\"";
-    r.object(value, path, {"role", "material"});
+    r.object(value, path, {"role", "material", "moves"});
     Entry& e = entries.emplace_back();
     e.key = key;
     if (const Json* role = find_key(value, "role")) e.role = parse_role(r, *role, path + ".role");
     if (const Json* m = find_key(value, "material")) e.material = parse_material(r, *m, path + ".material", e.role.value_or(Role::Both));
+    if (const Json* mv = find_key(value, "moves")) e.moves = r.boolean(*mv, path + ".moves");
   }
   auto names = [](const std::string& instance, const std::string& key) {
     return instance.starts_with(key) && (instance.size() == key.size() || instance[key.size()] == '/' || instance[key.size()] == '#');
@@ -565,14 +573,20 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   for (SceneObject& obj : sc.objects) {
     const Entry* role = nullptr;
     const Entry* material = nullptr;
+    const Entry* moves = nullptr;
     for (Entry& e : entries) {
       if (!names(obj.node_path, e.key)) continue;
       e.used = true;
       if (e.role && (!role || e.key.size() > role->key.size())) role = &e;
       if (e.material && (!material || e.key.size() > material->key.size())) material = &e;
+      if (e.moves && (!moves || e.key.size() > moves->key.size())) moves = &e;
     }
     if (role) obj.role = *role->role;
     if (material) obj.material = *material->material;
+    if (moves) {
+      obj.moves = *moves->moves;
+      obj.moves_reason = std::string("\"moves\": ") + (obj.moves ? "true" : "false") + " in the options (objects.\"" + moves->key + "\")";
+    }
   }
   std::string unknown;
   for (const Entry& e : entries)
@@ -785,6 +799,11 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
     if (p.occluder) {
       if (!scene.want_fiv) {
         p.left_out.push_back("fiv: not in bake.products");
+      } else if (!o.moves) {
+        // Paper 004 §1: FIV shells shade what a MOVING occluder casts on other receivers; a static
+        // occluder's shadows are already in every receiver's own products.
+        p.left_out.push_back("fiv: the object does not move (" + o.moves_reason +
+                             "); its shadows are in the receivers' own products (set \"moves\": true to bake its shells)");
       } else if (!env) {
         p.left_out.push_back("fiv: the scene has no environment (F = Int (1 - V) L w dw needs one)");
       } else {
@@ -800,7 +819,7 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
         }
         if (!other_receiver) p.left_out.push_back("fiv: no other receiver in the scene for it to shadow");
         else if (!reaches) p.left_out.push_back("fiv: its bounding sphere lies below the horizon of every vertex of every other receiver");
-        else p.fiv = true, p.baked.push_back("fiv: it can shadow another receiver");
+        else p.fiv = true, p.baked.push_back("fiv: it moves (" + o.moves_reason + ") and can shadow another receiver");
       }
     }
     plan.fiv_environment = plan.fiv_environment || p.fiv;

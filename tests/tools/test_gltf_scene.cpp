@@ -301,6 +301,51 @@ TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
   EXPECT_LT(after, 0.99f) << "the occluder half still shadows the ground";
 }
 
+// FIV shells are for occluders that move (bake/scene.h): a static glTF gets none; an animation
+// channel on "stack" moves its whole subtree (the box's two primitives and the quad), the options'
+// "moves" overrides per node path (the longest key wins), and "weights" (morph targets) is no move.
+TEST(GltfScene, OnlyAnimatedNodesGetFivShellsAndTheOptionsOverride) {
+  const fs::path d = dir_for("moves");
+  const std::string env = (fs::path(PRT_DATA_DIR) / "sunset.exr").string();
+  const std::string settings = R"({"prtbake_gltf_scene": 1, "environment": ")" + env +
+                               R"(", "bake": {"products": ["ao", "fiv"], "samples": 256, "report": 0, "fiv": {"shells": "8x5x3", "cube": 4}})";
+  auto shells = [](const F::Asset& a) {
+    std::vector<std::string> names;
+    for (const F::Occluder& o : a.occluders) names.push_back(o.name);
+    return names;
+  };
+  auto animate = [&](const std::string& path) {
+    write_gltf(d);
+    std::ifstream in(d / "stack.gltf");
+    json doc = json::parse(in);
+    // The sampler's accessors need not be valid for the walk: only the channel's target is read.
+    doc["animations"] = {{{"channels", {{{"sampler", 0}, {"target", {{"node", 3}, {"path", path}}}}}},
+                          {"samplers", {{{"input", 0}, {"output", 0}}}}}};
+    std::ofstream(d / "stack.gltf") << doc.dump();
+  };
+  auto run = [&](const std::string& options) {
+    write_text(d / "stack.options.json", options);
+    const auto r = bake(d, "'" + (d / "stack.gltf").string() + "' --options '" + (d / "stack.options.json").string() + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return r.code == 0 ? F::read_asset(d / "out.prt.h5") : F::Asset{};
+  };
+  write_gltf(d);
+  const F::Asset still = run(settings + "}");
+  EXPECT_TRUE(shells(still).empty()) << "nothing moves: no shells";
+  EXPECT_FALSE(still.fiv_environment.has_value()) << "and no environment FIV";
+  EXPECT_NE(still.find_object("stack|box")->left_out.value_or("").find("does not move"), std::string::npos);
+
+  animate("translation");
+  EXPECT_EQ(shells(run(settings + "}")), (std::vector<std::string>{"stack|box", "stack|box#p1", "stack|node2"}))
+      << "the animated node's subtree moves; the ground does not";
+  EXPECT_EQ(shells(run(settings + R"(, "objects": {"stack": {"moves": false}, "stack/box": {"moves": true}}})")),
+            (std::vector<std::string>{"stack|box", "stack|box#p1"}))
+      << "options override, the longest key winning";
+
+  animate("weights");
+  EXPECT_TRUE(shells(run(settings + "}")).empty()) << "morph weights do not move a node";
+}
+
 TEST(GltfScene, OptionsNamingNoNodeFailWithOneLineNamingTheFileAndTheName) {
   const fs::path d = dir_for("unknown_node");
   write_text(d / "stack.options.json", R"({"prtbake_gltf_scene": 1, "objects": {"stack/bx": {"role": "receiver"}}})");

@@ -171,6 +171,14 @@ TEST(SceneRules, FivOnlyForOccludersThatCanShadowAnotherReceiver) {
   EXPECT_NE(group_string(below.file, "/objects/box", "left_out").find("below the horizon of every vertex"),
             std::string::npos);
 
+  // A static occluder ("moves": false): its shadows are in the receivers' own products.
+  const std::string still = R"({"name": "box", "mesh": "box.obj", "role": "occluder", "moves": false})";
+  const Baked fixed = bake(d, scene_text(kSunset, "", kGround + ", " + still));
+  EXPECT_FALSE(has(fixed.file, "/fiv/occluders/box/shells"));
+  EXPECT_FALSE(has(fixed.file, "/fiv/environment"));
+  EXPECT_NE(group_string(fixed.file, "/objects/box", "left_out").find("does not move (\"moves\": false in the scene file)"),
+            std::string::npos);
+
   const Baked alone = bake(d, scene_text(kSunset, "", kBoxBoth));
   EXPECT_FALSE(has(alone.file, "/fiv/occluders/box/shells"));
   EXPECT_NE(group_string(alone.file, "/objects/box", "left_out").find("no other receiver"), std::string::npos);

@@ -189,6 +189,9 @@ Mesh load_mesh(const std::filesystem::path& path, const MeshLoadOptions& = {});
 struct MeshInstance {
   std::string name, node_path;
   std::optional<std::array<double, 3>> base_color;  // the material's pbrMetallicRoughness.baseColorFactor RGB, as in the file; none: no material
+  // An animation channel moves the node or one of its ancestors (translation, rotation or scale;
+  // "weights" animates morph targets, which are not moves): the instance moves at run time.
+  bool animated = false;
   Mesh mesh;
 };
 struct MeshInstances {

@@ -38,7 +38,8 @@
 //       "transform": {"translate": [x,y,z], "rotate": [rx,ry,rz] (degrees, about X then Y then Z),
 //                     "scale": s | [sx,sy,sz]}  or  {"matrix": [16 numbers, row-major, last row 0 0 0 1]},
 //                     its 3×3 part well-conditioned (σ_max/σ_min ≤ 1e8), else refused before any work,
-//       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]}
+//       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]},
+//       "moves": true                          optional: it may move at run time (FIV shells, below)
 //     } ]
 //   }
 // Unknown and duplicate keys are errors (a typo must not silently change a bake); every error
@@ -59,10 +60,10 @@
 //   {
 //     "prtbake_gltf_scene": 1,                   required: the options-file version
 //     "up", "environment", "bake":               as in a scene file (relative paths: to the options file)
-//     "objects": {"<node path or instance name>": {"role": ..., "material": {...}}}
+//     "objects": {"<node path or instance name>": {"role": ..., "material": {...}, "moves": true}}
 //   }
 // An "objects" key names an instance ("root/engine#p1") or a node path, which covers every
-// instance of that node and of the nodes below it ("root/engine"); for each of role and material
+// instance of that node and of the nodes below it ("root/engine"); for each of role, material and moves
 // the most specific (longest) key that sets it wins; a material replaces the default one whole.
 // A key that names no instance is an error (a typo must not silently change a bake); the rest is
 // checked as in a scene file.
@@ -85,7 +86,8 @@
 //     "relight": it is what shades under a changed or rotated lighting, at a third of S's size,
 //     and scenes baked before S keep it — leave "transfer" out for S alone);
 //   * no radiance and no FIV without an environment;
-//   * FIV shells only for an occluder that can shadow some other receiver: its bounding sphere
+//   * FIV shells only for an occluder that moves (SceneObject::moves: a glTF node an animation
+//     moves, or "moves": true) and can shadow some other receiver: its bounding sphere
 //     reaches above the tangent plane of at least one vertex of another receiver (paper 004 §4.3.1:
 //     case C, wholly below the horizon, occludes nothing);
 //   * the environment's FIV and DifMap only when some occluder gets shells;
@@ -134,6 +136,12 @@ struct SceneObject {
   std::string node_path;                          // glTF scenes: the instance's name (bake/mesh.h); empty in a scene file
   std::filesystem::path mesh;                     // resolved against the scene file's directory
   Role role = Role::Both;
+  // Whether it can move at run time: only a moving occluder gets FIV shells (its static shadows
+  // are in the receivers' own products). A scene file's "moves" (default true: a scene file lists
+  // objects to be placed at run time); a glTF instance: an animation channel moves its node or an
+  // ancestor, unless the options' "moves" says otherwise.
+  bool moves = true;
+  std::string moves_reason = "\"moves\" in the scene file (default true)";
   // The file's "transform": object space → world space, applied to column vectors
   // (docs/ARCHITECTURE.md §3 "Frames").
   Eigen::Matrix4d world_from_object = Eigen::Matrix4d::Identity();
