@@ -900,6 +900,24 @@ ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Me
   return plan;
 }
 
+void pool_product_errors(std::vector<ProductError>& into, std::span<const ProductError> add) {
+  for (const ProductError& a : add) {
+    auto it = std::find_if(into.begin(), into.end(), [&](const ProductError& e) { return e.product == a.product; });
+    if (it == into.end()) {
+      into.push_back(a);
+      continue;
+    }
+    const double n0 = double(it->values), n1 = double(a.values), n = std::max(n0 + n1, 1.0);
+    auto rms = [&](double x0, double x1) { return std::sqrt((n0 * x0 * x0 + n1 * x1 * x1) / n); };
+    it->rmse = rms(it->rmse, a.rmse);
+    it->reference_rms = rms(it->reference_rms, a.reference_rms);
+    it->bake_std_error = rms(it->bake_std_error, a.bake_std_error);
+    it->reference_std_error = rms(it->reference_std_error, a.reference_std_error);
+    it->max_abs = std::max(it->max_abs, a.max_abs);
+    it->values += a.values;
+  }
+}
+
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
   std::vector<std::string> out;
   for (const ProductError& e : report.products) {

@@ -108,21 +108,89 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   uint64_t receiver_vertices = 0;  // of the receivers with per-vertex products (the report's budget)
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (plan.objects[i].receiver && plan.objects[i].any_vertex_product()) receiver_vertices += meshes[i].positions.size();
-  size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const ObjectPlan& p = plan.objects[i];
-    if (!p.receiver || (!p.any_vertex_product() && !p.area_irradiance)) continue;
+  // Each receiver's shade points: a "both" receiver's vertices are shade points of the union
+  // (their own 1-ring occludes in the ε-limit), a receiver-only object's are free points.
+  auto shade_points = [&](size_t i) {
     const Mesh& m = meshes[i];
-    const ProductRequest r = request_of(p);
     std::vector<ShadePoint> points(m.positions.size());
     for (size_t v = 0; v < points.size(); ++v) {
-      if (p.occluder) {
+      if (plan.objects[i].occluder) {
         points[v] = vertex_shade_point(occluders, topo, uint32_t(base[i] + v));
       } else {
         points[v].p = m.positions[v].cast<double>();
         points[v].n = m.normals[v].cast<double>().normalized();
       }
     }
+    return points;
+  };
+  // With a target, one choice per distinct product request, made on the pooled shade points of
+  // every receiver that makes it (bake/scene.h "target error": the target holds for those
+  // receivers' values together): one pilot and one report reference for the scene, not one per
+  // object (115 pilots of 1-16 s each on an engine of small parts). The report's points are
+  // shared among the group's objects by their vertices, and its verdict is the pooled one.
+  struct Group {
+    std::vector<size_t> objects;      // in scene order
+    std::vector<ShadePoint> points;   // theirs, concatenated
+    IntegratorSpec spec;
+    IntegratorChoice choice;
+    std::optional<ReferencePlan> reference_plan;
+    std::unique_ptr<Integrator> integ, ref;
+    std::vector<ProductError> pooled;  // the objects' reports, merged as they come
+    size_t report_points = 0, remaining = 0;
+    bool chosen = false;
+  };
+  std::map<Key, Group> groups;
+  if (choose) {
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const ObjectPlan& p = plan.objects[i];
+      if (!p.receiver || !p.any_vertex_product()) continue;
+      Group& g = groups[key_of(request_of(p))];
+      g.objects.push_back(i);
+      ++g.remaining;
+    }
+  }
+  auto choose_for = [&](Group& g, const ProductRequest& r) {
+    for (size_t j : g.objects) {
+      std::vector<ShadePoint> pts = shade_points(j);
+      g.points.insert(g.points.end(), pts.begin(), pts.end());
+    }
+    ChooserOptions copt;
+    copt.target = scene.target_error;
+    if (scene.integrator_given) copt.only = scene.integrator.kind;
+    copt.counted_costs = scene.counted_costs;
+    g.choice = choose_integrator(g.points, occluders, topo, r, scene.integrator, copt, monitor, &accel);
+    g.spec = g.choice.spec;
+    // The report's reference: its noise within E/3 (or the plan says why not), bake/choose.h; the
+    // scene's ray budget shared among the groups by their vertices.
+    if (g.spec.report_points > 0 && !rows.rows_only) {
+      const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(g.points.size()) /
+                                       double(std::max<uint64_t>(receiver_vertices, 1)));
+      g.reference_plan = plan_report_reference(g.points, occluders, topo, r, g.spec, scene.target_error, monitor, &accel,
+                                               std::max<uint64_t>(budget, 1));
+      g.spec.report_rays = g.reference_plan->rays;
+    }
+    g.report_points = g.spec.report_points;
+    const std::string who = g.objects.size() == 1 ? scene.objects[g.objects.front()].name
+                                                  : std::to_string(g.objects.size()) + " receivers (" +
+                                                        std::to_string(g.points.size()) + " vertices, from " +
+                                                        scene.objects[g.objects.front()].name + ")";
+    if (on_choice)
+      on_choice(who, g.choice, g.reference_plan ? &*g.reference_plan : nullptr);
+    else
+      log(who + ": " + choice_summary(g.choice));
+    g.integ = make_integrator(g.spec, occluders, topo, r, &accel);
+    if (g.spec.report_points > 0 && !rows.rows_only) g.ref = make_reference(g.spec, occluders, topo, r, &accel);
+    g.points.clear();
+    g.points.shrink_to_fit();
+    g.chosen = true;
+  };
+
+  size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectPlan& p = plan.objects[i];
+    if (!p.receiver || (!p.any_vertex_product() && !p.area_irradiance)) continue;
+    const ProductRequest r = request_of(p);
+    const std::vector<ShadePoint> points = shade_points(i);
     ObjectBake& ob = out.objects[i];
     if (p.area_irradiance && !rows.rows_only) {
       const auto t0 = std::chrono::steady_clock::now();
@@ -136,33 +204,25 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
     if (!p.any_vertex_product()) continue;
     ob.integrator = scene.integrator;
-    std::unique_ptr<Integrator> own_integ, own_ref;  // with a target: this object's
+    const Integrator* integ = nullptr;
+    const Integrator* ref = nullptr;
+    Group* group = nullptr;
+    size_t report_points = scene.integrator.report_points;
     if (choose) {
-      ChooserOptions copt;
-      copt.target = scene.target_error;
-      if (scene.integrator_given) copt.only = scene.integrator.kind;
-      copt.counted_costs = scene.counted_costs;
-      ob.choice = choose_integrator(points, occluders, topo, r, scene.integrator, copt, monitor, &accel);
-      ob.integrator = ob.choice->spec;
-      // The report's reference: its noise within E/3 (or the plan says why not), bake/choose.h.
-      if (ob.integrator.report_points > 0 && !rows.rows_only) {
-        // The report's ray budget is the scene's, shared by the receivers' vertices.
-        const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(points.size()) /
-                                         double(std::max<uint64_t>(receiver_vertices, 1)));
-        ob.reference_plan = plan_report_reference(points, occluders, topo, r, ob.integrator, scene.target_error, monitor,
-                                                  &accel, std::max<uint64_t>(budget, 1));
-        ob.integrator.report_rays = ob.reference_plan->rays;
-      }
-      if (on_choice)
-        on_choice(scene.objects[i].name, *ob.choice, ob.reference_plan ? &*ob.reference_plan : nullptr);
-      else
-        log(scene.objects[i].name + ": " + choice_summary(*ob.choice));
-      own_integ = make_integrator(ob.integrator, occluders, topo, r, &accel);
-      if (ob.integrator.report_points > 0) own_ref = make_reference(ob.integrator, occluders, topo, r, &accel);
-    }
-    const Integrator* integ = own_integ.get();
-    const Integrator* ref = own_ref.get();
-    if (!choose) {
+      group = &groups.at(key_of(r));
+      if (!group->chosen) choose_for(*group, r);
+      ob.choice = group->choice;
+      ob.reference_plan = group->reference_plan;
+      ob.integrator = group->spec;
+      integ = group->integ.get();
+      ref = group->ref.get();
+      // This object's share of the group's report points, by its vertices (at least one).
+      uint64_t group_vertices = 0;
+      for (size_t j : group->objects) group_vertices += meshes[j].positions.size();
+      report_points = size_t(std::ceil(double(group->report_points) * double(points.size()) /
+                                       double(std::max<uint64_t>(group_vertices, 1))));
+      report_points = std::min(std::max<size_t>(report_points, 1), points.size());
+    } else {
       const auto& shared = integrators.at(key_of(r));
       integ = shared.first.get();
       ref = shared.second.get();
@@ -185,17 +245,36 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
         printf_string("%.2f s", ob.values->seconds) +
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
-    if (ref) {
-      ob.report = compare_points_with_reference(points, *ob.values, *ref, ob.integrator.report_points,
-                                                ob.integrator.seed, monitor);
+    if (ref && report_points > 0) {
+      ob.report = compare_points_with_reference(points, *ob.values, *ref, report_points, ob.integrator.seed, monitor);
+      std::string line = "  error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
       for (const auto& e : ob.report->products)
-        log("  " + std::string(product_label(e.product)) + ": " + printf_string("RMSE %.3e  max %.3e", e.rmse, e.max_abs) +
-            printf_string("  (reference's own std. error %.3e; reference took %.2f s)", e.reference_std_error,
-                ob.report->reference_seconds));
-      if (choose)
-        for (const std::string& line :
-             target_check_lines(*ob.report, scene.target_error, ob.reference_plan ? &*ob.reference_plan : nullptr))
-          log(line);
+        line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
+                printf_string("reference's own std. error %.1e)", e.reference_std_error);
+      log(line + printf_string("; reference took %.2f s", ob.report->reference_seconds));
+      if (group) {
+        pool_product_errors(group->pooled, ob.report->products);
+        out.report_seconds += ob.report->reference_seconds;
+      } else if (choose) {
+        for (const std::string& l : target_check_lines(*ob.report, scene.target_error, ob.reference_plan ? &*ob.reference_plan : nullptr))
+          log(l);
+      }
+    }
+    if (group && --group->remaining == 0 && !group->pooled.empty()) {
+      // The group's verdict on its pooled report (bake/choose.h target_check_lines).
+      ErrorReport pooled;
+      pooled.products = group->pooled;
+      size_t n = 0;
+      for (size_t j : group->objects)
+        if (out.objects[j].report) n += out.objects[j].report->vertices.size();
+      pooled.vertices.resize(n);
+      if (group->objects.size() > 1)
+        log("receivers from " + scene.objects[group->objects.front()].name + " (" + std::to_string(group->objects.size()) +
+            " objects), their " + std::to_string(n) + " report vertices together:");
+      for (const std::string& l : target_check_lines(pooled, scene.target_error, group->reference_plan ? &*group->reference_plan : nullptr))
+        log(l);
+      group->integ.reset();
+      group->ref.reset();
     }
   }
 

@@ -166,6 +166,38 @@ TEST(Prtbake, SceneBakesPrintThePilotTableWithVerbose) {
     EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
 }
 
+TEST(Prtbake, ASceneChoosesOncePerProductRequestAndJudgesTheTargetOnThePooledReport) {
+  // Two receivers with the same products share one pilot (bake/scene.h: the target holds for their
+  // values together); the report's 16 points are shared by their vertices (8 each, the same
+  // mesh), and the verdict is printed once, on the pooled report.
+  const fs::path dir = scratch("scene_pooled");
+  fs::create_directories(dir);
+  const fs::path scene = dir / "s.json";
+  const std::string mesh = (kData / "bunny.obj").string();
+  std::ofstream(scene) << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "target_error": 0.003, "report": 16},
+    "objects": [{"name": "a", "mesh": ")" << mesh << R"(", "role": "both"},
+                {"name": "b", "mesh": ")" << mesh << R"(", "role": "both", "transform": {"translate": [0.5, 0, 0]}}]})";
+  const fs::path out = dir / "s.prt.h5";
+  const Outcome r = run("scene " + scene.string() + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto count = [&](const std::string& s) {
+    size_t n = 0;
+    for (size_t at = r.out.find(s); at != std::string::npos; at = r.out.find(s, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("target error 0.003: chosen "), 1u) << r.out;
+  EXPECT_NE(r.out.find("2 receivers ("), std::string::npos) << r.out;
+  EXPECT_EQ(count("target 0.003 for AO: "), 1u) << r.out;
+  EXPECT_NE(r.out.find("(2 objects), their 16 report vertices together:"), std::string::npos) << r.out;
+  const F::Asset a = F::read_asset(out);
+  ASSERT_EQ(a.objects.size(), 2u);
+  for (const auto& o : a.objects) {
+    ASSERT_TRUE(o.set.ao.has_value()) << o.name;
+    EXPECT_EQ(o.set.ao->integrator, a.objects[0].set.ao->integrator) << "one choice for both";
+    EXPECT_EQ(o.set.ao->samples, a.objects[0].set.ao->samples) << "one choice for both";
+  }
+}
+
 TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   // The chooser's contract is tested in tests/bake/test_choose.cpp; here what the user sees: one
   // line saying what was chosen and why (the pilot on 1839 / 64 = 28, so at least 32, vertices),

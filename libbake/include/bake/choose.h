@@ -314,6 +314,11 @@ std::string choice_summary(const IntegratorChoice& choice);
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target,
                                             const ReferencePlan* plan = nullptr);
 
+// Pools reports of disjoint point sets: each of `add`'s products is merged into `into`'s entry of
+// the same product (appended when new), as if one report had compared all their values: values
+// add, rmse, reference_rms and the standard errors are RMS weighted by values, max_abs the max.
+void pool_product_errors(std::vector<ProductError>& into, std::span<const ProductError> add);
+
 // The report's error of `product` in the target's units (the file comment): RMSE, or RMSE / RMS of
 // the reference for band-1 radiance.
 double error_in_target_units(const ProductError& error);

@@ -252,6 +252,7 @@ struct SceneBake {
   Fiv environment_fiv{};            // when plan.fiv_environment
   std::vector<float> irradiance_cube;
   double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0, area_seconds = 0;
+  double report_seconds = 0;  // the error reports' reference integrals (with a target)
   uint64_t vertices = 0;  // receiver vertices integrated
 };
 
@@ -272,9 +273,13 @@ struct SceneRows {
   bool rows_only = false;
 };
 
-// With a target error, `on_choice` receives each receiver's choice (its object name, the choice,
-// and the error report's reference plan when a report is made) as soon as it is made, before
-// the receiver is baked; without it, `log` receives choice_summary.
+// With a target error the choice is made once per distinct product request, on the pooled shade
+// points of the receivers that make it (the target holds for their values together), when the
+// first of them is baked; `on_choice` receives it (who: "N receivers (V vertices, from <first>)",
+// the choice, and the error report's reference plan when a report is made) before they are
+// baked; without it, `log` receives choice_summary. Each receiver's report then takes its share
+// of the report's points by its vertices, and the target's verdict is logged for the pooled
+// reports once the group's last receiver is baked.
 using OnChoice = std::function<void(const std::string& object, const IntegratorChoice& choice, const ReferencePlan* plan)>;
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log,
