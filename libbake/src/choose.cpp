@@ -846,14 +846,18 @@ std::string choice_summary(const IntegratorChoice& c) {
 
 ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                     const ProductRequest& request, const IntegratorSpec& spec, double target,
-                                    const Monitor& monitor, const MeshAccel* accel, uint64_t ray_budget) {
+                                    const Monitor& monitor, const MeshAccel* accel, uint64_t ray_budget,
+                                    double cpu_seconds) {
   PRT_CHECK(target > 0);
   PRT_CHECK(!request.empty());
+  PRT_CHECK(cpu_seconds >= 0);
   ReferencePlan plan;
   plan.target = target;
   IntegratorSpec base = spec;
   base.report_rays = 0;
-  const uint32_t floor_rays = base.reference_rays();  // never fewer than the default reference
+  // Never fewer than the default reference, or with a CPU bound than the probe's finer level (the
+  // rays are then sized by measured noise alone, and the verdict includes that noise).
+  const uint32_t floor_rays = cpu_seconds > 0 ? ReferencePlan::kReportProbeRaysFine : base.reference_rays();
   // The report's own points (compare_points_with_reference), their first kReportProbePoints.
   const std::vector<uint32_t> vertices = seeded_sample(uint32_t(points.size()), spec.report_points, spec.seed);
   plan.points = vertices.size();
@@ -881,6 +885,7 @@ ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Me
   double need = floor_rays;
   for (size_t p = 0; p < products.size(); ++p) {
     plan.products.push_back(products[p].product);
+    plan.probe_values.push_back(probe.size() * products[p].count);
     sigma1[p] = d[p] / std::sqrt(1.0 + double(R1) / double(R2));
     // σ(R) = σ1·sqrt(R1/R) ≤ aim  ⇔  R ≥ R1·(σ1/aim)².
     const double r = double(R1) * (sigma1[p] / aim) * (sigma1[p] / aim);
@@ -888,6 +893,15 @@ ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Me
     need = std::max(need, r);
   }
   plan.ray_budget = ray_budget ? ray_budget : ReferencePlan::kReportRayBudget;
+  if (cpu_seconds > 0) {
+    // The rays `cpu_seconds` buys at the probe's measured CPU cost per ray (its finer level), at
+    // least the probe's own rays on every report point.
+    const double us_per_ray = std::max(b.cpu_us_per_point / double(R2), 1e-6);
+    const uint64_t affordable =
+        std::max<uint64_t>(uint64_t(std::min(cpu_seconds * 1e6 / us_per_ray, 1e18)), uint64_t(R2) * plan.points);
+    if (affordable < plan.ray_budget) plan.ray_budget = affordable, plan.cpu_bound = true;
+    plan.cpu_seconds = cpu_seconds;
+  }
   const uint64_t cap = std::max<uint64_t>(floor_rays, plan.ray_budget / plan.points);
   uint32_t rays = round_up_rays(need);
   if (rays > cap) rays = uint32_t(std::min<uint64_t>(cap, kMaxRays));
@@ -921,30 +935,53 @@ void pool_product_errors(std::vector<ProductError>& into, std::span<const Produc
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
   std::vector<std::string> out;
   for (const ProductError& e : report.products) {
-    const double err = error_in_target_units(e);
-    // The reference's own noise in the same units (its estimated standard error; QMC's actual
-    // error is often well below it): an RMSE above E with noise that large says nothing.
-    double noise = is_radiance(e.product) ? (e.reference_rms > 0 ? e.reference_std_error / e.reference_rms : 0.0)
-                                                       : e.reference_std_error;
-    const char* noise_kind = "estimated";
-    if (plan)
+    const double m = error_in_target_units(e);  // the measured RMSE, the reference's noise in it
+    // The reference's own noise σ in the same units. Measured on the report's own values (two
+    // independent halves, ErrorReport::reference_noise_measured): known to a relative δ on σ²,
+    // 3 standard deviations of a variance estimated from n Gaussian values, 3·sqrt(2/n). Else an
+    // upper bound: the plan's probe scaled at Monte Carlo's rate (the slowest QMC shows), or QMC's
+    // estimator (which overstates it) — then it cannot be subtracted, only bound the error below.
+    const bool measured = report.reference_noise_measured;
+    double sigma = is_radiance(e.product) ? (e.reference_std_error > 0 && e.reference_rms > 0
+                                                 ? e.reference_std_error / e.reference_rms
+                                                 : 0.0)
+                                          : e.reference_std_error;
+    const char* kind = measured ? "measured on these values" : "QMC's estimate, an upper bound";
+    if (!measured && plan)
       for (size_t p = 0; p < plan->products.size(); ++p)
-        if (plan->products[p] == e.product && p < plan->noise.size()) noise = plan->noise[p], noise_kind = "measured";
-    const bool unverifiable = err > target && noise >= 0.5 * target;
-    const char* verdict = err <= target ? "met" : unverifiable ? "not verifiable here" : "NOT met";
-    std::string why;
-    if (unverifiable) {
-      why = ": too noisy to tell";
+        if (plan->products[p] == e.product && p < plan->noise.size())
+          sigma = plan->noise[p], kind = "the probe's, an upper bound";
+    const double delta = measured ? 3.0 * std::sqrt(2.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
+    // m² = e² + σ² (independent errors): the bake's own error e with the noise removed, and the
+    // range it lies in. Met when its top is within E (always when m <= E), NOT met when its
+    // bottom exceeds E, else the reference cannot tell.
+    auto less_noise = [&](double factor) { return std::sqrt(std::max(0.0, m * m - sigma * sigma * factor)); };
+    const double e_mid = measured ? less_noise(1.0) : m;
+    const double e_hi = measured ? less_noise(std::max(0.0, 1.0 - delta)) : m;
+    const double e_lo = less_noise(1.0 + delta);
+    const bool met = e_hi <= target, not_met = e_lo > target;
+    const char* verdict = met ? "met" : not_met ? "NOT met" : "not verifiable here";
+    std::string line = format("  target %g for ", target) + product_label(e.product) +
+                       (is_radiance(e.product) ? " (relative)" : "") + ": " + verdict + ": ";
+    if (measured)
+      line += format("the bake's own error %.2e", e_mid) + format(" (%.2e to ", e_lo) + format("%.2e), ", e_hi) +
+              format("the measured RMSE %.3e less the reference's own noise ", m) +
+              format("%.1e (", sigma) + kind + ") in quadrature";
+    else
+      line += format("the measured RMSE %.3e, which includes the reference's own noise (", m) +
+              format("%.1e, ", sigma) + kind + format("): the bake's own error is %.2e to ", e_lo) + format("%.2e", m);
+    if (!met && !not_met) {
+      line += ": the reference is too noisy to tell";
       if (plan)
         for (size_t p = 0; p < plan->products.size(); ++p)
           if (plan->products[p] == e.product && plan->rays_needed[p] > plan->rays)
-            why += format("; E/3 would need %.3g rays per point, %.3g in all, over the report's budget of %.3g rays",
-                          double(plan->rays_needed[p]), double(plan->rays_needed[p]) * double(plan->points),
-                          double(plan->ray_budget ? plan->ray_budget : ReferencePlan::kReportRayBudget));
+            line += format("; E/3 would need %.3g rays per point, %.3g in all, over the report's budget of %.3g rays",
+                           double(plan->rays_needed[p]), double(plan->rays_needed[p]) * double(plan->points),
+                           double(plan->ray_budget ? plan->ray_budget : ReferencePlan::kReportRayBudget)) +
+                    (plan->cpu_bound ? format(" (what %.3g CPU s buy: the check may take as long as the bake)", plan->cpu_seconds)
+                                     : std::string());
     }
-    out.push_back(format("  target %g for ", target) + product_label(e.product) + ": " + verdict + format(" (%.3e", err) +
-                  (is_radiance(e.product) ? " relative" : "") +
-                  "; the reference's own " + noise_kind + format(" noise, included in it, is %.1e", noise) + why + ")");
+    out.push_back(line);
   }
   return out;
 }

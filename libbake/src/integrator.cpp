@@ -56,4 +56,13 @@ std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mes
                                          accel);
 }
 
+std::pair<std::unique_ptr<Integrator>, std::unique_ptr<Integrator>> make_reference_pair(
+    const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology, const ProductRequest& request,
+    const MeshAccel* accel) {
+  const uint32_t half = (spec.reference_rays() + 1) / 2;
+  return {std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{half, spec.reference_seed()}, accel),
+          std::make_unique<QmcIntegrator>(mesh, topology, request,
+                                          QmcOptions{half, mix64(spec.reference_seed() ^ 0x68616c66ull)}, accel)};
+}
+
 } // namespace prt::bake

@@ -134,7 +134,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     IntegratorSpec spec;
     IntegratorChoice choice;
     std::optional<ReferencePlan> reference_plan;
-    std::unique_ptr<Integrator> integ, ref;
+    std::unique_ptr<Integrator> integ, ref, ref2;
     std::vector<ProductError> pooled;  // the objects' reports, merged as they come
     size_t report_points = 0, remaining = 0;
     bool chosen = false;
@@ -165,8 +165,15 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (g.spec.report_points > 0 && !rows.rows_only) {
       const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(g.points.size()) /
                                        double(std::max<uint64_t>(receiver_vertices, 1)));
+      // The check may take about as long as the group's predicted bake (at least
+      // kReportMinCpuSeconds of CPU; not with counted costs, whose rays must not depend on speed).
+      double bake_cpu = 0;
+      for (const Prediction& pr : g.choice.predictions)
+        if (pr.kind == g.spec.kind) bake_cpu = pr.predicted_us_per_point * 1e-6 * double(g.points.size());
+      const double check_cpu =
+          scene.counted_costs ? 0.0 : std::max(ReferencePlan::kReportMinCpuSeconds, bake_cpu);
       g.reference_plan = plan_report_reference(g.points, occluders, topo, r, g.spec, scene.target_error, monitor, &accel,
-                                               std::max<uint64_t>(budget, 1));
+                                               std::max<uint64_t>(budget, 1), check_cpu);
       g.spec.report_rays = g.reference_plan->rays;
     }
     g.report_points = g.spec.report_points;
@@ -179,7 +186,9 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     else
       log(who + ": " + choice_summary(g.choice));
     g.integ = make_integrator(g.spec, occluders, topo, r, &accel);
-    if (g.spec.report_points > 0 && !rows.rows_only) g.ref = make_reference(g.spec, occluders, topo, r, &accel);
+    // The check's reference as two independent halves: its noise measured on the report's values.
+    if (g.spec.report_points > 0 && !rows.rows_only)
+      std::tie(g.ref, g.ref2) = make_reference_pair(g.spec, occluders, topo, r, &accel);
     g.points.clear();
     g.points.shrink_to_fit();
     g.chosen = true;
@@ -206,6 +215,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     ob.integrator = scene.integrator;
     const Integrator* integ = nullptr;
     const Integrator* ref = nullptr;
+    const Integrator* ref2 = nullptr;
     Group* group = nullptr;
     size_t report_points = scene.integrator.report_points;
     if (choose) {
@@ -216,6 +226,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ob.integrator = group->spec;
       integ = group->integ.get();
       ref = group->ref.get();
+      ref2 = group->ref2.get();
       // This object's share of the group's report points, by its vertices (at least one).
       uint64_t group_vertices = 0;
       for (size_t j : group->objects) group_vertices += meshes[j].positions.size();
@@ -246,7 +257,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         printf_string("%.2f s", ob.values->seconds) +
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref && report_points > 0) {
-      ob.report = compare_points_with_reference(points, *ob.values, *ref, report_points, ob.integrator.seed, monitor);
+      ob.report = compare_points_with_reference(points, *ob.values, *ref, report_points, ob.integrator.seed, monitor, ref2);
       std::string line = "  error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
       for (const auto& e : ob.report->products)
         line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
@@ -264,6 +275,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       // The group's verdict on its pooled report (bake/choose.h target_check_lines).
       ErrorReport pooled;
       pooled.products = group->pooled;
+      pooled.reference_noise_measured = group->ref2 != nullptr;
       size_t n = 0;
       for (size_t j : group->objects)
         if (out.objects[j].report) n += out.objects[j].report->vertices.size();
@@ -275,6 +287,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         log(l);
       group->integ.reset();
       group->ref.reset();
+      group->ref2.reset();
     }
   }
 

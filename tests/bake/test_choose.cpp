@@ -246,33 +246,50 @@ TEST(Choose, TheOneLineSummarySaysWhatWasChosenAndWhy) {
 }
 
 TEST(Choose, TheTargetCheckSaysMetNotMetOrNotVerifiable) {
-  // E = 1e-3: band-1 is judged relative to the reference's RMS, noise in the same units; a value
-  // above E is "not verifiable here" when the reference's own noise is at least E/2.
+  // E = 1e-3: band-1 is judged relative to the reference's RMS, noise in the same units. The
+  // measured RMSE m includes the reference's noise σ (m² = e² + σ²).
   ErrorReport report;
   ProductError ao;
-  ao.product = Product::Ao, ao.rmse = 9e-4, ao.reference_std_error = 5e-3;  // met, whatever the noise
+  ao.product = Product::Ao, ao.rmse = 9e-4, ao.reference_std_error = 5e-3, ao.values = 128;  // m <= E: met, whatever the noise
   ProductError t;
-  t.product = Product::TransferDiffuse, t.rmse = 2e-3, t.reference_std_error = 4e-4;  // noise < E/2
+  t.product = Product::TransferDiffuse, t.rmse = 2e-3, t.reference_std_error = 4e-4, t.values = 128 * 9;
   ProductError r;
-  r.product = Product::RadianceBand1, r.rmse = 3.0, r.reference_rms = 1000, r.reference_std_error = 0.5;  // 3e-3, noise 5e-4
+  r.product = Product::RadianceBand1, r.rmse = 3.0, r.reference_rms = 1000, r.reference_std_error = 2.9, r.values = 288;
   report.products = {ao, t, r};
+  // σ only QMC's estimate (an upper bound): e lies in [sqrt(m² − σ²), m].
   const std::vector<std::string> lines = target_check_lines(report, 1e-3);
   ASSERT_EQ(lines.size(), 3u);
-  EXPECT_NE(lines[0].find("for AO: met (9.000e-04"), std::string::npos) << lines[0];
-  EXPECT_NE(lines[1].find("for diffuse transfer: NOT met (2.000e-03"), std::string::npos) << lines[1];
-  EXPECT_NE(lines[2].find("for band-1 radiance: not verifiable here (3.000e-03 relative"), std::string::npos) << lines[2];
-  EXPECT_NE(lines[2].find("is 5.0e-04: too noisy to tell"), std::string::npos) << lines[2];
-  // With the reference's plan, the line says why it could not be made quieter.
+  EXPECT_NE(lines[0].find("for AO: met: the measured RMSE 9.000e-04"), std::string::npos) << lines[0];
+  // e >= sqrt(4 − 0.16)e-3 = 1.96e-3 > E.
+  EXPECT_NE(lines[1].find("for diffuse transfer: NOT met: the measured RMSE 2.000e-03"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find("the bake's own error is 1.96e-03 to 2.00e-03"), std::string::npos) << lines[1];
+  // e in [sqrt(9 − 8.41)e-3, 3e-3] = [7.7e-4, 3e-3] straddles E.
+  EXPECT_NE(lines[2].find("for band-1 radiance (relative): not verifiable here: the measured RMSE 3.000e-03"),
+            std::string::npos) << lines[2];
+  EXPECT_NE(lines[2].find("the reference is too noisy to tell"), std::string::npos) << lines[2];
+  // With the reference's plan the line says why it could not be made quieter.
   ReferencePlan plan;
   plan.target = 1e-3;
   plan.rays = 65536;
   plan.points = 128;
   plan.products = {Product::Ao, Product::TransferDiffuse, Product::RadianceBand1};
+  plan.noise = {5e-3, 4e-4, 2.9e-3};
   plan.rays_needed = {65536, 65536, 23000000};
   const std::vector<std::string> why = target_check_lines(report, 1e-3, &plan);
   EXPECT_NE(why[2].find("E/3 would need 2.3e+07 rays per point"), std::string::npos) << why[2];
   EXPECT_NE(why[2].find("over the report's budget"), std::string::npos) << why[2];
-  EXPECT_EQ(why[0], lines[0]);
+  EXPECT_EQ(why[0].substr(0, why[0].find('(')), lines[0].substr(0, lines[0].find('(')));
+  // Noise measured on the report's own values (two independent halves): it is taken out. σ =
+  // 1e-3 on 288 values (δ = 3 sqrt(2/288) = 0.25), m = 3e-3: e = 2.83e-3 in [2.78e-3, 2.87e-3], NOT met.
+  report.reference_noise_measured = true;
+  report.products[2].reference_std_error = 1.0;
+  const std::string measured = target_check_lines(report, 1e-3)[2];
+  EXPECT_NE(measured.find("NOT met: the bake's own error 2.83e-03 (2.78e-03 to 2.87e-03)"), std::string::npos) << measured;
+  EXPECT_NE(measured.find("(measured on these values) in quadrature"), std::string::npos) << measured;
+  // m = 1.2e-3 with σ = 1e-3 measured: e = 6.63e-4 in [4.36e-4, 8.31e-4]: met, where m alone is above E.
+  report.products[2].rmse = 1.2;
+  const std::string met = target_check_lines(report, 1e-3)[2];
+  EXPECT_NE(met.find("met: the bake's own error 6.63e-04 (4.36e-04 to 8.31e-04)"), std::string::npos) << met;
 }
 
 TEST(Choose, APilotReferenceTooCoarseForTheTargetIsRaisedOrSaysSo) {

@@ -226,7 +226,7 @@ TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   // The reference's own error is stated, and the report's reference is sized for E/3 (its noise
   // measured, not QMC's estimator): the check line says which noise it used.
   for (const char* s : {"reference N = 256: estimated error ", "within E/3 = 6.67e-04", "report reference: QMC at ",
-                        "the reference's own measured noise"})
+                        "less the reference's own noise ", "(measured on these values) in quadrature"})
     EXPECT_NE(v.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << v.out;
   EXPECT_EQ(v.out.find("not verifiable"), std::string::npos) << v.out;
   // -v and --quiet contradict each other: a usage error, nothing baked.

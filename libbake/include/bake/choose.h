@@ -277,14 +277,19 @@ struct ReferencePlan {
   // sphereWithHole.stl under city.exr); where the budget binds the report says what E/3 would
   // need, and a "met" verdict stays sound (its RMSE includes the reference's noise).
   static constexpr uint64_t kReportRayBudget = uint64_t(1) << 24;
+  // The CPU seconds tools give the check at least (plan_report_reference's cpu_seconds).
+  static constexpr double kReportMinCpuSeconds = 2.0;
   double target = 0;
   uint32_t rays = 0;                   // per point
   size_t points = 0;                   // the report's points
   std::vector<Product> products;
   std::vector<double> noise;           // measured, scaled to `rays` (E's units)
+  std::vector<size_t> probe_values;    // the values each product's noise was measured on
   std::vector<double> estimator_noise; // QMC's own standard-error estimate at `rays` (an upper bound)
   std::vector<uint64_t> rays_needed;   // for noise <= E/3
   uint64_t ray_budget = 0;             // the rays in all it could spend
+  double cpu_seconds = 0;              // the CPU time it was given (0: none, rays alone bound it)
+  bool cpu_bound = false;              // that time, not kReportRayBudget, set ray_budget
   bool budget_bound = false;           // the budget kept some product above E/3
   double probe_seconds = 0;
 };
@@ -293,11 +298,15 @@ struct ReferencePlan {
 // at least spec.reference_rays() (its default), rounded up like the chooser's rays. Deterministic
 // (seeded QMC). Set spec.report_rays = plan.rays for make_reference.
 // `ray_budget`: the rays in all it may spend (0: kReportRayBudget); a scene shares
-// kReportRayBudget among its receivers by their vertices.
+// kReportRayBudget among its receivers by their vertices. `cpu_seconds` > 0 bounds it further by
+// the CPU time the check may take, converted to rays at the probe's measured cost per ray (tools
+// give it as long as the bake, at least kReportMinCpuSeconds: a check that costs many times the
+// bake is a cost users notice); the floor is then the probe's 16,384 rays, not the default
+// reference's. Not with counted costs (the rays would depend on the machine).
 ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Mesh& mesh, const Topology& topology,
                                     const ProductRequest& request, const IntegratorSpec& spec, double target,
                                     const Monitor& monitor = {}, const MeshAccel* accel = nullptr,
-                                    uint64_t ray_budget = 0);
+                                    uint64_t ray_budget = 0, double cpu_seconds = 0);
 
 // What a tool prints about a choice (libbake prints nothing): the pilot table, each kind's model
 // and the choice, one line each, then a hint when the call was close (margin < 1.25).
@@ -306,11 +315,13 @@ std::vector<std::string> choice_lines(const IntegratorChoice& choice);
 // predicted error and µs per integral), and the pilot's size and time.
 std::string choice_summary(const IntegratorChoice& choice);
 
-// After the bake, one line per product: its error in the target's units against the target,
-// "met", "NOT met", or "not verifiable here" when it is above E but the reference's own estimated
-// noise (which the measured RMSE includes, in the same units) is at least E/2. With the
-// reference's plan the noise is the plan's measured one (else QMC's estimator, which overstates
-// it), and an unverifiable line says why (the rays E/3 would have needed against the budget).
+// After the bake, one line per product against the target E. The measured RMSE m includes the
+// reference's own noise σ (m² = e² + σ², independent errors). With the reference's plan σ is
+// measured (known to a relative δ = 3·sqrt(2/n) on σ², n the probe's values): the line states
+// the bake's own error e = sqrt(m² − σ²) and its range [sqrt(m² − σ²(1+δ)), sqrt(m² − σ²(1−δ))].
+// Without it σ is QMC's estimate, an upper bound: e lies in [sqrt(m² − σ²), m]. "met" when the
+// range's top is within E (always when m <= E), "NOT met" when its bottom exceeds E, else "not
+// verifiable here", saying why (the rays E/3 would have needed against the report's budget).
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target,
                                             const ReferencePlan* plan = nullptr);
 

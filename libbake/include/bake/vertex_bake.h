@@ -10,6 +10,7 @@
 #include <bake/progress.h>
 
 #include <memory>
+#include <utility>
 #include <span>
 #include <string>
 #include <vector>
@@ -106,18 +107,24 @@ struct ErrorReport {
   std::vector<ProductError> products;
   std::string reference;            // the reference integrator's description
   double reference_seconds = 0;     // apart from the bake time
+  // The reference was two independent halves: reference_std_error is their measured noise (the
+  // RMS of |a − b| / 2), not QMC's estimator (which overstates it).
+  bool reference_noise_measured = false;
 };
 
 // Picks min(n_points, V) distinct vertices with `seed`, integrates them with `reference`, and
 // compares with `bake` (which must have the same layout). The reference integration is a
 // "reference" stage of `monitor`: it reports progress and throws Cancelled like a bake.
+// With `second` (an independent reference of the same kind, make_reference_pair), the reference
+// is the mean of the two and its noise is measured per value as |a − b| / 2
+// (ErrorReport::reference_noise_measured).
 ErrorReport compare_with_reference(const Mesh& mesh, const Topology& topology, const VertexBake& bake,
                                    const Integrator& reference, size_t n_points, uint64_t seed,
-                                   const Monitor& monitor = {});
+                                   const Monitor& monitor = {}, const Integrator* second = nullptr);
 
 ErrorReport compare_points_with_reference(std::span<const ShadePoint> points, const VertexBake& bake,
                                           const Integrator& reference, size_t n_points, uint64_t seed,
-                                          const Monitor& monitor = {});
+                                          const Monitor& monitor = {}, const Integrator* second = nullptr);
 
 // The integrator a spec describes (bake/integrator.h). `mesh`, `topology` and the request's
 // environment must outlive it. With `accel` (bake/accel.h) its trees are shared, not built.
@@ -127,6 +134,11 @@ std::unique_ptr<Integrator> make_integrator(const IntegratorSpec& spec, const Me
 // spec.reference_rays() rays per point, seeded apart from the bake's points.
 std::unique_ptr<Integrator> make_reference(const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology,
                                            const ProductRequest& request, const MeshAccel* accel = nullptr);
+// The same reference as two independent halves (half the rays each, rounded up; seeds apart), for
+// compare_points_with_reference's measured noise: the check of a target error.
+std::pair<std::unique_ptr<Integrator>, std::unique_ptr<Integrator>> make_reference_pair(
+    const IntegratorSpec& spec, const Mesh& mesh, const Topology& topology, const ProductRequest& request,
+    const MeshAccel* accel = nullptr);
 
 // Distinct indices in [0, n), min(k, n) of them, chosen by seed (partial Fisher–Yates), sorted.
 std::vector<uint32_t> seeded_sample(uint32_t n, size_t k, uint64_t seed);
