@@ -37,3 +37,39 @@ TEST(PrtbakeCancel, CtrlCDuringABakeExits130AndWritesNothing) {
   for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
   fs::remove_all(dir);
 }
+
+// The bake is written before its error check (tools/prtbake: write, then check, then re-write
+// with the report): Ctrl-C during the check keeps the finished bake, says so, and exits 130.
+TEST(PrtbakeCancel, CtrlCDuringTheErrorCheckKeepsTheBakeWithoutItsReport) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / ("cancel_check." + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "bunny.h5";
+  // A fast bake (silhouette, 32 isolines) and a check of minutes: every vertex (4,240) against a
+  // 65,536-ray QMC reference, 2.8e8 rays.
+  prt::testing::BackgroundTool bake(PRT_PRTBAKE, {"vertex", std::string(PRT_DATA_DIR) + "/bunny_ground.obj", "-o",
+                                                  out.string(), "--integrator", "silhouette", "--samples", "1024",
+                                                  "--ao", "--report", "4240", "--threads", "2"});
+  ASSERT_TRUE(bake.started());
+  ASSERT_TRUE(bake.wait_for("reference:", std::chrono::seconds(120))) << bake.err();
+  bake.send(SIGINT);
+  const int code = bake.wait();
+  EXPECT_EQ(code, 130) << bake.err();
+  EXPECT_NE(bake.err().find("cancelled during the error check: " + out.string() +
+                            " holds the finished bake without its error report"),
+            std::string::npos)
+      << bake.err();
+  ASSERT_TRUE(fs::exists(out)) << bake.err();
+  // The file is whole: prtdump reads it, and it has AO and no report.
+  const auto dump = prt::testing::run_tool(PRT_PRTDUMP, "--json " + out.string(), dir);
+  EXPECT_EQ(dump.code, 0) << dump.err;
+  EXPECT_NE(dump.out.find("\"path\": \"/ao\""), std::string::npos) << dump.out;
+  EXPECT_EQ(dump.out.find("\"path\": \"/report/ao\""), std::string::npos) << dump.out;
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    ++files;
+    EXPECT_EQ(e.path(), out) << "left behind: " << e.path();
+  }
+  EXPECT_EQ(files, 1u);
+  fs::remove_all(dir);
+}

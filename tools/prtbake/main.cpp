@@ -694,58 +694,77 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
                 100 * result.busy_fraction(), result.cpu_seconds, result.seconds, result.threads);
   }
 
-  std::optional<bake::ErrorReport> report;
-  std::optional<bake::ReferencePlan> reference_plan;
-  if (spec.report_points > 0) {
-    if (a.target_error > 0) {  // a reference whose own noise is within E/3, or a budget that says why not
-      // The check may take about as long as the bake (at least kReportMinCpuSeconds of CPU); not
-      // with --reproducible, whose rays must not depend on the machine's speed.
-      const double check_cpu =
-          a.reproducible ? 0.0 : std::max(bake::ReferencePlan::kReportMinCpuSeconds, result.cpu_seconds);
-      reference_plan = bake::plan_report_reference(points, mesh, topo, req, spec, a.target_error, progress, &accel, 0,
-                                                   check_cpu);
-      spec.report_rays = reference_plan->rays;
-      if (say && a.verbose) print_reference_plan(*reference_plan);
-    }
-    // With a target, the reference is two independent halves: its noise is then measured on the
-    // report's own values, and the check can take it out of the RMSE (target_check_lines).
-    std::pair<std::unique_ptr<bake::Integrator>, std::unique_ptr<bake::Integrator>> reference;
-    if (a.target_error > 0) reference = bake::make_reference_pair(spec, mesh, topo, req, &accel);
-    else reference.first = bake::make_reference(spec, mesh, topo, req, &accel);
-    report = bake::compare_with_reference(mesh, topo, result, *reference.first, spec.report_points, spec.seed,
-                                          progress, reference.second.get());
-    if (say) {
-      std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
-                  "counted in the bake time):\n",
-                  spec.reference_rays(), report->vertices.size(), report->reference_seconds);
-      // The bake's own standard error is QMC's estimate; the silhouette integrator is deterministic
-      // (its error is a bias, which only the comparison measures), so it has none to print.
-      const bool sampled = integrator.kind() != bake::IntegratorKind::Silhouette;
-      for (const auto& e : report->products) {
-        std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse,
-                    e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
-        if (sampled) std::printf("bake's estimated std. error %.3e; ", e.bake_std_error);
-        std::printf("the reference's own std. error %.3e, %s)\n", e.reference_std_error,
-                    report->reference_noise_measured ? "measured from its two halves" : "QMC's estimate");
-      }
-      if (a.target_error > 0)
-        for (const std::string& line : bake::target_check_lines(*report, a.target_error, reference_plan ? &*reference_plan : nullptr))
-          std::printf("%s\n", line.c_str());
-    }
-  }
-
   // ---- the file (formats/SCHEMA.md) ----
   namespace F = prt::formats;
-  F::Asset asset;
-  asset.root = root_info(a, mesh_sha);
-  tool::set_mesh(asset.vertices, mesh);
-  if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
-  tool::set_products(asset.vertices, result,
-                     {integrator.name(), integrator.description(), spec.samples(), spec.seed, a.transfer, a.visibility,
-                      env ? &*env : nullptr, a.environment});
-  if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
-  tool::set_target_error(asset, a.target_error);
-  write_file(a, asset);
+  std::optional<bake::ErrorReport> report;
+  auto write_bake = [&] {
+    F::Asset asset;
+    asset.root = root_info(a, mesh_sha);
+    tool::set_mesh(asset.vertices, mesh);
+    if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
+    tool::set_products(asset.vertices, result,
+                       {integrator.name(), integrator.description(), spec.samples(), spec.seed, a.transfer, a.visibility,
+                        env ? &*env : nullptr, a.environment});
+    if (report) asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
+    tool::set_target_error(asset, a.target_error);
+    write_file(a, asset);
+  };
+  if (spec.report_points == 0) {
+    write_bake();
+    if (shards) shards->finish();
+    return 0;
+  }
+  // The bake is written first and checked after (the check re-writes the file with its report):
+  // a check cancelled with Ctrl-C, or one that costs more than the user will wait, never costs the bake.
+  write_bake();
+  if (say) std::printf("checking its error (Ctrl-C keeps the file as written, without its report; --report 0 skips the check)\n");
+  std::optional<bake::ReferencePlan> reference_plan;
+  try {
+    {
+      if (a.target_error > 0) {  // a reference whose own noise is within E/3, or a budget that says why not
+        // The check may take about as long as the bake (at least kReportMinCpuSeconds of CPU); not
+        // with --reproducible, whose rays must not depend on the machine's speed.
+        const double check_cpu =
+            a.reproducible ? 0.0 : std::max(bake::ReferencePlan::kReportMinCpuSeconds, result.cpu_seconds);
+        reference_plan = bake::plan_report_reference(points, mesh, topo, req, spec, a.target_error, progress, &accel, 0,
+                                                     check_cpu);
+        spec.report_rays = reference_plan->rays;
+        if (say && a.verbose) print_reference_plan(*reference_plan);
+      }
+      // With a target, the reference is two independent halves: its noise is then measured on the
+      // report's own values, and the check can take it out of the RMSE (target_check_lines).
+      std::pair<std::unique_ptr<bake::Integrator>, std::unique_ptr<bake::Integrator>> reference;
+      if (a.target_error > 0) reference = bake::make_reference_pair(spec, mesh, topo, req, &accel);
+      else reference.first = bake::make_reference(spec, mesh, topo, req, &accel);
+      report = bake::compare_with_reference(mesh, topo, result, *reference.first, spec.report_points, spec.seed,
+                                            progress, reference.second.get());
+      if (say) {
+        std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
+                    "counted in the bake time):\n",
+                    spec.reference_rays(), report->vertices.size(), report->reference_seconds);
+        // The bake's own standard error is QMC's estimate; the silhouette integrator is deterministic
+        // (its error is a bias, which only the comparison measures), so it has none to print.
+        const bool sampled = integrator.kind() != bake::IntegratorKind::Silhouette;
+        for (const auto& e : report->products) {
+          std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse,
+                      e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
+          if (sampled) std::printf("bake's estimated std. error %.3e; ", e.bake_std_error);
+          std::printf("the reference's own std. error %.3e, %s)\n", e.reference_std_error,
+                      report->reference_noise_measured ? "measured from its two halves" : "QMC's estimate");
+        }
+        if (a.target_error > 0)
+          for (const std::string& line : bake::target_check_lines(*report, a.target_error, reference_plan ? &*reference_plan : nullptr))
+            std::printf("%s\n", line.c_str());
+      }
+    }
+    write_bake();
+  } catch (const bake::Cancelled&) {
+    std::fprintf(stderr,
+                 "prtbake: cancelled during the error check: %s holds the finished bake without its error report "
+                 "(--report 0 skips the check)\n",
+                 a.output.c_str());
+    return tool::kExitCancelled;
+  }
   if (shards) shards->finish();
   return 0;
 }
