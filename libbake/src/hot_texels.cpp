@@ -48,8 +48,9 @@ struct Cap {
   Vector3d mid = Vector3d::UnitZ();
   double cos_h = -1, sin_h = 0;
 };
-Cap cap_of(const Vector3d& a, const Vector3d& b) {
-  const Vector3d ah = a.normalized(), bh = b.normalized(), sum = ah + bh;
+// The cap of the arc between unit vectors ah and bh.
+Cap cap_of_unit(const Vector3d& ah, const Vector3d& bh) {
+  const Vector3d sum = ah + bh;
   Cap c;
   const double n = sum.norm();
   if (!(n > 1e-6)) return c;  // (nearly) antipodal ends: no useful bound
@@ -58,6 +59,7 @@ Cap cap_of(const Vector3d& a, const Vector3d& b) {
   c.sin_h = std::sqrt(std::max(0.0, 1 - c.cos_h * c.cos_h));
   return c;
 }
+Cap cap_of(const Vector3d& a, const Vector3d& b) { return cap_of_unit(a.normalized(), b.normalized()); }
 // Whether two caps can meet: the angle between their centres is at most the sum of their half
 // angles (cos of the sum from the parts; with a margin of 1e-9 for rounding, so it only passes more).
 bool caps_meet(const Cap& a, const Cap& b) {
@@ -466,8 +468,8 @@ struct HotTexels::Impl {
   }
   static ArcInfo info_of(const DcfArc& arc) {
     ArcInfo i;
-    i.cap = cap_of(arc.a, arc.b);
     i.ah = arc.a.normalized(), i.bh = arc.b.normalized();
+    i.cap = cap_of_unit(i.ah, i.bh);
     const double nm = arc.m.norm();
     i.mh = nm > 0 ? Vector3d(arc.m / nm) : Vector3d::Zero();
     return i;
