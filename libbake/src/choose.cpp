@@ -893,6 +893,7 @@ ReferencePlan plan_report_reference(std::span<const ShadePoint> points, const Me
     need = std::max(need, r);
   }
   plan.ray_budget = ray_budget ? ray_budget : ReferencePlan::kReportRayBudget;
+  plan.us_per_ray = b.cpu_us_per_point / double(R2);
   if (cpu_seconds > 0) {
     // The rays `cpu_seconds` buys at the probe's measured CPU cost per ray (its finer level), at
     // least the probe's own rays on every report point.

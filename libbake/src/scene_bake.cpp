@@ -5,6 +5,7 @@
 #include <bake/scene.h>
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -16,6 +17,9 @@
 
 namespace prt::bake {
 namespace {
+
+// The dry run's estimate times each group's integrator on this many seeded vertices.
+constexpr size_t kEstimatePoints = 64;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -140,7 +144,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     bool chosen = false;
   };
   std::map<Key, Group> groups;
-  if (choose) {
+  if (choose || rows.estimate_only) {
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectPlan& p = plan.objects[i];
       if (!p.receiver || !p.any_vertex_product()) continue;
@@ -193,6 +197,49 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     g.points.shrink_to_fit();
     g.chosen = true;
   };
+
+  if (rows.estimate_only) {
+    // The dry run's estimate: per group, its integrator (chosen, with a target: the pilot runs)
+    // timed on seeded vertices of the group, scaled to all of them (SceneRows::estimate_only).
+    const double threads = double(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    for (auto& [key, g] : groups) {
+      const ProductRequest r = request_of(plan.objects[g.objects.front()]);
+      if (choose) choose_for(g, r);
+      const Integrator& integ = choose ? *g.integ : *integrators.at(key).first;
+      std::vector<ShadePoint> pts;
+      for (size_t j : g.objects) {
+        std::vector<ShadePoint> o = shade_points(j);
+        pts.insert(pts.end(), o.begin(), o.end());
+      }
+      const std::string who = g.objects.size() == 1 ? scene.objects[g.objects.front()].name
+                                                    : std::to_string(g.objects.size()) + " receivers (from " +
+                                                          scene.objects[g.objects.front()].name + ")";
+      if (integ.kind() == IntegratorKind::Filter) {
+        log(who + ": " + std::to_string(pts.size()) + " vertices; the filter integrator's cost is not estimated "
+                                                      "(it needs every vertex's rays)");
+        continue;
+      }
+      const std::vector<uint32_t> sample = seeded_sample(uint32_t(pts.size()), kEstimatePoints, scene.integrator.seed);
+      std::vector<double> row(integ.layout().width);
+      const double t0 = thread_cpu_seconds();
+      for (uint32_t v : sample) integ.integrate(pts[v], v, row);
+      const double per_point = (thread_cpu_seconds() - t0) / double(std::max<size_t>(sample.size(), 1));
+      const double cpu = per_point * double(pts.size());
+      const IntegratorSpec& spec = choose ? g.spec : scene.integrator;
+      log(who + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(pts.size()) + " vertices with " +
+          to_string(spec.kind) + " at " + std::to_string(spec.samples()) +
+          (spec.kind == IntegratorKind::Silhouette ? " samples (" + std::to_string(spec.isolines()) + " isolines)" : " rays") +
+          printf_string(", %.3g s on ", cpu / threads) + std::to_string(int(threads)) + " threads (timed on " +
+          std::to_string(sample.size()) + " seeded vertices)");
+      if (g.reference_plan && g.reference_plan->us_per_ray > 0)
+        log("  and its error check about " +
+            printf_string("%.3g CPU s", double(g.reference_plan->rays) * double(g.reference_plan->points) *
+                                            g.reference_plan->us_per_ray * 1e-6) +
+            " (a QMC reference of " + std::to_string(g.reference_plan->rays) + " rays on " +
+            std::to_string(g.reference_plan->points) + " vertices)");
+    }
+    return out;
+  }
 
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {

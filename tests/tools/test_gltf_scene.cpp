@@ -384,3 +384,23 @@ TEST(GltfScene, TwoCylinderEngineInstancesAreNamedObjects) {
     return o.node_path == "node0/node1/Piston_123-844_0_Parts_1";
   })) << "the piston of issue 29 by its mesh's name";
 }
+
+// The engine of issue 29 with only an environment: its dry run groups the 115 parts by their
+// decisions (two sets: 113 with band-1 radiance, the 2 without albedo), bakes no FIV shells (no
+// animation moves a part) and estimates each group's cost, in a few dozen lines; nothing written.
+TEST(GltfScene, TheEngineDryRunGroupsItsPartsAndEstimatesTheCost) {
+  const fs::path path = "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " is missing (Debian package assimp-testmodels)";
+  const fs::path d = dir_for("engine_dry_run");
+  write_text(d / "o.json", R"({"prtbake_gltf_scene": 1, "environment": ")" + (fs::path(PRT_DATA_DIR) / "sunset.exr").string() +
+                               R"(", "bake": {"integrator": "qmc", "samples": 64}})");
+  const auto r = bake(d, "'" + path.string() + "' --options '" + (d / "o.json").string() + "' --dry-run");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"113 objects (both): node0/body, node0/body~2, node0/Lifter_123-923_0_Parts_1 and 110 more; 82065 vertices",
+                        "2 objects (both): node0/node4/Piston_123-844_0_Parts_1#p1, node0/node1/Piston_123-844_0_Parts_1#p1",
+                        "fiv: the object does not move", "left out, no occluder has shells", "estimated cost (nothing is baked):",
+                        "113 receivers (from node0|body): about ", " CPU s to bake 82065 vertices with qmc at 64 rays"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
+  EXPECT_LT(std::count(r.out.begin(), r.out.end(), '\n'), 30) << r.out;
+  EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
+}

@@ -239,7 +239,8 @@ TEST(SceneRules, ExampleSceneParsesAndPlans) {
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* s : {"ground (receiver)", "bunny (both)", "statue (both)", "spider (occluder)",
                         "transfer/visibility: order 11 for the Phong exponent 24",
-                        "leave out  ao, transfer, radiance: occluder only"})
+                        "leave out  ao, transfer, radiance: occluder only", "estimated cost (nothing is baked):",
+                        " CPU s to bake ", "(timed on 64 seeded vertices)"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
 }
 

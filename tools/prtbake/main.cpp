@@ -965,12 +965,44 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
                 scene.objects.size(), env ? scene.environment->string().c_str() : "none",
                 bake::to_string(scene.integrator.kind),
                 scene.sh_tolerance);
-    for (size_t i = 0; i < scene.objects.size(); ++i) {
+    // Every object with its decisions; with many objects (an engine of 115 parts), the objects
+    // that share their role and decisions are printed once as a group (-v: every object).
+    auto decisions = [&](size_t i) {
+      std::string d = std::string(bake::role_name(scene.objects[i].role)) + "\n";
+      for (const auto& b : plan.objects[i].baked) d += "      bake       " + b + "\n";
+      for (const auto& l : plan.objects[i].left_out) d += "      leave out  " + l + "\n";
+      return d;
+    };
+    auto name_of = [&](size_t i) {
       const auto& o = scene.objects[i];
-      std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n", (o.node_path.empty() ? o.name : o.node_path).c_str(),
-                  bake::role_name(o.role), o.mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size());
-      for (const auto& b : plan.objects[i].baked) std::printf("      bake       %s\n", b.c_str());
-      for (const auto& l : plan.objects[i].left_out) std::printf("      leave out  %s\n", l.c_str());
+      return o.node_path.empty() ? o.name : o.node_path;
+    };
+    constexpr size_t kGroupAbove = 12;  // objects; fewer are listed one by one
+    if (a.verbose || scene.objects.size() <= kGroupAbove) {
+      for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string d = decisions(i);
+        std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n%s", name_of(i).c_str(), bake::role_name(scene.objects[i].role),
+                    scene.objects[i].mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size(),
+                    d.substr(d.find('\n') + 1).c_str());
+      }
+    } else {
+      std::vector<std::pair<std::string, std::vector<size_t>>> sets;  // in order of first appearance
+      for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string d = decisions(i);
+        auto it = std::find_if(sets.begin(), sets.end(), [&](const auto& x) { return x.first == d; });
+        if (it == sets.end()) sets.push_back({d, {i}});
+        else it->second.push_back(i);
+      }
+      for (const auto& [d, members] : sets) {
+        size_t vertices = 0, triangles = 0;
+        for (size_t i : members) vertices += meshes[i].positions.size(), triangles += meshes[i].triangles.size();
+        std::string names;
+        for (size_t k = 0; k < std::min<size_t>(members.size(), 3); ++k) names += (k ? ", " : "") + name_of(members[k]);
+        if (members.size() > 3) names += " and " + std::to_string(members.size() - 3) + " more";
+        std::printf("  %zu object%s (%s): %s; %zu vertices, %zu triangles\n%s", members.size(), members.size() == 1 ? "" : "s",
+                    d.substr(0, d.find('\n')).c_str(), names.c_str(), vertices, triangles, d.substr(d.find('\n') + 1).c_str());
+      }
+      std::printf("  (objects with the same role and decisions are grouped; -v lists every object)\n");
     }
     for (const auto& l : scene.lights)
       std::printf("  light %s (%s): %zu face(s), radiance %g %g %g%s\n", l.name.c_str(), bake::light_shape_name(l.shape),
@@ -978,7 +1010,21 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
     for (const auto& n : plan.notes) std::printf("  %s\n", n.c_str());
     std::fflush(stdout);
   }
-  if (a.dry_run) return 0;
+  if (a.dry_run) {
+    // What the bake would cost: each group's integrator timed on seeded vertices (with a target,
+    // after the pilot that chooses it), nothing baked or written.
+    if (say) std::printf("estimated cost (nothing is baked):\n");
+    bake::SceneRows estimate;
+    estimate.estimate_only = true;
+    const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
+    bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, bar.monitor(&tool::interrupt_token()),
+                     [&](const std::string& line) {
+                       if (say) std::printf("  %s\n", line.c_str());
+                       std::fflush(stdout);
+                     },
+                     estimate);
+    return 0;
+  }
 
   const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());

@@ -290,6 +290,7 @@ struct ReferencePlan {
   uint64_t ray_budget = 0;             // the rays in all it could spend
   double cpu_seconds = 0;              // the CPU time it was given (0: none, rays alone bound it)
   bool cpu_bound = false;              // that time, not kReportRayBudget, set ray_budget
+  double us_per_ray = 0;               // the probe's CPU µs per ray (its finer level; counted costs: timed all the same)
   bool budget_bound = false;           // the budget kept some product above E/3
   double probe_seconds = 0;
 };

@@ -271,6 +271,11 @@ struct SceneRows {
                            const Monitor& monitor, const std::string& label, uint64_t& closed_form)>
       rows;
   bool rows_only = false;
+  // The dry run's estimate: no receiver is baked; per distinct product request (the receivers that
+  // make it), the integrator — with a target, the one the pilot chooses — is timed on 64 seeded
+  // vertices and `log` receives its predicted CPU time for all of them (and the error check's
+  // bound); no area lights, reports or FIV.
+  bool estimate_only = false;
 };
 
 // With a target error the choice is made once per distinct product request, on the pooled shade
