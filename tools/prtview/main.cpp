@@ -602,7 +602,7 @@ int run(const Args& a) {
     const view::EnvironmentExposure e = view::environment_exposure(*env);
     exposure = e.exposure;
     char buf[160];
-    std::snprintf(buf, sizeof buf, "1 / %.4g, an unshadowed white surface facing the brightest sky of %s", e.brightest,
+    std::snprintf(buf, sizeof buf, "1 / %.4g, E/pi of an unshadowed white surface facing the brightest sky of %s", e.brightest,
                   white_sky ? "the white sky" : env_name.c_str());
     exposure_why = buf;
   } else if (png) {
@@ -612,7 +612,7 @@ int run(const Args& a) {
       std::nth_element(y.begin(), y.begin() + std::ptrdiff_t(k), y.end());
       if (y[k] > 0 && std::isfinite(y[k])) exposure = view::round_significant(1.0 / double(y[k]), 4);
       char buf[160];
-      std::snprintf(buf, sizeof buf, "1 / %.4g, the 99th percentile of the baked area lighting at %zu vertices", double(y[k]), y.size());
+      std::snprintf(buf, sizeof buf, "1 / %.4g, the 99th percentile of the baked area lighting E/pi at %zu vertices", double(y[k]), y.size());
       exposure_why = buf;
     } else {
       exposure_why = "no baked area lighting to derive it from: --exposure X to set it";
