@@ -121,6 +121,11 @@ view "Default scene: transfer order 8" "-" "$images/default_transfer8.png" \
 view "Default scene: band-1 radiance (exact at vertices)" "-" "$images/default_band1.png" \
   "$work/default_t3.prt.h5" --env "$SUNSET" --shade band1 --camera "$CAMD" --samples "$RAYS" --reference-cache "$work/ref_default_$SIZE.exr"
 
+# ---- the first look: the same file with no --camera, --shade or --env: prtview shows the best it holds
+# (band-1 radiance), framed without the ground, exposed for sunset.exr ----
+view "Default scene, first look (no --camera, --shade or --env): band-1 radiance, framed on the bunny" "-" "$images/first_look.png" \
+  "$work/default_t3.prt.h5" --samples "$RAYS"
+
 # ---- a scene file (prtbake scene): every object in one z-buffer, each with its own products and albedo ----
 run "$BAKE" scene data/scene_example.json --quiet -o "$work/scene.prt.h5"
 view "Scene file (data/scene_example.json: ground, bunny, statue, spider), receivers" "-" "$images/scene_example.png" \
@@ -135,10 +140,14 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "($(nproc) cores, load average ${load_start} at start, ${load_end} at end; git $(git rev-parse --short HEAD))."
   echo "Do not edit by hand: rerun the script."
   echo
-  echo "Each picture is a triptych: **runtime** (prtshade, what an engine shows) | **reference** (Embree"
-  echo "ray tracing, same view, same exposure) | **error** (false colour of |runtime − reference|: black 0,"
-  echo "pale yellow ≥ 10 % of the reference's range, grey = not compared). Values are the outgoing"
-  echo "radiance of a white diffuse surface, E/π, ${SIZE} pixels."
+  echo "Each picture is a triptych, its panels labelled in the picture: **baked** (prtshade, what an engine"
+  echo "shows) | **reference** (Embree ray tracing, same view, same exposure) | **error** (false colour of"
+  echo "|runtime − reference|: black 0, pale yellow ≥ 10 % of the reference's range, grey = not compared;"
+  echo "its colour scale under it). Under the panels: the RMSE and NRMSE of the picture, the exposure, and"
+  echo "the file's own error report. Values are the outgoing radiance of a white diffuse surface, E/π,"
+  echo "${SIZE} pixels. The exposure is fixed by the environment, not by the pixels: 1 / the brightest"
+  echo "unshadowed white surface under it (\`prtview --help\`, OUTPUT), so the pictures of one environment"
+  echo "compare by eye."
   echo
   echo "**NRMSE** = RMSE / (max − min of the reference) over the compared pixels and the three channels"
   echo "(paper 004 §5 reports NRMSE without printing its normalisation; this is the usual range-normalised"
@@ -178,21 +187,27 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   light below the horizon is not negligible.
 - **Default scene.** Order-3 transfer cannot hold sunset.exr's sun (a lobe 4,000x the mean):
   NRMSE 0.03, mostly in the contact and self-shadows; order 8 and band-1 radiance (exact at the
-  vertices; what is left is Gouraud interpolation between vertices) are within 0.006-0.007.
+  vertices; what is left is Gouraud interpolation between vertices) are within 0.006-0.008.
+- **First look.** `prtview FILE -o look.png` (here with `--triptych`) on the order-3 file, which
+  also holds band-1 radiance: prtview shows band-1 radiance (the best it holds) and frames the
+  bunny without the 30 x 30 ground (view/camera.h `focus_box`). Closer, the Gouraud interpolation
+  of the contact shadow between the bunny's vertices takes more of the picture, hence a larger
+  NRMSE than the same product seen from afar.
 
 ## Scene file
 
 `prtbake scene data/scene_example.json` bakes what each object needs (README "Scene files"):
-band-1 radiance for the diffuse ground and bunny, AO and order-11 visibility transfer for the
-glossy statue, FIV shells for the occluders. prtview draws every object in one z-buffer, each
-times its albedo: the ground and the bunny with shade_band1, the statue with AO x the DifMap's
-unshadowed irradiance (glossy shading is not in the runtime yet, so the statue shows its
-AO-shaded diffuse response), the spider (occluder only, no per-vertex data) with its FIV
-self-shadows. The reference traces the same objects: the bunny, statue and spider cast shadows,
-the ground ("receiver") does not. The NRMSE compares the receivers (ground, bunny, statue);
-prtview also prints each one's share (its RMSE over the same range). The error is the Gouraud
-interpolation of the contact shadows across the ground's 1.7-unit cells (under the bunny and the
-statue's feet) and the statue's AO approximation of a shadowed sun.
+band-1 radiance for the diffuse ground and bunny, AO, visibility transfer and shadowed radiance
+for the glossy statue, FIV shells for the occluders. prtview draws every object in one z-buffer,
+each times its albedo: the ground, the bunny and the statue with shade_band1 (the statue's
+band-1 radiance is band 1 of its shadowed radiance S, the same integrals: its diffuse response
+with exact shadows; its glossy lobe is drawn by `prtview --shade glossy`, bench/RESULTS.md
+"Glossy shading"), the spider (occluder only, no per-vertex data) with its FIV self-shadows.
+The reference traces the same objects: the bunny, statue and spider cast shadows, the ground
+("receiver") does not. The NRMSE compares the receivers (ground, bunny, statue); prtview also
+prints each one's share (its RMSE over the same range). The error is the Gouraud interpolation
+of the contact shadows across the ground's 1.7-unit cells (under the bunny and the statue's
+feet) and of the statue's sun shadows between its vertices.
 
 NOTES
   echo

@@ -1,7 +1,10 @@
 // End-to-end tests of the prtview binary: bad input fails cleanly (message, exit status, no file
 // left behind), and real renders of small baked files give the numbers their closed forms predict.
+#include <formats/asset.h>
 #include <formats/prtfile.h>
 #include <formats/testing.h>
+#include <view/image.h>
+#include <view/text.h>
 
 #include <gtest/gtest.h>
 
@@ -12,8 +15,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -89,6 +95,13 @@ std::pair<uint32_t, uint32_t> png_size(const fs::path& p) {
 
 const std::string kCamera = "--camera eye=0,3,4:at=0,0,0:fov=50";
 
+// The height of a labelled PNG (view/text.h labelled_row) of `h`-pixel pictures: the caption
+// strip, the error panel's scale strip and prtview's two footer lines (quality, the file's report).
+int labelled_height(int h) {
+  using namespace prt::view;
+  return (2 * kCaptionPad + kLineHeight) + h + (2 * kCaptionPad + 2 * kLineHeight) + (2 * kLineHeight + kCaptionPad);
+}
+
 // A flat n × n grid of unit cells in y = 0 centred on the origin (normals +Y from the
 // angle-weighted rule), written to `p` (default: a 4 × 4 grid in the scratch directory).
 fs::path plane_obj(int n = 4, fs::path p = {}) {
@@ -159,7 +172,7 @@ TEST(Prtview, Band1OfAnOpenPlaneMatchesTheReference) {
   ASSERT_TRUE(std::isfinite(e)) << r.out;
   EXPECT_LT(e, 2e-3) << r.out;
   EXPECT_NE(r.out.find("reference noise 0.00000"), std::string::npos) << r.out;
-  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{40, 30}));
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{40, uint32_t(labelled_height(30))})) << "the map, its scale and summary";
   // A wrong environment is refused: band-1 radiance belongs to the environment it was baked with.
   const Outcome w = view(h5.string() + " " + kCamera + " --env " + (kData / "forest.exr").string() + " -o " + scratch("w.png").string());
   EXPECT_EQ(w.code, 1);
@@ -182,10 +195,10 @@ TEST(Prtview, AoFileNeedsNoCameraAndShowsTheAoUnderAWhiteSky) {
   EXPECT_LT(nrmse(r.out), 1e-6) << r.out;
   EXPECT_NE(r.out.find("constant white sky"), std::string::npos) << r.out;
   // No camera: the asset is framed and the camera printed, ready to copy into --camera.
-  const std::string key = "framing the asset: --camera ";
+  const std::string key = "\n  --camera ";
   const size_t at = r.out.find(key);
   ASSERT_NE(at, std::string::npos) << r.out;
-  const std::string cam = r.out.substr(at + key.size(), r.out.find('\n', at) - at - key.size());
+  const std::string cam = r.out.substr(at + key.size(), r.out.find('\n', at + key.size()) - at - key.size());
   const Outcome again = view(h5.string() + " --size 40x30 --camera " + cam + " -o " + out.string());
   EXPECT_EQ(again.code, 0) << again.err;
   EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{40, 30}));
@@ -213,7 +226,7 @@ TEST(Prtview, FivTriptychOfACopiedOccluder) {
   EXPECT_TRUE(std::isfinite(nrmse(r.out))) << r.out;
   EXPECT_NE(r.out.find("2 copies"), std::string::npos) << r.out;
   // Three 32 × 24 panels and two 4-pixel gaps (bake::hstack).
-  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{3 * 32 + 2 * 4, 24}));
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{3 * 32 + 2 * 4, uint32_t(labelled_height(24))}));
   // The shells belong to cube.obj: another mesh is refused by its SHA-256.
   const Outcome w = view(h5.string() + " " + cam + " --occluder-mesh " + plane_obj().string() + " -o " + scratch("w.png").string());
   EXPECT_EQ(w.code, 1);
@@ -273,7 +286,7 @@ TEST(PrtviewScene, RendersEveryObjectAgainstTheReferenceWithRoles) {
   EXPECT_NE(r.out.find("ground: band-1 radiance"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("box: FIV self-shadows"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("shadows cast by 12 of 140 triangles"), std::string::npos) << "the box casts, the ground does not\n" << r.out;
-  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{3 * 48 + 2 * 4, 36}));
+  EXPECT_EQ(png_size(out), (std::pair<uint32_t, uint32_t>{3 * 48 + 2 * 4, uint32_t(labelled_height(36))}));
   // Compared: the ground (the only receiver). Its band-1 values are exact at the vertices up to the
   // bake's discretisation (1024 directions), so the runtime's own error is the Gouraud
   // interpolation of the box's shadow across 1-unit cells: NRMSE 0.011 against a 1024-ray
@@ -419,4 +432,257 @@ TEST(Prtview, DamagedAndOldFormatFilesGiveOneLineNeverACrash) {
   EXPECT_GT(refused, 18) << "most flips of a small file hit checksummed bytes";
   const Outcome old = view(bad.string() + " " + kCamera + " -o " + out.string());
   EXPECT_NE(old.err.find("oldest file format"), std::string::npos) << old.err;
+}
+
+// ---- the first look (issue 29): the best product, stated; framed on what matters; a fixed,
+// stated exposure; labelled panels; short log lines; --version ----
+
+namespace {
+
+// The default scene (data/bunny_ground.obj: the bunny on a 30 x 30 ground grid) with AO, order-3
+// transfer and band-1 radiance under sunset.exr: the file of the issue, coarse (256 directions,
+// no report: 0.2 s).
+fs::path bake_default(const std::string& tag) {
+  const fs::path h5 = scratch("default_" + tag + ".prt.h5");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + (kData / "bunny_ground.obj").string() + " --ao --transfer 3 --radiance " +
+                                         (kData / "sunset.exr").string() + " --samples 256 --report 0 --quiet -o " + h5.string());
+  EXPECT_EQ(b.code, 0) << b.err;
+  return h5;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+// The camera the first look printed ("  --camera SPEC"): eye, at, up, fov.
+struct PrintedCamera {
+  double eye[3], at[3], up[3], fov;
+  bool ok = false;
+};
+PrintedCamera printed_camera(const std::string& out) {
+  PrintedCamera c{};
+  const size_t at = out.find("\n  --camera ");
+  if (at == std::string::npos) return c;
+  c.ok = std::sscanf(out.c_str() + at + 12, "eye=%lf,%lf,%lf:at=%lf,%lf,%lf:up=%lf,%lf,%lf:fov=%lf", &c.eye[0], &c.eye[1],
+                     &c.eye[2], &c.at[0], &c.at[1], &c.at[2], &c.up[0], &c.up[1], &c.up[2], &c.fov) == 10;
+  return c;
+}
+
+} // namespace
+
+TEST(PrtviewFirstLook, ShowsTheBestProductTheFileHoldsAndSaysWhatElseItHas) {
+  // Band-1 radiance (exact shadows under the baked environment) over order-3 transfer over AO;
+  // the first line says which, and how to see the others.
+  const fs::path h5 = bake_default("best"), out = scratch("best.png");
+  const Outcome r = view(h5.string() + " --size 64x64 -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(first_line(r.out), h5.string() + ": the best it holds, band-1 radiance (exact shadows under sunset.exr); also: "
+                                             "diffuse transfer order 3 (--shade transfer), AO (--shade ao)");
+  EXPECT_NE(r.out.find("runtime ("), std::string::npos);
+  EXPECT_NE(r.out.find("prt::shade::shade_band1"), std::string::npos) << r.out;
+  // Asked for: shown, and the best named among the others.
+  const Outcome t = view(h5.string() + " --size 64x64 --shade transfer -o " + out.string());
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_EQ(first_line(t.out), h5.string() + ": diffuse transfer order 3 under sunset.exr; also: band-1 radiance (--shade band1), "
+                                             "AO (--shade ao)");
+  // Under another environment band-1 radiance cannot be shown: the first look takes the transfer
+  // and says why.
+  const Outcome w = view(h5.string() + " --size 64x64 --env " + (kData / "forest.exr").string() + " -o " + out.string());
+  ASSERT_EQ(w.code, 0) << w.err;
+  EXPECT_EQ(first_line(w.out).find(h5.string() + ": the best it holds, diffuse transfer order 3 under forest.exr (its band-1 "
+                                                 "radiance belongs to the environment it was baked with: drop --env to see it)"),
+            0u)
+      << w.out;
+  fs::remove(out);
+}
+
+TEST(PrtviewFirstLook, ShadowedRadianceAloneIsShownByItsBandOne) {
+  // A file with /radiance/shadowed (order 3) but no /radiance/band1: its coefficients i = 1..3
+  // are the band-1 radiance (the same integrals), so the first look shades them with
+  // shade_band1. On the open plane (no occlusion) that is the exact irradiance up to the bake's
+  // discretisation: NRMSE < 2e-3, the bound of Band1OfAnOpenPlaneMatchesTheReference.
+  const fs::path src = scratch("s_src.prt.h5"), h5 = scratch("s_only.prt.h5"), out = scratch("s_only.png");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
+                                         " --shadowed 3 --report 0 --quiet -o " + src.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  prt::formats::Asset a = prt::formats::read_asset(src);
+  ASSERT_TRUE(a.vertices.radiance_band1 && a.vertices.radiance_shadowed);
+  a.vertices.radiance_band1.reset();
+  prt::formats::write_asset(h5, a);
+  const Outcome r = view(h5.string() + " " + kCamera + " --size 40x30 --samples 8 --error -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(first_line(r.out), h5.string() + ": the best it holds, band 1 of the shadowed radiance (order 3) (exact shadows "
+                                             "under sunset.exr)");
+  EXPECT_LT(nrmse(r.out), 2e-3) << r.out;
+  fs::remove(out);
+}
+
+TEST(PrtviewFirstLook, FramesTheBunnyNotTheWholeGround) {
+  // The ground (48 x 48 quads, 42.4 wide) is 2.7x as wide as the bunny (15.8): set aside
+  // (view::focus_box), and the bunny is framed. Measured by projecting the bunny's own vertices
+  // (data/bunny.obj: the first 1839 of bunny_ground.obj's 4240) with the camera the first look prints:
+  // their bounding rectangle covers 46% of the picture (4.8% when the whole ground was framed).
+  // Bound 30%: frame_box fits the bunny's bounding box within 90% of the picture's height, and a
+  // three-quarter view of the bunny inside its own box covers well over half of the box's image.
+  const fs::path h5 = bake_default("frame"), out = scratch("frame.png");
+  const Outcome r = view(h5.string() + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("framing the geometry without its large flat part (4608 triangles"), std::string::npos) << r.out;
+  const PrintedCamera c = printed_camera(r.out);
+  ASSERT_TRUE(c.ok) << r.out;
+  const auto sub = [](const double* a, const double* b) { return std::array<double, 3>{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  const auto dot = [](const std::array<double, 3>& a, const std::array<double, 3>& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const auto unit = [&](std::array<double, 3> a) {
+    const double n = std::sqrt(dot(a, a));
+    return std::array<double, 3>{a[0] / n, a[1] / n, a[2] / n};
+  };
+  const auto cross = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  // view/camera.h: f = at - eye, r = f x up, u = r x f; pixel x = W/2 (1 + (d.r)/(z tan)), y = H/2 (1 - (d.u)/(z tan)).
+  const auto f = unit(sub(c.at, c.eye)), rt = unit(cross(f, {c.up[0], c.up[1], c.up[2]})), u = cross(rt, f);
+  const double t = std::tan(c.fov * std::numbers::pi / 360);
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  std::ifstream obj(kData / "bunny.obj");
+  int n = 0;
+  for (std::string line; std::getline(obj, line);) {
+    double q[3];
+    if (std::sscanf(line.c_str(), "v %lf %lf %lf", &q[0], &q[1], &q[2]) != 3) continue;
+    const auto d = sub(q, c.eye);
+    const double z = dot(d, f), x = 128 * (1 + dot(d, rt) / (z * t)), y = 128 * (1 - dot(d, u) / (z * t));
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    ++n;
+  }
+  ASSERT_EQ(n, 1839);
+  const double covered = (std::min(x1, 256.0) - std::max(x0, 0.0)) * (std::min(y1, 256.0) - std::max(y0, 0.0)) / (256.0 * 256.0);
+  EXPECT_GT(covered, 0.30) << r.out;
+  EXPECT_TRUE(x0 >= 0 && x1 <= 256 && y0 >= 0 && y1 <= 256) << "the whole bunny is in the picture\n" << r.out;
+  fs::remove(out);
+}
+
+TEST(PrtviewFirstLook, TheExposureIsFixedByTheEnvironmentAloneInATriptychAndUnderAnyCamera) {
+  // The exposure comes from sunset.exr (view::environment_exposure), not from this render's
+  // pixels: the same number alone, in the triptych (which used to expose for the reference:
+  // 1.363 alone, 1.062 in the triptych) and under another camera and size; --exposure overrides.
+  // Same exposure, same runtime render: the triptych's first panel is the lone picture, byte
+  // for byte.
+  const fs::path h5 = bake_default("exposure"), alone = scratch("alone.png"), tri = scratch("tri.png"), other = scratch("other.png");
+  const Outcome a = view(h5.string() + " --size 64x48 -o " + alone.string());
+  const Outcome b = view(h5.string() + " --size 64x48 --samples 8 --triptych -o " + tri.string());
+  const Outcome c = view(h5.string() + " --size 40x40 --camera eye=0,40,2:at=0,0,0 -o " + other.string());
+  const Outcome d = view(h5.string() + " --size 40x40 --exposure 0.5 -o " + other.string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  ASSERT_EQ(c.code, 0) << c.err;
+  const double e = number_after(a.out, "exposure ");
+  ASSERT_TRUE(std::isfinite(e) && e > 0) << a.out;
+  EXPECT_EQ(number_after(b.out, "exposure "), e) << b.out;
+  EXPECT_EQ(number_after(c.out, "exposure "), e) << c.out;
+  EXPECT_EQ(number_after(d.out, "exposure "), 0.5) << d.out;
+  EXPECT_NE(a.out.find("an unshadowed white surface facing the brightest sky of sunset.exr"), std::string::npos) << a.out;
+  const prt::view::Image8 one = prt::view::read_png(alone), three = prt::view::read_png(tri);
+  ASSERT_EQ(one.width, 64);
+  const int top = 2 * prt::view::kCaptionPad + prt::view::kLineHeight;  // the caption strip
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int k = 0; k < 3; ++k)
+        ASSERT_EQ(three.rgb[3 * (size_t(top + y) * size_t(three.width) + size_t(x)) + size_t(k)], one.rgb[3 * (size_t(y) * 64 + size_t(x)) + size_t(k)])
+            << x << "," << y;
+  fs::remove(alone);
+  fs::remove(tri);
+  fs::remove(other);
+}
+
+TEST(PrtviewFirstLook, TriptychPanelsAreLabelledWithTheErrorScaleAndTheQualityLine) {
+  // Each panel's caption is drawn above it (compared pixel for pixel with the same text drawn
+  // alone), the error panel has its colour ramp, and the quality line — RMSE of baked vs
+  // reference in this picture and the file's own report — is printed and drawn under the panels.
+  const fs::path h5 = bake_default("labels"), out = scratch("labels.png");
+  const Outcome r = view(h5.string() + " --size 64x48 --samples 8 --triptych -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const prt::view::Image8 im = prt::view::read_png(out);
+  ASSERT_EQ(im.width, 3 * 64 + 2 * 4);
+  ASSERT_EQ(im.height, labelled_height(48));
+  using namespace prt::view;
+  const int strip = 2 * kCaptionPad + kLineHeight;
+  const std::string captions[3] = {"baked (band-1 radiance)", "reference (ray traced)", "error x10"};
+  for (int p = 0; p < 3; ++p) {
+    Image8 expect(64, strip, 255);
+    draw_text(expect, kCaptionPad, kCaptionPad, fit_text(captions[p], 64 - 2 * kCaptionPad), {0, 0, 0});
+    int ink = 0;
+    for (int y = 0; y < strip; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const uint8_t v = im.rgb[3 * (size_t(y) * size_t(im.width) + size_t(68 * p + x))];
+        EXPECT_EQ(v, expect.rgb[3 * (size_t(y) * 64 + size_t(x))]) << "panel " << p << " at " << x << "," << y;
+        ink += v == 0;
+      }
+    EXPECT_GT(ink, 20) << "panel " << p;
+  }
+  const size_t bar = 3 * (size_t(strip + 48 + kCaptionPad) * size_t(im.width));
+  const auto lo = error_colour(0), hi = error_colour(1);
+  EXPECT_TRUE(std::equal(lo.begin(), lo.end(), im.rgb.begin() + std::ptrdiff_t(bar + 3 * size_t(136 + kCaptionPad)))) << "the ramp starts black";
+  EXPECT_TRUE(std::equal(hi.begin(), hi.end(), im.rgb.begin() + std::ptrdiff_t(bar + 3 * size_t(136 + 64 - kCaptionPad - 1))))
+      << "and ends pale yellow";
+  const size_t q = r.out.find("\nquality: RMSE ");
+  ASSERT_NE(q, std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("in this picture (NRMSE ", q), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("; file: no error report (baked with --report 0)", q), std::string::npos) << r.out;
+  int footer_ink = 0;
+  for (size_t i = 3 * size_t(strip + 48 + 2 * kCaptionPad + 2 * kLineHeight) * size_t(im.width); i < im.rgb.size(); i += 3) footer_ink += im.rgb[i] == 0;
+  EXPECT_GT(footer_ink, 100) << "two lines of text under the panels";
+  fs::remove(out);
+}
+
+TEST(PrtviewFirstLook, EveryLogLineIsShortWhateverTheScene) {
+  // A scene of 40 objects with 64-character names (a glTF's node paths are as long): the lists of
+  // objects are summarised ("a, b and 38 more"), per-object lines stop at 12, so every line of
+  // stdout and stderr stays within 200 characters (the first line used to list every object:
+  // 8,607 characters for the engine glTF). 200: a camera line (10 numbers of 9 digits) and a
+  // file path fit, a list of names does not.
+  const fs::path d = fs::path(PRT_TEST_TMP) / "prtview" / ("many_" + std::to_string(getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  plane_obj(8, d / "ground.obj");
+  std::ofstream(d / "box.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                  "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+  std::ofstream json(d / "scene.json");
+  json << "{\n  \"prtbake_scene\": 1,\n  \"environment\": \"" << (kData / "sunset.exr").string()
+       << "\",\n  \"bake\": {\"products\": [\"ao\"], \"samples\": 64, \"report\": 0},\n  \"objects\": [\n"
+          "    {\"name\": \"ground\", \"mesh\": \"ground.obj\", \"role\": \"receiver\"}";
+  for (int k = 0; k < 40; ++k) {
+    char name[80];
+    std::snprintf(name, sizeof name, "assembly_%02d_with_a_name_as_long_as_a_gltf_node_path_of_an_engine", k);
+    json << ",\n    {\"name\": \"" << name << "\", \"mesh\": \"box.obj\", \"role\": \"both\", \"transform\": {\"translate\": ["
+         << (k % 8) - 4 << ", 0, " << (k / 8) - 3 << "], \"scale\": 0.5}}";
+  }
+  json << "\n  ]\n}\n";
+  json.close();
+  const fs::path h5 = d / "scene.prt.h5", out = d / "many.png";
+  const Outcome b = run(PRT_PRTBAKE, "scene " + (d / "scene.json").string() + " --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const Outcome r = view(h5.string() + " --size 48x36 --samples 8 --triptych -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(first_line(r.out).find(" more"), std::string::npos) << first_line(r.out);
+  size_t lines = 0;
+  for (const std::string* text : {&r.out, &r.err})
+    for (const std::string& line : lines_of(*text)) {
+      EXPECT_LE(line.size(), 200u) << line;
+      ++lines;
+    }
+  EXPECT_LT(lines, 60u) << r.out << r.err;
+  fs::remove_all(d);
+}
+
+TEST(Prtview, AnswersVersionLikePrtbake) {
+  // The toolkit's version, as prtbake prints it, under prtview's own name; exit 0, nothing else.
+  const Outcome v = view("--version"), b = run(PRT_PRTBAKE, "--version");
+  EXPECT_EQ(v.code, 0) << v.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  ASSERT_EQ(b.out.rfind("prtbake ", 0), 0u) << b.out;
+  EXPECT_EQ(v.out, "prtview " + b.out.substr(8));
+  EXPECT_EQ(v.err, "");
 }

@@ -64,7 +64,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
     const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
     const F::SceneObject* fo = f.find_object(o.name);
     const F::Product* e = fo && fo->set.area_irradiance ? &*fo->set.area_irradiance : nullptr;
-    if (e && !exact) {
+    if (e) {
       // Column l of E is the light named on line l of its `lights` attribute.
       const std::vector<std::string> names = F::split_light_list(e->lights.value_or(""));
       std::vector<const bake::AreaLight*> column;
@@ -75,12 +75,18 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
         column.push_back(&*it);
       }
       const size_t L = column.size();
-      for (size_t v = 0; v < V; ++v)
+      for (size_t v = 0; v < V; ++v) {
+        float value[3];
         for (size_t c = 0; c < 3; ++c) {
           double sum = 0;
           for (size_t l = 0; l < L; ++l) sum += column[l]->radiance[c] * double(e->values[v * L + l]);
-          rgb.push_back(float(double(o.albedo[c]) * sum * std::numbers::inv_pi));
+          value[c] = float(double(o.albedo[c]) * sum * std::numbers::inv_pi);
         }
+        scene.baked_luminance.push_back(float(0.2126 * value[0] + 0.7152 * value[1] + 0.0722 * value[2]));
+        if (!exact) rgb.insert(rgb.end(), value, value + 3);
+      }
+    }
+    if (e && !exact) {
       per_pixel.insert(per_pixel.end(), T, 0);
       ++baked;
     } else {

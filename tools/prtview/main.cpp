@@ -10,12 +10,15 @@
 #include "tool_main.h"
 
 #include <view/camera.h>
+#include <view/exposure.h>
 #include <view/image.h>
 #include <view/raster.h>
 #include <view/reference.h>
+#include <view/text.h>
 
 #include <bake/envmap.h>
 #include <bake/error.h>
+#include <bake/sha256.h>
 #include <formats/asset.h>
 
 #include <CLI/CLI.hpp>
@@ -43,8 +46,9 @@ constexpr const char* kDescription =
     "prtview - render a baked file shaded by the runtime library, next to ray-traced ground truth\n\n"
     "  prtview FILE.prt.h5 -o IMAGE.png|IMAGE.exr [--camera eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]]\n"
     "          [--env ENV.exr] [--size WxH] [--reference | --error | --triptych] [OPTIONS]\n\n"
-    "  A first look needs only the file and an image: 'prtview baked.prt.h5 -o look.png' frames the\n"
-    "  whole asset and prints the camera it chose, to copy into --camera and adjust.\n";
+    "  A first look needs only the file and an image: 'prtview baked.prt.h5 -o look.png' shows the best\n"
+    "  product the file holds (and says what else it holds), frames the geometry without its large flat\n"
+    "  parts (a ground), prints the camera to copy into --camera, and the exposure, fixed by the environment.\n";
 
 constexpr const char* kFooter = R"(
 WHAT IS DRAWN
@@ -60,12 +64,16 @@ WHAT IS DRAWN
                 of the file) and every vertex gets sum_i T_i L_i (prt::shade::shade_transfer);
                 any environment works: the transfer does not depend on the lighting.
       band1     E = 4pi/3 sum_m y_1m(n) R_m at the baked normal (prt::shade::shade_band1): exact
-                all-frequency shadows under the environment the file was baked with.
+                all-frequency shadows under the environment the file was baked with. R is
+                /radiance/band1, or the band-1 coefficients of /radiance/shadowed (the same
+                integrals) when the file holds only that.
       ao        AO x E_unocc(n)/pi at each vertex, E_unocc the environment's unshadowed
                 irradiance at the baked normal (bake/irradiance.h): the ambient-occlusion
                 approximation. Without --env: a constant white sky (L = 1), so the picture IS
                 the AO (1 = white, 0 = black) and the reference is the true AO of each pixel.
-    The default --shade is the first the file holds of transfer, band1, ao.
+    The first look (no --shade) shows the best the file holds: band1, else transfer, else ao
+    (band1 only under its own environment: with another --env, transfer), and its first line
+    says so and names the others.
   FIV files (/fiv from 'prtbake fiv', paper 004): the occluder mesh (from --occluder-mesh, else
     the file's 'source' attribute; its SHA-256 must match the file's) stands on a square ground
     plane (the receiver), and each pixel is shaded by prtshade: the ground with
@@ -133,8 +141,14 @@ OUTPUT (-o; the extension picks the format: .png for people, .exr for numbers)
                   --error-scale x the reference's range; grey = not compared. EXR: the signed
                   difference runtime - reference in float) and prints NRMSE.
   --triptych      runtime | reference | error side by side (same exposure), prints NRMSE.
-  PNG: 8-bit sRGB of (exposure x value), clipped at 1; --exposure X, default: 1 / the 99th
-  percentile of the luminance (of the reference when it is rendered). EXR: float RGB, linear.
+  PNG: 8-bit sRGB of (exposure x value), clipped at 1. --exposure X, default: fixed by the
+  environment, never by the pixels, so a file gives the same exposure alone, in a triptych and
+  under any camera: 1 / the brightest unshadowed white surface, max over normals n of the
+  luminance of E_unocc(n)/pi, to 4 digits (view/exposure.h; a white sky: 1); area lights: 1 / the
+  99th percentile of the baked per-vertex lighting. Printed with what it came from.
+  PNG triptychs and error maps are labelled: a caption above each panel, the error panel's colour
+  scale, and two lines under them: RMSE/NRMSE in this picture and the file's own error report
+  (also printed as the 'quality:' line). EXR: float RGB, linear, no labels.
   Files are written to a temporary name and renamed: a failure leaves nothing behind.
 
 ERROR NUMBERS
@@ -150,6 +164,9 @@ ERROR NUMBERS
   (RMS standard error / range) with the noise-corrected NRMSE sqrt(RMSE^2 - sigma^2)/range.
 
 EXAMPLES
+  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5
+  prtview bunny.prt.h5 -o look.png                 the first look: band-1 radiance, framed on the bunny
+  prtview bunny.prt.h5 --triptych -o compare.png   the same view next to the reference, labelled
   prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5
   prtview bunny.fiv.prt.h5 --camera eye=0,22,24:at=0,0,2:fov=40 -o shadow.png
   prtview bunny.fiv.prt.h5 --camera eye=0,22,24:at=0,0,2:fov=40 --triptych -o compare.png
@@ -217,10 +234,11 @@ std::string wrap(const std::string& text, size_t width = 66) {
   return out + line;
 }
 
-// The command line; nullopt after --help.
+// The command line; nullopt after --help or --version (printed).
 std::optional<Args> parse(int argc, char** argv) {
   Args a;
   CLI::App app(kDescription, "prtview");
+  app.set_version_flag("--version", std::string("prtview ") + PRT_VERSION);
   app.footer(std::string(kFooter) + tool::kExitStatusHelp);
   app.get_formatter()->column_width(28);
   app.allow_extras();  // reported below as "unknown option" / "unexpected argument"
@@ -237,14 +255,15 @@ std::optional<Args> parse(int argc, char** argv) {
   app.add_option("--camera", a.camera,
                  "eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]: eye, at (required), up (default 0,1,0), fov = vertical "
                  "field of view in degrees (default 45); world units of the mesh. Default: a three-quarter view "
-                 "from above the front that frames the whole asset (printed, to copy and adjust).");
+                 "from above the front that frames the geometry without its large flat parts, e.g. a ground (printed, "
+                 "to copy and adjust).");
   app.add_option("--size", size, "WxH: image size in pixels (default 256x256).");
   app.add_flag("--reference", reference, "write the ray-traced reference instead of the runtime render.");
   app.add_flag("--error", error, "write a false-colour map of |runtime - reference| and print NRMSE.");
   app.add_flag("--triptych", triptych, "write runtime | reference | error side by side and print NRMSE.");
   app.add_option("--shade", a.shade,
-                 "transfer | band1 | ao | fiv (default: fiv if the file has /fiv, else the first it holds of "
-                 "transfer, band1, ao); scene files: glossy (the glossy objects' specular lobes), and with area "
+                 "transfer | band1 | ao | fiv (default: fiv if the file has /fiv, else the best it holds of "
+                 "band1, transfer, ao); scene files: glossy (the glossy objects' specular lobes), and with area "
                  "lights area | area-exact (see WHAT IS DRAWN).")
       ->check(CLI::IsMember({"transfer", "band1", "ao", "fiv", "glossy", "area", "area-exact"}));
   CLI::Option* phong_opt = app.add_option("--phong", phong_value,
@@ -264,7 +283,7 @@ std::optional<Args> parse(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", a.seed, "reference randomisation seed (default 1); same seed, same bytes.")
       ->check(CLI::NonNegativeNumber);
-  CLI::Option* exposure_opt = app.add_option("--exposure", exposure, "PNG exposure (see OUTPUT).");
+  CLI::Option* exposure_opt = app.add_option("--exposure", exposure, "PNG exposure (default: fixed by the environment; see OUTPUT).");
   app.add_option("--error-scale", a.error_scale, "error map full scale as a fraction of the reference range (default 0.1).");
   app.add_option("--region", a.region, "receiver | all (see ERROR NUMBERS).")->check(CLI::IsMember({"receiver", "all"}));
   app.add_option("--reference-cache", a.reference_cache,
@@ -293,6 +312,9 @@ std::optional<Args> parse(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
     std::fputs(app.help().c_str(), stdout);
+    return std::nullopt;
+  } catch (const CLI::Success& e) {  // --version
+    app.exit(e);
     return std::nullopt;
   } catch (const CLI::ParseError& e) {
     throw UsageError(e.what());
@@ -424,6 +446,7 @@ int run(const Args& a) {
   const F::Asset f = F::read_asset(a.file);
   const bool area = a.shade == "area" || a.shade == "area-exact";
   std::string kind = a.shade;
+  std::string skipped;  // why the first look did not take the best product
   if (area) {
     if (!prtview::is_scene_file(f))
       throw UsageError("--shade " + a.shade + ": " + a.file + " is not a scene file; area lights are baked by 'prtbake scene'");
@@ -434,13 +457,24 @@ int run(const Args& a) {
   } else if (a.shade == "glossy") {
     throw UsageError("--shade glossy: " + a.file + " is not a scene file; glossy objects are baked by 'prtbake scene'");
   } else if (kind.empty()) {
-    const std::vector<std::string> kinds = prtview::vertex_kinds(f);
+    // The first look: the best product the file holds (prtview::vertex_kinds' order), except
+    // band-1 radiance under an --env it was not baked with (it belongs to its own environment).
+    std::vector<std::string> kinds = prtview::vertex_kinds(f);
+    if (!a.env.empty() && kinds.size() > 1 && kinds.front() == "band1") {
+      const std::string baked_sha = prtview::band1_environment_sha256(f);
+      if (!baked_sha.empty() && fs::exists(a.env) && baked_sha != bake::sha256_file(a.env)) {
+        skipped = "its " + prtview::vertex_kind_label(f, "band1") + " belongs to the environment it was baked with: drop --env to see it";
+        kinds.erase(kinds.begin());
+      }
+    }
     kind = prtview::has_fiv(f) ? "fiv" : kinds.empty() ? "band1" : kinds.front();  // band1: its read names what is missing
   }
   if (kind != "scene" && kind != "glossy" && kind != "fiv" && !area && prtview::has_fiv(f))
     throw UsageError("--shade " + kind + ": " + a.file + " is an FIV file; it is shown with --shade fiv (the default)");
   if (kind == "transfer" || kind == "band1" || kind == "ao") prtview::require_vertex_kind(f, a.file, kind);
-  const view::Camera cam = given_camera ? *given_camera : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height, kind == "glossy");
+  const prtview::FirstLook look = given_camera ? prtview::FirstLook{*given_camera, ""}
+                                               : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height, kind == "glossy");
+  const view::Camera& cam = look.camera;
   // AO needs an environment only to weigh it: without one (AO files name none), a white sky.
   const bool white_sky = kind == "ao" && a.env.empty();
   if ((kind == "scene" || kind == "glossy" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
@@ -486,20 +520,61 @@ int run(const Args& a) {
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();
+  const std::string env_name = env_path.empty() ? std::string() : fs::path(env_path).filename().string();
+  // What the picture shows, for the first line and the first panel's caption.
+  std::string shown, caption;
+  if (kind == "band1" || kind == "transfer" || kind == "ao") {
+    caption = prtview::vertex_kind_label(f, kind);
+    shown = caption + (kind == "band1"        ? " (exact shadows under " + env_name + ")"
+                       : kind == "transfer" ? " under " + env_name
+                       : white_sky          ? " under a white sky"
+                                            : " x the unshadowed irradiance of " + env_name);
+  } else if (kind == "fiv") {
+    caption = "FIV shells";
+    shown = scene.what;
+  } else if (kind == "scene") {
+    caption = "per-object products";
+    shown = scene.what;
+  } else if (kind == "glossy") {
+    caption = "glossy lobes";
+    shown = scene.what;
+  } else {
+    caption = a.shade == "area-exact" ? "exact area lights" : "baked area lights";
+    shown = scene.what;
+  }
   if (say) {
-    std::printf("%s: %s\n", a.file.c_str(), scene.what.c_str());
+    std::vector<std::string> also;
+    if (kind == "band1" || kind == "transfer" || kind == "ao") {
+      for (const std::string& k : prtview::vertex_kinds(f))
+        if (k != kind) also.push_back(prtview::vertex_kind_label(f, k) + " (--shade " + k + ")");
+    } else if (kind == "scene" || kind == "glossy" || area) {
+      const bool glossy = std::any_of(f.objects.begin(), f.objects.end(), [](const F::SceneObject& o) {
+        return o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed);
+      });
+      if (kind != "scene") also.push_back("the objects under the environment (no --shade)");
+      if (glossy && kind != "glossy") also.push_back("glossy lobes (--shade glossy)");
+      if (!f.lights.empty() && !area) also.push_back(std::to_string(f.lights.size()) + " area light(s) (--shade area, area-exact)");
+    }
+    std::string line = a.file + ": " + (a.shade.empty() && kind != "scene" && kind != "fiv" ? "the best it holds, " : "") + shown;
+    if (!skipped.empty()) line += " (" + skipped + ")";
+    if (!also.empty()) {
+      line += "; also: ";
+      for (size_t k = 0; k < also.size(); ++k) line += (k ? ", " : "") + also[k];
+    }
+    std::printf("%s\n", line.c_str());
+    if (kind == "band1" || kind == "transfer" || kind == "ao") std::printf("%s\n", scene.what.c_str());
     if (white_sky) std::printf("environment: a constant white sky (L = 1): the picture is the AO itself (--env ENV.exr to light it)\n");
     else if (env) std::printf("environment: %s (%dx%d %s)\n", env_path.c_str(), env->info().width, env->info().height, env->info().layout.c_str());
     if (given_camera) std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
-    else std::printf("view: %dx%d, framing the asset: --camera %s\n", a.width, a.height, view::to_string(cam).c_str());
-    std::printf("runtime: %s: %.3f s\n", scene.how.c_str(), runtime_seconds);
+    else std::printf("view: %dx%d, framing %s; to adjust:\n  --camera %s\n", a.width, a.height, look.framed.c_str(), view::to_string(cam).c_str());
+    std::printf("runtime (%.3f s): %s\n", runtime_seconds, scene.how.c_str());
     std::fflush(stdout);
   }
   for (float v : runtime.rgb)
     if (!std::isfinite(v)) throw bake::ContractError("the runtime render produced a non-finite value");
   if (say && !scene.object_names.empty()) {  // scene files: what each object shows (mean over its pixels)
     const view::GBuffer g = view::rasterize(scene.mesh, cam);
-    for (size_t k = 0; k < scene.object_names.size(); ++k) {
+    for (size_t k = 0; k < std::min(scene.object_names.size(), prtview::kObjectLines); ++k) {
       double sum[3] = {0, 0, 0};
       size_t n = 0;
       for (size_t i = 0; i < g.triangle.size(); ++i) {
@@ -512,12 +587,46 @@ int run(const Args& a) {
         std::printf("  object %s: runtime mean %.9g %.9g %.9g (%zu pixels)\n", scene.object_names[k].c_str(), sum[0] / double(n),
                     sum[1] / double(n), sum[2] / double(n), n);
     }
+    if (scene.object_names.size() > prtview::kObjectLines)
+      std::printf("  (the first %zu of %zu objects)\n", prtview::kObjectLines, scene.object_names.size());
   }
 
+  // The exposure: given, or fixed by the environment (or the file's baked area lighting), never
+  // by this render's pixels: the same file gives the same exposure alone and in the triptych.
+  const bool png = fs::path(a.output).extension() == ".png";
+  double exposure = 1;
+  std::string exposure_why = "--exposure";
+  if (a.exposure) {
+    exposure = *a.exposure;
+  } else if (png && env) {
+    const view::EnvironmentExposure e = view::environment_exposure(*env);
+    exposure = e.exposure;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "1 / %.4g, E/pi of an unshadowed white surface facing the brightest sky of %s", e.brightest,
+                  white_sky ? "the white sky" : env_name.c_str());
+    exposure_why = buf;
+  } else if (png) {
+    std::vector<float> y = scene.baked_luminance;
+    if (!y.empty()) {
+      const size_t k = std::min(y.size() - 1, size_t(0.99 * double(y.size())));
+      std::nth_element(y.begin(), y.begin() + std::ptrdiff_t(k), y.end());
+      if (y[k] > 0 && std::isfinite(y[k])) exposure = view::round_significant(1.0 / double(y[k]), 4);
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "1 / %.4g, the 99th percentile of the baked area lighting E/pi at %zu vertices", double(y[k]), y.size());
+      exposure_why = buf;
+    } else {
+      exposure_why = "no baked area lighting to derive it from: --exposure X to set it";
+    }
+  }
+  const std::string report = prtview::report_summary(f, kind);
+  if (say && png) std::printf("exposure %.4g (%s; --exposure X to override)\n", exposure, exposure_why.c_str());
+
   if (a.mode == Output::Runtime) {
-    const double exposure = a.exposure ? *a.exposure : view::auto_exposure(runtime, {});
     write_image(a.output, runtime, view::tone_map(runtime, exposure));
-    if (say) std::printf("exposure %.4g; wrote %s\n", exposure, a.output.c_str());
+    if (say) {
+      std::printf("quality: not measured in this picture (--triptych or --error trace the reference); file: %s\n", report.c_str());
+      std::printf("wrote %s\n", a.output.c_str());
+    }
     return 0;
   }
 
@@ -538,10 +647,9 @@ int run(const Args& a) {
   if (std::count(mask.begin(), mask.end(), 1) == 0)
     throw bake::InputError("--camera", "no pixel shows the " + std::string(region == "all" ? "geometry" : "receiver") +
                                            " in both renders: nothing to compare (point the camera at the scene)");
-  const double exposure = a.exposure ? *a.exposure : view::auto_exposure(ref.radiance, covered);
   if (a.mode == Output::Reference) {
     write_image(a.output, ref.radiance, view::tone_map(ref.radiance, exposure));
-    if (say) std::printf("exposure %.4g; wrote %s\n", exposure, a.output.c_str());
+    if (say) std::printf("wrote %s\n", a.output.c_str());
     return 0;
   }
   const view::ImageError e = view::compare_images(runtime, ref.radiance, mask, &ref.std_error);
@@ -555,8 +663,11 @@ int run(const Args& a) {
   // Scene files: each receiver's share, RMSE over the pixels where both renders see that object,
   // divided by the same range (so NRMSE^2 = sum_k (pixels_k / pixels) NRMSE_k^2).
   const double range = e.ref_max - e.ref_min > 0 ? e.ref_max - e.ref_min : std::abs(e.ref_max) > 0 ? std::abs(e.ref_max) : 1.0;
+  size_t object_lines = 0, receivers = 0;
   for (size_t k = 0; k < scene.object_names.size(); ++k) {
     if (!scene.object_receiver[k]) continue;
+    ++receivers;
+    if (object_lines == prtview::kObjectLines) continue;
     std::vector<uint8_t> mk(n_px, 0);
     const auto in = [&](int32_t t) { return t >= 0 && size_t(t) >= scene.first_triangle[k] && size_t(t) < scene.first_triangle[k + 1]; };
     for (size_t i = 0; i < n_px; ++i) mk[i] = in(raster.triangle[i]) && in(ref.gbuffer.triangle[i]);
@@ -564,29 +675,47 @@ int run(const Args& a) {
     const view::ImageError ek = view::compare_images(runtime, ref.radiance, mk, &ref.std_error);
     std::printf("  object %s: NRMSE %.5f (%zu pixels; its RMSE %.4g / the range above)\n", scene.object_names[k].c_str(),
                 ek.rmse / range, ek.pixels, ek.rmse);
+    ++object_lines;
   }
+  if (object_lines == prtview::kObjectLines && receivers > object_lines)
+    std::printf("  (the first %zu receivers in view of %zu)\n", object_lines, receivers);
+  char quality[200];
+  std::snprintf(quality, sizeof quality, "RMSE %.4g in this picture (NRMSE %.4g, %zu px, reference noise %.2g)", e.rmse, e.nrmse,
+                e.pixels, e.ref_noise);
+  if (say) std::printf("quality: %s; file: %s\n", quality, report.c_str());
   view::Image diff(a.width, a.height);
   for (size_t i = 0; i < diff.rgb.size(); ++i) diff.rgb[i] = mask[i / 3] ? runtime.rgb[i] - ref.radiance.rgb[i] : 0.0f;
   const view::Image8 err8 = view::false_colour_error(runtime, ref.radiance, mask, e.ref_max - e.ref_min, a.error_scale);
+  // Captions of the 8-bit panels (view/text.h): what each shows, the error's colour scale, and
+  // the quality summary under them.
+  char error_caption[64], scale_end[64];
+  std::snprintf(error_caption, sizeof error_caption, "error x%.3g", 1.0 / a.error_scale);
+  std::snprintf(scale_end, sizeof scale_end, "%.3g%% of range", 100 * a.error_scale);
+  const view::Panel error_panel{err8, error_caption, std::array<std::string, 2>{"0", scale_end}};
+  const std::vector<std::string> footer = {quality, "file: " + report};
   if (a.mode == Output::Error) {
-    write_image(a.output, diff, err8);
+    if (png) view::write_png(a.output, view::labelled_row(std::span(&error_panel, 1), footer));
+    else view::write_exr(a.output, diff);
+  } else if (!png) {
+    const view::Image linear[3] = {runtime, ref.radiance, diff};
+    view::write_exr(a.output, view::hstack(linear));
   } else {
-    const view::Image8 parts[3] = {view::tone_map(runtime, exposure), view::tone_map(ref.radiance, exposure), err8};
-    if (fs::path(a.output).extension() == ".exr") {
-      const view::Image linear[3] = {runtime, ref.radiance, diff};
-      view::write_exr(a.output, view::hstack(linear));
-    } else {
-      view::write_png(a.output, view::hstack(parts));
-    }
+    char exposed[48];
+    std::snprintf(exposed, sizeof exposed, ", exposure %.4g", exposure);
+    const view::Panel panels[3] = {{view::tone_map(runtime, exposure), "baked (" + caption + ")", std::nullopt},
+                                   {view::tone_map(ref.radiance, exposure), "reference (ray traced)", std::nullopt},
+                                   error_panel};
+    std::vector<std::string> lines = footer;
+    lines.front() += exposed;
+    view::write_png(a.output, view::labelled_row(panels, lines));
   }
-  if (say)
-    std::printf("exposure %.4g; error map full scale %.3g x range; wrote %s\n", exposure, a.error_scale, a.output.c_str());
+  if (say) std::printf("error map full scale %.3g x range; wrote %s\n", a.error_scale, a.output.c_str());
   return 0;
 }
 
 int prtview_main(int argc, char** argv) {
   const std::optional<Args> a = parse(argc, argv);
-  if (!a) return 0;  // --help
+  if (!a) return 0;  // --help or --version
   tool::install_interrupt_handler();
   return run(*a);
 }

@@ -65,14 +65,35 @@ std::string found_beside(const std::string& name, const std::string& beside) {
 bool is_scene_file(const F::Asset& f) { return f.scene || !f.objects.empty(); }
 bool has_fiv(const F::Asset& f) { return f.irradiance_cube.has_value(); }
 bool has_transfer(const F::Asset& f) { return f.vertices.transfer_diffuse.has_value(); }
-bool has_band1(const F::Asset& f) { return f.vertices.radiance_band1.has_value(); }
+namespace {
+bool has_band1_in(const F::VertexSet& s) {
+  return s.radiance_band1 || (s.radiance_shadowed && s.radiance_shadowed->sh_order.value_or(0) >= 2);
+}
+} // namespace
+bool has_band1(const F::Asset& f) { return has_band1_in(f.vertices); }
 bool has_ao(const F::Asset& f) { return f.vertices.ao.has_value(); }
 std::vector<std::string> vertex_kinds(const F::Asset& f) {
   std::vector<std::string> kinds;
-  if (has_transfer(f)) kinds.push_back("transfer");
   if (has_band1(f)) kinds.push_back("band1");
+  if (has_transfer(f)) kinds.push_back("transfer");
   if (has_ao(f)) kinds.push_back("ao");
   return kinds;
+}
+std::string vertex_kind_label(const F::Asset& f, const std::string& kind) {
+  const F::VertexSet& s = f.vertices;
+  if (kind == "band1")
+    return s.radiance_band1 || !s.radiance_shadowed
+               ? "band-1 radiance"
+               : "band 1 of the shadowed radiance (order " + std::to_string(s.radiance_shadowed->sh_order.value_or(0)) + ")";
+  if (kind == "transfer")
+    return "diffuse transfer order " + (s.transfer_diffuse && s.transfer_diffuse->sh_order ? std::to_string(*s.transfer_diffuse->sh_order) : std::string("?"));
+  if (kind == "ao") return "AO";
+  return kind;
+}
+std::string band1_environment_sha256(const F::Asset& f) {
+  const F::VertexSet& s = f.vertices;
+  const std::optional<F::Product>& p = s.radiance_band1 ? s.radiance_band1 : s.radiance_shadowed;
+  return p ? p->environment_sha256.value_or("") : std::string();
 }
 bake::UpAxis up_axis(const F::Asset& f) { return f.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y; }
 
@@ -81,6 +102,7 @@ std::string baked_environment(const F::Asset& f, const std::string& file) {
   if (is_scene_file(f) && f.scene) env_path = f.scene->environment.value_or("");
   if (env_path.empty() && f.irradiance_cube) env_path = f.irradiance_cube->environment.value_or("");
   if (env_path.empty() && f.vertices.radiance_band1) env_path = f.vertices.radiance_band1->environment.value_or("");
+  if (env_path.empty() && f.vertices.radiance_shadowed) env_path = f.vertices.radiance_shadowed->environment.value_or("");
   if (env_path.empty()) throw InputError(file, "holds no environment name: give one with --env ENV.exr");
   env_path = found_beside(env_path, file);
   if (const std::string sf = f.scene ? f.scene->scene_file.value_or("") : std::string(); !sf.empty())
@@ -88,6 +110,41 @@ std::string baked_environment(const F::Asset& f, const std::string& file) {
   if (!fs::exists(env_path))
     throw InputError(env_path, "no such file (the environment " + file + " was baked with): give it with --env ENV.exr");
   return env_path;
+}
+
+std::string report_summary(const F::Asset& f, const std::string& kind) {
+  const F::ReportRow* row = nullptr;
+  std::string where;
+  size_t rows = 0;
+  const auto relative = [](const F::ReportRow& r) { return r.values[2] > 0 ? double(r.values[0]) / double(r.values[2]) : 0.0; };
+  const auto consider = [&](const F::ReportRow& r, const std::string& owner) {
+    ++rows;
+    if (!row || relative(r) > relative(*row)) row = &r, where = owner;
+  };
+  if (is_scene_file(f)) {
+    for (const F::SceneObject& o : f.objects)
+      for (const F::ReportRow& r : o.set.report.rows) consider(r, F::object_label(o) + " ");
+  } else if (has_fiv(f)) {
+    for (const F::Occluder& o : f.occluders)
+      if (o.report) consider(*o.report, "FIV ");
+  } else {
+    const F::VertexSet& s = f.vertices;
+    const std::string product = kind == "band1" ? std::string(s.radiance_band1 ? N::kRadianceBand1 : N::kRadianceShadowed).substr(1)
+                                : kind == "transfer" ? std::string(N::kTransferDiffuse).substr(1)
+                                                     : std::string(N::kAo).substr(1);
+    for (const F::ReportRow& r : s.report.rows)
+      if (r.product == product) consider(r, "");
+  }
+  if (!row) return "no error report (baked with --report 0)";
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%s%s%s RMSE %.3g at %lld points (%.2g%% of its RMS)", rows > 1 ? "worst row " : "", where.c_str(),
+                row->product.c_str(), double(row->values[0]), (long long)row->points.value_or(0), 100 * relative(*row));
+  std::string out = buf;
+  if (f.target_error) {
+    std::snprintf(buf, sizeof buf, ", target %.3g", *f.target_error);
+    out += buf;
+  }
+  return out;
 }
 
 bake::Mesh read_mesh(const F::Asset& f, const std::string& file, const std::string& object) {
@@ -134,10 +191,25 @@ const std::vector<float>& read_ao(const F::Asset& f, const std::string& file, co
 Band1 read_band1(const F::Asset& f, const std::string& file, const std::string& object, const bake::EnvMap& env) {
   const F::VertexSet& s = vertex_set(f, file, object);
   const std::string prefix = prefix_of(object), path = cat(prefix, N::kRadianceBand1);
-  if (!s.radiance_band1) throw InputError(file, "no dataset " + path + (object.empty() ? root_hint(f) : ""));
-  check_same_environment(*s.radiance_band1, path, env, file);
+  if (!has_band1_in(s)) throw InputError(file, "no dataset " + path + (object.empty() ? root_hint(f) : ""));
   if (!s.normals) throw InputError(file, "no dataset " + cat(prefix, N::kNormals));
-  return {s.normals->values.data(), s.radiance_band1->values.data()};
+  Band1 b;
+  b.normals = s.normals->values.data();
+  if (s.radiance_band1) {
+    check_same_environment(*s.radiance_band1, path, env, file);
+    b.baked = s.radiance_band1->values.data();
+    return b;
+  }
+  check_same_environment(*s.radiance_shadowed, cat(prefix, N::kRadianceShadowed), env, file);
+  const size_t n = size_t(*s.radiance_shadowed->sh_order) * size_t(*s.radiance_shadowed->sh_order), V = s.vertex_count();
+  const std::vector<float>& S = s.radiance_shadowed->values;
+  if (S.size() != V * 3 * n) throw InputError(file, cat(prefix, N::kRadianceShadowed) + " does not hold [V][3][L*L] values");
+  b.shadowed_order = int(*s.radiance_shadowed->sh_order);
+  b.copied.resize(V * 9);
+  for (size_t v = 0; v < V; ++v)
+    for (size_t c = 0; c < 3; ++c)
+      for (size_t m = 0; m < 3; ++m) b.copied[9 * v + 3 * c + m] = S[(3 * v + c) * n + 1 + m];
+  return b;
 }
 
 BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const std::string& name, const bake::EnvMap& env) {
@@ -238,7 +310,7 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
       objects.push_back(std::move(o));
       continue;
     }
-    if (s.radiance_band1) o.band1 = read_band1(f, file, baked.name, *env);
+    if (has_band1_in(s)) o.band1 = read_band1(f, file, baked.name, *env);
     else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
     else if (s.ao) o.ao = &s.ao->values;
     if (baked.phong_exponent.value_or(0) > 0 && (s.transfer_visibility || s.radiance_shadowed)) {

@@ -23,11 +23,19 @@ namespace prt::prtview {
 bool is_scene_file(const formats::Asset& f);
 bool has_fiv(const formats::Asset& f);
 bool has_transfer(const formats::Asset& f);
+// Band-1 radiance at the root: /radiance/band1, or the band-1 part of /radiance/shadowed (order >= 2).
 bool has_band1(const formats::Asset& f);
 bool has_ao(const formats::Asset& f);
-// The --shade kinds a per-vertex file (its root layout) can be shown with, in the default's order
-// of preference (transfer, band1, ao): what a hint names when the asked kind is missing.
+// The --shade kinds a per-vertex file (its root layout) can be shown with, in the first look's
+// order of preference — band1 (exact all-frequency shadows under the baked environment), transfer
+// (shadows only as sharp as its SH order), ao (the AO approximation): what the first look shows
+// and what a hint names when the asked kind is missing.
 std::vector<std::string> vertex_kinds(const formats::Asset& f);
+// What `kind` shows for the root layout, in a few words ("band-1 radiance", "band 1 of the
+// shadowed radiance (order 4)", "diffuse transfer order 3", "AO").
+std::string vertex_kind_label(const formats::Asset& f, const std::string& kind);
+// The root layout's environment for band1 (its environment_sha256; "" when it names none).
+std::string band1_environment_sha256(const formats::Asset& f);
 // Throws InputError naming the missing dataset and the kinds the file can be shown with, unless
 // the root layout holds `kind`'s product ("transfer", "band1" or "ao").
 void require_vertex_kind(const formats::Asset& f, const std::string& file, const std::string& kind);
@@ -36,6 +44,13 @@ bake::UpAxis up_axis(const formats::Asset& f);
 // the root band-1 radiance), found as given, next to the file, or next to the scene file. Throws
 // when it names none or the file does not exist.
 std::string baked_environment(const formats::Asset& f, const std::string& file);
+
+// The file's own error report (its /report rows: the bake against its reference integrator at a
+// few vertices), in one short phrase for what is shown: the row of `kind`'s product for a
+// per-vertex file (band1, transfer, ao), the worst row relative to its reference RMS over the
+// objects of a scene file, the occluder's row of an FIV file, and the target the bake was asked
+// for; "no error report" when the file has none (a bake with --report 0).
+std::string report_summary(const formats::Asset& f, const std::string& kind);
 
 // The mesh of a vertex set: object "" (the root layout) or the scene object of that name.
 bake::Mesh read_mesh(const formats::Asset& f, const std::string& file, const std::string& object);
@@ -47,10 +62,16 @@ struct Transfer {
 Transfer read_transfer(const formats::Asset& f, const std::string& file, const std::string& object);
 // AO [V] of a vertex set.
 const std::vector<float>& read_ao(const formats::Asset& f, const std::string& file, const std::string& object);
-// Band-1 radiance [V][3][3] baked under `env` (checked), with the baked normals [V][3].
+// Band-1 radiance [V][3][3] baked under `env` (checked), with the baked normals [V][3]: the
+// vertex set's /radiance/band1, else the band-1 coefficients (i = 1, 2, 3) of its
+// /radiance/shadowed S [V][3][L*L], L >= 2, which are the same integrals (docs/ARCHITECTURE.md §3:
+// R_c,m = S_c,i at i = l(l+1) + m, l = 1), copied out.
 struct Band1 {
   const float* normals = nullptr;
-  const float* radiance = nullptr;
+  const float* baked = nullptr;  // into the asset (/radiance/band1), or null
+  std::vector<float> copied;     // [V][3][3] from /radiance/shadowed
+  int shadowed_order = 0;        // L of /radiance/shadowed when copied from it, else 0
+  const float* radiance() const { return baked ? baked : copied.data(); }
 };
 Band1 read_band1(const formats::Asset& f, const std::string& file, const std::string& object, const bake::EnvMap& env);
 

@@ -62,9 +62,10 @@ std::vector<float> transfer_colours(const Transfer& t, const bake::EnvMap& env, 
 }
 std::vector<float> band1_colours(const Band1& b, size_t V, std::string& how) {
   std::vector<float> colour(3 * V);
-  shade::shade_band1_vertices(b.normals, b.radiance, V, colour.data());
+  shade::shade_band1_vertices(b.normals, b.radiance(), V, colour.data());
   for (float& c : colour) c *= float(std::numbers::inv_pi);
-  how = "prt::shade::shade_band1 per vertex (E/pi), Gouraud";
+  how = std::string("prt::shade::shade_band1 per vertex (E/pi") +
+        (b.shadowed_order ? ", band 1 of radiance/shadowed" : "") + "), Gouraud";
   return colour;
 }
 
@@ -92,6 +93,33 @@ std::vector<float> ao_colours(const std::vector<float>& ao, const bake::Mesh& me
 
 } // namespace
 
+std::string name_list(const std::vector<std::string>& names, size_t budget) {
+  std::string out;
+  size_t k = 0;
+  for (; k < names.size(); ++k) {
+    const std::string next = (k ? ", " : "") + names[k];
+    const size_t more = k + 1 < names.size() ? 16 : 0;  // room for " and N more"
+    if (k > 0 && out.size() + next.size() + more > budget) break;
+    out += next;
+  }
+  if (k < names.size()) out += " and " + std::to_string(names.size() - k) + " more";
+  return out;
+}
+
+void add_grouped(std::string& how, const std::vector<std::string>& names, const std::vector<std::string>& how_of) {
+  if (names.size() <= kObjectLines) {
+    for (size_t k = 0; k < names.size(); ++k) how += "\n  " + names[k] + ": " + how_of[k];
+    return;
+  }
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;  // in order of first use
+  for (size_t k = 0; k < names.size(); ++k) {
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == how_of[k]; });
+    if (it == groups.end()) it = groups.insert(groups.end(), {how_of[k], {}});
+    it->second.push_back(names[k]);
+  }
+  for (const auto& [h, n] : groups) how += "\n  " + std::to_string(n.size()) + " x " + h + ": " + name_list(n, 60);
+}
+
 view::Image render_vertex_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
                                const view::Camera& cam, RenderScene& scene) {
   scene.mesh = read_mesh(f, file, "");
@@ -110,25 +138,11 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
 }
 
-view::Camera first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height,
-                               bool glossy) {
-  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  const auto grow = [&](const std::optional<F::Array<double>>& positions) {
-    if (!positions) return;
-    const auto& p = positions->values;
-    for (size_t i = 0; i + 2 < p.size(); i += 3) {
-      const Vector3d q(p[i], p[i + 1], p[i + 2]);
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
-  };
-  if (is_scene_file(f)) {
-    for (const F::SceneObject& o : f.objects)
-      if (!glossy || (o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed)))
-        grow(o.set.positions);
-    if (glossy && !lo.allFinite())  // no glossy object: frame them all (the render says what is missing)
-      for (const F::SceneObject& o : f.objects) grow(o.set.positions);
-  } else if (has_fiv(f)) {
+FirstLook first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height,
+                            bool glossy) {
+  const Vector3d up = up_axis(f) == bake::UpAxis::Z ? Vector3d::UnitZ() : Vector3d::UnitY();
+  if (has_fiv(f) && !is_scene_file(f)) {  // the occluder copies, widened by R so that their shadows show
+    Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     const F::Occluder* o = f.find_occluder(choose_occluder(f, file, options.occluder));
     const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
     const std::vector<Vector3d> inst = options.instances.empty() ? std::vector<Vector3d>{Vector3d::Zero()} : options.instances;
@@ -136,12 +150,38 @@ view::Camera first_look_camera(const F::Asset& f, const std::string& file, const
       lo = lo.cwiseMin(c + t - Vector3d::Constant(2 * o->radius));
       hi = hi.cwiseMax(c + t + Vector3d::Constant(2 * o->radius));
     }
-  } else {
-    grow(f.vertices.positions);
+    return {view::frame_box(lo, hi, up, width, height), "the occluder and its shadow"};
   }
-  if (!lo.allFinite() || !hi.allFinite()) throw bake::InputError(file, "holds no geometry to look at (no vertex positions)");
-  const Vector3d up = up_axis(f) == bake::UpAxis::Z ? Vector3d::UnitZ() : Vector3d::UnitY();
-  return view::frame_box(lo, hi, up, width, height);
+  // Per-vertex files: the mesh; scene files: every object (--shade glossy: the glossy ones), in
+  // world space, as one mesh; framed without their large flat parts (view::focus_box).
+  std::vector<double> positions;
+  std::vector<uint32_t> triangles;
+  const auto add = [&](const F::VertexSet& s) {
+    if (!s.positions) return;
+    const uint32_t base = uint32_t(positions.size() / 3);
+    positions.insert(positions.end(), s.positions->values.begin(), s.positions->values.end());
+    if (s.triangles)
+      for (uint32_t v : s.triangles->values) triangles.push_back(base + v);
+  };
+  if (is_scene_file(f)) {
+    for (const F::SceneObject& o : f.objects)
+      if (!glossy || (o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed))) add(o.set);
+    if (glossy && positions.empty())  // no glossy object: frame them all (the render says what is missing)
+      for (const F::SceneObject& o : f.objects) add(o.set);
+  } else {
+    add(f.vertices);
+  }
+  if (positions.empty()) throw bake::InputError(file, "holds no geometry to look at (no vertex positions)");
+  for (uint32_t v : triangles)
+    if (size_t(v) >= positions.size() / 3) throw bake::InputError(file, "a triangle names a vertex the file does not hold");
+  const view::Focus focus = view::focus_box(positions, triangles);
+  char what[160];
+  if (focus.set_aside_parts > 0)
+    std::snprintf(what, sizeof what, "the geometry without its large flat part%s (%zu triangles, %.3g wide; the rest %.3g)",
+                  focus.set_aside_parts > 1 ? "s" : "", focus.set_aside_triangles, focus.set_aside_extent, focus.rest_extent);
+  else
+    std::snprintf(what, sizeof what, "all the geometry (no flat part %.3gx as wide as the rest)", view::kFlatPartRatio);
+  return {view::frame_box(focus.lo, focus.hi, up, width, height), what};
 }
 
 view::Image render_fiv_file(const F::Asset& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
@@ -276,8 +316,16 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
   std::vector<float> rgb;
   std::vector<uint8_t> per_pixel;
   scene.first_triangle = {0};
-  scene.what = "scene: " + std::to_string(objects.size()) + " objects";
   scene.how = "per object, times its albedo (white if none):";
+  std::vector<std::string> names, receivers, occluders;
+  for (const SceneObject& o : objects) {
+    names.push_back(o.name);
+    (o.receiver ? receivers : occluders).push_back(o.name);
+  }
+  add_grouped(scene.how, names, how_of);
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects: " + std::to_string(receivers.size()) + " receiving (" +
+               name_list(receivers, 50) + ")" +
+               (occluders.empty() ? "" : ", " + std::to_string(occluders.size()) + " only casting (" + name_list(occluders, 40) + ")");
   for (size_t k = 0; k < objects.size(); ++k) {
     const SceneObject& o = objects[k];
     const size_t T = o.mesh.triangles.size();
@@ -290,11 +338,6 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       bake::bounding_sphere(o.mesh, sp.centre, sp.radius);
       scene.spheres.push_back(sp);
     }
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%s %s (%zu vertices, albedo %.3g %.3g %.3g)", o.name.c_str(), o.role.c_str(),
-                  o.mesh.positions.size(), o.albedo[0], o.albedo[1], o.albedo[2]);
-    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + buf;
-    scene.how += "\n  " + o.name + ": " + how_of[k];
     parts.push_back(o.mesh);
   }
   scene.mesh = bake::merge_meshes(parts, file);
@@ -325,11 +368,10 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
   std::vector<bake::Mesh> parts;
   std::vector<float> rgb;
   scene.first_triangle = {0};
-  scene.what = "scene: " + std::to_string(objects.size()) + " objects, glossy lobes only";
-  scene.how = "specular lobes by route A (prt::shade::shade_glossy_vertices: environment SH x /transfer/visibility by the "
-              "triple product) or route B (prt::shade::shade_glossy_radiance_vertices: the baked /radiance/shadowed, paper "
-              "001 §4 material editing), normalised Phong lobe about the reflected view direction, times the specular "
-              "colour, Gouraud:";
+  scene.how = "specular lobes (normalised Phong about the reflected view direction) x specular colour, Gouraud, by\n"
+              "  route B: prt::shade::shade_glossy_radiance_vertices on the baked radiance/shadowed (paper 001 sec. 4) or\n"
+              "  route A: prt::shade::shade_glossy_vertices, environment SH x transfer/visibility by the triple product:";
+  std::vector<std::string> glossy_names, glossy_how, others;
   for (const SceneObject& o : objects) {
     const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
     std::vector<float> colour(3 * V, 0.0f);
@@ -365,19 +407,23 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
       }
       for (size_t v = 0; v < V; ++v)
         for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
-      char buf[240];
-      std::snprintf(buf, sizeof buf, "\n  %s: order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s", o.name.c_str(),
-                    order, s, phong ? " (--phong)" : "", o.specular[0], o.specular[1], o.specular[2],
-                    route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)");
-      scene.how += buf;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s", order, s, phong ? " (--phong)" : "",
+                    o.specular[0], o.specular[1], o.specular[2], route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)");
+      glossy_names.push_back(o.name);
+      glossy_how.push_back(buf);
     }
     rgb.insert(rgb.end(), colour.begin(), colour.end());
     scene.phong.insert(scene.phong.end(), T, s);
     scene.specular.insert(scene.specular.end(), T, o.receiver ? o.specular : std::array<float, 3>{0, 0, 0});
     add_object(scene, o);
-    scene.what += std::string(scene.object_names.size() == 1 ? ": " : ", ") + o.name + (o.receiver ? " (glossy)" : "");
+    if (!o.receiver) others.push_back(o.name);
     parts.push_back(o.mesh);
   }
+  add_grouped(scene.how, glossy_names, glossy_how);
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects, glossy lobes only: " + std::to_string(glossy_names.size()) +
+               " glossy (" + name_list(glossy_names, 50) + ")" +
+               (others.empty() ? "" : ", " + std::to_string(others.size()) + " drawn black (" + name_list(others, 40) + ")");
   scene.mesh = bake::merge_meshes(parts, file);
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), rgb);
 }

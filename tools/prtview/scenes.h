@@ -39,7 +39,20 @@ struct RenderScene {
   // reference's glossy mode (view::ReferenceOptions::glossy) uses; empty otherwise.
   std::vector<double> phong;
   std::vector<std::array<float, 3>> specular;
+  // Area-light views: the luminance of albedo / pi x sum_l radiance_l E_l at every vertex of the
+  // objects with baked area_lights/irradiance (both --shade area and area-exact): what the file
+  // says about the picture's brightness, the basis of its exposure.
+  std::vector<float> baked_luminance;
 };
+
+// Log lines stay short whatever the scene: a list of names is cut to about `budget` characters
+// ("a, b and 12 more"); per-object lines are printed for at most kObjectLines objects, else one
+// line per kind of shading with its count and a cut list of names.
+inline constexpr size_t kObjectLines = 12;
+std::string name_list(const std::vector<std::string>& names, size_t budget);
+// Appends to `how` one line "  name: how" per object, or (more than kObjectLines objects) one line
+// "  N x how: names" per distinct how.
+void add_grouped(std::string& how, const std::vector<std::string>& names, const std::vector<std::string>& how_of);
 
 // Per-vertex files: kind "transfer", "band1" or "ao".
 view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
@@ -52,12 +65,16 @@ struct FivView {
   std::optional<double> ground, ground_size;
   bool overlap = true, partial = true;
 };
-// The camera of a first look when none is given (view::frame_box): framing every object of a
-// scene file, the mesh of a per-vertex file, or an FIV file's occluder copies (their bounding
-// spheres, widened by R so that their shadows on the ground show). `glossy`: frame only a scene
-// file's glossy objects (--shade glossy).
-view::Camera first_look_camera(const formats::Asset& f, const std::string& file, const FivView& options, int width,
-                               int height, bool glossy = false);
+// The camera of a first look when none is given (view::frame_box) and what it frames: the objects
+// of a scene file (`glossy`: only its glossy objects, --shade glossy) or the mesh of a per-vertex
+// file, without their large flat parts (a ground: view::focus_box states the rule); an FIV file's
+// occluder copies (their bounding spheres, widened by R so that their shadows on the ground show).
+struct FirstLook {
+  view::Camera camera;
+  std::string framed;  // a few words: what the box holds
+};
+FirstLook first_look_camera(const formats::Asset& f, const std::string& file, const FivView& options, int width,
+                            int height, bool glossy = false);
 
 view::Image render_fiv_file(const formats::Asset& f, const std::string& file, const FivView& options,
                             const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);

@@ -8,8 +8,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace prt::view {
 
@@ -72,6 +74,107 @@ Camera frame_box(const Vector3d& lo, const Vector3d& hi, const Vector3d& up, int
   }
   c.eye = c.at + d * toward_eye;
   return c;
+}
+
+Focus focus_box(std::span<const double> positions, std::span<const uint32_t> triangles) {
+  PRT_CHECK(positions.size() % 3 == 0 && triangles.size() % 3 == 0);
+  const size_t V = positions.size() / 3, T = triangles.size() / 3;
+  const auto pos = [&](uint32_t v) { return Vector3d(positions[3 * size_t(v)], positions[3 * size_t(v) + 1], positions[3 * size_t(v) + 2]); };
+  for (uint32_t v : triangles) PRT_CHECK_OP(size_t(v), <, V);
+  Focus f;
+  f.lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+  f.hi = -f.lo;
+  for (size_t v = 0; v < V; ++v) f.lo = f.lo.cwiseMin(pos(uint32_t(v))), f.hi = f.hi.cwiseMax(pos(uint32_t(v)));
+  if (T == 0 || V == 0) {
+    f.rest_extent = V ? (f.hi - f.lo).norm() : 0;
+    return f;
+  }
+  const double tolerance = 1e-5 * (f.hi - f.lo).norm();
+  const double cos_angle = std::cos(std::numbers::pi / 180.0);
+  // Positions compared exactly: the same point under several vertex rows is one corner.
+  std::vector<uint32_t> order(V), corner(V);
+  for (uint32_t v = 0; v < V; ++v) order[v] = v;
+  const auto key = [&](uint32_t v) { return std::array<double, 3>{positions[3 * size_t(v)], positions[3 * size_t(v) + 1], positions[3 * size_t(v) + 2]}; };
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
+  for (size_t i = 0; i < V; ++i) corner[order[i]] = i > 0 && key(order[i]) == key(order[i - 1]) ? corner[order[i - 1]] : order[i];
+  // Edges (corner pairs) → triangles, sorted: neighbours are the runs of one edge.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * T);
+  for (size_t t = 0; t < T; ++t)
+    for (int k = 0; k < 3; ++k) {
+      uint64_t a = corner[triangles[3 * t + size_t(k)]], b = corner[triangles[3 * t + size_t(k + 1) % 3]];
+      if (a == b) continue;
+      if (a > b) std::swap(a, b);
+      edges.emplace_back(a << 32 | b, uint32_t(t));
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::vector<uint32_t>> neighbours(T);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    for (size_t a = i; a < j; ++a)
+      for (size_t b = i; b < j; ++b)
+        if (edges[a].second != edges[b].second) neighbours[edges[a].second].push_back(edges[b].second);
+    i = j;
+  }
+  std::vector<Vector3d> normal(T);
+  for (size_t t = 0; t < T; ++t) {
+    const Vector3d n = (pos(triangles[3 * t + 1]) - pos(triangles[3 * t])).cross(pos(triangles[3 * t + 2]) - pos(triangles[3 * t]));
+    normal[t] = n.norm() > 0 && n.allFinite() ? n.normalized() : Vector3d::Zero();
+  }
+  // Regions grown from each unassigned seed, in triangle order.
+  std::vector<uint32_t> region(T, UINT32_MAX);
+  std::vector<std::array<Vector3d, 2>> box;  // per region: lo, hi
+  std::vector<size_t> count;
+  for (size_t seed = 0; seed < T; ++seed) {
+    if (region[seed] != UINT32_MAX) continue;
+    const uint32_t r = uint32_t(box.size());
+    box.push_back({Vector3d::Constant(std::numeric_limits<double>::infinity()), Vector3d::Constant(-std::numeric_limits<double>::infinity())});
+    count.push_back(0);
+    const Vector3d n0 = normal[seed], p0 = pos(triangles[3 * seed]);
+    std::vector<uint32_t> stack = {uint32_t(seed)};
+    region[seed] = r;
+    while (!stack.empty()) {
+      const uint32_t t = stack.back();
+      stack.pop_back();
+      ++count[r];
+      for (int k = 0; k < 3; ++k) box[r][0] = box[r][0].cwiseMin(pos(triangles[3 * size_t(t) + size_t(k)])), box[r][1] = box[r][1].cwiseMax(pos(triangles[3 * size_t(t) + size_t(k)]));
+      if (n0 == Vector3d::Zero()) continue;  // a degenerate seed stays alone
+      for (const uint32_t u : neighbours[t]) {
+        if (region[u] != UINT32_MAX || std::abs(normal[u].dot(n0)) < cos_angle) continue;
+        bool in_plane = true;
+        for (int k = 0; k < 3; ++k) in_plane = in_plane && std::abs(n0.dot(pos(triangles[3 * size_t(u) + size_t(k)]) - p0)) <= tolerance;
+        if (!in_plane) continue;
+        region[u] = r;
+        stack.push_back(u);
+      }
+    }
+  }
+  // Set aside the widest part while it is kFlatPartRatio × as wide as the rest.
+  std::vector<uint8_t> aside(box.size(), 0);
+  const auto rest_box = [&](uint32_t without, Vector3d& lo, Vector3d& hi) {
+    lo = Vector3d::Constant(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    for (size_t t = 0; t < T; ++t)
+      if (!aside[region[t]] && region[t] != without)
+        for (int k = 0; k < 3; ++k) lo = lo.cwiseMin(pos(triangles[3 * t + size_t(k)])), hi = hi.cwiseMax(pos(triangles[3 * t + size_t(k)]));
+  };
+  for (;;) {
+    uint32_t widest = UINT32_MAX;
+    for (uint32_t r = 0; r < box.size(); ++r)
+      if (!aside[r] && (widest == UINT32_MAX || (box[r][1] - box[r][0]).norm() > (box[widest][1] - box[widest][0]).norm())) widest = r;
+    if (widest == UINT32_MAX) break;
+    Vector3d lo, hi;
+    rest_box(widest, lo, hi);
+    const double part = (box[widest][1] - box[widest][0]).norm(), rest = (hi - lo).norm();
+    if (!lo.allFinite() || !(rest > 0) || part < kFlatPartRatio * rest) break;
+    aside[widest] = 1;
+    if (f.set_aside_parts++ == 0) f.set_aside_extent = part;
+    f.set_aside_triangles += count[widest];
+  }
+  if (f.set_aside_parts > 0) rest_box(UINT32_MAX, f.lo, f.hi);
+  f.rest_extent = (f.hi - f.lo).norm();
+  return f;
 }
 
 std::string to_string(const Camera& c) {

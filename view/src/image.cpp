@@ -141,12 +141,21 @@ Image8 tone_map(const Image& image, double exposure) {
   return out;
 }
 
+std::array<uint8_t, 3> error_colour(double t) {
+  // Five stops (sRGB bytes), t = 0, 1/4, 1/2, 3/4, 1.
+  static constexpr double kStops[5][3] = {{0, 0, 0}, {72, 16, 130}, {200, 40, 70}, {245, 140, 20}, {255, 250, 190}};
+  const double s = std::clamp(std::isfinite(t) ? t : 1.0, 0.0, 1.0) * 4.0;
+  const int k = std::min(3, int(s));
+  const double f = s - k;
+  std::array<uint8_t, 3> rgb{};
+  for (size_t c = 0; c < 3; ++c) rgb[c] = uint8_t(std::lround((1 - f) * kStops[k][c] + f * kStops[k + 1][c]));
+  return rgb;
+}
+
 Image8 false_colour_error(const Image& test, const Image& reference, std::span<const uint8_t> mask, double range,
                           double full_scale) {
   PRT_CHECK(test.width == reference.width && test.height == reference.height);
   PRT_CHECK(full_scale > 0);
-  // Five stops (sRGB bytes), t = 0, 1/4, 1/2, 3/4, 1.
-  static constexpr double kStops[5][3] = {{0, 0, 0}, {72, 16, 130}, {200, 40, 70}, {245, 140, 20}, {255, 250, 190}};
   const size_t n = size_t(test.width) * size_t(test.height);
   PRT_CHECK(mask.empty() || mask.size() == n);
   Image8 out(test.width, test.height, 96);
@@ -158,11 +167,8 @@ Image8 false_colour_error(const Image& test, const Image& reference, std::span<c
       e2 += d * d;
     }
     const double e = range > 0 ? std::sqrt(e2 / 3) / range : 0.0;
-    const double t = std::clamp(std::isfinite(e) ? e / full_scale : 1.0, 0.0, 1.0) * 4.0;
-    const int k = std::min(3, int(t));
-    const double f = t - k;
-    for (int c = 0; c < 3; ++c)
-      out.rgb[3 * i + size_t(c)] = uint8_t(std::lround((1 - f) * kStops[k][c] + f * kStops[k + 1][c]));
+    const std::array<uint8_t, 3> rgb = error_colour(std::isfinite(e) ? e / full_scale : 1.0);
+    std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + std::ptrdiff_t(3 * i));
   }
   return out;
 }

@@ -121,21 +121,18 @@ ReferenceRenderer::~ReferenceRenderer() = default;
 
 std::string ReferenceRenderer::description() const {
   std::ostringstream os;
-  os << "Embree 3 ray tracing: primary ray per pixel centre; ";
+  os << "Embree: ";
   if (options_.glossy)
-    os << "GLOSSY: specular x the normalised Phong lobe about the reflected view direction, randomised Halton QMC, "
-       << options_.samples << " rays/pixel (mixture: lobe, environment)";
+    os << "specular x Phong lobe, " << options_.samples << " QMC rays/pixel (lobe + environment)";
   else
-    os << "E = unshadowed irradiance (the DifMap's texel sum) - randomised Halton QMC of the occluded part, "
-       << options_.samples << " shadow rays/pixel (mixture: cosine, environment"
-       << (options_.occluder_spheres.empty() ? "" : ", " + std::to_string(options_.occluder_spheres.size()) + " occluder cone(s)")
-       << ")";
+    os << "E = exact unshadowed - QMC occluded, " << options_.samples << " shadow rays/pixel (cosine + environment"
+       << (options_.occluder_spheres.empty() ? "" : " + " + std::to_string(options_.occluder_spheres.size()) + " cones") << ")";
   os << ", seed " << options_.seed;
   if (!options_.casts_shadow.empty()) {
     const auto n = std::count_if(options_.casts_shadow.begin(), options_.casts_shadow.end(), [](uint8_t c) { return c != 0; });
     os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
   }
-  if (!options_.albedo.empty() && !options_.glossy) os << "; per-object albedo";
+  if (!options_.albedo.empty() && !options_.glossy) os << "; albedos";
   return os.str();
 }
 

@@ -18,6 +18,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -53,6 +55,30 @@ Camera parse_camera(std::string_view spec, int width, int height);
 // the box of half-size 1 around it. lo and hi must be finite.
 Camera frame_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const Eigen::Vector3d& up, int width, int height,
                  double fov_y_degrees = 45);
+// What a first look frames (focus_box): the geometry without its large flat parts — a ground
+// plane 30 units wide under a 10-unit bunny would otherwise take the picture and shrink the
+// bunny to a few percent of it.
+//   1. Flat parts: triangles joined across shared edges (positions compared exactly) into
+//      regions grown from a seed triangle (in triangle order): a neighbour joins when its normal
+//      is within 1° of the seed's (either orientation) and its corners lie within 1e-5 × the
+//      whole mesh's bounding-box diagonal of the seed's plane. Degenerate triangles stay alone.
+//   2. The largest part (bounding-box diagonal; the first of equal ones) is set aside when it is
+//      at least kFlatPartRatio (1.5) × as wide as everything else together (the bounding box of
+//      the other triangles' corners): framing it would shrink the rest to at most 2/3 of the
+//      picture's width (4/9 of its area) while the part, being flat, shows nothing but what the
+//      rest casts on it, and the rest's box reaches down to where the rest stands on it. Repeat on
+//      what is left (a ground, then a rug on it) until no part qualifies or nothing would be left.
+//   3. The box: the corners of the triangles left; when nothing was set aside, every position.
+// positions [V][3], triangles [T][3] (indices < V); an empty mesh gives lo = +inf, hi = −inf.
+inline constexpr double kFlatPartRatio = 1.5;
+struct Focus {
+  Eigen::Vector3d lo, hi;
+  size_t set_aside_parts = 0, set_aside_triangles = 0;
+  double set_aside_extent = 0;  // the first part set aside: its bounding-box diagonal
+  double rest_extent = 0;       // of the box returned
+};
+Focus focus_box(std::span<const double> positions, std::span<const uint32_t> triangles);
+
 // The text form of `c` for people to copy into --camera ("eye=...:at=...:up=...:fov=..."), each
 // number with 9 significant digits: parse_camera reads back the same camera to 1e-9 relative.
 std::string to_string(const Camera& c);

@@ -36,6 +36,7 @@
 // R, G, B as 32-bit float, ZIP compression, increasing-Y line order.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -77,6 +78,9 @@ double auto_exposure(const Image& image, std::span<const uint8_t> mask = {});
 Image8 tone_map(const Image& image, double exposure);
 Image8 false_colour_error(const Image& test, const Image& reference, std::span<const uint8_t> mask, double range,
                           double full_scale);
+// The false-colour ramp at t (clamped to [0, 1]): the colour false_colour_error gives an error of
+// t · full_scale (view/text.h draws it as the error panel's scale).
+std::array<uint8_t, 3> error_colour(double t);
 // Pictures side by side, top-aligned, separated by `gap` columns of `gap_value` (grey).
 Image8 hstack(std::span<const Image8> parts, int gap = 4, uint8_t gap_value = 255);
 // Linear pictures side by side, top-aligned, no gap (rows below a shorter part are 0).
