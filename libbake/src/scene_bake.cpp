@@ -241,6 +241,24 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     return out;
   }
 
+  // One progress stage, "baking receivers", over every receiver's vertices (one ETA for the
+  // scene, not a stage per object): each object's bake reports into it, offset by the vertices
+  // baked before it; it finishes with the last.
+  uint64_t vertices_before = 0;
+  const auto t_receivers = std::chrono::steady_clock::now();
+  Monitor overall;
+  overall.cancel = monitor.cancel;
+  if (monitor.on_progress)
+    overall.on_progress = [&](const ProgressUpdate& u) {
+      ProgressUpdate o = u;
+      o.task = "baking receivers";
+      o.done = vertices_before + u.done;
+      o.total = receiver_vertices;
+      o.seconds = seconds_since(t_receivers);
+      o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last object, or a cancel
+      monitor.on_progress(o);
+    };
+
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -294,7 +312,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       if (rows.rows_only) continue;
     } else {
       const uint64_t closed_before = integrator.stats().closed_form;
-      ob.values = bake_points(points, integrator, monitor, label);
+      ob.values = bake_points(points, integrator, overall, label);
+      vertices_before += points.size();
       ob.closed_form_vertices = integrator.stats().closed_form - closed_before;
     }
     ob.integrator_description = integrator.description();
