@@ -819,7 +819,16 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
         }
         if (!other_receiver) p.left_out.push_back("fiv: no other receiver in the scene for it to shadow");
         else if (!reaches) p.left_out.push_back("fiv: its bounding sphere lies below the horizon of every vertex of every other receiver");
-        else p.fiv = true, p.baked.push_back("fiv: it moves (" + o.moves_reason + ") and can shadow another receiver");
+        else
+          p.fiv = true,
+          p.baked.push_back("fiv: it moves (" + o.moves_reason + ") and can shadow another receiver; shells up to " +
+                            std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) + "x" +
+                            std::to_string(scene.fiv.n_rho) + " by the silhouette integrator at k = " +
+                            std::to_string(scene.fiv.silhouette_k) +
+                            (scene.integrator.kind == IntegratorKind::Silhouette
+                                 ? std::string()
+                                 : std::string(" (paper 004's shells are integrated by silhouettes whatever "
+                                               "bake.integrator says; bake.fiv sets their grid)")));
       }
     }
     plan.fiv_environment = plan.fiv_environment || p.fiv;
