@@ -583,13 +583,15 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   return sc;
 }
 
-bool is_gltf(const std::filesystem::path& file) {
+bool is_gltf(const std::filesystem::path& file) { return is_gltf_scene(file); }
+
+} // namespace
+
+bool is_gltf_scene(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   return ext == ".gltf" || ext == ".glb";
 }
-
-} // namespace
 
 SceneDescription load_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& gltf_options) {
   if (is_gltf(file)) return load_gltf_scene(file, gltf_options);
