@@ -58,7 +58,10 @@ TEST(CliMessages, CommandLineMistakesExitTwoBeforeAnyFileIsRead) {
       {"vertex " + q(mesh) + " --ao --integrator filter --target-error 1e-3 -o " + q(out),
        "so it cannot take --target-error"},
       {"vertex " + q(mesh) + " --ao --shadowed 3 -o " + q(out), "vertex: --shadowed L needs --radiance ENV"},
-      {"vertex " + q(mesh) + " --ao --samples 64 --merge --resume -o " + q(out), "--merge computes nothing"},
+      {"vertex " + q(mesh) + " --ao --samples 64 --merge --resume -o " + q(out), "vertex: --merge computes nothing"},
+      {"vertex " + q(mesh) + " --ao --samples 64 --shard 0/2 --claim dynamic -o " + q(out),
+       "vertex: --claim dynamic with --shard 0/2: give --run-id ID, the same for every worker of this run (try "
+       "'prtbake vertex --help')"},
       {"fiv " + q(mesh) + " --env " + q(env) + " --samples 2 -o " + q(out), "fiv: --samples 2: the silhouette"},
       {"scene " + q(kData / "scene_example.json") + " --options " + q(d / "missing.json") + " -o " + q(out),
        "scene: --options " + (d / "missing.json").string() + " applies to a glTF scene (.gltf, .glb) only"},

@@ -426,7 +426,13 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
   if (a.output.empty() && !(a.command == "scene" && a.dry_run)) fail("no output file given (-o OUT.prt.h5)");
   // Who this process is among a sharded bake's workers (the options and the launcher's
   // environment), before the inputs are read.
-  if (a.shard.given() || mpi.active()) a.worker = tool::resolve_worker(a.shard, mpi);
+  if (a.shard.given() || mpi.active()) {
+    try {
+      a.worker = tool::resolve_worker(a.shard, mpi);
+    } catch (const UsageError& e) {
+      fail(e.what());
+    }
+  }
   if (a.command == "scene") {
     a.report_given = cmd.count("--report") > 0;
     if (!a.scene_options.empty() && !bake::is_gltf_scene(a.input))
