@@ -270,14 +270,19 @@ TEST(CliMessages, ALogHoldsAFewProgressLinesPerStage) {
   EXPECT_LE(total, 5 * progress_of(s.err).size());
 }
 
-TEST(CliMessages, AResumableBakeReportsTheThreadsItRanOn) {
+TEST(CliMessages, AResumableBakeReportsTheThreadsItRanOnAndAFewChunkLines) {
   const fs::path d = prt::testing::fresh_dir("cli_messages", "threads");
   const std::string args = "vertex " + q(kData / "bunny.obj") +
-                           " --ao --integrator qmc --samples 64 --report 0 --threads 2 --chunk-rows 512 -o " +
+                           " --ao --integrator qmc --samples 64 --report 0 --threads 2 --chunk-rows 128 -o " +
                            q(d / "b.prt.h5");
   const Outcome r = prtbake(d, args + " --resume");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("; 2 threads; setup"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" on 2 threads)"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find(" on 1 thread"), std::string::npos) << r.out;
+  // 15 chunks in well under 10 s: in a log, the first chunk's line and the last's.
+  size_t chunk_lines = 0;
+  for (size_t at = 0; (at = r.out.find(" committed: ", at)) != std::string::npos; ++at) ++chunk_lines;
+  EXPECT_EQ(chunk_lines, 2u) << r.out;
+  EXPECT_NE(r.out.find("committed: 15/15 chunks of all workers"), std::string::npos) << r.out;
 }

@@ -2,6 +2,7 @@
 #include "shards.h"
 
 #include "cli.h"
+#include "progress_bar.h"
 #include "tool_main.h"
 
 #include <bake/error.h>
@@ -260,6 +261,7 @@ struct ShardedRows::State {
   size_t before = 0, computed = 0, rows = 0;
   double busy = 0, cpu = 0;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  double last_line = -1;  // when the last "chunk committed" line was printed (seconds since start)
 };
 
 namespace {
@@ -348,6 +350,12 @@ void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set, cons
         }
       const size_t before = std::min(s.before, now);
       const double elapsed = seconds_since(s.start);
+      // In a log (stdout not a terminal) a few lines, as the progress lines: the first, then at
+      // most one every 10 s, and the last.
+      if (!isatty(STDOUT_FILENO) && s.last_line >= 0 && now < total &&
+          elapsed - s.last_line < ProgressBar::kLineSpacingSeconds)
+        continue;
+      s.last_line = elapsed;
       const double eta = now > before ? elapsed * double(total - now) / double(now - before) : 0.0;
       std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %s%.0f s\n", i, now, total, elapsed,
                   last_set && !last ? "at most " : "", eta);
