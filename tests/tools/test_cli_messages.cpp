@@ -137,6 +137,14 @@ TEST(CliMessages, UnknownCommandsAndOptionsGetTheNearestName) {
       {"export f.prt.h5 -o x.glb --too glb",
        "prtbake: export: unknown option '--too'; did you mean --to? (try 'prtbake export --help')\n"},
       {"vertex m.obj --ao -o o.prt.h5 n.obj", "prtbake: vertex: unexpected argument 'n.obj' (try 'prtbake vertex --help')\n"},
+      {"vertex m.obj --ao -o o.prt.h5 --radiance",
+       "prtbake: vertex: --radiance needs a value (--radiance ENV) (try 'prtbake vertex --help')\n"},
+      {"export f.prt.h5 -o x.json --to untiy",
+       "prtbake: export: --to: expects gltf, glb, bin, unity, godot or filament, got 'untiy'; did you mean unity? "
+       "(try 'prtbake export --help')\n"},
+      {"vertex m.obj --ao -o o.prt.h5 --integrator qcm",
+       "prtbake: vertex: --integrator: unknown integrator 'qcm'; did you mean qmc? (available: silhouette, qmc, "
+       "filter) (try 'prtbake vertex --help')\n"},
   };
   for (const Case& c : exact) {
     const Outcome r = prtbake(d, c.args);

@@ -195,8 +195,15 @@ std::string usage_message(const CLI::App& app, const CLI::ParseError& error, std
   }
   if (!options.empty()) return prefix + unknown_option(app, cmd, options.front(), tool);
   if (!others.empty()) return prefix + "unexpected argument " + in_quotes(others.front());
-  // An option given twice, perhaps by two of its names (--radiance and --env).
+  // An option given twice, perhaps by two of its names (--radiance and --env), or without its value.
   const std::string what = error.what();
+  if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) && what.find(" missing") != std::string::npos) {
+    const std::string name = what.substr(0, what.find(':'));
+    for (const CLI::Option* o : (cmd ? *cmd : app).get_options())
+      if (o->check_name(name))
+        return prefix + name + " needs a value" +
+               (o->get_option_text().empty() ? std::string() : " (" + name + " " + o->get_option_text() + ")");
+  }
   if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) && what.find("At Most 1 required") != std::string::npos) {
     const std::string name = what.substr(0, what.find(':'));
     for (const CLI::Option* o : (cmd ? *cmd : app).get_options())

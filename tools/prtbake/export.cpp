@@ -1,6 +1,7 @@
 // tools/prtbake/export.cpp — `prtbake export` (contract: export.h).
 #include "export.h"
 
+#include "cli.h"
 #include "tool_main.h"
 
 #include <bake/envmap.h>
@@ -53,7 +54,10 @@ void add_export(CLI::App& app, ExportArgs& args) {
       ->option_text("FORMAT")
       ->required()
       ->check([](const std::string& s) -> std::string {
-        return formats::parse_export_format(s) ? "" : "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'";
+        if (formats::parse_export_format(s)) return "";
+        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament"});
+        return "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'" +
+               (near ? "; did you mean " + *near + "?" : std::string());
       });
   cmd.add_option("-o,--output", args.output,
                  "the file to write (gltf: also <stem>.bin beside it). Written to a\n"

@@ -276,8 +276,12 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
          "--integrator",
          [&a](const std::string& name) {
            const auto kind = bake::parse_integrator_kind(name);
-           if (!kind)
-             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc, filter)");
+           if (!kind) {
+             const auto near = tool::closest(name, {"silhouette", "qmc", "filter"});
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "'" +
+                                                            (near ? "; did you mean " + *near + "?" : std::string()) +
+                                                            " (available: silhouette, qmc, filter)");
+           }
            a.integrator.kind = *kind;
          },
          "silhouette (the default with --samples): semi-analytic visibility\n"
