@@ -299,6 +299,7 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
     const Outcome c = run(std::string(cmd) + " --help");
     EXPECT_EQ(c.code, 0) << cmd;
     EXPECT_NE(c.out.find("--output"), std::string::npos) << cmd;
+    EXPECT_NE(c.out.find("Usage: prtbake " + std::string(cmd) + " [OPTIONS]"), std::string::npos) << c.out;
     EXPECT_NE(c.out.find("EXIT STATUS"), std::string::npos) << cmd;
   }
   const Outcome v = run("--version");

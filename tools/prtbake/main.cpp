@@ -488,7 +488,7 @@ std::optional<Args> parse(int argc, char** argv, const tool::MpiSession& mpi) {
   } catch (const CLI::CallForHelp&) {
     // A command's --help is its whole text; the tool's own lists the commands.
     const std::vector<CLI::App*> given = app.get_subcommands();
-    std::cout << (given.empty() ? overview() : given.front()->help());
+    std::cout << (given.empty() ? overview() : given.front()->help("prtbake"));
     return std::nullopt;
   } catch (const CLI::Success& e) {  // --version
     app.exit(e);
