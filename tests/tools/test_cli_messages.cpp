@@ -83,6 +83,20 @@ TEST(CliMessages, CommandLineMistakesExitTwoBeforeAnyFileIsRead) {
   EXPECT_EQ(prt::testing::listing(d), std::vector<std::string>{});
 }
 
+TEST(CliMessages, AScenesFilterIntegratorWithoutSamplesIsRefusedNamingTheFileBeforeAnyMesh) {
+  // The scene file's own "bake" settings are input (exit 1): the same mistake as vertex's
+  // --integrator filter without --samples, said in the file's terms and found when it is parsed.
+  const fs::path d = prt::testing::fresh_dir("cli_messages", "scene_filter");
+  std::ofstream(d / "scene.json") << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "integrator": "filter"},
+ "objects": [{"name": "ground", "mesh": ")" << (d / "missing.obj").string() << R"(", "role": "receiver"}]})";
+  const Outcome r = prtbake(d, "scene " + q(d / "scene.json") + " -o " + q(d / "s.prt.h5"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.err, "prtbake: error: " + (d / "scene.json").string() +
+                       ": bake.integrator \"filter\" needs bake.samples, its pass-1 rays per vertex (4-32): the "
+                       "target-error chooser has no model of the filter integrator\n");
+  EXPECT_EQ(r.out, "");
+}
+
 TEST(CliMessages, AValueThatIsNotANumberIsCalledSoAndTheOptionNamed) {
   const fs::path d = prt::testing::fresh_dir("cli_messages", "numbers");
   const std::string vertex = "vertex m.obj --ao -o o.prt.h5 ";
