@@ -132,20 +132,22 @@ const char* to_string(ExportFormat format) noexcept {
   return "?";
 }
 
-void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                  const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
+ExportSummary export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                           const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
   const bool probe = is_probe_format(format);
   if (environment && !probe) throw std::invalid_argument("an environment probe is written by the probe formats only");
   if (exporting::vertex_sets(asset).empty() && !(probe && environment))
     throw FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");
+  ExportSummary summary;
   switch (format) {
   case ExportFormat::Gltf:
-  case ExportFormat::Glb: exporting::export_gltf(asset, out, format == ExportFormat::Glb); return;
-  case ExportFormat::Binary: exporting::export_binary(asset, out); return;
+  case ExportFormat::Glb: exporting::export_gltf(asset, out, format == ExportFormat::Glb); break;
+  case ExportFormat::Binary: exporting::export_binary(asset, out); break;
   case ExportFormat::Unity:
   case ExportFormat::Godot:
-  case ExportFormat::Filament: exporting::export_probes(asset, source, format, out, environment); return;
+  case ExportFormat::Filament: summary.left_out = exporting::export_probes(asset, source, format, out, environment); break;
   }
+  return summary;
 }
 
 } // namespace prt::formats

@@ -67,7 +67,9 @@ void write_bytes(const std::filesystem::path& path, const std::string& bytes, co
 // The three exporters.
 void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb);
 void export_binary(const Asset& asset, const std::filesystem::path& out);
-void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat engine,
-                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment);
+// Returns the sets it skipped (no /radiance/band1), each as "<name>: <why>".
+std::vector<std::string> export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat engine,
+                                       const std::filesystem::path& out,
+                                       const std::optional<EnvironmentProbe>& environment);
 
 } // namespace prt::formats::exporting

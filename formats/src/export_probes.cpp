@@ -52,18 +52,43 @@ nlohmann::json in_frame(const std::vector<double>& xyz, const C::Mat3& M) {
   return out;
 }
 
+// Why a vertex set has no /radiance/band1: a scene object's plan says it (the "left_out" line that
+// names band-1 radiance); the root layout was baked without an environment.
+std::string why_no_band1(const Asset& asset, const VertexSet& set) {
+  for (const SceneObject& o : asset.objects) {
+    if (&o.set != &set) continue;
+    const std::string lines = o.left_out ? *o.left_out : std::string();
+    for (size_t a = 0; a < lines.size();) {
+      size_t b = lines.find('\n', a);
+      if (b == std::string::npos) b = lines.size();
+      const std::string line = lines.substr(a, b - a);
+      const size_t colon = line.find(": ");
+      if (colon != std::string::npos && line.substr(0, colon).find("radiance") != std::string::npos)
+        return "no band-1 radiance (the scene's plan left it out: " + line.substr(colon + 2) + ")";
+      a = b + 1;
+    }
+    return "no band-1 radiance was baked for it";
+  }
+  return "no band-1 radiance (baked without --radiance ENV)";
+}
+
 } // namespace
 
-void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
+std::vector<std::string> export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                                       const std::filesystem::path& out,
+                                       const std::optional<EnvironmentProbe>& environment) {
   const EngineInfo& e = info_of(format);
   const C::UpAxis up = asset.root.up_axis == "z" ? C::UpAxis::Z : C::UpAxis::Y;
   const C::Mat3 M = C::engine_from_file(e.engine, up);
 
   nlohmann::json sets = nlohmann::json::array();
+  std::vector<std::string> left_out;
   for (const SetRef& ref : vertex_sets(asset)) {
     const VertexSet& s = *ref.set;
-    if (!s.radiance_band1) continue;
+    if (!s.radiance_band1) {
+      left_out.push_back(ref.name + ": " + why_no_band1(asset, s));
+      continue;
+    }
     const size_t V = s.vertex_count();
     nlohmann::json sh = nlohmann::json::array();
     for (size_t v = 0; v < V; ++v) {
@@ -114,6 +139,7 @@ void export_probes(const Asset& asset, const std::filesystem::path& source, Expo
   Staging staging(out);
   write_bytes(staging.stage(out), j.dump() + "\n", out);
   staging.commit();
+  return left_out;
 }
 
 } // namespace prt::formats::exporting

@@ -360,7 +360,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   PRT_CHECK(!points.empty());
   if (options.only == IntegratorKind::Filter)
     throw InputError("", "the target-error chooser has no model of the filter integrator: give its pass-1 rays "
-                         "(--samples N)");
+                         "(its samples) instead of a target error");
   const auto wall0 = std::chrono::steady_clock::now();
   const double E = options.target;
   IntegratorChoice choice;

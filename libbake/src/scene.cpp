@@ -305,7 +305,7 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
     if (const Json* x = find_key(*bake, "integrator")) {
       const std::string& name = r.string(*x, "bake.integrator");
       const auto kind = parse_integrator_kind(name);
-      if (!kind) r.fail("bake.integrator must be \"silhouette\" or \"qmc\", not \"" + name + "\"");
+      if (!kind) r.fail("bake.integrator must be \"silhouette\", \"qmc\" or \"filter\", not \"" + name + "\"");
       sc.integrator.kind = *kind;
       sc.integrator_given = true;
     }
@@ -320,6 +320,9 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
         r.fail("bake.target_error and bake.samples both given: the target chooses the samples (give one)");
       if (!find_key(*bake, "report")) sc.integrator.report_points = ChooserOptions::kReportPoints;
     }
+    if (sc.integrator.kind == IntegratorKind::Filter && !find_key(*bake, "samples"))
+      r.fail("bake.integrator \"filter\" needs bake.samples, its pass-1 rays per vertex (4-32): the target-error "
+             "chooser has no model of the filter integrator");
     if (const Json* x = find_key(*bake, "sh_tolerance")) {
       sc.sh_tolerance = r.number(*x, "bake.sh_tolerance", 0, 1);
       if (!(sc.sh_tolerance > 0)) r.fail("bake.sh_tolerance must be > 0");
@@ -597,13 +600,15 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   return sc;
 }
 
-bool is_gltf(const std::filesystem::path& file) {
+bool is_gltf(const std::filesystem::path& file) { return is_gltf_scene(file); }
+
+} // namespace
+
+bool is_gltf_scene(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   return ext == ".gltf" || ext == ".glb";
 }
-
-} // namespace
 
 SceneDescription load_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& gltf_options) {
   if (is_gltf(file)) return load_gltf_scene(file, gltf_options);

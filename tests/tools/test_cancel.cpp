@@ -1,6 +1,7 @@
 // Ctrl-C in the middle of a bake, end to end: prtbake started as a user would, SIGINT once it has
 // started baking; it must stop with exit 130, say so, and leave nothing in the output directory
-// (tools/common/tool_main.h, bake/progress.h).
+// but the chunks a --resume bake committed, which it names with the command that resumes
+// (tools/common/tool_main.h, bake/progress.h, tools/prtbake/shards.h).
 #include <gtest/gtest.h>
 #include <run_tool.h>
 
@@ -8,7 +9,9 @@
 #include <csignal>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <unistd.h>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -19,7 +22,7 @@ TEST(PrtbakeCancel, CtrlCDuringABakeExits130AndWritesNothing) {
   const fs::path out = dir / "bunny.h5";
   // Ambient occlusion with 65536 QMC rays at each of the bunny-on-ground's vertices: minutes of work on two threads,
   // so the bake is still running when the signal arrives. stderr is a pipe, so progress comes as
-  // plain lines; the first ("baking vertices:   0% ...") is printed as the bake starts.
+  // plain lines; the first ("baking vertices:   N% ...") is printed once the stage has run 1 s.
   const auto start = std::chrono::steady_clock::now();
   prt::testing::BackgroundTool bake(PRT_PRTBAKE, {"vertex", std::string(PRT_DATA_DIR) + "/bunny_ground.obj", "-o",
                                                   out.string(), "--integrator", "qmc", "--samples", "65536", "--ao",
@@ -71,5 +74,58 @@ TEST(PrtbakeCancel, CtrlCDuringTheErrorCheckKeepsTheBakeWithoutItsReport) {
     EXPECT_EQ(e.path(), out) << "left behind: " << e.path();
   }
   EXPECT_EQ(files, 1u);
+  fs::remove_all(dir);
+}
+
+// Ctrl-C during a --resume bake: the chunks committed so far are kept (rightly), and the message
+// says so, where, and the command that resumes; that command, run as printed, reuses them.
+TEST(PrtbakeCancel, CtrlCOfAResumableBakeKeepsItsChunksAndSaysHowToResume) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / ("cancel_resume." + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "bunny.prt.h5", chunks = dir / "bunny.prt.h5.chunks";
+  // 15 chunks of 128 vertices, a fraction of a second each: the first is committed soon, the
+  // signal comes well before the last.
+  const std::vector<std::string> args = {"vertex", std::string(PRT_DATA_DIR) + "/bunny.obj", "--ao", "--integrator",
+                                         "qmc", "--samples", "4096", "--report", "0", "--threads", "2", "--resume",
+                                         "--chunk-rows", "128", "-o", out.string()};
+  prt::testing::BackgroundTool bake(PRT_PRTBAKE, args);
+  ASSERT_TRUE(bake.started());
+  const auto committed = [&] {
+    size_t n = 0;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(chunks, ec))
+      if (e.path().extension() == ".chunk") ++n;
+    return n;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (committed() == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_GT(committed(), 0u) << bake.err();
+  bake.send(SIGINT);
+  ASSERT_EQ(bake.wait(), 130) << bake.err();
+  const size_t kept = committed();
+  ASSERT_GT(kept, 0u);
+  ASSERT_LT(kept, 15u) << "the bake ran to its end before the signal";
+  EXPECT_FALSE(fs::exists(out));
+
+  // The one line: what is kept, where, and the command, exactly as it was run.
+  std::string command = PRT_PRTBAKE;
+  for (const std::string& a : args) command += " " + a;  // no argument here needs quoting
+  const std::string expected = "prtbake: cancelled; " + std::to_string(kept) + " of 15 chunks are committed (" +
+                               std::to_string(kept) + " by this run) and kept in " + chunks.string() +
+                               "/; to resume, rerun: " + command + "\n";
+  EXPECT_EQ(bake.err(), expected);
+
+  // Running it resumes: the kept chunks are reused, the file is written, the chunks removed.
+  const auto resumed = prt::testing::run_tool(PRT_PRTBAKE, command.substr(std::string(PRT_PRTBAKE).size() + 1), dir);
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find(std::to_string(kept) + " committed before this run (reused)"), std::string::npos)
+      << resumed.out;
+  // Its chunks were computed by two runs: the threads of the first are not known, so none is claimed.
+  EXPECT_NE(resumed.out.find("summed over the chunks of every worker and run"), std::string::npos) << resumed.out;
+  EXPECT_EQ(resumed.out.find(" on 1 thread"), std::string::npos) << resumed.out;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(chunks));
   fs::remove_all(dir);
 }

@@ -65,9 +65,9 @@ fs::path write_grid(const fs::path& dir) {
   return p;
 }
 
-std::vector<std::string> bake_args(const fs::path& mesh, const fs::path& out, int order) {
-  return {"vertex", mesh.string(), "--transfer", std::to_string(order), "--integrator", "qmc", "--samples", "16",
-          "--report", "0", "--threads", "2", "--reproducible", "-o", out.string()};
+std::vector<std::string> bake_args(const fs::path& mesh, const fs::path& out, int order, int samples = 16) {
+  return {"vertex", mesh.string(), "--transfer", std::to_string(order), "--integrator", "qmc", "--samples",
+          std::to_string(samples), "--report", "0", "--threads", "2", "--reproducible", "-o", out.string()};
 }
 
 // The temporaries "<out>.tmp.*" next to `out`.
@@ -155,13 +155,14 @@ TEST(Faults, OutputDirectoryRemovedDuringTheBakeIsOneLineExitOne) {
   fs::remove_all(work);
   fs::create_directories(work);
   const fs::path mesh = write_grid(work);
-  // Removed while the bake computes (its first progress line is printed), and as soon as the
-  // temporary appears (the write has begun).
+  // Removed while the bake computes (its first progress line is printed, once the stage has run a
+  // second: 256 rays per vertex keep it running several), and as soon as the temporary appears
+  // (the write has begun).
   for (const bool during_write : {false, true}) {
     SCOPED_TRACE(during_write ? "during the write" : "before the write");
     const fs::path dir = work / "out", out = dir / "v.prt.h5";
     fs::create_directories(dir);
-    std::vector<std::string> args = bake_args(mesh, out, 8);
+    std::vector<std::string> args = bake_args(mesh, out, 8, during_write ? 16 : 256);
     prt::testing::BackgroundTool bake(PRT_PRTBAKE, args);
     ASSERT_TRUE(bake.started());
     if (during_write) ASSERT_TRUE(wait_for_temporary(out, kBakeTimeout)) << bake.err();

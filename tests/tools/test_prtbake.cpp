@@ -314,16 +314,24 @@ TEST(Prtbake, UsageErrorsExitTwoAndHelpTeaches) {
   EXPECT_EQ(run("vertex x.obj --ao -o y --frobnicate").code, 2);
   EXPECT_EQ(run("vertex x.obj --ao -o y.prt.h5 --target-error 1e-3 --samples 64").code, 2) << "target and samples";
   EXPECT_EQ(run("vertex x.obj --ao -o y.prt.h5 --target-error 1e-6").code, 2) << "target below 1e-4";
+  // The tool's help lists the commands, one line each, and says where their options are.
   const Outcome h = run("--help");
   EXPECT_EQ(h.code, 0);
-  for (const char* s : {"--ao", "--transfer", "--visibility", "--radiance", "--samples", "--seed", "--threads", "--up",
-                        "EXAMPLES", "EXIT STATUS"})
+  for (const char* s : {"\n  vertex ", "\n  fiv ", "\n  scene ", "\n  export ", "'prtbake COMMAND --help'", "EXAMPLES",
+                        "EXIT STATUS"})
     EXPECT_NE(h.out.find(s), std::string::npos) << s;
+  EXPECT_EQ(h.out.find("--visibility"), std::string::npos) << "a command's options are in its own help:\n" << h.out;
+  EXPECT_LE(std::count(h.out.begin(), h.out.end(), '\n'), 40) << h.out;
+  const Outcome vh = run("vertex --help");
+  for (const char* s : {"--ao", "--transfer", "--visibility", "--radiance,--env", "--samples", "--seed", "--threads",
+                        "--up", "EXAMPLES", "EXIT STATUS"})
+    EXPECT_NE(vh.out.find(s), std::string::npos) << s;
   // Each command's help teaches its own options and ends with the exit codes too.
-  for (const char* cmd : {"vertex", "fiv", "scene"}) {
+  for (const char* cmd : {"vertex", "fiv", "scene", "export"}) {
     const Outcome c = run(std::string(cmd) + " --help");
     EXPECT_EQ(c.code, 0) << cmd;
     EXPECT_NE(c.out.find("--output"), std::string::npos) << cmd;
+    EXPECT_NE(c.out.find("Usage: prtbake " + std::string(cmd) + " [OPTIONS]"), std::string::npos) << c.out;
     EXPECT_NE(c.out.find("EXIT STATUS"), std::string::npos) << cmd;
   }
   const Outcome v = run("--version");

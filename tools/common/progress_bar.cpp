@@ -1,5 +1,6 @@
 #include "progress_bar.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <unistd.h>
 
@@ -28,10 +29,12 @@ bake::Monitor ProgressBar::monitor(const bake::CancelToken* cancel) const {
 
 // Called by libbake's Task, never concurrently for one task; tasks run one after another.
 void ProgressBar::draw(const bake::ProgressUpdate& u) const {
-  if (u.task != task_) {
+  if (u.task != task_ || stage_ended_) {  // a new stage (two in a row may share a label)
     task_ = std::string(u.task);
-    last_decile_ = -1;
+    printed_ = false;
+    last_quarter_ = 0;
   }
+  stage_ended_ = u.finished;
   if (u.total == 0) return;
   const double frac = double(u.done) / double(u.total);
   const double rate = u.seconds > 0 ? double(u.done) / u.seconds : 0.0;
@@ -45,12 +48,21 @@ void ProgressBar::draw(const bake::ProgressUpdate& u) const {
                  int(frac * 100), (unsigned long long)u.done, (unsigned long long)u.total, human_rate(rate).c_str(),
                  u.finished ? "took" : "ETA", u.finished ? u.seconds : eta, u.finished ? "\n" : "");
   } else {
-    const int decile = int(frac * 10);
-    if (decile == last_decile_ && !u.finished) return;
-    if (u.finished && last_decile_ == 10) return;
-    last_decile_ = decile;
-    std::fprintf(stderr, "%s: %3d%% (%llu/%llu) %s, %.1fs\n", task_.c_str(), int(frac * 100),
-                 (unsigned long long)u.done, (unsigned long long)u.total, human_rate(rate).c_str(), u.seconds);
+    const int quarter = std::min(int(frac * 4), 3);
+    if (u.finished) {
+      if (!printed_ && u.seconds < kFirstLineSeconds) return;  // a short stage: silent
+    } else if (!printed_) {
+      if (u.seconds < kFirstLineSeconds) return;
+    } else if (quarter <= last_quarter_ || u.seconds - last_line_seconds_ < kLineSpacingSeconds) {
+      return;
+    }
+    printed_ = true;
+    last_quarter_ = quarter;
+    last_line_seconds_ = u.seconds;
+    std::fprintf(stderr, "%s: %3d%% (%llu/%llu) %s, %.1fs", task_.c_str(), int(frac * 100), (unsigned long long)u.done,
+                 (unsigned long long)u.total, human_rate(rate).c_str(), u.seconds);
+    if (!u.finished && rate > 0) std::fprintf(stderr, ", ETA %.1fs", eta);
+    std::fputc('\n', stderr);
   }
   std::fflush(stderr);
 }

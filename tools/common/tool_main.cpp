@@ -39,12 +39,14 @@ int run_tool(const char* tool, int (*body)(int, char**), int argc, char** argv) 
   try {
     return body(argc, argv);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "%s: %s (try '%s --help')\n", tool, e.what(), tool);
+    std::fprintf(stderr, "%s: %s (try '%s --help')\n", tool, e.what(), e.help().empty() ? tool : e.help().c_str());
     return kExitUsage;
   } catch (const bake::InputError& e) {
     return fail(tool, "error: ", e.what(), kExitBadInput);
   } catch (const formats::FormatError& e) {
     return fail(tool, "error: ", e.what(), kExitBadInput);
+  } catch (const CancelledKeeping& e) {
+    return fail(tool, "cancelled; ", e.what(), kExitCancelled);
   } catch (const bake::Cancelled&) {
     return fail(tool, "cancelled; nothing was written", "", kExitCancelled);
   } catch (const bake::SystemError& e) {

@@ -8,13 +8,16 @@
 //   3    the machine failed: out of memory, no Embree device, a failed system call
 //        (bake::SystemError, std::bad_alloc)
 //   4    internal error: a broken invariant inside prt (a bug; please report it)
-//   130  cancelled (Ctrl-C / SIGINT): the bake stopped and wrote nothing
+//   130  cancelled (Ctrl-C / SIGINT): the bake stopped and wrote nothing (CancelledKeeping: a
+//        sharded or resumable bake keeps its committed chunks and the line says where and how
+//        to resume)
 #pragma once
 
 #include <bake/progress.h>
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace prt::tool {
 
@@ -35,10 +38,27 @@ inline constexpr const char* kExitStatusHelp =
     "  2    bad command line\n"
     "  3    the machine failed: out of memory, no Embree device, a failed system call\n"
     "  4    internal error: a bug in the prtbake toolkit (please report it with the command line)\n"
-    "  130  cancelled with Ctrl-C: nothing was written\n";
+    "  130  cancelled with Ctrl-C: nothing was written (a --resume or --shard bake keeps its\n"
+    "       committed chunks; the message says where and the command that resumes)\n";
 
-// A command-line mistake found after parsing (a missing output, options that do not go together).
+// The version every tool answers --version with ("prtbake 0.1.0", "prtdump 0.1.0").
+inline constexpr const char* kToolkitVersion = "0.1.0";
+
+// A command-line mistake (a missing output, options that do not go together), found before any
+// work. `help`: the command whose --help explains (default: the tool's own).
 class UsageError : public std::runtime_error {
+public:
+  explicit UsageError(const std::string& what, std::string help = "")
+      : std::runtime_error(what), help_(std::move(help)) {}
+  const std::string& help() const noexcept { return help_; }
+
+private:
+  std::string help_;
+};
+
+// A cancelled bake that keeps what it committed (chunks of a --resume or --shard bake): what()
+// says what is kept, where, and the command that resumes. Exit 130 like any cancellation.
+class CancelledKeeping : public std::runtime_error {
 public:
   using std::runtime_error::runtime_error;
 };

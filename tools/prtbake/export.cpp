@@ -1,14 +1,18 @@
 // tools/prtbake/export.cpp — `prtbake export` (contract: export.h).
 #include "export.h"
 
+#include "cli.h"
 #include "tool_main.h"
 
 #include <bake/envmap.h>
 #include <bake/error.h>
 #include <formats/export.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
+#include <utility>
+#include <vector>
 
 namespace prt::tool {
 namespace {
@@ -19,8 +23,10 @@ constexpr const char* kExportHelp =
     "object; the values are the file's, unchanged.\n"
     "  gltf      glTF 2.0, OUT.gltf + OUT.bin: per vertex set a mesh and a node (POSITION, NORMAL,\n"
     "            indices); AO as COLOR_0 (grey) and _AO; transfer, band-1 radiance and area-light\n"
-    "            data as _PRT_<NAME>_<k> attributes (4 components each: reassemble in order; the\n"
-    "            mapping is in asset.extras.prtbake). Loads in Blender and engine importers.\n"
+    "            data as _PRT_<NAME>_<k> attributes: VEC4 holding components 4k..4k+3 of the\n"
+    "            row, the last one SCALAR, VEC2 or VEC3 when the row's length is not a multiple\n"
+    "            of 4 (concatenate them in order; the mapping is in asset.extras.prtbake).\n"
+    "            Loads in Blender and engine importers.\n"
     "  glb       the same as one binary glTF file.\n"
     "  bin       plain binary: magic \"PRTBIN\", version, a JSON header naming each array (HDF5\n"
     "            path, dtype, shape, byte offset), little-endian arrays 16-byte aligned.\n"
@@ -31,8 +37,13 @@ constexpr const char* kExportHelp =
     "The probe formats evaluate, in each engine's own formula, to the baked irradiance/pi at the\n"
     "baked normal; they need a file baked with --radiance (or a scene with an environment), or\n"
     "--env ENV: the environment's own probe (its order-3 radiance SH, unshadowed), the ambient\n"
-    "probe for dynamic objects, consistent with the bake. Example:\n"
-    "  prtbake export bunny.prt.h5 --to unity --env data/sunset.exr -o bunny_probes.json";
+    "probe for dynamic objects, consistent with the bake. A vertex set without band-1 radiance\n"
+    "(an occluder, a glossy receiver) gets no probes; a warning names each and says why.";
+
+constexpr const char* kExportExamples =
+    "EXAMPLES\n"
+    "  prtbake export bunny.prt.h5 --to glb -o bunny.glb\n"
+    "  prtbake export bunny.prt.h5 --to unity --env data/sunset.exr -o bunny_probes.json\n\n";
 
 } // namespace
 
@@ -43,7 +54,10 @@ void add_export(CLI::App& app, ExportArgs& args) {
       ->option_text("FORMAT")
       ->required()
       ->check([](const std::string& s) -> std::string {
-        return formats::parse_export_format(s) ? "" : "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'";
+        if (formats::parse_export_format(s)) return "";
+        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament"});
+        return "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'" +
+               (near ? "; did you mean " + *near + "?" : std::string());
       });
   cmd.add_option("-o,--output", args.output,
                  "the file to write (gltf: also <stem>.bin beside it). Written to a\n"
@@ -55,6 +69,16 @@ void add_export(CLI::App& app, ExportArgs& args) {
                  "lat-long or cube, read in the file's up axis) as \"environment\"; it must be the\n"
                  "map the file's lighting was baked with, when the file names one.")
       ->option_text("ENV");
+  cmd.footer(std::string(kExportExamples) + kExitStatusHelp);
+}
+
+void check_export_args(const ExportArgs& args) {
+  const std::optional<formats::ExportFormat> format = formats::parse_export_format(args.format);
+  PRT_CHECK(format.has_value());  // the --to check
+  if (!args.env.empty() && !formats::is_probe_format(*format))
+    throw UsageError("export: --env writes an environment probe: it needs --to unity, godot or filament, not " +
+                         args.format,
+                     "prtbake export");
 }
 
 namespace {
@@ -93,13 +117,26 @@ formats::EnvironmentProbe environment_probe(const std::string& path, const forma
 
 int run_export(const ExportArgs& args) {
   const formats::ExportFormat format = *formats::parse_export_format(args.format);
-  const bool probe = formats::is_probe_format(format);
-  if (!args.env.empty() && !probe)
-    throw UsageError("--env writes an environment probe: it needs --to unity, godot or filament, not " + args.format);
   const formats::Asset asset = formats::read_asset(args.input);
   std::optional<formats::EnvironmentProbe> environment;
   if (!args.env.empty()) environment = environment_probe(args.env, asset, args.input);
-  formats::export_asset(asset, args.input, format, args.output, environment);
+  const formats::ExportSummary summary = formats::export_asset(asset, args.input, format, args.output, environment);
+  // The sets left out, one line per reason naming them ("<name>: <why>" each).
+  std::vector<std::pair<std::string, std::vector<std::string>>> by_reason;
+  for (const std::string& entry : summary.left_out) {
+    const size_t colon = entry.find(": ");
+    const std::string name = entry.substr(0, colon), why = colon == std::string::npos ? "" : entry.substr(colon + 2);
+    auto it = std::find_if(by_reason.begin(), by_reason.end(), [&](const auto& r) { return r.first == why; });
+    if (it == by_reason.end()) it = by_reason.insert(by_reason.end(), {why, {}});
+    it->second.push_back(name);
+  }
+  for (const auto& [why, sets] : by_reason) {
+    std::string list;
+    for (const std::string& n : sets) list += (list.empty() ? "" : ", ") + n;
+    std::fprintf(stderr, "prtbake: warning: export: no %s probes for %s%s: %s\n", formats::to_string(format),
+                 sets.size() == 1 ? "" : (std::to_string(sets.size()) + " vertex sets, ").c_str(), list.c_str(),
+                 why.c_str());
+  }
   std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), formats::to_string(format));
   return 0;
 }

@@ -15,7 +15,10 @@ struct ExportArgs {
 
 // Adds the `export` subcommand to `app`, parsing into `args`.
 void add_export(CLI::App& app, ExportArgs& args);
-// Runs it: reads the input (FormatError: exit 1), writes the output whole or not at all.
+// The checks of parsed arguments that need no file (UsageError: exit 2 before anything is read).
+void check_export_args(const ExportArgs& args);
+// Runs it: reads the input (FormatError: exit 1), writes the output whole or not at all; a warning
+// on stderr names the vertex sets a probe format leaves out, and why.
 int run_export(const ExportArgs& args);
 
 } // namespace prt::tool

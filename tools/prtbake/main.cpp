@@ -14,6 +14,7 @@
 #include <prtshade/sh.h>
 
 #include "bakefile.h"
+#include "cli.h"
 #include "export.h"
 #include "progress_bar.h"
 #include "shards.h"
@@ -46,7 +47,7 @@ using namespace prt;
 
 namespace {
 
-constexpr const char* kVersion = "0.1.0";
+constexpr const char* kVersion = tool::kToolkitVersion;
 
 constexpr const char* kDescription = "prtbake — bake precomputed radiance transfer (PRT) data for game geometry";
 
@@ -82,17 +83,39 @@ constexpr const char* kSceneHelp =
     "stored as /objects/root|engine|piston_2 with the path in node_path), role \"both\", albedo\n"
     "the material's baseColorFactor (0.8 grey without one). --options sets the rest.";
 
-constexpr const char* kExamples =
+// One line per command: the top-level --help and the message for an unknown command.
+const std::vector<tool::Command> kCommands = {
+    {"vertex", "per-vertex products of a mesh: AO, SH transfer, visibility, band-1 and shadowed radiance"},
+    {"fiv", "an occluder's Fullsphere Irradiance Vectors on shells around it, and the DifMap"},
+    {"scene", "a scene file or glTF: bakes what each object needs and says what it leaves out, and why"},
+    {"export", "a baked file as glTF, plain binary, or Unity / Godot / Filament light probes"},
+};
+
+// Each command's EXAMPLES (its --help shows its own); the top-level --help shows one per command.
+constexpr const char* kVertexExamples =
     "EXAMPLES\n"
     "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
     "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
-    "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
-    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
-    "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
     "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
     "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
+    "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
+constexpr const char* kFivExamples =
+    "EXAMPLES\n"
+    "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
     "  mpirun -n 4 prtbake fiv data/bunny.obj --env data/forest.exr -o bunny.fiv.prt.h5   # shells in slabs of samples\n"
-    "  prtbake export bunny.prt.h5 --to glb -o bunny.glb   # for engines without HDF5 (also gltf, bin, unity, godot, filament)\n"
+    "  prtdump bunny.fiv.prt.h5        # the shells, the DifMap, the error report\n\n";
+constexpr const char* kSceneExamples =
+    "EXAMPLES\n"
+    "  prtbake scene data/scene_example.json --dry-run      # the plan: what each object gets, and why\n"
+    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
+    "  prtdump scene.prt.h5 --vertex 0 --object bunny\n\n";
+constexpr const char* kTopExamples =
+    "EXAMPLES\n"
+    "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
+    "  prtbake fiv data/bunny.obj --env data/forest.exr -o bunny.fiv.prt.h5\n"
+    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtbake export bunny.prt.h5 --to glb -o bunny.glb\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
 using tool::UsageError;
@@ -102,7 +125,7 @@ struct Args {
   std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file or glTF (scene)
   std::string scene_options;  // scene: a glTF scene's options file (--options)
   std::string output;       // the .prt.h5 file
-  std::string environment;  // vertex: --radiance ENV; fiv: --env ENV
+  std::string environment;  // vertex: --radiance ENV (alias --env); fiv: --env ENV
   bool ao = false;
   int transfer = 0, visibility = 0;  // SH orders (0: not baked)
   int shadowed = 0;                  // vertex: --shadowed L, S under the --radiance environment
@@ -119,7 +142,8 @@ struct Args {
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
   tool::ExportArgs exported;  // export: a baked file in another format (export.h)
-  tool::ShardOptions shard;   // vertex, scene: sharded and resumable bakes (shards.h)
+  tool::ShardOptions shard;   // vertex, fiv, scene: sharded and resumable bakes (shards.h)
+  std::optional<tool::Worker> worker;  // who this process is in a sharded bake (nullopt: not sharded)
 };
 
 // The command line as stored in the file: the arguments that determine its contents, as typed
@@ -170,31 +194,32 @@ void add_report(CLI::App& cmd, Args& a, const std::string& reference) {
                      std::to_string(bake::IntegratorSpec{}.report_points) +
                      ";\n0 turns it off). Stored under /report in the file.")
       ->option_text("N")
-      ->check(CLI::Range(0u, 1u << 20));
+      ->check(tool::integer_in(0, 1 << 20));
 }
 
-void add_run_options(CLI::App& cmd, Args& a) {
+// --threads, --reproducible and --quiet. `target_help`: what --reproducible does to the command's
+// target-error choice ("" for a command without one: fiv).
+void add_run_options(CLI::App& cmd, Args& a, const std::string& target_help) {
   cmd.add_option("--threads", a.threads, "worker threads (default: all cores).")
       ->option_text("T")
-      ->check(CLI::Range(1, 4096));
+      ->check(tool::integer_in(1, 4096));
   cmd.add_flag("--reproducible", a.reproducible,
                "make the file a pure function of the inputs: 'created' is pinned to\n"
                "SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not\n"
-               "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org).\n"
-               "With a target error (the default), the integrator is chosen by the\n"
-               "pilot's counted work instead of its measured time, so the choice,\n"
-               "and the bytes, are the same on any machine. With --samples the\n"
-               "baked values are identical with or without it.");
+               "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org)." +
+                   (target_help.empty() ? std::string("\nThe baked values are identical with or without it.")
+                                        : "\n" + target_help));
   cmd.add_flag("-q,--quiet", a.quiet, "print nothing but warnings (about the input) and errors.");
 }
 
 // --samples, --seed and --up: what samples the sphere around a shade point.
 void add_sampling(CLI::App& cmd, Args& a, uint32_t& samples, const std::string& samples_help) {
-  cmd.add_option("--samples", samples, samples_help)->option_text("N")->check(CLI::Range(1u, 1u << 24));
+  cmd.add_option("--samples", samples, samples_help)->option_text("N")->check(tool::integer_in(1, 1 << 24));
   cmd.add_option("--seed", a.integrator.seed,
                  "randomisation seed (default " + std::to_string(bake::IntegratorSpec{}.seed) +
                      "). Same inputs and seed give identical\nbytes whatever --threads is.")
-      ->option_text("S");
+      ->option_text("S")
+      ->check(tool::integer_in(0, std::numeric_limits<int64_t>::max()));
   cmd.add_option_function<std::string>(
          "--up",
          [&a](const std::string& u) {
@@ -225,33 +250,38 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "diffuse transfer vectors T_i = 1/pi * Int V H (n.w) y_i dw, SH order L\n"
                  "(L bands, L*L coefficients; shade with albedo * sum_i T_i L_i)")
       ->option_text("L")
-      ->check(CLI::Range(1, sh::kMaxOrder))
+      ->check(tool::integer_in(1, sh::kMaxOrder))
       ->group(products);
   cmd.add_option("--visibility", a.visibility,
                  "visibility transfer vectors U_i = Int V H y_i dw, SH order L (glossy,\ntriple products)")
       ->option_text("L")
-      ->check(CLI::Range(1, sh::kMaxOrder))
+      ->check(tool::integer_in(1, sh::kMaxOrder))
       ->group(products);
-  cmd.add_option("--radiance", a.environment,
+  cmd.add_option("--radiance,--env", a.environment,
                  "band-1 shadowed radiance R_c,m = Int L_c V H y_1m dw from the HDR\n"
                  "environment ENV (OpenEXR lat-long or cube map): exact all-frequency\n"
                  "diffuse shadows with 3 coefficients per channel. Irradiance at the\n"
-                 "baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m.")
+                 "baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m. --env is the same\n"
+                 "option (the name fiv, export and prtview give the environment).")
       ->option_text("ENV")
       ->group(products);
   cmd.add_option("--shadowed", a.shadowed,
                  "shadowed radiance S_c,i = Int L_c V H y_i dw at SH order L under the\n"
-                 "--radiance environment (paper 001 sec. 4, material editing: glossy\n"
+                 "--radiance (--env) environment (paper 001 sec. 4, material editing: glossy\n"
                  "lobes chosen at run time; band 1 of S is R)")
       ->option_text("L")
-      ->check(CLI::Range(1, sh::kMaxOrder))
+      ->check(tool::integer_in(1, sh::kMaxOrder))
       ->group(products);
   cmd.add_option_function<std::string>(
          "--integrator",
          [&a](const std::string& name) {
            const auto kind = bake::parse_integrator_kind(name);
-           if (!kind)
-             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "' (available: silhouette, qmc, filter)");
+           if (!kind) {
+             const auto near = tool::closest(name, {"silhouette", "qmc", "filter"});
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "'" +
+                                                            (near ? "; did you mean " + *near + "?" : std::string()) +
+                                                            " (available: silhouette, qmc, filter)");
+           }
            a.integrator.kind = *kind;
          },
          "silhouette (the default with --samples): semi-analytic visibility\n"
@@ -278,7 +308,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                  "wins is measured speed: pin the printed choice with --integrator\n"
                  "and --samples, or use --reproducible, for the same bytes anywhere.")
       ->option_text("E")
-      ->check(CLI::Range(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
+      ->check(tool::number_in(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
   const bake::IntegratorSpec d;
   add_sampling(cmd, a, samples,
                "silhouette: " + silhouette_k_help(false) +
@@ -295,12 +325,17 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
   add_report(cmd, a,
              std::to_string(bake::IntegratorSpec::kQmcReferenceFactor) + "x the bake's rays for qmc, " +
                  std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays for silhouette");
-  add_run_options(cmd, a);
+  add_run_options(cmd, a,
+                  "With a target error (the default), the integrator is chosen by the\n"
+                  "pilot's counted work instead of its measured time, so the choice,\n"
+                  "and the bytes, are the same on any machine. With --samples the\n"
+                  "baked values are identical with or without it.");
   cmd.add_flag("-v,--verbose", a.verbose,
                "with a target error: print the pilot's table (each run's error and\n"
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
-  tool::add_shard_options(cmd, a.shard);
+  tool::add_shard_options(cmd, a.shard, "vertices");
+  cmd.footer(std::string(kVertexExamples) + tool::kExitStatusHelp);
 }
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
@@ -323,19 +358,19 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
       ->option_text("NPHIxNTHETAxNRHO");
   cmd.add_option("--cube", a.shell_spec.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
       ->option_text("S")
-      ->check(CLI::Range(1, 1024));
+      ->check(tool::integer_in(1, 1024));
   cmd.add_option("--fraction", a.shell_spec.fraction,
-                 "stop adding shells once |F| < FRACTION of Int L dw (default 1e-3)")
+                 "stop adding shells once |F| < FRACTION of Int L dw (default 1e-3;\n"
+                 "strictly between 0 and 1)")
       ->option_text("FRACTION")
-      ->check([](const std::string& s) -> std::string {
-        const double f = std::strtod(s.c_str(), nullptr);
-        return f > 0 && f < 1 ? "" : "expects a number in (0, 1), got '" + s + "'";
-      });
+      ->check(tool::number_between(0, 1));
   add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help(true) + ").");
   add_report(cmd, a,
              std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) +
                  " rays, full sphere, at seeded shell samples");
-  add_run_options(cmd, a);  tool::add_shard_options(cmd, a.shard);
+  add_run_options(cmd, a, "");
+  tool::add_shard_options(cmd, a.shard, "DifMap texels, or a FIV shell's samples");
+  cmd.footer(std::string(kFivExamples) + tool::kExitStatusHelp);
 }
 
 void add_scene(CLI::App& app, Args& a) {
@@ -350,78 +385,128 @@ void add_scene(CLI::App& app, Args& a) {
       ->option_text("FILE");
   cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
   add_report(cmd, a, "overrides the scene file's bake.report");
-  add_run_options(cmd, a);
+  add_run_options(cmd, a,
+                  "With a target error (the scene's bake.target_error; the default\n"
+                  "without bake.samples), each receiver's integrator is chosen by\n"
+                  "the pilot's counted work instead of its measured time, so the\n"
+                  "choice, and the bytes, are the same on any machine. With\n"
+                  "bake.samples the baked values are identical with or without it.");
   cmd.add_flag("-v,--verbose", a.verbose,
                "with a target error: print each receiver's pilot table (each run's\n"
                "error and cost, each integrator's model) instead of one line, and the\n"
                "error report's reference plan.")
       ->excludes("--quiet");
-  tool::add_shard_options(cmd, a.shard);
+  tool::add_shard_options(cmd, a.shard, "receiver vertices");
+  cmd.footer(std::string(kSceneExamples) + tool::kExitStatusHelp);
 }
 
-// Parses the command line; nullopt when it asked for help or the version (printed).
-std::optional<Args> parse(int argc, char** argv, bool under_mpirun) {
+// The top-level --help: the commands, one line each, and where each one's options are.
+std::string overview() {
+  std::string s = std::string(kDescription) + "\n\nUsage: prtbake COMMAND [OPTIONS] INPUT ...\n\nCommands:\n";
+  for (const tool::Command& c : kCommands) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-8s %s\n", c.name, c.summary);
+    s += line;
+  }
+  s += "\n'prtbake COMMAND --help' lists a command's options, says what it computes and gives\n"
+       "examples. Options go after the command, in any order; --opt value or --opt=value.\n\n"
+       "Options:\n"
+       "  -h,--help  this list\n"
+       "  --version  the version (prtbake " + std::string(kVersion) + ")\n\n";
+  return s + kTopExamples + tool::kExitStatusHelp;
+}
+
+// Every check of the command line that needs no file, after CLI11 has parsed it: a mistake is
+// exit 2 before any input is read (tool_main.h). `app`: the parsed command line.
+void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSession& mpi) {
+  const CLI::App& cmd = *app.get_subcommands().front();
+  const std::string help = "prtbake " + a.command;
+  const auto fail = [&](const std::string& what) { throw UsageError(a.command + ": " + what, help); };
+  if (a.command == "export") {
+    if (mpi.active()) fail("run it as one process, not under mpirun");
+    tool::check_export_args(a.exported);
+    return;
+  }
+  if (a.output.empty() && !(a.command == "scene" && a.dry_run)) fail("no output file given (-o OUT.prt.h5)");
+  // Who this process is among a sharded bake's workers (the options and the launcher's
+  // environment), before the inputs are read.
+  if (a.shard.given() || mpi.active()) {
+    try {
+      a.worker = tool::resolve_worker(a.shard, mpi);
+    } catch (const UsageError& e) {
+      fail(e.what());
+    }
+  }
+  if (a.command == "scene") {
+    a.report_given = cmd.count("--report") > 0;
+    if (!a.scene_options.empty() && !bake::is_gltf_scene(a.input))
+      fail("--options " + a.scene_options + " applies to a glTF scene (.gltf, .glb) only; " + a.input +
+           " is a JSON scene file, whose own \"bake\" section holds the options");
+    return;
+  }
+  if (a.command == "vertex") {
+    a.integrator_given = cmd.count("--integrator") > 0;
+    const bool target_given = a.target_error > 0;
+    if (target_given && samples != 0)
+      fail("--target-error and --samples both given: the target chooses the samples (give one)");
+    if (a.integrator.kind == bake::IntegratorKind::Filter && samples == 0)
+      fail(std::string("--integrator filter needs --samples N, its pass-1 rays per vertex (4-32): the target-error "
+                       "chooser has no model of the filter integrator") +
+           (target_given ? ", so it cannot take --target-error" : ""));
+    // Neither samples nor a target: the default target, checked exactly as the same target named.
+    if (!target_given && samples == 0) a.target_error = bake::ChooserOptions{}.target;
+    // Checking a target needs more vertices than the default report's 32 (RMSE over a sample);
+    // the check's reference takes about as long as the bake (plan_report_reference's CPU bound).
+    if (a.target_error > 0 && cmd.count("--report") == 0) a.integrator.report_points = bake::ChooserOptions::kReportPoints;
+    if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
+      fail("nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV (or --env ENV)");
+    if (a.shadowed && a.environment.empty())
+      fail("--shadowed L needs --radiance ENV (or --env ENV): the environment it is baked under");
+  }
+  if (samples != 0) a.integrator.set_samples(samples);
+  if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
+      a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
+    fail("--samples " + std::to_string(a.integrator.silhouette_k) + ": the silhouette integrator needs k >= " +
+         std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
+  if (a.command == "fiv") a.shell_spec.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
+}
+
+// Parses and checks the command line; nullopt when it asked for help or the version (printed).
+std::optional<Args> parse(int argc, char** argv, const tool::MpiSession& mpi) {
   Args a;
   uint32_t samples = 0;  // --samples: 0 if not given
   CLI::App app(kDescription, "prtbake");
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("prtbake ") + kVersion);
-  app.footer(std::string(kExamples) + tool::kExitStatusHelp);
   app.get_formatter()->column_width(24);
   add_vertex(app, a, samples);
   add_fiv(app, a, samples);
   add_scene(app, a);
   tool::add_export(app, a.exported);
-  for (CLI::App* cmd : app.get_subcommands({})) cmd->footer(app.get_footer());
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
-    std::cout << app.help("", CLI::AppFormatMode::All);
+    // A command's --help is its whole text; the tool's own lists the commands.
+    const std::vector<CLI::App*> given = app.get_subcommands();
+    std::cout << (given.empty() ? overview() : given.front()->help("prtbake"));
     return std::nullopt;
   } catch (const CLI::Success& e) {  // --version
     app.exit(e);
     return std::nullopt;
   } catch (const CLI::ParseError& e) {
-    throw UsageError(e.what());
+    const std::vector<CLI::App*> given = app.get_subcommands();
+    throw UsageError(tool::usage_message(app, e, "prtbake", kCommands),
+                     given.empty() ? "" : "prtbake " + given.front()->get_name());
   }
   a.command = app.get_subcommands().front()->get_name();
-  if (a.command == "export") {
-    if (under_mpirun) throw UsageError("export: run it as one process, not under mpirun");
-    return a;
+  if (a.command != "export") {
+    a.command_line = content_command_line(argc, argv);
+    a.shard.rerun_command = tool::shell_command(argc, argv);
+    if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
+    // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
+    if (a.shard.given() || mpi.active()) a.reproducible = true;
   }
-  a.command_line = content_command_line(argc, argv);
-  if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
-  // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
-  if (a.shard.given() || under_mpirun) a.reproducible = true;
-  if (a.command == "scene") {
-    a.report_given = app.get_subcommand("scene")->count("--report") > 0;
-    if (a.output.empty() && !a.dry_run) throw UsageError("scene: no output file given (-o OUT.prt.h5)");
-    return a;
-  }
-  if (a.output.empty()) throw UsageError(a.command + ": no output file given (-o OUT.prt.h5)");
-  if (a.command == "vertex") {
-    a.integrator_given = app.get_subcommand("vertex")->count("--integrator") > 0;
-    if (a.target_error > 0 && samples != 0)
-      throw UsageError("vertex: --target-error and --samples both given: the target chooses the samples (give one)");
-    // Neither samples nor a target: the default target, checked exactly as the same target named.
-    if (a.target_error == 0 && samples == 0) a.target_error = bake::ChooserOptions{}.target;
-    // Checking a target needs more vertices than the default report's 32 (RMSE over a sample);
-    // the check's reference takes about as long as the bake (plan_report_reference's CPU bound).
-    if (a.target_error > 0 && app.get_subcommand("vertex")->count("--report") == 0)
-      a.integrator.report_points = bake::ChooserOptions::kReportPoints;
-  }
-  if (samples != 0) a.integrator.set_samples(samples);
-  if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
-      a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
-    throw UsageError("--samples: the silhouette integrator needs k >= " +
-                     std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
-  if (a.command == "fiv") {
-    a.shell_spec.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
-    return a;
-  }
-  if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
-    throw UsageError("vertex: nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV");
-  if (a.shadowed && a.environment.empty()) throw UsageError("--shadowed L needs --radiance ENV (the environment it is baked under)");
+  validate(a, app, samples, mpi);
   return a;
 }
 
@@ -568,15 +653,10 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   }
 }
 
-// Who this process is in a sharded bake (nullopt: not sharded), before any long step.
-std::optional<tool::Worker> shard_worker(const Args& a, const tool::MpiSession& mpi) {
-  if (!a.shard.given() && !mpi.active()) return std::nullopt;
-  return tool::resolve_worker(a.shard, mpi);
-}
-
-int run_vertex(const Args& a, const tool::MpiSession& mpi) {
+// `shards`: emplaced when the bake is sharded (prtbake_main reports its chunks on Ctrl-C).
+int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
+  const std::optional<tool::Worker>& worker = a.worker;
   check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -653,7 +733,6 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
     std::fflush(stdout);
   }
   const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(mesh, topo);
-  std::optional<tool::ShardedRows> shards;
   bake::VertexBake result;
   if (worker) {
     const std::string manifest = tool::manifest_of(
@@ -690,8 +769,14 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi) {
     }
     std::printf(")\n");
     if (const std::string work = integrator.work_summary(); !work.empty()) std::printf("%s\n", work.c_str());
-    std::printf("threads busy %.0f%% of the bake (%.2f CPU s in the integrator over %.2f s on %d threads)\n",
-                100 * result.busy_fraction(), result.cpu_seconds, result.seconds, result.threads);
+    if (shards && shards->threads_of_chunks() == 0)  // chunks of other workers or runs: their threads are not recorded
+      std::printf("chunks: %.2f CPU s in the integrator over %.2f s of chunk wall time, summed over the chunks of "
+                  "every worker and run\n",
+                  result.cpu_seconds, result.seconds);
+    else
+      std::printf("threads busy %.0f%% of the bake (%.2f CPU s in the integrator over %.2f s on %d thread%s)\n",
+                  100 * result.busy_fraction(), result.cpu_seconds, result.seconds, result.threads,
+                  result.threads == 1 ? "" : "s");
   }
 
   // ---- the file (formats/SCHEMA.md) ----
@@ -858,9 +943,9 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
   return out;
 }
 
-int run_fiv(const Args& a, const tool::MpiSession& mpi) {
+int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
+  const std::optional<tool::Worker>& worker = a.worker;
   check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -886,7 +971,6 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
     std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.input.c_str(), mesh.triangles.size(),
                 a.environment.c_str(), env_info.width, env_info.height, env_info.layout.c_str());
 
-  std::optional<tool::ShardedRows> shards;
   std::optional<ShardedFiv> sharded;
   if (worker) {
     sharded = sharded_fiv(a, *worker, mpi, mesh, topo ? &*topo : nullptr, env ? &*env : nullptr, env_info, shards);
@@ -935,9 +1019,9 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi) {
   return 0;
 }
 
-int run_scene(const Args& a, const tool::MpiSession& mpi) {
+int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker> worker = shard_worker(a, mpi);
+  const std::optional<tool::Worker>& worker = a.worker;
   if (!a.dry_run) check_output_writable(a.output);
   const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
   tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -1030,7 +1114,6 @@ int run_scene(const Args& a, const tool::MpiSession& mpi) {
   const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   // Sharded: the receivers' rows in chunks (every worker), then the rest of the bake on the
   // merging process, its rows read back from the chunks (shards.h).
-  std::optional<tool::ShardedRows> shards;
   bake::SceneRows merged_rows;
   if (worker) {
     std::vector<uint64_t> set_rows;
@@ -1189,12 +1272,22 @@ void reuse_freed_memory() {
 int prtbake_main(int argc, char** argv) {
   reuse_freed_memory();
   const tool::MpiSession mpi(argc, argv);  // under mpirun: ranks are shard workers (shards.h)
-  const std::optional<Args> parsed = parse(argc, argv, mpi.active());
+  const std::optional<Args> parsed = parse(argc, argv, mpi);
   if (!parsed) return 0;  // --help or --version
   const Args& a = *parsed;
   tool::install_interrupt_handler();
   if (a.command == "export") return tool::run_export(a.exported);
-  return a.command == "fiv" ? run_fiv(a, mpi) : a.command == "scene" ? run_scene(a, mpi) : run_vertex(a, mpi);
+  std::optional<tool::ShardedRows> shards;
+  try {
+    return a.command == "fiv"     ? run_fiv(a, mpi, shards)
+           : a.command == "scene" ? run_scene(a, mpi, shards)
+                                  : run_vertex(a, mpi, shards);
+  } catch (const bake::Cancelled&) {
+    // A sharded or resumable bake keeps what it committed: say so, and how to go on.
+    if (shards)
+      if (const std::optional<std::string> kept = shards->kept_after_cancel()) throw tool::CancelledKeeping(*kept);
+    throw;
+  }
 }
 
 } // namespace

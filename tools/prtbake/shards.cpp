@@ -1,10 +1,14 @@
 // shards.cpp — sharded and resumable bakes (shards.h): launchers, chunk assignment, merge.
 #include "shards.h"
 
+#include "cli.h"
+#include "progress_bar.h"
 #include "tool_main.h"
 
 #include <bake/error.h>
 #include <bake/sha256.h>
+
+#include <tbb/global_control.h>
 
 #include <chrono>
 #include <cstdio>
@@ -69,12 +73,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 // ---- options ----
 
-void add_shard_options(CLI::App& cmd, ShardOptions& o) {
+void add_shard_options(CLI::App& cmd, ShardOptions& o, const std::string& rows) {
   const std::string group = "Sharded and resumable bakes (the file is the same bytes as --reproducible's)";
   cmd.add_flag("--resume", o.resume,
                "commit the bake in chunks to OUT.chunks/ and merge them at the end:\n"
-               "rerunning the same command after a crash reuses every committed\n"
-               "chunk. Under mpirun (with MPI) every rank is a worker and rank 0\n"
+               "rerunning the same command after a crash or Ctrl-C reuses every\n"
+               "committed chunk. Under mpirun (with MPI) every rank is a worker and rank 0\n"
                "merges, without this flag.")
       ->group(group);
   cmd.add_option("--shard", o.shard,
@@ -103,10 +107,10 @@ void add_shard_options(CLI::App& cmd, ShardOptions& o) {
       ->option_text("static|dynamic")
       ->group(group);
   cmd.add_option("--chunk-rows", o.chunk_rows,
-                 "rows per chunk: vertices, or a FIV shell's samples (default " +
+                 "rows per chunk: " + rows + " (default " +
                      std::to_string(ShardOptions{}.chunk_rows) + ");\nthe same for every worker of a bake, whatever their number.")
       ->option_text("R")
-      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 30))
+      ->check(integer_in(1, int64_t(1) << 30))
       ->group(group);
   cmd.add_option("--chunks", o.chunks_dir, "the chunk directory (default OUT.chunks), on a file system every\nworker and the merge see.")
       ->option_text("DIR")
@@ -251,10 +255,13 @@ struct ShardedRows::State {
   bake::ChunkStore store;
   std::vector<uint32_t> widths;
   bool quiet = false;
+  std::string rerun_command;
+  int threads = 1;  // this process's worker threads
   // This run's counts, for the progress and summary lines.
   size_t before = 0, computed = 0, rows = 0;
   double busy = 0, cpu = 0;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  double last_line = -1;  // when the last "chunk committed" line was printed (seconds since start)
 };
 
 namespace {
@@ -268,7 +275,8 @@ ShardedRows::ShardedRows(const Worker& worker, const MpiSession& mpi, const Shar
                          std::vector<uint32_t> set_widths, bool quiet)
     : s_(new State{worker, &mpi,
                    bake::ChunkStore(chunk_dir(options, output), manifest, bake::row_chunks(set_rows, options.chunk_rows)),
-                   std::move(set_widths), quiet}) {
+                   std::move(set_widths), quiet, options.rerun_command,
+                   int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))}) {
   PRT_CHECK_OP(s_->widths.size(), ==, set_rows.size());
 }
 
@@ -342,6 +350,12 @@ void ShardedRows::work(const Compute& compute, std::optional<uint32_t> set, cons
         }
       const size_t before = std::min(s.before, now);
       const double elapsed = seconds_since(s.start);
+      // In a log (stdout not a terminal) a few lines, as the progress lines: the first, then at
+      // most one every 10 s, and the last.
+      if (!isatty(STDOUT_FILENO) && s.last_line >= 0 && now < total &&
+          elapsed - s.last_line < ProgressBar::kLineSpacingSeconds)
+        continue;
+      s.last_line = elapsed;
       const double eta = now > before ? elapsed * double(total - now) / double(now - before) : 0.0;
       std::printf("chunk %zu committed: %zu/%zu chunks of all workers, %.1f s, ETA %s%.0f s\n", i, now, total, elapsed,
                   last_set && !last ? "at most " : "", eta);
@@ -392,10 +406,40 @@ bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& lay
   out.std_error.resize(out.values.size());  // a vertex bake's chunks all hold them
   out.seconds = d.seconds;
   out.cpu_seconds = d.cpu_seconds;
+  if (const int t = threads_of_chunks(); t > 0) out.threads = t;
   if (closed_form) *closed_form = d.closed_form;
   return out;
 }
 
 void ShardedRows::finish() const { s_->store.remove(); }
+
+std::optional<std::string> ShardedRows::kept_after_cancel() const {
+  const State& s = *s_;
+  const size_t committed = s.store.committed_count(), total = s.store.chunks().size();
+  if (committed == 0) {
+    s.store.remove();  // claims and temporaries of this run, and the directory it created
+    return std::nullopt;
+  }
+  const Worker& w = s.worker;
+  std::string line = std::to_string(committed) + " of " + std::to_string(total) + " chunks are committed (" +
+                     std::to_string(s.computed) + " by this run) and kept in " + s.store.dir().string() + "/; ";
+  if (!w.computes)
+    line += "the merge wrote nothing; to merge, rerun: ";
+  else if (s.mpi->active())
+    line += "to resume, rerun the same mpirun command (each rank ran: ";
+  else if (!w.merges)
+    line += "to resume this worker's share, rerun: ";
+  else
+    line += "to resume, rerun: ";
+  line += s.rerun_command;
+  if (w.computes && s.mpi->active()) line += ")";
+  else if (w.computes && !w.merges) line += " (then --merge)";
+  return line;
+}
+
+int ShardedRows::threads_of_chunks() const {
+  const State& s = *s_;
+  return s.worker.computes && s.worker.count == 1 && s.before == 0 ? s.threads : 0;
+}
 
 } // namespace prt::tool

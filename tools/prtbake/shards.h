@@ -52,11 +52,13 @@ struct ShardOptions {
   uint64_t chunk_rows = 2048;
   std::string chunks_dir;  // "": OUT.chunks
   std::string run_id;      // --run-id
+  std::string rerun_command;  // the command line as typed, shell-quoted: what resumes a cancelled bake
   bool given() const { return resume || !shard.empty() || merge; }
 };
 
-// --resume, --shard, --merge, --claim, --chunk-rows, --chunks, --run-id on a subcommand.
-void add_shard_options(CLI::App& cmd, ShardOptions& options);
+// --resume, --shard, --merge, --claim, --chunk-rows, --chunks, --run-id on a subcommand whose
+// rows are `rows` ("vertices": what --chunk-rows counts).
+void add_shard_options(CLI::App& cmd, ShardOptions& options, const std::string& rows);
 // The options above that take a value (the stored command line leaves them out: they do not
 // change the file).
 bool is_shard_option(const std::string& name, bool& takes_value);
@@ -127,6 +129,14 @@ public:
   bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
   // After the file is written: removes the chunk directory.
   void finish() const;
+  // After a cancellation (Ctrl-C): the chunks committed so far are kept for a rerun; the line
+  // that says how many, where, and the command that resumes. nullopt when none was committed (the
+  // chunk directory is then removed: nothing was written).
+  std::optional<std::string> kept_after_cancel() const;
+  // The threads one chunk's rows were computed on when every chunk of the bake was computed by
+  // this process in this run (a --resume run that reused nothing); 0 when chunks come from other
+  // workers or an earlier run, whose thread counts are not recorded.
+  int threads_of_chunks() const;
 
 private:
   struct State;

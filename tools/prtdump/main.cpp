@@ -6,6 +6,7 @@
 #include <formats/asset.h>
 #include <formats/names.h>
 
+#include "cli.h"
 #include "tool_main.h"
 
 #include <CLI/CLI.hpp>
@@ -790,6 +791,7 @@ uint64_t vertex_count(const pf::File& f, const std::string& file, const VertexSe
 
 int prtdump_main(int argc, char** argv) {
   CLI::App app(kDescription, "prtdump");
+  app.set_version_flag("--version", std::string("prtdump ") + prt::tool::kToolkitVersion);
   app.footer(std::string(kFooter) + "\n" + prt::tool::kExitStatusHelp);
   app.get_formatter()->column_width(22);
   bool json = false;
@@ -803,7 +805,8 @@ int prtdump_main(int argc, char** argv) {
                      "print vertex I (0-based) from every per-vertex dataset of the root layout, or of the scene "
                      "object --object names (mesh positions, normals and source positions, ao, transfer, radiance, "
                      "area lights); V, the vertex count, is the number of its mesh positions.")
-          ->type_name("I");
+          ->type_name("I")
+          ->check(prt::tool::integer_in(0, std::numeric_limits<int64_t>::max()));
   std::string object;
   CLI::Option* object_opt =
       app.add_option("--object", object,
@@ -815,10 +818,10 @@ int prtdump_main(int argc, char** argv) {
   app.add_option("FILE", file, "the .prt.h5 file to inspect")->required()->type_name("FILE.prt.h5");
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    throw prt::tool::UsageError(std::string(e.what()) + "; " + kUsage);
+    throw prt::tool::UsageError(prt::tool::usage_message(app, e, "prtdump") + "; " + kUsage);
   }
 
   const pf::Inspection in = pf::inspect_asset(file);

@@ -14,6 +14,7 @@
 //     glTF (.gltf) writes two files: `out` and its buffer `<stem>.bin` beside it.
 //   * The engine formats need /radiance/band1 in some vertex set (the only baked product that is
 //     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe.
+//     A set without it gets no probes; the summary names it and says why (the caller reports).
 // Errors: FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
 #pragma once
 
@@ -24,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace prt::formats {
 
@@ -46,9 +48,15 @@ struct EnvironmentProbe {
   std::string name, sha256;
 };
 
+// What an export left out: per vertex set "<name>: <why>" (the probe formats skip the sets without
+// /radiance/band1; the other formats export every set).
+struct ExportSummary {
+  std::vector<std::string> left_out;
+};
+
 // Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
 // `environment` adds the environment probe (probe formats only; std::invalid_argument otherwise).
-void export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+ExportSummary export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment = std::nullopt);
 
 // The binary format's magic (8 bytes) and version (SCHEMA.md "Exports").

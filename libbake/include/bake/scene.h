@@ -176,6 +176,9 @@ struct SceneDescription {
 // with a scene file are an InputError.
 SceneDescription load_scene(const std::filesystem::path& file,
                             const std::optional<std::filesystem::path>& gltf_options = std::nullopt);
+// Whether load_scene reads `file` as a glTF scene (.gltf, .glb, any case) rather than a scene file:
+// the tools check an options file against it before reading anything.
+bool is_gltf_scene(const std::filesystem::path& file);
 
 // The world-space meshes of scene.objects, in order: load_scene_mesh of each object of a scene
 // file (an error names the object and the scene), or the instances of a glTF scene (the file read
