@@ -1019,6 +1019,10 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Shar
   return 0;
 }
 
+// How the tools name a scene object to people: a glTF instance by its node path ("node0/body"),
+// a scene file's object by its name (the file's "|" spelling is for HDF5 paths only).
+std::string scene_object_label(const bake::SceneObject& o) { return o.node_path.empty() ? o.name : o.node_path; }
+
 int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
   const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
   const std::optional<tool::Worker>& worker = a.worker;
@@ -1041,8 +1045,8 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
   // Receivers with closed parts wound inwards: their vertices would see no sky.
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (plan.objects[i].receiver && plan.objects[i].any_vertex_product())
-      warn_inward(bake::winding_facts(meshes[i], bake::build_topology(meshes[i])), false, scene.objects[i].name,
-                  plan.objects[i].occluder);
+      warn_inward(bake::winding_facts(meshes[i], bake::build_topology(meshes[i])), false,
+                  scene_object_label(scene.objects[i]), plan.objects[i].occluder);
 
   if (say) {
     std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.input.c_str(),
@@ -1172,15 +1176,33 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
                                                     warn_unreached(choice, object);
                                                   });
   // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
+  // One line each for a few; past kNoSkyListed (an engine's internals) one line that counts them
+  // and names the first.
+  constexpr size_t kNoSkyListed = 5;
+  std::vector<std::pair<std::string, bake::NoSkyCount>> no_sky;
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (const auto& values = result.objects[i].values) {
       const bake::NoSkyCount count = bake::count_no_sky(*values);
-      if (count.share() > 0.5)
-        std::fprintf(stderr,
-                     "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
-                     "other objects, or its normals point inside (check its winding)\n",
-                     scene.objects[i].name.c_str(), 100 * count.share(), count.vertices, count.total);
+      if (count.share() > 0.5) no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
     }
+  if (!no_sky.empty() && (no_sky.size() <= kNoSkyListed || a.verbose)) {
+    for (const auto& [name, count] : no_sky)
+      std::fprintf(stderr,
+                   "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
+                   "other objects, or its normals point inside (check its winding)\n",
+                   name.c_str(), 100 * count.share(), count.vertices, count.total);
+  } else if (!no_sky.empty()) {
+    std::string first;
+    for (size_t k = 0; k < 3; ++k) {
+      char share[32];
+      std::snprintf(share, sizeof share, " (%.1f%%)", 100 * no_sky[k].second.share());
+      first += (k ? ", " : "") + no_sky[k].first + share;
+    }
+    std::fprintf(stderr,
+                 "prtbake: warning: %zu receivers have more than half their vertices seeing no sky at all (enclosed by "
+                 "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
+                 no_sky.size(), first.c_str(), no_sky.size() - 3);
+  }
   if (say)
     std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
                 (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
