@@ -140,7 +140,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     std::optional<ReferencePlan> reference_plan;
     std::unique_ptr<Integrator> integ, ref, ref2;
     std::vector<ProductError> pooled;  // the objects' reports, merged as they come
-    size_t report_points = 0, remaining = 0;
+    size_t report_points = 0, remaining = 0, checked = 0;
     bool chosen = false;
   };
   std::map<Key, Group> groups;
@@ -259,6 +259,15 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       monitor.on_progress(o);
     };
 
+  // The error reports to make once every receiver is baked.
+  struct Check {
+    size_t object;
+    const Integrator *ref, *ref2;
+    Group* group;
+    size_t points;
+  };
+  std::vector<Check> checks;
+
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -322,47 +331,66 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
         printf_string("%.2f s", ob.values->seconds) +
         (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
-    if (ref && report_points > 0) {
-      ob.report = compare_points_with_reference(points, *ob.values, *ref, report_points, ob.integrator.seed, monitor, ref2);
-      // In a group of receivers, each holds a few of the report's vertices: its own RMSE says
-      // little (it is in the file); the pooled lines below say what was met.
-      const bool own_line = !group || group->objects.size() == 1;
-      std::string line = "  error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
+    if (ref && report_points > 0) checks.push_back({i, ref, ref2, group, report_points});
+    if (group && --group->remaining == 0) group->integ.reset();  // its references stay for the checks
+  }
+
+  // ---- the error reports, once every receiver is baked ----
+  // (One "checking the error" progress stage over every report vertex, after the one bake stage.)
+  uint64_t check_total = 0, checked_before = 0;
+  for (const Check& c : checks) check_total += c.points;
+  const auto t_checks = std::chrono::steady_clock::now();
+  Monitor check_monitor;
+  check_monitor.cancel = monitor.cancel;
+  if (monitor.on_progress)
+    check_monitor.on_progress = [&](const ProgressUpdate& u) {
+      ProgressUpdate o = u;
+      o.task = "checking the error";
+      o.done = checked_before + u.done;
+      o.total = check_total;
+      o.seconds = seconds_since(t_checks);
+      o.finished = u.finished && (o.done == o.total || u.done < u.total);
+      monitor.on_progress(o);
+    };
+  for (Check& c : checks) {
+    const size_t i = c.object;
+    ObjectBake& ob = out.objects[i];
+    const std::vector<ShadePoint> points = shade_points(i);
+    Group* group = c.group;
+    ob.report = compare_points_with_reference(points, *ob.values, *c.ref, c.points, ob.integrator.seed, check_monitor,
+                                              c.ref2);
+    checked_before += ob.report->vertices.size();
+    out.report_seconds += ob.report->reference_seconds;
+    // In a group of receivers, each holds a few of the report's vertices: its own RMSE says
+    // little (it is in the file); the pooled lines below say what was met.
+    if (!group || group->objects.size() == 1) {
+      std::string line = scene.objects[i].name + ": error on " + std::to_string(ob.report->vertices.size()) +
+                         " seeded vertices:";
       for (const auto& e : ob.report->products)
         line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
                 printf_string("reference's own std. error %.1e)", e.reference_std_error);
-      if (own_line) log(line + printf_string("; reference took %.2f s", ob.report->reference_seconds));
-      if (group) {
-        pool_product_errors(group->pooled, ob.report->products);
-        out.report_seconds += ob.report->reference_seconds;
-      } else if (choose) {
-        for (const std::string& l : target_check_lines(*ob.report, scene.target_error, ob.reference_plan ? &*ob.reference_plan : nullptr))
-          log(l);
-      }
+      log(line + printf_string("; reference took %.2f s", ob.report->reference_seconds));
     }
-    if (group && --group->remaining == 0 && !group->pooled.empty()) {
-      // The group's verdict on its pooled report (bake/choose.h target_check_lines).
-      ErrorReport pooled;
-      pooled.products = group->pooled;
-      pooled.reference_noise_measured = group->ref2 != nullptr;
-      size_t n = 0;
-      for (size_t j : group->objects)
-        if (out.objects[j].report) n += out.objects[j].report->vertices.size();
-      pooled.vertices.resize(n);
-      if (group->objects.size() > 1) {
-        double seconds = 0;
-        for (size_t j : group->objects)
-          if (out.objects[j].report) seconds += out.objects[j].report->reference_seconds;
-        log("receivers from " + scene.objects[group->objects.front()].name + " (" + std::to_string(group->objects.size()) +
-            " objects), their " + std::to_string(n) + " report vertices together" +
-            printf_string(" (the reference took %.2f s):", seconds));
-      }
-      for (const std::string& l : target_check_lines(pooled, scene.target_error, group->reference_plan ? &*group->reference_plan : nullptr))
-        log(l);
-      group->integ.reset();
-      group->ref.reset();
-      group->ref2.reset();
-    }
+    if (!group) continue;
+    pool_product_errors(group->pooled, ob.report->products);
+    if (++group->checked < group->objects.size()) continue;
+    // The group's verdict on its pooled report (bake/choose.h target_check_lines).
+    ErrorReport pooled;
+    pooled.products = group->pooled;
+    pooled.reference_noise_measured = group->ref2 != nullptr;
+    size_t n = 0;
+    double seconds = 0;
+    for (size_t j : group->objects)
+      if (out.objects[j].report) n += out.objects[j].report->vertices.size(), seconds += out.objects[j].report->reference_seconds;
+    pooled.vertices.resize(n);
+    if (group->objects.size() > 1)
+      log("receivers from " + scene.objects[group->objects.front()].name + " (" + std::to_string(group->objects.size()) +
+          " objects), their " + std::to_string(n) + " report vertices together" +
+          printf_string(" (the reference took %.2f s):", seconds));
+    for (const std::string& l : target_check_lines(pooled, scene.target_error, group->reference_plan ? &*group->reference_plan : nullptr))
+      log(l);
+    group->ref.reset();
+    group->ref2.reset();
   }
 
   // ---- FIV ----
