@@ -335,6 +335,29 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (group && --group->remaining == 0) group->integ.reset();  // its references stay for the checks
   }
 
+  // ---- FIV ----
+  if (rows.rows_only) return out;
+  if (plan.fiv_environment) {
+    PRT_CHECK(env != nullptr);
+    const auto t0 = std::chrono::steady_clock::now();
+    out.environment_fiv = environment_fiv(*env);
+    out.irradiance_cube = irradiance_cube(*env, scene.fiv.cube);
+    out.environment_seconds = seconds_since(t0);
+    log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
+        printf_string("%.2f s", out.environment_seconds));
+  }
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    if (!plan.objects[i].fiv) continue;
+    const Mesh& m = meshes[i];
+    const Topology t = build_topology(m);
+    ObjectBake& ob = out.objects[i];
+    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
+    out.fiv_seconds += ob.shells->seconds;
+    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
+        "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
+  }
+  // The bake is whole: the caller may write it before the checks below (which may be cancelled).
+  if (rows.baked) rows.baked(out);
   // ---- the error reports, once every receiver is baked ----
   // (One "checking the error" progress stage over every report vertex, after the one bake stage.)
   uint64_t check_total = 0, checked_before = 0;
@@ -393,32 +416,15 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     group->ref2.reset();
   }
 
-  // ---- FIV ----
-  if (rows.rows_only) return out;
-  if (plan.fiv_environment) {
-    PRT_CHECK(env != nullptr);
-    const auto t0 = std::chrono::steady_clock::now();
-    out.environment_fiv = environment_fiv(*env);
-    out.irradiance_cube = irradiance_cube(*env, scene.fiv.cube);
-    out.environment_seconds = seconds_since(t0);
-    log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
-        printf_string("%.2f s", out.environment_seconds));
-  }
   for (size_t i = 0; i < scene.objects.size(); ++i) {
-    if (!plan.objects[i].fiv) continue;
+    ObjectBake& ob = out.objects[i];
+    if (!ob.shells || scene.integrator.report_points == 0) continue;
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
-    ObjectBake& ob = out.objects[i];
-    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
-    out.fiv_seconds += ob.shells->seconds;
-    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
-        "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
-    if (scene.integrator.report_points > 0) {
-      ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
-                                       scene.integrator.seed, monitor);
-      log("  fiv: " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
-                          ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
-    }
+    ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
+                                     scene.integrator.seed, monitor);
+    log(scene.objects[i].name + ": fiv " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
+                        ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <unistd.h>
@@ -127,5 +128,35 @@ TEST(PrtbakeCancel, CtrlCOfAResumableBakeKeepsItsChunksAndSaysHowToResume) {
   EXPECT_EQ(resumed.out.find(" on 1 thread"), std::string::npos) << resumed.out;
   EXPECT_TRUE(fs::exists(out));
   EXPECT_FALSE(fs::exists(chunks));
+  fs::remove_all(dir);
+}
+
+// The same for a scene: the file is written once the bake is whole, before its error reports.
+TEST(PrtbakeCancel, CtrlCDuringASceneErrorCheckKeepsTheBakeWithoutItsReports) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / ("cancel_scene_check." + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "scene.prt.h5", scene = dir / "scene.json";
+  // A fast bake (16 isolines) and a check of minutes (every vertex, 65,536-ray references).
+  {
+    std::ofstream f(scene);
+    f << R"({"prtbake_scene": 1, "bake": {"products": ["ao"], "integrator": "silhouette", "samples": 1024, "report": 4240},
+      "objects": [{"name": "bunny", "mesh": ")"
+      << std::string(PRT_DATA_DIR) + "/bunny_ground.obj" << R"(", "role": "both"}]})";
+  }
+  prt::testing::BackgroundTool bake(PRT_PRTBAKE, {"scene", scene.string(), "-o", out.string(), "--threads", "2"});
+  ASSERT_TRUE(bake.started());
+  ASSERT_TRUE(bake.wait_for("checking the error:", std::chrono::seconds(120))) << bake.err();
+  bake.send(SIGINT);
+  EXPECT_EQ(bake.wait(), 130) << bake.err();
+  EXPECT_NE(bake.err().find("cancelled during the error check: " + out.string() +
+                            " holds the finished bake without its error reports"),
+            std::string::npos)
+      << bake.err();
+  ASSERT_TRUE(fs::exists(out)) << bake.err();
+  const auto dump = prt::testing::run_tool(PRT_PRTDUMP, "--json " + out.string(), dir);
+  EXPECT_EQ(dump.code, 0) << dump.err;
+  EXPECT_NE(dump.out.find("\"path\": \"/objects/bunny/ao\""), std::string::npos) << dump.out;
+  EXPECT_EQ(dump.out.find("\"path\": \"/report/objects/bunny/ao\""), std::string::npos) << dump.out;
   fs::remove_all(dir);
 }

@@ -1155,125 +1155,154 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
       return shards->merge(uint32_t(set), integrator.layout(), &closed_form);
     };
   }
-  const bake::SceneBake result = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
-                                                  [&](const std::string& line) {
-                                                    if (say) std::printf("%s\n", line.c_str());
-                                                    std::fflush(stdout);
-                                                  },
-                                                  merged_rows,
-                                                  [&](const std::string& object, const bake::IntegratorChoice& choice,
-                                                      const bake::ReferencePlan* reference_plan) {
-                                                    if (say && a.verbose) {
-                                                      std::printf("%s: the target-error pilot:\n", object.c_str());
-                                                      for (const std::string& l : bake::choice_lines(choice))
-                                                        std::printf("%s\n", l.c_str());
-                                                      if (reference_plan) print_reference_plan(*reference_plan);
-                                                    } else if (say) {
-                                                      std::printf("%s: %s\n", object.c_str(),
-                                                                  bake::choice_summary(choice).c_str());
-                                                    }
-                                                    std::fflush(stdout);
-                                                    warn_unreached(choice, object);
-                                                  });
-  // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
-  // One line each for a few; past kNoSkyListed (an engine's internals) one line that counts them
-  // and names the first.
-  constexpr size_t kNoSkyListed = 5;
-  std::vector<std::pair<std::string, bake::NoSkyCount>> no_sky;
-  for (size_t i = 0; i < scene.objects.size(); ++i)
-    if (const auto& values = result.objects[i].values) {
-      const bake::NoSkyCount count = bake::count_no_sky(*values);
-      if (count.share() > 0.5) no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
-    }
-  if (!no_sky.empty() && (no_sky.size() <= kNoSkyListed || a.verbose)) {
-    for (const auto& [name, count] : no_sky)
-      std::fprintf(stderr,
-                   "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
-                   "other objects, or its normals point inside (check its winding)\n",
-                   name.c_str(), 100 * count.share(), count.vertices, count.total);
-  } else if (!no_sky.empty()) {
-    std::string first;
-    for (size_t k = 0; k < 3; ++k) {
-      char share[32];
-      std::snprintf(share, sizeof share, " (%.1f%%)", 100 * no_sky[k].second.share());
-      first += (k ? ", " : "") + no_sky[k].first + share;
-    }
-    std::fprintf(stderr,
-                 "prtbake: warning: %zu receivers have more than half their vertices seeing no sky at all (enclosed by "
-                 "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
-                 no_sky.size(), first.c_str(), no_sky.size() - 3);
-  }
-  if (say)
-    std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
-                (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
-                result.environment_seconds);
-
   namespace F = prt::formats;
-  F::Asset asset;
-  asset.root = root_info(file_args, bake::sha256_file(a.input));
-  const std::string env_path = env ? scene.environment->string() : std::string();
-  F::SceneInfo& info = asset.scene.emplace();
-  info.scene_file = a.input;
-  if (!a.scene_options.empty()) {
-    info.options_file = a.scene_options;
-    info.options_sha256 = bake::sha256_file(a.scene_options);
-  }
-  info.integrator = std::string(bake::to_string(scene.integrator.kind));
-  info.samples = int64_t(scene.integrator.samples());
-  info.seed = int64_t(scene.integrator.seed);
-  info.sh_tolerance = scene.sh_tolerance;
-  info.relight = int64_t(scene.relight);
-  if (env) {
-    info.environment = env_path;
-    info.environment_sha256 = env->info().sha256;
-  }
-  auto join = [](const std::vector<std::string>& lines, const char* none) {
-    std::string s;
-    for (const auto& l : lines) s += (s.empty() ? "" : "\n") + l;
-    return s.empty() ? std::string(none) : s;
+  // The file from a bake (with its reports once they are made).
+  auto write_scene = [&](const bake::SceneBake& result) {
+    F::Asset asset;
+    asset.root = root_info(file_args, bake::sha256_file(a.input));
+    const std::string env_path = env ? scene.environment->string() : std::string();
+    F::SceneInfo& info = asset.scene.emplace();
+    info.scene_file = a.input;
+    if (!a.scene_options.empty()) {
+      info.options_file = a.scene_options;
+      info.options_sha256 = bake::sha256_file(a.scene_options);
+    }
+    info.integrator = std::string(bake::to_string(scene.integrator.kind));
+    info.samples = int64_t(scene.integrator.samples());
+    info.seed = int64_t(scene.integrator.seed);
+    info.sh_tolerance = scene.sh_tolerance;
+    info.relight = int64_t(scene.relight);
+    if (env) {
+      info.environment = env_path;
+      info.environment_sha256 = env->info().sha256;
+    }
+    auto join = [](const std::vector<std::string>& lines, const char* none) {
+      std::string s;
+      for (const auto& l : lines) s += (s.empty() ? "" : "\n") + l;
+      return s.empty() ? std::string(none) : s;
+    };
+    info.plan = join(plan.notes, "");
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const auto& o = scene.objects[i];
+      const auto& p = plan.objects[i];
+      const auto& ob = result.objects[i];
+      F::SceneObject& obj = asset.objects.emplace_back();
+      obj.name = o.name;
+      obj.role = bake::role_name(o.role);
+      obj.mesh = o.mesh.string();
+      obj.mesh_sha256 = meshes[i].source_sha256;
+      if (!o.node_path.empty()) obj.node_path = o.node_path;
+      obj.transform.emplace(16);
+      for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
+      obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
+      obj.phong_exponent = o.material.phong_exponent;
+      obj.sh_order_diffuse = int64_t(p.transfer_order);
+      obj.sh_order_glossy = int64_t(std::max(p.visibility_order, p.shadowed_order));
+      obj.baked = join(p.baked, "-");
+      obj.left_out = join(p.left_out, "-");
+      if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());
+      if (ob.values) obj.closed_form_vertices = int64_t(ob.closed_form_vertices);
+      tool::set_mesh(obj.set, meshes[i]);
+      if (ob.values) {
+        tool::set_products(obj.set, *ob.values,
+                           {std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
+                            ob.integrator.samples(), ob.integrator.seed,
+                            p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+        if (ob.report)
+          obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
+      }
+      if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
+      if (ob.shells) {
+        F::Occluder& occluder =
+            asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
+        if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
+      }
+    }
+    for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
+    if (plan.fiv_environment)
+      tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+    tool::set_target_error(asset, scene.target_error);
+    write_file(a, asset);
   };
-  info.plan = join(plan.notes, "");
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const auto& o = scene.objects[i];
-    const auto& p = plan.objects[i];
-    const auto& ob = result.objects[i];
-    F::SceneObject& obj = asset.objects.emplace_back();
-    obj.name = o.name;
-    obj.role = bake::role_name(o.role);
-    obj.mesh = o.mesh.string();
-    obj.mesh_sha256 = meshes[i].source_sha256;
-    if (!o.node_path.empty()) obj.node_path = o.node_path;
-    obj.transform.emplace(16);
-    for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
-    obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
-    obj.phong_exponent = o.material.phong_exponent;
-    obj.sh_order_diffuse = int64_t(p.transfer_order);
-    obj.sh_order_glossy = int64_t(std::max(p.visibility_order, p.shadowed_order));
-    obj.baked = join(p.baked, "-");
-    obj.left_out = join(p.left_out, "-");
-    if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());
-    if (ob.values) obj.closed_form_vertices = int64_t(ob.closed_form_vertices);
-    tool::set_mesh(obj.set, meshes[i]);
-    if (ob.values) {
-      tool::set_products(obj.set, *ob.values,
-                         {std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
-                          ob.integrator.samples(), ob.integrator.seed,
-                          p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
-      if (ob.report)
-        obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
+  // Once the bake is whole: its warnings and summary, then the file, written before the error
+  // reports are made (bake_scene's SceneRows::baked); the reports re-write it.
+  bool written = false, checks = false;
+  merged_rows.baked = [&](const bake::SceneBake& result) {
+    // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
+    // One line each for a few; past kNoSkyListed (an engine's internals) one line that counts them
+    // and names the first.
+    constexpr size_t kNoSkyListed = 5;
+    std::vector<std::pair<std::string, bake::NoSkyCount>> no_sky;
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if (const auto& values = result.objects[i].values) {
+        const bake::NoSkyCount count = bake::count_no_sky(*values);
+        if (count.share() > 0.5) no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
+      }
+    if (!no_sky.empty() && (no_sky.size() <= kNoSkyListed || a.verbose)) {
+      for (const auto& [name, count] : no_sky)
+        std::fprintf(stderr,
+                     "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
+                     "other objects, or its normals point inside (check its winding)\n",
+                     name.c_str(), 100 * count.share(), count.vertices, count.total);
+    } else if (!no_sky.empty()) {
+      std::string first;
+      for (size_t k = 0; k < 3; ++k) {
+        char share[32];
+        std::snprintf(share, sizeof share, " (%.1f%%)", 100 * no_sky[k].second.share());
+        first += (k ? ", " : "") + no_sky[k].first + share;
+      }
+      std::fprintf(stderr,
+                   "prtbake: warning: %zu receivers have more than half their vertices seeing no sky at all (enclosed by "
+                   "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
+                   no_sky.size(), first.c_str(), no_sky.size() - 3);
     }
-    if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
-    if (ob.shells) {
-      F::Occluder& occluder =
-          asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
-      if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
-    }
+    if (say)
+      std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
+                  (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
+                  result.environment_seconds);
+
+    write_scene(result);
+    written = true;
+    // Reports follow for the receivers' rows and the FIV shells when the scene asks for them.
+    checks = scene.integrator.report_points > 0 &&
+             std::any_of(result.objects.begin(), result.objects.end(),
+                         [](const bake::ObjectBake& ob) { return ob.values.has_value() || ob.shells.has_value(); });
+    if (say && checks)
+      std::printf("checking its error (Ctrl-C keeps the file as written, without its reports; \"report\": 0 or --report 0 "
+                  "skips the check)\n");
+    std::fflush(stdout);
+  };
+  std::optional<bake::SceneBake> baked;
+  try {
+    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
+                             [&](const std::string& line) {
+                                                      if (say) std::printf("%s\n", line.c_str());
+                                                      std::fflush(stdout);
+                                                    },
+                                                    merged_rows,
+                                                    [&](const std::string& object, const bake::IntegratorChoice& choice,
+                                                        const bake::ReferencePlan* reference_plan) {
+                                                      if (say && a.verbose) {
+                                                        std::printf("%s: the target-error pilot:\n", object.c_str());
+                                                        for (const std::string& l : bake::choice_lines(choice))
+                                                          std::printf("%s\n", l.c_str());
+                                                        if (reference_plan) print_reference_plan(*reference_plan);
+                                                      } else if (say) {
+                                                        std::printf("%s: %s\n", object.c_str(),
+                                                                    bake::choice_summary(choice).c_str());
+                                                      }
+                                                      std::fflush(stdout);
+                                                      warn_unreached(choice, object);
+                                                    });
+  } catch (const bake::Cancelled&) {
+    if (!written) throw;
+    std::fprintf(stderr,
+                 "prtbake: cancelled during the error check: %s holds the finished bake without its error reports "
+                 "(--report 0 skips the check)\n",
+                 a.output.c_str());
+    return tool::kExitCancelled;
   }
-  for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
-  if (plan.fiv_environment)
-    tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
-  tool::set_target_error(asset, scene.target_error);
-  write_file(a, asset);
+  if (checks) write_scene(*baked);
   if (shards) shards->finish();
   return 0;
 }

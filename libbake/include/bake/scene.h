@@ -279,6 +279,10 @@ struct SceneRows {
   // vertices and `log` receives its predicted CPU time for all of them (and the error check's
   // bound); no area lights, reports or FIV.
   bool estimate_only = false;
+  // Called once the bake is whole (the receivers' rows, area lights and FIV shells), before any
+  // error report is made: a tool writes the file there, so a check cancelled with Ctrl-C (or one
+  // that takes longer than the user will wait) never costs the bake.
+  std::function<void(const SceneBake&)> baked;
 };
 
 // With a target error the choice is made once per distinct product request, on the pooled shade
