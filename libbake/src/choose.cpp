@@ -933,49 +933,62 @@ void pool_product_errors(std::vector<ProductError>& into, std::span<const Produc
   }
 }
 
-std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
-  std::vector<std::string> out;
+std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double target, const ReferencePlan* plan) {
+  std::vector<TargetVerdict> out;
   for (const ProductError& e : report.products) {
-    const double m = error_in_target_units(e);  // the measured RMSE, the reference's noise in it
+    TargetVerdict v;
+    v.product = e.product;
+    const double m = v.measured = error_in_target_units(e);  // the measured RMSE, the reference's noise in it
     // The reference's own noise σ in the same units. Measured on the report's own values (two
     // independent halves, ErrorReport::reference_noise_measured): known to a relative δ on σ²,
     // 3 standard deviations of a variance estimated from n Gaussian values, 3·sqrt(2/n). Else an
     // upper bound: the plan's probe scaled at Monte Carlo's rate (the slowest QMC shows), or QMC's
     // estimator (which overstates it) — then it cannot be subtracted, only bound the error below.
-    const bool measured = report.reference_noise_measured;
+    v.noise_measured = report.reference_noise_measured;
     double sigma = is_radiance(e.product) ? (e.reference_std_error > 0 && e.reference_rms > 0
                                                  ? e.reference_std_error / e.reference_rms
                                                  : 0.0)
                                           : e.reference_std_error;
-    const char* kind = measured ? "measured on these values" : "QMC's estimate, an upper bound";
-    if (!measured && plan)
+    v.noise_kind = v.noise_measured ? "measured on these values" : "QMC's estimate, an upper bound";
+    if (!v.noise_measured && plan)
       for (size_t p = 0; p < plan->products.size(); ++p)
         if (plan->products[p] == e.product && p < plan->noise.size())
-          sigma = plan->noise[p], kind = "the probe's, an upper bound";
-    const double delta = measured ? 3.0 * std::sqrt(2.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
+          sigma = plan->noise[p], v.noise_kind = "the probe's, an upper bound";
+    v.noise = sigma;
+    const double delta = v.noise_measured ? 3.0 * std::sqrt(2.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
     // m² = e² + σ² (independent errors): the bake's own error e with the noise removed, and the
     // range it lies in. Met when its top is within E (always when m <= E), NOT met when its
     // bottom exceeds E, else the reference cannot tell.
     auto less_noise = [&](double factor) { return std::sqrt(std::max(0.0, m * m - sigma * sigma * factor)); };
-    const double e_mid = measured ? less_noise(1.0) : m;
-    const double e_hi = measured ? less_noise(std::max(0.0, 1.0 - delta)) : m;
-    const double e_lo = less_noise(1.0 + delta);
-    const bool met = e_hi <= target, not_met = e_lo > target;
-    const char* verdict = met ? "met" : not_met ? "NOT met" : "not verifiable here";
-    std::string line = format("  target %g for ", target) + product_label(e.product) +
-                       (is_radiance(e.product) ? " (relative)" : "") + ": " + verdict + ": ";
-    if (measured)
-      line += format("the bake's own error %.2e", e_mid) + format(" (%.2e to ", e_lo) + format("%.2e), ", e_hi) +
-              format("the measured RMSE %.3e less the reference's own noise ", m) +
-              format("%.1e (", sigma) + kind + ") in quadrature";
+    v.error = v.noise_measured ? less_noise(1.0) : m;
+    v.error_hi = v.noise_measured ? less_noise(std::max(0.0, 1.0 - delta)) : m;
+    v.error_lo = less_noise(1.0 + delta);
+    v.met = v.error_hi <= target;
+    v.not_met = v.error_lo > target;
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
+  std::vector<std::string> out;
+  for (const TargetVerdict& v : target_verdicts(report, target, plan)) {
+    const char* verdict = v.met ? "met" : v.not_met ? "NOT met" : "not verifiable here";
+    std::string line = format("  target %g for ", target) + product_label(v.product) +
+                       (is_radiance(v.product) ? " (relative)" : "") + ": " + verdict + ": ";
+    if (v.noise_measured)
+      line += format("the bake's own error %.2e", v.error) + format(" (%.2e to ", v.error_lo) +
+              format("%.2e), ", v.error_hi) + format("the measured RMSE %.3e less the reference's own noise ", v.measured) +
+              format("%.1e (", v.noise) + v.noise_kind + ") in quadrature";
     else
-      line += format("the measured RMSE %.3e, which includes the reference's own noise (", m) +
-              format("%.1e, ", sigma) + kind + format("): the bake's own error is %.2e to ", e_lo) + format("%.2e", m);
-    if (!met && !not_met) {
+      line += format("the measured RMSE %.3e, which includes the reference's own noise (", v.measured) +
+              format("%.1e, ", v.noise) + v.noise_kind + format("): the bake's own error is %.2e to ", v.error_lo) +
+              format("%.2e", v.measured);
+    if (!v.met && !v.not_met) {
       line += ": the reference is too noisy to tell";
       if (plan)
         for (size_t p = 0; p < plan->products.size(); ++p)
-          if (plan->products[p] == e.product && plan->rays_needed[p] > plan->rays)
+          if (plan->products[p] == v.product && plan->rays_needed[p] > plan->rays)
             line += format("; E/3 would need %.3g rays per point, %.3g in all, over the report's budget of %.3g rays",
                            double(plan->rays_needed[p]), double(plan->rays_needed[p]) * double(plan->points),
                            double(plan->ray_budget ? plan->ray_budget : ReferencePlan::kReportRayBudget)) +
@@ -985,6 +998,38 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
     out.push_back(line);
   }
   return out;
+}
+
+std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, std::span<const TargetVerdict> verdicts) {
+  const ChooserOptions defaults;
+  const bool silhouette = choice.spec.kind == IntegratorKind::Silhouette;
+  if (!silhouette && choice.spec.kind != IntegratorKind::Qmc) return std::nullopt;
+  const double aim = (silhouette ? defaults.safety_silhouette : defaults.safety_qmc) * choice.target;
+  double ratio = 0;  // the worst product's error over the aim, where it is (likely) above E
+  for (const TargetVerdict& v : verdicts)
+    if (v.not_met || (v.noise_measured && v.error > choice.target)) ratio = std::max(ratio, v.error / aim);
+  if (!(ratio > 1)) return std::nullopt;
+  const Prediction* pred = nullptr;
+  for (const Prediction& p : choice.predictions)
+    if (p.kind == choice.spec.kind) pred = &p;
+  if (!pred) return std::nullopt;
+  // The model's rate, at least Monte Carlo's 1/2 (a slower one would promise a smaller step).
+  const double rate = std::max(pred->exponent, 0.5);
+  const double factor = std::pow(ratio, 1.0 / rate);
+  IntegratorSpec spec = choice.spec;
+  const double bound = pred->bound > 0 ? double(pred->bound) : std::numeric_limits<double>::infinity();
+  if (silhouette) {
+    const double N = double(choice.spec.isolines());
+    const double raised = std::min(std::ceil(N * factor / 2) * 2, bound);
+    if (!(raised > N)) return std::nullopt;
+    spec.set_samples(uint32_t(raised) * uint32_t(raised));
+  } else {
+    const double R = double(choice.spec.qmc_rays);
+    const double raised = std::min(std::ceil(R * factor), std::min(bound, double(kMaxRays)));
+    if (!(raised > R)) return std::nullopt;
+    spec.set_samples(uint32_t(raised));
+  }
+  return spec;
 }
 
 } // namespace prt::bake

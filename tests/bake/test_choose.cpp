@@ -578,3 +578,43 @@ TEST(Chooser, TheKnobSolvedFromABracketMeetsItsOwnPrediction) {
   EXPECT_GT(n, 128);
   EXPECT_LT(n, 256);
 }
+
+TEST(Choose, ACheckThatFindsTheTargetMissedRaisesTheKnobByTheModelsRate) {
+  // corrected_plan (bake/choose.h): the worst product's measured error e over the kind's aim
+  // safety·E, raised to 1/rate, scales the knob; within the kind's bound; nothing when met.
+  IntegratorChoice c;
+  c.target = 1e-3;
+  c.spec.kind = IntegratorKind::Silhouette;
+  c.spec.set_samples(148 * 148);
+  Prediction sil;
+  sil.kind = IntegratorKind::Silhouette, sil.exponent = 1.0, sil.bound = 4096;
+  Prediction qmc;
+  qmc.kind = IntegratorKind::Qmc, qmc.exponent = 0.3, qmc.bound = 1u << 20;  // below 1/2: taken as 1/2
+  c.predictions = {sil, qmc};
+  TargetVerdict missed;
+  missed.product = Product::RadianceBand1, missed.noise_measured = true;
+  missed.error = 1.4e-3, missed.error_lo = 1.2e-3, missed.error_hi = 1.6e-3, missed.not_met = true;  // 2 × aim 7e-4
+  TargetVerdict fine;
+  fine.product = Product::Ao, fine.noise_measured = true, fine.error = 2e-4, fine.error_hi = 3e-4, fine.met = true;
+  std::vector<TargetVerdict> v = {fine, missed};
+  std::optional<IntegratorSpec> s = corrected_plan(c, v);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->kind, IntegratorKind::Silhouette);
+  EXPECT_EQ(s->isolines(), 296) << "148 × (1.4e-3 / 7e-4)^(1/1)";
+  // The bound holds.
+  c.predictions[0].bound = 200;
+  EXPECT_EQ(corrected_plan(c, v)->isolines(), 200);
+  // A best estimate above E whose range straddles it (not verifiable) is corrected too; met is not.
+  v[1].not_met = false, v[1].error = 1.05e-3;
+  ASSERT_TRUE(corrected_plan(c, v).has_value());
+  v[1].error = 9e-4;
+  EXPECT_FALSE(corrected_plan(c, v).has_value()) << "its best estimate is within E";
+  v[1].met = true;
+  EXPECT_FALSE(corrected_plan(c, v).has_value());
+  // QMC: 1,024 rays, rate 0.3 taken as 1/2, e = 2 × aim 8e-4: 1,024 × 2² = 4,096 rays.
+  c.spec.kind = IntegratorKind::Qmc;
+  c.spec.set_samples(1024);
+  v[1].met = false, v[1].not_met = true, v[1].error = 1.6e-3;
+  ASSERT_TRUE(corrected_plan(c, v).has_value());
+  EXPECT_EQ(corrected_plan(c, v)->samples(), 4096u);
+}

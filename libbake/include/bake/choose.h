@@ -325,6 +325,26 @@ std::string choice_summary(const IntegratorChoice& choice);
 // verifiable here", saying why (the rays E/3 would have needed against the report's budget).
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target,
                                             const ReferencePlan* plan = nullptr);
+// The numbers behind each line (per product, in E's units).
+struct TargetVerdict {
+  Product product = Product::Ao;
+  double measured = 0;               // m, the RMSE against the reference
+  double noise = 0;                  // σ, the reference's own
+  bool noise_measured = false;       // σ measured on the report's values (else an upper bound)
+  const char* noise_kind = "";
+  double error = 0, error_lo = 0, error_hi = 0;  // the bake's own error and its range
+  bool met = false, not_met = false; // neither: not verifiable here
+};
+std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double target, const ReferencePlan* plan = nullptr);
+
+// The correction after a check (the chooser's pilot under-predicts where the error sits on a few
+// vertices it did not sample; the check's 128 vertices saw them): when some product is NOT met, or
+// its best estimate (noise measured and taken out) is above E though the range straddles it,
+// the chosen kind's knob raised by its model's rate (Prediction::exponent, at least 1/2) so that
+// the worst such product's measured error falls to its safety·E — N·(e/aim)^(1/a) isolines (even)
+// or R·(e/aim)^(1/a) rays — within the kind's bound (Prediction::bound). nullopt when nothing is
+// above E or the knob cannot rise. Tools bake it once more and check again; once.
+std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, std::span<const TargetVerdict> verdicts);
 
 // Pools reports of disjoint point sets: each of `add`'s products is merged into `into`'s entry of
 // the same product (appended when new), as if one report had compared all their values: values
