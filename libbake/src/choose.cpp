@@ -940,8 +940,10 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
     v.product = e.product;
     const double m = v.measured = error_in_target_units(e);  // the measured RMSE, the reference's noise in it
     // The reference's own noise σ in the same units. Measured on the report's own values (two
-    // independent halves, ErrorReport::reference_noise_measured): known to a relative δ on σ²,
-    // 3 standard deviations of a variance estimated from n Gaussian values, 3·sqrt(2/n). Else an
+    // independent halves, ErrorReport::reference_noise_measured). m² − σ² is then the difference of
+    // two independent estimates of σ² from n values each (the halves' mean and their difference
+    // are uncorrelated), each with a standard deviation σ²·sqrt(2/n) for Gaussian noise: e² is
+    // known to ±δσ², δ = 3·sqrt(4/n) (3 standard deviations of the difference). Else an
     // upper bound: the plan's probe scaled at Monte Carlo's rate (the slowest QMC shows), or QMC's
     // estimator (which overstates it) — then it cannot be subtracted, only bound the error below.
     v.noise_measured = report.reference_noise_measured;
@@ -955,7 +957,7 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
         if (plan->products[p] == e.product && p < plan->noise.size())
           sigma = plan->noise[p], v.noise_kind = "the probe's, an upper bound";
     v.noise = sigma;
-    const double delta = v.noise_measured ? 3.0 * std::sqrt(2.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
+    const double delta = v.noise_measured ? 3.0 * std::sqrt(4.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
     // m² = e² + σ² (independent errors): the bake's own error e with the noise removed, and the
     // range it lies in. Met when its top is within E (always when m <= E), NOT met when its
     // bottom exceeds E, else the reference cannot tell.

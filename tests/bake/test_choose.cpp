@@ -280,16 +280,16 @@ TEST(Choose, TheTargetCheckSaysMetNotMetOrNotVerifiable) {
   EXPECT_NE(why[2].find("over the report's budget"), std::string::npos) << why[2];
   EXPECT_EQ(why[0].substr(0, why[0].find('(')), lines[0].substr(0, lines[0].find('(')));
   // Noise measured on the report's own values (two independent halves): it is taken out. σ =
-  // 1e-3 on 288 values (δ = 3 sqrt(2/288) = 0.25), m = 3e-3: e = 2.83e-3 in [2.78e-3, 2.87e-3], NOT met.
+  // 1e-3 on 288 values (δ = 3 sqrt(4/288) = 0.35), m = 3e-3: e = 2.83e-3 in [2.77e-3, 2.89e-3], NOT met.
   report.reference_noise_measured = true;
   report.products[2].reference_std_error = 1.0;
   const std::string measured = target_check_lines(report, 1e-3)[2];
-  EXPECT_NE(measured.find("NOT met: the bake's own error 2.83e-03 (2.78e-03 to 2.87e-03)"), std::string::npos) << measured;
+  EXPECT_NE(measured.find("NOT met: the bake's own error 2.83e-03 (2.77e-03 to 2.89e-03)"), std::string::npos) << measured;
   EXPECT_NE(measured.find("(measured on these values) in quadrature"), std::string::npos) << measured;
-  // m = 1.2e-3 with σ = 1e-3 measured: e = 6.63e-4 in [4.36e-4, 8.31e-4]: met, where m alone is above E.
+  // m = 1.2e-3 with σ = 1e-3 measured: e = 6.63e-4 in [2.94e-4, 8.91e-4]: met, where m alone is above E.
   report.products[2].rmse = 1.2;
   const std::string met = target_check_lines(report, 1e-3)[2];
-  EXPECT_NE(met.find("met: the bake's own error 6.63e-04 (4.36e-04 to 8.31e-04)"), std::string::npos) << met;
+  EXPECT_NE(met.find("met: the bake's own error 6.63e-04 (2.94e-04 to 8.91e-04)"), std::string::npos) << met;
 }
 
 TEST(Choose, APilotReferenceTooCoarseForTheTargetIsRaisedOrSaysSo) {

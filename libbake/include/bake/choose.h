@@ -317,10 +317,11 @@ std::vector<std::string> choice_lines(const IntegratorChoice& choice);
 std::string choice_summary(const IntegratorChoice& choice);
 
 // After the bake, one line per product against the target E. The measured RMSE m includes the
-// reference's own noise σ (m² = e² + σ², independent errors). With the reference's plan σ is
-// measured (known to a relative δ = 3·sqrt(2/n) on σ², n the probe's values): the line states
-// the bake's own error e = sqrt(m² − σ²) and its range [sqrt(m² − σ²(1+δ)), sqrt(m² − σ²(1−δ))].
-// Without it σ is QMC's estimate, an upper bound: e lies in [sqrt(m² − σ²), m]. "met" when the
+// reference's own noise σ (m² = e² + σ², independent errors). When the report's reference was two
+// independent halves (ErrorReport::reference_noise_measured), σ is measured on the report's own
+// n values and e² is known to ±δσ², δ = 3·sqrt(4/n): the line states the bake's own error
+// e = sqrt(m² − σ²) and its range [sqrt(m² − σ²(1+δ)), sqrt(m² − σ²(1−δ))]. Otherwise σ is an
+// upper bound (the plan's probe, or QMC's estimate): e lies in [sqrt(m² − σ²), m]. "met" when the
 // range's top is within E (always when m <= E), "NOT met" when its bottom exceeds E, else "not
 // verifiable here", saying why (the rays E/3 would have needed against the report's budget).
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target,
