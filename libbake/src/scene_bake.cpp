@@ -18,6 +18,9 @@
 namespace prt::bake {
 namespace {
 
+// Receivers that get a log line each when baked (more: the progress stage and the total only).
+constexpr size_t kObjectLinesUpTo = 12;
+
 // The dry run's estimate times each group's integrator on this many seeded vertices.
 constexpr size_t kEstimatePoints = 64;
 
@@ -268,6 +271,10 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   };
   std::vector<Check> checks;
 
+  size_t receivers = 0;  // with per-vertex products
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    receivers += plan.objects[i].receiver && plan.objects[i].any_vertex_product();
+
   size_t set = 0;  // receivers with per-vertex products so far (SceneRows)
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -328,9 +335,12 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     ob.integrator_description = integrator.description();
     out.vertex_seconds += ob.values->seconds;
     out.vertices += points.size();
-    log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
-        printf_string("%.2f s", ob.values->seconds) +
-        (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
+    // A line per object for a scene of a few; an engine of 115 parts gets the progress stage and
+    // the total (the file has every object's time).
+    if (receivers <= kObjectLinesUpTo)
+      log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
+          printf_string("%.2f s", ob.values->seconds) +
+          (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
     if (ref && report_points > 0) checks.push_back({i, ref, ref2, group, report_points});
     if (group && --group->remaining == 0) group->integ.reset();  // its references stay for the checks
   }
