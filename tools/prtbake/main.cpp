@@ -755,7 +755,14 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
       if (!merges) return 0;
       result = shards->merge(0, integrator.layout());
     } else {
-      result = bake::bake_points(points, integrator, progress);
+      try {
+        result = bake::bake_points(points, integrator, progress);
+      } catch (const bake::Cancelled&) {
+        if (pass == 0) throw;  // nothing written yet
+        std::fprintf(stderr, "prtbake: cancelled while baking again: %s holds the first bake and its error report\n",
+                     a.output.c_str());
+        return tool::kExitCancelled;
+      }
     }
     warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
                 a.flip_normals);
