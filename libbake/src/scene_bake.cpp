@@ -28,6 +28,27 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// A monitor that folds a sequence of tasks (one per object) into one progress stage `label` of
+// `total` units: each task's count is offset by `*before` (the units of the tasks already done,
+// which the caller advances), the time runs from `start`, and the stage finishes with the last
+// task (or with a cancelled one).
+Monitor one_stage(const Monitor& monitor, const char* label, const uint64_t& total, const uint64_t& before,
+                  std::chrono::steady_clock::time_point start) {
+  Monitor m;
+  m.cancel = monitor.cancel;
+  if (monitor.on_progress)
+    m.on_progress = [&monitor, label, &total, &before, start](const ProgressUpdate& u) {
+      ProgressUpdate o = u;
+      o.task = label;
+      o.done = before + u.done;
+      o.total = total;
+      o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last task, or a cancel
+      monitor.on_progress(o);
+    };
+  return m;
+}
+
 // snprintf of one or two numbers into a string (the log lines).
 std::string printf_string(const char* f, double a, double b = 0) {
   char buf[160];
@@ -156,6 +177,14 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ++g.remaining;
     }
   }
+  // How the log names a group: its object, or "N receivers (V vertices, from <first>)".
+  auto group_label = [&](const Group& g) {
+    if (g.objects.size() == 1) return scene.objects[g.objects.front()].name;
+    uint64_t v = 0;
+    for (size_t j : g.objects) v += meshes[j].positions.size();
+    return std::to_string(g.objects.size()) + " receivers (" + std::to_string(v) + " vertices, from " +
+           scene.objects[g.objects.front()].name + ")";
+  };
   auto choose_for = [&](Group& g, const ProductRequest& r) {
     for (size_t j : g.objects) {
       std::vector<ShadePoint> pts = shade_points(j);
@@ -184,10 +213,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       g.spec.report_rays = g.reference_plan->rays;
     }
     g.report_points = g.spec.report_points;
-    const std::string who = g.objects.size() == 1 ? scene.objects[g.objects.front()].name
-                                                  : std::to_string(g.objects.size()) + " receivers (" +
-                                                        std::to_string(g.points.size()) + " vertices, from " +
-                                                        scene.objects[g.objects.front()].name + ")";
+    const std::string who = group_label(g);
     if (on_choice)
       on_choice(who, g.choice, g.reference_plan ? &*g.reference_plan : nullptr);
     else
@@ -214,9 +240,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         std::vector<ShadePoint> o = shade_points(j);
         pts.insert(pts.end(), o.begin(), o.end());
       }
-      const std::string who = g.objects.size() == 1 ? scene.objects[g.objects.front()].name
-                                                    : std::to_string(g.objects.size()) + " receivers (from " +
-                                                          scene.objects[g.objects.front()].name + ")";
+      const std::string who = group_label(g);
       if (integ.kind() == IntegratorKind::Filter) {
         log(who + ": " + std::to_string(pts.size()) + " vertices; the filter integrator's cost is not estimated "
                                                       "(it needs every vertex's rays)");
@@ -248,19 +272,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   // scene, not a stage per object): each object's bake reports into it, offset by the vertices
   // baked before it; it finishes with the last.
   uint64_t vertices_before = 0;
-  const auto t_receivers = std::chrono::steady_clock::now();
-  Monitor overall;
-  overall.cancel = monitor.cancel;
-  if (monitor.on_progress)
-    overall.on_progress = [&](const ProgressUpdate& u) {
-      ProgressUpdate o = u;
-      o.task = "baking receivers";
-      o.done = vertices_before + u.done;
-      o.total = receiver_vertices;
-      o.seconds = seconds_since(t_receivers);
-      o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last object, or a cancel
-      monitor.on_progress(o);
-    };
+  const Monitor overall = one_stage(monitor, "baking receivers", receiver_vertices, vertices_before,
+                                    std::chrono::steady_clock::now());
 
   // The error reports to make once every receiver is baked.
   struct Check {
@@ -372,19 +385,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   // (One "checking the error" progress stage over every report vertex, after the one bake stage.)
   uint64_t check_total = 0, checked_before = 0;
   for (const Check& c : checks) check_total += c.points;
-  const auto t_checks = std::chrono::steady_clock::now();
-  Monitor check_monitor;
-  check_monitor.cancel = monitor.cancel;
-  if (monitor.on_progress)
-    check_monitor.on_progress = [&](const ProgressUpdate& u) {
-      ProgressUpdate o = u;
-      o.task = "checking the error";
-      o.done = checked_before + u.done;
-      o.total = check_total;
-      o.seconds = seconds_since(t_checks);
-      o.finished = u.finished && (o.done == o.total || u.done < u.total);
-      monitor.on_progress(o);
-    };
+  const Monitor check_monitor =
+      one_stage(monitor, "checking the error", check_total, checked_before, std::chrono::steady_clock::now());
   for (Check& c : checks) {
     const size_t i = c.object;
     ObjectBake& ob = out.objects[i];

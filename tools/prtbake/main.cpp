@@ -1091,10 +1091,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
       for (const auto& l : plan.objects[i].left_out) d += "      leave out  " + l + "\n";
       return d;
     };
-    auto name_of = [&](size_t i) {
-      const auto& o = scene.objects[i];
-      return o.node_path.empty() ? o.name : o.node_path;
-    };
+    auto name_of = [&](size_t i) { return scene_object_label(scene.objects[i]); };
     constexpr size_t kGroupAbove = 12;  // objects; fewer are listed one by one
     if (a.verbose || scene.objects.size() <= kGroupAbove) {
       for (size_t i = 0; i < scene.objects.size(); ++i) {
