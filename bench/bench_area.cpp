@@ -1,29 +1,29 @@
-// bench_area — analytic area-light shading per shade point (bake/spherical_polygon.h,
-// bake/polygon_sh.h; paper 003 §4.1, Fig. 4: its per-core rates are the targets, ≥ 150k shade
+// bench_area — analytic area-light shading per shade point (bake/sphere/spherical_polygon.h,
+// bake/sphere/polygon_sh.h; paper 003 §4.1, Fig. 4: its per-core rates are the targets, ≥ 150k shade
 // points/s for one quad light with no occluder). One thread; rates are items per CPU second.
 //
 // Scene: a 1 × 1 quad light at height 1.5 over a 4 × 4 floor; 4096 shade points on the floor
 // with normals tilted up to 60° from +z, so a share of them sees the light cross the horizon.
 //   BM_QuadIrradiance    horizon clip + Lambert (the diffuse irradiance of the light)
 //   BM_QuadIrradianceSH  the same + the SH projection of the clipped polygon at orders 3 and 6
-// and with shadows (bake/visible_region.h; paper 003's target ≥ 17k shade points/s per core for
+// and with shadows (bake/visibility/visible_region.h; paper 003's target ≥ 17k shade points/s per core for
 // 3 lights × 3 occluders): three 1 × 1 quad lights at heights 2.5–3 and three boxes between
 // them and the floor (no culling: every box is tested against every light), per shade point the
 // boxes' silhouettes, then per light the horizon clip, the visible region and its irradiance:
 //   BM_ThreeLightsThreeBoxes/silhouette:1  the boxes as silhouette loops (paper §3.3)
 //   BM_ThreeLightsThreeBoxes/silhouette:0  the boxes as their front-facing triangles (§4.4)
-// and past a triangle mesh (bake/occluder_mesh.h: culling by the light's pyramid and plane, then
+// and past a triangle mesh (bake/visibility/occluder_mesh.h: culling by the light's pyramid and plane, then
 // the per-triangle union of every kept triangle, both facings):
 //   BM_ThreeLightsThreeBoxesMesh/culled:1  the three boxes as one 36-triangle mesh, culled per light
 //   BM_ThreeLightsThreeBoxesMesh/culled:0  the same through the unculled reference
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
-#include <bake/lights.h>
-#include <bake/mesh.h>
-#include <bake/occluder_mesh.h>
-#include <bake/polygon_sh.h>
-#include <bake/spherical_polygon.h>
-#include <bake/visible_region.h>
+#include <bake/lights/lights.h>
+#include <bake/mesh/mesh.h>
+#include <bake/visibility/occluder_mesh.h>
+#include <bake/sphere/polygon_sh.h>
+#include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/visible_region.h>
 
 #include <benchmark/benchmark.h>
 

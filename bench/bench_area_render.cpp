@@ -1,5 +1,5 @@
 // bench_area_render — paper 003's equal-time comparison (§5): per-pixel direct lighting from area
-// lights with exact soft shadows (view/area_lights.h render_area_analytic: bake/area_bake.h per
+// lights with exact soft shadows (view/area_lights.h render_area_analytic: bake/lights/area_bake.h per
 // pixel) against Embree ray tracing with light sampling (render_area_reference), on one thread,
 // next to each other in one run. The ray tracer runs at 1 shadow ray per pixel and light, and at
 // the ray count that takes the analytic render's CPU time ("equal time"); both are compared with a
@@ -25,8 +25,8 @@
 #include <view/image.h>
 #include <view/raster.h>
 
-#include <bake/lights.h>
-#include <bake/mesh.h>
+#include <bake/lights/lights.h>
+#include <bake/mesh/mesh.h>
 
 #include <tbb/global_control.h>
 

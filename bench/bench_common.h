@@ -4,7 +4,7 @@
 // Scene: data/bunny_ground.obj (the default scene: bunny, 1,839 vertices / 3,674 triangles,
 // on a 48×48-quad ground grid), products AO + order-3 diffuse transfer (ProductRequest{ao,
 // transfer_order = 3}: 10 doubles per integral). Finer scenes: the bunny part Loop-subdivided
-// (bake/subdivide.h) `level` times (3,674·4^level triangles) with the same ground grid, so
+// (bake/mesh/subdivide.h) `level` times (3,674·4^level triangles) with the same ground grid, so
 // level 0 is the file itself and levels 1, 2, 3 have ~15k, ~60k, ~240k bunny triangles.
 //
 // Shade points: seeded_sample(4,240 vertices of bunny_ground.obj, n, seed) — the same vertices
@@ -15,9 +15,9 @@
 //   PRT_BENCH_POINTS  shade points (default 64)      PRT_BENCH_SEED  sample seed (default 7)
 #pragma once
 
-#include <bake/integrator.h>
-#include <bake/mesh.h>
-#include <bake/products.h>
+#include <bake/integrators/integrator.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/products.h>
 
 #include <cstdint>
 #include <memory>

@@ -1,4 +1,4 @@
-// bench_contour — the contour search alone (bake/contour.h), against triangle count: for each
+// bench_contour — the contour search alone (bake/visibility/contour.h), against triangle count: for each
 // subdivision level of the benchmark scene (bench_common.h), CPU µs per ContourFinder::find on
 // the benchmark's shade points, the contour edges found and the query counters (nodes visited,
 // records tested, exact decisions), and the growth exponents of time and of edge count against
@@ -19,8 +19,8 @@
 //   PRT_BENCH_POINTS, PRT_BENCH_SEED (bench_common.h)
 #include <bench_common.h>
 
-#include <bake/contour.h>
-#include <bake/vertex_bake.h>
+#include <bake/visibility/contour.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <algorithm>
 #include <cmath>

@@ -22,8 +22,8 @@
 // PRT_BENCH_REF_RAYS, PRT_BENCH_QMC_SAMPLES and PRT_BENCH_ISOLINES set the same things.
 #include <bench_common.h>
 
-#include <bake/qmc.h>
-#include <bake/vertex_bake.h>
+#include <bake/integrators/qmc.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
                 s.mesh.source.c_str(), s.mesh.triangles.size(), n, (unsigned long long)bench::sample_seed());
     std::printf("`%s`\n\n", cmd.c_str());
 #if !PRT_BENCH_SILHOUETTE
-    std::printf("*Silhouette rows missing: libbake/src/silhouette.cpp did not exist when this was configured.*\n\n");
+    std::printf("*Silhouette rows missing: libbake/integrators/src/silhouette.cpp did not exist when this was configured.*\n\n");
     (void)isolines;
 #endif
 

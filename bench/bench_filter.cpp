@@ -1,5 +1,5 @@
-// bench_filter — quality per ray and CPU time of the sheared-filter integrator (bake/filter.h,
-// paper 002) next to QMC (bake/qmc.h) and, on the grass scene, the silhouette integrator, in one
+// bench_filter — quality per ray and CPU time of the sheared-filter integrator (bake/integrators/filter.h,
+// paper 002) next to QMC (bake/integrators/qmc.h) and, on the grass scene, the silhouette integrator, in one
 // run (docs/ARCHITECTURE.md, "Benchmarks").
 //
 //   bench_filter assets [names...]   AO + order-3 transfer on data/<name>.obj (default:
@@ -28,12 +28,12 @@
 // Errors are over the reference's vertices; "rays/pt" counts pass-1 and brute-force rays (the
 // filter) or rays (QMC); CPU seconds are the process's (every thread), including the filter's
 // neighbour search (prepare() and the k-d tree queries) and pass 1.
-#include <bake/filter.h>
-#include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/sampling.h>
-#include <bake/silhouette.h>
-#include <bake/vertex_bake.h>
+#include <bake/integrators/filter.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <bake/sphere/sampling.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 

@@ -25,7 +25,7 @@
 //   PRT_BENCH_POINTS, PRT_BENCH_SEED (bench_common.h)
 #include <bench_common.h>
 
-#include <bake/vertex_bake.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <benchmark/benchmark.h>
 
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond);
 #else
     (void)isolines;
-    std::fprintf(stderr, "bench_integrators: silhouette cases compiled out (libbake/src/silhouette.cpp "
+    std::fprintf(stderr, "bench_integrators: silhouette cases compiled out (libbake/integrators/src/silhouette.cpp "
                          "did not exist at configure time)\n");
 #endif
     for (long l : levels) {

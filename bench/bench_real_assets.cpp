@@ -20,7 +20,7 @@
 //              an opposite sheet welded into the ring) and how many repeat another ring triangle's
 //              corners (duplicated faces);
 //   +Y         the normal is exactly (0, 1, 0) and the ring's face normals cancel: the
-//              angle-weighted fallback of bake/mesh.h, not a normal of the vertex's own faces;
+//              angle-weighted fallback of bake/mesh/mesh.h, not a normal of the vertex's own faces;
 //   shared     other output vertices at the same welded position (split normals, coincident sheets).
 //
 //   bench_real_assets            the default run (~5–10 min on 2 cores)
@@ -32,11 +32,11 @@
 #include <arch_scene.h>
 #include <point_on_triangle.h>
 
-#include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/raycast.h>
-#include <bake/silhouette.h>
-#include <bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <bake/visibility/raycast.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <tbb/info.h>
 

@@ -1,5 +1,5 @@
 // bench_reference_error — the error of baked files against a converged independent reference, in
-// the units of the target error E (bake/choose.h): AO and diffuse transfer as the absolute RMSE
+// the units of the target error E (bake/bake/choose.h): AO and diffuse transfer as the absolute RMSE
 // over every value of the product at the sampled rows, band-1 radiance as that RMSE relative to
 // the RMS of the reference values. The driver is bench/default_vs_tuned.sh (issue 27: the default
 // bake against hand tuning), which bakes the files with prtbake and calls this once per
@@ -12,7 +12,7 @@
 // row per shade point and the mesh's SHA-256 as its source: otherwise the file is named and
 // the program fails (exit 2), since its rows would not be the ones integrated here.
 //
-// The reference: bake::QmcIntegrator (bake/qmc.h), `--replicates` M independent randomisations
+// The reference: bake::QmcIntegrator (bake/integrators/qmc.h), `--replicates` M independent randomisations
 // (seeds `--ref-seed` + j, apart from prtbake's default seed 1; point indices offset by the row
 // count, as the error reports do) of `--rays`/M rays per point each, averaged. Its standard error
 // per value is the replicates' own: sqrt(sample variance / M), the randomised-QMC estimate (Owen;
@@ -41,11 +41,11 @@
 //                         [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M]
 //                         [--cache PATH] FILE.prt.h5...
 //   bench_reference_error MESH --geometry
-#include <bake/envmap.h>
-#include <bake/mesh.h>
-#include <bake/products.h>
-#include <bake/qmc.h>
-#include <bake/vertex_bake.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/products.h>
+#include <bake/integrators/qmc.h>
+#include <bake/bake/vertex_bake.h>
 #include <formats/asset.h>
 
 #include <tbb/parallel_for.h>
@@ -276,7 +276,7 @@ int main(int argc, char** argv) try {
     }
     if (from_cache || !noisy || rays >= a.max_rays || raises == 2) break;
     // The rays that bring the noisiest product to E/3.3 at rate 0.75 (randomised QMC measured
-    // ~0.7 on the bunny, bake/choose.h; the Monte Carlo rate 0.5 would overshoot ~2x), a power of
+    // ~0.7 on the bunny, bake/bake/choose.h; the Monte Carlo rate 0.5 would overshoot ~2x), a power of
     // two within --max-rays; the pass above is discarded. At most twice.
     double worst = 0;
     for (size_t p = 0; p < slots.size(); ++p) worst = std::max(worst, ref_se[p] / (a.target / 3.3));

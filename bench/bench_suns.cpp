@@ -1,12 +1,12 @@
 // bench_suns — the silhouette integrator's error under HDR skies with suns, against the isoline
-// count N (issue 27: the environment's hot texels integrated exactly, bake/hot_texels.h).
+// count N (issue 27: the environment's hot texels integrated exactly, bake/integrators/hot_texels.h).
 //
 // Per (mesh, environment): S seeded vertices (PRT_SUNS_POINTS, default 24; seed 12345), a QMC
 // reference with 2^19 rays (PRT_SUNS_REF_RAYS; seed 77) whose own estimated noise is printed
 // beside it (its RMS standard error, relative like the errors), then the silhouette integrator at
 // N = 64, 128, 256, 512 (PRT_SUNS_LEVELS="a,b,..."): band-1 radiance R and order-3 shadowed
 // radiance S, each as the RMSE
-// relative to the reference's RMS (bake/choose.h's units), and the CPU µs per integral at N = 256
+// relative to the reference's RMS (bake/bake/choose.h's units), and the CPU µs per integral at N = 256
 // (each thread's own clock). An error that stops falling with N at the reference's noise level is
 // the reference's; one that grows with N, or stalls well above it, is the integrator's.
 //
@@ -16,11 +16,11 @@
 //
 // The same source builds against an older libbake for a before/after comparison (the command is in
 // bench/RESULTS.md).
-#include <bake/envmap.h>
-#include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/silhouette.h>
-#include <bake/vertex_bake.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 

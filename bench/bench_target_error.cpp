@@ -1,4 +1,4 @@
-// bench_target_error — "ask for an error, not a sample count" (bake/choose.h) against hand
+// bench_target_error — "ask for an error, not a sample count" (bake/bake/choose.h) against hand
 // tuning, on the real-asset set: the bunny on its ground (data/bunny_ground.obj), wuson, the
 // spider on a ground, 2CylinderEngine.glb (CAD), the generated architectural scene
 // (tests/common/arch_scene.h), and the bunny Loop-subdivided to ~240k and ~1M triangles
@@ -20,7 +20,7 @@
 //   chooser     choose_integrator (the prtbake default pilot), timed as process CPU time, then
 //               its choice measured like a sweep level (RMSE; its µs from the same line as the
 //               sweep's): cost = setup + V × µs, and with the pilot; as in prtbake, the pilot
-//               builds the mesh's trees (bake/accel.h) and the bake reuses them, so the bake's
+//               builds the mesh's trees (bake/visibility/accel.h) and the bake reuses them, so the bake's
 //               setup is its tables and the trees are counted once, in the pilot
 //               (hand tuning's own runs are not counted: the ratio with the pilot is the harder one).
 // Printed as markdown: one summary row per asset (the ratio chooser / faster hand-tuned, and
@@ -33,11 +33,11 @@
 
 #include <arch_scene.h>
 
-#include <bake/choose.h>
-#include <bake/mesh.h>
-#include <bake/qmc.h>
-#include <bake/silhouette.h>
-#include <bake/vertex_bake.h>
+#include <bake/bake/choose.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>

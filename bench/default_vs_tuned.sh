@@ -24,7 +24,7 @@
 #               that met E within 2x of the fastest, one rung between its last miss and its
 #               first hit (the geometric mean: N x 1.41 or R x 1.41), so the grid is ~1.41x.
 #               The fastest plan that meets E is the hand-tuned plan;
-#   reference   bench_reference_error: prtbake's QMC integrator (bake/qmc.h) at REF_RAYS rays on
+#   reference   bench_reference_error: prtbake's QMC integrator (bake/integrators/qmc.h) at REF_RAYS rays on
 #               POINTS seeded rows of the mesh's own shade points (loaded as prtbake loads them),
 #               independent seeds, 4 replicates (their spread is its standard error); rays
 #               doubled (to 2^22) while its standard error on some product is above E/3. Every file's error is measured against it in E's units.

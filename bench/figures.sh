@@ -156,7 +156,7 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "own standard error (RMS over the compared pixels, from 8 independent randomised-QMC replicates per"
   echo "pixel) divided by the same range; since E[RMSE²] = RMSE²_true + σ², **noise-corrected** is"
   echo "sqrt(RMSE² − σ²)/range, the error of the runtime alone. Reference rays per pixel: ${RAYS_FIG12}"
-  echo "(Figure 12), ${RAYS} (the rest), on top of the exact unshadowed irradiance (bake/irradiance.h)."
+  echo "(Figure 12), ${RAYS} (the rest), on top of the exact unshadowed irradiance (bake/environment/irradiance.h)."
   echo
   echo "| experiment | NRMSE | reference noise | noise-corrected NRMSE | paper 004 | image |"
   echo "|---|---|---|---|---|---|"

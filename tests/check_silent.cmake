@@ -6,7 +6,7 @@
 # because it is the usual way to reach stdout by hand, and files are written through the
 # formats/, OpenEXR and libpng libraries instead. OpenMesh's message streams (omerr, omlog,
 # omout, which write to std::cerr inside libOpenMeshCore) are referenced by libbake's subdivision
-# through OpenMesh's inline code; libbake/src/openmesh.h disables them for the process and the
+# through OpenMesh's inline code; libbake/mesh/src/openmesh.h disables them for the process and the
 # bake test SilentLibrary.* checks at run time that nothing is printed.
 #   cmake -DNM=<nm> -DLIB=<libx.a> -P check_silent.cmake
 if(NOT NM OR NOT LIB)

@@ -31,7 +31,7 @@
 // d = 4: 9,778; d = 13, the benchmark's size: 102,354 triangles / 51,206 vertices).
 #pragma once
 
-#include <bake/mesh.h>
+#include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
 

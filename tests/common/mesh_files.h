@@ -1,9 +1,9 @@
-// Scratch mesh files for the mesh-input tests (bake/mesh.h): writing them, and the contract every
+// Scratch mesh files for the mesh-input tests (bake/mesh/mesh.h): writing them, and the contract every
 // refused file must meet (a one-line InputError naming the file and the defect).
 #pragma once
 
-#include <bake/error.h>
-#include <bake/mesh.h>
+#include <bake/core/error.h>
+#include <bake/mesh/mesh.h>
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Exact location of a point relative to a triangle: outside its plane, or in its plane and then
 // inside the face, on an edge's interior, at a corner, or outside — decided with the exact
-// orientation predicate of bake/contour.h (orient3d_exact, Shewchuk 1997), so a T-junction (a
+// orientation predicate of bake/mesh/predicates.h (orient3d_exact, Shewchuk 1997), so a T-junction (a
 // vertex lying on another triangle's edge or inside its face, without being one of its corners)
 // is recognised exactly, never within a tolerance. Shared by the geometry tests and the benchmark
 // that explains disagreements between the integrators (bench/bench_real_assets.cpp).
@@ -12,7 +12,7 @@
 // d is a + (the unit axis of the normal's largest component): clearly off a non-degenerate plane.
 #pragma once
 
-#include <bake/contour.h>
+#include <bake/mesh/predicates.h>
 
 #include <Eigen/Geometry>
 

@@ -1,8 +1,8 @@
-// A progress callback for tests (bake/progress.h): records every update a Monitor's callback
+// A progress callback for tests (bake/core/progress.h): records every update a Monitor's callback
 // receives and counts calls that overlapped (the contract says they never do).
 #pragma once
 
-#include <bake/progress.h>
+#include <bake/core/progress.h>
 
 #include <gtest/gtest.h>
 

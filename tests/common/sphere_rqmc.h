@@ -1,6 +1,6 @@
 // sphere_rqmc.h — randomised-QMC reference integrals over the unit sphere for tests, with an
 // honest standard error: R independent Cranley–Patterson rotations of the same Halton points
-// (bake/sampling.h) give R i.i.d. unbiased estimates; their mean is the estimate and the standard
+// (bake/sphere/sampling.h) give R i.i.d. unbiased estimates; their mean is the estimate and the standard
 // deviation of the mean (sample std / √R) its standard error (Owen, "Monte Carlo theory, methods
 // and examples", §17.1). The tests use R = 64: the standard error is itself estimated, so the
 // deviation in standard errors follows Student's t with R − 1 degrees of freedom, and with 32
@@ -9,7 +9,7 @@
 // random rotation.
 #pragma once
 
-#include <bake/sampling.h>
+#include <bake/sphere/sampling.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -1,7 +1,7 @@
 // Small scenes and closed forms shared by the integrator tests.
 #pragma once
 
-#include <bake/mesh.h>
+#include <bake/mesh/mesh.h>
 
 #include <Eigen/Geometry>
 #include <cmath>

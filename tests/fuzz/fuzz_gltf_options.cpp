@@ -1,12 +1,12 @@
-// tests/fuzz/fuzz_gltf_options.cpp — libFuzzer target of the glTF scene options file (bake/scene.h
+// tests/fuzz/fuzz_gltf_options.cpp — libFuzzer target of the glTF scene options file (bake/bake/scene.h
 // "glTF SCENES": `prtbake scene x.gltf --options o.json`): the input is the options JSON, read
 // with bake::load_scene(kScene, input) against one fixed glTF scene whose instances are
 // root/a, root/a#p1, root/b, root/b#p1 (so that "objects" keys can name instances and node
 // paths). Accepted failure: bake::InputError.
 #include "fuzz_common.h"
 
-#include <bake/error.h>
-#include <bake/scene.h>
+#include <bake/core/error.h>
+#include <bake/bake/scene.h>
 
 namespace {
 

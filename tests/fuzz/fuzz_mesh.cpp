@@ -1,16 +1,16 @@
 // tests/fuzz/fuzz_mesh.cpp — one libFuzzer target per mesh format (OBJ, PLY, OFF, STL, glTF,
 // GLB), compiled once per format with PRT_FUZZ_FORMAT = obj | ply | off | stl | gltf | glb.
-// The input is the whole file. It goes the way load_mesh takes it (libbake/src/mesh_io.cpp):
+// The input is the whole file. It goes the way load_mesh takes it (libbake/mesh/src/mesh_io.cpp):
 // the format's reader parses the bytes in memory (mesh_readers.h, gltf_reader.h), build_mesh
 // turns the polygons into a Mesh, and the welded topology and winding facts prtbake computes
 // before a bake follow. glTF also takes load_mesh_instances' path (one Mesh per instance). The
-// only accepted failure is bake::InputError (bake/mesh.h "ERRORS"); fuzz_common.h says the rest.
+// only accepted failure is bake::InputError (bake/mesh/mesh.h "ERRORS"); fuzz_common.h says the rest.
 #include "fuzz_common.h"
-#include "gltf_reader.h"
-#include "mesh_readers.h"
+#include <bake/mesh/gltf_reader.h>
+#include <bake/mesh/mesh_readers.h>
 
-#include <bake/error.h>
-#include <bake/mesh.h>
+#include <bake/core/error.h>
+#include <bake/mesh/mesh.h>
 
 #include <fstream>
 #include <vector>

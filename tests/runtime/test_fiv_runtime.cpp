@@ -48,7 +48,7 @@ struct Shells {
   }
 };
 
-// Offset s at continuous grid coordinates (t, u) and radius rho (bake/fiv.h grid convention).
+// Offset s at continuous grid coordinates (t, u) and radius rho (bake/bake/fiv.h grid convention).
 void offset_at(const Shells& o, double t, double u, double rho, float s[3]) {
   const double theta = kPi * t / (o.n_theta - 1), phi = 2 * kPi * u / o.n_phi;
   s[0] = float(rho * std::sin(theta) * std::sin(phi));
@@ -241,7 +241,7 @@ struct Cube {
   DifMap view() const { return {S, texels.data()}; }
 };
 
-// Unnormalised direction of texel (face, r, q) in the OpenGL convention of bake/fiv.h.
+// Unnormalised direction of texel (face, r, q) in the OpenGL convention of bake/bake/fiv.h.
 void texel_direction(int face, int r, int q, int S, float d[3]) {
   const float s = 2.0f * (float(q) + 0.5f) / float(S) - 1.0f, t = 2.0f * (float(r) + 0.5f) / float(S) - 1.0f;
   const float dirs[6][3] = {{1, -t, -s}, {-1, -t, s}, {s, 1, t}, {s, -1, -t}, {s, -t, 1}, {-s, -t, -1}};

@@ -1,7 +1,7 @@
 // Ctrl-C in the middle of a bake, end to end: prtbake started as a user would, SIGINT once it has
 // started baking; it must stop with exit 130, say so, and leave nothing in the output directory
 // but the chunks a --resume bake committed, which it names with the command that resumes
-// (tools/common/tool_main.h, bake/progress.h, tools/prtbake/shards.h).
+// (tools/common/tool_main.h, bake/core/progress.h, tools/prtbake/shards.h).
 #include <gtest/gtest.h>
 #include <run_tool.h>
 

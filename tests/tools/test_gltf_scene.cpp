@@ -1,9 +1,9 @@
-// `prtbake scene` on a glTF (bake/scene.h "glTF scenes"): every primitive instance is an object
+// `prtbake scene` on a glTF (bake/bake/scene.h "glTF scenes"): every primitive instance is an object
 // named by its node path, baked exactly as the same geometry in a JSON scene; the options file sets
 // roles and materials per node path and refuses a path that names no node; prtdump lists the
 // objects by node path and dumps one object's vertex by it; unnamed nodes take their mesh's name.
-#include <bake/scene.h>
-#include <bake/sha256.h>
+#include <bake/bake/scene.h>
+#include <bake/core/sha256.h>
 #include <formats/asset.h>
 
 #include <gltf_builder.h>
@@ -250,7 +250,7 @@ TEST(GltfScene, PrtdumpPrintsOneObjectsVertexByNodePathOrStoredName) {
 
 TEST(GltfScene, UnnamedNodesAreNamedAfterTheirMeshes) {
   // CAD exports name meshes, not nodes (2CylinderEngine.glb: "Piston_123-844_0_Parts_1"): an
-  // unnamed node's segment is its mesh's name (bake/mesh.h NAMES), made unique among siblings;
+  // unnamed node's segment is its mesh's name (bake/mesh/mesh.h NAMES), made unique among siblings;
   // a node's own name wins; neither: node<N>.
   const fs::path d = dir_for("mesh_names");
   Gltf g;
@@ -301,7 +301,7 @@ TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
   EXPECT_LT(after, 0.99f) << "the occluder half still shadows the ground";
 }
 
-// FIV shells are for occluders that move (bake/scene.h): a static glTF gets none; an animation
+// FIV shells are for occluders that move (bake/bake/scene.h): a static glTF gets none; an animation
 // channel on "stack" moves its whole subtree (the box's two primitives and the quad), the options'
 // "moves" overrides per node path (the longest key wins), and "weights" (morph targets) is no move.
 TEST(GltfScene, OnlyAnimatedNodesGetFivShellsAndTheOptionsOverride) {

@@ -85,7 +85,7 @@ TEST(Prtbake, BakesEveryProductOfARealMeshInOnePass) {
   ASSERT_TRUE(tri && pos);
   EXPECT_EQ(tri->shape[0], 1368u) << "every triangle of spider.obj reaches the file";
   // spider.obj has 762 positions and 918 distinct (position, normal) pairs: rows 0..761 are the
-  // file's vertices in file order, the 156 hard-edge splits follow (bake/mesh.h).
+  // file's vertices in file order, the 156 hard-edge splits follow (bake/mesh/mesh.h).
   EXPECT_EQ(pos->shape[0], 918u);
   const size_t V = pos->shape[0];
   const auto& src = std::get<std::vector<uint32_t>>(F::find_dataset(f, "/mesh/source_position")->data);
@@ -167,7 +167,7 @@ TEST(Prtbake, SceneBakesPrintThePilotTableWithVerbose) {
 }
 
 TEST(Prtbake, ASceneChoosesOncePerProductRequestAndJudgesTheTargetOnThePooledReport) {
-  // Two receivers with the same products share one pilot (bake/scene.h: the target holds for their
+  // Two receivers with the same products share one pilot (bake/bake/scene.h: the target holds for their
   // values together); the report's 16 points are shared by their vertices (8 each, the same
   // mesh), and the verdict is printed once, on the pooled report.
   const fs::path dir = scratch("scene_pooled");

@@ -160,7 +160,7 @@ TEST(Prtview, Band1OfAnOpenPlaneMatchesTheReference) {
   // An unoccluded plane: band-1 shading at the baked normal is the exact irradiance (up to the
   // silhouette integrator's discretisation, ~5e-4 relative at k = 128², bench/RESULTS.md), and the
   // reference is the unshadowed irradiance with no occluded part (zero noise; horizon-cut texels
-  // sub-sampled 4x4, bake/irradiance.h). The image is constant, so NRMSE is normalised by
+  // sub-sampled 4x4, bake/environment/irradiance.h). The image is constant, so NRMSE is normalised by
   // |reference|: < 2e-3.
   const fs::path h5 = scratch("plane.prt.h5"), out = scratch("plane.png");
   const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
@@ -329,7 +329,7 @@ TEST(PrtviewScene, GlossyRouteBFromTheBakedShadowedRadianceAndRouteAOnRequest) {
 
 TEST(PrtviewScene, GlossyLobesOfTheGlossyObjectsAgainstTheReference) {
   // The ground gets a Phong lobe (s = 8): the plan bakes its visibility transfer at order 7 (1% of
-  // the lobe's energy beyond, bake/zonal.h). --shade glossy shades it by the triple product and the
+  // the lobe's energy beyond, bake/sphere/zonal.h). --shade glossy shades it by the triple product and the
   // lobe (prtshade/glossy.h) and compares with the reference's glossy mode. Measured: noise-
   // corrected NRMSE 0.026 at 1024 rays per pixel — the SH truncation of the lobe and of the box's
   // shadow in U, and Gouraud interpolation of a view-dependent value over 1-unit cells. The bound

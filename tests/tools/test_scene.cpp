@@ -119,7 +119,7 @@ TEST(SceneRules, DiffuseReceiverGetsBand1RadianceAndNoHigherOrder) {
 
 TEST(SceneRules, RelightAndNoEnvironmentGiveDiffuseTransferAtTheToleranceOrder) {
   // Clamped cosine: 1/128 of its energy lies beyond order 3 and 1/8 + 1/128 beyond order 2
-  // (bake/zonal.h), so a 1% tolerance gives order 3 and 20% gives order 2.
+  // (bake/sphere/zonal.h), so a 1% tolerance gives order 3 and 20% gives order 2.
   const fs::path d = dir_for("relight");
   write_meshes(d);
   const Baked relit = bake(d, scene_text(kSunset, "\"relight\": true", kGround + ", " + kBoxBoth));
@@ -137,7 +137,7 @@ TEST(SceneRules, RelightAndNoEnvironmentGiveDiffuseTransferAtTheToleranceOrder) 
 }
 
 TEST(SceneRules, GlossyReceiverGetsVisibilityTransferAtThePhongOrder) {
-  // Phong exponent 24 at 1%: order 11 (0.67% beyond 11, above 1% beyond 10 — bake/zonal.h);
+  // Phong exponent 24 at 1%: order 11 (0.67% beyond 11, above 1% beyond 10 — bake/sphere/zonal.h);
   // exponent 4: order 5. No diffuse lobe, so no band-1 radiance and no diffuse transfer.
   const fs::path d = dir_for("glossy");
   write_meshes(d);

@@ -6,8 +6,8 @@
 // box hides part of the light; the SH's constant term is the visible solid angle over 2√π. The
 // same scene gives the same bytes with 1 and 2 threads, the scene without its light writes
 // nothing of lights and the same values for every other dataset, and prtdump shows the light.
-#include <bake/lights.h>
-#include <bake/visible_region.h>
+#include <bake/lights/lights.h>
+#include <bake/visibility/visible_region.h>
 #include <formats/asset.h>
 
 #include <gtest/gtest.h>

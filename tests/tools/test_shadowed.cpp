@@ -1,4 +1,4 @@
-// The shadowed radiance S (paper 001 §4 "material editing"; bake/products.h, /radiance/shadowed in
+// The shadowed radiance S (paper 001 §4 "material editing"; bake/integrators/products.h, /radiance/shadowed in
 // formats/SCHEMA.md) through the tools: prtbake vertex --shadowed L writes it with band 1 equal to
 // /radiance/band1, refuses it without an environment; a sharded bake with it has the bytes of the
 // single-process one; a scene's glossy receiver under the environment gets it at the Phong order

@@ -1,8 +1,8 @@
 // What every tool shares (tools/common): run_tool's mapping from what a tool throws to one stderr
 // line and an exit code (tool_main.h), the Ctrl-C token, the non-terminal progress lines
 // (progress_bar.h), and the command-line checks and suggestions (cli.h).
-#include <bake/error.h>
-#include <bake/progress.h>
+#include <bake/core/error.h>
+#include <bake/core/progress.h>
 #include <formats/prtfile.h>
 #include <cli.h>
 #include <progress_bar.h>

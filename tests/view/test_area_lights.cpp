@@ -7,8 +7,8 @@
 #include <view/camera.h>
 #include <view/raster.h>
 
-#include <bake/lights.h>
-#include <bake/mesh.h>
+#include <bake/lights/lights.h>
+#include <bake/mesh/mesh.h>
 
 #include <prtshade/ltc.h>
 

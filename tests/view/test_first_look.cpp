@@ -5,8 +5,8 @@
 #include <view/exposure.h>
 #include <view/image.h>
 
-#include <bake/envmap.h>
-#include <bake/irradiance.h>
+#include <bake/environment/envmap.h>
+#include <bake/environment/irradiance.h>
 
 #include <gtest/gtest.h>
 

@@ -1,19 +1,19 @@
 // view/: PNG files (libpng's output decoded by Python's zlib, an independent inflater, and read
 // back through libpng), tone mapping and NRMSE, the camera's text form, rasterizer coverage and
 // perspective-correct interpolation against closed forms, the unshadowed irradiance the reference
-// uses (bake/irradiance.h) against the DifMap and the flat texel sum, and the reference renderer
+// uses (bake/environment/irradiance.h) against the DifMap and the flat texel sum, and the reference renderer
 // against π·L and Lambert's form factor.
 #include <view/camera.h>
 #include <view/image.h>
 #include <view/raster.h>
 #include <view/reference.h>
 
-#include <bake/envmap.h>
-#include <bake/error.h>
-#include <bake/fiv.h>
-#include <bake/irradiance.h>
-#include <bake/mesh.h>
-#include <bake/sampling.h>
+#include <bake/environment/envmap.h>
+#include <bake/core/error.h>
+#include <bake/bake/fiv.h>
+#include <bake/environment/irradiance.h>
+#include <bake/mesh/mesh.h>
+#include <bake/sphere/sampling.h>
 
 #include <test_scenes.h>
 

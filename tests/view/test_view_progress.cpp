@@ -1,11 +1,11 @@
-// The reference renderer's progress and cancellation (view/reference.h, bake/progress.h): the same
+// The reference renderer's progress and cancellation (view/reference.h, bake/core/progress.h): the same
 // contract as libbake's bakes, and a watched render gives the same image.
 #include <view/camera.h>
 #include <view/reference.h>
 
-#include <bake/envmap.h>
-#include <bake/mesh.h>
-#include <bake/progress.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
+#include <bake/core/progress.h>
 
 #include <gtest/gtest.h>
 #include <progress_recorder.h>

@@ -1,4 +1,4 @@
-// tools/common/progress_bar.h — the tools' side of libbake's progress callbacks (bake/progress.h):
+// tools/common/progress_bar.h — the tools' side of libbake's progress callbacks (bake/core/progress.h):
 // draws what the library reports. libbake itself never writes to the terminal.
 //
 //   Bar:   on a terminal, one self-overwriting line on stderr:
@@ -12,7 +12,7 @@
 //   Quiet: nothing (--quiet).
 #pragma once
 
-#include <bake/progress.h>
+#include <bake/core/progress.h>
 
 #include <string>
 

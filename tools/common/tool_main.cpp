@@ -1,6 +1,6 @@
 #include "tool_main.h"
 
-#include <bake/error.h>
+#include <bake/core/error.h>
 #include <formats/prtfile.h>
 
 #include <csignal>

@@ -13,7 +13,7 @@
 //        to resume)
 #pragma once
 
-#include <bake/progress.h>
+#include <bake/core/progress.h>
 
 #include <stdexcept>
 #include <string>

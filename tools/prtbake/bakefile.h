@@ -4,11 +4,11 @@
 // attributes whichever command baked it (docs/ARCHITECTURE.md §4).
 #pragma once
 
-#include <bake/envmap.h>
-#include <bake/fiv.h>
-#include <bake/lights.h>
-#include <bake/mesh.h>
-#include <bake/vertex_bake.h>
+#include <bake/environment/envmap.h>
+#include <bake/bake/fiv.h>
+#include <bake/lights/lights.h>
+#include <bake/mesh/mesh.h>
+#include <bake/bake/vertex_bake.h>
 #include <formats/asset.h>
 
 #include <string>
@@ -35,7 +35,7 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
 // An area light as the file stores it (/lights/<name>: world-space faces, radiance, two_sided).
 F::Light light_of(const bake::AreaLight& light);
 // area_lights/irradiance [V][lights] and, when sh_order > 0, area_lights/sh [V][lights][n²] from
-// AreaLightIntegrator rows ([V][lights][1 + n²], bake/area_bake.h); `lights` in column order.
+// AreaLightIntegrator rows ([V][lights][1 + n²], bake/lights/area_bake.h); `lights` in column order.
 void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
                      int sh_order);
 
@@ -45,7 +45,7 @@ void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const s
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible);
 
 // Records the target error the bake was asked to reach (/report's target_error; SCHEMA.md) when
-// it had one: `target` > 0 (bake/choose.h; the default target counts), else nothing.
+// it had one: `target` > 0 (bake/bake/choose.h; the default target counts), else nothing.
 void set_target_error(F::Asset& asset, double target);
 
 // F_env and the irradiance cube (DifMap) of the asset, from the environment `env` (its SHA-256).

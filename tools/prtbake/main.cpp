@@ -1,15 +1,15 @@
 // prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments (CLI11:
 // one subcommand per kind of bake, each with only the options that apply to it, into the typed
 // specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
-#include <bake/choose.h>
-#include <bake/envmap.h>
-#include <bake/error.h>
-#include <bake/fiv.h>
-#include <bake/irradiance.h>
-#include <bake/mesh.h>
-#include <bake/sha256.h>
-#include <bake/scene.h>
-#include <bake/vertex_bake.h>
+#include <bake/bake/choose.h>
+#include <bake/environment/envmap.h>
+#include <bake/core/error.h>
+#include <bake/bake/fiv.h>
+#include <bake/environment/irradiance.h>
+#include <bake/mesh/mesh.h>
+#include <bake/core/sha256.h>
+#include <bake/bake/scene.h>
+#include <bake/bake/vertex_bake.h>
 #include <formats/asset.h>
 #include <prtshade/sh.h>
 
@@ -138,7 +138,7 @@ struct Args {
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;
   bool verbose = false;  // vertex: the pilot's whole table, not its one-line summary
   bool flip_normals = false;  // vertex: reverse every triangle and file normal
-  double target_error = 0;    // vertex: --target-error E (0: not given; bake/choose.h)
+  double target_error = 0;    // vertex: --target-error E (0: not given; bake/bake/choose.h)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
   tool::ExportArgs exported;  // export: a baked file in another format (export.h)
@@ -551,7 +551,7 @@ const char* flip_fix(bool flipped) {
   return flipped ? "rerun without --flip-normals (this run flipped the mesh)" : "rerun with --flip-normals";
 }
 
-// Closed components wound inwards (bake/mesh.h winding_facts): their vertices will see no sky.
+// Closed components wound inwards (bake/mesh/mesh.h winding_facts): their vertices will see no sky.
 // `object`: a scene's object ("" for prtbake vertex, whose --flip-normals can fix a whole mesh).
 // `casts`: the mesh shadows itself (a vertex bake, a scene's "both"), so those vertices see no sky;
 // a receiver-only object casts nothing and is shaded about normals that point inside.
@@ -572,7 +572,7 @@ void warn_inward(const bake::WindingFacts& facts, bool flipped, const std::strin
                casts ? "see no sky" : "are shaded as if seen from inside", fix.c_str());
 }
 
-// More than half the vertices saw no sky at all (bake/vertex_bake.h count_no_sky). Which
+// More than half the vertices saw no sky at all (bake/bake/vertex_bake.h count_no_sky). Which
 // explanation fits: closed parts wound inwards (said above), or else the flip probe — with their
 // normals reversed, would these vertices see sky (normals pointing inside: flip them) or not
 // (vertices enclosed by other geometry: an engine's internals under its housing, parts pushed
@@ -597,7 +597,7 @@ void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts,
 }
 
 // A target the chooser could not reach within its bounds: it baked the best plan it had
-// (bake/choose.h, step 5); say so on stderr, with the options that go further.
+// (bake/bake/choose.h, step 5); say so on stderr, with the options that go further.
 void warn_unreached(const bake::IntegratorChoice& choice, const std::string& object) {
   if (choice.reaches) return;
   std::fprintf(stderr,
@@ -607,7 +607,7 @@ void warn_unreached(const bake::IntegratorChoice& choice, const std::string& obj
                choice.spec.samples(), choice.expected_error, choice.further.c_str());
 }
 
-// The error report's reference for a target (bake/choose.h plan_report_reference), with -v.
+// The error report's reference for a target (bake/bake/choose.h plan_report_reference), with -v.
 void print_reference_plan(const bake::ReferencePlan& plan) {
   std::printf("report reference: QMC at %u rays per point on %zu points (probe at %u rays, %.2f s); expected noise",
               plan.rays, plan.points, bake::ReferencePlan::kReportProbeRays, plan.probe_seconds);
@@ -673,7 +673,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
                 a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
                 mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
                 a.flip_normals ? ", flipped" : "");
-  if (say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh.h, ORIGIN)
+  if (say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh/mesh.h, ORIGIN)
     std::printf("mesh: baked relative to its origin (%.17g, %.17g, %.17g); /mesh/positions holds world coordinates\n",
                 mesh.origin.x(), mesh.origin.y(), mesh.origin.z());
   const bake::WindingFacts winding = bake::winding_facts(mesh, topo);
@@ -720,7 +720,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
   }
   // Bake, write, check; when the check finds a product NOT met (the pilot's sample missed where the
   // error sits), bake once more at the knob the measured error and the model's rate call for
-  // (bake/choose.h corrected_plan), and check again.
+  // (bake/bake/choose.h corrected_plan), and check again.
   for (int pass = 0;; ++pass) {
     const auto setup_start = std::chrono::steady_clock::now();
     const std::unique_ptr<bake::Integrator> integrator_ptr =

@@ -5,8 +5,8 @@
 #include "progress_bar.h"
 #include "tool_main.h"
 
-#include <bake/error.h>
-#include <bake/sha256.h>
+#include <bake/core/error.h>
+#include <bake/core/sha256.h>
 
 #include <tbb/global_control.h>
 

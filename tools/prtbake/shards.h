@@ -12,13 +12,13 @@
 //   prtbake ... --merge         verifies every chunk and writes the file (a dependent job).
 //   prtbake ... --resume        one process: its chunks, then the merge.
 // Chunks live in OUT.chunks/ (--chunks DIR), are removed after a successful merge, and are reused
-// by a rerun of the same command (bake/chunks.h: checksummed, tagged with the bake's manifest).
+// by a rerun of the same command (bake/core/chunks.h: checksummed, tagged with the bake's manifest).
 // Static claiming gives worker i the chunks i, i + N, ...; dynamic claiming lets each worker take
-// the next unclaimed chunk (claim files of this run, bake/chunks.h). A run is one launch: mpirun
+// the next unclaimed chunk (claim files of this run, bake/core/chunks.h). A run is one launch: mpirun
 // (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
 // another run are stale by definition, so a rerun recomputes what a dead run claimed.
 // FIV bakes: row set 0 is the DifMap's texels, row set 1 the environment FIV (one row), row set
-// 2 + k shell k's samples, each cut into slabs of rows. Where the shells stop depends on the shells themselves (bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
+// 2 + k shell k's samples, each cut into slabs of rows. Where the shells stop depends on the shells themselves (bake/bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
 // after shell without waiting for each other and read the stopping rule from committed chunks:
 // once a complete shell meets it, no worker starts a chunk beyond it. A worker ahead of the
 // others may compute chunks past the last shell while that shell is not complete (about one
@@ -28,9 +28,9 @@
 // one wall time of many workers, and a target error's choice must be the same on every worker.
 #pragma once
 
-#include <bake/chunks.h>
-#include <bake/progress.h>
-#include <bake/vertex_bake.h>
+#include <bake/core/chunks.h>
+#include <bake/core/progress.h>
+#include <bake/bake/vertex_bake.h>
 
 #include <CLI/CLI.hpp>
 

@@ -4,7 +4,7 @@
 
 #include <view/raster.h>
 
-#include <bake/error.h>
+#include <bake/core/error.h>
 #include <formats/names.h>
 #include <formats/prtfile.h>
 

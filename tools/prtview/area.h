@@ -19,7 +19,7 @@
 #include <view/camera.h>
 #include <view/image.h>
 
-#include <bake/lights.h>
+#include <bake/lights/lights.h>
 #include <formats/asset.h>
 
 #include <string>

@@ -16,9 +16,9 @@
 #include <view/reference.h>
 #include <view/text.h>
 
-#include <bake/envmap.h>
-#include <bake/error.h>
-#include <bake/sha256.h>
+#include <bake/environment/envmap.h>
+#include <bake/core/error.h>
+#include <bake/core/sha256.h>
 #include <formats/asset.h>
 
 #include <CLI/CLI.hpp>
@@ -68,7 +68,7 @@ WHAT IS DRAWN
                 /radiance/band1, or the band-1 coefficients of /radiance/shadowed (the same
                 integrals) when the file holds only that.
       ao        AO x E_unocc(n)/pi at each vertex, E_unocc the environment's unshadowed
-                irradiance at the baked normal (bake/irradiance.h): the ambient-occlusion
+                irradiance at the baked normal (bake/environment/irradiance.h): the ambient-occlusion
                 approximation. Without --env: a constant white sky (L = 1), so the picture IS
                 the AO (1 = white, 0 = black) and the reference is the true AO of each pixel.
     The first look (no --shade) shows the best the file holds: band1, else transfer, else ao
@@ -100,7 +100,7 @@ WHAT IS DRAWN
     The environment must be the one of /scene (checked by SHA-256); default: its 'environment'.
     --shade, --instance, --occluder(-mesh), --ground(-size), --no-overlap/--no-partial do not
     apply. The reference renders the same objects: "occluder" and "both" objects cast shadows,
-    "receiver" objects do not (not even on themselves: the scene semantics, bake/scene.h), and a
+    "receiver" objects do not (not even on themselves: the scene semantics, bake/bake/scene.h), and a
     pixel shows albedo x E/pi.
 
   glossy objects of scene files (--shade glossy; objects with a phong_exponent, whose
@@ -130,7 +130,7 @@ WHAT IS DRAWN
     (Embree; 8 replicates give the standard error) over the same pixels and casters.
 
   --reference renders the same view by ray tracing (Embree): a primary ray per pixel centre, then
-  E = (exact unshadowed irradiance, the function the DifMap samples: bake/irradiance.h) - (QMC
+  E = (exact unshadowed irradiance, the function the DifMap samples: bake/environment/irradiance.h) - (QMC
   estimate of the light the scene blocks), with --samples shadow rays per pixel and a per-pixel standard error.
   That is the standard rendering equation with visibility, the paper's "brute force" reference.
 

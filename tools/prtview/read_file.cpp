@@ -1,8 +1,8 @@
 // prtview/read_file.cpp — what prtview takes from a baked file's asset (read_file.h).
 #include "read_file.h"
 
-#include <bake/error.h>
-#include <bake/sha256.h>
+#include <bake/core/error.h>
+#include <bake/core/sha256.h>
 #include <formats/names.h>
 
 #include <algorithm>

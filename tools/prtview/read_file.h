@@ -7,8 +7,8 @@
 // prtshade views point into the Asset, which must outlive them.
 #pragma once
 
-#include <bake/envmap.h>
-#include <bake/mesh.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 #include <prtshade/fiv.h>
 

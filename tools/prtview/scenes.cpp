@@ -5,9 +5,9 @@
 
 #include <view/raster.h>
 
-#include <bake/error.h>
-#include <bake/fiv.h>
-#include <bake/irradiance.h>
+#include <bake/core/error.h>
+#include <bake/bake/fiv.h>
+#include <bake/environment/irradiance.h>
 #include <prtshade/fiv.h>
 #include <formats/names.h>
 #include <prtshade/glossy.h>

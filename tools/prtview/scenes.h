@@ -8,8 +8,8 @@
 #include <view/image.h>
 #include <view/reference.h>
 
-#include <bake/envmap.h>
-#include <bake/mesh.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 
 #include <Eigen/Core>

@@ -1,7 +1,7 @@
 // camera.cpp — the pinhole camera and its text form (view/camera.h).
 #include <view/camera.h>
 
-#include <bake/error.h>
+#include <bake/core/error.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -1,8 +1,8 @@
 // exposure.cpp — the fixed exposure of prtview's pictures (view/exposure.h).
 #include <view/exposure.h>
 
-#include <bake/error.h>
-#include <bake/irradiance.h>
+#include <bake/core/error.h>
+#include <bake/environment/irradiance.h>
 
 #include <Eigen/Geometry>
 #include <tbb/parallel_for.h>

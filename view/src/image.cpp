@@ -1,6 +1,6 @@
 // image.cpp — PNG (libpng), float EXR (OpenEXR), tone map, false colour, NRMSE.
 // Conventions and formulas: view/image.h.
-#include <bake/error.h>
+#include <bake/core/error.h>
 #include <view/image.h>
 
 #include <IexBaseExc.h>

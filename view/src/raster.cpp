@@ -2,7 +2,7 @@
 // (view/raster.h: conventions and coverage rules).
 #include <view/raster.h>
 
-#include <bake/error.h>
+#include <bake/core/error.h>
 
 #include <tbb/parallel_for.h>
 

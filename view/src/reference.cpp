@@ -2,10 +2,10 @@
 // estimators and conventions).
 #include <view/reference.h>
 
-#include <bake/error.h>
-#include <bake/raycast.h>
-#include <bake/sampling.h>
-#include <bake/sha256.h>
+#include <bake/core/error.h>
+#include <bake/visibility/raycast.h>
+#include <bake/sphere/sampling.h>
+#include <bake/core/sha256.h>
 
 #include <IexBaseExc.h>
 #include <ImfChannelList.h>
@@ -65,7 +65,7 @@ void replicate_mean(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& 
 
 } // namespace
 
-// The ray queries of the reference: libbake's RayCaster (bake/raycast.h) over the rendered mesh for
+// The ray queries of the reference: libbake's RayCaster (bake/visibility/raycast.h) over the rendered mesh for
 // primary rays, and over the shadow-casting triangles only when some triangles cast no shadow.
 struct ReferenceRenderer::Rays {
   Topology topology;
@@ -87,7 +87,7 @@ struct ReferenceRenderer::Rays {
   }
   const RayCaster& shadow_caster() const { return casters ? *casters : every_triangle; }
   // A shading point's shadow rays start at o itself (a free point, welded = -1); the triangles
-  // near o are found once per point, not once per ray (bake/raycast.h NearTriangles).
+  // near o are found once per point, not once per ray (bake/visibility/raycast.h NearTriangles).
   bake::NearTriangles near(const Vector3d& o) const {
     ShadePoint sp;
     sp.p = o;

@@ -1,7 +1,7 @@
 // text.cpp — the bitmap font and the labelled row of panels (view/text.h).
 #include <view/text.h>
 
-#include <bake/error.h>
+#include <bake/core/error.h>
 
 #include <algorithm>
 #include <cstring>

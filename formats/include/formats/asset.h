@@ -218,7 +218,7 @@ struct Asset {
   std::optional<IrradianceCube> irradiance_cube;
   std::vector<Occluder> occluders;  // read back sorted by name
   std::vector<Light> lights;        // read back sorted by name (the products name their order)
-  // /report's target_error: the RMSE the bake was asked to reach (bake/choose.h; the default
+  // /report's target_error: the RMSE the bake was asked to reach (bake/bake/choose.h; the default
   // target when neither samples nor a target was given), when it had one. Optional: older files
   // have none.
   std::optional<double> target_error;
@@ -239,7 +239,7 @@ struct Asset {
 // Object names, one spelling for people. The name people read for a scene object is its glTF
 // node path when it has one ("node0/node13/node71"), else its name. The file stores a glTF
 // object under the node path with '/' written as '|' ("/objects/node0|node13|node71": an HDF5
-// link name cannot hold '/'; bake/mesh.h NAMES keeps '|' out of node paths, so the two are one to
+// link name cannot hold '/'; bake/mesh/mesh.h NAMES keeps '|' out of node paths, so the two are one to
 // one). Tools print the label and accept either spelling (Asset::find_object_by_label).
 std::string object_label(std::string_view stored_name, const std::optional<std::string>& node_path);
 inline std::string object_label(const SceneObject& object) { return object_label(object.name, object.node_path); }

@@ -4,7 +4,7 @@
 // lookup of an occluder's baked FIV shells, the three occluder cases A/B/C with the partial-
 // occluder factor, the overlap correction for several occluders (eq. 13–14) and self-shadows
 // (eq. 12). This header is the contract shared with the C API and the GLSL mirrors
-// (docs/ARCHITECTURE.md §2); the baked data and its conventions are libbake/include/bake/fiv.h
+// (docs/ARCHITECTURE.md §2); the baked data and its conventions are libbake/bake/include/bake/bake/fiv.h
 // and formats/SCHEMA.md.
 //
 // Quantities (per RGB channel c; an FIV is [RGB][xyz] = 9 floats, row-major):
@@ -15,7 +15,7 @@
 //   E(p, n) = E_tot(n) − Σ_i I_i,   I_i = n · F_i(p − centre_i)   (case A, eq. 10),
 // an unshadowed irradiance minus what each occluder hides. Units: radiance × steradian, like E.
 //
-// Shell grid (bake/fiv.h): sample (k, i, j) sits at centre + ρ_k d(θ_i, φ_j) with
+// Shell grid (bake/bake/fiv.h): sample (k, i, j) sits at centre + ρ_k d(θ_i, φ_j) with
 //   θ_i = π i / (Nθ − 1) from +Y (poles included), φ_j = 2π j / Nφ from +Z towards +X,
 //   d(θ, φ) = (sin θ sin φ, cos θ, sin θ cos φ), radii ρ_k increasing;
 //   shells [Nρ][Nθ][Nφ][RGB][xyz], valid [Nρ][Nθ][Nφ] (0 = inside closed geometry).

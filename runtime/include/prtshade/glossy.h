@@ -12,7 +12,7 @@
 // returns 1 where the lobe stays above the horizon); the caller multiplies by its specular colour.
 // (No cosine factor: the classic PRT glossy lobe — Sloan, Kautz, Snyder 2002 §6; Ramamoorthi &
 // Hanrahan 2002 §3 — and paper 001 §4 "glossy": the order is chosen from the lobe's SH energy,
-// bake/zonal.h.)
+// bake/sphere/zonal.h.)
 //
 // Both routes end the same way. With S_i = ∫ L V H y_i dω (per RGB channel) the shadowed incident
 // radiance's SH, the Funk–Hecke theorem turns the lobe into a per-band scale:
@@ -20,7 +20,7 @@
 //   I_l(s) = ∫_0^1 t^s P_l(t) dt   (I_0 = 1/(s+1), I_1 = 1/(s+2), I_{l+2} = I_l (s−l)/(s+l+3):
 //   Gradshteyn & Ryzhik 7.126.2; the ratio of two Gamma closed forms, exact, no cancellation).
 // The truncation to L bands is the only approximation of the last step: exact for a lobe
-// band-limited to L, and the energy beyond is bake/zonal.h's clamped_power_energy_beyond.
+// band-limited to L, and the energy beyond is bake/sphere/zonal.h's clamped_power_energy_beyond.
 //   route A (relightable): S = P_L(L · U), the SH triple product of the lighting L and the baked
 //     visibility transfer U_i = ∫ V H y_i dω (/transfer/visibility), both at order L:
 //       S_k = Σ_ij Γ_ijk L_i U_j,   Γ_ijk = ∫ y_i y_j y_k dω   (the real Gaunt coefficients),
@@ -51,7 +51,7 @@ namespace prt::shade {
 
 inline constexpr int kMaxGlossyOrder = 16;  // bands of the triple product (256 coefficients)
 // Bands of route B (no triple product: any order of the SH basis, prtshade/sh.h kMaxOrder). A
-// Phong exponent of 128 wants ~25 bands at 1% of the lobe's energy (bake/zonal.h).
+// Phong exponent of 128 wants ~25 bands at 1% of the lobe's energy (bake/sphere/zonal.h).
 inline constexpr int kMaxShadowedOrder = 64;
 
 // I_l(s) = ∫_0^1 t^s P_l(t) dt for l = 0 … order−1 (out[order]); s ≥ 0 finite. Throws

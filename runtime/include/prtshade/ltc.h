@@ -31,7 +31,7 @@
 // |A·∫_P D_M − A_true·∫_P D̂| ≤ |A − A_true| + A_true·TV (and B ≤ A, B → 0 at normal incidence).
 //
 // Horizon clipping of a region given by boundary arcs (a 1-chain, not necessarily chained into
-// loops, as bake/visible_region.h makes them): every arc is clipped to z ≥ 0 (each endpoint
+// loops, as bake/visibility/visible_region.h makes them): every arc is clipped to z ≥ 0 (each endpoint
 // classified by the sign of its z, so an endpoint shared by two arcs is classified once), and the
 // clipped region's boundary along the horizon is the horizon weighted by the region's winding
 // number w(φ) there: z·Φ(P ∩ H) = ½ Σ_arcs θ u_z + ½ ∫_0^{2π} w(φ) dφ. w changes by +1 where an
@@ -42,7 +42,7 @@
 // region already lies above it and nothing is clipped: the result is then exactly Lambert's
 // n·Φ(P)/π.
 //
-// Preconditions: unit n and v; arcs as bake/spherical_polygon.h Arc (shorter than π, non-zero
+// Preconditions: unit n and v; arcs as bake/sphere/spherical_polygon.h Arc (shorter than π, non-zero
 // finite endpoints, any lengths, the region on their left, positively oriented), all above n's
 // horizon (n·ω ≥ 0, as OccluderMesh::visible_light returns them). Thread-safe, no allocation.
 #pragma once

@@ -1,5 +1,5 @@
 // prtshade/quadrature.h — Gauss–Legendre quadrature: the one rule prtshade (the Gaunt table of
-// prtshade/glossy.h) and libbake (the exact per-cell integrals of bake/filter.h) integrate
+// prtshade/glossy.h) and libbake (the exact per-cell integrals of bake/integrators/filter.h) integrate
 // polynomials with. docs/ARCHITECTURE.md §2 ("Layers": the runtime is the bottom layer).
 //
 // gauss_legendre(n, a, b, x, w): the n-point rule on [a, b], exact for polynomials of degree

@@ -9,7 +9,7 @@
 // (rotate the lighting, not the transfer).
 //
 // Lat-long pixels (project_latlong) follow OpenEXR's Imf::LatLongMap exactly as libbake's EnvMap
-// (libbake/include/bake/envmap.h) does, +Y up (map space == scene space; a Z-up scene converts
+// (libbake/environment/include/bake/environment/envmap.h) does, +Y up (map space == scene space; a Z-up scene converts
 // its directions itself). For a W × H image, integer pixel positions are texel CENTRES:
 //   latitude(py) = π/2 − π·py/(H−1),  longitude(px) = π − 2π·px/(W−1),
 //   direction    = (sin lon · cos lat, sin lat, cos lon · cos lat),

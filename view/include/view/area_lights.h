@@ -8,12 +8,12 @@
 // normal turned to the side of n; ε = 1e-5 × the mesh's diagonal + 1e-6 × its largest coordinate,
 // as the environment reference, view/reference.h), with n the interpolated shading normal, so
 // that both methods see the same point and neither meets its own triangle.
-//   * Analytic (render_area_analytic): E_l from bake/area_bake.h at p' (the light's spherical
+//   * Analytic (render_area_analytic): E_l from bake/lights/area_bake.h at p' (the light's spherical
 //     polygon minus every triangle's image, clipped to n's horizon, Lambert's closed form): exact,
-//     no noise. Cost grows with the triangles between the point and the light (bake/occluder_mesh.h).
+//     no noise. Cost grows with the triangles between the point and the light (bake/visibility/occluder_mesh.h).
 //   * Reference (render_area_reference): light sampling with shadow rays. Per pixel and light, N
 //     points y uniform over the light's area A (a face by its area, then a uniform point of a
-//     triangle of its fan, from a randomised 3D Halton point: bake/sampling.h RotatedHalton3 keyed by
+//     triangle of its fan, from a randomised 3D Halton point: bake/sphere/sampling.h RotatedHalton3 keyed by
 //     (seed, pixel, light, replicate)), each contributing
 //       A · max(n·ω, 0) · c_l / r² · [segment p'→y unblocked],  ω = (y − p')/r, r = |y − p'|,
 //     with c_l = −n_f·ω on a face's emitting side (|n_f·ω| for two-sided lights) and 0 behind it:
@@ -23,8 +23,8 @@
 // exchange between the two; prtshade/ltc.h's BRDF: height-correlated Smith masking, Schlick's
 // Fresnel with per-channel F0, roughness α), with v = (eye − p')/|eye − p'| and n as above:
 //   L_o(p) += Σ_l radiance_l · ∫_{visible part of light l} f(v, ω) max(n·ω, 0) dω.
-//   * Analytic: each light face's visible arcs (bake/occluder_mesh.h OccluderMesh::visible_light,
-//     the faces and emitting sides decided as bake/area_bake.h does) integrated through the
+//   * Analytic: each light face's visible arcs (bake/visibility/occluder_mesh.h OccluderMesh::visible_light,
+//     the faces and emitting sides decided as bake/lights/area_bake.h does) integrated through the
 //     linearly transformed cosines of prtshade/ltc.h: (F0·A + (1 − F0)·B) · ∫ D_M; E from the same
 //     arcs. Not exact: within prtshade::ltc::error_bound per light (the fit's measured bound).
 //   * Reference: the same light samples also weigh f(v, ω) (an unbiased estimate of the integral).
@@ -35,8 +35,8 @@
 #include <view/image.h>
 #include <view/raster.h>
 
-#include <bake/lights.h>
-#include <bake/mesh.h>
+#include <bake/lights/lights.h>
+#include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
 

@@ -6,7 +6,7 @@
 // ENVIRONMENT EXPOSURE (environment_exposure). The pictures show E/π of a white diffuse surface
 // (view/image.h). The brightest such surface nothing shadows faces the brightest part of the
 // sky: B = max over unit normals n of Y(E_unocc(n)) / π, with E_unocc the exact unshadowed
-// irradiance (bake/irradiance.h) and Y the Rec. 709 luminance 0.2126 R + 0.7152 G + 0.0722 B
+// irradiance (bake/environment/irradiance.h) and Y the Rec. 709 luminance 0.2126 R + 0.7152 G + 0.0722 B
 // (as view/image.h auto_exposure). The exposure is 1 / B rounded to 4 significant digits (the
 // printed number is the one used): an unshadowed white surface turned to the light is white,
 // everything shadowed or turned away is darker, nothing diffuse and white clips. A constant sky
@@ -19,7 +19,7 @@
 // environment gives the same bits.
 #pragma once
 
-#include <bake/envmap.h>
+#include <bake/environment/envmap.h>
 
 #include <Eigen/Core>
 

@@ -30,7 +30,7 @@
 #include <view/camera.h>
 #include <view/image.h>
 
-#include <bake/mesh.h>
+#include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
 #include <array>

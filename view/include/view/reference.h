@@ -10,10 +10,10 @@
 // white Lambertian surface, E / π, with the irradiance
 //   E(p, n) = ∫ L(ω) V(p, ω) H(ω, n) (n · ω) dω     (docs/ARCHITECTURE.md §3; paper 004 eq. 2)
 // computed as E = E_unocc(n) − ∫ L (1 − V) H (n · ω) dω:
-//   * E_unocc(n) = E_tot(n) of bake/irradiance.h (UnshadowedIrradiance: the same function the
+//   * E_unocc(n) = E_tot(n) of bake/environment/irradiance.h (UnshadowedIrradiance: the same function the
 //     DifMap of FIV files samples), a deterministic sum over every environment texel: no noise
 //     where nothing occludes;
-//   * the occluded part by randomised QMC (bake/sampling.h: a 3D Halton sequence with a
+//   * the occluded part by randomised QMC (bake/sphere/sampling.h: a 3D Halton sequence with a
 //     Cranley–Patterson rotation keyed by (seed, pixel index, replicate) — identical bytes for any
 //     thread count), as 8 independent replicates of samples/8 points each: the estimate is their
 //     mean and its standard error the spread of the 8 means / √8 (the honest RQMC error; the iid
@@ -37,10 +37,10 @@
 #include <view/image.h>
 #include <view/raster.h>
 
-#include <bake/envmap.h>
-#include <bake/irradiance.h>
-#include <bake/mesh.h>
-#include <bake/progress.h>
+#include <bake/environment/envmap.h>
+#include <bake/environment/irradiance.h>
+#include <bake/mesh/mesh.h>
+#include <bake/core/progress.h>
 
 #include <Eigen/Core>
 #include <array>
@@ -63,7 +63,7 @@ struct ReferenceOptions {
   uint32_t samples = 1024;  // QMC shadow rays per pixel (occluded part); a multiple of 8 (8 replicates)
   uint64_t seed = 1;
   std::vector<Sphere> occluder_spheres;
-  // Scenes of several objects (prtview on scene files, roles of bake/scene.h), one entry per
+  // Scenes of several objects (prtview on scene files, roles of bake/bake/scene.h), one entry per
   // triangle of the rendered mesh; empty vectors keep the single-object behaviour above.
   //   casts_shadow[t] == 0: triangle t is seen by primary rays but never blocks a shadow ray (an
   //     object with role "receiver" casts no shadow, not even on itself). When no triangle casts,
@@ -121,7 +121,7 @@ public:
 private:
   // irradiance() with the unshadowed part E_unocc(f.n) already known.
   void irradiance(const Fragment& f, uint64_t index, const bake::Rgb& unocc, double E[3], double std_error[3]) const;
-  struct Rays;  // bake/raycast.h RayCaster over the mesh
+  struct Rays;  // bake/visibility/raycast.h RayCaster over the mesh
   const bake::Mesh& mesh_;
   const bake::EnvMap& env_;
   ReferenceOptions options_;

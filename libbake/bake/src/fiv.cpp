@@ -1,0 +1,327 @@
+#include <bake/core/error.h>
+#include <bake/bake/fiv.h>
+#include <bake/environment/irradiance.h>
+#include <bake/integrators/qmc.h>
+#include <bake/sphere/sampling.h>
+#include <bake/bake/vertex_bake.h>
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+namespace prt::bake {
+
+using Eigen::Vector3d;
+
+namespace {
+// y_{1,-1} = −k y, y_{1,0} = k z, y_{1,1} = −k x with k = √(3/4π): ω from band-1 rows [c][m].
+constexpr double kBand1 = 0.48860251190291992159;  // √(3 / 4π)
+void omega_from_band1(const double* r, double* f) {
+  for (int c = 0; c < 3; ++c) {
+    f[3 * c + 0] = -r[3 * c + 2] / kBand1;
+    f[3 * c + 1] = -r[3 * c + 0] / kBand1;
+    f[3 * c + 2] = r[3 * c + 1] / kBand1;
+  }
+}
+} // namespace
+
+Fiv environment_fiv(const EnvMap& env) {
+  Fiv f{};
+  if (env.texel_count() == 0) return f;  // constant(): ∫ ω dω = 0
+  const auto m = texel_moments(env);
+  for (int t = 0; t < env.texel_count(); ++t) {
+    const Rgb L = env.texel_value(t);
+    const double c[3] = {L.r, L.g, L.b};
+    for (int ch = 0; ch < 3; ++ch)
+      for (int a = 0; a < 3; ++a) f[size_t(3 * ch + a)] += c[ch] * m[size_t(t)][a];
+  }
+  return f;
+}
+
+Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size) {
+  const double s = 2 * (column + 0.5) / size - 1, t = 2 * (row + 0.5) / size - 1;
+  Vector3d d;
+  switch (face) {
+    case 0: d = {1, -t, -s}; break;
+    case 1: d = {-1, -t, s}; break;
+    case 2: d = {s, 1, t}; break;
+    case 3: d = {s, -1, -t}; break;
+    case 4: d = {s, -t, 1}; break;
+    default: d = {-s, -t, -1}; break;
+  }
+  return d.normalized();
+}
+
+namespace {
+// Texels [begin, end) of the DifMap [6][S][S][3]: E(n) at each cube texel direction, as float.
+template <class Irradiance>
+std::vector<float> cube_of(int size, const Irradiance& E, size_t begin, size_t end) {
+  PRT_CHECK(size >= 1 && begin <= end && end <= size_t(6) * size_t(size) * size_t(size));
+  std::vector<float> out((end - begin) * 3, 0.0f);
+  tbb::parallel_for(begin, end, [&](size_t t) {
+    const int idx = int(t);
+    const Rgb e = E(gl_cube_direction(idx / (size * size), (idx / size) % size, idx % size, size));
+    out[(t - begin) * 3] = float(e.r);
+    out[(t - begin) * 3 + 1] = float(e.g);
+    out[(t - begin) * 3 + 2] = float(e.b);
+  });
+  return out;
+}
+size_t cube_texels(int size) { return size_t(6) * size_t(size) * size_t(size); }
+} // namespace
+
+std::vector<float> irradiance_cube(const EnvMap& env, int size) {
+  PRT_CHECK(size >= 1);
+  const UnshadowedIrradiance E(env);
+  return cube_of(size, E, 0, cube_texels(size));
+}
+
+std::vector<float> irradiance_cube_texels(const UnshadowedIrradiance& irradiance, int size, size_t begin, size_t end) {
+  return cube_of(size, irradiance, begin, end);
+}
+
+std::vector<float> irradiance_cube_reference(const EnvMap& env, int size) {
+  PRT_CHECK(size >= 1 && env.texel_count() > 0);
+  const UnshadowedIrradiance E(env);
+  return cube_of(size, [&](const Vector3d& n) { return E.reference(n); }, 0, cube_texels(size));
+}
+
+Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {
+  const double th = std::numbers::pi * i_theta / std::max(n_theta - 1, 1), ph = 2 * std::numbers::pi * j_phi / n_phi;
+  return {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+}
+
+void bounding_sphere(const Mesh& mesh, Vector3d& centre, double& radius) {
+  PRT_CHECK(!mesh.positions.empty());
+  Vector3d lo = mesh.positions[0].cast<double>(), hi = lo;
+  for (const auto& p : mesh.positions) {
+    lo = lo.cwiseMin(p.cast<double>());
+    hi = hi.cwiseMax(p.cast<double>());
+  }
+  centre = 0.5 * (lo + hi);
+  radius = 0;
+  for (const auto& p : mesh.positions) radius = std::max(radius, (p.cast<double>() - centre).norm());
+}
+
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& position, bool* inside) {
+  const ProductLayout& L = integrator.layout();
+  PRT_CHECK(L.radiance_count == 9 && L.visibility_count >= 1);
+  std::vector<double> vis(L.width), all(L.width);
+  ShadePoint sp;
+  sp.p = position;
+  sp.n = Vector3d(0.3, 0.8, -0.52).normalized();  // only decides ties of a point exactly on a face plane
+  sp.hemisphere = false;
+  integrator.integrate(sp, 0, vis);
+  integrator.unoccluded(all);
+  double occ[9];
+  for (int k = 0; k < 9; ++k) occ[k] = all[L.radiance + size_t(k)] - vis[L.radiance + size_t(k)];
+  if (inside) *inside = vis[L.visibility] == 0.0;
+  Fiv f{};
+  omega_from_band1(occ, f.data());
+  return f;
+}
+
+Fiv qmc_occluded_fiv(const QmcIntegrator& integrator, const Fiv& environment, const Vector3d& position,
+                     uint64_t point_index, Fiv* std_error) {
+  const ProductLayout& L = integrator.layout();
+  PRT_CHECK(L.radiance_count == 9);
+  std::vector<double> v(L.width), se(L.width);
+  ShadePoint sp;
+  sp.p = position;
+  sp.hemisphere = false;
+  integrator.integrate(sp, point_index, v, se);
+  Fiv vis{}, f{};
+  omega_from_band1(v.data() + L.radiance, vis.data());
+  for (int k = 0; k < 9; ++k) f[size_t(k)] = environment[size_t(k)] - vis[size_t(k)];
+  if (std_error) {
+    double s[9];
+    for (int k = 0; k < 9; ++k) s[k] = se[L.radiance + size_t(k)];
+    omega_from_band1(s, std_error->data());
+    for (double& x : *std_error) x = std::abs(x);
+  }
+  return f;
+}
+
+bool parse_shell_grid(std::string_view text, ShellSpec& spec) {
+  int n[3] = {0, 0, 0};
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0 && (p == end || *p++ != 'x')) return false;
+    const auto [q, ec] = std::from_chars(p, end, n[i]);
+    if (ec != std::errc() || q == p) return false;
+    p = q;
+  }
+  if (p != end || n[0] < 1 || n[0] > 4096 || n[1] < 2 || n[1] > 4096 || n[2] < 1 || n[2] > 1024) return false;
+  spec.n_phi = n[0];
+  spec.n_theta = n[1];
+  spec.n_rho = n[2];
+  return true;
+}
+
+namespace {
+ProductRequest band1_radiance(const EnvMap& env) {
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  return req;
+}
+} // namespace
+
+FivShellRows::FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec)
+    : FivShellRows(occluder, spec) {
+  integrator_ = std::make_unique<const SilhouetteIntegrator>(occluder, topology, band1_radiance(env),
+                                                             SilhouetteOptions{silhouette_isolines(spec.silhouette_k), 1});
+  // The scale the occluded FIV is compared with: ∫ L_c dω, the full-sphere irradiance. (|F^env|
+  // itself cancels to 0 for a uniform sky, so a fraction of it is ill-posed.)
+  if (env.texel_count() == 0) {
+    const Rgb L = env.radiance(Vector3d::UnitY());
+    env_norm_[0] = 4 * std::numbers::pi * L.r;
+    env_norm_[1] = 4 * std::numbers::pi * L.g;
+    env_norm_[2] = 4 * std::numbers::pi * L.b;
+  }
+  for (int t = 0; t < env.texel_count(); ++t) {
+    const Rgb L = env.texel_value(t);
+    const double w = env.texel_solid_angle(t);
+    env_norm_[0] += L.r * w;
+    env_norm_[1] += L.g * w;
+    env_norm_[2] += L.b * w;
+  }
+}
+
+FivShellRows::FivShellRows(const Mesh& occluder, const ShellSpec& spec) : spec_(spec) {
+  PRT_CHECK(spec.n_phi >= 1 && spec.n_theta >= 2 && spec.n_rho >= 1 && spec.fraction > 0 && spec.inner > 0);
+  bounding_sphere(occluder, frame_.centre, frame_.radius);
+  frame_.origin = occluder.origin;
+  frame_.n_phi = spec.n_phi;
+  frame_.n_theta = spec.n_theta;
+  const double R = std::max(frame_.radius, 1e-30);
+  const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
+  const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
+  for (int k = 0; k < spec.n_rho; ++k) radii_.push_back(rho0 * std::pow(g, k));
+}
+
+FivShellRows::~FivShellRows() = default;
+
+size_t FivShellRows::rows_per_shell() const { return size_t(spec_.n_theta) * size_t(spec_.n_phi); }
+
+FivShells FivShellRows::empty_shells() const {
+  // Room for every shell the bake may use, so that append() never moves what it appended (the
+  // pages of shells never appended are never touched).
+  FivShells out = frame_;
+  out.values.reserve(size_t(shell_count()) * rows_per_shell() * 9);
+  out.valid.reserve(size_t(shell_count()) * rows_per_shell());
+  return out;
+}
+
+std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task* task) const {
+  PRT_CHECK(integrator_ && begin <= end && end <= rows_per_shell());
+  std::vector<double> out((end - begin) * kRowWidth, 0.0);
+  const double rho = radius(shell);
+  tbb::parallel_for(begin, end, [&](size_t idx) {
+    const int i = int(idx / size_t(spec_.n_phi)), j = int(idx % size_t(spec_.n_phi));
+    bool inside = false;
+    const Fiv f = occluded_fiv(*integrator_, frame_.centre + rho * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside);
+    double r = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
+                                  f[size_t(3 * c + 2)] * f[size_t(3 * c + 2)]);
+      if (env_norm_[c] > 0) r = std::max(r, nf / env_norm_[c]);
+    }
+    double* row = out.data() + (idx - begin) * kRowWidth;
+    for (int q = 0; q < 9; ++q) row[q] = double(float(f[size_t(q)]));
+    row[9] = inside ? 0.0 : 1.0;
+    row[10] = inside ? 0.0 : r;  // offsets inside the geometry say nothing about distance
+    if (task) task->advance();
+  });
+  return out;
+}
+
+// Far enough (and outside the bounding sphere, so never inside the occluder).
+bool FivShellRows::may_stop_after(int shell) const { return radius(shell) >= std::max(frame_.radius, 1e-30); }
+
+bool FivShellRows::stops_after(int shell, std::span<const double> rows) const {
+  PRT_CHECK_OP(rows.size(), ==, rows_per_shell() * kRowWidth);
+  if (!may_stop_after(shell)) return false;
+  double worst = 0;
+  for (size_t idx = 0; idx < rows_per_shell(); ++idx) worst = std::max(worst, rows[idx * kRowWidth + 10]);
+  return worst < spec_.fraction;
+}
+
+void FivShellRows::append(FivShells& shells, int shell, std::span<const double> rows) const {
+  PRT_CHECK(rows.size() == rows_per_shell() * kRowWidth && shells.radii.size() == size_t(shell));
+  shells.radii.push_back(radius(shell));
+  // Into the room empty_shells() reserved: no reallocation, and no zeroing pass before the values.
+  for (size_t idx = 0; idx < rows_per_shell(); ++idx) {
+    const double* row = rows.data() + idx * kRowWidth;
+    for (int q = 0; q < 9; ++q) shells.values.push_back(float(row[q]));
+    shells.valid.push_back(row[9] != 0.0 ? 1 : 0);
+  }
+  shells.integrals += rows_per_shell();
+}
+
+FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                          const Monitor& monitor) {
+  const FivShellRows baker(occluder, topology, env, spec);
+  FivShells out = baker.empty_shells();
+  const size_t per_shell = baker.rows_per_shell();
+  Task progress(monitor, "baking FIV shells", uint64_t(spec.n_rho) * per_shell);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < baker.shell_count(); ++k) {
+    const std::vector<double> rows = baker.rows(k, 0, per_shell, &progress);
+    baker.append(out, k, rows);
+    if (baker.stops_after(k, rows)) break;
+  }
+  progress.finish();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
+                                const Fiv& fenv, size_t points, uint64_t seed, const Monitor& monitor) {
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  const QmcIntegrator qmc(occluder, topology, req, {IntegratorSpec::kSilhouetteReferenceRays, mix64(seed ^ 0x66697672656675ull)});
+  const size_t per_shell = size_t(shells.n_theta) * size_t(shells.n_phi), total = shells.radii.size() * per_shell;
+  const auto picks = seeded_sample(uint32_t(total), points, seed);
+  std::vector<double> err2(picks.size(), 0.0), se2(picks.size(), 0.0), maxe(picks.size(), 0.0);
+  const auto r0 = std::chrono::steady_clock::now();
+  Task progress(monitor, "reference", picks.size());
+  tbb::parallel_for(size_t(0), picks.size(), [&](size_t q) {
+    const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
+    const int i = int(ij / size_t(shells.n_phi)), j = int(ij % size_t(shells.n_phi));
+    Fiv se;
+    const Fiv ref = qmc_occluded_fiv(qmc, fenv, shells.centre + shells.radii[k] * shell_direction(i, shells.n_theta, j, shells.n_phi), idx, &se);
+    for (size_t x = 0; x < 9; ++x) {
+      const double d = double(shells.values[idx * 9 + x]) - ref[x];
+      err2[q] += d * d;
+      se2[q] += se[x] * se[x];
+      maxe[q] = std::max(maxe[q], std::abs(d));
+    }
+    progress.advance();
+  });
+  progress.finish();
+  FivErrorReport r;
+  r.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+  r.points = picks.size();
+  r.reference = qmc.description() + " (full sphere)";
+  double e = 0, s2 = 0, n2 = 0;
+  for (size_t q = 0; q < picks.size(); ++q) {
+    e += err2[q];
+    s2 += se2[q];
+    r.max_abs = std::max(r.max_abs, maxe[q]);
+  }
+  for (double x : fenv) n2 += x * x;
+  const double nval = double(std::max<size_t>(9 * picks.size(), 1));
+  r.rmse = std::sqrt(e / nval);
+  r.reference_std_error = std::sqrt(s2 / nval);
+  r.reference_rms = std::sqrt(n2 / 9);
+  return r;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,120 @@
+// bake/integrators/integrator.h — the interface every spherical integrator implements, so products can be
+// baked by the QMC baseline (bake/integrators/qmc.h), the silhouette integrator (paper 001 §3) or the
+// sheared-filter integrator (paper 002, bake/integrators/filter.h) and compared value by value — and the typed configuration that chooses one (IntegratorSpec).
+#pragma once
+
+#include <bake/integrators/products.h>
+#include <bake/mesh/shade_point.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace prt::bake {
+
+enum class IntegratorKind { Silhouette, Qmc, Filter };
+
+// The names files and tools use ("silhouette", "qmc", "filter"): the one place they are spelled.
+const char* to_string(IntegratorKind kind);
+std::optional<IntegratorKind> parse_integrator_kind(std::string_view name);  // nullopt for another name
+
+// The silhouette integrator's k → N rule: N = round(√k) u-isolines (at least 2; the integrator
+// then rounds N up to even), k = N² spherical samples.
+int silhouette_isolines(uint32_t k);
+
+// Which integrator, its sampling knob, its seed and the error report's reference settings; each
+// default is spelled here once. Files and tools carry one user-facing "samples" number, which is
+// the knob of the chosen kind (samples() / set_samples()).
+struct IntegratorSpec {
+  static constexpr uint32_t kDefaultSilhouetteK = 16384;  // 128² spherical samples
+  static constexpr uint32_t kDefaultQmcRays = 1024;
+  static constexpr uint32_t kDefaultFilterRays = 16;     // pass-1 rays (paper 002 §5: 4-32)
+  static constexpr uint32_t kMinSilhouetteK = 4;          // 2 u-isolines
+  // The converged reference of a silhouette bake (and of FIV shells, bake/bake/fiv.h): QMC rays per point.
+  static constexpr uint32_t kSilhouetteReferenceRays = 65536;
+  static constexpr uint32_t kQmcReferenceFactor = 10;     // a qmc bake's reference: 10× its rays
+
+  IntegratorKind kind = IntegratorKind::Silhouette;
+  uint32_t silhouette_k = kDefaultSilhouetteK;  // silhouette: k spherical samples (silhouette_isolines(k))
+  uint32_t qmc_rays = kDefaultQmcRays;          // qmc: rays per shade point
+  uint32_t filter_rays = kDefaultFilterRays;    // filter: pass-1 rays per shade point
+  uint64_t seed = 1;
+  uint32_t report_points = 32;                  // error report: seeded points re-integrated (0: none)
+  // error report: the QMC reference's rays per point, sized for a target error
+  // (bake/bake/choose.h plan_report_reference); 0: the defaults below.
+  uint32_t report_rays = 0;
+
+  // The chosen kind's knob.
+  static uint32_t IntegratorSpec::*knob(IntegratorKind k) {
+    switch (k) {
+    case IntegratorKind::Qmc: return &IntegratorSpec::qmc_rays;
+    case IntegratorKind::Filter: return &IntegratorSpec::filter_rays;
+    case IntegratorKind::Silhouette: break;
+    }
+    return &IntegratorSpec::silhouette_k;
+  }
+  uint32_t samples() const { return this->*knob(kind); }
+  void set_samples(uint32_t n) { this->*knob(kind) = n; }
+  int isolines() const { return silhouette_isolines(silhouette_k); }
+  // Rays per point of the QMC reference the error report compares with.
+  uint32_t reference_rays() const {
+    if (report_rays > 0) return report_rays;
+    return kind == IntegratorKind::Qmc ? qmc_rays * kQmcReferenceFactor : kSilhouetteReferenceRays;
+  }
+  // The reference's randomisation seed, apart from the bake's points.
+  uint64_t reference_seed() const;
+
+};
+
+// Work counters, summed over all integrate() calls. A counter an integrator does not keep stays
+// 0 (the QMC integrator keeps none; the silhouette integrator all of them, bake/integrators/silhouette.h).
+struct IntegratorStats {
+  uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
+  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
+  // Hemisphere points with no contour edge in view, given closed forms instead of a DCF walk
+  // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
+  uint64_t closed_form = 0, enclosed = 0;
+  double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
+  // The filter integrator (bake/integrators/filter.h): pass-1 rays cast (once per point), rays of brute-forced
+  // cells, hemisphere cells integrated and how many of them by brute force, and points integrated
+  // by brute force because prepare() had not seen them.
+  uint64_t pass1_rays = 0, fallback_rays = 0, cells = 0, brute_cells = 0, unprepared = 0;
+  // Its neighbours kept (the receiver included) and the samples with a non-zero filter weight in
+  // the cells it filtered, summed over points.
+  uint64_t neighbours = 0, filtered_samples = 0;
+  double brute_fraction() const { return cells ? double(brute_cells) / double(cells) : 0.0; }
+  double neighbours_per_point() const { return points ? double(neighbours) / double(points) : 0.0; }
+  double samples_per_filtered_cell() const {
+    return cells > brute_cells ? double(filtered_samples) / double(cells - brute_cells) : 0.0;
+  }
+  double rays_per_point() const { return points ? double(pass1_rays + fallback_rays) / double(points) : 0.0; }
+};
+
+class Integrator {
+public:
+  virtual ~Integrator() = default;
+  virtual IntegratorKind kind() const = 0;
+  std::string name() const { return to_string(kind()); }
+  virtual std::string description() const = 0;     // one line: method and its parameters
+  virtual const ProductLayout& layout() const = 0;
+  // Called once before a bake's integrate() calls with ALL its points (bake_points: row i is
+  // points[i]), never concurrently with integrate(); integrate(points[i], i) may then use the other
+  // points (the filter integrator reuses its neighbours' rays). A later call replaces the earlier
+  // set. Default: nothing to prepare.
+  virtual void prepare(std::span<const ShadePoint> points) const { (void)points; }
+  // Writes one row of estimates (layout().width doubles) for the shade point. `point_index`
+  // identifies the point for deterministic per-point randomisation. `std_error` (optional, same
+  // width) receives each value's estimated standard error (0 for a deterministic integrator).
+  // Thread-safe: called concurrently for different points.
+  virtual void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
+                         std::span<double> std_error = {}) const = 0;
+  virtual IntegratorStats stats() const { return {}; }
+  // One line on the work done so far, from stats(), for a tool to print after a bake; empty when
+  // the integrator has nothing to add to its rays and time.
+  virtual std::string work_summary() const { return {}; }
+};
+
+} // namespace prt::bake

@@ -1,0 +1,81 @@
+// bake/integrators/silhouette.h — the semi-analytic visibility-silhouette integrator (Nowrouzezahrai,
+// Baran, Mitchell, Jarosz: "Visibility Silhouettes for Semi-Analytic Spherical Integration",
+// CGF 2014, §3; paper 001 in ../shared/papers). The data path, one stage per file:
+//
+//   mesh ─▶ contour edges (bake/visibility/contour.h: 4D dual-space BVH, eq. 6, orientation-free steps)
+//        ─▶ octahedral arcs and isoline buckets (bake/sphere/octahedral.h: §3.3)
+//        ─▶ DCF walk along each u-isoline and integrals over runs with W = 0 using
+//           summed-area tables of f·J along isolines (bake/sphere/isoline_tables.h: §3.2, §4)
+//        ─▶ the same product rows as the QMC baseline (bake/integrators/products.h).
+//
+// Conventions and choices (see the .cpp for the derivations):
+//  * Octahedral map (u, v) = (x, y)/(|x|+|y|+|z|), one sheet per sign of z; dω = J du dv with
+//    J = (u² + v² + (1−|u|−|v|)²)^(−3/2). (The paper prints the exponent as +1.5; the solid angle
+//    element of q = (u, v, 1−|u|−|v|) is |q·(q_u × q_v)|/|q|³ = 1/|q|³.)
+//  * k = N² samples: N u-isolines at u_i = −1 + (i + ½)·2/N; along an isoline, f·J is tabulated
+//    in cells of width 2/N in v on both sheets and integrated exactly between crossings
+//    (piecewise constant per cell); the u direction is the midpoint rule. Error falls with N.
+//  * Each isoline is walked as one closed loop over both sheets; the depth complexity W is
+//    propagated along a "spine" (the half equator z = 0, y < 0, where every loop starts) from
+//    one direction whose W is counted with an Embree ray. No "minimum W is 0" assumption: fully
+//    enclosed points are exact (W > 0 everywhere).
+//  * The hemisphere H(ω,n) is a virtual occluder: the horizon great circle is walked like an
+//    edge with step +1 into the lower hemisphere (paper §4: clamping is part of visibility), so
+//    integrands never carry H and the tables are shared by all shade points.
+//  * A hemisphere point with no contour edge in view takes closed forms (bake/sphere/zonal.h) after one
+//    ray decides enclosed / open; its band-1 and shadowed radiance (R, S) are the horizon-only
+//    walk, once per normal.
+//  * Visibility is the limit from p + εn, ε → 0+: every orientation predicate at p is evaluated
+//    symbolically at p + εn (sign of the value, else of its ε-derivative), and the shade point's
+//    own vertex is seen in direction −n. A flat 1-ring therefore covers exactly the lower
+//    hemisphere and a concave one reaches above the horizon — with no ε offset in the numbers.
+#pragma once
+
+#include <bake/visibility/accel.h>
+#include <bake/integrators/integrator.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/products.h>
+
+#include <atomic>
+#include <memory>
+
+namespace prt::bake {
+
+struct SilhouetteOptions {
+  int isolines = 256;  // N; k = N² (IntegratorSpec's k gives N = silhouette_isolines(k), bake/integrators/integrator.h)
+  uint64_t seed = 1;   // only for the direction of the counted start ray when the default is degenerate
+};
+
+class SilhouetteIntegrator final : public Integrator {
+public:
+  // `mesh`, `topology` and the request's environment must outlive the integrator. With `accel`
+  // (of the same mesh and topology, bake/visibility/accel.h), its contour tree and ray scene are shared
+  // instead of built: the same results, bit for bit.
+  SilhouetteIntegrator(const Mesh& mesh, const Topology& topology, const ProductRequest& request,
+                       const SilhouetteOptions& options, const MeshAccel* accel = nullptr);
+  ~SilhouetteIntegrator() override;
+  SilhouetteIntegrator(const SilhouetteIntegrator&) = delete;
+  SilhouetteIntegrator& operator=(const SilhouetteIntegrator&) = delete;
+
+  IntegratorKind kind() const override { return IntegratorKind::Silhouette; }
+  std::string description() const override;
+  const ProductLayout& layout() const override;
+  // std_error is filled with 0: the integrator is deterministic; its error is discretisation.
+  void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
+                 std::span<double> std_error = {}) const override;
+
+  // The full-sphere integrals with V ≡ 1 from the same tables (the visibility and radiance rows of
+  // the layout; others 0). ∫ (1 − V) f = unoccluded − integrate(full sphere) then shares the
+  // discretisation of both terms, so an occluder subtending little keeps its relative accuracy.
+  void unoccluded(std::span<double> out) const;
+
+  // Every counter of IntegratorStats (bake/integrators/integrator.h), kept with relaxed atomics.
+  IntegratorStats stats() const override;
+  const SilhouetteOptions& options() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace prt::bake

@@ -1,0 +1,119 @@
+// bake/visibility/occluder_mesh.h — the visible part of a planar area light past an arbitrary triangle mesh
+// (non-convex, open, non-manifold: any triangle soup), seen from a shade point in the ε-limit
+// p + εn, as the boundary arcs of bake/visibility/visible_region.h (paper 003 §3.5 "GetBetween" culling and
+// §4.4 the per-triangle variant; issue 13; docs/ARCHITECTURE.md "Conventions").
+//
+// Method: the light polygon (world coordinates, planar, convex, either winding) is seen from p,
+// oriented positively and clipped to the horizon n·ω ≥ 0 (bake/sphere/spherical_polygon.h). Only the
+// triangles that can hide part of it are kept (culling, conservative):
+//  * a binary AABB tree over the triangles (median splits, leaves of ≤ 4) is walked against the
+//    planes of the pyramid spanned by p and the clipped light (m_i = l_i × l_{i+1}, inside
+//    m_i·(x − p) ≥ 0) and the light's own plane (p's side): a box or a triangle entirely outside
+//    one plane by more than a rounding margin (1e-12 relative: far above the error of the
+//    floating-point plane values) is dropped. Nothing dropped overlaps the light's interior.
+//  * the light's plane decides depth EXACTLY (orient3d_exact on three light vertices): a triangle
+//    with no vertex strictly on p's side is behind the light and dropped; one straddling the
+//    plane is clipped to p's side (crossing points in floating point). Since the light is planar
+//    and convex, a ray from p towards the light is blocked iff it meets a triangle on p's side.
+// Each kept triangle becomes its spherical image from p + εn (ε → 0+), a convex spherical polygon:
+//  * p strictly off its plane: its vertices' directions x − p, positively oriented by the exact
+//    sign of det(a − p, b − p, c − p);
+//  * p in its plane but outside it (orient3d_exact = 0): an image of zero area in the limit; dropped;
+//  * p on it (a vertex, e.g. the shade point's own 1-ring, a point of an edge or of the face, all
+//    decided exactly): split into triangles (p, v_i, v_{i+1}) and each seen from p + εn is the
+//    spherical triangle (v_i − p, v_{i+1} − p, −n) (a ray p + εn + t d meets it iff
+//    d ∈ cone(v_i − p, v_{i+1} − p, −n), as bake/visibility/raycast.h occludes_from_above); when n lies in the
+//    face's plane that cone has no interior and is dropped (ShadePoint::t is not used: such a face
+//    blocks nothing, as with t = 0).
+// Then visible_region(light, images) gives V = light \ ∪ images exactly (every orientation
+// decided by orient3d_exact; unions counted once). Triangles are passed in index order whatever
+// the tree's walk, so the culled query and the reference below make the same decisions on ties.
+// Cost: the walk is output-sensitive; visible_region is O(E²) in the kept edges E (3 per kept
+// triangle), so the cost grows with the square of the triangles inside the light's pyramid
+// (bench/bench_area.cpp: three boxes as one mesh ≥ 17k shade points/s for 3 lights; the bunny
+// under a quad light, ~280 kept triangles, some 10² shade points/s: a contour-loop variant
+// linear in the silhouette is not built yet).
+#pragma once
+
+#include <bake/mesh/shade_point.h>
+#include <bake/mesh/mesh.h>
+#include <bake/sphere/spherical_polygon.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace prt::bake {
+
+class OccluderMesh {
+public:
+  // The mesh's world positions (Mesh::world_position, in double) and triangles are copied: the
+  // mesh need not outlive this object. Zero-area triangles are kept (their images are dropped).
+  explicit OccluderMesh(const Mesh& mesh);
+  OccluderMesh(std::vector<Eigen::Vector3d> positions, std::vector<std::array<uint32_t, 3>> triangles);
+
+  // Per-thread scratch buffers, reused across queries (visible_region still allocates its own).
+  // After a query, `clipped` holds the light as visible_region got it (directions from p,
+  // positively oriented, clipped to the horizon; empty when the query returned no light): its
+  // integrals are the unshadowed values.
+  struct Workspace {
+    struct Plane {  // kept side: m·(x − o) ≥ −margin
+      Eigen::Vector3d m, o;
+      double margin_coef;  // margin = margin_coef · (|x − o| bound)
+    };
+    std::vector<Plane> planes;
+    std::vector<Eigen::Vector3d> rel, clipped, poly;
+    std::vector<std::vector<Eigen::Vector3d>> images;
+    std::vector<uint32_t> kept, stack;
+    size_t image_count = 0;
+  };
+
+  // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
+  // light visible from point.p + ε point.n above its horizon (point.hemisphere = false: no horizon
+  // clip). `light`: ≥ 3 world-space vertices of a planar convex polygon, either winding (a
+  // one-sided light's back side is the caller's decision). Empty when p lies in the light's plane
+  // or nothing of it is above the horizon. Integrate with point.n·vector_irradiance(out) (the
+  // irradiance from unit radiance) and PolygonSH::project(out) (bake/sphere/polygon_sh.h).
+  // Returns the number of triangles kept after culling (those passed to visible_region).
+  // Thread-safe (const) with one Workspace per thread. A convex emitter (box, cylinder, sphere as
+  // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
+  // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
+  // dropped by the depth test).
+  size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
+                       Workspace& ws) const {
+    return query(light, point, out, ws, true);
+  }
+  // Reference: no tree and no pyramid culling (every triangle goes through the exact depth test
+  // and the image rule above). The same arcs' integrals as visible_light.
+  size_t visible_light_reference(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                                 std::vector<Arc>& out, Workspace& ws) const {
+    return query(light, point, out, ws, false);
+  }
+
+  size_t triangle_count() const { return triangles_.size(); }
+
+private:
+  struct Node {
+    Eigen::Vector3d lo, hi;
+    uint32_t index;  // leaf: first entry of order_; inner: right child (left child is this + 1)
+    uint32_t count;  // leaf: triangle count (> 0); inner: 0
+  };
+  struct LightFrame;
+
+  uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
+  bool prepare(std::span<const Eigen::Vector3d> light, const ShadePoint& point, Workspace& ws, LightFrame& frame) const;
+  void add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
+  size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
+               bool culled) const;
+  void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+
+  std::vector<Eigen::Vector3d> positions_;
+  std::vector<std::array<uint32_t, 3>> triangles_;
+  std::vector<uint32_t> order_;  // triangle indices, leaves' ranges
+  std::vector<Node> nodes_;
+};
+
+} // namespace prt::bake

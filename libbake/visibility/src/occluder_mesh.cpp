@@ -1,0 +1,268 @@
+// occluder_mesh.cpp — the visible part of a planar light past a triangle mesh: culling by the
+// light's pyramid and plane, exact depth and ε-limit images, then visible_region
+// (bake/visibility/occluder_mesh.h has the method).
+#include <bake/visibility/occluder_mesh.h>
+
+#include <bake/visibility/contour.h>
+#include <bake/core/error.h>
+#include <bake/visibility/visible_region.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace prt::bake {
+
+using V3 = Eigen::Vector3d;
+
+namespace {
+
+// Culling margin relative to the scale of a plane value m·(x − o) (see the header): the float
+// plane values err by a few ulps of |factors| · |x − o|; 1e-12 is ~4500 ulps.
+constexpr double kMargin = 1e-12;
+constexpr uint32_t kLeafSize = 4;
+
+}  // namespace
+
+// The light's plane as three of its vertices, and p's side of it.
+struct OccluderMesh::LightFrame {
+  V3 a, b, c;
+  int p_side = 0;  // orient3d_exact(a, b, c, p) ≠ 0
+};
+
+namespace {
+
+std::vector<V3> world_positions(const Mesh& mesh) {
+  std::vector<V3> out;
+  out.reserve(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) out.push_back(mesh.world_position(v));
+  return out;
+}
+
+}  // namespace
+
+OccluderMesh::OccluderMesh(const Mesh& mesh) : OccluderMesh(world_positions(mesh), mesh.triangles) {}
+
+OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uint32_t, 3>> triangles)
+    : positions_(std::move(positions)), triangles_(std::move(triangles)) {
+  std::vector<V3> centroids;
+  for (const auto& t : triangles_) {
+    for (uint32_t v : t) PRT_CHECK(v < positions_.size());
+    centroids.push_back((positions_[t[0]] + positions_[t[1]] + positions_[t[2]]) / 3);
+  }
+  order_.resize(triangles_.size());
+  for (uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+  if (!triangles_.empty()) build(0, uint32_t(triangles_.size()), centroids);
+}
+
+uint32_t OccluderMesh::build(uint32_t first, uint32_t count, std::vector<V3>& centroids) {
+  const uint32_t at = uint32_t(nodes_.size());
+  nodes_.push_back({V3::Zero(), V3::Zero(), 0, 0});
+  V3 lo = V3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  V3 clo = lo, chi = hi;
+  for (uint32_t i = first; i < first + count; ++i) {
+    for (uint32_t v : triangles_[order_[i]]) {
+      lo = lo.cwiseMin(positions_[v]);
+      hi = hi.cwiseMax(positions_[v]);
+    }
+    clo = clo.cwiseMin(centroids[order_[i]]);
+    chi = chi.cwiseMax(centroids[order_[i]]);
+  }
+  nodes_[at].lo = lo;
+  nodes_[at].hi = hi;
+  if (count <= kLeafSize) {
+    nodes_[at].index = first;
+    nodes_[at].count = count;
+    return at;
+  }
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const uint32_t half = count / 2;
+  std::nth_element(order_.begin() + first, order_.begin() + first + half, order_.begin() + first + count,
+                   [&](uint32_t x, uint32_t y) { return centroids[x][axis] < centroids[y][axis]; });
+  build(first, half, centroids);
+  const uint32_t right = build(first + half, count - half, centroids);
+  nodes_[at].index = right;
+  nodes_[at].count = 0;
+  return at;
+}
+
+bool OccluderMesh::prepare(std::span<const V3> light, const ShadePoint& point, Workspace& ws, LightFrame& frame) const {
+  ws.image_count = 0;
+  ws.kept.clear();
+  ws.clipped.clear();
+  if (light.size() < 3) return false;
+  // The light's plane: the fan triangle (L_0, L_k, L_k+1) of largest area (any of them for a planar polygon).
+  size_t best = 1;
+  double best_area = -1;
+  for (size_t k = 1; k + 1 < light.size(); ++k) {
+    const double area = (light[k] - light[0]).cross(light[k + 1] - light[0]).squaredNorm();
+    if (area > best_area) best_area = area, best = k;
+  }
+  frame.a = light[0];
+  frame.b = light[best];
+  frame.c = light[best + 1];
+  frame.p_side = orient3d_exact(frame.a, frame.b, frame.c, point.p);
+  if (frame.p_side == 0) return false;  // p in the light's plane: no solid angle
+
+  // Directions, positively oriented (det(a − p, b − p, c − p) has the sign p_side), clipped.
+  ws.rel.resize(light.size());
+  for (size_t k = 0; k < light.size(); ++k) ws.rel[k] = light[k] - point.p;
+  if (frame.p_side < 0) std::reverse(ws.rel.begin(), ws.rel.end());
+  if (point.hemisphere) {
+    clip_to_horizon(ws.rel, point.n, ws.clipped);
+  } else {
+    ws.clipped = ws.rel;
+  }
+  if (ws.clipped.size() < 3) return false;
+
+  // Culling planes: the pyramid's sides through p and the light's plane (p's side kept).
+  ws.planes.clear();
+  const auto& c = ws.clipped;
+  for (size_t k = 0; k < c.size(); ++k) {
+    const V3& u = c[k];
+    const V3& v = c[k + 1 == c.size() ? 0 : k + 1];
+    ws.planes.push_back({u.cross(v), point.p, kMargin * u.norm() * v.norm()});
+  }
+  const V3 ab = frame.b - frame.a, ac = frame.c - frame.a;
+  // det(a − p, b − p, c − p) = −N·(p − a) with N = (b − a)×(c − a): p's side has −p_side·N·(x − a) > 0.
+  ws.planes.push_back({-double(frame.p_side) * ab.cross(ac), frame.a, kMargin * ab.norm() * ac.norm()});
+  return true;
+}
+
+void OccluderMesh::add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const {
+  const auto& t = triangles_[triangle];
+  const V3* x[3] = {&positions_[t[0]], &positions_[t[1]], &positions_[t[2]]};
+  // Depth, exactly: s > 0 on p's side of the light's plane.
+  int s[3];
+  bool any_front = false, any_back = false;
+  for (int k = 0; k < 3; ++k) {
+    s[k] = orient3d_exact(frame.a, frame.b, frame.c, *x[k]) * frame.p_side;
+    any_front = any_front || s[k] > 0;
+    any_back = any_back || s[k] < 0;
+  }
+  if (!any_front) return;  // behind the light (or in its plane)
+  auto& poly = ws.poly;
+  poly.clear();
+  if (!any_back) {
+    for (const V3* v : x) poly.push_back(*v);
+  } else {  // straddles the plane: keep p's side (Sutherland–Hodgman, sides exact)
+    const V3& m = ws.planes.back().m;
+    for (int k = 0; k < 3; ++k) {
+      const int k1 = k == 2 ? 0 : k + 1;
+      if (s[k] >= 0) poly.push_back(*x[k]);
+      if (s[k] * s[k1] < 0) {
+        const double da = m.dot(*x[k] - frame.a), db = m.dot(*x[k1] - frame.a);
+        const double u = std::clamp(da / (da - db), 0.0, 1.0);
+        poly.push_back(*x[k] + u * (*x[k1] - *x[k]));
+      }
+    }
+  }
+  auto push = [&ws](auto&& fill) {
+    if (ws.image_count == ws.images.size()) ws.images.emplace_back();
+    auto& image = ws.images[ws.image_count++];
+    image.clear();
+    fill(image);
+  };
+
+  const int side = orient3d_exact(*x[0], *x[1], *x[2], point.p);
+  if (side != 0) {  // p off the plane: the directions to the corners
+    push([&](std::vector<V3>& image) {
+      for (const V3& v : poly) image.push_back(v - point.p);
+      if (side < 0) std::reverse(image.begin(), image.end());
+    });
+    return;
+  }
+  // p in the plane: is it on the (clipped) face? In-plane sides from a point q off the plane.
+  V3 q = point.p;
+  bool found = false;
+  for (int axis = 0; axis < 3 && !found; ++axis) {
+    q = point.p + V3::Unit(axis);
+    found = orient3d_exact(*x[0], *x[1], *x[2], q) != 0;
+  }
+  if (!found) return;  // a zero-area triangle
+  const size_t m = poly.size();
+  int seen = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const int sk = orient3d_exact(poly[k], poly[k + 1 == m ? 0 : k + 1], q, point.p);
+    if (sk != 0 && seen != 0 && sk != seen) return;  // outside: no area in the limit
+    if (sk != 0) seen = sk;
+  }
+  // p on the face: the triangles (p, v_k, v_k+1) seen from p + εn are cones (v_k − p, v_k+1 − p, −n).
+  const V3 down = -point.n;
+  for (size_t k = 0; k < m; ++k) {
+    const V3& v0 = poly[k];
+    const V3& v1 = poly[k + 1 == m ? 0 : k + 1];
+    if (orient3d_exact(v0, v1, q, point.p) == 0) continue;  // p on this edge (or its line)
+    const V3 a = v0 - point.p, b = v1 - point.p;
+    const int o = orient3d_exact(a, b, down, V3::Zero());
+    if (o == 0) continue;  // n in the face's plane: no interior
+    push([&](std::vector<V3>& image) {
+      if (o > 0) {
+        image.assign({a, b, down});
+      } else {
+        image.assign({b, a, down});
+      }
+    });
+  }
+}
+
+size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
+                           bool culled) const {
+  LightFrame frame;
+  if (!prepare(light, point, ws, frame)) {
+    out.clear();
+    return 0;
+  }
+  if (culled) {
+    cull(ws);
+    std::sort(ws.kept.begin(), ws.kept.end());
+  } else {
+    for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
+  }
+  for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
+  visible_region(ws.clipped, std::span<const std::vector<V3>>(ws.images.data(), ws.image_count), out);
+  return ws.kept.size();
+}
+
+void OccluderMesh::cull(Workspace& ws) const {
+  if (nodes_.empty()) return;
+  auto box_outside = [&](const Node& node) {
+    const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
+    for (const auto& plane : ws.planes) {
+      const V3 r = centre - plane.o;
+      const double top = plane.m.dot(r) + plane.m.cwiseAbs().dot(half);
+      if (top < -plane.margin_coef * (r.norm() + half.norm())) return true;
+    }
+    return false;
+  };
+  auto triangle_outside = [&](uint32_t t) {
+    for (const auto& plane : ws.planes) {
+      double top = -std::numeric_limits<double>::infinity(), reach = 0;
+      for (uint32_t v : triangles_[t]) {
+        const V3 r = positions_[v] - plane.o;
+        top = std::max(top, plane.m.dot(r));
+        reach = std::max(reach, r.norm());
+      }
+      if (top < -plane.margin_coef * reach) return true;
+    }
+    return false;
+  };
+  ws.stack.assign(1, 0);
+  while (!ws.stack.empty()) {
+    const uint32_t at = ws.stack.back();
+    const Node& node = nodes_[at];
+    ws.stack.pop_back();
+    if (box_outside(node)) continue;
+    if (node.count == 0) {
+      ws.stack.push_back(node.index);
+      ws.stack.push_back(at + 1);
+      continue;
+    }
+    for (uint32_t i = node.index; i < node.index + node.count; ++i)
+      if (!triangle_outside(order_[i])) ws.kept.push_back(order_[i]);
+  }
+}
+
+} // namespace prt::bake

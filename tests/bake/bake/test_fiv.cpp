@@ -1,0 +1,246 @@
+// FIV products (bake/bake/fiv.h, paper 004 §3–4.2) against quadrature, QMC and closed forms.
+#include <bake/environment/envmap.h>
+#include <bake/core/error.h>
+#include <bake/bake/fiv.h>
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <prtshade/sh.h>
+
+#include <gtest/gtest.h>
+#include <test_scenes.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace prt::bake;
+using prt::testing::box;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+using std::numbers::pi;
+
+namespace {
+
+// 64×32 map: a dim sky gradient plus a 3×2-texel sun ~2000× brighter.
+EnvMap test_env() {
+  const int W = 64, H = 32;
+  std::vector<float> rgb(size_t(W * H * 3));
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      for (int c = 0; c < 3; ++c) rgb[size_t(3 * (y * W + x) + c)] = 0.2f + 0.5f * float(H - y) / H + 0.1f * float(c);
+  for (int y = 9; y <= 10; ++y)
+    for (int x = 40; x <= 42; ++x)
+      for (int c = 0; c < 3; ++c) rgb[size_t(3 * (y * W + x) + c)] = 2000.f - 300.f * float(c);
+  return EnvMap::from_latlong(W, H, rgb, UpAxis::Y, "test-sun");
+}
+
+// Quadrature of g(ω) L(ω) over the sphere on an n × n grid in (φ, y): rows are circles of
+// latitude, so texel boundaries in latitude are cut at most once per row.
+template <class G>
+std::array<double, 3> quad(const EnvMap& env, G g, int n = 2048) {
+  std::array<double, 3> s{};
+  for (int j = 0; j < n; ++j) {
+    const double y = -1 + (j + 0.5) * 2.0 / n, r = std::sqrt(1 - y * y);
+    for (int i = 0; i < n; ++i) {
+      const double ph = (i + 0.5) * 2 * pi / n;
+      const Vector3d d(r * std::cos(ph), y, r * std::sin(ph));
+      const double w = g(d) * (2.0 / n) * (2 * pi / n);
+      if (w == 0) continue;
+      const Rgb L = env.radiance(d);
+      s[0] += L.r * w;
+      s[1] += L.g * w;
+      s[2] += L.b * w;
+    }
+  }
+  return s;
+}
+
+
+} // namespace
+
+TEST(Fiv, ShellDirectionConvention) {
+  EXPECT_NEAR((shell_direction(0, 65, 17, 128) - Vector3d(0, 1, 0)).norm(), 0, 1e-15);   // θ = 0: +Y
+  EXPECT_NEAR((shell_direction(64, 65, 5, 128) - Vector3d(0, -1, 0)).norm(), 0, 1e-15);  // θ = π: −Y
+  EXPECT_NEAR((shell_direction(32, 65, 0, 128) - Vector3d(0, 0, 1)).norm(), 0, 1e-15);   // φ = 0: +Z
+  EXPECT_NEAR((shell_direction(32, 65, 32, 128) - Vector3d(1, 0, 0)).norm(), 0, 1e-15);  // φ = π/2: +X
+}
+
+// Exact ∫_texel ω dω of lat-long texel (x, y) in OpenEXR's convention: centre longitude
+// π − 2πx/(W−1), latitude π/2 − πy/(H−1), half-texels at the seam and the poles; direction
+// (cos λ sin φ, sin λ, cos λ cos φ).
+Vector3d latlong_texel_moment(int x, int y, int W, int H) {
+  const double dphi = 2 * pi / (W - 1), dlat = pi / (H - 1);
+  const double pc = pi - dphi * x, lc = pi / 2 - dlat * y;
+  const double p0 = std::max(-pi, pc - dphi / 2), p1 = std::min(pi, pc + dphi / 2);
+  const double l0 = std::max(-pi / 2, lc - dlat / 2), l1 = std::min(pi / 2, lc + dlat / 2);
+  const double cos2 = (l1 / 2 + std::sin(2 * l1) / 4) - (l0 / 2 + std::sin(2 * l0) / 4);
+  const double sincos = (std::sin(l1) * std::sin(l1) - std::sin(l0) * std::sin(l0)) / 2;
+  return {cos2 * (std::cos(p0) - std::cos(p1)), sincos * (p1 - p0), cos2 * (std::sin(p1) - std::sin(p0))};
+}
+
+TEST(Fiv, EnvironmentFivMatchesExactTexelMoments) {
+  const EnvMap env = test_env();
+  const int W = 64, H = 32;
+  double exact[9] = {};
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const Vector3d m = latlong_texel_moment(x, y, W, H);
+      const Rgb L = env.texel_value(y * W + x);
+      const double c[3] = {L.r, L.g, L.b};
+      for (int ch = 0; ch < 3; ++ch)
+        for (int a = 0; a < 3; ++a) exact[3 * ch + a] += c[ch] * m[a];
+    }
+  const Fiv f = environment_fiv(env);
+  double scale = 0;
+  for (double e : exact) scale = std::max(scale, std::abs(e));
+  // 4×4 midpoint sub-samples per texel: O((h/4)²) ≈ 4e-5 of each texel's moment.
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(f[size_t(k)], exact[k], 1e-4 * scale) << k;
+  const Fiv zero = environment_fiv(EnvMap::constant({1, 1, 1}));
+  for (double x : zero) EXPECT_EQ(x, 0.0);
+}
+
+TEST(Fiv, IrradianceCubeIsExactNotSh9) {
+  // A smooth environment (no sun): the (φ, y) quadrature is accurate to ~1e-4 here.
+  std::vector<float> rgb(size_t(64 * 32 * 3));
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c)
+        rgb[size_t(3 * (y * 64 + x) + c)] = 0.3f + 0.6f * float(32 - y) / 32 + 0.2f * float(c) * float(x) / 64;
+  const EnvMap env = EnvMap::from_latlong(64, 32, rgb, UpAxis::Y, "sky");
+  const int S = 4;
+  const auto cube = irradiance_cube(env, S);
+  ASSERT_EQ(cube.size(), size_t(6 * S * S * 3));
+  for (int face = 0; face < 6; ++face) {
+    const int row = (face * 3) % S, col = (face * 5 + 1) % S;
+    const Vector3d n = gl_cube_direction(face, row, col, S);
+    const auto q = quad(env, [&](const Vector3d& d) { return std::max(0.0, n.dot(d)); });
+    for (int c = 0; c < 3; ++c) {
+      const float e = cube[size_t(((face * S + row) * S + col) * 3 + c)];
+      EXPECT_NEAR(e, q[size_t(c)], 2e-3 * q[size_t(c)]) << face << " " << c;
+    }
+  }
+  // White furnace: E = π for every normal.
+  for (float e : irradiance_cube(EnvMap::constant({1, 1, 1}), 2)) EXPECT_NEAR(e, pi, 1e-6);
+}
+
+TEST(Fiv, IrradianceCubeCellsEqualTheTexelByTexelReference) {
+  // The cell hierarchy only regroups a sum (cells wholly above a horizon add their texels'
+  // moments at once): on a real HDR map with a sun the two agree to float rounding of the
+  // output (a few ulps; the doubles differ only by summation order).
+  const EnvMap env = EnvMap::load(std::string(PRT_DATA_DIR) + "/sunset.exr", UpAxis::Y);
+  const auto fast = irradiance_cube(env, 6), slow = irradiance_cube_reference(env, 6);
+  ASSERT_EQ(fast.size(), slow.size());
+  for (size_t i = 0; i < fast.size(); ++i) EXPECT_NEAR(fast[i], slow[i], 4e-7 * std::abs(slow[i])) << i;
+}
+
+TEST(Fiv, OccludedFivMatchesQmcFullSphere) {
+  const EnvMap env = test_env();
+  const Mesh m = load_mesh(std::string(PRT_DATA_DIR) + "/bunny.obj", {.use_file_normals = false});
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  const SilhouetteIntegrator sil(m, topo, req, {256, 1});
+  const QmcIntegrator qmc(m, topo, req, {262144, 5});
+  const Fiv fenv = environment_fiv(env);
+  Vector3d c;
+  double R;
+  bounding_sphere(m, c, R);
+  for (const Vector3d& off : {Vector3d(1.3, 0.2, 0.1), Vector3d(-0.4, 1.1, 0.9), Vector3d(0.2, -1.05, 0.3)}) {
+    const Vector3d p = c + R * off;
+    const Fiv f = occluded_fiv(sil, p);
+    Fiv se;
+    const Fiv fq = qmc_occluded_fiv(qmc, fenv, p, 0, &se);
+    for (int ch = 0; ch < 3; ++ch) {
+      const double scale = std::abs(fenv[size_t(3 * ch)]) + std::abs(fenv[size_t(3 * ch + 1)]) + std::abs(fenv[size_t(3 * ch + 2)]);
+      for (int a = 0; a < 3; ++a) {
+        const size_t k = size_t(3 * ch + a);
+        // 4 standard errors of QMC plus the silhouette's discretisation at k = 256² (2e-3 of |F^env|).
+        EXPECT_NEAR(f[k], fq[k], 4 * se[k] + 2e-3 * scale) << "offset " << off.transpose() << " c" << ch << " a" << a;
+      }
+    }
+  }
+}
+
+TEST(Fiv, InsideClosedGeometryIsInvalidAndFullyOccluded) {
+  const EnvMap env = test_env();
+  const Mesh m = box({-1, -1, -1}, {1, 1, 1});
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 1;
+  const SilhouetteIntegrator sil(m, topo, req, {64, 1});
+  bool inside = false;
+  const Fiv f = occluded_fiv(sil, Vector3d(0.1, 0.2, -0.3), &inside);
+  EXPECT_TRUE(inside);
+  std::vector<double> all(10);
+  sil.unoccluded(all);
+  for (int c = 0; c < 3; ++c) {
+    const double expect[3] = {-all[1 + size_t(3 * c + 2)] / 0.48860251190291992159, -all[1 + size_t(3 * c)] / 0.48860251190291992159,
+                              all[1 + size_t(3 * c + 1)] / 0.48860251190291992159};
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(f[size_t(3 * c + a)], expect[a], 1e-12 * (1 + std::abs(expect[a])));
+  }
+  occluded_fiv(sil, Vector3d(3, 0.2, 0.1), &inside);
+  EXPECT_FALSE(inside);
+}
+
+namespace {
+// A thin 2 × 0.02 × 2 plate (R = 1.4143) under a uniform grey sky, an 8x5x12 grid, fraction 0.02.
+struct PlateUnderGreySky {
+  EnvMap env = EnvMap::from_latlong(16, 8, std::vector<float>(16 * 8 * 3, 1.0f), UpAxis::Y, "grey");
+  Mesh m = box({-1, -0.01f, -1}, {1, 0.01f, 1});
+  Topology topo = build_topology(m);
+  ShellSpec spec = [] {
+    ShellSpec s;
+    s.n_phi = 8;
+    s.n_theta = 5;
+    s.n_rho = 12;
+    s.silhouette_k = 64 * 64;  // 64 u-isolines
+    s.fraction = 0.02;
+    return s;
+  }();
+};
+} // namespace
+
+TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
+  // The plate: radii run geometrically from 0.707 to R / (2√0.02) = 5.0 over 12 shells (… 2.94,
+  // 3.51, 4.19, 5.0). Face-on, the plate subtends Ω = 4 atan(1 / (ρ √(2 + ρ²))) and |F| ≈ Ω of
+  // ∫ L = 4π: 0.0237 at ρ = 3.51 (go on), 0.0170 at ρ = 4.19 (stop) — 11 shells.
+  const PlateUnderGreySky p;
+  const FivShells s = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
+  EXPECT_NEAR(s.radius, std::sqrt(2.0001), 1e-6);
+  ASSERT_EQ(s.radii.size(), 11u) << "stops at the first shell below the fraction";
+  for (size_t k = 1; k < s.radii.size(); ++k) EXPECT_GT(s.radii[k], s.radii[k - 1]);
+  EXPECT_NEAR(s.radii[0], 0.5 * s.radius, 1e-9);
+  ASSERT_EQ(s.values.size(), s.radii.size() * 5 * 8 * 9);
+  ASSERT_EQ(s.valid.size(), s.radii.size() * 5 * 8);
+  // First shell (ρ = 0.707): the equator row θ = π/2 lies inside the plate (|y| = 0 < 0.01).
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 8; ++j) EXPECT_EQ(s.valid[size_t(i * 8 + j)], i == 2 ? 0 : 1) << i << " " << j;
+  for (float x : s.values) EXPECT_TRUE(std::isfinite(x));
+}
+
+// A merge's FivShellRows (the mesh and the spec only: no environment, no integrator) has the
+// integrating one's frame, radii and stopping rule, and appends the same shells from its rows.
+TEST(Fiv, FrameOnlyShellRowsAgreeWithTheIntegratingOnes) {
+  const PlateUnderGreySky p;
+  const FivShellRows baker(p.m, p.topo, p.env, p.spec), frame(p.m, p.spec);
+  ASSERT_EQ(frame.shell_count(), baker.shell_count());
+  ASSERT_EQ(frame.rows_per_shell(), baker.rows_per_shell());
+  FivShells a = baker.empty_shells(), b = frame.empty_shells();
+  EXPECT_EQ(a.centre, b.centre);
+  EXPECT_EQ(a.radius, b.radius);
+  for (int k = 0; k < baker.shell_count(); ++k) {
+    EXPECT_EQ(frame.radius(k), baker.radius(k));
+    const std::vector<double> rows = baker.rows(k, 0, baker.rows_per_shell());
+    baker.append(a, k, rows);
+    frame.append(b, k, rows);
+    ASSERT_EQ(frame.stops_after(k, rows), baker.stops_after(k, rows)) << "shell " << k;
+    if (baker.stops_after(k, rows)) break;
+  }
+  const FivShells whole = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
+  EXPECT_EQ(b.radii, whole.radii);
+  EXPECT_EQ(b.values, whole.values);
+  EXPECT_EQ(b.valid, whole.valid);
+  EXPECT_EQ(a.values, whole.values);
+  EXPECT_THROW((void)frame.rows(0, 0, 1), ContractError);  // nothing to integrate with
+}

@@ -1,0 +1,50 @@
+// bake_scene's progress (bake/bake/scene.h): the receivers' vertices are one stage, "baking
+// receivers", whose count runs over every receiver (one ETA for the scene) and finishes once,
+// with the last of them.
+#include <bake/bake/scene.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace prt::bake;
+
+TEST(SceneBake, TheReceiversAreOneProgressStageOverAllTheirVertices) {
+  SceneDescription scene = load_scene(fs::path(PRT_DATA_DIR) / "scene_example.json");
+  scene.integrator.report_points = 0;
+  scene.want_fiv = false;
+  scene.integrator.set_samples(256);  // 16 isolines: the stage, not the values, is under test
+  std::vector<std::string> warnings;
+  const std::vector<Mesh> meshes = load_scene_meshes(scene, warnings);
+  const EnvMap env = EnvMap::load(*scene.environment, scene.up);
+  const ScenePlan plan = plan_scene(scene, meshes);
+  uint64_t receivers = 0;
+  size_t objects = 0;
+  for (size_t i = 0; i < meshes.size(); ++i)
+    if (plan.objects[i].receiver && plan.objects[i].any_vertex_product()) receivers += meshes[i].positions.size(), ++objects;
+  ASSERT_GE(objects, 2u) << "the stage must span several objects";
+  std::vector<ProgressUpdate> seen;
+  std::vector<std::string> tasks;
+  Monitor monitor;
+  monitor.on_progress = [&](const ProgressUpdate& u) {
+    if (std::string(u.task).starts_with("baking")) seen.push_back(u), tasks.emplace_back(u.task);
+  };
+  const SceneBake out = bake_scene(scene, plan, meshes, &env, monitor, [](const std::string&) {});
+  EXPECT_EQ(out.vertices, receivers);
+  ASSERT_FALSE(seen.empty());
+  size_t finished = 0;
+  uint64_t last = 0;
+  for (size_t k = 0; k < seen.size(); ++k) {
+    EXPECT_EQ(tasks[k], "baking receivers");
+    EXPECT_EQ(seen[k].total, receivers);
+    EXPECT_GE(seen[k].done, last) << "the count never restarts";
+    last = seen[k].done;
+    finished += seen[k].finished;
+  }
+  EXPECT_EQ(finished, 1u);
+  EXPECT_TRUE(seen.back().finished);
+  EXPECT_EQ(seen.back().done, receivers);
+}

@@ -1,0 +1,328 @@
+// Stiff and extreme cases for the silhouette integrator (issue: "each a test with an exact or
+// relational expectation"). Exact expectations come from Lambert's polygon formula and solid
+// angles; relational ones from the QMC reference within its standard error, or from a clean twin
+// of the scene.
+#include <bake/mesh/mesh.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/mesh/receivers.h>
+#include <bake/sphere/sampling.h>
+
+#include <gtest/gtest.h>
+#include <test_scenes.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace prt::bake;
+using prt::testing::grid;
+using prt::testing::grid_centre;
+using prt::testing::polygon_form_factor;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+using std::numbers::pi;
+using Tris = std::vector<std::array<uint32_t, 3>>;
+
+namespace {
+
+// At k = 256² the discretisation error of smooth integrands is O(h²) ≈ 6e-5 (issue: ≤ 1e-4).
+constexpr double kTol = 1e-4;
+constexpr int kN = 256;
+
+
+// Solid angle of a planar convex polygon seen from p (fan of Van Oosterom–Strackee triangles).
+double polygon_solid_angle(const Vector3d& p, const std::vector<Vector3d>& poly) {
+  double s = 0;
+  const Vector3d a = poly[0] - p;
+  for (size_t i = 1; i + 1 < poly.size(); ++i) {
+    const Vector3d b = poly[i] - p, c = poly[i + 1] - p;
+    const double num = a.dot(b.cross(c));
+    const double den = a.norm() * b.norm() * c.norm() + a.dot(b) * c.norm() + a.dot(c) * b.norm() + b.dot(c) * a.norm();
+    s += 2 * std::atan2(std::abs(num), den);
+  }
+  return s;
+}
+
+Mesh quad(const std::vector<Vector3f>& c, const std::string& name) { return make_mesh(c, {{0, 1, 2}, {0, 2, 3}}, name); }
+
+
+Mesh merge(std::vector<Mesh> parts) { return merge_meshes(parts, "scene"); }
+
+double ao_at(const Mesh& m, const ShadePoint& sp, int n = kN) {
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.ao = true;
+  SilhouetteIntegrator sil(m, topo, req, {n, 1});
+  double ao = -1;
+  sil.integrate(sp, 0, std::span(&ao, 1));
+  EXPECT_TRUE(std::isfinite(ao));
+  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  return ao;
+}
+
+ShadePoint free_point(Vector3d p, Vector3d n = Vector3d::UnitZ()) {
+  ShadePoint s;
+  s.p = p;
+  s.n = n.normalized();
+  return s;
+}
+
+const std::vector<Vector3f> kSquare = {{-0.5f, -1, 1}, {1.5f, -1, 1}, {1.5f, 1, 1}, {-0.5f, 1, 1}};
+std::vector<Vector3d> to_d(const std::vector<Vector3f>& v) {
+  std::vector<Vector3d> o;
+  for (auto& x : v) o.push_back(x.cast<double>());
+  return o;
+}
+
+} // namespace
+
+TEST(Stiff, CoplanarDuplicateTrianglesChangeNothing) {
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
+  const double once = ao_at(quad(kSquare, "sq"), free_point({0, 0, 0}));
+  const double twice = ao_at(merge({quad(kSquare, "a"), quad(kSquare, "b")}), free_point({0, 0, 0}));
+  // The same square again, split along the other diagonal (coplanar, overlapping, not identical).
+  const double other = ao_at(merge({quad(kSquare, "a"), make_mesh(kSquare, {{0, 1, 3}, {1, 2, 3}}, "b")}),
+                             free_point({0, 0, 0}));
+  EXPECT_NEAR(once, exact, kTol);
+  EXPECT_NEAR(twice, once, 1e-12);
+  EXPECT_NEAR(other, once, 1e-12);
+}
+
+TEST(Stiff, ZeroAreaAndNeedleTrianglesChangeNothing) {
+  const double base = ao_at(quad(kSquare, "sq"), free_point({0, 0, 0}));
+  std::vector<Vector3f> p = kSquare;
+  p.push_back({0.5f, 0, 1});      // 4: centre of the square
+  p.push_back({0.5f, 0, 2});      // 5: above it
+  p.push_back({0.5f, 0, 3});      // 6: collinear with 4, 5
+  p.push_back({0.5f, 1e-6f, 2});  // 7: a needle's far corner
+  Tris t = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {5, 5, 6}, {4, 4, 4}};  // + zero-area: collinear, repeated
+  EXPECT_NEAR(ao_at(make_mesh(p, t, "degenerate"), free_point({0, 0, 0})), base, 1e-12);
+  t.push_back({4, 5, 7});  // a needle 1e-6 wide standing on the square: area ≈ 5e-7
+  EXPECT_NEAR(ao_at(make_mesh(p, t, "needle"), free_point({0, 0, 0})), base, 1e-6);
+}
+
+TEST(Stiff, ThinTwoSidedPlateOccludesLikeItsOutline) {
+  // A plate of thickness 1e-5 (a flat box) over p, and the same plate as two coincident sheets
+  // wound oppositely: both occlude exactly the outline's form factor.
+  const float z0 = 1, z1 = 1 + 1e-5f;
+  std::vector<Vector3f> p = {{-0.5f, -1, z0}, {1.5f, -1, z0}, {1.5f, 1, z0}, {-0.5f, 1, z0},
+                             {-0.5f, -1, z1}, {1.5f, -1, z1}, {1.5f, 1, z1}, {-0.5f, 1, z1}};
+  Tris box = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+              {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
+  EXPECT_NEAR(ao_at(make_mesh(p, box, "plate"), free_point({0, 0, 0})), exact, kTol);
+  Tris sheets = {{0, 1, 2}, {0, 2, 3}, {0, 2, 1}, {0, 3, 2}};
+  EXPECT_NEAR(ao_at(make_mesh(p, sheets, "sheets"), free_point({0, 0, 0})), exact, kTol);
+  // Seen from inside the thin plate: enclosed.
+  EXPECT_EQ(ao_at(make_mesh(p, box, "plate"), free_point({0.5, 0, 1 + 5e-6})), 0.0);
+}
+
+TEST(Stiff, EdgeSharedByThreeFacesMatchesQmc) {
+  // A "book" of three pages on a common spine above p: non-manifold edge with 3 faces.
+  std::vector<Vector3f> p = {{-1, 0, 1}, {1, 0, 1}, {-1, 1, 1.2f}, {1, 1, 1.2f}, {-1, -1, 1.3f}, {1, -1, 1.3f},
+                             {-1, 0.3f, 2}, {1, 0.3f, 2}};
+  Tris t = {{0, 1, 3}, {0, 3, 2}, {0, 1, 5}, {0, 5, 4}, {0, 1, 7}, {0, 7, 6}};
+  std::vector<Mesh> parts{grid(2, 3), make_mesh(p, t, "book")};
+  const Mesh m = merge(parts);
+  const Topology topo = build_topology(m);
+  bool has_three = false;
+  for (size_t e = 0; e < topo.edges.size(); ++e) has_three |= topo.faces_of_edge(uint32_t(e)).size() == 3;
+  ASSERT_TRUE(has_three);
+  ProductRequest req;
+  req.ao = true;
+  req.transfer_order = 2;
+  SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+  QmcIntegrator qmc(m, topo, req, {65536, 3});
+  const ShadePoint sp = vertex_shade_point(m, topo, 2 * 5 * 2 + 2);  // the ground's centre vertex
+  std::vector<double> a(5), b(5), se(5);
+  sil.integrate(sp, 0, a);
+  qmc.integrate(sp, 0, b, se);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << k;
+  EXPECT_LT(a[0], 0.99);  // the book does shadow the point (its steep pages subtend little)
+}
+
+TEST(Stiff, AxisAlignedCubeOnTheOctahedralSeamsThroughP) {
+  // A unit cube with faces on the planes x = 0 and y = 0 through p (the octahedral seams of an
+  // unrotated frame) above p. Convex: its front faces tile its silhouette.
+  std::vector<Vector3f> c;
+  for (int k = 0; k < 8; ++k) c.emplace_back(k & 1 ? 1.f : 0.f, k & 2 ? 1.f : 0.f, k & 4 ? 2.f : 1.f);
+  Tris t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  // Seen from the origin only the bottom face (z = 1) faces p; the x = 0 and y = 0 faces are edge-on.
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(),
+                                               {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}});
+  EXPECT_NEAR(ao_at(make_mesh(c, t, "cube"), free_point({0, 0, 0})), exact, kTol);
+  // The cube lowered to straddle z = 0, so p lies on its vertical edge x = y = 0: faces x = 0 and
+  // y = 0 contain p and stay edge-on in the limit. From p + εn the solid fills exactly the quadrant
+  // x, y > 0, a quarter of the cosine-weighted hemisphere: AO = 3/4 exactly. (A ray caster cannot
+  // take this case: its rays start on the faces.)
+  std::vector<Vector3f> c2;
+  for (auto v : c) c2.push_back(v - Vector3f(0, 0, 1.5f));
+  EXPECT_NEAR(ao_at(make_mesh(c2, t, "cube2"), free_point({0, 0, 0})), 0.75, kTol);
+}
+
+TEST(Stiff, GroundPlaneThroughP) {
+  // p on a ground triangle's interior (not a vertex) and at a ground vertex: the plane itself
+  // occludes nothing of the upper hemisphere.
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
+  const Mesh m = merge({grid(2, 4), quad(kSquare, "sq")});
+  EXPECT_NEAR(ao_at(m, free_point({0.1234, 0.0567, 0})), 1 - polygon_form_factor({0.1234, 0.0567, 0}, Vector3d::UnitZ(), to_d(kSquare)), kTol);
+  const Topology topo = build_topology(m);
+  EXPECT_NEAR(ao_at(m, vertex_shade_point(m, topo, 2 * 5 + 2)), exact, kTol);
+  EXPECT_NEAR(ao_at(m, free_point({0, 0, 0})), exact, kTol);  // the same vertex as a free point
+}
+
+TEST(Stiff, OccluderCrossingTheHorizon) {
+  // A wall x = 1, |y| ≤ 1, -1 ≤ z ≤ 1 seen from p = 0 with n = +z: only its upper half counts.
+  const std::vector<Vector3f> wall = {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}};
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(),
+                                               {{1, -1, 0}, {1, 1, 0}, {1, 1, 1}, {1, -1, 1}});
+  EXPECT_NEAR(ao_at(quad(wall, "wall"), free_point({0, 0, 0})), exact, kTol);
+  // Tilted normal: the horizon cuts the wall obliquely; compare with QMC.
+  const Mesh m = quad(wall, "wall");
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.ao = true;
+  req.transfer_order = 3;
+  const ShadePoint sp = free_point({0, 0, 0}, {0.4, 0.3, 1});
+  SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+  QmcIntegrator qmc(m, topo, req, {65536, 9});
+  std::vector<double> a(10), b(10), se(10);
+  sil.integrate(sp, 0, a);
+  qmc.integrate(sp, 0, b, se);
+  for (int k = 0; k < 10; ++k) EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << k;
+}
+
+TEST(Stiff, FullSphereModeSolidAngles) {
+  // No normal, no hemisphere: ∫ V y_00 dω = (4π − Ω(square)) / (2√π).
+  const Mesh m = quad(kSquare, "sq");
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.visibility_order = 1;
+  SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+  ShadePoint sp = free_point({0, 0, 0});
+  sp.hemisphere = false;
+  double u0;
+  sil.integrate(sp, 0, std::span(&u0, 1));
+  const double omega = polygon_solid_angle(Vector3d::Zero(), to_d(kSquare));
+  EXPECT_NEAR(u0, (4 * pi - omega) / (2 * std::sqrt(pi)), kTol);
+}
+
+TEST(Stiff, SaddleAndCreaseVerticesMatchQmcInTheLimitFromAbove) {
+  // z = 0.8 (x² − y²) sampled on a 9×9 grid (saddle at the centre), z = |x| (a concave valley
+  // crease) and z = −0.7|x| (a convex ridge),
+  // both shaded at the centre vertex: two independent treatments of the 1-ring limit (QMC's
+  // analytic cone test, the silhouette's ε-predicates) must agree.
+  for (int shape = 0; shape < 3; ++shape) {
+    std::vector<Vector3f> p;
+    Tris t;
+    const int n = 9;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const float x = (i - 4) * 0.25f, y = (j - 4) * 0.25f;
+        const float z = shape == 0 ? 0.8f * (x * x - y * y) : shape == 1 ? std::abs(x) : -0.7f * std::abs(x);
+        p.emplace_back(x, y, z);
+      }
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i) {
+        const uint32_t a = uint32_t(j * n + i), b = a + 1, c = a + uint32_t(n) + 1, d = a + uint32_t(n);
+        t.push_back({a, b, c});
+        t.push_back({a, c, d});
+      }
+    const Mesh m = make_mesh(p, t, "surface");
+    const Topology topo = build_topology(m);
+    ProductRequest req;
+    req.ao = true;
+    req.transfer_order = 3;
+    SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+    QmcIntegrator qmc(m, topo, req, {65536, 21});
+    const ShadePoint sp = vertex_shade_point(m, topo, 4 * n + 4);
+    std::vector<double> a(10), b(10), se(10);
+    sil.integrate(sp, 0, a);
+    qmc.integrate(sp, 0, b, se);
+    for (int k = 0; k < 10; ++k)
+      EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << "shape " << shape << " value " << k;
+    EXPECT_EQ(sil.stats().inconsistent_loops, 0u) << "shape " << shape;
+    if (shape == 1) {
+      EXPECT_LT(a[0], 0.95) << "a concave crease occludes its own vertex";
+    }
+    if (shape == 2) {
+      EXPECT_NEAR(a[0], 1.0, kTol) << "a convex ridge does not";
+    }
+  }
+}
+
+TEST(Stiff, TranslationAndScaleInvariance) {
+  // A scene on a dyadic grid, so translating by 2^17 (≈ 1.3e5) and scaling by 2^-13 (≈ 1.2e-4)
+  // are exact in float: the answers must agree to rounding of the double predicates.
+  auto scene = [](float s, Vector3f off) {
+    std::vector<Vector3f> sq, g;
+    for (const auto& v : kSquare) sq.push_back(v * s + off);
+    Mesh gr = grid(2, 4);
+    for (auto& v : gr.positions) v = v * s + off;
+    gr = make_mesh(gr.positions, gr.triangles, "ground");
+    return merge({gr, quad(sq, "sq")});
+  };
+  const Mesh base = scene(1, Vector3f::Zero());
+  const Topology tb = build_topology(base);
+  const double a0 = ao_at(base, vertex_shade_point(base, tb, 12));
+  const Mesh far = scene(1, Vector3f(131072, -131072, 131072));
+  const Topology tf = build_topology(far);
+  EXPECT_NEAR(ao_at(far, vertex_shade_point(far, tf, 12)), a0, 1e-9);
+  const Mesh tiny = scene(std::ldexp(1.0f, -13), Vector3f::Zero());
+  const Topology tt = build_topology(tiny);
+  EXPECT_NEAR(ao_at(tiny, vertex_shade_point(tiny, tt, 12)), a0, 1e-9);
+}
+
+TEST(Stiff, VeryLowAndVeryHighK) {
+  const double exact = 1 - polygon_form_factor(Vector3d::Zero(), Vector3d::UnitZ(), to_d(kSquare));
+  const Mesh m = merge({grid(2, 4), quad(kSquare, "sq")});
+  const Topology topo = build_topology(m);
+  for (int n : {2, 4, 1024}) {
+    const double ao = ao_at(m, vertex_shade_point(m, topo, 12), n);
+    EXPECT_GE(ao, 0.0);
+    EXPECT_LE(ao, 1.0 + 1e-9);
+    if (n == 1024) {
+      EXPECT_NEAR(ao, exact, kTol / 4);
+    }
+  }
+}
+
+TEST(Stiff, BoundaryVertexOfAHalfPlane) {
+  // A flat half-plane z = 0, y ≥ 0 (a fan of 4 large triangles) shaded at the origin on its
+  // boundary: the spokes along the boundary are 1-face contour edges that start at the shade
+  // point itself, seen from p + εn in direction −n.
+  const float S = 1000;
+  std::vector<Vector3f> p = {{0, 0, 0}, {S, 0, 0}, {S, S, 0}, {-S, S, 0}, {-S, 0, 0}};
+  const Tris t = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}};
+  // Full sphere: the half-plane covers exactly half of the lower hemisphere (solid angle π) in the
+  // limit, so ∫ V y_00 = (4π − π) · y_00 (the planes' far edges, 1000 away, cut < 1e-6 of it).
+  {
+    const Mesh m = make_mesh(p, t, "halfplane", std::vector<Vector3f>(p.size(), Vector3f(0, 0, 1)));
+    const Topology topo = build_topology(m);
+    ProductRequest req;
+    req.visibility_order = 1;
+    SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+    ShadePoint sp = vertex_shade_point(m, topo, 0);
+    sp.hemisphere = false;
+    double u0;
+    sil.integrate(sp, 0, std::span(&u0, 1));
+    EXPECT_NEAR(u0, 3 * pi / (2 * std::sqrt(pi)), kTol);
+  }
+  // Hemisphere with n tilted over the plane (+y): part of the upper hemisphere dips below z = 0 on
+  // the plane's side and is blocked. Compare with QMC's independent analytic 1-ring test.
+  const Vector3f tilt = Vector3f(0, 0.5f, 1).normalized();
+  const Mesh m = make_mesh(p, t, "halfplane", std::vector<Vector3f>(p.size(), tilt));
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.ao = true;
+  req.transfer_order = 2;
+  SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+  QmcIntegrator qmc(m, topo, req, {65536, 13});
+  const ShadePoint sp = vertex_shade_point(m, topo, 0);
+  std::vector<double> a(5), b(5), se(5);
+  sil.integrate(sp, 0, a);
+  qmc.integrate(sp, 0, b, se);
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << k;
+  EXPECT_LT(a[0], 0.99);
+}
