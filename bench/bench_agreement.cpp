@@ -6,11 +6,11 @@
 //
 //   bench_agreement                    defaults: 24 seeded vertices per scene, N = 256, 10^6 rays
 //   PRT_AGREE_POINTS, PRT_AGREE_ISOLINES, PRT_AGREE_RAYS override them.
+#include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 
 #include <tbb/parallel_for.h>
 

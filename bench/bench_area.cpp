@@ -20,9 +20,9 @@
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
-#include <bake/visibility/occluder_mesh.h>
 #include <bake/sphere/polygon_sh.h>
 #include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/occluder_mesh.h>
 #include <bake/visibility/visible_region.h>
 
 #include <benchmark/benchmark.h>

@@ -1,7 +1,7 @@
 #include <bench_common.h>
 
-#include <bake/mesh/subdivide.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/mesh/subdivide.h>
 
 #include <chrono>
 #include <cstdlib>

@@ -16,8 +16,8 @@
 #pragma once
 
 #include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
+#include <bake/mesh/mesh.h>
 
 #include <cstdint>
 #include <memory>

@@ -19,8 +19,8 @@
 //   PRT_BENCH_POINTS, PRT_BENCH_SEED (bench_common.h)
 #include <bench_common.h>
 
-#include <bake/visibility/contour.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/visibility/contour.h>
 
 #include <algorithm>
 #include <cmath>

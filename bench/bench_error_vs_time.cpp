@@ -22,8 +22,8 @@
 // PRT_BENCH_REF_RAYS, PRT_BENCH_QMC_SAMPLES and PRT_BENCH_ISOLINES set the same things.
 #include <bench_common.h>
 
-#include <bake/integrators/qmc.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/qmc.h>
 
 #include <tbb/parallel_for.h>
 

@@ -28,12 +28,12 @@
 // Errors are over the reference's vertices; "rays/pt" counts pass-1 and brute-force rays (the
 // filter) or rays (QMC); CPU seconds are the process's (every thread), including the filter's
 // neighbour search (prepare() and the k-d tree queries) and pass 1.
-#include <bake/integrators/filter.h>
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/qmc.h>
-#include <bake/sphere/sampling.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/filter.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
+#include <bake/sphere/sampling.h>
 
 #include <tbb/parallel_for.h>
 

@@ -4,10 +4,10 @@
 // Accuracy: at seeded random offsets (radii between 0.5 R and 8 R), the silhouette's occluded FIV
 // (k = 128², the bake's default) against F^env − ∫ V L ω dω from QMC (full-sphere mode); RMSE over
 // offsets and RGB·xyz, relative to the RMS of |F^env| components.
-#include <bake/environment/envmap.h>
 #include <bake/bake/fiv.h>
-#include <bake/mesh/mesh.h>
+#include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
+#include <bake/mesh/mesh.h>
 #include <bake/sphere/sampling.h>
 
 #include <tbb/parallel_for.h>

@@ -32,11 +32,11 @@
 #include <arch_scene.h>
 #include <point_on_triangle.h>
 
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/qmc.h>
-#include <bake/visibility/raycast.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
+#include <bake/visibility/raycast.h>
 
 #include <tbb/info.h>
 

@@ -41,11 +41,11 @@
 //                         [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M]
 //                         [--cache PATH] FILE.prt.h5...
 //   bench_reference_error MESH --geometry
+#include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
 #include <bake/integrators/qmc.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 
 #include <tbb/parallel_for.h>

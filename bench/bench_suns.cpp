@@ -16,11 +16,11 @@
 //
 // The same source builds against an older libbake for a before/after comparison (the command is in
 // bench/RESULTS.md).
+#include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 
 #include <tbb/parallel_for.h>
 

@@ -34,10 +34,10 @@
 #include <arch_scene.h>
 
 #include <bake/bake/choose.h>
-#include <bake/mesh/mesh.h>
+#include <bake/bake/vertex_bake.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>

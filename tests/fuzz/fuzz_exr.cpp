@@ -3,8 +3,8 @@
 // both up axes, then projected to SH order 3 as a bake does. Accepted failure: bake::InputError.
 #include "fuzz_common.h"
 
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path path = prt::fuzz::write_input("input.exr", prt::fuzz::as_bytes(data, size));

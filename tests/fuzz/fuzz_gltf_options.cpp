@@ -5,8 +5,8 @@
 // paths). Accepted failure: bake::InputError.
 #include "fuzz_common.h"
 
-#include <bake/core/error.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
 
 namespace {
 

@@ -3,8 +3,8 @@
 // environment it names are not opened by load_scene). Accepted failure: bake::InputError.
 #include "fuzz_common.h"
 
-#include <bake/core/error.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path path = prt::fuzz::write_input("input.json", prt::fuzz::as_bytes(data, size));

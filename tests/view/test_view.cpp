@@ -8,9 +8,9 @@
 #include <view/raster.h>
 #include <view/reference.h>
 
-#include <bake/environment/envmap.h>
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
+#include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 #include <bake/environment/irradiance.h>
 #include <bake/mesh/mesh.h>
 #include <bake/sphere/sampling.h>

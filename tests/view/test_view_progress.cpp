@@ -3,9 +3,9 @@
 #include <view/camera.h>
 #include <view/reference.h>
 
+#include <bake/core/progress.h>
 #include <bake/environment/envmap.h>
 #include <bake/mesh/mesh.h>
-#include <bake/core/progress.h>
 
 #include <gtest/gtest.h>
 #include <progress_recorder.h>

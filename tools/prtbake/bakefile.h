@@ -4,11 +4,11 @@
 // attributes whichever command baked it (docs/ARCHITECTURE.md §4).
 #pragma once
 
-#include <bake/environment/envmap.h>
 #include <bake/bake/fiv.h>
+#include <bake/bake/vertex_bake.h>
+#include <bake/environment/envmap.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
-#include <bake/bake/vertex_bake.h>
 #include <formats/asset.h>
 
 #include <string>

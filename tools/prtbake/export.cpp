@@ -4,8 +4,8 @@
 #include "cli.h"
 #include "tool_main.h"
 
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 #include <formats/export.h>
 
 #include <algorithm>

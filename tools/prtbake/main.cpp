@@ -2,14 +2,14 @@
 // one subcommand per kind of bake, each with only the options that apply to it, into the typed
 // specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/bake/choose.h>
-#include <bake/environment/envmap.h>
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
-#include <bake/environment/irradiance.h>
-#include <bake/mesh/mesh.h>
-#include <bake/core/sha256.h>
 #include <bake/bake/scene.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
+#include <bake/core/sha256.h>
+#include <bake/environment/envmap.h>
+#include <bake/environment/irradiance.h>
+#include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 #include <prtshade/sh.h>
 
@@ -767,20 +767,8 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
     warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
                 a.flip_normals);
     if (say) {
-      std::printf("baked %zu vertices in %.2f s (%.0f integrals/s", mesh.positions.size(), result.seconds,
+      std::printf("baked %zu vertices in %.2f s (%.0f integrals/s)\n", mesh.positions.size(), result.seconds,
                   mesh.positions.size() / result.seconds);
-      if (spec.kind == bake::IntegratorKind::Qmc)
-        std::printf(", %.2f M rays/s", double(mesh.positions.size()) * spec.qmc_rays / result.seconds / 1e6);
-      if (spec.kind == bake::IntegratorKind::Silhouette) {
-        const bake::IntegratorStats st = integrator.stats();
-        std::printf("; per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% "
-                    "integration",
-                    double(st.contour_edges) / double(std::max<uint64_t>(st.points, 1)),
-                    double(st.crossings) / double(std::max<uint64_t>(st.points, 1)),
-                    100 * st.contour_seconds / std::max(1e-12, st.contour_seconds + st.integrate_seconds),
-                    100 * st.integrate_seconds / std::max(1e-12, st.contour_seconds + st.integrate_seconds));
-      }
-      std::printf(")\n");
       if (const std::string work = integrator.work_summary(); !work.empty()) std::printf("%s\n", work.c_str());
       if (shards && shards->threads_of_chunks() == 0)  // chunks of other workers or runs: their threads are not recorded
         std::printf("chunks: %.2f CPU s in the integrator over %.2f s of chunk wall time, summed over the chunks of "
@@ -840,9 +828,10 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
           std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                       "counted in the bake time):\n",
                       spec.reference_rays(), report->vertices.size(), report->reference_seconds);
-          // The bake's own standard error is QMC's estimate; the silhouette integrator is deterministic
-          // (its error is a bias, which only the comparison measures), so it has none to print.
-          const bool sampled = integrator.kind() != bake::IntegratorKind::Silhouette;
+          // The bake's own standard error is a sampled integrator's estimate; a deterministic one
+          // (silhouette: its error is a bias, which only the comparison measures) has none to print.
+          const bool sampled = std::any_of(report->products.begin(), report->products.end(),
+                                           [](const auto& e) { return e.bake_std_error > 0; });
           for (const auto& e : report->products) {
             std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse,
                         e.max_abs, e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
@@ -868,12 +857,9 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
         *chosen, bake::target_verdicts(*report, a.target_error, reference_plan ? &*reference_plan : nullptr));
     if (!better) break;
     if (say) {
-      std::printf("the check puts the bake's error above the target: baking again with %s at %u %s (was %u; the "
+      std::printf("the check puts the bake's error above the target: baking again with %s at %s (was %s; the "
                   "pilot's rate from the check's measured error; once)\n",
-                  bake::to_string(better->kind), better->kind == bake::IntegratorKind::Silhouette
-                                                     ? unsigned(better->isolines()) : unsigned(better->samples()),
-                  better->kind == bake::IntegratorKind::Silhouette ? "isolines" : "rays",
-                  spec.kind == bake::IntegratorKind::Silhouette ? unsigned(spec.isolines()) : unsigned(spec.samples()));
+                  bake::to_string(better->kind), better->knob_text().c_str(), spec.knob_text().c_str());
       std::fflush(stdout);
     }
     spec = *better;

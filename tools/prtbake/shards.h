@@ -28,9 +28,9 @@
 // one wall time of many workers, and a target error's choice must be the same on every worker.
 #pragma once
 
+#include <bake/bake/vertex_bake.h>
 #include <bake/core/chunks.h>
 #include <bake/core/progress.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <CLI/CLI.hpp>
 

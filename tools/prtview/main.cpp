@@ -16,9 +16,9 @@
 #include <view/reference.h>
 #include <view/text.h>
 
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>
+#include <bake/environment/envmap.h>
 #include <formats/asset.h>
 
 #include <CLI/CLI.hpp>

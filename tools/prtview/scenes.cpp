@@ -5,8 +5,8 @@
 
 #include <view/raster.h>
 
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
+#include <bake/core/error.h>
 #include <bake/environment/irradiance.h>
 #include <prtshade/fiv.h>
 #include <formats/names.h>

@@ -1,12 +1,12 @@
 #include <view/area_lights.h>
 
-#include <bake/lights/area_bake.h>
-#include <bake/visibility/contour.h>
 #include <bake/core/error.h>
-#include <bake/visibility/occluder_mesh.h>
-#include <bake/visibility/raycast.h>
+#include <bake/lights/area_bake.h>
 #include <bake/sphere/sampling.h>
 #include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/contour.h>
+#include <bake/visibility/occluder_mesh.h>
+#include <bake/visibility/raycast.h>
 
 #include <prtshade/ltc.h>
 

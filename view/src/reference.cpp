@@ -3,9 +3,9 @@
 #include <view/reference.h>
 
 #include <bake/core/error.h>
-#include <bake/visibility/raycast.h>
-#include <bake/sphere/sampling.h>
 #include <bake/core/sha256.h>
+#include <bake/sphere/sampling.h>
+#include <bake/visibility/raycast.h>
 
 #include <IexBaseExc.h>
 #include <ImfChannelList.h>

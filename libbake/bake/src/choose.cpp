@@ -5,10 +5,10 @@
 #include <bake/bake/choose.h>
 
 #include <bake/core/error.h>
-#include <bake/sphere/octahedral.h>
 #include <bake/integrators/qmc.h>
-#include <bake/sphere/sampling.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/sphere/octahedral.h>
+#include <bake/sphere/sampling.h>
 
 #include <tbb/parallel_for.h>
 

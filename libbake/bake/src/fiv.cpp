@@ -1,9 +1,9 @@
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
+#include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
 #include <bake/environment/irradiance.h>
 #include <bake/integrators/qmc.h>
 #include <bake/sphere/sampling.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <tbb/parallel_for.h>
 

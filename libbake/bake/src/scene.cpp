@@ -1,7 +1,7 @@
 // scene.cpp — scene files and the bake plan (bake/bake/scene.h).
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
 #include <bake/sphere/zonal.h>
 
 #include <prtshade/sh.h>

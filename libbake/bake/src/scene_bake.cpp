@@ -1,8 +1,8 @@
 // scene_bake.cpp — runs a scene plan (bake/bake/scene.h): the receivers' per-vertex products against
 // the union of the occluders and the area lights' rows, then FIV shells per occluder that needs them.
-#include <bake/lights/area_bake.h>
-#include <bake/core/error.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
+#include <bake/lights/area_bake.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -254,8 +254,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       const double cpu = per_point * double(pts.size());
       const IntegratorSpec& spec = choose ? g.spec : scene.integrator;
       log(who + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(pts.size()) + " vertices with " +
-          to_string(spec.kind) + " at " + std::to_string(spec.samples()) +
-          (spec.kind == IntegratorKind::Silhouette ? " samples (" + std::to_string(spec.isolines()) + " isolines)" : " rays") +
+          to_string(spec.kind) + " at " + spec.knob_text() +
           printf_string(", %.3g s on ", cpu / threads) + std::to_string(int(threads)) + " threads (timed on " +
           std::to_string(sample.size()) + " seeded vertices)");
       if (g.reference_plan && g.reference_plan->us_per_ray > 0)
@@ -334,7 +333,6 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
     PRT_CHECK(integ != nullptr);
     const Integrator& integrator = *integ;
-    const bool silhouette = integrator.kind() == IntegratorKind::Silhouette;
     const std::string label = "baking " + scene.objects[i].name;
     if (rows.rows) {
       ob.values = rows.rows(set++, points, integrator, monitor, label, ob.closed_form_vertices);
@@ -353,7 +351,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (receivers <= kObjectLinesUpTo)
       log(scene.objects[i].name + ": " + std::to_string(points.size()) + " vertices in " +
           printf_string("%.2f s", ob.values->seconds) +
-          (silhouette ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)" : std::string()));
+          (ob.closed_form_vertices > 0 ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)"
+                                       : std::string()));
     if (ref && report_points > 0) checks.push_back({i, ref, ref2, group, report_points});
     if (group && --group->remaining == 0) group->integ.reset();  // its references stay for the checks
   }

@@ -1,7 +1,7 @@
-#include <bake/core/error.h>
-#include <bake/visibility/raycast.h>
-#include <bake/sphere/sampling.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
+#include <bake/sphere/sampling.h>
+#include <bake/visibility/raycast.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -49,12 +49,6 @@ VertexBake bake_point_rows(std::span<const ShadePoint> points, size_t begin, siz
   for (double x : out.values)
     if (!std::isfinite(x)) throw ContractError("bake_points: non-finite value from integrator " + integrator.name());
   return out;
-}
-
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,

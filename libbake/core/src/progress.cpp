@@ -1,5 +1,7 @@
 #include <bake/core/progress.h>
 
+#include <ctime>
+
 #include <algorithm>
 
 namespace prt::bake {
@@ -51,6 +53,12 @@ void Task::report(uint64_t done, bool final) noexcept {
   u.seconds = elapsed_seconds();
   u.finished = final;
   monitor_.on_progress(u);
+}
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 } // namespace prt::bake

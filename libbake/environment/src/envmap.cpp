@@ -1,8 +1,8 @@
 // Environment maps: OpenEXR reading, texel geometry, importance sampling, SH projection.
 // Conventions and policies are specified in bake/environment/envmap.h.
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>
+#include <bake/environment/envmap.h>
 
 #include <prtshade/sh.h>
 

@@ -1,12 +1,15 @@
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
 #include <bake/sphere/sampling.h>
 
 #include <prtshade/sh.h>
 
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -56,6 +59,18 @@ bool QmcIntegrator::visible(const ShadePoint& point, const Vector3d& d) const { 
 void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                               std::span<double> std_error) const {
   PRT_CHECK_OP(out.size(), >=, layout_.width);
+  // The point's time in here into the counters, however the call ends (steady_clock, as the
+  // silhouette integrator's: a thread CPU clock costs a system call per read).
+  struct Counted {
+    const QmcIntegrator& q;
+    std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
+    ~Counted() {
+      q.points_.fetch_add(1, std::memory_order_relaxed);
+      q.cpu_ns_.fetch_add(uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                       std::chrono::steady_clock::now() - t0).count()),
+                          std::memory_order_relaxed);
+    }
+  } counted{*this};
   // Full-sphere mode (H ≡ 1): the hemisphere strategies become one uniform-sphere strategy of the
   // same total weight; AO and diffuse transfer (defined with n·ω) are hemisphere products only.
   const bool full = !point.hemisphere;
@@ -116,6 +131,21 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
       std_error[k] = std::sqrt(var);
     }
   }
+}
+
+IntegratorStats QmcIntegrator::stats() const {
+  IntegratorStats s;
+  s.points = points_.load();
+  s.integrate_seconds = double(cpu_ns_.load()) * 1e-9;
+  return s;
+}
+
+std::string QmcIntegrator::work_summary() const {
+  const IntegratorStats st = stats();
+  char line[160];
+  std::snprintf(line, sizeof line, "%u rays per point; %.2f M rays per second of integrator time", unsigned(options_.rays),
+                st.integrate_seconds > 0 ? double(st.points) * options_.rays / st.integrate_seconds / 1e6 : 0.0);
+  return line;
 }
 
 } // namespace prt::bake

@@ -2,16 +2,16 @@
 // stages are: contour edges (bake/visibility/contour.h) → arcs in the octahedral frame → crossings with
 // the u-isolines, bucketed per isoline, and with the spine → W at the spine start from one
 // counted ray → DCF walk along every isoline loop with summed-area tables (bake/sphere/isoline_tables.h).
-#include <bake/visibility/contour.h>
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 #include <bake/integrators/hot_texels.h>
+#include <bake/integrators/silhouette.h>
 #include <bake/sphere/isoline_tables.h>
 #include <bake/sphere/octahedral.h>
-#include <bake/visibility/raycast.h>
 #include <bake/sphere/sampling.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/sphere/zonal.h>
+#include <bake/visibility/contour.h>
+#include <bake/visibility/raycast.h>
 
 #include <prtshade/sh.h>
 
@@ -23,6 +23,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <functional>
 #include <limits>
@@ -603,6 +604,18 @@ IntegratorStats SilhouetteIntegrator::stats() const {
   s.contour_seconds = double(impl_->contour_ns.load()) * 1e-9;
   s.integrate_seconds = double(impl_->integrate_ns.load()) * 1e-9;
   return s;
+}
+
+std::string SilhouetteIntegrator::work_summary() const {
+  const IntegratorStats st = stats();
+  const double points = double(std::max<uint64_t>(st.points, 1)), cpu = std::max(1e-12, st.contour_seconds + st.integrate_seconds);
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% integration; "
+                "%llu of %llu points saw no contour edge (closed form)",
+                double(st.contour_edges) / points, double(st.crossings) / points, 100 * st.contour_seconds / cpu,
+                100 * st.integrate_seconds / cpu, (unsigned long long)st.closed_form, (unsigned long long)st.points);
+  return line;
 }
 
 } // namespace prt::bake

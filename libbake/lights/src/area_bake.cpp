@@ -1,8 +1,8 @@
 // area_bake.cpp — per-shade-point area-light integrals (bake/lights/area_bake.h).
-#include <bake/lights/area_bake.h>
-#include <bake/visibility/contour.h>
 #include <bake/core/error.h>
+#include <bake/lights/area_bake.h>
 #include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/contour.h>
 
 #include <algorithm>
 

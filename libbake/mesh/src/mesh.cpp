@@ -1,7 +1,7 @@
 // mesh.cpp — in-memory meshes, normals and welded topology (contracts in bake/mesh/mesh.h).
-#include <bake/mesh/predicates.h>
 #include <bake/core/error.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/predicates.h>
 
 #include <Eigen/Geometry>
 

@@ -35,8 +35,8 @@
 #include <bake/mesh/mesh_readers.h>
 
 #include <bake/core/error.h>
-#include <bake/mesh/mesh.h>
 #include <bake/core/sha256.h>
+#include <bake/mesh/mesh.h>
 
 #include <bit>
 #include <cerrno>

@@ -33,9 +33,9 @@
 //    Points with |q|₁ ≥ 1e30 (beyond float) take the brute-force path. Faces with η > 1e-6
 //    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
 //    the always-tested list.
-#include <bake/visibility/contour.h>
-#include <bake/mesh/predicates.h>
 #include <bake/core/error.h>
+#include <bake/mesh/predicates.h>
+#include <bake/visibility/contour.h>
 
 #include <algorithm>
 #include <array>

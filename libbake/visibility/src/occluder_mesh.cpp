@@ -3,8 +3,8 @@
 // (bake/visibility/occluder_mesh.h has the method).
 #include <bake/visibility/occluder_mesh.h>
 
-#include <bake/visibility/contour.h>
 #include <bake/core/error.h>
+#include <bake/visibility/contour.h>
 #include <bake/visibility/visible_region.h>
 
 #include <algorithm>

@@ -1,5 +1,5 @@
-#include <bake/visibility/contour.h>
 #include <bake/core/error.h>
+#include <bake/visibility/contour.h>
 #include <bake/visibility/raycast.h>
 
 #include <embree3/rtcore.h>

@@ -2,8 +2,8 @@
 // (bake/visibility/visible_region.h has the method and its predicates).
 #include <bake/visibility/visible_region.h>
 
-#include <bake/visibility/contour.h>
 #include <bake/core/error.h>
+#include <bake/visibility/contour.h>
 
 #include <algorithm>
 #include <cmath>

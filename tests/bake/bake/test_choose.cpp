@@ -2,12 +2,12 @@
 // the pilot never saw, a tighter target asks for more samples, the knobs are a function of the
 // inputs and the seed, a named integrator keeps its kind, and the scene file's "target_error".
 #include <bake/bake/choose.h>
-#include <bake/core/error.h>
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/qmc.h>
 #include <bake/bake/scene.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Chunk files of sharded bakes (bake/core/chunks.h) and the row-range form of bake_points.
+#include <bake/bake/vertex_bake.h>
 #include <bake/core/chunks.h>
 #include <bake/core/error.h>
 #include <bake/mesh/mesh.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <gtest/gtest.h>
 

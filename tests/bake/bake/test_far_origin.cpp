@@ -1,10 +1,10 @@
 // Positions far from the origin (bake/mesh/mesh.h, ORIGIN): read in double, baked relative to the mesh's
 // own origin, so a mesh translated by ~1e5 and scaled by 1e-4 bakes to the values of the
 // original; ordinary meshes keep origin 0 and the floats they always had.
-#include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
 #include <bake/bake/scene.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/integrator.h>
+#include <bake/mesh/mesh.h>
 
 #include <gtest/gtest.h>
 #include <mesh_files.h>

@@ -1,12 +1,12 @@
 // Tests of the sheared-filter integrator (bake/integrators/filter.h): exact trivial cases, the reduction to
 // the stratified estimator, stiff geometry against a converged QMC reference, convergence in the
 // pass-1 ray budget, and determinism over threads and row subsets.
-#include <bake/integrators/filter.h>
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/qmc.h>
-#include <bake/visibility/raycast.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/filter.h>
+#include <bake/integrators/qmc.h>
+#include <bake/mesh/mesh.h>
 #include <bake/sphere/zonal.h>
+#include <bake/visibility/raycast.h>
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
 // FIV products (bake/bake/fiv.h, paper 004 §3–4.2) against quadrature, QMC and closed forms.
-#include <bake/environment/envmap.h>
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
-#include <bake/mesh/mesh.h>
+#include <bake/core/error.h>
+#include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
+#include <bake/mesh/mesh.h>
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>

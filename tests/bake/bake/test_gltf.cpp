@@ -2,11 +2,11 @@
 // hand-written glTFs (JSON with base64 data-URI buffers, an external .bin, a .glb) for transforms,
 // strips, fans, non-indexed primitives and normals; each defect the reader refuses; and a walk of
 // Debian's assimp-testmodels glTF2 folder (good and broken public files) plus 2CylinderEngine.glb.
+#include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>
+#include <bake/core/sha256.h>
 #include <bake/integrators/integrator.h>
 #include <bake/mesh/mesh.h>
-#include <bake/core/sha256.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <gltf_builder.h>
 #include <mesh_files.h>

@@ -5,10 +5,10 @@
 // The parent never starts a thread pool before forking (a child of a process with TBB workers
 // could deadlock) and writes its inputs as streams (freed heap it kept mapped would be room for
 // the child), so this file is its own executable.
-#include <bake/environment/envmap.h>
-#include <bake/core/error.h>
-#include <bake/mesh/mesh.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
 
 #include <mesh_files.h>
 

@@ -17,10 +17,10 @@
 // h = 2/256, bounded by kAnalyticTol = 1e-4 for these polygonal regions (as in
 // test_silhouette.cpp); QMC is compared within 4 of its own standard errors, plus 1e-12 for
 // rounding when every ray agrees (its standard error is then 0).
-#include <bake/mesh/mesh.h>
+#include <bake/bake/vertex_bake.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 
 #include <gtest/gtest.h>
 #include <test_scenes.h>

@@ -1,10 +1,10 @@
 // Shade points a few ulps from another surface (near-duplicate shells, as in data/wuson.obj, whose
 // eyes are two layers 1e-6 apart): the counted start ray of the silhouette integrator must be
 // decided exactly near p (bake/visibility/raycast.h), not rejected as ambiguous in every direction.
+#include <bake/bake/vertex_bake.h>
+#include <bake/integrators/silhouette.h>
 #include <bake/mesh/mesh.h>
 #include <bake/visibility/raycast.h>
-#include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <gtest/gtest.h>
 #include <test_scenes.h>

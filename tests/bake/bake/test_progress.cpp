@@ -3,14 +3,14 @@
 // how a CancelToken stops bake_vertices and bake_fiv_shells, that watching a bake does not
 // change its numbers, and that libbake prints nothing (the link-level half of that check is
 // tests/check_silent.cmake).
-#include <bake/environment/envmap.h>
-#include <bake/core/error.h>
 #include <bake/bake/fiv.h>
-#include <bake/mesh/mesh.h>
-#include <bake/core/progress.h>
-#include <bake/integrators/qmc.h>
-#include <bake/mesh/subdivide.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
+#include <bake/core/progress.h>
+#include <bake/environment/envmap.h>
+#include <bake/integrators/qmc.h>
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/subdivide.h>
 
 #include <gtest/gtest.h>
 #include <progress_recorder.h>

@@ -1,9 +1,9 @@
 // Tests of the Embree QMC integrator (bake/integrators/qmc.h) against closed forms, with statistical
 // tolerances from the integrator's own standard error.
-#include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/qmc.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/environment/envmap.h>
+#include <bake/integrators/qmc.h>
+#include <bake/mesh/mesh.h>
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>

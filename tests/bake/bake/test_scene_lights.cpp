@@ -1,7 +1,7 @@
 // Area lights in scene files (bake/bake/scene.h "lights", bake/lights/lights.h shapes): every shape parses into
 // its faces with its radiance, and every mistake is refused naming the file and the key.
-#include <bake/core/error.h>
 #include <bake/bake/scene.h>
+#include <bake/core/error.h>
 
 #include <gtest/gtest.h>
 

@@ -2,13 +2,13 @@
 // "Material Editing"): closed forms, an exactly known occluded case, band 1 against the band-1
 // radiance R, agreement of the silhouette and QMC integrators within QMC's standard error, and the
 // filter integrator's QMC route.
+#include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/filter.h>
-#include <bake/mesh/mesh.h>
-#include <bake/sphere/polygon_sh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
+#include <bake/sphere/polygon_sh.h>
 #include <bake/sphere/zonal.h>
 #include <prtshade/sh.h>
 

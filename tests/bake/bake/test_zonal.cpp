@@ -1,10 +1,10 @@
 // Tests of the zonal closed forms (bake/sphere/zonal.h) and of the silhouette integrator's closed-form
 // path for shade points that see no contour edge (docs/ARCHITECTURE.md §5).
+#include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
-#include <bake/bake/vertex_bake.h>
+#include <bake/mesh/mesh.h>
 #include <bake/sphere/zonal.h>
 #include <prtshade/sh.h>
 

@@ -4,9 +4,9 @@
 //
 // The tests write their own small EXR files with a minimal uncompressed-scanline writer
 // (write_exr below, after the OpenEXR file layout document), so they need no OpenEXR headers.
-#include <bake/environment/envmap.h>
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>
+#include <bake/environment/envmap.h>
 
 #include <prtshade/sh.h>
 

@@ -1,13 +1,13 @@
 // Tests of shared acceleration structures (bake/visibility/accel.h): integrators that share one MeshAccel
 // give the rows of integrators that build their own, bit for bit; the trees are built once, on
 // first use; an accel of another mesh is refused.
-#include <bake/visibility/accel.h>
 #include <bake/core/error.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
+#include <bake/visibility/accel.h>
 
 #include <gtest/gtest.h>
 

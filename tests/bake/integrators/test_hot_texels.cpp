@@ -4,11 +4,11 @@
 // clipped by a great circle, and PolygonSH projects it exactly (bake/sphere/polygon_sh.h).
 #include <bake/environment/envmap.h>
 #include <bake/integrators/hot_texels.h>
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
 #include <bake/mesh/mesh.h>
 #include <bake/sphere/polygon_sh.h>
-#include <bake/integrators/qmc.h>
 #include <bake/sphere/sampling.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/sphere/spherical_polygon.h>
 #include <prtshade/sh.h>
 

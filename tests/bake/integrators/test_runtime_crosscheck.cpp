@@ -2,9 +2,9 @@
 // project_latlong vs EnvMap::project_sh on data/forest.exr, and band-1 shading of baked shadowed
 // radiance (silhouette integrator, bunny on its ground plane) vs E = (4π/3) Σ y_1m(n) R_m in double.
 #include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
 #include <prtshade/sh.h>

@@ -1,12 +1,12 @@
 // Tests of the silhouette integrator (bake/integrators/silhouette.h, paper 001 §3): analytic cases,
 // agreement with the QMC reference within its standard error, stiff cases and invariances.
 #include <bake/environment/envmap.h>
-#include <bake/sphere/isoline_tables.h>
-#include <bake/mesh/mesh.h>
-#include <bake/sphere/octahedral.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
+#include <bake/sphere/isoline_tables.h>
+#include <bake/sphere/octahedral.h>
 #include <bake/sphere/sampling.h>
 #include <prtshade/sh.h>
 

@@ -2,9 +2,9 @@
 // relational expectation"). Exact expectations come from Lambert's polygon formula and solid
 // angles; relational ones from the QMC reference within its standard error, or from a clean twin
 // of the scene.
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
 

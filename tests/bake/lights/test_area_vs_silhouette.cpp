@@ -10,10 +10,10 @@
 // closed forms on one side, isoline walks over contour edges on the other. The silhouette
 // integrator converges at O(h²) in its isoline spacing h = 2/N (its tests): the difference must
 // shrink about 16x from N = 64 to N = 256 and stay under the bound measured here.
+#include <bake/integrators/silhouette.h>
 #include <bake/lights/area_bake.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
 

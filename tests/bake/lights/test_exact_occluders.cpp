@@ -7,14 +7,14 @@
 //   U_i = ∫_H y_i dω − ∫_{S ∩ H} y_i dω   (the first term: zonal closed form, bake/sphere/zonal.h),
 // with S the silhouette polygon and H the hemisphere about n. QMC must agree within 4 standard
 // errors; the silhouette integrator within its discretisation error, which must shrink with N.
+#include <bake/integrators/qmc.h>
+#include <bake/integrators/silhouette.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
 #include <bake/sphere/polygon_sh.h>
-#include <bake/integrators/qmc.h>
-#include <bake/integrators/silhouette.h>
 #include <bake/sphere/spherical_polygon.h>
-#include <bake/visibility/visible_region.h>
 #include <bake/sphere/zonal.h>
+#include <bake/visibility/visible_region.h>
 
 #include <gtest/gtest.h>
 #include <test_scenes.h>

@@ -1,8 +1,8 @@
 // Tests for bake/mesh/mesh.h: the format readers and build_mesh, vertex-order and normal contracts,
 // the source digest, welded topology, and hostile inputs.
 #include <bake/core/error.h>
-#include <bake/mesh/mesh.h>
 #include <bake/core/sha256.h>
+#include <bake/mesh/mesh.h>
 
 #include <mesh_files.h>
 

@@ -1,9 +1,9 @@
 // Tests for bake/visibility/contour.h: the exact ε-limit orientation predicate and the 4D dual-space BVH
 // of contour edges (paper 001 §3.1), checked against brute force on real meshes and against
 // hand-worked configurations.
-#include <bake/visibility/contour.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/subdivide.h>
+#include <bake/visibility/contour.h>
 
 #include <gtest/gtest.h>
 

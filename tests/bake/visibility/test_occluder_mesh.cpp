@@ -4,11 +4,11 @@
 // (ConvexPolyhedron), the bunny against Embree ray casting, and the stiff cases of issue 13 that a
 // mesh brings: the shade point on the occluder (a vertex of its 1-ring, an edge, a face) in a
 // concave wedge, an occluder behind or across the light's plane, a light of solid angle 1e-10.
+#include <bake/sphere/polygon_sh.h>
+#include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/contour.h>
 #include <bake/visibility/occluder_mesh.h>
-#include <bake/sphere/polygon_sh.h>
 #include <bake/visibility/raycast.h>
-#include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/visible_region.h>
 
 #include <sphere_rqmc.h>

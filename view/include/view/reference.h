@@ -37,10 +37,10 @@
 #include <view/image.h>
 #include <view/raster.h>
 
+#include <bake/core/progress.h>
 #include <bake/environment/envmap.h>
 #include <bake/environment/irradiance.h>
 #include <bake/mesh/mesh.h>
-#include <bake/core/progress.h>
 
 #include <Eigen/Core>
 #include <array>

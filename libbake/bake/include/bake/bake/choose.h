@@ -102,11 +102,11 @@
 // function of the inputs, the seed and E.
 #pragma once
 
-#include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
-#include <bake/integrators/products.h>
-#include <bake/core/progress.h>
 #include <bake/bake/vertex_bake.h>
+#include <bake/core/progress.h>
+#include <bake/integrators/integrator.h>
+#include <bake/integrators/products.h>
+#include <bake/mesh/mesh.h>
 
 #include <cstdint>
 #include <functional>

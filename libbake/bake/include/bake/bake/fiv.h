@@ -27,10 +27,10 @@
 //   +X (1, −t, −s)   −X (−1, −t, s)   +Y (s, 1, t)   −Y (s, −1, −t)   +Z (s, −t, 1)   −Z (−s, −t, −1).
 #pragma once
 
-#include <bake/environment/envmap.h>
-#include <bake/mesh/mesh.h>
 #include <bake/core/progress.h>
+#include <bake/environment/envmap.h>
 #include <bake/integrators/silhouette.h>
+#include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
 #include <array>

@@ -102,12 +102,12 @@
 #pragma once
 
 #include <bake/bake/choose.h>
-#include <bake/environment/envmap.h>
 #include <bake/bake/fiv.h>
+#include <bake/bake/vertex_bake.h>
+#include <bake/core/progress.h>
+#include <bake/environment/envmap.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
-#include <bake/core/progress.h>
-#include <bake/bake/vertex_bake.h>
 
 #include <Eigen/Core>
 #include <array>

@@ -4,13 +4,13 @@
 // randomisation is keyed by its index, so any thread count gives the same numbers.
 #pragma once
 
-#include <bake/visibility/accel.h>
+#include <bake/core/progress.h>
 #include <bake/integrators/integrator.h>
 #include <bake/integrators/registry.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
-#include <bake/core/progress.h>
+#include <bake/visibility/accel.h>
 
 #include <memory>
 #include <utility>
@@ -34,8 +34,6 @@ struct VertexBake {
   double busy_fraction() const { return seconds > 0 ? cpu_seconds / (seconds * threads) : 0.0; }
 };
 
-// The calling thread's CPU time in seconds (CLOCK_THREAD_CPUTIME_ID).
-double thread_cpu_seconds();
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,
                          const Monitor& monitor = {}, const std::string& label = "baking vertices");

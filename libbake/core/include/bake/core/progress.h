@@ -80,4 +80,8 @@ private:
   std::chrono::steady_clock::time_point start_;
 };
 
+// The calling thread's CPU time in seconds (CLOCK_THREAD_CPUTIME_ID): what a bake and its
+// integrators count as work, since idle or spinning workers do not advance it.
+double thread_cpu_seconds();
+
 } // namespace prt::bake

@@ -87,12 +87,12 @@
 // against the QMC reference. Products and integrands: docs/ARCHITECTURE.md ("Conventions").
 #pragma once
 
-#include <bake/visibility/accel.h>
 #include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
-#include <bake/visibility/raycast.h>
+#include <bake/mesh/mesh.h>
 #include <bake/sphere/sampling.h>
+#include <bake/visibility/accel.h>
+#include <bake/visibility/raycast.h>
 
 #include <array>
 #include <atomic>

@@ -57,6 +57,8 @@ struct IntegratorSpec {
     return &IntegratorSpec::silhouette_k;
   }
   uint32_t samples() const { return this->*knob(kind); }
+  // The knob as a reader counts it: "148 isolines", "1024 rays", "16 pass-1 rays".
+  std::string knob_text() const;
   void set_samples(uint32_t n) { this->*knob(kind) = n; }
   int isolines() const { return silhouette_isolines(silhouette_k); }
   // Rays per point of the QMC reference the error report compares with.

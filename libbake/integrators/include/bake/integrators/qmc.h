@@ -32,12 +32,13 @@
 // (occludes_from_above, orient_eps). Hits on any other triangle at any t ≥ 0 occlude.
 #pragma once
 
-#include <bake/visibility/accel.h>
 #include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
+#include <bake/mesh/mesh.h>
+#include <bake/visibility/accel.h>
 #include <bake/visibility/raycast.h>
 
+#include <atomic>
 #include <memory>
 
 namespace prt::bake {
@@ -63,6 +64,12 @@ public:
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                  std::span<double> std_error = {}) const override;
 
+  // Points integrated and the time spent integrating them, summed over threads
+  // (IntegratorStats::points, integrate_seconds).
+  IntegratorStats stats() const override;
+  // Rays per point, and rays per second of that time.
+  std::string work_summary() const override;
+
   // Visibility of direction d (unit) from the shade point, in the limit from above.
   bool visible(const ShadePoint& point, const Eigen::Vector3d& d) const;
   const QmcOptions& options() const { return options_; }
@@ -75,6 +82,7 @@ private:
   int sh_order_ = 0;                          // SH order evaluated per sample
   const EnvMap* env_ = nullptr;               // of R and S (ProductRequest::environment())
   std::shared_ptr<const RayCaster> rays_;
+  mutable std::atomic<uint64_t> points_{0}, cpu_ns_{0};  // relaxed counters for stats()
 };
 
 } // namespace prt::bake

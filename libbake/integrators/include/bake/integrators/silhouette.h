@@ -31,10 +31,10 @@
 //    hemisphere and a concave one reaches above the horizon — with no ε offset in the numbers.
 #pragma once
 
-#include <bake/visibility/accel.h>
 #include <bake/integrators/integrator.h>
-#include <bake/mesh/mesh.h>
 #include <bake/integrators/products.h>
+#include <bake/mesh/mesh.h>
+#include <bake/visibility/accel.h>
 
 #include <atomic>
 #include <memory>
@@ -71,6 +71,9 @@ public:
 
   // Every counter of IntegratorStats (bake/integrators/integrator.h), kept with relaxed atomics.
   IntegratorStats stats() const override;
+  // Per integral: contour edges and isoline crossings, and the CPU time split between the contour
+  // search and the rest; points that saw no contour edge (closed forms).
+  std::string work_summary() const override;
   const SilhouetteOptions& options() const;
 
 private:

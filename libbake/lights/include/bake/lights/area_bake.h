@@ -20,11 +20,11 @@
 // their digits; shade points are in the mesh's frame, as every integrator's.
 #pragma once
 
-#include <bake/visibility/contour.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
-#include <bake/visibility/occluder_mesh.h>
 #include <bake/sphere/polygon_sh.h>
+#include <bake/visibility/contour.h>
+#include <bake/visibility/occluder_mesh.h>
 
 #include <span>
 #include <utility>

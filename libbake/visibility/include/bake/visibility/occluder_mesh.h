@@ -35,8 +35,8 @@
 // linear in the silhouette is not built yet).
 #pragma once
 
-#include <bake/mesh/shade_point.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/shade_point.h>
 #include <bake/sphere/spherical_polygon.h>
 
 #include <Eigen/Core>

@@ -15,8 +15,8 @@
 // the count ambiguous: the caller picks another direction.
 #pragma once
 
-#include <bake/mesh/shade_point.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/shade_point.h>
 
 #include <Eigen/Core>
 #include <memory>
