@@ -3,7 +3,7 @@
 // specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/bake/choose.h>
 #include <bake/bake/fiv.h>
-#include <bake/bake/scene.h>
+#include <bake/bake/scene_bake.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>

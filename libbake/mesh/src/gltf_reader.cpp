@@ -37,7 +37,7 @@ namespace {
 
 constexpr uintmax_t kMaxBufferFileBytes = uintmax_t{4} << 30;  // as for mesh files (mesh_io.cpp)
 // Deeper JSON is refused before tinygltf parses it; a glTF's own structure is about 8 deep, and
-// scene files have the same limit (scene.cpp).
+// scene files have the same limit (scene_json.cpp).
 constexpr int kMaxJsonDepth = 128;
 // Extensions whose data we cannot decode: a primitive using them has no readable accessors.
 constexpr std::string_view kUnsupportedExtensions[] = {"KHR_draco_mesh_compression", "EXT_meshopt_compression",

@@ -92,7 +92,7 @@ TEST(InputMemory, MeshReadOutOfMemoryNamesTheFile) {
 TEST(InputMemory, SceneFileOutOfMemoryNamesTheFile) {
   if (kSanitized) GTEST_SKIP() << "the sanitizers' shadow memory does not fit an address-space limit";
   // 12 MB of JSON read with 4 MiB of headroom: the text itself does not fit. (Running out inside
-  // the JSON library cannot be reported, scene.cpp kMaxJsonFileBytes: the file limit bounds it.)
+  // the JSON library cannot be reported, scene_json.cpp kMaxJsonFileBytes: the file limit bounds it.)
   const fs::path p = prt::testing::test_dir("input_memory") / "large.json";
   {
     std::ofstream out(p);

@@ -1,7 +1,7 @@
 // bake_scene's progress (bake/bake/scene.h): the receivers' vertices are one stage, "baking
 // receivers", whose count runs over every receiver (one ETA for the scene) and finishes once,
 // with the last of them.
-#include <bake/bake/scene.h>
+#include <bake/bake/scene_bake.h>
 
 #include <gtest/gtest.h>
 

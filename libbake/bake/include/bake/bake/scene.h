@@ -101,18 +101,15 @@
 //     (bake/lights/area_bake.h) against the union of the occluders, the same as the other products'.
 #pragma once
 
-#include <bake/bake/choose.h>
 #include <bake/bake/fiv.h>
-#include <bake/bake/vertex_bake.h>
-#include <bake/core/progress.h>
 #include <bake/environment/envmap.h>
+#include <bake/integrators/integrator.h>
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
-#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -229,72 +226,5 @@ struct ScenePlan {
 // scene.objects (load_scene_mesh), used by the FIV rule. Throws InputError when a material has no
 // SH order within kMaxOrder for the tolerance.
 ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes);
-
-// ---- the bake itself ----
-
-struct ObjectBake {
-  // Receivers: one row per vertex of the object's world mesh, in its layout.
-  std::optional<VertexBake> values;
-  std::optional<ErrorReport> report;
-  IntegratorSpec integrator;           // what baked the values: the scene's, or the target's choice
-  std::optional<IntegratorChoice> choice;  // with a target error
-  std::optional<ReferencePlan> reference_plan;  // with a target error and a report (bake/bake/choose.h)
-  std::string integrator_description;
-  uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
-  // Occluders with shells (in world space: centre and radii in scene units).
-  std::optional<FivShells> shells;
-  std::optional<FivErrorReport> fiv_report;
-  // Receivers with area lights: [V][lights][1 + n²] per vertex and light, E then the SH at
-  // order n = area_sh_order (AreaLightIntegrator's rows).
-  std::optional<std::vector<double>> area;
-  double area_seconds = 0;
-};
-
-struct SceneBake {
-  std::vector<ObjectBake> objects;  // parallel to SceneDescription::objects
-  Fiv environment_fiv{};            // when plan.fiv_environment
-  std::vector<float> irradiance_cube;
-  double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0, area_seconds = 0;
-  double report_seconds = 0;  // the error reports' reference integrals (with a target)
-  uint64_t vertices = 0;  // receiver vertices integrated
-};
-
-// Runs the plan. Visibility for every receiver is the union of the occluders ("occluder" and
-// "both" objects) in world space; a "both" receiver's vertices are shade points of that union
-// (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
-// The area lights' rows are the same for any thread count (each vertex's row is its own).
-// `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
-// How bake_scene integrates receiver rows, for sharded bakes (bake/core/chunks.h). `rows` replaces
-// bake_points for every receiver with per-vertex products: `set` numbers those receivers in object
-// order; it returns the rows of all of `points` (or none, with rows_only) and sets `closed_form` to
-// their IntegratorStats::closed_form. With rows_only, bake_scene stops there: no area lights, error
-// reports, FIV or environment (what a worker that only computes chunks needs).
-struct SceneRows {
-  std::function<VertexBake(size_t set, std::span<const ShadePoint> points, const Integrator& integrator,
-                           const Monitor& monitor, const std::string& label, uint64_t& closed_form)>
-      rows;
-  bool rows_only = false;
-  // The dry run's estimate: no receiver is baked; per distinct product request (the receivers that
-  // make it), the integrator — with a target, the one the pilot chooses — is timed on 64 seeded
-  // vertices and `log` receives its predicted CPU time for all of them (and the error check's
-  // bound); no area lights, reports or FIV.
-  bool estimate_only = false;
-  // Called once the bake is whole (the receivers' rows, area lights and FIV shells), before any
-  // error report is made: a tool writes the file there, so a check cancelled with Ctrl-C (or one
-  // that takes longer than the user will wait) never costs the bake.
-  std::function<void(const SceneBake&)> baked;
-};
-
-// With a target error the choice is made once per distinct product request, on the pooled shade
-// points of the receivers that make it (the target holds for their values together), when the
-// first of them is baked; `on_choice` receives it (who: "N receivers (V vertices, from <first>)",
-// the choice, and the error report's reference plan when a report is made) before they are
-// baked; without it, `log` receives choice_summary. Each receiver's report then takes its share
-// of the report's points by its vertices, and the target's verdict is logged for the pooled
-// reports once the group's last receiver is baked.
-using OnChoice = std::function<void(const std::string& object, const IntegratorChoice& choice, const ReferencePlan* plan)>;
-SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
-                     const Monitor& monitor, const std::function<void(const std::string&)>& log,
-                     const SceneRows& rows = {}, const OnChoice& on_choice = {});
 
 } // namespace prt::bake

@@ -110,7 +110,7 @@ public:
   // (float slices; alpha and other channels ignored); a luminance-only image (Y) is read as
   // grey; a luminance/chroma image (Y, RY, BY) is converted by Imf::RgbaInputFile.
   // Throws InputError("<exr>: <defect>") for a missing/unreadable/truncated/garbled file, an
-  // unsupported shape or channel set, a header whose pixels cannot fit in the file (envmap.cpp,
+  // unsupported shape or channel set, a header whose pixels cannot fit in the file (exr_file.cpp,
   // max_compression_ratio), or a NaN/Inf pixel. No OpenEXR exception escapes. Running out of
   // memory is a SystemError("<exr>: out of memory while reading the file").
   static EnvMap load(const std::filesystem::path& exr, UpAxis up);

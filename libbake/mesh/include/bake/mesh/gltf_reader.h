@@ -2,7 +2,8 @@
 // one more entry of the reader table in mesh_io.cpp. Called by load_mesh and the fuzz targets.
 //
 // Parsing is tinygltf's (Debian's libtinygltf, a shared library with its own JSON inside, so it
-// cannot meet the nlohmann-json that scene.cpp uses); images are never decoded. What the result
+// cannot meet the nlohmann-json that the scene files' parser, scene_json.cpp, uses); images are
+// never decoded. What the result
 // holds — rows, normals, transforms, primitive modes, what is refused — is documented in
 // bake/mesh/mesh.h (the glTF paragraphs) and follows the glTF 2.0 specification (Khronos), sections
 // "Nodes and Hierarchy", "Transformations", "Accessors" and "Meshes".

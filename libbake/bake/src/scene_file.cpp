@@ -1,19 +1,17 @@
-// scene.cpp — scene files and the bake plan (bake/bake/scene.h).
-#include <bake/bake/fiv.h>
+// scene_file.cpp — scene files and glTF scenes with their options files, read into a
+// SceneDescription (bake/bake/scene.h: the format, the rules for glTF instances and options).
+#include <bake/bake/choose.h>
 #include <bake/bake/scene.h>
 #include <bake/core/error.h>
-#include <bake/sphere/zonal.h>
 
-#include <prtshade/sh.h>
+#include "scene_json.h"
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
-#include <nlohmann/json.hpp>
 #include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <limits>
 #include <numbers>
 #include <set>
@@ -21,6 +19,11 @@
 #include <vector>
 
 namespace prt::bake {
+
+using scene_json::find_key;
+using scene_json::Json;
+using scene_json::parse_json_file;
+using scene_json::Reader;
 
 const char* role_name(Role r) {
   switch (r) {
@@ -32,168 +35,6 @@ const char* role_name(Role r) {
 }
 
 namespace {
-
-using Json = nlohmann::ordered_json;  // keeps the file's key order, so messages follow it
-
-constexpr size_t kMaxDepth = 128;  // nesting deeper than this is refused
-
-// "objects[2].material" for the value at that path; "the scene" for the root.
-std::string shown_path(const std::string& path) { return path.empty() ? "the scene" : path; }
-
-// Parses a scene file strictly: nlohmann's RFC 8259 parser (syntax errors with line and column),
-// and what it lets through refused here with the key path: a duplicate key (nlohmann keeps the
-// last one silently) and nesting deeper than kMaxDepth.
-Json parse_json(const std::string& text, const std::string& file) {
-  struct Container {
-    std::string path;
-    bool object = false;
-    std::set<std::string> keys;
-    std::string key;    // object: the member being read
-    size_t index = 0;   // array: the next element's index
-  };
-  std::vector<Container> open;
-  auto child_path = [&]() -> std::string {
-    if (open.empty()) return "";
-    Container& c = open.back();
-    if (c.object) return (c.path.empty() ? "" : c.path + ".") + c.key;
-    return c.path + "[" + std::to_string(c.index++) + "]";
-  };
-  const Json::parser_callback_t strict = [&](int, Json::parse_event_t event, Json& parsed) {
-    switch (event) {
-    case Json::parse_event_t::object_start:
-    case Json::parse_event_t::array_start: {
-      std::string path = child_path();
-      if (open.size() >= kMaxDepth)
-        throw InputError(file, (path.size() > 60 ? path.substr(0, 60) + "..." : path) + " is nested deeper than " +
-                                   std::to_string(kMaxDepth) + " levels");
-      open.push_back({std::move(path), event == Json::parse_event_t::object_start, {}, {}, 0});
-      break;
-    }
-    case Json::parse_event_t::key: {
-      Container& c = open.back();
-      c.key = parsed.get<std::string>();
-      if (!c.keys.insert(c.key).second)
-        throw InputError(file, "duplicate key \"" + c.key + "\" in " + shown_path(c.path));
-      break;
-    }
-    case Json::parse_event_t::object_end:
-    case Json::parse_event_t::array_end: open.pop_back(); break;
-    case Json::parse_event_t::value:
-      if (!open.empty() && !open.back().object) ++open.back().index;
-      break;
-    }
-    return true;
-  };
-  try {
-    return Json::parse(text, strict);
-  } catch (const Json::parse_error& e) {
-    // e.byte counts the bytes read up to and including the one in error (1-based).
-    const size_t at = std::min(text.size(), e.byte > 0 ? size_t(e.byte - 1) : size_t(0));
-    const size_t line_start = text.rfind('\n', at == 0 ? std::string::npos : at - 1);
-    const size_t line = 1 + size_t(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n'));
-    const size_t column = at - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
-    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at line L, column C: <problem>"
-    const size_t colon = what.find(": ");
-    if (colon != std::string::npos) what = what.substr(colon + 2);
-    throw InputError(file, "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what);
-  } catch (const Json::exception& e) {  // e.g. a number too large for a double ("1e400")
-    std::string what = e.what();
-    const size_t bracket = what.find("] ");
-    throw InputError(file, bracket == std::string::npos ? what : what.substr(bracket + 2));
-  }
-}
-
-// A scene or options file lists objects and settings: 16 MiB is far beyond any real one (about
-// 200 bytes an object). Read up to one byte more, so a pipe or a device (/dev/zero) is refused at
-// the limit, not read forever. The parsed tree takes at most ~32 bytes per byte of text (a 16-byte
-// value, its heap block and vector growth for "[]," or "0,"): 512 MiB at the limit. Running out of
-// memory inside the JSON library cannot be reported (it allocates while destroying a partial
-// tree, and terminates); this bound is what keeps that away.
-constexpr size_t kMaxJsonFileBytes = size_t{16} << 20;
-
-Json read_json_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "cannot open the file");
-  std::string text;
-  for (char buffer[65536]; text.size() <= kMaxJsonFileBytes && in;) {
-    in.read(buffer, sizeof buffer);
-    text.append(buffer, static_cast<size_t>(in.gcount()));
-  }
-  if (in.bad()) throw InputError(file.string(), "cannot read the file");
-  if (text.size() > kMaxJsonFileBytes)
-    throw InputError(file.string(), "larger than " + std::to_string(kMaxJsonFileBytes >> 20) + " MiB; a scene file is not that large");
-  return parse_json(text, file.string());
-}
-Json parse_json_file(const std::filesystem::path& file) {
-  return reading_file(file.string(), [&] { return read_json_file(file); });
-}
-
-// An object's member, nullptr if absent.
-const Json* find_key(const Json& object, const char* key) {
-  const auto it = object.find(key);
-  return it == object.end() ? nullptr : &*it;
-}
-
-// Reads typed members with messages that name the file and the key path.
-class Reader {
-public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const std::string& what) const { throw InputError(file_, what); }
-
-  const Json& object(const Json& v, const std::string& key_path, std::initializer_list<std::string_view> allowed) const {
-    if (!v.is_object()) fail(key_path + " must be an object, not " + v.type_name());
-    for (const auto& [k, member] : v.items()) {
-      bool ok = false;
-      for (std::string_view a : allowed) ok = ok || k == a;
-      if (!ok) {
-        std::string list;
-        for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        fail("unknown key \"" + k + "\" in " + key_path + " (allowed: " + list + ")");
-      }
-    }
-    return v;
-  }
-
-  double number(const Json& v, const std::string& key, double lo, double hi) const {
-    if (!v.is_number()) fail(key + " must be a number, not " + v.type_name());
-    const double x = v.get<double>();
-    if (!(x >= lo && x <= hi)) {
-      std::ostringstream os;
-      os << key << " must be in [" << lo << ", " << hi << "], got " << x;
-      fail(os.str());
-    }
-    return x;
-  }
-
-  int64_t integer(const Json& v, const std::string& key, int64_t lo, int64_t hi) const {
-    const double x = number(v, key, double(lo), double(hi));
-    if (x != std::floor(x)) fail(key + " must be an integer");
-    return int64_t(x);
-  }
-
-  const std::string& string(const Json& v, const std::string& key) const {
-    if (!v.is_string()) fail(key + " must be a string, not " + v.type_name());
-    const std::string& s = v.get_ref<const std::string&>();
-    if (s.empty()) fail(key + " must not be empty");
-    return s;
-  }
-
-  bool boolean(const Json& v, const std::string& key) const {
-    if (!v.is_boolean()) fail(key + " must be true or false, not " + v.type_name());
-    return v.get<bool>();
-  }
-
-  std::array<double, 3> vec3(const Json& v, const std::string& key, double lo, double hi) const {
-    if (!v.is_array() || v.size() != 3) fail(key + " must be an array of 3 numbers");
-    std::array<double, 3> out{};
-    for (size_t i = 0; i < 3; ++i) out[i] = number(v[i], key + "[" + std::to_string(i) + "]", lo, hi);
-    return out;
-  }
-
-private:
-  std::string file_;
-};
 
 constexpr double kHuge = 1e30;
 
@@ -600,8 +441,6 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   return sc;
 }
 
-bool is_gltf(const std::filesystem::path& file) { return is_gltf_scene(file); }
-
 } // namespace
 
 bool is_gltf_scene(const std::filesystem::path& file) {
@@ -611,236 +450,10 @@ bool is_gltf_scene(const std::filesystem::path& file) {
 }
 
 SceneDescription load_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& gltf_options) {
-  if (is_gltf(file)) return load_gltf_scene(file, gltf_options);
+  if (is_gltf_scene(file)) return load_gltf_scene(file, gltf_options);
   if (gltf_options)
     throw InputError(gltf_options->string(), "scene options apply to a glTF scene only; " + file.string() + " is a JSON scene file");
   return load_json_scene(file);
-}
-
-std::vector<Mesh> load_scene_meshes(const SceneDescription& scene, std::vector<std::string>& warnings) {
-  // The files' meshes first (a glTF's instances are already in world space: their objects'
-  // transforms are the identity), then one scene origin over all of them, so that receivers and
-  // occluders share one frame (bake/mesh/mesh.h ORIGIN), then each object placed in it.
-  std::vector<Mesh> files;
-  if (is_gltf(scene.file)) {
-    MeshInstances file = load_mesh_instances(scene.file);
-    if (file.instances.size() != scene.objects.size())
-      throw InputError(scene.file.string(), "has changed since it was read: " + std::to_string(file.instances.size()) +
-                                                " instances, was " + std::to_string(scene.objects.size()));
-    warnings.insert(warnings.end(), file.warnings.begin(), file.warnings.end());
-    for (MeshInstance& in : file.instances) files.push_back(std::move(in.mesh));
-  } else {
-    for (const SceneObject& o : scene.objects) {
-      try {
-        files.push_back(load_mesh(o.mesh));
-      } catch (const InputError& e) {  // say which object of which scene wanted the mesh
-        throw InputError(e.file(), e.defect() + " (object '" + o.name + "' of " + scene.file.string() + ")");
-      }
-      warnings.insert(warnings.end(), files.back().warnings.begin(), files.back().warnings.end());
-    }
-  }
-  const Eigen::Vector3d origin = scene_origin(files, scene.objects);
-  std::vector<Mesh> meshes;
-  meshes.reserve(files.size());
-  for (size_t i = 0; i < files.size(); ++i) {
-    try {
-      meshes.push_back(place_scene_object(files[i], scene.objects[i], origin));
-    } catch (const InputError& e) {
-      throw InputError(e.file(), e.defect() + " (object '" + scene.objects[i].name + "' of " + scene.file.string() + ")");
-    }
-  }
-  return meshes;
-}
-
-namespace {
-
-// world_from_object applied in double to the file mesh's world positions (unchecked).
-std::vector<Eigen::Vector3d> world_positions(const Mesh& file_mesh, const SceneObject& object) {
-  const Eigen::Matrix3d A = object.world_from_object.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t = object.world_from_object.topRightCorner<3, 1>();
-  std::vector<Eigen::Vector3d> world(file_mesh.positions.size());
-  for (size_t i = 0; i < world.size(); ++i) world[i] = A * file_mesh.world_position(i) + t;
-  return world;
-}
-
-bool usable(const Eigen::Vector3d& p) { return p.allFinite() && p.cwiseAbs().maxCoeff() <= 1e30; }
-
-} // namespace
-
-Eigen::Vector3d scene_origin(std::span<const Mesh> file_meshes, std::span<const SceneObject> objects) {
-  PRT_CHECK_OP(file_meshes.size(), ==, objects.size());
-  Eigen::AlignedBox3d bounds;
-  for (size_t i = 0; i < objects.size(); ++i)
-    for (const Eigen::Vector3d& p : world_positions(file_meshes[i], objects[i]))
-      if (usable(p)) bounds.extend(p);  // the others are refused by place_scene_object
-  return bounds.isEmpty() ? Eigen::Vector3d::Zero() : frame_origin(bounds);
-}
-
-Mesh load_scene_mesh(const SceneObject& object) {
-  const Mesh file_mesh = load_mesh(object.mesh);
-  return place_scene_object(file_mesh, object, scene_origin(std::span(&file_mesh, 1), std::span(&object, 1)));
-}
-
-Mesh place_scene_object(const Mesh& file_mesh, const SceneObject& object, const Eigen::Vector3d& origin) {
-  Mesh m = file_mesh;
-  const Eigen::Matrix3d N = object.world_from_object.topLeftCorner<3, 3>().inverse().transpose();
-  const std::vector<Eigen::Vector3d> world = world_positions(file_mesh, object);
-  for (size_t i = 0; i < world.size(); ++i)
-    if (!usable(world[i]))
-      throw InputError(object.mesh.string(), "vertex " + std::to_string(i) + " is not finite after the scene transform of '" +
-                                                 object.name + "'");
-  m.positions = offsets_from(world, origin, object.mesh.string());
-  m.origin = origin;
-  if (m.normal_source == Mesh::NormalSource::File) {
-    for (auto& n : m.normals) n = (N * n.cast<double>()).normalized().cast<float>();
-  } else {
-    m.normals = welded_angle_weighted_normals(m.positions, m.triangles);
-  }
-  return m;
-}
-
-ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes) {
-  PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
-  ScenePlan plan;
-  plan.objects.resize(scene.objects.size());
-  const bool env = scene.environment.has_value();
-  const std::string env_name = env ? scene.environment->filename().string() : "";
-  const int diffuse_order = clamped_power_order(1.0, scene.sh_tolerance, sh::kMaxOrder);
-  auto pct = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.2g%%", x * 100);
-    return std::string(buf);
-  };
-
-  // Bounding spheres for the FIV rule.
-  std::vector<Eigen::Vector3d> centre(meshes.size());
-  std::vector<double> radius(meshes.size());
-  for (size_t i = 0; i < meshes.size(); ++i) bounding_sphere(meshes[i], centre[i], radius[i]);
-
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const SceneObject& o = scene.objects[i];
-    ObjectPlan& p = plan.objects[i];
-    p.receiver = o.role != Role::Occluder;
-    p.occluder = o.role != Role::Receiver;
-    if (!p.receiver) {
-      p.left_out.push_back("ao, transfer, radiance: occluder only (role \"occluder\"): nothing is shaded on it");
-    } else {
-      if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
-      else p.left_out.push_back("ao: not in bake.products");
-      const Material& m = o.material;
-      if (!scene.lights.empty()) {
-        p.area_irradiance = true;
-        p.baked.push_back("area_lights/irradiance: " + std::to_string(scene.lights.size()) +
-                          " area light(s), exact soft shadows (paper 003)");
-        if (!m.glossy()) p.left_out.push_back("area_lights/sh: no glossy lobe (irradiance is exact for a diffuse receiver)");
-      }
-      if (m.diffuse()) {
-        if (!scene.want_radiance) p.left_out.push_back("radiance/band1: not in bake.products");
-        else if (!env) p.left_out.push_back("radiance/band1: the scene has no environment");
-        else p.radiance = true, p.baked.push_back("radiance/band1: diffuse albedo under " + env_name +
-                                                  ": exact shadowed irradiance with 3 coefficients per channel (paper 001 §4)");
-        if (!scene.want_transfer) {
-          p.left_out.push_back("transfer/diffuse: not in bake.products");
-        } else if (p.radiance && !scene.relight) {
-          p.left_out.push_back("transfer/diffuse: band-1 radiance is exact for a diffuse receiver under the scene's "
-                               "environment; no higher order is needed (set bake.relight for relightable transfer)");
-        } else {
-          p.transfer_order = diffuse_order;
-          p.baked.push_back("transfer/diffuse: order " + std::to_string(diffuse_order) +
-                            ", the smallest whose clamped-cosine energy beyond it (" +
-                            pct(clamped_power_energy_beyond(1.0, diffuse_order)) + ") is <= sh_tolerance " +
-                            pct(scene.sh_tolerance) + (env ? " (bake.relight)" : " (no environment: relightable)"));
-        }
-      } else {
-        p.left_out.push_back("radiance/band1, transfer/diffuse: the material has no diffuse albedo");
-      }
-      if (m.glossy()) {
-        const bool shadowed = scene.want_radiance && env;
-        if (!scene.want_radiance) p.left_out.push_back("radiance/shadowed: not in bake.products");
-        else if (!env) p.left_out.push_back("radiance/shadowed: the scene has no environment");
-        if (!scene.want_transfer) {
-          p.left_out.push_back("transfer/visibility: not in bake.products");
-          if (!scene.lights.empty())
-            p.left_out.push_back("area_lights/sh: transfer/visibility is not baked (not in bake.products)");
-        }
-        if (scene.want_transfer || shadowed) {
-          const int L = clamped_power_order(m.phong_exponent, scene.sh_tolerance, sh::kMaxOrder);
-          if (L == 0) {
-            std::ostringstream os;
-            os << "object '" << o.name << "': a Phong exponent of " << m.phong_exponent
-               << " needs more than " << sh::kMaxOrder << " SH bands to keep the energy beyond them under "
-               << pct(scene.sh_tolerance) << " (" << pct(clamped_power_energy_beyond(m.phong_exponent, sh::kMaxOrder))
-               << " at order " << sh::kMaxOrder << "); lower the exponent or raise bake.sh_tolerance";
-            throw InputError(scene.file.string(), os.str());
-          }
-          std::ostringstream os;
-          os << "order " << L << " for the Phong exponent " << m.phong_exponent
-             << ", the smallest whose lobe energy beyond it (" << pct(clamped_power_energy_beyond(m.phong_exponent, L))
-             << ") is <= sh_tolerance " << pct(scene.sh_tolerance);
-          // S for the scene's own environment (exact shadows, any lobe at run time); U besides it
-          // whenever transfer is asked for: it is what relights or rotates the lighting (route A),
-          // at a third of S's size, and a scene that wants the fixed environment only leaves
-          // "transfer" out of bake.products.
-          if (shadowed) {
-            p.shadowed_order = L;
-            p.baked.push_back("radiance/shadowed: " + os.str() + ", under " + env_name +
-                              ": the shadowed incident radiance, the lobe applied at run time (paper 001 §4, "
-                              "material editing)");
-          }
-          if (scene.want_transfer) {
-            p.visibility_order = L;
-            p.baked.push_back("transfer/visibility: " + os.str() +
-                              (shadowed ? " (relightable: the lighting may change or rotate; radiance/shadowed "
-                                          "serves the fixed environment)"
-                                        : ""));
-            if (!scene.lights.empty()) {
-              p.area_sh_order = L;
-              p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
-            }
-          }
-        }
-      }
-    }
-    if (p.occluder) {
-      if (!scene.want_fiv) {
-        p.left_out.push_back("fiv: not in bake.products");
-      } else if (!o.moves) {
-        // Paper 004 §1: FIV shells shade what a MOVING occluder casts on other receivers; a static
-        // occluder's shadows are already in every receiver's own products.
-        p.left_out.push_back("fiv: the object does not move (" + o.moves_reason +
-                             "); its shadows are in the receivers' own products (set \"moves\": true to bake its shells)");
-      } else if (!env) {
-        p.left_out.push_back("fiv: the scene has no environment (F = Int (1 - V) L w dw needs one)");
-      } else {
-        // Can it shadow another receiver? Paper 004 §4.3.1: an occluder whose bounding sphere lies
-        // wholly below a receiver point's tangent plane (case C) occludes nothing there.
-        bool other_receiver = false, reaches = false;
-        for (size_t j = 0; j < scene.objects.size() && !reaches; ++j) {
-          if (j == i || scene.objects[j].role == Role::Occluder) continue;
-          other_receiver = true;
-          const Mesh& R = meshes[j];
-          for (size_t v = 0; v < R.positions.size() && !reaches; ++v)
-            reaches = R.normals[v].cast<double>().dot(centre[i] - R.positions[v].cast<double>()) > -radius[i];
-        }
-        if (!other_receiver) p.left_out.push_back("fiv: no other receiver in the scene for it to shadow");
-        else if (!reaches) p.left_out.push_back("fiv: its bounding sphere lies below the horizon of every vertex of every other receiver");
-        else
-          p.fiv = true,
-          p.baked.push_back("fiv: it moves (" + o.moves_reason + ") and can shadow another receiver; shells up to " +
-                            std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) + "x" +
-                            std::to_string(scene.fiv.n_rho) + " by the silhouette integrator at k = " +
-                            std::to_string(scene.fiv.silhouette_k) +
-                            (scene.integrator.kind == IntegratorKind::Silhouette
-                                 ? std::string()
-                                 : std::string(" (paper 004's shells are integrated by silhouettes whatever "
-                                               "bake.integrator says; bake.fiv sets their grid)")));
-      }
-    }
-    plan.fiv_environment = plan.fiv_environment || p.fiv;
-  }
-  if (plan.fiv_environment) plan.notes.push_back("fiv/environment and fiv/irradiance_cube: some occluder has shells");
-  else plan.notes.push_back("fiv/environment and fiv/irradiance_cube: left out, no occluder has shells");
-  return plan;
 }
 
 } // namespace prt::bake
