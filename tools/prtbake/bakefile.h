@@ -4,6 +4,7 @@
 // attributes whichever command baked it (docs/ARCHITECTURE.md §4).
 #pragma once
 
+#include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>

@@ -2,6 +2,8 @@
 // one subcommand per kind of bake, each with only the options that apply to it, into the typed
 // specs of libbake), reports progress and calls libbake (integration) and formats (the HDF5 file).
 #include <bake/bake/choose.h>
+#include <bake/bake/diagnostics.h>
+#include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/scene_bake.h>
 #include <bake/bake/vertex_bake.h>

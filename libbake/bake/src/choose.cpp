@@ -3,6 +3,7 @@
 // bounds, costs measured, the cheaper prediction chosen and checked; and the error report's
 // reference sized for the target.
 #include <bake/bake/choose.h>
+#include <bake/bake/error_report.h>
 
 #include <bake/core/error.h>
 #include <bake/integrators/qmc.h>

@@ -1,5 +1,6 @@
 // scene_bake.cpp — runs a scene plan (bake/bake/scene.h): the receivers' per-vertex products against
 // the union of the occluders and the area lights' rows, then FIV shells per occluder that needs them.
+#include <bake/bake/error_report.h>
 #include <bake/bake/scene_bake.h>
 #include <bake/core/error.h>
 #include <bake/lights/area_bake.h>

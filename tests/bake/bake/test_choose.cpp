@@ -2,6 +2,7 @@
 // the pilot never saw, a tighter target asks for more samples, the knobs are a function of the
 // inputs and the seed, a named integrator keeps its kind, and the scene file's "target_error".
 #include <bake/bake/choose.h>
+#include <bake/bake/error_report.h>
 #include <bake/bake/scene.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>

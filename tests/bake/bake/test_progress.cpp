@@ -3,6 +3,7 @@
 // how a CancelToken stops bake_vertices and bake_fiv_shells, that watching a bake does not
 // change its numbers, and that libbake prints nothing (the link-level half of that check is
 // tests/check_silent.cmake).
+#include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>

@@ -1,5 +1,6 @@
 // Winding facts (bake/mesh/mesh.h winding_facts), MeshLoadOptions::flip_normals (build_mesh) and the
 // no-sky count of a bake (bake/bake/vertex_bake.h count_no_sky), with both integrators.
+#include <bake/bake/diagnostics.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/integrators/integrator.h>
 #include <bake/mesh/mesh.h>

@@ -102,6 +102,7 @@
 // function of the inputs, the seed and E.
 #pragma once
 
+#include <bake/bake/error_report.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/progress.h>
 #include <bake/integrators/integrator.h>

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bake/bake/choose.h>
+#include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/scene.h>
 #include <bake/bake/vertex_bake.h>

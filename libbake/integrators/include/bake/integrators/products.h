@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 namespace prt::bake {
 
@@ -75,5 +76,18 @@ struct ProductLayout {
     width = shadowed + shadowed_count;
   }
 };
+
+// The per-vertex products, as libbake knows them; the file names them through formats/ (the
+// baker maps each to its dataset there), libbake only labels them for people.
+enum class Product { Ao, TransferDiffuse, TransferVisibility, RadianceBand1, RadianceShadowed };
+const char* product_label(Product product);  // "AO", "diffuse transfer", ... (for logs)
+
+// Where each product a layout holds lies in a row, in row order (AO, diffuse transfer,
+// visibility transfer, band-1 radiance, shadowed radiance); products the layout does not hold are left out.
+struct ProductSlice {
+  Product product;
+  size_t offset, count;
+};
+std::vector<ProductSlice> product_slices(const ProductLayout& layout);
 
 } // namespace prt::bake
