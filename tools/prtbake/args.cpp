@@ -1,0 +1,458 @@
+// tools/prtbake/args.cpp — prtbake's command line (contract: args.h): the help texts, the
+// options of each subcommand, and the checks that need no file.
+#include "args.h"
+
+#include <bake/bake/choose.h>
+#include <bake/bake/scene.h>
+#include <prtshade/sh.h>
+
+#include "cli.h"
+#include "tool_main.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <limits>
+#include <vector>
+
+namespace prt::tool {
+namespace {
+
+constexpr const char* kDescription = "prtbake — bake precomputed radiance transfer (PRT) data for game geometry";
+
+constexpr const char* kVertexHelp =
+    "Bakes per-vertex products for every vertex of MESH (OBJ, PLY, OFF, STL, glTF, GLB) in one\n"
+    "pass: the rays cast from a vertex serve every product at once. Rows follow the file's vertex\n"
+    "order (glTF: the vertices of each primitive instance of the default scene, in node order);\n"
+    "a position with several normals in the file (OBJ v//vn hard edges) gives one row per\n"
+    "(position, normal) pair, and /mesh/source_position says which file vertex each row is.\n"
+    "Give at least one of the products.";
+
+constexpr const char* kFivHelp =
+    "Bakes an occluder's Fullsphere Irradiance Vectors (paper 004): the environment's FIV\n"
+    "F_env = Int L w dw, the diffuse irradiance cube map (DifMap) E(n) = Int L H (n.w) dw (exact,\n"
+    "not SH9), and the occluded FIV F(s) = Int (1 - V(s,w)) L w dw on concentric shells around the\n"
+    "occluder's bounding sphere, radii from half the bounding radius outwards, stopping once\n"
+    "|F| < --fraction of Int L dw. Always with the silhouette integrator.";
+
+constexpr const char* kSceneHelp =
+    "Bakes a scene file (JSON: objects with mesh, transform, material and role receiver /\n"
+    "occluder / both; one environment; what may be baked — see data/scene_example.json and the\n"
+    "README) and bakes only what the scene needs, printing what it leaves out and why:\n"
+    "occluder-only objects get no per-vertex products; a diffuse receiver gets band-1 radiance\n"
+    "under the environment (exact) and no higher order, or diffuse transfer at the order the SH\n"
+    "tolerance needs when there is no environment (or \"relight\"); a glossy (Phong) receiver gets\n"
+    "visibility transfer at the smallest order whose lobe energy beyond it is under the tolerance;\n"
+    "no radiance or FIV without an environment; FIV shells only for occluders that can shadow\n"
+    "another receiver; vertices that see no contour edge get closed forms. Products, integrator,\n"
+    "samples, seed and FIV shells are set in the file's \"bake\" section. Per-object results go\n"
+    "under /objects/<name>/ in the file.\n"
+    "A glTF (.gltf, .glb) is a scene too: each primitive instance of its default scene is an\n"
+    "object named by its node path (\"root/engine/piston_2\", \"#p1\" for a mesh's 2nd primitive;\n"
+    "stored as /objects/root|engine|piston_2 with the path in node_path), role \"both\", albedo\n"
+    "the material's baseColorFactor (0.8 grey without one). --options sets the rest.";
+
+// One line per command: the top-level --help and the message for an unknown command.
+const std::vector<tool::Command> kCommands = {
+    {"vertex", "per-vertex products of a mesh: AO, SH transfer, visibility, band-1 and shadowed radiance"},
+    {"fiv", "an occluder's Fullsphere Irradiance Vectors on shells around it, and the DifMap"},
+    {"scene", "a scene file or glTF: bakes what each object needs and says what it leaves out, and why"},
+    {"export", "a baked file as glTF, plain binary, or Unity / Godot / Filament light probes"},
+};
+
+// Each command's EXAMPLES (its --help shows its own); the top-level --help shows one per command.
+constexpr const char* kVertexExamples =
+    "EXAMPLES\n"
+    "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
+    "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
+    "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
+    "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
+    "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
+constexpr const char* kFivExamples =
+    "EXAMPLES\n"
+    "  prtbake fiv data/bunny.obj --env data/forest.exr --shells 64x33x30 -o bunny.fiv.prt.h5\n"
+    "  mpirun -n 4 prtbake fiv data/bunny.obj --env data/forest.exr -o bunny.fiv.prt.h5   # shells in slabs of samples\n"
+    "  prtdump bunny.fiv.prt.h5        # the shells, the DifMap, the error report\n\n";
+constexpr const char* kSceneExamples =
+    "EXAMPLES\n"
+    "  prtbake scene data/scene_example.json --dry-run      # the plan: what each object gets, and why\n"
+    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtbake scene engine.glb --options engine.options.json -o engine.prt.h5\n"
+    "  prtdump scene.prt.h5 --vertex 0 --object bunny\n\n";
+constexpr const char* kTopExamples =
+    "EXAMPLES\n"
+    "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
+    "  prtbake fiv data/bunny.obj --env data/forest.exr -o bunny.fiv.prt.h5\n"
+    "  prtbake scene data/scene_example.json -o scene.prt.h5\n"
+    "  prtbake export bunny.prt.h5 --to glb -o bunny.glb\n"
+    "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
+
+
+// The command line as stored in the file: the arguments that determine its contents, as typed
+// (without --threads, --quiet, --verbose, --dry-run, --reproducible and the sharding options);
+// "--opt=value" is stored as "--opt value".
+std::string content_command_line(int argc, char** argv) {
+  std::string line = "prtbake";
+  for (int i = 1; i < argc; ++i) {
+    std::string s = argv[i], value;
+    const size_t eq = s.rfind("--", 0) == 0 ? s.find('=') : std::string::npos;
+    if (eq != std::string::npos) value = s.substr(eq + 1), s.resize(eq);
+    bool takes_value = false;
+    if (s == "--threads" || tool::is_shard_option(s, takes_value)) {
+      if ((s == "--threads" || takes_value) && eq == std::string::npos) ++i;
+      continue;
+    }
+    if (s == "--quiet" || s == "-q" || s == "--verbose" || s == "-v" || s == "--dry-run" || s == "--reproducible")
+      continue;
+    line += " " + s;
+    if (eq != std::string::npos) line += " " + value;
+  }
+  return line;
+}
+
+// Why `path` cannot be the output file ("" if it can): prtbake writes HDF5 files only.
+std::string output_problem(const std::string& path) {
+  if (path == "-")
+    return "cannot write to standard output: an HDF5 file needs a seekable file; give a name ending in .prt.h5";
+  if (!path.ends_with(".h5"))
+    return "'" + path + "' does not end in .h5: prtbake writes HDF5 files only (.prt.h5 or .h5 expected)";
+  return "";
+}
+
+// ---- the options, each defined once and added to the subcommands it applies to ----
+
+void add_output(CLI::App& cmd, Args& a) {
+  cmd.add_option("-o,--output", a.output,
+                 "the .prt.h5 file to write (HDF5; see formats/SCHEMA.md). Written to a\n"
+                 "temporary file first and renamed, so FILE is never half-written.")
+      ->option_text("FILE")
+      ->check(output_problem);
+}
+
+void add_report(CLI::App& cmd, Args& a, const std::string& reference) {
+  cmd.add_option("--report", a.integrator.report_points,
+                 "after the bake, re-integrate N seeded points with a converged QMC\nreference (" + reference +
+                     ")\nand print/store the error (RMSE, max) next to the run time (default " +
+                     std::to_string(bake::IntegratorSpec{}.report_points) +
+                     ";\n0 turns it off). Stored under /report in the file.")
+      ->option_text("N")
+      ->check(tool::integer_in(0, 1 << 20));
+}
+
+// --threads, --reproducible and --quiet. `target_help`: what --reproducible does to the command's
+// target-error choice ("" for a command without one: fiv).
+void add_run_options(CLI::App& cmd, Args& a, const std::string& target_help) {
+  cmd.add_option("--threads", a.threads, "worker threads (default: all cores).")
+      ->option_text("T")
+      ->check(tool::integer_in(1, 4096));
+  cmd.add_flag("--reproducible", a.reproducible,
+               "make the file a pure function of the inputs: 'created' is pinned to\n"
+               "SOURCE_DATE_EPOCH (or 0) and measured wall times are printed but not\n"
+               "stored. Implied when SOURCE_DATE_EPOCH is set (reproducible-builds.org)." +
+                   (target_help.empty() ? std::string("\nThe baked values are identical with or without it.")
+                                        : "\n" + target_help));
+  cmd.add_flag("-q,--quiet", a.quiet, "print nothing but warnings (about the input) and errors.");
+}
+
+// --samples, --seed and --up: what samples the sphere around a shade point.
+void add_sampling(CLI::App& cmd, Args& a, uint32_t& samples, const std::string& samples_help) {
+  cmd.add_option("--samples", samples, samples_help)->option_text("N")->check(tool::integer_in(1, 1 << 24));
+  cmd.add_option("--seed", a.integrator.seed,
+                 "randomisation seed (default " + std::to_string(bake::IntegratorSpec{}.seed) +
+                     "). Same inputs and seed give identical\nbytes whatever --threads is.")
+      ->option_text("S")
+      ->check(tool::integer_in(0, std::numeric_limits<int64_t>::max()));
+  cmd.add_option_function<std::string>(
+         "--up",
+         [&a](const std::string& u) {
+           if (u == "y" || u == "Y") a.up = bake::UpAxis::Y;
+           else if (u == "z" || u == "Z") a.up = bake::UpAxis::Z;
+           else throw CLI::ValidationError("--up", "expects y or z, got '" + u + "'");
+         },
+         "the scene's up axis (default y). With z (Blender), scene direction\n"
+         "(x,y,z) is looked up in the environment as (x,z,-y).")
+      ->option_text("y|z");
+}
+
+// The fiv command's k has a default; a vertex bake without --samples has its k chosen by the
+// target error instead.
+std::string silhouette_k_help(bool with_default) {
+  const bake::IntegratorSpec d;
+  return "k = N, the number of spherical samples\n(sqrt(k) u-isolines, rounded to even" +
+         (with_default ? "; default " + std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2" : "");
+}
+
+void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
+  CLI::App& cmd = *app.add_subcommand("vertex", kVertexHelp);
+  cmd.add_option("MESH", a.input, "the mesh (OBJ, PLY, OFF, STL, glTF, GLB; a glTF's primitive\ninstances are concatenated in node order)")->required()->type_name("");
+  add_output(cmd, a);
+  const std::string products = "Products (at least one)";
+  cmd.add_flag("--ao", a.ao, "ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]")->group(products);
+  cmd.add_option("--transfer", a.transfer,
+                 "diffuse transfer vectors T_i = 1/pi * Int V H (n.w) y_i dw, SH order L\n"
+                 "(L bands, L*L coefficients; shade with albedo * sum_i T_i L_i)")
+      ->option_text("L")
+      ->check(tool::integer_in(1, sh::kMaxOrder))
+      ->group(products);
+  cmd.add_option("--visibility", a.visibility,
+                 "visibility transfer vectors U_i = Int V H y_i dw, SH order L (glossy,\ntriple products)")
+      ->option_text("L")
+      ->check(tool::integer_in(1, sh::kMaxOrder))
+      ->group(products);
+  cmd.add_option("--radiance,--env", a.environment,
+                 "band-1 shadowed radiance R_c,m = Int L_c V H y_1m dw from the HDR\n"
+                 "environment ENV (OpenEXR lat-long or cube map): exact all-frequency\n"
+                 "diffuse shadows with 3 coefficients per channel. Irradiance at the\n"
+                 "baked normal n: E = 4pi/3 * sum_m y_1m(n) R_m. --env is the same\n"
+                 "option (the name fiv, export and prtview give the environment).")
+      ->option_text("ENV")
+      ->group(products);
+  cmd.add_option("--shadowed", a.shadowed,
+                 "shadowed radiance S_c,i = Int L_c V H y_i dw at SH order L under the\n"
+                 "--radiance (--env) environment (paper 001 sec. 4, material editing: glossy\n"
+                 "lobes chosen at run time; band 1 of S is R)")
+      ->option_text("L")
+      ->check(tool::integer_in(1, sh::kMaxOrder))
+      ->group(products);
+  cmd.add_option_function<std::string>(
+         "--integrator",
+         [&a](const std::string& name) {
+           const auto kind = bake::parse_integrator_kind(name);
+           if (!kind) {
+             const auto near = tool::closest(name, {"silhouette", "qmc", "filter"});
+             throw CLI::ValidationError("--integrator", "unknown integrator '" + name + "'" +
+                                                            (near ? "; did you mean " + *near + "?" : std::string()) +
+                                                            " (available: silhouette, qmc, filter)");
+           }
+           a.integrator.kind = *kind;
+         },
+         "silhouette (the default with --samples): semi-analytic visibility\n"
+         "silhouettes (paper 001 §3): contour edges, depth complexity along\n"
+         "octahedral u-isolines, summed-area tables. Deterministic; error\n"
+         "falls with k, no noise.\n"
+         "qmc: Embree ray casting, importance-sampled randomised Halton QMC, the\n"
+         "baseline and the reference.\n"
+         "filter: a few rays per vertex reused by its neighbours through the\n"
+         "sheared filter (paper 002); --samples is its pass-1 rays (4-32).")
+      ->option_text("NAME");
+  cmd.add_option("--target-error", a.target_error,
+                 "the default (E = 1e-3) unless --samples is given: the integrator\n"
+                 "and its samples chosen for you, the cheapest bake whose RMSE is\n"
+                 "at most E per product (AO, transfer: absolute; band-1\n"
+                 "radiance: relative to its RMS), from a pilot on 32-128 seeded vertices\n"
+                 "(both integrators timed, or their work counted with --reproducible,\n"
+                 "and their errors measured against a 256- or 512-isoline silhouette\n"
+                 "reference). E in [1e-4, 0.1].\n"
+                 "With --integrator, only its samples are chosen; not with --samples.\n"
+                 "The choice is printed in one line (with -v, the pilot's table);\n"
+                 "the error report (on 128 vertices when --target-error is given,\n"
+                 "unless --report says otherwise) then checks E. Which integrator\n"
+                 "wins is measured speed: pin the printed choice with --integrator\n"
+                 "and --samples, or use --reproducible, for the same bytes anywhere.")
+      ->option_text("E")
+      ->check(tool::number_in(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
+  const bake::IntegratorSpec d;
+  add_sampling(cmd, a, samples,
+               "silhouette: " + silhouette_k_help(false) +
+                   ";\n64^2 to 256^2 converge for HDR environments). qmc: rays per vertex;\n"
+                   "the error falls like 1/sqrt(N) or faster. Without it, --target-error\n"
+                   "chooses N (and the integrator, unless --integrator names one).");
+  cmd.add_flag_callback("--no-file-normals", [&a] { a.file_normals = false; },
+                        "ignore normals in the mesh file; use angle-weighted vertex normals.");
+  cmd.add_flag("--flip-normals", a.flip_normals,
+               "reverse every triangle's winding and negate the file's normals (so\n"
+               "file and angle-weighted normals both point the other way): for a\n"
+               "mesh wound inwards, whose vertices would otherwise see no sky.\n"
+               "/mesh/normals' source then ends in ', flipped'.");
+  add_report(cmd, a,
+             std::to_string(bake::IntegratorSpec::kQmcReferenceFactor) + "x the bake's rays for qmc, " +
+                 std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) + " rays for silhouette");
+  add_run_options(cmd, a,
+                  "With a target error (the default), the integrator is chosen by the\n"
+                  "pilot's counted work instead of its measured time, so the choice,\n"
+                  "and the bytes, are the same on any machine. With --samples the\n"
+                  "baked values are identical with or without it.");
+  cmd.add_flag("-v,--verbose", a.verbose,
+               "with a target error: print the pilot's table (each run's error and\n"
+               "cost, each integrator's model) instead of one line.")
+      ->excludes("--quiet");
+  tool::add_shard_options(cmd, a.shard, "vertices");
+  cmd.footer(std::string(kVertexExamples) + tool::kExitStatusHelp);
+}
+
+void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
+  CLI::App& cmd = *app.add_subcommand("fiv", kFivHelp);
+  cmd.add_option("OCCLUDER", a.input, "the occluder's mesh (OBJ, PLY, OFF, STL, glTF, GLB)")->required()->type_name("");
+  add_output(cmd, a);
+  cmd.add_option("--env", a.environment, "the HDR environment (OpenEXR lat-long or cube map)")
+      ->option_text("ENV")
+      ->required();
+  const bake::ShellSpec d;
+  cmd.add_option_function<std::string>(
+         "--shells",
+         [&a](const std::string& g) {
+           if (!bake::parse_shell_grid(g, a.shell_spec))
+             throw CLI::ValidationError("--shells",
+                                        "expects NPHIxNTHETAxNRHO, e.g. 128x65x30 (NTHETA >= 2), got '" + g + "'");
+         },
+         "the shell grid: NPHI x NTHETA (poles included) directions on each of\nNRHO shells (default " +
+             std::to_string(d.n_phi) + "x" + std::to_string(d.n_theta) + "x" + std::to_string(d.n_rho) + ")")
+      ->option_text("NPHIxNTHETAxNRHO");
+  cmd.add_option("--cube", a.shell_spec.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
+      ->option_text("S")
+      ->check(tool::integer_in(1, 1024));
+  cmd.add_option("--fraction", a.shell_spec.fraction,
+                 "stop adding shells once |F| < FRACTION of Int L dw (default 1e-3;\n"
+                 "strictly between 0 and 1)")
+      ->option_text("FRACTION")
+      ->check(tool::number_between(0, 1));
+  add_sampling(cmd, a, samples, "the silhouette integrator's " + silhouette_k_help(true) + ").");
+  add_report(cmd, a,
+             std::to_string(bake::IntegratorSpec::kSilhouetteReferenceRays) +
+                 " rays, full sphere, at seeded shell samples");
+  add_run_options(cmd, a, "");
+  tool::add_shard_options(cmd, a.shard, "DifMap texels, or a FIV shell's samples");
+  cmd.footer(std::string(kFivExamples) + tool::kExitStatusHelp);
+}
+
+void add_scene(CLI::App& app, Args& a) {
+  CLI::App& cmd = *app.add_subcommand("scene", kSceneHelp);
+  cmd.add_option("SCENE", a.input, "the scene file (JSON), or a glTF (.gltf, .glb)")->required()->type_name("");
+  add_output(cmd, a);
+  cmd.add_option("--options", a.scene_options,
+                 "glTF scenes only: a JSON file {\"prtbake_gltf_scene\": 1, \"up\", \"environment\",\n"
+                 "\"bake\" (as in a scene file), \"objects\": {\"<node path>\": {\"role\": ...,\n"
+                 "\"material\": {...}}}}; a node path covers the nodes below it, the longest\n"
+                 "match wins, a path that names no node is an error (README \"Scene files\").")
+      ->option_text("FILE");
+  cmd.add_flag("--dry-run", a.dry_run, "print the plan and stop (no output file needed).");
+  add_report(cmd, a, "overrides the scene file's bake.report");
+  add_run_options(cmd, a,
+                  "With a target error (the scene's bake.target_error; the default\n"
+                  "without bake.samples), each receiver's integrator is chosen by\n"
+                  "the pilot's counted work instead of its measured time, so the\n"
+                  "choice, and the bytes, are the same on any machine. With\n"
+                  "bake.samples the baked values are identical with or without it.");
+  cmd.add_flag("-v,--verbose", a.verbose,
+               "with a target error: print each receiver's pilot table (each run's\n"
+               "error and cost, each integrator's model) instead of one line, and the\n"
+               "error report's reference plan.")
+      ->excludes("--quiet");
+  tool::add_shard_options(cmd, a.shard, "receiver vertices");
+  cmd.footer(std::string(kSceneExamples) + tool::kExitStatusHelp);
+}
+
+// The top-level --help: the commands, one line each, and where each one's options are.
+std::string overview() {
+  std::string s = std::string(kDescription) + "\n\nUsage: prtbake COMMAND [OPTIONS] INPUT ...\n\nCommands:\n";
+  for (const tool::Command& c : kCommands) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  %-8s %s\n", c.name, c.summary);
+    s += line;
+  }
+  s += "\n'prtbake COMMAND --help' lists a command's options, says what it computes and gives\n"
+       "examples. Options go after the command, in any order; --opt value or --opt=value.\n\n"
+       "Options:\n"
+       "  -h,--help  this list\n"
+       "  --version  the version (prtbake " + std::string(kToolkitVersion) + ")\n\n";
+  return s + kTopExamples + tool::kExitStatusHelp;
+}
+
+// Every check of the command line that needs no file, after CLI11 has parsed it: a mistake is
+// exit 2 before any input is read (tool_main.h). `app`: the parsed command line.
+void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSession& mpi) {
+  const CLI::App& cmd = *app.get_subcommands().front();
+  const std::string help = "prtbake " + a.command;
+  const auto fail = [&](const std::string& what) { throw UsageError(a.command + ": " + what, help); };
+  if (a.command == "export") {
+    if (mpi.active()) fail("run it as one process, not under mpirun");
+    tool::check_export_args(a.exported);
+    return;
+  }
+  if (a.output.empty() && !(a.command == "scene" && a.dry_run)) fail("no output file given (-o OUT.prt.h5)");
+  // Who this process is among a sharded bake's workers (the options and the launcher's
+  // environment), before the inputs are read.
+  if (a.shard.given() || mpi.active()) {
+    try {
+      a.worker = tool::resolve_worker(a.shard, mpi);
+    } catch (const UsageError& e) {
+      fail(e.what());
+    }
+  }
+  if (a.command == "scene") {
+    a.report_given = cmd.count("--report") > 0;
+    if (!a.scene_options.empty() && !bake::is_gltf_scene(a.input))
+      fail("--options " + a.scene_options + " applies to a glTF scene (.gltf, .glb) only; " + a.input +
+           " is a JSON scene file, whose own \"bake\" section holds the options");
+    return;
+  }
+  if (a.command == "vertex") {
+    a.integrator_given = cmd.count("--integrator") > 0;
+    const bool target_given = a.target_error > 0;
+    if (target_given && samples != 0)
+      fail("--target-error and --samples both given: the target chooses the samples (give one)");
+    if (a.integrator.kind == bake::IntegratorKind::Filter && samples == 0)
+      fail(std::string("--integrator filter needs --samples N, its pass-1 rays per vertex (4-32): the target-error "
+                       "chooser has no model of the filter integrator") +
+           (target_given ? ", so it cannot take --target-error" : ""));
+    // Neither samples nor a target: the default target, checked exactly as the same target named.
+    if (!target_given && samples == 0) a.target_error = bake::ChooserOptions{}.target;
+    // Checking a target needs more vertices than the default report's 32 (RMSE over a sample);
+    // the check's reference takes about as long as the bake (plan_report_reference's CPU bound).
+    if (a.target_error > 0 && cmd.count("--report") == 0) a.integrator.report_points = bake::ChooserOptions::kReportPoints;
+    if (!a.ao && !a.transfer && !a.visibility && a.environment.empty())
+      fail("nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV (or --env ENV)");
+    if (a.shadowed && a.environment.empty())
+      fail("--shadowed L needs --radiance ENV (or --env ENV): the environment it is baked under");
+  }
+  if (samples != 0) a.integrator.set_samples(samples);
+  if (a.integrator.kind == bake::IntegratorKind::Silhouette &&
+      a.integrator.silhouette_k < bake::IntegratorSpec::kMinSilhouetteK)
+    fail("--samples " + std::to_string(a.integrator.silhouette_k) + ": the silhouette integrator needs k >= " +
+         std::to_string(bake::IntegratorSpec::kMinSilhouetteK) + " (2 u-isolines)");
+  if (a.command == "fiv") a.shell_spec.silhouette_k = a.integrator.silhouette_k;  // the shells' k (as in scene files)
+}
+
+} // namespace
+
+std::optional<Args> parse(int argc, char** argv, const tool::MpiSession& mpi) {
+  Args a;
+  uint32_t samples = 0;  // --samples: 0 if not given
+  CLI::App app(kDescription, "prtbake");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("prtbake ") + kToolkitVersion);
+  app.get_formatter()->column_width(24);
+  add_vertex(app, a, samples);
+  add_fiv(app, a, samples);
+  add_scene(app, a);
+  tool::add_export(app, a.exported);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    // A command's --help is its whole text; the tool's own lists the commands.
+    const std::vector<CLI::App*> given = app.get_subcommands();
+    std::cout << (given.empty() ? overview() : given.front()->help("prtbake"));
+    return std::nullopt;
+  } catch (const CLI::Success& e) {  // --version
+    app.exit(e);
+    return std::nullopt;
+  } catch (const CLI::ParseError& e) {
+    const std::vector<CLI::App*> given = app.get_subcommands();
+    throw UsageError(tool::usage_message(app, e, "prtbake", kCommands),
+                     given.empty() ? "" : "prtbake " + given.front()->get_name());
+  }
+  a.command = app.get_subcommands().front()->get_name();
+  if (a.command != "export") {
+    a.command_line = content_command_line(argc, argv);
+    a.shard.rerun_command = tool::shell_command(argc, argv);
+    if (std::getenv("SOURCE_DATE_EPOCH")) a.reproducible = true;
+    // A sharded bake's file is the --reproducible one, whichever worker merges (shards.h).
+    if (a.shard.given() || mpi.active()) a.reproducible = true;
+  }
+  validate(a, app, samples, mpi);
+  return a;
+}
+
+} // namespace prt::tool

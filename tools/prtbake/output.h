@@ -1,0 +1,53 @@
+// tools/prtbake/output.h — what the bake commands say besides their progress and results:
+// warnings about the input on stderr (each "prtbake: warning: ..."), the error report's
+// reference plan; and the file they write: its root attributes, and the write itself.
+#pragma once
+
+#include <bake/bake/choose.h>
+#include <bake/bake/diagnostics.h>
+#include <bake/mesh/mesh.h>
+#include <formats/asset.h>
+
+#include "args.h"
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace prt::tool {
+
+// Fails early (before a long bake) if the output's directory cannot take a file (InputError).
+void check_output_writable(const std::filesystem::path& out);
+
+// Prints reader warnings once each, with a count for repeats.
+void print_warnings(const std::vector<std::string>& warnings);
+
+// Closed components wound inwards (bake/mesh/mesh.h winding_facts): their vertices will see no sky.
+// `object`: a scene's object ("" for prtbake vertex, whose --flip-normals can fix a whole mesh).
+// `casts`: the mesh shadows itself (a vertex bake, a scene's "both"), so those vertices see no sky;
+// a receiver-only object casts nothing and is shaded about normals that point inside.
+void warn_inward(const bake::WindingFacts& facts, bool flipped, const std::string& object = "", bool casts = true);
+
+// More than half the vertices saw no sky at all (bake/bake/diagnostics.h count_no_sky). Which
+// explanation fits: closed parts wound inwards (said above), or else the flip probe — with their
+// normals reversed, would these vertices see sky (normals pointing inside: flip them) or not
+// (vertices enclosed by other geometry: an engine's internals under its housing, parts pushed
+// into each other; the bake is right and nothing is to be fixed)?
+void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts,
+                 const std::function<bake::FlipProbe()>& probe, bool flipped);
+
+// A target the chooser could not reach within its bounds: it baked the best plan it had
+// (bake/bake/choose.h, step 5); say so on stderr, with the options that go further.
+void warn_unreached(const bake::IntegratorChoice& choice, const std::string& object);
+
+// The error report's reference for a target (bake/bake/choose.h plan_report_reference), with -v.
+void print_reference_plan(const bake::ReferencePlan& plan);
+
+// The root attributes every file carries (formats/SCHEMA.md).
+prt::formats::RootInfo root_info(const Args& a, const std::string& source_sha);
+
+// Writes the asset (validated, temp + rename: formats/asset.h) and says where and how big.
+void write_file(const Args& a, const prt::formats::Asset& asset);
+
+} // namespace prt::tool

@@ -1,0 +1,325 @@
+// tools/prtbake/run_scene.cpp — `prtbake scene` (commands.h): a scene file or glTF. Prints the
+// plan (what each object gets, and why; --dry-run: and what it would cost), bakes what it asks
+// for (sharded: the receivers' rows in chunks, shards.h), writes the file once the bake is whole
+// and again with the error reports.
+#include <bake/bake/diagnostics.h>
+#include <bake/bake/scene.h>
+#include <bake/bake/scene_bake.h>
+#include <bake/bake/vertex_bake.h>
+#include <bake/core/sha256.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
+#include <formats/asset.h>
+
+#include "bakefile.h"
+#include "commands.h"
+#include "output.h"
+#include "shards.h"
+#include "progress_bar.h"
+#include "tool_main.h"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace prt::tool {
+namespace {
+
+// How the tools name a scene object to people: a glTF instance by its node path ("node0/body"),
+// a scene file's object by its name (the file's "|" spelling is for HDF5 paths only).
+std::string scene_object_label(const bake::SceneObject& o) { return o.node_path.empty() ? o.name : o.node_path; }
+
+} // namespace
+
+int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
+  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
+  const std::optional<tool::Worker>& worker = a.worker;
+  if (!a.dry_run) check_output_writable(a.output);
+  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
+  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+  bake::SceneDescription scene = bake::load_scene(
+      a.input, a.scene_options.empty() ? std::nullopt : std::optional<fs::path>(a.scene_options));
+  if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
+  scene.counted_costs = a.reproducible;  // a target's choice by counted work: the same on any machine
+  Args file_args = a;  // the root attributes follow the scene file
+  file_args.up = scene.up;
+
+  std::vector<std::string> warnings;
+  const std::vector<bake::Mesh> meshes = bake::load_scene_meshes(scene, warnings);
+  print_warnings(warnings);
+  std::optional<bake::EnvMap> env;
+  if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
+  const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
+  // Receivers with closed parts wound inwards: their vertices would see no sky.
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    if (plan.objects[i].receiver && plan.objects[i].any_vertex_product())
+      warn_inward(bake::winding_facts(meshes[i], bake::build_topology(meshes[i])), false,
+                  scene_object_label(scene.objects[i]), plan.objects[i].occluder);
+
+  if (say) {
+    std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.input.c_str(),
+                scene.objects.size(), env ? scene.environment->string().c_str() : "none",
+                bake::to_string(scene.integrator.kind),
+                scene.sh_tolerance);
+    // Every object with its decisions; with many objects (an engine of 115 parts), the objects
+    // that share their role and decisions are printed once as a group (-v: every object).
+    auto decisions = [&](size_t i) {
+      std::string d = std::string(bake::role_name(scene.objects[i].role)) + "\n";
+      for (const auto& b : plan.objects[i].baked) d += "      bake       " + b + "\n";
+      for (const auto& l : plan.objects[i].left_out) d += "      leave out  " + l + "\n";
+      return d;
+    };
+    auto name_of = [&](size_t i) { return scene_object_label(scene.objects[i]); };
+    constexpr size_t kGroupAbove = 12;  // objects; fewer are listed one by one
+    if (a.verbose || scene.objects.size() <= kGroupAbove) {
+      for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string d = decisions(i);
+        std::printf("  %s (%s): %s, %zu vertices, %zu triangles\n%s", name_of(i).c_str(), bake::role_name(scene.objects[i].role),
+                    scene.objects[i].mesh.string().c_str(), meshes[i].positions.size(), meshes[i].triangles.size(),
+                    d.substr(d.find('\n') + 1).c_str());
+      }
+    } else {
+      std::vector<std::pair<std::string, std::vector<size_t>>> sets;  // in order of first appearance
+      for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const std::string d = decisions(i);
+        auto it = std::find_if(sets.begin(), sets.end(), [&](const auto& x) { return x.first == d; });
+        if (it == sets.end()) sets.push_back({d, {i}});
+        else it->second.push_back(i);
+      }
+      for (const auto& [d, members] : sets) {
+        size_t vertices = 0, triangles = 0;
+        for (size_t i : members) vertices += meshes[i].positions.size(), triangles += meshes[i].triangles.size();
+        std::string names;
+        for (size_t k = 0; k < std::min<size_t>(members.size(), 3); ++k) names += (k ? ", " : "") + name_of(members[k]);
+        if (members.size() > 3) names += " and " + std::to_string(members.size() - 3) + " more";
+        std::printf("  %zu object%s (%s): %s; %zu vertices, %zu triangles\n%s", members.size(), members.size() == 1 ? "" : "s",
+                    d.substr(0, d.find('\n')).c_str(), names.c_str(), vertices, triangles, d.substr(d.find('\n') + 1).c_str());
+      }
+      std::printf("  (objects with the same role and decisions are grouped; -v lists every object)\n");
+    }
+    for (const auto& l : scene.lights)
+      std::printf("  light %s (%s): %zu face(s), radiance %g %g %g%s\n", l.name.c_str(), bake::light_shape_name(l.shape),
+                  l.faces.size(), l.radiance[0], l.radiance[1], l.radiance[2], l.two_sided ? ", two-sided" : "");
+    for (const auto& n : plan.notes) std::printf("  %s\n", n.c_str());
+    std::fflush(stdout);
+  }
+  if (a.dry_run) {
+    // What the bake would cost: each group's integrator timed on seeded vertices (with a target,
+    // after the pilot that chooses it), nothing baked or written.
+    if (say) std::printf("estimated cost (nothing is baked):\n");
+    bake::SceneRows estimate;
+    estimate.estimate_only = true;
+    const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
+    bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, bar.monitor(&tool::interrupt_token()),
+                     [&](const std::string& line) {
+                       if (say) std::printf("  %s\n", line.c_str());
+                       std::fflush(stdout);
+                     },
+                     estimate);
+    return 0;
+  }
+
+  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
+  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
+  // Sharded: the receivers' rows in chunks (every worker), then the rest of the bake on the
+  // merging process, its rows read back from the chunks (shards.h).
+  bake::SceneRows merged_rows;
+  if (worker) {
+    std::vector<uint64_t> set_rows;
+    std::vector<uint32_t> widths;
+    std::vector<std::string> lines = {"scene", kToolkitVersion, a.command_line, bake::sha256_file(a.input),
+                                      a.scene_options.empty() ? "" : bake::sha256_file(a.scene_options),
+                                      env ? env->info().sha256 : "no environment", std::to_string(a.shard.chunk_rows)};
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const bake::ObjectPlan& p = plan.objects[i];
+      if (!p.receiver || !p.any_vertex_product()) continue;
+      set_rows.push_back(meshes[i].positions.size());
+      widths.push_back(uint32_t(bake::ProductLayout(bake::product_request(p, env ? &*env : nullptr)).width));
+    }
+    // Every object's mesh, occluders included: they shape the receivers' values.
+    for (size_t i = 0; i < scene.objects.size(); ++i) lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
+    shards.emplace(*worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
+    const bool merges = shards->run([&] {
+      bake::SceneRows work;
+      work.rows_only = true;
+      work.rows = [&](size_t set, std::span<const bake::ShadePoint> points, const bake::Integrator& integrator,
+                      const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+        shards->work(
+            [&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
+              return tool::bake_chunk(points, r, integrator, monitor);
+            },
+            uint32_t(set));
+        closed_form = 0;
+        return bake::VertexBake{};
+      };
+      bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress, [](const std::string&) {}, work);
+    });
+    if (!merges) return 0;
+    merged_rows.rows = [&](size_t set, std::span<const bake::ShadePoint>, const bake::Integrator& integrator,
+                           const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+      return shards->merge(uint32_t(set), integrator.layout(), &closed_form);
+    };
+  }
+  namespace F = prt::formats;
+  // The file from a bake (with its reports once they are made).
+  auto write_scene = [&](const bake::SceneBake& result) {
+    F::Asset asset;
+    asset.root = root_info(file_args, bake::sha256_file(a.input));
+    const std::string env_path = env ? scene.environment->string() : std::string();
+    F::SceneInfo& info = asset.scene.emplace();
+    info.scene_file = a.input;
+    if (!a.scene_options.empty()) {
+      info.options_file = a.scene_options;
+      info.options_sha256 = bake::sha256_file(a.scene_options);
+    }
+    info.integrator = std::string(bake::to_string(scene.integrator.kind));
+    info.samples = int64_t(scene.integrator.samples());
+    info.seed = int64_t(scene.integrator.seed);
+    info.sh_tolerance = scene.sh_tolerance;
+    info.relight = int64_t(scene.relight);
+    if (env) {
+      info.environment = env_path;
+      info.environment_sha256 = env->info().sha256;
+    }
+    auto join = [](const std::vector<std::string>& lines, const char* none) {
+      std::string s;
+      for (const auto& l : lines) s += (s.empty() ? "" : "\n") + l;
+      return s.empty() ? std::string(none) : s;
+    };
+    info.plan = join(plan.notes, "");
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const auto& o = scene.objects[i];
+      const auto& p = plan.objects[i];
+      const auto& ob = result.objects[i];
+      F::SceneObject& obj = asset.objects.emplace_back();
+      obj.name = o.name;
+      obj.role = bake::role_name(o.role);
+      obj.mesh = o.mesh.string();
+      obj.mesh_sha256 = meshes[i].source_sha256;
+      if (!o.node_path.empty()) obj.node_path = o.node_path;
+      obj.transform.emplace(16);
+      for (int k = 0; k < 16; ++k) (*obj.transform)[size_t(k)] = o.world_from_object(k / 4, k % 4);
+      obj.albedo = std::vector<double>(o.material.albedo.begin(), o.material.albedo.end());
+      obj.phong_exponent = o.material.phong_exponent;
+      obj.sh_order_diffuse = int64_t(p.transfer_order);
+      obj.sh_order_glossy = int64_t(std::max(p.visibility_order, p.shadowed_order));
+      obj.baked = join(p.baked, "-");
+      obj.left_out = join(p.left_out, "-");
+      if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());
+      if (ob.values) obj.closed_form_vertices = int64_t(ob.closed_form_vertices);
+      tool::set_mesh(obj.set, meshes[i]);
+      if (ob.values) {
+        tool::set_products(obj.set, *ob.values,
+                           {std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
+                            ob.integrator.samples(), ob.integrator.seed,
+                            p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+        if (ob.report)
+          obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
+      }
+      if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
+      if (ob.shells) {
+        F::Occluder& occluder =
+            asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
+        if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
+      }
+    }
+    for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
+    if (plan.fiv_environment)
+      tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
+    tool::set_target_error(asset, scene.target_error);
+    write_file(a, asset);
+  };
+  // Once the bake is whole: its warnings and summary, then the file, written before the error
+  // reports are made (bake_scene's SceneRows::baked); the reports re-write it.
+  bool written = false, checks = false;
+  merged_rows.baked = [&](const bake::SceneBake& result) {
+    // A receiver most of whose vertices see no sky: buried in other objects, or turned inside out.
+    // One line each for a few; past kNoSkyListed (an engine's internals) one line that counts them
+    // and names the first.
+    constexpr size_t kNoSkyListed = 5;
+    std::vector<std::pair<std::string, bake::NoSkyCount>> no_sky;
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if (const auto& values = result.objects[i].values) {
+        const bake::NoSkyCount count = bake::count_no_sky(*values);
+        if (count.share() > 0.5) no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
+      }
+    if (!no_sky.empty() && (no_sky.size() <= kNoSkyListed || a.verbose)) {
+      for (const auto& [name, count] : no_sky)
+        std::fprintf(stderr,
+                     "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
+                     "other objects, or its normals point inside (check its winding)\n",
+                     name.c_str(), 100 * count.share(), count.vertices, count.total);
+    } else if (!no_sky.empty()) {
+      std::string first;
+      for (size_t k = 0; k < 3; ++k) {
+        char share[32];
+        std::snprintf(share, sizeof share, " (%.1f%%)", 100 * no_sky[k].second.share());
+        first += (k ? ", " : "") + no_sky[k].first + share;
+      }
+      std::fprintf(stderr,
+                   "prtbake: warning: %zu receivers have more than half their vertices seeing no sky at all (enclosed by "
+                   "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
+                   no_sky.size(), first.c_str(), no_sky.size() - 3);
+    }
+    if (say)
+      std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
+                  (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
+                  result.environment_seconds);
+
+    write_scene(result);
+    written = true;
+    // Reports follow for the receivers' rows and the FIV shells when the scene asks for them.
+    checks = scene.integrator.report_points > 0 &&
+             std::any_of(result.objects.begin(), result.objects.end(),
+                         [](const bake::ObjectBake& ob) { return ob.values.has_value() || ob.shells.has_value(); });
+    if (say && checks)
+      std::printf("checking its error (Ctrl-C keeps the file as written, without its reports; \"report\": 0 or --report 0 "
+                  "skips the check)\n");
+    std::fflush(stdout);
+  };
+  std::optional<bake::SceneBake> baked;
+  try {
+    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
+                             [&](const std::string& line) {
+                                                      if (say) std::printf("%s\n", line.c_str());
+                                                      std::fflush(stdout);
+                                                    },
+                                                    merged_rows,
+                                                    [&](const std::string& object, const bake::IntegratorChoice& choice,
+                                                        const bake::ReferencePlan* reference_plan) {
+                                                      if (say && a.verbose) {
+                                                        std::printf("%s: the target-error pilot:\n", object.c_str());
+                                                        for (const std::string& l : bake::choice_lines(choice))
+                                                          std::printf("%s\n", l.c_str());
+                                                        if (reference_plan) print_reference_plan(*reference_plan);
+                                                      } else if (say) {
+                                                        std::printf("%s: %s\n", object.c_str(),
+                                                                    bake::choice_summary(choice).c_str());
+                                                      }
+                                                      std::fflush(stdout);
+                                                      warn_unreached(choice, object);
+                                                    });
+  } catch (const bake::Cancelled&) {
+    if (!written) throw;
+    std::fprintf(stderr,
+                 "prtbake: cancelled during the error check: %s holds the finished bake without its error reports "
+                 "(--report 0 skips the check)\n",
+                 a.output.c_str());
+    return tool::kExitCancelled;
+  }
+  if (checks) write_scene(*baked);
+  if (shards) shards->finish();
+  return 0;
+}
+
+} // namespace prt::tool
