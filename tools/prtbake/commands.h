@@ -1,19 +1,40 @@
-// tools/prtbake/commands.h — prtbake's bake commands (vertex, fiv, scene; export is export.h).
-// prtbake_main (main.cpp) parses the command line (args.h) and calls the command's run_*; each
-// returns the exit code (tool_main.h) or throws.
+// tools/prtbake/commands.h — prtbake's bake commands (vertex, fiv, scene; export is export.h) and
+// the run they share. prtbake_main (main.cpp) parses the command line (args.h), begins the run
+// once, and calls the command's run_*; each returns the exit code (tool_main.h) or throws.
 #pragma once
 
+#include <bake/core/progress.h>
+
 #include "args.h"
+#include "progress_bar.h"
 #include "shards.h"
+
+#include <tbb/global_control.h>
 
 #include <optional>
 
 namespace prt::tool {
 
+// What every bake sets up before it reads an input, once: the output's directory is checked
+// (InputError before a long bake rather than at its end; scene --dry-run writes nothing), the
+// thread limit (--threads) holds until the command returns, and libbake's stages report their
+// progress to one bar on stderr and are cancelled by Ctrl-C. Neither copied nor moved:
+// `progress` draws on `bar`.
+struct RunContext {
+  RunContext(const Args& a, const MpiSession& mpi);
+
+  const MpiSession& mpi;
+  const bool say;     // print what the bake does: not --quiet, and rank 0 (under mpirun it speaks for all)
+  const int threads;  // --threads, or all cores
+  const tbb::global_control threads_limit;
+  const ProgressBar bar;          // quiet unless `say`
+  const bake::Monitor progress;  // bar's, with tool::interrupt_token()
+};
+
 // The bakes. `shards`: emplaced when the bake is sharded, so that prtbake_main can report its
 // committed chunks on Ctrl-C (ShardedRows::kept_after_cancel).
-int run_vertex(const Args& a, const MpiSession& mpi, std::optional<ShardedRows>& shards);
-int run_fiv(const Args& a, const MpiSession& mpi, std::optional<ShardedRows>& shards);
-int run_scene(const Args& a, const MpiSession& mpi, std::optional<ShardedRows>& shards);
+int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
+int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
+int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 
 } // namespace prt::tool

@@ -1,8 +1,8 @@
 // prtbake — bakes precomputed radiance transfer assets. A thin shell: it parses arguments (CLI11:
 // one subcommand per kind of bake, each with only the options that apply to it, into the typed
 // specs of libbake; args.h), reports progress and calls libbake (integration) and formats (the
-// HDF5 file). This file hands the parsed command line to its command (commands.h, export.h).
-#include <bake/core/progress.h>
+// HDF5 file). This file begins a run and hands it to its command (commands.h, export.h).
+#include <bake/core/error.h>
 
 #include "args.h"
 #include "commands.h"
@@ -10,11 +10,43 @@
 #include "shards.h"
 #include "tool_main.h"
 
+#include <tbb/info.h>
+
+#include <filesystem>
 #ifdef __GLIBC__
 #include <malloc.h>
 #endif
 #include <optional>
 #include <string>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace prt::tool {
+namespace {
+
+// Fails early (before a long bake) if the output's directory cannot take a file.
+void check_output_writable(const fs::path& out) {
+  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw bake::InputError(out.string(), "cannot write: directory '" + dir.string() + "' does not exist");
+  if (fs::is_directory(out, ec)) throw bake::InputError(out.string(), "cannot write: it is a directory");
+  if (access(dir.c_str(), W_OK) != 0) throw bake::InputError(out.string(), "cannot write: directory '" + dir.string() + "' is not writable");
+}
+
+} // namespace
+
+RunContext::RunContext(const Args& a, const MpiSession& session)
+    : mpi(session),
+      say(!a.quiet && session.rank() == 0),
+      threads(a.threads > 0 ? a.threads : tbb::info::default_concurrency()),
+      threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads)),
+      bar(say ? ProgressStyle::Auto : ProgressStyle::Quiet),
+      progress(bar.monitor(&interrupt_token())) {
+  if (!a.dry_run) check_output_writable(a.output);  // scene --dry-run writes nothing
+}
+
+} // namespace prt::tool
 
 namespace {
 
@@ -42,10 +74,11 @@ int prtbake_main(int argc, char** argv) {
   tool::install_interrupt_handler();
   if (a.command == "export") return tool::run_export(a.exported);
   std::optional<tool::ShardedRows> shards;
+  const tool::RunContext run(a, mpi);  // the thread limit and the progress bar, until the command returns
   try {
-    return a.command == "fiv"     ? tool::run_fiv(a, mpi, shards)
-           : a.command == "scene" ? tool::run_scene(a, mpi, shards)
-                                  : tool::run_vertex(a, mpi, shards);
+    return a.command == "fiv"     ? tool::run_fiv(a, run, shards)
+           : a.command == "scene" ? tool::run_scene(a, run, shards)
+                                  : tool::run_vertex(a, run, shards);
   } catch (const bake::Cancelled&) {
     // A sharded or resumable bake keeps what it committed: say so, and how to go on.
     if (shards)

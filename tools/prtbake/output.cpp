@@ -2,8 +2,6 @@
 // (contract: output.h).
 #include "output.h"
 
-#include <bake/core/error.h>
-
 #include "tool_main.h"
 
 #include <algorithm>
@@ -12,7 +10,6 @@
 #include <ctime>
 #include <filesystem>
 #include <sys/resource.h>
-#include <unistd.h>
 #include <utility>
 
 namespace fs = std::filesystem;
@@ -48,14 +45,6 @@ std::string human_bytes(uintmax_t b) {
 }
 
 } // namespace
-
-void check_output_writable(const fs::path& out) {
-  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw bake::InputError(out.string(), "cannot write: directory '" + dir.string() + "' does not exist");
-  if (fs::is_directory(out, ec)) throw bake::InputError(out.string(), "cannot write: it is a directory");
-  if (access(dir.c_str(), W_OK) != 0) throw bake::InputError(out.string(), "cannot write: directory '" + dir.string() + "' is not writable");
-}
 
 void print_warnings(const std::vector<std::string>& warnings) {
   std::vector<std::pair<std::string, size_t>> seen;

@@ -10,15 +10,11 @@
 
 #include "args.h"
 
-#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace prt::tool {
-
-// Fails early (before a long bake) if the output's directory cannot take a file (InputError).
-void check_output_writable(const std::filesystem::path& out);
 
 // Prints reader warnings once each, with a count for repeats.
 void print_warnings(const std::vector<std::string>& warnings);

@@ -12,11 +12,7 @@
 #include "commands.h"
 #include "output.h"
 #include "shards.h"
-#include "progress_bar.h"
 #include "tool_main.h"
-
-#include <tbb/global_control.h>
-#include <tbb/info.h>
 
 #include <algorithm>
 #include <chrono>
@@ -124,12 +120,7 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
 
 } // namespace
 
-int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
-  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker>& worker = a.worker;
-  check_output_writable(a.output);
-  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
-  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards) {
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = false;  // an occluder's normals play no part in its FIVs
   const bake::Mesh mesh = bake::load_mesh(a.input, mopt);
@@ -138,7 +129,7 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Shar
   // the manifest and the file) but not its pixels, nor the mesh's topology, unless its error
   // report integrates a reference. The workers loaded the same bytes (the manifest holds their
   // SHA-256) and checked the pixels.
-  const bool integrates = !worker || worker->computes || a.integrator.report_points > 0;
+  const bool integrates = !a.worker || a.worker->computes || a.integrator.report_points > 0;
   std::optional<bake::Topology> topo;
   std::optional<bake::EnvMap> env;
   if (integrates) {
@@ -146,15 +137,13 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Shar
     env = bake::EnvMap::load(a.environment, a.up);
   }
   const bake::EnvMapInfo env_info = env ? env->info() : bake::EnvMap::identify(a.environment);
-  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
-  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
-  if (say)
+  if (run.say)
     std::printf("occluder: %s: %zu triangles; environment: %s (%dx%d %s)\n", a.input.c_str(), mesh.triangles.size(),
                 a.environment.c_str(), env_info.width, env_info.height, env_info.layout.c_str());
 
   std::optional<ShardedFiv> sharded;
-  if (worker) {
-    sharded = sharded_fiv(a, *worker, mpi, mesh, topo ? &*topo : nullptr, env ? &*env : nullptr, env_info, shards);
+  if (a.worker) {
+    sharded = sharded_fiv(a, *a.worker, run.mpi, mesh, topo ? &*topo : nullptr, env ? &*env : nullptr, env_info, shards);
     if (!sharded) return 0;
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -162,8 +151,8 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Shar
   const std::vector<float> cube = sharded ? std::move(sharded->cube) : bake::irradiance_cube(*env, a.shell_spec.cube);
   const double env_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bake::FivShells shells =
-      sharded ? std::move(sharded->shells) : bake::bake_fiv_shells(mesh, *topo, *env, a.shell_spec, progress);
-  if (say) {
+      sharded ? std::move(sharded->shells) : bake::bake_fiv_shells(mesh, *topo, *env, a.shell_spec, run.progress);
+  if (run.say) {
     std::printf("environment FIV and %dx%dx6 DifMap in %.2f s%s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds,
                 sharded ? " (both in the chunks)" : "");
     std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
@@ -182,8 +171,8 @@ int run_fiv(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Shar
   if (a.integrator.report_points > 0) {
     // Error against a QMC reference (65,536 rays, full-sphere mode) at seeded shell samples.
     const bake::FivErrorReport r = bake::fiv_error_report(mesh, *topo, *env, shells, fenv, a.integrator.report_points,
-                                                          a.integrator.seed, progress);
-    if (say)
+                                                          a.integrator.seed, run.progress);
+    if (run.say)
       std::printf("error against a %u-ray QMC reference at %zu seeded shell samples (reference took %.2f s, not "
                   "counted): RMSE %.3e, max %.3e, RMSE / RMS|F_env| %.3e (reference's own std. error %.3e)\n",
                   bake::IntegratorSpec::kSilhouetteReferenceRays, r.points, r.reference_seconds, r.rmse, r.max_abs,

@@ -15,11 +15,7 @@
 #include "commands.h"
 #include "output.h"
 #include "shards.h"
-#include "progress_bar.h"
 #include "tool_main.h"
-
-#include <tbb/global_control.h>
-#include <tbb/info.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -41,12 +37,7 @@ std::string scene_object_label(const bake::SceneObject& o) { return o.node_path.
 
 } // namespace
 
-int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
-  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker>& worker = a.worker;
-  if (!a.dry_run) check_output_writable(a.output);
-  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
-  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards) {
   bake::SceneDescription scene = bake::load_scene(
       a.input, a.scene_options.empty() ? std::nullopt : std::optional<fs::path>(a.scene_options));
   if (a.report_given) scene.integrator.report_points = a.integrator.report_points;
@@ -66,7 +57,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
       warn_inward(bake::winding_facts(meshes[i], bake::build_topology(meshes[i])), false,
                   scene_object_label(scene.objects[i]), plan.objects[i].occluder);
 
-  if (say) {
+  if (run.say) {
     std::printf("scene: %s: %zu objects, environment %s, integrator %s, SH tolerance %g\n", a.input.c_str(),
                 scene.objects.size(), env ? scene.environment->string().c_str() : "none",
                 bake::to_string(scene.integrator.kind),
@@ -116,25 +107,22 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
   if (a.dry_run) {
     // What the bake would cost: each group's integrator timed on seeded vertices (with a target,
     // after the pilot that chooses it), nothing baked or written.
-    if (say) std::printf("estimated cost (nothing is baked):\n");
+    if (run.say) std::printf("estimated cost (nothing is baked):\n");
     bake::SceneRows estimate;
     estimate.estimate_only = true;
-    const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
-    bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, bar.monitor(&tool::interrupt_token()),
+    bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress,
                      [&](const std::string& line) {
-                       if (say) std::printf("  %s\n", line.c_str());
+                       if (run.say) std::printf("  %s\n", line.c_str());
                        std::fflush(stdout);
                      },
                      estimate);
     return 0;
   }
 
-  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
-  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   // Sharded: the receivers' rows in chunks (every worker), then the rest of the bake on the
   // merging process, its rows read back from the chunks (shards.h).
   bake::SceneRows merged_rows;
-  if (worker) {
+  if (a.worker) {
     std::vector<uint64_t> set_rows;
     std::vector<uint32_t> widths;
     std::vector<std::string> lines = {"scene", kToolkitVersion, a.command_line, bake::sha256_file(a.input),
@@ -148,7 +136,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
     }
     // Every object's mesh, occluders included: they shape the receivers' values.
     for (size_t i = 0; i < scene.objects.size(); ++i) lines.push_back(scene.objects[i].name + " " + meshes[i].source_sha256);
-    shards.emplace(*worker, mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
+    shards.emplace(*a.worker, run.mpi, a.shard, a.output, tool::manifest_of(lines), set_rows, widths, a.quiet);
     const bool merges = shards->run([&] {
       bake::SceneRows work;
       work.rows_only = true;
@@ -162,7 +150,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
         closed_form = 0;
         return bake::VertexBake{};
       };
-      bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress, [](const std::string&) {}, work);
+      bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress, [](const std::string&) {}, work);
     });
     if (!merges) return 0;
     merged_rows.rows = [&](size_t set, std::span<const bake::ShadePoint>, const bake::Integrator& integrator,
@@ -271,7 +259,7 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
                    "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
                    no_sky.size(), first.c_str(), no_sky.size() - 3);
     }
-    if (say)
+    if (run.say)
       std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
                   (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
                   result.environment_seconds);
@@ -282,27 +270,27 @@ int run_scene(const Args& a, const tool::MpiSession& mpi, std::optional<tool::Sh
     checks = scene.integrator.report_points > 0 &&
              std::any_of(result.objects.begin(), result.objects.end(),
                          [](const bake::ObjectBake& ob) { return ob.values.has_value() || ob.shells.has_value(); });
-    if (say && checks)
+    if (run.say && checks)
       std::printf("checking its error (Ctrl-C keeps the file as written, without its reports; \"report\": 0 or --report 0 "
                   "skips the check)\n");
     std::fflush(stdout);
   };
   std::optional<bake::SceneBake> baked;
   try {
-    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, progress,
+    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress,
                              [&](const std::string& line) {
-                                                      if (say) std::printf("%s\n", line.c_str());
+                                                      if (run.say) std::printf("%s\n", line.c_str());
                                                       std::fflush(stdout);
                                                     },
                                                     merged_rows,
                                                     [&](const std::string& object, const bake::IntegratorChoice& choice,
                                                         const bake::ReferencePlan* reference_plan) {
-                                                      if (say && a.verbose) {
+                                                      if (run.say && a.verbose) {
                                                         std::printf("%s: the target-error pilot:\n", object.c_str());
                                                         for (const std::string& l : bake::choice_lines(choice))
                                                           std::printf("%s\n", l.c_str());
                                                         if (reference_plan) print_reference_plan(*reference_plan);
-                                                      } else if (say) {
+                                                      } else if (run.say) {
                                                         std::printf("%s: %s\n", object.c_str(),
                                                                     bake::choice_summary(choice).c_str());
                                                       }

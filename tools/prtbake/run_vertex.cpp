@@ -16,11 +16,7 @@
 #include "commands.h"
 #include "output.h"
 #include "shards.h"
-#include "progress_bar.h"
 #include "tool_main.h"
-
-#include <tbb/global_control.h>
-#include <tbb/info.h>
 
 #include <algorithm>
 #include <chrono>
@@ -33,13 +29,7 @@
 
 namespace prt::tool {
 
-int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::ShardedRows>& shards) {
-  const bool say = !a.quiet && mpi.rank() == 0;  // under mpirun, rank 0 speaks for all
-  const std::optional<tool::Worker>& worker = a.worker;
-  check_output_writable(a.output);
-  const int threads = a.threads > 0 ? a.threads : tbb::info::default_concurrency();
-  tbb::global_control threads_limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-
+int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards) {
   bake::MeshLoadOptions mopt;
   mopt.use_file_normals = a.file_normals;
   mopt.flip_normals = a.flip_normals;
@@ -47,12 +37,12 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
   const bake::Topology topo = bake::build_topology(mesh);
   const std::string mesh_sha = mesh.source_sha256;
   print_warnings(mesh.warnings);
-  if (say)
+  if (run.say)
     std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s%s\n",
                 a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
                 mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
                 a.flip_normals ? ", flipped" : "");
-  if (say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh/mesh.h, ORIGIN)
+  if (run.say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh/mesh.h, ORIGIN)
     std::printf("mesh: baked relative to its origin (%.17g, %.17g, %.17g); /mesh/positions holds world coordinates\n",
                 mesh.origin.x(), mesh.origin.y(), mesh.origin.z());
   const bake::WindingFacts winding = bake::winding_facts(mesh, topo);
@@ -62,7 +52,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
   if (!a.environment.empty()) {
     env = bake::EnvMap::load(a.environment, a.up);
     const auto& i = env->info();
-    if (say)
+    if (run.say)
       std::printf("environment: %s: %dx%d %s, luminance max %.4g / mean %.4g (%.0fx), %llu negative pixel values "
                   "clamped to 0 (min seen %.3g)\n",
                   a.environment.c_str(), i.width, i.height, i.layout.c_str(), i.max_luminance, i.mean_luminance,
@@ -77,8 +67,6 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
   req.radiance = env ? &*env : nullptr;
   if (a.shadowed) req.shadowed = req.radiance, req.shadowed_order = a.shadowed;
 
-  const tool::ProgressBar bar(say ? tool::ProgressStyle::Auto : tool::ProgressStyle::Quiet);
-  const bake::Monitor progress = bar.monitor(&tool::interrupt_token());
   bake::IntegratorSpec spec = a.integrator;
   const bake::MeshAccel accel(mesh, topo);  // the mesh's trees, shared by the pilot, the bake and the report
   std::optional<bake::IntegratorChoice> chosen;  // the chooser's, with a target
@@ -88,12 +76,12 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
     if (a.integrator_given) copt.only = a.integrator.kind;
     copt.counted_costs = a.reproducible;  // the same choice, and bytes, on any machine
     const bake::IntegratorChoice choice = bake::choose_integrator(bake::vertex_shade_points(mesh, topo), mesh, topo, req,
-                                                                  a.integrator, copt, progress, &accel);
+                                                                  a.integrator, copt, run.progress, &accel);
     spec = choice.spec;
     chosen = choice;
-    if (say && a.verbose)
+    if (run.say && a.verbose)
       for (const std::string& line : bake::choice_lines(choice)) std::printf("%s\n", line.c_str());
-    else if (say)
+    else if (run.say)
       std::printf("%s\n", bake::choice_summary(choice).c_str());
     warn_unreached(choice, "");
   }
@@ -106,7 +94,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
         bake::make_integrator(spec, mesh, topo, req, &accel);
     const bake::Integrator& integrator = *integrator_ptr;
     const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - setup_start).count();
-    if (say) {
+    if (run.say) {
       std::printf("baking:");
       if (a.ao) std::printf(" ao");
       if (a.transfer) std::printf(" transfer/diffuse (order %d, %d coefficients)", a.transfer, a.transfer * a.transfer);
@@ -114,17 +102,17 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
       if (env) std::printf(" radiance/band1 (3x3)");
       if (a.shadowed) std::printf(" radiance/shadowed (order %d, 3x%d)", a.shadowed, a.shadowed * a.shadowed);
       std::printf("\nintegrator: %s; %d threads; setup (ray/contour BVHs, tables) %.2f s\n",
-                  integrator.description().c_str(), threads, setup_seconds);
+                  integrator.description().c_str(), run.threads, setup_seconds);
       std::fflush(stdout);
     }
     const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(mesh, topo);
     bake::VertexBake result;
-    if (worker) {
+    if (a.worker) {
       const std::string manifest = tool::manifest_of(
           {"vertex", kToolkitVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment",
            integrator.description(), bake::to_string(spec.kind), std::to_string(spec.samples()),
            std::to_string(spec.seed), std::to_string(integrator.layout().width), std::to_string(a.shard.chunk_rows)});
-      shards.emplace(*worker, mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
+      shards.emplace(*a.worker, run.mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
                      std::vector<uint32_t>{uint32_t(integrator.layout().width)}, a.quiet);
       const bool merges = shards->run([&] {
         shards->work([&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
@@ -135,7 +123,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
       result = shards->merge(0, integrator.layout());
     } else {
       try {
-        result = bake::bake_points(points, integrator, progress);
+        result = bake::bake_points(points, integrator, run.progress);
       } catch (const bake::Cancelled&) {
         if (pass == 0) throw;  // nothing written yet
         std::fprintf(stderr, "prtbake: cancelled while baking again: %s holds the first bake and its error report\n",
@@ -145,7 +133,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
     }
     warn_no_sky(bake::count_no_sky(result), winding, [&] { return bake::probe_flipped_normals(mesh, topo, result); },
                 a.flip_normals);
-    if (say) {
+    if (run.say) {
       std::printf("baked %zu vertices in %.2f s (%.0f integrals/s)\n", mesh.positions.size(), result.seconds,
                   mesh.positions.size() / result.seconds);
       if (const std::string work = integrator.work_summary(); !work.empty()) std::printf("%s\n", work.c_str());
@@ -182,7 +170,7 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
     // The bake is written first and checked after (the check re-writes the file with its report):
     // a check cancelled with Ctrl-C, or one that costs more than the user will wait, never costs the bake.
     write_bake();
-    if (say) std::printf("checking its error (Ctrl-C keeps the file as written, without its report; --report 0 skips the check)\n");
+    if (run.say) std::printf("checking its error (Ctrl-C keeps the file as written, without its report; --report 0 skips the check)\n");
     std::optional<bake::ReferencePlan> reference_plan;
     try {
       {
@@ -191,10 +179,10 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
           // with --reproducible, whose rays must not depend on the machine's speed.
           const double check_cpu =
               a.reproducible ? 0.0 : std::max(bake::ReferencePlan::kReportMinCpuSeconds, result.cpu_seconds);
-          reference_plan = bake::plan_report_reference(points, mesh, topo, req, spec, a.target_error, progress, &accel, 0,
+          reference_plan = bake::plan_report_reference(points, mesh, topo, req, spec, a.target_error, run.progress, &accel, 0,
                                                        check_cpu);
           spec.report_rays = reference_plan->rays;
-          if (say && a.verbose) print_reference_plan(*reference_plan);
+          if (run.say && a.verbose) print_reference_plan(*reference_plan);
         }
         // With a target, the reference is two independent halves: its noise is then measured on the
         // report's own values, and the check can take it out of the RMSE (target_check_lines).
@@ -202,8 +190,8 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
         if (a.target_error > 0) reference = bake::make_reference_pair(spec, mesh, topo, req, &accel);
         else reference.first = bake::make_reference(spec, mesh, topo, req, &accel);
         report = bake::compare_with_reference(mesh, topo, result, *reference.first, spec.report_points, spec.seed,
-                                              progress, reference.second.get());
-        if (say) {
+                                              run.progress, reference.second.get());
+        if (run.say) {
           std::printf("error against a %u-ray QMC reference on %zu seeded vertices (reference took %.2f s, not "
                       "counted in the bake time):\n",
                       spec.reference_rays(), report->vertices.size(), report->reference_seconds);
@@ -231,11 +219,11 @@ int run_vertex(const Args& a, const tool::MpiSession& mpi, std::optional<tool::S
                    a.output.c_str());
       return tool::kExitCancelled;
     }
-    if (pass > 0 || !chosen || worker || !report) break;
+    if (pass > 0 || !chosen || a.worker || !report) break;
     const std::optional<bake::IntegratorSpec> better = bake::corrected_plan(
         *chosen, bake::target_verdicts(*report, a.target_error, reference_plan ? &*reference_plan : nullptr));
     if (!better) break;
-    if (say) {
+    if (run.say) {
       std::printf("the check puts the bake's error above the target: baking again with %s at %s (was %s; the "
                   "pilot's rate from the check's measured error; once)\n",
                   bake::to_string(better->kind), better->knob_text().c_str(), spec.knob_text().c_str());
