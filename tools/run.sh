@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 
 # What the libraries and the three tools need to build and run: each is a find_package or
 # pkg-config module of formats/, libbake/, view/ or tools/ (README "From zero to a baked file").
-# libopenmesh-dev pulls in OpenSceneGraph and, through it, GDAL and a MariaDB client: 53 of the
+# libopenmesh-dev pulls in OpenSceneGraph and, through it, GDAL and a MariaDB client: 48 of the
 # demo's 84 packages on a fresh machine; only Loop subdivision (tests, benchmarks) uses OpenMesh.
 TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev
                 libopenexr-dev libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev
