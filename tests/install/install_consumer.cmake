@@ -1,8 +1,8 @@
 # Script of the install_consumer test (see CMakeLists.txt): install, check the installed layout,
-# run the installed tools from the prefix (--version, --help, a small bake read back by prtdump),
-# configure + build + run the consumers against the installed package only: the core alone (with
-# HDF5 and oneTBB made unfindable, so the core package needs neither), then with the hdf5
-# component, whose program loads the file the installed prtbake baked.
+# run the installed tools from the prefix (--version, --help, a small bake read back by prtdump
+# and drawn by prtview), configure + build + run the consumers against the installed package
+# only: the core alone (with HDF5 and oneTBB made unfindable, so the core package needs neither),
+# then with the hdf5 component, whose program loads the file the installed prtbake baked.
 foreach(v BUILD_DIR CONSUMER_SOURCE WORK_DIR GENERATOR CXX_COMPILER VERSION)
   if(NOT DEFINED ${v})
     message(FATAL_ERROR "install_consumer.cmake: -D${v}=... missing")
@@ -70,6 +70,7 @@ file(WRITE ${run_dir}/tiny.obj "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nf 1 3 2\
 run_tool("prtbake vertex" "wrote tiny.prt.h5" ${prefix}/bin/prtbake vertex tiny.obj --ao --samples 256
          --report 0 -o tiny.prt.h5)
 run_tool("prtdump" "schema +valid" ${prefix}/bin/prtdump tiny.prt.h5)
+run_tool("prtview" "wrote look.png" ${prefix}/bin/prtview tiny.prt.h5 --size 64x48 -o look.png)
 
 # A consumer that sees only the installed prefix. A sanitizer build (PRT_SANITIZE) installs an
 # instrumented library, so its consumer must link the sanitizer runtimes too.
