@@ -1,31 +1,44 @@
 #!/usr/bin/env bash
 # tools/run.sh — one command from a fresh Debian 12 machine to a result.
-#   tools/run.sh demo   install dependencies, build (release), bake the default scene
-#                       (data/bunny_ground.obj under data/sunset.exr) to out/default.prt.h5,
-#                       show what was baked, then bake data/scene_example.json to out/scene.prt.h5.
-#   tools/run.sh test   install dependencies, build (ci preset: warnings are errors), run every
-#                       test with ctest, then build the fuzz targets (fuzz preset: clang 14,
-#                       ASan + UBSan) and run each briefly (tests/fuzz/run.sh short: its saved
-#                       regression inputs, then 20 s from its seeds). This is what CI runs (.ci/run).
-#   tools/run.sh deps   only install the Debian packages (apt-get; needs root or sudo).
+#   tools/run.sh demo   install what the tools need (TOOLS_PACKAGES), build the libraries and the
+#                       three tools only (preset tools: Release, no tests or benchmarks), bake the
+#                       default scene (data/bunny_ground.obj under data/sunset.exr) to
+#                       out/default.prt.h5, show what was baked, then bake data/scene_example.json
+#                       to out/scene.prt.h5.
+#   tools/run.sh test   install everything (TOOLS_PACKAGES and TEST_PACKAGES), build (ci preset:
+#                       warnings are errors), run every test with ctest, then build the fuzz
+#                       targets (fuzz preset: clang 14, ASan + UBSan) and run each briefly
+#                       (tests/fuzz/run.sh short: its saved regression inputs, then 20 s from its
+#                       seeds). This is what CI runs (.ci/run).
+#   tools/run.sh deps   only install the Debian packages of `test` (apt-get; needs root or sudo);
+#                       `tools/run.sh deps tools` only those of `demo`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev hdf5-tools
-          libopenexr-dev openexr libtbb-dev libeigen3-dev libgtest-dev python3-h5py
-          glslc libvulkan-dev mesa-vulkan-drivers
-          libcli11-dev nlohmann-json3-dev libpng-dev libssl-dev libtinygltf-dev libdeflate-dev zlib1g-dev
-          assimp-testmodels
-          openmpi-bin libopenmpi-dev blender python3-numpy
-          clang-14 libclang-rt-14-dev time)
+# What the libraries and the three tools need to build and run: each is a find_package or
+# pkg-config module of formats/, libbake/, view/ or tools/ (README "From zero to a baked file").
+# libopenmesh-dev pulls in OpenSceneGraph and, through it, GDAL and a MariaDB client: 48 of the
+# demo's 84 packages on a fresh machine; only Loop subdivision (tests, benchmarks) uses OpenMesh.
+TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev
+                libopenexr-dev libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev
+                libssl-dev libtinygltf-dev libdeflate-dev)
+# What only the tests, the fuzz targets and CI need, and who uses it: GoogleTest; h5dump and h5py
+# (files read by other HDF5 clients); zlib (chunk filter tests); the shader tests' compiler and
+# Vulkan device; the public models of the mesh and glTF tests; mpirun for sharded bakes; Blender
+# for the glTF round trip; clang 14 and its sanitizer runtimes, and GNU time, for the fuzz targets.
+TEST_PACKAGES=(libgtest-dev hdf5-tools openexr python3-h5py python3-numpy zlib1g-dev
+               glslc libvulkan-dev mesa-vulkan-drivers
+               assimp-testmodels
+               openmpi-bin libopenmpi-dev blender
+               clang-14 libclang-rt-14-dev time)
 JOBS=${JOBS:-$(nproc)}
 
-install_deps() {
+install_deps() {  # $@ = the packages
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
-  if [ ${#missing[@]} -eq 0 ]; then echo "deps: all ${#PACKAGES[@]} packages present"; return; fi
+  if [ ${#missing[@]} -eq 0 ]; then echo "deps: all $# packages present"; return; fi
   echo "deps: installing ${missing[*]}"
   local sudo=""
   [ "$(id -u)" -eq 0 ] || sudo="sudo"
@@ -39,26 +52,29 @@ build() {  # $1 = preset
 }
 
 case "${1:-}" in
-  deps) install_deps ;;
+  deps)
+    if [ "${2:-}" = tools ]; then install_deps "${TOOLS_PACKAGES[@]}"
+    else install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"; fi ;;
   demo)
-    install_deps
-    build release
+    install_deps "${TOOLS_PACKAGES[@]}"
+    build tools
+    B=./build/tools/tools
     mkdir -p out
-    ./build/release/tools/prtbake vertex data/bunny_ground.obj --ao --transfer 3 --visibility 3 \
+    $B/prtbake vertex data/bunny_ground.obj --ao --transfer 3 --visibility 3 \
       --radiance data/sunset.exr -o out/default.prt.h5
-    ./build/release/tools/prtdump out/default.prt.h5
+    $B/prtdump out/default.prt.h5
     # A scene file: several objects, roles and materials; prtbake bakes what the scene needs
     # and prints what it leaves out and why (README "Scene files").
-    ./build/release/tools/prtbake scene data/scene_example.json -o out/scene.prt.h5
+    $B/prtbake scene data/scene_example.json -o out/scene.prt.h5
     ;;
   test)
-    install_deps
+    install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
     build ci
     ctest --preset ci
     build fuzz
     tests/fuzz/run.sh short
     ;;
   *)
-    sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
     exit 2 ;;
 esac

@@ -62,8 +62,9 @@ std::string fresh_run_id() {
   return buf;
 }
 
-// Whether a launcher started this process as one of several ranks (mpirun, srun with PMI).
-bool launched_by_mpirun() { return env("OMPI_COMM_WORLD_SIZE") || env("PMI_SIZE") || env("PMIX_RANK"); }
+// Whether a launcher started this process as one of several ranks (mpirun, srun with PMI). Used
+// only when prtbake links MPI (PRT_HAVE_MPI; the tools preset builds without it).
+[[maybe_unused]] bool launched_by_mpirun() { return env("OMPI_COMM_WORLD_SIZE") || env("PMI_SIZE") || env("PMIX_RANK"); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
