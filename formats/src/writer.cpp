@@ -3,11 +3,11 @@
 #include <formats/names.h>
 #include <formats/prtfile.h>
 
+#include <formats/temporaries.h>
 #include <formats/testing.h>
 
 #include "chunk_filters.h"
 #include "h5util.h"
-#include "temporaries.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -293,9 +293,9 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
   if (std::filesystem::is_directory(final_path, ec))
     throw FormatError(msg_file, "the output path is an existing directory");
 
-  const std::string prefix = final_path.filename().string() + ".tmp." + detail::host_tag() + ".";
-  const std::filesystem::path tmp = dir / detail::temporary_name(prefix);
-  detail::remove_stale_temporaries(dir, prefix);
+  const std::string prefix = final_path.filename().string() + ".tmp." + host_tag() + ".";
+  const std::filesystem::path tmp = dir / temporary_name(prefix);
+  remove_stale_temporaries(dir, prefix);
 
   const std::lock_guard lock(detail::hdf5_mutex());
   detail::silence_hdf5_errors();

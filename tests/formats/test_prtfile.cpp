@@ -3,7 +3,7 @@
 // interoperability with h5dump and h5py.
 #include <formats/prtfile.h>
 
-#include "temporaries.h"
+#include <formats/temporaries.h>
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
@@ -357,7 +357,7 @@ TEST(Atomicity, StaleTemporariesOfKilledBakesAreRemovedLiveOnesKept) {
   // removes it when the pid is dead on this machine, and keeps a live pid's (another bake writing
   // now), another machine's, another name's and anything else.
   const fs::path dir = scratch("stale_tmp");
-  const std::string h = prt::formats::detail::host_tag();
+  const std::string h = prt::formats::host_tag();
   const pid_t dead = ::fork();  // a pid that is surely dead once reaped
   if (dead == 0) ::_exit(0);
   ASSERT_GT(dead, 0);
