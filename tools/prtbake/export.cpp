@@ -119,6 +119,8 @@ exports::EnvironmentProbe environment_probe(const std::string& path, const forma
 int run_export(const ExportArgs& args) {
   const exports::ExportFormat format = *exports::parse_export_format(args.format);
   const formats::Asset asset = formats::read_asset(args.input);
+  for (const formats::SkippedAttr& s : asset.skipped_attrs)  // another tool's; no export carries it
+    std::fprintf(stderr, "prtbake: warning: export: %s: %s\n", args.input.c_str(), formats::describe(s).c_str());
   std::optional<exports::EnvironmentProbe> environment;
   if (!args.env.empty()) environment = environment_probe(args.env, asset, args.input);
   const exports::ExportSummary summary = exports::export_asset(asset, args.input, format, args.output, environment);
