@@ -20,8 +20,8 @@
 #include <fstream>
 #include <limits>
 #include <new>
-#include <tuple>
 #include <optional>
+#include <tuple>
 
 namespace prt::formats {
 namespace {
@@ -165,8 +165,8 @@ public:
     return out;
   }
 
-  // One attribute, or nullopt when it is left out (listed in skipped(): its type is not one the
-  // model holds, or its text is in a global heap that cannot be read safely). Damage that HDF5
+  // One attribute, or nullopt when it is left out (listed for take_skipped(): its type is not one
+  // the model holds, or its text cannot be read safely from a global heap). Damage that HDF5
   // reports, or sizes the file cannot hold, refuse the file.
   std::optional<Attr> read_attr(hid_t a, const std::string& path, const std::string& owner) {
     Attr out;
