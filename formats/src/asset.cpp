@@ -415,6 +415,7 @@ File to_file(const Asset& a) {
 
 Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
   Asset a;
+  a.skipped_attrs = f.skipped_attrs;
   std::vector<Attr> root;
   for (const Attr& at : f.root_attrs) {
     if (at.name == N::kFormatVersion && std::holds_alternative<int64_t>(at.value))

@@ -67,8 +67,9 @@ inline Hid object_id(hid_t id) { return {id, &H5Oclose}; }
 // A fixed-length, NUL-padded UTF-8 string type of `bytes` bytes (at least 1): the type of every
 // string attribute we write. Fixed-length strings live inside the (checksummed) object header;
 // variable-length ones live in the global heap, which HDF5 1.10 reads without bounds checks,
-// so a damaged file could crash the reader. The writer therefore never uses them, and the reader
-// refuses those that other tools add (h5py str attributes) by their type, before their text.
+// so a damaged file could crash a reader that lets HDF5 read them. The writer therefore never
+// writes them, and the reader reads those that other tools add (h5py str attributes) with its
+// own bounds-checked code (global_heap.h).
 Hid make_utf8_string_type(std::size_t bytes);
 
 } // namespace prt::formats::detail

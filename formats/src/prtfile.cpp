@@ -1,7 +1,9 @@
-// prtfile.cpp — model helpers (lookups, dtype names) and the shared HDF5 plumbing of h5util.h.
+// prtfile.cpp — model helpers (lookups, dtype names), the shared HDF5 plumbing of h5util.h and
+// the UTF-8 check of utf8.h.
 #include <formats/prtfile.h>
 
 #include "h5util.h"
+#include "utf8.h"
 
 #include <limits>
 
@@ -11,6 +13,10 @@ const Attr* find_attr(const std::vector<Attr>& attrs, std::string_view name) {
   for (const Attr& a : attrs)
     if (a.name == name) return &a;
   return nullptr;
+}
+
+std::string describe(const SkippedAttr& skipped) {
+  return "attribute '" + skipped.name + "' of " + skipped.owner + " skipped: " + skipped.reason;
 }
 
 const Dataset* find_dataset(const File& file, std::string_view path) {
@@ -79,6 +85,32 @@ std::string take_hdf5_error() {
   for (char& c : msg)
     if (c == '\n' || c == '\r') c = ' ';
   return msg;
+}
+
+bool valid_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    uint32_t cp = 0;
+    if (c < 0x80) { ++i; continue; }
+    if ((c & 0xE0) == 0xC0) { n = 1; cp = c & 0x1F; }
+    else if ((c & 0xF0) == 0xE0) { n = 2; cp = c & 0x0F; }
+    else if ((c & 0xF8) == 0xF0) { n = 3; cp = c & 0x07; }
+    else return false;
+    if (i + n >= s.size()) return false;  // truncated sequence
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3F);
+    }
+    // Overlong forms, surrogates and out-of-range code points are invalid.
+    if ((n == 1 && cp < 0x80) || (n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) ||
+        cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+      return false;
+    i += n + 1;
+  }
+  return true;
 }
 
 Hid make_utf8_string_type(std::size_t bytes) {

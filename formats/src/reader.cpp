@@ -5,11 +5,14 @@
 // not bounds-check what it parses from unchecksummed metadata, so before HDF5 parses a structure
 // we check from the raw bytes that it is one of the checksummed kinds our writer makes (the policy
 // is in formats/prtfile.h, "Which files the reader opens"; the byte layouts are HDF5's File Format
-// Specification version 3.0, sections II.A (superblock) and IV.A.1.b (version-2 object header)).
+// Specification version 3.0, sections II.A (superblock) and IV.A.1.b (version-2 object header)),
+// and HDF5 never reads a global heap: variable-length strings are read by global_heap.h.
 #include <formats/names.h>
 #include <formats/prtfile.h>
 
+#include "global_heap.h"
 #include "h5util.h"
+#include "utf8.h"
 
 #include <algorithm>
 #include <array>
@@ -17,6 +20,8 @@
 #include <fstream>
 #include <limits>
 #include <new>
+#include <optional>
+#include <tuple>
 
 namespace prt::formats {
 namespace {
@@ -25,6 +30,7 @@ using detail::Hid;
 
 constexpr int kMaxDepth = 32;
 constexpr std::size_t kMaxObjects = 1'000'000;
+constexpr std::size_t kMaxAttrValues = std::size_t{1} << 28;
 
 // The file's bytes, read directly, for the structure checks below.
 class RawBytes {
@@ -106,10 +112,26 @@ void check_object_header(RawBytes& raw, uint64_t address, const std::string& wha
                                        "or written in an old format that prtbake does not open");
 }
 
+// An HDF5 type class in words, for the message of an attribute left out for its type.
+std::string type_class_name(H5T_class_t c) {
+  switch (c) {
+  case H5T_TIME: return "an HDF5 time";
+  case H5T_BITFIELD: return "an HDF5 bitfield";
+  case H5T_OPAQUE: return "an HDF5 opaque type";
+  case H5T_COMPOUND: return "an HDF5 compound";
+  case H5T_REFERENCE: return "an HDF5 reference";
+  case H5T_ENUM: return "an HDF5 enum, as h5py stores a bool";
+  case H5T_VLEN: return "an HDF5 variable-length sequence";
+  case H5T_ARRAY: return "an HDF5 array type";
+  default: return "HDF5 type class " + std::to_string(static_cast<int>(c));
+  }
+}
+
 class Reader {
 public:
   Reader(std::string file_for_messages, RawBytes& raw)
-      : msg_file_(std::move(file_for_messages)), file_size_(raw.size()), raw_(raw) {}
+      : msg_file_(std::move(file_for_messages)), file_size_(raw.size()), raw_(raw),
+        heaps_(raw.size(), [&raw](uint64_t at, void* out, std::size_t n) { return raw.read(at, out, n); }) {}
 
   // Deflate cannot expand data by more than ~1032:1, so a dataset (attributes are stored
   // uncompressed) claiming more bytes than that is damaged: refuse before allocating.
@@ -129,7 +151,8 @@ public:
     return id;
   }
 
-  std::vector<Attr> read_attrs(hid_t obj, const std::string& owner) const {
+  // The attributes of `obj` at `path` ("/" for the root group), named `owner` in messages.
+  std::vector<Attr> read_attrs(hid_t obj, const std::string& path, const std::string& owner) {
     H5O_info_t info;
     if (H5Oget_info2(obj, &info, H5O_INFO_NUM_ATTRS) < 0) fail("cannot inspect " + owner);
     std::vector<Attr> out;
@@ -137,12 +160,15 @@ public:
       Hid a = check(detail::attr_id(H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i,
                                                   H5P_DEFAULT, H5P_DEFAULT)),
                     "cannot open attribute " + std::to_string(i) + " of " + owner);
-      out.push_back(read_attr(a.get(), owner));
+      if (std::optional<Attr> attr = read_attr(a.get(), path, owner)) out.push_back(std::move(*attr));
     }
     return out;
   }
 
-  Attr read_attr(hid_t a, const std::string& owner) const {
+  // One attribute, or nullopt when it is left out (listed for take_skipped(): its type is not one
+  // the model holds, or its text cannot be read safely from a global heap). Damage that HDF5
+  // reports, or sizes the file cannot hold, refuse the file.
+  std::optional<Attr> read_attr(hid_t a, const std::string& path, const std::string& owner) {
     Attr out;
     const ssize_t len = H5Aget_name(a, 0, nullptr);
     if (len < 0) fail("cannot read an attribute name of " + owner);
@@ -151,6 +177,10 @@ public:
       fail("cannot read an attribute name of " + owner);
     out.name.resize(static_cast<std::size_t>(len));
     const std::string what = "attribute '" + out.name + "' of " + owner;
+    auto skip = [&](std::string reason) -> std::optional<Attr> {
+      skipped_.push_back({path, owner, out.name, std::move(reason)});
+      return std::nullopt;
+    };
 
     Hid type = check(detail::type_id(H5Aget_type(a)), "cannot read the type of " + what);
     Hid space = check(detail::space_id(H5Aget_space(a)), "cannot read the shape of " + what);
@@ -158,35 +188,54 @@ public:
     const hssize_t npoints = sclass == H5S_NULL ? 0 : H5Sget_simple_extent_npoints(space.get());
     if (npoints < 0) fail("cannot read the shape of " + what);
     const auto n = static_cast<std::size_t>(npoints);
+    const bool scalar = sclass == H5S_SCALAR;
     const H5T_class_t tclass = H5Tget_class(type.get());
+    if (n > kMaxAttrValues || !plausible(uint64_t{16} * n, false))
+      fail(what + " claims " + std::to_string(n) + " values, more than the file can hold (damaged?)");
 
     if (tclass == H5T_STRING) {
-      if (sclass != H5S_SCALAR) fail(what + " is an array of strings (not supported)");
       const htri_t is_var = H5Tis_variable_str(type.get());
       if (is_var < 0) fail("cannot read the type of " + what);
+      std::vector<std::string> texts;
       if (is_var > 0) {
-        // Its text lives in a global heap, which has no checksum and which HDF5 1.10 parses
-        // without bounds checks: flipping a byte of a heap object's size crashed (SIGSEGV) or hung
-        // HDF5 (docs/RELIABILITY.md). The type is known without touching the heap.
-        fail(what + " is a variable-length string (h5py's default for str), which prtbake does not "
-                    "read: HDF5 reads its unchecksummed heap unsafely; store it fixed-length, e.g. with "
-                    "h5py attrs.create(name, text.encode(), dtype=h5py.string_dtype('utf-8', len(text.encode())))");
+        // HDF5 hands back the references the (checksummed) attribute stores, never reading the
+        // global heap; our own bounds-checked reader takes the text from the raw bytes. The heap
+        // has no checksum, so its damage leaves the attribute out rather than the file.
+        const std::vector<detail::HeapId> ids = detail::read_heap_ids(a, n);
+        if (ids.size() != n) fail("cannot read " + what);
+        for (std::size_t i = 0; i < n; ++i) {
+          const std::string text = scalar ? std::string("its text") : "the text of its string " + std::to_string(i);
+          try {
+            std::string s = heaps_.object(ids[i]);
+            s.resize(std::min(s.size(), s.find('\0')));
+            if (!detail::valid_utf8(s))
+              return skip(text + " in the HDF5 global heap, which has no checksum, is not UTF-8 (damaged?)");
+            texts.push_back(std::move(s));
+          } catch (const detail::HeapError& e) {
+            return skip(text + " cannot be read safely from the HDF5 global heap: " + e.what());
+          }
+        }
+      } else {
+        const std::size_t size = H5Tget_size(type.get());
+        if (size == 0 || !plausible(uint64_t{size} * n, false)) fail(what + " has an invalid string size");
+        std::string all(size * n, '\0');
+        Hid mem = check(detail::type_id(H5Tcopy(type.get())), what);
+        if (n > 0 && H5Aread(a, mem.get(), all.data()) < 0) fail("cannot read " + what);
+        for (std::size_t i = 0; i < n; ++i) texts.push_back(all.substr(i * size, size));
       }
-      const std::size_t size = H5Tget_size(type.get());
-      if (size == 0 || !plausible(size, false)) fail(what + " has an invalid string size");
-      std::string s(size, '\0');
-      Hid mem = check(detail::type_id(H5Tcopy(type.get())), what);
-      if (H5Aread(a, mem.get(), s.data()) < 0) fail("cannot read " + what);
-      s.resize(std::min(s.size(), s.find('\0')));
-      if (H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD)
-        s.erase(s.find_last_not_of(' ') + 1);
-      out.value = std::move(s);
+      // Text ends at the first NUL (fixed-length strings are padded with them); space-padded
+      // strings lose their trailing spaces.
+      const bool space_padded = H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD;
+      for (std::string& s : texts) {
+        s.resize(std::min(s.size(), s.find('\0')));
+        if (space_padded) s.erase(s.find_last_not_of(' ') + 1);
+      }
+      if (scalar) out.value = std::move(texts.at(0));
+      else out.value = std::move(texts);
       return out;
     }
-    if (tclass != H5T_INTEGER && tclass != H5T_FLOAT) fail(what + " has an unsupported type");
-    if (n > (std::size_t{1} << 28) || !plausible(uint64_t{8} * n, false))
-      fail(what + " claims " + std::to_string(n) + " values, more than the file can hold (damaged?)");
-    const bool scalar = sclass == H5S_SCALAR;
+    if (tclass != H5T_INTEGER && tclass != H5T_FLOAT)
+      return skip("its type (" + type_class_name(tclass) + ") is not one the model holds (strings, integers, floats)");
     if (tclass == H5T_INTEGER) {
       std::vector<int64_t> v(n);
       if (n > 0 && H5Aread(a, H5T_NATIVE_INT64, v.data()) < 0) fail("cannot read " + what);
@@ -201,7 +250,7 @@ public:
     return out;
   }
 
-  Dataset read_dataset(hid_t parent, const std::string& link, const std::string& path) const {
+  Dataset read_dataset(hid_t parent, const std::string& link, const std::string& path) {
     const std::string name = "dataset '" + path + "'";
     Dataset out;
     out.path = path;
@@ -253,7 +302,7 @@ public:
     }
     if (n > 0 && H5Dread(ds.get(), mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
       fail("cannot read " + name + " (damaged or truncated data, or a checksum mismatch)");
-    out.attrs = read_attrs(ds.get(), name);
+    out.attrs = read_attrs(ds.get(), path, name);
     return out;
   }
 
@@ -280,7 +329,7 @@ public:
       const H5I_type_t t = H5Iget_type(obj.get());
       if (t == H5I_GROUP) {
         check_structures(obj.get(), "group '" + child + "'");
-        std::vector<Attr> attrs = read_attrs(obj.get(), "group '" + child + "'");
+        std::vector<Attr> attrs = read_attrs(obj.get(), child, "group '" + child + "'");
         if (!attrs.empty()) out.group_attrs.emplace_back(child, std::move(attrs));
         read_group(obj.get(), child, depth + 1, out);
       } else if (t == H5I_DATASET) {
@@ -313,10 +362,15 @@ public:
       fail(what + " indexes its chunks with an unchecksummed version-1 B-tree, which prtbake does not open");
   }
 
+  // The attributes left out so far (read_attr).
+  std::vector<SkippedAttr> take_skipped() { return std::move(skipped_); }
+
 private:
   std::string msg_file_;
   uint64_t file_size_;
   RawBytes& raw_;
+  detail::GlobalHeaps heaps_;  // the variable-length strings' collections, each read once
+  std::vector<SkippedAttr> skipped_;
   std::size_t objects_ = 0;
 };
 
@@ -350,7 +404,7 @@ File read_file(const std::filesystem::path& path, ReadCheck check) {
       if (!f.valid()) r.fail("cannot open the HDF5 file (damaged or truncated?)");
       Hid root = r.check(detail::group_id(H5Gopen2(f.get(), "/", H5P_DEFAULT)), "cannot open the root group");
       r.check_structures(root.get(), "the root group");
-      out.root_attrs = r.read_attrs(root.get(), "the root group");
+      out.root_attrs = r.read_attrs(root.get(), "/", "the root group");
 
       const Attr* fmt = find_attr(out.root_attrs, names::kFormat);
       const auto* fmt_s = fmt ? std::get_if<std::string>(&fmt->value) : nullptr;
@@ -369,6 +423,7 @@ File read_file(const std::filesystem::path& path, ReadCheck check) {
         throw FormatError(msg_file, "invalid " + std::string(names::kFormatVersion) + " " + std::to_string(*ver_i));
 
       r.read_group(root.get(), "/", 1, out);
+      out.skipped_attrs = r.take_skipped();
       root.close();
       if (f.close() < 0) r.fail("cannot close the file");
     } catch (const std::bad_alloc&) {
@@ -380,6 +435,8 @@ File read_file(const std::filesystem::path& path, ReadCheck check) {
             [](const Dataset& a, const Dataset& b) { return a.path < b.path; });
   std::sort(out.group_attrs.begin(), out.group_attrs.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(out.skipped_attrs.begin(), out.skipped_attrs.end(),
+            [](const SkippedAttr& a, const SkippedAttr& b) { return std::tie(a.path, a.name) < std::tie(b.path, b.name); });
   if (check == ReadCheck::full) validate(out, path);
   return out;
 }

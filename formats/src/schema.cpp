@@ -1,7 +1,9 @@
-// schema.cpp — schema v3 (formats/SCHEMA.md) as code: validate() is the single check that the
+// schema.cpp — schema v4 (formats/SCHEMA.md) as code: validate() is the single check that the
 // writer applies before writing and the reader applies after reading. Names: <formats/names.h>.
 #include <formats/names.h>
 #include <formats/prtfile.h>
+
+#include "utf8.h"
 
 #include <algorithm>
 #include <array>
@@ -12,6 +14,8 @@
 
 namespace prt::formats {
 namespace {
+
+using detail::valid_utf8;
 
 namespace N = names;
 
@@ -32,32 +36,6 @@ std::vector<std::string_view> split_path(std::string_view path) {
     i = j + 1;
   }
   return parts;
-}
-
-bool valid_utf8(std::string_view s) {
-  std::size_t i = 0;
-  while (i < s.size()) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    std::size_t n = 0;
-    uint32_t cp = 0;
-    if (c < 0x80) { ++i; continue; }
-    if ((c & 0xE0) == 0xC0) { n = 1; cp = c & 0x1F; }
-    else if ((c & 0xF0) == 0xE0) { n = 2; cp = c & 0x0F; }
-    else if ((c & 0xF8) == 0xF0) { n = 3; cp = c & 0x07; }
-    else return false;
-    if (i + n >= s.size()) return false;  // truncated sequence
-    for (std::size_t k = 1; k <= n; ++k) {
-      const auto cc = static_cast<unsigned char>(s[i + k]);
-      if ((cc & 0xC0) != 0x80) return false;
-      cp = (cp << 6) | (cc & 0x3F);
-    }
-    // Overlong forms, surrogates and out-of-range code points are invalid.
-    if ((n == 1 && cp < 0x80) || (n == 2 && cp < 0x800) || (n == 3 && cp < 0x10000) ||
-        cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
-      return false;
-    i += n + 1;
-  }
-  return true;
 }
 
 // A link name HDF5 and h5py accept unchanged: non-empty, not "." or "..", no control chars.
@@ -117,6 +95,11 @@ public:
       if (const auto* s = std::get_if<std::string>(&a.value)) {
         if (s->find('\0') != std::string::npos) fail(what + " contains a NUL character");
         if (!valid_utf8(*s)) fail(what + " is not valid UTF-8");
+      } else if (const auto* vs = std::get_if<std::vector<std::string>>(&a.value)) {
+        for (std::size_t i = 0; i < vs->size(); ++i) {
+          if ((*vs)[i].find('\0') != std::string::npos) fail(what + " has a NUL character in string " + std::to_string(i));
+          if (!valid_utf8((*vs)[i])) fail(what + " has a string that is not valid UTF-8 (string " + std::to_string(i) + ")");
+        }
       } else if (const auto* d = std::get_if<double>(&a.value)) {
         if (!std::isfinite(*d)) fail(what + " is not finite (" + std::to_string(*d) + ")");
       } else if (const auto* v = std::get_if<std::vector<double>>(&a.value)) {

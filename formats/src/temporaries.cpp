@@ -1,5 +1,5 @@
-// temporaries.cpp — see temporaries.h.
-#include "temporaries.h"
+// temporaries.cpp — see formats/temporaries.h.
+#include <formats/temporaries.h>
 
 #include <signal.h>
 #include <unistd.h>
@@ -9,7 +9,7 @@
 #include <cerrno>
 #include <system_error>
 
-namespace prt::formats::detail {
+namespace prt::formats {
 
 std::string host_tag() {
   char buf[256] = {};
@@ -38,4 +38,4 @@ void remove_stale_temporaries(const std::filesystem::path& dir, const std::strin
   }
 }
 
-} // namespace prt::formats::detail
+} // namespace prt::formats

@@ -3,11 +3,11 @@
 #include <formats/names.h>
 #include <formats/prtfile.h>
 
+#include <formats/temporaries.h>
 #include <formats/testing.h>
 
 #include "chunk_filters.h"
 #include "h5util.h"
-#include "temporaries.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -122,6 +122,20 @@ public:
       std::string padded = *s;
       padded.resize(std::max<std::size_t>(s->size(), 1), '\0');
       check(H5Awrite(attr.get(), type.get(), padded.data()), what);
+      return;
+    }
+    if (const auto* vs = std::get_if<std::vector<std::string>>(&a.value)) {
+      // One fixed length for the array, its longest string's; an empty array has a null dataspace.
+      std::size_t width = 1;
+      for (const std::string& s : *vs) width = std::max(width, s.size());
+      std::string packed(width * vs->size(), '\0');
+      for (std::size_t i = 0; i < vs->size(); ++i) packed.replace(i * width, (*vs)[i].size(), (*vs)[i]);
+      const hsize_t n = vs->size();
+      Hid type = check(detail::make_utf8_string_type(width), what);
+      Hid space = check(detail::space_id(n == 0 ? H5Screate(H5S_NULL) : H5Screate_simple(1, &n, nullptr)), what);
+      Hid attr = check(detail::attr_id(H5Acreate2(owner, a.name.c_str(), type.get(), space.get(),
+                                                 H5P_DEFAULT, H5P_DEFAULT)), what);
+      if (n > 0) check(H5Awrite(attr.get(), type.get(), packed.data()), what);
       return;
     }
     hid_t file_type = H5T_STD_I64LE, mem_type = H5T_NATIVE_INT64;
@@ -293,9 +307,9 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
   if (std::filesystem::is_directory(final_path, ec))
     throw FormatError(msg_file, "the output path is an existing directory");
 
-  const std::string prefix = final_path.filename().string() + ".tmp." + detail::host_tag() + ".";
-  const std::filesystem::path tmp = dir / detail::temporary_name(prefix);
-  detail::remove_stale_temporaries(dir, prefix);
+  const std::string prefix = final_path.filename().string() + ".tmp." + host_tag() + ".";
+  const std::filesystem::path tmp = dir / temporary_name(prefix);
+  remove_stale_temporaries(dir, prefix);
 
   const std::lock_guard lock(detail::hdf5_mutex());
   detail::silence_hdf5_errors();

@@ -3,7 +3,7 @@
 // interoperability with h5dump and h5py.
 #include <formats/prtfile.h>
 
-#include "temporaries.h"
+#include <formats/temporaries.h>
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
@@ -75,7 +75,9 @@ File make_file() {
                          {"radii", std::vector<double>{3, 5}},
                          {"ids", std::vector<int64_t>{-1, 2}},
                          {"empty", std::vector<double>{}},
-                         {"one", std::vector<double>{0.125}}}});
+                         {"one", std::vector<double>{0.125}},
+                         {"labels", std::vector<std::string>{"a", "", "ccc \u2713"}},
+                         {"no_labels", std::vector<std::string>{}}}});
   f.datasets.push_back({"/fiv/occluders/rock/valid", {2, 2, 3},
                         std::vector<uint8_t>{1, 0, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1}, {}});
   f.datasets.push_back({"/report/ao_error", {2}, std::vector<float>{1e-3f, 2e-3f}, {{"unit", std::string("1")}}});
@@ -167,10 +169,18 @@ TEST(RoundTrip, AllDatasetKindsSurviveWriteRead) {
     ASSERT_NE(got, nullptr) << g;
     expect_same_attrs(attrs, *got, g);
   }
-  // A one-element vector stays a vector; an empty vector survives.
+  // A one-element vector stays a vector; an empty vector survives; so do arrays of strings (an
+  // empty string among them), written fixed-length.
   const Attr* one = find_attr(find_dataset(out, "/fiv/occluders/rock/shells")->attrs, "one");
   ASSERT_NE(one, nullptr);
   EXPECT_TRUE(std::holds_alternative<std::vector<double>>(one->value));
+  const Attr* labels = find_attr(find_dataset(out, "/fiv/occluders/rock/shells")->attrs, "labels");
+  ASSERT_NE(labels, nullptr);
+  EXPECT_EQ(std::get<std::vector<std::string>>(labels->value), (std::vector<std::string>{"a", "", "ccc \u2713"}));
+  const Attr* none = find_attr(find_dataset(out, "/fiv/occluders/rock/shells")->attrs, "no_labels");
+  ASSERT_NE(none, nullptr);
+  EXPECT_EQ(std::get<std::vector<std::string>>(none->value), std::vector<std::string>{});
+  EXPECT_TRUE(out.skipped_attrs.empty());
 }
 
 TEST(RoundTrip, OverwritesAnExistingFile) {
@@ -311,6 +321,12 @@ INSTANTIATE_TEST_SUITE_P(
                "has attribute 'generator' twice"},
         Defect{"bad_utf8", [](File& f) { f.root_attrs[0].value = std::string("\xff\xfe"); },
                "is not valid UTF-8"},
+        Defect{"bad_utf8_in_a_string_array",
+               [](File& f) { f.root_attrs.push_back({"tags", std::vector<std::string>{"ok", "\xc0\xaf"}}); },
+               "attribute 'tags' of the root group has a string that is not valid UTF-8 (string 1)"},
+        Defect{"nul_in_a_string_array",
+               [](File& f) { f.root_attrs.push_back({"tags", std::vector<std::string>{std::string("a\0b", 3)}}); },
+               "attribute 'tags' of the root group has a NUL character in string 0"},
         Defect{"unknown_top_level", [](File& f) { f.datasets.push_back({"/foo", {1}, std::vector<float>{1}, {}}); },
                "unknown dataset path '/foo'"},
         Defect{"unknown_under_mesh", [](File& f) { f.datasets.push_back({"/mesh/colors", {kV}, std::vector<float>(kV), {}}); },
@@ -357,7 +373,7 @@ TEST(Atomicity, StaleTemporariesOfKilledBakesAreRemovedLiveOnesKept) {
   // removes it when the pid is dead on this machine, and keeps a live pid's (another bake writing
   // now), another machine's, another name's and anything else.
   const fs::path dir = scratch("stale_tmp");
-  const std::string h = prt::formats::detail::host_tag();
+  const std::string h = prt::formats::host_tag();
   const pid_t dead = ::fork();  // a pid that is surely dead once reaped
   if (dead == 0) ::_exit(0);
   ASSERT_GT(dead, 0);

@@ -5,6 +5,9 @@
 //   prt/vertex.prt.h5, prt/fiv.prt.h5   small files from our writer (formats::write_asset): a
 //        tetrahedron's vertex products (ao, diffuse and visibility transfer, band-1 radiance);
 //        an FIV file (environment, DifMap, one occluder), for fuzz_prt_dump and fuzz_prt_loader;
+//   prt/annotated.prt.h5   vertex.prt.h5 with attributes as h5py adds them (issue 28):
+//        variable-length strings on the root (a scalar and an array of three), on /mesh and on
+//        /ao, their text in a global heap collection that the targets then damage;
 //   prt/old_format.prt.h5   the same root attributes and mesh datasets written with HDF5's
 //        defaults instead of our writer's settings: superblock version 0, old-style groups,
 //        contiguous and chunked-deflated datasets without checksums — the kind of file
@@ -173,6 +176,32 @@ void write_old_format(const fs::path& path) {
   H5Fclose(file);
 }
 
+// Adds a variable-length string attribute (h5py's kind for a str, or a list of them) to `location`.
+void vlen_attr(hid_t location, const char* name, const std::vector<const char*>& texts, bool scalar) {
+  const hid_t type = checked(H5Tcopy(H5T_C_S1), "H5Tcopy");
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  const hsize_t n = texts.size();
+  const hid_t space = checked(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), "H5Screate");
+  const hid_t attr = checked(H5Acreate2(location, name, type, space, H5P_DEFAULT, H5P_DEFAULT), name);
+  H5Awrite(attr, type, texts.data());
+  H5Aclose(attr), H5Sclose(space), H5Tclose(type);
+}
+
+void write_annotated(const fs::path& path) {
+  pf::write_asset(path, vertex_asset());
+  const hid_t file = checked(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), "H5Fopen");
+  vlen_attr(file, "note", {"root note \u2713"}, true);
+  vlen_attr(file, "tags", {"a", "bb", "ccc"}, false);
+  const hid_t mesh = checked(H5Gopen2(file, "/mesh", H5P_DEFAULT), "H5Gopen2");
+  vlen_attr(mesh, "note", {"group note"}, true);
+  H5Gclose(mesh);
+  const hid_t ao = checked(H5Dopen2(file, "/ao", H5P_DEFAULT), "H5Dopen2");
+  vlen_attr(ao, "note", {"dataset note"}, true);
+  H5Dclose(ao);
+  if (H5Fclose(file) < 0) throw std::runtime_error("HDF5: H5Fclose failed");
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -190,6 +219,7 @@ int main(int argc, char** argv) {
     pf::write_asset(dir / "prt" / "vertex.prt.h5", vertex_asset());
     pf::write_asset(dir / "prt" / "fiv.prt.h5", fiv_asset());
     write_old_format(dir / "prt" / "old_format.prt.h5");
+    write_annotated(dir / "prt" / "annotated.prt.h5");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_seeds: %s\n", e.what());
     return 1;

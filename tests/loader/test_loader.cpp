@@ -1,6 +1,7 @@
 // Tests of prtshade/loader.h (prt::prtshade_hdf5): a file written by the real writer comes back as
 // the same arrays, its views shade exactly like views of the original arrays, scene objects (v2)
-// are separate vertex sets, and broken occluder data is refused with a message naming the file.
+// are separate vertex sets, broken occluder data is refused with a message naming the file, and a
+// file annotated with h5py (variable-length strings) loads with its notes.
 #include <prtshade/loader.h>
 #include <prtshade/shade.h>
 
@@ -8,6 +9,8 @@
 #include <formats/testing.h>
 
 #include <byte_flips.h>
+#include <h5py.h>
+#include <hdf5_bytes.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -166,6 +169,61 @@ TEST(Loader, IrradianceBeyondTheShadingLimitIsRefusedNamingTheDataset) {
   const auto path = tmp("loader_env_beyond_limit.prt.h5");
   write_broken(path, f);
   expect_refused(path, {"/fiv/environment: ", "environment FIV value 4 = 3.00000001e+38: must be finite with magnitude <= 2^64"});
+}
+
+// What shading reads of a loaded asset, for comparing two loads.
+void expect_same_data(const prt::shade::LoadedAsset& a, const prt::shade::LoadedAsset& b) {
+  ASSERT_EQ(a.vertex_sets.size(), b.vertex_sets.size());
+  for (std::size_t i = 0; i < a.vertex_sets.size(); ++i) {
+    EXPECT_EQ(a.vertex_sets[i].name, b.vertex_sets[i].name);
+    EXPECT_EQ(a.vertex_sets[i].positions, b.vertex_sets[i].positions);
+    EXPECT_EQ(a.vertex_sets[i].ao, b.vertex_sets[i].ao);
+    EXPECT_EQ(a.vertex_sets[i].transfer, b.vertex_sets[i].transfer);
+    EXPECT_EQ(a.vertex_sets[i].radiance_band1, b.vertex_sets[i].radiance_band1);
+  }
+  EXPECT_EQ(a.irradiance_cube, b.irradiance_cube);
+  ASSERT_EQ(a.occluders.size(), b.occluders.size());
+  for (std::size_t i = 0; i < a.occluders.size(); ++i) EXPECT_EQ(a.occluders[i].shells, b.occluders[i].shells);
+}
+
+TEST(Loader, FilesAnotherToolAnnotatedWithH5pyLoadWithTheirNotes) {
+  // h5py's str attributes are variable-length strings (issue 28): the loader reads them through
+  // the reader's own heap code and loads the same arrays; a damaged heap leaves the notes out,
+  // named in skipped_attrs, and still loads the same arrays.
+  const auto dir = tmp("loader_h5py");
+  std::filesystem::create_directories(dir);
+  const std::string python = prt::testing::python_with_h5py(dir);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  const auto path = dir / "a.prt.h5";
+  prt::formats::write_file(path, make_file(true));
+  const prt::shade::LoadedAsset plain = prt::shade::load_prt(path);
+  ASSERT_EQ(prt::testing::add_h5py_notes(python, path, "objects/tree/mesh", "fiv/occluders/rock/shells",
+                                         prt::testing::H5pyStrings::variable_length),
+            "");
+  const prt::shade::LoadedAsset annotated = prt::shade::load_prt(path);
+  expect_same_data(annotated, plain);
+  EXPECT_TRUE(annotated.skipped_attrs.empty());
+  const Attr* note = prt::formats::find_attr(annotated.occluders.at(0).attrs, "note");
+  ASSERT_NE(note, nullptr) << "the shells dataset's attributes, as stored";
+  EXPECT_EQ(std::get<std::string>(note->value), "dataset note");
+
+  prt::testing::Bytes bytes = prt::testing::file_bytes(path);
+  bytes[prt::testing::only_collection(bytes)] = 'g';  // "gCOL": no collection there any more
+  prt::testing::write_file_bytes(path, bytes);
+  const prt::shade::LoadedAsset damaged = prt::shade::load_prt(path);
+  expect_same_data(damaged, plain);
+  EXPECT_EQ(prt::formats::find_attr(damaged.occluders.at(0).attrs, "note"), nullptr);
+  std::vector<std::string> skipped;
+  for (const prt::formats::SkippedAttr& s : damaged.skipped_attrs) skipped.push_back(prt::formats::describe(s));
+  ASSERT_EQ(skipped.size(), 4u);
+  EXPECT_EQ(skipped[0].rfind("attribute 'note' of the root group skipped: its text cannot be read safely from the "
+                             "HDF5 global heap: no global heap collection starts at byte ",
+                             0),
+            0u)
+      << skipped[0];
+  EXPECT_EQ(skipped[1].rfind("attribute 'tags' of the root group skipped: the text of its string 0 ", 0), 0u) << skipped[1];
+  EXPECT_EQ(skipped[2].rfind("attribute 'note' of dataset '/fiv/occluders/rock/shells' skipped: ", 0), 0u) << skipped[2];
+  EXPECT_EQ(skipped[3].rfind("attribute 'note' of group '/objects/tree/mesh' skipped: ", 0), 0u) << skipped[3];
 }
 
 } // namespace

@@ -1,7 +1,10 @@
 // `prtbake export` as a user runs it: a real bake exported to each format; bad input gives one
 // line naming the file and the problem, exit 1, and leaves nothing behind (no output, no staging
-// directory); a bad --to is a command-line error (exit 2).
+// directory); a bad --to is a command-line error (exit 2); a file h5py annotated exports the
+// bytes of the file without its notes.
 #include <gtest/gtest.h>
+#include <h5py.h>
+#include <hdf5_bytes.h>
 #include <run_tool.h>
 #include <scratch.h>
 
@@ -99,6 +102,48 @@ TEST(ExportCli, EnvironmentProbeMustBeTheBakesEnvironment) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--env writes an environment probe"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "x.glb"));
+}
+
+TEST(ExportCli, AFileAnnotatedWithH5pyExportsTheSameBytes) {
+  // h5py's str attributes (variable-length strings, issue 28) are read, or left out with a
+  // warning when their heap is damaged; no export carries attributes, so every format gives the
+  // bytes of the file without them.
+  const fs::path d = fresh("h5py");
+  const std::string python = prt::testing::python_with_h5py(d);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  const fs::path plain = d / "plain.prt.h5", notes = d / "notes.prt.h5";
+  const auto bake = run_tool(PRT_PRTBAKE, "vertex '" + std::string(PRT_DATA_DIR) + "/ground.obj' --ao --radiance '" +
+                                              std::string(PRT_DATA_DIR) + "/sunset.exr' --integrator qmc --samples 16 --report 0 -q -o '" +
+                                              plain.string() + "'",
+                             d);
+  ASSERT_EQ(bake.code, 0) << bake.err;
+  fs::copy_file(plain, notes);
+  ASSERT_EQ(prt::testing::add_h5py_notes(python, notes, "mesh", "ao", prt::testing::H5pyStrings::variable_length), "");
+  prt::testing::Bytes damaged = prt::testing::file_bytes(notes);
+  damaged[prt::testing::only_collection(damaged) + 1] = 'X';  // "GXOL"
+  prt::testing::write_file_bytes(d / "damaged.prt.h5", damaged);
+  for (const char* to : {"gltf", "glb", "bin", "unity", "godot", "filament"}) {
+    SCOPED_TRACE(to);
+    for (const char* input : {"plain", "notes", "damaged"}) {
+      fs::create_directories(d / input);
+      const auto r = run_tool(PRT_PRTBAKE, export_args(d / (std::string(input) + ".prt.h5"), to, d / input / "out"), d);
+      ASSERT_EQ(r.code, 0) << input << ": " << r.err;
+      const std::size_t warnings = std::string(input) == "damaged" ? 4 : 0;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), warnings) << input << ": " << r.err;
+      if (warnings) {
+        EXPECT_NE(r.err.find("prtbake: warning: export: " + (d / "damaged.prt.h5").string() +
+                             ": attribute 'note' of group '/mesh' skipped: its text cannot be read safely from the HDF5 "
+                             "global heap: no global heap collection starts at byte "),
+                  std::string::npos)
+            << r.err;
+      }
+    }
+    for (const char* input : {"notes", "damaged"})
+      for (const char* file : {"out", "out.bin"}) {
+        if (!fs::exists(d / "plain" / file)) continue;  // out.bin: the glTF buffer only
+        EXPECT_EQ(prt::testing::read_bytes(d / input / file), prt::testing::read_bytes(d / "plain" / file)) << input << "/" << file;
+      }
+  }
 }
 
 TEST(ExportCli, UnknownFormatIsACommandLineError) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 #include <h5py.h>
+#include <hdf5_bytes.h>
 #include <run_tool.h>
 
 #include <sys/wait.h>
@@ -432,4 +433,49 @@ TEST(Prtdump, ShowsAttributesAnotherToolAdded) {
   ASSERT_EQ(j.exit_code, 0) << j.err;
   for (const char* s : {"\"note\": \"root note \u2713\"", "\"note\": \"dataset note\"", "\"/mesh\": {"})
     EXPECT_NE(j.out.find(s), std::string::npos) << "JSON lacks " << s << ":\n" << j.out;
+}
+
+TEST(Prtdump, ShowsVariableLengthStringsAnotherToolAddedAndWhatADamagedHeapLeftOut) {
+  // h5py's defaults (issue 28): str attributes and a list of str are variable-length strings,
+  // read by the reader's own heap code. A damaged heap leaves them out: exit 0, the data whole,
+  // each one named with the reason (text and --json).
+  const fs::path dir = scratch("foreign_vlen_attrs");
+  const std::string python = prt::testing::python_with_h5py(dir);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  write_file(dir / "a.prt.h5", make_file());
+  ASSERT_EQ(prt::testing::add_h5py_notes(python, dir / "a.prt.h5", "mesh", "ao", prt::testing::H5pyStrings::variable_length), "");
+  const CmdResult r = prtdump(dir, q(dir / "a.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* s : {"schema   valid", "  note            \"root note \u2713\"", "  tags            [\"a\", \"bb\", \"ccc \u2713\"]",
+                        "  fixed           \"fixed text\"", "note = \"dataset note\"", "  /mesh\n      note = \"group note\""})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << r.out;
+  EXPECT_EQ(r.out.find("Skipped attributes"), std::string::npos) << r.out;
+  const CmdResult j = prtdump(dir, "--json " + q(dir / "a.prt.h5"));
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  for (const char* s : {"\"note\": \"root note \u2713\"", "\"note\": \"dataset note\"", "\"note\": \"group note\"",
+                        "\"fixed\": \"fixed text\"", "\"skipped_attrs\": []"})
+    EXPECT_NE(j.out.find(s), std::string::npos) << "JSON lacks " << s << ":\n" << j.out;
+  EXPECT_NE(j.out.find("\"tags\": [\n"), std::string::npos) << "tags is an array:\n" << j.out;
+
+  prt::testing::Bytes bytes = prt::testing::file_bytes(dir / "a.prt.h5");
+  const std::size_t gcol = prt::testing::only_collection(bytes);
+  bytes[gcol + 4] = 7;  // a collection version HDF5 never wrote
+  prt::testing::write_file_bytes(dir / "a.prt.h5", bytes);
+  const std::string why = "cannot be read safely from the HDF5 global heap: the global heap collection at byte " +
+                          std::to_string(gcol) + " has version 7 (HDF5 writes version 1)";
+  const CmdResult d = prtdump(dir, q(dir / "a.prt.h5"));
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  for (const std::string& s : {std::string("schema   valid"), std::string("  fixed           \"fixed text\""),
+                               "\nSkipped attributes (left out by the reader; the file's data is whole)\n"
+                               "  attribute 'note' of the root group skipped: its text " + why + "\n"
+                               "  attribute 'tags' of the root group skipped: the text of its string 0 " + why + "\n"
+                               "  attribute 'note' of dataset '/ao' skipped: its text " + why + "\n"
+                               "  attribute 'note' of group '/mesh' skipped: its text " + why + "\n"})
+    EXPECT_NE(d.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << d.out;
+  EXPECT_EQ(d.out.find("root note"), std::string::npos) << d.out;
+  const CmdResult dj = prtdump(dir, "--json " + q(dir / "a.prt.h5"));
+  ASSERT_EQ(dj.exit_code, 0) << dj.err;
+  for (const std::string& s : {"\"path\": \"/\",\n      \"name\": \"tags\",\n      \"reason\": \"the text of its string 0 " + why + "\"",
+                               "\"path\": \"/mesh\",\n      \"name\": \"note\",\n      \"reason\": \"its text " + why + "\""})
+    EXPECT_NE(dj.out.find(s), std::string::npos) << "JSON lacks " << s << ":\n" << dj.out;
 }

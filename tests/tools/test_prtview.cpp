@@ -7,6 +7,8 @@
 #include <view/text.h>
 
 #include <gtest/gtest.h>
+#include <h5py.h>
+#include <hdf5_bytes.h>
 
 #include <algorithm>
 #include <array>
@@ -432,6 +434,43 @@ TEST(Prtview, DamagedAndOldFormatFilesGiveOneLineNeverACrash) {
   EXPECT_GT(refused, 18) << "most flips of a small file hit checksummed bytes";
   const Outcome old = view(bad.string() + " " + kCamera + " -o " + out.string());
   EXPECT_NE(old.err.find("oldest file format"), std::string::npos) << old.err;
+}
+
+TEST(Prtview, FilesAnnotatedWithH5pyAreDrawnTheSameAndADamagedHeapIsAWarning) {
+  // h5py's str attributes (variable-length strings, issue 28) do not change what prtview reads:
+  // the same picture, byte for byte; a damaged heap leaves them out with one warning each.
+  const fs::path h5 = scratch("h5py_src.prt.h5"), annotated = scratch("h5py_notes.prt.h5");
+  const Outcome b = run(PRT_PRTBAKE, "vertex " + plane_obj().string() + " --radiance " + (kData / "sunset.exr").string() +
+                                         " --report 0 --quiet -o " + h5.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::string python = prt::testing::python_with_h5py(annotated.parent_path());
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  fs::copy_file(h5, annotated, fs::copy_options::overwrite_existing);
+  ASSERT_EQ(prt::testing::add_h5py_notes(python, annotated, "mesh", "radiance/band1", prt::testing::H5pyStrings::variable_length), "");
+  const std::string args = std::string(" ") + kCamera + " --size 16x12 --samples 8 -o ";
+  const fs::path plain_png = scratch("h5py_plain.png"), notes_png = scratch("h5py_notes.png"), damaged_png = scratch("h5py_damaged.png");
+  const Outcome plain = view(h5.string() + args + plain_png.string());
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  const Outcome notes = view(annotated.string() + args + notes_png.string());
+  ASSERT_EQ(notes.code, 0) << notes.err;
+  EXPECT_EQ(notes.err.find("warning"), std::string::npos) << notes.err;
+  EXPECT_EQ(slurp(notes_png), slurp(plain_png));
+
+  prt::testing::Bytes bytes = prt::testing::file_bytes(annotated);
+  const std::size_t gcol = prt::testing::only_collection(bytes);
+  prt::testing::put_le(bytes, prt::testing::heap_object(bytes, gcol, 2) + 8, uint64_t{1} << 50, 8);  // "group note"
+  prt::testing::write_file_bytes(annotated, bytes);
+  const Outcome damaged = view(annotated.string() + args + damaged_png.string());
+  ASSERT_EQ(damaged.code, 0) << damaged.err;
+  EXPECT_EQ(slurp(damaged_png), slurp(plain_png));
+  const std::string warning = "prtview: warning: " + annotated.string() + ": attribute '";
+  const std::string why = " cannot be read safely from the HDF5 global heap: object 2 of the global heap collection at byte " +
+                          std::to_string(gcol) + " claims 1125899906842624 bytes, past the collection's end";
+  for (const std::string& line : {warning + "note' of the root group skipped: its text" + why,
+                                  warning + "tags' of the root group skipped: the text of its string 0" + why,
+                                  warning + "note' of dataset '/radiance/band1' skipped: its text" + why,
+                                  warning + "note' of group '/mesh' skipped: its text" + why})
+    EXPECT_NE(damaged.err.find(line), std::string::npos) << "stderr lacks " << line << ":\n" << damaged.err;
 }
 
 // ---- the first look (issue 29): the best product, stated; framed on what matters; a fixed,

@@ -6,7 +6,8 @@
 
 #include <bake/core/error.h>
 #include <bake/environment/envmap.h>
-#include <formats/export.h>
+#include <exports/export.h>
+#include <formats/asset.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -54,7 +55,7 @@ void add_export(CLI::App& app, ExportArgs& args) {
       ->option_text("FORMAT")
       ->required()
       ->check([](const std::string& s) -> std::string {
-        if (formats::parse_export_format(s)) return "";
+        if (exports::parse_export_format(s)) return "";
         const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament"});
         return "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'" +
                (near ? "; did you mean " + *near + "?" : std::string());
@@ -73,9 +74,9 @@ void add_export(CLI::App& app, ExportArgs& args) {
 }
 
 void check_export_args(const ExportArgs& args) {
-  const std::optional<formats::ExportFormat> format = formats::parse_export_format(args.format);
+  const std::optional<exports::ExportFormat> format = exports::parse_export_format(args.format);
   PRT_CHECK(format.has_value());  // the --to check
-  if (!args.env.empty() && !formats::is_probe_format(*format))
+  if (!args.env.empty() && !exports::is_probe_format(*format))
     throw UsageError("export: --env writes an environment probe: it needs --to unity, godot or filament, not " +
                          args.format,
                      "prtbake export");
@@ -97,14 +98,14 @@ std::set<std::string> recorded_environments(const formats::Asset& asset) {
 
 // The environment probe of `path`, read in the file's up axis, after checking it is the map the
 // file's lighting was baked with (when the file records one).
-formats::EnvironmentProbe environment_probe(const std::string& path, const formats::Asset& asset, const std::string& input) {
+exports::EnvironmentProbe environment_probe(const std::string& path, const formats::Asset& asset, const std::string& input) {
   const bake::UpAxis up = asset.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y;
   const bake::EnvMap env = bake::EnvMap::load(path, up);
   const std::set<std::string> recorded = recorded_environments(asset);
   if (!recorded.empty() && !recorded.count(env.info().sha256))
     throw bake::InputError(path, "is not the environment " + input + " was baked with (its SHA-256 is " + env.info().sha256 +
                                      ", the file records " + *recorded.begin() + ")");
-  formats::EnvironmentProbe probe;
+  exports::EnvironmentProbe probe;
   const std::vector<double> sh = env.project_sh(3);  // [i*3 + c]
   for (size_t c = 0; c < 3; ++c)
     for (size_t i = 0; i < 9; ++i) probe.radiance[c][i] = sh[i * 3 + c];
@@ -116,11 +117,13 @@ formats::EnvironmentProbe environment_probe(const std::string& path, const forma
 } // namespace
 
 int run_export(const ExportArgs& args) {
-  const formats::ExportFormat format = *formats::parse_export_format(args.format);
+  const exports::ExportFormat format = *exports::parse_export_format(args.format);
   const formats::Asset asset = formats::read_asset(args.input);
-  std::optional<formats::EnvironmentProbe> environment;
+  for (const formats::SkippedAttr& s : asset.skipped_attrs)  // another tool's; no export carries it
+    std::fprintf(stderr, "prtbake: warning: export: %s: %s\n", args.input.c_str(), formats::describe(s).c_str());
+  std::optional<exports::EnvironmentProbe> environment;
   if (!args.env.empty()) environment = environment_probe(args.env, asset, args.input);
-  const formats::ExportSummary summary = formats::export_asset(asset, args.input, format, args.output, environment);
+  const exports::ExportSummary summary = exports::export_asset(asset, args.input, format, args.output, environment);
   // The sets left out, one line per reason naming them ("<name>: <why>" each).
   std::vector<std::pair<std::string, std::vector<std::string>>> by_reason;
   for (const std::string& entry : summary.left_out) {
@@ -133,11 +136,11 @@ int run_export(const ExportArgs& args) {
   for (const auto& [why, sets] : by_reason) {
     std::string list;
     for (const std::string& n : sets) list += (list.empty() ? "" : ", ") + n;
-    std::fprintf(stderr, "prtbake: warning: export: no %s probes for %s%s: %s\n", formats::to_string(format),
+    std::fprintf(stderr, "prtbake: warning: export: no %s probes for %s%s: %s\n", exports::to_string(format),
                  sets.size() == 1 ? "" : (std::to_string(sets.size()) + " vertex sets, ").c_str(), list.c_str(),
                  why.c_str());
   }
-  std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), formats::to_string(format));
+  std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), exports::to_string(format));
   return 0;
 }
 

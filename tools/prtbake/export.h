@@ -1,6 +1,7 @@
 // tools/prtbake/export.h — `prtbake export`: a baked file in formats engines load without HDF5
 // (glTF, a plain binary + JSON header, per-vertex light probes in Unity / Godot / Filament SH
-// conventions). The command line only; the formats are formats/export.h and SCHEMA.md "Exports".
+// conventions). The command line only; the formats are exports/export.h and formats/SCHEMA.md
+// "Exports".
 #pragma once
 
 #include <CLI/CLI.hpp>

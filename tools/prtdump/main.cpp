@@ -79,6 +79,11 @@ What the summary shows:
                    converged reference, the reference's RMS and own standard error, bake and
                    reference wall times. --json carries every column of every row by name.
   Group attributes attributes on groups such as /scene and each scene object's.
+  Skipped attributes
+                   attributes another tool added that the reader left out, each with the
+                   reason: a type the model does not hold (h5py's bool, a compound), or
+                   text in an HDF5 global heap found damaged. The file's data is whole; a
+                   file rewritten by prtbake does not keep them. (--json: skipped_attrs.)
   Statistics       per dataset: min, max and mean over the finite values, and the number of
                    NaN and Inf values (a valid file has none). For a dataset whose last axis is
                    small (<= 16, e.g. xyz, RGB or SH coefficients) also per-column min/max/mean,
@@ -168,6 +173,7 @@ std::string attr_text(const pf::AttrValue& v) {
           for (std::size_t i = 0; i < x.size(); ++i) {
             if (i) s += ", ";
             if constexpr (std::is_same_v<T, std::vector<double>>) s += num(x[i]);
+            else if constexpr (std::is_same_v<T, std::vector<std::string>>) s += Json(x[i]).dump();
             else s += std::to_string(x[i]);
           }
           return s + "]";
@@ -555,6 +561,10 @@ void summary_text(std::ostream& os, const std::string& path, const pf::Inspectio
       attrs_text(os, attrs);
     }
   }
+  if (!f.skipped_attrs.empty()) {
+    os << "\nSkipped attributes (left out by the reader; the file's data is whole)\n";
+    for (const pf::SkippedAttr& s : f.skipped_attrs) os << "  " << pf::describe(s) << '\n';
+  }
   os << "\nStatistics (min, max, mean over finite values; counts of NaN and Inf)\n";
   each_dataset([&](const pf::Dataset& d, const std::string& head) {
     const DatasetStats s = compute_stats(d);
@@ -606,6 +616,10 @@ Json summary_json(const std::string& path, const pf::Inspection& in) {
   Json groups = Json::object();
   for (const auto& [g, attrs] : f.group_attrs) groups[g] = json_attrs(attrs);
   j["group_attrs"] = std::move(groups);
+  Json skipped = Json::array();
+  for (const pf::SkippedAttr& s : f.skipped_attrs)
+    skipped.push_back({{"path", s.path}, {"name", s.name}, {"reason", s.reason}});
+  j["skipped_attrs"] = std::move(skipped);
   // Scene objects by the name people read ("name": the node path of a glTF scene's object) and
   // the group the file stores them in; every "object" below spells the name the same way.
   const std::vector<FileObject> objects = file_objects(f);

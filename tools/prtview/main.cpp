@@ -444,6 +444,8 @@ int run(const Args& a) {
   }
   if (!fs::exists(a.file)) throw bake::InputError(a.file, "no such file");
   const F::Asset f = F::read_asset(a.file);
+  for (const F::SkippedAttr& s : f.skipped_attrs)  // another tool's attribute, nothing drawn needs
+    std::fprintf(stderr, "prtview: warning: %s: %s\n", a.file.c_str(), F::describe(s).c_str());
   const bool area = a.shade == "area" || a.shade == "area-exact";
   std::string kind = a.shade;
   std::string skipped;  // why the first look did not take the best product

@@ -13,11 +13,13 @@
 //   * read_asset(path) reads with read_file (full schema check) and converts (to_asset).
 //     read_asset(write_asset(a)) == a for every field (std::optional: absent stays absent).
 //   * Extra attributes: any attribute the model does not type (another tool's, e.g. h5py's
-//     `f.attrs["note"] = "..."`, fixed- or variable-length string) is kept in `extra` of its
-//     location (root, /scene, /objects/<name>, each dataset) or, for other groups, in
-//     Asset::group_extras; it is written back (as a fixed-length string) and never makes a file
-//     unreadable. An attribute with a schema name but another type than the model's is kept
-//     there too.
+//     `f.attrs["note"] = "..."`, fixed- or variable-length string, or a list of them) is kept in
+//     `extra` of its location (root, /scene, /objects/<name>, each dataset) or, for other groups,
+//     in Asset::group_extras; it is written back (strings as fixed-length ones) and never makes a
+//     file unreadable. An attribute with a schema name but another type than the model's is kept
+//     there too. One the reader cannot hold or read safely (a bool, a compound; a string in a
+//     damaged global heap) is left out and named in Asset::skipped_attrs with the reason;
+//     write_asset writes nothing for it.
 //   * inspect_asset(path) is for inspectors (prtdump): the file as stored (format and version
 //     checked only) and, when it passes the schema, the asset; else the schema defect.
 // Errors: FormatError "<file>: <defect>" (prtfile.h).
@@ -226,6 +228,8 @@ struct Asset {
   std::vector<Dataset> other_reports;
   // Attributes of groups without typed attributes (/mesh, /report, /fiv/occluders/<name>, ...).
   std::vector<std::pair<std::string, ExtraAttrs>> group_extras;
+  // What the reader left out (File::skipped_attrs): shown by the tools, never written.
+  std::vector<SkippedAttr> skipped_attrs;
 
   const SceneObject* find_object(std::string_view name) const noexcept;
   const Occluder* find_occluder(std::string_view name) const noexcept;

@@ -1,4 +1,4 @@
-// formats/prtfile.h — the baked file (HDF5, schema version 3): the in-memory model, the one
+// formats/prtfile.h — the baked file (HDF5, schema version 4): the in-memory model, the one
 // writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
 // depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
 // specified in formats/SCHEMA.md (docs/ARCHITECTURE.md §5); every path and attribute
@@ -11,12 +11,13 @@
 //   listed: they exist because a dataset lies under them or because they carry attributes.
 //   On-disk types: std::vector<float> <-> float32 (IEEE little endian), std::vector<uint32_t>
 //   <-> uint32, std::vector<uint8_t> <-> uint8. Attribute values: std::string <-> fixed-length
-//   UTF-8 string (the writer's; other tools' fixed-length strings are read too, variable-length
-//   ones refused: "Which files the reader opens"), int64_t <-> scalar int64, double <-> scalar float64, std::vector<double> and
-//   std::vector<int64_t> <-> 1-D arrays (a one-element vector stays a vector).
+//   UTF-8 string (the writer's; other tools' strings are read too, fixed- or variable-length:
+//   "Which files the reader opens"), int64_t <-> scalar int64, double <-> scalar float64,
+//   std::vector<double>, std::vector<int64_t> and std::vector<std::string> <-> 1-D arrays (a
+//   one-element vector stays a vector; strings written fixed-length, as long as the longest).
 //
 // Writer contract (write_file)
-//   * Validates the whole File against schema v3 (validate()) before touching the disk.
+//   * Validates the whole File against schema v4 (validate()) before touching the disk.
 //   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
 //     other required root attribute (generator, created, command_line, source, source_sha256,
 //     up_axis, sh_convention).
@@ -38,6 +39,10 @@
 //     "written by a newer prtbake (format_version N > 1)"). With ReadCheck::full (the default)
 //     it then applies validate(), so callers can trust shapes, index ranges and finiteness.
 //   * Damaged, truncated or non-HDF5 files give a FormatError naming the file; never a crash.
+//   * An attribute the model cannot hold, or whose text cannot be read safely (a variable-length
+//     string in a damaged global heap), is left out and listed in File::skipped_attrs with the
+//     reason: another tool's attribute never makes a file unreadable (SCHEMA.md, "Extra
+//     attributes"). A schema attribute left out so is then missing, which validate() reports.
 //
 // Which files the reader opens
 //   HDF5 1.10 parses what it reads from a file without bounds checks in several places; a
@@ -54,10 +59,13 @@
 //   that says so (`h5repack --latest --filter=FLET IN OUT` rewrites another tool's file into
 //   the accepted format; --latest alone copies object headers unchanged). What remains reaches HDF5 only through checksummed metadata: a flipped or truncated
 //   byte is a checksum or bounds error, not a crash. Variable-length strings (h5py's default
-//   for a str attribute) are refused by their type, before HDF5 reads their text from the
-//   global heap, which has no checksum and which a flipped byte made HDF5 crash or hang on
-//   (docs/RELIABILITY.md). A file crafted on purpose with valid checksums is beyond what checks
-//   of this kind can promise; docs/RELIABILITY.md records what was fuzzed.
+//   for a str attribute) keep their text in a global heap, which has no checksum and which a
+//   flipped byte made HDF5 crash or hang on (docs/RELIABILITY.md): HDF5 never reads it here. It
+//   hands back the references stored in the (checksummed) attribute, and the reader's own
+//   bounds-checked code reads the text from the raw bytes (formats/src/global_heap.h); a
+//   reference or collection it finds damaged leaves the attribute out (File::skipped_attrs).
+//   A file crafted on purpose with valid checksums is beyond what checks of this kind can
+//   promise; docs/RELIABILITY.md records what was fuzzed.
 //
 // Errors: every failure is a FormatError whose what() is one line "<file>: <defect>".
 // Threads: serial HDF5 is not thread-safe; write_file/read_file serialise their HDF5 calls with
@@ -81,8 +89,8 @@ inline constexpr int kFormatVersion = 4;
 // Value of the root attribute "format".
 inline constexpr std::string_view kFormatName = "prtbake";
 
-using AttrValue =
-    std::variant<std::string, int64_t, double, std::vector<double>, std::vector<int64_t>>;
+using AttrValue = std::variant<std::string, int64_t, double, std::vector<double>, std::vector<int64_t>,
+                               std::vector<std::string>>;
 
 struct Attr {
   std::string name;
@@ -101,6 +109,17 @@ struct Dataset {
   bool operator==(const Dataset&) const = default;
 };
 
+// An attribute the reader left out, and why (reader contract above).
+struct SkippedAttr {
+  std::string path;    // where it is: "/" for the root group, else the group's or dataset's path
+  std::string owner;   // the same as messages name it: "the root group", "group '/mesh'", "dataset '/ao'"
+  std::string name;    // the attribute's name
+  std::string reason;  // why, e.g. "its text is in an HDF5 global heap that cannot be read safely: ..."
+  bool operator==(const SkippedAttr&) const = default;
+};
+// "attribute '<name>' of <owner> skipped: <reason>" (one line).
+std::string describe(const SkippedAttr& skipped);
+
 struct File {
   std::vector<Attr> root_attrs;
   std::vector<Dataset> datasets;
@@ -109,6 +128,8 @@ struct File {
   // /lights, /lights/<name> (v3: a light's shape, radiance, two_sided),
   // /report and any group under /report. The root's attributes go in root_attrs, not here.
   std::vector<std::pair<std::string, std::vector<Attr>>> group_attrs;
+  // Attributes the reader left out (sorted by path, then name); the writer writes none of them.
+  std::vector<SkippedAttr> skipped_attrs;
 };
 
 // An input error about a baked file: what() == "<file>: <defect>" (one line).

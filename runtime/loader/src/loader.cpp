@@ -92,6 +92,7 @@ LoadedAsset load_prt(const std::filesystem::path& path) {
   asset.path = path;
   asset.format_version = a.root.format_version;
   asset.up_axis = a.root.up_axis;
+  asset.skipped_attrs = a.skipped_attrs;
   if (a.vertices.positions) asset.vertex_sets.push_back(vertex_set_of(a.vertices, "", file));
   for (const formats::SceneObject& o : a.objects)
     if (o.set.positions) asset.vertex_sets.push_back(vertex_set_of(o.set, o.name, file));

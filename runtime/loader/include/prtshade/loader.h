@@ -22,7 +22,9 @@
 // crash, hang or allocate more than the file's size allows. HDF5 1.10 itself is not safe on
 // damaged unchecksummed metadata, so the reader hands HDF5 only checksummed structures, checked
 // from the raw bytes first (formats/prtfile.h, "Which files the reader opens"): files in HDF5's
-// oldest format and variable-length strings are refused. Tested by byte flips over whole files
+// oldest format are refused, and the text of variable-length strings (h5py's attributes) is
+// read by the reader's own bounds-checked code, never by HDF5 (an attribute whose text is in a
+// damaged heap is left out: skipped_attrs). Tested by byte flips over whole files
 // (tests/loader) and fuzzed (docs/RELIABILITY.md). Not covered: a file crafted on purpose with
 // valid checksums around malformed HDF5 structures; load untrusted files (user mods, downloads)
 // in a separate process if that matters.
@@ -83,6 +85,9 @@ struct LoadedAsset {
   int irradiance_cube_size = 0;            // S (0: absent)
   std::vector<float> irradiance_cube;      // [6][S][S][3]
   std::vector<LoadedOccluder> occluders;   // sorted by name
+  // Attributes another tool added that the reader left out, with the reason
+  // (formats::describe gives one line each): nothing shading reads; an engine may log them.
+  std::vector<formats::SkippedAttr> skipped_attrs;
 
   // The vertex set named `name` ("" = root layout), or nullptr.
   const LoadedVertexSet* find_vertex_set(std::string_view name) const noexcept;

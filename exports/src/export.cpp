@@ -1,17 +1,17 @@
-// export.cpp — export_asset and what the exporters share (contracts: formats/export.h,
+// export.cpp — export_asset and what the exporters share (contracts: exports/export.h,
 // export_common.h).
-#include <formats/export.h>
-#include <formats/names.h>
+#include <exports/export.h>
 
 #include "export_common.h"
-#include "temporaries.h"
+
+#include <formats/temporaries.h>
 
 #include <algorithm>
 #include <fstream>
 #include <stdexcept>
 
-namespace prt::formats {
-namespace exporting {
+namespace prt::exports {
+namespace detail {
 namespace {
 
 constexpr struct {
@@ -79,9 +79,9 @@ Staging::Staging(const std::filesystem::path& out) : out_(out) {
   if (!std::filesystem::is_directory(parent, ec))
     throw FormatError(msg, "output directory '" + parent.string() + "' does not exist");
   if (std::filesystem::is_directory(out, ec)) throw FormatError(msg, "the output path is an existing directory");
-  const std::string prefix = "." + out.filename().string() + ".export." + detail::host_tag() + ".";
-  detail::remove_stale_temporaries(parent, prefix);
-  dir_ = parent / detail::temporary_name(prefix);
+  const std::string prefix = "." + out.filename().string() + ".export." + formats::host_tag() + ".";
+  formats::remove_stale_temporaries(parent, prefix);
+  dir_ = parent / formats::temporary_name(prefix);
   std::filesystem::remove_all(dir_, ec);
   if (!std::filesystem::create_directory(dir_, ec))
     throw FormatError(msg, "cannot create the staging directory '" + dir_.string() + "': " + ec.message());
@@ -118,36 +118,36 @@ void write_bytes(const std::filesystem::path& path, const std::string& bytes, co
   if (!f) throw FormatError(out.string(), "cannot write '" + path.string() + "' (disk full?)");
 }
 
-} // namespace exporting
+} // namespace detail
 
 std::optional<ExportFormat> parse_export_format(std::string_view name) {
-  for (const auto& f : exporting::kFormatNames)
+  for (const auto& f : detail::kFormatNames)
     if (name == f.name) return f.format;
   return std::nullopt;
 }
 
 const char* to_string(ExportFormat format) noexcept {
-  for (const auto& f : exporting::kFormatNames)
+  for (const auto& f : detail::kFormatNames)
     if (format == f.format) return f.name;
   return "?";
 }
 
-ExportSummary export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::path& source, ExportFormat format,
                            const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment) {
   const bool probe = is_probe_format(format);
   if (environment && !probe) throw std::invalid_argument("an environment probe is written by the probe formats only");
-  if (exporting::vertex_sets(asset).empty() && !(probe && environment))
-    throw FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");
+  if (detail::vertex_sets(asset).empty() && !(probe && environment))
+    throw formats::FormatError(source.string(), "has no vertex set with /mesh/positions (and vertices) to export (an FIV-only file?)");
   ExportSummary summary;
   switch (format) {
   case ExportFormat::Gltf:
-  case ExportFormat::Glb: exporting::export_gltf(asset, out, format == ExportFormat::Glb); break;
-  case ExportFormat::Binary: exporting::export_binary(asset, out); break;
+  case ExportFormat::Glb: detail::export_gltf(asset, out, format == ExportFormat::Glb); break;
+  case ExportFormat::Binary: detail::export_binary(asset, out); break;
   case ExportFormat::Unity:
   case ExportFormat::Godot:
-  case ExportFormat::Filament: summary.left_out = exporting::export_probes(asset, source, format, out, environment); break;
+  case ExportFormat::Filament: summary.left_out = detail::export_probes(asset, source, format, out, environment); break;
   }
   return summary;
 }
 
-} // namespace prt::formats
+} // namespace prt::exports

@@ -1,18 +1,18 @@
-// Exports (formats/export.h), each re-read by a second, independent reader:
+// Exports (exports/export.h), each re-read by a second, independent reader:
 //   * glTF / GLB: tinygltf loads what we wrote; the test checks the structure glTF 2.0 requires
 //     (buffer views inside the buffer, accessors inside their views, 4-byte alignment, POSITION
 //     min/max equal to the data's bounds, application-specific attributes named "_…" with float
 //     SCALAR..VEC4 accessors, indices < vertex count) and reassembles every product from its
 //     attributes via asset.extras.prtbake: values equal bit for bit (no arithmetic on them).
-//   * PRTBIN: tests/formats/prtbin_reader.py, written from SCHEMA.md with Python's struct/json,
+//   * PRTBIN: tests/exports/prtbin_reader.py, written from SCHEMA.md with Python's struct/json,
 //     checks the layout and returns every array: values equal bit for bit.
 //   * Probes: each engine file's SH evaluated with that engine's formula (tests/common/engine_sh.h:
 //     Unity's ShadeSH9, Godot's capture formula, Filament's) at each vertex's normal in the
 //     engine's frame equals the baked E/π of SCHEMA.md's (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 of
 //     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
-#include <formats/export.h>
+#include <exports/export.h>
 
-#include "temporaries.h"
+#include <formats/temporaries.h>
 
 #include <engine_sh.h>
 #include <gtest/gtest.h>
@@ -35,6 +35,7 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using namespace prt::exports;
 
 namespace {
 
@@ -277,7 +278,7 @@ TEST(Export, StagingLeftByAKilledExportIsRemovedLiveAndOtherHostsKept) {
   if (dead == 0) ::_exit(0);
   ASSERT_GT(dead, 0);
   ::waitpid(dead, nullptr, 0);
-  const std::string h = prt::formats::detail::host_tag();
+  const std::string h = prt::formats::host_tag();
   const std::string stale = ".a.glb.export." + h + "." + std::to_string(dead);
   const std::string live = ".a.glb.export." + h + "." + std::to_string(::getppid());
   const std::string other_host = ".a.glb.export.elsewhere-" + h + "." + std::to_string(dead);
@@ -311,7 +312,7 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
   if (prt::testing::run_tool("python3", "-c 'import json, struct'", dir).code != 0) GTEST_SKIP() << "no python3";
   for (const Asset& a : {vertex_asset(), scene_asset()}) {
     export_asset(a, "in.prt.h5", ExportFormat::Binary, dir / "a.prtbin");
-    const auto run = prt::testing::run_tool("python3", std::string(PRT_SOURCE_TESTS) + "/formats/prtbin_reader.py '" +
+    const auto run = prt::testing::run_tool("python3", std::string(PRT_SOURCE_TESTS) + "/exports/prtbin_reader.py '" +
                                                            (dir / "a.prtbin").string() + "' '" + (dir / "a.json").string() + "'",
                                             dir);
     ASSERT_EQ(run.code, 0) << run.err;

@@ -1,5 +1,5 @@
 // export_gltf.cpp — glTF 2.0 export (.gltf + .bin, or .glb), written by tinygltf (contract:
-// formats/export.h; layout: formats/SCHEMA.md "Exports"). Per vertex set one mesh (one primitive)
+// exports/export.h; layout: formats/SCHEMA.md "Exports"). Per vertex set one mesh (one primitive)
 // and one node. POSITION, NORMAL and the indices as glTF defines them; AO as COLOR_0 (grey,
 // linear) and exactly as `_AO`; every other product as application-specific attributes
 // (glTF 2.0 §3.7.2.1: names start with "_", float components) `_PRT_<NAME>_<k>`, attribute k
@@ -8,7 +8,6 @@
 // order; asset.extras.prtbake lists, per mesh, each product's dataset, shape and attributes.
 #include "export_common.h"
 
-#include <formats/names.h>
 
 #include <tiny_gltf.h>
 
@@ -19,7 +18,7 @@
 #include <limits>
 #include <sstream>
 
-namespace prt::formats::exporting {
+namespace prt::exports::detail {
 namespace {
 
 using tinygltf::Value;
@@ -236,4 +235,4 @@ void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb)
   staging.commit();
 }
 
-} // namespace prt::formats::exporting
+} // namespace prt::exports::detail

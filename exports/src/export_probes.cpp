@@ -4,13 +4,12 @@
 // formats/SCHEMA.md "Exports"). Positions and normals are given in the engine's frame.
 #include "export_common.h"
 
-#include <formats/names.h>
 
 #include <prtshade/conventions.h>
 
 #include <nlohmann/json.hpp>
 
-namespace prt::formats::exporting {
+namespace prt::exports::detail {
 namespace {
 
 namespace C = prt::conventions;
@@ -142,4 +141,4 @@ std::vector<std::string> export_probes(const Asset& asset, const std::filesystem
   return left_out;
 }
 
-} // namespace prt::formats::exporting
+} // namespace prt::exports::detail

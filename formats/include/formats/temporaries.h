@@ -1,12 +1,13 @@
-// temporaries.h (private) — names of the temporary files and directories that make outputs appear
-// whole (the HDF5 writer's "<name>.tmp.<host>.<pid>", the exporters' ".<name>.export.<host>.<pid>/"),
-// and the removal of those a killed process on this machine left behind. Nothing here is public API.
+// formats/temporaries.h — names of the temporary files and directories that make outputs appear
+// whole (the HDF5 writer's "<name>.tmp.<host>.<pid>", the exporters' ".<name>.export.<host>.<pid>/",
+// exports/export.h), and the removal of those a killed process on this machine left behind.
+// Shared by the writers of baked files and of exports; not meant for engines.
 #pragma once
 
 #include <filesystem>
 #include <string>
 
-namespace prt::formats::detail {
+namespace prt::formats {
 
 // This machine's name as it goes into temporary names: [A-Za-z0-9._-] only ("host" if none).
 std::string host_tag();
@@ -21,4 +22,4 @@ std::string temporary_name(const std::string& prefix);
 // anything else in the directory. Best effort: an entry that cannot be removed stays.
 void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& prefix);
 
-} // namespace prt::formats::detail
+} // namespace prt::formats

@@ -1,16 +1,15 @@
 // export_binary.cpp — the plain binary export: magic, version, a JSON header naming every array
 // (dtype, shape, byte offset), then the arrays, little-endian, 16-byte aligned (contract:
-// formats/export.h; layout: formats/SCHEMA.md "Exports").
+// exports/export.h; layout: formats/SCHEMA.md "Exports").
 #include "export_common.h"
 
-#include <formats/names.h>
 
 #include <nlohmann/json.hpp>
 
 #include <bit>
 #include <cstring>
 
-namespace prt::formats::exporting {
+namespace prt::exports::detail {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "the binary export writes the host's bytes: little-endian only");
@@ -103,4 +102,4 @@ void export_binary(const Asset& asset, const std::filesystem::path& out) {
   staging.commit();
 }
 
-} // namespace prt::formats::exporting
+} // namespace prt::exports::detail

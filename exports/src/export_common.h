@@ -1,16 +1,28 @@
-// export_common.h (private to formats) — what the exporters share: the vertex sets and products
+// export_common.h (private to exports) — what the exporters share: the vertex sets and products
 // of an asset in export order, and the staging directory that makes outputs appear whole
-// (contract: formats/export.h).
+// (contract: exports/export.h).
 #pragma once
 
+#include <exports/export.h>
+
 #include <formats/asset.h>
-#include <formats/export.h>
+#include <formats/names.h>
+#include <formats/prtfile.h>
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
-namespace prt::formats::exporting {
+namespace prt::exports::detail {
+
+// The baked file's model and names, which every exporter reads.
+using formats::Asset;
+using formats::FormatError;
+using formats::Product;
+using formats::RootInfo;
+using formats::SceneObject;
+using formats::VertexSet;
+namespace names = formats::names;
 
 // A vertex set to export: the root layout (prefix "", name from the source file) or a scene
 // object (prefix "objects/<name>").
@@ -41,7 +53,7 @@ std::string join(const std::string& prefix, const std::string& dataset);
 // Staged outputs: files are written under a hidden directory beside the final output
 // (".<name>.export.<host>.<pid>") and renamed into place by commit(); the destructor removes the
 // directory and anything left in it. The constructor first removes the staging directories that
-// killed exports to the same name on this machine left (temporaries.h).
+// killed exports to the same name on this machine left (formats/temporaries.h).
 class Staging {
 public:
   // Checks that `out` can be written (its directory exists, it is not a directory); FormatError.
@@ -72,4 +84,4 @@ std::vector<std::string> export_probes(const Asset& asset, const std::filesystem
                                        const std::filesystem::path& out,
                                        const std::optional<EnvironmentProbe>& environment);
 
-} // namespace prt::formats::exporting
+} // namespace prt::exports::detail

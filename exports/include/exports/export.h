@@ -1,8 +1,12 @@
-// formats/export.h — a baked asset for consumers that read neither HDF5 nor our schema: glTF 2.0
+// exports/export.h — a baked asset for consumers that read neither HDF5 nor our schema: glTF 2.0
 // with the baked per-vertex data as vertex attributes, a plain binary file with a JSON header,
 // and per-vertex light probes in the SH conventions of Unity, Godot and Filament. The layouts
 // are formats/SCHEMA.md "Exports" (docs/ARCHITECTURE.md "Schema"); the engine conventions are
 // prtshade/conventions.h.
+//
+// Target prt::exports (exports/): formats' asset model in, tinygltf, nlohmann-json and
+// prtshade's conventions out. It is a component of its own so that formats (and the runtime
+// loader, which links formats) needs none of the exporters' dependencies.
 //
 // Contract
 //   * Every vertex set with at least one vertex is exported: the root layout, then each scene
@@ -15,10 +19,11 @@
 //   * The engine formats need /radiance/band1 in some vertex set (the only baked product that is
 //     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe.
 //     A set without it gets no probes; the summary names it and says why (the caller reports).
-// Errors: FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
+// Errors: formats::FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
 #pragma once
 
 #include <formats/asset.h>
+#include <formats/prtfile.h>
 
 #include <array>
 #include <filesystem>
@@ -27,7 +32,7 @@
 #include <string_view>
 #include <vector>
 
-namespace prt::formats {
+namespace prt::exports {
 
 enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament };
 
@@ -56,11 +61,11 @@ struct ExportSummary {
 
 // Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
 // `environment` adds the environment probe (probe formats only; std::invalid_argument otherwise).
-ExportSummary export_asset(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::path& source, ExportFormat format,
                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment = std::nullopt);
 
 // The binary format's magic (8 bytes) and version (SCHEMA.md "Exports").
 inline constexpr char kBinaryMagic[8] = {'P', 'R', 'T', 'B', 'I', 'N', '\0', '\0'};
 inline constexpr uint32_t kBinaryVersion = 1;
 
-} // namespace prt::formats
+} // namespace prt::exports
