@@ -89,7 +89,6 @@ constexpr const char* kTopExamples =
     "  prtbake export bunny.prt.h5 --to glb -o bunny.glb\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
 
-
 // The command line as stored in the file: the arguments that determine its contents, as typed
 // (without --threads, --quiet, --verbose, --dry-run, --reproducible and the sharding options);
 // "--opt=value" is stored as "--opt value".
