@@ -17,16 +17,17 @@ cd "$(dirname "$0")/.."
 
 # What the libraries and the three tools need to build and run: each is a find_package or
 # pkg-config module of formats/, libbake/, view/ or tools/ (README "From zero to a baked file").
-# libopenmesh-dev pulls in OpenSceneGraph and, through it, GDAL and a MariaDB client: 48 of the
-# demo's 84 packages on a fresh machine; only Loop subdivision (tests, benchmarks) uses OpenMesh.
-TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libopenmesh-dev libhdf5-dev
+TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libhdf5-dev
                 libopenexr-dev libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev
                 libssl-dev libtinygltf-dev libdeflate-dev)
-# What only the tests, the fuzz targets and CI need, and who uses it: GoogleTest; h5dump and h5py
-# (files read by other HDF5 clients); zlib (chunk filter tests); the shader tests' compiler and
-# Vulkan device; the public models of the mesh and glTF tests; mpirun for sharded bakes; Blender
-# for the glTF round trip; clang 14 and its sanitizer runtimes, and GNU time, for the fuzz targets.
-TEST_PACKAGES=(libgtest-dev hdf5-tools openexr python3-h5py python3-numpy zlib1g-dev
+# What only the tests, the benchmarks, the fuzz targets and CI need, and who uses it: OpenMesh
+# (Loop subdivision makes the tests' and benchmarks' large meshes; libopenmesh-dev pulls in
+# OpenSceneGraph and through it GDAL and a MariaDB client, 48 packages); GoogleTest; h5dump and
+# h5py (files read by other HDF5 clients); zlib (chunk filter tests); the shader tests' compiler
+# and Vulkan device; the public models of the mesh and glTF tests; mpirun for sharded bakes;
+# Blender for the glTF round trip; clang 14 and its sanitizer runtimes, and GNU time, for the
+# fuzz targets.
+TEST_PACKAGES=(libopenmesh-dev libgtest-dev hdf5-tools openexr python3-h5py python3-numpy zlib1g-dev
                glslc libvulkan-dev mesa-vulkan-drivers
                assimp-testmodels
                openmpi-bin libopenmpi-dev blender
