@@ -127,7 +127,7 @@ Result run_filter(const Asset& a, const ProductRequest& req, uint32_t rays, cons
         std::printf("DBG %u p %.3f %.3f %.3f n %.2f %.2f %.2f ref %.3f got %.3f\n", rows[i], a.points[rows[i]].p.x(),
                     a.points[rows[i]].p.y(), a.points[rows[i]].p.z(), a.points[rows[i]].n.x(), a.points[rows[i]].n.y(),
                     a.points[rows[i]].n.z(), ref[i * W], values[i * W]);
-  const IntegratorStats s = f.stats();
+  const FilterStats s = f.filter_stats();
   r.rays = s.rays_per_point();
   r.brute = s.brute_fraction();
   r.neighbours = s.neighbours_per_point();

@@ -10,7 +10,7 @@
 // One benchmark iteration integrates every shade point of the scene once, in order, on the
 // calling thread; the counter `per_integral` is CPU seconds per integral (per core; printed as e.g. 83.6us).
 // Integrator construction (BVHs, tables) is outside the timed loop and reported as `setup_s`.
-// Silhouette cases also report SilhouetteIntegrator::stats() per integral over the timed loop:
+// Silhouette cases also report SilhouetteIntegrator::silhouette_stats() per integral over the timed loop:
 // contour-search and integration µs, contour edges and isoline crossings.
 //
 // After the runs, a table of the triangle sweep: per level the contour edges found, contour
@@ -26,6 +26,7 @@
 #include <bench_common.h>
 
 #include <bake/bake/vertex_bake.h>
+#include <bake/integrators/silhouette.h>
 
 #include <benchmark/benchmark.h>
 
@@ -99,10 +100,11 @@ void integrator_case(benchmark::State& state, int level, const bake::IntegratorS
   const auto t0 = std::chrono::steady_clock::now();
   const std::unique_ptr<bake::Integrator> integ = bake::make_integrator(spec, s.mesh, s.topology, bench::request());
   state.counters["setup_s"] = since(t0);
-  const bake::IntegratorStats before = integ->stats();
+  const auto* silhouette = dynamic_cast<const bake::SilhouetteIntegrator*>(integ.get());
+  const bake::SilhouetteStats before = silhouette ? silhouette->silhouette_stats() : bake::SilhouetteStats{};
   const double cpu_us = integrate_all(state, s, *integ);
-  if (spec.kind != bake::IntegratorKind::Silhouette) return;
-  const bake::IntegratorStats after = integ->stats();
+  if (!silhouette) return;
+  const bake::SilhouetteStats after = silhouette->silhouette_stats();
   const double k = double(after.points - before.points);
   if (k > 0) {
     state.counters["contour_us"] = 1e6 * (after.contour_seconds - before.contour_seconds) / k;

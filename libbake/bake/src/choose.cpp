@@ -111,8 +111,10 @@ Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> p
 // integrator reports for the pilot points priced at the constants above.
 double cost_per_point(const Rows& rows, const Integrator& integrator, uint32_t knob, bool counted) {
   if (!counted) return rows.cpu_us_per_point;
-  if (integrator.kind() == IntegratorKind::Qmc) return kCountedUsPerPoint + kCountedUsPerRay * knob;
-  const IntegratorStats st = integrator.stats();
+  // The chooser's cost model knows the two kinds it chooses between.
+  const auto* silhouette = dynamic_cast<const SilhouetteIntegrator*>(&integrator);
+  if (!silhouette) return kCountedUsPerPoint + kCountedUsPerRay * knob;
+  const SilhouetteStats st = silhouette->silhouette_stats();
   const double n = double(std::max<uint64_t>(st.points, 1));
   return kCountedUsPerPoint + kCountedUsPerEdge * double(st.contour_edges) / n +
          kCountedUsPerCrossing * double(st.crossings) / n;

@@ -493,8 +493,8 @@ void FilterIntegrator::integrate(const ShadePoint& point, uint64_t point_index, 
   filtered_samples_.fetch_add(n_filtered, std::memory_order_relaxed);
 }
 
-IntegratorStats FilterIntegrator::stats() const {
-  IntegratorStats s;
+FilterStats FilterIntegrator::filter_stats() const {
+  FilterStats s;
   s.points = points_.load();
   s.pass1_rays = pass1_rays_.load();
   s.fallback_rays = fallback_rays_.load();
@@ -507,7 +507,7 @@ IntegratorStats FilterIntegrator::stats() const {
 }
 
 std::string FilterIntegrator::work_summary() const {
-  const IntegratorStats s = stats();
+  const FilterStats s = filter_stats();
   const double points = double(std::max<uint64_t>(s.points, 1));
   std::ostringstream os;
   os.setf(std::ios::fixed);

@@ -136,7 +136,7 @@ void QmcIntegrator::integrate(const ShadePoint& point, uint64_t point_index, std
 IntegratorStats QmcIntegrator::stats() const {
   IntegratorStats s;
   s.points = points_.load();
-  s.integrate_seconds = double(cpu_ns_.load()) * 1e-9;
+  s.cpu_seconds = double(cpu_ns_.load()) * 1e-9;
   return s;
 }
 
@@ -144,7 +144,7 @@ std::string QmcIntegrator::work_summary() const {
   const IntegratorStats st = stats();
   char line[160];
   std::snprintf(line, sizeof line, "%u rays per point; %.2f M rays per second of integrator time", unsigned(options_.rays),
-                st.integrate_seconds > 0 ? double(st.points) * options_.rays / st.integrate_seconds / 1e6 : 0.0);
+                st.cpu_seconds > 0 ? double(st.points) * options_.rays / st.cpu_seconds / 1e6 : 0.0);
   return line;
 }
 

@@ -591,8 +591,8 @@ void SilhouetteIntegrator::unoccluded(std::span<double> out) const {
   std::copy(impl_->unoccluded_row.begin(), impl_->unoccluded_row.end(), out.begin());
 }
 
-IntegratorStats SilhouetteIntegrator::stats() const {
-  IntegratorStats s;
+SilhouetteStats SilhouetteIntegrator::silhouette_stats() const {
+  SilhouetteStats s;
   s.points = impl_->n_points.load();
   s.contour_edges = impl_->n_edges.load();
   s.crossings = impl_->n_crossings.load();
@@ -603,11 +603,12 @@ IntegratorStats SilhouetteIntegrator::stats() const {
   s.enclosed = impl_->n_enclosed.load();
   s.contour_seconds = double(impl_->contour_ns.load()) * 1e-9;
   s.integrate_seconds = double(impl_->integrate_ns.load()) * 1e-9;
+  s.cpu_seconds = s.contour_seconds + s.integrate_seconds;
   return s;
 }
 
 std::string SilhouetteIntegrator::work_summary() const {
-  const IntegratorStats st = stats();
+  const SilhouetteStats st = silhouette_stats();
   const double points = double(std::max<uint64_t>(st.points, 1)), cpu = std::max(1e-12, st.contour_seconds + st.integrate_seconds);
   char line[256];
   std::snprintf(line, sizeof line,

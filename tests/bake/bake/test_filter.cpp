@@ -137,7 +137,7 @@ TEST(Filter, ZeroRadiusIsTheStratifiedEstimatorBitForBit) {
   o.radius_factor = 0;  // no filtering: every cell brute-forced, one ray each
   const FilterIntegrator f(s.mesh, s.topo, r, o);
   const VertexBake b = bake_points(s.points, f);
-  EXPECT_EQ(f.stats().brute_cells, f.stats().cells);
+  EXPECT_EQ(f.filter_stats().brute_cells, f.filter_stats().cells);
   const RayCaster caster(s.mesh, s.topo);
   const CellIntegrals& cells = f.cell_integrals();
   const size_t W = b.layout.width;
@@ -159,14 +159,14 @@ TEST(Filter, ZeroRadiusIsTheStratifiedEstimatorBitForBit) {
   std::vector<double> row(W);
   cold.integrate(s.points[5], 5, row);
   for (size_t k = 0; k < W; ++k) EXPECT_EQ(row[k], b.values[5 * W + k]);
-  EXPECT_EQ(cold.stats().unprepared, 1u);
+  EXPECT_EQ(cold.filter_stats().unprepared, 1u);
 }
 
 TEST(Filter, StatsCountNeighboursAndFilteredSamples) {
   const Scene s = ground_and_box();
   const FilterIntegrator f(s.mesh, s.topo, ao_t3_u3(), {});
   bake_points(s.points, f);
-  const IntegratorStats st = f.stats();
+  const FilterStats st = f.filter_stats();
   EXPECT_EQ(st.points, s.points.size());
   EXPECT_GE(st.neighbours, st.points);  // every receiver counts itself
   // A filtered cell holds filter weight ≥ min_weight (2) and each sample weighs at most 1.
@@ -177,9 +177,9 @@ TEST(Filter, StatsCountNeighboursAndFilteredSamples) {
   o.radius_factor = 0;  // no filtering: no neighbours, no filtered cell
   const FilterIntegrator g(s.mesh, s.topo, ao_t3_u3(), o);
   bake_points(s.points, g);
-  EXPECT_EQ(g.stats().neighbours, 0u);
-  EXPECT_EQ(g.stats().filtered_samples, 0u);
-  EXPECT_EQ(g.stats().samples_per_filtered_cell(), 0.0);
+  EXPECT_EQ(g.filter_stats().neighbours, 0u);
+  EXPECT_EQ(g.filter_stats().filtered_samples, 0u);
+  EXPECT_EQ(g.filter_stats().samples_per_filtered_cell(), 0.0);
 }
 
 TEST(Filter, EnclosedVertexIsExactlyDark) {
@@ -209,7 +209,7 @@ TEST(Filter, IsolatedVertexWithoutNeighbours) {
   q.integrate(p, 0, std::span(&ref, 1));
   // ≥ 256 stratified rays: the AO's standard error is ≤ 0.5/16 ≈ 0.03; 0.1 is > 3σ.
   EXPECT_NEAR(b.values[0], ref, 0.1);
-  EXPECT_GT(f.stats().brute_cells, 0u);
+  EXPECT_GT(f.filter_stats().brute_cells, 0u);
 }
 
 TEST(Filter, LayersFacingAwayDoNotLeak) {
@@ -342,5 +342,5 @@ TEST(Filter, DeterministicOverThreadsAndRowSubsets) {
     f.integrate(s.points[v], v, row);
     for (size_t k = 0; k < W; ++k) ASSERT_EQ(row[k], one.values[v * W + k]) << v;
   }
-  EXPECT_LT(f.stats().pass1_rays, uint64_t(s.points.size()) * 16);  // only the rows' neighbours cast rays
+  EXPECT_LT(f.filter_stats().pass1_rays, uint64_t(s.points.size()) * 16);  // only the rows' neighbours cast rays
 }

@@ -136,7 +136,7 @@ Both ao_at(const Mesh& m, const Topology& topo, const ShadePoint& sp, uint64_t i
   std::vector<double> a(1), b(1), se(1);
   in.sil.integrate(sp, index, a);
   in.qmc.integrate(sp, index, b, se);
-  EXPECT_EQ(in.sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(in.sil.silhouette_stats().inconsistent_loops, 0u);
   return {a[0], b[0], se[0]};
 }
 
@@ -155,7 +155,7 @@ void expect_agreement(const Mesh& m, const Topology& topo, const char* what) {
   for (size_t v = 0; v < m.positions.size(); ++v)
     EXPECT_NEAR(a.values[v], b.values[v], 4 * b.std_error[v] + kAnalyticTol + 3.0 / AoIntegrators::kRays)
         << what << ": vertex " << v << " at " << m.positions[v].transpose() << " normal " << m.normals[v].transpose();
-  EXPECT_EQ(in.sil.stats().inconsistent_loops, 0u) << what;
+  EXPECT_EQ(in.sil.silhouette_stats().inconsistent_loops, 0u) << what;
 }
 
 // The unit box [0,1]³ with a corner at the origin, and the big quads through the origin that the

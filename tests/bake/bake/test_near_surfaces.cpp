@@ -35,7 +35,7 @@ TEST(NearSurfaces, ShellInsideANearDuplicateShellIsEnclosed) {
     EXPECT_GT(b.values[v * W], 0.1);
     EXPECT_NEAR(b.values[v * W], b.values[8 * W], 1e-12);
   }
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
 }
 
 TEST(NearSurfaces, SpikeTipInsideANearDuplicateSpikeIsEnclosed) {

@@ -88,7 +88,7 @@ TEST(ShadowedRadiance, UnoccludedVertexUnderAConstantSkyIsTheClampedConstant) {
     const ProductRequest req = shadowed(env, order);
     const SilhouetteIntegrator sil(m, topo, req, {128, 1});
     const std::vector<double> s = row_of(sil, p, 0);
-    EXPECT_EQ(sil.stats().closed_form, 1u) << "no contour edge in view: the horizon-only walk";
+    EXPECT_EQ(sil.silhouette_stats().closed_form, 1u) << "no contour edge in view: the horizon-only walk";
     // The horizon walk's discretisation: midpoint rule across isolines, cell-constant f·J along
     // them, O(h²) with h = 2/128 (≈ 2.4e-4), the cells straddling the horizon O(h) each but
     // cancelling along it. Measured (max |ΔS| / c): 2.4e-4 at order 4, 6.4e-4 at order 18, where
@@ -198,7 +198,7 @@ TEST(ShadowedRadiance, SilhouetteAgreesWithQmcWithinItsStandardError) {
     }
   }
   RecordProperty("max_error_over_tolerance", std::to_string(max_z));
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
 }
 
 TEST(ShadowedRadiance, FilterRoutesItToQmc) {

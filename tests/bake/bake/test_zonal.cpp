@@ -155,9 +155,9 @@ TEST(SilhouetteClosedForm, UnoccludedVerticesSkipTheWalkAndAreExact) {
   const VertexBake b = bake_vertices(m, topo, sil);
   const auto& L = sil.layout();
   const size_t V = m.positions.size();
-  EXPECT_EQ(sil.stats().closed_form, V);
-  EXPECT_EQ(sil.stats().enclosed, 0u);
-  EXPECT_EQ(sil.stats().crossings, 0u);
+  EXPECT_EQ(sil.silhouette_stats().closed_form, V);
+  EXPECT_EQ(sil.silhouette_stats().enclosed, 0u);
+  EXPECT_EQ(sil.silhouette_stats().crossings, 0u);
   for (size_t v = 0; v < V; ++v) {
     const double* row = &b.values[v * L.width];
     const Vector3d n = m.normals[v].cast<double>();
@@ -197,6 +197,6 @@ TEST(SilhouetteClosedForm, EnclosedPointGetsZerosFromOneRay) {
   std::vector<double> row(sil.layout().width, -1.0);
   sil.integrate(sp, 0, row);
   for (double x : row) EXPECT_EQ(x, 0.0);
-  EXPECT_EQ(sil.stats().closed_form, 1u);
-  EXPECT_EQ(sil.stats().enclosed, 1u);
+  EXPECT_EQ(sil.silhouette_stats().closed_form, 1u);
+  EXPECT_EQ(sil.silhouette_stats().enclosed, 1u);
 }

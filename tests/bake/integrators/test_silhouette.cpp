@@ -93,7 +93,7 @@ TEST(Silhouette, UnoccludedVertexClosedForms) {
     EXPECT_NEAR(r[L.transfer + size_t(i)], exact, kAnalyticTol) << "T_" << i;
   }
   EXPECT_NEAR(r[L.visibility], std::sqrt(pi), kAnalyticTol);
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
 }
 
 TEST(Silhouette, WhiteFurnaceBand1IrradianceIsPi) {
@@ -173,7 +173,7 @@ TEST(Silhouette, EnclosedPointSeesNothing) {
     sp.hemisphere = false;
     for (double x : integrate(sil, sp).v) EXPECT_EQ(x, 0.0);
   }
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
 }
 
 TEST(Silhouette, InconsistentWindingAndSoupEqualTheCleanMesh) {
@@ -241,7 +241,7 @@ TEST(Silhouette, AgreesWithQmcWithinItsStandardError) {
     }
   }
   RecordProperty("rmse_vs_qmc", std::to_string(std::sqrt(sum_sq / count)));
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
 }
 
 TEST(Silhouette, SunOnTheHorizonIsExact) {

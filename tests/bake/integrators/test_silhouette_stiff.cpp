@@ -56,7 +56,7 @@ double ao_at(const Mesh& m, const ShadePoint& sp, int n = kN) {
   double ao = -1;
   sil.integrate(sp, 0, std::span(&ao, 1));
   EXPECT_TRUE(std::isfinite(ao));
-  EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
   return ao;
 }
 
@@ -242,7 +242,7 @@ TEST(Stiff, SaddleAndCreaseVerticesMatchQmcInTheLimitFromAbove) {
     qmc.integrate(sp, 0, b, se);
     for (int k = 0; k < 10; ++k)
       EXPECT_NEAR(a[size_t(k)], b[size_t(k)], 4 * se[size_t(k)] + kTol) << "shape " << shape << " value " << k;
-    EXPECT_EQ(sil.stats().inconsistent_loops, 0u) << "shape " << shape;
+    EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u) << "shape " << shape;
     if (shape == 1) {
       EXPECT_LT(a[0], 0.95) << "a concave crease occludes its own vertex";
     }

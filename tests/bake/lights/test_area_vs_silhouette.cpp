@@ -89,7 +89,7 @@ TEST(AreaVsSilhouette, AnEnclosingLightGivesAoAndTheVisibilityVector) {
       worst[size_t(j)] = std::max(worst[size_t(j)], d);
       min_ao = std::min(min_ao, row[L.ao]);
     }
-    EXPECT_EQ(sil.stats().inconsistent_loops, 0u);
+    EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
   }
   // Measured (worst over 57 vertices of AO and the nine U_i): 1.8e-2 at N = 64, 8.8e-4 at 256,
   // 8.8e-5 at 1024 (x20, then x10: second order, with some first-order aliasing of slivers).

@@ -147,6 +147,21 @@ private:
   std::vector<double> values_;  // [cell][width]
 };
 
+// The filter integrator's work, summed over its integrate() calls: pass-1 rays cast (once per
+// point), rays of brute-forced cells, hemisphere cells integrated and how many of them by brute
+// force, points integrated by brute force because prepare() had not seen them; its neighbours kept
+// (the receiver included) and the samples with a non-zero filter weight in the cells it filtered.
+struct FilterStats : IntegratorStats {
+  uint64_t pass1_rays = 0, fallback_rays = 0, cells = 0, brute_cells = 0, unprepared = 0;
+  uint64_t neighbours = 0, filtered_samples = 0;
+  double brute_fraction() const { return cells ? double(brute_cells) / double(cells) : 0.0; }
+  double neighbours_per_point() const { return points ? double(neighbours) / double(points) : 0.0; }
+  double samples_per_filtered_cell() const {
+    return cells > brute_cells ? double(filtered_samples) / double(cells - brute_cells) : 0.0;
+  }
+  double rays_per_point() const { return points ? double(pass1_rays + fallback_rays) / double(points) : 0.0; }
+};
+
 class FilterIntegrator final : public Integrator {
 public:
   // `mesh` and `topology` (and the request's environment) must outlive the integrator. With
@@ -161,11 +176,12 @@ public:
   std::string description() const override;
   const ProductLayout& layout() const override { return layout_; }
   void prepare(std::span<const ShadePoint> points) const override;
+  bool prepares() const override { return true; }
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                  std::span<double> std_error = {}) const override;
-  // points, pass1_rays, fallback_rays, cells, brute_cells, unprepared, neighbours, filtered_samples
-  // (bake/integrators/integrator.h).
-  IntegratorStats stats() const override;
+  // Its work counters (FilterStats); stats() is their common part.
+  FilterStats filter_stats() const;
+  IntegratorStats stats() const override { return filter_stats(); }
   // Rays per point (pass-1 + fallback), the brute-forced cell fraction, neighbours
   // and samples per filtered cell.
   std::string work_summary() const override;

@@ -71,28 +71,15 @@ struct IntegratorSpec {
 
 };
 
-// Work counters, summed over all integrate() calls. A counter an integrator does not keep stays
-// 0 (the QMC integrator keeps none; the silhouette integrator all of them, bake/integrators/silhouette.h).
+// What every integrator counts, summed over its integrate() calls (relaxed atomics): the
+// integrals made, those given in closed form, and the CPU time inside integrate() (0 when the
+// integrator does not keep it). An integrator's own work (contour edges, rays, cells) is its own
+// stats type (SilhouetteStats, FilterStats) and its work_summary() line: no caller needs to know
+// which kind it holds.
 struct IntegratorStats {
-  uint64_t points = 0, contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
-  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
-  // Hemisphere points with no contour edge in view, given closed forms instead of a DCF walk
-  // (of which `enclosed` saw nothing at all: W > 0 over the whole hemisphere).
-  uint64_t closed_form = 0, enclosed = 0;
-  double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
-  // The filter integrator (bake/integrators/filter.h): pass-1 rays cast (once per point), rays of brute-forced
-  // cells, hemisphere cells integrated and how many of them by brute force, and points integrated
-  // by brute force because prepare() had not seen them.
-  uint64_t pass1_rays = 0, fallback_rays = 0, cells = 0, brute_cells = 0, unprepared = 0;
-  // Its neighbours kept (the receiver included) and the samples with a non-zero filter weight in
-  // the cells it filtered, summed over points.
-  uint64_t neighbours = 0, filtered_samples = 0;
-  double brute_fraction() const { return cells ? double(brute_cells) / double(cells) : 0.0; }
-  double neighbours_per_point() const { return points ? double(neighbours) / double(points) : 0.0; }
-  double samples_per_filtered_cell() const {
-    return cells > brute_cells ? double(filtered_samples) / double(cells - brute_cells) : 0.0;
-  }
-  double rays_per_point() const { return points ? double(pass1_rays + fallback_rays) / double(points) : 0.0; }
+  uint64_t points = 0;
+  uint64_t closed_form = 0;  // integrals given in closed form, with no numerical integration
+  double cpu_seconds = 0;
 };
 
 class Integrator {
@@ -107,6 +94,9 @@ public:
   // points (the filter integrator reuses its neighbours' rays). A later call replaces the earlier
   // set. Default: nothing to prepare.
   virtual void prepare(std::span<const ShadePoint> points) const { (void)points; }
+  // Whether prepare() does work that integrate() depends on (a row integrated unprepared costs
+  // more, and a few rows timed alone do not predict a bake's cost).
+  virtual bool prepares() const { return false; }
   // Writes one row of estimates (layout().width doubles) for the shade point. `point_index`
   // identifies the point for deterministic per-point randomisation. `std_error` (optional, same
   // width) receives each value's estimated standard error (0 for a deterministic integrator).

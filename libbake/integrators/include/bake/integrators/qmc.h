@@ -65,7 +65,7 @@ public:
                  std::span<double> std_error = {}) const override;
 
   // Points integrated and the time spent integrating them, summed over threads
-  // (IntegratorStats::points, integrate_seconds).
+  // (IntegratorStats::points, cpu_seconds).
   IntegratorStats stats() const override;
   // Rays per point, and rays per second of that time.
   std::string work_summary() const override;

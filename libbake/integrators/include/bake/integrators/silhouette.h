@@ -46,6 +46,17 @@ struct SilhouetteOptions {
   uint64_t seed = 1;   // only for the direction of the counted start ray when the default is degenerate
 };
 
+// The silhouette integrator's work, summed over its integrate() calls. `closed_form`: hemisphere
+// points with no contour edge in view, given closed forms instead of a DCF walk (of which
+// `enclosed` saw nothing at all: W > 0 over the whole hemisphere); cpu_seconds = contour_seconds
+// + integrate_seconds.
+struct SilhouetteStats : IntegratorStats {
+  uint64_t contour_edges = 0, crossings = 0, start_rays = 0, start_retries = 0;
+  uint64_t inconsistent_loops = 0;  // isoline loops whose W did not return to its start value (should be 0)
+  uint64_t enclosed = 0;
+  double contour_seconds = 0, integrate_seconds = 0;  // CPU time in contour search / the rest
+};
+
 class SilhouetteIntegrator final : public Integrator {
 public:
   // `mesh`, `topology` and the request's environment must outlive the integrator. With `accel`
@@ -69,8 +80,9 @@ public:
   // discretisation of both terms, so an occluder subtending little keeps its relative accuracy.
   void unoccluded(std::span<double> out) const;
 
-  // Every counter of IntegratorStats (bake/integrators/integrator.h), kept with relaxed atomics.
-  IntegratorStats stats() const override;
+  // Its work counters, kept with relaxed atomics (SilhouetteStats); stats() is their common part.
+  SilhouetteStats silhouette_stats() const;
+  IntegratorStats stats() const override { return silhouette_stats(); }
   // Per integral: contour edges and isoline crossings, and the CPU time split between the contour
   // search and the rest; points that saw no contour edge (closed forms).
   std::string work_summary() const override;
