@@ -187,10 +187,14 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
   // The FIV shells are always baked with the silhouette integrator: at the scene's k for a
   // silhouette scene, at the default k for a qmc one.
   sc.fiv.silhouette_k = sc.integrator.silhouette_k;
-  // Neither "samples" nor "target_error": the default target (as prtbake vertex), with the
-  // report's default size.
+  // Neither "samples" nor "target_error": the default target, and the same report as a named
+  // target's (kReportPoints unless "report" is given), as prtbake vertex: the same request gets
+  // the same check.
   const Json* bake = find_key(root, "bake");
-  if (!bake || (!find_key(*bake, "samples") && !find_key(*bake, "target_error"))) sc.target_error = ChooserOptions{}.target;
+  if (!bake || (!find_key(*bake, "samples") && !find_key(*bake, "target_error"))) {
+    sc.target_error = ChooserOptions{}.target;
+    if (!bake || !find_key(*bake, "report")) sc.integrator.report_points = ChooserOptions::kReportPoints;
+  }
 }
 
 Role parse_role(const Reader& r, const Json& v, const std::string& key) {

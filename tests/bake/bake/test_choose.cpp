@@ -539,10 +539,16 @@ TEST(Choose, SceneFilesTakeATargetInsteadOfSamples) {
   EXPECT_TRUE(q.integrator_given);
   EXPECT_EQ(q.integrator.kind, IntegratorKind::Qmc);
   EXPECT_EQ(q.integrator.report_points, 8u);
-  // Neither samples nor a target: the default target, the default report.
+  // Neither samples nor a target: the default target, with the same report as the target named
+  // (as prtbake vertex: the same request gets the same check), unless "report" is given.
   const SceneDescription d = load_scene(write("default.json", R"({"integrator": "qmc"})"), std::nullopt);
   EXPECT_EQ(d.target_error, ChooserOptions{}.target);
-  EXPECT_EQ(d.integrator.report_points, IntegratorSpec{}.report_points);
+  EXPECT_EQ(d.integrator.report_points, ChooserOptions::kReportPoints);
+  const SceneDescription dr = load_scene(write("default_report.json", R"({"report": 8})"), std::nullopt);
+  EXPECT_EQ(dr.target_error, ChooserOptions{}.target);
+  EXPECT_EQ(dr.integrator.report_points, 8u);
+  const SceneDescription none = load_scene(write("no_bake.json", R"({})"), std::nullopt);
+  EXPECT_EQ(none.integrator.report_points, ChooserOptions::kReportPoints);
   const SceneDescription k = load_scene(write("samples.json", R"({"samples": 4096})"), std::nullopt);
   EXPECT_EQ(k.target_error, 0.0);
   EXPECT_EQ(k.integrator.silhouette_k, 4096u);
