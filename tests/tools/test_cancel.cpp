@@ -55,7 +55,7 @@ TEST(PrtbakeCancel, CtrlCDuringTheErrorCheckKeepsTheBakeWithoutItsReport) {
                                                   out.string(), "--integrator", "silhouette", "--samples", "1024",
                                                   "--ao", "--report", "4240", "--threads", "2"});
   ASSERT_TRUE(bake.started());
-  ASSERT_TRUE(bake.wait_for("reference:", std::chrono::seconds(120))) << bake.err();
+  ASSERT_TRUE(bake.wait_for("checking the error:", std::chrono::seconds(120))) << bake.err();
   bake.send(SIGINT);
   const int code = bake.wait();
   EXPECT_EQ(code, 130) << bake.err();

@@ -141,22 +141,19 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
       bake::SceneRows work;
       work.rows_only = true;
       work.rows = [&](size_t set, std::span<const bake::ShadePoint> points, const bake::Integrator& integrator,
-                      const bake::Monitor&, const std::string&, uint64_t& closed_form) {
+                      const bake::Monitor&) {
         shards->work(
             [&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
               return tool::bake_chunk(points, r, integrator, monitor);
             },
             uint32_t(set));
-        closed_form = 0;
         return bake::VertexBake{};
       };
       bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress, [](const std::string&) {}, work);
     });
     if (!merges) return 0;
     merged_rows.rows = [&](size_t set, std::span<const bake::ShadePoint>, const bake::Integrator& integrator,
-                           const bake::Monitor&, const std::string&, uint64_t& closed_form) {
-      return shards->merge(uint32_t(set), integrator.layout(), &closed_form);
-    };
+                           const bake::Monitor&) { return shards->merge(uint32_t(set), integrator.layout()); };
   }
   namespace F = prt::formats;
   // The file from a bake (with its reports once they are made).
@@ -275,28 +272,29 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                   "skips the check)\n");
     std::fflush(stdout);
   };
+  merged_rows.check_planned = [&](const std::string& who, const bake::ReferencePlan& reference) {
+    if (!run.say || !a.verbose) return;
+    std::printf("%s: the error check's reference:\n", who.c_str());
+    print_reference_plan(reference);
+    std::fflush(stdout);
+  };
+  auto log = [&](const std::string& line) {
+    if (run.say) std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  auto on_choice = [&](const std::string& object, const bake::IntegratorChoice& choice) {
+    if (run.say && a.verbose) {
+      std::printf("%s: the target-error pilot:\n", object.c_str());
+      for (const std::string& l : bake::choice_lines(choice)) std::printf("%s\n", l.c_str());
+    } else if (run.say) {
+      std::printf("%s: %s\n", object.c_str(), bake::choice_summary(choice).c_str());
+    }
+    std::fflush(stdout);
+    warn_unreached(choice, object);
+  };
   std::optional<bake::SceneBake> baked;
   try {
-    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress,
-                             [&](const std::string& line) {
-                                                      if (run.say) std::printf("%s\n", line.c_str());
-                                                      std::fflush(stdout);
-                                                    },
-                                                    merged_rows,
-                                                    [&](const std::string& object, const bake::IntegratorChoice& choice,
-                                                        const bake::ReferencePlan* reference_plan) {
-                                                      if (run.say && a.verbose) {
-                                                        std::printf("%s: the target-error pilot:\n", object.c_str());
-                                                        for (const std::string& l : bake::choice_lines(choice))
-                                                          std::printf("%s\n", l.c_str());
-                                                        if (reference_plan) print_reference_plan(*reference_plan);
-                                                      } else if (run.say) {
-                                                        std::printf("%s: %s\n", object.c_str(),
-                                                                    bake::choice_summary(choice).c_str());
-                                                      }
-                                                      std::fflush(stdout);
-                                                      warn_unreached(choice, object);
-                                                    });
+    baked = bake::bake_scene(scene, plan, meshes, env ? &*env : nullptr, run.progress, log, merged_rows, on_choice);
   } catch (const bake::Cancelled&) {
     if (!written) throw;
     std::fprintf(stderr,

@@ -225,10 +225,9 @@ Worker resolve_worker(const ShardOptions& o, const MpiSession& mpi) {
 
 bake::ChunkData bake_chunk(std::span<const bake::ShadePoint> points, const bake::ChunkRange& range,
                            const bake::Integrator& integrator, const bake::Monitor& monitor) {
-  const uint64_t before = integrator.stats().closed_form;  // chunks run one at a time in a process
   bake::VertexBake rows = bake::bake_point_rows(points, range.begin, range.end, integrator, monitor);
   bake::ChunkData d;
-  d.closed_form = integrator.stats().closed_form - before;
+  d.closed_form = rows.closed_form;
   d.values = std::move(rows.values);
   d.std_error = std::move(rows.std_error);
   d.cpu_seconds = rows.cpu_seconds;
@@ -397,7 +396,7 @@ void ShardedRows::join(uint32_t set, bake::ChunkData& out) const {
                                  std::to_string(chunks[i].end) + "): no worker committed it; rerun the bake to compute it");
 }
 
-bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form) const {
+bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& layout) const {
   PRT_CHECK_OP(s_->widths.at(set), ==, layout.width);
   bake::ChunkData d = join(set);
   bake::VertexBake out;
@@ -408,7 +407,7 @@ bake::VertexBake ShardedRows::merge(uint32_t set, const bake::ProductLayout& lay
   out.seconds = d.seconds;
   out.cpu_seconds = d.cpu_seconds;
   if (const int t = threads_of_chunks(); t > 0) out.threads = t;
-  if (closed_form) *closed_form = d.closed_form;
+  out.closed_form = d.closed_form;
   return out;
 }
 

@@ -125,8 +125,8 @@ public:
   // join() into `out`, its memory reused (set after set into one ChunkData: no new allocation
   // for sets of the same size); each chunk's rows are read from its file straight into place.
   void join(uint32_t set, bake::ChunkData& out) const;
-  // join() as one bake of that set's rows in `layout`. `closed_form`: the rows' counter.
-  bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout, uint64_t* closed_form = nullptr) const;
+  // join() as one bake of that set's rows in `layout` (its closed_form counter too).
+  bake::VertexBake merge(uint32_t set, const bake::ProductLayout& layout) const;
   // After the file is written: removes the chunk directory.
   void finish() const;
   // After a cancellation (Ctrl-C): the chunks committed so far are kept for a rerun; the line

@@ -2,6 +2,7 @@
 #include <bake/mesh/receivers.h>
 
 #include <cmath>
+#include <utility>
 
 namespace prt::bake {
 
@@ -28,6 +29,14 @@ std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& to
   std::vector<ShadePoint> points(mesh.positions.size());
   for (size_t v = 0; v < points.size(); ++v) points[v] = vertex_shade_point(mesh, topology, uint32_t(v));
   return points;
+}
+
+ReceiverSet vertex_receivers(const Mesh& mesh, const Topology& topology, std::string name, size_t tag) {
+  ReceiverSet set;
+  set.name = std::move(name);
+  set.points = vertex_shade_points(mesh, topology);
+  set.tag = tag;
+  return set;
 }
 
 } // namespace prt::bake

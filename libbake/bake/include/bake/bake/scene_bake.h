@@ -1,6 +1,6 @@
 // bake/bake/scene_bake.h — baking a scene's plan (bake/bake/scene.h): every receiver's rows against
-// the union of the occluders, the target-error choice once per distinct product request, area
-// lights, FIV shells and the environment's FIV, then the error reports (docs/ARCHITECTURE.md §5).
+// the union of the occluders through the bake pipeline (bake/bake/pipeline.h), area lights, FIV
+// shells and the environment's FIV, then the error reports (docs/ARCHITECTURE.md §5).
 #pragma once
 
 #include <bake/bake/choose.h>
@@ -28,7 +28,7 @@ struct ObjectBake {
   std::optional<IntegratorChoice> choice;  // with a target error
   std::optional<ReferencePlan> reference_plan;  // with a target error and a report (bake/bake/choose.h)
   std::string integrator_description;
-  uint64_t closed_form_vertices = 0;  // vertices that saw no contour edge (silhouette only)
+  uint64_t closed_form_vertices = 0;  // vertices whose integral took a closed form (VertexBake::closed_form)
   // Occluders with shells (in world space: centre and radii in scene units).
   std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
@@ -50,16 +50,21 @@ struct SceneBake {
 // Runs the plan. Visibility for every receiver is the union of the occluders ("occluder" and
 // "both" objects) in world space; a "both" receiver's vertices are shade points of that union
 // (their own 1-ring occludes in the ε-limit), a receiver-only object's vertices are free points.
-// The area lights' rows are the same for any thread count (each vertex's row is its own).
+// In order: the area lights' rows (exact), the environment's FIV and the occluders' FIV shells,
+// then the receivers' per-vertex products through the bake pipeline (bake/bake/pipeline.h: one job
+// per distinct product request over the receivers that make it; choose, integrate, check,
+// correct), then the FIV shells' error reports. Every row is the same for any thread count.
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
-// How bake_scene integrates receiver rows, for sharded bakes (bake/core/chunks.h). `rows` replaces
-// bake_points for every receiver with per-vertex products: `set` numbers those receivers in object
-// order; it returns the rows of all of `points` (or none, with rows_only) and sets `closed_form` to
-// their IntegratorStats::closed_form. With rows_only, bake_scene stops there: no area lights, error
-// reports, FIV or environment (what a worker that only computes chunks needs).
+//
+// How bake_scene integrates receiver rows, for sharded bakes (bake/core/chunks.h), and what it
+// tells its caller. `rows` replaces the row loop for every receiver with per-vertex products:
+// `set` numbers those receivers in object order; it returns the rows of all of `points` (or
+// none, with rows_only), their VertexBake::closed_form set. With rows_only, bake_scene stops
+// there: no area lights, error reports, FIV or environment (what a worker that only computes
+// chunks needs). With `rows`, no correction pass (its rows cannot be baked again here).
 struct SceneRows {
   std::function<VertexBake(size_t set, std::span<const ShadePoint> points, const Integrator& integrator,
-                           const Monitor& monitor, const std::string& label, uint64_t& closed_form)>
+                           const Monitor& monitor)>
       rows;
   bool rows_only = false;
   // The dry run's estimate: no receiver is baked; per distinct product request (the receivers that
@@ -69,18 +74,21 @@ struct SceneRows {
   bool estimate_only = false;
   // Called once the bake is whole (the receivers' rows, area lights and FIV shells), before any
   // error report is made: a tool writes the file there, so a check cancelled with Ctrl-C (or one
-  // that takes longer than the user will wait) never costs the bake.
+  // that takes longer than the user will wait) never costs the bake. Called again after a
+  // correction's rows.
   std::function<void(const SceneBake&)> baked;
+  // With a target, when a job's error-report reference is planned (who: as OnChoice's).
+  std::function<void(const std::string& who, const ReferencePlan& plan)> check_planned;
 };
 
 // With a target error the choice is made once per distinct product request, on the pooled shade
-// points of the receivers that make it (the target holds for their values together), when the
-// first of them is baked; `on_choice` receives it (who: "N receivers (V vertices, from <first>)",
-// the choice, and the error report's reference plan when a report is made) before they are
-// baked; without it, `log` receives choice_summary. Each receiver's report then takes its share
-// of the report's points by its vertices, and the target's verdict is logged for the pooled
-// reports once the group's last receiver is baked.
-using OnChoice = std::function<void(const std::string& object, const IntegratorChoice& choice, const ReferencePlan* plan)>;
+// points of the receivers that make it (the target holds for their values together), before they
+// are baked; `on_choice` receives it (who: the receiver, or "N receivers (V vertices, from
+// <first>)"); without it, `log` receives choice_summary. The check's reference is planned after
+// the bake (SceneRows::check_planned). Each receiver's report then takes its share of the
+// report's points by its vertices, and the target's verdict is logged for the pooled reports
+// once the job's receivers are checked.
+using OnChoice = std::function<void(const std::string& who, const IntegratorChoice& choice)>;
 SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::span<const Mesh> meshes, const EnvMap* env,
                      const Monitor& monitor, const std::function<void(const std::string&)>& log,
                      const SceneRows& rows = {}, const OnChoice& on_choice = {});

@@ -1,6 +1,7 @@
-// bake/bake/vertex_bake.h — per-vertex bakes: every output vertex of a Mesh is a shade point (its
-// position, its baked normal, its welded 1-ring), integrated in parallel with oneTBB.
-// Results are a function of (mesh, request, integrator parameters, seed) only: each vertex's
+// bake/bake/vertex_bake.h — the row loop: one row of values per receiver (a mesh's vertex, a
+// scene object's vertex; bake/mesh/receivers.h), integrated in parallel with oneTBB. Every bake's
+// rows come from here: an integrator's (bake_point_rows) and the area lights' (bake_rows).
+// Results are a function of (receivers, request, integrator parameters, seed) only: each row's
 // randomisation is keyed by its index, so any thread count gives the same numbers.
 #pragma once
 
@@ -12,6 +13,7 @@
 #include <bake/sphere/sampling.h>
 #include <bake/visibility/accel.h>
 
+#include <functional>
 #include <memory>
 #include <utility>
 #include <span>
@@ -31,8 +33,21 @@ struct VertexBake {
   // the last (a serial tail or a starved worker shows as less than 1).
   double cpu_seconds = 0;
   int threads = 1;
+  // Rows whose integral took a closed form, with no numerical integration (IntegratorStats::closed_form).
+  uint64_t closed_form = 0;
   double busy_fraction() const { return seconds > 0 ? cpu_seconds / (seconds * threads) : 0.0; }
 };
+
+// Writes row `index`: `values` and `std_error` are its `width` doubles (zeroed). Called
+// concurrently for different rows.
+using RowFunction = std::function<void(size_t index, std::span<double> values, std::span<double> std_error)>;
+
+// The row loop: rows [begin, end) in parallel (grains of 16 rows), a progress task `label` of
+// `monitor` (cancellable between grains), the wall and per-thread CPU times; throws
+// ContractError naming `source` and the row when a value is not finite. The result holds
+// end − begin rows; its layout is the caller's to set.
+VertexBake bake_rows(size_t begin, size_t end, size_t width, const RowFunction& row, const Monitor& monitor,
+                     const std::string& label, const std::string& source);
 
 
 VertexBake bake_vertices(const Mesh& mesh, const Topology& topology, const Integrator& integrator,

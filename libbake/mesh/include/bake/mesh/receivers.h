@@ -1,13 +1,16 @@
 // bake/mesh/receivers.h — receivers: the points a bake writes one row for, as shade points
-// (bake/mesh/shade_point.h). Today the vertices of a mesh (or of a scene object, placed in the
-// scene's frame); the bake pipeline (bake/bake/vertex_bake.h) takes any span of shade points, so a
-// new receiver kind (the texels of a lightmap) adds a function here and touches no integrator.
+// (bake/mesh/shade_point.h), gathered in ReceiverSets. Today the vertices of a mesh (or of a scene
+// object, placed in the scene's frame); the bake pipeline (bake/bake/pipeline.h) takes any
+// ReceiverSet, so a new receiver kind (the texels of a lightmap) adds a maker of ReceiverSets here
+// and touches neither the pipeline nor the integrators.
 #pragma once
 
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/shade_point.h>
 
+#include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace prt::bake {
@@ -19,5 +22,17 @@ ShadePoint vertex_shade_point(const Mesh& mesh, const Topology& topology, uint32
 
 // The shade points of every vertex of `mesh` (vertex_shade_point for each, in order).
 std::vector<ShadePoint> vertex_shade_points(const Mesh& mesh, const Topology& topology);
+
+// Receivers that share one product request: row i of their bake is points[i], randomised by i
+// (so any cut of the rows into ranges, threads or shards gives the same numbers).
+struct ReceiverSet {
+  std::string name;                // how logs name it: a file, a scene object
+  std::vector<ShadePoint> points;  // one per row, in the order the rows are written
+  size_t tag = 0;                  // the caller's: which object, which shard set
+  const char* rows_noun = "vertices";  // how logs count its rows
+};
+
+// Every vertex of `mesh` (vertex_shade_points) as one set.
+ReceiverSet vertex_receivers(const Mesh& mesh, const Topology& topology, std::string name, size_t tag = 0);
 
 } // namespace prt::bake

@@ -1,0 +1,245 @@
+// pipeline.cpp — choose, integrate, check and correct, for any receiver sets (bake/bake/pipeline.h).
+#include <bake/bake/pipeline.h>
+#include <bake/core/error.h>
+#include <bake/integrators/registry.h>
+#include <bake/sphere/sampling.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+#include <tuple>
+#include <utility>
+
+namespace prt::bake {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A monitor that folds a sequence of tasks (one per receiver set) into one progress stage `label`
+// of `total` units: each task's count is offset by `*before` (the units of the tasks already done,
+// which the caller advances), the time runs from `start`, and the stage finishes with the last
+// task (or with a cancelled one).
+Monitor one_stage(const Monitor& monitor, const std::string& label, const uint64_t& total, const uint64_t& before,
+                  std::chrono::steady_clock::time_point start) {
+  Monitor m;
+  m.cancel = monitor.cancel;
+  if (monitor.on_progress)
+    m.on_progress = [&monitor, label, &total, &before, start](const ProgressUpdate& u) {
+      ProgressUpdate o = u;
+      o.task = label;
+      o.done = before + u.done;
+      o.total = total;
+      o.seconds = seconds_since(start);
+      o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last task, or a cancel
+      monitor.on_progress(o);
+    };
+  return m;
+}
+
+// The job's shade points as one span: its set's own when it has one, else their concatenation
+// (in `storage`).
+std::span<const ShadePoint> pooled_points(const BakeJob& job, std::vector<ShadePoint>& storage) {
+  if (job.sets.size() == 1) return job.sets.front().points;
+  storage.clear();
+  for (const ReceiverSet& set : job.sets) storage.insert(storage.end(), set.points.begin(), set.points.end());
+  return storage;
+}
+
+} // namespace
+
+size_t BakeJob::row_count() const {
+  size_t n = 0;
+  for (const ReceiverSet& set : sets) n += set.points.size();
+  return n;
+}
+
+double BakeJob::cpu_seconds() const {
+  double s = 0;
+  for (const VertexBake& r : rows) s += r.cpu_seconds;
+  return s;
+}
+
+BakePipeline::BakePipeline(const Mesh& occluders, const Topology& topology, const MeshAccel& accel,
+                           PipelineSettings settings, std::vector<BakeJob> jobs)
+    : occluders_(occluders), topology_(topology), accel_(accel), settings_(std::move(settings)), jobs_(std::move(jobs)) {}
+
+void BakePipeline::plan(const Monitor& monitor, const PipelineHooks& hooks) {
+  for (BakeJob& job : jobs_) {
+    if (job.integrator) continue;
+    job.spec = settings_.integrator;
+    if (settings_.target_error > 0 && !job.choice) {
+      ChooserOptions options;
+      options.target = settings_.target_error;
+      if (settings_.integrator_given) options.only = settings_.integrator.kind;
+      options.counted_costs = settings_.counted_costs;
+      std::vector<ShadePoint> storage;
+      job.choice = choose_integrator(pooled_points(job, storage), occluders_, topology_, job.request,
+                                     settings_.integrator, options, monitor, &accel_);
+      job.spec = job.choice->spec;
+      if (hooks.chosen) hooks.chosen(job);
+    } else if (job.choice) {
+      job.spec = job.choice->spec;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
+    job.setup_seconds = seconds_since(t0);
+    job.integrator_description = job.integrator->description();
+    if (hooks.ready) hooks.ready(job);
+  }
+}
+
+void BakePipeline::integrate(BakeJob& job, const Monitor& stage, uint64_t& before, const PipelineHooks& hooks) {
+  PRT_CHECK(job.integrator != nullptr);
+  job.rows.assign(job.sets.size(), VertexBake{});
+  job.reports.assign(job.sets.size(), std::nullopt);
+  job.pooled.reset();
+  job.reference_plan.reset();
+  for (size_t s = 0; s < job.sets.size(); ++s) {
+    const ReceiverSet& set = job.sets[s];
+    VertexBake rows = hooks.rows ? hooks.rows(job, s, stage)
+                                 : bake_points(set.points, *job.integrator, stage, "baking " + set.name);
+    before += set.points.size();  // the stage's count goes on from here
+    if (hooks.rows_only) continue;
+    PRT_CHECK_OP(rows.values.size(), ==, set.points.size() * job.integrator->layout().width);
+    job.rows[s] = std::move(rows);
+    if (hooks.set_baked) hooks.set_baked(job, s);
+  }
+}
+
+void BakePipeline::run(const Monitor& monitor, const PipelineHooks& hooks) {
+  plan(monitor, hooks);
+  // One bake stage over the rows of the jobs `which` selects.
+  auto bake = [&](const std::vector<bool>& which) {
+    uint64_t total = 0, before = 0;
+    for (size_t j = 0; j < jobs_.size(); ++j)
+      if (which[j]) total += jobs_[j].row_count();
+    const Monitor stage = one_stage(monitor, settings_.bake_stage, total, before, std::chrono::steady_clock::now());
+    for (size_t j = 0; j < jobs_.size(); ++j) {
+      if (!which[j]) continue;
+      integrate(jobs_[j], stage, before, hooks);
+    }
+  };
+  std::vector<bool> which(jobs_.size(), true);
+  bake(which);
+  if (hooks.rows_only) return;
+  if (hooks.baked) hooks.baked();
+  check(monitor, hooks, which);
+  if (!(settings_.correct && settings_.target_error > 0)) return;
+
+  // The correction, once (file comment).
+  bool any = false;
+  for (size_t j = 0; j < jobs_.size(); ++j) {
+    BakeJob& job = jobs_[j];
+    which[j] = false;
+    if (!job.choice || !job.pooled || job.pass > 0) continue;
+    const std::optional<IntegratorSpec> better = corrected_plan(
+        *job.choice,
+        target_verdicts(*job.pooled, settings_.target_error, job.reference_plan ? &*job.reference_plan : nullptr));
+    if (!better) continue;
+    if (hooks.correcting) hooks.correcting(job, *better);
+    job.spec = *better;
+    job.spec.report_rays = 0;
+    job.pass = 1;
+    job.integrator.reset();
+    const auto t0 = std::chrono::steady_clock::now();
+    job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
+    job.setup_seconds = seconds_since(t0);
+    job.integrator_description = job.integrator->description();
+    if (hooks.ready) hooks.ready(job);
+    which[j] = any = true;
+  }
+  if (!any) return;
+  bake(which);
+  if (hooks.baked) hooks.baked();
+  check(monitor, hooks, which);  // the corrected jobs; the others keep their reports
+}
+
+void BakePipeline::plan_check(BakeJob& job, double check_cpu, const Monitor& monitor) {
+  if (settings_.target_error <= 0 || job.spec.report_points == 0) return;
+  // The report's ray budget shared among the jobs by their rows.
+  uint64_t rows = 0;
+  for (const BakeJob& j : jobs_) rows += j.row_count();
+  const uint64_t budget = uint64_t(double(ReferencePlan::kReportRayBudget) * double(job.row_count()) /
+                                   double(std::max<uint64_t>(rows, 1)));
+  std::vector<ShadePoint> storage;
+  job.reference_plan = plan_report_reference(pooled_points(job, storage), occluders_, topology_, job.request, job.spec,
+                                             settings_.target_error, monitor, &accel_, std::max<uint64_t>(budget, 1),
+                                             check_cpu);
+  job.spec.report_rays = job.reference_plan->rays;
+}
+
+size_t BakePipeline::report_points(const BakeJob& job, size_t s) const {
+  const size_t n = job.sets[s].points.size();
+  if (job.spec.report_points == 0 || n == 0) return 0;
+  if (settings_.target_error <= 0) return job.spec.report_points;
+  // This set's share of the job's report points, by its rows (at least one).
+  const size_t share = size_t(std::ceil(double(job.spec.report_points) * double(n) /
+                                        double(std::max<size_t>(job.row_count(), 1))));
+  return std::min(std::max<size_t>(share, 1), n);
+}
+
+void BakePipeline::check(const Monitor& monitor, const PipelineHooks& hooks, const std::vector<bool>& which) {
+  uint64_t total = 0, before = 0;
+  for (size_t j = 0; j < jobs_.size(); ++j)
+    for (size_t s = 0; s < jobs_[j].sets.size() && which[j]; ++s)
+      total += std::min(report_points(jobs_[j], s), jobs_[j].sets[s].points.size());
+  if (total == 0) return;
+  if (hooks.checking) hooks.checking();
+  const Monitor stage = one_stage(monitor, settings_.check_stage, total, before, std::chrono::steady_clock::now());
+  for (size_t j = 0; j < jobs_.size(); ++j) {
+    BakeJob& job = jobs_[j];
+    if (!which[j] || job.spec.report_points == 0) continue;
+    const bool target = settings_.target_error > 0;
+    if (target) {
+      // The check may take about as long as the job's bake (at least kReportMinCpuSeconds of CPU);
+      // not with counted costs, whose rays must not depend on the machine's speed.
+      const double check_cpu =
+          settings_.counted_costs ? 0.0 : std::max(ReferencePlan::kReportMinCpuSeconds, job.cpu_seconds());
+      plan_check(job, check_cpu, monitor);
+      if (hooks.check_planned) hooks.check_planned(job);
+    }
+    // With E, the reference is two independent halves: its noise is then measured on the report's
+    // own values, and the verdict can take it out of the RMSE (target_check_lines).
+    std::unique_ptr<Integrator> reference, second;
+    if (target) std::tie(reference, second) = make_reference_pair(job.spec, occluders_, topology_, job.request, &accel_);
+    else reference = make_reference(job.spec, occluders_, topology_, job.request, &accel_);
+    ErrorReport pooled;
+    pooled.reference_noise_measured = second != nullptr;
+    size_t checked = 0;
+    for (size_t s = 0; s < job.sets.size(); ++s) {
+      const size_t n = report_points(job, s);
+      if (n == 0) continue;
+      job.reports[s] = compare_points_with_reference(job.sets[s].points, job.rows[s], *reference, n, job.spec.seed,
+                                                     stage, second.get());
+      before += job.reports[s]->vertices.size();
+      const ErrorReport& r = *job.reports[s];
+      if (checked++ == 0) pooled = r;
+      else {
+        pool_product_errors(pooled.products, r.products);
+        pooled.vertices.insert(pooled.vertices.end(), r.vertices.begin(), r.vertices.end());
+        pooled.reference_seconds += r.reference_seconds;
+      }
+      if (hooks.set_checked) hooks.set_checked(job, s);
+    }
+    if (checked == 0) continue;
+    job.pooled = std::move(pooled);
+    if (hooks.job_checked) hooks.job_checked(job);
+  }
+}
+
+std::optional<double> BakePipeline::cpu_seconds_per_row(const BakeJob& job, size_t n) const {
+  PRT_CHECK(job.integrator != nullptr);
+  if (job.integrator->prepares()) return std::nullopt;
+  std::vector<ShadePoint> storage;
+  const std::span<const ShadePoint> points = pooled_points(job, storage);
+  const std::vector<uint32_t> sample = seeded_sample(uint32_t(points.size()), n, settings_.integrator.seed);
+  std::vector<double> row(job.integrator->layout().width);
+  const double t0 = thread_cpu_seconds();
+  for (uint32_t v : sample) job.integrator->integrate(points[v], v, row);
+  return (thread_cpu_seconds() - t0) / double(std::max<size_t>(sample.size(), 1));
+}
+
+} // namespace prt::bake

@@ -1,0 +1,185 @@
+// The bake pipeline (bake/bake/pipeline.h): a job's rows are the row loop's, whatever its receiver
+// sets hold (a mesh's vertices, or free points as a lightmap's texels will be); the steps and the
+// hooks come in the documented order; the report's points are shared by the sets' rows with a
+// target and given to each set without one; a caller's rows replace the row loop (sharded bakes).
+#include <bake/bake/pipeline.h>
+#include <bake/integrators/registry.h>
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/receivers.h>
+#include <bake/visibility/accel.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace prt::bake;
+
+namespace {
+
+struct Ground {
+  Mesh mesh = load_mesh(fs::path(PRT_DATA_DIR) / "bunny_ground.obj");
+  Topology topology = build_topology(mesh);
+  MeshAccel accel{mesh, topology};
+};
+
+ProductRequest ao() {
+  ProductRequest r;
+  r.ao = true;
+  return r;
+}
+
+// QMC at `rays` per point with `report` report points.
+PipelineSettings qmc(uint32_t rays, uint32_t report) {
+  PipelineSettings settings;
+  settings.integrator.kind = IntegratorKind::Qmc;
+  settings.integrator.qmc_rays = rays;
+  settings.integrator.report_points = report;
+  return settings;
+}
+
+// Two sets: the first 600 vertices, and 300 free points a little above later vertices along their
+// normals (points that are no vertex of the occluders, as a lightmap's texels are not).
+std::vector<ReceiverSet> two_sets(const Ground& g);
+
+// One AO job over two_sets(g).
+std::vector<BakeJob> one_job(const Ground& g) {
+  std::vector<BakeJob> jobs(1);
+  jobs[0].name = "two sets";
+  jobs[0].request = ao();
+  jobs[0].sets = two_sets(g);
+  return jobs;
+}
+
+std::vector<ReceiverSet> two_sets(const Ground& g) {
+  const std::vector<ShadePoint> all = vertex_shade_points(g.mesh, g.topology);
+  std::vector<ReceiverSet> sets(2);
+  sets[0].name = "vertices";
+  sets[0].points.assign(all.begin(), all.begin() + 600);
+  sets[1].name = "free points";
+  sets[1].tag = 7;
+  for (size_t v = 1000; v < 1300; ++v) {
+    ShadePoint p;
+    p.n = all[v].n;
+    p.p = all[v].p + 0.01 * all[v].n;
+    sets[1].points.push_back(p);
+  }
+  return sets;
+}
+
+void expect_same_rows(const VertexBake& a, const VertexBake& b, const std::string& what) {
+  ASSERT_EQ(a.values.size(), b.values.size()) << what;
+  for (size_t k = 0; k < a.values.size(); ++k) ASSERT_EQ(a.values[k], b.values[k]) << what << " value " << k;
+  for (size_t k = 0; k < a.std_error.size(); ++k) ASSERT_EQ(a.std_error[k], b.std_error[k]) << what << " std error " << k;
+}
+
+} // namespace
+
+TEST(Pipeline, RowsAreTheRowLoopsForAnyReceiversAndHooksComeInOrder) {
+  const Ground g;
+  const PipelineSettings settings = qmc(64, 8);
+  std::vector<BakeJob> jobs = one_job(g);
+  const std::vector<ReceiverSet> sets = jobs[0].sets;
+  BakePipeline pipeline(g.mesh, g.topology, g.accel, settings, std::move(jobs));
+
+  std::vector<std::string> calls;
+  PipelineHooks hooks;
+  hooks.chosen = [&](const BakeJob&) { calls.push_back("chosen"); };
+  hooks.ready = [&](const BakeJob&) { calls.push_back("ready"); };
+  hooks.set_baked = [&](const BakeJob&, size_t s) { calls.push_back("set_baked " + std::to_string(s)); };
+  hooks.baked = [&] { calls.push_back("baked"); };
+  hooks.checking = [&] { calls.push_back("checking"); };
+  hooks.check_planned = [&](const BakeJob&) { calls.push_back("check_planned"); };
+  hooks.set_checked = [&](const BakeJob&, size_t s) { calls.push_back("set_checked " + std::to_string(s)); };
+  hooks.job_checked = [&](const BakeJob&) { calls.push_back("job_checked"); };
+  hooks.correcting = [&](const BakeJob&, const IntegratorSpec&) { calls.push_back("correcting"); };
+  pipeline.run({}, hooks);
+  // Without a target: no choice, no reference plan, no correction.
+  EXPECT_EQ(calls, (std::vector<std::string>{"ready", "set_baked 0", "set_baked 1", "baked", "checking", "set_checked 0",
+                                             "set_checked 1", "job_checked"}));
+
+  const BakeJob& job = pipeline.jobs().front();
+  const std::unique_ptr<Integrator> alone = make_integrator(settings.integrator, g.mesh, g.topology, ao());
+  for (size_t s = 0; s < 2; ++s) {
+    // Row i of a set is randomised by i: the same numbers as the row loop on that set alone.
+    expect_same_rows(job.rows[s], bake_points(sets[s].points, *alone), sets[s].name);
+    for (double x : job.rows[s].values) EXPECT_TRUE(std::isfinite(x) && x >= 0 && x <= 1) << x;
+    // Without a target each set gets the report's points.
+    ASSERT_TRUE(job.reports[s].has_value());
+    EXPECT_EQ(job.reports[s]->vertices.size(), 8u);
+  }
+  // The pooled report is both sets' values: 16 AO values.
+  ASSERT_TRUE(job.pooled.has_value());
+  ASSERT_EQ(job.pooled->products.size(), 1u);
+  EXPECT_EQ(job.pooled->products[0].values, 16u);
+  EXPECT_EQ(job.integrator_description, alone->description());
+}
+
+TEST(Pipeline, ATargetSharesTheReportsPointsByRowsAndPoolsTheVerdict) {
+  const Ground g;
+  PipelineSettings settings;
+  settings.target_error = 0.01;     // loose: the pilot is short
+  settings.counted_costs = true;    // the same choice on any machine
+  settings.integrator.report_points = 40;
+  settings.correct = false;
+  BakePipeline pipeline(g.mesh, g.topology, g.accel, settings, one_job(g));
+  int chosen = 0, planned = 0;
+  PipelineHooks hooks;
+  hooks.chosen = [&](const BakeJob& j) {
+    ++chosen;
+    EXPECT_TRUE(j.choice.has_value());
+  };
+  hooks.check_planned = [&](const BakeJob& j) {
+    ++planned;
+    ASSERT_TRUE(j.reference_plan.has_value());
+    EXPECT_EQ(j.spec.report_rays, j.reference_plan->rays);
+  };
+  pipeline.run({}, hooks);
+  EXPECT_EQ(chosen, 1) << "one pilot for the job, on both sets' points";
+  EXPECT_EQ(planned, 1);
+  const BakeJob& job = pipeline.jobs().front();
+  // 600 and 300 rows of 900 share 40 points: ceil(40·600/900) = 27 and ceil(40·300/900) = 14.
+  EXPECT_EQ(pipeline.report_points(job, 0), 27u);
+  EXPECT_EQ(pipeline.report_points(job, 1), 14u);
+  ASSERT_TRUE(job.reports[0] && job.reports[1]);
+  EXPECT_EQ(job.reports[0]->vertices.size(), 27u);
+  EXPECT_EQ(job.reports[1]->vertices.size(), 14u);
+  EXPECT_TRUE(job.reports[0]->reference_noise_measured) << "with a target: two independent halves";
+  ASSERT_TRUE(job.pooled.has_value());
+  EXPECT_EQ(job.pooled->vertices.size(), 41u);
+  EXPECT_EQ(job.pooled->products[0].values, 41u);
+  // The pooled RMSE is the RMS of the sets' over their values.
+  const double a = job.reports[0]->products[0].rmse, b = job.reports[1]->products[0].rmse;
+  EXPECT_NEAR(job.pooled->products[0].rmse, std::sqrt((27 * a * a + 14 * b * b) / 41), 1e-15);
+}
+
+TEST(Pipeline, ACallersRowsReplaceTheRowLoop) {
+  const Ground g;
+  BakePipeline pipeline(g.mesh, g.topology, g.accel, qmc(32, 0), one_job(g));
+  // A worker's run: its rows go elsewhere (here: kept by the test), nothing else happens.
+  std::vector<VertexBake> kept(2);
+  bool baked = false;
+  PipelineHooks work;
+  work.rows_only = true;
+  work.baked = [&] { baked = true; };
+  work.rows = [&](const BakeJob& j, size_t s, const Monitor& m) {
+    kept[s] = bake_points(j.sets[s].points, *j.integrator, m);
+    return VertexBake{};
+  };
+  pipeline.run({}, work);
+  EXPECT_FALSE(baked);
+  // The merge's run: the rows come back through the hook, and the pipeline goes on.
+  PipelineHooks merge;
+  merge.rows = [&](const BakeJob&, size_t s, const Monitor&) { return kept[s]; };
+  merge.baked = [&] { baked = true; };
+  pipeline.run({}, merge);
+  EXPECT_TRUE(baked);
+  for (size_t s = 0; s < 2; ++s) expect_same_rows(pipeline.jobs()[0].rows[s], kept[s], "set " + std::to_string(s));
+  // A caller's rows of the wrong size are refused, not written.
+  PipelineHooks wrong;
+  wrong.rows = [&](const BakeJob&, size_t, const Monitor&) { return VertexBake{}; };
+  EXPECT_THROW(pipeline.run({}, wrong), std::exception);
+}
