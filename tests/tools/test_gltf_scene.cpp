@@ -399,7 +399,7 @@ TEST(GltfScene, TheEngineDryRunGroupsItsPartsAndEstimatesTheCost) {
   for (const char* s : {"113 objects (both): node0/body, node0/body~2, node0/Lifter_123-923_0_Parts_1 and 110 more; 82065 vertices",
                         "2 objects (both): node0/node4/Piston_123-844_0_Parts_1#p1, node0/node1/Piston_123-844_0_Parts_1#p1",
                         "fiv: the object does not move", "left out, no occluder has shells", "estimated cost (nothing is baked):",
-                        "113 receivers (82065 vertices, from node0|body): about ", " CPU s to bake 82065 vertices with qmc at 64 rays"})
+                        "113 receivers (82065 vertices, from node0/body): about ", " CPU s to bake 82065 vertices with qmc at 64 rays"})
     EXPECT_NE(r.out.find(s), std::string::npos) << "missing '" << s << "' in:\n" << r.out;
   EXPECT_LT(std::count(r.out.begin(), r.out.end(), '\n'), 30) << r.out;
   EXPECT_FALSE(fs::exists(d / "out.prt.h5"));

@@ -30,6 +30,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// How the log names an object to people: a glTF instance by its node path ("node0/body"), a
+// scene file's object by its name (the "|" spelling of glTF names is for HDF5 paths only).
+const std::string& label_of(const SceneObject& o) { return o.node_path.empty() ? o.name : o.node_path; }
+
 // snprintf of one or two numbers into a string (the log lines).
 std::string printf_string(const char* f, double a, double b = 0) {
   char buf[160];
@@ -84,7 +88,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   auto receivers_of = [&](size_t i) {
     const Mesh& m = meshes[i];
     ReceiverSet set;
-    set.name = scene.objects[i].name;
+    set.name = label_of(scene.objects[i]);
     set.tag = i;
     set.points.resize(m.positions.size());
     for (size_t v = 0; v < set.points.size(); ++v) {
@@ -215,7 +219,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     ObjectBake& ob = out.objects[i];
     ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
     out.fiv_seconds += ob.shells->seconds;
-    log(scene.objects[i].name + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
+    log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
         "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
   }
 
@@ -295,7 +299,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const Topology t = build_topology(m);
     ob.fiv_report = fiv_error_report(m, t, *env, *ob.shells, out.environment_fiv, scene.integrator.report_points,
                                      scene.integrator.seed, monitor);
-    log(scene.objects[i].name + ": fiv " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
+    log(label_of(scene.objects[i]) + ": fiv " + printf_string("RMSE %.3e, relative to RMS|F_env| %.3e", ob.fiv_report->rmse,
                         ob.fiv_report->reference_rms > 0 ? ob.fiv_report->rmse / ob.fiv_report->reference_rms : 0.0));
   }
   return out;
