@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "tool_main.h"
 #include "values.h"
+#include "objects.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -97,96 +98,6 @@ What the summary shows:
 Exit status 1 also covers a vertex index out of range, an unknown --object, and --vertex on a
 scene file without --object (the message lists the objects).
 )";
-
-// ---- scene objects: one spelling for people ------------------------------------------------
-
-// The scene objects of a file as stored (a file that fails the schema has no asset): each
-// object's stored name and, for a glTF scene's, its node path. Object names are printed as
-// formats::object_label gives them (the node path, "node0/node13/node71"), never as the HDF5
-// name ("node0|node13|node71"), which appears only where it is labelled as one.
-struct FileObject {
-  std::string name;                      // as stored: /objects/<name>
-  std::optional<std::string> node_path;  // the group's node_path attribute, when it is a string
-  std::string label() const { return pf::object_label(name, node_path); }
-};
-
-std::vector<FileObject> file_objects(const pf::File& f) {
-  const std::string dir = std::string(names::kObjects) + "/";
-  std::vector<FileObject> out;
-  auto add = [&](std::string_view prefix) -> FileObject* {
-    if (!prefix.starts_with(dir)) return nullptr;
-    const std::string_view name = prefix.substr(dir.size());
-    if (name.empty() || name.find('/') != std::string_view::npos) return nullptr;
-    for (FileObject& o : out)
-      if (o.name == name) return &o;
-    return &out.emplace_back(FileObject{std::string(name), std::nullopt});
-  };
-  for (const pf::Dataset& d : f.datasets) add(pf::vertex_set_of(d.path));
-  for (const auto& [g, attrs] : f.group_attrs)
-    if (FileObject* o = add(g))
-      if (const pf::Attr* a = pf::find_attr(attrs, names::kNodePath))
-        if (const auto* s = std::get_if<std::string>(&a->value)) o->node_path = *s;
-  std::sort(out.begin(), out.end(), [](const FileObject& x, const FileObject& y) { return x.name < y.name; });
-  return out;
-}
-
-const FileObject* find_file_object(const std::vector<FileObject>& objects, std::string_view name) {
-  for (const FileObject& o : objects)
-    if (o.name == name) return &o;
-  return nullptr;
-}
-
-// A dataset path that belongs to scene object `object` (its vertex set, its report, its FIV
-// shells), and the path within it as printed under the object: "mesh/positions", "report/ao",
-// "fiv/shells", "report/fiv".
-struct ObjectPath {
-  const FileObject* object = nullptr;
-  std::string rest;
-};
-ObjectPath object_path(const std::vector<FileObject>& objects, std::string_view path) {
-  const std::string objects_dir = std::string(names::kObjects) + "/";
-  const std::pair<std::string, std::string> dirs[] = {
-      {objects_dir, ""},
-      {std::string(names::kReport) + objects_dir, "report/"},
-      {std::string(names::kOccluders) + "/", "fiv/"},
-      {std::string(names::kReportFiv) + "/", "report/fiv"}};
-  for (const auto& [dir, shown] : dirs) {
-    if (!path.starts_with(dir)) continue;
-    const std::string_view tail = path.substr(dir.size());
-    const std::size_t slash = tail.find('/');
-    const FileObject* o = find_file_object(objects, tail.substr(0, slash));
-    if (o == nullptr) continue;
-    if (slash == std::string_view::npos) return {o, shown.ends_with('/') ? shown.substr(0, shown.size() - 1) : shown};
-    return {o, shown + std::string(tail.substr(slash + 1))};
-  }
-  return {};
-}
-
-// "object node0/node13/node71 (HDF5 name node0|node13|node71)": the heading of an object's lines.
-std::string object_heading(const FileObject& o) {
-  const std::string label = o.label();
-  return "object " + label + (label != o.name ? " (stored as " + std::string(names::kObjects) + "/" + o.name + ")" : "");
-}
-
-// Datasets in the order printed: the ones of no object first (file order), then each object's.
-struct DatasetGroups {
-  std::vector<const pf::Dataset*> loose;
-  std::vector<std::pair<const FileObject*, std::vector<std::pair<const pf::Dataset*, std::string>>>> objects;
-};
-DatasetGroups group_datasets(const pf::File& f, const std::vector<FileObject>& objects) {
-  DatasetGroups g;
-  for (const FileObject& o : objects) g.objects.push_back({&o, {}});
-  for (const pf::Dataset& d : f.datasets) {
-    const ObjectPath op = object_path(objects, d.path);
-    if (op.object == nullptr) {
-      g.loose.push_back(&d);
-      continue;
-    }
-    for (auto& [o, list] : g.objects)
-      if (o == op.object) list.emplace_back(&d, op.rest);
-  }
-  return g;
-}
 
 // ---- summary -----------------------------------------------------------------------------
 
