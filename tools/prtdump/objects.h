@@ -37,7 +37,7 @@ struct ObjectPath {
 };
 ObjectPath object_path(const std::vector<FileObject>& objects, std::string_view path);
 
-// "object node0/node13/node71 (HDF5 name node0|node13|node71)": the heading of an object's lines.
+// "object node0/node13/node71 (stored as /objects/node0|node13|node71)": the heading of an object's lines.
 std::string object_heading(const FileObject& o);
 
 // Datasets in the order printed: the ones of no object first (file order), then each object's.
