@@ -10,11 +10,13 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <random>
+#include <thread>
 #include <time.h>
 #include <unistd.h>
 
@@ -132,6 +134,26 @@ bool is_shard_option(const std::string& name, bool& takes_value) {
 
 // ---- MPI ----
 
+#ifdef PRT_HAVE_MPI
+namespace {
+// Waits for a non-blocking collective without spinning. Open MPI's blocking collectives poll at
+// full speed, so a rank with nothing left to do (its chunks done, or none claimed) burned a core
+// while it waited for the others, stealing it from a working rank whenever ranks outnumber cores
+// (mpirun -n 2 on a one-chunk bake: 5.7 CPU s against 3.0 for one process). MPI_Test drives the
+// collective's progress; the pause between tests grows from 0.1 ms to 20 ms, so a short wait
+// stays short and a long one costs nothing.
+void wait_without_spinning(MPI_Request& request) {
+  std::chrono::microseconds pause{100};
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(pause);
+    pause = std::min(pause * 2, std::chrono::microseconds{20000});
+  }
+}
+} // namespace
+#endif
+
 MpiSession::MpiSession([[maybe_unused]] int& argc, [[maybe_unused]] char**& argv) {
 #ifdef PRT_HAVE_MPI
   if (!launched_by_mpirun()) return;
@@ -144,7 +166,14 @@ MpiSession::MpiSession([[maybe_unused]] int& argc, [[maybe_unused]] char**& argv
 
 MpiSession::~MpiSession() {
 #ifdef PRT_HAVE_MPI
-  if (active_ && std::uncaught_exceptions() == 0) MPI_Finalize();
+  if (active_ && std::uncaught_exceptions() == 0) {
+    // The ranks that return first (rank 0 merges) wait here for the rest, asleep, before
+    // MPI_Finalize's own synchronisation (which spins).
+    MPI_Request request;
+    MPI_Ibarrier(MPI_COMM_WORLD, &request);
+    wait_without_spinning(request);
+    MPI_Finalize();
+  }
 #endif
 }
 
@@ -152,7 +181,9 @@ bool MpiSession::all(bool ok) const {
 #ifdef PRT_HAVE_MPI
   if (active_) {
     int mine = ok ? 1 : 0, every = 0;
-    MPI_Allreduce(&mine, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Request request;
+    MPI_Iallreduce(&mine, &every, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &request);
+    wait_without_spinning(request);
     return every == 1;
   }
 #endif
@@ -164,7 +195,9 @@ std::string MpiSession::broadcast(const std::string& text) const {
   if (active_) {
     char buf[128] = {};
     text.copy(buf, sizeof buf - 1);
-    MPI_Bcast(buf, int(sizeof buf), MPI_CHAR, 0, MPI_COMM_WORLD);
+    MPI_Request request;
+    MPI_Ibcast(buf, int(sizeof buf), MPI_CHAR, 0, MPI_COMM_WORLD, &request);
+    wait_without_spinning(request);
     return buf;
   }
 #endif
