@@ -137,7 +137,20 @@ inline Eigen::Vector3d add_origin(const Eigen::Vector3d& origin, const Eigen::Ve
   return origin == Eigen::Vector3d::Zero() ? offset : Eigen::Vector3d(origin + offset);
 }
 
+// A texture-coordinate set, per triangle corner (per corner, not per vertex: a UV seam splits no
+// vertex row, so the per-vertex contracts above hold with or without UVs). Lightmaps (per-texel
+// bakes, bake/mesh/texels.h) are baked in one such set. `corners[3 t + c]` is corner c of
+// triangle t in Mesh::triangles order (after the fan, and after flip_normals' reversal: the UV
+// follows its corner). Values as the file has them (glTF: (u, v) with v down the image, as
+// TEXCOORD_n; OBJ: `vt` u v, v up, converted to glTF's v-down as 1 − v, so every set uses one
+// convention: texel row 0 is v = 0).
+struct UvSet {
+  std::string name;                      // "TEXCOORD_0", "TEXCOORD_1" (glTF), "vt" (OBJ)
+  std::vector<Eigen::Vector2f> corners;  // 3 per triangle
+};
+
 struct Mesh {
+  std::vector<UvSet> uv_sets;                          // in the file's order; empty: the file has none
   std::vector<Eigen::Vector3f> positions;              // one per output vertex, relative to origin (file comment: ORIGIN)
   std::vector<Eigen::Vector3f> normals;                // unit, one per output vertex
   std::vector<std::array<uint32_t, 3>> triangles;      // indices into output vertices, file order (polygons fan-triangulated in place)
@@ -212,6 +225,14 @@ struct Polygons {
   std::vector<uint32_t> offsets{0};         // polygon_count() + 1 entries, ascending
   std::vector<uint32_t> corner_position;    // per corner: index into positions
   std::vector<uint32_t> corner_normal;      // per corner: index into normals or kNoNormal; empty = none has one
+  // Texture-coordinate sets: per corner an index into values (every corner has one; a set that
+  // some corners lack is not a set: the reader drops it with a warning).
+  struct Uvs {
+    std::string name;
+    std::vector<Eigen::Vector2f> values;
+    std::vector<uint32_t> corner;  // one per corner (corner_position.size())
+  };
+  std::vector<Uvs> uv_sets;
   size_t polygon_count() const { return offsets.size() - 1; }
   void end_polygon() { offsets.push_back(static_cast<uint32_t>(corner_position.size())); }
 };
