@@ -150,7 +150,6 @@ struct UvSet {
 };
 
 struct Mesh {
-  std::vector<UvSet> uv_sets;                          // in the file's order; empty: the file has none
   std::vector<Eigen::Vector3f> positions;              // one per output vertex, relative to origin (file comment: ORIGIN)
   std::vector<Eigen::Vector3f> normals;                // unit, one per output vertex
   std::vector<std::array<uint32_t, 3>> triangles;      // indices into output vertices, file order (polygons fan-triangulated in place)
@@ -161,6 +160,7 @@ struct Mesh {
   std::vector<std::string> warnings;                   // non-fatal reader messages, one line each, "<file>: <finding>"
   std::string source_sha256;                           // load_mesh: SHA-256 (64 lowercase hex) of the bytes parsed; empty from make_mesh / merge_meshes / build_mesh
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();    // world = origin + positions[v], in double (frame_origin)
+  std::vector<UvSet> uv_sets;                          // in the file's order; empty: the file has none
   Eigen::Vector3d world_position(size_t v) const { return add_origin(origin, positions[v].cast<double>()); }
 };
 
