@@ -1,0 +1,62 @@
+// bake/mesh/texels.h — the texels of a lightmap as receivers (issue 30): which texels of a W × H
+// atlas a mesh covers through one of its UV sets (bake/mesh/mesh.h UvSet), and a shade point on
+// the surface for each, gathered as a ReceiverSet (bake/mesh/receivers.h) that the bake pipeline
+// (bake/bake/pipeline.h) integrates like any other: no integrator knows texels.
+//
+// Texel space: u·W, v·H (v as glTF's TEXCOORD: row 0 of the image at v = 0); texel (x, y) is the
+// square [x, x + 1] × [y, y + 1], its centre (x + ½, y + ½), its index y·W + x. UVs outside
+// [0, 1] cover nothing there (they are clipped to the atlas).
+//
+// Coverage is CONSERVATIVE: a texel is covered when a triangle's UV image meets its closed square
+// (decided by separating axes in double: the triangle's three edge normals and the square's two),
+// so thin triangles and chart borders get the texels they touch, not only those whose centres
+// they contain. A covered texel's sample (TexelSample) is
+//   * the texel centre, when it lies in a triangle's UV image (barycentric coordinates all >= 0);
+//     of several such triangles (overlapping UVs: a lightmap set should have none) the first in
+//     triangle order;
+//   * else the point of the covering triangles' UV images nearest to the centre (their closest
+//     triangle, ties to the first), so the sample lies ON the surface, never off its edge.
+// The shade point is the sample's surface point: positions interpolated in double with its
+// barycentric coordinates; the normal is the interpolated vertex normals (the smooth shading the
+// vertex bakes use), or the triangle's face normal where they cancel. Texel points are free
+// points of the mesh (no welded vertex, `welded` = −1): the integrators decide the point's own
+// triangle and its neighbours exactly in the ε-limit p + εn (bake/visibility/raycast.h
+// NearTriangles, bake/visibility/contour.h), as for a scene's receiver-only vertices.
+//
+// Rows: the covered texels in index order (row-major), so the rows — and with them every
+// per-row randomisation — depend on the mesh, the UV set and W × H only.
+#pragma once
+
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/receivers.h>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace prt::bake {
+
+struct TexelSample {
+  uint32_t texel = 0;            // y·W + x
+  uint32_t triangle = 0;         // the triangle the sample lies on
+  Eigen::Vector3d barycentric;   // of the sample in that triangle (sums to 1, each >= 0)
+  bool centre = true;            // the texel centre (else the nearest point of a covering triangle)
+};
+
+struct TexelAtlas {
+  uint32_t width = 0, height = 0;
+  std::string uv_set;                // the UvSet's name
+  std::vector<TexelSample> samples;  // one per covered texel, in texel order: row i of the bake
+  ReceiverSet receivers;             // samples' shade points (rows_noun "texels")
+  std::vector<uint8_t> coverage;     // width·height: 1 where a texel is covered
+  size_t texels_off_centre() const;  // samples that are not their texel's centre
+};
+
+// The atlas of `uv` (one of mesh.uv_sets; 3 UVs per triangle) at width × height texels (each
+// 1..16384; InputError(mesh.source, ...) otherwise, and for a set whose size does not match the
+// triangles or holds a non-finite UV). `name` names the receiver set in logs.
+TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32_t height, std::string name);
+
+} // namespace prt::bake

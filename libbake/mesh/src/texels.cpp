@@ -1,0 +1,172 @@
+// texels.cpp — a lightmap atlas's covered texels and their shade points (bake/mesh/texels.h).
+#include <bake/mesh/texels.h>
+#include <bake/core/error.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace prt::bake {
+namespace {
+
+constexpr uint32_t kMaxSide = 8192;  // texels per side: the per-texel choice below keeps 8 bytes per texel
+constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+
+using V2 = Eigen::Vector2d;
+
+double cross(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Whether triangle (a, b, c) meets the closed square [x0, x0 + 1] × [y0, y0 + 1]: separating axes
+// (the square's two are the caller's bounding-box test; here the triangle's three edge normals).
+bool meets_square(const V2 (&t)[3], double x0, double y0) {
+  const V2 corners[4] = {{x0, y0}, {x0 + 1, y0}, {x0, y0 + 1}, {x0 + 1, y0 + 1}};
+  for (int e = 0; e < 3; ++e) {
+    const V2 d = t[(e + 1) % 3] - t[e];
+    const V2 normal(-d.y(), d.x());
+    // The triangle projects onto [min(edge, third vertex), max(...)] along the edge's normal.
+    const double edge = normal.dot(t[e]), third = normal.dot(t[(e + 2) % 3]);
+    const double tlo = std::min(edge, third), thi = std::max(edge, third);
+    double slo = std::numeric_limits<double>::infinity(), shi = -slo;
+    for (const V2& q : corners) {
+      const double s = normal.dot(q);
+      slo = std::min(slo, s);
+      shi = std::max(shi, s);
+    }
+    if (shi < tlo || slo > thi) return false;
+  }
+  return true;
+}
+
+// The point of segment [p, q] nearest to c, as the parameter s in [0, 1] of p + s (q − p).
+double nearest_on_segment(const V2& p, const V2& q, const V2& c) {
+  const V2 d = q - p;
+  const double len2 = d.squaredNorm();
+  if (len2 == 0) return 0;
+  return std::clamp((c - p).dot(d) / len2, 0.0, 1.0);
+}
+
+} // namespace
+
+size_t TexelAtlas::texels_off_centre() const {
+  return size_t(std::count_if(samples.begin(), samples.end(), [](const TexelSample& s) { return !s.centre; }));
+}
+
+TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32_t height, std::string name) {
+  if (width == 0 || height == 0 || width > kMaxSide || height > kMaxSide)
+    throw InputError(mesh.source, "a lightmap of " + std::to_string(width) + "x" + std::to_string(height) +
+                                      " texels: each side must be 1 to " + std::to_string(kMaxSide));
+  if (uv.corners.size() != 3 * mesh.triangles.size())
+    throw InputError(mesh.source, "UV set " + uv.name + " has " + std::to_string(uv.corners.size()) + " corners for " +
+                                      std::to_string(mesh.triangles.size()) + " triangles (3 each)");
+  for (size_t k = 0; k < uv.corners.size(); ++k)
+    if (!uv.corners[k].allFinite())
+      throw InputError(mesh.source, "UV set " + uv.name + ": corner " + std::to_string(k % 3) + " of triangle " +
+                                        std::to_string(k / 3) + " is not finite");
+  const size_t texels = size_t(width) * size_t(height);
+  // Per texel, the best triangle so far and its squared distance in texel space (−1: the centre
+  // lies in it). Triangles come in order and replace only when strictly better: ties keep the first.
+  std::vector<uint32_t> best(texels, kNone);
+  std::vector<float> best_d2(texels, std::numeric_limits<float>::infinity());
+  auto texel_space = [&](size_t t, int c) {
+    const Eigen::Vector2f& q = uv.corners[3 * t + size_t(c)];
+    return V2(double(q.x()) * width, double(q.y()) * height);
+  };
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const V2 tri[3] = {texel_space(t, 0), texel_space(t, 1), texel_space(t, 2)};
+    const double area2 = cross(tri[1] - tri[0], tri[2] - tri[0]);
+    if (area2 == 0) continue;  // no area in the lightmap: no texel is its
+    const double lo_x = std::min({tri[0].x(), tri[1].x(), tri[2].x()}), hi_x = std::max({tri[0].x(), tri[1].x(), tri[2].x()});
+    const double lo_y = std::min({tri[0].y(), tri[1].y(), tri[2].y()}), hi_y = std::max({tri[0].y(), tri[1].y(), tri[2].y()});
+    // Texels whose closed squares meet the bounding box, clipped to the atlas.
+    const double x_first = std::max(std::ceil(lo_x) - 1, 0.0), x_last = std::min(std::floor(hi_x), double(width) - 1);
+    const double y_first = std::max(std::ceil(lo_y) - 1, 0.0), y_last = std::min(std::floor(hi_y), double(height) - 1);
+    for (double y = y_first; y <= y_last; ++y)
+      for (double x = x_first; x <= x_last; ++x) {
+        if (!meets_square(tri, x, y)) continue;
+        const V2 c(x + 0.5, y + 0.5);
+        const double l0 = cross(tri[1] - c, tri[2] - c) / area2, l1 = cross(tri[2] - c, tri[0] - c) / area2;
+        const double l2 = 1 - l0 - l1;
+        float d2 = -1;
+        if (!(l0 >= 0 && l1 >= 0 && l2 >= 0)) {
+          double nearest = std::numeric_limits<double>::infinity();
+          for (int e = 0; e < 3; ++e) {
+            const V2 &p = tri[e], &q = tri[(e + 1) % 3];
+            const double s = nearest_on_segment(p, q, c);
+            nearest = std::min(nearest, (p + s * (q - p) - c).squaredNorm());
+          }
+          d2 = float(nearest);
+        }
+        const size_t k = size_t(y) * width + size_t(x);
+        if (d2 < best_d2[k]) best[k] = uint32_t(t), best_d2[k] = d2;
+      }
+  }
+
+  TexelAtlas out;
+  out.width = width;
+  out.height = height;
+  out.uv_set = uv.name;
+  out.coverage.assign(texels, 0);
+  out.receivers.name = std::move(name);
+  out.receivers.rows_noun = "texels";
+  for (size_t k = 0; k < texels; ++k) {
+    if (best[k] == kNone) continue;
+    const uint32_t t = best[k];
+    const V2 tri[3] = {texel_space(t, 0), texel_space(t, 1), texel_space(t, 2)};
+    const double area2 = cross(tri[1] - tri[0], tri[2] - tri[0]);
+    const V2 c(double(k % width) + 0.5, double(k / width) + 0.5);
+    TexelSample s;
+    s.texel = uint32_t(k);
+    s.triangle = t;
+    s.centre = best_d2[k] < 0;
+    if (s.centre) {
+      const double l0 = cross(tri[1] - c, tri[2] - c) / area2, l1 = cross(tri[2] - c, tri[0] - c) / area2;
+      s.barycentric = {l0, l1, 1 - l0 - l1};
+    } else {
+      // The nearest point of the triangle's boundary, as barycentric coordinates of its edge.
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int e = 0; e < 3; ++e) {
+        const V2 &p = tri[e], &q = tri[(e + 1) % 3];
+        const double sp = nearest_on_segment(p, q, c), d2 = (p + sp * (q - p) - c).squaredNorm();
+        if (d2 < nearest) {
+          nearest = d2;
+          s.barycentric = Eigen::Vector3d::Zero();
+          s.barycentric[e] = 1 - sp;
+          s.barycentric[(e + 1) % 3] = sp;
+        }
+      }
+    }
+    s.barycentric = s.barycentric.cwiseMax(0.0);
+    s.barycentric /= s.barycentric.sum();
+    // The surface point: positions and normals interpolated in double.
+    const auto& tv = mesh.triangles[t];
+    ShadePoint sp;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero();
+    sp.p = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d p = mesh.positions[tv[size_t(i)]].cast<double>();
+      sp.p += s.barycentric[i] * p;
+      centroid += p / 3;
+      n += s.barycentric[i] * mesh.normals[tv[size_t(i)]].cast<double>();
+    }
+    const Eigen::Vector3d face = (mesh.positions[tv[1]] - mesh.positions[tv[0]])
+                                     .cast<double>()
+                                     .cross((mesh.positions[tv[2]] - mesh.positions[tv[0]]).cast<double>());
+    if (n.norm() > 0 && std::isfinite(n.norm())) sp.n = n.normalized();
+    else if (face.norm() > 0) sp.n = face.normalized();
+    else sp.n = mesh.normals[tv[0]].cast<double>().normalized();
+    // The tie-break into its own surface (as a vertex's, bake/mesh/receivers.h): towards the
+    // triangle's centroid, in the tangent plane.
+    Eigen::Vector3d into = centroid - sp.p;
+    into -= sp.n.dot(into) * sp.n;
+    if (const double len = into.norm(); len > 0 && std::isfinite(len)) sp.t = into / len;
+    out.coverage[k] = 1;
+    out.samples.push_back(s);
+    out.receivers.points.push_back(sp);
+  }
+  return out;
+}
+
+} // namespace prt::bake

@@ -1,0 +1,131 @@
+// Texels through the bake pipeline (bake/mesh/texels.h, bake/bake/pipeline.h), against a closed
+// form: a floor with a unit box standing on it. AO at a floor point p (normal +z) is
+//   AO(p) = 1 − (1/π) Σ_{box faces facing p} ∫_face (n·ω) dω,
+// the faces seen from p not overlapping (a convex solid), each entirely above p's horizon (the
+// side faces span z ∈ [0, 1], the floor is z = 0), so their cosine integrals have closed forms
+// (Lambert's vector irradiance, bake/sphere/spherical_polygon.h). Every floor texel outside the
+// box's foot is checked, the row of texels next to its foot included (their samples 1/16 of a
+// unit from the box's walls).
+//
+// Tolerances: QMC is held to 4 of its own standard errors, plus 1e-12 for rounding when every ray
+// agrees. The silhouette integrator's error here is not the O(h²) of the vertex tests
+// (tests/bake/integrators/test_silhouette.cpp, 1e-4 at N = 256): a texel 0.19 from the box's
+// unit face sees the face's edges cross the isolines at a steep angle, and its error oscillates
+// in sign with an amplitude falling like ~0.1/N (measured at texel (0.1875, −0.6875): 3.4e-3 at
+// N = 96, 1.3e-3 at 256, 3.8e-4 at 512, 7.7e-5 at 1024, 2.6e-5 at 1536), so at N = 1536 the
+// bound ~0.1/N = 6.5e-5 is within 1e-4 (the worst texel measured: 2.7e-5; at N = 1024 one texel
+// was 1.02e-4, at 2048 the worst 5.3e-5).
+#include <bake/bake/pipeline.h>
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/texels.h>
+#include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/accel.h>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+using namespace prt::bake;
+using Eigen::Vector2f;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// The floor [−2, 2]² at z = 0, UVs ((x + 2)/4, (y + 2)/4), and the box [−½, ½]² × [0, 1] on it.
+struct FloorAndBox {
+  Mesh floor, box, both;
+  UvSet uv;
+  FloorAndBox() {
+    floor = make_mesh({{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, "floor");
+    uv.name = "uv";
+    for (const auto& t : floor.triangles)
+      for (uint32_t v : t) uv.corners.emplace_back((floor.positions[v].x() + 2) / 4, (floor.positions[v].y() + 2) / 4);
+    std::vector<Vector3f> c;
+    for (int k = 0; k < 8; ++k) c.emplace_back(k & 1 ? 0.5f : -0.5f, k & 2 ? 0.5f : -0.5f, k & 4 ? 1.0f : 0.0f);
+    // Outward, counter-clockwise seen from outside.
+    box = make_mesh(c,
+                    {{{0, 2, 1}}, {{1, 2, 3}}, {{4, 5, 6}}, {{5, 7, 6}}, {{0, 1, 4}}, {{1, 5, 4}},
+                     {{2, 6, 3}}, {{3, 6, 7}}, {{0, 4, 2}}, {{2, 4, 6}}, {{1, 3, 5}}, {{3, 7, 5}}},
+                    "box");
+    both = merge_meshes(std::vector<Mesh>{floor, box}, "floor and box");
+  }
+};
+
+// The closed form of the file comment at a floor point p.
+double ao_closed_form(const Vector3d& p) {
+  const Vector3d n(0, 0, 1);
+  // The four side faces, each as its corners (outward normal, facing p when normal·(p − centre) > 0).
+  const std::array<std::array<Vector3d, 4>, 4> faces = {{
+      {{{0.5, -0.5, 0}, {0.5, 0.5, 0}, {0.5, 0.5, 1}, {0.5, -0.5, 1}}},
+      {{{-0.5, 0.5, 0}, {-0.5, -0.5, 0}, {-0.5, -0.5, 1}, {-0.5, 0.5, 1}}},
+      {{{0.5, 0.5, 0}, {-0.5, 0.5, 0}, {-0.5, 0.5, 1}, {0.5, 0.5, 1}}},
+      {{{-0.5, -0.5, 0}, {0.5, -0.5, 0}, {0.5, -0.5, 1}, {-0.5, -0.5, 1}}},
+  }};
+  const std::array<Vector3d, 4> normals = {Vector3d(1, 0, 0), Vector3d(-1, 0, 0), Vector3d(0, 1, 0), Vector3d(0, -1, 0)};
+  double blocked = 0;
+  for (size_t f = 0; f < 4; ++f) {
+    const Vector3d centre = (faces[f][0] + faces[f][2]) / 2;
+    if (normals[f].dot(p - centre) <= 0) continue;
+    std::vector<Vector3d> rel;
+    for (const Vector3d& v : faces[f]) rel.push_back((v - p).normalized());
+    blocked += std::abs(cosine_integral(rel, n));
+  }
+  return 1 - blocked / kPi;
+}
+
+VertexBake bake_ao(const FloorAndBox& s, const TexelAtlas& atlas, const IntegratorSpec& spec) {
+  const Topology topo = build_topology(s.both);
+  const MeshAccel accel(s.both, topo);
+  PipelineSettings settings;
+  settings.integrator = spec;
+  settings.integrator.report_points = 0;
+  std::vector<BakeJob> jobs(1);
+  jobs[0].request.ao = true;
+  jobs[0].sets.push_back(atlas.receivers);
+  BakePipeline pipeline(s.both, topo, accel, settings, std::move(jobs));
+  pipeline.run({});
+  return pipeline.jobs()[0].rows[0];
+}
+
+} // namespace
+
+TEST(TexelBake, FloorTexelsAroundABoxMatchTheClosedFormWithEveryIntegrator) {
+  const FloorAndBox s;
+  const TexelAtlas atlas = texel_atlas(s.floor, s.uv, 32, 32, "floor");
+  ASSERT_EQ(atlas.samples.size(), 32u * 32u);
+  // Texels whose sample is outside the box's foot (the 8 × 8 under it are inside the box).
+  std::vector<size_t> outside;
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const Vector3d& p = atlas.receivers.points[i].p;
+    if (std::abs(p.x()) > 0.5 || std::abs(p.y()) > 0.5) outside.push_back(i);
+  }
+  ASSERT_EQ(outside.size(), 32u * 32u - 8u * 8u);
+
+  IntegratorSpec sil;
+  sil.kind = IntegratorKind::Silhouette;
+  sil.silhouette_k = 1536 * 1536;
+  const std::vector<double> a = bake_ao(s, atlas, sil).values;
+  size_t next_to_foot = 0;
+  for (size_t i : outside) {
+    const Vector3d& p = atlas.receivers.points[i].p;
+    const double exact = ao_closed_form(p);
+    EXPECT_NEAR(a[i], exact, 1e-4) << "texel " << atlas.samples[i].texel << " at " << p.transpose();
+    next_to_foot += std::max(std::abs(p.x()), std::abs(p.y())) < 0.5 + 1.0 / 8;
+  }
+  EXPECT_EQ(next_to_foot, 36u) << "the ring of texels next to the box's foot is checked";
+
+  IntegratorSpec qmc;
+  qmc.kind = IntegratorKind::Qmc;
+  qmc.qmc_rays = 1024;
+  const VertexBake q = bake_ao(s, atlas, qmc);
+  for (size_t i : outside) {
+    const double exact = ao_closed_form(atlas.receivers.points[i].p);
+    EXPECT_NEAR(q.values[i], exact, 4 * q.std_error[i] + 1e-12) << "texel " << atlas.samples[i].texel;
+  }
+}
