@@ -54,7 +54,45 @@ size_t TexelAtlas::texels_off_centre() const {
   return size_t(std::count_if(samples.begin(), samples.end(), [](const TexelSample& s) { return !s.centre; }));
 }
 
-TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32_t height, std::string name) {
+// Chart of every triangle (file comment), numbered in order of each chart's first triangle.
+std::vector<uint32_t> charts_of(const Mesh& mesh, const Topology& topo, const UvSet& uv) {
+  const size_t T = mesh.triangles.size();
+  std::vector<uint32_t> parent(T);
+  for (size_t t = 0; t < T; ++t) parent[t] = uint32_t(t);
+  auto find = [&](uint32_t t) {
+    while (parent[t] != t) t = parent[t] = parent[parent[t]];
+    return t;
+  };
+  // The UV of triangle t's corner at welded position w (the first such corner).
+  auto uv_at = [&](uint32_t t, uint32_t w) -> const Eigen::Vector2f* {
+    for (size_t c = 0; c < 3; ++c)
+      if (topo.weld[mesh.triangles[t][c]] == w) return &uv.corners[3 * size_t(t) + c];
+    return nullptr;
+  };
+  for (size_t e = 0; e < topo.edges.size(); ++e) {
+    const std::span<const uint32_t> faces = topo.faces_of_edge(uint32_t(e));
+    for (size_t i = 1; i < faces.size(); ++i) {
+      const uint32_t a = faces[0], b = faces[i];
+      bool same = true;
+      for (uint32_t w : topo.edges[e]) {
+        const Eigen::Vector2f *ua = uv_at(a, w), *ub = uv_at(b, w);
+        same = same && ua && ub && (*ua).x() == (*ub).x() && (*ua).y() == (*ub).y();
+      }
+      if (same) parent[find(a)] = find(b);
+    }
+  }
+  std::vector<uint32_t> chart(T), number(T, kNone);
+  uint32_t next = 0;
+  for (size_t t = 0; t < T; ++t) {
+    uint32_t& n = number[find(uint32_t(t))];
+    if (n == kNone) n = next++;
+    chart[t] = n;
+  }
+  return chart;
+}
+
+TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& uv, uint32_t width, uint32_t height,
+                       std::string name) {
   if (width == 0 || height == 0 || width > kMaxSide || height > kMaxSide)
     throw InputError(mesh.source, "a lightmap of " + std::to_string(width) + "x" + std::to_string(height) +
                                       " texels: each side must be 1 to " + std::to_string(kMaxSide));
@@ -104,7 +142,9 @@ TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32
       }
   }
 
+  const std::vector<uint32_t> chart = charts_of(mesh, topology, uv);
   TexelAtlas out;
+  for (uint32_t c : chart) out.charts = std::max(out.charts, c + 1);
   out.width = width;
   out.height = height;
   out.uv_set = uv.name;
@@ -120,6 +160,7 @@ TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32
     TexelSample s;
     s.texel = uint32_t(k);
     s.triangle = t;
+    s.chart = chart[t];
     s.centre = best_d2[k] < 0;
     if (s.centre) {
       const double l0 = cross(tri[1] - c, tri[2] - c) / area2, l1 = cross(tri[2] - c, tri[0] - c) / area2;

@@ -15,11 +15,14 @@
 // N = 96, 1.3e-3 at 256, 3.8e-4 at 512, 7.7e-5 at 1024, 2.6e-5 at 1536), so at N = 1536 the
 // bound ~0.1/N = 6.5e-5 is within 1e-4 (the worst texel measured: 2.7e-5; at N = 1024 one texel
 // was 1.02e-4, at 2048 the worst 5.3e-5).
+#include <bake/bake/lightmap.h>
 #include <bake/bake/pipeline.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/texels.h>
 #include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/accel.h>
+#include <bake/visibility/enclosure.h>
+#include <bake/visibility/raycast.h>
 
 #include <gtest/gtest.h>
 
@@ -97,7 +100,7 @@ VertexBake bake_ao(const FloorAndBox& s, const TexelAtlas& atlas, const Integrat
 
 TEST(TexelBake, FloorTexelsAroundABoxMatchTheClosedFormWithEveryIntegrator) {
   const FloorAndBox s;
-  const TexelAtlas atlas = texel_atlas(s.floor, s.uv, 32, 32, "floor");
+  const TexelAtlas atlas = texel_atlas(s.floor, build_topology(s.floor), s.uv, 32, 32, "floor");
   ASSERT_EQ(atlas.samples.size(), 32u * 32u);
   // Texels whose sample is outside the box's foot (the 8 × 8 under it are inside the box).
   std::vector<size_t> outside;
@@ -127,5 +130,56 @@ TEST(TexelBake, FloorTexelsAroundABoxMatchTheClosedFormWithEveryIntegrator) {
   for (size_t i : outside) {
     const double exact = ao_closed_form(atlas.receivers.points[i].p);
     EXPECT_NEAR(q.values[i], exact, 4 * q.std_error[i] + 1e-12) << "texel " << atlas.samples[i].texel;
+  }
+}
+
+// The 8 × 8 floor texels under the box lie inside it: exactly they are enclosed (the rule of
+// bake/visibility/enclosure.h), the ring next to its foot is not; the lightmap fills them from
+// their valid neighbours, so the image has no dark texels where the box stands.
+TEST(TexelBake, TexelsUnderTheBoxAreEnclosedAndFilledFromTheirNeighbours) {
+  const FloorAndBox s;
+  const TexelAtlas atlas = texel_atlas(s.floor, build_topology(s.floor), s.uv, 32, 32, "floor");
+  const Topology topo = build_topology(s.both);
+  const RayCaster rays(s.both, topo);
+  std::vector<uint8_t> invalid(atlas.samples.size());
+  size_t enclosed_count = 0;
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const Vector3d& p = atlas.receivers.points[i].p;
+    const bool under = std::abs(p.x()) < 0.5 && std::abs(p.y()) < 0.5;
+    invalid[i] = enclosed(atlas.receivers.points[i], rays);
+    EXPECT_EQ(bool(invalid[i]), under) << "texel " << atlas.samples[i].texel << " at " << p.transpose();
+    enclosed_count += invalid[i];
+  }
+  EXPECT_EQ(enclosed_count, 64u);
+  // A point under an open sheet is not enclosed: the floor alone with only the box's top face
+  // above it (a canopy) leaves the texel below it valid.
+  const Mesh canopy = merge_meshes(std::vector<Mesh>{s.floor, make_mesh({{-0.5f, -0.5f, 1}, {0.5f, -0.5f, 1}, {0.5f, 0.5f, 1},
+                                                                         {-0.5f, 0.5f, 1}},
+                                                                        {{{0, 1, 2}}, {{0, 2, 3}}}, "canopy")},
+                                   "floor and canopy");
+  const Topology canopy_topo = build_topology(canopy);
+  const RayCaster canopy_rays(canopy, canopy_topo);
+  for (size_t i = 0; i < atlas.samples.size(); ++i)
+    EXPECT_FALSE(enclosed(atlas.receivers.points[i], canopy_rays)) << "texel " << atlas.samples[i].texel;
+
+  IntegratorSpec sil;
+  sil.kind = IntegratorKind::Silhouette;
+  sil.silhouette_k = 64 * 64;
+  const VertexBake ao = bake_ao(s, atlas, sil);
+  const Lightmap m = make_lightmap(atlas, ao.values, 1, invalid, 0);
+  EXPECT_EQ(m.filled, 64u);
+  EXPECT_EQ(m.unfilled, 0u);
+  double lowest_valid = 1;
+  for (size_t i = 0; i < atlas.samples.size(); ++i)
+    if (!invalid[i]) lowest_valid = std::min(lowest_valid, ao.values[i]);
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const size_t k = atlas.samples[i].texel;
+    EXPECT_EQ(m.state[k], uint8_t(invalid[i] ? TexelState::Filled : TexelState::Baked));
+    // A mean of means of valid texels: never darker than the darkest valid one (the enclosed
+    // rows themselves are 0: the box hides everything).
+    EXPECT_GE(m.values[k], lowest_valid) << "texel " << k;
+    if (invalid[i]) {
+      EXPECT_LT(ao.values[i], 1e-12) << "an enclosed point sees nothing";
+    }
   }
 }

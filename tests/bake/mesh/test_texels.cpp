@@ -33,7 +33,7 @@ Mesh square(float s, UvSet& uv) {
 TEST(Texels, ASquareFillingTheAtlasGetsEveryCentre) {
   UvSet uv;
   const Mesh m = square(1, uv);
-  const TexelAtlas a = texel_atlas(m, uv, 4, 4, "square");
+  const TexelAtlas a = texel_atlas(m, build_topology(m), uv, 4, 4, "square");
   ASSERT_EQ(a.samples.size(), 16u);
   EXPECT_EQ(a.texels_off_centre(), 0u);
   EXPECT_STREQ(a.receivers.rows_noun, "texels");
@@ -55,7 +55,7 @@ TEST(Texels, ASquareFillingTheAtlasGetsEveryCentre) {
 TEST(Texels, CoverageIsConservativeAndOffCentreSamplesLieOnTheTriangle) {
   UvSet uv;
   const Mesh m = square(0.5f, uv);  // UVs fill [0, ½]²: texels 0..3 of an 8 × 8 atlas, plus those touching
-  const TexelAtlas a = texel_atlas(m, uv, 8, 8, "half");
+  const TexelAtlas a = texel_atlas(m, build_topology(m), uv, 8, 8, "half");
   // Texels x, y in 0..4 meet the closed square [0, 4]²: the 4 × 4 with their centres inside and
   // the 9 of row 4 and column 4, which touch its edges.
   EXPECT_EQ(a.samples.size(), 25u);
@@ -82,7 +82,7 @@ TEST(Texels, ANeedleInsideOneTexelGetsThatTexel) {
   // A needle triangle whose UV image lies inside texel (2, 1) of a 4 × 4 atlas without its centre.
   Mesh m = make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 0.01f, 0}}, {{{0, 1, 2}}}, "needle");
   UvSet uv{"uv", {Vector2f(0.51f, 0.26f), Vector2f(0.56f, 0.26f), Vector2f(0.51f, 0.262f)}};
-  const TexelAtlas a = texel_atlas(m, uv, 4, 4, "needle");
+  const TexelAtlas a = texel_atlas(m, build_topology(m), uv, 4, 4, "needle");
   ASSERT_EQ(a.samples.size(), 1u);
   EXPECT_EQ(a.samples[0].texel, 1u * 4 + 2);
   EXPECT_FALSE(a.samples[0].centre);
@@ -99,21 +99,40 @@ TEST(Texels, ANeedleInsideOneTexelGetsThatTexel) {
 TEST(Texels, BadAtlasesAreRefusedNamingTheProblem) {
   UvSet uv;
   const Mesh m = square(1, uv);
-  EXPECT_THROW(texel_atlas(m, uv, 0, 4, "x"), InputError);
-  EXPECT_THROW(texel_atlas(m, uv, 4, 1 << 20, "x"), InputError);
+  EXPECT_THROW(texel_atlas(m, build_topology(m), uv, 0, 4, "x"), InputError);
+  EXPECT_THROW(texel_atlas(m, build_topology(m), uv, 4, 1 << 20, "x"), InputError);
   UvSet short_set = uv;
   short_set.corners.pop_back();
   try {
-    texel_atlas(m, short_set, 4, 4, "x");
+    texel_atlas(m, build_topology(m), short_set, 4, 4, "x");
     ADD_FAILURE() << "a UV set of the wrong size accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("5 corners for 2 triangles"), std::string::npos) << e.what();
   }
   UvSet nan_set = uv;
   nan_set.corners[4].x() = std::nanf("");
-  EXPECT_THROW(texel_atlas(m, nan_set, 4, 4, "x"), InputError);
+  EXPECT_THROW(texel_atlas(m, build_topology(m), nan_set, 4, 4, "x"), InputError);
   // UVs outside [0, 1] cover nothing there; a square at [2, 3]² covers no texel at all.
   UvSet away = uv;
   for (Vector2f& c : away.corners) c += Vector2f(2, 2);
-  EXPECT_TRUE(texel_atlas(m, away, 4, 4, "away").samples.empty());
+  EXPECT_TRUE(texel_atlas(m, build_topology(m), away, 4, 4, "away").samples.empty());
+}
+
+TEST(Texels, ChartsJoinTrianglesWhoseSharedEdgeHasTheSameUvs) {
+  UvSet uv;
+  const Mesh m = square(1, uv);
+  const TexelAtlas one = texel_atlas(m, build_topology(m), uv, 4, 4, "one chart");
+  EXPECT_EQ(one.charts, 1u);
+  for (const TexelSample& s : one.samples) EXPECT_EQ(s.chart, 0u);
+  // The second triangle moved in UV space: the diagonal is a seam, two charts.
+  UvSet cut = uv;
+  for (size_t c = 3; c < 6; ++c) cut.corners[c] = 0.5f * cut.corners[c];
+  const TexelAtlas two = texel_atlas(m, build_topology(m), cut, 4, 4, "two charts");
+  EXPECT_EQ(two.charts, 2u);
+  bool saw[2] = {false, false};
+  for (const TexelSample& s : two.samples) {
+    saw[s.chart] = true;
+    EXPECT_EQ(s.chart, s.triangle);
+  }
+  EXPECT_TRUE(saw[0] && saw[1]);
 }

@@ -25,6 +25,12 @@
 //
 // Rows: the covered texels in index order (row-major), so the rows — and with them every
 // per-row randomisation — depend on the mesh, the UV set and W × H only.
+//
+// Charts: triangles joined across an edge whose two welded corners (Topology) carry the same UVs,
+// bit for bit, in both triangles are one chart (a UV seam, or a hard edge with its UVs cut,
+// separates charts). A texel belongs to its sample's triangle's chart: a lightmap fills and pads
+// a texel only from texels of its own chart (bake/bake/lightmap.h), so colours never bleed
+// across a seam inside the atlas.
 #pragma once
 
 #include <bake/mesh/mesh.h>
@@ -43,6 +49,7 @@ struct TexelSample {
   uint32_t triangle = 0;         // the triangle the sample lies on
   Eigen::Vector3d barycentric;   // of the sample in that triangle (sums to 1, each >= 0)
   bool centre = true;            // the texel centre (else the nearest point of a covering triangle)
+  uint32_t chart = 0;            // of its triangle (file comment), numbered in triangle order from 0
 };
 
 struct TexelAtlas {
@@ -52,11 +59,13 @@ struct TexelAtlas {
   ReceiverSet receivers;             // samples' shade points (rows_noun "texels")
   std::vector<uint8_t> coverage;     // width·height: 1 where a texel is covered
   size_t texels_off_centre() const;  // samples that are not their texel's centre
+  uint32_t charts = 0;               // of the UV set's triangles with area in the atlas
 };
 
 // The atlas of `uv` (one of mesh.uv_sets; 3 UVs per triangle) at width × height texels (each
 // 1..16384; InputError(mesh.source, ...) otherwise, and for a set whose size does not match the
 // triangles or holds a non-finite UV). `name` names the receiver set in logs.
-TexelAtlas texel_atlas(const Mesh& mesh, const UvSet& uv, uint32_t width, uint32_t height, std::string name);
+TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& uv, uint32_t width, uint32_t height,
+                       std::string name);
 
 } // namespace prt::bake

@@ -1,0 +1,90 @@
+// Lightmap images from texel rows (bake/bake/lightmap.h): rows placed at their texels, padding
+// rings with the mean of their known neighbours (exact values), invalid texels filled from their
+// own chart only, and the image full after enough padding.
+#include <bake/bake/lightmap.h>
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/texels.h>
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+using namespace prt::bake;
+using Eigen::Vector2f;
+
+namespace {
+
+// The unit square (two triangles) with UVs scaled by s: at 8 × 8 texels and s = ½ it covers
+// texels x, y <= 4 (bake/mesh/texels.h: conservative).
+struct Square {
+  Mesh mesh = make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, "square");
+  UvSet uv;
+  explicit Square(float s, float second = 1) {
+    uv.name = "uv";
+    for (size_t t = 0; t < 2; ++t)
+      for (uint32_t v : mesh.triangles[t])
+        uv.corners.emplace_back((t == 1 ? second : 1.0f) * s * mesh.positions[v].x(),
+                                (t == 1 ? second : 1.0f) * s * mesh.positions[v].y());
+  }
+  TexelAtlas atlas(uint32_t n) const { return texel_atlas(mesh, build_topology(mesh), uv, n, n, "square"); }
+};
+
+} // namespace
+
+TEST(Lightmap, RowsLandOnTheirTexelsAndPaddingRingsTakeTheirNeighboursMean) {
+  const Square sq(0.5f);
+  const TexelAtlas a = sq.atlas(8);
+  ASSERT_EQ(a.samples.size(), 25u);
+  std::vector<double> rows;
+  for (const TexelSample& s : a.samples) rows.push_back(double(s.texel));  // each texel's own index
+  const Lightmap none = make_lightmap(a, rows, 1, {}, 0);
+  for (const TexelSample& s : a.samples) {
+    EXPECT_EQ(none.values[s.texel], double(s.texel));
+    EXPECT_EQ(none.state[s.texel], uint8_t(TexelState::Baked));
+  }
+  EXPECT_EQ(none.padded, 0u);
+
+  const Lightmap one = make_lightmap(a, rows, 1, {}, 1);
+  // Ring 1: x or y = 5, both <= 5: 11 texels.
+  EXPECT_EQ(one.padded, 11u);
+  // (5, 5) has one known neighbour, (4, 4) = texel 36; (5, 0) has (4, 0) and (4, 1): texels 4 and 12.
+  EXPECT_EQ(one.values[5 * 8 + 5], 36.0);
+  EXPECT_EQ(one.values[0 * 8 + 5], (4.0 + 12.0) / 2);
+  EXPECT_EQ(one.state[6 * 8 + 6], uint8_t(TexelState::Empty)) << "one ring only";
+
+  const Lightmap all = make_lightmap(a, rows, 1, {}, 8);
+  for (uint8_t s : all.state) EXPECT_NE(s, uint8_t(TexelState::Empty));
+  EXPECT_EQ(all.padded, 64u - 25u);
+}
+
+TEST(Lightmap, InvalidTexelsAreFilledFromTheirOwnChartOnly) {
+  // Two charts: triangle 0 at full scale, triangle 1 moved by scaling its UVs by 0.5 (a seam on
+  // the diagonal); at 8 × 8 texels they overlap in UV space near the origin, where texels belong to
+  // the first triangle that contains the centre.
+  const Square sq(1, 0.5f);
+  const TexelAtlas a = sq.atlas(8);
+  ASSERT_EQ(a.charts, 2u);
+  std::vector<double> rows;
+  std::vector<uint8_t> invalid;
+  for (const TexelSample& s : a.samples) {
+    rows.push_back(s.chart == 0 ? 10.0 : 20.0);
+    invalid.push_back(0);
+  }
+  // Invalidate one texel of each chart that has both charts among its neighbours.
+  size_t marked = 0;
+  for (size_t i = 0; i < a.samples.size() && marked < 2; ++i) {
+    const uint32_t x = a.samples[i].texel % 8, y = a.samples[i].texel / 8;
+    if (x > 0 && y > 0 && x < 7 && y < 7 && (marked == 0 ? a.samples[i].chart == 0 : a.samples[i].chart == 1)) {
+      invalid[i] = 1;
+      rows[i] = -1;  // the enclosed row: never to be seen
+      ++marked;
+    }
+  }
+  ASSERT_EQ(marked, 2u);
+  const Lightmap m = make_lightmap(a, rows, 1, invalid, 0);
+  EXPECT_EQ(m.filled, 2u);
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    if (!invalid[i]) continue;
+    EXPECT_EQ(m.values[a.samples[i].texel], a.samples[i].chart == 0 ? 10.0 : 20.0) << "filled from its own chart";
+  }
+}
