@@ -98,6 +98,31 @@ struct Report {
   bool operator==(const Report&) const = default;
 };
 
+// /mesh/uv (v5): the UV set a lightmap is baked in, per triangle corner [T][3][2] (u, v; v down
+// the image as glTF's TEXCOORD_n), and the set's name in the asset.
+struct Uvs {
+  std::vector<float> values;
+  std::optional<std::string> uv_set;
+  ExtraAttrs extra;
+  bool operator==(const Uvs&) const = default;
+};
+
+// /lightmap/... (v5): a vertex set's surface baked per texel of an H × W image (row 0 at v = 0).
+// `state` [H][W]: 0 empty (no triangle covers it), 1 baked, 2 filled (inside the geometry: from
+// its chart's valid neighbours), 3 padding (a chart's gutter); products as the per-vertex ones
+// with the vertex axis replaced by [H][W]; positions and normals of the texels' shade points
+// (world space; 0 where empty or padding).
+struct Lightmap {
+  uint64_t width = 0, height = 0;
+  Array<uint8_t> state;
+  std::optional<int64_t> padding;  // attribute of state
+  std::optional<Array<double>> positions;  // float32 on disk when exact, else float64 (as /mesh/positions)
+  std::optional<Array<float>> normals;
+  std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1, radiance_shadowed;
+  std::size_t texel_count() const noexcept { return std::size_t(width * height); }
+  bool operator==(const Lightmap&) const = default;
+};
+
 // A vertex set: the root layout or one scene object's /objects/<name>/... (SCHEMA.md).
 struct VertexSet {
   // [V][3], world space. Held in double; write_asset stores them as float32 when every
@@ -111,13 +136,15 @@ struct VertexSet {
   std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1;
   std::optional<Product> area_irradiance, area_sh;  // v3
   std::optional<Product> radiance_shadowed;         // v4
+  std::optional<Uvs> uv;                            // v5
+  std::optional<Lightmap> lightmap;                 // v5
   Report report;
 
   std::size_t vertex_count() const noexcept { return positions ? positions->values.size() / 3 : 0; }
   bool empty() const noexcept {
     return !positions && !normals && !triangles && !source_position && !ao && !transfer_diffuse &&
-           !transfer_visibility && !radiance_band1 && !area_irradiance && !area_sh && !radiance_shadowed &&
-           report.empty();
+           !transfer_visibility && !radiance_band1 && !area_irradiance && !area_sh && !radiance_shadowed && !uv &&
+           !lightmap && report.empty();
   }
   bool operator==(const VertexSet&) const = default;
 };

@@ -34,6 +34,18 @@ inline constexpr std::string_view kRadianceShadowed = "/radiance/shadowed";  // 
 inline constexpr std::string_view kAreaLightsGroup = "/area_lights";           // v3
 inline constexpr std::string_view kAreaIrradiance = "/area_lights/irradiance";  // [V][L]
 inline constexpr std::string_view kAreaSh = "/area_lights/sh";                  // [V][L][n*n]
+// v5: the lightmap of a vertex set (per-texel bakes): the UV set per triangle corner, the texels'
+// state, surface points and products, images of H × W texels (row 0 at v = 0).
+inline constexpr std::string_view kUv = "/mesh/uv";                                  // float32 [T][3][2]
+inline constexpr std::string_view kLightmapGroup = "/lightmap";
+inline constexpr std::string_view kLightmapState = "/lightmap/state";                // uint8 [H][W]: 0 empty, 1 baked, 2 filled, 3 padding
+inline constexpr std::string_view kLightmapPositions = "/lightmap/positions";        // float32/64 [H][W][3], world space
+inline constexpr std::string_view kLightmapNormals = "/lightmap/normals";            // float32 [H][W][3]
+inline constexpr std::string_view kLightmapAo = "/lightmap/ao";                      // float32 [H][W]
+inline constexpr std::string_view kLightmapTransferDiffuse = "/lightmap/transfer/diffuse";        // [H][W][L*L]
+inline constexpr std::string_view kLightmapTransferVisibility = "/lightmap/transfer/visibility";  // [H][W][L*L]
+inline constexpr std::string_view kLightmapRadianceBand1 = "/lightmap/radiance/band1";            // [H][W][3][3]
+inline constexpr std::string_view kLightmapRadianceShadowed = "/lightmap/radiance/shadowed";      // [H][W][3][L*L]
 // ---- FIV datasets ----
 inline constexpr std::string_view kFivEnvironment = "/fiv/environment";
 inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";
@@ -70,6 +82,9 @@ inline constexpr std::string_view kIntegratorDescription = "integrator_descripti
 inline constexpr std::string_view kSamples = "samples";
 inline constexpr std::string_view kSeed = "seed";
 inline constexpr std::string_view kVisibility = "visibility";
+// ---- lightmap attributes (v5) ----
+inline constexpr std::string_view kUvSet = "uv_set";    // on /mesh/uv: the set's name in the asset ("TEXCOORD_1", "vt")
+inline constexpr std::string_view kPadding = "padding";  // on /lightmap/state: gutter rings, in texels
 
 // ---- FIV attributes ----
 inline constexpr std::string_view kFaceConvention = "face_convention";
