@@ -135,11 +135,11 @@ TEST(CliMessages, UnknownCommandsAndOptionsGetTheNearestName) {
   };
   const Case exact[] = {
       {"bake m.obj -o o.prt.h5",
-       "prtbake: unknown command 'bake': the commands are vertex, fiv, scene and export (try 'prtbake --help')\n"},
+       "prtbake: unknown command 'bake': the commands are vertex, texel, fiv, scene and export (try 'prtbake --help')\n"},
       {"vertx m.obj --ao -o o.prt.h5",
-       "prtbake: unknown command 'vertx'; did you mean 'vertex'? (the commands are vertex, fiv, scene and export) "
+       "prtbake: unknown command 'vertx'; did you mean 'vertex'? (the commands are vertex, texel, fiv, scene and export) "
        "(try 'prtbake --help')\n"},
-      {"", "prtbake: no command given (the commands are vertex, fiv, scene and export) (try 'prtbake --help')\n"},
+      {"", "prtbake: no command given (the commands are vertex, texel, fiv, scene and export) (try 'prtbake --help')\n"},
       {"vertex m.obj --ao -o o.prt.h5 --radiancee e.exr",
        "prtbake: vertex: unknown option '--radiancee'; did you mean --radiance? (try 'prtbake vertex --help')\n"},
       {"vertex m.obj --ao -o o.prt.h5 --environment=e.exr",

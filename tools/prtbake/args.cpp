@@ -30,6 +30,16 @@ constexpr const char* kVertexHelp =
     "(position, normal) pair, and /mesh/source_position says which file vertex each row is.\n"
     "Give at least one of the products.";
 
+constexpr const char* kTexelHelp =
+    "Bakes the per-vertex products per texel of a lightmap: every texel of a W x H atlas that\n"
+    "MESH covers through its lightmap UV set (glTF TEXCOORD_1, else its only set; --uv names one)\n"
+    "gets a shade point on the surface (the texel centre, or the nearest point of the triangles\n"
+    "that touch the texel), baked like a vertex. Texels inside the geometry (under a box standing\n"
+    "on the floor) are found exactly and filled from their chart's neighbours, and each chart is\n"
+    "padded into its gutter, so bilinear filtering never reads an empty texel. Written as\n"
+    "/lightmap/... images [H][W][...] beside the mesh and its UVs (/mesh/uv), format version 5.\n"
+    "Give at least one of the products.";
+
 constexpr const char* kFivHelp =
     "Bakes an occluder's Fullsphere Irradiance Vectors (paper 004): the environment's FIV\n"
     "F_env = Int L w dw, the diffuse irradiance cube map (DifMap) E(n) = Int L H (n.w) dw (exact,\n"
@@ -57,6 +67,7 @@ constexpr const char* kSceneHelp =
 // One line per command: the top-level --help and the message for an unknown command.
 const std::vector<tool::Command> kCommands = {
     {"vertex", "per-vertex products of a mesh: AO, SH transfer, visibility, band-1 and shadowed radiance"},
+    {"texel", "the same products per texel of a lightmap, through the mesh's lightmap UVs"},
     {"fiv", "an occluder's Fullsphere Irradiance Vectors on shells around it, and the DifMap"},
     {"scene", "a scene file or glTF: bakes what each object needs and says what it leaves out, and why"},
     {"export", "a baked file as glTF, plain binary, or Unity / Godot / Filament light probes"},
@@ -183,9 +194,36 @@ std::string silhouette_k_help(bool with_default) {
          (with_default ? "; default " + std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2" : "");
 }
 
-void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
-  CLI::App& cmd = *app.add_subcommand("vertex", kVertexHelp);
+// `name`: "vertex", or "texel" (the same products per texel of a lightmap).
+void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& command = "vertex") {
+  const bool texel = command == "texel";
+  CLI::App& cmd = *app.add_subcommand(command, texel ? kTexelHelp : kVertexHelp);
   cmd.add_option("MESH", a.input, "the mesh (OBJ, PLY, OFF, STL, glTF, GLB; a glTF's primitive\ninstances are concatenated in node order)")->required()->type_name("");
+  if (texel) {
+    cmd.add_option_function<std::string>(
+           "--resolution",
+           [&a](const std::string& text) {
+             unsigned w = 0, h = 0;
+             char x = 0, rest = 0;
+             const int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &rest);
+             if (n == 1) h = w;
+             else if (n != 3 || x != 'x') throw CLI::ValidationError("--resolution", "expects N or WxH, got '" + text + "'");
+             if (w < 1 || h < 1 || w > 8192 || h > 8192)
+               throw CLI::ValidationError("--resolution", "each side must be 1 to 8192 texels, got '" + text + "'");
+             a.lightmap_width = w;
+             a.lightmap_height = h;
+           },
+           "the lightmap's texels: N (N x N) or WxH, each 1 to 8192")
+        ->option_text("N|WxH")
+        ->required();
+    cmd.add_option("--uv", a.uv_set,
+                   "the UV set to bake in, by its name in the asset (TEXCOORD_1, vt);\n"
+                   "default: TEXCOORD_1 when the mesh has it, else its only set")
+        ->option_text("NAME");
+    cmd.add_option("--padding", a.padding, "gutter rings each chart is dilated into, in texels (default 2)")
+        ->option_text("P")
+        ->check(tool::integer_in(0, 64));
+  }
   add_output(cmd, a);
   const std::string products = "Products (at least one)";
   cmd.add_flag("--ao", a.ao, "ambient occlusion  A = 1/pi * Int V H (n.w) dw, in [0,1]")->group(products);
@@ -277,8 +315,9 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples) {
                "with a target error: print the pilot's table (each run's error and\n"
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
-  tool::add_shard_options(cmd, a.shard, "vertices");
-  cmd.footer(std::string(kVertexExamples) + tool::kExitStatusHelp);
+  if (!texel) tool::add_shard_options(cmd, a.shard, "vertices");
+  cmd.footer(texel ? std::string("Example:\n  prtbake texel scene.glb --resolution 512 --ao -o scene.prt.h5\n\n") + tool::kExitStatusHelp
+                   : std::string(kVertexExamples) + tool::kExitStatusHelp);
 }
 
 void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
@@ -387,7 +426,7 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
            " is a JSON scene file, whose own \"bake\" section holds the options");
     return;
   }
-  if (a.command == "vertex") {
+  if (a.command == "vertex" || a.command == "texel") {
     a.integrator_given = cmd.count("--integrator") > 0;
     const bool target_given = a.target_error > 0;
     if (target_given && samples != 0)
@@ -424,6 +463,7 @@ std::optional<Args> parse(int argc, char** argv, const tool::MpiSession& mpi) {
   app.set_version_flag("--version", std::string("prtbake ") + kToolkitVersion);
   app.get_formatter()->column_width(24);
   add_vertex(app, a, samples);
+  add_vertex(app, a, samples, "texel");
   add_fiv(app, a, samples);
   add_scene(app, a);
   tool::add_export(app, a.exported);

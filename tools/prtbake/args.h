@@ -16,7 +16,7 @@
 namespace prt::tool {
 
 struct Args {
-  std::string command;      // vertex, fiv, scene or export
+  std::string command;      // vertex, texel, fiv, scene or export
   std::string input;        // the mesh (vertex), the occluder (fiv) or the scene file or glTF (scene)
   std::string scene_options;  // scene: a glTF scene's options file (--options)
   std::string output;       // the .prt.h5 file
@@ -28,6 +28,11 @@ struct Args {
   bake::IntegratorSpec integrator;
   bake::ShellSpec shell_spec;  // fiv
   bool report_given = false;  // scene: --report overrides the scene file's
+  // texel: the lightmap's texels (--resolution W[xH]), the UV set (--uv; empty: the default rule
+  // of run_texel.cpp) and the gutter rings (--padding).
+  uint32_t lightmap_width = 0, lightmap_height = 0;
+  std::string uv_set;
+  uint32_t padding = 2;
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;

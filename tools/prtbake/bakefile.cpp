@@ -124,6 +124,48 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
   }
 }
 
+void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& uv, const bake::TexelAtlas& atlas,
+                  const bake::Lightmap& image, const bake::ProductLayout& layout, const ProductInfo& info,
+                  uint32_t padding) {
+  F::Uvs& u = set.uv.emplace();
+  u.uv_set = uv.name;
+  for (const Eigen::Vector2f& c : uv.corners) u.values.insert(u.values.end(), {c.x(), c.y()});
+  F::Lightmap& m = set.lightmap.emplace();
+  m.width = image.width;
+  m.height = image.height;
+  m.state.values = image.state;
+  m.padding = int64_t(padding);
+  const size_t texels = size_t(image.width) * image.height;
+  F::Array<double>& positions = m.positions.emplace();
+  F::Array<float>& normals = m.normals.emplace();
+  positions.values.assign(3 * texels, 0.0);
+  normals.values.assign(3 * texels, 0.0f);
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const size_t k = atlas.samples[i].texel;
+    const bake::ShadePoint& p = atlas.receivers.points[i];
+    const Eigen::Vector3d world = bake::add_origin(mesh.origin, p.p);
+    for (int c = 0; c < 3; ++c) {
+      positions.values[3 * k + size_t(c)] = world[c];
+      normals.values[3 * k + size_t(c)] = float(p.n[c]);
+    }
+  }
+  // The products as images: one row per texel, through the per-vertex layout and attributes.
+  bake::VertexBake rows;
+  rows.layout = layout;
+  rows.values = image.values;
+  F::VertexSet products;
+  set_products(products, rows, info);
+  m.ao = std::move(products.ao);
+  m.transfer_diffuse = std::move(products.transfer_diffuse);
+  m.transfer_visibility = std::move(products.transfer_visibility);
+  m.radiance_band1 = std::move(products.radiance_band1);
+  m.radiance_shadowed = std::move(products.radiance_shadowed);
+  for (std::optional<F::Product>* p : {&m.radiance_band1, &m.radiance_shadowed})
+    if (*p && (*p)->integrand)
+      if (const size_t at = (*p)->integrand->find("[vertex]"); at != std::string::npos)
+        (*p)->integrand->replace(at, 8, "[row][col]");
+}
+
 F::Light light_of(const bake::AreaLight& light) {
   F::Light l;
   l.name = light.name;

@@ -6,6 +6,8 @@
 
 #include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
+#include <bake/bake/lightmap.h>
+#include <bake/mesh/texels.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
 #include <bake/lights/lights.h>
@@ -32,6 +34,14 @@ struct ProductInfo {
 };
 // ao, transfer_diffuse, transfer_visibility, radiance_band1: whatever the layout holds.
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info);
+
+// The lightmap of a texel bake (format v5): /mesh/uv from the UV set, /lightmap/state from the
+// image's texel states (its `padding`), the texels' shade points as world positions and normals
+// (0 where empty or padding), and the products as images (set_products' layout and attributes,
+// rows = texels in row-major order).
+void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& uv, const bake::TexelAtlas& atlas,
+                  const bake::Lightmap& image, const bake::ProductLayout& layout, const ProductInfo& info,
+                  uint32_t padding);
 
 // An area light as the file stores it (/lights/<name>: world-space faces, radiance, two_sided).
 F::Light light_of(const bake::AreaLight& light);

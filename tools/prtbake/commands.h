@@ -3,6 +3,7 @@
 // once, and calls the command's run_*; each returns the exit code (tool_main.h) or throws.
 #pragma once
 
+#include <bake/bake/pipeline.h>
 #include <bake/core/progress.h>
 
 #include "args.h"
@@ -11,6 +12,7 @@
 
 #include <tbb/global_control.h>
 
+#include <functional>
 #include <optional>
 
 namespace prt::tool {
@@ -31,9 +33,22 @@ struct RunContext {
   const bake::Monitor progress;  // bar's, with tool::interrupt_token()
 };
 
+// The console and the file of a bake of receivers (vertex, texel; bake/bake/pipeline.h): hooks()
+// prints the choice, the products and integrator, the check and its verdict and the correction,
+// and writes the file (`write`) once the bake is whole and again with its report, so a check
+// cancelled with Ctrl-C, or one that costs more than the user will wait, never costs the bake.
+// `written` and `rebaking` say what the file holds when a Ctrl-C comes. The hooks refer to this
+// object: it must outlive the pipeline's run. A command adds its own `set_baked`.
+struct ReceiverConsole {
+  bool written = false;   // the file holds a bake
+  bool rebaking = false;  // a correction's rows are being made (the file holds the first bake and its report)
+  bake::PipelineHooks hooks(const Args& a, const RunContext& run, std::function<void()> write);
+};
+
 // The bakes. `shards`: emplaced when the bake is sharded, so that prtbake_main can report its
 // committed chunks on Ctrl-C (ShardedRows::kept_after_cancel).
 int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
+int run_texel(const Args& a, const RunContext& run);  // not sharded (yet)
 int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 

@@ -138,4 +138,104 @@ void write_file(const Args& a, const prt::formats::Asset& asset) {
   }
 }
 
+bake::Mesh load_receiver_mesh(const Args& a, bool say) {
+  bake::MeshLoadOptions mopt;
+  mopt.use_file_normals = a.file_normals;
+  mopt.flip_normals = a.flip_normals;
+  bake::Mesh mesh = bake::load_mesh(a.input, mopt);
+  print_warnings(mesh.warnings);
+  if (say)
+    std::printf("mesh: %s: %zu vertices, %zu triangles (%zu file positions, %zu faces), normals %s%s\n",
+                a.input.c_str(), mesh.positions.size(), mesh.triangles.size(), mesh.file_positions, mesh.file_faces,
+                mesh.normal_source == bake::Mesh::NormalSource::File ? "from the file" : "angle-weighted",
+                a.flip_normals ? ", flipped" : "");
+  if (say && mesh.origin != Eigen::Vector3d::Zero())  // far from the world origin (bake/mesh/mesh.h, ORIGIN)
+    std::printf("mesh: baked relative to its origin (%.17g, %.17g, %.17g); /mesh/positions holds world coordinates\n",
+                mesh.origin.x(), mesh.origin.y(), mesh.origin.z());
+  return mesh;
+}
+
+std::optional<bake::EnvMap> load_environment(const Args& a, bool say) {
+  std::optional<bake::EnvMap> env;
+  if (a.environment.empty()) return env;
+  env = bake::EnvMap::load(a.environment, a.up);
+  const auto& i = env->info();
+  if (say)
+    std::printf("environment: %s: %dx%d %s, luminance max %.4g / mean %.4g (%.0fx), %llu negative pixel values "
+                "clamped to 0 (min seen %.3g)\n",
+                a.environment.c_str(), i.width, i.height, i.layout.c_str(), i.max_luminance, i.mean_luminance,
+                i.mean_luminance > 0 ? i.max_luminance / i.mean_luminance : 0.0,
+                (unsigned long long)i.negative_pixels_clamped, i.min_value_seen);
+  return env;
+}
+
+bake::ProductRequest product_request(const Args& a, const bake::EnvMap* env) {
+  bake::ProductRequest req;
+  req.ao = a.ao;
+  req.transfer_order = a.transfer;
+  req.visibility_order = a.visibility;
+  req.radiance = env;
+  if (a.shadowed) req.shadowed = req.radiance, req.shadowed_order = a.shadowed;
+  return req;
+}
+
+void print_baking(const Args& a, const bake::BakeJob& job, int threads) {
+  std::printf("baking:");
+  if (a.ao) std::printf(" ao");
+  if (a.transfer) std::printf(" transfer/diffuse (order %d, %d coefficients)", a.transfer, a.transfer * a.transfer);
+  if (a.visibility) std::printf(" transfer/visibility (order %d, %d coefficients)", a.visibility, a.visibility * a.visibility);
+  if (!a.environment.empty()) std::printf(" radiance/band1 (3x3)");
+  if (a.shadowed) std::printf(" radiance/shadowed (order %d, 3x%d)", a.shadowed, a.shadowed * a.shadowed);
+  std::printf("\nintegrator: %s; %d threads; setup (ray/contour BVHs, tables) %.2f s\n", job.integrator_description.c_str(),
+              threads, job.setup_seconds);
+  std::fflush(stdout);
+}
+
+void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads) {
+  const bake::VertexBake& result = job.rows.front();
+  const size_t n = job.sets.front().points.size();
+  std::printf("baked %zu %s in %.2f s (%.0f integrals/s)\n", n, job.sets.front().rows_noun, result.seconds,
+              double(n) / result.seconds);
+  if (const std::string work = job.integrator->work_summary(); !work.empty()) std::printf("%s\n", work.c_str());
+  if (shards_without_threads)
+    std::printf("chunks: %.2f CPU s in the integrator over %.2f s of chunk wall time, summed over the chunks of "
+                "every worker and run\n",
+                result.cpu_seconds, result.seconds);
+  else
+    std::printf("threads busy %.0f%% of the bake (%.2f CPU s in the integrator over %.2f s on %d thread%s)\n",
+                100 * result.busy_fraction(), result.cpu_seconds, result.seconds, result.threads,
+                result.threads == 1 ? "" : "s");
+}
+
+void print_error_report(const bake::BakeJob& job) {
+  const bake::ErrorReport& report = *job.reports.front();
+  std::printf("error against a %u-ray QMC reference on %zu seeded %s (reference took %.2f s, not "
+              "counted in the bake time):\n",
+              job.spec.reference_rays(), report.vertices.size(), job.sets.front().rows_noun, report.reference_seconds);
+  // The bake's own standard error is a sampled integrator's estimate; a deterministic one
+  // (silhouette: its error is a bias, which only the comparison measures) has none to print.
+  const bool sampled =
+      std::any_of(report.products.begin(), report.products.end(), [](const auto& e) { return e.bake_std_error > 0; });
+  for (const auto& e : report.products) {
+    std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse, e.max_abs,
+                e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
+    if (sampled) std::printf("bake's estimated std. error %.3e; ", e.bake_std_error);
+    std::printf("the reference's own std. error %.3e, %s)\n", e.reference_std_error,
+                report.reference_noise_measured ? "measured from its two halves" : "QMC's estimate");
+  }
+}
+
+void print_target_verdict(const bake::BakeJob& job, double target) {
+  for (const std::string& line :
+       bake::target_check_lines(*job.pooled, target, job.reference_plan ? &*job.reference_plan : nullptr))
+    std::printf("%s\n", line.c_str());
+}
+
+void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better) {
+  std::printf("the check puts the bake's error above the target: baking again with %s at %s (was %s; the "
+              "pilot's rate from the check's measured error; once)\n",
+              bake::to_string(better.kind), better.knob_text().c_str(), job.spec.knob_text().c_str());
+  std::fflush(stdout);
+}
+
 } // namespace prt::tool

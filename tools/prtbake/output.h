@@ -5,12 +5,14 @@
 
 #include <bake/bake/choose.h>
 #include <bake/bake/diagnostics.h>
+#include <bake/bake/pipeline.h>
 #include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 
 #include "args.h"
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,25 @@ void warn_unreached(const bake::IntegratorChoice& choice, const std::string& obj
 
 // The error report's reference for a target (bake/bake/choose.h plan_report_reference), with -v.
 void print_reference_plan(const bake::ReferencePlan& plan);
+
+// The mesh of prtbake vertex and texel (--no-file-normals, --flip-normals), its warnings printed,
+// and (with `say`) one line on it.
+bake::Mesh load_receiver_mesh(const Args& a, bool say);
+// --radiance's environment (none without it), and (with `say`) one line on it.
+std::optional<bake::EnvMap> load_environment(const Args& a, bool say);
+// The products the command line asks for (--ao, --transfer, --visibility, --radiance, --shadowed).
+bake::ProductRequest product_request(const Args& a, const bake::EnvMap* env);
+
+// What a bake of receivers (prtbake vertex, texel; bake/bake/pipeline.h) says as it goes, on
+// stdout: the products and the integrator once it is made (`rows`: "vertices", "texels"); the
+// rows baked, the integrator's own work and the threads' use; the error report; the target's
+// verdict; the correction. `shards_without_threads`: the rows came from chunks of other workers
+// or runs, whose threads are not recorded.
+void print_baking(const Args& a, const bake::BakeJob& job, int threads);
+void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
+void print_error_report(const bake::BakeJob& job);
+void print_target_verdict(const bake::BakeJob& job, double target);
+void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better);
 
 // The root attributes every file carries (formats/SCHEMA.md).
 prt::formats::RootInfo root_info(const Args& a, const std::string& source_sha);

@@ -1,0 +1,149 @@
+// tools/prtbake/run_texel.cpp — `prtbake texel` (commands.h): the products of `prtbake vertex` per
+// texel of a lightmap. The mesh's lightmap UV set gives the atlas's texels and their shade points
+// (bake/mesh/texels.h); texels inside the geometry are found (bake/visibility/enclosure.h) and
+// left out of the bake; the rest are one job of the bake pipeline (bake/bake/pipeline.h), as a
+// vertex bake's vertices are; the rows become a lightmap image, filled and padded
+// (bake/bake/lightmap.h), written as /lightmap/... beside the mesh (format v5).
+#include <bake/bake/lightmap.h>
+#include <bake/bake/pipeline.h>
+#include <bake/core/error.h>
+#include <bake/environment/envmap.h>
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/texels.h>
+#include <bake/visibility/accel.h>
+#include <bake/visibility/enclosure.h>
+#include <formats/asset.h>
+
+#include "bakefile.h"
+#include "commands.h"
+#include "output.h"
+#include "tool_main.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace prt::tool {
+namespace {
+
+// The UV set to bake in: --uv's, else TEXCOORD_1 (glTF's lightmap set by convention), else the
+// mesh's only set. InputError naming the mesh and its sets otherwise.
+const bake::UvSet& lightmap_uvs(const bake::Mesh& mesh, const std::string& wanted) {
+  std::string names;
+  for (const bake::UvSet& s : mesh.uv_sets) names += (names.empty() ? "" : ", ") + s.name;
+  auto find = [&](const std::string& name) -> const bake::UvSet* {
+    for (const bake::UvSet& s : mesh.uv_sets)
+      if (s.name == name) return &s;
+    return nullptr;
+  };
+  if (!wanted.empty()) {
+    if (const bake::UvSet* s = find(wanted)) return *s;
+    throw bake::InputError(mesh.source, "has no UV set '" + wanted + "'" +
+                                            (names.empty() ? std::string(" (it has none)") : " (it has " + names + ")"));
+  }
+  if (const bake::UvSet* s = find("TEXCOORD_1")) return *s;
+  if (mesh.uv_sets.size() == 1) return mesh.uv_sets.front();
+  if (mesh.uv_sets.empty())
+    throw bake::InputError(mesh.source, "has no UV set: a lightmap is baked in the mesh's lightmap UVs (glTF TEXCOORD_1, "
+                                        "OBJ vt); generating them is not implemented yet");
+  throw bake::InputError(mesh.source, "has several UV sets (" + names + ") and no TEXCOORD_1: name the lightmap's with --uv");
+}
+
+} // namespace
+
+int run_texel(const Args& a, const RunContext& run) {
+  const bake::Mesh mesh = load_receiver_mesh(a, run.say);
+  const bake::Topology topo = bake::build_topology(mesh);
+  warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
+  const bake::UvSet& uv = lightmap_uvs(mesh, a.uv_set);
+  const bake::TexelAtlas atlas = bake::texel_atlas(mesh, topo, uv, a.lightmap_width, a.lightmap_height, a.input);
+  if (atlas.samples.empty())
+    throw bake::InputError(mesh.source, "its UV set " + uv.name + " covers no texel of the " +
+                                            std::to_string(a.lightmap_width) + "x" + std::to_string(a.lightmap_height) +
+                                            " lightmap (are its UVs inside [0, 1]?)");
+  const std::optional<bake::EnvMap> env = load_environment(a, run.say);
+  const bake::ProductRequest req = product_request(a, env ? &*env : nullptr);
+  const bake::MeshAccel accel(mesh, topo);
+
+  // Texels inside the geometry: left out of the bake, filled from their chart afterwards.
+  std::vector<uint8_t> invalid(atlas.samples.size());
+  {
+    const std::shared_ptr<const bake::RayCaster> rays = accel.rays();
+    tbb::parallel_for(size_t(0), atlas.samples.size(),
+                      [&](size_t i) { invalid[i] = bake::enclosed(atlas.receivers.points[i], *rays); });
+  }
+  std::vector<size_t> valid;
+  for (size_t i = 0; i < invalid.size(); ++i)
+    if (!invalid[i]) valid.push_back(i);
+  if (run.say)
+    std::printf("lightmap: %ux%u texels in UV set %s: %zu covered (%zu by the nearest point of a triangle touching "
+                "the texel, not its centre), %u charts; %zu inside the geometry, filled from their charts\n",
+                atlas.width, atlas.height, uv.name.c_str(), atlas.samples.size(), atlas.texels_off_centre(), atlas.charts,
+                atlas.samples.size() - valid.size());
+
+  bake::PipelineSettings settings;
+  settings.integrator = a.integrator;
+  settings.target_error = a.target_error;
+  settings.integrator_given = a.integrator_given;
+  settings.counted_costs = a.reproducible;
+  settings.bake_stage = "baking texels";
+  std::vector<bake::BakeJob> jobs(1);
+  jobs[0].name = a.input;
+  jobs[0].request = req;
+  bake::ReceiverSet& set = jobs[0].sets.emplace_back();
+  set.name = a.input;
+  set.rows_noun = "texels";
+  for (size_t i : valid) set.points.push_back(atlas.receivers.points[i]);
+  bake::BakePipeline pipeline(mesh, topo, accel, std::move(settings), std::move(jobs));
+  const bake::BakeJob& job = pipeline.jobs().front();
+
+  namespace F = prt::formats;
+  auto write_bake = [&] {
+    const bake::VertexBake& result = job.rows.front();
+    const size_t W = result.layout.width;
+    std::vector<double> rows(atlas.samples.size() * W, 0.0);  // the invalid texels' rows: filled below
+    for (size_t r = 0; r < valid.size(); ++r)
+      std::copy_n(result.values.begin() + std::ptrdiff_t(r * W), W, rows.begin() + std::ptrdiff_t(valid[r] * W));
+    const bake::Lightmap image = bake::make_lightmap(atlas, rows, W, invalid, a.padding);
+    F::Asset asset;
+    asset.root = root_info(a, mesh.source_sha256);
+    tool::set_mesh(asset.vertices, mesh);
+    if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
+    tool::set_lightmap(asset.vertices, mesh, uv, atlas, image, result.layout,
+                       {job.integrator->name(), job.integrator_description, job.spec.samples(), job.spec.seed, a.transfer,
+                        a.visibility, env ? &*env : nullptr, a.environment},
+                       a.padding);
+    if (const auto& report = job.reports.front()) {
+      bake::ErrorReport by_texel = *report;  // its rows are valid texels: named by their texels
+      for (uint32_t& r : by_texel.vertices) r = atlas.samples[valid[r]].texel;
+      asset.vertices.report = tool::report_of(by_texel, result.seconds, valid.size(), a.reproducible);
+    }
+    tool::set_target_error(asset, a.target_error);
+    write_file(a, asset);
+    if (run.say && image.unfilled > 0)
+      std::printf("lightmap: %zu texels inside the geometry had no valid neighbour in their chart: left 0\n", image.unfilled);
+  };
+
+  ReceiverConsole console;
+  bake::PipelineHooks hooks = console.hooks(a, run, write_bake);
+  hooks.set_baked = [&](const bake::BakeJob& j, size_t) {
+    if (run.say) print_rows_baked(j, false);
+  };
+  try {
+    pipeline.run(run.progress, hooks);
+  } catch (const bake::Cancelled&) {
+    if (!console.written) throw;
+    std::fprintf(stderr,
+                 console.rebaking ? "prtbake: cancelled while baking again: %s holds the first bake and its error report\n"
+                                  : "prtbake: cancelled during the error check: %s holds the finished bake without its "
+                                    "error report (--report 0 skips the check)\n",
+                 a.output.c_str());
+    return tool::kExitCancelled;
+  }
+  return 0;
+}
+
+} // namespace prt::tool
