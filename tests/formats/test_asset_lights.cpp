@@ -9,6 +9,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <schema_refusal.h>
 
 #include <cmath>
 #include <functional>
@@ -16,6 +17,7 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::expect_refused;
 
 namespace {
 
@@ -69,16 +71,6 @@ Asset lit_asset() {
   return a;
 }
 
-// validate() of `f` must throw a FormatError whose message contains `part`.
-void expect_refused(const File& f, const std::string& part) {
-  try {
-    validate(f, "lit.prt.h5");
-    ADD_FAILURE() << "accepted; expected a refusal containing '" << part << "'";
-  } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).rfind("lit.prt.h5: ", 0), 0u) << e.what();
-  }
-}
 
 Dataset& dataset(File& f, const std::string& path) {
   for (Dataset& d : f.datasets)
