@@ -104,6 +104,10 @@ constexpr Field<ReportRow> kReportFields[] = {
     {N::kBakeSeconds, &ReportRow::bake_seconds},
     {N::kIntegralsPerSecond, &ReportRow::integrals_per_second}};
 
+constexpr Field<Uvs> kUvFields[] = {{N::kUvSet, &Uvs::uv_set}};
+
+constexpr Field<Lightmap> kStateFields[] = {{N::kPadding, &Lightmap::padding}};  // of /lightmap/state
+
 constexpr Field<FivEnvironment> kFivEnvironmentFields[] = {
     {N::kEnvironment, &FivEnvironment::environment},
     {N::kEnvironmentSha256, &FivEnvironment::environment_sha256},
@@ -176,8 +180,9 @@ void add_array(File& f, const std::string& path, std::vector<uint64_t> shape, Da
   f.datasets.push_back({path, std::move(shape), std::move(data), std::move(attrs)});
 }
 
-// ---- products -----------------------------------------------------------------------------
-// A product runs along [V], then along axes of its own (SCHEMA.md).
+// ---- products: per vertex and per texel ---------------------------------------------------
+// A product runs along [V] (per vertex) or [H, W] (per texel of a lightmap), then along axes of
+// its own, the same in both (SCHEMA.md).
 
 // The L*L width of an SH product (L = sh_order; else what its values give for `rows` rows).
 uint64_t sh_width(const Product& p, uint64_t rows) {
@@ -216,7 +221,14 @@ constexpr ProductSlot<VertexSet> kVertexProducts[] = {
     {N::kAreaIrradiance, DatasetKind::area_irradiance, &VertexSet::area_irradiance, light_axes},
     {N::kAreaSh, DatasetKind::area_sh, &VertexSet::area_sh, light_sh_axes}};
 
-// Writes the products `s` holds under `prefix`, each along `rows` (here [V]) and then its own axes.
+constexpr ProductSlot<Lightmap> kTexelProducts[] = {
+    {N::kLightmapAo, DatasetKind::lightmap_ao, &Lightmap::ao, no_axes},
+    {N::kLightmapTransferDiffuse, DatasetKind::lightmap_transfer_diffuse, &Lightmap::transfer_diffuse, sh_axes},
+    {N::kLightmapTransferVisibility, DatasetKind::lightmap_transfer_visibility, &Lightmap::transfer_visibility, sh_axes},
+    {N::kLightmapRadianceBand1, DatasetKind::lightmap_radiance_band1, &Lightmap::radiance_band1, rgb_m_axes},
+    {N::kLightmapRadianceShadowed, DatasetKind::lightmap_radiance_shadowed, &Lightmap::radiance_shadowed, rgb_sh_axes}};
+
+// Writes the products `s` holds under `prefix`, each along `rows` and then its own axes.
 template <class S>
 void add_products(File& f, const std::string& prefix, std::span<const ProductSlot<S>> slots, const S& s,
                   const std::vector<uint64_t>& rows) {
@@ -252,6 +264,18 @@ DatasetData positions_data(const std::vector<double>& values) {
   return std::vector<float>(values.begin(), values.end());
 }
 
+// A vertex set's lightmap (v5): the texels' state [H, W], which the others run along, their
+// surface points, then the products as a vertex set's.
+void add_lightmap(File& f, const std::string& prefix, const Lightmap& m) {
+  const std::vector<uint64_t> texels = {m.height, m.width};
+  add_array(f, cat(prefix, N::kLightmapState), texels, m.state.values, attrs_of<Lightmap>(m, kStateFields, m.state.extra));
+  if (m.positions)
+    add_array(f, cat(prefix, N::kLightmapPositions), {m.height, m.width, 3}, positions_data(m.positions->values),
+              m.positions->extra);
+  if (m.normals) add_array(f, cat(prefix, N::kLightmapNormals), {m.height, m.width, 3}, m.normals->values, m.normals->extra);
+  add_products<Lightmap>(f, prefix, kTexelProducts, m, texels);
+}
+
 void add_vertex_set(File& f, const std::string& prefix, const std::string& report_dir, const VertexSet& s) {
   const uint64_t V = s.vertex_count();
   if (s.positions) add_array(f, cat(prefix, N::kPositions), {V, 3}, positions_data(s.positions->values), s.positions->extra);
@@ -265,6 +289,10 @@ void add_vertex_set(File& f, const std::string& prefix, const std::string& repor
     add_array(f, cat(prefix, N::kSourcePosition), {s.source_position->values.size()}, s.source_position->values,
               s.source_position->extra);
   add_products<VertexSet>(f, prefix, kVertexProducts, s, {V});
+  if (s.uv)  // v5, after everything of version 4: a file without it keeps its bytes
+    add_array(f, cat(prefix, N::kUv), {s.uv->values.size() / 6, 3, 2}, s.uv->values,
+              attrs_of<Uvs>(*s.uv, kUvFields, s.uv->extra));
+  if (s.lightmap) add_lightmap(f, prefix, *s.lightmap);
   add_report(f, report_dir, s.report);
 }
 
@@ -351,6 +379,19 @@ template <class S> bool take_product(S& s, std::span<const ProductSlot<S>> slots
   return false;
 }
 
+void take_lightmap_dataset(Lightmap& m, DatasetKind kind, const Dataset& d) {
+  m.height = d.shape[0], m.width = d.shape[1];  // every lightmap dataset runs along [H, W] (validate)
+  switch (kind) {
+  case DatasetKind::lightmap_state:
+    m.state.values = values<uint8_t>(d);
+    take_attrs<Lightmap>(m, kStateFields, d.attrs, m.state.extra);
+    break;
+  case DatasetKind::lightmap_positions: m.positions = positions_of(d); break;
+  case DatasetKind::lightmap_normals: m.normals = array_of<float>(d); break;
+  default: take_product<Lightmap>(m, kTexelProducts, kind, d);
+  }
+}
+
 void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
   switch (kind) {
   case DatasetKind::positions: s.positions = positions_of(d); break;
@@ -360,7 +401,13 @@ void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
     break;
   case DatasetKind::triangles: s.triangles = array_of<uint32_t>(d); break;
   case DatasetKind::source_position: s.source_position = array_of<uint32_t>(d); break;
-  default: take_product<VertexSet>(s, kVertexProducts, kind, d);
+  case DatasetKind::uv:
+    s.uv.emplace().values = values<float>(d);
+    take_attrs<Uvs>(*s.uv, kUvFields, d.attrs, s.uv->extra);
+    break;
+  default:
+    if (take_product<VertexSet>(s, kVertexProducts, kind, d)) break;
+    if (is_lightmap_kind(kind)) take_lightmap_dataset(s.lightmap ? *s.lightmap : s.lightmap.emplace(), kind, d);
   }
 }
 

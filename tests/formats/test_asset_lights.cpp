@@ -51,7 +51,7 @@ Light box(const std::string& name) {  // two faces are enough for the model; geo
 // sorted order read_asset returns the lights in), SH at order 2.
 Asset lit_asset() {
   Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake scene s.json", "s.json", std::string(64, 'a'),
+  a.root = {kFormatVersionWithoutLightmaps, "test", "2024-01-02T03:04:05Z", "prtbake scene s.json", "s.json", std::string(64, 'a'),
             "y", "real orthonormal", {}};
   SceneObject& o = a.objects.emplace_back();
   o.name = "ground";
@@ -103,7 +103,7 @@ TEST(AssetLights, EveryFieldSurvivesWriteRead) {
   const Asset a = lit_asset();
   write_asset(dir / "a.prt.h5", a);
   const Asset b = read_asset(dir / "a.prt.h5");
-  EXPECT_EQ(b.root.format_version, kFormatVersion);
+  EXPECT_EQ(b.root.format_version, kFormatVersionWithoutLightmaps);
   ASSERT_EQ(b.lights.size(), 2u);
   EXPECT_EQ(b.lights[1], a.lights[1]);
   EXPECT_EQ(b.lights[0], a.lights[0]);  // with the extras of its group and its vertices dataset

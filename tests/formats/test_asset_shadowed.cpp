@@ -41,7 +41,7 @@ VertexSet vertex_set() {
 
 Asset asset(bool scene) {
   Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
+  a.root = {kFormatVersionWithoutLightmaps, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
             "y", "real orthonormal", {}};
   if (!scene) {
     a.vertices = vertex_set();
