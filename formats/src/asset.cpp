@@ -104,6 +104,10 @@ constexpr Field<ReportRow> kReportFields[] = {
     {N::kBakeSeconds, &ReportRow::bake_seconds},
     {N::kIntegralsPerSecond, &ReportRow::integrals_per_second}};
 
+constexpr Field<Uvs> kUvFields[] = {{N::kUvSet, &Uvs::uv_set}};
+
+constexpr Field<Lightmap> kStateFields[] = {{N::kPadding, &Lightmap::padding}};  // of /lightmap/state
+
 constexpr Field<FivEnvironment> kFivEnvironmentFields[] = {
     {N::kEnvironment, &FivEnvironment::environment},
     {N::kEnvironmentSha256, &FivEnvironment::environment_sha256},
@@ -176,23 +180,67 @@ void add_array(File& f, const std::string& path, std::vector<uint64_t> shape, Da
   f.datasets.push_back({path, std::move(shape), std::move(data), std::move(attrs)});
 }
 
-// `trailing`: the shape after the vertex axis ([] for /ao, [L*L] for transfer, [3, 3] for band1).
-void add_product(File& f, const std::string& path, const std::optional<Product>& p, uint64_t V,
-                 const std::vector<uint64_t>& trailing) {
-  if (!p) return;
-  std::vector<uint64_t> shape(1 + trailing.size(), V);
-  std::copy(trailing.begin(), trailing.end(), shape.begin() + 1);
-  add_array(f, path, std::move(shape), p->values, attrs_of<Product>(*p, kProductFields, p->extra));
-}
+// ---- products: per vertex and per texel ---------------------------------------------------
+// A product runs along [V] (per vertex) or [H, W] (per texel of a lightmap), then along axes of
+// its own, the same in both (SCHEMA.md).
 
 // The L*L width of an SH product (L = sh_order; else what its values give for `rows` rows).
-uint64_t sh_width(const std::optional<Product>& p, uint64_t rows) {
-  if (p->sh_order) return uint64_t(*p->sh_order * *p->sh_order);
-  return rows ? p->values.size() / rows : 0;
+uint64_t sh_width(const Product& p, uint64_t rows) {
+  if (p.sh_order) return uint64_t(*p.sh_order * *p.sh_order);
+  return rows ? p.values.size() / rows : 0;
 }
-std::vector<uint64_t> sh_shape(const std::optional<Product>& p, uint64_t V) {
-  if (!p) return {};
-  return {sh_width(p, V)};
+uint64_t light_count(const Product& p) { return p.lights ? uint64_t(split_light_list(*p.lights).size()) : 0; }
+
+// A product's own axes, for `n` rows.
+using OwnAxes = std::vector<uint64_t> (*)(const Product& p, uint64_t n);
+std::vector<uint64_t> no_axes(const Product&, uint64_t) { return {}; }
+std::vector<uint64_t> sh_axes(const Product& p, uint64_t n) { return {sh_width(p, n)}; }
+std::vector<uint64_t> rgb_m_axes(const Product&, uint64_t) { return {3, 3}; }
+std::vector<uint64_t> rgb_sh_axes(const Product& p, uint64_t n) { return {3, sh_width(p, 3 * n)}; }
+std::vector<uint64_t> light_axes(const Product& p, uint64_t) { return {light_count(p)}; }
+std::vector<uint64_t> light_sh_axes(const Product& p, uint64_t n) {
+  const uint64_t L = light_count(p);
+  return {L, sh_width(p, n * L)};
+}
+
+// Where a product of S lives: its path under the vertex set, its kind, its member, its own axes.
+template <class S> struct ProductSlot {
+  std::string_view path;
+  DatasetKind kind;
+  std::optional<Product> S::*member;
+  OwnAxes own;
+};
+
+// In the order they are written.
+constexpr ProductSlot<VertexSet> kVertexProducts[] = {
+    {N::kAo, DatasetKind::ao, &VertexSet::ao, no_axes},
+    {N::kTransferDiffuse, DatasetKind::transfer_diffuse, &VertexSet::transfer_diffuse, sh_axes},
+    {N::kTransferVisibility, DatasetKind::transfer_visibility, &VertexSet::transfer_visibility, sh_axes},
+    {N::kRadianceBand1, DatasetKind::radiance_band1, &VertexSet::radiance_band1, rgb_m_axes},
+    {N::kRadianceShadowed, DatasetKind::radiance_shadowed, &VertexSet::radiance_shadowed, rgb_sh_axes},
+    {N::kAreaIrradiance, DatasetKind::area_irradiance, &VertexSet::area_irradiance, light_axes},
+    {N::kAreaSh, DatasetKind::area_sh, &VertexSet::area_sh, light_sh_axes}};
+
+constexpr ProductSlot<Lightmap> kTexelProducts[] = {
+    {N::kLightmapAo, DatasetKind::lightmap_ao, &Lightmap::ao, no_axes},
+    {N::kLightmapTransferDiffuse, DatasetKind::lightmap_transfer_diffuse, &Lightmap::transfer_diffuse, sh_axes},
+    {N::kLightmapTransferVisibility, DatasetKind::lightmap_transfer_visibility, &Lightmap::transfer_visibility, sh_axes},
+    {N::kLightmapRadianceBand1, DatasetKind::lightmap_radiance_band1, &Lightmap::radiance_band1, rgb_m_axes},
+    {N::kLightmapRadianceShadowed, DatasetKind::lightmap_radiance_shadowed, &Lightmap::radiance_shadowed, rgb_sh_axes}};
+
+// Writes the products `s` holds under `prefix`, each along `rows` and then its own axes.
+template <class S>
+void add_products(File& f, const std::string& prefix, std::span<const ProductSlot<S>> slots, const S& s,
+                  const std::vector<uint64_t>& rows) {
+  const uint64_t n = shape_product(rows);
+  for (const ProductSlot<S>& slot : slots) {
+    const std::optional<Product>& p = s.*slot.member;
+    if (!p) continue;
+    std::vector<uint64_t> shape = rows;
+    const std::vector<uint64_t> own = slot.own(*p, n);
+    shape.insert(shape.end(), own.begin(), own.end());
+    add_array(f, cat(prefix, slot.path), std::move(shape), p->values, attrs_of<Product>(*p, kProductFields, p->extra));
+  }
 }
 
 std::vector<Attr> row_attrs(const ReportRow& r) { return attrs_of<ReportRow>(r, kReportFields, r.extra); }
@@ -216,6 +264,18 @@ DatasetData positions_data(const std::vector<double>& values) {
   return std::vector<float>(values.begin(), values.end());
 }
 
+// A vertex set's lightmap (v5): the texels' state [H, W], which the others run along, their
+// surface points, then the products as a vertex set's.
+void add_lightmap(File& f, const std::string& prefix, const Lightmap& m) {
+  const std::vector<uint64_t> texels = {m.height, m.width};
+  add_array(f, cat(prefix, N::kLightmapState), texels, m.state.values, attrs_of<Lightmap>(m, kStateFields, m.state.extra));
+  if (m.positions)
+    add_array(f, cat(prefix, N::kLightmapPositions), {m.height, m.width, 3}, positions_data(m.positions->values),
+              m.positions->extra);
+  if (m.normals) add_array(f, cat(prefix, N::kLightmapNormals), {m.height, m.width, 3}, m.normals->values, m.normals->extra);
+  add_products<Lightmap>(f, prefix, kTexelProducts, m, texels);
+}
+
 void add_vertex_set(File& f, const std::string& prefix, const std::string& report_dir, const VertexSet& s) {
   const uint64_t V = s.vertex_count();
   if (s.positions) add_array(f, cat(prefix, N::kPositions), {V, 3}, positions_data(s.positions->values), s.positions->extra);
@@ -228,20 +288,11 @@ void add_vertex_set(File& f, const std::string& prefix, const std::string& repor
   if (s.source_position)
     add_array(f, cat(prefix, N::kSourcePosition), {s.source_position->values.size()}, s.source_position->values,
               s.source_position->extra);
-  add_product(f, cat(prefix, N::kAo), s.ao, V, {});
-  add_product(f, cat(prefix, N::kTransferDiffuse), s.transfer_diffuse, V, sh_shape(s.transfer_diffuse, V));
-  add_product(f, cat(prefix, N::kTransferVisibility), s.transfer_visibility, V, sh_shape(s.transfer_visibility, V));
-  add_product(f, cat(prefix, N::kRadianceBand1), s.radiance_band1, V, {3, 3});
-  if (s.radiance_shadowed)
-    add_product(f, cat(prefix, N::kRadianceShadowed), s.radiance_shadowed, V, {3, sh_width(s.radiance_shadowed, 3 * V)});
-  const auto lights = [](const std::optional<Product>& p) {
-    return p && p->lights ? uint64_t(split_light_list(*p->lights).size()) : uint64_t(0);
-  };
-  add_product(f, cat(prefix, N::kAreaIrradiance), s.area_irradiance, V, {lights(s.area_irradiance)});
-  if (s.area_sh) {
-    const uint64_t L = lights(s.area_sh);
-    add_product(f, cat(prefix, N::kAreaSh), s.area_sh, V, {L, sh_width(s.area_sh, V * L)});
-  }
+  add_products<VertexSet>(f, prefix, kVertexProducts, s, {V});
+  if (s.uv)  // v5, after everything of version 4: a file without it keeps its bytes
+    add_array(f, cat(prefix, N::kUv), {s.uv->values.size() / 6, 3, 2}, s.uv->values,
+              attrs_of<Uvs>(*s.uv, kUvFields, s.uv->extra));
+  if (s.lightmap) add_lightmap(f, prefix, *s.lightmap);
   add_report(f, report_dir, s.report);
 }
 
@@ -312,26 +363,51 @@ std::string_view after(std::string_view path, std::string_view prefix) {
   return path.starts_with(prefix) ? path.substr(prefix.size()) : std::string_view();
 }
 
+// Positions as the model holds them (positions_data's inverse): float32 widened exactly, or float64.
+Array<double> positions_of(const Dataset& d) {
+  if (const auto* f = std::get_if<std::vector<float>>(&d.data)) return {{f->begin(), f->end()}, d.attrs};
+  return array_of<double>(d);
+}
+
+// Puts `d` into the product of `s` its kind names; false when it is no product of S.
+template <class S> bool take_product(S& s, std::span<const ProductSlot<S>> slots, DatasetKind kind, const Dataset& d) {
+  for (const ProductSlot<S>& slot : slots)
+    if (slot.kind == kind) {
+      s.*slot.member = product_of(d);
+      return true;
+    }
+  return false;
+}
+
+void take_lightmap_dataset(Lightmap& m, DatasetKind kind, const Dataset& d) {
+  m.height = d.shape[0], m.width = d.shape[1];  // every lightmap dataset runs along [H, W] (validate)
+  switch (kind) {
+  case DatasetKind::lightmap_state:
+    m.state.values = values<uint8_t>(d);
+    take_attrs<Lightmap>(m, kStateFields, d.attrs, m.state.extra);
+    break;
+  case DatasetKind::lightmap_positions: m.positions = positions_of(d); break;
+  case DatasetKind::lightmap_normals: m.normals = array_of<float>(d); break;
+  default: take_product<Lightmap>(m, kTexelProducts, kind, d);
+  }
+}
+
 void take_vertex_dataset(VertexSet& s, DatasetKind kind, const Dataset& d) {
   switch (kind) {
-  case DatasetKind::positions:  // float32 widened exactly, or float64
-    if (const auto* f = std::get_if<std::vector<float>>(&d.data)) s.positions = Array<double>{{f->begin(), f->end()}, d.attrs};
-    else s.positions = array_of<double>(d);
-    break;
+  case DatasetKind::positions: s.positions = positions_of(d); break;
   case DatasetKind::normals:
     s.normals.emplace().values = values<float>(d);
     take_attrs<Normals>(*s.normals, kNormalsFields, d.attrs, s.normals->extra);
     break;
   case DatasetKind::triangles: s.triangles = array_of<uint32_t>(d); break;
   case DatasetKind::source_position: s.source_position = array_of<uint32_t>(d); break;
-  case DatasetKind::ao: s.ao = product_of(d); break;
-  case DatasetKind::transfer_diffuse: s.transfer_diffuse = product_of(d); break;
-  case DatasetKind::transfer_visibility: s.transfer_visibility = product_of(d); break;
-  case DatasetKind::radiance_band1: s.radiance_band1 = product_of(d); break;
-  case DatasetKind::radiance_shadowed: s.radiance_shadowed = product_of(d); break;
-  case DatasetKind::area_irradiance: s.area_irradiance = product_of(d); break;
-  case DatasetKind::area_sh: s.area_sh = product_of(d); break;
-  default: break;
+  case DatasetKind::uv:
+    s.uv.emplace().values = values<float>(d);
+    take_attrs<Uvs>(*s.uv, kUvFields, d.attrs, s.uv->extra);
+    break;
+  default:
+    if (take_product<VertexSet>(s, kVertexProducts, kind, d)) break;
+    if (is_lightmap_kind(kind)) take_lightmap_dataset(s.lightmap ? *s.lightmap : s.lightmap.emplace(), kind, d);
   }
 }
 

@@ -1,4 +1,4 @@
-// schema.cpp — schema v4 (formats/SCHEMA.md) as code: validate() is the single check that the
+// schema.cpp — schema v5 (formats/SCHEMA.md) as code: validate() is the single check that the
 // writer applies before writing and the reader applies after reading. Names: <formats/names.h>.
 #include <formats/names.h>
 #include <formats/prtfile.h>
@@ -63,12 +63,14 @@ std::string index_str(uint64_t flat, const std::vector<uint64_t>& shape) {
   return shape_str(idx);
 }
 
-// The dataset paths schema v4 allows, for messages.
+// The dataset paths schema v5 allows, for messages.
 std::string allowed_paths() {
   std::string s;
   for (std::string_view p : {N::kPositions, N::kNormals, N::kTriangles, N::kSourcePosition, N::kAo,
                              N::kTransferDiffuse, N::kTransferVisibility, N::kRadianceBand1, N::kRadianceShadowed, N::kAreaIrradiance,
-                             N::kAreaSh})
+                             N::kAreaSh, N::kUv, N::kLightmapState, N::kLightmapPositions, N::kLightmapNormals,
+                             N::kLightmapAo, N::kLightmapTransferDiffuse, N::kLightmapTransferVisibility,
+                             N::kLightmapRadianceBand1, N::kLightmapRadianceShadowed})
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
          std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
@@ -166,7 +168,13 @@ public:
         {N::kAo, Kind::ao},                         {N::kTransferDiffuse, Kind::transfer_diffuse},
         {N::kTransferVisibility, Kind::transfer_visibility}, {N::kRadianceBand1, Kind::radiance_band1},
         {N::kRadianceShadowed, Kind::radiance_shadowed},
-        {N::kAreaIrradiance, Kind::area_irradiance}, {N::kAreaSh, Kind::area_sh}};
+        {N::kAreaIrradiance, Kind::area_irradiance}, {N::kAreaSh, Kind::area_sh},
+        {N::kUv, Kind::uv},                         {N::kLightmapState, Kind::lightmap_state},
+        {N::kLightmapPositions, Kind::lightmap_positions}, {N::kLightmapNormals, Kind::lightmap_normals},
+        {N::kLightmapAo, Kind::lightmap_ao},        {N::kLightmapTransferDiffuse, Kind::lightmap_transfer_diffuse},
+        {N::kLightmapTransferVisibility, Kind::lightmap_transfer_visibility},
+        {N::kLightmapRadianceBand1, Kind::lightmap_radiance_band1},
+        {N::kLightmapRadianceShadowed, Kind::lightmap_radiance_shadowed}};
     for (const auto& [name, kind] : kVertexSet)
       if (local == name) return kind;
     if (object) return Kind::unknown;
@@ -208,6 +216,17 @@ public:
       fail("dataset '" + d.path + "' has " + sh_order + " " + std::to_string(*L) +
            "; the number of bands must be in 1..65535");
     return static_cast<uint64_t>(*L);
+  }
+
+  // The texels [H, W] of the lightmap of vertex set `prefix`: the shape of its /lightmap/state,
+  // which every lightmap dataset `d` needs beside it.
+  std::vector<uint64_t> texels(const File& file, const std::string& prefix, const Dataset& d) const {
+    const std::string path = prefix + std::string(N::kLightmapState);
+    const Dataset* state = find_dataset(file, path);
+    if (state == nullptr) fail("dataset '" + d.path + "' needs " + path + " beside it (it defines the texels H x W)");
+    if (state->shape.size() != 2 || state->shape[0] == 0 || state->shape[1] == 0)
+      fail("dataset '" + path + "' has shape " + shape_str(state->shape) + "; expected [H, W] with H, W >= 1");
+    return state->shape;
   }
 
   // The lights an area-light dataset names (its `lights` attribute): at least one, each once,
@@ -309,6 +328,23 @@ DatasetKind dataset_kind(std::string_view path) {
   return path.size() >= 2 && path[0] == '/' ? Checker::classify(path) : Kind::unknown;
 }
 
+bool is_lightmap_kind(DatasetKind kind) {
+  switch (kind) {
+  case Kind::uv: case Kind::lightmap_state: case Kind::lightmap_positions: case Kind::lightmap_normals:
+  case Kind::lightmap_ao: case Kind::lightmap_transfer_diffuse: case Kind::lightmap_transfer_visibility:
+  case Kind::lightmap_radiance_band1: case Kind::lightmap_radiance_shadowed:
+    return true;
+  default:
+    return false;
+  }
+}
+
+int64_t written_format_version(const File& file) {
+  const bool lightmap = std::any_of(file.datasets.begin(), file.datasets.end(),
+                                    [](const Dataset& d) { return is_lightmap_kind(dataset_kind(d.path)); });
+  return lightmap ? kFormatVersion : kFormatVersionWithoutLightmaps;
+}
+
 bool is_per_vertex_path(std::string_view path) {
   if (path.size() < 2 || path[0] != '/') return false;
   std::string prefix;
@@ -350,7 +386,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     std::string prefix;
     const Kind k = Checker::classify(d.path, &prefix);
     if (k == Kind::unknown)
-      c.fail("unknown dataset path '" + d.path + "' (schema v4 allows " + allowed_paths() + ")");
+      c.fail("unknown dataset path '" + d.path + "' (schema v5 allows " + allowed_paths() + ")");
     if (!prefix.empty() && version < 2)
       c.fail("dataset '" + d.path + "' is a scene object's, which needs format_version 2 (the file says " +
              std::to_string(version) + ")");
@@ -359,6 +395,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
              std::to_string(version) + ")");
     if (k == Kind::radiance_shadowed && version < 4)
       c.fail("dataset '" + d.path + "' is shadowed radiance, which needs format_version 4 (the file says " +
+             std::to_string(version) + ")");
+    if (is_lightmap_kind(k) && version < 5)
+      c.fail("dataset '" + d.path + "' is a lightmap's, which needs format_version 5 (the file says " +
              std::to_string(version) + ")");
     kinds.push_back(k);
     prefixes.push_back(std::move(prefix));
@@ -397,7 +436,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   }
 
   // Schema rules per known dataset. Each vertex set (the root layout, or one scene object under
-  // /objects/<name>) has its own V = rows of its mesh/positions.
+  // /objects/<name>) has its own V = rows of its mesh/positions, and its lightmap its own texels
+  // H x W = the shape of its lightmap/state; a product's values run along [V] per vertex and
+  // along [H, W] per texel, followed by the same axes of its own.
   struct VertexSet {
     const Dataset* positions = nullptr;
     uint64_t V = 0;
@@ -423,15 +464,45 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     if (is_per_vertex_path(d.path) && positions == nullptr)
       c.fail("dataset '" + d.path + "' is per-vertex but the file has no " + mesh_positions + " to " +
              "define the vertex count V");
+    const bool texel = is_lightmap_kind(k) && k != Kind::uv;
+    const std::vector<uint64_t> rows = texel ? c.texels(file, prefix, d) : std::vector<uint64_t>{V};
+    const std::string rows_rule = texel ? "H, W" : "V";
+    const auto rows_and = [&rows](std::initializer_list<uint64_t> own) {
+      std::vector<uint64_t> s = rows;
+      s.insert(s.end(), own);
+      return s;
+    };
+    const std::string uv = prefix + std::string(N::kUv);
+    if (texel && find_dataset(file, uv) == nullptr)
+      c.fail("dataset '" + d.path + "' needs " + uv + " (the UV set its texels lie in)");
     switch (k) {
     case Kind::positions:  // float32, or float64 where float32 would lose precision (SCHEMA.md)
+    case Kind::lightmap_positions:
       if (d.data.index() != 3) c.dtype(d, 0);
-      c.shape(d, {V, 3}, "[V, 3]");
+      c.shape(d, rows_and({3}), "[" + rows_rule + ", 3]");
       break;
     case Kind::normals:
+    case Kind::lightmap_normals:
       c.dtype(d, 0);
-      c.shape(d, {V, 3}, "[V, 3]");
+      c.shape(d, rows_and({3}), "[" + rows_rule + ", 3]");
       break;
+    case Kind::uv: {
+      const std::string triangles = prefix + std::string(N::kTriangles);
+      const Dataset* t = find_dataset(file, triangles);
+      if (t == nullptr) c.fail("dataset '" + d.path + "' needs " + triangles + " (it holds a UV per triangle corner)");
+      c.dtype(d, 0);
+      c.shape(d, {t->shape[0], 3, 2}, "[T, 3 (corners), 2 (u, v)] with T = rows of " + triangles);
+      break;
+    }
+    case Kind::lightmap_state: {  // its shape: texels()
+      c.dtype(d, 2);
+      const auto& state = std::get<std::vector<uint8_t>>(d.data);
+      for (std::size_t j = 0; j < state.size(); ++j)
+        if (state[j] > 3)
+          c.fail("dataset '" + d.path + "' has state " + std::to_string(state[j]) + " at index " + std::to_string(j) +
+                 " " + index_str(j, d.shape) + "; a texel is 0 (empty), 1 (baked), 2 (filled) or 3 (padding)");
+      break;
+    }
     case Kind::triangles: {
       if (positions == nullptr)
         c.fail("dataset '" + d.path + "' needs " + mesh_positions + " (its indices refer to it)");
@@ -451,14 +522,17 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.shape(d, {V}, "[V]");
       break;
     case Kind::ao:
+    case Kind::lightmap_ao:
       c.dtype(d, 0);
-      c.shape(d, {V}, "[V]");
+      c.shape(d, rows, "[" + rows_rule + "]");
       break;
     case Kind::transfer_diffuse:
-    case Kind::transfer_visibility: {
+    case Kind::transfer_visibility:
+    case Kind::lightmap_transfer_diffuse:
+    case Kind::lightmap_transfer_visibility: {
       c.dtype(d, 0);
       const uint64_t L = c.sh_order(d);
-      c.shape(d, {V, L * L}, "[V, L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
+      c.shape(d, rows_and({L * L}), "[" + rows_rule + ", L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
       break;
     }
     case Kind::area_irradiance:
@@ -495,13 +569,16 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       if (d.shape.size() != 1) c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) + "; expected [K]");
       break;
     case Kind::radiance_band1:
+    case Kind::lightmap_radiance_band1:
       c.dtype(d, 0);
-      c.shape(d, {V, 3, 3}, "[V, 3 (RGB), 3 (m = -1, 0, 1)]");
+      c.shape(d, rows_and({3, 3}), "[" + rows_rule + ", 3 (RGB), 3 (m = -1, 0, 1)]");
       break;
-    case Kind::radiance_shadowed: {
+    case Kind::radiance_shadowed:
+    case Kind::lightmap_radiance_shadowed: {
       c.dtype(d, 0);
       const uint64_t L = c.sh_order(d);
-      c.shape(d, {V, 3, L * L}, "[V, 3 (RGB), L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
+      c.shape(d, rows_and({3, L * L}),
+              "[" + rows_rule + ", 3 (RGB), L*L] with L = " + std::string(N::kShOrder) + " = " + std::to_string(L));
       break;
     }
     case Kind::fiv_environment:

@@ -339,7 +339,7 @@ void write_checked(const std::filesystem::path& final_path, const File& file, bo
     if (!root.valid()) fail("cannot open the root group");
     if (add_format) {
       w.write_attr(root.get(), {std::string(names::kFormat), std::string(kFormatName)}, "the root group");
-      w.write_attr(root.get(), {std::string(names::kFormatVersion), int64_t{kFormatVersion}}, "the root group");
+      w.write_attr(root.get(), {std::string(names::kFormatVersion), written_format_version(file)}, "the root group");
     }
     for (const Attr& a : file.root_attrs)
       if (!add_format || (a.name != names::kFormat && a.name != names::kFormatVersion))  // validated equal

@@ -9,6 +9,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <schema_refusal.h>
 
 #include <cmath>
 #include <functional>
@@ -16,6 +17,7 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::expect_refused;
 
 namespace {
 
@@ -49,7 +51,7 @@ Light box(const std::string& name) {  // two faces are enough for the model; geo
 // sorted order read_asset returns the lights in), SH at order 2.
 Asset lit_asset() {
   Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake scene s.json", "s.json", std::string(64, 'a'),
+  a.root = {kFormatVersionWithoutLightmaps, "test", "2024-01-02T03:04:05Z", "prtbake scene s.json", "s.json", std::string(64, 'a'),
             "y", "real orthonormal", {}};
   SceneObject& o = a.objects.emplace_back();
   o.name = "ground";
@@ -69,16 +71,6 @@ Asset lit_asset() {
   return a;
 }
 
-// validate() of `f` must throw a FormatError whose message contains `part`.
-void expect_refused(const File& f, const std::string& part) {
-  try {
-    validate(f, "lit.prt.h5");
-    ADD_FAILURE() << "accepted; expected a refusal containing '" << part << "'";
-  } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).rfind("lit.prt.h5: ", 0), 0u) << e.what();
-  }
-}
 
 Dataset& dataset(File& f, const std::string& path) {
   for (Dataset& d : f.datasets)
@@ -111,7 +103,7 @@ TEST(AssetLights, EveryFieldSurvivesWriteRead) {
   const Asset a = lit_asset();
   write_asset(dir / "a.prt.h5", a);
   const Asset b = read_asset(dir / "a.prt.h5");
-  EXPECT_EQ(b.root.format_version, kFormatVersion);
+  EXPECT_EQ(b.root.format_version, kFormatVersionWithoutLightmaps);
   ASSERT_EQ(b.lights.size(), 2u);
   EXPECT_EQ(b.lights[1], a.lights[1]);
   EXPECT_EQ(b.lights[0], a.lights[0]);  // with the extras of its group and its vertices dataset

@@ -8,9 +8,11 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <schema_refusal.h>
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::expect_refused;
 
 namespace {
 
@@ -39,7 +41,7 @@ VertexSet vertex_set() {
 
 Asset asset(bool scene) {
   Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
+  a.root = {kFormatVersionWithoutLightmaps, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
             "y", "real orthonormal", {}};
   if (!scene) {
     a.vertices = vertex_set();
@@ -50,15 +52,6 @@ Asset asset(bool scene) {
   o.role = "both";
   o.set = vertex_set();
   return a;
-}
-
-void expect_refused(const File& f, const std::string& part) {
-  try {
-    validate(f, "s.prt.h5");
-    ADD_FAILURE() << "accepted; expected a refusal containing '" << part << "'";
-  } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-  }
 }
 
 Dataset& shadowed_dataset(File& f) {

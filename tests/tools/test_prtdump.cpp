@@ -335,6 +335,34 @@ TEST(Prtdump, JsonHasTheKeyFieldsAndParses) {
   EXPECT_EQ(std::system(check.c_str()), 0) << "python3 json rejected or disagreed:\n" << r.out << v.out;
 }
 
+TEST(Prtdump, AVersion5FileShowsItsUvSetAndLightmap) {
+  // make_file() plus a UV set (4 triangles) and a 2 x 3 lightmap: the writer makes it version 5;
+  // the layout, attributes and statistics are generic, and --vertex stays per-vertex.
+  const fs::path dir = scratch("v5");
+  File f = make_file();
+  f.datasets.push_back({"/mesh/uv", {4, 3, 2}, std::vector<float>(24, 0.5f), {{"uv_set", std::string("TEXCOORD_1")}}});
+  f.datasets.push_back({"/lightmap/state", {2, 3}, std::vector<uint8_t>{1, 1, 2, 3, 0, 1}, {{"padding", int64_t{2}}}});
+  f.datasets.push_back({"/lightmap/ao", {2, 3}, std::vector<float>{0.25f, 0.5f, 0.75f, 1, 0, 0.5f}, {}});
+  write_file(dir / "l.prt.h5", f);
+  const CmdResult r = prtdump(dir, q(dir / "l.prt.h5"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  for (const char* s : {"format_version 5", "schema   valid (schema v5", "/mesh/uv", "float32  [4, 3, 2]",
+                        "uv_set = \"TEXCOORD_1\"", "/lightmap/state", "uint8    [2, 3]", "padding = 2",
+                        "/lightmap/ao", "min 0  max 1  mean 0.5  nan 0  inf 0"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << "summary lacks '" << s << "':\n" << r.out;
+  const CmdResult v = prtdump(dir, "--vertex 2 " + q(dir / "l.prt.h5"));
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  EXPECT_NE(v.out.find("vertex 2 of 4"), std::string::npos) << v.out;
+  EXPECT_EQ(v.out.find("/lightmap"), std::string::npos) << "texels are not per-vertex:\n" << v.out;
+  EXPECT_EQ(v.out.find("/mesh/uv"), std::string::npos) << "UVs are per triangle corner:\n" << v.out;
+  const CmdResult j = prtdump(dir, "--json " + q(dir / "l.prt.h5"));
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  for (const char* s : {"\"format_version\": 5", "\"schema_valid\": true", "\"path\": \"/lightmap/state\"",
+                        "\"dtype\": \"uint8\"", "\"padding\": 2", "\"uv_set\": \"TEXCOORD_1\""})
+    EXPECT_NE(j.out.find(s), std::string::npos) << "JSON lacks " << s << ":\n" << j.out;
+}
+
 TEST(Prtdump, ShowsNaNCountsAndSchemaDefectOfABadFile) {
   const fs::path dir = scratch("nan");
   File f = make_file();

@@ -6,12 +6,14 @@
 // Contract
 //   * write_asset(path, a) converts `a` to the generic File (to_file) and writes it with
 //     write_file: the schema check, temp file + rename and deterministic bytes of prtfile.h.
-//     Datasets are written in a fixed order (root vertex set and its report; then each scene
+//     Datasets are written in a fixed order (root vertex set — mesh, products, then its UV set
+//     and lightmap (v5) — and its report; then each scene
 //     object with its report, the occluder of the same name and that occluder's report; then
 //     the FIV environment; then the other occluders; then the lights; then other /report datasets), attributes
 //     in the order of the field tables in asset.cpp followed by the extra attributes.
 //   * read_asset(path) reads with read_file (full schema check) and converts (to_asset).
-//     read_asset(write_asset(a)) == a for every field (std::optional: absent stays absent).
+//     read_asset(write_asset(a)) == a for every field (std::optional: absent stays absent;
+//     root.format_version when it is the version written, RootInfo).
 //   * Extra attributes: any attribute the model does not type (another tool's, e.g. h5py's
 //     `f.attrs["note"] = "..."`, fixed- or variable-length string, or a list of them) is kept in
 //     `extra` of its location (root, /scene, /objects/<name>, each dataset) or, for other groups,
@@ -44,7 +46,9 @@ template <class T> struct Array {
 
 // The root attributes (all required except the extras; format/format_version are the writer's).
 struct RootInfo {
-  int64_t format_version = kFormatVersion;  // as read; write_asset always writes kFormatVersion
+  // As read. write_asset ignores it and writes written_format_version (prtfile.h): 5 for an asset
+  // with a lightmap or UV set, else 4, so a round trip keeps it only when it is that version.
+  int64_t format_version = kFormatVersion;
   std::string generator, created, command_line, source, source_sha256, up_axis, sh_convention;
   ExtraAttrs extra;
   bool operator==(const RootInfo&) const = default;

@@ -1,4 +1,4 @@
-// formats/prtfile.h — the baked file (HDF5, schema version 4): the in-memory model, the one
+// formats/prtfile.h — the baked file (HDF5, schema version 5): the in-memory model, the one
 // writer, the one reader and the schema check. No algorithm code lives here; formats/ does not
 // depend on libbake. The schema (every path, dtype, shape, attribute and convention) is
 // specified in formats/SCHEMA.md (docs/ARCHITECTURE.md §5); every path and attribute
@@ -17,10 +17,12 @@
 //   one-element vector stays a vector; strings written fixed-length, as long as the longest).
 //
 // Writer contract (write_file)
-//   * Validates the whole File against schema v4 (validate()) before touching the disk.
-//   * Adds format="prtbake" and format_version=kFormatVersion itself; the caller gives every
-//     other required root attribute (generator, created, command_line, source, source_sha256,
-//     up_axis, sh_convention).
+//   * Validates the whole File against schema v5 (validate()) before touching the disk.
+//   * Adds format="prtbake" and format_version=written_format_version(file) itself: 5 when the
+//     file holds a version-5 dataset (/mesh/uv, /lightmap/..., in any vertex set), else 4, so a
+//     file that needs nothing of version 5 keeps the bytes version 4 gave it (SCHEMA.md,
+//     "Versioning"). The caller gives every other required root attribute (generator, created,
+//     command_line, source, source_sha256, up_axis, sh_convention).
 //   * Writes "<dir>/<name>.tmp.<host>.<pid>" and renames it onto the final name: on any error the
 //     temporary file is removed, nothing new exists under the final name and a file already
 //     there is untouched. A temporary of a bake to the same name that was killed (kill -9) on
@@ -35,8 +37,8 @@
 //   * Reads every dataset and every attribute of the root, of each group and of each dataset.
 //     Datasets come back sorted by path, attributes sorted by name, group_attrs sorted by path
 //     (the writer keeps the caller's order; compare by name, not by position).
-//   * Checks format=="prtbake" and format_version (a newer version is rejected with
-//     "written by a newer prtbake (format_version N > 1)"). With ReadCheck::full (the default)
+//   * Checks format=="prtbake" and format_version 1..kFormatVersion (a newer version is rejected
+//     with "written by a newer prtbake (format_version N > 5)"). With ReadCheck::full (the default)
 //     it then applies validate(), so callers can trust shapes, index ranges and finiteness.
 //   * Damaged, truncated or non-HDF5 files give a FormatError naming the file; never a crash.
 //   * An attribute the model cannot hold, or whose text cannot be read safely (a variable-length
@@ -83,9 +85,14 @@
 
 namespace prt::formats {
 
-// Schema version written by this library and the newest one it reads (policy: SCHEMA.md).
-// 3 added area lights (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 4;
+// The newest schema version this library reads, and the one it writes for a file that holds a
+// version-5 dataset (written_format_version; policy: SCHEMA.md "Versioning"). 5 added lightmaps
+// (/mesh/uv, /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights (/lights,
+// area_lights/*); 2 scene objects (/objects). Older files still read.
+inline constexpr int kFormatVersion = 5;
+// The version written for a file without any version-5 dataset: such a file is byte for byte
+// what this library wrote before version 5 existed, and version-4 readers open it.
+inline constexpr int kFormatVersionWithoutLightmaps = 4;
 // Value of the root attribute "format".
 inline constexpr std::string_view kFormatName = "prtbake";
 
@@ -149,17 +156,22 @@ private:
 void write_file(const std::filesystem::path& final_path, const File& file);
 
 enum class ReadCheck {
-  full,    // format, format_version and the whole schema v4 (validate())
+  full,    // format, format_version and the whole schema v5 (validate())
   header,  // format and format_version only: for inspectors (prtdump) that show what is wrong
 };
 
 // Reads the whole file at `path` (see the reader contract above). Throws FormatError.
 File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::full);
 
-// Checks `file` against schema v4 exactly as write_file does; messages name `file_for_messages`.
+// Checks `file` against schema v5 exactly as write_file does; messages name `file_for_messages`.
 // Root "format"/"format_version" may be absent (the writer adds them) but, if present, must be
-// "prtbake" / 1..kFormatVersion. Throws FormatError on the first defect found.
+// "prtbake" / 1..kFormatVersion, and every dataset must be one that version has. Throws
+// FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
+
+// The format_version write_file gives `file`: kFormatVersion when a dataset of it is of a
+// version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
+int64_t written_format_version(const File& file);
 
 // Lookups; nullptr when absent.
 const Attr* find_attr(const std::vector<Attr>& attrs, std::string_view name);
@@ -170,15 +182,21 @@ const std::vector<Attr>* find_group_attrs(const File& file, std::string_view gro
 // mesh/positions): /mesh/positions, /mesh/normals, /mesh/source_position, /ao, /transfer/diffuse,
 // /transfer/visibility, /radiance/band1, /radiance/shadowed (v4), /area_lights/{irradiance,sh} (v3),
 // and the same under
-// /objects/<name>/ (scene files, v2). /report datasets are never per-vertex.
+// /objects/<name>/ (scene files, v2). /report datasets are never per-vertex, nor are a
+// lightmap's (v5: /mesh/uv is per triangle corner, /lightmap/... per texel).
 bool is_per_vertex_path(std::string_view path);
 // What a dataset path is in the schema (the same rules under /objects/<name>/ for vertex sets).
 enum class DatasetKind {
   positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
   radiance_band1, radiance_shadowed, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
-  light_vertices, light_face_sizes, light_face_indices, report, unknown
+  light_vertices, light_face_sizes, light_face_indices,
+  uv, lightmap_state, lightmap_positions, lightmap_normals, lightmap_ao, lightmap_transfer_diffuse,  // v5
+  lightmap_transfer_visibility, lightmap_radiance_band1, lightmap_radiance_shadowed,                // v5
+  report, unknown
 };
 DatasetKind dataset_kind(std::string_view path);
+// True for the kinds version 5 added: a vertex set's /mesh/uv and its /lightmap/... datasets.
+bool is_lightmap_kind(DatasetKind kind);
 // The vertex set a dataset path belongs to: "" for the root layout, "/objects/<name>" for a scene
 // object (its V is the rows of "<set>/mesh/positions").
 std::string vertex_set_of(std::string_view path);
