@@ -239,26 +239,33 @@ struct Polygons {
 
 // The one polygon-to-mesh step behind load_mesh (vertex order, hard-edge splits, fans, normals:
 // the contracts in the file comment). Validates what a reader may pass through (finite
-// positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits) and throws
-// InputError(source, defect). Sets source, file_positions, file_faces and origin (frame_origin of the
-// positions' bounds); not source_sha256 or warnings.
+// positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits, finite texture
+// coordinates and their indices in range) and throws InputError(source, defect); a texture-coordinate
+// set without one index per corner is a reader's bug (ContractError). Each Polygons::Uvs becomes
+// a UvSet of the same name, in the same order, through the same fan and flip as the triangles.
+// Sets source, file_positions, file_faces and origin (frame_origin of the positions' bounds); not
+// source_sha256 or warnings.
 Mesh build_mesh(const Polygons& polygons, std::string source, const MeshLoadOptions& = {});
 
 // Build a mesh in memory (tests, generated geometry), origin 0. Output vertex i = positions[i],
 // source_position[i] = i, file_positions = positions.size(), file_faces = triangles.size().
 // Normals: angle-weighted over welded positions (as load_mesh) unless `normals` is given, in which
 // case it must have one finite non-zero vector per position; it is normalised and
-// normal_source = File. Validates (finite positions, indices in range, at least one triangle)
-// and throws InputError(name, defect).
+// normal_source = File. `uv_sets` (none by default) are taken as they are: 3 finite corners per
+// triangle each (UvSet). Validates (finite positions, indices in range, at least one triangle,
+// the sets) and throws InputError(name, defect).
 Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<uint32_t, 3>> triangles,
-               std::string name, std::vector<Eigen::Vector3f> normals = {});
+               std::string name, std::vector<Eigen::Vector3f> normals = {}, std::vector<UvSet> uv_sets = {});
 
 // Concatenation (e.g. asset + ground plane): vertices and triangles of parts[0], then parts[1]…;
 // triangle indices are offset by the vertex count before each part, source_position by the sum
 // of file_positions before it (so it stays unique across parts). normal_source = File only if
-// every part's is; warnings are concatenated. `parts` must not be empty (contract). Origin: the
-// parts' when they all have the same one (offsets copied); else frame_origin of the union of the
-// parts' world bounds, every offset re-expressed from its world position in double.
+// every part's is; warnings are concatenated. A texture-coordinate set is kept (by name, in
+// parts[0]'s order, corners in part order) only when every part has one of that name, else it is
+// dropped without a warning (a part made in memory, a ground plane, has none). `parts` must not
+// be empty (contract). Origin: the parts' when they all have the same one (offsets copied); else
+// frame_origin of the union of the parts' world bounds, every offset re-expressed from its world
+// position in double.
 Mesh merge_meshes(std::span<const Mesh> parts, std::string name);
 
 // Angle-weighted vertex normals over the given indexing (no welding): n_v = normalize(Σ_t α_t(v)
