@@ -142,7 +142,11 @@ std::string lowercase(std::string s) {
 
 Polygons read_obj(std::string_view text, const SourceFile& file) {
   Polygons poly;
-  size_t texcoords = 0;
+  // `vt` values in glTF's convention (u, 1 − v), and each corner's index into them or kNoNormal
+  // (the same "none" marker as normals).
+  std::vector<Eigen::Vector2f> texcoords;
+  std::vector<uint32_t> corner_texcoord;
+  size_t corners_with_texcoord = 0;
   // Positive indices may point forward (to `v` lines further down): checked at the end.
   struct Pending { long long index; size_t line; char kind; };
   std::vector<Pending> forward;
@@ -161,12 +165,13 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
       if (kw == "v") poly.positions.push_back(parse_vec3<Eigen::Vector3d>(file, values, ln));
       else poly.normals.push_back(parse_vec3<Eigen::Vector3f>(file, values, ln));
     } else if (kw == "vt") {
-      float x = 0;
+      // "vt u v [w]": w (3D textures) is neither read nor kept.
+      float x[2] = {};
       if (tok.size() < 3) throw InputError(file.name, at_line(ln) + "'vt' needs 2 coordinates");
-      for (int k = 1; k <= 2; ++k)
-        if (auto defect = parse_float(tok[static_cast<size_t>(k)], x); !defect.empty())
+      for (size_t k = 0; k < 2; ++k)
+        if (auto defect = parse_float(tok[k + 1], x[k]); !defect.empty())
           throw InputError(file.name, at_line(ln) + defect);
-      ++texcoords;
+      texcoords.emplace_back(x[0], 1.0f - x[1]);
     } else if (kw == "f") {
       if (tok.size() < 4)
         throw InputError(file.name, at_line(ln) + "face has " + std::to_string(tok.size() - 1) + " corners, needs at least 3");
@@ -199,7 +204,9 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
         };
         if (part[0].empty()) throw InputError(file.name, at_line(ln) + "face corner " + shown(tok[c]) + " has no vertex index");
         poly.corner_position.push_back(resolve(part[0], poly.positions.size(), 'v'));
-        if (n_parts >= 2 && !part[1].empty()) resolve(part[1], texcoords, 't');
+        const bool has_texcoord = n_parts >= 2 && !part[1].empty();
+        corner_texcoord.push_back(has_texcoord ? resolve(part[1], texcoords.size(), 't') : Polygons::kNoNormal);
+        corners_with_texcoord += has_texcoord;
         const bool has_normal = n_parts == 3 && !part[2].empty();
         poly.corner_normal.push_back(has_normal ? resolve(part[2], poly.normals.size(), 'n') : Polygons::kNoNormal);
       }
@@ -209,11 +216,18 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
     }
   }
   for (const Pending& p : forward) {
-    const size_t count = p.kind == 'v' ? poly.positions.size() : p.kind == 'n' ? poly.normals.size() : texcoords;
+    const size_t count = p.kind == 'v' ? poly.positions.size() : p.kind == 'n' ? poly.normals.size() : texcoords.size();
     if (static_cast<unsigned long long>(p.index) > count)
       throw InputError(file.name, at_line(p.line) + kind_name(p.kind) + " index " + std::to_string(p.index) +
                                       " is out of range (the file has " + std::to_string(count) + ")");
   }
+  // One set "vt" when every face corner has a texture coordinate (bake/mesh/mesh.h Polygons::Uvs).
+  const size_t corners = poly.corner_position.size();
+  if (corners_with_texcoord == corners && corners > 0)
+    poly.uv_sets.push_back({"vt", std::move(texcoords), std::move(corner_texcoord)});
+  else if (corners_with_texcoord > 0)
+    file.warnings.push_back(std::to_string(corners - corners_with_texcoord) + " of " + std::to_string(corners) +
+                            " face corners have no texture coordinate (f v/vt); the file's texture coordinates are not read");
   return poly;
 }
 
