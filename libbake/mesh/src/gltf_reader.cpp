@@ -457,16 +457,16 @@ class Reader {
     if (out_.polygon_count() == 0 && skipped_primitives_ > 0)
       fail("no triangles: only " + std::to_string(skipped_primitives_) + " point or line primitive instance(s), nothing to bake");
     if (skipped_primitives_ > 0)
-      file_.warnings.push_back(file_.name + ": " + std::to_string(skipped_primitives_) +
+      file_.warnings.push_back(std::to_string(skipped_primitives_) +
                                " point or line primitive instance(s) skipped (only triangles are baked)");
     // KHR_lights_punctual: points, spots and suns have no area, so nothing of them is baked; the
     // user must hear it, not find the lights missing in the engine's shading.
     if (!model_.lights.empty())
-      file_.warnings.push_back(file_.name + ": " + std::to_string(model_.lights.size()) +
+      file_.warnings.push_back(std::to_string(model_.lights.size()) +
                                " punctual light(s) (KHR_lights_punctual) are not baked: they have no area, and "
                                "prtbake bakes the environment's light");
     if (skinned_instances_ + morphed_primitives_ > 0)
-      file_.warnings.push_back(file_.name + ": skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
+      file_.warnings.push_back("skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
                                " skinned mesh instance(s), " + std::to_string(morphed_primitives_) +
                                " primitive instance(s) with morph targets): the rest pose is baked");
   }
@@ -541,7 +541,7 @@ class Reader {
       }
     }
     if (empty > 0)
-      file_.warnings.push_back(file_.name + ": " + std::to_string(empty) + " triangle primitive instance(s) without a triangle skipped");
+      file_.warnings.push_back(std::to_string(empty) + " triangle primitive instance(s) without a triangle skipped");
     if (result.empty()) fail("no triangles: no primitive instance has a triangle, nothing to bake");
     return result;
   }
