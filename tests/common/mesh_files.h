@@ -44,4 +44,14 @@ inline void expect_input_error(const std::filesystem::path& path, const std::str
   }
 }
 
+// build_mesh(polygons, "generated") must throw InputError "generated: <...defect_part...>".
+inline void expect_build_defect(const bake::Polygons& polygons, const std::string& defect_part) {
+  try {
+    (void)bake::build_mesh(polygons, "generated");
+    ADD_FAILURE() << "accepted; expected '" << defect_part << "'";
+  } catch (const bake::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("generated: " + defect_part), std::string::npos) << e.what();
+  }
+}
+
 } // namespace prt::testing

@@ -24,10 +24,13 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -127,23 +130,42 @@ size_t component_bytes(int type) {
   }
 }
 
+// n of a TEXCOORD_n attribute name (glTF 2.0 specification, "Meshes": n without leading zeros),
+// or none for any other attribute.
+std::optional<int> texcoord_set(std::string_view attribute) {
+  constexpr std::string_view kPrefix = "TEXCOORD_";
+  if (!attribute.starts_with(kPrefix)) return std::nullopt;
+  const std::string_view digits = attribute.substr(kPrefix.size());
+  if (digits.empty() || (digits.size() > 1 && digits[0] == '0') ||
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return std::nullopt;
+  int n = 0;
+  if (std::from_chars(digits.data(), digits.data() + digits.size(), n).ec != std::errc()) return std::nullopt;  // past int
+  return n;
+}
+
 class Reader {
  public:
   Reader(const tinygltf::Model& model, const SourceFile& file) : model_(model), file_(file) {}
 
   [[noreturn]] void fail(const std::string& defect) const { throw InputError(file_.name, defect); }
 
-  // `what` names the accessor's use in messages ("mesh 0 primitive 1 POSITION").
-  AccessorView view(int index, const std::string& what, int type, std::initializer_list<int> component_types) const {
+  // `what` names the accessor's use in messages ("mesh 0 primitive 1 POSITION"). Integer
+  // components are read as they are, or with `normalized_integers` (TEXCOORD_n) only normalized.
+  AccessorView view(int index, const std::string& what, int type, std::initializer_list<int> component_types,
+                    bool normalized_integers = false) const {
     const std::string name = what + " (accessor " + std::to_string(index) + ")";
     if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
       fail(what + ": accessor " + std::to_string(index) + " does not exist (" + std::to_string(model_.accessors.size()) + " accessors)");
     const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(index)];
     if (a.sparse.isSparse) fail(name + " is sparse; sparse accessors are not supported");
-    if (a.type != type) fail(name + " is not " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR"));
+    if (a.type != type)
+      fail(name + " is not " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : type == TINYGLTF_TYPE_VEC2 ? "VEC2" : "SCALAR"));
     if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end())
       fail(name + " has unsupported componentType " + std::to_string(a.componentType));
-    if (a.normalized && a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) fail(name + " is normalized; not supported");
+    const bool integer = a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT;
+    if (integer && a.normalized != normalized_integers)
+      fail(name + (normalized_integers ? " is not normalized; integer components must be" : " is normalized; not supported"));
     if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= model_.bufferViews.size())
       fail(name + " has no valid bufferView (" + std::to_string(a.bufferView) + ")");
     const tinygltf::BufferView& bv = model_.bufferViews[static_cast<size_t>(a.bufferView)];
@@ -155,7 +177,7 @@ class Reader {
     if (__builtin_add_overflow(bv.byteOffset, bv.byteLength, &bv_end) || bv_end > buffer.size())
       fail(bv_name + " (offset " + std::to_string(bv.byteOffset) + ", " + std::to_string(bv.byteLength) +
            " bytes) lies past the end of buffer " + std::to_string(bv.buffer) + " (" + std::to_string(buffer.size()) + " bytes)");
-    const size_t components = type == TINYGLTF_TYPE_VEC3 ? 3 : 1;
+    const auto components = static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(type)));
     const size_t element = components * component_bytes(a.componentType);
     const size_t stride = bv.byteStride == 0 ? element : bv.byteStride;
     if (stride < element) fail(bv_name + " has byteStride " + std::to_string(stride) + ", less than the " + std::to_string(element) + "-byte elements of " + name);
@@ -177,6 +199,20 @@ class Reader {
     float f[3];
     std::memcpy(f, v.data + i * v.stride, sizeof f);
     return {f[0], f[1], f[2]};
+  }
+  // A VEC2 of floats, or of normalized unsigned bytes or shorts (c / 255, c / 65535: glTF 2.0
+  // specification, "Accessors", normalized data).
+  static Eigen::Vector2f vec2(const AccessorView& v, size_t i) {
+    const unsigned char* p = v.data + i * v.stride;
+    if (v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) return {p[0] / 255.0f, p[1] / 255.0f};
+    if (v.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) {
+      uint16_t s[2];
+      std::memcpy(s, p, sizeof s);
+      return {s[0] / 65535.0f, s[1] / 65535.0f};
+    }
+    float f[2];
+    std::memcpy(f, p, sizeof f);
+    return {f[0], f[1]};
   }
   static uint32_t index(const AccessorView& v, size_t i) {
     const unsigned char* p = v.data + i * v.stride;
@@ -272,6 +308,25 @@ class Reader {
           const double len = n.norm();
           out_.normals.push_back(len > 0.0 && std::isfinite(len) ? Eigen::Vector3f((n / len).cast<float>()) : n.cast<float>());
         }
+      }
+      // Texture-coordinate sets (glTF 2.0 specification, "Meshes": TEXCOORD_n, a VEC2 of floats or
+      // of normalized unsigned bytes or shorts), per vertex like the positions.
+      for (const auto& [attribute, accessor] : prim.attributes) {
+        const std::optional<int> set = texcoord_set(attribute);
+        if (!set) continue;
+        const std::string what = name + " " + attribute;
+        const AccessorView uv = view(accessor, what, TINYGLTF_TYPE_VEC2,
+                                     {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                                     true);
+        if (uv.count != positions.count)
+          fail(name + " has " + std::to_string(uv.count) + " " + attribute + " elements for " + std::to_string(positions.count) + " positions");
+        std::vector<Eigen::Vector2f>& rows = texcoord_rows_[*set];
+        rows.resize(base);  // rows of earlier instances without the set stay zero: never referenced
+        for (size_t i = 0; i < uv.count; ++i) {
+          rows.push_back(vec2(uv, i));
+          if (!rows.back().allFinite()) fail(what + " " + std::to_string(i) + " is not finite (NaN or Inf)");
+        }
+        instances_.back().texcoords.push_back(*set);
       }
       // The primitive's vertex sequence: its indices, or 0 … count−1.
       std::vector<uint32_t> sequence;
@@ -402,16 +457,16 @@ class Reader {
     if (out_.polygon_count() == 0 && skipped_primitives_ > 0)
       fail("no triangles: only " + std::to_string(skipped_primitives_) + " point or line primitive instance(s), nothing to bake");
     if (skipped_primitives_ > 0)
-      file_.warnings.push_back(file_.name + ": " + std::to_string(skipped_primitives_) +
+      file_.warnings.push_back(std::to_string(skipped_primitives_) +
                                " point or line primitive instance(s) skipped (only triangles are baked)");
     // KHR_lights_punctual: points, spots and suns have no area, so nothing of them is baked; the
     // user must hear it, not find the lights missing in the engine's shading.
     if (!model_.lights.empty())
-      file_.warnings.push_back(file_.name + ": " + std::to_string(model_.lights.size()) +
+      file_.warnings.push_back(std::to_string(model_.lights.size()) +
                                " punctual light(s) (KHR_lights_punctual) are not baked: they have no area, and "
                                "prtbake bakes the environment's light");
     if (skinned_instances_ + morphed_primitives_ > 0)
-      file_.warnings.push_back(file_.name + ": skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
+      file_.warnings.push_back("skins and morph targets are ignored (" + std::to_string(skinned_instances_) +
                                " skinned mesh instance(s), " + std::to_string(morphed_primitives_) +
                                " primitive instance(s) with morph targets): the rest pose is baked");
   }
@@ -420,6 +475,25 @@ class Reader {
     walk();
     if (all_have_normals_ && !out_.normals.empty()) out_.corner_normal = out_.corner_position;
     else out_.normals.clear();
+    // A texture-coordinate set of the concatenation must cover every triangle (Polygons::Uvs): it
+    // is kept when every primitive instance with a triangle has it, else dropped and said.
+    size_t with_triangles = 0;
+    std::map<int, size_t> having;
+    for (const Instance& in : instances_)
+      if (in.polygon_end > in.polygon_begin) {
+        ++with_triangles;
+        for (int n : in.texcoords) ++having[n];
+      }
+    for (auto& [n, rows] : texcoord_rows_) {
+      const std::string attribute = "TEXCOORD_" + std::to_string(n);
+      if (having[n] == with_triangles) {
+        rows.resize(out_.positions.size());
+        out_.uv_sets.push_back({attribute, std::move(rows), out_.corner_position});
+      } else {
+        file_.warnings.push_back(attribute + " is on " + std::to_string(having[n]) + " of " + std::to_string(with_triangles) +
+                                 " primitive instances with triangles; not read (a texture coordinate set must cover every triangle)");
+      }
+    }
     return std::move(out_);
   }
 
@@ -457,9 +531,17 @@ class Reader {
         p.normals.assign(out_.normals.begin() + std::ptrdiff_t(in.normal_begin), out_.normals.begin() + std::ptrdiff_t(in.normal_begin + rows));
         p.corner_normal = p.corner_position;
       }
+      std::vector<int> sets = in.texcoords;  // attribute (name) order: by n
+      std::sort(sets.begin(), sets.end());
+      for (int n : sets) {
+        const std::vector<Eigen::Vector2f>& all = texcoord_rows_.at(n);
+        p.uv_sets.push_back({"TEXCOORD_" + std::to_string(n),
+                             {all.begin() + std::ptrdiff_t(in.position_begin), all.begin() + std::ptrdiff_t(in.position_begin + rows)},
+                             p.corner_position});
+      }
     }
     if (empty > 0)
-      file_.warnings.push_back(file_.name + ": " + std::to_string(empty) + " triangle primitive instance(s) without a triangle skipped");
+      file_.warnings.push_back(std::to_string(empty) + " triangle primitive instance(s) without a triangle skipped");
     if (result.empty()) fail("no triangles: no primitive instance has a triangle, nothing to bake");
     return result;
   }
@@ -472,7 +554,8 @@ class Reader {
     size_t position_begin, normal_begin;
     bool has_normals;
     size_t polygon_begin, polygon_end;
-    bool animated;  // an animation channel moves its node or an ancestor
+    bool animated;                 // an animation channel moves its node or an ancestor
+    std::vector<int> texcoords{};  // the n of its TEXCOORD_n attributes (values in texcoord_rows_)
   };
   // The first row after `in`'s: the next instance's first row, or the end.
   size_t next_position_begin(const Instance& in) const {
@@ -484,6 +567,8 @@ class Reader {
   const SourceFile& file_;
   Polygons out_;
   std::vector<Instance> instances_;
+  // TEXCOORD_n's values by n, one per row of out_ up to the last instance that has the set.
+  std::map<int, std::vector<Eigen::Vector2f>> texcoord_rows_;
   bool all_have_normals_ = true;
   size_t skipped_primitives_ = 0, skinned_instances_ = 0, morphed_primitives_ = 0;
 };

@@ -201,7 +201,7 @@ std::vector<Eigen::Vector3f> welded_angle_weighted_normals(std::span<const Eigen
 }
 
 Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<uint32_t, 3>> triangles,
-               std::string name, std::vector<Eigen::Vector3f> normals) {
+               std::string name, std::vector<Eigen::Vector3f> normals, std::vector<UvSet> uv_sets) {
   if (positions.size() >= std::numeric_limits<uint32_t>::max())
     throw InputError(name, "too many vertices (" + std::to_string(positions.size()) + ") for 32-bit indices");
   if (triangles.empty()) throw InputError(name, "mesh has no triangles");
@@ -236,6 +236,15 @@ Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<ui
     mesh.normals = welded_angle_weighted_normals(positions, triangles);
     mesh.normal_source = Mesh::NormalSource::AngleWeighted;
   }
+  for (const UvSet& set : uv_sets) {
+    if (set.corners.size() != 3 * triangles.size())
+      throw InputError(name, "texture coordinate set '" + set.name + "' has " + std::to_string(set.corners.size()) +
+                                 " corners for " + std::to_string(triangles.size()) + " triangles (needs 3 per triangle)");
+    for (size_t c = 0; c < set.corners.size(); ++c)
+      if (!set.corners[c].allFinite())
+        throw InputError(name, "texture coordinate set '" + set.name + "': corner " + std::to_string(c) + " is not finite");
+  }
+  mesh.uv_sets = std::move(uv_sets);
   mesh.source_position.resize(positions.size());
   std::iota(mesh.source_position.begin(), mesh.source_position.end(), 0u);
   mesh.file_positions = positions.size();
@@ -292,6 +301,22 @@ Mesh merge_meshes(std::span<const Mesh> parts, std::string name) {
     out.file_positions += m.file_positions;
     out.file_faces += m.file_faces;
     out.warnings.insert(out.warnings.end(), m.warnings.begin(), m.warnings.end());
+  }
+  // Texture-coordinate sets that every part has (by name, in parts[0]'s order): a set must cover
+  // every triangle (bake/mesh/mesh.h UvSet).
+  for (const UvSet& first : parts[0].uv_sets) {
+    auto set_of = [&](const Mesh& m) {
+      return std::find_if(m.uv_sets.begin(), m.uv_sets.end(), [&](const UvSet& s) { return s.name == first.name; });
+    };
+    if (!std::all_of(parts.begin(), parts.end(), [&](const Mesh& m) { return set_of(m) != m.uv_sets.end(); })) continue;
+    UvSet& merged = out.uv_sets.emplace_back();
+    merged.name = first.name;
+    merged.corners.reserve(3 * n_triangles);
+    for (const Mesh& m : parts) {
+      const UvSet& set = *set_of(m);
+      PRT_CHECK_OP(set.corners.size(), ==, 3 * m.triangles.size());
+      merged.corners.insert(merged.corners.end(), set.corners.begin(), set.corners.end());
+    }
   }
   return out;
 }

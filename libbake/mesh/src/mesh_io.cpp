@@ -157,6 +157,17 @@ void validate(const Polygons& poly, const std::string& source, bool use_normals)
     }
   }
   if (triangles >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too large for 32-bit indices");
+  for (const Polygons::Uvs& set : poly.uv_sets) {
+    PRT_CHECK_OP(set.corner.size(), ==, poly.corner_position.size());  // every corner has one (reader contract)
+    const std::string name = "texture coordinate set " + mesh_readers::shown(set.name);
+    for (size_t i = 0; i < set.values.size(); ++i)
+      if (!set.values[i].allFinite()) throw InputError(source, name + ": value " + std::to_string(i) + " is not finite");
+    for (size_t f = 0; f < n_polygons; ++f)
+      for (uint32_t c = poly.offsets[f]; c < poly.offsets[f + 1]; ++c)
+        if (set.corner[c] >= set.values.size())
+          throw InputError(source, name + ": face " + std::to_string(f) + ": index " + std::to_string(set.corner[c]) +
+                                       " is out of range [0, " + std::to_string(set.values.size()) + ")");
+  }
 }
 
 // Reader warnings as load_mesh returns them: "<file>: <finding>" (bake/mesh/mesh.h).
@@ -224,12 +235,22 @@ Mesh build_mesh(const Polygons& poly, std::string source, const MeshLoadOptions&
   }
   if (mesh.positions.size() >= std::numeric_limits<uint32_t>::max()) throw InputError(source, "too many vertices for 32-bit indices");
 
-  // Fan triangulation in place (each fan triangle reversed when flipping).
+  // Fan triangulation in place (each fan triangle reversed when flipping), as the polygon
+  // corners of each triangle corner: the rows and the texture coordinates both follow them.
   const int second = options.flip_normals ? 1 : 0;
+  std::vector<uint32_t> fan_corner;
   for (size_t f = 0; f < poly.polygon_count(); ++f) {
     const uint32_t b = poly.offsets[f], e = poly.offsets[f + 1];
-    for (uint32_t i = b + 1; i + 1 < e; ++i)
-      mesh.triangles.push_back({corner_vertex[b], corner_vertex[i + second], corner_vertex[i + 1 - second]});
+    for (uint32_t i = b + 1; i + 1 < e; ++i) fan_corner.insert(fan_corner.end(), {b, i + second, i + 1 - second});
+  }
+  mesh.triangles.resize(fan_corner.size() / 3);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (size_t k = 0; k < 3; ++k) mesh.triangles[t][k] = corner_vertex[fan_corner[3 * t + k]];
+  for (const Polygons::Uvs& set : poly.uv_sets) {
+    UvSet& out = mesh.uv_sets.emplace_back();
+    out.name = set.name;
+    out.corners.reserve(fan_corner.size());
+    for (uint32_t c : fan_corner) out.corners.push_back(set.values[set.corner[c]]);
   }
 
   // Normals: the file's where usable, else angle-weighted over welded positions.

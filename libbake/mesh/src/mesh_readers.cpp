@@ -5,6 +5,7 @@
 #include <bake/core/error.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -142,7 +143,11 @@ std::string lowercase(std::string s) {
 
 Polygons read_obj(std::string_view text, const SourceFile& file) {
   Polygons poly;
-  size_t texcoords = 0;
+  // `vt` values in glTF's convention (u, 1 − v), and each corner's index into them or kNoNormal
+  // (the same "none" marker as normals).
+  std::vector<Eigen::Vector2f> texcoords;
+  std::vector<uint32_t> corner_texcoord;
+  size_t corners_with_texcoord = 0;
   // Positive indices may point forward (to `v` lines further down): checked at the end.
   struct Pending { long long index; size_t line; char kind; };
   std::vector<Pending> forward;
@@ -161,12 +166,13 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
       if (kw == "v") poly.positions.push_back(parse_vec3<Eigen::Vector3d>(file, values, ln));
       else poly.normals.push_back(parse_vec3<Eigen::Vector3f>(file, values, ln));
     } else if (kw == "vt") {
-      float x = 0;
+      // "vt u v [w]": w (3D textures) is neither read nor kept.
+      float x[2] = {};
       if (tok.size() < 3) throw InputError(file.name, at_line(ln) + "'vt' needs 2 coordinates");
-      for (int k = 1; k <= 2; ++k)
-        if (auto defect = parse_float(tok[static_cast<size_t>(k)], x); !defect.empty())
+      for (size_t k = 0; k < 2; ++k)
+        if (auto defect = parse_float(tok[k + 1], x[k]); !defect.empty())
           throw InputError(file.name, at_line(ln) + defect);
-      ++texcoords;
+      texcoords.emplace_back(x[0], 1.0f - x[1]);
     } else if (kw == "f") {
       if (tok.size() < 4)
         throw InputError(file.name, at_line(ln) + "face has " + std::to_string(tok.size() - 1) + " corners, needs at least 3");
@@ -199,7 +205,9 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
         };
         if (part[0].empty()) throw InputError(file.name, at_line(ln) + "face corner " + shown(tok[c]) + " has no vertex index");
         poly.corner_position.push_back(resolve(part[0], poly.positions.size(), 'v'));
-        if (n_parts >= 2 && !part[1].empty()) resolve(part[1], texcoords, 't');
+        const bool has_texcoord = n_parts >= 2 && !part[1].empty();
+        corner_texcoord.push_back(has_texcoord ? resolve(part[1], texcoords.size(), 't') : Polygons::kNoNormal);
+        corners_with_texcoord += has_texcoord;
         const bool has_normal = n_parts == 3 && !part[2].empty();
         poly.corner_normal.push_back(has_normal ? resolve(part[2], poly.normals.size(), 'n') : Polygons::kNoNormal);
       }
@@ -209,11 +217,18 @@ Polygons read_obj(std::string_view text, const SourceFile& file) {
     }
   }
   for (const Pending& p : forward) {
-    const size_t count = p.kind == 'v' ? poly.positions.size() : p.kind == 'n' ? poly.normals.size() : texcoords;
+    const size_t count = p.kind == 'v' ? poly.positions.size() : p.kind == 'n' ? poly.normals.size() : texcoords.size();
     if (static_cast<unsigned long long>(p.index) > count)
       throw InputError(file.name, at_line(p.line) + kind_name(p.kind) + " index " + std::to_string(p.index) +
                                       " is out of range (the file has " + std::to_string(count) + ")");
   }
+  // One set "vt" when every face corner has a texture coordinate (bake/mesh/mesh.h Polygons::Uvs).
+  const size_t corners = poly.corner_position.size();
+  if (corners_with_texcoord == corners && corners > 0)
+    poly.uv_sets.push_back({"vt", std::move(texcoords), std::move(corner_texcoord)});
+  else if (corners_with_texcoord > 0)
+    file.warnings.push_back(std::to_string(corners - corners_with_texcoord) + " of " + std::to_string(corners) +
+                            " face corners have no texture coordinate (f v/vt); the file's texture coordinates are not read");
   return poly;
 }
 
@@ -271,22 +286,27 @@ PlyValue ply_binary_value(const char* p, PlyType t, bool big_endian) {
   return v;
 }
 
-// What the reader does with a vertex property: coordinate k of the position or of the normal.
+// What the reader does with a vertex property: a coordinate of the position (double), or a
+// component of the normal or of the texture coordinate (float).
 struct VertexSlot {
-  Eigen::Vector3d* position = nullptr;
-  Eigen::Vector3f* normal = nullptr;
-  int axis = 0;
-  explicit operator bool() const { return position || normal; }
+  double* position = nullptr;
+  float* value = nullptr;
+  explicit operator bool() const { return position || value; }
   // Parses the ascii value into the slot; the defect, or empty.
   std::string parse(std::string_view tok) const {
-    return position ? parse_coordinate(tok, (*position)[axis]) : parse_float(tok, (*normal)[axis]);
+    return position ? parse_coordinate(tok, *position) : parse_float(tok, *value);
   }
-  // Stores a binary value: positions keep it (float32 widens exactly), normals round to float.
+  // Stores a binary value: positions keep it (float32 widens exactly), the rest round to float.
   void store(double v) const {
-    if (position) (*position)[axis] = v;
-    else (*normal)[axis] = static_cast<float>(v);
+    if (position) *position = v;
+    else *value = static_cast<float>(v);
   }
 };
+
+// The vertex property pairs read as texture coordinates, the first the vertex element has: Turk's
+// PLY names none, and exporters write (u, v), (s, t) (Blender) or (texture_u, texture_v) (VCG,
+// MeshLab).
+constexpr std::array<std::array<std::string_view, 2>, 3> kPlyTexcoordNames = {{{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}}};
 
 } // namespace
 
@@ -372,6 +392,8 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
   }
   Polygons poly;
   bool has_normals = false;
+  const std::array<std::string_view, 2>* texcoord_names = nullptr;  // the pair the vertex element has, if any
+  std::vector<Eigen::Vector2f> texcoords;
   for (const PlyElement& e : elements) {
     if (e.name == "vertex") {
       for (const char* axis : {"x", "y", "z"})
@@ -381,6 +403,12 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
                                 [](const PlyProperty& p) { return !p.list && (p.name == "nx" || p.name == "ny" || p.name == "nz"); });
       poly.positions.assign(e.count, Eigen::Vector3d::Zero());
       if (has_normals) poly.normals.assign(e.count, Eigen::Vector3f::Zero());
+      auto has = [&](std::string_view name) {
+        return std::any_of(e.props.begin(), e.props.end(), [&](const PlyProperty& p) { return !p.list && p.name == name; });
+      };
+      for (const auto& pair : kPlyTexcoordNames)
+        if (!texcoord_names && has(pair[0]) && has(pair[1])) texcoord_names = &pair;
+      if (texcoord_names) texcoords.assign(e.count, Eigen::Vector2f::Zero());
     }
     if (e.name == "face" && e.count > 0 &&
         std::none_of(e.props.begin(), e.props.end(), [&](const PlyProperty& p) { return is_face_list(e, p); }))
@@ -390,10 +418,13 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
   auto slot_of = [&](const PlyElement& e, const PlyProperty& p, size_t item) -> VertexSlot {
     if (e.name != "vertex" || p.list || p.name.empty()) return {};
     const std::string_view n = p.name;
+    if (texcoord_names)
+      for (int k = 0; k < 2; ++k)
+        if (n == (*texcoord_names)[static_cast<size_t>(k)]) return {nullptr, &texcoords[item][k]};
     const int axis = n.back() - 'x';
     if (axis < 0 || axis > 2) return {};
-    if (n.size() == 1) return {&poly.positions[item], nullptr, axis};
-    if (n.size() == 2 && n[0] == 'n') return {nullptr, &poly.normals[item], axis};
+    if (n.size() == 1) return {&poly.positions[item][axis], nullptr};
+    if (n.size() == 2 && n[0] == 'n') return {nullptr, &poly.normals[item][axis]};
     return {};
   };
   auto truncated = [&](const PlyElement& e, size_t item) {
@@ -490,6 +521,11 @@ Polygons read_ply(std::string_view text, const SourceFile& file) {
     }
   }
   if (has_normals) corner_normals_per_vertex(poly);
+  // Per vertex, like the normals; v is up the image in PLY as in OBJ: to glTF's convention.
+  if (texcoord_names) {
+    for (Eigen::Vector2f& uv : texcoords) uv.y() = 1.0f - uv.y();
+    poly.uv_sets.push_back({"uv", std::move(texcoords), poly.corner_position});
+  }
   return poly;
 }
 

@@ -8,12 +8,13 @@
 // READING (load_mesh) happens in two steps with one seam between them:
 //   1. The file's bytes are read once, into memory. Mesh::source_sha256 is the SHA-256 of exactly
 //      those bytes (so a caller never hashes the file again), and ONE reader per format parses
-//      them once into a Polygons: the file's positions and normal values in file order, and its
-//      polygons as corner lists (position index, optional normal index per corner), in file
-//      order, exactly as the file has them (zero-area, needle and repeated-index polygons are
-//      kept). Readers: OBJ, PLY (ascii, binary little/big endian), OFF ([ST][C][N]OFF, ascii),
-//      STL (ascii, binary), glTF 2.0 (.gltf, .glb; parsed by tinygltf, gltf_reader.cpp). Why the
-//      first four are ours and not OpenMesh's: see mesh_io.cpp. A .gltf with external
+//      them once into a Polygons: the file's positions, normal and texture-coordinate values in
+//      file order, and its polygons as corner lists (position index, optional normal index, an
+//      index per texture-coordinate set), in file order, exactly as the file has them (zero-area,
+//      needle and repeated-index polygons are kept). Readers: OBJ, PLY (ascii, binary
+//      little/big endian), OFF ([ST][C][N]OFF, ascii), STL (ascii, binary), glTF 2.0 (.gltf,
+//      .glb; parsed by tinygltf, gltf_reader.cpp). Why the first four are ours and not
+//      OpenMesh's: see mesh_io.cpp. A .gltf with external
 //      buffers is the one input made of several files: its source_sha256 is the SHA-256 of the
 //      .gltf's bytes followed by the 64 hex digits of each external buffer file's SHA-256, in the
 //      order of its "buffers" array (so a changed .bin changes the digest, and a resumed sharded
@@ -100,20 +101,34 @@
 // in place. Winding is the file's (each triangle reversed with MeshLoadOptions::flip_normals,
 // which also negates file normals); nothing here assumes it is consistent.
 //
+// TEXTURE COORDINATES (Mesh::uv_sets, per triangle corner: UvSet below; they never split or move a
+// row, so every rule above holds with or without them):
+//   * OBJ: `vt u v [w]` (w ignored) with `f v/vt[/vn]` corners: one set "vt".
+//   * PLY: the first of the vertex property pairs (u, v), (s, t), (texture_u, texture_v) that the
+//     vertex element has: one set "uv", per vertex.
+//   * glTF: each TEXCOORD_n of a primitive (VEC2 of float, or of normalized unsigned byte / short,
+//     read as c / 255, c / 65535): a set "TEXCOORD_n", per vertex, sets in order of n.
+//   * OFF, STL: none.
+// OBJ and PLY put v up the image; they are converted to glTF's v down as 1 − v. A set covers every
+// corner or is not a set: an OBJ where only some corners have a vt gets none, with a warning that
+// counts the corners without one; load_mesh keeps a glTF set only when every primitive instance
+// with a triangle has it (else a warning naming it), load_mesh_instances keeps each instance's own.
+//
 // ERRORS: bad input throws prt::bake::InputError whose what() is "<path>: <defect>" (one line),
 // with a line number where the format has lines: missing/unreadable/oversized file, unknown
 // extension, empty mesh, truncated or garbled file (an OBJ line with an unknown keyword is
-// garbage), NaN/Inf or out-of-float-range coordinates, zero / negative / out-of-range face
-// indices, faces with fewer than 3 corners. An OBJ's material library (`mtllib`) is never
+// garbage), NaN/Inf or out-of-float-range coordinates or texture coordinates, zero / negative /
+// out-of-range face indices (texture-coordinate indices too), faces with fewer than 3 corners. An OBJ's material library (`mtllib`) is never
 // opened and a missing one is not reported: a bake does not use materials, and a line about it
 // would be noise (Mesh::warnings holds only what matters to the bake). Binary OFF is not supported (InputError).
 // glTF: tinygltf's own parse errors (JSON, GLB container, missing or short buffers), and ours:
 // no scene, a reference to a node / mesh / accessor / buffer view / buffer that does not exist,
 // an accessor past its buffer view or a view past its buffer, an index out of range, a
 // non-finite position, a recursive node graph or a node reached twice (the hierarchy must be
-// disjoint trees), component types other than FLOAT positions/normals and unsigned
-// byte/short/int indices, sparse accessors, TRIANGLES with a count not a multiple of 3, and
-// required compression/quantization extensions. Textures are never decoded.
+// disjoint trees), component types other than FLOAT positions/normals, unsigned byte/short/int
+// indices and the TEXCOORD_n types above (a TEXCOORD_n that is not VEC2, integers not normalized,
+// a count other than POSITION's), sparse accessors, TRIANGLES with a count not a multiple of 3,
+// and required compression/quantization extensions. Textures are never decoded.
 // Reading is re-entrant: no global state.
 #pragma once
 
@@ -142,10 +157,10 @@ inline Eigen::Vector3d add_origin(const Eigen::Vector3d& origin, const Eigen::Ve
 // bakes, bake/mesh/texels.h) are baked in one such set. `corners[3 t + c]` is corner c of
 // triangle t in Mesh::triangles order (after the fan, and after flip_normals' reversal: the UV
 // follows its corner). Values as the file has them (glTF: (u, v) with v down the image, as
-// TEXCOORD_n; OBJ: `vt` u v, v up, converted to glTF's v-down as 1 − v, so every set uses one
-// convention: texel row 0 is v = 0).
+// TEXCOORD_n; OBJ: `vt` u v and PLY: u v, v up, converted to glTF's v-down as 1 − v, so every set
+// uses one convention: texel row 0 is v = 0). Which files have which sets: TEXTURE COORDINATES above.
 struct UvSet {
-  std::string name;                      // "TEXCOORD_0", "TEXCOORD_1" (glTF), "vt" (OBJ)
+  std::string name;                      // "TEXCOORD_0", "TEXCOORD_1" (glTF), "vt" (OBJ), "uv" (PLY)
   std::vector<Eigen::Vector2f> corners;  // 3 per triangle
 };
 
@@ -239,26 +254,33 @@ struct Polygons {
 
 // The one polygon-to-mesh step behind load_mesh (vertex order, hard-edge splits, fans, normals:
 // the contracts in the file comment). Validates what a reader may pass through (finite
-// positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits) and throws
-// InputError(source, defect). Sets source, file_positions, file_faces and origin (frame_origin of the
-// positions' bounds); not source_sha256 or warnings.
+// positions, >= 3 corners, indices in range, at least one polygon, 32-bit limits, finite texture
+// coordinates and their indices in range) and throws InputError(source, defect); a texture-coordinate
+// set without one index per corner is a reader's bug (ContractError). Each Polygons::Uvs becomes
+// a UvSet of the same name, in the same order, through the same fan and flip as the triangles.
+// Sets source, file_positions, file_faces and origin (frame_origin of the positions' bounds); not
+// source_sha256 or warnings.
 Mesh build_mesh(const Polygons& polygons, std::string source, const MeshLoadOptions& = {});
 
 // Build a mesh in memory (tests, generated geometry), origin 0. Output vertex i = positions[i],
 // source_position[i] = i, file_positions = positions.size(), file_faces = triangles.size().
 // Normals: angle-weighted over welded positions (as load_mesh) unless `normals` is given, in which
 // case it must have one finite non-zero vector per position; it is normalised and
-// normal_source = File. Validates (finite positions, indices in range, at least one triangle)
-// and throws InputError(name, defect).
+// normal_source = File. `uv_sets` (none by default) are taken as they are: 3 finite corners per
+// triangle each (UvSet). Validates (finite positions, indices in range, at least one triangle,
+// the sets) and throws InputError(name, defect).
 Mesh make_mesh(std::vector<Eigen::Vector3f> positions, std::vector<std::array<uint32_t, 3>> triangles,
-               std::string name, std::vector<Eigen::Vector3f> normals = {});
+               std::string name, std::vector<Eigen::Vector3f> normals = {}, std::vector<UvSet> uv_sets = {});
 
 // Concatenation (e.g. asset + ground plane): vertices and triangles of parts[0], then parts[1]…;
 // triangle indices are offset by the vertex count before each part, source_position by the sum
 // of file_positions before it (so it stays unique across parts). normal_source = File only if
-// every part's is; warnings are concatenated. `parts` must not be empty (contract). Origin: the
-// parts' when they all have the same one (offsets copied); else frame_origin of the union of the
-// parts' world bounds, every offset re-expressed from its world position in double.
+// every part's is; warnings are concatenated. A texture-coordinate set is kept (by name, in
+// parts[0]'s order, corners in part order) only when every part has one of that name, else it is
+// dropped without a warning (a part made in memory, a ground plane, has none). `parts` must not
+// be empty (contract). Origin: the parts' when they all have the same one (offsets copied); else
+// frame_origin of the union of the parts' world bounds, every offset re-expressed from its world
+// position in double.
 Mesh merge_meshes(std::span<const Mesh> parts, std::string name);
 
 // Angle-weighted vertex normals over the given indexing (no welding): n_v = normalize(Σ_t α_t(v)
