@@ -1,0 +1,155 @@
+// prtbake texel end to end (tools/prtbake/run_texel.cpp): an OBJ floor with lightmap UVs (vt)
+// and a box standing on it, baked per texel, read back through the asset model (format v5).
+// The floor texels outside the box's foot hold the closed-form AO of
+// tests/bake/bake/test_texel_bake.cpp (silhouette at N = 1536: within 1e-4 there; plus the
+// float32 of the file, 6e-8); the 8 × 8 under the box are inside it and filled; /lightmap/positions are the
+// texel centres on the floor; /mesh/uv is the file's vt (v flipped to glTF's convention).
+// Mistakes about UVs exit 1 naming the file.
+#include <formats/asset.h>
+
+#include <gtest/gtest.h>
+#include <run_tool.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+
+namespace {
+
+// Three doubles, enough vector algebra for the closed form (tools' tests use no Eigen).
+struct Vector3d {
+  double v[3] = {0, 0, 0};
+  Vector3d() = default;
+  Vector3d(double x, double y, double z) : v{x, y, z} {}
+  double operator[](int i) const { return v[i]; }
+  double x() const { return v[0]; }
+  double y() const { return v[1]; }
+  Vector3d operator-(const Vector3d& o) const { return {v[0] - o.v[0], v[1] - o.v[1], v[2] - o.v[2]}; }
+  Vector3d operator+(const Vector3d& o) const { return {v[0] + o.v[0], v[1] + o.v[1], v[2] + o.v[2]}; }
+  Vector3d operator/(double s) const { return {v[0] / s, v[1] / s, v[2] / s}; }
+  double dot(const Vector3d& o) const { return v[0] * o.v[0] + v[1] * o.v[1] + v[2] * o.v[2]; }
+  Vector3d cross(const Vector3d& o) const {
+    return {v[1] * o.v[2] - v[2] * o.v[1], v[2] * o.v[0] - v[0] * o.v[2], v[0] * o.v[1] - v[1] * o.v[0]};
+  }
+  double norm() const { return std::sqrt(dot(*this)); }
+  Vector3d normalized() const { return *this / norm(); }
+};
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(PRT_TEST_TMP) / "prtbake_texel";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// The floor [−2, 2]² at z = 0 with vt ((x + 2)/4, 1 − (y + 2)/4) (so glTF-convention v = (y + 2)/4),
+// and the unit box [−½, ½]² × [0, 1] on it, its corners at vt (3, 3): outside the atlas, so it
+// occludes and has no texels.
+fs::path floor_and_box() {
+  const fs::path obj = scratch("floor_box.obj");
+  std::ofstream out(obj);
+  out << "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\n";
+  out << "vt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\nvt 3 3\n";
+  out << "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  for (int k = 0; k < 8; ++k)
+    out << "v " << (k & 1 ? 0.5 : -0.5) << " " << (k & 2 ? 0.5 : -0.5) << " " << (k & 4 ? 1 : 0) << "\n";
+  const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                            {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& f : faces) out << "f " << f[0] + 5 << "/5 " << f[1] + 5 << "/5 " << f[2] + 5 << "/5\n";
+  return obj;
+}
+
+// ∫_P (n·ω) dω of a spherical polygon (unit vertices, either orientation): Lambert's formula,
+// ½ |Σ_i θ_i n·(v_i × v_{i+1}) / |v_i × v_{i+1}||, θ_i the arc between consecutive vertices —
+// written here again so the test does not use the library's (bake/sphere/spherical_polygon.h).
+double cosine_integral(const std::vector<Vector3d>& v, const Vector3d& n) {
+  double sum = 0;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const Vector3d& a = v[i];
+    const Vector3d& b = v[(i + 1) % v.size()];
+    const Vector3d c = a.cross(b);
+    sum += std::atan2(c.norm(), a.dot(b)) * n.dot(c) / c.norm();
+  }
+  return std::abs(sum) / 2;
+}
+
+double ao_closed_form(const Vector3d& p) {
+  const std::array<std::array<Vector3d, 4>, 4> faces = {{
+      {{{0.5, -0.5, 0}, {0.5, 0.5, 0}, {0.5, 0.5, 1}, {0.5, -0.5, 1}}},
+      {{{-0.5, 0.5, 0}, {-0.5, -0.5, 0}, {-0.5, -0.5, 1}, {-0.5, 0.5, 1}}},
+      {{{0.5, 0.5, 0}, {-0.5, 0.5, 0}, {-0.5, 0.5, 1}, {0.5, 0.5, 1}}},
+      {{{-0.5, -0.5, 0}, {0.5, -0.5, 0}, {0.5, -0.5, 1}, {-0.5, -0.5, 1}}},
+  }};
+  const std::array<Vector3d, 4> normals = {Vector3d(1, 0, 0), Vector3d(-1, 0, 0), Vector3d(0, 1, 0), Vector3d(0, -1, 0)};
+  double blocked = 0;
+  for (size_t f = 0; f < 4; ++f) {
+    if (normals[f].dot(p - (faces[f][0] + faces[f][2]) / 2) <= 0) continue;
+    std::vector<Vector3d> rel;
+    for (const Vector3d& v : faces[f]) rel.push_back((v - p).normalized());
+    blocked += cosine_integral(rel, Vector3d(0, 0, 1));
+  }
+  return 1 - blocked / std::numbers::pi;
+}
+
+} // namespace
+
+TEST(PrtbakeTexel, AFloorAroundABoxBakesToTheClosedFormPerTexel) {
+  const fs::path obj = floor_and_box(), out = scratch("floor_box.prt.h5");
+  fs::remove(out);
+  const auto run = prt::testing::run_tool(PRT_PRTBAKE,
+                                          "texel '" + obj.string() + "' --resolution 32 --ao --integrator silhouette "
+                                          "--samples 2359296 --report 0 --padding 0 -o '" + out.string() + "'",
+                                          scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("lightmap: 32x32 texels in UV set vt: 1024 covered"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("64 inside the geometry"), std::string::npos) << run.out;
+  const F::Asset a = F::read_asset(out);
+  EXPECT_EQ(a.root.format_version, 5);
+  ASSERT_TRUE(a.vertices.uv && a.vertices.lightmap);
+  EXPECT_EQ(a.vertices.uv->uv_set, "vt");
+  ASSERT_EQ(a.vertices.uv->values.size(), 14u * 3 * 2);
+  EXPECT_EQ(a.vertices.uv->values[1], 0.0f) << "vt v = 1 is glTF v = 0";
+  const F::Lightmap& m = *a.vertices.lightmap;
+  ASSERT_EQ(m.width, 32u);
+  ASSERT_EQ(m.height, 32u);
+  ASSERT_TRUE(m.ao && m.positions);
+  size_t filled = 0;
+  for (size_t k = 0; k < 32 * 32; ++k) {
+    // Texel (x, y) is centred at u = (x + ½)/32, v = (y + ½)/32: x = 4u − 2, y = 4v − 2 on the floor.
+    const Vector3d centre(4 * (double(k % 32) + 0.5) / 32 - 2, 4 * (double(k / 32) + 0.5) / 32 - 2, 0);
+    const bool under = std::abs(centre.x()) < 0.5 && std::abs(centre.y()) < 0.5;
+    EXPECT_EQ(m.state.values[k], under ? 2 : 1) << "texel " << k;
+    filled += m.state.values[k] == 2;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.positions->values[3 * k + size_t(c)], centre[c], 1e-6) << "texel " << k;
+    if (!under) {
+      EXPECT_NEAR(m.ao->values[k], ao_closed_form(centre), 1e-4 + 6e-8) << "texel " << k;
+    }
+  }
+  EXPECT_EQ(filled, 64u);
+}
+
+TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
+  const fs::path out = scratch("x.prt.h5");
+  const std::string bunny = std::string(PRT_DATA_DIR) + "/bunny.obj";
+  auto run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + bunny + "' --resolution 16 --ao --samples 64 -o '" + out.string() + "'",
+                                    scratch("capture"));
+  EXPECT_EQ(run.code, 1);
+  EXPECT_NE(run.err.find("bunny.obj: has no UV set"), std::string::npos) << run.err;
+  const fs::path obj = floor_and_box();
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + obj.string() + "' --uv TEXCOORD_1 --resolution 16 --ao --samples 64 -o '" +
+                                   out.string() + "'",
+                               scratch("capture"));
+  EXPECT_EQ(run.code, 1);
+  EXPECT_NE(run.err.find("has no UV set 'TEXCOORD_1' (it has vt)"), std::string::npos) << run.err;
+  run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + obj.string() + "' --resolution 0 --ao -o '" + out.string() + "'",
+                               scratch("capture"));
+  EXPECT_EQ(run.code, 2) << "a command-line mistake";
+  EXPECT_FALSE(fs::exists(out));
+}
