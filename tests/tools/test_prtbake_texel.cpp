@@ -141,6 +141,15 @@ TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
                                     scratch("capture"));
   EXPECT_EQ(run.code, 1);
   EXPECT_NE(run.err.find("bunny.obj: has no UV set"), std::string::npos) << run.err;
+  // wuson.obj's vt is one repeated (0, 0): a set, but no lightmap.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + std::string(PRT_DATA_DIR) + "/wuson.obj' --resolution 16 --ao --samples 64 -o '" +
+                                   out.string() + "'",
+                               scratch("capture"));
+  EXPECT_EQ(run.code, 1);
+  EXPECT_NE(run.err.find("wuson.obj: its UV set vt covers no texel of the 16x16 lightmap: every triangle has zero area"),
+            std::string::npos)
+      << run.err;
   const fs::path obj = floor_and_box();
   run = prt::testing::run_tool(PRT_PRTBAKE,
                                "texel '" + obj.string() + "' --uv TEXCOORD_1 --resolution 16 --ao --samples 64 -o '" +

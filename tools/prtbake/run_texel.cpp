@@ -60,10 +60,21 @@ int run_texel(const Args& a, const RunContext& run) {
   warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
   const bake::UvSet& uv = lightmap_uvs(mesh, a.uv_set);
   const bake::TexelAtlas atlas = bake::texel_atlas(mesh, topo, uv, a.lightmap_width, a.lightmap_height, a.input);
-  if (atlas.samples.empty())
+  if (atlas.samples.empty()) {
+    // Why: every triangle flat in UV space (a set of one repeated vt, as wuson.obj's), or UVs
+    // outside the atlas.
+    size_t flat = 0;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Eigen::Vector2f &p = uv.corners[3 * t], &q = uv.corners[3 * t + 1], &r = uv.corners[3 * t + 2];
+      flat += (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x() == 0;
+    }
     throw bake::InputError(mesh.source, "its UV set " + uv.name + " covers no texel of the " +
                                             std::to_string(a.lightmap_width) + "x" + std::to_string(a.lightmap_height) +
-                                            " lightmap (are its UVs inside [0, 1]?)");
+                                            " lightmap: " +
+                                            (flat == mesh.triangles.size()
+                                                 ? "every triangle has zero area in it (not a lightmap UV set)"
+                                                 : "its UVs lie outside [0, 1]"));
+  }
   const std::optional<bake::EnvMap> env = load_environment(a, run.say);
   const bake::ProductRequest req = product_request(a, env ? &*env : nullptr);
   const bake::MeshAccel accel(mesh, topo);
