@@ -68,6 +68,14 @@ struct SpineCrossing {
 
 struct Scratch {
   std::vector<ContourEdge> edges;
+  // Contour components below the horizon (cull_below_horizon): the dropped edges and their arcs
+  // (built only for the start ray's correction); the union-find over welded vertices, with
+  // node_of (welded id -> node, -1: none; reset after each point) sized to the welded count.
+  std::vector<ContourEdge> dropped;
+  std::vector<Arc> dropped_arcs;
+  std::vector<int32_t> node_of;
+  std::vector<uint32_t> parent, touched;
+  std::vector<uint8_t> below;
   std::vector<Arc> arcs;
   std::vector<Crossing> crossings, sorted;
   std::vector<SpineCrossing> spine;
@@ -108,7 +116,7 @@ struct SilhouetteIntegrator::Impl {
   std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
-      n_closed_form{0}, n_enclosed{0};
+      n_closed_form{0}, n_enclosed{0}, n_culled{0};
   // R and S of the unoccluded hemisphere about n (the n_env environment columns), per distinct
   // normal (bit pattern): the one environment-dependent part of the closed form (see closed_form()).
   mutable std::mutex hemisphere_mutex;
@@ -311,13 +319,14 @@ struct SilhouetteIntegrator::Impl {
   }
 
 
-  // The horizon of n as a virtual occluder boundary (four quarter arcs): +1 when crossing into n·ω < 0.
-  void add_horizon(const Vector3d& n, std::vector<Arc>& arcs) const {
+  // The horizon of n as a virtual occluder boundary (four quarter arcs): +step when crossing into
+  // n·ω < 0 (1, or K when contour components below the horizon were dropped: see cull_below_horizon).
+  void add_horizon(const Vector3d& n, std::vector<Arc>& arcs, int step = 1) const {
     const Vector3d nf = frame_from_world * n;
     const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
     const Vector3d t2v = nf.cross(t1v);
     const Vector3d c[4] = {t1v, t2v, -t1v, -t2v};
-    for (int k = 0; k < 4; ++k) arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -1});
+    for (int k = 0; k < 4; ++k) arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -step});
   }
 
   // Isoline crossings and spine crossings of every arc in s.arcs.
@@ -426,6 +435,99 @@ struct SilhouetteIntegrator::Impl {
     return hemisphere_radiance_cache.emplace(key, r).first->second;
   }
 
+  // Whether welded vertex w is certainly strictly below the tangent plane of (p, n): the point's
+  // own vertex is seen at −n; otherwise n·(x − p) < 0 beyond its rounding bound (the difference
+  // and the three-term dot product err by at most γ₄·Σ|n_i (x_i − p_i)|; 8u covers it and the
+  // rounding of the sum of magnitudes).
+  bool certainly_below(const ShadePoint& point, uint32_t w) const {
+    if (point.welded >= 0 && w == uint32_t(point.welded)) return true;
+    const Vector3d v = topo.welded_positions[w].cast<double>() - point.p;
+    const double a = point.n.x() * v.x(), b = point.n.y() * v.y(), c = point.n.z() * v.z();
+    return a + b + c < -8 * 0x1p-53 * (std::abs(a) + std::abs(b) + std::abs(c));
+  }
+
+  // Moves the contour edges of every component (connected through welded vertices) that lies
+  // wholly below the horizon from s.edges to s.dropped, keeping the others in order, and returns
+  // the horizon's step K = 1 + 2·Σ_dropped |S_e| (1 when nothing is dropped: the unculled walk).
+  // See bake/integrators/silhouette.h for why W = 0 is then decided on the same runs.
+  int cull_below_horizon(const ShadePoint& point, Scratch& s) const {
+    s.dropped.clear();
+    s.dropped_arcs.clear();
+    if (s.edges.empty()) return 1;
+    if (s.node_of.size() < topo.welded_positions.size()) s.node_of.resize(topo.welded_positions.size(), -1);
+    s.parent.clear();
+    s.below.clear();
+    s.touched.clear();
+    auto node = [&](uint32_t w) {
+      int32_t& k = s.node_of[w];
+      if (k < 0) {
+        k = int32_t(s.parent.size());
+        s.parent.push_back(uint32_t(k));
+        s.below.push_back(certainly_below(point, w) ? 1 : 0);
+        s.touched.push_back(w);
+      }
+      return uint32_t(k);
+    };
+    auto root = [&](uint32_t x) {
+      while (s.parent[x] != x) x = s.parent[x] = s.parent[s.parent[x]];
+      return x;
+    };
+    for (const ContourEdge& ce : s.edges) {
+      const auto& e = topo.edges[ce.edge];
+      const uint32_t ra = root(node(e[0])), rb = root(node(e[1]));
+      if (ra == rb) continue;
+      s.parent[ra] = rb;
+      s.below[rb] &= s.below[ra];
+    }
+    int64_t dropped_sum = 0;
+    size_t kept = 0;
+    for (const ContourEdge& ce : s.edges) {
+      if (s.below[root(uint32_t(s.node_of[topo.edges[ce.edge][0]]))]) {
+        s.dropped.push_back(ce);
+        dropped_sum += std::abs(int64_t(ce.side_sum));
+      } else {
+        s.edges[kept++] = ce;
+      }
+    }
+    s.edges.resize(kept);
+    for (const uint32_t w : s.touched) s.node_of[w] = -1;
+    PRT_CHECK_OP(dropped_sum, <, int64_t(1) << 29);
+    return int(1 + 2 * dropped_sum);
+  }
+
+  // W_D(n) − W_D(x) for the dropped components' step function W_D, world direction x (unit): what
+  // the depth complexity counted along x must be corrected by so that W' = W − W_D + W_D(upper)
+  // (bake/integrators/silhouette.h). 0 when x is clearly above the horizon (W_D is constant on the
+  // closed upper hemisphere, which no dropped arc enters); otherwise the steps of the dropped arcs
+  // along a path from x up to n (any path: W_D is single-valued), via a waypoint when x is far
+  // below.
+  int dropped_correction(const ShadePoint& point, Scratch& s, const Vector3d& x) const {
+    if (s.dropped.empty() || point.n.dot(x) > 1e-9) return 0;
+    if (s.dropped_arcs.empty()) {
+      for (const ContourEdge& ce : s.dropped) {
+        const auto& e = topo.edges[ce.edge];
+        auto dir = [&](uint32_t w) -> Vector3d {
+          if (point.welded >= 0 && w == uint32_t(point.welded)) return -point.n;
+          return topo.welded_positions[w].cast<double>() - point.p;
+        };
+        Arc arc;
+        arc.a = frame_from_world * dir(e[0]);
+        arc.b = frame_from_world * dir(e[1]);
+        arc.m = arc.a.cross(arc.b);
+        arc.side_sum = ce.side_sum;
+        // Both ends strictly below: an edge collinear with p does not pass through it and is seen
+        // as a point (crossed by no path), as in integrate().
+        if (arc.m.squaredNorm() != 0) s.dropped_arcs.push_back(arc);
+      }
+    }
+    const Vector3d P = frame_from_world * x, Q = frame_from_world * point.n;
+    if (P.dot(Q) > -0.5) return dcf_path_steps(s.dropped_arcs, P, Q);
+    Vector3d mid = P.cross(Vector3d(0.5466, -0.3719, 0.7503));
+    if (mid.squaredNorm() < 1e-6) mid = P.cross(Vector3d(-0.2377, 0.8716, 0.4288));
+    mid.normalize();
+    return dcf_path_steps(s.dropped_arcs, P, mid) + dcf_path_steps(s.dropped_arcs, mid, Q);
+  }
+
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out) const {
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
@@ -446,6 +548,16 @@ struct SilhouetteIntegrator::Impl {
       integrate_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(clock::now() - t1).count(),
                              std::memory_order_relaxed);
       return;
+    }
+
+    // ---- contour components below the horizon: left out, the horizon's step raised instead ----
+    const size_t found_edges = s.edges.size();
+    int horizon_step = 1;
+    if (point.hemisphere && opt.cull_below_horizon) {
+      horizon_step = cull_below_horizon(point, s);
+      if (!s.dropped.empty()) n_culled.fetch_add(s.dropped.size(), std::memory_order_relaxed);
+    } else {
+      s.dropped.clear();
     }
 
     // ---- arcs in the octahedral frame ----
@@ -496,7 +608,7 @@ struct SilhouetteIntegrator::Impl {
       }
       push(da, db);
     }
-    if (point.hemisphere) add_horizon(n, s.arcs);
+    if (point.hemisphere) add_horizon(n, s.arcs, horizon_step);
     add_crossings(s);
 
     // ---- W at the spine start (frame direction (−1, 0, 0)) from one counted ray ----
@@ -520,7 +632,8 @@ struct SilhouetteIntegrator::Impl {
       if (point.hemisphere) {
         const double hz = n.dot(wr);
         if (std::abs(hz) < 1e-12) continue;
-        w += hz < 0 ? 1 : 0;
+        w += hz < 0 ? horizon_step : 0;
+        w += dropped_correction(point, s, wr);
       }
       if (attempt > 0) {
         w += dcf_path_steps(s.arcs, frame_from_world * wr, s0);  // bake/integrators/hot_texels.h
@@ -551,7 +664,7 @@ struct SilhouetteIntegrator::Impl {
 
     const auto t2 = clock::now();
     n_points.fetch_add(1, std::memory_order_relaxed);
-    n_edges.fetch_add(s.edges.size(), std::memory_order_relaxed);
+    n_edges.fetch_add(found_edges, std::memory_order_relaxed);
     n_crossings.fetch_add(s.crossings.size(), std::memory_order_relaxed);
     if (inconsistent) n_inconsistent.fetch_add(inconsistent, std::memory_order_relaxed);
     contour_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), std::memory_order_relaxed);
@@ -609,12 +722,14 @@ IntegratorStats SilhouetteIntegrator::stats() const {
 std::string SilhouetteIntegrator::work_summary() const {
   const IntegratorStats st = stats();
   const double points = double(std::max<uint64_t>(st.points, 1)), cpu = std::max(1e-12, st.contour_seconds + st.integrate_seconds);
-  char line[256];
+  char line[384];
   std::snprintf(line, sizeof line,
                 "per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% integration; "
-                "%llu of %llu points saw no contour edge (closed form)",
+                "%llu of %llu points saw no contour edge (closed form); %.1f edges per integral below the horizon, "
+                "left out",
                 double(st.contour_edges) / points, double(st.crossings) / points, 100 * st.contour_seconds / cpu,
-                100 * st.integrate_seconds / cpu, (unsigned long long)st.closed_form, (unsigned long long)st.points);
+                100 * st.integrate_seconds / cpu, (unsigned long long)st.closed_form, (unsigned long long)st.points,
+                double(impl_->n_culled.load()) / points);
   return line;
 }
 
