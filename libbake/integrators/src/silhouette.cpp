@@ -500,32 +500,49 @@ struct SilhouetteIntegrator::Impl {
   // (bake/integrators/silhouette.h). 0 when x is clearly above the horizon (W_D is constant on the
   // closed upper hemisphere, which no dropped arc enters); otherwise the steps of the dropped arcs
   // along a path from x up to n (any path: W_D is single-valued), via a waypoint when x is far
-  // below.
+  // below. A dropped edge with both ends clearly on one side of a leg's plane (relative margin
+  // 1e-7, far above rounding) cannot cross it and is skipped before its arc is built.
   int dropped_correction(const ShadePoint& point, Scratch& s, const Vector3d& x) const {
     if (s.dropped.empty() || point.n.dot(x) > 1e-9) return 0;
-    if (s.dropped_arcs.empty()) {
+    const Vector3d P = frame_from_world * x, Q = frame_from_world * point.n;
+    Vector3d legs[3] = {P, Q, Q};
+    int n_legs = 1;
+    if (P.dot(Q) <= -0.5) {
+      Vector3d mid = P.cross(Vector3d(0.5466, -0.3719, 0.7503));
+      if (mid.squaredNorm() < 1e-6) mid = P.cross(Vector3d(-0.2377, 0.8716, 0.4288));
+      legs[1] = mid.normalized();
+      n_legs = 2;
+    }
+    const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    int steps = 0;
+    for (int l = 0; l < n_legs; ++l) {
+      const Vector3d& from = legs[l];
+      const Vector3d& to = legs[l + 1];
+      const Vector3d m2 = world_from_frame * from.cross(to);  // the leg's plane, world frame
+      const double k2 = 1e-14 * m2.squaredNorm();
+      s.dropped_arcs.clear();
       for (const ContourEdge& ce : s.dropped) {
         const auto& e = topo.edges[ce.edge];
         auto dir = [&](uint32_t w) -> Vector3d {
           if (point.welded >= 0 && w == uint32_t(point.welded)) return -point.n;
           return topo.welded_positions[w].cast<double>() - point.p;
         };
+        const Vector3d da = dir(e[0]), db = dir(e[1]);
+        const double sa = da.dot(m2), sb = db.dot(m2);
+        if (((sa > 0 && sb > 0) || (sa < 0 && sb < 0)) && sa * sa > k2 * da.squaredNorm() && sb * sb > k2 * db.squaredNorm())
+          continue;
         Arc arc;
-        arc.a = frame_from_world * dir(e[0]);
-        arc.b = frame_from_world * dir(e[1]);
+        arc.a = frame_from_world * da;
+        arc.b = frame_from_world * db;
         arc.m = arc.a.cross(arc.b);
         arc.side_sum = ce.side_sum;
         // Both ends strictly below: an edge collinear with p does not pass through it and is seen
         // as a point (crossed by no path), as in integrate().
         if (arc.m.squaredNorm() != 0) s.dropped_arcs.push_back(arc);
       }
+      steps += dcf_path_steps(s.dropped_arcs, from, to);
     }
-    const Vector3d P = frame_from_world * x, Q = frame_from_world * point.n;
-    if (P.dot(Q) > -0.5) return dcf_path_steps(s.dropped_arcs, P, Q);
-    Vector3d mid = P.cross(Vector3d(0.5466, -0.3719, 0.7503));
-    if (mid.squaredNorm() < 1e-6) mid = P.cross(Vector3d(-0.2377, 0.8716, 0.4288));
-    mid.normalize();
-    return dcf_path_steps(s.dropped_arcs, P, mid) + dcf_path_steps(s.dropped_arcs, mid, Q);
+    return steps;
   }
 
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out) const {
