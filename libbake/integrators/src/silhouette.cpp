@@ -68,14 +68,21 @@ struct SpineCrossing {
 
 struct Scratch {
   std::vector<ContourEdge> edges;
-  // Contour components below the horizon (cull_below_horizon): the dropped edges and their arcs
-  // (built only for the start ray's correction); the union-find over welded vertices, with
-  // node_of (welded id -> node, -1: none; reset after each point) sized to the welded count.
+  // The contour edges' end vertices, each once (prepare_edges): its direction from the shade
+  // point in the world and the octahedral frame, and the union-find of the components below the
+  // horizon; node_of maps a welded id to its node (-1: none; reset after each point). ends[i]
+  // are edges[i]'s nodes. The dropped edges (with their ends) and their arcs, built only for the
+  // start ray's correction.
+  struct Node {
+    Vector3d v, f;  // p → vertex (−n for the point's own vertex), world; the same in the frame
+    uint32_t welded, parent;
+    uint8_t below;
+  };
+  std::vector<Node> nodes;
+  std::vector<std::array<uint32_t, 2>> ends, dropped_ends;
+  std::vector<int32_t> node_of;
   std::vector<ContourEdge> dropped;
   std::vector<Arc> dropped_arcs;
-  std::vector<int32_t> node_of;
-  std::vector<uint32_t> parent, touched;
-  std::vector<uint8_t> below;
   std::vector<Arc> arcs;
   std::vector<Crossing> crossings, sorted;
   std::vector<SpineCrossing> spine;
@@ -320,7 +327,7 @@ struct SilhouetteIntegrator::Impl {
 
 
   // The horizon of n as a virtual occluder boundary (four quarter arcs): +step when crossing into
-  // n·ω < 0 (1, or K when contour components below the horizon were dropped: see cull_below_horizon).
+  // n·ω < 0 (1, or K when contour components below the horizon were dropped: see prepare_edges).
   void add_horizon(const Vector3d& n, std::vector<Arc>& arcs, int step = 1) const {
     const Vector3d nf = frame_from_world * n;
     const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
@@ -435,62 +442,73 @@ struct SilhouetteIntegrator::Impl {
     return hemisphere_radiance_cache.emplace(key, r).first->second;
   }
 
-  // Whether welded vertex w is certainly strictly below the tangent plane of (p, n): the point's
-  // own vertex is seen at −n; otherwise n·(x − p) < 0 beyond its rounding bound (the difference
-  // and the three-term dot product err by at most γ₄·Σ|n_i (x_i − p_i)|; 8u covers it and the
-  // rounding of the sum of magnitudes).
-  bool certainly_below(const ShadePoint& point, uint32_t w) const {
-    if (point.welded >= 0 && w == uint32_t(point.welded)) return true;
-    const Vector3d v = topo.welded_positions[w].cast<double>() - point.p;
-    const double a = point.n.x() * v.x(), b = point.n.y() * v.y(), c = point.n.z() * v.z();
+  // Whether the vertex at p + v is certainly strictly below the tangent plane of (p, n):
+  // n·v < 0 beyond its rounding bound (v = x − p and the three-term dot product err by at most
+  // γ₄·Σ|n_i (x_i − p_i)|; 8u covers it and the rounding of the sum of magnitudes). (The point's
+  // own vertex, seen at −n, is below without this test.)
+  static bool certainly_below(const Vector3d& n, const Vector3d& v) {
+    const double a = n.x() * v.x(), b = n.y() * v.y(), c = n.z() * v.z();
     return a + b + c < -8 * 0x1p-53 * (std::abs(a) + std::abs(b) + std::abs(c));
   }
 
-  // Moves the contour edges of every component (connected through welded vertices) that lies
-  // wholly below the horizon from s.edges to s.dropped, keeping the others in order, and returns
-  // the horizon's step K = 1 + 2·Σ_dropped |S_e| (1 when nothing is dropped: the unculled walk).
-  // See bake/integrators/silhouette.h for why W = 0 is then decided on the same runs.
-  int cull_below_horizon(const ShadePoint& point, Scratch& s) const {
+  // The nodes of the contour edges' ends (Scratch::nodes, ends). With `cull`, moves the edges of
+  // every component (connected through welded vertices) that lies wholly below the horizon from
+  // s.edges to s.dropped, keeping the others in order, and returns the horizon's step
+  // K = 1 + 2·Σ_dropped |S_e| (1 when nothing is dropped: the unculled walk). See
+  // bake/integrators/silhouette.h for why W = 0 is then decided on the same runs.
+  int prepare_edges(const ShadePoint& point, Scratch& s, bool cull) const {
+    s.nodes.clear();
+    s.ends.clear();
     s.dropped.clear();
+    s.dropped_ends.clear();
     s.dropped_arcs.clear();
-    if (s.edges.empty()) return 1;
     if (s.node_of.size() < topo.welded_positions.size()) s.node_of.resize(topo.welded_positions.size(), -1);
-    s.parent.clear();
-    s.below.clear();
-    s.touched.clear();
     auto node = [&](uint32_t w) {
       int32_t& k = s.node_of[w];
       if (k < 0) {
-        k = int32_t(s.parent.size());
-        s.parent.push_back(uint32_t(k));
-        s.below.push_back(certainly_below(point, w) ? 1 : 0);
-        s.touched.push_back(w);
+        k = int32_t(s.nodes.size());
+        Scratch::Node nd;
+        nd.welded = w;
+        nd.parent = uint32_t(k);
+        const bool own = point.welded >= 0 && w == uint32_t(point.welded);
+        nd.v = own ? Vector3d(-point.n) : Vector3d(topo.welded_positions[w].cast<double>() - point.p);  // seen from p + εn
+        nd.f = frame_from_world * nd.v;
+        nd.below = cull && (own || certainly_below(point.n, nd.v)) ? 1 : 0;
+        s.nodes.push_back(nd);
       }
       return uint32_t(k);
     };
-    auto root = [&](uint32_t x) {
-      while (s.parent[x] != x) x = s.parent[x] = s.parent[s.parent[x]];
-      return x;
-    };
     for (const ContourEdge& ce : s.edges) {
       const auto& e = topo.edges[ce.edge];
-      const uint32_t ra = root(node(e[0])), rb = root(node(e[1]));
-      if (ra == rb) continue;
-      s.parent[ra] = rb;
-      s.below[rb] &= s.below[ra];
+      s.ends.push_back({node(e[0]), node(e[1])});
     }
     int64_t dropped_sum = 0;
-    size_t kept = 0;
-    for (const ContourEdge& ce : s.edges) {
-      if (s.below[root(uint32_t(s.node_of[topo.edges[ce.edge][0]]))]) {
-        s.dropped.push_back(ce);
-        dropped_sum += std::abs(int64_t(ce.side_sum));
-      } else {
-        s.edges[kept++] = ce;
+    if (cull) {
+      auto root = [&](uint32_t x) {
+        while (s.nodes[x].parent != x) x = s.nodes[x].parent = s.nodes[s.nodes[x].parent].parent;
+        return x;
+      };
+      for (const auto& en : s.ends) {
+        const uint32_t ra = root(en[0]), rb = root(en[1]);
+        if (ra == rb) continue;
+        s.nodes[ra].parent = rb;
+        s.nodes[rb].below &= s.nodes[ra].below;
       }
+      size_t kept = 0;
+      for (size_t i = 0; i < s.edges.size(); ++i) {
+        if (s.nodes[root(s.ends[i][0])].below) {
+          s.dropped.push_back(s.edges[i]);
+          s.dropped_ends.push_back(s.ends[i]);
+          dropped_sum += std::abs(int64_t(s.edges[i].side_sum));
+        } else {
+          s.edges[kept] = s.edges[i];
+          s.ends[kept++] = s.ends[i];
+        }
+      }
+      s.edges.resize(kept);
+      s.ends.resize(kept);
     }
-    s.edges.resize(kept);
-    for (const uint32_t w : s.touched) s.node_of[w] = -1;
+    for (const Scratch::Node& nd : s.nodes) s.node_of[nd.welded] = -1;
     PRT_CHECK_OP(dropped_sum, <, int64_t(1) << 29);
     return int(1 + 2 * dropped_sum);
   }
@@ -521,19 +539,16 @@ struct SilhouetteIntegrator::Impl {
       const Vector3d m2 = world_from_frame * from.cross(to);  // the leg's plane, world frame
       const double k2 = 1e-14 * m2.squaredNorm();
       s.dropped_arcs.clear();
-      for (const ContourEdge& ce : s.dropped) {
-        const auto& e = topo.edges[ce.edge];
-        auto dir = [&](uint32_t w) -> Vector3d {
-          if (point.welded >= 0 && w == uint32_t(point.welded)) return -point.n;
-          return topo.welded_positions[w].cast<double>() - point.p;
-        };
-        const Vector3d da = dir(e[0]), db = dir(e[1]);
+      for (size_t i = 0; i < s.dropped.size(); ++i) {
+        const ContourEdge& ce = s.dropped[i];
+        const Scratch::Node &A = s.nodes[s.dropped_ends[i][0]], &B = s.nodes[s.dropped_ends[i][1]];
+        const Vector3d &da = A.v, &db = B.v;
         const double sa = da.dot(m2), sb = db.dot(m2);
         if (((sa > 0 && sb > 0) || (sa < 0 && sb < 0)) && sa * sa > k2 * da.squaredNorm() && sb * sb > k2 * db.squaredNorm())
           continue;
         Arc arc;
-        arc.a = frame_from_world * da;
-        arc.b = frame_from_world * db;
+        arc.a = A.f;
+        arc.b = B.f;
         arc.m = arc.a.cross(arc.b);
         arc.side_sum = ce.side_sum;
         // Both ends strictly below: an edge collinear with p does not pass through it and is seen
@@ -569,24 +584,17 @@ struct SilhouetteIntegrator::Impl {
 
     // ---- contour components below the horizon: left out, the horizon's step raised instead ----
     const size_t found_edges = s.edges.size();
-    int horizon_step = 1;
-    if (point.hemisphere && opt.cull_below_horizon) {
-      horizon_step = cull_below_horizon(point, s);
-      if (!s.dropped.empty()) n_culled.fetch_add(s.dropped.size(), std::memory_order_relaxed);
-    } else {
-      s.dropped.clear();
-    }
+    const int horizon_step = prepare_edges(point, s, point.hemisphere && opt.cull_below_horizon);
+    if (!s.dropped.empty()) n_culled.fetch_add(s.dropped.size(), std::memory_order_relaxed);
 
     // ---- arcs in the octahedral frame ----
     s.arcs.clear();
     const Vector3d n = point.n;
-    for (const ContourEdge& ce : s.edges) {
-      const auto& e = topo.edges[ce.edge];
-      auto dir = [&](uint32_t w) -> Vector3d {
-        if (point.welded >= 0 && w == uint32_t(point.welded)) return -n;  // seen from p + εn
-        return topo.welded_positions[w].cast<double>() - point.p;
-      };
-      const Vector3d da = dir(e[0]), db = dir(e[1]);
+    for (size_t i = 0; i < s.edges.size(); ++i) {
+      const ContourEdge& ce = s.edges[i];
+      const Scratch::Node &A = s.nodes[s.ends[i][0]], &B = s.nodes[s.ends[i][1]];
+      const std::array<uint32_t, 2> e = {A.welded, B.welded};
+      const Vector3d &da = A.v, &db = B.v;  // seen from p + εn (the point's own vertex at −n)
       auto push = [&](const Vector3d& a, const Vector3d& b) {
         Arc arc;
         arc.a = frame_from_world * a;
@@ -623,7 +631,12 @@ struct SilhouetteIntegrator::Impl {
         }
         continue;
       }
-      push(da, db);
+      Arc arc;  // push(da, db), with the frame directions computed once per vertex
+      arc.a = A.f;
+      arc.b = B.f;
+      arc.m = arc.a.cross(arc.b);
+      arc.side_sum = ce.side_sum;
+      s.arcs.push_back(arc);
     }
     if (point.hemisphere) add_horizon(n, s.arcs, horizon_step);
     add_crossings(s);
