@@ -75,10 +75,11 @@ struct Scratch {
   // start ray's correction.
   struct Node {
     Vector3d v, f;  // p → vertex (−n for the point's own vertex), world; the same in the frame
-    uint32_t welded, parent;
-    uint8_t below;
+    uint32_t welded;
   };
   std::vector<Node> nodes;
+  std::vector<uint32_t> parent, size;  // union-find over nodes (by size, path halving)
+  std::vector<uint8_t> below;          // per node; per root: the whole component
   std::vector<std::array<uint32_t, 2>> ends, dropped_ends;
   std::vector<int32_t> node_of;
   std::vector<ContourEdge> dropped;
@@ -458,6 +459,9 @@ struct SilhouetteIntegrator::Impl {
   // bake/integrators/silhouette.h for why W = 0 is then decided on the same runs.
   int prepare_edges(const ShadePoint& point, Scratch& s, bool cull) const {
     s.nodes.clear();
+    s.parent.clear();
+    s.size.clear();
+    s.below.clear();
     s.ends.clear();
     s.dropped.clear();
     s.dropped_ends.clear();
@@ -469,11 +473,12 @@ struct SilhouetteIntegrator::Impl {
         k = int32_t(s.nodes.size());
         Scratch::Node nd;
         nd.welded = w;
-        nd.parent = uint32_t(k);
         const bool own = point.welded >= 0 && w == uint32_t(point.welded);
         nd.v = own ? Vector3d(-point.n) : Vector3d(topo.welded_positions[w].cast<double>() - point.p);  // seen from p + εn
         nd.f = frame_from_world * nd.v;
-        nd.below = cull && (own || certainly_below(point.n, nd.v)) ? 1 : 0;
+        s.below.push_back(cull && (own || certainly_below(point.n, nd.v)) ? 1 : 0);
+        s.parent.push_back(uint32_t(k));
+        s.size.push_back(1);
         s.nodes.push_back(nd);
       }
       return uint32_t(k);
@@ -484,19 +489,22 @@ struct SilhouetteIntegrator::Impl {
     }
     int64_t dropped_sum = 0;
     if (cull) {
-      auto root = [&](uint32_t x) {
-        while (s.nodes[x].parent != x) x = s.nodes[x].parent = s.nodes[s.nodes[x].parent].parent;
+      uint32_t* const parent = s.parent.data();
+      auto root = [parent](uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
         return x;
       };
       for (const auto& en : s.ends) {
-        const uint32_t ra = root(en[0]), rb = root(en[1]);
+        uint32_t ra = root(en[0]), rb = root(en[1]);
         if (ra == rb) continue;
-        s.nodes[ra].parent = rb;
-        s.nodes[rb].below &= s.nodes[ra].below;
+        if (s.size[ra] > s.size[rb]) std::swap(ra, rb);
+        parent[ra] = rb;
+        s.size[rb] += s.size[ra];
+        s.below[rb] &= s.below[ra];
       }
       size_t kept = 0;
       for (size_t i = 0; i < s.edges.size(); ++i) {
-        if (s.nodes[root(s.ends[i][0])].below) {
+        if (s.below[root(s.ends[i][0])]) {
           s.dropped.push_back(s.edges[i]);
           s.dropped_ends.push_back(s.ends[i]);
           dropped_sum += std::abs(int64_t(s.edges[i].side_sum));
