@@ -223,6 +223,20 @@ struct SilhouetteIntegrator::Impl {
   // Crossings of one arc with isolines [i_begin, i_end) of grid g, per octant piece.
   static void add_arc(const Arc& arc, const oct::Grid& g, int i_begin, int i_end, std::vector<Crossing>& out) {
     if (arc.m.squaredNorm() == 0 || arc.side_sum == 0) return;
+    // Most arcs of a fine mesh lie in one octant (no coordinate changes sign: one piece below)
+    // and between two neighbouring isolines. Their u range in isoline units, t = (u + 1)/h − ½,
+    // computed here with rounding far below the margin of 1e-6, holds no integer: then the piece's
+    // own first_at_or_after(umin) ≥ umax's and it adds nothing; leave before the general path.
+    if ((arc.a.x() < 0) == (arc.b.x() < 0) && (arc.a.y() < 0) == (arc.b.y() < 0) && (arc.a.z() < 0) == (arc.b.z() < 0)) {
+      const double sa = std::abs(arc.a.x()) + std::abs(arc.a.y()) + std::abs(arc.a.z());
+      const double sb = std::abs(arc.b.x()) + std::abs(arc.b.y()) + std::abs(arc.b.z());
+      if (sa > 0 && sb > 0) {
+        const double half_n = 0.5 * g.n;
+        const double ta = (arc.a.x() / sa + 1) * half_n - 0.5, tb = (arc.b.x() / sb + 1) * half_n - 0.5;
+        const double lo = std::min(ta, tb) - 1e-6, hi = std::max(ta, tb) + 1e-6;
+        if (lo > -2 && hi < g.n + 1 && oct::ceil_int(lo) >= hi) return;
+      }
+    }
     const Vector3d d = arc.b - arc.a;
     double lam[5] = {0, 1, 1, 1, 1};
     int nl = 1;
