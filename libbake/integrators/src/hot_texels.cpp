@@ -82,7 +82,8 @@ struct Scratch {
   std::vector<std::pair<double, size_t>> active;
   std::vector<Vector2d> band, clip_tmp;
   std::vector<Vector3d> world;
-  std::vector<ArcInfo> info;  // per arc of the current call
+  std::vector<ArcInfo> info;  // per arc of the current call (computed for the arcs that need it)
+  std::vector<uint8_t> has_info;
   std::vector<std::vector<size_t>> node_arcs;  // per depth of the cluster tree
   std::vector<double> xs;
   std::vector<std::pair<double, size_t>> order;
@@ -688,19 +689,64 @@ void HotTexels::accumulate(std::span<const DcfArc> arcs, const Vector3d& s0, int
   if (I.nodes.empty()) return;
   Scratch& s = tl_scratch;
   s.info.resize(arcs.size());
+  s.has_info.assign(arcs.size(), 0);
   s.node_arcs.resize(size_t(I.depth) + 1);
+  // An arc's cap and unit vectors only when a test needs them: most arcs of a cluttered scene
+  // are dismissed by one of the two plane tests below, which need neither.
+  auto info = [&](size_t j) -> const ArcInfo& {
+    if (!s.has_info[j]) {
+      s.info[j] = Impl::info_of(arcs[j]);
+      s.has_info[j] = 1;
+    }
+    return s.info[j];
+  };
+  // Relative margin of the plane tests: far above the rounding of a·m and b·m, so an arc they
+  // dismiss is dismissed by the exact-arithmetic argument, never by rounding.
+  constexpr double kMargin = 1e-7;
   std::vector<size_t>& root = s.node_arcs[0];
   root.clear();
+  const Impl::Node& n = I.nodes[0];
+  Cap cap;
+  cap.mid = n.c, cap.cos_h = n.cos_r, cap.sin_h = n.sin_r;
+  const double gc_limit = n.sin_r + kMargin;
   for (size_t j = 0; j < arcs.size(); ++j) {
-    s.info[j] = Impl::info_of(arcs[j]);
     if (arcs[j].side_sum == 0) continue;
-    const Impl::Node& n = I.nodes[0];
-    Cap cap;
-    cap.mid = n.c, cap.cos_h = n.cos_r, cap.sin_h = n.sin_r;
-    if (n.cos_r <= -1 || caps_meet(s.info[j].cap, cap)) root.push_back(j);
+    if (n.cos_r > -1) {
+      // The arc's great circle passes farther than the root cap's radius (< 1 rad) from its
+      // centre, |c·m̂| > sin r: the arc cannot meet the cap nor, the cap being convex, any cap
+      // or path inside it (every cluster's cap and every leg descend() tests are in it).
+      const Vector3d& m = arcs[j].m;
+      const double cm = n.c.dot(m), m2 = m.squaredNorm();
+      if (m2 > 0 && cm * cm > gc_limit * gc_limit * m2) continue;
+    }
+    if (caps_meet(info(j).cap, cap)) root.push_back(j);  // (caps_meet passes every arc when cos_r = −1)
   }
-  // W at the root's reference point from s0: a long path, every arc tested (by its cap first).
-  const int W_root = W0 + Impl::steps_between(arcs, s.info, s0, I.nodes[0].ref);
+  // W at the root's reference point from s0: a long path, the legs of steps_between (via a
+  // waypoint when nearly opposite), every arc tested by its cap first, then by dcf_path_steps. An
+  // arc with both ends clearly on one side of a leg's great circle cannot cross the leg
+  // (dcf_path_steps would add 0): dismissed before its cap is computed.
+  int W_root = W0;
+  auto leg = [&](auto&& self, const Vector3d& from, const Vector3d& to) -> void {
+    if (from.dot(to) <= -0.5 * from.norm() * to.norm()) {
+      const Vector3d mid = Impl::waypoint(from);
+      self(self, from, mid);
+      self(self, mid, to);
+      return;
+    }
+    if (from == to) return;
+    const Cap leg_cap = cap_of(from, to);
+    const Vector3d m2 = from.cross(to);
+    const double m2n = m2.squaredNorm(), k2 = kMargin * kMargin * m2n;
+    for (size_t j = 0; j < arcs.size(); ++j) {
+      const DcfArc& arc = arcs[j];
+      const double da = arc.a.dot(m2), db = arc.b.dot(m2);
+      if (((da > 0 && db > 0) || (da < 0 && db < 0)) && da * da > k2 * arc.a.squaredNorm() &&
+          db * db > k2 * arc.b.squaredNorm())
+        continue;
+      if (caps_meet(info(j).cap, leg_cap)) W_root += dcf_path_steps(arcs.subspan(j, 1), from, to);
+    }
+  };
+  leg(leg, s0, n.ref);
   I.descend(0, arcs, root, W_root, out, s, 0);
 }
 

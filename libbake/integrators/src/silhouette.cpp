@@ -68,6 +68,22 @@ struct SpineCrossing {
 
 struct Scratch {
   std::vector<ContourEdge> edges;
+  // The contour edges' end vertices, each once (prepare_edges): its direction from the shade
+  // point in the world and the octahedral frame, and the union-find of the components below the
+  // horizon; node_of maps a welded id to its node (-1: none; reset after each point). ends[i]
+  // are edges[i]'s nodes. The dropped edges (with their ends) and their arcs, built only for the
+  // start ray's correction.
+  struct Node {
+    Vector3d v, f;  // p → vertex (−n for the point's own vertex), world; the same in the frame
+    uint32_t welded;
+  };
+  std::vector<Node> nodes;
+  std::vector<uint32_t> parent, size;  // union-find over nodes (by size, path halving)
+  std::vector<uint8_t> below;          // per node; per root: the whole component
+  std::vector<std::array<uint32_t, 2>> ends, dropped_ends;
+  std::vector<int32_t> node_of;
+  std::vector<ContourEdge> dropped;
+  std::vector<Arc> dropped_arcs;
   std::vector<Arc> arcs;
   std::vector<Crossing> crossings, sorted;
   std::vector<SpineCrossing> spine;
@@ -108,7 +124,7 @@ struct SilhouetteIntegrator::Impl {
   std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
-      n_closed_form{0}, n_enclosed{0};
+      n_closed_form{0}, n_enclosed{0}, n_culled{0};
   // R and S of the unoccluded hemisphere about n (the n_env environment columns), per distinct
   // normal (bit pattern): the one environment-dependent part of the closed form (see closed_form()).
   mutable std::mutex hemisphere_mutex;
@@ -207,6 +223,20 @@ struct SilhouetteIntegrator::Impl {
   // Crossings of one arc with isolines [i_begin, i_end) of grid g, per octant piece.
   static void add_arc(const Arc& arc, const oct::Grid& g, int i_begin, int i_end, std::vector<Crossing>& out) {
     if (arc.m.squaredNorm() == 0 || arc.side_sum == 0) return;
+    // Most arcs of a fine mesh lie in one octant (no coordinate changes sign: one piece below)
+    // and between two neighbouring isolines. Their u range in isoline units, t = (u + 1)/h − ½,
+    // computed here with rounding far below the margin of 1e-6, holds no integer: then the piece's
+    // own first_at_or_after(umin) ≥ umax's and it adds nothing; leave before the general path.
+    if ((arc.a.x() < 0) == (arc.b.x() < 0) && (arc.a.y() < 0) == (arc.b.y() < 0) && (arc.a.z() < 0) == (arc.b.z() < 0)) {
+      const double sa = std::abs(arc.a.x()) + std::abs(arc.a.y()) + std::abs(arc.a.z());
+      const double sb = std::abs(arc.b.x()) + std::abs(arc.b.y()) + std::abs(arc.b.z());
+      if (sa > 0 && sb > 0) {
+        const double half_n = 0.5 * g.n;
+        const double ta = (arc.a.x() / sa + 1) * half_n - 0.5, tb = (arc.b.x() / sb + 1) * half_n - 0.5;
+        const double lo = std::min(ta, tb) - 1e-6, hi = std::max(ta, tb) + 1e-6;
+        if (lo > -2 && hi < g.n + 1 && oct::ceil_int(lo) >= hi) return;
+      }
+    }
     const Vector3d d = arc.b - arc.a;
     double lam[5] = {0, 1, 1, 1, 1};
     int nl = 1;
@@ -311,13 +341,14 @@ struct SilhouetteIntegrator::Impl {
   }
 
 
-  // The horizon of n as a virtual occluder boundary (four quarter arcs): +1 when crossing into n·ω < 0.
-  void add_horizon(const Vector3d& n, std::vector<Arc>& arcs) const {
+  // The horizon of n as a virtual occluder boundary (four quarter arcs): +step when crossing into
+  // n·ω < 0 (1, or K when contour components below the horizon were dropped: see prepare_edges).
+  void add_horizon(const Vector3d& n, std::vector<Arc>& arcs, int step = 1) const {
     const Vector3d nf = frame_from_world * n;
     const Vector3d t1v = (std::abs(nf.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY()).cross(nf).normalized();
     const Vector3d t2v = nf.cross(t1v);
     const Vector3d c[4] = {t1v, t2v, -t1v, -t2v};
-    for (int k = 0; k < 4; ++k) arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -1});
+    for (int k = 0; k < 4; ++k) arcs.push_back({c[k], c[(k + 1) % 4], c[k].cross(c[(k + 1) % 4]), -step});
   }
 
   // Isoline crossings and spine crossings of every arc in s.arcs.
@@ -426,6 +457,131 @@ struct SilhouetteIntegrator::Impl {
     return hemisphere_radiance_cache.emplace(key, r).first->second;
   }
 
+  // Whether the vertex at p + v is certainly strictly below the tangent plane of (p, n):
+  // n·v < 0 beyond its rounding bound (v = x − p and the three-term dot product err by at most
+  // γ₄·Σ|n_i (x_i − p_i)|; 8u covers it and the rounding of the sum of magnitudes). (The point's
+  // own vertex, seen at −n, is below without this test.)
+  static bool certainly_below(const Vector3d& n, const Vector3d& v) {
+    const double a = n.x() * v.x(), b = n.y() * v.y(), c = n.z() * v.z();
+    return a + b + c < -8 * 0x1p-53 * (std::abs(a) + std::abs(b) + std::abs(c));
+  }
+
+  // The nodes of the contour edges' ends (Scratch::nodes, ends). With `cull`, moves the edges of
+  // every component (connected through welded vertices) that lies wholly below the horizon from
+  // s.edges to s.dropped, keeping the others in order, and returns the horizon's step
+  // K = 1 + 2·Σ_dropped |S_e| (1 when nothing is dropped: the unculled walk). See
+  // bake/integrators/silhouette.h for why W = 0 is then decided on the same runs.
+  int prepare_edges(const ShadePoint& point, Scratch& s, bool cull) const {
+    s.nodes.clear();
+    s.parent.clear();
+    s.size.clear();
+    s.below.clear();
+    s.ends.clear();
+    s.dropped.clear();
+    s.dropped_ends.clear();
+    s.dropped_arcs.clear();
+    if (s.node_of.size() < topo.welded_positions.size()) s.node_of.resize(topo.welded_positions.size(), -1);
+    auto node = [&](uint32_t w) {
+      int32_t& k = s.node_of[w];
+      if (k < 0) {
+        k = int32_t(s.nodes.size());
+        Scratch::Node nd;
+        nd.welded = w;
+        const bool own = point.welded >= 0 && w == uint32_t(point.welded);
+        nd.v = own ? Vector3d(-point.n) : Vector3d(topo.welded_positions[w].cast<double>() - point.p);  // seen from p + εn
+        nd.f = frame_from_world * nd.v;
+        s.below.push_back(cull && (own || certainly_below(point.n, nd.v)) ? 1 : 0);
+        s.parent.push_back(uint32_t(k));
+        s.size.push_back(1);
+        s.nodes.push_back(nd);
+      }
+      return uint32_t(k);
+    };
+    for (const ContourEdge& ce : s.edges) {
+      const auto& e = topo.edges[ce.edge];
+      s.ends.push_back({node(e[0]), node(e[1])});
+    }
+    int64_t dropped_sum = 0;
+    if (cull) {
+      uint32_t* const parent = s.parent.data();
+      auto root = [parent](uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+      };
+      for (const auto& en : s.ends) {
+        uint32_t ra = root(en[0]), rb = root(en[1]);
+        if (ra == rb) continue;
+        if (s.size[ra] > s.size[rb]) std::swap(ra, rb);
+        parent[ra] = rb;
+        s.size[rb] += s.size[ra];
+        s.below[rb] &= s.below[ra];
+      }
+      size_t kept = 0;
+      for (size_t i = 0; i < s.edges.size(); ++i) {
+        if (s.below[root(s.ends[i][0])]) {
+          s.dropped.push_back(s.edges[i]);
+          s.dropped_ends.push_back(s.ends[i]);
+          dropped_sum += std::abs(int64_t(s.edges[i].side_sum));
+        } else {
+          s.edges[kept] = s.edges[i];
+          s.ends[kept++] = s.ends[i];
+        }
+      }
+      s.edges.resize(kept);
+      s.ends.resize(kept);
+    }
+    for (const Scratch::Node& nd : s.nodes) s.node_of[nd.welded] = -1;
+    PRT_CHECK_OP(dropped_sum, <, int64_t(1) << 29);
+    return int(1 + 2 * dropped_sum);
+  }
+
+  // W_D(n) − W_D(x) for the dropped components' step function W_D, world direction x (unit): what
+  // the depth complexity counted along x must be corrected by so that W' = W − W_D + W_D(upper)
+  // (bake/integrators/silhouette.h). 0 when x is clearly above the horizon (W_D is constant on the
+  // closed upper hemisphere, which no dropped arc enters); otherwise the steps of the dropped arcs
+  // along a path from x up to n (any path: W_D is single-valued), via a waypoint when x is far
+  // below. A dropped edge with both ends clearly on one side of a leg's plane (relative margin
+  // 1e-7, far above rounding) cannot cross it and is skipped before its arc is built.
+  int dropped_correction(const ShadePoint& point, Scratch& s, const Vector3d& x) const {
+    if (s.dropped.empty() || point.n.dot(x) > 1e-9) return 0;
+    const Vector3d P = frame_from_world * x, Q = frame_from_world * point.n;
+    Vector3d legs[3] = {P, Q, Q};
+    int n_legs = 1;
+    if (P.dot(Q) <= -0.5) {
+      Vector3d mid = P.cross(Vector3d(0.5466, -0.3719, 0.7503));
+      if (mid.squaredNorm() < 1e-6) mid = P.cross(Vector3d(-0.2377, 0.8716, 0.4288));
+      legs[1] = mid.normalized();
+      n_legs = 2;
+    }
+    const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    int steps = 0;
+    for (int l = 0; l < n_legs; ++l) {
+      const Vector3d& from = legs[l];
+      const Vector3d& to = legs[l + 1];
+      const Vector3d m2 = world_from_frame * from.cross(to);  // the leg's plane, world frame
+      const double k2 = 1e-14 * m2.squaredNorm();
+      s.dropped_arcs.clear();
+      for (size_t i = 0; i < s.dropped.size(); ++i) {
+        const ContourEdge& ce = s.dropped[i];
+        const Scratch::Node &A = s.nodes[s.dropped_ends[i][0]], &B = s.nodes[s.dropped_ends[i][1]];
+        const Vector3d &da = A.v, &db = B.v;
+        const double sa = da.dot(m2), sb = db.dot(m2);
+        if (((sa > 0 && sb > 0) || (sa < 0 && sb < 0)) && sa * sa > k2 * da.squaredNorm() && sb * sb > k2 * db.squaredNorm())
+          continue;
+        Arc arc;
+        arc.a = A.f;
+        arc.b = B.f;
+        arc.m = arc.a.cross(arc.b);
+        arc.side_sum = ce.side_sum;
+        // Both ends strictly below: an edge collinear with p does not pass through it and is seen
+        // as a point (crossed by no path), as in integrate().
+        if (arc.m.squaredNorm() != 0) s.dropped_arcs.push_back(arc);
+      }
+      steps += dcf_path_steps(s.dropped_arcs, from, to);
+    }
+    return steps;
+  }
+
   void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out) const {
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
@@ -448,16 +604,19 @@ struct SilhouetteIntegrator::Impl {
       return;
     }
 
+    // ---- contour components below the horizon: left out, the horizon's step raised instead ----
+    const size_t found_edges = s.edges.size();
+    const int horizon_step = prepare_edges(point, s, point.hemisphere && opt.cull_below_horizon);
+    if (!s.dropped.empty()) n_culled.fetch_add(s.dropped.size(), std::memory_order_relaxed);
+
     // ---- arcs in the octahedral frame ----
     s.arcs.clear();
     const Vector3d n = point.n;
-    for (const ContourEdge& ce : s.edges) {
-      const auto& e = topo.edges[ce.edge];
-      auto dir = [&](uint32_t w) -> Vector3d {
-        if (point.welded >= 0 && w == uint32_t(point.welded)) return -n;  // seen from p + εn
-        return topo.welded_positions[w].cast<double>() - point.p;
-      };
-      const Vector3d da = dir(e[0]), db = dir(e[1]);
+    for (size_t i = 0; i < s.edges.size(); ++i) {
+      const ContourEdge& ce = s.edges[i];
+      const Scratch::Node &A = s.nodes[s.ends[i][0]], &B = s.nodes[s.ends[i][1]];
+      const std::array<uint32_t, 2> e = {A.welded, B.welded};
+      const Vector3d &da = A.v, &db = B.v;  // seen from p + εn (the point's own vertex at −n)
       auto push = [&](const Vector3d& a, const Vector3d& b) {
         Arc arc;
         arc.a = frame_from_world * a;
@@ -494,9 +653,14 @@ struct SilhouetteIntegrator::Impl {
         }
         continue;
       }
-      push(da, db);
+      Arc arc;  // push(da, db), with the frame directions computed once per vertex
+      arc.a = A.f;
+      arc.b = B.f;
+      arc.m = arc.a.cross(arc.b);
+      arc.side_sum = ce.side_sum;
+      s.arcs.push_back(arc);
     }
-    if (point.hemisphere) add_horizon(n, s.arcs);
+    if (point.hemisphere) add_horizon(n, s.arcs, horizon_step);
     add_crossings(s);
 
     // ---- W at the spine start (frame direction (−1, 0, 0)) from one counted ray ----
@@ -520,7 +684,8 @@ struct SilhouetteIntegrator::Impl {
       if (point.hemisphere) {
         const double hz = n.dot(wr);
         if (std::abs(hz) < 1e-12) continue;
-        w += hz < 0 ? 1 : 0;
+        w += hz < 0 ? horizon_step : 0;
+        w += dropped_correction(point, s, wr);
       }
       if (attempt > 0) {
         w += dcf_path_steps(s.arcs, frame_from_world * wr, s0);  // bake/integrators/hot_texels.h
@@ -551,7 +716,7 @@ struct SilhouetteIntegrator::Impl {
 
     const auto t2 = clock::now();
     n_points.fetch_add(1, std::memory_order_relaxed);
-    n_edges.fetch_add(s.edges.size(), std::memory_order_relaxed);
+    n_edges.fetch_add(found_edges, std::memory_order_relaxed);
     n_crossings.fetch_add(s.crossings.size(), std::memory_order_relaxed);
     if (inconsistent) n_inconsistent.fetch_add(inconsistent, std::memory_order_relaxed);
     contour_ns.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count(), std::memory_order_relaxed);
@@ -610,12 +775,14 @@ SilhouetteStats SilhouetteIntegrator::silhouette_stats() const {
 std::string SilhouetteIntegrator::work_summary() const {
   const SilhouetteStats st = silhouette_stats();
   const double points = double(std::max<uint64_t>(st.points, 1)), cpu = std::max(1e-12, st.contour_seconds + st.integrate_seconds);
-  char line[256];
+  char line[384];
   std::snprintf(line, sizeof line,
                 "per integral %.1f contour edges, %.0f crossings; CPU time %.0f%% contour search, %.0f%% integration; "
-                "%llu of %llu points saw no contour edge (closed form)",
+                "%llu of %llu points saw no contour edge (closed form); %.1f edges per integral below the horizon, "
+                "left out",
                 double(st.contour_edges) / points, double(st.crossings) / points, 100 * st.contour_seconds / cpu,
-                100 * st.integrate_seconds / cpu, (unsigned long long)st.closed_form, (unsigned long long)st.points);
+                100 * st.integrate_seconds / cpu, (unsigned long long)st.closed_form, (unsigned long long)st.points,
+                double(impl_->n_culled.load()) / points);
   return line;
 }
 

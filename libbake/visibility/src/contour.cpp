@@ -30,6 +30,9 @@
 //        edge under it has an exactly known σ that makes S = 0.
 //    A record stored negated (oriented by its face 1's winding) changes none of this: negation
 //    is exact, and the leaf's contour sign is negated back.
+//    Faces of always-tested edges are filtered the same way: their ĝ in float (a zero record for
+//    an ill-conditioned face), evaluated four at a time with δ_rec from their own η and A
+//    (always_coef_); orient_eps decides every face within it.
 //    Points with |q|₁ ≥ 1e30 (beyond float) take the brute-force path. Faces with η > 1e-6
 //    (slivers, collinear corners) and repeated welded corners keep their edge out of the BVH, in
 //    the always-tested list.
@@ -210,7 +213,7 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   std::vector<Corners> crs;
   recs.reserve(E);
   crs.reserve(E);
-  double eta_max = 0, amax = 0;
+  double eta_max = 0, amax = 0, eta_always = 0, amax_always = 0;
   for (uint32_t e = 0; e < E; ++e) {
     const auto [ia, ib] = topology.edges[e];
     const auto faces = topology.faces_of_edge(e);
@@ -260,6 +263,16 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
           af.a[i] = wp[ia][i];
           af.b[i] = wp[ib][i];
           af.c[i] = wp[c][i];
+        }
+        // Its plane for the float filter, as a BVH face's (a zero record when ill-conditioned:
+        // its value 0 is never beyond the tolerance, so orient_eps decides it every time).
+        const size_t k = always_faces_.size();
+        if (k % 4 == 0) always_blocks_.emplace_back();
+        const FaceDual fd = face_dual(wp[ia], wp[ib], wp[c], origin_, scale_);
+        if (fd.ok) {
+          for (int i = 0; i < 4; ++i) always_blocks_.back().g[i][k % 4] = float(fd.g[i]);
+          eta_always = std::max(eta_always, fd.eta);
+          amax_always = std::max(amax_always, ((wp[ia].cast<double>() - origin_) * scale_).cwiseAbs().sum());
         }
         always_faces_.push_back(af);
       }
@@ -312,6 +325,9 @@ ContourFinder::ContourFinder(const Mesh& mesh, const Topology& topology) : mesh_
   // |ap|₁ was computed in floating point: inflate slightly.
   max_a_ = amax * (1 + 8 * kU);
   delta_coef_ = 1.01 * (eta_max + 10 * kU);
+  // The always-tested faces' float filter: the leaves' bound (δ_rec) with their own η and A.
+  always_max_a_ = amax_always * (1 + 8 * kU);
+  always_coef_ = 1.01 * (eta_always + 10 * kU) + 1.01 * 8 * 0x1p-24;
   stats_.normal_error = eta_max;
   stats_.bvh_edges = recs.size();
   stats_.always_tested = always_.size();
@@ -596,13 +612,37 @@ void ContourFinder::find_impl(const ShadePoint& point, std::vector<ContourEdge>&
   const double nn[3] = {point.n.x(), point.n.y(), point.n.z()};
   const double* tt = tie_break(point) ? point.t.data() : nullptr;
   if constexpr (Count) work.always = always_.size();
-  for (size_t i = 0, f = 0; i < always_.size(); ++i) {  // side_sum_slow from the stored corners
-    int s = 0;
-    for (; f < always_end_[i]; ++f) {
-      const AlwaysFace& af = always_faces_[f];
-      s += orient_eps_f(af.a, af.b, af.c, p, nn, tt);
+  if (!always_.empty()) {
+    // side_sum_slow from the stored corners, each face's σ first from its plane in float, four
+    // faces at a time, as in the leaves: v = ĝ·(q, 1) ∝ π(p), σ = −sign π when |v| exceeds the
+    // rigorous tolerance (the constructor's always_coef_), else orient_eps decides (kUndecided).
+    constexpr int8_t kUndecided = 2;
+    thread_local std::vector<int8_t> tl_sigma;
+    if (tl_sigma.size() < 4 * always_blocks_.size()) tl_sigma.resize(4 * always_blocks_.size());
+    int8_t* const sigma = tl_sigma.data();
+    const double q[3] = {(p[0] - origin_.x()) * scale_, (p[1] - origin_.y()) * scale_, (p[2] - origin_.z()) * scale_};
+    const f4 qx = splat(float(q[0])), qy = splat(float(q[1])), qz = splat(float(q[2]));
+    const f4 da = splat(float(always_coef_ * ((std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2])) + always_max_a_)));
+    for (size_t b = 0; b < always_blocks_.size(); ++b) {
+      const FaceBlock& fb = always_blocks_[b];
+      const f4 v = load(fb.g[0]) * qx + load(fb.g[1]) * qy + load(fb.g[2]) * qz + load(fb.g[3]);
+      const unsigned pos = lanes(v > da), neg = lanes(v < -da);
+      for (int j = 0; j < 4; ++j)
+        sigma[4 * b + size_t(j)] = (pos >> j & 1u) ? int8_t(-1) : (neg >> j & 1u) ? int8_t(1) : kUndecided;
     }
-    if (s != 0) emit(always_[i], s);
+    for (size_t i = 0, f = 0; i < always_.size(); ++i) {
+      int s = 0;
+      for (; f < always_end_[i]; ++f) {
+        if (sigma[f] != kUndecided) {
+          s += sigma[f];
+          continue;
+        }
+        if constexpr (Count) ++work.exact;
+        const AlwaysFace& af = always_faces_[f];
+        s += orient_eps_f(af.a, af.b, af.c, p, nn, tt);
+      }
+      if (s != 0) emit(always_[i], s);
+    }
   }
   if (!wide_.empty()) {
     const double q[4] = {(p[0] - origin_.x()) * scale_, (p[1] - origin_.y()) * scale_, (p[2] - origin_.z()) * scale_,

@@ -391,6 +391,45 @@ TEST(ContourFinder, MatchesBruteForceOnEdgesFacesAndFarPoints) {
   expect_equal_on_edges_faces_and_extremes(transformed(b.mesh, 1e-4, 1e3), 40, 13, "bunny*1e-4+1e3");
 }
 
+// Most edges always tested (their faces' σ from a float filter, orient_eps where it cannot
+// decide): the bunny with every third face removed (boundary edges), every fifth face doubled as a
+// flap on its first edge (3-face edges) and slivers (ill-conditioned faces: zero records, always
+// orient_eps), at vertices, on edges and faces (σ = 0 exactly), far away, and translated by 1e5.
+Scene riddled(const Mesh& m) {
+  std::vector<Vector3f> pos = m.positions;
+  std::vector<std::array<uint32_t, 3>> tris;
+  for (size_t f = 0; f < m.triangles.size(); ++f) {
+    const auto& t = m.triangles[f];
+    if (f % 3 == 1) continue;
+    tris.push_back(t);
+    if (f % 5 == 0) {  // a flap on edge (t0, t1), its apex off the face
+      const Vector3f a = pos[t[0]], b = pos[t[1]], c = pos[t[2]];
+      pos.push_back(0.5f * (a + b) + 0.7f * ((b - a).cross(c - a)).normalized() * (b - a).norm());
+      tris.push_back({t[0], t[1], uint32_t(pos.size() - 1)});
+    }
+    if (f % 11 == 0) {  // a sliver on edge (t1, t2): its apex 1e-4 of the way from t1 to t2
+      pos.push_back(pos[t[1]] + 1e-4f * (pos[t[2]] - pos[t[1]]));
+      tris.push_back({t[1], t[2], uint32_t(pos.size() - 1)});
+    }
+  }
+  Scene s{prt::bake::make_mesh(pos, tris, "riddled"), {}};
+  s.topo = prt::bake::build_topology(s.mesh);
+  return s;
+}
+TEST(ContourFinder, MatchesBruteForceWhereMostEdgesAreAlwaysTested) {
+  const Scene b = load("bunny.obj");
+  const Scene r = riddled(b.mesh);
+  {
+    const ContourFinder finder(r.mesh, r.topo);
+    EXPECT_GT(finder.stats().always_tested, finder.stats().edges / 3);
+  }
+  expect_equal_to_brute_force(r, 150, 21, "riddled bunny");
+  expect_equal_on_edges_faces_and_extremes(r, 40, 22, "riddled bunny");
+  const Scene t = riddled(transformed(b.mesh, 1, 1e5).mesh);
+  expect_equal_to_brute_force(t, 60, 23, "riddled bunny+1e5");
+  expect_equal_on_edges_faces_and_extremes(t, 20, 24, "riddled bunny+1e5");
+}
+
 // A finer mesh (a deeper tree, smaller nodes near the shade point) and the ground's coplanar
 // grid: vertex, off-surface, inside and far points, then edges and faces.
 TEST(ContourFinder, MatchesBruteForceOnSubdividedBunnyOnGround) {

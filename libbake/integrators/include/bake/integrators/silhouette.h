@@ -22,6 +22,20 @@
 //  * The hemisphere H(ω,n) is a virtual occluder: the horizon great circle is walked like an
 //    edge with step +1 into the lower hemisphere (paper §4: clamping is part of visibility), so
 //    integrands never carry H and the tables are shared by all shade points.
+//  * Contour components below the horizon (hemisphere points): the contour edges form a graph on
+//    the welded vertices, and each connected component's arcs are a closed boundary by themselves
+//    (every face's projected triangle is balanced at each of its corners, and an edge's faces sum
+//    to its side sum S_e), so their step function W_D is single-valued. A component whose every
+//    vertex is certainly strictly below the tangent plane (n·(x − p) < 0 beyond its rounding
+//    bound; the point's own vertex, seen at −n, counts) lies in the open lower hemisphere, where
+//    W_D differs from its value on the upper hemisphere by at most Σ_D |S_e|. Such components
+//    are dropped before any per-arc work (arcs, isoline and spine crossings, hot texels) and the
+//    horizon's step is raised from 1 to K = 1 + 2·Σ_D |S_e| (paper §4: the hemisphere is a
+//    virtual occluder; only W = 0 matters, not W's value): W' = W − W_D + W_D(upper) then equals
+//    W on the closed upper hemisphere and is ≥ 1 below it, so the runs with W' = 0 are exactly
+//    those with W = 0. The counted start ray is corrected by the dropped arcs it would cross on
+//    a path up to n. Only the order in which float crossings are added can change, so results
+//    match the unculled path (SilhouetteOptions::cull_below_horizon = false) to rounding.
 //  * A hemisphere point with no contour edge in view takes closed forms (bake/sphere/zonal.h) after one
 //    ray decides enclosed / open; its band-1 and shadowed radiance (R, S) are the horizon-only
 //    walk, once per normal.
@@ -44,6 +58,9 @@ namespace prt::bake {
 struct SilhouetteOptions {
   int isolines = 256;  // N; k = N² (IntegratorSpec's k gives N = silhouette_isolines(k), bake/integrators/integrator.h)
   uint64_t seed = 1;   // only for the direction of the counted start ray when the default is degenerate
+  // Leave out the contour components that lie wholly below the horizon (see the file comment):
+  // the same visible runs, hence the same integrals; false is the unculled reference path.
+  bool cull_below_horizon = true;
 };
 
 // The silhouette integrator's work, summed over its integrate() calls. `closed_form`: hemisphere
