@@ -341,7 +341,7 @@ TEST(Silhouette, ComponentsBelowTheHorizonLeftOutChangeNothing) {
   // A sun of 2×2 texels below the equator and one above, over a dim sky.
   const int W = 64, Hh = 32;
   std::vector<float> rgb(size_t(W * Hh * 3), 0.05f);
-  for (const auto [y0, x0] : {std::pair{20, 10}, std::pair{8, 40}})
+  for (const auto& [y0, x0] : {std::pair{20, 10}, std::pair{8, 40}})
     for (int y = y0; y <= y0 + 1; ++y)
       for (int x = x0; x <= x0 + 1; ++x)
         for (int c = 0; c < 3; ++c) rgb[size_t(3 * (y * W + x) + c)] = c == 0 ? 900.f : 600.f;
@@ -364,8 +364,8 @@ TEST(Silhouette, ComponentsBelowTheHorizonLeftOutChangeNothing) {
     for (size_t k = 0; k < a.v.size(); ++k)
       EXPECT_NEAR(a[k], b[k], 1e-11 * std::max(1.0, std::abs(b[k]))) << "point " << i << " value " << k;
   }
-  EXPECT_EQ(culled.stats().inconsistent_loops, 0u);
-  EXPECT_EQ(full.stats().inconsistent_loops, 0u);
+  EXPECT_EQ(culled.silhouette_stats().inconsistent_loops, 0u);
+  EXPECT_EQ(full.silhouette_stats().inconsistent_loops, 0u);
   // Something was left out (else the test checks nothing): the summary's count is not 0.0.
   const std::string work = culled.work_summary();
   EXPECT_EQ(work.find("; 0.0 edges per integral below the horizon"), std::string::npos) << work;
