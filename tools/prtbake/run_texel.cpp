@@ -89,6 +89,9 @@ int run_texel(const Args& a, const RunContext& run) {
   std::vector<size_t> valid;
   for (size_t i = 0; i < invalid.size(); ++i)
     if (!invalid[i]) valid.push_back(i);
+  if (valid.empty())
+    throw bake::InputError(mesh.source, "every texel its UV set " + uv.name + " covers lies inside the geometry: nothing "
+                                        "to bake (are its normals pointing inside? see --flip-normals)");
   if (run.say)
     std::printf("lightmap: %ux%u texels in UV set %s: %zu covered (%zu by the nearest point of a triangle touching "
                 "the texel, not its centre), %u charts; %zu inside the geometry, filled from their charts\n",
