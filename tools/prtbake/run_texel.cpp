@@ -89,6 +89,17 @@ int run_texel(const Args& a, const RunContext& run) {
   std::vector<size_t> valid;
   for (size_t i = 0; i < invalid.size(); ++i)
     if (!invalid[i]) valid.push_back(i);
+  // The UV set's checks at this resolution (bake/mesh/texels.h).
+  if (atlas.overlapping_texels > 0)
+    std::fprintf(stderr,
+                 "prtbake: warning: %s: UV set %s overlaps itself: %zu texels lie inside triangles of two charts "
+                 "(a texture set that mirrors or reuses parts is no lightmap set): each holds one chart's value\n",
+                 a.input.c_str(), uv.name.c_str(), atlas.overlapping_texels);
+  if (atlas.shared_texels > atlas.overlapping_texels)
+    std::fprintf(stderr,
+                 "prtbake: warning: %s: %zu texels of the %ux%u lightmap are touched by two charts of UV set %s: too "
+                 "little gutter at this resolution (bilinear filtering bleeds one chart into the other)\n",
+                 a.input.c_str(), atlas.shared_texels, atlas.width, atlas.height, uv.name.c_str());
   if (valid.empty())
     throw bake::InputError(mesh.source, "every texel its UV set " + uv.name + " covers lies inside the geometry: nothing "
                                         "to bake (are its normals pointing inside? see --flip-normals)");

@@ -108,6 +108,12 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
   // lies in it). Triangles come in order and replace only when strictly better: ties keep the first.
   std::vector<uint32_t> best(texels, kNone);
   std::vector<float> best_d2(texels, std::numeric_limits<float>::infinity());
+  // The UV set's checks (texels.h): per texel, a chart that touches it and one whose triangle
+  // contains its centre; a second chart doing either is counted once per texel.
+  const std::vector<uint32_t> chart = charts_of(mesh, topology, uv);
+  std::vector<uint32_t> touching(texels, kNone), containing(texels, kNone);
+  std::vector<uint8_t> counted(texels, 0);  // bit 0: shared, bit 1: overlapping
+  size_t shared = 0, overlapping = 0;
   auto texel_space = [&](size_t t, int c) {
     const Eigen::Vector2f& q = uv.corners[3 * t + size_t(c)];
     return V2(double(q.x()) * width, double(q.y()) * height);
@@ -139,11 +145,19 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
         }
         const size_t k = size_t(y) * width + size_t(x);
         if (d2 < best_d2[k]) best[k] = uint32_t(t), best_d2[k] = d2;
+        const uint32_t ct = chart[t];
+        if (touching[k] == kNone) touching[k] = ct;
+        else if (touching[k] != ct && !(counted[k] & 1)) counted[k] |= 1, ++shared;
+        if (d2 < 0) {
+          if (containing[k] == kNone) containing[k] = ct;
+          else if (containing[k] != ct && !(counted[k] & 2)) counted[k] |= 2, ++overlapping;
+        }
       }
   }
 
-  const std::vector<uint32_t> chart = charts_of(mesh, topology, uv);
   TexelAtlas out;
+  out.shared_texels = shared;
+  out.overlapping_texels = overlapping;
   for (uint32_t c : chart) out.charts = std::max(out.charts, c + 1);
   out.width = width;
   out.height = height;

@@ -136,3 +136,22 @@ TEST(Texels, ChartsJoinTrianglesWhoseSharedEdgeHasTheSameUvs) {
   }
   EXPECT_TRUE(saw[0] && saw[1]);
 }
+
+TEST(Texels, OverlappingChartsAndSharedTexelsAreCounted) {
+  // Two separate triangles (two charts) mapped onto the same UV triangle (0, 0), (1, 0), (0, 1)
+  // of a 4 × 4 atlas: centres with x + y <= 3 (texel units, 10 texels) lie in both; texels whose
+  // closed squares meet it, x + y <= 4 (13 texels), are touched by both.
+  Mesh m = make_mesh({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 0, 0}, {6, 0, 0}, {5, 1, 0}}, {{{0, 1, 2}}, {{3, 4, 5}}}, "two");
+  UvSet uv{"uv", {Vector2f(0, 0), Vector2f(1, 0), Vector2f(0, 1), Vector2f(0, 0), Vector2f(1, 0), Vector2f(0, 1)}};
+  const TexelAtlas a = texel_atlas(m, build_topology(m), uv, 4, 4, "two");
+  EXPECT_EQ(a.charts, 2u);
+  EXPECT_EQ(a.overlapping_texels, 10u);
+  EXPECT_EQ(a.shared_texels, 13u);
+  for (const TexelSample& s : a.samples) EXPECT_EQ(s.triangle, 0u) << "ties keep the first triangle";
+  // One chart alone: neither.
+  UvSet one = uv;
+  for (size_t c = 3; c < 6; ++c) one.corners[c] += Vector2f(5, 5);  // outside the atlas
+  const TexelAtlas b = texel_atlas(m, build_topology(m), one, 4, 4, "one");
+  EXPECT_EQ(b.overlapping_texels, 0u);
+  EXPECT_EQ(b.shared_texels, 0u);
+}

@@ -60,6 +60,11 @@ struct TexelAtlas {
   std::vector<uint8_t> coverage;     // width·height: 1 where a texel is covered
   size_t texels_off_centre() const;  // samples that are not their texel's centre
   uint32_t charts = 0;               // of the UV set's triangles with area in the atlas
+  // Checks of the UV set at this resolution: texels that triangles of two charts touch (too
+  // little gutter: a texel's value is then one chart's, and bilinear filtering bleeds the other's
+  // in), and texels whose centre lies inside triangles of two charts (overlapping charts: a
+  // lightmap set must have none; a texture set that mirrors or reuses parts has them).
+  size_t shared_texels = 0, overlapping_texels = 0;
 };
 
 // The atlas of `uv` (one of mesh.uv_sets; 3 UVs per triangle) at width × height texels (each
