@@ -98,7 +98,7 @@ VertexBake bake_ao(const FloorAndBox& s, const TexelAtlas& atlas, const Integrat
 
 } // namespace
 
-TEST(TexelBake, FloorTexelsAroundABoxMatchTheClosedFormWithEveryIntegrator) {
+TEST(TexelBake, FloorTexelsAroundABoxMatchTheClosedFormWithSilhouetteAndQmc) {
   const FloorAndBox s;
   const TexelAtlas atlas = texel_atlas(s.floor, build_topology(s.floor), s.uv, 32, 32, "floor");
   ASSERT_EQ(atlas.samples.size(), 32u * 32u);

@@ -1,4 +1,4 @@
-// bake/bake/pipeline.h — the bake pipeline, written once for any receivers (docs/ARCHITECTURE.md §5):
+// bake/bake/pipeline.h — the bake pipeline, written once for any receivers (docs/ARCHITECTURE.md §4, step 6):
 //
 //   receiver sets ─► choose ─► integrate ─► [baked: the caller writes the file] ─► check ─► correct
 //
