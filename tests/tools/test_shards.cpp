@@ -358,8 +358,11 @@ TEST(ShardsFiv, ResumeShardWorkersAndMergeGiveTheSingleProcessBytes) {
   EXPECT_TRUE(leftovers(dir, out).empty());
   fs::remove(out);
 
-  // Dynamic: two workers at once; together they compute every needed chunk once, and stop within
-  // a chunk each of the last shell.
+  // Dynamic: two workers at once; together they compute every needed chunk once. Past the last
+  // shell a worker that runs ahead computes chunks until that shell is complete (shards.h): about
+  // one chunk each when they keep pace, but more when one is descheduled (seen: 8 + 25 = 33 on
+  // a loaded 2-core machine), so the bound that holds is the claims': no chunk twice, at most
+  // every chunk of the 16 shells.
   const std::string worker = std::string("'") + PRT_PRTBAKE + "' " + fiv_bake() + " -o " + out.string();
   const std::string both = "(" + worker + " --shard 0/2 --claim dynamic --run-id f1 > " + (dir / "w0").string() +
                            " & " + worker + " --shard 1/2 --claim dynamic --run-id f1 > " + (dir / "w1").string() +
@@ -367,7 +370,7 @@ TEST(ShardsFiv, ResumeShardWorkersAndMergeGiveTheSingleProcessBytes) {
   ASSERT_EQ(std::system(both.c_str()), 0);
   const int c0 = resumed_of(read_bytes(dir / "w0")).computed, c1 = resumed_of(read_bytes(dir / "w1")).computed;
   EXPECT_GE(c0 + c1, kFivChunks) << c0 << " + " << c1;
-  EXPECT_LE(c0 + c1, kFivChunks + 2) << c0 << " + " << c1;
+  EXPECT_LE(c0 + c1, 2 + 4 * 16) << c0 << " + " << c1;
   fs::remove(dir / "w0"), fs::remove(dir / "w1");
   m = prtbake(fiv_bake() + " --merge -o " + out.string(), dir);
   ASSERT_EQ(m.code, 0) << m.err;
