@@ -111,13 +111,13 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
   };
   if (L.radiance_count) {
     F::Product& p = set.radiance_band1.emplace(
-        product(L.radiance, 9, "R_c,m = Int L_c V H y_1m dw, layout [vertex][RGB][m=-1,0,1]"));
+        product(L.radiance, 9, "R_c,m = Int L_c V H y_1m dw, layout [" + info.rows + "][RGB][m=-1,0,1]"));
     p.shading = "E_c = (4 pi / 3) sum_m y_1m(n) R_c,m";
     environment(p);
   }
   if (L.shadowed_count) {
     F::Product& p = set.radiance_shadowed.emplace(
-        product(L.shadowed, L.shadowed_count, "S_c,i = Int L_c V H y_i dw, layout [vertex][RGB][i=l(l+1)+m]"));
+        product(L.shadowed, L.shadowed_count, "S_c,i = Int L_c V H y_i dw, layout [" + info.rows + "][RGB][i=l(l+1)+m]"));
     p.sh_order = L.shadowed_order;
     p.shading = "L_out = sum_l lambda_l sum_m S_c,lm y_lm(r), lambda_l = (s+1) Int_0^1 t^s P_l(t) dt (Phong s)";
     environment(p);
@@ -154,16 +154,14 @@ void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& 
   rows.layout = layout;
   rows.values = image.values;
   F::VertexSet products;
-  set_products(products, rows, info);
+  ProductInfo per_texel = info;
+  per_texel.rows = "row][col";  // the integrands' layout: [row][col][RGB]...
+  set_products(products, rows, per_texel);
   m.ao = std::move(products.ao);
   m.transfer_diffuse = std::move(products.transfer_diffuse);
   m.transfer_visibility = std::move(products.transfer_visibility);
   m.radiance_band1 = std::move(products.radiance_band1);
   m.radiance_shadowed = std::move(products.radiance_shadowed);
-  for (std::optional<F::Product>* p : {&m.radiance_band1, &m.radiance_shadowed})
-    if (*p && (*p)->integrand)
-      if (const size_t at = (*p)->integrand->find("[vertex]"); at != std::string::npos)
-        (*p)->integrand->replace(at, 8, "[row][col]");
 }
 
 F::Light light_of(const bake::AreaLight& light) {

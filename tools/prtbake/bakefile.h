@@ -31,6 +31,7 @@ struct ProductInfo {
   int transfer_order = 0, visibility_order = 0;
   const bake::EnvMap* env = nullptr;  // for radiance/band1
   std::string env_path;
+  std::string rows = "vertex";  // what a row is, as the integrands' layouts name it ("vertex"; lightmaps: "row][col")
 };
 // ao, transfer_diffuse, transfer_visibility, radiance_band1: whatever the layout holds.
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info);
