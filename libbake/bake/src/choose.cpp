@@ -45,11 +45,13 @@ constexpr double kRichardsonOrderMin = 1.0, kRichardsonOrderMax = 2.0;
 // difference from an exact reference is σ² with a spread of ~σ²·sqrt(2/n) (Gaussian errors); a
 // bias shows only beyond kQmcCheckSigmas of that spread.
 constexpr double kQmcCheckSigmas = 3.0;
-// The check's rays under an environment: 16,384 (and 4,096) per pilot point, ~0.01 CPU s each; at
-// 128 points ~1.3 CPU s. The two runs differed by 5.5e-3 relative on band-1 under a sun of
-// 3·10^4× the mean (sphereWithHole.stl, city.exr, 32 points × 9 values), so a bias from ~1.6e-3
-// up shows.
+// The check's rays under an environment: 16,384 (and 4,096) per pilot point, ~0.01 CPU s each.
+// On 32 points a band-1 bias from 1.9e-3 (city.exr, a sun of 3·10^4× the mean), 2.5e-3 (sunset)
+// and 3.2e-3 (studio) relative up shows (sphereWithHole.stl; sqrt(3 · sd/√K) of the products).
 constexpr uint32_t kCheckRays = 16384;
+// ... on the first 32 pilot points at most (the seeded sample's order): the bound is a t-test over
+// points, whose spread 32 points already estimate, and 128 points would cost 4× the rays.
+constexpr size_t kCheckPoints = 32;
 constexpr uint64_t kCheckSalt = 0x636865636b736565ull;
 // The silhouette levels: 32 and 64 always; 16 only when some product already meets the goal at
 // 32 (its bracket is then [16, 32]); doubling levels while some product still misses it (their
@@ -483,31 +485,39 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     // Under an environment the hot texels are integrated apart from the isolines (bake/
     // silhouette.h), so their error need not shrink with N and Richardson cannot see it. Two
     // independent QMC runs f, c (kCheckRays and a quarter of it): their noises are independent of
-    // each other and of the reference's error b, so the mean of (f − ref)(c − ref) over the n
-    // values is b² with a spread of at most σ_f σ_c / sqrt(n) ≤ d² / (2 sqrt(n)), d = RMS(f − c)
-    // — no convergence rate assumed. The bound: b² ≥ that mean − kQmcCheckSigmas spreads.
+    // each other and of the reference's error b, so the mean of (f − ref)(c − ref) is b² — no
+    // convergence rate assumed — with the spread of its per-point means (below).
     const QmcIntegrator fine(mesh, topology, request, QmcOptions{kCheckRays, mix64(base.seed ^ kCheckSalt)}, shared);
     const QmcIntegrator coarse(mesh, topology, request, QmcOptions{kCheckRays / 4, mix64(base.seed ^ kCheckSalt ^ 1)},
                                shared);
-    const Rows f = integrate_pilot(fine, points, sample, progress);
-    const Rows c = integrate_pilot(coarse, points, sample, progress);
+    const std::vector<uint32_t> check_sample(sample.begin(), sample.begin() + std::min(K, kCheckPoints));
+    const size_t Kc = check_sample.size();
+    const Rows f = integrate_pilot(fine, points, check_sample, progress);
+    const Rows c = integrate_pilot(coarse, points, check_sample, progress);
     for (size_t p = 0; p < P; ++p) {
       const ProductSlice& sl = products[p];
-      double cross = 0, d2 = 0, r2 = 0;
-      for (size_t i = 0; i < K; ++i)
+      // Per pilot point i: x_i = the mean over its values of (f − ref)(c − ref). The values of one
+      // point share its rays (one sun sample moves all nine band-1 numbers), so the points, not
+      // the values, are the independent draws: b² ≥ mean(x) − kQmcCheckSigmas · sd(x)/√K.
+      std::vector<double> x(Kc, 0.0);
+      double r2 = 0;
+      for (size_t i = 0; i < Kc; ++i)
         for (size_t k = 0; k < sl.count; ++k) {
           const size_t j = i * W + sl.offset + k;
-          cross += (f.values[j] - ref[j]) * (c.values[j] - ref[j]);
-          d2 += (f.values[j] - c.values[j]) * (f.values[j] - c.values[j]);
+          x[i] += (f.values[j] - ref[j]) * (c.values[j] - ref[j]);
           r2 += ref[j] * ref[j];
         }
-      const double n = double(std::max<size_t>(K * sl.count, 1));
-      cross /= n, d2 /= n, r2 /= n;
-      if (is_radiance(sl.product)) {  // relative, like pilot_errors
-        cross = r2 > 0 ? cross / r2 : 0.0;
-        d2 = r2 > 0 ? d2 / r2 : 0.0;
-      }
-      e_qmc[p] = std::sqrt(std::max(0.0, cross - kQmcCheckSigmas * d2 / (2.0 * std::sqrt(n))));
+      const double n = double(std::max<size_t>(Kc * sl.count, 1));
+      r2 /= n;
+      // Relative, like pilot_errors, for R and S.
+      double scale = 1.0 / double(std::max<size_t>(sl.count, 1));
+      if (is_radiance(sl.product)) scale = r2 > 0 ? scale / r2 : 0.0;
+      double mean = 0, var = 0;
+      for (double& xi : x) xi *= scale, mean += xi;
+      mean /= double(std::max<size_t>(Kc, 1));
+      for (const double xi : x) var += (xi - mean) * (xi - mean);
+      var /= double(std::max<size_t>(Kc, 2) - 1);
+      e_qmc[p] = std::sqrt(std::max(0.0, mean - kQmcCheckSigmas * std::sqrt(var / double(std::max<size_t>(Kc, 1)))));
     }
     qmc_check_rays = kCheckRays;
   }

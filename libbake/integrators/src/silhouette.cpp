@@ -113,7 +113,8 @@ struct SilhouetteIntegrator::Impl {
   size_t c_ao = 0, c_t = 0, c_u = 0, c_r = 0, c_s = 0, F = 0, n_env = 0;
   const EnvMap* envmap = nullptr;  // of R and S
   int env_order = 0;            // SH order the environment's columns need
-  int subsamples = 1;
+  int subsamples = 1;             // per cell, of the smooth columns (the midpoint rule)
+  int max_texel_subsamples = 0;   // k × k per texel of the environment's point masses (0: none)
   std::unique_ptr<IsolineTables> tables;
   // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
   // left out of the tables and integrated exactly over their visible part (bake/integrators/hot_texels.h), so
@@ -151,17 +152,11 @@ struct SilhouetteIntegrator::Impl {
     F = c_s + size_t(3 * ls * ls);
     n_env = F - c_r;
     PRT_CHECK(F > 0);
-    if (envmap) {
-      // Box-filter the environment over each cell: ~2 sub-samples per texel width.
-      const double texel = std::sqrt(4 * std::numbers::pi / double(std::max<size_t>(envmap->texel_count(), 1)));
-      subsamples = std::clamp(int(std::ceil(2.0 * grid.h / texel)), 1, 8);
-    }
     const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
     if (envmap && envmap->texel_count() > 0 && env_order > 0) {
       hot = std::make_unique<HotTexels>(*envmap, frame_from_world, env_order, kHotFactor, kMaxHot);
       if (hot->empty()) hot.reset();
     }
-    auto is_hot = [&](const Vector3d& w) { return hot && hot->is_hot(envmap->texel_of(w)); };
     // The SH basis at w up to `order` in `small` (orders ≤ 16) or `big`.
     auto eval_sh = [](int order, const Vector3d& w, std::span<double> small, std::vector<double>& big) -> double* {
       double* yp = small.data();
@@ -183,6 +178,46 @@ struct SilhouetteIntegrator::Impl {
       for (int c = 0; c < 3; ++c)
         for (size_t i = 0; i < ns; ++i) s_out[size_t(c) * ns + i] = rgb[c] * yp[i];
     };
+    // A map's texels enter the tables as point masses (bake/sphere/isoline_tables.h): texel t's
+    // value × its exact solid angle Ω_t, spread evenly over k × k stratified sub-samples of it
+    // (EnvMap::sample_texel_grid), each weighing L_t · Ω_t / k² · y(ω). k ≈ 2 sub-samples per mean
+    // cell width (√(4π)/N) across the texel, at least 1: where cells are wider than texels a mass
+    // sits within half a texel of its share, where they are narrower it spreads over the cells the
+    // texel covers. The hot texels are left out exactly (their own integral, hot_texels.h); a
+    // constant environment is smooth and stays in f.
+    IsolineTables::PointMasses masses;
+    if (envmap && envmap->texel_count() > 0 && n_env > 0) {
+      constexpr int kBlockTexels = 4096;
+      const int texels = envmap->texel_count();
+      const double cells_per_radian = double(grid.n) / std::sqrt(4 * std::numbers::pi);
+      masses.first = int(c_r), masses.count = int(n_env);
+      masses.blocks = size_t((texels + kBlockTexels - 1) / kBlockTexels);
+      masses.emit = [&, texels, cells_per_radian](size_t b, const IsolineTables::MassSink& sink) {
+        std::vector<Vector3d> dirs;
+        std::vector<double> y(size_t(sh::num_coeffs(16))), ybig, vals(n_env);
+        const int t_end = std::min(texels, int(b + 1) * kBlockTexels);
+        for (int tx = int(b) * kBlockTexels; tx < t_end; ++tx) {
+          if (hot && hot->is_hot(tx)) continue;
+          const Rgb L = envmap->texel_value(tx);
+          if (L.r == 0 && L.g == 0 && L.b == 0) continue;
+          const double omega = envmap->texel_solid_angle(tx);
+          const int k = std::clamp(int(std::ceil(2.0 * std::sqrt(omega) * cells_per_radian)), 1, 16);
+          const double w = omega / double(k * k);
+          dirs.resize(size_t(k * k));
+          envmap->sample_texel_grid(tx, k, dirs);
+          const Rgb mass{L.r * w, L.g * w, L.b * w};
+          for (const Vector3d& d : dirs) {
+            env_columns(mass, eval_sh(env_order, d, y, ybig), vals.data());
+            sink(frame_from_world * d, vals.data());
+          }
+        }
+      };
+      max_texel_subsamples = 1;
+      for (int tx = 0; tx < texels; tx += std::max(1, texels / 64))
+        max_texel_subsamples = std::max(
+            max_texel_subsamples,
+            std::clamp(int(std::ceil(2.0 * std::sqrt(envmap->texel_solid_angle(tx)) * cells_per_radian)), 1, 16));
+    }
     tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
       const Vector3d w = world_from_frame * w_frame;
       double y[sh::num_coeffs(16)];
@@ -195,8 +230,8 @@ struct SilhouetteIntegrator::Impl {
       for (int a = 0; a < 3; ++a)
         for (size_t i = 0; i < nt; ++i) out[c_t + size_t(a) * nt + i] = w[a] * yp[i] * kInvPi;
       for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
-      if (envmap) env_columns(is_hot(w) ? Rgb{} : envmap->radiance(w), yp, &out[c_r]);  // hot texels: exact, apart
-    });
+      if (envmap && envmap->texel_count() == 0) env_columns(envmap->radiance(w), yp, &out[c_r]);  // constant: smooth
+    }, masses.count > 0 ? &masses : nullptr);
     unoccluded_row = unoccluded_totals();
   }
 
@@ -735,6 +770,9 @@ std::string SilhouetteIntegrator::description() const {
   os << "visibility silhouettes (paper 001 §3): " << impl_->grid.n << " u-isolines (k = " << impl_->grid.n << "^2), "
      << impl_->F << " integrand components in " << (impl_->tables->bytes() >> 20) << " MiB of isoline tables, "
      << impl_->subsamples << "x" << impl_->subsamples << " sub-samples per cell";
+  if (impl_->max_texel_subsamples > 0)
+    os << ", the environment's texels as exact masses (up to " << impl_->max_texel_subsamples << "x"
+       << impl_->max_texel_subsamples << " sub-samples per texel)";
   if (impl_->hot)
     os << "; " << impl_->hot->texels() << " hot environment texels (>= " << Impl::kHotFactor
        << "x mean luminance) in " << impl_->hot->clusters() << " clusters, integrated exactly over their visible parts";

@@ -29,10 +29,12 @@ void cell_integral(const IsolineTables::Integrand& f, double h, double ui, doubl
 }
 } // namespace
 
-IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsamples, const Integrand& f)
+IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsamples, const Integrand& f,
+                             const PointMasses* masses)
     : grid_(grid), components_(components) {
   PRT_CHECK(grid.n >= 2 && grid.n % 2 == 0);
   PRT_CHECK(components > 0 && subsamples >= 1);
+  PRT_CHECK(!masses || (masses->first >= 0 && masses->count >= 0 && masses->first + masses->count <= components));
   const size_t F = size_t(components);
   offset_.resize(size_t(grid.n));
   size_t rows = 0;
@@ -43,6 +45,8 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
   table_.assign(rows * F, 0.0);
   const double h = grid.h;
   const int S = subsamples;
+  const size_t m_first = masses ? size_t(masses->first) : 0, m_count = masses ? size_t(masses->count) : 0;
+  // 1. Each cell's integral into row j + 1 (summed in step 3).
   tbb::parallel_for(0, grid.n, [&](int i) {
     std::vector<double> g(F), cell(F);
     const int M = grid.cells_per_sheet(i);
@@ -53,9 +57,58 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
       // The cell's v-interval (sheet 1 runs downwards in v).
       const double v_lo = sheet == 0 ? -l + j * h : l - (j - M + 1) * h;
       cell_integral(f, h, ui, v_lo, sheet, S, g, cell);
-      for (size_t c = 0; c < F; ++c) row[(size_t(j) + 1) * F + c] = row[size_t(j) * F + c] + cell[c];
+      for (size_t c = m_first; c < m_first + m_count; ++c) cell[c] = 0.0;
+      std::copy(cell.begin(), cell.end(), row + (size_t(j) + 1) * F);
     }
   });
+  // 2. The point masses, block by block in index order (a wave of blocks at a time runs in
+  // parallel into its own lists; a fixed wave size, so the order of additions is the same for
+  // every thread count).
+  if (masses && m_count > 0 && masses->blocks > 0) {
+    struct Block {
+      std::vector<size_t> rows;
+      std::vector<double> values;
+    };
+    constexpr size_t kWave = 16;
+    std::vector<Block> wave(kWave);
+    for (size_t b0 = 0; b0 < masses->blocks; b0 += kWave) {
+      const size_t nb = std::min(kWave, masses->blocks - b0);
+      tbb::parallel_for(size_t(0), nb, [&](size_t k) {
+        Block& blk = wave[k];
+        blk.rows.clear(), blk.values.clear();
+        masses->emit(b0 + k, [&](const Eigen::Vector3d& omega, const double* values) {
+          const auto [i, j] = cell_of(omega);
+          blk.rows.push_back(offset_[size_t(i)] + size_t(j) + 1);
+          blk.values.insert(blk.values.end(), values, values + m_count);
+        });
+      });
+      const double inv_h = 1.0 / h;  // a cell holds h · mean(f J) = ∫_cell f dω / h
+      for (size_t k = 0; k < nb; ++k)
+        for (size_t r = 0; r < wave[k].rows.size(); ++r) {
+          double* dst = &table_[wave[k].rows[r] * F + m_first];
+          const double* src = &wave[k].values[r * m_count];
+          for (size_t c = 0; c < m_count; ++c) dst[c] += src[c] * inv_h;
+        }
+    }
+  }
+  // 3. Prefix sums along each loop.
+  tbb::parallel_for(0, grid.n, [&](int i) {
+    double* row = &table_[offset_[size_t(i)] * F];
+    for (int j = 0; j < 2 * grid.cells_per_sheet(i); ++j)
+      for (size_t c = 0; c < F; ++c) row[(size_t(j) + 1) * F + c] += row[size_t(j) * F + c];
+  });
+}
+
+std::pair<int, int> IsolineTables::cell_of(const Eigen::Vector3d& omega) const noexcept {
+  const double s = std::abs(omega.x()) + std::abs(omega.y()) + std::abs(omega.z());
+  const double u = omega.x() / s, v = omega.y() / s;
+  const int sheet = omega.z() < 0 ? 1 : 0;
+  // int() truncates towards 0: floor for the non-negative quotients, and a quotient in (−1, 0)
+  // (a direction just past the diamond's end of its strip) clamps to the same first cell.
+  const int i = std::clamp(int((u + 1.0) / grid_.h), 0, grid_.n - 1);
+  const int M = grid_.cells_per_sheet(i);
+  const int j = std::clamp(int(grid_.t_of(i, v, sheet) / grid_.h), sheet * M, sheet * M + M - 1);
+  return {i, j};
 }
 
 void IsolineTables::accumulate(int i, double t, double weight, double* acc) const noexcept {

@@ -23,19 +23,22 @@
 //       as large as its whole step from N_ref/2;
 //       independent check, under an environment (R, S): its hot texels are integrated apart
 //       from the isolines, so their error need not shrink with N and Richardson cannot see it.
-//       QMC at 16,384 and 4,096 rays (independent seeds) on the pilot points, f and c: their
-//       noises are independent of each other and of the reference's error b, so the mean of
-//       (f − ref)(c − ref) over the n values is b², with a spread of at most d²/(2 sqrt(n)),
-//       d = RMS(f − c) (no convergence rate assumed); the bound is
-//       sqrt(max(0, mean − 3·d²/(2 sqrt(n)))): biases from ~1.6e-3 relative show for band-1
-//       under a sun of 3·10^4× the mean on 32 points. Without an
+//       QMC at 16,384 and 4,096 rays (independent seeds) on the first 32 pilot points, f and c:
+//       their noises are independent of each other and of the reference's error b, so the
+//       per-point means x_i of (f − ref)(c − ref) average b² (no convergence rate assumed). The
+//       values of one point share its rays, so the points are the independent draws: the bound is
+//       sqrt(max(0, mean(x) − 3·sd(x)/√K)) — band-1 biases from ~2–3e-3 relative show (choose.cpp,
+//       kCheckRays). (It was a spread over the n values as if independent: a sun sample moves all
+//       nine band-1 numbers of a point together, and the check saw a bias of 1.2e-3 under
+//       studio.exr where the reference was within 1.6e-4 of QMC at 2^20 rays.) Without an
 //       environment, the pilot's finest QMC level with its estimated standard errors (which
 //       overstate QMC's noise: only gross biases show), at no extra cost;
 //     e_ref = the larger. While the worst product's Richardson estimate exceeds kReferenceShare·E
 //     (E/3) the reference level doubles, up to the memory bound below. A bias the QMC check sees
-//     is stated, not chased: finer isolines do not remove it, and it may be a disagreement on how
-//     the environment is reconstructed between texels rather than an error (chasing it sent a
-//     285-triangle mesh to 147,456 QMC rays, 115 s); if e_ref still exceeds E/3,
+//     is stated, not chased: both integrate the same environment (constant per texel, the
+//     silhouette's tables holding each texel's mass exactly), so what Richardson cannot see is not
+//     an isoline error that finer isolines remove (chasing it, before the tables held texels
+//     exactly, sent a 285-triangle mesh to 147,456 QMC rays, 115 s); if e_ref still exceeds E/3,
 //     IntegratorChoice::reference_ok is false and the printed lines say so (the pilot's errors
 //     are then only known to within e_ref).
 //  2. silhouette at N = 32 and 64, then 16 if a product already meets the goal at 32, and
