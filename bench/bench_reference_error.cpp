@@ -37,7 +37,7 @@
 // when PATH holds one for the same rows, seeds and layout, else integrated and written there, so
 // the driver can measure each rung of a ladder as it is baked without integrating it again.
 //
-//   bench_reference_error MESH [--ao] [--transfer L] [--radiance ENV] [--target E] [--points K]
+//   bench_reference_error MESH [--ao] [--transfer L] [--radiance ENV] [--target E] [--points K] [--per-row]
 //                         [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M]
 //                         [--cache PATH] FILE.prt.h5...
 //   bench_reference_error MESH --geometry
@@ -79,6 +79,7 @@ struct Args {
   uint64_t ref_seed = 0x27271;
   uint32_t replicates = 4;
   bool geometry = false;
+  bool per_row = false;  // --per-row: also each sampled row's error (`row <file> <row> <product>=<RMSE>`)
   std::string cache;
   std::vector<std::string> files;
 };
@@ -86,7 +87,7 @@ struct Args {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "bench_reference_error: %s\nusage: bench_reference_error MESH [--ao] [--transfer L] [--radiance ENV] "
-               "[--target E] [--points K] [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M] [--cache PATH] FILE.prt.h5... | MESH --geometry\n",
+               "[--target E] [--points K] [--per-row] [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M] [--cache PATH] FILE.prt.h5... | MESH --geometry\n",
                why.c_str());
   std::exit(2);
 }
@@ -104,6 +105,7 @@ Args parse(int argc, char** argv) {
     else if (s == "--radiance") a.environment = value();
     else if (s == "--target") a.target = std::stod(value());
     else if (s == "--points") a.points = std::stoul(value());
+    else if (s == "--per-row") a.per_row = true;
     else if (s == "--point-seed") a.point_seed = std::stoull(value());
     else if (s == "--rays") a.rays = uint32_t(std::stoul(value()));
     else if (s == "--max-rays") a.max_rays = uint32_t(std::stoul(value()));
@@ -330,6 +332,21 @@ int main(int argc, char** argv) try {
       std::printf("\t%s=%.4g", slots[p].name, slots[p].relative ? rmse / ref_rms[p] : rmse);
     }
     std::printf("\n");
+    for (size_t i = 0; i < K && a.per_row; ++i) {
+      std::printf("row\t%s\t%u", path.c_str(), rows[i]);
+      for (size_t p = 0; p < slots.size(); ++p) {
+        const std::optional<formats::Product>& product = set.*(slots[p].dataset);
+        if (!product || product->values.size() != points.size() * slots[p].count) continue;
+        double sum = 0;
+        for (size_t c = 0; c < slots[p].count; ++c) {
+          const double d = double(product->values[size_t(rows[i]) * slots[p].count + c]) - ref[i * W + slots[p].offset + c];
+          sum += d * d;
+        }
+        const double rmse = std::sqrt(sum / double(slots[p].count));
+        std::printf("\t%s=%.4g", slots[p].name, slots[p].relative ? rmse / ref_rms[p] : rmse);
+      }
+      std::printf("\n");
+    }
   }
   return status;
 } catch (const std::exception& e) {

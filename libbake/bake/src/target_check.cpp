@@ -108,6 +108,8 @@ void pool_product_errors(std::vector<ProductError>& into, std::span<const Produc
     it->reference_std_error = rms(it->reference_std_error, a.reference_std_error);
     it->max_abs = std::max(it->max_abs, a.max_abs);
     it->values += a.values;
+    if (it->finer != a.finer || it->finer_knob != a.finer_knob) it->finer = 0, it->finer_knob = 0;  // not one level: no extrapolation
+    it->finer_points += a.finer_points;
   }
 }
 
@@ -119,7 +121,7 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
     const double m = v.measured = error_in_target_units(e);  // the measured RMSE, the reference's noise in it
     // The reference's own noise σ in the same units. Measured on the report's own values (two
     // independent halves, ErrorReport::reference_noise_measured). m² − σ² is then the difference of
-    // two independent estimates of σ² from n values each (the halves' mean and their difference
+    // two independent estimates of σ² from n draws each (the halves' mean and their difference
     // are uncorrelated), each with a standard deviation σ²·sqrt(2/n) for Gaussian noise: e² is
     // known to ±δσ², δ = 3·sqrt(4/n) (3 standard deviations of the difference). Else an
     // upper bound: the plan's probe scaled at Monte Carlo's rate (the slowest QMC shows), or QMC's
@@ -135,7 +137,23 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
         if (plan->products[p] == e.product && p < plan->noise.size())
           sigma = plan->noise[p], v.noise_kind = "the probe's, an upper bound";
     v.noise = sigma;
-    const double delta = v.noise_measured ? 3.0 * std::sqrt(4.0 / double(std::max<size_t>(e.values, 1))) : 0.0;
+    if (e.finer > 1) {
+      const double f = e.finer;
+      v.extrapolated = true, v.finer = f, v.finer_knob = e.finer_knob, v.finer_points = e.finer_points;
+      v.noise_measured = false;
+      v.noise_kind = "the finer level's own error, at order 1 to 2";
+      v.noise = m / (f - 1.0);
+      v.error_lo = m / (1.0 - 1.0 / (f * f));
+      v.error = v.error_hi = m / (1.0 - 1.0 / f);
+      v.met = v.error_hi <= target;
+      v.not_met = v.error_lo > target;
+      out.push_back(v);
+      continue;
+    }
+    // n counts independent draws: the report's points, not its values (a point's values share its
+    // rays — one sun sample moves all nine band-1 numbers — so they are not independent).
+    const size_t draws = report.vertices.empty() ? e.values : std::min(e.values, report.vertices.size());
+    const double delta = v.noise_measured ? 3.0 * std::sqrt(4.0 / double(std::max<size_t>(draws, 1))) : 0.0;
     // m² = e² + σ² (independent errors): the bake's own error e with the noise removed, and the
     // range it lies in. Met when its top is within E (always when m <= E), NOT met when its
     // bottom exceeds E, else the reference cannot tell.
@@ -156,7 +174,12 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
     const char* verdict = v.met ? "met" : v.not_met ? "NOT met" : "not verifiable here";
     std::string line = format("  target %g for ", target) + product_label(v.product) +
                        (is_radiance(v.product) ? " (relative)" : "") + ": " + verdict + ": ";
-    if (v.noise_measured)
+    if (v.extrapolated)
+      line += format("the bake's own error %.2e to ", v.error_lo) + format("%.2e, from its RMSE ", v.error_hi) +
+              format("%.3e against the same integrator at %.0fx its isolines (N = ", v.measured, v.finer) +
+              format("%.0f) on ", double(v.finer_knob)) + format("%.0f points, which converges at order 1 to 2 ", double(v.finer_points)) +
+              "(a QMC reference within E/3 would take too many rays)";
+    else if (v.noise_measured)
       line += format("the bake's own error %.2e", v.error) + format(" (%.2e to ", v.error_lo) +
               format("%.2e), ", v.error_hi) + format("the measured RMSE %.3e less the reference's own noise ", v.measured) +
               format("%.1e (", v.noise) + v.noise_kind + ") in quadrature";
@@ -187,7 +210,7 @@ std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, std
   const double aim = (silhouette ? defaults.safety_silhouette : defaults.safety_qmc) * choice.target;
   double ratio = 0;  // the worst product's error over the aim, where it is (likely) above E
   for (const TargetVerdict& v : verdicts)
-    if (v.not_met || (v.noise_measured && v.error > choice.target)) ratio = std::max(ratio, v.error / aim);
+    if (v.not_met || ((v.noise_measured || v.extrapolated) && v.error > choice.target)) ratio = std::max(ratio, v.error / aim);
   if (!(ratio > 1)) return std::nullopt;
   const Prediction* pred = nullptr;
   for (const Prediction& p : choice.predictions)

@@ -339,6 +339,15 @@ struct TargetVerdict {
   const char* noise_kind = "";
   double error = 0, error_lo = 0, error_hi = 0;  // the bake's own error and its range
   bool met = false, not_met = false; // neither: not verifiable here
+  // The reference was the bake's integrator at f = ProductError::finer times its knob: the
+  // difference m = R(N) − R(fN) is c·N^-a·(1 − f^-a) at the integrator's order a ∈ [1, 2] (the
+  // pilot's clamp), so the bake's own error c·N^-a lies in [m/(1 − f^-2), m/(1 − f^-1)] and the
+  // finer level's in [m/(f² − 1), m/(f − 1)]. `error` is the top of the range (what a correction
+  // aims from), `noise` the finer level's own error at its top.
+  bool extrapolated = false;
+  double finer = 0;
+  uint32_t finer_knob = 0;
+  size_t finer_points = 0;
 };
 std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double target, const ReferencePlan* plan = nullptr);
 

@@ -25,6 +25,13 @@ struct ProductError {
   double reference_rms = 0;         // RMS of the reference values (for relative errors)
   double bake_std_error = 0;        // RMS of the bake's own estimated standard errors
   double reference_std_error = 0;   // RMS of the reference's standard errors (its own noise)
+  // > 1: the reference was the bake's own integrator at `finer` times its knob (the silhouette
+  // integrator at finer·N isolines, bake/bake/choose.h "The check"): deterministic, so rmse is the
+  // bake's error less the finer level's, both of one sign, and the verdict extrapolates from it at
+  // the integrator's order (target_verdicts). 0: an independent reference (QMC).
+  double finer = 0;
+  uint32_t finer_knob = 0;          // the finer level's isolines
+  size_t finer_points = 0;          // the points it compared (every row when that was affordable)
 };
 struct ErrorReport {
   std::vector<uint32_t> vertices;

@@ -133,6 +133,11 @@ private:
   // `before`: the rows of the stage done before this job's (advanced by its sets').
   void integrate(BakeJob& job, const Monitor& stage, uint64_t& before, const PipelineHooks& hooks);
   void check(const Monitor& monitor, const PipelineHooks& hooks, const std::vector<bool>& which);
+  // A silhouette bake's R and S that its QMC reference could not tell (a sun needs ~10^5–10^6 rays
+  // per point for E/3): checked again against the same integrator at kFinerFactor × N isolines on
+  // the same points (ProductError::finer; bake/bake/choose.h "The check").
+  void check_finer(BakeJob& job, const Monitor& monitor);
+  static constexpr int kFinerFactor = 4;
 
   const Mesh& occluders_;
   const Topology& topology_;
