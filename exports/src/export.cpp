@@ -18,7 +18,8 @@ constexpr struct {
   ExportFormat format;
   const char* name;
 } kFormatNames[] = {{ExportFormat::Gltf, "gltf"},   {ExportFormat::Glb, "glb"},     {ExportFormat::Binary, "bin"},
-                    {ExportFormat::Unity, "unity"}, {ExportFormat::Godot, "godot"}, {ExportFormat::Filament, "filament"}};
+                    {ExportFormat::Unity, "unity"}, {ExportFormat::Godot, "godot"}, {ExportFormat::Filament, "filament"},
+                    {ExportFormat::Exr, "exr"}};
 
 std::string relative(std::string_view path) { return std::string(path.substr(1)); }
 
@@ -143,6 +144,7 @@ ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::p
   case ExportFormat::Gltf:
   case ExportFormat::Glb: detail::export_gltf(asset, out, format == ExportFormat::Glb); break;
   case ExportFormat::Binary: detail::export_binary(asset, out); break;
+  case ExportFormat::Exr: detail::export_exr(asset, source, out); break;
   case ExportFormat::Unity:
   case ExportFormat::Godot:
   case ExportFormat::Filament: summary.left_out = detail::export_probes(asset, source, format, out, environment); break;
