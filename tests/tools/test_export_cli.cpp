@@ -14,6 +14,7 @@
 #include <hdf5_bytes.h>
 #include <run_tool.h>
 #include <scratch.h>
+#include <unit_box_obj.h>
 
 #include <nlohmann/json.hpp>
 
@@ -183,11 +184,7 @@ fs::path seamed_floor_and_box(const fs::path& dir) {
   out << "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\n";
   out << "vt 0.05 0.95\nvt 0.9 0.95\nvt 0.9 0.1\nvt 0.1 0.9\nvt 0.95 0.05\nvt 0.1 0.05\nvt 3 3\n";
   out << "f 1/1 2/2 3/3\nf 1/4 3/5 4/6\n";
-  for (int k = 0; k < 8; ++k)
-    out << "v " << (k & 1 ? 0.5 : -0.5) << " " << (k & 2 ? 0.5 : -0.5) << " " << (k & 4 ? 1 : 0) << "\n";
-  const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                            {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& f : faces) out << "f " << f[0] + 5 << "/7 " << f[1] + 5 << "/7 " << f[2] + 5 << "/7\n";
+  prt::testing::write_unit_box_obj(out, 5, 7);
   return obj;
 }
 
