@@ -10,6 +10,10 @@
 //     Unity's ShadeSH9, Godot's capture formula, Filament's) at each vertex's normal in the
 //     engine's frame equals the baked E/π of SCHEMA.md's (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 of
 //     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
+//   * Lightmaps (format v5): tinygltf reads a scene whose objects' UVs have seams at every shared
+//     vertex — each corner's TEXCOORD_1, position, normal and per-vertex attribute are the file's
+//     row's, bit for bit — and decodes the occlusion PNG to round(255·AO) of a non-square
+//     lightmap; EXR files are named per object; a value beyond half's range is refused.
 #include <exports/export.h>
 
 #include <formats/temporaries.h>
@@ -447,9 +451,143 @@ TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
   }
 }
 
+// ---- lightmaps ----
+
+// A Y-up scene of two objects ("a", and "b|c" as a glTF node path is stored), each a strip of 6
+// vertices (4 triangles) with AO and order-2 transfer per vertex, its corners' UVs all distinct
+// (every vertex shared by two triangles is on a seam), and a 4 × 3 lightmap (W ≠ H) with state,
+// positions, normals, AO, order-2 transfer and band-1 radiance.
+Asset lightmap_asset() {
+  Asset a;
+  a.root = root("y");
+  a.scene.emplace();
+  for (const char* name : {"a", "b|c"}) {
+    SceneObject& o = a.objects.emplace_back();
+    o.name = name;
+    const size_t V = 6, W = 4, H = 3, texels = W * H;
+    fill_mesh(o.set, V, 0.0);
+    for (double& x : o.set.positions->values) x = double(float(x));  // float32 positions: no node translation
+    o.set.ao = product(values(V, 1.1));
+    o.set.transfer_diffuse = product(values(V * 4, 1.2), 2);
+    Uvs& uv = o.set.uv.emplace();
+    uv.uv_set = "TEXCOORD_1";
+    for (size_t i = 0; i < o.set.triangles->values.size(); ++i) uv.values.insert(uv.values.end(), {float(i) / 16, 1 - float(i) / 32});
+    Lightmap& m = o.set.lightmap.emplace();
+    m.width = W;
+    m.height = H;
+    m.padding = 1;
+    for (size_t k = 0; k < texels; ++k) m.state.values.push_back(uint8_t(k % 4));
+    m.positions.emplace().values.assign(3 * texels, 0.25);
+    m.normals.emplace().values.assign(3 * texels, 0.0f);
+    for (size_t k = 0; k < texels; ++k) m.normals->values[3 * k + 1] = 1;
+    m.ao = product(values(texels, 1.3));
+    m.ao->values[0] = -0.2f;  // clamped to code 0
+    m.ao->values[1] = 1.5f;   // clamped to 255
+    m.transfer_diffuse = product(values(texels * 4, 1.4), 2);
+    m.radiance_band1 = product(values(texels * 9, 1.5));
+  }
+  return a;
+}
+
+TEST(ExportLightmap, SeamsSplitVerticesCopyingEveryAttributeAndTheOcclusionPngDecodes) {
+  const Asset a = lightmap_asset();
+  const fs::path dir = fresh_dir("lightmap_gltf");
+  export_asset(a, "in.prt.h5", ExportFormat::Glb, dir / "lm.glb");
+  const tinygltf::Model m = load(dir / "lm.glb", true);
+  const tinygltf::Value& sets = m.asset.extras.Get("prtbake").Get("sets");
+  ASSERT_EQ(sets.ArrayLen(), 2u);
+  for (size_t si = 0; si < 2; ++si) {
+    const VertexSet& s = a.objects[si].set;
+    SCOPED_TRACE(a.objects[si].name);
+    const tinygltf::Value& entry = sets.Get(int(si));
+    const tinygltf::Primitive& prim = m.meshes.at(size_t(entry.Get("mesh").Get<int>())).primitives.at(0);
+    const std::vector<uint32_t> idx = read_accessor<uint32_t>(m, prim.indices);
+    const std::vector<uint32_t>& tri = s.triangles->values;
+    ASSERT_EQ(idx.size(), tri.size());
+    // Every corner's UV differs from every other's: each corner is its own export vertex, the
+    // file's V rows (at their first corner) and one copy per further corner of a row.
+    const size_t V = s.vertex_count(), exported = m.accessors.at(size_t(prim.attributes.at("POSITION"))).count;
+    EXPECT_EQ(exported, tri.size()) << "every corner its own vertex here";
+    const tinygltf::Value& copies = entry.Get("vertices").Get("copies_of");
+    ASSERT_EQ(copies.ArrayLen(), exported - V);
+    for (size_t j = 0; j < copies.ArrayLen(); ++j) EXPECT_LT(size_t(copies.Get(int(j)).Get<int>()), V);
+    // Each corner's attributes are its file row's, bit for bit.
+    const std::vector<float> uv1 = read_accessor<float>(m, prim.attributes.at("TEXCOORD_1"));
+    EXPECT_EQ(read_accessor<float>(m, prim.attributes.at("TEXCOORD_0")), uv1);
+    const std::vector<float> pos = read_accessor<float>(m, prim.attributes.at("POSITION"));
+    const std::vector<float> nrm = read_accessor<float>(m, prim.attributes.at("NORMAL"));
+    const std::vector<float> ao = read_accessor<float>(m, prim.attributes.at("_AO"));
+    const std::vector<float> tr = read_accessor<float>(m, prim.attributes.at("_PRT_DIFFUSE_0"));
+    for (size_t i = 0; i < tri.size(); ++i) {
+      const size_t g = idx[i], f = tri[i];
+      EXPECT_EQ(uv1[2 * g], s.uv->values[2 * i]);
+      EXPECT_EQ(uv1[2 * g + 1], s.uv->values[2 * i + 1]);
+      EXPECT_EQ(ao[g], s.ao->values[f]);
+      for (size_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(pos[3 * g + c], float(s.positions->values[3 * f + c]));
+        EXPECT_EQ(nrm[3 * g + c], s.normals->values[3 * f + c]);
+      }
+      for (size_t c = 0; c < 4; ++c) EXPECT_EQ(tr[4 * g + c], s.transfer_diffuse->values[4 * f + c]);
+    }
+    // The occlusion texture: texCoord 1, a PNG tinygltf decodes to the AO codes (R channel).
+    const tinygltf::Material& mat = m.materials.at(size_t(prim.material));
+    EXPECT_EQ(mat.occlusionTexture.texCoord, 1);
+    EXPECT_EQ(mat.pbrMetallicRoughness.metallicFactor, 0.0);
+    const tinygltf::Image& image = m.images.at(size_t(m.textures.at(size_t(mat.occlusionTexture.index)).source));
+    const Lightmap& lm = *s.lightmap;
+    ASSERT_EQ(size_t(image.width), lm.width);
+    ASSERT_EQ(size_t(image.height), lm.height);
+    ASSERT_EQ(image.bits, 8);
+    const size_t comps = size_t(image.component);
+    for (size_t k = 0; k < lm.texel_count(); ++k)
+      EXPECT_EQ(int(image.image.at(k * comps)), int(std::lround(std::clamp(double(lm.ao->values[k]), 0.0, 1.0) * 255.0)))
+          << "texel " << k;
+    EXPECT_EQ(image.image.at(0), 0);
+    EXPECT_EQ(image.image.at(comps), 255);
+    // The lightmap datasets as buffer views, bit for bit.
+    const tinygltf::Value& datasets = entry.Get("lightmap").Get("datasets");
+    ASSERT_EQ(datasets.ArrayLen(), 6u);  // state, positions, normals, ao, transfer/diffuse, radiance/band1
+    for (size_t d = 0; d < datasets.ArrayLen(); ++d) {
+      const tinygltf::Value& de = datasets.Get(int(d));
+      const tinygltf::BufferView& view = m.bufferViews.at(size_t(de.Get("bufferView").Get<int>()));
+      const std::string name = de.Get("dataset").Get<std::string>();
+      const std::vector<unsigned char>& buf = m.buffers.at(0).data;
+      auto floats = [&] {
+        std::vector<float> v(view.byteLength / 4);
+        std::memcpy(v.data(), buf.data() + view.byteOffset, view.byteLength);
+        return v;
+      };
+      const std::string prefix = "objects/" + a.objects[si].name + "/lightmap/";
+      if (name == prefix + "state") EXPECT_EQ(std::vector<uint8_t>(buf.begin() + long(view.byteOffset), buf.begin() + long(view.byteOffset + view.byteLength)), lm.state.values);
+      else if (name == prefix + "ao") EXPECT_EQ(floats(), lm.ao->values);
+      else if (name == prefix + "transfer/diffuse") EXPECT_EQ(floats(), lm.transfer_diffuse->values);
+      else if (name == prefix + "radiance/band1") EXPECT_EQ(floats(), lm.radiance_band1->values);
+      else if (name == prefix + "normals") EXPECT_EQ(floats(), lm.normals->values);
+      else EXPECT_EQ(name, prefix + "positions");
+    }
+  }
+}
+
+TEST(ExportLightmap, ExrFilesAreNamedPerObjectAndHalfOverflowIsRefused) {
+  Asset a = lightmap_asset();
+  const fs::path dir = fresh_dir("lightmap_exr");
+  export_asset(a, "in.prt.h5", ExportFormat::Exr, dir / "scene.exr");
+  EXPECT_EQ(listing(dir), (std::vector<std::string>{"scene.a.exr", "scene.b|c.exr"}));
+  const fs::path dir2 = fresh_dir("lightmap_exr_overflow");
+  a.objects[1].set.lightmap->radiance_band1->values[5] = 1e5f;  // texel 0, G, m = 1: beyond half's 65504
+  try {
+    export_asset(a, "in.prt.h5", ExportFormat::Exr, dir2 / "scene");
+    ADD_FAILURE() << "no error";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.file(), "in.prt.h5");
+    EXPECT_NE(e.defect().find("channel radiance.band1.G.m1 holds 100000"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(listing(dir2).empty()) << "nothing half-written: not even the first object's file";
+}
+
 TEST(Export, FormatNamesRoundTrip) {
   for (ExportFormat f : {ExportFormat::Gltf, ExportFormat::Glb, ExportFormat::Binary, ExportFormat::Unity,
-                         ExportFormat::Godot, ExportFormat::Filament})
+                         ExportFormat::Godot, ExportFormat::Filament, ExportFormat::Exr})
     EXPECT_EQ(parse_export_format(to_string(f)), f);
   EXPECT_EQ(parse_export_format("fbx"), std::nullopt);
 }
