@@ -57,7 +57,7 @@ size_t aligned(size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
 
 } // namespace
 
-void export_binary(const Asset& asset, const std::filesystem::path& out) {
+std::vector<std::filesystem::path> export_binary(const Asset& asset, const std::filesystem::path& out) {
   Staging staging(out);
   std::vector<Array> arrays;
   for (const SetRef& ref : vertex_sets(asset)) add_set(arrays, ref);
@@ -99,7 +99,7 @@ void export_binary(const Asset& asset, const std::filesystem::path& out) {
     bytes.resize(aligned(bytes.size()), '\0');
   }
   write_bytes(staging.stage(out), bytes, out);
-  staging.commit();
+  return staging.commit();
 }
 
 } // namespace prt::exports::detail

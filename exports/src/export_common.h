@@ -65,8 +65,9 @@ public:
   const std::filesystem::path& directory() const noexcept { return dir_; }
   // The staged path of `final_path` (a file in the output's directory); commit() moves it there.
   std::filesystem::path stage(const std::filesystem::path& final_path);
-  // Renames every staged file onto its final path, in the order staged. FormatError.
-  void commit();
+  // Renames every staged file onto its final path, in the order staged; returns those paths.
+  // FormatError.
+  std::vector<std::filesystem::path> commit();
 
 private:
   std::filesystem::path out_, dir_;
@@ -119,15 +120,18 @@ void write_exr_half(const std::filesystem::path& path, uint64_t width, uint64_t 
                     const std::vector<ExrChannel>& channels, const std::filesystem::path& source,
                     const std::filesystem::path& out);
 
-// The exporters.
-void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb);
+// The exporters; each returns the files it wrote, in the order written.
+std::vector<std::filesystem::path> export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb);
 // Lightmaps as half-float EXR files (OUT a directory or a prefix, see export.h).
-void export_exr(const Asset& asset, const std::filesystem::path& source, const std::filesystem::path& out);
-void export_binary(const Asset& asset, const std::filesystem::path& out);
+std::vector<std::filesystem::path> export_exr(const Asset& asset, const std::filesystem::path& source,
+                                              const std::filesystem::path& out);
+std::vector<std::filesystem::path> export_binary(const Asset& asset, const std::filesystem::path& out);
 // Returns the sets it skipped (no /radiance/band1), each as "<name>: <why>".
 // Godot also writes the directional (L1 SH) lightmap of every set with /lightmap/radiance/band1.
-std::vector<std::string> export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat engine,
-                                       const std::filesystem::path& out,
-                                       const std::optional<EnvironmentProbe>& environment);
+// Fills the summary: the sets it skipped (no /radiance/band1), each as "<name>: <why>", and the
+// files written.
+void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat engine,
+                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment,
+                   ExportSummary& summary);
 
 } // namespace prt::exports::detail

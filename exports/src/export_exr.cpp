@@ -9,7 +9,8 @@
 
 namespace prt::exports::detail {
 
-void export_exr(const Asset& asset, const std::filesystem::path& source, const std::filesystem::path& out) {
+std::vector<std::filesystem::path> export_exr(const Asset& asset, const std::filesystem::path& source,
+                                              const std::filesystem::path& out) {
   const std::vector<LightmapRef> maps = lightmap_sets(asset);
   if (maps.empty())
     throw FormatError(source.string(), "has no lightmap (/lightmap/state): EXR lightmaps need a per-texel bake "
@@ -30,7 +31,7 @@ void export_exr(const Asset& asset, const std::filesystem::path& source, const s
     for (const LightmapChannel& c : channels) exr.push_back({c.name, &c.values});
     write_exr_half(staging.stage(file), map.lightmap->width, map.lightmap->height, exr, source, file);
   }
-  staging.commit();
+  return staging.commit();
 }
 
 } // namespace prt::exports::detail

@@ -374,7 +374,7 @@ Value add_set(ModelBuilder& b, const SetRef& ref, const std::filesystem::path& o
 
 } // namespace
 
-void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb) {
+std::vector<std::filesystem::path> export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb) {
   Staging staging(out);
   ModelBuilder b;
   tinygltf::Model& m = b.model();
@@ -432,7 +432,7 @@ void export_gltf(const Asset& asset, const std::filesystem::path& out, bool glb)
     if (!writer.WriteGltfSceneToFile(&m, staging.stage(out).string(), false, false, true, false))
       throw FormatError(msg, "cannot write the glTF or its buffer '" + bin.string() + "' (disk full?)");
   }
-  staging.commit();
+  return staging.commit();
 }
 
 } // namespace prt::exports::detail

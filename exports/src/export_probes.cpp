@@ -144,9 +144,9 @@ constexpr const char* kGodotImport =
 
 } // namespace
 
-std::vector<std::string> export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                                       const std::filesystem::path& out,
-                                       const std::optional<EnvironmentProbe>& environment) {
+void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment,
+                   ExportSummary& summary) {
   const EngineInfo& e = info_of(format);
   const C::UpAxis up = asset.root.up_axis == "z" ? C::UpAxis::Z : C::UpAxis::Y;
   const C::Mat3 M = C::engine_from_file(e.engine, up);
@@ -255,8 +255,8 @@ std::vector<std::string> export_probes(const Asset& asset, const std::filesystem
         "baked normal (formats/SCHEMA.md, Exports)";
   }
   write_bytes(staging.stage(out), j.dump() + "\n", out);
-  staging.commit();
-  return left_out;
+  summary.written = staging.commit();
+  summary.left_out = std::move(left_out);
 }
 
 } // namespace prt::exports::detail

@@ -13,7 +13,9 @@
 //   * Lightmaps (format v5): tinygltf reads a scene whose objects' UVs have seams at every shared
 //     vertex — each corner's TEXCOORD_1, position, normal and per-vertex attribute are the file's
 //     row's, bit for bit — and decodes the occlusion PNG to round(255·AO) of a non-square
-//     lightmap; EXR files are named per object; a value beyond half's range is refused.
+//     lightmap; EXR files are named per object; a value beyond half's range is refused; Godot's
+//     directional lightmap of a Z-up file, shaded by Godot's formula at the texel's normal turned
+//     into Godot's frame, is the baked E/π.
 #include <exports/export.h>
 
 #include <formats/temporaries.h>
@@ -23,6 +25,10 @@
 #include <run_tool.h>
 #include <scratch.h>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -583,6 +589,66 @@ TEST(ExportLightmap, ExrFilesAreNamedPerObjectAndHalfOverflowIsRefused) {
     EXPECT_NE(e.defect().find("channel radiance.band1.G.m1 holds 100000"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(listing(dir2).empty()) << "nothing half-written: not even the first object's file";
+}
+
+TEST(ExportLightmap, GodotLayersShadeToTheBakedIrradianceAtTheNormalInGodotsFrame) {
+  Asset a = lightmap_asset();
+  a.root = root("z");
+  for (SceneObject& o : a.objects) {
+    std::vector<float>& n = o.set.lightmap->normals->values;
+    for (size_t k = 0; k < n.size() / 3; ++k) {
+      const double v[3] = {std::sin(double(k) + 1), std::cos(2.0 * double(k)), 0.5 + std::sin(3.0 * double(k))};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (size_t c = 0; c < 3; ++c) n[3 * k + c] = float(v[c] / len);
+    }
+  }
+  const fs::path dir = fresh_dir("lightmap_godot");
+  const ExportSummary summary = export_asset(a, "in.prt.h5", ExportFormat::Godot, dir / "g.json");
+  EXPECT_EQ(listing(dir), (std::vector<std::string>{"g.json", "g.lightmap.a.exr", "g.lightmap.a.exr.import",
+                                                     "g.lightmap.b|c.exr", "g.lightmap.b|c.exr.import"}));
+  EXPECT_EQ(summary.written.size(), 5u);
+  EXPECT_TRUE(summary.left_out.empty()) << "lit per texel: not left out";
+  const Lightmap& m = *a.objects[0].set.lightmap;
+  Imf::InputFile file((dir / "g.lightmap.a.exr").c_str());
+  const Imath::Box2i w = file.header().dataWindow();
+  ASSERT_EQ(size_t(w.max.x - w.min.x + 1), m.width);
+  ASSERT_EQ(size_t(w.max.y - w.min.y + 1), 4 * m.height);
+  const size_t texels = m.texel_count();
+  std::vector<float> rgb[3];
+  Imf::FrameBuffer frame;
+  for (size_t c = 0; c < 3; ++c) {
+    rgb[c].resize(4 * texels);
+    frame.insert(std::string(1, "RGB"[c]), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgb[c].data()), sizeof(float), sizeof(float) * m.width));
+  }
+  file.setFrameBuffer(frame);
+  file.readPixels(w.min.y, w.max.y);
+  // Half rounding: l0 within 2⁻¹¹ relative; each packed t in [0, 1] within 2⁻¹² absolute, so each
+  // unpacked a within 2⁻¹¹ and Godot's 4 l0 (a·n) within 4 l0 · 3 · 2⁻¹¹ of its exact value.
+  const double k1 = std::sqrt(3 / (4 * kPi));
+  size_t lit = 0;
+  for (size_t k = 0; k < texels; ++k) {
+    const float* n = &m.normals->values[3 * k];
+    const double godot_n[3] = {n[0], n[2], -n[1]};  // Z-up file turned Y-up: (x, y, z) -> (x, z, -y)
+    for (size_t c = 0; c < 3; ++c) {
+      const float* R = &m.radiance_band1->values[9 * k + 3 * c];
+      // E/π = (4/3) Σ_m y_1m(n) R_m, y_1m = k1 (−y, z, −x) (m = −1, 0, 1).
+      const double e = 4.0 / 3 * k1 * (-n[1] * R[0] + n[2] * R[1] - n[0] * R[2]);
+      const double l0 = rgb[c][k];
+      double l1[3];
+      for (size_t layer = 1; layer <= 3; ++layer) l1[layer - 1] = (rgb[c][layer * texels + k] - 0.5) * 2;
+      if (m.state.values[k] == 0 || e <= 0) {
+        EXPECT_EQ(l0, 0.0) << "texel " << k;
+        for (double x : l1) EXPECT_EQ(x, 0.0) << "texel " << k;
+        continue;
+      }
+      ++lit;
+      EXPECT_NEAR(l0, e, std::ldexp(e, -11)) << "texel " << k << " channel " << c;
+      const double shaded = l0 + 4 * l0 * (l1[0] * godot_n[1] + l1[1] * godot_n[2] + l1[2] * godot_n[0]);
+      EXPECT_NEAR(shaded, e, std::ldexp(e, -11) + 4 * l0 * 3 * std::ldexp(1.0, -11)) << "texel " << k << " channel " << c;
+      for (double x : l1) EXPECT_LE(std::abs(x), 1.0);
+    }
+  }
+  EXPECT_GT(lit, 5u) << "some texels are lit (else the check says little)";
 }
 
 TEST(Export, FormatNamesRoundTrip) {

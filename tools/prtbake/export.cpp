@@ -157,7 +157,9 @@ int run_export(const ExportArgs& args) {
                  sets.size() == 1 ? "" : (std::to_string(sets.size()) + " vertex sets, ").c_str(), list.c_str(),
                  why.c_str());
   }
-  std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), exports::to_string(format));
+  std::string files;
+  for (const std::filesystem::path& f : summary.written) files += (files.empty() ? "" : ", ") + f.string();
+  std::printf("exported %s to %s (%s)\n", args.input.c_str(), files.c_str(), exports::to_string(format));
   return 0;
 }
 

@@ -63,9 +63,10 @@ struct EnvironmentProbe {
 };
 
 // What an export left out: per vertex set "<name>: <why>" (the probe formats skip the sets without
-// /radiance/band1; the other formats export every set).
+// /radiance/band1; the other formats export every set); and the files it wrote, in order.
 struct ExportSummary {
   std::vector<std::string> left_out;
+  std::vector<std::filesystem::path> written;
 };
 
 // Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
