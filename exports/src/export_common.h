@@ -88,6 +88,10 @@ struct LightmapRef {
 };
 std::vector<LightmapRef> lightmap_sets(const Asset& asset);
 
+// The products of a lightmap as ProductRefs: dataset relative to the set ("lightmap/ao", ...),
+// shape after the [H][W] axes ({} for AO, {L*L} for transfer, {3, 3} / {3, L*L} for radiance).
+std::vector<ProductRef> lightmap_products(const Lightmap& m);
+
 // One float image of a lightmap, [H][W] texels: a channel of a product (or the state mask).
 // `name` is the EXR channel name (formats/SCHEMA.md "Exports", "Lightmaps"): "state", "ao",
 // "transfer.diffuse.c<i>", "transfer.visibility.c<i>", "radiance.band1.<R|G|B>.m<-1|0|1>",

@@ -239,16 +239,8 @@ Value add_lightmap(ModelBuilder& b, const SetRef& ref, const std::filesystem::pa
       dataset(names::kLightmapPositions, "float64", {3}, add_array_view(b, m.positions->values));
   }
   if (m.normals) dataset(names::kLightmapNormals, "float32", {3}, add_array_view(b, m.normals->values));
-  const size_t texels = m.texel_count();
-  auto product = [&](std::string_view path, const std::optional<Product>& p, std::vector<int> trailing) {
-    if (p) dataset(path, "float32", std::move(trailing), add_array_view(b, p->values));
-  };
-  auto width = [&](const std::optional<Product>& p) { return p && texels ? int(p->values.size() / texels) : 0; };
-  product(names::kLightmapAo, m.ao, {});
-  product(names::kLightmapTransferDiffuse, m.transfer_diffuse, {width(m.transfer_diffuse)});
-  product(names::kLightmapTransferVisibility, m.transfer_visibility, {width(m.transfer_visibility)});
-  product(names::kLightmapRadianceBand1, m.radiance_band1, {3, 3});
-  product(names::kLightmapRadianceShadowed, m.radiance_shadowed, {3, width(m.radiance_shadowed) / 3});
+  for (const ProductRef& pr : lightmap_products(m))
+    dataset("/" + pr.dataset, "float32", std::vector<int>(pr.shape.begin(), pr.shape.end()), add_array_view(b, pr.product->values));
   entry["datasets"] = Value(std::move(datasets));
   return Value(std::move(entry));
 }

@@ -23,6 +23,21 @@ std::vector<LightmapRef> lightmap_sets(const Asset& asset) {
   return out;
 }
 
+std::vector<ProductRef> lightmap_products(const Lightmap& m) {
+  const size_t texels = m.texel_count();
+  std::vector<ProductRef> out;
+  auto width = [&](const std::optional<Product>& p) { return p && texels > 0 ? uint64_t(p->values.size() / texels) : 0; };
+  auto add = [&](std::string_view path, const std::optional<Product>& p, std::vector<uint64_t> shape) {
+    if (p) out.push_back({std::string(path.substr(1)), std::move(shape), &*p});
+  };
+  add(names::kLightmapAo, m.ao, {});
+  add(names::kLightmapTransferDiffuse, m.transfer_diffuse, {width(m.transfer_diffuse)});
+  add(names::kLightmapTransferVisibility, m.transfer_visibility, {width(m.transfer_visibility)});
+  add(names::kLightmapRadianceBand1, m.radiance_band1, {3, 3});
+  add(names::kLightmapRadianceShadowed, m.radiance_shadowed, {3, width(m.radiance_shadowed) / 3});
+  return out;
+}
+
 std::vector<LightmapChannel> lightmap_channels(const Lightmap& m) {
   const size_t texels = m.texel_count();
   std::vector<LightmapChannel> out;

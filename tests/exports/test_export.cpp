@@ -132,6 +132,42 @@ Asset scene_asset() {
   return a;
 }
 
+// A Y-up scene of two objects ("a", and "b|c" as a glTF node path is stored), each a strip of 6
+// vertices (4 triangles) with AO and order-2 transfer per vertex, its corners' UVs all distinct
+// (every vertex shared by two triangles is on a seam), and a 4 × 3 lightmap (W ≠ H) with state,
+// positions, normals, AO, order-2 transfer and band-1 radiance.
+Asset lightmap_asset() {
+  Asset a;
+  a.root = root("y");
+  a.scene.emplace();
+  for (const char* name : {"a", "b|c"}) {
+    SceneObject& o = a.objects.emplace_back();
+    o.name = name;
+    const size_t V = 6, W = 4, H = 3, texels = W * H;
+    fill_mesh(o.set, V, 0.0);
+    for (double& x : o.set.positions->values) x = double(float(x));  // float32 positions: no node translation
+    o.set.ao = product(values(V, 1.1));
+    o.set.transfer_diffuse = product(values(V * 4, 1.2), 2);
+    Uvs& uv = o.set.uv.emplace();
+    uv.uv_set = "TEXCOORD_1";
+    for (size_t i = 0; i < o.set.triangles->values.size(); ++i) uv.values.insert(uv.values.end(), {float(i) / 16, 1 - float(i) / 32});
+    Lightmap& m = o.set.lightmap.emplace();
+    m.width = W;
+    m.height = H;
+    m.padding = 1;
+    for (size_t k = 0; k < texels; ++k) m.state.values.push_back(uint8_t(k % 4));
+    m.positions.emplace().values.assign(3 * texels, 0.25);
+    m.normals.emplace().values.assign(3 * texels, 0.0f);
+    for (size_t k = 0; k < texels; ++k) m.normals->values[3 * k + 1] = 1;
+    m.ao = product(values(texels, 1.3));
+    m.ao->values[0] = -0.2f;  // clamped to code 0
+    m.ao->values[1] = 1.5f;   // clamped to 255
+    m.transfer_diffuse = product(values(texels * 4, 1.4), 2);
+    m.radiance_band1 = product(values(texels * 9, 1.5));
+  }
+  return a;
+}
+
 // Every per-vertex product an export carries, by its dataset name relative to the set.
 std::vector<std::pair<std::string, const std::optional<Product>*>> exported_products(const VertexSet& s) {
   return {{"ao", &s.ao},
@@ -320,7 +356,7 @@ TEST(ExportGltf, ZUpBakesHangUnderANodeTurningZToY) {
 TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
   const fs::path dir = fresh_dir("bin");
   if (prt::testing::run_tool("python3", "-c 'import json, struct'", dir).code != 0) GTEST_SKIP() << "no python3";
-  for (const Asset& a : {vertex_asset(), scene_asset()}) {
+  for (const Asset& a : {vertex_asset(), scene_asset(), lightmap_asset()}) {
     export_asset(a, "in.prt.h5", ExportFormat::Binary, dir / "a.prtbin");
     const auto run = prt::testing::run_tool("python3", std::string(PRT_SOURCE_TESTS) + "/exports/prtbin_reader.py '" +
                                                            (dir / "a.prtbin").string() + "' '" + (dir / "a.json").string() + "'",
@@ -337,6 +373,15 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
       want[name("mesh/source_position")] = {{s.source_position->values.begin(), s.source_position->values.end()}, "uint32"};
       for (auto [d, p] : exported_products(s))
         if (*p) want[name(d)] = {{(*p)->values.begin(), (*p)->values.end()}, "float32"};
+      if (s.uv) want[name("mesh/uv")] = {{s.uv->values.begin(), s.uv->values.end()}, "float32"};
+      if (!s.lightmap) return;
+      const Lightmap& m = *s.lightmap;
+      want[name("lightmap/state")] = {{m.state.values.begin(), m.state.values.end()}, "uint8"};
+      want[name("lightmap/positions")] = {m.positions->values, "float32"};  // 0.25: exactly float
+      want[name("lightmap/normals")] = {{m.normals->values.begin(), m.normals->values.end()}, "float32"};
+      want[name("lightmap/ao")] = {{m.ao->values.begin(), m.ao->values.end()}, "float32"};
+      want[name("lightmap/transfer/diffuse")] = {{m.transfer_diffuse->values.begin(), m.transfer_diffuse->values.end()}, "float32"};
+      want[name("lightmap/radiance/band1")] = {{m.radiance_band1->values.begin(), m.radiance_band1->values.end()}, "float32"};
     };
     if (a.objects.empty()) add("", a.vertices);
     for (const SceneObject& o : a.objects) add("objects/" + o.name, o.set);
@@ -347,9 +392,22 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
       EXPECT_EQ(h["dtype"], want[name].second) << name;
       EXPECT_EQ(j["arrays"][name].get<std::vector<double>>(), want[name].first) << name;
     }
-    const auto& sh = *std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
-                                   [&](const auto& h) { return h["name"] == (a.objects.empty() ? "transfer/diffuse" : "objects/far/transfer/diffuse"); });
-    EXPECT_EQ(sh["attrs"]["sh_order"], a.objects.empty() ? 3 : 5);
+    // An SH product's attributes: the root's, the far object's, a lightmap's.
+    const bool lightmaps = !a.objects.empty() && a.objects[0].set.lightmap;
+    const std::string sh_name = a.objects.empty() ? "transfer/diffuse"
+                                : lightmaps       ? "objects/a/lightmap/transfer/diffuse"
+                                                  : "objects/far/transfer/diffuse";
+    const auto sh = std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
+                                 [&](const auto& h) { return h["name"] == sh_name; });
+    ASSERT_NE(sh, j["header"]["arrays"].end()) << sh_name;
+    EXPECT_EQ((*sh)["attrs"]["sh_order"], a.objects.empty() ? 3 : lightmaps ? 2 : 5);
+    if (lightmaps) {
+      const auto state = std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
+                                      [&](const auto& h) { return h["name"] == "objects/a/lightmap/state"; });
+      ASSERT_NE(state, j["header"]["arrays"].end());
+      EXPECT_EQ((*state)["shape"], nlohmann::json({3, 4})) << "[H][W]";
+      EXPECT_EQ((*state)["attrs"]["padding"], 1);
+    }
   }
 }
 
@@ -458,42 +516,6 @@ TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
 }
 
 // ---- lightmaps ----
-
-// A Y-up scene of two objects ("a", and "b|c" as a glTF node path is stored), each a strip of 6
-// vertices (4 triangles) with AO and order-2 transfer per vertex, its corners' UVs all distinct
-// (every vertex shared by two triangles is on a seam), and a 4 × 3 lightmap (W ≠ H) with state,
-// positions, normals, AO, order-2 transfer and band-1 radiance.
-Asset lightmap_asset() {
-  Asset a;
-  a.root = root("y");
-  a.scene.emplace();
-  for (const char* name : {"a", "b|c"}) {
-    SceneObject& o = a.objects.emplace_back();
-    o.name = name;
-    const size_t V = 6, W = 4, H = 3, texels = W * H;
-    fill_mesh(o.set, V, 0.0);
-    for (double& x : o.set.positions->values) x = double(float(x));  // float32 positions: no node translation
-    o.set.ao = product(values(V, 1.1));
-    o.set.transfer_diffuse = product(values(V * 4, 1.2), 2);
-    Uvs& uv = o.set.uv.emplace();
-    uv.uv_set = "TEXCOORD_1";
-    for (size_t i = 0; i < o.set.triangles->values.size(); ++i) uv.values.insert(uv.values.end(), {float(i) / 16, 1 - float(i) / 32});
-    Lightmap& m = o.set.lightmap.emplace();
-    m.width = W;
-    m.height = H;
-    m.padding = 1;
-    for (size_t k = 0; k < texels; ++k) m.state.values.push_back(uint8_t(k % 4));
-    m.positions.emplace().values.assign(3 * texels, 0.25);
-    m.normals.emplace().values.assign(3 * texels, 0.0f);
-    for (size_t k = 0; k < texels; ++k) m.normals->values[3 * k + 1] = 1;
-    m.ao = product(values(texels, 1.3));
-    m.ao->values[0] = -0.2f;  // clamped to code 0
-    m.ao->values[1] = 1.5f;   // clamped to 255
-    m.transfer_diffuse = product(values(texels * 4, 1.4), 2);
-    m.radiance_band1 = product(values(texels * 9, 1.5));
-  }
-  return a;
-}
 
 TEST(ExportLightmap, SeamsSplitVerticesCopyingEveryAttributeAndTheOcclusionPngDecodes) {
   const Asset a = lightmap_asset();

@@ -22,7 +22,7 @@
 //     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe
 //     (godot: or a lightmap with /lightmap/radiance/band1, written as its directional lightmap).
 //     A set without it gets no probes; the summary names it and says why (the caller reports).
-//   * Lightmaps: glTF carries every set's lightmap (TEXCOORD_1 from /mesh/uv, split vertices where
+//   * Lightmaps: bin carries /mesh/uv and every /lightmap/... array; glTF carries every set's lightmap (TEXCOORD_1 from /mesh/uv, split vertices where
 //     corners of one vertex carry different UVs; AO as occlusionTexture; the float datasets as
 //     buffer views named in extras). `exr` needs a lightmap (FormatError naming the input
 //     otherwise) and writes one file per set with one: `out` names an existing directory
