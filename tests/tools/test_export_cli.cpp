@@ -288,6 +288,8 @@ TEST(ExportCli, GlbCarriesTheLightmapUvsAndTheAoAsItsOcclusionTexture) {
     codes.insert(want);
   }
   EXPECT_GT(codes.size(), 10u) << "the AO varies around the box (else the check says little)";
+  RecordProperty("distinct_codes", std::to_string(codes.size()));
+  RecordProperty("vertices", std::to_string(pos.size() / 3) + " of " + std::to_string(V) + " rows");
 }
 
 // Half's rounding to nearest: within 2⁻¹¹ of the value relative to it (11 significant bits) for
@@ -338,11 +340,17 @@ TEST(ExportCli, ExrLightmapsHoldEveryValueToHalfPrecision) {
             m.radiance_band1->values[9 * k + 3 * c + size_t(mm + 1)]);
   }
   ASSERT_EQ(channels.size(), want.size());
+  double worst = 0;  // the largest error in units of the tolerance
   for (const auto& [name, values] : want) {
     ASSERT_TRUE(channels.count(name)) << name;
     const std::vector<float>& got = channels.at(name);
-    for (size_t k = 0; k < texels; ++k) EXPECT_LE(std::abs(got[k] - values[k]), half_tolerance(values[k])) << name << " texel " << k;
+    for (size_t k = 0; k < texels; ++k) {
+      EXPECT_LE(std::abs(got[k] - values[k]), half_tolerance(values[k])) << name << " texel " << k;
+      worst = std::max(worst, std::abs(got[k] - values[k]) / half_tolerance(values[k]));
+    }
   }
+  RecordProperty("channels", std::to_string(channels.size()));
+  RecordProperty("worst_error_over_tolerance", std::to_string(worst));
   // A directory as -o: DIR/lightmap.exr.
   fs::create_directories(d / "dir");
   r = run_tool(PRT_PRTBAKE, export_args(texel_bake(), "exr", d / "dir"), d);
@@ -415,6 +423,7 @@ TEST(ExportCli, GodotDirectionalLightmapFollowsGodotsL1Layout) {
     }
   }
   EXPECT_GT(lit, texels) << "most texel channels are lit (else the check says little)";
+  RecordProperty("lit_texel_channels", std::to_string(lit) + " of " + std::to_string(3 * texels));
 }
 
 TEST(ExportCli, HelpTeachesTheLightmapExports) {
