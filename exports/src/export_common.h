@@ -115,13 +115,14 @@ std::string encode_png_grey(const std::vector<uint8_t>& grey, uint64_t width, ui
 
 // A half-float OpenEXR image (scanlines, ZIP, one part) of the channels, each [H][W] floats, row
 // 0 at the top (OpenEXR's data window y = 0). Every value must be finite in half (|x| ≤ 65504):
-// FormatError naming `source` and the channel otherwise; FormatError naming `out` on I/O errors.
+// FormatError naming `source`, the set and the channel otherwise; FormatError naming `out` on
+// I/O errors.
 struct ExrChannel {
   std::string name;
   const std::vector<float>* values = nullptr;
 };
 void write_exr_half(const std::filesystem::path& path, uint64_t width, uint64_t height,
-                    const std::vector<ExrChannel>& channels, const std::filesystem::path& source,
+                    const std::vector<ExrChannel>& channels, const std::filesystem::path& source, const SetRef& set,
                     const std::filesystem::path& out);
 
 // The exporters; each returns the files it wrote, in the order written.

@@ -29,7 +29,7 @@ std::vector<std::filesystem::path> export_exr(const Asset& asset, const std::fil
     const std::vector<LightmapChannel> channels = lightmap_channels(*map.lightmap);
     std::vector<ExrChannel> exr;
     for (const LightmapChannel& c : channels) exr.push_back({c.name, &c.values});
-    write_exr_half(staging.stage(file), map.lightmap->width, map.lightmap->height, exr, source, file);
+    write_exr_half(staging.stage(file), map.lightmap->width, map.lightmap->height, exr, source, map.set, file);
   }
   return staging.commit();
 }

@@ -251,7 +251,9 @@ Value add_set(ModelBuilder& b, const SetRef& ref, const std::filesystem::path& o
   const bool lightmap = s.lightmap && s.lightmap->texel_count() > 0 && s.uv && s.triangles;
   UvVertices split;
   if (lightmap) split = split_by_uv(s);
-  const std::vector<double> p = lightmap ? gather(s.positions->values, split.rows, 3) : s.positions->values;
+  std::vector<double> split_positions;  // the rows of split vertices (copies only when there is a lightmap)
+  if (lightmap) split_positions = gather(s.positions->values, split.rows, 3);
+  const std::vector<double>& p = lightmap ? split_positions : s.positions->values;
   const size_t V = p.size() / 3;
   // Positions in float32: the file's own when they are float32, else relative to the bounding
   // box centre, which becomes the node's translation (double in the JSON).
@@ -296,8 +298,9 @@ Value add_set(ModelBuilder& b, const SetRef& ref, const std::filesystem::path& o
   const size_t rows = s.vertex_count();
   for (const ProductRef& pr : products(s)) {
     const uint64_t C = pr.components();
-    const std::vector<float> values = lightmap ? gather(pr.product->values, split.rows, pr.product->values.size() / rows)
-                                               : pr.product->values;
+    std::vector<float> split_values;
+    if (lightmap) split_values = gather(pr.product->values, split.rows, pr.product->values.size() / rows);
+    const std::vector<float>& values = lightmap ? split_values : pr.product->values;
     const std::string base = attribute_base(pr.dataset);
     std::vector<std::string> attrs;
     if (pr.dataset == "ao") {

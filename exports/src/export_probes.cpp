@@ -236,7 +236,7 @@ void export_probes(const Asset& asset, const std::filesystem::path& source, Expo
       const std::filesystem::path file = lightmap_file(prefix, map.set);
       const GodotLayers layers = godot_layers(lm, M);
       write_exr_half(staging.stage(file), lm.width, kGodotLayers * lm.height,
-                     {{"R", &layers.r}, {"G", &layers.g}, {"B", &layers.b}}, source, file);
+                     {{"R", &layers.r}, {"G", &layers.g}, {"B", &layers.b}}, source, map.set, file);
       std::filesystem::path import = file;
       import += ".import";
       write_bytes(staging.stage(import), kGodotImport, out);

@@ -101,7 +101,7 @@ std::string encode_png_grey(const std::vector<uint8_t>& grey, uint64_t width, ui
 }
 
 void write_exr_half(const std::filesystem::path& path, uint64_t width, uint64_t height,
-                    const std::vector<ExrChannel>& channels, const std::filesystem::path& source,
+                    const std::vector<ExrChannel>& channels, const std::filesystem::path& source, const SetRef& set,
                     const std::filesystem::path& out) {
   const size_t texels = size_t(width * height);
   std::vector<std::vector<Imath::half>> halves;
@@ -112,7 +112,7 @@ void write_exr_half(const std::filesystem::path& path, uint64_t width, uint64_t 
       const float x = (*c.values)[k];
       h[k] = Imath::half(x);  // round to nearest even: |h − x| ≤ 2⁻¹¹ |x| for normal halves
       if (!std::isfinite(float(h[k])))
-        throw FormatError(source.string(), "channel " + c.name + " holds " + std::to_string(x) + " at texel (" +
+        throw FormatError(source.string(), "lightmap of " + set.name + ": channel " + c.name + " holds " + std::to_string(x) + " at texel (" +
                                                std::to_string(k % width) + ", " + std::to_string(k / width) +
                                                "), beyond half float's largest finite value 65504: not written as EXR");
     }

@@ -608,7 +608,7 @@ TEST(ExportLightmap, ExrFilesAreNamedPerObjectAndHalfOverflowIsRefused) {
     ADD_FAILURE() << "no error";
   } catch (const FormatError& e) {
     EXPECT_EQ(e.file(), "in.prt.h5");
-    EXPECT_NE(e.defect().find("channel radiance.band1.G.m1 holds 100000"), std::string::npos) << e.what();
+    EXPECT_NE(e.defect().find("lightmap of b|c: channel radiance.band1.G.m1 holds 100000"), std::string::npos) << e.what();
   }
   EXPECT_TRUE(listing(dir2).empty()) << "nothing half-written: not even the first object's file";
 }
