@@ -18,7 +18,8 @@ constexpr struct {
   ExportFormat format;
   const char* name;
 } kFormatNames[] = {{ExportFormat::Gltf, "gltf"},   {ExportFormat::Glb, "glb"},     {ExportFormat::Binary, "bin"},
-                    {ExportFormat::Unity, "unity"}, {ExportFormat::Godot, "godot"}, {ExportFormat::Filament, "filament"}};
+                    {ExportFormat::Unity, "unity"}, {ExportFormat::Godot, "godot"}, {ExportFormat::Filament, "filament"},
+                    {ExportFormat::Exr, "exr"}};
 
 std::string relative(std::string_view path) { return std::string(path.substr(1)); }
 
@@ -98,7 +99,7 @@ std::filesystem::path Staging::stage(const std::filesystem::path& final_path) {
   return staged;
 }
 
-void Staging::commit() {
+std::vector<std::filesystem::path> Staging::commit() {
   std::vector<std::filesystem::path> done;
   for (const auto& [staged, final_path] : files_) {
     std::error_code ec;
@@ -109,6 +110,7 @@ void Staging::commit() {
     }
     done.push_back(final_path);
   }
+  return done;
 }
 
 void write_bytes(const std::filesystem::path& path, const std::string& bytes, const std::filesystem::path& out) {
@@ -141,11 +143,12 @@ ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::p
   ExportSummary summary;
   switch (format) {
   case ExportFormat::Gltf:
-  case ExportFormat::Glb: detail::export_gltf(asset, out, format == ExportFormat::Glb); break;
-  case ExportFormat::Binary: detail::export_binary(asset, out); break;
+  case ExportFormat::Glb: summary.written = detail::export_gltf(asset, out, format == ExportFormat::Glb); break;
+  case ExportFormat::Binary: summary.written = detail::export_binary(asset, out); break;
+  case ExportFormat::Exr: summary.written = detail::export_exr(asset, source, out); break;
   case ExportFormat::Unity:
   case ExportFormat::Godot:
-  case ExportFormat::Filament: summary.left_out = detail::export_probes(asset, source, format, out, environment); break;
+  case ExportFormat::Filament: detail::export_probes(asset, source, format, out, environment, summary); break;
   }
   return summary;
 }

@@ -51,13 +51,41 @@ void add_set(std::vector<Array>& arrays, const SetRef& ref) {
     if (pr.product->integrand) a.attrs[std::string(names::kIntegrand)] = *pr.product->integrand;
     arrays.push_back(std::move(a));
   }
+  // The lightmap (format v5): the UVs per triangle corner and every [H][W]... dataset.
+  if (s.uv) {
+    Array a{name(names::kUv), "float32", {s.uv->values.size() / 6, 3, 2}, nlohmann::json::object(), bytes_of(s.uv->values)};
+    if (s.uv->uv_set) a.attrs[std::string(names::kUvSet)] = *s.uv->uv_set;
+    arrays.push_back(std::move(a));
+  }
+  if (!s.lightmap) return;
+  const formats::Lightmap& m = *s.lightmap;
+  Array state{name(names::kLightmapState), "uint8", {m.height, m.width}, nlohmann::json::object(), bytes_of(m.state.values)};
+  if (m.padding) state.attrs[std::string(names::kPadding)] = *m.padding;
+  arrays.push_back(std::move(state));
+  if (m.positions) {
+    const std::vector<double>& lp = m.positions->values;
+    if (exactly_float(lp))
+      arrays.push_back({name(names::kLightmapPositions), "float32", {m.height, m.width, 3}, nlohmann::json::object(),
+                        bytes_of(std::vector<float>(lp.begin(), lp.end()))});
+    else
+      arrays.push_back({name(names::kLightmapPositions), "float64", {m.height, m.width, 3}, nlohmann::json::object(), bytes_of(lp)});
+  }
+  if (m.normals)
+    arrays.push_back({name(names::kLightmapNormals), "float32", {m.height, m.width, 3}, nlohmann::json::object(), bytes_of(m.normals->values)});
+  for (const ProductRef& pr : lightmap_products(m)) {
+    Array a{join(ref.prefix, pr.dataset), "float32", {m.height, m.width}, nlohmann::json::object(), bytes_of(pr.product->values)};
+    a.shape.insert(a.shape.end(), pr.shape.begin(), pr.shape.end());
+    if (pr.product->sh_order) a.attrs[std::string(names::kShOrder)] = *pr.product->sh_order;
+    if (pr.product->integrand) a.attrs[std::string(names::kIntegrand)] = *pr.product->integrand;
+    arrays.push_back(std::move(a));
+  }
 }
 
 size_t aligned(size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
 
 } // namespace
 
-void export_binary(const Asset& asset, const std::filesystem::path& out) {
+std::vector<std::filesystem::path> export_binary(const Asset& asset, const std::filesystem::path& out) {
   Staging staging(out);
   std::vector<Array> arrays;
   for (const SetRef& ref : vertex_sets(asset)) add_set(arrays, ref);
@@ -99,7 +127,7 @@ void export_binary(const Asset& asset, const std::filesystem::path& out) {
     bytes.resize(aligned(bytes.size()), '\0');
   }
   write_bytes(staging.stage(out), bytes, out);
-  staging.commit();
+  return staging.commit();
 }
 
 } // namespace prt::exports::detail

@@ -2,12 +2,17 @@
 // band-1 radiance: the probe of a vertex is the radiance SH (0; 2R; 0), which every engine's own
 // formula evaluates to exactly the baked E/π at the baked normal (prtshade/conventions.h; layout:
 // formats/SCHEMA.md "Exports"). Positions and normals are given in the engine's frame.
+// Godot also gets the lightmaps baked with band-1 radiance as the directional (L1 SH) lightmaps
+// of its LightmapGI (godot_lightmap below).
 #include "export_common.h"
 
 
 #include <prtshade/conventions.h>
 
 #include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace prt::exports::detail {
 namespace {
@@ -71,21 +76,98 @@ std::string why_no_band1(const Asset& asset, const VertexSet& set) {
   return "no band-1 radiance (baked without --radiance ENV)";
 }
 
+// Godot 4's directional lightmap (LightmapGI "directional", uses_spherical_harmonics, with the
+// packed L1 coefficients of Godot 4.4+, godotengine/godot PR #96114). Read from its forward
+// shaders (scene_forward_clustered.glsl, scene_forward_mobile.glsl): per lightmap slice four
+// layers of a 2D texture array, sampled bilinearly at the mesh's UV2,
+//   l0 = layer 0 (RGB), a_k = (layer k − 0.5) · 2 for k = 1, 2, 3 (l1n1, l1_0, l1p1),
+//   ambient(n) = l0 + 4 · l0 · (a_1 n.y + a_2 n.z + a_3 n.x)   (times exposure_normalization),
+// n the normal in the LightmapGI node's frame, and ambient is multiplied by the albedo: it is
+// E(n)/π. LightmapGI::bake writes the layers stacked vertically in one EXR (layer j at rows
+// j·H … (j+1)·H − 1), imported as a 2D array texture with slices/vertical = 4.
+//
+// Ours per texel, per colour channel, from /lightmap/radiance/band1 R and the texel's normal n0
+// (the file's frame; M turns it into Godot's): E(n)/π = g · n with g = (4/3)·0.488603·d,
+// d = (−R_1, −R_−1, R_0) (the header of prtshade/conventions.h: E = (4π/3) Σ_m y_1m(n) R_m,
+// y_1m = 0.488603·(−y, z, −x)). Then l0 = g · n0, exact at the baked normal, and
+// a = M (g − (g·n0) n0) / (4 l0): the tangential part of g, which tilts the value with the normal
+// as the vector irradiance does (to first order); a stays tangential, so ambient(M n0) = l0
+// exactly. a is scaled down as a whole (it stays tangential) until every component lies in
+// [−1, 1], the range the packed layers hold; where l0 ≤ 0 (no light, an empty texel) a = 0.
+constexpr int kGodotLayers = 4;
+
+struct GodotLayers {
+  std::vector<float> r, g, b;  // [4H][W]
+};
+
+GodotLayers godot_layers(const Lightmap& m, const C::Mat3& M) {
+  const size_t W = m.width, H = m.height, texels = W * H;
+  constexpr double k1 = 0.4886025119029199;  // sqrt(3 / 4π)
+  GodotLayers out{std::vector<float>(kGodotLayers * texels), std::vector<float>(kGodotLayers * texels),
+                  std::vector<float>(kGodotLayers * texels)};
+  std::vector<float>* channel[3] = {&out.r, &out.g, &out.b};
+  const std::vector<float>& R = m.radiance_band1->values;
+  for (size_t k = 0; k < texels; ++k) {
+    const double n0[3] = {m.normals->values[3 * k], m.normals->values[3 * k + 1], m.normals->values[3 * k + 2]};
+    for (size_t c = 0; c < 3; ++c) {
+      const float* Rc = &R[9 * k + 3 * c];  // m = −1, 0, 1
+      const double d[3] = {-double(Rc[2]), -double(Rc[0]), double(Rc[1])};
+      double g[3], e0 = 0;
+      for (int i = 0; i < 3; ++i) g[i] = 4.0 / 3.0 * k1 * d[i], e0 += g[i] * n0[i];
+      double a[3] = {0, 0, 0};
+      if (e0 > 0 && m.state.values[k] != 0) {
+        double t[3];
+        for (int i = 0; i < 3; ++i) t[i] = g[i] - e0 * n0[i];
+        double largest = 1;
+        for (int r = 0; r < 3; ++r) {
+          a[r] = (M[r][0] * t[0] + M[r][1] * t[1] + M[r][2] * t[2]) / (4 * e0);
+          largest = std::max(largest, std::abs(a[r]));
+        }
+        for (double& x : a) x /= largest;
+      } else {
+        e0 = 0;
+      }
+      std::vector<float>& out_c = *channel[c];
+      out_c[k] = float(e0);
+      out_c[1 * texels + k] = float(a[1] * 0.5 + 0.5);  // l1n1: y
+      out_c[2 * texels + k] = float(a[2] * 0.5 + 0.5);  // l1_0: z
+      out_c[3 * texels + k] = float(a[0] * 0.5 + 0.5);  // l1p1: x
+    }
+  }
+  return out;
+}
+
+// Godot's import settings for the layered EXR, as LightmapGI::bake writes them beside its own.
+constexpr const char* kGodotImport =
+    "[remap]\n\nimporter=\"2d_array_texture\"\ntype=\"CompressedTexture2DArray\"\n\n[params]\n\n"
+    "compress/mode=3\ncompress/channel_pack=1\nmipmaps/generate=false\nslices/horizontal=1\nslices/vertical=4\n";
+
 } // namespace
 
-std::vector<std::string> export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
-                                       const std::filesystem::path& out,
-                                       const std::optional<EnvironmentProbe>& environment) {
+void export_probes(const Asset& asset, const std::filesystem::path& source, ExportFormat format,
+                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment,
+                   ExportSummary& summary) {
   const EngineInfo& e = info_of(format);
   const C::UpAxis up = asset.root.up_axis == "z" ? C::UpAxis::Z : C::UpAxis::Y;
   const C::Mat3 M = C::engine_from_file(e.engine, up);
 
   nlohmann::json sets = nlohmann::json::array();
   std::vector<std::string> left_out;
+  // Godot's directional lightmaps: the sets whose lightmap holds band-1 radiance.
+  std::vector<LightmapRef> lightmaps;
+  for (const LightmapRef& map : lightmap_sets(asset))
+    if (map.lightmap->radiance_band1 && map.lightmap->normals) lightmaps.push_back(map);
+  auto lit_per_texel = [&](const VertexSet& s) {
+    return s.lightmap && s.lightmap->radiance_band1 && s.lightmap->normals;
+  };
   for (const SetRef& ref : vertex_sets(asset)) {
     const VertexSet& s = *ref.set;
     if (!s.radiance_band1) {
-      left_out.push_back(ref.name + ": " + why_no_band1(asset, s));
+      if (!lit_per_texel(s))
+        left_out.push_back(ref.name + ": " + why_no_band1(asset, s));
+      else if (format != ExportFormat::Godot)
+        left_out.push_back(ref.name + ": its band-1 radiance is per texel (a lightmap): --to godot writes it as "
+                                      "Godot's directional lightmap, --to exr as EXR channels");
       continue;
     }
     const size_t V = s.vertex_count();
@@ -103,7 +185,14 @@ std::vector<std::string> export_probes(const Asset& asset, const std::filesystem
     if (s.normals) set["normals"] = in_frame(std::vector<double>(s.normals->values.begin(), s.normals->values.end()), M);
     sets.push_back(std::move(set));
   }
-  if (sets.empty() && !environment)
+  if (format != ExportFormat::Godot) lightmaps.clear();
+  const std::vector<SetRef> all_sets = vertex_sets(asset);
+  if (sets.empty() && !environment && lightmaps.empty() &&
+      std::any_of(all_sets.begin(), all_sets.end(), [&](const SetRef& r) { return lit_per_texel(*r.set); }))
+    throw FormatError(source.string(), std::string("has band-1 radiance per texel only (a lightmap), no per-vertex "
+                                                   "/radiance/band1 for ") + e.name +
+                                           " probes: export it --to godot (Godot's directional lightmap) or --to exr");
+  if (sets.empty() && !environment && lightmaps.empty())
     throw FormatError(source.string(),
                       std::string("has no /radiance/band1, the only baked product that is lighting: a ") + e.name +
                           " probe needs it (bake with prtbake vertex --radiance ENV, or a scene with an environment), "
@@ -136,9 +225,38 @@ std::vector<std::string> export_probes(const Asset& asset, const std::filesystem
   }
 
   Staging staging(out);
+  if (!lightmaps.empty()) {
+    // Beside OUT: <OUT without its extension>.lightmap[.<object>].exr and its .import.
+    std::filesystem::path prefix = out;
+    prefix.replace_extension();
+    prefix += ".lightmap";
+    nlohmann::json list = nlohmann::json::array();
+    for (const LightmapRef& map : lightmaps) {
+      const Lightmap& lm = *map.lightmap;
+      const std::filesystem::path file = lightmap_file(prefix, map.set);
+      const GodotLayers layers = godot_layers(lm, M);
+      write_exr_half(staging.stage(file), lm.width, kGodotLayers * lm.height,
+                     {{"R", &layers.r}, {"G", &layers.g}, {"B", &layers.b}}, source, map.set, file);
+      std::filesystem::path import = file;
+      import += ".import";
+      write_bytes(staging.stage(import), kGodotImport, out);
+      list.push_back({{"name", map.set.name},
+                      {"dataset", join(map.set.prefix, std::string(names::kLightmapRadianceBand1.substr(1)))},
+                      {"file", file.filename().string()},
+                      {"width", lm.width},
+                      {"height", lm.height},
+                      {"layers", kGodotLayers}});
+    }
+    j["lightmaps"] = std::move(list);
+    j["lightmap_layout"] =
+        "Godot 4.4+ LightmapGI directional (L1 SH, packed): an RGB half EXR of W x 4H, layers stacked vertically "
+        "(layer j = rows jH..(j+1)H-1), imported as a 2D array (slices/vertical = 4); layer 0 = l0, layers 1-3 = "
+        "a/2 + 0.5 for a = (l1n1, l1_0, l1p1) ~ (y, z, x); Godot shades l0 + 4 l0 (a.n) = E/pi, exact at the "
+        "baked normal (formats/SCHEMA.md, Exports)";
+  }
   write_bytes(staging.stage(out), j.dump() + "\n", out);
-  staging.commit();
-  return left_out;
+  summary.written = staging.commit();
+  summary.left_out = std::move(left_out);
 }
 
 } // namespace prt::exports::detail

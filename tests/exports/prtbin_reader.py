@@ -13,7 +13,7 @@ import json
 import struct
 import sys
 
-ITEM = {"float32": ("f", 4), "float64": ("d", 8), "uint32": ("I", 4)}
+ITEM = {"float32": ("f", 4), "float64": ("d", 8), "uint32": ("I", 4), "uint8": ("B", 1)}
 
 
 def fail(msg):

@@ -10,6 +10,12 @@
 //     Unity's ShadeSH9, Godot's capture formula, Filament's) at each vertex's normal in the
 //     engine's frame equals the baked E/π of SCHEMA.md's (4π/3) Σ_m y_1m(n) R_m / π, to 1e-5 of
 //     the terms' magnitude (Godot's 6-digit constants; float data, double arithmetic).
+//   * Lightmaps (format v5): tinygltf reads a scene whose objects' UVs have seams at every shared
+//     vertex — each corner's TEXCOORD_1, position, normal and per-vertex attribute are the file's
+//     row's, bit for bit — and decodes the occlusion PNG to round(255·AO) of a non-square
+//     lightmap; EXR files are named per object; a value beyond half's range is refused; Godot's
+//     directional lightmap of a Z-up file, shaded by Godot's formula at the texel's normal turned
+//     into Godot's frame, is the baked E/π.
 #include <exports/export.h>
 
 #include <formats/temporaries.h>
@@ -19,6 +25,10 @@
 #include <run_tool.h>
 #include <scratch.h>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -119,6 +129,42 @@ Asset scene_asset() {
   lit.set.area_sh = product(values(6 * 2 * 4, 0.7), 2);
   lit.set.area_sh->lights = "key\nfill";
   lit.set.radiance_band1 = product(values(6 * 9, 0.8));
+  return a;
+}
+
+// A Y-up scene of two objects ("a", and "b|c" as a glTF node path is stored), each a strip of 6
+// vertices (4 triangles) with AO and order-2 transfer per vertex, its corners' UVs all distinct
+// (every vertex shared by two triangles is on a seam), and a 4 × 3 lightmap (W ≠ H) with state,
+// positions, normals, AO, order-2 transfer and band-1 radiance.
+Asset lightmap_asset() {
+  Asset a;
+  a.root = root("y");
+  a.scene.emplace();
+  for (const char* name : {"a", "b|c"}) {
+    SceneObject& o = a.objects.emplace_back();
+    o.name = name;
+    const size_t V = 6, W = 4, H = 3, texels = W * H;
+    fill_mesh(o.set, V, 0.0);
+    for (double& x : o.set.positions->values) x = double(float(x));  // float32 positions: no node translation
+    o.set.ao = product(values(V, 1.1));
+    o.set.transfer_diffuse = product(values(V * 4, 1.2), 2);
+    Uvs& uv = o.set.uv.emplace();
+    uv.uv_set = "TEXCOORD_1";
+    for (size_t i = 0; i < o.set.triangles->values.size(); ++i) uv.values.insert(uv.values.end(), {float(i) / 16, 1 - float(i) / 32});
+    Lightmap& m = o.set.lightmap.emplace();
+    m.width = W;
+    m.height = H;
+    m.padding = 1;
+    for (size_t k = 0; k < texels; ++k) m.state.values.push_back(uint8_t(k % 4));
+    m.positions.emplace().values.assign(3 * texels, 0.25);
+    m.normals.emplace().values.assign(3 * texels, 0.0f);
+    for (size_t k = 0; k < texels; ++k) m.normals->values[3 * k + 1] = 1;
+    m.ao = product(values(texels, 1.3));
+    m.ao->values[0] = -0.2f;  // clamped to code 0
+    m.ao->values[1] = 1.5f;   // clamped to 255
+    m.transfer_diffuse = product(values(texels * 4, 1.4), 2);
+    m.radiance_band1 = product(values(texels * 9, 1.5));
+  }
   return a;
 }
 
@@ -310,7 +356,7 @@ TEST(ExportGltf, ZUpBakesHangUnderANodeTurningZToY) {
 TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
   const fs::path dir = fresh_dir("bin");
   if (prt::testing::run_tool("python3", "-c 'import json, struct'", dir).code != 0) GTEST_SKIP() << "no python3";
-  for (const Asset& a : {vertex_asset(), scene_asset()}) {
+  for (const Asset& a : {vertex_asset(), scene_asset(), lightmap_asset()}) {
     export_asset(a, "in.prt.h5", ExportFormat::Binary, dir / "a.prtbin");
     const auto run = prt::testing::run_tool("python3", std::string(PRT_SOURCE_TESTS) + "/exports/prtbin_reader.py '" +
                                                            (dir / "a.prtbin").string() + "' '" + (dir / "a.json").string() + "'",
@@ -327,6 +373,15 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
       want[name("mesh/source_position")] = {{s.source_position->values.begin(), s.source_position->values.end()}, "uint32"};
       for (auto [d, p] : exported_products(s))
         if (*p) want[name(d)] = {{(*p)->values.begin(), (*p)->values.end()}, "float32"};
+      if (s.uv) want[name("mesh/uv")] = {{s.uv->values.begin(), s.uv->values.end()}, "float32"};
+      if (!s.lightmap) return;
+      const Lightmap& m = *s.lightmap;
+      want[name("lightmap/state")] = {{m.state.values.begin(), m.state.values.end()}, "uint8"};
+      want[name("lightmap/positions")] = {m.positions->values, "float32"};  // 0.25: exactly float
+      want[name("lightmap/normals")] = {{m.normals->values.begin(), m.normals->values.end()}, "float32"};
+      want[name("lightmap/ao")] = {{m.ao->values.begin(), m.ao->values.end()}, "float32"};
+      want[name("lightmap/transfer/diffuse")] = {{m.transfer_diffuse->values.begin(), m.transfer_diffuse->values.end()}, "float32"};
+      want[name("lightmap/radiance/band1")] = {{m.radiance_band1->values.begin(), m.radiance_band1->values.end()}, "float32"};
     };
     if (a.objects.empty()) add("", a.vertices);
     for (const SceneObject& o : a.objects) add("objects/" + o.name, o.set);
@@ -337,9 +392,22 @@ TEST(ExportBinary, PythonReaderFromTheSpecReadsBackEveryValue) {
       EXPECT_EQ(h["dtype"], want[name].second) << name;
       EXPECT_EQ(j["arrays"][name].get<std::vector<double>>(), want[name].first) << name;
     }
-    const auto& sh = *std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
-                                   [&](const auto& h) { return h["name"] == (a.objects.empty() ? "transfer/diffuse" : "objects/far/transfer/diffuse"); });
-    EXPECT_EQ(sh["attrs"]["sh_order"], a.objects.empty() ? 3 : 5);
+    // An SH product's attributes: the root's, the far object's, a lightmap's.
+    const bool lightmaps = !a.objects.empty() && a.objects[0].set.lightmap;
+    const std::string sh_name = a.objects.empty() ? "transfer/diffuse"
+                                : lightmaps       ? "objects/a/lightmap/transfer/diffuse"
+                                                  : "objects/far/transfer/diffuse";
+    const auto sh = std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
+                                 [&](const auto& h) { return h["name"] == sh_name; });
+    ASSERT_NE(sh, j["header"]["arrays"].end()) << sh_name;
+    EXPECT_EQ((*sh)["attrs"]["sh_order"], a.objects.empty() ? 3 : lightmaps ? 2 : 5);
+    if (lightmaps) {
+      const auto state = std::find_if(j["header"]["arrays"].begin(), j["header"]["arrays"].end(),
+                                      [&](const auto& h) { return h["name"] == "objects/a/lightmap/state"; });
+      ASSERT_NE(state, j["header"]["arrays"].end());
+      EXPECT_EQ((*state)["shape"], nlohmann::json({3, 4})) << "[H][W]";
+      EXPECT_EQ((*state)["attrs"]["padding"], 1);
+    }
   }
 }
 
@@ -447,9 +515,167 @@ TEST(ExportProbes, AFileWithoutBandOneRadianceIsRefusedNamingIt) {
   }
 }
 
+// ---- lightmaps ----
+
+TEST(ExportLightmap, SeamsSplitVerticesCopyingEveryAttributeAndTheOcclusionPngDecodes) {
+  const Asset a = lightmap_asset();
+  const fs::path dir = fresh_dir("lightmap_gltf");
+  export_asset(a, "in.prt.h5", ExportFormat::Glb, dir / "lm.glb");
+  const tinygltf::Model m = load(dir / "lm.glb", true);
+  const tinygltf::Value& sets = m.asset.extras.Get("prtbake").Get("sets");
+  ASSERT_EQ(sets.ArrayLen(), 2u);
+  for (size_t si = 0; si < 2; ++si) {
+    const VertexSet& s = a.objects[si].set;
+    SCOPED_TRACE(a.objects[si].name);
+    const tinygltf::Value& entry = sets.Get(int(si));
+    const tinygltf::Primitive& prim = m.meshes.at(size_t(entry.Get("mesh").Get<int>())).primitives.at(0);
+    const std::vector<uint32_t> idx = read_accessor<uint32_t>(m, prim.indices);
+    const std::vector<uint32_t>& tri = s.triangles->values;
+    ASSERT_EQ(idx.size(), tri.size());
+    // Every corner's UV differs from every other's: each corner is its own export vertex, the
+    // file's V rows (at their first corner) and one copy per further corner of a row.
+    const size_t V = s.vertex_count(), exported = m.accessors.at(size_t(prim.attributes.at("POSITION"))).count;
+    EXPECT_EQ(exported, tri.size()) << "every corner its own vertex here";
+    const tinygltf::Value& copies = entry.Get("vertices").Get("copies_of");
+    ASSERT_EQ(copies.ArrayLen(), exported - V);
+    for (size_t j = 0; j < copies.ArrayLen(); ++j) EXPECT_LT(size_t(copies.Get(int(j)).Get<int>()), V);
+    // Each corner's attributes are its file row's, bit for bit.
+    const std::vector<float> uv1 = read_accessor<float>(m, prim.attributes.at("TEXCOORD_1"));
+    EXPECT_EQ(read_accessor<float>(m, prim.attributes.at("TEXCOORD_0")), uv1);
+    const std::vector<float> pos = read_accessor<float>(m, prim.attributes.at("POSITION"));
+    const std::vector<float> nrm = read_accessor<float>(m, prim.attributes.at("NORMAL"));
+    const std::vector<float> ao = read_accessor<float>(m, prim.attributes.at("_AO"));
+    const std::vector<float> tr = read_accessor<float>(m, prim.attributes.at("_PRT_DIFFUSE_0"));
+    for (size_t i = 0; i < tri.size(); ++i) {
+      const size_t g = idx[i], f = tri[i];
+      EXPECT_EQ(uv1[2 * g], s.uv->values[2 * i]);
+      EXPECT_EQ(uv1[2 * g + 1], s.uv->values[2 * i + 1]);
+      EXPECT_EQ(ao[g], s.ao->values[f]);
+      for (size_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(pos[3 * g + c], float(s.positions->values[3 * f + c]));
+        EXPECT_EQ(nrm[3 * g + c], s.normals->values[3 * f + c]);
+      }
+      for (size_t c = 0; c < 4; ++c) EXPECT_EQ(tr[4 * g + c], s.transfer_diffuse->values[4 * f + c]);
+    }
+    // The occlusion texture: texCoord 1, a PNG tinygltf decodes to the AO codes (R channel).
+    const tinygltf::Material& mat = m.materials.at(size_t(prim.material));
+    EXPECT_EQ(mat.occlusionTexture.texCoord, 1);
+    EXPECT_EQ(mat.pbrMetallicRoughness.metallicFactor, 0.0);
+    const tinygltf::Image& image = m.images.at(size_t(m.textures.at(size_t(mat.occlusionTexture.index)).source));
+    const Lightmap& lm = *s.lightmap;
+    ASSERT_EQ(size_t(image.width), lm.width);
+    ASSERT_EQ(size_t(image.height), lm.height);
+    ASSERT_EQ(image.bits, 8);
+    const size_t comps = size_t(image.component);
+    for (size_t k = 0; k < lm.texel_count(); ++k)
+      EXPECT_EQ(int(image.image.at(k * comps)), int(std::lround(std::clamp(double(lm.ao->values[k]), 0.0, 1.0) * 255.0)))
+          << "texel " << k;
+    EXPECT_EQ(image.image.at(0), 0);
+    EXPECT_EQ(image.image.at(comps), 255);
+    // The lightmap datasets as buffer views, bit for bit.
+    const tinygltf::Value& datasets = entry.Get("lightmap").Get("datasets");
+    ASSERT_EQ(datasets.ArrayLen(), 6u);  // state, positions, normals, ao, transfer/diffuse, radiance/band1
+    for (size_t d = 0; d < datasets.ArrayLen(); ++d) {
+      const tinygltf::Value& de = datasets.Get(int(d));
+      const tinygltf::BufferView& view = m.bufferViews.at(size_t(de.Get("bufferView").Get<int>()));
+      const std::string name = de.Get("dataset").Get<std::string>();
+      const std::vector<unsigned char>& buf = m.buffers.at(0).data;
+      auto floats = [&] {
+        std::vector<float> v(view.byteLength / 4);
+        std::memcpy(v.data(), buf.data() + view.byteOffset, view.byteLength);
+        return v;
+      };
+      const std::string prefix = "objects/" + a.objects[si].name + "/lightmap/";
+      if (name == prefix + "state") EXPECT_EQ(std::vector<uint8_t>(buf.begin() + long(view.byteOffset), buf.begin() + long(view.byteOffset + view.byteLength)), lm.state.values);
+      else if (name == prefix + "ao") EXPECT_EQ(floats(), lm.ao->values);
+      else if (name == prefix + "transfer/diffuse") EXPECT_EQ(floats(), lm.transfer_diffuse->values);
+      else if (name == prefix + "radiance/band1") EXPECT_EQ(floats(), lm.radiance_band1->values);
+      else if (name == prefix + "normals") EXPECT_EQ(floats(), lm.normals->values);
+      else EXPECT_EQ(name, prefix + "positions");
+    }
+  }
+}
+
+TEST(ExportLightmap, ExrFilesAreNamedPerObjectAndHalfOverflowIsRefused) {
+  Asset a = lightmap_asset();
+  const fs::path dir = fresh_dir("lightmap_exr");
+  export_asset(a, "in.prt.h5", ExportFormat::Exr, dir / "scene.exr");
+  EXPECT_EQ(listing(dir), (std::vector<std::string>{"scene.a.exr", "scene.b|c.exr"}));
+  const fs::path dir2 = fresh_dir("lightmap_exr_overflow");
+  a.objects[1].set.lightmap->radiance_band1->values[5] = 1e5f;  // texel 0, G, m = 1: beyond half's 65504
+  try {
+    export_asset(a, "in.prt.h5", ExportFormat::Exr, dir2 / "scene");
+    ADD_FAILURE() << "no error";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.file(), "in.prt.h5");
+    EXPECT_NE(e.defect().find("lightmap of b|c: channel radiance.band1.G.m1 holds 100000"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(listing(dir2).empty()) << "nothing half-written: not even the first object's file";
+}
+
+TEST(ExportLightmap, GodotLayersShadeToTheBakedIrradianceAtTheNormalInGodotsFrame) {
+  Asset a = lightmap_asset();
+  a.root = root("z");
+  for (SceneObject& o : a.objects) {
+    std::vector<float>& n = o.set.lightmap->normals->values;
+    for (size_t k = 0; k < n.size() / 3; ++k) {
+      const double v[3] = {std::sin(double(k) + 1), std::cos(2.0 * double(k)), 0.5 + std::sin(3.0 * double(k))};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (size_t c = 0; c < 3; ++c) n[3 * k + c] = float(v[c] / len);
+    }
+  }
+  const fs::path dir = fresh_dir("lightmap_godot");
+  const ExportSummary summary = export_asset(a, "in.prt.h5", ExportFormat::Godot, dir / "g.json");
+  EXPECT_EQ(listing(dir), (std::vector<std::string>{"g.json", "g.lightmap.a.exr", "g.lightmap.a.exr.import",
+                                                     "g.lightmap.b|c.exr", "g.lightmap.b|c.exr.import"}));
+  EXPECT_EQ(summary.written.size(), 5u);
+  EXPECT_TRUE(summary.left_out.empty()) << "lit per texel: not left out";
+  const Lightmap& m = *a.objects[0].set.lightmap;
+  Imf::InputFile file((dir / "g.lightmap.a.exr").c_str());
+  const Imath::Box2i w = file.header().dataWindow();
+  ASSERT_EQ(size_t(w.max.x - w.min.x + 1), m.width);
+  ASSERT_EQ(size_t(w.max.y - w.min.y + 1), 4 * m.height);
+  const size_t texels = m.texel_count();
+  std::vector<float> rgb[3];
+  Imf::FrameBuffer frame;
+  for (size_t c = 0; c < 3; ++c) {
+    rgb[c].resize(4 * texels);
+    frame.insert(std::string(1, "RGB"[c]), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgb[c].data()), sizeof(float), sizeof(float) * m.width));
+  }
+  file.setFrameBuffer(frame);
+  file.readPixels(w.min.y, w.max.y);
+  // Half rounding: l0 within 2⁻¹¹ relative; each packed t in [0, 1] within 2⁻¹² absolute, so each
+  // unpacked a within 2⁻¹¹ and Godot's 4 l0 (a·n) within 4 l0 · 3 · 2⁻¹¹ of its exact value.
+  const double k1 = std::sqrt(3 / (4 * kPi));
+  size_t lit = 0;
+  for (size_t k = 0; k < texels; ++k) {
+    const float* n = &m.normals->values[3 * k];
+    const double godot_n[3] = {n[0], n[2], -n[1]};  // Z-up file turned Y-up: (x, y, z) -> (x, z, -y)
+    for (size_t c = 0; c < 3; ++c) {
+      const float* R = &m.radiance_band1->values[9 * k + 3 * c];
+      // E/π = (4/3) Σ_m y_1m(n) R_m, y_1m = k1 (−y, z, −x) (m = −1, 0, 1).
+      const double e = 4.0 / 3 * k1 * (-n[1] * R[0] + n[2] * R[1] - n[0] * R[2]);
+      const double l0 = rgb[c][k];
+      double l1[3];
+      for (size_t layer = 1; layer <= 3; ++layer) l1[layer - 1] = (rgb[c][layer * texels + k] - 0.5) * 2;
+      if (m.state.values[k] == 0 || e <= 0) {
+        EXPECT_EQ(l0, 0.0) << "texel " << k;
+        for (double x : l1) EXPECT_EQ(x, 0.0) << "texel " << k;
+        continue;
+      }
+      ++lit;
+      EXPECT_NEAR(l0, e, std::ldexp(e, -11)) << "texel " << k << " channel " << c;
+      const double shaded = l0 + 4 * l0 * (l1[0] * godot_n[1] + l1[1] * godot_n[2] + l1[2] * godot_n[0]);
+      EXPECT_NEAR(shaded, e, std::ldexp(e, -11) + 4 * l0 * 3 * std::ldexp(1.0, -11)) << "texel " << k << " channel " << c;
+      for (double x : l1) EXPECT_LE(std::abs(x), 1.0);
+    }
+  }
+  EXPECT_GT(lit, 5u) << "some texels are lit (else the check says little)";
+}
+
 TEST(Export, FormatNamesRoundTrip) {
   for (ExportFormat f : {ExportFormat::Gltf, ExportFormat::Glb, ExportFormat::Binary, ExportFormat::Unity,
-                         ExportFormat::Godot, ExportFormat::Filament})
+                         ExportFormat::Godot, ExportFormat::Filament, ExportFormat::Exr})
     EXPECT_EQ(parse_export_format(to_string(f)), f);
   EXPECT_EQ(parse_export_format("fbx"), std::nullopt);
 }

@@ -154,7 +154,7 @@ TEST(CliMessages, UnknownCommandsAndOptionsGetTheNearestName) {
       {"vertex m.obj --ao -o o.prt.h5 --radiance",
        "prtbake: vertex: --radiance needs a value (--radiance ENV) (try 'prtbake vertex --help')\n"},
       {"export f.prt.h5 -o x.json --to untiy",
-       "prtbake: export: --to: expects gltf, glb, bin, unity, godot or filament, got 'untiy'; did you mean unity? "
+       "prtbake: export: --to: expects gltf, glb, bin, unity, godot, filament or exr, got 'untiy'; did you mean unity? "
        "(try 'prtbake export --help')\n"},
       {"vertex m.obj --ao -o o.prt.h5 --integrator qcm",
        "prtbake: vertex: --integrator: unknown integrator 'qcm'; did you mean qmc? (available: silhouette, qmc, "

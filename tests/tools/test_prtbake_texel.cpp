@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <run_tool.h>
+#include <unit_box_obj.h>
 
 #include <array>
 #include <cmath>
@@ -57,11 +58,7 @@ fs::path floor_and_box() {
   out << "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\n";
   out << "vt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\nvt 3 3\n";
   out << "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
-  for (int k = 0; k < 8; ++k)
-    out << "v " << (k & 1 ? 0.5 : -0.5) << " " << (k & 2 ? 0.5 : -0.5) << " " << (k & 4 ? 1 : 0) << "\n";
-  const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                            {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  for (const auto& f : faces) out << "f " << f[0] + 5 << "/5 " << f[1] + 5 << "/5 " << f[2] + 5 << "/5\n";
+  prt::testing::write_unit_box_obj(out, 5, 5);
   return obj;
 }
 

@@ -30,11 +30,24 @@ constexpr const char* kExportHelp =
     "            Loads in Blender and engine importers.\n"
     "  glb       the same as one binary glTF file.\n"
     "  bin       plain binary: magic \"PRTBIN\", version, a JSON header naming each array (HDF5\n"
-    "            path, dtype, shape, byte offset), little-endian arrays 16-byte aligned.\n"
+    "            path, dtype, shape, byte offset), little-endian arrays 16-byte aligned;\n"
+    "            a lightmap's mesh/uv and lightmap/* arrays too.\n"
     "  unity     per-vertex light probes (JSON) from /radiance/band1 as SphericalHarmonicsL2\n"
     "            coefficients ([rgb][9], ShadeSH9's pre-scaling, Unity's left-handed frame).\n"
     "  godot     the same as Godot 4 LightmapGI probe SH ([9][rgb], radiance/pi, no CS phase).\n"
     "  filament  the same as Filament/cmgen pre-scaled irradiance SH ([9][rgb]).\n"
+    "  exr       lightmaps only (a file from prtbake texel): per vertex set with a lightmap one\n"
+    "            half-float OpenEXR image, W x H, row 0 at v = 0, one channel per value:\n"
+    "            state (0 empty, 1 baked, 2 filled, 3 padding), ao, transfer.diffuse.c<i>,\n"
+    "            transfer.visibility.c<i> (i = l(l+1)+m), radiance.band1.<R|G|B>.m<-1|0|1>,\n"
+    "            radiance.shadowed.<R|G|B>.c<i>. -o names a directory (DIR/lightmap.exr,\n"
+    "            DIR/lightmap.<object>.exr) or a prefix (OUT.exr, OUT.<object>.exr).\n"
+    "Lightmaps (files from prtbake texel) travel with gltf/glb too: the mesh gets the lightmap\n"
+    "UVs as TEXCOORD_1 (and TEXCOORD_0; vertices split where a UV seam runs), a material whose\n"
+    "occlusionTexture (texCoord 1) is the AO as an 8-bit PNG in the file (round(255*AO)), and\n"
+    "every lightmap dataset as a float buffer view listed in asset.extras.prtbake. godot also\n"
+    "writes each lightmap with band-1 radiance as a Godot 4.4+ directional lightmap (L1 SH):\n"
+    "OUT-stem.lightmap.exr, 4 layers stacked vertically, with its .import (slices/vertical=4).\n"
     "The probe formats evaluate, in each engine's own formula, to the baked irradiance/pi at the\n"
     "baked normal; they need a file baked with --radiance (or a scene with an environment), or\n"
     "--env ENV: the environment's own probe (its order-3 radiance SH, unshadowed), the ambient\n"
@@ -44,25 +57,30 @@ constexpr const char* kExportHelp =
 constexpr const char* kExportExamples =
     "EXAMPLES\n"
     "  prtbake export bunny.prt.h5 --to glb -o bunny.glb\n"
-    "  prtbake export bunny.prt.h5 --to unity --env data/sunset.exr -o bunny_probes.json\n\n";
+    "  prtbake export bunny.prt.h5 --to unity --env data/sunset.exr -o bunny_probes.json\n"
+    "  prtbake texel floor.obj --resolution 256 --ao --radiance data/sunset.exr -o floor.prt.h5\n"
+    "  prtbake export floor.prt.h5 --to glb -o floor.glb        # AO on TEXCOORD_1\n"
+    "  prtbake export floor.prt.h5 --to exr -o floor            # floor.exr\n"
+    "  prtbake export floor.prt.h5 --to godot -o floor.json     # + floor.lightmap.exr\n\n";
 
 } // namespace
 
 void add_export(CLI::App& app, ExportArgs& args) {
   CLI::App& cmd = *app.add_subcommand("export", kExportHelp);
   cmd.add_option("FILE", args.input, "the baked file (.prt.h5)")->required()->type_name("");
-  cmd.add_option("--to", args.format, "gltf, glb, bin, unity, godot or filament (see above)")
+  cmd.add_option("--to", args.format, "gltf, glb, bin, unity, godot, filament or exr (see above)")
       ->option_text("FORMAT")
       ->required()
       ->check([](const std::string& s) -> std::string {
         if (exports::parse_export_format(s)) return "";
-        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament"});
-        return "expects gltf, glb, bin, unity, godot or filament, got '" + s + "'" +
+        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament", "exr"});
+        return "expects gltf, glb, bin, unity, godot, filament or exr, got '" + s + "'" +
                (near ? "; did you mean " + *near + "?" : std::string());
       });
   cmd.add_option("-o,--output", args.output,
-                 "the file to write (gltf: also <stem>.bin beside it). Written to a\n"
-                 "staging directory first and renamed, so OUT is never half-written.")
+                 "the file to write (gltf: also <stem>.bin beside it; exr: a directory or a\n"
+                 "file prefix). Written to a staging directory first and renamed, so OUT is\n"
+                 "never half-written.")
       ->option_text("OUT")
       ->required();
   cmd.add_option("--env", args.env,
@@ -140,7 +158,9 @@ int run_export(const ExportArgs& args) {
                  sets.size() == 1 ? "" : (std::to_string(sets.size()) + " vertex sets, ").c_str(), list.c_str(),
                  why.c_str());
   }
-  std::printf("exported %s to %s (%s)\n", args.input.c_str(), args.output.c_str(), exports::to_string(format));
+  std::string files;
+  for (const std::filesystem::path& f : summary.written) files += (files.empty() ? "" : ", ") + f.string();
+  std::printf("exported %s to %s (%s)\n", args.input.c_str(), files.c_str(), exports::to_string(format));
   return 0;
 }
 

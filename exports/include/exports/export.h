@@ -1,6 +1,8 @@
 // exports/export.h — a baked asset for consumers that read neither HDF5 nor our schema: glTF 2.0
 // with the baked per-vertex data as vertex attributes, a plain binary file with a JSON header,
-// and per-vertex light probes in the SH conventions of Unity, Godot and Filament. The layouts
+// and per-vertex light probes in the SH conventions of Unity, Godot and Filament; lightmaps
+// (format v5) as glTF's occlusion texture on TEXCOORD_1, half-float EXR images and Godot 4's
+// directional (L1 SH) lightmap layout. The layouts
 // are formats/SCHEMA.md "Exports" (docs/ARCHITECTURE.md "Schema"); the engine conventions are
 // prtshade/conventions.h.
 //
@@ -17,8 +19,15 @@
 //     error nothing exists under the final name(s) and files already there are untouched.
 //     glTF (.gltf) writes two files: `out` and its buffer `<stem>.bin` beside it.
 //   * The engine formats need /radiance/band1 in some vertex set (the only baked product that is
-//     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe.
+//     lighting; see SCHEMA.md "Exports" for why the others are not probes) or an environment probe
+//     (godot: or a lightmap with /lightmap/radiance/band1, written as its directional lightmap).
 //     A set without it gets no probes; the summary names it and says why (the caller reports).
+//   * Lightmaps: bin carries /mesh/uv and every /lightmap/... array; glTF carries every set's lightmap (TEXCOORD_1 from /mesh/uv, split vertices where
+//     corners of one vertex carry different UVs; AO as occlusionTexture; the float datasets as
+//     buffer views named in extras). `exr` needs a lightmap (FormatError naming the input
+//     otherwise) and writes one file per set with one: `out` names an existing directory
+//     (DIR/lightmap.exr, DIR/lightmap.<object>.exr) or a prefix (OUT.exr, OUT.<object>.exr;
+//     a trailing ".exr" of OUT is dropped first).
 // Errors: formats::FormatError "<file>: <problem>" (the input for what it lacks, the output for I/O).
 #pragma once
 
@@ -34,9 +43,9 @@
 
 namespace prt::exports {
 
-enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament };
+enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament, Exr };
 
-// "gltf", "glb", "bin", "unity", "godot", "filament" (nullopt for anything else).
+// "gltf", "glb", "bin", "unity", "godot", "filament", "exr" (nullopt for anything else).
 std::optional<ExportFormat> parse_export_format(std::string_view name);
 const char* to_string(ExportFormat format) noexcept;
 // Unity, Godot, Filament: the light-probe formats (the ones an EnvironmentProbe may join).
@@ -54,9 +63,10 @@ struct EnvironmentProbe {
 };
 
 // What an export left out: per vertex set "<name>: <why>" (the probe formats skip the sets without
-// /radiance/band1; the other formats export every set).
+// /radiance/band1; the other formats export every set); and the files it wrote, in order.
 struct ExportSummary {
   std::vector<std::string> left_out;
+  std::vector<std::filesystem::path> written;
 };
 
 // Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
