@@ -463,66 +463,170 @@ void orient_chart(Chart& c) {
 // A rectangle's texels at density s (header, step 3), the gutter not included.
 uint32_t cells(double extent, double s) { return uint32_t(std::floor(extent * s + 2 * kMargin)) + 1; }
 
-// Skyline bottom-left packing (header, step 3) of the charts' rectangles at density s into W × H;
-// false when one does not fit. `origin` receives each chart's rectangle corner.
-bool pack(const std::vector<Chart>& charts, double s, uint32_t gutter, uint32_t W, uint32_t H,
-          std::vector<std::array<uint32_t, 2>>& origin) {
-  struct Rect {
-    uint64_t w, h;
-    uint32_t chart;
-  };
-  std::vector<Rect> rects(charts.size());
-  for (uint32_t i = 0; i < charts.size(); ++i) {
-    const double ws = charts[i].extent.x() * s, hs = charts[i].extent.y() * s;
-    if (!(ws < double(W) && hs < double(H))) return false;
-    rects[i] = {uint64_t(cells(charts[i].extent.x(), s)) + gutter, uint64_t(cells(charts[i].extent.y(), s)) + gutter, i};
+// The span of coordinate 1 − a over the points of triangle t whose coordinate a lies in [lo, hi]
+// (its vertices there and its edges' crossings of the two lines); empty: (+inf, −inf).
+std::pair<double, double> slab_span(const V2 (&t)[3], int a, double lo, double hi) {
+  double mn = std::numeric_limits<double>::infinity(), mx = -mn;
+  const int b = 1 - a;
+  for (int k = 0; k < 3; ++k) {
+    const V2 &p = t[k], &q = t[(k + 1) % 3];
+    if (p[a] >= lo && p[a] <= hi) mn = std::min(mn, p[b]), mx = std::max(mx, p[b]);
+    for (const double x : {lo, hi})
+      if (p[a] != q[a] && (p[a] - x) * (q[a] - x) <= 0) {
+        const double w = (x - p[a]) / (q[a] - p[a]), y = p[b] + w * (q[b] - p[b]);
+        mn = std::min(mn, y), mx = std::max(mx, y);
+      }
   }
-  std::sort(rects.begin(), rects.end(), [](const Rect& a, const Rect& b) {
-    return a.h != b.h ? a.h > b.h : a.w != b.w ? a.w > b.w : a.chart < b.chart;
+  return {mn, mx};
+}
+
+// A chart's texels at density s in its box of w × h texels (the chart centred in it, header step
+// 3): per column the first and last row it touches, per row the first and last column. A
+// superset of texel_atlas's conservative coverage (bake/mesh/texels.h): each texel square is
+// widened by kSlack, more than the float rounding of a stored UV (2^-24 of 16384 texels, 1e-3)
+// and less than the chart's inset in its box (> kMargin), so the chart stays inside its box.
+constexpr double kSlack = 1.0 / 128;
+struct Footprint {
+  int32_t w = 0, h = 0;
+  std::vector<int32_t> top, bottom;  // per column
+  std::vector<int32_t> left, right;  // per row
+  V2 inset = V2::Zero();             // the chart's corner (0, 0) in its box, in texels
+};
+
+Footprint footprint(const Chart& c, double s) {
+  Footprint f;
+  f.w = int32_t(cells(c.extent.x(), s));
+  f.h = int32_t(cells(c.extent.y(), s));
+  f.inset = V2((f.w - c.extent.x() * s) / 2, (f.h - c.extent.y() * s) / 2);
+  f.top.assign(size_t(f.w), f.h);
+  f.bottom.assign(size_t(f.w), -1);
+  f.left.assign(size_t(f.h), f.w);
+  f.right.assign(size_t(f.h), -1);
+  for (const auto& k : c.corners) {
+    const V2 t[3] = {f.inset + c.uv[k[0]] * s, f.inset + c.uv[k[1]] * s, f.inset + c.uv[k[2]] * s};
+    for (int a = 0; a < 2; ++a) {
+      const double lo = std::min({t[0][a], t[1][a], t[2][a]}), hi = std::max({t[0][a], t[1][a], t[2][a]});
+      const int32_t n = a == 0 ? f.w : f.h, other = a == 0 ? f.h : f.w;
+      const int32_t first = std::max(0, int32_t(std::floor(lo - kSlack)));
+      const int32_t last = std::min(n - 1, int32_t(std::floor(hi + kSlack)));
+      std::vector<int32_t>& low = a == 0 ? f.top : f.left;
+      std::vector<int32_t>& high = a == 0 ? f.bottom : f.right;
+      for (int32_t i = first; i <= last; ++i) {
+        const auto [mn, mx] = slab_span(t, a, double(i) - kSlack, double(i) + 1 + kSlack);
+        if (mn > mx) continue;
+        low[size_t(i)] = std::min(low[size_t(i)], std::max(0, int32_t(std::floor(mn - kSlack))));
+        high[size_t(i)] = std::max(high[size_t(i)], std::min(other - 1, int32_t(std::floor(mx + kSlack))));
+      }
+    }
+  }
+  // A connected chart touches every column and row of its box; fill any gap conservatively.
+  for (int32_t col = 0; col < f.w; ++col)
+    if (f.bottom[size_t(col)] < 0) f.top[size_t(col)] = 0, f.bottom[size_t(col)] = f.h - 1;
+  for (int32_t r = 0; r < f.h; ++r)
+    if (f.right[size_t(r)] < 0) f.left[size_t(r)] = 0, f.right[size_t(r)] = f.w - 1;
+  return f;
+}
+
+// A footprint's column profile turned by rotation r (0°, 90°, 180°, 270° about its box, each
+// keeping windings: header step 3): width, height, first and last row per column.
+struct Profile {
+  int32_t w = 0, h = 0;
+  std::vector<int32_t> top, bottom;
+};
+
+Profile profile(const Footprint& f, int r) {
+  Profile p;
+  const bool turned = r % 2 == 1;
+  p.w = turned ? f.h : f.w;
+  p.h = turned ? f.w : f.h;
+  p.top.resize(size_t(p.w));
+  p.bottom.resize(size_t(p.w));
+  for (int32_t c = 0; c < p.w; ++c) {
+    const size_t i = size_t(c), mirrored = size_t(p.w - 1 - c);
+    switch (r) {
+    case 0: p.top[i] = f.top[i], p.bottom[i] = f.bottom[i]; break;
+    case 1: p.top[i] = f.left[mirrored], p.bottom[i] = f.right[mirrored]; break;  // (u, v) -> (h − v, u)
+    case 2: p.top[i] = f.h - 1 - f.bottom[mirrored], p.bottom[i] = f.h - 1 - f.top[mirrored]; break;  // (w − u, h − v)
+    default: p.top[i] = f.w - 1 - f.right[i], p.bottom[i] = f.w - 1 - f.left[i]; break;  // (v, w − u)
+    }
+  }
+  return p;
+}
+
+// Texel position of point q of a footprint's box after rotation r (Profile), the box at (x, y).
+V2 placed(const Footprint& f, int r, const V2& q, int64_t x, int64_t y) {
+  V2 p = q;
+  switch (r) {
+  case 1: p = V2(f.h - q.y(), q.x()); break;
+  case 2: p = V2(f.w - q.x(), f.h - q.y()); break;
+  case 3: p = V2(q.y(), f.w - q.x()); break;
+  default: break;
+  }
+  return p + V2(double(x), double(y));
+}
+
+struct Placement {
+  int64_t x = 0, y = 0;
+  int rotation = 0;
+};
+
+// Horizon packing (header, step 3) at density s into W × H. False when a chart does not fit.
+bool pack(const std::vector<Chart>& charts, double s, uint32_t gutter, uint32_t W, uint32_t H,
+          std::vector<Footprint>& prints, std::vector<Placement>& where) {
+  const int64_t G = gutter, near = G / 2, far = G - G / 2;  // border margins: near at 0, far at W, H
+  const double side = std::max(W, H);
+  prints.resize(charts.size());
+  std::vector<uint32_t> order(charts.size());
+  for (uint32_t i = 0; i < charts.size(); ++i) {
+    if (!(charts[i].extent.x() * s < side)) return false;  // in no rotation
+    prints[i] = footprint(charts[i], s);
+    order[i] = i;
+  }
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    const int64_t aa = int64_t(prints[a].w) * prints[a].h, ab = int64_t(prints[b].w) * prints[b].h;
+    return aa != ab ? aa > ab : a < b;
   });
-  struct Segment {
-    uint64_t x, y, w;
-  };
-  std::vector<Segment> sky{{0, 0, W}};
-  origin.assign(charts.size(), {0, 0});
-  for (const Rect& r : rects) {
-    if (r.w > W || r.h > H) return false;
-    uint64_t best_y = std::numeric_limits<uint64_t>::max(), best_x = 0;
-    size_t best_i = kNone;
-    for (size_t i = 0; i < sky.size(); ++i) {
-      const uint64_t x = sky[i].x;
-      if (x + r.w > W) break;
-      uint64_t y = 0, covered = 0;
-      for (size_t j = i; j < sky.size() && covered < r.w; ++j) {
-        y = std::max(y, sky[j].y);
-        covered = sky[j].x + sky[j].w - x;
+  where.assign(charts.size(), {});
+  std::vector<int64_t> horizon(W, 0);  // per column one past the lowest texel taken; 0: none yet
+  std::vector<int64_t> dilated;
+  for (uint32_t i : order) {
+    int64_t best_bottom = std::numeric_limits<int64_t>::max(), best_x = 0, best_y = 0;
+    int best_r = -1;
+    for (int r = 0; r < 4; ++r) {
+      const Profile p = profile(prints[i], r);
+      if (p.w + near + far > int64_t(W) || p.h + near + far > int64_t(H)) continue;
+      int64_t top_min = p.h, bottom_max = 0;
+      for (int32_t c = 0; c < p.w; ++c) {
+        top_min = std::min<int64_t>(top_min, p.top[size_t(c)]);
+        bottom_max = std::max<int64_t>(bottom_max, p.bottom[size_t(c)]);
       }
-      if (y + r.h <= H && y < best_y) best_y = y, best_x = x, best_i = i;
-    }
-    if (best_i == kNone) return false;
-    origin[r.chart] = {uint32_t(best_x), uint32_t(best_y)};
-    // The new segment replaces [x, x + w) of the skyline.
-    const uint64_t x0 = best_x, x1 = best_x + r.w;
-    std::vector<Segment> next;
-    next.reserve(sky.size() + 2);
-    bool placed = false;  // segments are in x order and cover [0, W): the first one met takes the new one
-    for (const Segment& g : sky) {
-      const uint64_t g1 = g.x + g.w;
-      if (g1 <= x0 || g.x >= x1) {
-        next.push_back(g);
-        continue;
+      // The profile's top dilated by G: column d − G (d = 0 … w + 2G − 1) takes the least top of
+      // the columns within G of it, less G.
+      dilated.assign(size_t(p.w + 2 * G), std::numeric_limits<int64_t>::max());
+      for (int32_t c = 0; c < p.w; ++c)
+        for (int64_t d = c; d <= c + 2 * G; ++d) dilated[size_t(d)] = std::min(dilated[size_t(d)], int64_t(p.top[size_t(c)]) - G);
+      // The lowest bottom any position can give: nothing can beat it, so the scan stops there.
+      const int64_t floor_bottom = near - top_min + bottom_max;
+      const int64_t probes[3] = {G, G + p.w / 2, G + p.w - 1};  // profile columns for a cheap lower bound
+      for (int64_t x = near; x + p.w + far <= int64_t(W) && best_bottom > floor_bottom; ++x) {
+        int64_t y = near - top_min;
+        for (const int64_t d : probes)
+          if (const int64_t h = horizon[size_t(x - G + d)]; h != 0) y = std::max(y, h - dilated[size_t(d)]);
+        // A lower bound already no better, or past the atlas's bottom.
+        if (y + bottom_max >= best_bottom || y + bottom_max + far >= int64_t(H)) continue;
+        const int64_t d0 = std::max<int64_t>(0, G - x), d1 = std::min<int64_t>(p.w + 2 * G, int64_t(W) - x + G);
+        for (int64_t d = d0; d < d1; ++d)
+          if (const int64_t h = horizon[size_t(x - G + d)]; h != 0) y = std::max(y, h - dilated[size_t(d)]);
+        const int64_t bottom = y + bottom_max;
+        if (bottom + far >= int64_t(H)) continue;
+        if (bottom < best_bottom) best_bottom = bottom, best_x = x, best_y = y, best_r = r;
       }
-      if (g.x < x0) next.push_back({g.x, g.y, x0 - g.x});
-      if (!placed) next.push_back({x0, best_y + r.h, r.w});
-      placed = true;
-      if (g1 > x1) next.push_back({x1, g.y, g1 - x1});
     }
-    // Merge neighbours of equal height.
-    sky.clear();
-    for (const Segment& g : next) {
-      if (!sky.empty() && sky.back().y == g.y && sky.back().x + sky.back().w == g.x) sky.back().w += g.w;
-      else sky.push_back(g);
-    }
+    if (best_r < 0) return false;
+    where[i] = {best_x, best_y, best_r};
+    const Profile best = profile(prints[i], best_r);
+    for (int32_t c = 0; c < best.w; ++c)
+      horizon[size_t(best_x + c)] = std::max(horizon[size_t(best_x + c)], best_y + best.bottom[size_t(c)] + 1);
   }
   return true;
 }
@@ -561,8 +665,9 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
   }
 
   // The density and the atlas (header, step 3).
-  std::vector<std::array<uint32_t, 2>> origin;
-  auto fits = [&](double s, uint32_t W, uint32_t H) { return pack(charts, s, o.gutter, W, H, origin); };
+  std::vector<Footprint> prints;
+  std::vector<Placement> where;
+  auto fits = [&](double s, uint32_t W, uint32_t H) { return pack(charts, s, o.gutter, W, H, prints, where); };
   auto largest_density = [&](uint32_t W, uint32_t H) {
     double lo = 0, hi = std::sqrt(double(W) * double(H) / area);
     while (fits(hi, W, H)) lo = hi, hi *= 2;  // never in practice: the charts' cells exceed their area
@@ -600,17 +705,16 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
   if (!fits(r.density, r.width, r.height)) throw ContractError("unwrap: the chosen atlas does not pack");
 
   // UVs and the report.
-  const double s = r.density, W = r.width, H = r.height, half = double(o.gutter / 2);
+  const double s = r.density, W = r.width, H = r.height;
   out.uv.name = o.name;
   out.uv.corners.assign(3 * mesh.triangles.size(), Eigen::Vector2f::Zero());
   double weighted = 0, uv_area = 0;
   r.worst_stretch = 0;
   for (size_t i = 0; i < charts.size(); ++i) {
     const Chart& c = charts[i];
-    const V2 cell_origin(double(origin[i][0]) + half, double(origin[i][1]) + half);
-    const V2 inset((double(cells(c.extent.x(), s)) - c.extent.x() * s) / 2, (double(cells(c.extent.y(), s)) - c.extent.y() * s) / 2);
+    const Footprint& box = prints[i];
     std::vector<V2> texel(c.uv.size());
-    for (size_t v = 0; v < c.uv.size(); ++v) texel[v] = cell_origin + inset + c.uv[v] * s;
+    for (size_t v = 0; v < c.uv.size(); ++v) texel[v] = placed(box, where[i].rotation, box.inset + c.uv[v] * s, where[i].x, where[i].y);
     for (size_t k = 0; k < c.triangles.size(); ++k) {
       const uint32_t t = c.triangles[k];
       for (size_t j = 0; j < 3; ++j) {
