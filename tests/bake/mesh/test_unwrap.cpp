@@ -10,6 +10,7 @@
 #include <bake/mesh/unwrap.h>
 
 #include <gtest/gtest.h>
+#include <test_scenes.h>
 
 #include <algorithm>
 #include <cmath>
@@ -19,6 +20,8 @@
 #include <vector>
 
 using namespace prt::bake;
+using prt::testing::box;
+using prt::testing::grid;
 using Eigen::Vector2f;
 using Eigen::Vector3f;
 
@@ -31,31 +34,6 @@ const std::string kData = PRT_DATA_DIR;
 int orient2d(const Vector2f& a, const Vector2f& b, const Vector2f& c) {
   auto lift = [](const Vector2f& p) { return Eigen::Vector3d(p.x(), p.y(), 0); };
   return -orient3d_exact(lift(a), lift(b), lift(c), Eigen::Vector3d(0, 0, 1));
-}
-
-// Flat square grid [0, 1]² at z = 0, m × m quads, normal +z.
-Mesh grid(int m) {
-  std::vector<Vector3f> p;
-  std::vector<std::array<uint32_t, 3>> t;
-  for (int j = 0; j <= m; ++j)
-    for (int i = 0; i <= m; ++i) p.emplace_back(float(i) / float(m), float(j) / float(m), 0.0f);
-  for (int j = 0; j < m; ++j)
-    for (int i = 0; i < m; ++i) {
-      const uint32_t a = uint32_t(j * (m + 1) + i), b = a + 1, c = a + uint32_t(m) + 2, d = a + uint32_t(m) + 1;
-      t.push_back({a, b, c});
-      t.push_back({a, c, d});
-    }
-  return make_mesh(std::move(p), std::move(t), "grid");
-}
-
-// The unit cube [0, 1]³, 8 shared vertices, 12 triangles wound outwards.
-Mesh cube() {
-  std::vector<Vector3f> p;
-  for (int k = 0; k < 8; ++k) p.emplace_back(float(k & 1), float((k >> 1) & 1), float((k >> 2) & 1));
-  return make_mesh(std::move(p),
-                   {{{0, 2, 1}}, {{1, 2, 3}}, {{4, 5, 6}}, {{5, 7, 6}}, {{0, 1, 4}}, {{1, 5, 4}},
-                    {{2, 6, 3}}, {{3, 6, 7}}, {{0, 4, 2}}, {{2, 4, 6}}, {{1, 3, 5}}, {{3, 7, 5}}},
-                   "cube");
 }
 
 // An icosahedron subdivided `levels` times, every vertex pushed onto the unit sphere.
@@ -140,6 +118,15 @@ size_t check_layout(const Mesh& m, const UvSet& uv) {
   return overlaps;
 }
 
+// texel_atlas's checks of the set at side × side: no texel touched by two charts (gutters) and
+// none inside triangles of two charts (overlap). Returns the atlas for further checks.
+TexelAtlas expect_clean_atlas(const Mesh& m, const Topology& topo, const UvSet& uv, uint32_t side) {
+  TexelAtlas a = texel_atlas(m, topo, uv, side, side, m.source);
+  EXPECT_EQ(a.overlapping_texels, 0u) << m.source;
+  EXPECT_EQ(a.shared_texels, 0u) << m.source;
+  return a;
+}
+
 } // namespace
 
 TEST(Unwrap, ExactOrientationIsCalibrated) {
@@ -151,7 +138,7 @@ TEST(Unwrap, ExactOrientationIsCalibrated) {
 }
 
 TEST(Unwrap, APlanarGridIsOneExactChartFillingTheClosedForm) {
-  const Mesh m = grid(8);
+  const Mesh m = grid(4, 0.5f);  // [−½, ½]², 8 × 8 cells
   UnwrapOptions o;
   o.width = o.height = 64;
   const Unwrapped u = unwrap(m, build_topology(m), o);
@@ -170,13 +157,11 @@ TEST(Unwrap, APlanarGridIsOneExactChartFillingTheClosedForm) {
   EXPECT_NEAR(u.report.density, s, 1e-9);
   EXPECT_NEAR(u.report.utilisation, s * s / (64.0 * 64.0), 1e-9);
   EXPECT_EQ(check_layout(m, u.uv), 0u);
-  const TexelAtlas a = texel_atlas(m, build_topology(m), u.uv, 64, 64, "grid");
-  EXPECT_EQ(a.charts, 1u);
-  EXPECT_EQ(a.overlapping_texels, 0u);
+  EXPECT_EQ(expect_clean_atlas(m, build_topology(m), u.uv, 64).charts, 1u);
 }
 
 TEST(Unwrap, ACubeIsSixSquaresWithWholeTexelGutters) {
-  const Mesh m = cube();
+  const Mesh m = box({0, 0, 0}, {1, 1, 1}, "cube");  // triangles 2f, 2f + 1: face f
   const Topology topo = build_topology(m);
   UnwrapOptions o;
   o.width = o.height = 128;
@@ -214,10 +199,7 @@ TEST(Unwrap, ACubeIsSixSquaresWithWholeTexelGutters) {
       }
       EXPECT_GE(gap, 2) << "faces " << f << " and " << g;
     }
-  const TexelAtlas a = texel_atlas(m, topo, u.uv, 128, 128, "cube");
-  EXPECT_EQ(a.charts, 6u);
-  EXPECT_EQ(a.shared_texels, 0u);
-  EXPECT_EQ(a.overlapping_texels, 0u);
+  EXPECT_EQ(expect_clean_atlas(m, topo, u.uv, 128).charts, 6u);
 }
 
 TEST(Unwrap, ASphereHasNoFoldAndNoOverlap) {
@@ -228,9 +210,7 @@ TEST(Unwrap, ASphereHasNoFoldAndNoOverlap) {
   const Unwrapped u = unwrap(m, topo, o);
   EXPECT_GE(u.report.charts, 2u) << "a closed sphere cannot be one chart within a 65° cone";
   EXPECT_EQ(check_layout(m, u.uv), 0u);
-  const TexelAtlas a = texel_atlas(m, topo, u.uv, 512, 512, "sphere");
-  EXPECT_EQ(a.overlapping_texels, 0u);
-  EXPECT_EQ(a.shared_texels, 0u);
+  expect_clean_atlas(m, topo, u.uv, 512);
   // LSCM of caps within a 65° cone: conformal, and its area scale over a cap bounded; a stretch
   // above 2 would mean a badly flattened chart (the cap's projection alone gives 1/cos 65° = 2.4).
   EXPECT_LT(u.report.worst_stretch, 2.0);
@@ -245,9 +225,7 @@ TEST(Unwrap, TheBunnyHasNoFoldAndNoOverlapAndTheSameBytesTwice) {
   const Unwrapped u = unwrap(m, topo, o);
   EXPECT_EQ(u.uv.corners.size(), 3 * m.triangles.size());
   EXPECT_EQ(check_layout(m, u.uv), 0u);
-  const TexelAtlas a = texel_atlas(m, topo, u.uv, 512, 512, "bunny");
-  EXPECT_EQ(a.overlapping_texels, 0u);
-  EXPECT_EQ(a.shared_texels, 0u);
+  expect_clean_atlas(m, topo, u.uv, 512);
   const Unwrapped again = unwrap(m, topo, o);
   ASSERT_EQ(again.uv.corners.size(), u.uv.corners.size());
   EXPECT_EQ(std::memcmp(again.uv.corners.data(), u.uv.corners.data(), u.uv.corners.size() * sizeof(Vector2f)), 0);
@@ -270,13 +248,11 @@ TEST(Unwrap, DegenerateAndNonManifoldTrianglesAreKept) {
   EXPECT_EQ(u.report.charts, 3u) << "the square, and each fin apart (the non-manifold edge joins nothing)";
   for (size_t k : {6u, 7u, 8u, 15u, 16u, 17u}) EXPECT_EQ(u.uv.corners[k], Vector2f(0, 0)) << "degenerate corner " << k;
   EXPECT_EQ(check_layout(m, u.uv), 0u);
-  const TexelAtlas a = texel_atlas(m, topo, u.uv, 64, 64, "messy");
-  EXPECT_EQ(a.overlapping_texels, 0u);
-  EXPECT_EQ(a.shared_texels, 0u);
+  expect_clean_atlas(m, topo, u.uv, 64);
 }
 
 TEST(Unwrap, ADensityChoosesTheSmallestSquareAndRefusesPastTheLimit) {
-  const Mesh m = cube();
+  const Mesh m = box({0, 0, 0}, {1, 1, 1}, "cube");
   const Topology topo = build_topology(m);
   UnwrapOptions o;
   o.density = 10;  // each face 11 texels + 2 of gutter: six 13 × 13 rectangles
