@@ -99,9 +99,12 @@ int run_texel(const Args& a, const RunContext& run) {
     height = r.height;
     if (run.say)
       std::fprintf(stderr,
-                   "prtbake: %s: %s: generated lightmap UVs %s: %zu charts, utilisation %.2f, worst stretch %.2f "
+                   "prtbake: %s: %s: generated lightmap UVs %s: %zu charts%s, utilisation %.2f, worst stretch %.2f "
                    "(mean %.2f), %ux%u texels at %.4g texels per unit, %.1f s\n",
                    a.input.c_str(), a.unwrap ? "--unwrap" : "no UV set", generated->uv.name.c_str(), r.charts,
+                   r.degenerate_triangles == 0
+                       ? ""
+                       : (" (and " + std::to_string(r.degenerate_triangles) + " zero-area triangles at UV (0, 0))").c_str(),
                    r.utilisation, r.worst_stretch, r.mean_stretch, r.width, r.height, r.density, r.seconds);
   }
   const bake::UvSet& uv = generated ? generated->uv : lightmap_uvs(mesh, a.uv_set);
