@@ -43,10 +43,10 @@ void row(const std::string& name, const bake::Mesh& mesh, uint32_t side) {
     const Eigen::Vector2d e = b - a, f = c - a;
     not_ccw += !(e.x() * f.y() - e.y() * f.x() > 0);
   }
-  std::printf("| %s | %zu | %ux%u | %zu (%zu LSCM, %zu planar, %zu single) | %zu | %zu | %.2f | %.3f | %.4f | %.3f | "
+  std::printf("| %s | %zu | %ux%u | %zu (%zu LSCM, %zu planar, %zu single) | %zu (%zu) | %zu | %.2f | %.3f | %.4f | %.3f | "
               "%.3f | %zu | %zu | %zu | %.1f |\n",
               name.c_str(), mesh.triangles.size(), r.width, r.height, r.charts, r.lscm_charts, r.planar_charts,
-              r.single_triangle_charts, r.splits, r.degenerate_triangles, r.seconds, r.density, r.utilisation,
+              r.single_triangle_charts, r.splits, r.stretch_splits, r.degenerate_triangles, r.seconds, r.density, r.utilisation,
               r.worst_stretch, r.mean_stretch, atlas.overlapping_texels, atlas.shared_texels, not_ccw - r.degenerate_triangles,
               check_s);
   std::fflush(stdout);
@@ -59,7 +59,7 @@ int main() {
   const std::vector<long> sizes = bench::env_list("PRT_BENCH_SIZES", {1024, 2048});
   const int levels = int(bench::env_long("PRT_BENCH_BUNNY_LEVELS", 4));
   std::printf("Lightmap unwrapper, one thread, gutter 2 texels, CPU %s\n\n", bench::cpu_model().c_str());
-  std::printf("| mesh | triangles | atlas | charts | split | degenerate | unwrap s | density (texels/unit) | utilisation | "
+  std::printf("| mesh | triangles | atlas | charts | split (for stretch) | degenerate | unwrap s | density (texels/unit) | utilisation | "
               "worst stretch | mean stretch | overlapping texels | shared texels | flat or flipped in float | check s |\n"
               "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   std::string engine;

@@ -23,11 +23,26 @@ constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 constexpr double kMargin = 1.0 / 64;       // m (header): texels between a chart and its cells' border
 constexpr double kPlanarCos = 1 - 1e-9;    // a chart is planar when every n·n_seed is at least this
 constexpr int kBisections = 40;            // density steps: 2^-40 of the first bracket
+constexpr double kMaxChartStretch = 2;     // a flattened chart with a triangle stretched more is split
 
 using V2 = Eigen::Vector2d;
 using V3 = Eigen::Vector3d;
 
 double cross2(const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// The square of Sander's L2 stretch (header, REPORT) of the map from UV triangle q (world units,
+// counter-clockwise) to surface triangle p: (|S_u|² + |S_v|²) / 2, S the map's Jacobian.
+double l2_stretch_squared(const std::array<V3, 3>& p, const std::array<V2, 3>& q) {
+  const double a2 = cross2(q[1] - q[0], q[2] - q[0]);
+  const V3 su = (p[0] * (q[1].y() - q[2].y()) + p[1] * (q[2].y() - q[0].y()) + p[2] * (q[0].y() - q[1].y())) / a2;
+  const V3 sv = (p[0] * (q[2].x() - q[1].x()) + p[1] * (q[0].x() - q[2].x()) + p[2] * (q[1].x() - q[0].x())) / a2;
+  return (su.squaredNorm() + sv.squaredNorm()) / 2;
+}
+
+std::array<V3, 3> corners_of(const Mesh& mesh, uint32_t t) {
+  const auto& tri = mesh.triangles[t];
+  return {mesh.positions[tri[0]].cast<double>(), mesh.positions[tri[1]].cast<double>(), mesh.positions[tri[2]].cast<double>()};
+}
 
 // Per triangle: unit normal and area in double from the float positions; area 0: degenerate.
 struct Faces {
@@ -176,8 +191,9 @@ public:
         ok = lscm(c) && accepted(c);
         report.lscm_charts += ok;
       }
+      if (ok) normalise(c);
+      if (ok && c.triangles.size() > 1 && worst_stretch(c) > kMaxChartStretch) ok = false, ++report.stretch_splits;
       if (ok) {
-        normalise(c);
         done.push_back(std::move(c));
         continue;
       }
@@ -360,6 +376,15 @@ private:
             return true;
         }
     return false;
+  }
+
+  // The largest L2 stretch of a chart's triangles (its UVs in world units).
+  double worst_stretch(const Chart& c) const {
+    double worst = 0;
+    for (size_t k = 0; k < c.triangles.size(); ++k)
+      worst = std::max(worst, l2_stretch_squared(corners_of(mesh_, c.triangles[k]),
+                                                 {c.uv[c.corners[k][0]], c.uv[c.corners[k][1]], c.uv[c.corners[k][2]]}));
+    return std::sqrt(worst);
   }
 
   // UV area = surface area (header, step 2).
@@ -721,16 +746,10 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
         const V2& q = texel[c.corners[k][j]];
         out.uv.corners[3 * size_t(t) + j] = Eigen::Vector2f(float(q.x() / W), float(q.y() / H));
       }
-      // Sander's L2 stretch of the texture -> surface map, texture in world units (texels / s).
-      const V2 q0 = texel[c.corners[k][0]] / s, q1 = texel[c.corners[k][1]] / s, q2 = texel[c.corners[k][2]] / s;
-      const double a2 = cross2(q1 - q0, q2 - q0);
-      uv_area += a2 / 2 * s * s;
-      const auto& tri = mesh.triangles[t];
-      const V3 p0 = mesh.positions[tri[0]].cast<double>(), p1 = mesh.positions[tri[1]].cast<double>(),
-               p2 = mesh.positions[tri[2]].cast<double>();
-      const V3 su = (p0 * (q1.y() - q2.y()) + p1 * (q2.y() - q0.y()) + p2 * (q0.y() - q1.y())) / a2;
-      const V3 sv = (p0 * (q2.x() - q1.x()) + p1 * (q0.x() - q2.x()) + p2 * (q1.x() - q0.x())) / a2;
-      const double l2sq = (su.squaredNorm() + sv.squaredNorm()) / 2;
+      // Sander's L2 stretch, the texture in world units (texels / s).
+      const std::array<V2, 3> q = {texel[c.corners[k][0]] / s, texel[c.corners[k][1]] / s, texel[c.corners[k][2]] / s};
+      uv_area += cross2(q[1] - q[0], q[2] - q[0]) / 2 * s * s;
+      const double l2sq = l2_stretch_squared(corners_of(mesh, t), q);
       r.worst_stretch = std::max(r.worst_stretch, std::sqrt(l2sq));
       weighted += l2sq * f.area[t];
     }

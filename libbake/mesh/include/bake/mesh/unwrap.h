@@ -30,7 +30,9 @@
 //    (double arithmetic; a chart that fails either — a fold, a flip, a boundary overlapping
 //    itself — or whose solve fails is SPLIT in two at the median of its triangles' centroids
 //    along its longest axis, into connected parts, and each part is flattened again; one triangle
-//    always succeeds). Each chart is then scaled so that its UV area equals its surface area.
+//    always succeeds). Each chart is then scaled so that its UV area equals its surface area, and
+//    one whose largest triangle stretch (REPORT below) exceeds 2 is split the same way: LSCM is
+//    conformal but lets area drift along a long curved chart.
 // 3. PACKING at one density s (texels per world unit) with gutters in texels. Each chart is
 //    rotated to its minimal-area bounding rectangle (over the edges of its convex hull; turned
 //    by 90° to lie wide), then occupies whole cells: w = floor(s·width + 2·m) + 1 texels (m =
@@ -83,7 +85,8 @@ struct UnwrapReport {
   size_t charts = 0;                  // charts with area
   size_t degenerate_triangles = 0;    // UVs at (0, 0)
   size_t planar_charts = 0, lscm_charts = 0, single_triangle_charts = 0;
-  size_t splits = 0;                  // charts split because their flattening folded or failed
+  size_t splits = 0;                  // charts split: their flattening folded, failed or stretched
+  size_t stretch_splits = 0;          // of those, because a triangle's L2 stretch exceeded 2
   double utilisation = 0;             // Σ chart UV area / (W·H)
   double worst_stretch = 1, mean_stretch = 1;  // Sander's L2 (file comment)
   double seconds = 0;                 // wall time of unwrap()
