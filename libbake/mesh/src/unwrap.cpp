@@ -23,7 +23,9 @@ constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 constexpr double kMargin = 1.0 / 64;       // m (header): texels between a chart and its cells' border
 constexpr double kPlanarCos = 1 - 1e-9;    // a chart is planar when every n·n_seed is at least this
 constexpr int kBisections = 40;            // density steps: 2^-40 of the first bracket
-constexpr double kMaxChartStretch = 2;     // a flattened chart with a triangle stretched more is split
+constexpr double kMaxChartStretch = 2;
+constexpr int kSmoothPasses = 4;           // border smoothing passes (grow_charts)
+constexpr double kSmoothCos = 0.0872;      // cos 85°: how far a smoothed-in triangle may turn from the seed     // a flattened chart with a triangle stretched more is split
 
 using V2 = Eigen::Vector2d;
 using V3 = Eigen::Vector3d;
@@ -104,34 +106,74 @@ std::vector<std::array<uint32_t, 3>> neighbours(const Mesh& mesh, const Topology
   return nbr;
 }
 
-// Region growing (header, step 1): per triangle its chart, kNone for degenerate ones.
+// Region growing (header, step 1), then the borders smoothed: the charts as triangle lists.
 std::vector<std::vector<uint32_t>> grow_charts(const Faces& f, const std::vector<std::array<uint32_t, 3>>& nbr,
                                                double cone_degrees) {
   const size_t T = f.area.size();
   const double min_cos = std::cos(cone_degrees * std::numbers::pi / 180);
-  std::vector<uint8_t> taken(T, 0);
-  std::vector<std::vector<uint32_t>> charts;
+  std::vector<uint32_t> chart_of(T, kNone);
+  std::vector<V3> seed_normal;
   using Item = std::pair<double, uint32_t>;  // (n·n_seed, triangle): larger first, then lower triangle
   auto later = [](const Item& x, const Item& y) { return x.first != y.first ? x.first < y.first : x.second > y.second; };
   std::priority_queue<Item, std::vector<Item>, decltype(later)> queue(later);
   for (uint32_t seed = 0; seed < T; ++seed) {
-    if (taken[seed] || f.area[seed] == 0) continue;
+    if (chart_of[seed] != kNone || f.area[seed] == 0) continue;
     const V3 d = f.normal[seed];
-    std::vector<uint32_t>& chart = charts.emplace_back();
+    const uint32_t id = uint32_t(seed_normal.size());
+    seed_normal.push_back(d);
     queue.push({1.0, seed});
     while (!queue.empty()) {
       const uint32_t t = queue.top().second;
       queue.pop();
-      if (taken[t]) continue;
-      taken[t] = 1;
-      chart.push_back(t);
+      if (chart_of[t] != kNone) continue;
+      chart_of[t] = id;
       for (uint32_t n : nbr[t]) {
-        if (n == kNone || taken[n]) continue;
+        if (n == kNone || chart_of[n] != kNone) continue;
         const double c = f.normal[n].dot(d);
         if (c >= min_cos) queue.push({c, n});
       }
     }
-    std::sort(chart.begin(), chart.end());
+  }
+  // Smoothing: on a noisy surface (a scan) the cone's limit runs through single triangles, leaving
+  // spikes and one-triangle holes along and inside the borders, which waste atlas space. In
+  // synchronous passes, a triangle two of whose neighbours lie in another chart joins that chart
+  // when its normal is within kSmoothCos of that chart's seed (still a height field over the
+  // seed's plane).
+  for (int pass = 0; pass < kSmoothPasses; ++pass) {
+    std::vector<uint32_t> next = chart_of;
+    for (size_t t = 0; t < T; ++t) {
+      if (chart_of[t] == kNone) continue;
+      const std::array<uint32_t, 3>& n = nbr[t];
+      for (int i = 0; i < 3; ++i) {
+        if (n[size_t(i)] == kNone) continue;
+        const uint32_t c = chart_of[n[size_t(i)]];
+        if (c == chart_of[t]) continue;
+        int same = 0;
+        for (uint32_t m : n) same += m != kNone && chart_of[m] == c;
+        if (same >= 2 && f.normal[t].dot(seed_normal[c]) >= kSmoothCos) {
+          next[t] = c;
+          break;
+        }
+      }
+    }
+    chart_of.swap(next);
+  }
+  // The charts' connected parts (a smoothed border may cut a chart), by their lowest triangle.
+  std::vector<std::vector<uint32_t>> charts;
+  std::vector<uint8_t> seen(T, 0);
+  for (uint32_t start = 0; start < T; ++start) {
+    if (chart_of[start] == kNone || seen[start]) continue;
+    std::vector<uint32_t>& part = charts.emplace_back();
+    std::vector<uint32_t> stack{start};
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const uint32_t t = stack.back();
+      stack.pop_back();
+      part.push_back(t);
+      for (uint32_t n : nbr[t])
+        if (n != kNone && !seen[n] && chart_of[n] == chart_of[t]) seen[n] = 1, stack.push_back(n);
+    }
+    std::sort(part.begin(), part.end());
   }
   return charts;
 }

@@ -13,7 +13,11 @@
 //    unassigned triangle first, over neighbours, flattest first (a priority queue on n·n_seed,
 //    ties to the lower triangle), taking only triangles whose normal lies within
 //    `cone_degrees` of the seed's: a chart is a height field over its seed's plane, so it can be
-//    flattened without folds and with bounded stretch.
+//    flattened without folds and with bounded stretch. On a noisy surface (a scan) the cone's
+//    limit runs through single triangles, leaving spikes and one-triangle holes; 4 synchronous
+//    smoothing passes move a triangle two of whose neighbours lie in another chart into that
+//    chart when its normal is within 85° of that chart's seed, and the charts are then cut into
+//    their connected parts (numbered by lowest triangle).
 // 2. FLATTENING per chart, in world units (chart-local vertices: the chart's copy of each welded
 //    position). One triangle: its own plane, exact. A planar chart (every normal within 1e-9 of
 //    the seed's in cosine): orthogonal projection onto that plane, exact. Otherwise LSCM — least
