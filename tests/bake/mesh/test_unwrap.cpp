@@ -211,9 +211,11 @@ TEST(Unwrap, ASphereHasNoFoldAndNoOverlap) {
   EXPECT_GE(u.report.charts, 2u) << "a closed sphere cannot be one chart within a 65° cone";
   EXPECT_EQ(check_layout(m, u.uv), 0u);
   expect_clean_atlas(m, topo, u.uv, 512);
-  // LSCM of caps within a 65° cone: conformal, and its area scale over a cap bounded; a stretch
-  // above 2 would mean a badly flattened chart (the cap's projection alone gives 1/cos 65° = 2.4).
-  EXPECT_LT(u.report.worst_stretch, 2.0);
+  // The unwrapper splits a chart with a triangle stretched past 2 (unwrap.h), so none may be;
+  // exactly 2 is allowed (the split is on "exceeds").
+  EXPECT_LE(u.report.worst_stretch, 2.0);
+  // A loose floor, not a target: a handful of round caps, each in a square-ish profile, packed
+  // by the horizon packer fill about half of the atlas; below 0.3 the packing would be broken.
   EXPECT_GT(u.report.utilisation, 0.3);
 }
 
