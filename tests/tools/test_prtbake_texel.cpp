@@ -140,7 +140,10 @@ TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
   auto run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + bunny + "' --resolution 16 --ao --samples 64 -o '" + out.string() + "'",
                                     scratch("capture"));
   EXPECT_EQ(run.code, 1) << "the bunny has no UVs: generated ones do not fit 16 x 16 with their gutters";
-  EXPECT_NE(run.err.find("bunny.obj: 59 charts do not fit in 16x16 texels"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(" charts do not fit in 16x16 texels even at one texel each plus the gutter of 2"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("bunny.obj: "), std::string::npos) << run.err;
   // spider.obj's vt is a texture set that reuses parts: an error that names the cure.
   run = prt::testing::run_tool(PRT_PRTBAKE,
                                "texel '" + std::string(PRT_DATA_DIR) + "/spider.obj' --resolution 64 --ao --samples 64 -o '" +
@@ -186,9 +189,8 @@ TEST(PrtbakeTexel, AMeshWithoutUvsBakesInGeneratedOnes) {
                                         out.string() + "'",
                                     scratch("capture"));
   ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_NE(run.err.find("bunny.obj: no UV set: generated lightmap UVs prtbake_lightmap: 59 charts, utilisation "),
-            std::string::npos)
-      << run.err;
+  EXPECT_NE(run.err.find("bunny.obj: no UV set: generated lightmap UVs prtbake_lightmap: "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(" charts, utilisation "), std::string::npos) << run.err;
   EXPECT_NE(run.out.find("lightmap: 64x64 texels in UV set prtbake_lightmap"), std::string::npos) << run.out;
   F::Asset a = F::read_asset(out);
   ASSERT_TRUE(a.vertices.uv && a.vertices.lightmap);

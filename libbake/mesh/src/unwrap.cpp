@@ -12,7 +12,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <queue>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -106,6 +108,31 @@ std::vector<std::array<uint32_t, 3>> neighbours(const Mesh& mesh, const Topology
   return nbr;
 }
 
+// The connected parts (over `nbr`) of equally labelled triangles among `triangles`, each sorted,
+// in order of their first triangle there; kNone labels are left out. Consumes the labels: every
+// triangle visited is relabelled kNone.
+std::vector<std::vector<uint32_t>> connected_parts(const std::vector<std::array<uint32_t, 3>>& nbr,
+                                                   std::span<const uint32_t> triangles, std::vector<uint32_t>& label) {
+  std::vector<std::vector<uint32_t>> parts;
+  std::vector<uint32_t> stack;
+  for (uint32_t start : triangles) {
+    const uint32_t mine = label[start];
+    if (mine == kNone) continue;
+    std::vector<uint32_t>& part = parts.emplace_back();
+    stack.assign(1, start);
+    label[start] = kNone;
+    while (!stack.empty()) {
+      const uint32_t t = stack.back();
+      stack.pop_back();
+      part.push_back(t);
+      for (uint32_t n : nbr[t])
+        if (n != kNone && label[n] == mine) label[n] = kNone, stack.push_back(n);
+    }
+    std::sort(part.begin(), part.end());
+  }
+  return parts;
+}
+
 // Region growing (header, step 1), then the borders smoothed: the charts as triangle lists.
 std::vector<std::vector<uint32_t>> grow_charts(const Faces& f, const std::vector<std::array<uint32_t, 3>>& nbr,
                                                double cone_degrees) {
@@ -159,22 +186,9 @@ std::vector<std::vector<uint32_t>> grow_charts(const Faces& f, const std::vector
     chart_of.swap(next);
   }
   // The charts' connected parts (a smoothed border may cut a chart), by their lowest triangle.
-  std::vector<std::vector<uint32_t>> charts;
-  std::vector<uint8_t> seen(T, 0);
-  for (uint32_t start = 0; start < T; ++start) {
-    if (chart_of[start] == kNone || seen[start]) continue;
-    std::vector<uint32_t>& part = charts.emplace_back();
-    std::vector<uint32_t> stack{start};
-    seen[start] = 1;
-    while (!stack.empty()) {
-      const uint32_t t = stack.back();
-      stack.pop_back();
-      part.push_back(t);
-      for (uint32_t n : nbr[t])
-        if (n != kNone && !seen[n] && chart_of[n] == chart_of[t]) seen[n] = 1, stack.push_back(n);
-    }
-    std::sort(part.begin(), part.end());
-  }
+  std::vector<uint32_t> all(T);
+  std::iota(all.begin(), all.end(), 0u);
+  const std::vector<std::vector<uint32_t>> charts = connected_parts(nbr, all, chart_of);
   return charts;
 }
 
@@ -205,7 +219,7 @@ class Flattener {
 public:
   Flattener(const Mesh& mesh, const Topology& topo, const Faces& f, const std::vector<std::array<uint32_t, 3>>& nbr)
       : mesh_(mesh), topo_(topo), f_(f), nbr_(nbr), local_(topo.welded_positions.size(), kNone),
-        member_(mesh.triangles.size(), 0) {}
+        member_(mesh.triangles.size(), kNone) {}
 
   // Flattens every chart of `seeds`, splitting where needed; the accepted charts in order of
   // their first triangle.
@@ -253,7 +267,7 @@ private:
   const Faces& f_;
   const std::vector<std::array<uint32_t, 3>>& nbr_;
   std::vector<uint32_t> local_;   // welded -> local vertex of the chart at hand (kNone elsewhere)
-  std::vector<uint8_t> member_;   // scratch of split()
+  std::vector<uint32_t> member_;  // scratch of split(): kNone between calls
 
   V3 position(uint32_t welded) const { return topo_.welded_positions[welded].cast<double>(); }
 
@@ -455,25 +469,7 @@ private:
     std::sort(key.begin(), key.end());
     const size_t half = key.size() / 2;
     for (size_t i = 0; i < key.size(); ++i) member_[key[i].second] = i < half ? 1 : 2;
-    std::vector<std::vector<uint32_t>> parts;
-    for (uint32_t start : tris) {
-      if (member_[start] == 0) continue;
-      const uint8_t side = member_[start];
-      std::vector<uint32_t>& part = parts.emplace_back();
-      std::vector<uint32_t> stack{start};
-      member_[start] = 0;
-      while (!stack.empty()) {
-        const uint32_t t = stack.back();
-        stack.pop_back();
-        part.push_back(t);
-        for (uint32_t n : nbr_[t])
-          if (n != kNone && member_[n] == side) {
-            member_[n] = 0;
-            stack.push_back(n);
-          }
-      }
-      std::sort(part.begin(), part.end());
-    }
+    std::vector<std::vector<uint32_t>> parts = connected_parts(nbr_, tris, member_);
     return parts;
   }
 };
@@ -527,7 +523,7 @@ void orient_chart(Chart& c) {
   c.extent = box.sizes();
 }
 
-// A rectangle's texels at density s (header, step 3), the gutter not included.
+// A chart box's side in texels at density s for an extent in world units (header, step 3).
 uint32_t cells(double extent, double s) { return uint32_t(std::floor(extent * s + 2 * kMargin)) + 1; }
 
 // The span of coordinate 1 − a over the points of triangle t whose coordinate a lies in [lo, hi]

@@ -39,16 +39,25 @@
 //    conformal but lets area drift along a long curved chart.
 // 3. PACKING at one density s (texels per world unit) with gutters in texels. Each chart is
 //    rotated to its minimal-area bounding rectangle (over the edges of its convex hull; turned
-//    by 90° to lie wide), then occupies whole cells: w = floor(s·width + 2·m) + 1 texels (m =
-//    1/64 texel, so the chart lies strictly inside its cells, centred, and its float UVs cannot
-//    reach the next texel), likewise h. Rectangles of (w + G) × (h + G) texels, sorted by height,
-//    then width (descending), then chart, are placed by skyline bottom-left packing at integer
-//    texel positions, the chart at (G/2, G/2) inside its rectangle: at least G empty texels lie
-//    between two charts' touched texels (and G/2 at the atlas border, so a REPEAT sampler does
-//    not mix charts either). With a given W × H the largest density that packs is found by
-//    bisection (40 steps); with a given density the atlas is the smallest square whose side is a
-//    multiple of 4 (block-compression friendly) that packs, found by bisection, at most max_side.
-//    UV = texel position / W (/ H), stored as float; v is glTF's (row 0 of the image at v = 0).
+//    by 90° to lie wide) and given a box of whole texels: w = floor(s·width + 2·m) + 1 (m = 1/64
+//    texel), likewise h, the chart centred in it, so it lies strictly inside its box and its float
+//    UVs cannot reach the next texel. Its FOOTPRINT is the texels it touches, as texel_atlas
+//    (bake/mesh/texels.h) counts them, each texel square widened by 1/128 texel (more than the
+//    float rounding of a UV at 16384 texels): per column of the box its first and last row
+//    (computed exactly per triangle over each column's and row's slab), per row its first and
+//    last column. HORIZON PACKING: charts by box area (largest first, then chart order); each is
+//    tried in 4 rotations (multiples of 90°, windings kept) at every integer column x, resting on
+//    the horizon — per atlas column one past the lowest texel taken — with its column profile's
+//    top dilated by G (over the G columns on either side, less G rows); it goes where its lowest
+//    texel ends highest (then leftmost, then the first rotation). So at least G empty texels lie
+//    between the texels of two charts (Chebyshev distance > G), and G/2 (G − G/2 at the far
+//    sides) between a chart and the atlas border, so a REPEAT sampler does not mix charts either.
+//    With a given W × H the largest density that packs is found by bisection (40 steps from
+//    sqrt(W·H / surface area), which no packing reaches); with a given density the atlas is the
+//    smallest square whose side is a multiple of 4 (block-compression friendly) that packs,
+//    found by bisection, at most max_side. UV = texel position / W (/ H), stored as float; v is
+//    glTF's (row 0 of the image at v = 0). Charts under another's overhang are not nested: the
+//    packing fills about 60% of the atlas with footprints on a scanned mesh (bench/RESULTS.md).
 //
 // REPORT (UnwrapReport): the chart count (degenerate triangles apart), the density, the
 // utilisation Σ chart UV areas / (W·H) (geometric, in texels: the fraction of the atlas that the
