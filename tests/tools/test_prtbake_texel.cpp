@@ -212,6 +212,14 @@ TEST(PrtbakeTexel, AMeshWithoutUvsBakesInGeneratedOnes) {
   EXPECT_EQ(a.vertices.lightmap->width % 4, 0u);
   EXPECT_EQ(a.vertices.lightmap->width, a.vertices.lightmap->height);
   EXPECT_NE(run.err.find("at 10 texels per unit"), std::string::npos) << run.err;
+  // --density with the asset's own set: the floor's vt maps 4 × 4 units onto [0, 1]² (the box's
+  // corners all at vt (3, 3) map no area and do not count), so 8 texels per unit is 32 × 32.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + floor_and_box().string() +
+                                   "' --density 8 --ao --integrator qmc --samples 16 --report 0 -o '" + out.string() + "'",
+                               scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("lightmap: 32x32 texels in UV set vt"), std::string::npos) << run.out;
   // --unwrap replaces the floor's own vt.
   run = prt::testing::run_tool(PRT_PRTBAKE,
                                "texel '" + floor_and_box().string() +

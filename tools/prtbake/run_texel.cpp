@@ -56,17 +56,20 @@ const bake::UvSet& lightmap_uvs(const bake::Mesh& mesh, const std::string& wante
 constexpr uint32_t kMaxSide = 8192;  // texel_atlas's limit (bake/mesh/texels.h), as --resolution's
 
 // The side of the square atlas (a multiple of 4, at most kMaxSide) whose texels have `density`
-// texels per unit on average over the surface through `uv`: N = density · sqrt(surface area / UV
-// area). InputError when that exceeds kMaxSide.
+// texels per unit on average over the surface that `uv` maps (triangles with UV area; those
+// without cover no texel): N = density · sqrt(their surface area / their UV area), rounded up.
+// InputError when that exceeds kMaxSide.
 uint32_t side_for_density(const bake::Mesh& mesh, const bake::UvSet& uv, double density) {
   double surface = 0, uv_area = 0;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
-    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>();
-    surface += (mesh.positions[tri[1]].cast<double>() - a).cross(mesh.positions[tri[2]].cast<double>() - a).norm() / 2;
     const Eigen::Vector2d p = uv.corners[3 * t].cast<double>(), q = uv.corners[3 * t + 1].cast<double>() - p,
                           r = uv.corners[3 * t + 2].cast<double>() - p;
-    uv_area += std::abs(q.x() * r.y() - q.y() * r.x()) / 2;
+    const double mapped = std::abs(q.x() * r.y() - q.y() * r.x()) / 2;
+    if (mapped == 0) continue;
+    uv_area += mapped;
+    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>();
+    surface += (mesh.positions[tri[1]].cast<double>() - a).cross(mesh.positions[tri[2]].cast<double>() - a).norm() / 2;
   }
   if (!(uv_area > 0)) return 4;  // covers no texel at any size: texel_atlas's caller says so
   const double side = std::ceil(density * std::sqrt(surface / uv_area) / 4) * 4;
