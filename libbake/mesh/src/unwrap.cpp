@@ -25,9 +25,9 @@ constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
 constexpr double kMargin = 1.0 / 64;       // m (header): texels between a chart and its cells' border
 constexpr double kPlanarCos = 1 - 1e-9;    // a chart is planar when every n·n_seed is at least this
 constexpr int kBisections = 40;            // density steps: 2^-40 of the first bracket
-constexpr double kMaxChartStretch = 2;
+constexpr double kMaxChartStretch = 2;     // a flattened chart with a triangle stretched more is split
 constexpr int kSmoothPasses = 4;           // border smoothing passes (grow_charts)
-constexpr double kSmoothCos = 0.0872;      // cos 85°: how far a smoothed-in triangle may turn from the seed     // a flattened chart with a triangle stretched more is split
+constexpr double kSmoothCos = 0.0872;      // cos 85°: how far a smoothed-in triangle may turn from the seed
 
 using V2 = Eigen::Vector2d;
 using V3 = Eigen::Vector3d;
@@ -406,8 +406,10 @@ private:
     std::vector<std::vector<uint32_t>> grid(side * side);
     for (uint32_t i = 0; i < edges.size(); ++i) {
       const V2 &p = uv[edges[i][0]], &q = uv[edges[i][1]];
-      const size_t x0 = cell(std::min(p.x(), q.x()), box.min().x(), size.x()), x1 = cell(std::max(p.x(), q.x()), box.min().x(), size.x());
-      const size_t y0 = cell(std::min(p.y(), q.y()), box.min().y(), size.y()), y1 = cell(std::max(p.y(), q.y()), box.min().y(), size.y());
+      const size_t x0 = cell(std::min(p.x(), q.x()), box.min().x(), size.x());
+      const size_t x1 = cell(std::max(p.x(), q.x()), box.min().x(), size.x());
+      const size_t y0 = cell(std::min(p.y(), q.y()), box.min().y(), size.y());
+      const size_t y1 = cell(std::max(p.y(), q.y()), box.min().y(), size.y());
       for (size_t y = y0; y <= y1; ++y)
         for (size_t x = x0; x <= x1; ++x) grid[y * side + x].push_back(i);
     }
@@ -777,7 +779,8 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
     const Chart& c = charts[i];
     const Footprint& box = prints[i];
     std::vector<V2> texel(c.uv.size());
-    for (size_t v = 0; v < c.uv.size(); ++v) texel[v] = placed(box, where[i].rotation, box.inset + c.uv[v] * s, where[i].x, where[i].y);
+    for (size_t v = 0; v < c.uv.size(); ++v)
+      texel[v] = placed(box, where[i].rotation, box.inset + c.uv[v] * s, where[i].x, where[i].y);
     for (size_t k = 0; k < c.triangles.size(); ++k) {
       const uint32_t t = c.triangles[k];
       for (size_t j = 0; j < 3; ++j) {

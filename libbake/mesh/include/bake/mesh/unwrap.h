@@ -22,10 +22,10 @@
 //    position). One triangle: its own plane, exact. A planar chart (every normal within 1e-9 of
 //    the seed's in cosine): orthogonal projection onto that plane, exact. Otherwise LSCM — least
 //    squares conformal maps (B. Lévy, S. Petitjean, N. Ray, J. Maillot, "Least Squares Conformal
-//    Maps for Automatic Texture Atlas Generation", SIGGRAPH 2002, the conformality criterion): on each triangle, in
-//    its own orthonormal frame (x along its first edge, y = n × x), the linear map (u, v) is
-//    conformal when ∇v = R90 ∇u (Cauchy–Riemann; R90 the +90° rotation, which also makes the
-//    map keep the triangle's winding); with ∇φ_j = R90 e_j / (2A) (e_j the edge opposite corner
+//    Maps for Automatic Texture Atlas Generation", SIGGRAPH 2002, its conformality criterion):
+//    on each triangle, in its own orthonormal frame (x along its first edge, y = n × x), the
+//    linear map (u, v) is conformal when ∇v = R90 ∇u (Cauchy–Riemann; R90 the +90° rotation,
+//    which also makes the map keep the triangle's winding); with ∇φ_j = R90 e_j / (2A) (e_j the edge opposite corner
 //    j, counter-clockwise) the residual is r_T = Σ_j (u_j e_j + v_j R90 e_j) / (2A) and the energy
 //    Σ_T A_T |r_T|² = Σ_T |Σ_j u_j e_j + v_j R90 e_j|² / (4 A_T). The two chart vertices found by
 //    two farthest-point sweeps are pinned at (0, 0) and (d, 0), d their distance; the normal
@@ -43,9 +43,9 @@
 //    texel), likewise h, the chart centred in it, so it lies strictly inside its box and its float
 //    UVs cannot reach the next texel. Its FOOTPRINT is the texels it touches, as texel_atlas
 //    (bake/mesh/texels.h) counts them, each texel square widened by 1/128 texel (more than the
-//    float rounding of a UV at 16384 texels): per column of the box its first and last row
-//    (in double, per triangle over each column's and row's slab, then widened), per row its first and
-//    last column. HORIZON PACKING: charts by box area (largest first, then chart order); each is
+//    float rounding of a UV at 16384 texels): per column of the box its first and last row, per
+//    row its first and last column (in double, per triangle over each column's and row's slab).
+//    HORIZON PACKING: charts by box area (largest first, then chart order); each is
 //    tried in 4 rotations (multiples of 90°, windings kept) at every integer column x, resting on
 //    the horizon — per atlas column one past the lowest texel taken — with its column profile's
 //    top dilated by G (over the G columns on either side, less G rows); it goes where its lowest
