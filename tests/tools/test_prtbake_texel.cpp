@@ -136,8 +136,19 @@ TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
   const std::string bunny = std::string(PRT_DATA_DIR) + "/bunny.obj";
   auto run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + bunny + "' --resolution 16 --ao --samples 64 -o '" + out.string() + "'",
                                     scratch("capture"));
+  EXPECT_EQ(run.code, 1) << "the bunny has no UVs: generated ones do not fit 16 x 16 with their gutters";
+  EXPECT_NE(run.err.find(" charts do not fit in 16x16 texels even at one texel each plus the gutter of 2"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("bunny.obj: "), std::string::npos) << run.err;
+  // spider.obj's vt is a texture set that reuses parts: an error that names the cure.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + std::string(PRT_DATA_DIR) + "/spider.obj' --resolution 64 --ao --samples 64 -o '" +
+                                   out.string() + "'",
+                               scratch("capture"));
   EXPECT_EQ(run.code, 1);
-  EXPECT_NE(run.err.find("bunny.obj: has no UV set"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("spider.obj: its UV set vt overlaps itself: "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("pass --unwrap"), std::string::npos) << run.err;
   // wuson.obj's vt is one repeated (0, 0): a set, but no lightmap.
   run = prt::testing::run_tool(PRT_PRTBAKE,
                                "texel '" + std::string(PRT_DATA_DIR) + "/wuson.obj' --resolution 16 --ao --samples 64 -o '" +
@@ -157,5 +168,64 @@ TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
   run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + obj.string() + "' --resolution 0 --ao -o '" + out.string() + "'",
                                scratch("capture"));
   EXPECT_EQ(run.code, 2) << "a command-line mistake";
+  run = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + obj.string() + "' --ao -o '" + out.string() + "'", scratch("capture"));
+  EXPECT_EQ(run.code, 2) << "no size";
+  EXPECT_NE(run.err.find("give --resolution N|WxH (texels) or --density T"), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// A mesh without UVs (the bunny) gets generated lightmap UVs (bake/mesh/unwrap.h), said in one
+// line on stderr, stored as /mesh/uv under their name; --density picks the atlas; --unwrap
+// replaces an asset's own set.
+TEST(PrtbakeTexel, AMeshWithoutUvsBakesInGeneratedOnes) {
+  const fs::path out = scratch("bunny_unwrapped.prt.h5");
+  const std::string bunny = std::string(PRT_DATA_DIR) + "/bunny.obj";
+  fs::remove(out);
+  auto run = prt::testing::run_tool(PRT_PRTBAKE,
+                                    "texel '" + bunny + "' --resolution 64 --ao --integrator qmc --samples 16 --report 0 -o '" +
+                                        out.string() + "'",
+                                    scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("bunny.obj: no UV set: generated lightmap UVs prtbake_lightmap: "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(" charts, utilisation "), std::string::npos) << run.err;
+  EXPECT_NE(run.out.find("lightmap: 64x64 texels in UV set prtbake_lightmap"), std::string::npos) << run.out;
+  F::Asset a = F::read_asset(out);
+  ASSERT_TRUE(a.vertices.uv && a.vertices.lightmap);
+  EXPECT_EQ(a.vertices.uv->uv_set, "prtbake_lightmap");
+  ASSERT_EQ(a.vertices.uv->values.size(), 3674u * 3 * 2) << "every triangle of the bunny has its three UVs";
+  for (float v : a.vertices.uv->values) {
+    EXPECT_GE(v, 0.0f);
+    EXPECT_LE(v, 1.0f);
+  }
+  EXPECT_EQ(a.vertices.lightmap->width, 64u);
+  // --density: texels per unit; the atlas is the smallest square (a multiple of 4) that holds the charts.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + bunny + "' --density 10 --ao --integrator qmc --samples 16 --report 0 -o '" +
+                                   out.string() + "'",
+                               scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  a = F::read_asset(out);
+  ASSERT_TRUE(a.vertices.lightmap);
+  EXPECT_EQ(a.vertices.lightmap->width % 4, 0u);
+  EXPECT_EQ(a.vertices.lightmap->width, a.vertices.lightmap->height);
+  EXPECT_NE(run.err.find("at 10 texels per unit"), std::string::npos) << run.err;
+  // --density with the asset's own set: the floor's vt maps 4 × 4 units onto [0, 1]² (the box's
+  // corners all at vt (3, 3) map no area and do not count), so 8 texels per unit is 32 × 32.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + floor_and_box().string() +
+                                   "' --density 8 --ao --integrator qmc --samples 16 --report 0 -o '" + out.string() + "'",
+                               scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("lightmap: 32x32 texels in UV set vt"), std::string::npos) << run.out;
+  // --unwrap replaces the floor's own vt.
+  run = prt::testing::run_tool(PRT_PRTBAKE,
+                               "texel '" + floor_and_box().string() +
+                                   "' --unwrap --resolution 64 --ao --integrator qmc --samples 16 --report 0 -o '" +
+                                   out.string() + "'",
+                               scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("--unwrap: generated lightmap UVs prtbake_lightmap"), std::string::npos) << run.err;
+  a = F::read_asset(out);
+  ASSERT_TRUE(a.vertices.uv);
+  EXPECT_EQ(a.vertices.uv->uv_set, "prtbake_lightmap");
 }

@@ -38,6 +38,13 @@ constexpr const char* kTexelHelp =
     "on the floor) are found exactly and filled from their chart's neighbours, and each chart is\n"
     "padded into its gutter, so bilinear filtering never reads an empty texel. Written as\n"
     "/lightmap/... images [H][W][...] beside the mesh and its UVs (/mesh/uv), format version 5.\n"
+    "A mesh without UVs (a CAD export) gets a generated set, prtbake_lightmap: charts cut at hard\n"
+    "edges and where the surface turns more than 65 degrees, each flattened without folds (LSCM),\n"
+    "packed at one texel density with --gutter empty texels between charts; one line on stderr\n"
+    "gives its charts, utilisation and worst stretch. --unwrap generates it even when the mesh has\n"
+    "UVs. A set whose charts overlap (a texture set that mirrors or reuses parts) is an error:\n"
+    "pass --unwrap to replace it. The size is --resolution, or --density texels per unit (the\n"
+    "atlas then is the smallest square, a multiple of 4, that holds the charts).\n"
     "Give at least one of the products.";
 
 constexpr const char* kFivHelp =
@@ -213,13 +220,27 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
              a.lightmap_width = w;
              a.lightmap_height = h;
            },
-           "the lightmap's texels: N (N x N) or WxH, each 1 to 8192")
-        ->option_text("N|WxH")
-        ->required();
+           "the lightmap's texels: N (N x N) or WxH, each 1 to 8192 (or --density)")
+        ->option_text("N|WxH");
+    cmd.add_option("--density", a.lightmap_density,
+                   "texels per unit of the mesh's length (instead of --resolution): generated\n"
+                   "UVs are packed at this density into the smallest square atlas that holds\n"
+                   "them; an asset's own set gets the square whose texels have this density\n"
+                   "on average. At most 8192 x 8192 texels.")
+        ->option_text("T")
+        ->check(tool::number_in(1e-9, 1e9))
+        ->excludes("--resolution");
     cmd.add_option("--uv", a.uv_set,
                    "the UV set to bake in, by its name in the asset (TEXCOORD_1, vt);\n"
                    "default: TEXCOORD_1 when the mesh has it, else its only set")
         ->option_text("NAME");
+    cmd.add_flag("--unwrap", a.unwrap,
+                 "generate the lightmap UVs (set prtbake_lightmap) even when the mesh\n"
+                 "has UVs; they are generated anyway when it has none")
+        ->excludes("--uv");
+    cmd.add_option("--gutter", a.gutter, "empty texels between two charts of generated UVs (default 2)")
+        ->option_text("G")
+        ->check(tool::integer_in(0, 64));
     cmd.add_option("--padding", a.padding, "gutter rings each chart is dilated into, in texels (default 2)")
         ->option_text("P")
         ->check(tool::integer_in(0, 64));
@@ -316,7 +337,10 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
   if (!texel) tool::add_shard_options(cmd, a.shard, "vertices");
-  cmd.footer(texel ? std::string("Example:\n  prtbake texel scene.glb --resolution 512 --ao -o scene.prt.h5\n\n") + tool::kExitStatusHelp
+  cmd.footer(texel ? std::string("Examples:\n  prtbake texel scene.glb --resolution 512 --ao -o scene.prt.h5\n"
+                                 "  prtbake texel 2CylinderEngine.glb --density 0.5 --ao -o engine.prt.h5   (generated UVs)\n"
+                                 "  prtbake texel asset.obj --unwrap --resolution 1024 --ao -o asset.prt.h5\n\n") +
+                         tool::kExitStatusHelp
                    : std::string(kVertexExamples) + tool::kExitStatusHelp);
 }
 
@@ -426,6 +450,8 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
            " is a JSON scene file, whose own \"bake\" section holds the options");
     return;
   }
+  if (a.command == "texel" && a.lightmap_width == 0 && a.lightmap_density == 0)
+    fail("the lightmap's size is missing: give --resolution N|WxH (texels) or --density T (texels per unit)");
   if (a.command == "vertex" || a.command == "texel") {
     a.integrator_given = cmd.count("--integrator") > 0;
     const bool target_given = a.target_error > 0;

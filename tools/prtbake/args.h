@@ -28,10 +28,15 @@ struct Args {
   bake::IntegratorSpec integrator;
   bake::ShellSpec shell_spec;  // fiv
   bool report_given = false;  // scene: --report overrides the scene file's
-  // texel: the lightmap's texels (--resolution W[xH]), the UV set (--uv; empty: the default rule
-  // of run_texel.cpp) and the gutter rings (--padding).
+  // texel: the lightmap's texels (--resolution W[xH]; 0 x 0: chosen from --density, texels per
+  // unit), the UV set (--uv; empty: the default rule of run_texel.cpp), generated UVs (--unwrap,
+  // or the mesh has none: bake/mesh/unwrap.h, with --gutter texels between charts) and the gutter
+  // rings (--padding).
   uint32_t lightmap_width = 0, lightmap_height = 0;
+  double lightmap_density = 0;
   std::string uv_set;
+  bool unwrap = false;
+  uint32_t gutter = 2;
   uint32_t padding = 2;
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;

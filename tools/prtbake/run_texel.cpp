@@ -1,5 +1,6 @@
 // tools/prtbake/run_texel.cpp — `prtbake texel` (commands.h): the products of `prtbake vertex` per
-// texel of a lightmap. The mesh's lightmap UV set gives the atlas's texels and their shade points
+// texel of a lightmap. The mesh's lightmap UV set — or one generated for it (bake/mesh/unwrap.h)
+// when it has none, or on --unwrap — gives the atlas's texels and their shade points
 // (bake/mesh/texels.h); texels inside the geometry are found (bake/visibility/enclosure.h) and
 // left out of the bake; the rest are one job of the bake pipeline (bake/bake/pipeline.h), as a
 // vertex bake's vertices are; the rows become a lightmap image, filled and padded
@@ -10,6 +11,7 @@
 #include <bake/environment/envmap.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/texels.h>
+#include <bake/mesh/unwrap.h>
 #include <bake/visibility/accel.h>
 #include <bake/visibility/enclosure.h>
 #include <formats/asset.h>
@@ -22,6 +24,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -46,10 +50,34 @@ const bake::UvSet& lightmap_uvs(const bake::Mesh& mesh, const std::string& wante
   }
   if (const bake::UvSet* s = find("TEXCOORD_1")) return *s;
   if (mesh.uv_sets.size() == 1) return mesh.uv_sets.front();
-  if (mesh.uv_sets.empty())
-    throw bake::InputError(mesh.source, "has no UV set: a lightmap is baked in the mesh's lightmap UVs (glTF TEXCOORD_1, "
-                                        "OBJ vt); generating them is not implemented yet");
   throw bake::InputError(mesh.source, "has several UV sets (" + names + ") and no TEXCOORD_1: name the lightmap's with --uv");
+}
+
+constexpr uint32_t kMaxSide = 8192;  // texel_atlas's limit (bake/mesh/texels.h), as --resolution's
+
+// The side of the square atlas (a multiple of 4, at most kMaxSide) whose texels have `density`
+// texels per unit on average over the surface that `uv` maps (triangles with UV area; those
+// without cover no texel): N = density · sqrt(their surface area / their UV area), rounded up.
+// InputError when that exceeds kMaxSide.
+uint32_t side_for_density(const bake::Mesh& mesh, const bake::UvSet& uv, double density) {
+  double surface = 0, uv_area = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Eigen::Vector2d p = uv.corners[3 * t].cast<double>(), q = uv.corners[3 * t + 1].cast<double>() - p,
+                          r = uv.corners[3 * t + 2].cast<double>() - p;
+    const double mapped = std::abs(q.x() * r.y() - q.y() * r.x()) / 2;
+    if (mapped == 0) continue;
+    uv_area += mapped;
+    const Eigen::Vector3d a = mesh.positions[tri[0]].cast<double>();
+    surface += (mesh.positions[tri[1]].cast<double>() - a).cross(mesh.positions[tri[2]].cast<double>() - a).norm() / 2;
+  }
+  if (!(uv_area > 0)) return 4;  // covers no texel at any size: texel_atlas's caller says so
+  const double side = std::ceil(density * std::sqrt(surface / uv_area) / 4) * 4;
+  if (!(side <= kMaxSide))
+    throw bake::InputError(mesh.source, "at " + std::to_string(density) + " texels per unit its UV set " + uv.name +
+                                            " needs a lightmap of " + std::to_string(side) + " texels a side; the most is " +
+                                            std::to_string(kMaxSide));
+  return std::max<uint32_t>(4, uint32_t(side));
 }
 
 } // namespace
@@ -58,8 +86,33 @@ int run_texel(const Args& a, const RunContext& run) {
   const bake::Mesh mesh = load_receiver_mesh(a, run.say);
   const bake::Topology topo = bake::build_topology(mesh);
   warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
-  const bake::UvSet& uv = lightmap_uvs(mesh, a.uv_set);
-  const bake::TexelAtlas atlas = bake::texel_atlas(mesh, topo, uv, a.lightmap_width, a.lightmap_height, a.input);
+  // The UV set: generated when the mesh has none (and --uv names none) or on --unwrap.
+  std::optional<bake::Unwrapped> generated;
+  uint32_t width = a.lightmap_width, height = a.lightmap_height;
+  if (a.unwrap || (mesh.uv_sets.empty() && a.uv_set.empty())) {
+    bake::UnwrapOptions o;
+    o.width = width;
+    o.height = height;
+    o.density = width == 0 ? a.lightmap_density : 0;
+    o.gutter = a.gutter;
+    o.max_side = kMaxSide;
+    generated = bake::unwrap(mesh, topo, o);
+    const bake::UnwrapReport& r = generated->report;
+    width = r.width;
+    height = r.height;
+    if (run.say)
+      std::fprintf(stderr,
+                   "prtbake: %s: %s: generated lightmap UVs %s: %zu charts%s, utilisation %.2f, worst stretch %.2f "
+                   "(mean %.2f), %ux%u texels at %.4g texels per unit, %.1f s\n",
+                   a.input.c_str(), a.unwrap ? "--unwrap" : "no UV set", generated->uv.name.c_str(), r.charts,
+                   r.degenerate_triangles == 0
+                       ? ""
+                       : (" (and " + std::to_string(r.degenerate_triangles) + " zero-area triangles at UV (0, 0))").c_str(),
+                   r.utilisation, r.worst_stretch, r.mean_stretch, r.width, r.height, r.density, r.seconds);
+  }
+  const bake::UvSet& uv = generated ? generated->uv : lightmap_uvs(mesh, a.uv_set);
+  if (width == 0) width = height = side_for_density(mesh, uv, a.lightmap_density);
+  const bake::TexelAtlas atlas = bake::texel_atlas(mesh, topo, uv, width, height, a.input);
   if (atlas.samples.empty()) {
     // Why: every triangle flat in UV space (a set of one repeated vt, as wuson.obj's), or UVs
     // outside the atlas.
@@ -69,12 +122,19 @@ int run_texel(const Args& a, const RunContext& run) {
       flat += (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x() == 0;
     }
     throw bake::InputError(mesh.source, "its UV set " + uv.name + " covers no texel of the " +
-                                            std::to_string(a.lightmap_width) + "x" + std::to_string(a.lightmap_height) +
+                                            std::to_string(width) + "x" + std::to_string(height) +
                                             " lightmap: " +
                                             (flat == mesh.triangles.size()
                                                  ? "every triangle has zero area in it (not a lightmap UV set)"
                                                  : "its UVs lie outside [0, 1]"));
   }
+  // The UV set's checks at this resolution (bake/mesh/texels.h).
+  if (atlas.overlapping_texels > 0)
+    throw bake::InputError(mesh.source, "its UV set " + uv.name + " overlaps itself: " +
+                                            std::to_string(atlas.overlapping_texels) +
+                                            " texels lie inside triangles of two charts (a texture set that mirrors or "
+                                            "reuses parts is no lightmap set); pass --unwrap to bake in generated "
+                                            "lightmap UVs instead");
   const std::optional<bake::EnvMap> env = load_environment(a, run.say);
   const bake::ProductRequest req = product_request(a, env ? &*env : nullptr);
   const bake::MeshAccel accel(mesh, topo);
@@ -89,12 +149,6 @@ int run_texel(const Args& a, const RunContext& run) {
   std::vector<size_t> valid;
   for (size_t i = 0; i < invalid.size(); ++i)
     if (!invalid[i]) valid.push_back(i);
-  // The UV set's checks at this resolution (bake/mesh/texels.h).
-  if (atlas.overlapping_texels > 0)
-    std::fprintf(stderr,
-                 "prtbake: warning: %s: UV set %s overlaps itself: %zu texels lie inside triangles of two charts "
-                 "(a texture set that mirrors or reuses parts is no lightmap set): each holds one chart's value\n",
-                 a.input.c_str(), uv.name.c_str(), atlas.overlapping_texels);
   if (atlas.shared_texels > atlas.overlapping_texels)
     std::fprintf(stderr,
                  "prtbake: warning: %s: %zu texels of the %ux%u lightmap are touched by two charts of UV set %s: too "
