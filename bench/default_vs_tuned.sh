@@ -14,6 +14,7 @@
 #               does not count it in the bake time either), timed as a whole process. When a
 #               product misses E against the reference, the same command without --report 0 runs
 #               again, untimed for the ratio, for the verdict of the default's own error report
+#               and the error of the file it leaves (re-baked once when its check said NOT met)
 #               ("met", "NOT met", "not verifiable here"); the table shows that run's wall time too;
 #   hand-tuned  two ladders of pinned plans, each `--report 0`, timed as whole processes:
 #               silhouette N = 16, 32, ..., 1024 u-isolines (--samples N^2) and qmc R = 64, 128,
@@ -217,6 +218,12 @@ for entry in "${accepted[@]}"; do
         d_verdicts=$(grep -E '^ *target [0-9.e+-]+ for ' "$case_dir/report.log" | grep -v ': met' |
                        sed -E 's/^ *target [0-9.e+-]+ for ([^:]*): ([^(]*)\(([0-9.e+-]*).*/\1: \2(\3)/' | tr '\n' ';' | sed 's/;$//')
         [ "$rc" != 0 ] && d_verdicts="the run with its report: exit $rc"
+        if [ "$rc" = 0 ]; then  # the file the run with its report left (corrected when the check said NOT met)
+          measure "$case_dir/report.prt.h5"
+          r_plan=$(echo "$plan" | awk -F: '$1=="silhouette"{printf "silhouette N=%d", sqrt($2)+0.5; next} $1=="qmc"{printf "qmc R=%s", $2; next} {print}')
+          r_errs=$(echo "$errs" | tr ' ' '\n' | awk -F= -v E="$E" 'NF==2{printf "%s%s %.2f", sep, $1, $2/E; sep=", "}')
+          d_verdicts="${d_verdicts:+$d_verdicts; }its file: $r_plan, $r_errs (/E)"
+        fi
       fi
     else
       d_plan="exit $d_rc: $(grep -v '^\(mesh\|environment\|pilot\|baking\|reference\)' "$case_dir/default.log" | head -1 | cut -c1-160)"

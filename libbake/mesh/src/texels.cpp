@@ -1,10 +1,13 @@
 // texels.cpp — a lightmap atlas's covered texels and their shade points (bake/mesh/texels.h).
 #include <bake/mesh/texels.h>
 #include <bake/core/error.h>
+#include <bake/mesh/receivers.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -46,6 +49,50 @@ double nearest_on_segment(const V2& p, const V2& q, const V2& c) {
   const double len2 = d.squaredNorm();
   if (len2 == 0) return 0;
   return std::clamp((c - p).dot(d) / len2, 0.0, 1.0);
+}
+
+
+// x + y and x · y in double, true when exact (Knuth's TwoSum error and the fma residue are 0).
+bool exact_sum(double x, double y, double& out) {
+  out = x + y;
+  const double bb = out - x;
+  return (x - (out - bb)) + (y - bb) == 0.0;
+}
+bool exact_product(double x, double y, double& out) {
+  out = x * y;
+  return std::fma(x, y, -out) == 0.0;
+}
+
+// The point o + Σ_k w_k (q_k − o) of a triangle's plane (or an edge's line: one q), computed so that
+// every operation is exact in double: then it lies EXACTLY in the plane of o and the q_k (on the line
+// through o and q), as a mesh vertex lies in its triangles' planes, and the exact predicates treat it
+// as on its own surface (bake/visibility: a point a rounding below its own triangle would see that
+// triangle from behind, as a roof over half its hemisphere). The weights are rounded to dyadic
+// fractions of 2^-bits, from 30 bits down until every operation is exact (the float corners'
+// differences are exact in double for corners within 2^29 of each other's scale; the products and
+// sums need the weights' bits to fit beside them). false when none down to 2 bits is.
+bool exact_point_on(const Eigen::Vector3d& o, std::span<const Eigen::Vector3d> q, std::span<double> w,
+                    Eigen::Vector3d& out) {
+  for (int bits = 30; bits >= 2; --bits) {
+    const double scale = std::ldexp(1.0, bits);
+    bool exact = true;
+    std::array<double, 2> wr{};
+    // (The weights, all but the largest corner's, sum to at most 2/3: rounded, never past 1.)
+    for (size_t k = 0; k < q.size(); ++k) wr[k] = std::round(w[k] * scale) / scale;
+    for (int i = 0; i < 3 && exact; ++i) {
+      double acc = o[i];
+      for (size_t k = 0; k < q.size() && exact; ++k) {
+        double d, term;
+        exact = exact_sum(q[k][i], -o[i], d) && exact_product(wr[k], d, term) && exact_sum(acc, term, acc);
+      }
+      out[i] = acc;
+    }
+    if (exact) {
+      for (size_t k = 0; k < q.size(); ++k) w[k] = wr[k];
+      return true;
+    }
+  }
+  return false;
 }
 
 } // namespace
@@ -195,28 +242,57 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
     }
     s.barycentric = s.barycentric.cwiseMax(0.0);
     s.barycentric /= s.barycentric.sum();
-    // The surface point: positions and normals interpolated in double.
     const auto& tv = mesh.triangles[t];
+    // The surface point EXACTLY on its triangle (exact_point_on): from the corner of largest
+    // weight along the edges to the others with weight (two on the face, one on an edge, none at
+    // a corner — then the point is that vertex, with its ring decided exactly as a vertex's).
+    int o = 0;
+    for (int i = 1; i < 3; ++i)
+      if (s.barycentric[i] > s.barycentric[o]) o = i;
+    std::array<Eigen::Vector3d, 2> q;
+    std::array<double, 2> w{};
+    std::array<int, 2> qi{};
+    size_t nq = 0;
+    for (int i = 0; i < 3; ++i)
+      if (i != o && s.barycentric[i] > 0) qi[nq] = i, q[nq] = mesh.positions[tv[size_t(i)]].cast<double>(), w[nq] = s.barycentric[i], ++nq;
+    const Eigen::Vector3d corner = mesh.positions[tv[size_t(o)]].cast<double>();
     ShadePoint sp;
-    Eigen::Vector3d n = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero();
-    sp.p = Eigen::Vector3d::Zero();
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d p = mesh.positions[tv[size_t(i)]].cast<double>();
-      sp.p += s.barycentric[i] * p;
-      centroid += p / 3;
-      n += s.barycentric[i] * mesh.normals[tv[size_t(i)]].cast<double>();
+    Eigen::Vector3d exact_p;
+    if (nq == 0) {
+      s.barycentric = Eigen::Vector3d::Zero();
+      s.barycentric[o] = 1;
+      sp = vertex_shade_point(mesh, topology, tv[size_t(o)]);
+    } else {
+      if (exact_point_on(corner, std::span(q.data(), nq), std::span(w.data(), nq), exact_p)) {
+        s.barycentric = Eigen::Vector3d::Zero();
+        double rest = 1;
+        for (size_t j = 0; j < nq; ++j) s.barycentric[qi[j]] = w[j], rest -= w[j];
+        s.barycentric[o] = rest;
+      } else {
+        ++out.inexact_samples;
+        exact_p = Eigen::Vector3d::Zero();
+        for (int i = 0; i < 3; ++i) exact_p += s.barycentric[i] * mesh.positions[tv[size_t(i)]].cast<double>();
+      }
+      sp.p = exact_p;
+      // The normal: the vertex normals interpolated (the smooth shading the vertex bakes use), or
+      // the face normal where they cancel.
+      Eigen::Vector3d n = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero();
+      for (int i = 0; i < 3; ++i) {
+        centroid += mesh.positions[tv[size_t(i)]].cast<double>() / 3;
+        n += s.barycentric[i] * mesh.normals[tv[size_t(i)]].cast<double>();
+      }
+      const Eigen::Vector3d face = (mesh.positions[tv[1]] - mesh.positions[tv[0]])
+                                       .cast<double>()
+                                       .cross((mesh.positions[tv[2]] - mesh.positions[tv[0]]).cast<double>());
+      if (n.norm() > 0 && std::isfinite(n.norm())) sp.n = n.normalized();
+      else if (face.norm() > 0) sp.n = face.normalized();
+      else sp.n = mesh.normals[tv[0]].cast<double>().normalized();
+      // The tie-break into its own surface (as a vertex's, bake/mesh/receivers.h): towards the
+      // triangle's centroid, in the tangent plane.
+      Eigen::Vector3d into = centroid - sp.p;
+      into -= sp.n.dot(into) * sp.n;
+      if (const double len = into.norm(); len > 0 && std::isfinite(len)) sp.t = into / len;
     }
-    const Eigen::Vector3d face = (mesh.positions[tv[1]] - mesh.positions[tv[0]])
-                                     .cast<double>()
-                                     .cross((mesh.positions[tv[2]] - mesh.positions[tv[0]]).cast<double>());
-    if (n.norm() > 0 && std::isfinite(n.norm())) sp.n = n.normalized();
-    else if (face.norm() > 0) sp.n = face.normalized();
-    else sp.n = mesh.normals[tv[0]].cast<double>().normalized();
-    // The tie-break into its own surface (as a vertex's, bake/mesh/receivers.h): towards the
-    // triangle's centroid, in the tangent plane.
-    Eigen::Vector3d into = centroid - sp.p;
-    into -= sp.n.dot(into) * sp.n;
-    if (const double len = into.norm(); len > 0 && std::isfinite(len)) sp.t = into / len;
     out.coverage[k] = 1;
     out.samples.push_back(s);
     out.receivers.points.push_back(sp);

@@ -16,11 +16,15 @@
 //     triangle order;
 //   * else the point of the covering triangles' UV images nearest to the centre (their closest
 //     triangle, ties to the first), so the sample lies ON the surface, never off its edge.
-// The shade point is the sample's surface point: positions interpolated in double with its
-// barycentric coordinates; the normal is the interpolated vertex normals (the smooth shading the
-// vertex bakes use), or the triangle's face normal where they cancel. Texel points are free
-// points of the mesh (no welded vertex, `welded` = −1): the integrators decide the point's own
-// triangle and its neighbours exactly in the ε-limit p + εn (bake/visibility/raycast.h
+// The shade point is the sample's surface point, put EXACTLY on its triangle: its barycentric
+// coordinates rounded to dyadic fractions (2^-30 or coarser) for which the interpolation in double
+// is exact, so it lies in the triangle's plane as a vertex does (a point a rounding below its own
+// triangle would see it from behind: a roof over half its hemisphere); on an edge exactly on the
+// edge's line; at a corner it is that vertex's shade point (bake/mesh/receivers.h). The normal is
+// the interpolated vertex normals (the smooth shading the vertex bakes use), or the triangle's
+// face normal where they cancel. Other texel points are free points of the mesh (no welded
+// vertex, `welded` = −1): the integrators decide the point's own triangle and its neighbours
+// exactly in the ε-limit p + εn (bake/visibility/raycast.h
 // NearTriangles, bake/visibility/contour.h), as for a scene's receiver-only vertices.
 //
 // Rows: the covered texels in index order (row-major), so the rows — and with them every
@@ -65,6 +69,10 @@ struct TexelAtlas {
   // in), and texels whose centre lies inside triangles of two charts (overlapping charts: a
   // lightmap set must have none; a texture set that mirrors or reuses parts has them).
   size_t shared_texels = 0, overlapping_texels = 0;
+  // Samples whose surface point could not be put exactly on its triangle (texels.cpp
+  // exact_point_on: corners too far apart in scale for double) and carry the interpolation's
+  // rounding instead. 0 on every mesh we have seen.
+  size_t inexact_samples = 0;
 };
 
 // The atlas of `uv` (one of mesh.uv_sets; 3 UVs per triangle) at width × height texels (each
