@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <mutex>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -504,6 +505,23 @@ void EnvMap::sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out)
   for (int a = 0; a < k; ++a)
     for (int b = 0; b < k; ++b)
       out[size_t(a * k + b)] = scene_from_map(Eigen::Vector3d(sl[b] * c[a], s[a], cl[b] * c[a]), up_);
+}
+
+struct EnvMap::Midpoints {
+  std::once_flag once;
+  std::vector<Eigen::Vector3d> directions;
+};
+
+EnvMap::EnvMap() : midpoints_(std::make_shared<Midpoints>()) {}
+
+std::span<const Eigen::Vector3d> EnvMap::texel_midpoints() const {
+  PRT_CHECK(midpoints_ != nullptr);
+  std::call_once(midpoints_->once, [&] {
+    std::vector<Eigen::Vector3d> d(static_cast<size_t>(texel_count()));
+    for (int t = 0; t < texel_count(); ++t) sample_texel_grid(t, 1, std::span(&d[size_t(t)], 1));
+    midpoints_->directions = std::move(d);
+  });
+  return midpoints_->directions;
 }
 
 // ---------------------------------------------------------------------------------------------

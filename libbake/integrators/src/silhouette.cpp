@@ -192,9 +192,11 @@ struct SilhouetteIntegrator::Impl {
       const double cells_per_radian = double(grid.n) / std::sqrt(4 * std::numbers::pi);
       masses.first = int(c_r), masses.count = int(n_env);
       masses.blocks = size_t((texels + kBlockTexels - 1) / kBlockTexels);
-      masses.emit = [&, texels, cells_per_radian](size_t b, const IsolineTables::MassSink& sink) {
+      const std::span<const Vector3d> midpoints = envmap->texel_midpoints();
+      masses.emit = [&, texels, cells_per_radian, midpoints](size_t b, std::vector<Vector3d>& directions,
+                                                            std::vector<double>& values) {
         std::vector<Vector3d> dirs;
-        std::vector<double> y(size_t(sh::num_coeffs(16))), ybig, vals(n_env);
+        std::vector<double> y(size_t(sh::num_coeffs(16))), ybig;
         const int t_end = std::min(texels, int(b + 1) * kBlockTexels);
         for (int tx = int(b) * kBlockTexels; tx < t_end; ++tx) {
           if (hot && hot->is_hot(tx)) continue;
@@ -204,11 +206,13 @@ struct SilhouetteIntegrator::Impl {
           const int k = std::clamp(int(std::ceil(2.0 * std::sqrt(omega) * cells_per_radian)), 1, 16);
           const double w = omega / double(k * k);
           dirs.resize(size_t(k * k));
-          envmap->sample_texel_grid(tx, k, dirs);
+          if (k == 1) dirs[0] = midpoints[size_t(tx)];  // the same values, computed once per map
+          else envmap->sample_texel_grid(tx, k, dirs);
           const Rgb mass{L.r * w, L.g * w, L.b * w};
           for (const Vector3d& d : dirs) {
-            env_columns(mass, eval_sh(env_order, d, y, ybig), vals.data());
-            sink(frame_from_world * d, vals.data());
+            values.resize(values.size() + n_env);
+            env_columns(mass, eval_sh(env_order, d, y, ybig), values.data() + values.size() - n_env);
+            directions.push_back(frame_from_world * d);
           }
         }
       };

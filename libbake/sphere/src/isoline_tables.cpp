@@ -66,8 +66,9 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
   // every thread count).
   if (masses && m_count > 0 && masses->blocks > 0) {
     struct Block {
-      std::vector<size_t> rows;
+      std::vector<Eigen::Vector3d> directions;
       std::vector<double> values;
+      std::vector<size_t> rows;
     };
     constexpr size_t kWave = 16;
     std::vector<Block> wave(kWave);
@@ -75,12 +76,13 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
       const size_t nb = std::min(kWave, masses->blocks - b0);
       tbb::parallel_for(size_t(0), nb, [&](size_t k) {
         Block& blk = wave[k];
-        blk.rows.clear(), blk.values.clear();
-        masses->emit(b0 + k, [&](const Eigen::Vector3d& omega, const double* values) {
+        blk.directions.clear(), blk.values.clear(), blk.rows.clear();
+        masses->emit(b0 + k, blk.directions, blk.values);
+        PRT_CHECK_OP(blk.values.size(), ==, blk.directions.size() * m_count);
+        for (const Eigen::Vector3d& omega : blk.directions) {
           const auto [i, j] = cell_of(omega);
           blk.rows.push_back(offset_[size_t(i)] + size_t(j) + 1);
-          blk.values.insert(blk.values.end(), values, values + m_count);
-        });
+        }
       });
       const double inv_h = 1.0 / h;  // a cell holds h · mean(f J) = ∫_cell f dω / h
       for (size_t k = 0; k < nb; ++k)

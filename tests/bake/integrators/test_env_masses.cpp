@@ -111,9 +111,8 @@ TEST(EnvMasses, EveryMassLandsOnceInTheCellThatHoldsIt) {
     const oct::Grid grid(N);
     IsolineTables::PointMasses masses;
     masses.first = 0, masses.count = 1, masses.blocks = 3;
-    masses.emit = [&](size_t b, const IsolineTables::MassSink& sink) {
-      const double one = 1.0;
-      for (size_t k = b; k < dirs.size(); k += 3) sink(dirs[k], &one);
+    masses.emit = [&](size_t b, std::vector<Vector3d>& directions, std::vector<double>& values) {
+      for (size_t k = b; k < dirs.size(); k += 3) directions.push_back(dirs[k]), values.push_back(1.0);
     };
     const IsolineTables t(grid, 1, 1, [](const Vector3d&, std::span<double> out) { out[0] = 7; }, &masses);
     double total = 0;

@@ -71,6 +71,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -177,6 +178,10 @@ public:
   // (1 ≤ k ≤ 16), the same values bit for bit; lat-long texels share the k latitudes and k
   // longitudes (2k transcendental pairs instead of k²).
   void sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out) const;
+  // sample_texel_grid(t, 1) of every texel (the same values bit for bit), computed on first use
+  // (thread-safe) and kept, 24 bytes per texel: the silhouette integrator's point masses need them
+  // at every isoline level it builds (bake/integrators/silhouette.cpp).
+  std::span<const Eigen::Vector3d> texel_midpoints() const;
 
   // OpenEXR's own texel-centre direction (map space, float precision) for pixel (x, y) of a
   // `layout` ("latlong" | "cube") image of width × height, computed by Imf::LatLongMap::
@@ -188,7 +193,7 @@ private:
   enum class Layout { Constant, LatLong, ExrCube };  // an OpenEXR cube (docs/ARCHITECTURE.md §3 "Two cube conventions")
   struct Region;  // a texel's region in its parametrisation (envmap.cpp)
 
-  EnvMap() = default;
+  EnvMap();
   static EnvMap read(const std::filesystem::path& exr, const std::string& file, UpAxis up);  // load, memory aside
   static EnvMap build(Layout layout, int width, int height, std::vector<float> rgb, UpAxis up, EnvMapInfo info);
   static EnvMap from_memory(Layout layout, int width, int height, std::vector<float> rgb, UpAxis up, std::string name);
@@ -207,6 +212,8 @@ private:
   // 1, col_cdf_ height_ rows of width_+1 entries from 0 to 1. inv_total_ = 1 / Σ lum Ω.
   std::vector<double> row_cdf_, col_cdf_;
   double inv_total_ = 0;
+  struct Midpoints;                         // texel_midpoints()'s cache (envmap.cpp), shared by copies
+  std::shared_ptr<Midpoints> midpoints_;
 };
 
 } // namespace prt::bake

@@ -39,16 +39,15 @@ public:
   // f(ω, out): the integrand's components at unit direction ω (in the octahedral frame).
   using Integrand = std::function<void(const Eigen::Vector3d& omega, std::span<double> out)>;
 
-  // Point masses for components [first, first + count): emit(b, sink) calls sink(ω, values) for
-  // the masses of block b ∈ [0, blocks) in a fixed order (ω unit, in the octahedral frame; values
-  // the mass of each component, ∫ over the mass's share of the sphere). Blocks may run
-  // concurrently; their masses are added block by block in index order, so the tables' bytes do
-  // not depend on the thread count. f's values for these components are ignored.
-  using MassSink = std::function<void(const Eigen::Vector3d& omega, const double* values)>;
+  // Point masses for components [first, first + count): emit(b, directions, values) appends the
+  // masses of block b ∈ [0, blocks) in a fixed order — each a unit direction ω (in the octahedral
+  // frame) and `count` values (the mass of each component, ∫ over the mass's share of the sphere).
+  // Blocks may run concurrently; their masses are added block by block in index order, so the
+  // tables' bytes do not depend on the thread count. f's values for these components are ignored.
   struct PointMasses {
     int first = 0, count = 0;
     size_t blocks = 0;
-    std::function<void(size_t block, const MassSink& sink)> emit;
+    std::function<void(size_t block, std::vector<Eigen::Vector3d>& directions, std::vector<double>& values)> emit;
   };
 
   IsolineTables(const oct::Grid& grid, int components, int subsamples, const Integrand& f,
