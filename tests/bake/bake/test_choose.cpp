@@ -293,6 +293,42 @@ TEST(Choose, TheTargetCheckSaysMetNotMetOrNotVerifiable) {
   EXPECT_NE(met.find("met: the bake's own error 6.63e-04 (2.94e-04 to 8.91e-04)"), std::string::npos) << met;
 }
 
+TEST(Choose, TheCheckCountsPointsAndExtrapolatesAFinerSilhouetteReference) {
+  // The noise taken out of band-1 (σ = 1e-3 relative, m = 3e-3) is known to ±δσ² with δ = 3·sqrt(4/n)
+  // for n INDEPENDENT draws: a point's nine values share its rays, so 32 points are 32 draws, not
+  // 288 (δ = 1.06): e in [sqrt(9 − 2.06), 3]·1e-3 = [2.63e-3, 3.00e-3].
+  ErrorReport report;
+  ProductError r;
+  r.product = Product::RadianceBand1, r.rmse = 3.0, r.reference_rms = 1000, r.reference_std_error = 1.0, r.values = 288;
+  report.products = {r};
+  report.reference_noise_measured = true;
+  report.vertices.assign(32, 0);
+  const std::string counted = target_check_lines(report, 1e-3)[0];
+  EXPECT_NE(counted.find("NOT met: the bake's own error 2.83e-03 (2.63e-03 to 3.00e-03)"), std::string::npos) << counted;
+  // Against the same integrator at f = 4× its isolines, m = R(N) − R(4N) = c·N^-a·(1 − 4^-a) for
+  // a in [1, 2]: the bake's error c·N^-a lies in [m/(1 − 1/16), m/(1 − 1/4)].
+  auto finer = [&](double m) {
+    ErrorReport f;
+    ProductError e;
+    e.product = Product::RadianceBand1, e.rmse = m * 1000, e.reference_rms = 1000, e.values = 9 * 2108;
+    e.finer = 4, e.finer_knob = 272, e.finer_points = 2108;
+    f.products = {e};
+    return std::pair(target_verdicts(f, 1e-3)[0], target_check_lines(f, 1e-3)[0]);
+  };
+  const auto [above, above_line] = finer(1.14e-3);  // [1.216e-3, 1.52e-3]: NOT met
+  EXPECT_TRUE(above.extrapolated && above.not_met && !above.met);
+  EXPECT_NEAR(above.error_lo, 1.14e-3 * 16 / 15, 1e-15);
+  EXPECT_NEAR(above.error_hi, 1.14e-3 * 4 / 3, 1e-15);
+  EXPECT_NEAR(above.noise, 1.14e-3 / 3, 1e-15);  // the finer level's own error at order 1
+  EXPECT_NE(above_line.find("NOT met: the bake's own error 1.22e-03 to 1.52e-03"), std::string::npos) << above_line;
+  EXPECT_NE(above_line.find("at 4x its isolines (N = 272) on 2108 points"), std::string::npos) << above_line;
+  const auto [below, below_line] = finer(5e-4);  // [5.33e-4, 6.67e-4]: met
+  EXPECT_TRUE(below.met && !below.not_met) << below_line;
+  const auto [straddle, straddle_line] = finer(8e-4);  // [8.53e-4, 1.07e-3]: cannot tell
+  EXPECT_TRUE(!straddle.met && !straddle.not_met) << straddle_line;
+  EXPECT_NE(straddle_line.find("not verifiable here"), std::string::npos) << straddle_line;
+}
+
 TEST(Choose, APilotReferenceTooCoarseForTheTargetIsRaisedOrSaysSo) {
   // The reference's own error is estimated (Richardson from N_ref/2 and N_ref/4, bake/bake/choose.h
   // step 1) and must be within E/3. Forced to start at 64 isolines (AO RMSE ~6e-4 on this asset,
