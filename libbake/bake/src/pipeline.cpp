@@ -261,7 +261,9 @@ void BakePipeline::check_finer(BakeJob& job, const Monitor& monitor) {
     if (n == 0 || !job.reports[s]) continue;
     ErrorReport r = compare_points_with_reference(job.sets[s].points, job.rows[s], *finer, n, job.spec.seed, monitor);
     const double per_point = r.reference_seconds / double(std::max<size_t>(r.vertices.size(), 1));
-    if (rows > n && per_point * double(rows) <= budget * double(rows) / double(std::max<uint64_t>(job.row_count(), 1)))
+    // (Not with counted costs: which points are checked must not depend on the machine's speed.)
+    if (!settings_.counted_costs && rows > n &&
+        per_point * double(rows) <= budget * double(rows) / double(std::max<uint64_t>(job.row_count(), 1)))
       r = compare_points_with_reference(job.sets[s].points, job.rows[s], *finer, rows, job.spec.seed, monitor);
     for (ProductError& e : r.products)
       e.finer = double(fine_n) / double(N), e.finer_knob = uint32_t(fine_n), e.finer_points = r.vertices.size();
