@@ -36,7 +36,9 @@ constexpr const char* kTexelHelp =
     "gets a shade point on the surface (the texel centre, or the nearest point of the triangles\n"
     "that touch the texel), baked like a vertex. Texels inside the geometry (under a box standing\n"
     "on the floor) are found exactly and filled from their chart's neighbours, and each chart is\n"
-    "padded into its gutter, so bilinear filtering never reads an empty texel. Written as\n"
+    "padded into its gutter, so bilinear filtering never reads an empty texel. Where the UVs are\n"
+    "cut over a continuous surface (a seam), the texels on both sides are moved by least squares\n"
+    "until bilinear lookups from either side agree (--no-stitch: not). Written as\n"
     "/lightmap/... images [H][W][...] beside the mesh and its UVs (/mesh/uv), format version 5.\n"
     "A mesh without UVs (a CAD export) gets a generated set, prtbake_lightmap: charts cut at hard\n"
     "edges and where the surface turns more than 65 degrees, each flattened without folds (LSCM),\n"
@@ -244,6 +246,9 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
     cmd.add_option("--padding", a.padding, "gutter rings each chart is dilated into, in texels (default 2)")
         ->option_text("P")
         ->check(tool::integer_in(0, 64));
+    cmd.add_flag("--no-stitch", a.no_stitch,
+                 "leave the texels along UV seams as baked (by default they are moved by least\n"
+                 "squares so that both sides of a seam agree where the surface is continuous)");
   }
   add_output(cmd, a);
   const std::string products = "Products (at least one)";

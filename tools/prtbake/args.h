@@ -31,13 +31,15 @@ struct Args {
   // texel: the lightmap's texels (--resolution W[xH]; 0 x 0: chosen from --density, texels per
   // unit), the UV set (--uv; empty: the default rule of run_texel.cpp), generated UVs (--unwrap,
   // or the mesh has none: bake/mesh/unwrap.h, with --gutter texels between charts) and the gutter
-  // rings (--padding).
+  // rings (--padding); --no-stitch leaves the texels along UV seams as baked (bake/bake/lightmap.h
+  // stitch_seams).
   uint32_t lightmap_width = 0, lightmap_height = 0;
   double lightmap_density = 0;
   std::string uv_set;
   bool unwrap = false;
   uint32_t gutter = 2;
   uint32_t padding = 2;
+  bool no_stitch = false;
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;
   bool file_normals = true, quiet = false, reproducible = false, dry_run = false;

@@ -186,7 +186,16 @@ int run_texel(const Args& a, const RunContext& run) {
     std::vector<double> rows(atlas.samples.size() * W, 0.0);  // the invalid texels' rows: filled below
     for (size_t r = 0; r < valid.size(); ++r)
       std::copy_n(result.values.begin() + std::ptrdiff_t(r * W), W, rows.begin() + std::ptrdiff_t(valid[r] * W));
-    const bake::Lightmap image = bake::make_lightmap(atlas, rows, W, invalid, a.padding);
+    bake::Lightmap image = bake::make_lightmap(atlas, rows, W, invalid, a.padding);
+    if (!a.no_stitch) {
+      const bake::SeamStitch seams = bake::stitch_seams(image, atlas, mesh, topo, uv);
+      if (run.say && seams.edges > 0)
+        std::printf("seams: %zu UV seam edges, %zu points looked up from both sides (%zu reach an empty texel or another chart's: "
+                    "left out), %zu texels moved (a baked one by %.2e at most): mean |difference| %.2e -> %.2e, "
+                    "largest %.2e -> %.2e\n",
+                    seams.edges, seams.points, seams.skipped_points, seams.texels, seams.baked_moved_max, seams.mean_before,
+                    seams.mean_after, seams.max_before, seams.max_after);
+    }
     F::Asset asset;
     asset.root = root_info(a, mesh.source_sha256);
     tool::set_mesh(asset.vertices, mesh);

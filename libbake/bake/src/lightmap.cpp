@@ -2,7 +2,14 @@
 #include <bake/bake/lightmap.h>
 #include <bake/core/error.h>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
 
 namespace prt::bake {
 namespace {
@@ -106,6 +113,160 @@ Lightmap make_lightmap(const TexelAtlas& atlas, std::span<const double> rows, si
     m.padded += round(ring, TexelState::Padded);
   }
   return m;
+}
+
+namespace {
+
+// The bilinear lookup at UV (u, v) (formats/SCHEMA.md): four texels and their weights, clamped
+// to the image.
+struct Lookup {
+  std::array<size_t, 4> texel{};
+  std::array<double, 4> weight{};
+};
+Lookup lookup(double u, double v, size_t W, size_t H) {
+  const double x = u * double(W) - 0.5, y = v * double(H) - 0.5;
+  const double fx0 = std::floor(x), fy0 = std::floor(y);
+  const double fx = x - fx0, fy = y - fy0;
+  auto clampi = [](double c, size_t n) { return size_t(std::clamp(c, 0.0, double(n - 1))); };
+  const size_t x0 = clampi(fx0, W), x1 = clampi(fx0 + 1, W), y0 = clampi(fy0, H), y1 = clampi(fy0 + 1, H);
+  Lookup l;
+  l.texel = {y0 * W + x0, y0 * W + x1, y1 * W + x0, y1 * W + x1};
+  l.weight = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  return l;
+}
+
+} // namespace
+
+SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& mesh, const Topology& topology,
+                        const UvSet& uv, double lambda) {
+  PRT_CHECK_OP(atlas.triangle_chart.size(), ==, mesh.triangles.size());
+  PRT_CHECK_OP(uv.corners.size(), ==, mesh.triangles.size() * 3);
+  PRT_CHECK(lambda > 0);
+  SeamStitch out;
+  const size_t W = image.width, H = image.height, C = image.channels;
+  if (W == 0 || H == 0 || C == 0) return out;
+  // Edges by their welded corners: (triangle, corner index of the edge's first end) per side.
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<std::pair<uint32_t, int>>> edges;
+  for (uint32_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t a = topology.weld[mesh.triangles[t][size_t(c)]], b = topology.weld[mesh.triangles[t][size_t((c + 1) % 3)]];
+      if (a != b) edges[std::minmax(a, b)].push_back({t, c});
+    }
+  struct Point {
+    Lookup side[2];
+  };
+  std::vector<Point> points;
+  auto uv_at = [&](uint32_t t, int c) { return uv.corners[size_t(3 * t + uint32_t(c))].cast<double>(); };
+  for (const auto& [key, sides] : edges) {
+    if (sides.size() != 2) continue;  // a border or a non-manifold edge: no two sides to agree
+    // Each side's UVs at the edge's welded ends, in the order (key.first, key.second).
+    std::array<std::array<Eigen::Vector2d, 2>, 2> end;
+    for (int s = 0; s < 2; ++s) {
+      const auto [t, c] = sides[size_t(s)];
+      const bool forward = topology.weld[mesh.triangles[t][size_t(c)]] == key.first;
+      end[size_t(s)][0] = uv_at(t, forward ? c : (c + 1) % 3);
+      end[size_t(s)][1] = uv_at(t, forward ? (c + 1) % 3 : c);
+    }
+    if (end[0][0] == end[1][0] && end[0][1] == end[1][1]) continue;  // the same UVs: one chart, no seam
+    // A hard edge (the two sides' normals differ at an end) is a crease of the shading, not a seam
+    // of a continuous surface: its two sides rightly differ.
+    bool smooth = true;
+    for (int e = 0; e < 2 && smooth; ++e) {
+      std::array<Eigen::Vector3f, 2> nrm;
+      for (int s = 0; s < 2; ++s) {
+        const auto [t, c] = sides[size_t(s)];
+        const bool forward = topology.weld[mesh.triangles[t][size_t(c)]] == key.first;
+        const int corner = (e == 0) == forward ? c : (c + 1) % 3;
+        nrm[size_t(s)] = mesh.normals[mesh.triangles[t][size_t(corner)]];
+      }
+      smooth = nrm[0] == nrm[1];
+    }
+    if (!smooth) continue;
+    const Eigen::Vector2d scale{static_cast<double>(W), static_cast<double>(H)};
+    const double len = std::max((end[0][1] - end[0][0]).cwiseProduct(scale).norm(), (end[1][1] - end[1][0]).cwiseProduct(scale).norm());
+    if (!(len > 0) || !std::isfinite(len)) continue;
+    ++out.edges;
+    const int k = std::max(2, int(std::ceil(2 * len)));
+    for (int i = 0; i < k; ++i) {
+      const double f = (i + 0.5) / k;
+      Point p;
+      bool usable = true;
+      for (int s = 0; s < 2; ++s) {
+        const Eigen::Vector2d q = (1 - f) * end[size_t(s)][0] + f * end[size_t(s)][1];
+        p.side[s] = lookup(q.x(), q.y(), W, H);
+        const uint32_t own = atlas.triangle_chart[sides[size_t(s)].first];
+        for (const size_t tx : p.side[s].texel)
+          usable = usable && image.state[tx] != uint8_t(TexelState::Empty) && image.chart[tx] == own;
+      }
+      if (usable) points.push_back(p);
+      else ++out.skipped_points;
+    }
+  }
+  out.points = points.size();
+  if (points.empty()) return out;
+  // The unknowns: the texels the points touch, in texel order.
+  std::map<size_t, int> index;
+  for (const Point& p : points)
+    for (const Lookup& l : p.side)
+      for (const size_t tx : l.texel) index.emplace(tx, 0);
+  int n = 0;
+  for (auto& [tx, i] : index) i = n++;
+  out.texels = index.size();
+  auto difference = [&](const Point& p, size_t c) {
+    double d = 0;
+    for (int q = 0; q < 4; ++q) d += p.side[0].weight[size_t(q)] * image.values[p.side[0].texel[size_t(q)] * C + c];
+    for (int q = 0; q < 4; ++q) d -= p.side[1].weight[size_t(q)] * image.values[p.side[1].texel[size_t(q)] * C + c];
+    return std::abs(d);
+  };
+  for (const Point& p : points)
+    for (size_t c = 0; c < C; ++c) {
+      const double d = difference(p, c);
+      out.mean_before += d, out.max_before = std::max(out.max_before, d);
+    }
+  out.mean_before /= double(points.size() * C);
+  // AᵀA + λ²I: each point's row is +w on side 0's texels, −w on side 1's.
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (const Point& p : points) {
+    std::array<std::pair<int, double>, 8> row;
+    for (int s = 0; s < 2; ++s)
+      for (int q = 0; q < 4; ++q)
+        row[size_t(4 * s + q)] = {index.at(p.side[s].texel[size_t(q)]), (s == 0 ? 1.0 : -1.0) * p.side[s].weight[size_t(q)]};
+    for (const auto& [i, wi] : row)
+      for (const auto& [j, wj] : row) triplets.emplace_back(i, j, wi * wj);
+  }
+  // λ per texel: a texel baked at its centre holds the exact surface value there; one baked at the
+  // nearest point of a border holds a value from elsewhere (bilinear filtering takes it for its
+  // centre's), a filled or padded one only its chart's mean beside it: those follow the seam (λ/10).
+  std::vector<double> lam2(static_cast<size_t>(n));
+  std::vector<uint8_t> centre(W * H, 0);  // baked at its own centre (not the nearest point of a border)
+  for (const TexelSample& sm : atlas.samples) centre[sm.texel] = sm.centre;
+  for (const auto& [tx, i] : index) {
+    const double l = image.state[tx] == uint8_t(TexelState::Baked) && centre[tx] ? lambda : 0.1 * lambda;
+    lam2[size_t(i)] = l * l;
+  }
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, lam2[size_t(i)]);
+  Eigen::SparseMatrix<double> M(n, n);
+  M.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(M);
+  PRT_CHECK(solver.info() == Eigen::Success);  // positive definite: AᵀA + λ²I with λ > 0
+  Eigen::VectorXd rhs(n);
+  for (size_t c = 0; c < C; ++c) {
+    for (const auto& [tx, i] : index) rhs[i] = lam2[size_t(i)] * image.values[tx * C + c];
+    const Eigen::VectorXd x = solver.solve(rhs);
+    for (const auto& [tx, i] : index)
+      if (std::isfinite(x[i])) {
+        if (image.state[tx] == uint8_t(TexelState::Baked) && centre[tx])
+          out.baked_moved_max = std::max(out.baked_moved_max, std::abs(x[i] - image.values[tx * C + c]));
+        image.values[tx * C + c] = x[i];
+      }
+  }
+  for (const Point& p : points)
+    for (size_t c = 0; c < C; ++c) {
+      const double d = difference(p, c);
+      out.mean_after += d, out.max_after = std::max(out.max_after, d);
+    }
+  out.mean_after /= double(points.size() * C);
+  return out;
 }
 
 } // namespace prt::bake

@@ -203,6 +203,7 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
   }
 
   TexelAtlas out;
+  out.triangle_chart = chart;
   out.shared_texels = shared;
   out.overlapping_texels = overlapping;
   for (uint32_t c : chart) out.charts = std::max(out.charts, c + 1);

@@ -88,3 +88,37 @@ TEST(Lightmap, InvalidTexelsAreFilledFromTheirOwnChartOnly) {
     EXPECT_EQ(m.values[a.samples[i].texel], a.samples[i].chart == 0 ? 10.0 : 20.0) << "filled from its own chart";
   }
 }
+
+TEST(Lightmap, SeamStitchMakesBothSidesOfASeamAgree) {
+  // A unit square of two triangles whose UVs are cut along the diagonal: triangle 0 in the atlas's
+  // left half, triangle 1 in its right half (rotated), 2 texels apart. Each baked texel holds
+  // f(p) = 1 + p.x + 2 p.y² at its sample (smooth over the continuous square). Bilinear lookups
+  // along the diagonal from the two sides differ (each side's footprint reaches its padding,
+  // which holds its chart's mean beside it); stitching must bring them together: the mean
+  // |difference| falls at least tenfold, and a baked texel moves less than the largest difference
+  // before (it only shares the seam's correction).
+  const Mesh square = make_mesh({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{{0, 1, 2}}, {{0, 2, 3}}}, "square");
+  const Topology topo = build_topology(square);
+  UvSet uv;
+  uv.name = "cut";
+  // Triangle 0 (0,0)-(1,0)-(1,1) at u in [0.05, 0.45]; triangle 1 (0,0)-(1,1)-(0,1) at u in [0.55, 0.95], mirrored.
+  uv.corners = {{0.05f, 0.05f}, {0.45f, 0.05f}, {0.45f, 0.45f}, {0.55f, 0.05f}, {0.95f, 0.45f}, {0.55f, 0.45f}};
+  const TexelAtlas atlas = texel_atlas(square, topo, uv, 40, 40, "square");
+  ASSERT_EQ(atlas.charts, 2u);
+  std::vector<double> rows;
+  for (const ShadePoint& p : atlas.receivers.points) rows.push_back(1 + p.p.x() + 2 * p.p.y() * p.p.y());
+  Lightmap image = make_lightmap(atlas, rows, 1, {}, 2);
+  const Lightmap before = image;
+  const SeamStitch s = stitch_seams(image, atlas, square, topo, uv);
+  EXPECT_EQ(s.edges, 1u);
+  EXPECT_GT(s.points, 20u);  // ~2 per texel along a diagonal ~23 texels long
+  EXPECT_EQ(s.skipped_points, 0u);
+  EXPECT_GT(s.mean_before, 0.0);
+  EXPECT_LT(s.mean_after, s.mean_before / 10);
+  EXPECT_LT(s.baked_moved_max, s.max_before);
+  // Nothing but the seam's texels moved.
+  size_t moved = 0;
+  for (size_t k = 0; k < image.values.size(); ++k) moved += image.values[k] != before.values[k];
+  EXPECT_LE(moved, s.texels);
+  EXPECT_GT(moved, 0u);
+}

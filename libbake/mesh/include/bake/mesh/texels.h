@@ -64,6 +64,7 @@ struct TexelAtlas {
   std::vector<uint8_t> coverage;     // width·height: 1 where a texel is covered
   size_t texels_off_centre() const;  // samples that are not their texel's centre
   uint32_t charts = 0;               // of the UV set's triangles with area in the atlas
+  std::vector<uint32_t> triangle_chart;  // per triangle of the mesh (file comment)
   // Checks of the UV set at this resolution: texels that triangles of two charts touch (too
   // little gutter: a texel's value is then one chart's, and bilinear filtering bleeds the other's
   // in), and texels whose centre lies inside triangles of two charts (overlapping charts: a
