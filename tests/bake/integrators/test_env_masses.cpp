@@ -131,3 +131,29 @@ TEST(EnvMasses, EveryMassLandsOnceInTheCellThatHoldsIt) {
     }
   }
 }
+
+TEST(EnvMasses, AoAndTransferDoNotDependOnWhetherAnEnvironmentIsBaked) {
+  // The environment's columns no longer ask the tables for sub-samples (they are masses), so the
+  // smooth columns are the midpoint rule at every N whatever else is requested: AO and transfer of
+  // a bake with band-1 radiance are those of a bake without it, bit for bit.
+  const EnvMap env = panel_sky(64, 32);
+  const Vector3d n = Vector3d(0.3, 0.9, 0.2).normalized();
+  // A tent of two triangles over the point: it occludes, so the contour walk runs.
+  const Mesh mesh = make_mesh({{-1, 0.5f, -1}, {1, 0.5f, -1}, {0, 0.8f, 1}, {0, 0.2f, 2}}, {{0, 1, 2}, {0, 2, 3}}, "tent");
+  const Topology topo = build_topology(mesh);
+  ShadePoint sp;
+  sp.n = n;
+  ProductRequest plain, with_env;
+  plain.ao = with_env.ao = true;
+  plain.transfer_order = with_env.transfer_order = 3;
+  with_env.radiance = &env;
+  for (const int N : {32, 128}) {
+    const SilhouetteIntegrator a(mesh, topo, plain, {N, 1}), b(mesh, topo, with_env, {N, 1});
+    std::vector<double> ra(a.layout().width), rb(b.layout().width);
+    a.integrate(sp, 0, ra);
+    b.integrate(sp, 0, rb);
+    ASSERT_GT(ra[0], 0.0);
+    ASSERT_LT(ra[0], 1.0);
+    for (size_t k = 0; k < ra.size(); ++k) EXPECT_EQ(ra[k], rb[k]) << "N = " << N << ", value " << k;
+  }
+}
