@@ -187,23 +187,31 @@ struct SilhouetteIntegrator::Impl {
     // constant environment is smooth and stays in f.
     IsolineTables::PointMasses masses;
     if (envmap && envmap->texel_count() > 0 && n_env > 0) {
-      constexpr int kBlockTexels = 4096;
       const int texels = envmap->texel_count();
       const double cells_per_radian = double(grid.n) / std::sqrt(4 * std::numbers::pi);
+      auto subsamples_of = [cells_per_radian](double omega) {
+        return std::clamp(int(std::ceil(2.0 * std::sqrt(omega) * cells_per_radian)), 1, 16);
+      };
+      max_texel_subsamples = 1;
+      for (int tx = 0; tx < texels; ++tx)
+        max_texel_subsamples = std::max(max_texel_subsamples, subsamples_of(envmap->texel_solid_angle(tx)));
+      // Blocks of at most ~16,384 masses (a wave of 16 blocks holds them at once: ≤ 16 · 16,384 ·
+      // (24 + 8·n_env) bytes, 80 MiB with S of order 3), fixed by N and the map alone.
+      const int block_texels = std::clamp(16384 / (max_texel_subsamples * max_texel_subsamples), 1, 4096);
       masses.first = int(c_r), masses.count = int(n_env);
-      masses.blocks = size_t((texels + kBlockTexels - 1) / kBlockTexels);
+      masses.blocks = size_t((texels + block_texels - 1) / block_texels);
       const std::span<const Vector3d> midpoints = envmap->texel_midpoints();
-      masses.emit = [&, texels, cells_per_radian, midpoints](size_t b, std::vector<Vector3d>& directions,
-                                                            std::vector<double>& values) {
+      masses.emit = [&, texels, block_texels, subsamples_of, midpoints](size_t b, std::vector<Vector3d>& directions,
+                                                                       std::vector<double>& values) {
         std::vector<Vector3d> dirs;
         std::vector<double> y(size_t(sh::num_coeffs(16))), ybig;
-        const int t_end = std::min(texels, int(b + 1) * kBlockTexels);
-        for (int tx = int(b) * kBlockTexels; tx < t_end; ++tx) {
+        const int t_end = std::min(texels, int(b + 1) * block_texels);
+        for (int tx = int(b) * block_texels; tx < t_end; ++tx) {
           if (hot && hot->is_hot(tx)) continue;
           const Rgb L = envmap->texel_value(tx);
           if (L.r == 0 && L.g == 0 && L.b == 0) continue;
           const double omega = envmap->texel_solid_angle(tx);
-          const int k = std::clamp(int(std::ceil(2.0 * std::sqrt(omega) * cells_per_radian)), 1, 16);
+          const int k = subsamples_of(omega);
           const double w = omega / double(k * k);
           dirs.resize(size_t(k * k));
           if (k == 1) dirs[0] = midpoints[size_t(tx)];  // the same values, computed once per map
@@ -216,11 +224,6 @@ struct SilhouetteIntegrator::Impl {
           }
         }
       };
-      max_texel_subsamples = 1;
-      for (int tx = 0; tx < texels; tx += std::max(1, texels / 64))
-        max_texel_subsamples = std::max(
-            max_texel_subsamples,
-            std::clamp(int(std::ceil(2.0 * std::sqrt(envmap->texel_solid_angle(tx)) * cells_per_radian)), 1, 16));
     }
     tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
       const Vector3d w = world_from_frame * w_frame;
