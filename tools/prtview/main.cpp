@@ -74,6 +74,14 @@ WHAT IS DRAWN
     The first look (no --shade) shows the best the file holds: band1, else transfer, else ao
     (band1 only under its own environment: with another --env, transfer), and its first line
     says so and names the others.
+  per-texel files (/mesh/uv + /lightmap/... from 'prtbake texel', format version 5): drawn per
+    texel as an engine samples a lightmap (formats/SCHEMA.md): each pixel's UV interpolated from
+    its triangle's three corner UVs, the lightmap's product filtered bilinearly at texel
+    coordinates (u W - 1/2, v H - 1/2) (clamped to the edge), then the same prtshade formulas as
+    for a vertex (band1 and ao at the pixel's interpolated normal). stderr and the summary say
+    "per texel, WxH lightmap" and count the pixels whose bilinear footprint reached an empty
+    texel (0 when the padding does its job). --per-vertex draws a file's per-vertex products
+    instead (an error when it holds none: a texel bake writes none).
   FIV files (/fiv from 'prtbake fiv', paper 004): the occluder mesh (from --occluder-mesh, else
     the file's 'source' attribute; its SHA-256 must match the file's) stands on a square ground
     plane (the receiver), and each pixel is shaded by prtshade: the ground with
