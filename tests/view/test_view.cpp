@@ -5,6 +5,7 @@
 // against π·L and Lambert's form factor.
 #include <view/camera.h>
 #include <view/image.h>
+#include <view/lightmap.h>
 #include <view/raster.h>
 #include <view/reference.h>
 
@@ -534,4 +535,29 @@ TEST(Reference, SquareOccluderMatchesLambertFormFactor) {
       EXPECT_LT(se[0], 0.02 * pi);  // and precise enough to mean something (2 % of π L at 4096 rays)
     }
   }
+}
+
+// ---- per-texel sampling (view/lightmap.h) ----------------------------------------------------
+
+TEST(ViewLightmap, BilinearAtTexelCoordinatesWithClampToEdgeAndTheEmptyTexelCheck) {
+  // A 3 x 2 map of one channel, value 10 y + x, texel (2, 1) empty (state 0, value 0).
+  const std::vector<float> values = {0, 1, 2, 10, 11, 0};
+  const std::vector<uint8_t> state = {1, 1, 3, 1, 2, 0};
+  const prt::view::LightmapImage map{3, 2, 1, values, state};
+  float out = -1;
+  // A texel centre ((x + 1/2)/W, (y + 1/2)/H) gives the texel itself, with weight 0 elsewhere:
+  // no empty texel is reached even beside one.
+  EXPECT_FALSE(prt::view::sample_lightmap(map, 1.5 / 3, 1.5 / 2, &out));
+  EXPECT_EQ(out, 11.0f);
+  // Between the centres of (0, 0), (1, 0), (0, 1), (1, 1) at fractions (1/4, 1/2): a plane's
+  // value 10 fy + fx, exact in binary.
+  EXPECT_FALSE(prt::view::sample_lightmap(map, (0.5 + 0.25) / 3, (0.5 + 0.5) / 2, &out));
+  EXPECT_EQ(out, 5.25f);
+  // Outside [0, 1]: clamped to the edge texels' centres.
+  EXPECT_FALSE(prt::view::sample_lightmap(map, -1, -1, &out));
+  EXPECT_EQ(out, 0.0f);
+  // A footprint with weight on the empty texel (2, 1) is reported.
+  EXPECT_TRUE(prt::view::sample_lightmap(map, 2.25 / 3, 1.25 / 2, &out));
+  // (1.75, 0.75) in texel coordinates: 0.25*0.25*1 + 0.75*0.25*2 + 0.25*0.75*11 + 0.75*0.75*0
+  EXPECT_FLOAT_EQ(out, float(0.0625 + 0.375 + 2.0625));
 }

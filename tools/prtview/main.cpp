@@ -74,6 +74,14 @@ WHAT IS DRAWN
     The first look (no --shade) shows the best the file holds: band1, else transfer, else ao
     (band1 only under its own environment: with another --env, transfer), and its first line
     says so and names the others.
+  per-texel files (/mesh/uv + /lightmap/... from 'prtbake texel', format version 5): drawn per
+    texel as an engine samples a lightmap (formats/SCHEMA.md): each pixel's UV interpolated from
+    its triangle's three corner UVs, the lightmap's product filtered bilinearly at texel
+    coordinates (u W - 1/2, v H - 1/2) (clamped to the edge), then the same prtshade formulas as
+    for a vertex (band1 and ao at the pixel's interpolated normal). stderr and the summary say
+    "per texel, WxH lightmap" and count the pixels whose bilinear footprint reached an empty
+    texel (0 when the padding does its job). --per-vertex draws a file's per-vertex products
+    instead (an error when it holds none: a texel bake writes none).
   FIV files (/fiv from 'prtbake fiv', paper 004): the occluder mesh (from --occluder-mesh, else
     the file's 'source' attribute; its SHA-256 must match the file's) stands on a square ground
     plane (the receiver), and each pixel is shaded by prtshade: the ground with
@@ -196,6 +204,7 @@ struct Args {
   std::optional<double> phong;  // --phong S (--shade glossy)
   std::string glossy_route;     // --glossy-route a|b (--shade glossy; empty: B where the file has S)
   bool quiet = false;
+  bool per_vertex = false;  // --per-vertex: the per-vertex products even when the file has a lightmap
   int threads = 0;
 };
 
@@ -304,6 +313,9 @@ std::optional<Args> parse(int argc, char** argv) {
       app.add_option("--ground-size", ground_size, "FIV files: half-size of the ground square (default 4R + the copies' spread).");
   app.add_flag("--no-overlap", no_overlap, "FIV files: switch off the overlap correction for several occluders (eq. 13-14).");
   app.add_flag("--no-partial", no_partial, "FIV files: switch off the partial-occluder factor (h+R)/2R (case B).");
+  app.add_flag("--per-vertex", a.per_vertex,
+               "per-vertex and per-texel files: draw the per-vertex products (Gouraud) even when the file has a "
+               "lightmap (/lightmap, 'prtbake texel'), which is drawn per texel by default.");
   app.add_option("--threads", a.threads, "worker threads (default: all cores).")->check(CLI::Range(1, 4096));
   app.add_flag("-q,--quiet", a.quiet, "only errors.");
   for (CLI::Option* o : app.get_options()) o->description(wrap(o->get_description()));
@@ -458,14 +470,25 @@ int run(const Args& a) {
     kind = a.shade == "glossy" ? "glossy" : "scene";
   } else if (a.shade == "glossy") {
     throw UsageError("--shade glossy: " + a.file + " is not a scene file; glossy objects are baked by 'prtbake scene'");
-  } else if (kind.empty()) {
+  }
+  // Per-vertex files with a lightmap ('prtbake texel') are drawn per texel unless --per-vertex.
+  const bool plain = !area && !prtview::is_scene_file(f) && !prtview::has_fiv(f);
+  if (a.per_vertex && !plain) throw UsageError("--per-vertex applies to per-vertex and per-texel files, not to " + a.file);
+  if (a.per_vertex && prtview::vertex_kinds(f).empty() && prtview::has_lightmap(f))
+    throw bake::InputError(a.file, "holds no per-vertex product (AO, diffuse transfer or band-1 radiance): it was baked per texel "
+                                   "('prtbake texel': /lightmap/...); drop --per-vertex to draw its lightmap");
+  const bool texel = plain && !a.per_vertex && prtview::has_lightmap(f);
+  const auto kinds_of = [&] { return texel ? prtview::texel_kinds(f) : prtview::vertex_kinds(f); };
+  const auto label_of = [&](const std::string& k) { return texel ? prtview::texel_kind_label(f, k) : prtview::vertex_kind_label(f, k); };
+  if (!area && !prtview::is_scene_file(f) && a.shade != "glossy" && kind.empty()) {
     // The first look: the best product the file holds (prtview::vertex_kinds' order), except
     // band-1 radiance under an --env it was not baked with (it belongs to its own environment).
-    std::vector<std::string> kinds = prtview::vertex_kinds(f);
+    std::vector<std::string> kinds = kinds_of();
     if (!a.env.empty() && kinds.size() > 1 && kinds.front() == "band1") {
-      const std::string baked_sha = prtview::band1_environment_sha256(f);
+      const std::string baked_sha = texel ? f.vertices.lightmap->radiance_band1->environment_sha256.value_or("")
+                                          : prtview::band1_environment_sha256(f);
       if (!baked_sha.empty() && fs::exists(a.env) && baked_sha != bake::sha256_file(a.env)) {
-        skipped = "its " + prtview::vertex_kind_label(f, "band1") + " belongs to the environment it was baked with: drop --env to see it";
+        skipped = "its " + label_of("band1") + " belongs to the environment it was baked with: drop --env to see it";
         kinds.erase(kinds.begin());
       }
     }
@@ -473,7 +496,10 @@ int run(const Args& a) {
   }
   if (kind != "scene" && kind != "glossy" && kind != "fiv" && !area && prtview::has_fiv(f))
     throw UsageError("--shade " + kind + ": " + a.file + " is an FIV file; it is shown with --shade fiv (the default)");
-  if (kind == "transfer" || kind == "band1" || kind == "ao") prtview::require_vertex_kind(f, a.file, kind);
+  if (kind == "transfer" || kind == "band1" || kind == "ao") {
+    if (texel) prtview::require_texel_kind(f, a.file, kind);
+    else prtview::require_vertex_kind(f, a.file, kind);
+  }
   const prtview::FirstLook look = given_camera ? prtview::FirstLook{*given_camera, ""}
                                                : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height, kind == "glossy");
   const view::Camera& cam = look.camera;
@@ -520,14 +546,23 @@ int run(const Args& a) {
                                                                                                           : prtview::GlossyRoute::Auto,
                                                                                   scene)
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
+                              : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();
+  if (!a.quiet && !scene.form.empty()) {  // which form was drawn, on stderr (the summary below says it too)
+    if (texel)
+      std::fprintf(stderr, "prtview: %s: drawn %s (bilinear through /mesh/uv); %zu of %zu pixels reached an empty texel\n",
+                   a.file.c_str(), scene.form.c_str(), scene.empty_texel_pixels, scene.texel_pixels);
+    else
+      std::fprintf(stderr, "prtview: %s: drawn %s (Gouraud)%s\n", a.file.c_str(), scene.form.c_str(),
+                   prtview::has_lightmap(f) ? "; its lightmap is drawn without --per-vertex" : "");
+  }
   const std::string env_name = env_path.empty() ? std::string() : fs::path(env_path).filename().string();
   // What the picture shows, for the first line and the first panel's caption.
   std::string shown, caption;
   if (kind == "band1" || kind == "transfer" || kind == "ao") {
-    caption = prtview::vertex_kind_label(f, kind);
-    shown = caption + (kind == "band1"        ? " (exact shadows under " + env_name + ")"
+    caption = label_of(kind);
+    shown = caption + (texel ? ", " + scene.form : std::string()) + (kind == "band1" ? " (exact shadows under " + env_name + ")"
                        : kind == "transfer" ? " under " + env_name
                        : white_sky          ? " under a white sky"
                                             : " x the unshadowed irradiance of " + env_name);
@@ -547,8 +582,9 @@ int run(const Args& a) {
   if (say) {
     std::vector<std::string> also;
     if (kind == "band1" || kind == "transfer" || kind == "ao") {
-      for (const std::string& k : prtview::vertex_kinds(f))
-        if (k != kind) also.push_back(prtview::vertex_kind_label(f, k) + " (--shade " + k + ")");
+      for (const std::string& k : kinds_of())
+        if (k != kind) also.push_back(label_of(k) + " (--shade " + k + ")");
+      if (texel && !prtview::vertex_kinds(f).empty()) also.push_back("the per-vertex products (--per-vertex)");
     } else if (kind == "scene" || kind == "glossy" || area) {
       const bool glossy = std::any_of(f.objects.begin(), f.objects.end(), [](const F::SceneObject& o) {
         return o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed);
@@ -681,9 +717,9 @@ int run(const Args& a) {
   }
   if (object_lines == prtview::kObjectLines && receivers > object_lines)
     std::printf("  (the first %zu receivers in view of %zu)\n", object_lines, receivers);
-  char quality[200];
-  std::snprintf(quality, sizeof quality, "RMSE %.4g in this picture (NRMSE %.4g, %zu px, reference noise %.2g)", e.rmse, e.nrmse,
-                e.pixels, e.ref_noise);
+  char quality[256];
+  std::snprintf(quality, sizeof quality, "RMSE %.4g in this picture (NRMSE %.4g, %zu px, reference noise %.2g%s%s)", e.rmse, e.nrmse,
+                e.pixels, e.ref_noise, scene.form.empty() ? "" : "; ", scene.form.c_str());
   if (say) std::printf("quality: %s; file: %s\n", quality, report.c_str());
   view::Image diff(a.width, a.height);
   for (size_t i = 0; i < diff.rgb.size(); ++i) diff.rgb[i] = mask[i / 3] ? runtime.rgb[i] - ref.radiance.rgb[i] : 0.0f;
@@ -704,7 +740,9 @@ int run(const Args& a) {
   } else {
     char exposed[48];
     std::snprintf(exposed, sizeof exposed, ", exposure %.4g", exposure);
-    const view::Panel panels[3] = {{view::tone_map(runtime, exposure), "baked (" + caption + ")", std::nullopt},
+    const view::Panel panels[3] = {{view::tone_map(runtime, exposure),
+                                                     "baked (" + caption + (scene.form.empty() ? "" : ", " + scene.form.substr(0, scene.form.find(','))) + ")",
+                                                     std::nullopt},
                                    {view::tone_map(ref.radiance, exposure), "reference (ray traced)", std::nullopt},
                                    error_panel};
     std::vector<std::string> lines = footer;

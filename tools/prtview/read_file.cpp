@@ -95,6 +95,71 @@ std::string band1_environment_sha256(const F::Asset& f) {
   const std::optional<F::Product>& p = s.radiance_band1 ? s.radiance_band1 : s.radiance_shadowed;
   return p ? p->environment_sha256.value_or("") : std::string();
 }
+bool has_lightmap(const F::Asset& f) { return f.vertices.lightmap.has_value(); }
+std::vector<std::string> texel_kinds(const F::Asset& f) {
+  std::vector<std::string> kinds;
+  if (!f.vertices.lightmap) return kinds;
+  const F::Lightmap& m = *f.vertices.lightmap;
+  if (m.radiance_band1) kinds.push_back("band1");
+  if (m.transfer_diffuse) kinds.push_back("transfer");
+  if (m.ao) kinds.push_back("ao");
+  return kinds;
+}
+std::string texel_kind_label(const F::Asset& f, const std::string& kind) {
+  if (kind == "band1") return "band-1 radiance";
+  if (kind == "transfer") {
+    const F::Lightmap* m = f.vertices.lightmap ? &*f.vertices.lightmap : nullptr;
+    const bool known = m && m->transfer_diffuse && m->transfer_diffuse->sh_order;
+    return "diffuse transfer order " + (known ? std::to_string(*m->transfer_diffuse->sh_order) : std::string("?"));
+  }
+  if (kind == "ao") return "AO";
+  return kind;
+}
+void require_texel_kind(const F::Asset& f, const std::string& file, const std::string& kind) {
+  const std::vector<std::string> kinds = texel_kinds(f);
+  if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) return;
+  const std::string_view path = kind == "transfer" ? N::kLightmapTransferDiffuse : kind == "band1" ? N::kLightmapRadianceBand1 : N::kLightmapAo;
+  std::string hint = " (its lightmap holds no product prtview shades: AO, diffuse transfer or band-1 radiance)";
+  if (!kinds.empty()) {
+    hint = " (its lightmap can be shown with";
+    for (size_t i = 0; i < kinds.size(); ++i) hint += (i ? i + 1 == kinds.size() ? " or " : ", " : " ") + ("--shade " + kinds[i]);
+    hint += ")";
+  }
+  throw InputError(file, "no dataset " + std::string(path) + hint);
+}
+TexelProduct read_texel_product(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env) {
+  require_texel_kind(f, file, kind);
+  const F::VertexSet& s = f.vertices;
+  const F::Lightmap& m = *s.lightmap;
+  if (!s.uv) throw InputError(file, "no dataset " + std::string(N::kUv) + " (the lightmap's UVs)");
+  if (!s.triangles || s.uv->values.size() != 2 * s.triangles->values.size())
+    throw InputError(file, std::string(N::kUv) + " does not hold one (u, v) per corner of " + std::string(N::kTriangles));
+  TexelProduct p;
+  p.width = int(m.width);
+  p.height = int(m.height);
+  p.state = &m.state.values;
+  p.corner_uv = &s.uv->values;
+  p.uv_set = s.uv->uv_set.value_or("");
+  const F::Product* product = nullptr;
+  std::string_view path;
+  if (kind == "ao") {
+    product = &*m.ao, path = N::kLightmapAo, p.channels = 1;
+  } else if (kind == "transfer") {
+    product = &*m.transfer_diffuse, path = N::kLightmapTransferDiffuse;
+    if (!product->sh_order) throw InputError(file, std::string(path) + " lacks the attribute " + quoted(N::kShOrder));
+    p.order = int(*product->sh_order);
+    p.channels = size_t(p.order) * size_t(p.order);
+  } else {
+    product = &*m.radiance_band1, path = N::kLightmapRadianceBand1, p.channels = 9, p.order = 2;
+    check_same_environment(*product, std::string(path), env, file);
+  }
+  p.values = &product->values;
+  const size_t texels = m.texel_count();
+  if (m.width == 0 || m.height == 0 || m.state.values.size() != texels || product->values.size() != texels * p.channels)
+    throw InputError(file, std::string(path) + " does not hold [H][W][" + std::to_string(p.channels) + "] values of the " +
+                               std::to_string(m.height) + " x " + std::to_string(m.width) + " lightmap");
+  return p;
+}
 bake::UpAxis up_axis(const F::Asset& f) { return f.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y; }
 
 std::string baked_environment(const F::Asset& f, const std::string& file) {

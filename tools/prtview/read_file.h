@@ -39,6 +39,28 @@ std::string band1_environment_sha256(const formats::Asset& f);
 // Throws InputError naming the missing dataset and the kinds the file can be shown with, unless
 // the root layout holds `kind`'s product ("transfer", "band1" or "ao").
 void require_vertex_kind(const formats::Asset& f, const std::string& file, const std::string& kind);
+// Per-texel files (format version 5, 'prtbake texel'): the root layout's /lightmap with its UVs
+// (/mesh/uv). texel_kinds: the --shade kinds its lightmap can be shown with, in vertex_kinds'
+// order (band1 = /lightmap/radiance/band1, transfer, ao); texel_kind_label names them as
+// vertex_kind_label does.
+bool has_lightmap(const formats::Asset& f);
+std::vector<std::string> texel_kinds(const formats::Asset& f);
+std::string texel_kind_label(const formats::Asset& f, const std::string& kind);
+// Throws InputError naming the missing /lightmap dataset and the kinds the lightmap holds.
+void require_texel_kind(const formats::Asset& f, const std::string& file, const std::string& kind);
+// `kind`'s lightmap product of the root layout, checked: shape [H][W][channels] (ao 1, transfer
+// order², band1 3x3), /mesh/uv holding 6 floats per triangle, the state [H][W]; band1 baked under
+// `env` (SHA-256). Pointers into the asset.
+struct TexelProduct {
+  int width = 0, height = 0;
+  size_t channels = 0;
+  int order = 0;  // transfer: the SH order; band1: 2; ao: 0
+  const std::vector<float>* values = nullptr;
+  const std::vector<uint8_t>* state = nullptr;
+  const std::vector<float>* corner_uv = nullptr;
+  std::string uv_set;
+};
+TexelProduct read_texel_product(const formats::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env);
 bake::UpAxis up_axis(const formats::Asset& f);
 // The environment the file names (the 'environment' of the scene, of the irradiance cube or of
 // the root band-1 radiance), found as given, next to the file, or next to the scene file. Throws

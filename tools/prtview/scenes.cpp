@@ -3,6 +3,7 @@
 
 #include "read_file.h"
 
+#include <view/lightmap.h>
 #include <view/raster.h>
 
 #include <bake/bake/fiv.h>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -135,7 +137,54 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
     colour = ao_colours(read_ao(f, file, ""), scene.mesh, nullptr, &exact, scene.how);
     scene.how += " per vertex, Gouraud";
   }
+  scene.form = "per vertex";
   return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), colour);
+}
+
+view::Image render_texel_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
+                              const view::Camera& cam, RenderScene& scene) {
+  scene.mesh = read_mesh(f, file, "");
+  const TexelProduct p = read_texel_product(f, file, kind, env);
+  const view::LightmapImage map{p.width, p.height, p.channels, *p.values, *p.state};
+  scene.form = "per texel, " + std::to_string(p.width) + "x" + std::to_string(p.height) + " lightmap";
+  scene.what = "mesh: " + std::to_string(scene.mesh.positions.size()) + " vertices, " + std::to_string(scene.mesh.triangles.size()) +
+               " triangles; " + scene.form + " (UV set " + (p.uv_set.empty() ? std::string("unnamed") : p.uv_set) + ")";
+  const auto to_float = [](const Vector3d& n, float* out) {
+    for (int c = 0; c < 3; ++c) out[c] = float(n[c]);
+  };
+  std::function<void(const view::Fragment&, const float*, float*)> shade;
+  std::vector<float> light;
+  std::unique_ptr<bake::UnshadowedIrradiance> exact;
+  if (kind == "transfer") {
+    light = environment_sh(env, p.order, scene.how);
+    shade = [&](const view::Fragment&, const float* t, float* rgb) { shade::shade_transfer_vertices(t, 1, p.order, light.data(), rgb); };
+  } else if (kind == "band1") {
+    scene.how = "prt::shade::shade_band1 (E/pi) at the pixel's interpolated normal";
+    shade = [&](const view::Fragment& fr, const float* r, float* rgb) {
+      float n[3];
+      to_float(fr.n, n);
+      shade::shade_band1_vertices(n, r, 1, rgb);
+      for (int c = 0; c < 3; ++c) rgb[c] *= float(std::numbers::inv_pi);
+    };
+  } else {
+    exact = std::make_unique<bake::UnshadowedIrradiance>(env);
+    scene.how = "AO x exact unshadowed irradiance at the pixel's interpolated normal / pi";
+    shade = [&](const view::Fragment& fr, const float* ao, float* rgb) {
+      const bake::Rgb u = (*exact)(fr.n);
+      const double e[3] = {u.r, u.g, u.b};
+      for (int c = 0; c < 3; ++c) rgb[c] = float(double(ao[0]) * e[c] * std::numbers::inv_pi);
+    };
+  }
+  // The sample is shaded per pixel; the text says so in place of "per vertex, Gouraud".
+  const std::string gouraud = " per vertex, Gouraud";
+  if (const size_t at = scene.how.find(gouraud); at != std::string::npos) scene.how.erase(at);
+  if (const size_t at = scene.how.find(", Gouraud"); at != std::string::npos) scene.how.erase(at);
+  view::TexelRender r = view::shade_texels(scene.mesh, view::rasterize(scene.mesh, cam), *p.corner_uv, map, shade);
+  scene.texel_pixels = r.pixels;
+  scene.empty_texel_pixels = r.empty_hits;
+  scene.how += ", " + scene.form + ", bilinear through /mesh/uv; " + std::to_string(r.empty_hits) + " of " +
+               std::to_string(r.pixels) + " pixels reached an empty texel";
+  return std::move(r.image);
 }
 
 FirstLook first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height,

@@ -28,6 +28,11 @@ struct RenderScene {
   std::vector<view::Sphere> spheres;
   std::string what;  // one line: what was drawn
   std::string how;   // how the runtime shaded it
+  // Per-vertex and per-texel files: which form was drawn ("per vertex" or "per texel, 512x512
+  // lightmap") and, per texel, the covered pixels whose bilinear footprint reached an empty texel
+  // (view/lightmap.h's check; 0 when the padding does its job).
+  std::string form;
+  size_t texel_pixels = 0, empty_texel_pixels = 0;
   // Scene files: the reference's per-triangle shadow casters and albedos (view::ReferenceOptions),
   // and the objects' triangle ranges: object k owns [first_triangle[k], first_triangle[k + 1]).
   std::vector<uint8_t> casts_shadow;
@@ -57,6 +62,14 @@ void add_grouped(std::string& how, const std::vector<std::string>& names, const 
 // Per-vertex files: kind "transfer", "band1" or "ao".
 view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
                                const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
+
+// Per-texel files (/lightmap, 'prtbake texel'): `kind` "transfer", "band1" or "ao" of the
+// lightmap, each pixel sampled bilinearly through its triangle's interpolated UV
+// (view::shade_texels, SCHEMA's rule) and shaded by the same prtshade formulas as a vertex, at the
+// pixel's interpolated normal where the formula takes one (band1's y_1m(n), AO's unshadowed
+// irradiance).
+view::Image render_texel_file(const formats::Asset& f, const std::string& file, const std::string& kind,
+                              const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
 struct FivView {
