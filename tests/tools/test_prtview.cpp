@@ -371,8 +371,8 @@ TEST(PrtviewScene, AlbedoScalesTheObjectsPixelsExactly) {
   // product, interpolated sum and float conversion halves exactly), so the mean over the ground's
   // pixels (double sums of halved floats) halves exactly; printed with 9 digits: 1e-8 relative.
   // The box (no material: the scene's default) is unchanged.
-  const fs::path half = bake_scene("half", 0.5), one = bake_scene("one", 1.0);
-  const Outcome a = view(half.string() + " " + kSceneCamera + " --size 48x36 -o " + scratch("half.png").string());
+  const fs::path halved = bake_scene("half", 0.5), one = bake_scene("one", 1.0);
+  const Outcome a = view(halved.string() + " " + kSceneCamera + " --size 48x36 -o " + scratch("half.png").string());
   const Outcome b = view(one.string() + " " + kSceneCamera + " --size 48x36 -o " + scratch("one.png").string());
   ASSERT_EQ(a.code, 0) << a.err;
   ASSERT_EQ(b.code, 0) << b.err;
