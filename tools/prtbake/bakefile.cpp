@@ -4,6 +4,8 @@
 #include <formats/names.h>
 
 #include <cctype>
+#include <cmath>
+#include <string>
 
 namespace prt::tool {
 namespace {
@@ -204,13 +206,22 @@ void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const s
 
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible) {
   F::Report out;
-  for (const auto& e : report.products)
+  for (const auto& e : report.products) {
+    // A product checked against the bake's own integrator at a finer level (bake/bake/error_report.h
+    // ProductError::finer) says so, with its own points.
+    const bool finer = e.finer > 1;
+    const std::string reference =
+        finer ? "the bake's integrator at " + std::to_string(e.finer_knob) + " isolines (" +
+                    std::to_string(int(std::lround(e.finer))) + "x the bake's; deterministic: reference_std_error is "
+                    "its own error at most, order 1)"
+              : report.reference;
     out.rows.push_back(report_row(report_row_name(e.product),
                                   {float(e.rmse), float(e.max_abs), float(e.reference_rms), float(e.bake_std_error),
                                    float(e.reference_std_error)},
                                   "rmse, max_abs, reference_rms, bake_std_error, reference_std_error",
-                                  report.vertices.size(), report.reference, report.reference_seconds, bake_seconds,
-                                  double(points) / bake_seconds, reproducible));
+                                  finer ? e.finer_points : report.vertices.size(), reference, report.reference_seconds,
+                                  bake_seconds, double(points) / bake_seconds, reproducible));
+  }
   out.vertices = F::Array<uint32_t>{report.vertices, {}};
   return out;
 }

@@ -220,8 +220,12 @@ void print_error_report(const bake::BakeJob& job) {
     std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse, e.max_abs,
                 e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
     if (sampled) std::printf("bake's estimated std. error %.3e; ", e.bake_std_error);
-    std::printf("the reference's own std. error %.3e, %s)\n", e.reference_std_error,
-                report.reference_noise_measured ? "measured from its two halves" : "QMC's estimate");
+    if (e.finer > 1)
+      std::printf("against the same integrator at %.0fx its isolines, N = %u, on %zu %s: its own error at most %.3e)\n",
+                  e.finer, e.finer_knob, e.finer_points, job.sets.front().rows_noun, e.reference_std_error);
+    else
+      std::printf("the reference's own std. error %.3e, %s)\n", e.reference_std_error,
+                  report.reference_noise_measured ? "measured from its two halves" : "QMC's estimate");
   }
 }
 

@@ -265,21 +265,26 @@ void BakePipeline::check_finer(BakeJob& job, const Monitor& monitor) {
     if (!settings_.counted_costs && rows > n &&
         per_point * double(rows) <= budget * double(rows) / double(std::max<uint64_t>(job.row_count(), 1)))
       r = compare_points_with_reference(job.sets[s].points, job.rows[s], *finer, rows, job.spec.seed, monitor);
-    for (ProductError& e : r.products)
-      e.finer = double(fine_n) / double(N), e.finer_knob = uint32_t(fine_n), e.finer_points = r.vertices.size();
-    // The same points as the QMC reference's (the same seed and count): replace the undecided
-    // products' rows of this set's report too, so that what is printed is what was judged.
+    const double f = double(fine_n) / double(N);
+    for (ProductError& e : r.products) {
+      e.finer = f, e.finer_knob = uint32_t(fine_n), e.finer_points = r.vertices.size();
+      // The finer level's own error, at most m/(f − 1) (order 1; TargetVerdict): the column the
+      // file and the printed report call the reference's own.
+      e.reference_std_error = e.rmse / (f - 1.0);
+    }
+    // Replace the undecided products' rows of this set's report too (their points are the finer
+    // check's, finer_points), so that what is printed and written is what was judged.
     for (ProductError& e : job.reports[s]->products)
       if (std::find(undecided.begin(), undecided.end(), e.product) != undecided.end())
-        for (const ProductError& f : r.products)
-          if (f.product == e.product) e = f;
+        for (const ProductError& fe : r.products)
+          if (fe.product == e.product) e = fe;
     job.reports[s]->reference_seconds += r.reference_seconds;
     pool_product_errors(pooled, r.products);
   }
   for (ProductError& e : job.pooled->products)
     if (std::find(undecided.begin(), undecided.end(), e.product) != undecided.end())
-      for (const ProductError& f : pooled)
-        if (f.product == e.product) e = f;
+      for (const ProductError& fe : pooled)
+        if (fe.product == e.product) e = fe;
 }
 
 std::optional<double> BakePipeline::cpu_seconds_per_row(const BakeJob& job, size_t n) const {
