@@ -223,11 +223,13 @@ void BakePipeline::check(const Monitor& monitor, const PipelineHooks& hooks, con
         pooled.vertices.insert(pooled.vertices.end(), r.vertices.begin(), r.vertices.end());
         pooled.reference_seconds += r.reference_seconds;
       }
-      if (hooks.set_checked) hooks.set_checked(job, s);
     }
     if (checked == 0) continue;
     job.pooled = std::move(pooled);
     if (target) check_finer(job, monitor);
+    // The sets' reports as judged (check_finer may have replaced their R and S rows).
+    for (size_t s = 0; s < job.sets.size() && hooks.set_checked; ++s)
+      if (job.reports[s]) hooks.set_checked(job, s);
     if (hooks.job_checked) hooks.job_checked(job);
   }
 }

@@ -94,7 +94,7 @@ struct PipelineHooks {
   std::function<void()> baked;
   std::function<void()> checking;                        // before the first check of a round
   std::function<void(const BakeJob&)> check_planned;     // with E: its reference plan is made
-  std::function<void(const BakeJob&, size_t s)> set_checked;
+  std::function<void(const BakeJob&, size_t s)> set_checked;   // its report is final (after the finer check)
   std::function<void(const BakeJob&)> job_checked;       // its pooled report is made
   std::function<void(const BakeJob&, const IntegratorSpec& better)> correcting;
 };
