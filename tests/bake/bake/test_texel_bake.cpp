@@ -84,18 +84,23 @@ double ao_closed_form(const Vector3d& p) {
   return 1 - blocked / kPi;
 }
 
-VertexBake bake_ao(const FloorAndBox& s, const TexelAtlas& atlas, const IntegratorSpec& spec) {
-  const Topology topo = build_topology(s.both);
-  const MeshAccel accel(s.both, topo);
+// AO of the atlas's texels through the pipeline, occluded by `mesh`, without a report.
+VertexBake bake_ao(const Mesh& mesh, const Topology& topo, const MeshAccel& accel, const TexelAtlas& atlas,
+                   const IntegratorSpec& spec) {
   PipelineSettings settings;
   settings.integrator = spec;
   settings.integrator.report_points = 0;
   std::vector<BakeJob> jobs(1);
   jobs[0].request.ao = true;
   jobs[0].sets.push_back(atlas.receivers);
-  BakePipeline pipeline(s.both, topo, accel, settings, std::move(jobs));
+  BakePipeline pipeline(mesh, topo, accel, settings, std::move(jobs));
   pipeline.run({});
   return pipeline.jobs()[0].rows[0];
+}
+VertexBake bake_ao(const FloorAndBox& s, const TexelAtlas& atlas, const IntegratorSpec& spec) {
+  const Topology topo = build_topology(s.both);
+  const MeshAccel accel(s.both, topo);
+  return bake_ao(s.both, topo, accel, atlas, spec);
 }
 
 } // namespace
@@ -257,15 +262,7 @@ TEST(TexelBake, TexelsOnACurvedSurfaceLieOnTheirTrianglesAndSeeWhatIsAboveTheirF
   // silhouette integrator at N = 256 within 1e-3: the sliver is bounded by the own face's edges,
   // whose error oscillates at ~0.1/N (file comment), 4e-4 here (measured: worst 3.0e-4).
   auto check = [&](const IntegratorSpec& spec, double tol_abs, double tol_se, const char* what) {
-    PipelineSettings settings;
-    settings.integrator = spec;
-    settings.integrator.report_points = 0;
-    std::vector<BakeJob> jobs(1);
-    jobs[0].request.ao = true;
-    jobs[0].sets.push_back(atlas.receivers);
-    BakePipeline pipeline(mesh, topo, accel, settings, std::move(jobs));
-    pipeline.run({});
-    const VertexBake& rows = pipeline.jobs()[0].rows[0];
+    const VertexBake rows = bake_ao(mesh, topo, accel, atlas, spec);
     double worst = 0;
     for (size_t i = 0; i < want.size(); ++i)
       if (want[i] >= 0) {
