@@ -2,6 +2,8 @@
 // floating-point expansion arithmetic (Shewchuk 1997), used only when a filter cannot decide.
 #include <bake/mesh/predicates.h>
 
+#include "error_free.h"
+
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -13,24 +15,10 @@ namespace {
 // ---------------------------------------------------------------- expansion arithmetic
 // Non-overlapping expansions in increasing magnitude, zero components eliminated (Shewchuk,
 // "Adaptive Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates", 1997).
-inline void two_sum(double a, double b, double& x, double& y) {
-  x = a + b;
-  const double bv = x - a, av = x - bv;
-  y = (a - av) + (b - bv);
-}
-inline void fast_two_sum(double a, double b, double& x, double& y) {  // |a| >= |b|
-  x = a + b;
-  y = b - (x - a);
-}
-inline void two_diff(double a, double b, double& x, double& y) {
-  x = a - b;
-  const double bv = a - x, av = x + bv;
-  y = (a - av) + (bv - b);
-}
-inline void two_product(double a, double b, double& x, double& y) {
-  x = a * b;
-  y = std::fma(a, b, -x);
-}
+using error_free::fast_two_sum;
+using error_free::two_diff;
+using error_free::two_product;
+using error_free::two_sum;
 
 template <int Cap>
 struct Expansion {

@@ -3,13 +3,15 @@
 #include <bake/core/error.h>
 #include <bake/mesh/receivers.h>
 
+#include "error_free.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
-#include <span>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <utility>
 
 namespace prt::bake {
@@ -51,16 +53,16 @@ double nearest_on_segment(const V2& p, const V2& q, const V2& c) {
   return std::clamp((c - p).dot(d) / len2, 0.0, 1.0);
 }
 
-
-// x + y and x · y in double, true when exact (Knuth's TwoSum error and the fma residue are 0).
+// x + y and x · y in double, true when exact (their rounding errors, error_free.h, are 0).
 bool exact_sum(double x, double y, double& out) {
-  out = x + y;
-  const double bb = out - x;
-  return (x - (out - bb)) + (y - bb) == 0.0;
+  double err;
+  error_free::two_sum(x, y, out, err);
+  return err == 0.0;
 }
 bool exact_product(double x, double y, double& out) {
-  out = x * y;
-  return std::fma(x, y, -out) == 0.0;
+  double err;
+  error_free::two_product(x, y, out, err);
+  return err == 0.0;
 }
 
 // The point o + Σ_k w_k (q_k − o) of a triangle's plane (or an edge's line: one q), computed so that
