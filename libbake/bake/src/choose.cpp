@@ -49,6 +49,13 @@ constexpr double kQmcCheckSigmas = 3.0;
 // On 32 points a band-1 bias from 1.9e-3 (city.exr, a sun of 3·10^4× the mean), 2.5e-3 (sunset)
 // and 3.2e-3 (studio) relative up shows (sphereWithHole.stl; sqrt(3 · sd/√K) of the products).
 constexpr uint32_t kCheckRays = 16384;
+// ... fewer, by octaves down to kCheckRaysMin, where those rays would cost more than
+// kCheckBudgetShare × the chosen plan's predicted cost (setup and bake): on a mesh that bakes in
+// 0.08 s the check must not be the pilot's largest part (it was 0.35 of 0.64 CPU s on
+// sphereWithHole.stl). The detection limit grows as sqrt(kCheckRays / rays) (4× at 1,024), and
+// the error report after the bake (bake/bake/target_check.h) verifies the file at E/3 anyway.
+constexpr uint32_t kCheckRaysMin = 1024;
+constexpr double kCheckBudgetShare = 1.0;
 // ... on the first 32 pilot points at most (the seeded sample's order): the bound is a t-test over
 // points, whose spread 32 points already estimate, and 128 points would cost 4× the rays.
 constexpr size_t kCheckPoints = 32;
@@ -402,18 +409,28 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   struct SilRun {
     Rows rows;
     double cost = 0;
+    std::unique_ptr<SilhouetteIntegrator> integrator;  // kept for the reference level only (Prediction::built)
   };
   std::map<int, SilRun> sil;
+  // The levels share the environment's hot texels and point masses (built once, not per level).
+  // The setup a level's build measures is then less than a bake's, which builds them afresh:
+  // setup_sil is the first level's (the reference, which built them).
+  const auto env_cache = std::make_shared<SilhouetteEnvCache>();
+  // Step 1 keeps its levels' integrators (one of them becomes the reference); only the
+  // reference's stays after it, and only when the bake shares the pilot's trees (accel).
+  bool keep_integrators = accel != nullptr;
   auto run_sil = [&](int N) -> const SilRun& {
     if (const auto it = sil.find(N); it != sil.end()) return it->second;
     double s = 0;
-    const auto integrator = timed_build(
-        [&] { return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, SilhouetteOptions{N, base.seed}, shared); },
-        s);
+    SilhouetteOptions so{N, base.seed};
+    so.env_cache = env_cache;
+    auto integrator = timed_build(
+        [&] { return std::make_unique<SilhouetteIntegrator>(mesh, topology, request, so, shared); }, s);
     setup_sil = std::max(setup_sil, s);
     SilRun run;
     run.rows = integrate_pilot(*integrator, points, sample, progress);
     run.cost = cost_per_point(run.rows, *integrator, uint32_t(N), counted);
+    if (keep_integrators) run.integrator = std::move(integrator);
     return sil.emplace(N, std::move(run)).first->second;
   };
 
@@ -450,7 +467,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     N_ref *= 2;
   }
   choice.reference_isolines = uint32_t(N_ref);
-  const SilRun& ref_run = run_sil(N_ref);
+  for (auto& [N, run] : sil)
+    if (N != N_ref) run.integrator.reset();
+  keep_integrators = false;
+  SilRun& ref_run = sil.at(N_ref);
   const std::vector<double>& ref = ref_run.rows.values;
   size_t worst_p = 0;
   for (size_t p = 0; p < P; ++p)
@@ -481,46 +501,6 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     if (is_radiance(sl.product))
       for (size_t i = 0; i < K && !any_radiance; ++i)
         for (size_t k = 0; k < sl.count; ++k) any_radiance = any_radiance || ref[i * W + sl.offset + k] != 0.0;
-  if (request.environment() && any_radiance) {
-    // Under an environment the hot texels are integrated apart from the isolines (bake/
-    // silhouette.h), so their error need not shrink with N and Richardson cannot see it. Two
-    // independent QMC runs f, c (kCheckRays and a quarter of it): their noises are independent of
-    // each other and of the reference's error b, so the mean of (f − ref)(c − ref) is b² — no
-    // convergence rate assumed — with the spread of its per-point means (below).
-    const QmcIntegrator fine(mesh, topology, request, QmcOptions{kCheckRays, mix64(base.seed ^ kCheckSalt)}, shared);
-    const QmcIntegrator coarse(mesh, topology, request, QmcOptions{kCheckRays / 4, mix64(base.seed ^ kCheckSalt ^ 1)},
-                               shared);
-    const std::vector<uint32_t> check_sample(sample.begin(), sample.begin() + std::min(K, kCheckPoints));
-    const size_t Kc = check_sample.size();
-    const Rows f = integrate_pilot(fine, points, check_sample, progress);
-    const Rows c = integrate_pilot(coarse, points, check_sample, progress);
-    for (size_t p = 0; p < P; ++p) {
-      const ProductSlice& sl = products[p];
-      // Per pilot point i: x_i = the mean over its values of (f − ref)(c − ref). The values of one
-      // point share its rays (one sun sample moves all nine band-1 numbers), so the points, not
-      // the values, are the independent draws: b² ≥ mean(x) − kQmcCheckSigmas · sd(x)/√K.
-      std::vector<double> x(Kc, 0.0);
-      double r2 = 0;
-      for (size_t i = 0; i < Kc; ++i)
-        for (size_t k = 0; k < sl.count; ++k) {
-          const size_t j = i * W + sl.offset + k;
-          x[i] += (f.values[j] - ref[j]) * (c.values[j] - ref[j]);
-          r2 += ref[j] * ref[j];
-        }
-      const double n = double(std::max<size_t>(Kc * sl.count, 1));
-      r2 /= n;
-      // Relative, like pilot_errors, for R and S.
-      double scale = 1.0 / double(std::max<size_t>(sl.count, 1));
-      if (is_radiance(sl.product)) scale = r2 > 0 ? scale / r2 : 0.0;
-      double mean = 0, var = 0;
-      for (double& xi : x) xi *= scale, mean += xi;
-      mean /= double(std::max<size_t>(Kc, 1));
-      for (const double xi : x) var += (xi - mean) * (xi - mean);
-      var /= double(std::max<size_t>(Kc, 2) - 1);
-      e_qmc[p] = std::sqrt(std::max(0.0, mean - kQmcCheckSigmas * std::sqrt(var / double(std::max<size_t>(Kc, 1)))));
-    }
-    qmc_check_rays = kCheckRays;
-  }
   // A bias the check sees is stated (reference_ok, reference_note), not chased: finer isolines do
   // not remove it, and the QMC reference and the silhouette integrator may differ in how they
   // reconstruct the environment between texels as well as in error; the predictions stay those
@@ -651,6 +631,104 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     choice.predictions.push_back(pr);
   }
 
+  // ---- 5. the pick ----
+  if (counted) {
+    // Counted setup is the trees' (calibrated on whole builds): none when the bake reuses them.
+    setup_sil = accel ? 0.0 : kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
+    setup_qmc = accel ? 0.0 : kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
+  } else if (!accel) {
+    setup_sil += rays_seconds + contours_seconds;
+    setup_qmc += rays_seconds;
+  }
+  auto cost = [&](const Prediction& p) {
+    return (p.built ? 0.0 : p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) +
+           V * p.predicted_us_per_point * 1e-6;
+  };
+  // The reference level as the silhouette plan (Prediction::built): no setup, the reference's
+  // own estimated error. Taken where it meets the aim (or errs less than a plan that misses it)
+  // at no more than the model's plan costs with its setup.
+  for (Prediction& p : choice.predictions) {
+    if (p.kind != IntegratorKind::Silhouette || !ref_run.integrator) continue;
+    Prediction r = p;
+    r.knob = uint32_t(N_ref), r.built = true, r.extrapolated = false;
+    r.predicted_error = worst_of(e_ref), r.predicted_us_per_point = ref_run.cost;
+    r.reachable = r.predicted_error <= goal_sil;
+    if ((r.reachable || (!p.reachable && r.predicted_error < p.predicted_error)) && cost(r) <= cost(p)) p = r;
+  }
+  std::vector<PlanCandidate> candidates;
+  for (const Prediction& p : choice.predictions)
+    candidates.push_back({p.kind, p.knob, p.predicted_error,
+                          p.kind == IntegratorKind::Silhouette ? goal_sil : goal_qmc, cost(p)});
+  // The sanity check's measurement: a plan's error against the reference on the pilot points; at
+  // or above the reference level a silhouette plan is compared with itself, so its error is the
+  // reference's own estimate.
+  auto measure = [&](const PlanCandidate& c) {
+    if (c.kind == IntegratorKind::Silhouette) {
+      std::vector<double> e = pilot_errors(run_sil(int(c.knob)).rows.values, ref, W, products);
+      if (int(c.knob) >= N_ref)
+        for (size_t p = 0; p < P; ++p) e[p] = std::max(e[p], e_ref[p]);
+      return worst_of(e);
+    }
+    for (const PilotRun& r : choice.runs)
+      if (r.kind == IntegratorKind::Qmc && r.knob == c.knob) return worst_of(r.error);
+    const QmcIntegrator integrator(mesh, topology, request, QmcOptions{c.knob, base.seed}, shared);
+    return worst_of(pilot_errors(integrate_pilot(integrator, points, sample, progress).values, ref, W, products));
+  };
+  const PlanPick pick = pick_plan(candidates, E, measure);
+  if (request.environment() && any_radiance) {
+    // Its rays: kCheckRays, fewer (by octaves, at least kCheckRaysMin) where those would cost more
+    // than the plan it protects (cost(best), the bake's predicted CPU seconds with its setup): a
+    // 285-triangle mesh bakes in 0.08 s, and 32 × 20,480 rays took 0.35 s. The rays' cost: the
+    // pilot's QMC levels' per-ray cost (counted: kCountedUsPerRay).
+    const Prediction& planned = choice.predictions[pick.index];
+    double us_per_ray = kCountedUsPerRay;
+    if (!counted)
+      for (const PilotRun& r : choice.runs)
+        if (r.kind == IntegratorKind::Qmc && r.knob > 0) us_per_ray = r.cpu_us_per_point / double(r.knob);
+    const double check_points = double(std::min(K, kCheckPoints));
+    uint32_t check_rays = kCheckRays;
+    while (check_rays > kCheckRaysMin &&
+           check_points * 1.25 * check_rays * us_per_ray * 1e-6 > kCheckBudgetShare * cost(planned))
+      check_rays /= 2;
+    // Under an environment the hot texels are integrated apart from the isolines (bake/
+    // silhouette.h), so their error need not shrink with N and Richardson cannot see it. Two
+    // independent QMC runs f, c (kCheckRays and a quarter of it): their noises are independent of
+    // each other and of the reference's error b, so the mean of (f − ref)(c − ref) is b² — no
+    // convergence rate assumed — with the spread of its per-point means (below).
+    const QmcIntegrator fine(mesh, topology, request, QmcOptions{check_rays, mix64(base.seed ^ kCheckSalt)}, shared);
+    const QmcIntegrator coarse(mesh, topology, request, QmcOptions{check_rays / 4, mix64(base.seed ^ kCheckSalt ^ 1)},
+                               shared);
+    const std::vector<uint32_t> check_sample(sample.begin(), sample.begin() + std::min(K, kCheckPoints));
+    const size_t Kc = check_sample.size();
+    const Rows f = integrate_pilot(fine, points, check_sample, progress);
+    const Rows c = integrate_pilot(coarse, points, check_sample, progress);
+    for (size_t p = 0; p < P; ++p) {
+      const ProductSlice& sl = products[p];
+      // Per pilot point i: x_i = the mean over its values of (f − ref)(c − ref). The values of one
+      // point share its rays (one sun sample moves all nine band-1 numbers), so the points, not
+      // the values, are the independent draws: b² ≥ mean(x) − kQmcCheckSigmas · sd(x)/√K.
+      std::vector<double> x(Kc, 0.0);
+      double r2 = 0;
+      for (size_t i = 0; i < Kc; ++i)
+        for (size_t k = 0; k < sl.count; ++k) {
+          const size_t j = i * W + sl.offset + k;
+          x[i] += (f.values[j] - ref[j]) * (c.values[j] - ref[j]);
+          r2 += ref[j] * ref[j];
+        }
+      const double n = double(std::max<size_t>(Kc * sl.count, 1));
+      r2 /= n;
+      // Relative, like pilot_errors, for R and S.
+      double scale = 1.0 / double(std::max<size_t>(sl.count, 1));
+      if (is_radiance(sl.product)) scale = r2 > 0 ? scale / r2 : 0.0;
+      double mean = 0, var = 0;
+      for (double& xi : x) xi *= scale, mean += xi;
+      mean /= double(std::max<size_t>(Kc, 1));
+      for (const double xi : x) var += (xi - mean) * (xi - mean);
+      var /= double(std::max<size_t>(Kc, 2) - 1);
+      e_qmc[p] = std::sqrt(std::max(0.0, mean - kQmcCheckSigmas * std::sqrt(var / double(std::max<size_t>(Kc, 1)))));
+    }
+    qmc_check_rays = check_rays;
+  }
   if (qmc_check_rays == 0 && !finest_qmc.values.empty()) {
     // Without one, the pilot's finest QMC level with its estimated standard errors (which
     // overstate QMC's noise: a check that sees only gross biases, at no extra cost).
@@ -676,40 +754,13 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                                       : ref_bound) +
                                  "; the pilot's errors are known only to within it");
 
-  // ---- 5. the pick ----
-  if (counted) {
-    // Counted setup is the trees' (calibrated on whole builds): none when the bake reuses them.
-    setup_sil = accel ? 0.0 : kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
-    setup_qmc = accel ? 0.0 : kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
-  } else if (!accel) {
-    setup_sil += rays_seconds + contours_seconds;
-    setup_qmc += rays_seconds;
-  }
-  auto cost = [&](const Prediction& p) {
-    return (p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) + V * p.predicted_us_per_point * 1e-6;
-  };
-  std::vector<PlanCandidate> candidates;
-  for (const Prediction& p : choice.predictions)
-    candidates.push_back({p.kind, p.knob, p.predicted_error,
-                          p.kind == IntegratorKind::Silhouette ? goal_sil : goal_qmc, cost(p)});
-  // The sanity check's measurement: a plan's error against the reference on the pilot points; at
-  // or above the reference level a silhouette plan is compared with itself, so its error is the
-  // reference's own estimate.
-  auto measure = [&](const PlanCandidate& c) {
-    if (c.kind == IntegratorKind::Silhouette) {
-      std::vector<double> e = pilot_errors(run_sil(int(c.knob)).rows.values, ref, W, products);
-      if (int(c.knob) >= N_ref)
-        for (size_t p = 0; p < P; ++p) e[p] = std::max(e[p], e_ref[p]);
-      return worst_of(e);
-    }
-    for (const PilotRun& r : choice.runs)
-      if (r.kind == IntegratorKind::Qmc && r.knob == c.knob) return worst_of(r.error);
-    const QmcIntegrator integrator(mesh, topology, request, QmcOptions{c.knob, base.seed}, shared);
-    return worst_of(pilot_errors(integrate_pilot(integrator, points, sample, progress).values, ref, W, products));
-  };
-  const PlanPick pick = pick_plan(candidates, E, measure);
   progress.finish();
   const Prediction& best = choice.predictions[pick.index];
+  if (best.built) {
+    ref_run.integrator->reset_stats();  // the bake's work summary counts the bake's integrals only
+    choice.integrator = std::move(ref_run.integrator);
+  }
+  ref_run.integrator.reset();
   choice.spec.kind = best.kind;
   if (best.kind == IntegratorKind::Silhouette)
     choice.spec.silhouette_k = best.knob * best.knob;
@@ -735,9 +786,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
                                ? format("N = %.0f isolines (k = %.0f)", best.knob, double(best.knob) * best.knob)
                                : format("%.0f rays", best.knob);
   choice.reason = std::string(to_string(best.kind)) + " at " + knob + ": " +
-                  (pick.switched ? "measured" : "predicted") +
+                  (pick.switched ? "measured" : best.built ? "the pilot's reference level, its estimated" : "predicted") +
                   format(" error %.2g (target %g), %.1f µs per integral, %.2f CPU s for the bake", pick.expected_error, E,
-                         best.predicted_us_per_point, cost(best));
+                         best.predicted_us_per_point, cost(best)) +
+                  (best.built ? " (its tables already built: cheaper than a lower N's fresh build)" : "");
   if (pick.switched)
     choice.reason += "; taken by the sanity check over the " + std::string(to_string(choice.predictions[1 - pick.index].kind)) +
                      format(" plan (%.1fx its cost)", cost(choice.predictions[1 - pick.index]) / std::max(cost(best), 1e-12));
@@ -820,8 +872,13 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
       if (p.extrapolated) note += "; extrapolated beyond the last measured " + knob_text(p.kind, p.last_measured);
       if (!p.reachable)
         note += "; cannot reach the target within its bound " + knob_text(p.kind, p.bound) + ": " + p.bound_reason;
-      std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral", to_string(p.kind),
-                    knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point);
+      if (p.built)
+        std::snprintf(buf, sizeof buf, "  model: %-10s %s: the reference level itself, already built (no setup): its "
+                      "estimated error %.3g, %.1f µs/integral", to_string(p.kind), knob_text(p.kind, p.knob).c_str(),
+                      p.predicted_error, p.predicted_us_per_point);
+      else
+        std::snprintf(buf, sizeof buf, "  model: %-10s %s: error %.3g (rate knob^-%.2f), %.1f µs/integral", to_string(p.kind),
+                      knob_text(p.kind, p.knob).c_str(), p.predicted_error, p.exponent, p.predicted_us_per_point);
       out.push_back(buf + note);
       continue;
     }

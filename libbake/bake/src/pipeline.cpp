@@ -85,7 +85,12 @@ void BakePipeline::plan(const Monitor& monitor, const PipelineHooks& hooks) {
       job.spec = job.choice->spec;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
+    if (job.choice && job.choice->integrator) {
+      job.integrator = std::move(job.choice->integrator);  // the pilot built this plan's integrator
+      job.choice->integrator.reset();
+    } else {
+      job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
+    }
     job.setup_seconds = seconds_since(t0);
     job.integrator_description = job.integrator->description();
     if (hooks.ready) hooks.ready(job);

@@ -14,6 +14,7 @@
 #include <ImfEnvmap.h>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <mutex>
@@ -518,7 +519,11 @@ std::span<const Eigen::Vector3d> EnvMap::texel_midpoints() const {
   PRT_CHECK(midpoints_ != nullptr);
   std::call_once(midpoints_->once, [&] {
     std::vector<Eigen::Vector3d> d(static_cast<size_t>(texel_count()));
-    for (int t = 0; t < texel_count(); ++t) sample_texel_grid(t, 1, std::span(&d[size_t(t)], 1));
+    // Each texel's own value, whatever the thread that computes it. Isolated: a thread waiting
+    // here takes no outer task that could call texel_midpoints() again inside call_once.
+    tbb::this_task_arena::isolate([&] {
+      tbb::parallel_for(0, texel_count(), [&](int t) { sample_texel_grid(t, 1, std::span(&d[size_t(t)], 1)); });
+    });
     midpoints_->directions = std::move(d);
   });
   return midpoints_->directions;

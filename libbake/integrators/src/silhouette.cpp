@@ -94,6 +94,38 @@ thread_local Scratch tl_scratch;
 
 } // namespace
 
+struct SilhouetteEnvCache::Impl {
+  // The key: the map (its address and its midpoints', which copies share) and the columns.
+  const EnvMap* map = nullptr;
+  const void* map_data = nullptr;
+  int env_order = 0, shadowed_order = 0;
+  size_t n_env = 0;
+  bool radiance = false, keyed = false;
+  bool hot_known = false;
+  std::shared_ptr<const HotTexels> hot;
+  struct Masses {
+    struct Block {
+      std::vector<Eigen::Vector3d> directions;
+      std::vector<double> values;
+    };
+    std::vector<Block> blocks;
+    bool complete = false;
+  } masses;
+
+  // Whether this cache serves (map, columns); the first caller keys it.
+  bool fits(const EnvMap* m, int order, size_t n, bool rad, int ls) {
+    const void* data = m && m->texel_count() > 0 ? static_cast<const void*>(m->texel_midpoints().data()) : nullptr;
+    if (!keyed) {
+      map = m, map_data = data, env_order = order, n_env = n, radiance = rad, shadowed_order = ls, keyed = true;
+      return true;
+    }
+    return map == m && map_data == data && env_order == order && n_env == n && radiance == rad && shadowed_order == ls;
+  }
+};
+
+SilhouetteEnvCache::SilhouetteEnvCache() : impl_(std::make_unique<Impl>()) {}
+SilhouetteEnvCache::~SilhouetteEnvCache() = default;
+
 struct SilhouetteIntegrator::Impl {
   const Mesh& mesh;
   const Topology& topo;
@@ -115,13 +147,14 @@ struct SilhouetteIntegrator::Impl {
   int env_order = 0;            // SH order the environment's columns need
   int subsamples = 1;             // per cell, of the smooth columns (the midpoint rule)
   int max_texel_subsamples = 0;   // k × k per texel of the environment's point masses (0: none)
+  SilhouetteEnvCache::Impl::Masses* filling = nullptr;  // the cache this construction fills
   std::unique_ptr<IsolineTables> tables;
   // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
   // left out of the tables and integrated exactly over their visible part (bake/integrators/hot_texels.h), so
   // that suns cut by a shadow edge or by the horizon carry no discretisation error at any N.
   static constexpr double kHotFactor = 64;
   static constexpr size_t kMaxHot = 4096;
-  std::unique_ptr<HotTexels> hot;
+  std::shared_ptr<const HotTexels> hot;
   std::vector<double> unoccluded_row;  // the layout's row with V ≡ 1 (full sphere), fixed by the tables
 
   mutable std::atomic<uint64_t> n_points{0}, n_edges{0}, n_crossings{0}, n_rays{0}, n_retries{0}, n_inconsistent{0},
@@ -153,9 +186,17 @@ struct SilhouetteIntegrator::Impl {
     n_env = F - c_r;
     PRT_CHECK(F > 0);
     const Eigen::Matrix3d world_from_frame = frame_from_world.transpose();
+    // The pilot's shared part (SilhouetteEnvCache), when it was filled for this map and these columns.
+    SilhouetteEnvCache::Impl* cache = o.env_cache ? &o.env_cache->impl() : nullptr;
+    if (cache && !cache->fits(envmap, env_order, n_env, r.radiance, ls)) cache = nullptr;
     if (envmap && envmap->texel_count() > 0 && env_order > 0) {
-      hot = std::make_unique<HotTexels>(*envmap, frame_from_world, env_order, kHotFactor, kMaxHot);
-      if (hot->empty()) hot.reset();
+      if (cache && cache->hot_known) {
+        hot = cache->hot;
+      } else {
+        auto made = std::make_shared<const HotTexels>(*envmap, frame_from_world, env_order, kHotFactor, kMaxHot);
+        if (!made->empty()) hot = std::move(made);
+        if (cache) cache->hot = hot, cache->hot_known = true;
+      }
     }
     // The SH basis at w up to `order` in `small` (orders ≤ 16) or `big`.
     auto eval_sh = [](int order, const Vector3d& w, std::span<double> small, std::vector<double>& big) -> double* {
@@ -200,12 +241,31 @@ struct SilhouetteIntegrator::Impl {
       const int block_texels = std::clamp(16384 / (max_texel_subsamples * max_texel_subsamples), 1, 4096);
       masses.first = int(c_r), masses.count = int(n_env);
       masses.blocks = size_t((texels + block_texels - 1) / block_texels);
+      // One sub-sample per texel: the masses of every such level are the same; the cache's, when
+      // it holds them, else this level's, kept for the next when they fit.
+      SilhouetteEnvCache::Impl::Masses* shared_masses = nullptr;
+      if (cache && max_texel_subsamples == 1) {
+        if (cache->masses.complete && cache->masses.blocks.size() == masses.blocks) {
+          const auto* held = &cache->masses;
+          masses.view = [held](size_t b, std::span<const Vector3d>& d, std::span<const double>& v) {
+            d = held->blocks[b].directions, v = held->blocks[b].values;
+            return true;
+          };
+        } else if (!cache->masses.complete &&
+                   size_t(texels) * (sizeof(Vector3d) + n_env * sizeof(double)) <= SilhouetteEnvCache::kMaxBytes) {
+          shared_masses = &cache->masses;
+          shared_masses->blocks.assign(masses.blocks, {});
+        }
+      }
       const std::span<const Vector3d> midpoints = envmap->texel_midpoints();
       masses.emit = [&, texels, block_texels, subsamples_of, midpoints](size_t b, std::vector<Vector3d>& directions,
                                                                        std::vector<double>& values) {
         std::vector<Vector3d> dirs;
         std::vector<double> y(size_t(sh::num_coeffs(16))), ybig;
         const int t_end = std::min(texels, int(b + 1) * block_texels);
+        const size_t most = size_t(t_end - int(b) * block_texels) * size_t(max_texel_subsamples * max_texel_subsamples);
+        directions.reserve(directions.size() + most);  // no reallocation while the block fills
+        values.reserve(values.size() + most * n_env);
         for (int tx = int(b) * block_texels; tx < t_end; ++tx) {
           if (hot && hot->is_hot(tx)) continue;
           const Rgb L = envmap->texel_value(tx);
@@ -217,13 +277,26 @@ struct SilhouetteIntegrator::Impl {
           if (k == 1) dirs[0] = midpoints[size_t(tx)];  // the same values, computed once per map
           else envmap->sample_texel_grid(tx, k, dirs);
           const Rgb mass{L.r * w, L.g * w, L.b * w};
+          size_t at = values.size();
+          values.resize(at + dirs.size() * n_env);
           for (const Vector3d& d : dirs) {
-            values.resize(values.size() + n_env);
-            env_columns(mass, eval_sh(env_order, d, y, ybig), values.data() + values.size() - n_env);
+            env_columns(mass, eval_sh(env_order, d, y, ybig), values.data() + at);
+            at += n_env;
             directions.push_back(frame_from_world * d);
           }
         }
       };
+      if (shared_masses) {
+        // Emitted straight into the cache's slots (each block its own) and read from there.
+        filling = shared_masses;
+        masses.view = [emit = masses.emit, shared_masses](size_t b, std::span<const Vector3d>& d,
+                                                           std::span<const double>& v) {
+          auto& slot = shared_masses->blocks[b];
+          emit(b, slot.directions, slot.values);
+          d = slot.directions, v = slot.values;
+          return true;
+        };
+      }
     }
     tables = std::make_unique<IsolineTables>(grid, int(F), subsamples, [&](const Vector3d& w_frame, std::span<double> out) {
       const Vector3d w = world_from_frame * w_frame;
@@ -239,6 +312,7 @@ struct SilhouetteIntegrator::Impl {
       for (size_t i = 0; i < size_t(lv * lv); ++i) out[c_u + i] = yp[i];
       if (envmap && envmap->texel_count() == 0) env_columns(envmap->radiance(w), yp, &out[c_r]);  // constant: smooth
     }, masses.count > 0 ? &masses : nullptr);
+    if (filling) filling->complete = true, filling = nullptr;  // every block emitted; the cache is not ours
     unoccluded_row = unoccluded_totals();
   }
 
@@ -815,6 +889,14 @@ SilhouetteStats SilhouetteIntegrator::silhouette_stats() const {
   s.integrate_seconds = double(impl_->integrate_ns.load()) * 1e-9;
   s.cpu_seconds = s.contour_seconds + s.integrate_seconds;
   return s;
+}
+
+void SilhouetteIntegrator::reset_stats() const {
+  Impl& I = *impl_;
+  for (std::atomic<uint64_t>* n : {&I.n_points, &I.n_edges, &I.n_crossings, &I.n_rays, &I.n_retries, &I.n_inconsistent,
+                                   &I.n_closed_form, &I.n_enclosed, &I.n_culled})
+    n->store(0);
+  I.contour_ns.store(0), I.integrate_ns.store(0);
 }
 
 std::string SilhouetteIntegrator::work_summary() const {

@@ -68,18 +68,23 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
     struct Block {
       std::vector<Eigen::Vector3d> directions;
       std::vector<double> values;
+      std::span<const double> masses;  // values, or the caller's view
       std::vector<size_t> rows;
     };
-    constexpr size_t kWave = 16;
+    constexpr size_t kWave = 4;
     std::vector<Block> wave(kWave);
     for (size_t b0 = 0; b0 < masses->blocks; b0 += kWave) {
       const size_t nb = std::min(kWave, masses->blocks - b0);
       tbb::parallel_for(size_t(0), nb, [&](size_t k) {
         Block& blk = wave[k];
         blk.directions.clear(), blk.values.clear(), blk.rows.clear();
-        masses->emit(b0 + k, blk.directions, blk.values);
-        PRT_CHECK_OP(blk.values.size(), ==, blk.directions.size() * m_count);
-        for (const Eigen::Vector3d& omega : blk.directions) {
+        std::span<const Eigen::Vector3d> dirs;
+        if (!(masses->view && masses->view(b0 + k, dirs, blk.masses))) {
+          masses->emit(b0 + k, blk.directions, blk.values);
+          dirs = blk.directions, blk.masses = blk.values;
+        }
+        PRT_CHECK_OP(blk.masses.size(), ==, dirs.size() * m_count);
+        for (const Eigen::Vector3d& omega : dirs) {
           const auto [i, j] = cell_of(omega);
           blk.rows.push_back(offset_[size_t(i)] + size_t(j) + 1);
         }
@@ -88,7 +93,7 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
       for (size_t k = 0; k < nb; ++k)
         for (size_t r = 0; r < wave[k].rows.size(); ++r) {
           double* dst = &table_[wave[k].rows[r] * F + m_first];
-          const double* src = &wave[k].values[r * m_count];
+          const double* src = &wave[k].masses[r * m_count];
           for (size_t c = 0; c < m_count; ++c) dst[c] += src[c] * inv_h;
         }
     }

@@ -28,6 +28,16 @@ struct Ground {
   MeshAccel accel{mesh, topology};
 };
 
+// A 6 × 6 floor (y = 0, up) and a unit box standing on it at the origin.
+Mesh floor_and_box() {
+  std::vector<Eigen::Vector3f> c = {{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}};
+  for (int k = 0; k < 8; ++k) c.emplace_back(k & 1 ? 0.5f : -0.5f, k & 4 ? 1.0f : 0.0f, k & 2 ? -0.5f : 0.5f);
+  return make_mesh(c,
+                   {{{0, 1, 2}}, {{0, 2, 3}}, {{4, 6, 5}}, {{5, 6, 7}}, {{8, 9, 10}}, {{9, 11, 10}}, {{4, 5, 8}},
+                    {{5, 9, 8}}, {{6, 10, 7}}, {{7, 10, 11}}, {{4, 8, 6}}, {{6, 8, 10}}, {{5, 7, 9}}, {{7, 11, 9}}},
+                   "floor and box");
+}
+
 ProductRequest ao() {
   ProductRequest r;
   r.ao = true;
@@ -192,13 +202,7 @@ TEST(Pipeline, RUnderASunIsCheckedAgainstTheSameIntegratorAtFourTimesItsIsolines
   // verdict on R comes from the silhouette integrator at 4N on the report's points. Its RMSE is
   // checked against that integrator run independently on the same points (to rounding: the same
   // integrals summed in another order), and the verdict's range is m/(1 − 1/16) to m/(1 − 1/4).
-  std::vector<Eigen::Vector3f> c = {{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}};  // y up
-  for (int k = 0; k < 8; ++k) c.emplace_back(k & 1 ? 0.5f : -0.5f, k & 4 ? 1.0f : 0.0f, k & 2 ? -0.5f : 0.5f);
-  const Mesh mesh = make_mesh(c,
-                              {{{0, 1, 2}}, {{0, 2, 3}}, {{4, 6, 5}}, {{5, 6, 7}}, {{8, 9, 10}}, {{9, 11, 10}},
-                               {{4, 5, 8}}, {{5, 9, 8}}, {{6, 10, 7}}, {{7, 10, 11}}, {{4, 8, 6}}, {{6, 8, 10}},
-                               {{5, 7, 9}}, {{7, 11, 9}}},
-                              "floor and box");
+  const Mesh mesh = floor_and_box();
   const Topology topo = build_topology(mesh);
   const MeshAccel accel(mesh, topo);
   const EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
@@ -249,4 +253,51 @@ TEST(Pipeline, RUnderASunIsCheckedAgainstTheSameIntegratorAtFourTimesItsIsolines
   EXPECT_TRUE(v.extrapolated);
   EXPECT_NEAR(v.error_lo, m * 16 / 15, 1e-12 * m);
   EXPECT_NEAR(v.error_hi, m * 4 / 3, 1e-12 * m);
+}
+
+TEST(Pipeline, ASmallBakeTakesThePilotsReferenceIntegratorAndItsRowsAreAFreshBuildsBytes) {
+  // Twenty floor points beside a box under data/studio.exr: baking them at the reference level
+  // costs a fraction of a millisecond, building a lower level's tables (524,288 texel masses) tens
+  // of milliseconds, so the plan is the reference level the pilot already built (Prediction::built)
+  // and the bake takes that integrator. Its rows must be those of the same spec built afresh, bit
+  // for bit, and its work summary must count the bake's points, not the pilot's.
+  const Mesh mesh = floor_and_box();
+  const Topology topo = build_topology(mesh);
+  const MeshAccel accel(mesh, topo);
+  const EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
+  std::vector<BakeJob> jobs(1);
+  jobs[0].request.ao = true;
+  jobs[0].request.radiance = &env;
+  jobs[0].sets.resize(1);
+  jobs[0].sets[0].name = "floor points";
+  for (int i = 0; i < 20; ++i) {
+    ShadePoint p;
+    p.p = Eigen::Vector3d(-2.9 + 0.29 * i, 0, 0.9);  // on the floor, beside the box
+    p.n = Eigen::Vector3d::UnitY();
+    jobs[0].sets[0].points.push_back(p);
+  }
+  PipelineSettings settings;
+  settings.integrator.report_points = 0;
+  settings.target_error = 1e-3;
+  settings.correct = false;
+  BakePipeline pipeline(mesh, topo, accel, settings, std::move(jobs));
+  pipeline.run({});
+  const BakeJob& job = pipeline.jobs().front();
+  ASSERT_TRUE(job.choice.has_value());
+  const IntegratorChoice& choice = *job.choice;
+  ASSERT_TRUE(job.spec.kind == IntegratorKind::Silhouette) << choice.reason;
+  ASSERT_EQ(uint32_t(job.spec.isolines()), choice.reference_isolines) << choice.reason;
+  bool built = false;
+  for (const Prediction& p : choice.predictions) built = built || p.built;
+  EXPECT_TRUE(built);
+  EXPECT_EQ(choice.integrator, nullptr);  // handed to the bake
+  EXPECT_NE(choice.reason.find("reference level"), std::string::npos) << choice.reason;
+  EXPECT_EQ(job.integrator->stats().points, 20u);
+  const auto fresh = make_integrator(job.spec, mesh, topo, job.request, &accel);
+  const size_t W = fresh->layout().width;
+  std::vector<double> row(W);
+  for (size_t i = 0; i < 20; ++i) {
+    fresh->integrate(job.sets[0].points[i], i, row);
+    for (size_t k = 0; k < W; ++k) EXPECT_EQ(job.rows[0].values[i * W + k], row[k]) << "point " << i << ", value " << k;
+  }
 }

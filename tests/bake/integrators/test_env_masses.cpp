@@ -157,3 +157,45 @@ TEST(EnvMasses, AoAndTransferDoNotDependOnWhetherAnEnvironmentIsBaked) {
     for (size_t k = 0; k < ra.size(); ++k) EXPECT_EQ(ra[k], rb[k]) << "N = " << N << ", value " << k;
   }
 }
+
+TEST(EnvMasses, LevelsSharingTheEnvironmentCacheIntegrateTheSameBytes) {
+  // The chooser's pilot builds its levels with one SilhouetteEnvCache: the first fills it (hot
+  // texels, masses), the rest read it. Integrals must be those of integrators built alone, bit for
+  // bit — with a hot texel (a sun the cache hands on) and with a level (N = 128 on this 256 × 128
+  // map: 2 × 2 sub-samples per texel) whose masses differ and must not come from the cache.
+  EnvMap env = [] {
+    const int W = 256, H = 128;
+    std::vector<float> rgb(size_t(W * H * 3), 1.0f);
+    for (int c = 0; c < 3; ++c) rgb[size_t(3 * (10 * W + 20) + c)] = 5000.0f;  // far above 64× the mean
+    return EnvMap::from_latlong(W, H, rgb, UpAxis::Y, "sun");
+  }();
+  const Mesh mesh = make_mesh({{-1, 0.5f, -1}, {1, 0.5f, -1}, {0, 0.8f, 1}, {0, 0.2f, 2}}, {{0, 1, 2}, {0, 2, 3}}, "tent");
+  const Topology topo = build_topology(mesh);
+  ProductRequest req;
+  req.ao = true;
+  req.radiance = &env;
+  req.shadowed_order = 2;
+  req.shadowed = &env;
+  const auto cache = std::make_shared<SilhouetteEnvCache>();
+  std::vector<ShadePoint> points(3);
+  points[0].n = Vector3d(0.3, 0.9, 0.2).normalized();
+  points[1].n = Vector3d(0, 1, 0);
+  points[2].n = Vector3d(-0.5, 0.2, 0.8).normalized();
+  bool any_nonzero = false;
+  for (const int N : {64, 16, 128, 32, 48}) {
+    SilhouetteOptions shared{N, 1};
+    shared.env_cache = cache;
+    const SilhouetteIntegrator alone(mesh, topo, req, {N, 1}), with(mesh, topo, req, shared);
+    EXPECT_NE(alone.description().find("hot environment texel"), std::string::npos);
+    for (size_t i = 0; i < points.size(); ++i) {
+      std::vector<double> a(alone.layout().width), b(with.layout().width);
+      alone.integrate(points[i], i, a);
+      with.integrate(points[i], i, b);
+      for (size_t k = 0; k < a.size(); ++k) {
+        EXPECT_EQ(a[k], b[k]) << "N = " << N << ", point " << i << ", value " << k;
+        any_nonzero = any_nonzero || a[k] != 0;
+      }
+    }
+  }
+  EXPECT_TRUE(any_nonzero);
+}

@@ -64,7 +64,7 @@ struct BakeJob {
   // ---- filled by the pipeline ----
   IntegratorSpec spec;                     // what bakes (after a correction: the corrected plan)
   std::optional<IntegratorChoice> choice;  // with E
-  std::unique_ptr<Integrator> integrator;
+  std::shared_ptr<Integrator> integrator;
   std::string integrator_description;
   double setup_seconds = 0;                // making the integrator (its tables; the trees are shared)
   int pass = 0;                            // 1 once corrected

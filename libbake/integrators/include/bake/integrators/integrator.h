@@ -104,6 +104,9 @@ public:
   virtual void integrate(const ShadePoint& point, uint64_t point_index, std::span<double> out,
                          std::span<double> std_error = {}) const = 0;
   virtual IntegratorStats stats() const { return {}; }
+  // Sets stats() back to zero (an integrator used by a pilot and then handed to the bake counts
+  // the bake's work only). Not concurrently with integrate().
+  virtual void reset_stats() const {}
   // One line on the work done so far, from stats(), for a tool to print after a bake; empty when
   // the integrator has nothing to add to its rays and time.
   virtual std::string work_summary() const { return {}; }

@@ -55,12 +55,37 @@
 
 namespace prt::bake {
 
+// What integrators of one mesh's pilot share about the environment (SilhouetteOptions::env_cache):
+// its hot texels, and its point masses at one sub-sample per texel — the same bytes at every N
+// whose cells are wider than the map's texels (N ≤ 290 for a 1024 × 512 map), so the levels
+// after the first copy nothing and recompute nothing (the chooser builds five; each spent ~30 ms
+// of CPU recomputing 524,288 masses). Filled by the first integrator that uses it; read, never
+// changed, by the rest; keyed by the map and the environment's columns (another request or map
+// uses none of it). Holds at most kMaxBytes of masses, else only the hot texels. Not for
+// concurrent construction of integrators.
+class SilhouetteEnvCache {
+public:
+  static constexpr size_t kMaxBytes = size_t(256) << 20;
+  SilhouetteEnvCache();
+  ~SilhouetteEnvCache();
+  SilhouetteEnvCache(const SilhouetteEnvCache&) = delete;
+  SilhouetteEnvCache& operator=(const SilhouetteEnvCache&) = delete;
+  struct Impl;
+  Impl& impl() const noexcept { return *impl_; }
+
+private:
+  std::unique_ptr<Impl> impl_;
+};
+
 struct SilhouetteOptions {
   int isolines = 256;  // N; k = N² (IntegratorSpec's k gives N = silhouette_isolines(k), bake/integrators/integrator.h)
   uint64_t seed = 1;   // only for the direction of the counted start ray when the default is degenerate
   // Leave out the contour components that lie wholly below the horizon (see the file comment):
   // the same visible runs, hence the same integrals; false is the unculled reference path.
   bool cull_below_horizon = true;
+  // Shared with the integrators built before and after this one (SilhouetteEnvCache); null: none.
+  // The integrals are the same bytes with and without it.
+  std::shared_ptr<SilhouetteEnvCache> env_cache;
 };
 
 // The silhouette integrator's work, summed over its integrate() calls. `closed_form`: hemisphere
@@ -100,6 +125,7 @@ public:
   // Its work counters, kept with relaxed atomics (SilhouetteStats); stats() is their common part.
   SilhouetteStats silhouette_stats() const;
   IntegratorStats stats() const override { return silhouette_stats(); }
+  void reset_stats() const override;
   // Per integral: contour edges and isoline crossings, and the CPU time split between the contour
   // search and the rest; points that saw no contour edge (closed forms).
   std::string work_summary() const override;

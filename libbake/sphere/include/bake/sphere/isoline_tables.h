@@ -44,10 +44,13 @@ public:
   // frame) and `count` values (the mass of each component, ∫ over the mass's share of the sphere).
   // Blocks may run concurrently; their masses are added block by block in index order, so the
   // tables' bytes do not depend on the thread count. f's values for these components are ignored.
+  // `view`, when set and it returns true for block b, gives that block's masses as spans instead
+  // (held by the caller for the constructor's duration; the same bytes emit would append).
   struct PointMasses {
     int first = 0, count = 0;
     size_t blocks = 0;
     std::function<void(size_t block, std::vector<Eigen::Vector3d>& directions, std::vector<double>& values)> emit;
+    std::function<bool(size_t block, std::span<const Eigen::Vector3d>& directions, std::span<const double>& values)> view;
   };
 
   IsolineTables(const oct::Grid& grid, int components, int subsamples, const Integrand& f,
