@@ -23,7 +23,10 @@
 //       as large as its whole step from N_ref/2;
 //       independent check, under an environment (R, S): its hot texels are integrated apart
 //       from the isolines, so their error need not shrink with N and Richardson cannot see it.
-//       QMC at 16,384 and 4,096 rays (independent seeds) on the first 32 pilot points, f and c:
+//       QMC at R and R/4 rays (independent seeds) on the first 32 pilot points, f and c, run after
+//       the pick: R = 16,384, or fewer by octaves (down to 1,024) where those rays would cost
+//       more than the chosen plan (choose.cpp, kCheckBudgetShare; the detection limit grows as
+//       sqrt(16,384/R), and the error report after the bake checks the file at E/3 anyway):
 //       their noises are independent of each other and of the reference's error b, so the
 //       per-point means x_i of (f − ref)(c − ref) average b² (no convergence rate assumed). The
 //       values of one point share its rays, so the points are the independent draws: the bound is
@@ -65,7 +68,15 @@
 //     count does not enter), per point; silhouette cost(N) linear in N through the measured
 //     levels (the contour search does not depend on N, the walk does), QMC cost linear in rays;
 //     with counted_costs, the pilot's counted work priced at fixed constants instead (below).
-//  5. the pick (pick_plan, a pure function of the plans' predicted errors and costs): the cheapest
+//  5. the pick. First the reference level as the silhouette plan (Prediction::built): the pilot
+//     built its integrator, so it costs no setup and its error is the reference's estimate; it
+//     replaces the model's plan where it meets the aim (or errs less than a plan that misses it)
+//     at no more than that plan's cost with its setup, and the bake takes the pilot's integrator
+//     (IntegratorChoice::integrator) — on a small mesh under an environment the tables' build
+//     (524,288 texel masses) is most of a bake, and a lower N would build them again. The pilot's
+//     levels share those masses and the hot texels (SilhouetteEnvCache), so a level costs its
+//     cells and points, not the map. Then (pick_plan, a pure function of the plans' predicted
+//     errors and costs): the cheapest
 //     plan predicted to reach its safety·E; if none does, the plan with the lowest predicted
 //     error (the cheaper on a tie) — a default never refuses: the choice states the error it
 //     expects (IntegratorChoice::expected_error, reaches = false) and how to go further
