@@ -16,6 +16,7 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 namespace fs = std::filesystem;
 namespace F = prt::formats;
@@ -233,6 +234,47 @@ TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   fs::remove(out);
   EXPECT_EQ(run(bake + " -v --quiet").code, 2);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// The lines of `out` that begin with `prefix`, in order.
+std::vector<std::string> lines_starting(const std::string& out, const std::string& prefix) {
+  std::vector<std::string> found;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(prefix, 0) == 0) found.push_back(line);
+  return found;
+}
+
+TEST(Prtbake, TheDefaultTargetGetsTheReportOfTheSameTargetNamed) {
+  // Issue 29: the default bake checked 32 vertices and said "not verifiable here" where
+  // --target-error 1e-3, the same target named, checked 128 and said "met". The same request must
+  // get the same check. --reproducible makes the pilot's choice a function of the inputs, so both
+  // bakes are the same bake and their reports can be compared value for value.
+  const std::string mesh = (kData / "bunny.obj").string();
+  const fs::path def = scratch("default_target.prt.h5"), named = scratch("named_target.prt.h5");
+  const Outcome d = run("vertex " + mesh + " --ao --reproducible -o " + def.string());
+  const Outcome n = run("vertex " + mesh + " --ao --reproducible --target-error 1e-3 -o " + named.string());
+  ASSERT_EQ(d.code, 0) << d.err;
+  ASSERT_EQ(n.code, 0) << n.err;
+  const F::Asset a = F::read_asset(def), b = F::read_asset(named);
+  EXPECT_EQ(a.target_error, 1e-3);
+  EXPECT_EQ(b.target_error, 1e-3);
+  ASSERT_TRUE(a.vertices.report.vertices.has_value());
+  EXPECT_EQ(a.vertices.report.vertices->values.size(), size_t(128)) << "the default checks as many vertices as a target";
+  EXPECT_EQ(a.vertices.report, b.vertices.report) << "the same points, values and reference";
+  EXPECT_EQ(a.vertices.ao, b.vertices.ao) << "the same bake";
+  // What is printed about the check, the verdict included, is the same line for line.
+  for (const char* prefix : {"error against a ", "  AO ", "  target "}) {
+    const auto ld = lines_starting(d.out, prefix), ln = lines_starting(n.out, prefix);
+    EXPECT_FALSE(ld.empty()) << "no line starting '" << prefix << "' in:\n" << d.out;
+    if (std::string(prefix) == "error against a ") {  // the reference's time differs run to run
+      ASSERT_EQ(ld.size(), ln.size());
+      for (size_t i = 0; i < ld.size(); ++i) EXPECT_EQ(ld[i].substr(0, ld[i].find(" (")), ln[i].substr(0, ln[i].find(" (")));
+    } else {
+      EXPECT_EQ(ld, ln);
+    }
+  }
+  EXPECT_NE(d.out.find("on 128 seeded vertices"), std::string::npos) << d.out;
 }
 
 TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {
