@@ -270,18 +270,20 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     std::string line = set.name + ": error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
     for (const auto& e : ob.report->products)
       line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
-              printf_string("reference's own std. error %.1e)", e.reference_std_error);
+              (ob.report->reference_noise_measured ? "reference's own noise, measured, " : "reference's own std. error ") +
+              printf_string("%.1e)", e.reference_std_error);
     log(line + printf_string("; reference took %.2f s", ob.report->reference_seconds));
   };
   hooks.job_checked = [&](const BakeJob& job) {
-    if (!target) return;
-    // The job's verdict on its pooled report (bake/bake/choose.h target_check_lines).
+    // The job's verdict on its pooled report, or without a target what its RMSE means: the bake's
+    // own error with the reference's noise taken out (bake/bake/choose.h).
     if (job.sets.size() > 1)
       log("receivers from " + job.sets.front().name + " (" + std::to_string(job.sets.size()) + " objects), their " +
           std::to_string(job.pooled->vertices.size()) + " report vertices together" +
           printf_string(" (the reference took %.2f s):", job.pooled->reference_seconds));
     for (const std::string& l :
-         target_check_lines(*job.pooled, scene.target_error, job.reference_plan ? &*job.reference_plan : nullptr))
+         target ? target_check_lines(*job.pooled, scene.target_error, job.reference_plan ? &*job.reference_plan : nullptr)
+                : error_estimate_lines(*job.pooled))
       log(l);
   };
   hooks.correcting = [&](const BakeJob& job, const IntegratorSpec& better) {
