@@ -151,9 +151,12 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
 
   if (rows.estimate_only) {
     // The dry run's estimate: per job, its integrator (chosen, with a target: the pilot runs)
-    // timed on seeded vertices of its receivers, scaled to all of them (SceneRows::estimate_only).
+    // timed on seeded vertices of its receivers, scaled to all of them; then the FIV steps the
+    // same way, and the whole (SceneRows::estimate_only).
     pipeline.plan(monitor, hooks);
+    const double planned = seconds_since(t_setup);  // the occluders' trees, the pilots
     const double threads = double(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    double total = 0;  // wall seconds on `threads` after the plan
     for (BakeJob& job : pipeline.jobs()) {
       const size_t n = job.row_count();
       const std::optional<double> per_row = pipeline.cpu_seconds_per_row(job, kEstimatePoints);
@@ -163,6 +166,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         continue;
       }
       const double cpu = *per_row * double(n);
+      total += cpu / threads;
       log(job.name + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(n) + " vertices with " +
           to_string(job.spec.kind) + " at " + job.spec.knob_text() + printf_string(", %.3g s on ", cpu / threads) +
           std::to_string(int(threads)) + " threads (timed on " + std::to_string(std::min(kEstimatePoints, n)) +
@@ -172,11 +176,51 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       // kReportMinCpuSeconds), from the estimate.
       pipeline.plan_check(job, scene.counted_costs ? 0.0 : std::max(ReferencePlan::kReportMinCpuSeconds, cpu), monitor);
       const ReferencePlan& rp = *job.reference_plan;
-      if (rp.us_per_ray > 0)
-        log("  and its error check about " +
-            printf_string("%.3g CPU s", double(rp.rays) * double(rp.points) * rp.us_per_ray * 1e-6) +
-            " (a QMC reference of " + std::to_string(rp.rays) + " rays on " + std::to_string(rp.points) + " vertices)");
+      if (rp.us_per_ray > 0) {
+        const double check = double(rp.rays) * double(rp.points) * rp.us_per_ray * 1e-6;
+        total += check / threads;
+        log("  and its error check about " + printf_string("%.3g CPU s", check) + " (a QMC reference of " +
+            std::to_string(rp.rays) + " rays on " + std::to_string(rp.points) + " vertices)");
+      }
     }
+    // The FIV steps, each timed on seeded samples after its setup (done for real).
+    auto fiv_line = [&](const std::string& what, const FivCost& c) {
+      total += c.setup_seconds + c.cpu_seconds / threads;
+      log(what + ": about " + printf_string("%.3g CPU s, %.3g s on ", c.cpu_seconds, c.setup_seconds + c.cpu_seconds / threads) +
+          std::to_string(int(threads)) + " threads" + printf_string(" (setup %.2f s, then ", c.setup_seconds) +
+          std::to_string(c.timed) + " seeded samples timed)");
+    };
+    if (plan.fiv_environment)
+      fiv_line("the environment's FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) +
+                   "x6 DifMap",
+               environment_fiv_cost(*env, scene.fiv.cube, kEstimatePoints));
+    // Each occluder's shells; with many (an engine whose parts all move), one line for them all.
+    const std::string grid = "FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
+                             "x" + std::to_string(scene.fiv.n_rho);
+    const std::string every = " (if every shell is needed)";
+    size_t movers = 0;
+    for (const ObjectPlan& p : plan.objects) movers += p.fiv ? 1 : 0;
+    FivCost all;
+    std::string dearest;
+    double dearest_cpu = -1;
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if (plan.objects[i].fiv) {
+        const Topology t = build_topology(meshes[i]);
+        const FivCost c = fiv_shells_cost(meshes[i], t, *env, scene.fiv, kEstimatePoints);
+        if (movers <= kObjectLinesUpTo) {
+          fiv_line(label_of(scene.objects[i]) + ": " + grid + every, c);
+          continue;
+        }
+        all.setup_seconds += c.setup_seconds, all.cpu_seconds += c.cpu_seconds, all.timed += c.timed;
+        if (c.cpu_seconds > dearest_cpu) dearest_cpu = c.cpu_seconds, dearest = label_of(scene.objects[i]);
+      }
+    if (movers > kObjectLinesUpTo)
+      fiv_line(std::to_string(movers) + " occluders' " + grid + ", the dearest " + dearest +
+                   printf_string(" at %.3g CPU s", dearest_cpu) + every,
+               all);
+    log(printf_string("in all about %.3g s on ", total + planned) + std::to_string(int(threads)) +
+        printf_string(" threads: %.3g s of setup and choice (done above), ", planned) +
+        printf_string("%.3g s after it (area lights and writing the file not counted)", total));
     return out;
   }
 
