@@ -19,27 +19,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// A monitor that folds a sequence of tasks (one per receiver set) into one progress stage `label`
-// of `total` units: each task's count is offset by `*before` (the units of the tasks already done,
-// which the caller advances), the time runs from `start`, and the stage finishes with the last
-// task (or with a cancelled one).
-Monitor one_stage(const Monitor& monitor, const std::string& label, const uint64_t& total, const uint64_t& before,
-                  std::chrono::steady_clock::time_point start) {
-  Monitor m;
-  m.cancel = monitor.cancel;
-  if (monitor.on_progress)
-    m.on_progress = [&monitor, label, &total, &before, start](const ProgressUpdate& u) {
-      ProgressUpdate o = u;
-      o.task = label;
-      o.done = before + u.done;
-      o.total = total;
-      o.seconds = seconds_since(start);
-      o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last task, or a cancel
-      monitor.on_progress(o);
-    };
-  return m;
-}
-
 // The job's shade points as one span: its set's own when it has one, else their concatenation
 // (in `storage`).
 std::span<const ShadePoint> pooled_points(const BakeJob& job, std::vector<ShadePoint>& storage) {
@@ -117,7 +96,7 @@ void BakePipeline::run(const Monitor& monitor, const PipelineHooks& hooks) {
     uint64_t total = 0, before = 0;
     for (size_t j = 0; j < jobs_.size(); ++j)
       if (which[j]) total += jobs_[j].row_count();
-    const Monitor stage = one_stage(monitor, settings_.bake_stage, total, before, std::chrono::steady_clock::now());
+    const Monitor stage = fold_tasks(monitor, settings_.bake_stage, total, before, std::chrono::steady_clock::now());
     for (size_t j = 0; j < jobs_.size(); ++j) {
       if (!which[j]) continue;
       integrate(jobs_[j], stage, before, hooks);
@@ -189,7 +168,7 @@ void BakePipeline::check(const Monitor& monitor, const PipelineHooks& hooks, con
       total += std::min(report_points(jobs_[j], s), jobs_[j].sets[s].points.size());
   if (total == 0) return;
   if (hooks.checking) hooks.checking();
-  const Monitor stage = one_stage(monitor, settings_.check_stage, total, before, std::chrono::steady_clock::now());
+  const Monitor stage = fold_tasks(monitor, settings_.check_stage, total, before, std::chrono::steady_clock::now());
   for (size_t j = 0; j < jobs_.size(); ++j) {
     BakeJob& job = jobs_[j];
     if (!which[j] || job.spec.report_points == 0) continue;

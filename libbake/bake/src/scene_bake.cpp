@@ -256,16 +256,33 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
         printf_string("%.2f s", out.environment_seconds));
   }
-  for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i) {
-    if (!plan.objects[i].fiv) continue;
+  // Every occluder's shells as one progress stage (each may stop before its last shell: its share
+  // is counted whole once it is done); a log line per occluder for a few, else the total.
+  std::vector<size_t> movers;
+  for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i)
+    if (plan.objects[i].fiv) movers.push_back(i);
+  const uint64_t share = uint64_t(scene.fiv.n_rho) * uint64_t(scene.fiv.n_phi) * uint64_t(scene.fiv.n_theta);
+  const uint64_t fiv_total = share * movers.size();
+  uint64_t fiv_before = 0;
+  bool fiv_last = false;
+  const Monitor fiv_stage = fold_tasks(monitor, "baking FIV shells", fiv_total, fiv_before, std::chrono::steady_clock::now(), &fiv_last);
+  for (size_t k = 0; k < movers.size(); ++k) {
+    const size_t i = movers[k];
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
     ObjectBake& ob = out.objects[i];
-    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
+    fiv_last = k + 1 == movers.size();
+    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, fiv_stage);
+    fiv_before += share;
     out.fiv_seconds += ob.shells->seconds;
-    log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
-        "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
+    if (movers.size() <= kObjectLinesUpTo)
+      log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +
+          std::to_string(scene.fiv.n_theta) + "x" + std::to_string(ob.shells->radii.size()) + " in " +
+          printf_string("%.2f s", ob.shells->seconds));
   }
+  if (movers.size() > kObjectLinesUpTo)
+    log(std::to_string(movers.size()) + " occluders' FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +
+        std::to_string(scene.fiv.n_theta) + " in " + printf_string("%.2f s", out.fiv_seconds));
 
   // ---- receivers: the pipeline (choose, integrate, check, correct) ----
   hooks.ready = [&](const BakeJob& job) { out.setup_seconds += job.setup_seconds; };
