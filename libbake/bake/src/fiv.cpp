@@ -309,11 +309,12 @@ FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const En
   const auto t0 = std::chrono::steady_clock::now();
   const FivShellRows baker(occluder, topology, env, spec);
   cost.setup_seconds = seconds_since(t0);
+  // Seeded rows of a shell (at most 4096 x 4096: a uint32 count), taken on the shells in turn.
   const size_t per_shell = baker.rows_per_shell(), total = per_shell * size_t(baker.shell_count());
-  const std::vector<uint32_t> picks = seeded_sample(uint32_t(total), samples, 0x7368656cull);
+  const std::vector<uint32_t> picks = seeded_sample(uint32_t(per_shell), samples, 0x7368656cull);
   const double c0 = thread_cpu_seconds();
   // One row at a time: a range of one runs on the calling thread, whose CPU time is what is counted.
-  for (uint32_t r : picks) (void)baker.rows(int(r / per_shell), r % per_shell, r % per_shell + 1);
+  for (size_t q = 0; q < picks.size(); ++q) (void)baker.rows(int(q % size_t(baker.shell_count())), picks[q], picks[q] + 1);
   cost.timed = picks.size();
   cost.cpu_seconds = (thread_cpu_seconds() - c0) * double(total) / double(std::max<size_t>(picks.size(), 1));
   return cost;
