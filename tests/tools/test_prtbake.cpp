@@ -16,6 +16,7 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 namespace fs = std::filesystem;
 namespace F = prt::formats;
@@ -233,6 +234,87 @@ TEST(Prtbake, TargetErrorChoosesPrintsWhyAndTheReportChecksIt) {
   fs::remove(out);
   EXPECT_EQ(run(bake + " -v --quiet").code, 2);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// The lines of `out` that begin with `prefix`, in order.
+std::vector<std::string> lines_starting(const std::string& out, const std::string& prefix) {
+  std::vector<std::string> found;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(prefix, 0) == 0) found.push_back(line);
+  return found;
+}
+
+TEST(Prtbake, TheDefaultTargetGetsTheReportOfTheSameTargetNamed) {
+  // Issue 29: the default bake checked 32 vertices and said "not verifiable here" where
+  // --target-error 1e-3, the same target named, checked 128 and said "met". The same request must
+  // get the same check. --reproducible makes the pilot's choice a function of the inputs, so both
+  // bakes are the same bake and their reports can be compared value for value.
+  const std::string mesh = (kData / "bunny.obj").string();
+  const fs::path def = scratch("default_target.prt.h5"), named = scratch("named_target.prt.h5");
+  const Outcome d = run("vertex " + mesh + " --ao --reproducible -o " + def.string());
+  const Outcome n = run("vertex " + mesh + " --ao --reproducible --target-error 1e-3 -o " + named.string());
+  ASSERT_EQ(d.code, 0) << d.err;
+  ASSERT_EQ(n.code, 0) << n.err;
+  const F::Asset a = F::read_asset(def), b = F::read_asset(named);
+  EXPECT_EQ(a.target_error, 1e-3);
+  EXPECT_EQ(b.target_error, 1e-3);
+  ASSERT_TRUE(a.vertices.report.vertices.has_value());
+  EXPECT_EQ(a.vertices.report.vertices->values.size(), size_t(128)) << "the default checks as many vertices as a target";
+  EXPECT_EQ(a.vertices.report, b.vertices.report) << "the same points, values and reference";
+  EXPECT_EQ(a.vertices.ao, b.vertices.ao) << "the same bake";
+  // What is printed about the check, the verdict included, is the same line for line.
+  for (const char* prefix : {"error against a ", "  AO ", "  target "}) {
+    const auto ld = lines_starting(d.out, prefix), ln = lines_starting(n.out, prefix);
+    EXPECT_FALSE(ld.empty()) << "no line starting '" << prefix << "' in:\n" << d.out;
+    if (std::string(prefix) == "error against a ") {  // the reference's time differs run to run
+      ASSERT_EQ(ld.size(), ln.size());
+      for (size_t i = 0; i < ld.size(); ++i) EXPECT_EQ(ld[i].substr(0, ld[i].find(" (")), ln[i].substr(0, ln[i].find(" (")));
+    } else {
+      EXPECT_EQ(ld, ln);
+    }
+  }
+  EXPECT_NE(d.out.find("on 128 seeded vertices"), std::string::npos) << d.out;
+}
+
+// The number after `label` in `line` (NaN when it is not there).
+double number_after(const std::string& line, const std::string& label) {
+  const size_t at = line.find(label);
+  return at == std::string::npos ? std::nan("") : std::stod(line.substr(at + label.size()));
+}
+
+TEST(Prtbake, TheReportSaysWhatEachNumberIsAndNoNumberContradictsAnother) {
+  // Issue 29: an accurate bake printed "AO RMSE 3.0e-04 ... (the reference's own std. error
+  // 2.4e-03, QMC's estimate)": a reference noisier than the whole difference it is part of. QMC's
+  // estimator overstates randomised QMC's noise several times; the reference is now two
+  // independent halves whose noise is measured on the report's values, and the bake's own error
+  // (the RMSE with that noise taken out, and its range) is said with or without a target.
+  const std::string mesh = (kData / "bunny.obj").string();
+  const Outcome s = run("vertex " + mesh + " --ao --samples 65536 --report 128 -o " + scratch("sil_report.prt.h5").string());
+  ASSERT_EQ(s.code, 0) << s.err;
+  const auto table = lines_starting(s.out, "  AO ");
+  ASSERT_EQ(table.size(), size_t(1)) << s.out;
+  EXPECT_NE(table[0].find("measured from its two halves"), std::string::npos) << table[0];
+  const double m = number_after(table[0], "RMSE "), sigma = number_after(table[0], "the reference's own std. error ");
+  // m² = e² + σ² in expectation; the measured σ² is known to ±δσ², δ = 3·sqrt(4/n) for n = 128 points
+  // (bake/bake/choose.h target_check_lines): σ above m/sqrt(1 − δ) cannot be the reference's noise.
+  const double delta = 3 * std::sqrt(4.0 / 128);
+  EXPECT_GT(sigma, 0.0) << table[0];
+  EXPECT_LE(sigma, m / std::sqrt(1 - delta)) << table[0];
+  // A deterministic integrator has no standard error of its own to print (it printed 0.000e+00,
+  // which reads as "no error"): its error is a bias, which only the comparison measures.
+  EXPECT_EQ(table[0].find("the bake's std. error"), std::string::npos) << table[0];
+  const auto own = lines_starting(s.out, "  AO: the bake's own error ");
+  ASSERT_EQ(own.size(), size_t(1)) << s.out;
+  EXPECT_NE(own[0].find("less the reference's own noise "), std::string::npos) << own[0];
+  EXPECT_LE(number_after(own[0], "the bake's own error "), m) << own[0];
+  // A QMC bake has a standard error of its own, and it is not zero.
+  const Outcome q = run("vertex " + mesh + " --ao --integrator qmc --samples 64 --report 16 -o " +
+                        scratch("qmc_report.prt.h5").string());
+  ASSERT_EQ(q.code, 0) << q.err;
+  const auto qmc = lines_starting(q.out, "  AO ");
+  ASSERT_EQ(qmc.size(), size_t(1)) << q.out;
+  EXPECT_GT(number_after(qmc[0], "the bake's std. error by QMC's estimator, an upper bound, "), 0.0) << qmc[0];
 }
 
 TEST(Prtbake, PrintsWhatItBakedTheTimeAndTheError) {

@@ -219,7 +219,7 @@ void print_error_report(const bake::BakeJob& job) {
   for (const auto& e : report.products) {
     std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse, e.max_abs,
                 e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
-    if (sampled) std::printf("bake's estimated std. error %.3e; ", e.bake_std_error);
+    if (sampled) std::printf("the bake's std. error by QMC's estimator, an upper bound, %.3e; ", e.bake_std_error);
     if (e.finer > 1)
       std::printf("against the same integrator at %.0fx its isolines, N = %u, on %zu %s: its own error at most %.3e)\n",
                   e.finer, e.finer_knob, e.finer_points, job.sets.front().rows_noun, e.reference_std_error);
@@ -229,10 +229,11 @@ void print_error_report(const bake::BakeJob& job) {
   }
 }
 
-void print_target_verdict(const bake::BakeJob& job, double target) {
-  for (const std::string& line :
-       bake::target_check_lines(*job.pooled, target, job.reference_plan ? &*job.reference_plan : nullptr))
-    std::printf("%s\n", line.c_str());
+void print_error_verdict(const bake::BakeJob& job, double target) {
+  const std::vector<std::string> lines =
+      target > 0 ? bake::target_check_lines(*job.pooled, target, job.reference_plan ? &*job.reference_plan : nullptr)
+                 : bake::error_estimate_lines(*job.pooled);
+  for (const std::string& line : lines) std::printf("%s\n", line.c_str());
 }
 
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better) {

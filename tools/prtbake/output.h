@@ -53,12 +53,12 @@ bake::ProductRequest product_request(const Args& a, const bake::EnvMap* env);
 // What a bake of receivers (prtbake vertex, texel; bake/bake/pipeline.h) says as it goes, on
 // stdout: the products and the integrator once it is made (`rows`: "vertices", "texels"); the
 // rows baked, the integrator's own work and the threads' use; the error report; the target's
-// verdict; the correction. `shards_without_threads`: the rows came from chunks of other workers
+// verdict (without a target, the bake's own error its RMSE means); the correction. `shards_without_threads`: the rows came from chunks of other workers
 // or runs, whose threads are not recorded.
 void print_baking(const Args& a, const bake::BakeJob& job, int threads);
 void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
 void print_error_report(const bake::BakeJob& job);
-void print_target_verdict(const bake::BakeJob& job, double target);
+void print_error_verdict(const bake::BakeJob& job, double target);  // target 0: what the RMSE means
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better);
 
 // The root attributes every file carries (formats/SCHEMA.md).

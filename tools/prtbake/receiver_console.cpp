@@ -36,7 +36,7 @@ bake::PipelineHooks ReceiverConsole::hooks(const Args& a, const RunContext& run,
     if (run.say) print_error_report(j);
   };
   h.job_checked = [&a, &run, write](const bake::BakeJob& j) {
-    if (run.say && a.target_error > 0) print_target_verdict(j, a.target_error);
+    if (run.say) print_error_verdict(j, a.target_error);
     write();
   };
   h.correcting = [this, &run](const bake::BakeJob& j, const bake::IntegratorSpec& better) {

@@ -281,6 +281,45 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
   return out;
 }
 
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+} // namespace
+
+FivCost environment_fiv_cost(const EnvMap& env, int size, size_t samples) {
+  PRT_CHECK(size >= 1);
+  FivCost cost;
+  const auto t0 = std::chrono::steady_clock::now();
+  (void)environment_fiv(env);
+  const UnshadowedIrradiance E(env);
+  cost.setup_seconds = seconds_since(t0);
+  const size_t texels = cube_texels(size);
+  const std::vector<uint32_t> picks = seeded_sample(uint32_t(texels), samples, 0x6469666dull);
+  const double c0 = thread_cpu_seconds();
+  for (uint32_t t : picks) (void)E(gl_cube_direction(int(t) / (size * size), (int(t) / size) % size, int(t) % size, size));
+  cost.timed = picks.size();
+  cost.cpu_seconds = (thread_cpu_seconds() - c0) * double(texels) / double(std::max<size_t>(picks.size(), 1));
+  return cost;
+}
+
+FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                        size_t samples) {
+  FivCost cost;
+  const auto t0 = std::chrono::steady_clock::now();
+  const FivShellRows baker(occluder, topology, env, spec);
+  cost.setup_seconds = seconds_since(t0);
+  // Seeded rows of a shell (at most 4096 x 4096: a uint32 count), taken on the shells in turn.
+  const size_t per_shell = baker.rows_per_shell(), total = per_shell * size_t(baker.shell_count());
+  const std::vector<uint32_t> picks = seeded_sample(uint32_t(per_shell), samples, 0x7368656cull);
+  const double c0 = thread_cpu_seconds();
+  // One row at a time: a range of one runs on the calling thread, whose CPU time is what is counted.
+  for (size_t q = 0; q < picks.size(); ++q) (void)baker.rows(int(q % size_t(baker.shell_count())), picks[q], picks[q] + 1);
+  cost.timed = picks.size();
+  cost.cpu_seconds = (thread_cpu_seconds() - c0) * double(total) / double(std::max<size_t>(picks.size(), 1));
+  return cost;
+}
+
 FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, const EnvMap& env, const FivShells& shells,
                                 const Fiv& fenv, size_t points, uint64_t seed, const Monitor& monitor) {
   ProductRequest req;

@@ -151,9 +151,12 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
 
   if (rows.estimate_only) {
     // The dry run's estimate: per job, its integrator (chosen, with a target: the pilot runs)
-    // timed on seeded vertices of its receivers, scaled to all of them (SceneRows::estimate_only).
+    // timed on seeded vertices of its receivers, scaled to all of them; then the FIV steps the
+    // same way, and the whole (SceneRows::estimate_only).
     pipeline.plan(monitor, hooks);
+    const double planned = seconds_since(t_setup);  // the occluders' trees, the pilots
     const double threads = double(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    double total = 0;  // wall seconds on `threads` after the plan
     for (BakeJob& job : pipeline.jobs()) {
       const size_t n = job.row_count();
       const std::optional<double> per_row = pipeline.cpu_seconds_per_row(job, kEstimatePoints);
@@ -163,6 +166,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
         continue;
       }
       const double cpu = *per_row * double(n);
+      total += cpu / threads;
       log(job.name + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(n) + " vertices with " +
           to_string(job.spec.kind) + " at " + job.spec.knob_text() + printf_string(", %.3g s on ", cpu / threads) +
           std::to_string(int(threads)) + " threads (timed on " + std::to_string(std::min(kEstimatePoints, n)) +
@@ -172,11 +176,51 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       // kReportMinCpuSeconds), from the estimate.
       pipeline.plan_check(job, scene.counted_costs ? 0.0 : std::max(ReferencePlan::kReportMinCpuSeconds, cpu), monitor);
       const ReferencePlan& rp = *job.reference_plan;
-      if (rp.us_per_ray > 0)
-        log("  and its error check about " +
-            printf_string("%.3g CPU s", double(rp.rays) * double(rp.points) * rp.us_per_ray * 1e-6) +
-            " (a QMC reference of " + std::to_string(rp.rays) + " rays on " + std::to_string(rp.points) + " vertices)");
+      if (rp.us_per_ray > 0) {
+        const double check = double(rp.rays) * double(rp.points) * rp.us_per_ray * 1e-6;
+        total += check / threads;
+        log("  and its error check about " + printf_string("%.3g CPU s", check) + " (a QMC reference of " +
+            std::to_string(rp.rays) + " rays on " + std::to_string(rp.points) + " vertices)");
+      }
     }
+    // The FIV steps, each timed on seeded samples after its setup (done for real).
+    auto fiv_line = [&](const std::string& what, const FivCost& c) {
+      total += c.setup_seconds + c.cpu_seconds / threads;
+      log(what + ": about " + printf_string("%.3g CPU s, %.3g s on ", c.cpu_seconds, c.setup_seconds + c.cpu_seconds / threads) +
+          std::to_string(int(threads)) + " threads" + printf_string(" (setup %.2f s, then ", c.setup_seconds) +
+          std::to_string(c.timed) + " seeded samples timed)");
+    };
+    if (plan.fiv_environment)
+      fiv_line("the environment's FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) +
+                   "x6 DifMap",
+               environment_fiv_cost(*env, scene.fiv.cube, kEstimatePoints));
+    // Each occluder's shells; with many (an engine whose parts all move), one line for them all.
+    const std::string grid = "FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
+                             "x" + std::to_string(scene.fiv.n_rho);
+    const std::string every = " (if every shell is needed)";
+    size_t movers = 0;
+    for (const ObjectPlan& p : plan.objects) movers += p.fiv ? 1 : 0;
+    FivCost all;
+    std::string dearest;
+    double dearest_cpu = -1;
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if (plan.objects[i].fiv) {
+        const Topology t = build_topology(meshes[i]);
+        const FivCost c = fiv_shells_cost(meshes[i], t, *env, scene.fiv, kEstimatePoints);
+        if (movers <= kObjectLinesUpTo) {
+          fiv_line(label_of(scene.objects[i]) + ": " + grid + every, c);
+          continue;
+        }
+        all.setup_seconds += c.setup_seconds, all.cpu_seconds += c.cpu_seconds, all.timed += c.timed;
+        if (c.cpu_seconds > dearest_cpu) dearest_cpu = c.cpu_seconds, dearest = label_of(scene.objects[i]);
+      }
+    if (movers > kObjectLinesUpTo)
+      fiv_line(std::to_string(movers) + " occluders' " + grid + ", the dearest " + dearest +
+                   printf_string(" at %.3g CPU s", dearest_cpu) + every,
+               all);
+    log(printf_string("in all about %.3g s on ", total + planned) + std::to_string(int(threads)) +
+        printf_string(" threads: %.3g s of setup and choice (done above), ", planned) +
+        printf_string("%.3g s after it (area lights and writing the file not counted)", total));
     return out;
   }
 
@@ -212,16 +256,33 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     log("environment FIV and " + std::to_string(scene.fiv.cube) + "x" + std::to_string(scene.fiv.cube) + "x6 DifMap in " +
         printf_string("%.2f s", out.environment_seconds));
   }
-  for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i) {
-    if (!plan.objects[i].fiv) continue;
+  // Every occluder's shells as one progress stage (each may stop before its last shell: its share
+  // is counted whole once it is done); a log line per occluder for a few, else the total.
+  std::vector<size_t> movers;
+  for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i)
+    if (plan.objects[i].fiv) movers.push_back(i);
+  const uint64_t share = uint64_t(scene.fiv.n_rho) * uint64_t(scene.fiv.n_phi) * uint64_t(scene.fiv.n_theta);
+  const uint64_t fiv_total = share * movers.size();
+  uint64_t fiv_before = 0;
+  bool fiv_last = false;
+  const Monitor fiv_stage = fold_tasks(monitor, "baking FIV shells", fiv_total, fiv_before, std::chrono::steady_clock::now(), &fiv_last);
+  for (size_t k = 0; k < movers.size(); ++k) {
+    const size_t i = movers[k];
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
     ObjectBake& ob = out.objects[i];
-    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, monitor);
+    fiv_last = k + 1 == movers.size();
+    ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, fiv_stage);
+    fiv_before += share;
     out.fiv_seconds += ob.shells->seconds;
-    log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" + std::to_string(scene.fiv.n_theta) +
-        "x" + std::to_string(ob.shells->radii.size()) + " in " + printf_string("%.2f s", ob.shells->seconds));
+    if (movers.size() <= kObjectLinesUpTo)
+      log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +
+          std::to_string(scene.fiv.n_theta) + "x" + std::to_string(ob.shells->radii.size()) + " in " +
+          printf_string("%.2f s", ob.shells->seconds));
   }
+  if (movers.size() > kObjectLinesUpTo)
+    log(std::to_string(movers.size()) + " occluders' FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +
+        std::to_string(scene.fiv.n_theta) + " in " + printf_string("%.2f s", out.fiv_seconds));
 
   // ---- receivers: the pipeline (choose, integrate, check, correct) ----
   hooks.ready = [&](const BakeJob& job) { out.setup_seconds += job.setup_seconds; };
@@ -270,18 +331,20 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     std::string line = set.name + ": error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
     for (const auto& e : ob.report->products)
       line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
-              printf_string("reference's own std. error %.1e)", e.reference_std_error);
+              (ob.report->reference_noise_measured ? "reference's own noise, measured, " : "reference's own std. error ") +
+              printf_string("%.1e)", e.reference_std_error);
     log(line + printf_string("; reference took %.2f s", ob.report->reference_seconds));
   };
   hooks.job_checked = [&](const BakeJob& job) {
-    if (!target) return;
-    // The job's verdict on its pooled report (bake/bake/choose.h target_check_lines).
+    // The job's verdict on its pooled report, or without a target what its RMSE means: the bake's
+    // own error with the reference's noise taken out (bake/bake/choose.h).
     if (job.sets.size() > 1)
       log("receivers from " + job.sets.front().name + " (" + std::to_string(job.sets.size()) + " objects), their " +
           std::to_string(job.pooled->vertices.size()) + " report vertices together" +
           printf_string(" (the reference took %.2f s):", job.pooled->reference_seconds));
     for (const std::string& l :
-         target_check_lines(*job.pooled, scene.target_error, job.reference_plan ? &*job.reference_plan : nullptr))
+         target ? target_check_lines(*job.pooled, scene.target_error, job.reference_plan ? &*job.reference_plan : nullptr)
+                : error_estimate_lines(*job.pooled))
       log(l);
   };
   hooks.correcting = [&](const BakeJob& job, const IntegratorSpec& better) {

@@ -168,25 +168,45 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
   return out;
 }
 
+namespace {
+
+// What a verdict's numbers are: the bake's own error (the reference's noise taken out) and the
+// range it lies in, from what was measured.
+std::string verdict_numbers(const TargetVerdict& v) {
+  std::string line;
+  if (v.extrapolated)
+    line += format("the bake's own error %.2e to ", v.error_lo) + format("%.2e, from its RMSE ", v.error_hi) +
+            format("%.3e against the same integrator at %.0fx its isolines (N = ", v.measured, v.finer) +
+            format("%.0f) on ", double(v.finer_knob)) + format("%.0f points, which converges at order 1 to 2 ", double(v.finer_points)) +
+            "(a QMC reference within E/3 would take too many rays)";
+  else if (v.noise_measured)
+    line += format("the bake's own error %.2e", v.error) + format(" (%.2e to ", v.error_lo) +
+            format("%.2e), ", v.error_hi) + format("the measured RMSE %.3e less the reference's own noise ", v.measured) +
+            format("%.1e (", v.noise) + v.noise_kind + ") in quadrature";
+  else
+    line += format("the measured RMSE %.3e, which includes the reference's own noise (", v.measured) +
+            format("%.1e, ", v.noise) + v.noise_kind + format("): the bake's own error is %.2e to ", v.error_lo) +
+            format("%.2e", v.measured);
+  return line;
+}
+
+} // namespace
+
+std::vector<std::string> error_estimate_lines(const ErrorReport& report) {
+  std::vector<std::string> out;
+  // No target: only the numbers of target_verdicts, whose met / NOT met are not used.
+  for (const TargetVerdict& v : target_verdicts(report, 1.0))
+    out.push_back(std::string("  ") + product_label(v.product) + (is_radiance(v.product) ? " (relative)" : "") + ": " +
+                  verdict_numbers(v));
+  return out;
+}
+
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target, const ReferencePlan* plan) {
   std::vector<std::string> out;
   for (const TargetVerdict& v : target_verdicts(report, target, plan)) {
     const char* verdict = v.met ? "met" : v.not_met ? "NOT met" : "not verifiable here";
     std::string line = format("  target %g for ", target) + product_label(v.product) +
-                       (is_radiance(v.product) ? " (relative)" : "") + ": " + verdict + ": ";
-    if (v.extrapolated)
-      line += format("the bake's own error %.2e to ", v.error_lo) + format("%.2e, from its RMSE ", v.error_hi) +
-              format("%.3e against the same integrator at %.0fx its isolines (N = ", v.measured, v.finer) +
-              format("%.0f) on ", double(v.finer_knob)) + format("%.0f points, which converges at order 1 to 2 ", double(v.finer_points)) +
-              "(a QMC reference within E/3 would take too many rays)";
-    else if (v.noise_measured)
-      line += format("the bake's own error %.2e", v.error) + format(" (%.2e to ", v.error_lo) +
-              format("%.2e), ", v.error_hi) + format("the measured RMSE %.3e less the reference's own noise ", v.measured) +
-              format("%.1e (", v.noise) + v.noise_kind + ") in quadrature";
-    else
-      line += format("the measured RMSE %.3e, which includes the reference's own noise (", v.measured) +
-              format("%.1e, ", v.noise) + v.noise_kind + format("): the bake's own error is %.2e to ", v.error_lo) +
-              format("%.2e", v.measured);
+                       (is_radiance(v.product) ? " (relative)" : "") + ": " + verdict + ": " + verdict_numbers(v);
     if (!v.met && !v.not_met) {
       line += ": the reference is too noisy to tell";
       if (plan)

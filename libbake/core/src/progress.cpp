@@ -61,4 +61,26 @@ double thread_cpu_seconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+Monitor fold_tasks(const Monitor& monitor, const std::string& label, const uint64_t& total, const uint64_t& before,
+                   std::chrono::steady_clock::time_point start, const bool* last) {
+  Monitor m;
+  m.cancel = monitor.cancel;
+  if (monitor.on_progress)
+    m.on_progress = [&monitor, label, &total, &before, start, last](const ProgressUpdate& u) {
+      ProgressUpdate o = u;
+      o.task = label;
+      o.done = before + u.done;
+      o.total = total;
+      o.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!last) {
+        o.finished = u.finished && (o.done == o.total || u.done < u.total);  // the last task, or a cancel
+      } else {
+        o.finished = u.finished && (*last || monitor.cancelled());
+        if (o.finished && !monitor.cancelled()) o.done = total;  // the last task may end short of its share
+      }
+      monitor.on_progress(o);
+    };
+  return m;
+}
+
 } // namespace prt::bake

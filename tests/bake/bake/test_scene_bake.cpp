@@ -48,3 +48,44 @@ TEST(SceneBake, TheReceiversAreOneProgressStageOverAllTheirVertices) {
   EXPECT_TRUE(seen.back().finished);
   EXPECT_EQ(seen.back().done, receivers);
 }
+
+TEST(SceneBake, EveryOccludersShellsAreOneProgressStage) {
+  // Issue 29: each moving occluder's shells were a stage of their own, so a log restarted at 0%
+  // per part with no ETA for the scene. They are one stage, "baking FIV shells", over every
+  // occluder's share (n_rho shells each; a share that stops early is counted whole once done),
+  // which never goes backwards and finishes once, at its total.
+  SceneDescription scene = load_scene(fs::path(PRT_DATA_DIR) / "scene_example.json");
+  scene.integrator.report_points = 0;
+  scene.integrator.set_samples(256);
+  scene.fiv.n_phi = 8, scene.fiv.n_theta = 5, scene.fiv.n_rho = 6;  // the stage, not the values, is under test
+  scene.fiv.silhouette_k = 256;
+  std::vector<std::string> warnings;
+  const std::vector<Mesh> meshes = load_scene_meshes(scene, warnings);
+  const EnvMap env = EnvMap::load(*scene.environment, scene.up);
+  const ScenePlan plan = plan_scene(scene, meshes);
+  size_t movers = 0;
+  for (const ObjectPlan& p : plan.objects) movers += p.fiv ? 1 : 0;
+  ASSERT_GE(movers, 2u) << "the stage must span several occluders";
+  const uint64_t total = uint64_t(movers) * 6 * 8 * 5;
+  std::vector<ProgressUpdate> seen;
+  Monitor monitor;
+  monitor.on_progress = [&](const ProgressUpdate& u) {
+    if (u.task == "baking FIV shells") seen.push_back(u);
+  };
+  const SceneBake out = bake_scene(scene, plan, meshes, &env, monitor, [](const std::string&) {});
+  ASSERT_FALSE(seen.empty());
+  size_t finished = 0;
+  uint64_t last = 0;
+  for (const ProgressUpdate& u : seen) {
+    EXPECT_EQ(u.total, total);
+    EXPECT_GE(u.done, last) << "the count never restarts";
+    last = u.done;
+    finished += u.finished;
+  }
+  EXPECT_EQ(finished, 1u);
+  EXPECT_TRUE(seen.back().finished);
+  EXPECT_EQ(seen.back().done, total);
+  size_t baked = 0;
+  for (const ObjectBake& ob : out.objects) baked += ob.shells ? 1 : 0;
+  EXPECT_EQ(baked, movers);
+}

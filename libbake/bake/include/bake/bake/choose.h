@@ -351,6 +351,9 @@ std::string choice_summary(const IntegratorChoice& choice);
 // verifiable here", saying why (the rays E/3 would have needed against the report's budget).
 std::vector<std::string> target_check_lines(const ErrorReport& report, double target,
                                             const ReferencePlan* plan = nullptr);
+// Without a target, one line per product saying what its RMSE means: the bake's own error with
+// the reference's noise taken out, and its range (target_verdicts' numbers, without a verdict).
+std::vector<std::string> error_estimate_lines(const ErrorReport& report);
 // The numbers behind each line (per product, in E's units).
 struct TargetVerdict {
   Product product = Product::Ao;

@@ -100,6 +100,21 @@ void bounding_sphere(const Mesh& mesh, Eigen::Vector3d& centre, double& radius);
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
                           const Monitor& monitor = {});
 
+// What an FIV step would cost, for a dry run's estimate (bake/bake/scene_bake.h): its setup's wall
+// seconds (done for real: the integrator's tables, the environment's cell hierarchy) and the CPU
+// seconds of all its samples, `samples` seeded ones timed on the calling thread and scaled.
+struct FivCost {
+  double setup_seconds = 0;
+  double cpu_seconds = 0;
+  size_t timed = 0;  // the samples timed
+};
+// environment_fiv and irradiance_cube(env, size): the DifMap's 6·S² texels.
+FivCost environment_fiv_cost(const EnvMap& env, int size, size_t samples);
+// bake_fiv_shells with every one of spec.n_rho shells baked (the bake may stop earlier, once
+// |F| < spec.fraction; under a sun it seldom does), the samples spread over the shells.
+FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                        size_t samples);
+
 // The shell bake as rows, for bakes cut into chunks (sharded and resumable bakes): bake_fiv_shells
 // is this class's rows shell after shell, stopping where stops_after() says, so any cut of the
 // shells' rows gives the same numbers. Row r of shell k is grid sample r = i·Nφ + j, kRowWidth

@@ -67,10 +67,12 @@ struct SceneRows {
                            const Monitor& monitor)>
       rows;
   bool rows_only = false;
-  // The dry run's estimate: no receiver is baked; per distinct product request (the receivers that
+  // The dry run's estimate: nothing is baked; per distinct product request (the receivers that
   // make it), the integrator — with a target, the one the pilot chooses — is timed on 64 seeded
   // vertices and `log` receives its predicted CPU time for all of them (and the error check's
-  // bound); no area lights, reports or FIV.
+  // bound); the environment's FIV and DifMap and each occluder's shells are timed on 64 seeded
+  // samples after their setup (bake/bake/fiv.h FivCost); last, the whole in wall seconds on the
+  // threads allowed. Area lights are not estimated.
   bool estimate_only = false;
   // Called once the bake is whole (the receivers' rows, area lights and FIV shells), before any
   // error report is made: a tool writes the file there, so a check cancelled with Ctrl-C (or one

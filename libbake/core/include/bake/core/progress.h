@@ -80,6 +80,16 @@ private:
   std::chrono::steady_clock::time_point start_;
 };
 
+// A monitor that folds a sequence of tasks (one per receiver set, one per occluder's shells) into
+// one progress stage `label` of `total` units, so that a log shows one stage with one ETA: each
+// task's count is offset by `*before` (the units of the tasks already done, which the caller
+// advances), the time runs from `start`. The stage finishes with the last task: when `last` is
+// null, the task that reaches `total`; else the task during which `*last` is true (a task may end
+// short of its share, as FIV shells that stop early). A cancelled task finishes it too.
+// `monitor`, `total`, `before` and `last` must outlive the returned monitor.
+Monitor fold_tasks(const Monitor& monitor, const std::string& label, const uint64_t& total, const uint64_t& before,
+                   std::chrono::steady_clock::time_point start, const bool* last = nullptr);
+
 // The calling thread's CPU time in seconds (CLOCK_THREAD_CPUTIME_ID): what a bake and its
 // integrators count as work, since idle or spinning workers do not advance it.
 double thread_cpu_seconds();
