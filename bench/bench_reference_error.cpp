@@ -33,13 +33,23 @@
 //   file <path> plan=<integrator>:<samples> <product>=<error> ...
 // Products are named ao, transfer, radiance.
 //
+// With `--truth TRUTH.prt.h5` (a bake of the same mesh and products by a converged integrator, e.g.
+// prtbake's silhouette integrator at N = 1024, whose own error is ~1e-2 E): each FILE's errors are
+// those over ALL its rows against TRUTH — AO and transfer absolute, radiance relative to the RMS
+// of TRUTH's radiance over all rows, the whole-mesh quantities E is defined on — instead of the
+// sampled rows' (whose 20-row RMSE, and a radiance RMS over 20 rows where half a mesh may see no
+// sky, vary by tens of percent from sample to sample). TRUTH itself is checked against the
+// independent QMC reference on the sampled rows:
+//   truth <path> plan=<integrator>:<samples> <product>=<error at the sampled rows, E's units of the file line>
+// which must stay within the reference's own noise (the `reference` line) for TRUTH to stand.
+//
 // With `--cache PATH` the reference (its rays, rows, values and standard errors) is read from PATH
 // when PATH holds one for the same rows, seeds and layout, else integrated and written there, so
 // the driver can measure each rung of a ladder as it is baked without integrating it again.
 //
 //   bench_reference_error MESH [--ao] [--transfer L] [--radiance ENV] [--target E] [--points K] [--per-row]
 //                         [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M]
-//                         [--cache PATH] FILE.prt.h5...
+//                         [--cache PATH] [--truth TRUTH.prt.h5] FILE.prt.h5...
 //   bench_reference_error MESH --geometry
 #include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
@@ -81,13 +91,14 @@ struct Args {
   bool geometry = false;
   bool per_row = false;  // --per-row: also each sampled row's error (`row <file> <row> <product>=<RMSE>`)
   std::string cache;
+  std::string truth;  // --truth: errors over all rows against this file
   std::vector<std::string> files;
 };
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "bench_reference_error: %s\nusage: bench_reference_error MESH [--ao] [--transfer L] [--radiance ENV] "
-               "[--target E] [--points K] [--per-row] [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M] [--cache PATH] FILE.prt.h5... | MESH --geometry\n",
+               "[--target E] [--points K] [--per-row] [--point-seed S] [--rays R] [--max-rays R] [--ref-seed S] [--replicates M] [--cache PATH] [--truth TRUTH.prt.h5] FILE.prt.h5... | MESH --geometry\n",
                why.c_str());
   std::exit(2);
 }
@@ -111,6 +122,7 @@ Args parse(int argc, char** argv) {
     else if (s == "--max-rays") a.max_rays = uint32_t(std::stoul(value()));
     else if (s == "--ref-seed") a.ref_seed = std::stoull(value());
     else if (s == "--cache") a.cache = value();
+    else if (s == "--truth") a.truth = value();
     else if (s == "--replicates") a.replicates = uint32_t(std::stoul(value()));
     else if (s == "--geometry") a.geometry = true;
     else if (s.starts_with("--")) usage("unknown option " + s);
@@ -299,37 +311,83 @@ int main(int argc, char** argv) try {
   std::printf("\n");
 
   int status = 0;
-  for (const std::string& path : a.files) {
-    const formats::Asset asset = formats::read_asset(path);
+  // A baked file of this mesh's rows, or nothing (named on stderr, status 2).
+  auto read_rows = [&](const std::string& path) -> std::optional<formats::Asset> {
+    formats::Asset asset = formats::read_asset(path);
     const formats::VertexSet& set = asset.vertices;
     if (set.vertex_count() != points.size() || asset.root.source_sha256 != mesh.source_sha256) {
       std::fprintf(stderr, "%s: %zu rows of mesh %s, not the %zu rows of %s (%s)\n", path.c_str(), set.vertex_count(),
                    asset.root.source_sha256.c_str(), points.size(), a.mesh.c_str(), mesh.source_sha256.c_str());
       status = 2;
-      continue;
+      return std::nullopt;
     }
-    // The plan the file was baked with, as its first product records it (integrator:samples).
+    return asset;
+  };
+  // Product p of a file with its values per row, or null (named on stderr, status 2).
+  auto product_of = [&](const formats::Asset& asset, const std::string& path, size_t p) -> const formats::Product* {
+    const std::optional<formats::Product>& product = asset.vertices.*(slots[p].dataset);
+    if (!product || product->values.size() != points.size() * slots[p].count) {
+      std::fprintf(stderr, "%s: no %s of %zu values per row\n", path.c_str(), slots[p].name, slots[p].count);
+      status = 2;
+      return nullptr;
+    }
+    return &*product;
+  };
+  // "<tag>\t<path>\tplan=integrator:samples": the plan as the file's first product records it.
+  auto print_head = [&](const char* tag, const formats::Asset& asset, const std::string& path) {
     const formats::Product* first = nullptr;
     for (const Slot& slot : slots)
-      if (!first && set.*(slot.dataset)) first = &*(set.*(slot.dataset));
-    std::printf("file\t%s\tplan=%s:%lld", path.c_str(), first && first->integrator ? first->integrator->c_str() : "?",
+      if (!first && asset.vertices.*(slot.dataset)) first = &*(asset.vertices.*(slot.dataset));
+    std::printf("%s\t%s\tplan=%s:%lld", tag, path.c_str(), first && first->integrator ? first->integrator->c_str() : "?",
                 first && first->samples ? (long long)*first->samples : -1LL);
+  };
+  // The sampled rows' error of product p against the QMC reference (E's units).
+  auto sampled_error = [&](const formats::Product& product, size_t p) {
+    double sum = 0;
+    for (size_t i = 0; i < K; ++i)
+      for (size_t c = 0; c < slots[p].count; ++c) {
+        const double d = double(product.values[size_t(rows[i]) * slots[p].count + c]) - ref[i * W + slots[p].offset + c];
+        sum += d * d;
+      }
+    const double rmse = std::sqrt(sum / double(K * slots[p].count));
+    return slots[p].relative ? rmse / ref_rms[p] : rmse;
+  };
+  std::optional<formats::Asset> truth;
+  if (!a.truth.empty()) {
+    truth = read_rows(a.truth);
+    if (!truth) return 2;
+    print_head("truth", *truth, a.truth);
     for (size_t p = 0; p < slots.size(); ++p) {
-      const std::optional<formats::Product>& product = set.*(slots[p].dataset);
-      if (!product || product->values.size() != points.size() * slots[p].count) {
-        std::fprintf(stderr, "%s: no %s of %zu values per row\n", path.c_str(), slots[p].name, slots[p].count);
-        status = 2;
+      const formats::Product* product = product_of(*truth, a.truth, p);
+      if (!product) return 2;
+      std::printf("\t%s=%.4g", slots[p].name, sampled_error(*product, p));
+    }
+    std::printf("\n");
+  }
+  for (const std::string& path : a.files) {
+    const std::optional<formats::Asset> asset = read_rows(path);
+    if (!asset) continue;
+    const formats::VertexSet& set = asset->vertices;
+    print_head("file", *asset, path);
+    for (size_t p = 0; p < slots.size(); ++p) {
+      const formats::Product* product = product_of(*asset, path, p);
+      if (!product) {
         std::printf("\t%s=nan", slots[p].name);
         continue;
       }
-      double sum = 0;
-      for (size_t i = 0; i < K; ++i)
-        for (size_t c = 0; c < slots[p].count; ++c) {
-          const double d = double(product->values[size_t(rows[i]) * slots[p].count + c]) - ref[i * W + slots[p].offset + c];
-          sum += d * d;
-        }
-      const double rmse = std::sqrt(sum / double(K * slots[p].count));
-      std::printf("\t%s=%.4g", slots[p].name, slots[p].relative ? rmse / ref_rms[p] : rmse);
+      if (!truth) {
+        std::printf("\t%s=%.4g", slots[p].name, sampled_error(*product, p));
+        continue;
+      }
+      // Over every row against the truth; radiance relative to the truth's RMS over every row.
+      const std::vector<float>& t = product_of(*truth, a.truth, p)->values;
+      double d2 = 0, t2 = 0;
+      for (size_t x = 0; x < t.size(); ++x) {
+        const double d = double(product->values[x]) - double(t[x]);
+        d2 += d * d, t2 += double(t[x]) * double(t[x]);
+      }
+      const double rmse = std::sqrt(d2 / double(t.size())), truth_rms = std::sqrt(t2 / double(t.size()));
+      std::printf("\t%s=%.4g", slots[p].name, slots[p].relative ? (truth_rms > 0 ? rmse / truth_rms : 0.0) : rmse);
     }
     std::printf("\n");
     for (size_t i = 0; i < K && a.per_row; ++i) {

@@ -410,11 +410,13 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     Rows rows;
     double cost = 0;
     std::unique_ptr<SilhouetteIntegrator> integrator;  // kept for the reference level only (Prediction::built)
+    double build_seconds = 0;  // its build, wall
+    bool fresh = true;         // built as a bake builds it (not from masses another level computed)
   };
   std::map<int, SilRun> sil;
   // The levels share the environment's hot texels and point masses (built once, not per level).
-  // The setup a level's build measures is then less than a bake's, which builds them afresh:
-  // setup_sil is the first level's (the reference, which built them).
+  // A level that read them builds faster than a bake would: a plan's setup is that of the
+  // smallest level at or above its N that built its own (sil_setup below).
   const auto env_cache = std::make_shared<SilhouetteEnvCache>();
   // Step 1 keeps its levels' integrators (one of them becomes the reference); only the
   // reference's stays after it, and only when the bake shares the pilot's trees (accel).
@@ -430,6 +432,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     SilRun run;
     run.rows = integrate_pilot(*integrator, points, sample, progress);
     run.cost = cost_per_point(run.rows, *integrator, uint32_t(N), counted);
+    run.build_seconds = s, run.fresh = !integrator->masses_from_cache();
     if (keep_integrators) run.integrator = std::move(integrator);
     return sil.emplace(N, std::move(run)).first->second;
   };
@@ -636,12 +639,21 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     // Counted setup is the trees' (calibrated on whole builds): none when the bake reuses them.
     setup_sil = accel ? 0.0 : kCountedSetupPerTriangleSilhouette * double(mesh.triangles.size());
     setup_qmc = accel ? 0.0 : kCountedSetupPerTriangleQmc * double(mesh.triangles.size());
-  } else if (!accel) {
-    setup_sil += rays_seconds + contours_seconds;
-    setup_qmc += rays_seconds;
   }
+  const double trees_sil = counted || accel ? 0.0 : rays_seconds + contours_seconds;
+  if (!counted && !accel) setup_qmc += rays_seconds;
+  // A silhouette plan's setup: a bake builds its tables afresh, like the smallest pilot level at
+  // or above its N that built its own (the first level of each sub-sample count fills the shared
+  // masses; its build is what a bake's costs: the masses and a few more cells than N needs).
+  // Without one (counted costs), setup_sil: the largest build.
+  auto sil_setup = [&](uint32_t N) {
+    if (counted) return setup_sil;
+    for (const auto& [n, run] : sil)
+      if (n >= int(N) && run.fresh) return run.build_seconds + trees_sil;
+    return setup_sil + trees_sil;
+  };
   auto cost = [&](const Prediction& p) {
-    return (p.built ? 0.0 : p.kind == IntegratorKind::Silhouette ? setup_sil : setup_qmc) +
+    return (p.built ? 0.0 : p.kind == IntegratorKind::Silhouette ? sil_setup(p.knob) : setup_qmc) +
            V * p.predicted_us_per_point * 1e-6;
   };
   // The reference level as the silhouette plan (Prediction::built): no setup, the reference's

@@ -148,6 +148,7 @@ struct SilhouetteIntegrator::Impl {
   int subsamples = 1;             // per cell, of the smooth columns (the midpoint rule)
   int max_texel_subsamples = 0;   // k × k per texel of the environment's point masses (0: none)
   SilhouetteEnvCache::Impl::Masses* filling = nullptr;  // the cache this construction fills
+  bool masses_from_cache = false;
   std::unique_ptr<IsolineTables> tables;
   // Hot texels of the environment (≥ kHotFactor × the mean luminance, at most kMaxHot of them):
   // left out of the tables and integrated exactly over their visible part (bake/integrators/hot_texels.h), so
@@ -247,6 +248,7 @@ struct SilhouetteIntegrator::Impl {
       if (cache && max_texel_subsamples == 1) {
         if (cache->masses.complete && cache->masses.blocks.size() == masses.blocks) {
           const auto* held = &cache->masses;
+          masses_from_cache = true;
           masses.view = [held](size_t b, std::span<const Vector3d>& d, std::span<const double>& v) {
             d = held->blocks[b].directions, v = held->blocks[b].values;
             return true;
@@ -890,6 +892,8 @@ SilhouetteStats SilhouetteIntegrator::silhouette_stats() const {
   s.cpu_seconds = s.contour_seconds + s.integrate_seconds;
   return s;
 }
+
+bool SilhouetteIntegrator::masses_from_cache() const noexcept { return impl_->masses_from_cache; }
 
 void SilhouetteIntegrator::reset_stats() const {
   Impl& I = *impl_;

@@ -126,6 +126,9 @@ public:
   SilhouetteStats silhouette_stats() const;
   IntegratorStats stats() const override { return silhouette_stats(); }
   void reset_stats() const override;
+  // Whether its tables took the environment's masses from a SilhouetteEnvCache another
+  // integrator filled (its build then cost less than a build of its own would).
+  bool masses_from_cache() const noexcept;
   // Per integral: contour edges and isoline crossings, and the CPU time split between the contour
   // search and the rest; points that saw no contour edge (closed forms).
   std::string work_summary() const override;
