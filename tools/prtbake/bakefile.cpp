@@ -221,6 +221,10 @@ F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t
                                   "rmse, max_abs, reference_rms, bake_std_error, reference_std_error",
                                   finer ? e.finer_points : report.vertices.size(), reference, report.reference_seconds,
                                   bake_seconds, double(points) / bake_seconds, reproducible));
+    // What a relative error divides by (formats/SCHEMA.md "Error reports"): the product's RMS over
+    // every row, for band-1 and S.
+    const bool relative = e.product == bake::Product::RadianceBand1 || e.product == bake::Product::RadianceShadowed;
+    if (relative && e.mesh_rms > 0) out.rows.back().extra.push_back({"mesh_rms", e.mesh_rms});
   }
   out.vertices = F::Array<uint32_t>{report.vertices, {}};
   return out;

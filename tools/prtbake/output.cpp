@@ -218,7 +218,7 @@ void print_error_report(const bake::BakeJob& job) {
       std::any_of(report.products.begin(), report.products.end(), [](const auto& e) { return e.bake_std_error > 0; });
   for (const auto& e : report.products) {
     std::printf("  %-20s RMSE %.3e  max %.3e  relative RMSE %.3e  (", bake::product_label(e.product), e.rmse, e.max_abs,
-                e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0);
+                bake::relative_scale(e) > 0 ? e.rmse / bake::relative_scale(e) : 0.0);
     if (sampled) std::printf("the bake's std. error by QMC's estimator, an upper bound, %.3e; ", e.bake_std_error);
     if (e.finer > 1)
       std::printf("against the same integrator at %.0fx its isolines, N = %u, on %zu %s: its own error at most %.3e)\n",

@@ -283,7 +283,7 @@ std::string knob_text(IntegratorKind kind, uint32_t knob) {
 
 double error_in_target_units(const ProductError& e) {
   if (!is_radiance(e.product)) return e.rmse;
-  return e.reference_rms > 0 ? e.rmse / e.reference_rms : 0.0;
+  return relative_scale(e) > 0 ? e.rmse / relative_scale(e) : 0.0;
 }
 
 size_t isoline_table_bytes(const ProductRequest& r, int isolines) {

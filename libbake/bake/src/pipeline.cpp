@@ -210,11 +210,42 @@ void BakePipeline::check(const Monitor& monitor, const PipelineHooks& hooks, con
     }
     if (checked == 0) continue;
     job.pooled = std::move(pooled);
+    set_mesh_rms(job);
     if (target) check_finer(job, monitor);
+    set_mesh_rms(job);  // on the rows check_finer replaced too
     // The sets' reports as judged (check_finer may have replaced their R and S rows).
     for (size_t s = 0; s < job.sets.size() && hooks.set_checked; ++s)
       if (job.reports[s]) hooks.set_checked(job, s);
     if (hooks.job_checked) hooks.job_checked(job);
+  }
+}
+
+void BakePipeline::set_mesh_rms(BakeJob& job) const {
+  const ProductLayout layout(job.request);
+  const size_t W = layout.width;
+  // Σ v² and the count of the product's values over set s's rows.
+  auto sums = [&](size_t s, const ProductSlice& sl, double& sum2, size_t& n) {
+    const std::vector<double>& v = job.rows[s].values;
+    const size_t rows = W ? v.size() / W : 0;
+    for (size_t r = 0; r < rows; ++r)
+      for (size_t c = 0; c < sl.count; ++c) sum2 += v[r * W + sl.offset + c] * v[r * W + sl.offset + c];
+    n += rows * sl.count;
+  };
+  auto fill = [](ErrorReport& report, Product p, double sum2, size_t n) {
+    for (ProductError& e : report.products)
+      if (e.product == p) e.mesh_rms = n ? std::sqrt(sum2 / double(n)) : 0.0;
+  };
+  for (const ProductSlice& sl : product_slices(layout)) {
+    double all2 = 0;
+    size_t all_n = 0;
+    for (size_t s = 0; s < job.sets.size(); ++s) {
+      double sum2 = 0;
+      size_t n = 0;
+      sums(s, sl, sum2, n);
+      if (job.reports[s]) fill(*job.reports[s], sl.product, sum2, n);
+      all2 += sum2, all_n += n;
+    }
+    if (job.pooled) fill(*job.pooled, sl.product, all2, all_n);
   }
 }
 

@@ -104,6 +104,7 @@ void pool_product_errors(std::vector<ProductError>& into, std::span<const Produc
     auto rms = [&](double x0, double x1) { return std::sqrt((n0 * x0 * x0 + n1 * x1 * x1) / n); };
     it->rmse = rms(it->rmse, a.rmse);
     it->reference_rms = rms(it->reference_rms, a.reference_rms);
+    it->mesh_rms = 0;  // the pooled rows' own: the caller's (BakePipeline sets it over every row)
     it->bake_std_error = rms(it->bake_std_error, a.bake_std_error);
     it->reference_std_error = rms(it->reference_std_error, a.reference_std_error);
     it->max_abs = std::max(it->max_abs, a.max_abs);
@@ -127,8 +128,8 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
     // upper bound: the plan's probe scaled at Monte Carlo's rate (the slowest QMC shows), or QMC's
     // estimator (which overstates it) — then it cannot be subtracted, only bound the error below.
     v.noise_measured = report.reference_noise_measured;
-    double sigma = is_radiance(e.product) ? (e.reference_std_error > 0 && e.reference_rms > 0
-                                                 ? e.reference_std_error / e.reference_rms
+    double sigma = is_radiance(e.product) ? (e.reference_std_error > 0 && relative_scale(e) > 0
+                                                 ? e.reference_std_error / relative_scale(e)
                                                  : 0.0)
                                           : e.reference_std_error;
     v.noise_kind = v.noise_measured ? "measured on these values" : "QMC's estimate, an upper bound";

@@ -301,3 +301,51 @@ TEST(Pipeline, ASmallBakeTakesThePilotsReferenceIntegratorAndItsRowsAreAFreshBui
     for (size_t k = 0; k < W; ++k) EXPECT_EQ(job.rows[0].values[i * W + k], row[k]) << "point " << i << ", value " << k;
   }
 }
+
+TEST(Pipeline, ARelativeErrorDividesByTheProductsRmsOverEveryRow) {
+  // Half the points see the sky, half lie under the box's roof (a lid 0.01 above the floor hides
+  // them: band-1 is 0 there), so an RMS over a few compared points can miss the mesh's by a factor;
+  // the report's relative error must divide by the RMS of the bake's values over every row of
+  // each set (each set's own, the pooled report's over all), and the verdict with it.
+  std::vector<Eigen::Vector3f> c = {{-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}};
+  for (int k = 0; k < 4; ++k) c.emplace_back(k & 1 ? 2.9f : -2.9f, 0.01f, k & 2 ? -0.1f : 2.9f);  // a lid over z > -0.1
+  const Mesh mesh = make_mesh(c, {{{0, 1, 2}}, {{0, 2, 3}}, {{4, 6, 5}}, {{5, 6, 7}}}, "floor under a half lid");
+  const Topology topo = build_topology(mesh);
+  const MeshAccel accel(mesh, topo);
+  const EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
+  std::vector<BakeJob> jobs(1);
+  jobs[0].request.radiance = &env;
+  jobs[0].sets.resize(2);
+  for (int s = 0; s < 2; ++s) {
+    jobs[0].sets[size_t(s)].name = s ? "open" : "mixed";
+    for (int i = 0; i < 40; ++i) {
+      ShadePoint p;
+      p.p = Eigen::Vector3d(-2.5 + 0.12 * i, 0, s ? -1.0 : (i % 2 ? 1.0 : -1.0));  // under the lid where z = 1
+      p.n = Eigen::Vector3d::UnitY();
+      jobs[0].sets[size_t(s)].points.push_back(p);
+    }
+  }
+  BakePipeline pipeline(mesh, topo, accel, qmc(256, 8), std::move(jobs));
+  pipeline.run({});
+  const BakeJob& job = pipeline.jobs().front();
+  ASSERT_TRUE(job.pooled.has_value());
+  double all2 = 0;
+  size_t all_n = 0;
+  for (size_t s = 0; s < 2; ++s) {
+    double sum2 = 0;
+    for (const double v : job.rows[s].values) sum2 += v * v;  // the layout is band-1 only: 9 per row
+    all2 += sum2, all_n += job.rows[s].values.size();
+    ASSERT_TRUE(job.reports[s].has_value());
+    const ProductError& e = job.reports[s]->products.front();
+    ASSERT_EQ(e.product, Product::RadianceBand1);
+    EXPECT_NEAR(e.mesh_rms, std::sqrt(sum2 / double(job.rows[s].values.size())), 1e-12 * e.mesh_rms);
+    EXPECT_GT(e.mesh_rms, 0.0);
+  }
+  const ProductError& pooled = job.pooled->products.front();
+  const double mesh_rms = std::sqrt(all2 / double(all_n));
+  EXPECT_NEAR(pooled.mesh_rms, mesh_rms, 1e-12 * mesh_rms);
+  EXPECT_LT(job.reports[0]->products.front().mesh_rms, 0.9 * job.reports[1]->products.front().mesh_rms);  // the lid's zeros
+  const TargetVerdict v = target_verdicts(*job.pooled, 1e-3).front();
+  EXPECT_NEAR(v.measured, pooled.rmse / mesh_rms, 1e-12 * v.measured);
+  EXPECT_GT(v.measured, 0.0);
+}

@@ -137,6 +137,8 @@ private:
   // per point for E/3): checked again against the same integrator at kFinerFactor × N isolines on
   // the same points (ProductError::finer; bake/bake/choose.h "The check").
   void check_finer(BakeJob& job, const Monitor& monitor);
+  // ProductError::mesh_rms of the job's reports: each set's over its rows, the pooled one's over all.
+  void set_mesh_rms(BakeJob& job) const;
   static constexpr int kFinerFactor = 4;
 
   const Mesh& occluders_;
