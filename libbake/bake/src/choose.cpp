@@ -456,6 +456,17 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   int N_ref = options.reference_isolines ? int(options.reference_isolines) : reference_isolines(E);
   N_ref = std::max(4 * kMinIsolines, std::min(N_ref + (N_ref & 1), ref_top - (ref_top & 1)));
   std::vector<double> e_ref(P, 0.0), orders(P, kRichardsonOrderMin);
+  const double V = double(points.size());
+  // A small bake: every point at level N costs no more CPU than that level's build (measured, so
+  // not with counted costs), so the reference level the pilot built is the cheapest plan there is
+  // (Prediction::built). Then the reference stops doubling once it meets the plan's aim — it needs
+  // E/3 only to judge other levels, which a small bake does not measure — and no level below it
+  // is run but Richardson's two.
+  auto small_at = [&](int N) {
+    const SilRun& r = sil.at(N);
+    return keep_integrators && want_sil && !counted && V * r.cost * 1e-6 <= r.build_seconds;
+  };
+  bool small = false, reference_is_plan = false;
   for (;;) {
     const std::vector<double>& ref = run_sil(N_ref).rows.values;
     const std::vector<double>& half = run_sil(N_ref / 2).rows.values;
@@ -466,9 +477,17 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       orders[p] = std::clamp(std::isfinite(a) ? a : kRichardsonOrderMin, kRichardsonOrderMin, kRichardsonOrderMax);
       e_ref[p] = d[p] / (std::exp2(orders[p]) - 1.0);
     }
-    if (worst_of(e_ref) <= ChooserOptions::kReferenceShare * E || 2 * N_ref > ref_top) break;
+    if (worst_of(e_ref) <= ChooserOptions::kReferenceShare * E || 2 * N_ref > ref_top) {
+      small = small_at(N_ref);
+      break;
+    }
+    if (worst_of(e_ref) <= goal_sil && small_at(N_ref)) {
+      small = reference_is_plan = true;
+      break;
+    }
     N_ref *= 2;
   }
+  choice.reference_is_plan = reference_is_plan;
   choice.reference_isolines = uint32_t(N_ref);
   for (auto& [N, run] : sil)
     if (N != N_ref) run.integrator.reset();
@@ -510,7 +529,6 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   // against the silhouette reference, known only to within it.
 
   // ---- 2. silhouette levels ----
-  const double V = double(points.size());
   std::vector<int> sil_levels;  // ascending, below N_ref
   if (want_sil) {
     auto level_errors = [&](int N) { return pilot_errors(run_sil(N).rows.values, ref, W, products); };
@@ -519,10 +537,12 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       const std::vector<double> e = level_errors(N);
       return std::any_of(e.begin(), e.end(), [&](double x) { return x <= goal_sil; });
     };
-    for (int N : kSilhouetteFirst)
-      if (N < N_ref) run_sil(N);
-    if (N_ref > kSilhouetteLow * 2 && meets_any(std::min(kSilhouetteFirst[0], N_ref / 2))) run_sil(kSilhouetteLow);
-    for (int N = kSilhouetteFirst[1]; 2 * N < N_ref && misses(N); N *= 2) run_sil(2 * N);
+    if (!small) {  // (a small bake's plan is the reference level: Richardson's levels suffice)
+      for (int N : kSilhouetteFirst)
+        if (N < N_ref) run_sil(N);
+      if (N_ref > kSilhouetteLow * 2 && meets_any(std::min(kSilhouetteFirst[0], N_ref / 2))) run_sil(kSilhouetteLow);
+      for (int N = kSilhouetteFirst[1]; 2 * N < N_ref && misses(N); N *= 2) run_sil(2 * N);
+    }
     for (const auto& [N, run] : sil)
       if (N < N_ref) sil_levels.push_back(N);
     std::vector<double> xs, ts;
@@ -561,7 +581,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
 
   // ---- 3. QMC levels ----
   Rows finest_qmc;  // the finest QMC level's rows, for the reference's independent check
-  if (want_qmc) {
+  if (want_qmc && !reference_is_plan) {  // (its levels would be judged against a reference above E/3)
     std::vector<double> xs, ts;
     std::vector<std::vector<double>> errors;
     // QMC cannot win once a level that misses the goal already costs more per integral than the
@@ -665,7 +685,8 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     r.knob = uint32_t(N_ref), r.built = true, r.extrapolated = false;
     r.predicted_error = worst_of(e_ref), r.predicted_us_per_point = ref_run.cost;
     r.reachable = r.predicted_error <= goal_sil;
-    if ((r.reachable || (!p.reachable && r.predicted_error < p.predicted_error)) && cost(r) <= cost(p)) p = r;
+    if (reference_is_plan || ((r.reachable || (!p.reachable && r.predicted_error < p.predicted_error)) && cost(r) <= cost(p)))
+      p = r;
   }
   std::vector<PlanCandidate> candidates;
   for (const Prediction& p : choice.predictions)
@@ -758,6 +779,8 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
              choice.reference_richardson_order) +
       (qmc_check_rays ? format("; QMC check at %.0f rays: %.2e", qmc_check_rays, worst_of(e_qmc)) : std::string()) + ")" +
       (choice.reference_ok ? format(", within E/3 = %.2e", ChooserOptions::kReferenceShare * E)
+       : reference_is_plan ? format(", within the aim %.2e but not E/3: a small bake, whose plan is this level (every "
+                                    "point at it costs no more than building a finer one)", goal_sil)
                            : format(", ABOVE E/3 = %.2e: ", ChooserOptions::kReferenceShare * E) +
                                  (worst_of(e_qmc) > worst_of(e_ref)
                                       ? std::string("the QMC check disagrees with the reference by more than finer "
@@ -899,7 +922,7 @@ std::vector<std::string> choice_lines(const IntegratorChoice& c) {
   if (!c.sanity.empty()) out.push_back("  " + c.sanity);
   out.push_back("chosen: " + c.reason);
   if (!c.further.empty()) out.push_back("  " + c.further);
-  if (!c.reference_ok)
+  if (!c.reference_ok && !c.reference_is_plan)
     out.push_back(format("  (the pilot's reference is not within E/3: its estimated error is %.2e, so the errors above "
                          "are only known to within it)",
                          c.reference_error.empty() ? 0.0 : *std::max_element(c.reference_error.begin(), c.reference_error.end())));

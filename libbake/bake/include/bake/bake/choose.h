@@ -264,6 +264,9 @@ struct IntegratorChoice {
   std::vector<double> reference_error;
   double reference_richardson_order = 0;  // the order a used (worst product)
   bool reference_ok = true;
+  // A small bake (every point at the reference level costs no more than building a level): the
+  // reference stopped doubling once within the plan's aim, and it is the plan (Prediction::built).
+  bool reference_is_plan = false;
   std::string reference_note;
   int max_isolines = 0;              // the memory bound on N
   std::string max_isolines_reason;
