@@ -37,7 +37,10 @@
 //       environment, the pilot's finest QMC level with its estimated standard errors (which
 //       overstate QMC's noise: only gross biases show), at no extra cost;
 //     e_ref = the larger. While the worst product's Richardson estimate exceeds kReferenceShare·E
-//     (E/3) the reference level doubles, up to the memory bound below. A bias the QMC check sees
+//     (E/3) the reference level doubles, up to the memory bound below — except in a small bake,
+//     where every point at the reference level costs no more CPU than that level's build: there
+//     the reference is the plan (step 5), so it stops once its estimate meets the plan's aim
+//     (IntegratorChoice::reference_is_plan) and step 2 runs no level but Richardson's two. A bias the QMC check sees
 //     is stated, not chased: both integrate the same environment (constant per texel, the
 //     silhouette's tables holding each texel's mass exactly), so what Richardson cannot see is not
 //     an isoline error that finer isolines remove (chasing it, before the tables held texels
