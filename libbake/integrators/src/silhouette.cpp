@@ -237,8 +237,8 @@ struct SilhouetteIntegrator::Impl {
       max_texel_subsamples = 1;
       for (int tx = 0; tx < texels; ++tx)
         max_texel_subsamples = std::max(max_texel_subsamples, subsamples_of(envmap->texel_solid_angle(tx)));
-      // Blocks of at most ~16,384 masses (a wave of 16 blocks holds them at once: ≤ 16 · 16,384 ·
-      // (24 + 8·n_env) bytes, 80 MiB with S of order 3), fixed by N and the map alone.
+      // Blocks of at most ~16,384 masses (a wave of 4 blocks holds them at once, IsolineTables:
+      // ≤ 4 · 16,384 · (24 + 8·n_env) bytes, 20 MiB with S of order 3), fixed by N and the map alone.
       const int block_texels = std::clamp(16384 / (max_texel_subsamples * max_texel_subsamples), 1, 4096);
       masses.first = int(c_r), masses.count = int(n_env);
       masses.blocks = size_t((texels + block_texels - 1) / block_texels);

@@ -71,7 +71,7 @@ IsolineTables::IsolineTables(const oct::Grid& grid, int components, int subsampl
       std::span<const double> masses;  // values, or the caller's view
       std::vector<size_t> rows;
     };
-    constexpr size_t kWave = 4;
+    constexpr size_t kWave = 4;  // blocks held at once: enough for 2–4 threads, little memory
     std::vector<Block> wave(kWave);
     for (size_t b0 = 0; b0 < masses->blocks; b0 += kWave) {
       const size_t nb = std::min(kWave, masses->blocks - b0);
