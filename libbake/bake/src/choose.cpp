@@ -93,6 +93,14 @@ constexpr double kCountedUsPerEdge = 0.083, kCountedUsPerCrossing = 0.043, kCoun
 constexpr double kCountedUsPerPoint = 3.0;
 constexpr double kCountedSetupPerTriangleSilhouette = 6e-6, kCountedSetupPerTriangleQmc = 2e-7;
 constexpr uint64_t kPilotSalt = 0x70696c6f74736565ull;  // the pilot's sample, apart from the report's
+// The radiance products' RMS over the mesh, which the pilot's relative errors divide by (as the
+// error report's do, bake/bake/error_report.h mesh_rms): the silhouette integrator at
+// kScaleIsolines on up to kScalePoints seeded points (the pilot's among them). Its own error
+// (~1.5e-2 of R at N = 16) moves the scale by as much, and the pilot's 32–128 points alone can
+// misjudge it by a factor: on 3DSMaxExport.STL under city.exr the pilot read N = 128 at 1.3e-3
+// where the whole mesh is at 6.9e-4, and chose N = 204.
+constexpr int kScaleIsolines = 16;
+constexpr size_t kScalePoints = 1024;
 
 Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> points,
                      const std::vector<uint32_t>& sample, Task& progress, uint64_t index_offset) {
@@ -133,10 +141,11 @@ double cost_per_point(const Rows& rows, const Integrator& integrator, uint32_t k
 // units (relative to the RMS of `ref` there for the radiance products, bake/bake/choose.h).
 template <class Value>
 std::vector<double> per_product_rms(const std::vector<double>& ref, size_t W, const std::vector<ProductSlice>& products,
-                                    Value value) {
+                                    Value value, const std::vector<double>* scale) {
   const size_t K = W ? ref.size() / W : 0;
   std::vector<double> out;
   for (const ProductSlice& p : products) {
+    const size_t pi = out.size();
     double e2 = 0, r2 = 0;
     for (size_t i = 0; i < K; ++i)
       for (size_t c = 0; c < p.count; ++c) {
@@ -147,7 +156,10 @@ std::vector<double> per_product_rms(const std::vector<double>& ref, size_t W, co
       }
     const double n = double(std::max<size_t>(K * p.count, 1));
     double e = std::sqrt(e2 / n);
-    if (is_radiance(p.product)) e = r2 > 0 ? e / std::sqrt(r2 / n) : 0.0;
+    if (is_radiance(p.product)) {
+      const double rms = scale && (*scale)[pi] > 0 ? (*scale)[pi] : std::sqrt(r2 / n);
+      e = rms > 0 ? e / rms : 0.0;
+    }
     out.push_back(e);
   }
   return out;
@@ -155,14 +167,14 @@ std::vector<double> per_product_rms(const std::vector<double>& ref, size_t W, co
 
 // Per product: RMSE of `rows` against `ref` in the target's units.
 std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
-                                 const std::vector<ProductSlice>& products) {
-  return per_product_rms(ref, W, products, [&](size_t k) { return rows[k] - ref[k]; });
+                                 const std::vector<ProductSlice>& products, const std::vector<double>* scale) {
+  return per_product_rms(ref, W, products, [&](size_t k) { return rows[k] - ref[k]; }, scale);
 }
 
 // Per product: the RMS of `std_error` in the target's units (like pilot_errors).
 std::vector<double> pilot_noise(const std::vector<double>& std_error, const std::vector<double>& ref, size_t W,
-                                const std::vector<ProductSlice>& products) {
-  return per_product_rms(ref, W, products, [&](size_t k) { return std_error[k]; });
+                                const std::vector<ProductSlice>& products, const std::vector<double>* scale) {
+  return per_product_rms(ref, W, products, [&](size_t k) { return std_error[k]; }, scale);
 }
 
 double worst_of(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
@@ -457,6 +469,30 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   N_ref = std::max(4 * kMinIsolines, std::min(N_ref + (N_ref & 1), ref_top - (ref_top & 1)));
   std::vector<double> e_ref(P, 0.0), orders(P, kRichardsonOrderMin);
   const double V = double(points.size());
+  // The radiance products' RMS over the mesh (kScalePoints above); 0 (the pilot's own points'
+  // RMS) where the pilot holds every point or no product is relative.
+  std::vector<double> mesh_scale(P, 0.0);
+  bool scaled = false;
+  auto estimate_scale = [&] {
+    if (scaled) return;
+    scaled = true;
+    if (points.size() <= K || std::none_of(products.begin(), products.end(),
+                                           [](const ProductSlice& sl) { return is_radiance(sl.product); }))
+      return;
+    const std::vector<uint32_t> wide =
+        seeded_sample(uint32_t(points.size()), kScalePoints, mix64(base.seed ^ kPilotSalt));  // ⊇ sample
+    SilhouetteOptions so{kScaleIsolines, base.seed};
+    so.env_cache = env_cache;
+    const SilhouetteIntegrator coarse(mesh, topology, request, so, shared);
+    const Rows r = integrate_pilot(coarse, points, wide, progress);
+    for (size_t p = 0; p < P; ++p) {
+      if (!is_radiance(products[p].product)) continue;
+      double r2 = 0;
+      for (size_t i = 0; i < wide.size(); ++i)
+        for (size_t c = 0; c < products[p].count; ++c) r2 += r.values[i * W + products[p].offset + c] * r.values[i * W + products[p].offset + c];
+      mesh_scale[p] = std::sqrt(r2 / double(std::max<size_t>(wide.size() * products[p].count, 1)));
+    }
+  };
   // A small bake: every point at level N costs no more CPU than that level's build (measured, so
   // not with counted costs), so the reference level the pilot built is the cheapest plan there is
   // (Prediction::built). Then the reference stops doubling once it meets the plan's aim — it needs
@@ -469,9 +505,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   bool small = false, reference_is_plan = false;
   for (;;) {
     const std::vector<double>& ref = run_sil(N_ref).rows.values;
+    estimate_scale();  // after the first level, which built the environment's masses for the rest
     const std::vector<double>& half = run_sil(N_ref / 2).rows.values;
     const std::vector<double>& quarter = run_sil(N_ref / 4).rows.values;
-    const std::vector<double> d = pilot_errors(half, ref, W, products), d2 = pilot_errors(quarter, half, W, products);
+    const std::vector<double> d = pilot_errors(half, ref, W, products, &mesh_scale), d2 = pilot_errors(quarter, half, W, products, &mesh_scale);
     for (size_t p = 0; p < P; ++p) {
       const double a = d[p] > 0 && d2[p] > 0 ? std::log2(d2[p] / d[p]) : kRichardsonOrderMin;
       orders[p] = std::clamp(std::isfinite(a) ? a : kRichardsonOrderMin, kRichardsonOrderMin, kRichardsonOrderMax);
@@ -489,6 +526,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   }
   choice.reference_is_plan = reference_is_plan;
   choice.reference_isolines = uint32_t(N_ref);
+  choice.relative_scale = mesh_scale;
   for (auto& [N, run] : sil)
     if (N != N_ref) run.integrator.reset();
   keep_integrators = false;
@@ -509,7 +547,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   std::vector<double> e_qmc(P, 0.0);
   uint32_t qmc_check_rays = 0;
   auto check = [&](const std::vector<double>& qmc_rows, const std::vector<double>& sigma) {
-    const std::vector<double> D = pilot_errors(qmc_rows, ref, W, products);
+    const std::vector<double> D = pilot_errors(qmc_rows, ref, W, products, &mesh_scale);
     for (size_t p = 0; p < P; ++p) {
       const double n = double(K * products[p].count);
       const double null = sigma[p] * sigma[p] * (1.0 + kQmcCheckSigmas * std::sqrt(2.0 / n));
@@ -531,7 +569,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   // ---- 2. silhouette levels ----
   std::vector<int> sil_levels;  // ascending, below N_ref
   if (want_sil) {
-    auto level_errors = [&](int N) { return pilot_errors(run_sil(N).rows.values, ref, W, products); };
+    auto level_errors = [&](int N) { return pilot_errors(run_sil(N).rows.values, ref, W, products, &mesh_scale); };
     auto misses = [&](int N) { return worst_of(level_errors(N)) > goal_sil; };
     auto meets_any = [&](int N) {
       const std::vector<double> e = level_errors(N);
@@ -610,7 +648,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
           timed_build([&] { return std::make_unique<QmcIntegrator>(mesh, topology, request, QmcOptions{R, base.seed}, shared); }, s);
       setup_qmc = std::max(setup_qmc, s);
       Rows r = integrate_pilot(*integrator, points, sample, progress);
-      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref, W, products),
+      choice.runs.push_back({IntegratorKind::Qmc, R, pilot_errors(r.values, ref, W, products, &mesh_scale),
                              cost_per_point(r, *integrator, R, counted)});
       xs.push_back(R), ts.push_back(choice.runs.back().cpu_us_per_point), errors.push_back(choice.runs.back().error);
       finest_qmc = std::move(r);
@@ -697,7 +735,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
   // reference's own estimate.
   auto measure = [&](const PlanCandidate& c) {
     if (c.kind == IntegratorKind::Silhouette) {
-      std::vector<double> e = pilot_errors(run_sil(int(c.knob)).rows.values, ref, W, products);
+      std::vector<double> e = pilot_errors(run_sil(int(c.knob)).rows.values, ref, W, products, &mesh_scale);
       if (int(c.knob) >= N_ref)
         for (size_t p = 0; p < P; ++p) e[p] = std::max(e[p], e_ref[p]);
       return worst_of(e);
@@ -705,7 +743,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     for (const PilotRun& r : choice.runs)
       if (r.kind == IntegratorKind::Qmc && r.knob == c.knob) return worst_of(r.error);
     const QmcIntegrator integrator(mesh, topology, request, QmcOptions{c.knob, base.seed}, shared);
-    return worst_of(pilot_errors(integrate_pilot(integrator, points, sample, progress).values, ref, W, products));
+    return worst_of(pilot_errors(integrate_pilot(integrator, points, sample, progress).values, ref, W, products, &mesh_scale));
   };
   const PlanPick pick = pick_plan(candidates, E, measure);
   if (request.environment() && any_radiance) {
@@ -752,7 +790,10 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
       r2 /= n;
       // Relative, like pilot_errors, for R and S.
       double scale = 1.0 / double(std::max<size_t>(sl.count, 1));
-      if (is_radiance(sl.product)) scale = r2 > 0 ? scale / r2 : 0.0;
+      if (is_radiance(sl.product)) {
+        const double s2 = mesh_scale[p] > 0 ? mesh_scale[p] * mesh_scale[p] : r2;
+        scale = s2 > 0 ? scale / s2 : 0.0;
+      }
       double mean = 0, var = 0;
       for (double& xi : x) xi *= scale, mean += xi;
       mean /= double(std::max<size_t>(Kc, 1));
@@ -767,7 +808,7 @@ IntegratorChoice choose_integrator(std::span<const ShadePoint> points, const Mes
     // overstate QMC's noise: a check that sees only gross biases, at no extra cost).
     for (const PilotRun& r : choice.runs)
       if (r.kind == IntegratorKind::Qmc) qmc_check_rays = std::max(qmc_check_rays, r.knob);
-    check(finest_qmc.values, pilot_noise(finest_qmc.std_error, ref, W, products));
+    check(finest_qmc.values, pilot_noise(finest_qmc.std_error, ref, W, products, &mesh_scale));
   }
   choice.reference_error.resize(P);
   for (size_t p = 0; p < P; ++p) choice.reference_error[p] = std::max(e_ref[p], e_qmc[p]);

@@ -35,12 +35,13 @@ struct Rows {
 Rows integrate_pilot(const Integrator& integrator, std::span<const ShadePoint> points,
                      const std::vector<uint32_t>& sample, Task& progress, uint64_t index_offset = 0);
 
-// Per product: RMSE of `rows` against `ref` in the target's units.
+// Per product: RMSE of `rows` against `ref` in the target's units: relative for R and S, to
+// scale[p] when given (> 0; the product's RMS over the mesh, estimated), else to ref's RMS.
 std::vector<double> pilot_errors(const std::vector<double>& rows, const std::vector<double>& ref, size_t W,
-                                 const std::vector<ProductSlice>& products);
+                                 const std::vector<ProductSlice>& products, const std::vector<double>* scale = nullptr);
 // Per product: the RMS of `std_error` in the target's units (like pilot_errors).
 std::vector<double> pilot_noise(const std::vector<double>& std_error, const std::vector<double>& ref, size_t W,
-                                const std::vector<ProductSlice>& products);
+                                const std::vector<ProductSlice>& products, const std::vector<double>* scale = nullptr);
 
 // Rays for a need of `need`, rounded up to an eighth of an octave, within [kMinRays, kMaxRays].
 uint32_t round_up_rays(double need);

@@ -8,7 +8,10 @@
 //     (every coefficient of every vertex), absolute — these are dimensionless (AO in [0, 1],
 //     |T_i| <= 1/√π, |U_i| <= 2√π);
 //   band-1 radiance R_c,m and shadowed radiance S_c,i: the RMSE relative to the RMS of the
-//     reference values (their unit is the environment's, which E cannot know).
+//     product over the whole mesh (their unit is the environment's, which E cannot know). The
+//     error report divides by the bake's own RMS over every row (ProductError::mesh_rms); the
+//     pilot by an estimate of it (the integrator at N = 16 on up to 1,024 seeded points, its own
+//     among them), since its 32–128 points' RMS can be far from the mesh's.
 // Every requested product must meet E.
 //
 // The pilot (choose_integrator), on a seeded sample of the bake's shade points (a 64th of them,
@@ -270,6 +273,9 @@ struct IntegratorChoice {
   // A small bake (every point at the reference level costs no more than building a level): the
   // reference stopped doubling once within the plan's aim, and it is the plan (Prediction::built).
   bool reference_is_plan = false;
+  // Per product (the order of PilotRun::error): what the pilot's relative errors divide by, the
+  // product's RMS over the mesh as estimated (0: the pilot's own points' RMS, or not relative).
+  std::vector<double> relative_scale;
   std::string reference_note;
   int max_isolines = 0;              // the memory bound on N
   std::string max_isolines_reason;
