@@ -34,7 +34,7 @@
 // Products are named ao, transfer, radiance.
 //
 // With `--truth TRUTH.prt.h5` (a bake of the same mesh and products by a converged integrator, e.g.
-// prtbake's silhouette integrator at N = 1024, whose own error is ~1e-2 E): each FILE's errors are
+// prtbake's silhouette integrator at N = 1024, whose own error is 0.05–0.15 E): each FILE's errors are
 // those over ALL its rows against TRUTH — AO and transfer absolute, radiance relative to the RMS
 // of TRUTH's radiance over all rows, the whole-mesh quantities E is defined on — instead of the
 // sampled rows' (whose 20-row RMSE, and a radiance RMS over 20 rows where half a mesh may see no

@@ -29,7 +29,7 @@
 #               POINTS seeded rows of the mesh's own shade points (loaded as prtbake loads them),
 #               independent seeds, 4 replicates (their spread is its standard error); rays
 #               doubled (to 2^22) while its standard error on some product is above E/3. Every file's error is measured against it in E's units.
-#   truth       prtbake's silhouette integrator at N = TRUTH_N isolines (1024: its own error ~1e-2 E,
+#   truth       prtbake's silhouette integrator at N = TRUTH_N isolines (1024: its own error 0.05–0.15 E,
 #               its Richardson estimate) on EVERY row of the mesh. With it, every file's error (the
 #               default's, each rung's "meets E") is measured over all rows against it, radiance
 #               relative to its RMS over all rows: the whole-mesh numbers E is defined on (20 rows'
