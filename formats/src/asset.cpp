@@ -102,7 +102,8 @@ constexpr Field<ReportRow> kReportFields[] = {
     {N::kReference, &ReportRow::reference},
     {N::kReferenceSeconds, &ReportRow::reference_seconds},
     {N::kBakeSeconds, &ReportRow::bake_seconds},
-    {N::kIntegralsPerSecond, &ReportRow::integrals_per_second}};
+    {N::kIntegralsPerSecond, &ReportRow::integrals_per_second},
+    {N::kMeshRms, &ReportRow::mesh_rms}};
 
 constexpr Field<Uvs> kUvFields[] = {{N::kUvSet, &Uvs::uv_set}};
 

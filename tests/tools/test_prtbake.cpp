@@ -492,3 +492,23 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " -o " + out.string()).code, 2) << "no --env";
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);
 }
+
+TEST(Prtbake, TheBand1ReportRowCarriesTheRmsItsRelativeErrorDividesBy) {
+  // formats/SCHEMA.md "Error reports": a band-1 row's mesh_rms is the RMS of the file's band-1 over
+  // every vertex (the bake's doubles; the file holds floats, within 2^-24 relative of them).
+  const fs::path out = scratch("mesh_rms.prt.h5");
+  const Outcome r = run("vertex " + (kData / "bunny.obj").string() + " --radiance " + (kData / "sunset.exr").string() +
+                        " --integrator silhouette --samples 1024 --report 16 -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const F::Asset a = F::read_asset(out);
+  ASSERT_TRUE(a.vertices.radiance_band1.has_value());
+  double s2 = 0;
+  for (const float v : a.vertices.radiance_band1->values) s2 += double(v) * double(v);
+  const double rms = std::sqrt(s2 / double(a.vertices.radiance_band1->values.size()));
+  const auto row = std::find_if(a.vertices.report.rows.begin(), a.vertices.report.rows.end(),
+                                [](const F::ReportRow& x) { return x.product == "radiance/band1"; });
+  ASSERT_NE(row, a.vertices.report.rows.end());
+  ASSERT_TRUE(row->mesh_rms.has_value());
+  EXPECT_NEAR(*row->mesh_rms, rms, 1e-6 * rms);
+  EXPECT_GT(rms, 0.0);
+}

@@ -224,7 +224,7 @@ F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t
     // What a relative error divides by (formats/SCHEMA.md "Error reports"): the product's RMS over
     // every row, for band-1 and S.
     const bool relative = e.product == bake::Product::RadianceBand1 || e.product == bake::Product::RadianceShadowed;
-    if (relative && e.mesh_rms > 0) out.rows.back().extra.push_back({"mesh_rms", e.mesh_rms});
+    if (relative && e.mesh_rms > 0) out.rows.back().mesh_rms = e.mesh_rms;
   }
   out.vertices = F::Array<uint32_t>{report.vertices, {}};
   return out;

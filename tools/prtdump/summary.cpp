@@ -193,6 +193,7 @@ Json report_json(const pf::Asset& a) {
     x["reference_seconds"] = row.reference_seconds ? json_double(*row.reference_seconds) : Json(nullptr);
     x["bake_seconds"] = row.bake_seconds ? json_double(*row.bake_seconds) : Json(nullptr);
     x["integrals_per_second"] = row.integrals_per_second ? json_double(*row.integrals_per_second) : Json(nullptr);
+    x["mesh_rms"] = row.mesh_rms ? json_double(*row.mesh_rms) : Json(nullptr);
     if (!row.extra.empty()) x["attrs"] = json_attrs(row.extra);
     rows.push_back(std::move(x));
   }

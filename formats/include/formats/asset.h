@@ -90,6 +90,9 @@ struct ReportRow {
   std::optional<int64_t> points;
   std::optional<std::string> reference;
   std::optional<double> reference_seconds, bake_seconds, integrals_per_second;
+  // Band-1 and S rows (files from 2026-12-06 on): the product's RMS over every row of the set the
+  // report covers, which the relative error divides by (SCHEMA.md "Error reports").
+  std::optional<double> mesh_rms;
   ExtraAttrs extra;
   bool operator==(const ReportRow&) const = default;
 };

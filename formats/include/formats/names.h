@@ -109,6 +109,7 @@ inline constexpr std::string_view kReference = "reference";
 inline constexpr std::string_view kReferenceSeconds = "reference_seconds";
 inline constexpr std::string_view kBakeSeconds = "bake_seconds";
 inline constexpr std::string_view kIntegralsPerSecond = "integrals_per_second";
+inline constexpr std::string_view kMeshRms = "mesh_rms";  // band-1 / S rows: what their relative error divides by
 inline constexpr std::string_view kTargetError = "target_error";  // on the /report group: the RMSE the bake was asked for
 
 // ---- /scene attributes ----
