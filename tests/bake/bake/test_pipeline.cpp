@@ -38,6 +38,21 @@ Mesh floor_and_box() {
                    "floor and box");
 }
 
+// The floor and box under data/studio.exr, and one band-1 job over an empty set "floor points".
+struct FloorAndBoxUnderStudio {
+  Mesh mesh = floor_and_box();
+  Topology topo = build_topology(mesh);
+  MeshAccel accel{mesh, topo};
+  EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
+  std::vector<BakeJob> one_job() const {
+    std::vector<BakeJob> jobs(1);
+    jobs[0].request.radiance = &env;
+    jobs[0].sets.resize(1);
+    jobs[0].sets[0].name = "floor points";
+    return jobs;
+  }
+};
+
 ProductRequest ao() {
   ProductRequest r;
   r.ao = true;
@@ -202,14 +217,11 @@ TEST(Pipeline, RUnderASunIsCheckedAgainstTheSameIntegratorAtFourTimesItsIsolines
   // verdict on R comes from the silhouette integrator at 4N on the report's points. Its RMSE is
   // checked against that integrator run independently on the same points (to rounding: the same
   // integrals summed in another order), and the verdict's range is m/(1 − 1/16) to m/(1 − 1/4).
-  const Mesh mesh = floor_and_box();
-  const Topology topo = build_topology(mesh);
-  const MeshAccel accel(mesh, topo);
-  const EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
-  std::vector<BakeJob> jobs(1);
-  jobs[0].request.radiance = &env;
-  jobs[0].sets.resize(1);
-  jobs[0].sets[0].name = "floor points";
+  const FloorAndBoxUnderStudio scene;
+  const Mesh& mesh = scene.mesh;
+  const Topology& topo = scene.topo;
+  const MeshAccel& accel = scene.accel;
+  std::vector<BakeJob> jobs = scene.one_job();
   for (int i = 0; i < 12; ++i)
     for (int j = 0; j < 12; ++j) {
       ShadePoint p;
@@ -266,15 +278,12 @@ TEST(Pipeline, ASmallBakeTakesThePilotsReferenceIntegratorAndItsRowsAreAFreshBui
   // of milliseconds, so the plan is the reference level the pilot already built (Prediction::built)
   // and the bake takes that integrator. Its rows must be those of the same spec built afresh, bit
   // for bit, and its work summary must count the bake's points, not the pilot's.
-  const Mesh mesh = floor_and_box();
-  const Topology topo = build_topology(mesh);
-  const MeshAccel accel(mesh, topo);
-  const EnvMap env = EnvMap::load(fs::path(PRT_DATA_DIR) / "studio.exr", UpAxis::Y);
-  std::vector<BakeJob> jobs(1);
+  const FloorAndBoxUnderStudio scene;
+  const Mesh& mesh = scene.mesh;
+  const Topology& topo = scene.topo;
+  const MeshAccel& accel = scene.accel;
+  std::vector<BakeJob> jobs = scene.one_job();
   jobs[0].request.ao = true;
-  jobs[0].request.radiance = &env;
-  jobs[0].sets.resize(1);
-  jobs[0].sets[0].name = "floor points";
   for (int i = 0; i < 20; ++i) {
     ShadePoint p;
     p.p = Eigen::Vector3d(-2.9 + 0.29 * i, 0, 0.9);  // on the floor, beside the box
