@@ -353,6 +353,7 @@ int main(int argc, char** argv) try {
     return slots[p].relative ? rmse / ref_rms[p] : rmse;
   };
   std::optional<formats::Asset> truth;
+  std::vector<const formats::Product*> truth_products;  // per slot, when --truth
   if (!a.truth.empty()) {
     truth = read_rows(a.truth);
     if (!truth) return 2;
@@ -360,6 +361,7 @@ int main(int argc, char** argv) try {
     for (size_t p = 0; p < slots.size(); ++p) {
       const formats::Product* product = product_of(*truth, a.truth, p);
       if (!product) return 2;
+      truth_products.push_back(product);
       std::printf("\t%s=%.4g", slots[p].name, sampled_error(*product, p));
     }
     std::printf("\n");
@@ -380,7 +382,7 @@ int main(int argc, char** argv) try {
         continue;
       }
       // Over every row against the truth; radiance relative to the truth's RMS over every row.
-      const std::vector<float>& t = product_of(*truth, a.truth, p)->values;
+      const std::vector<float>& t = truth_products[p]->values;
       double d2 = 0, t2 = 0;
       for (size_t x = 0; x < t.size(); ++x) {
         const double d = double(product->values[x]) - double(t[x]);
