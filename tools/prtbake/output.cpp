@@ -237,9 +237,7 @@ void print_error_verdict(const bake::BakeJob& job, double target) {
 }
 
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better) {
-  std::printf("the check puts the bake's error above the target: baking again with %s at %s (was %s; the "
-              "pilot's rate from the check's measured error; once)\n",
-              bake::to_string(better.kind), better.knob_text().c_str(), job.spec.knob_text().c_str());
+  std::printf("%s\n", bake::correction_text(job, better).c_str());
   std::fflush(stdout);
 }
 

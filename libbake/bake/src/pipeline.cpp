@@ -114,32 +114,43 @@ void BakePipeline::run(const Monitor& monitor, const PipelineHooks& hooks) {
   check(monitor, hooks, which);
   if (!(settings_.correct && settings_.target_error > 0)) return;
 
-  // The correction, once (file comment).
-  bool any = false;
-  for (size_t j = 0; j < jobs_.size(); ++j) {
-    BakeJob& job = jobs_[j];
-    which[j] = false;
-    if (!job.choice || !job.pooled || job.pass > 0) continue;
-    const std::optional<IntegratorSpec> better = corrected_plan(
-        *job.choice,
-        target_verdicts(*job.pooled, settings_.target_error, job.reference_plan ? &*job.reference_plan : nullptr));
-    if (!better) continue;
-    if (hooks.correcting) hooks.correcting(job, *better);
-    job.spec = *better;
-    job.spec.report_rays = 0;
-    job.pass = 1;
-    job.integrator.reset();
-    const auto t0 = std::chrono::steady_clock::now();
-    job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
-    job.setup_seconds = seconds_since(t0);
-    job.integrator_description = job.integrator->description();
-    if (hooks.ready) hooks.ready(job);
-    which[j] = any = true;
+  // The corrections (file comment): each from the plan that made the rows just checked.
+  for (int pass = 1; pass <= settings_.max_corrections; ++pass) {
+    bool any = false;
+    for (size_t j = 0; j < jobs_.size(); ++j) {
+      BakeJob& job = jobs_[j];
+      const bool checked = which[j];
+      which[j] = false;
+      if (!checked || !job.choice || !job.pooled) continue;
+      CheckedPlan now{job.spec, target_verdicts(*job.pooled, settings_.target_error,
+                                                job.reference_plan ? &*job.reference_plan : nullptr)};
+      const std::optional<IntegratorSpec> better =
+          corrected_plan(*job.choice, job.spec, now.verdicts, job.last_checked ? &*job.last_checked : nullptr);
+      if (!better) continue;
+      job.last_checked = std::move(now);
+      if (hooks.correcting) hooks.correcting(job, *better);
+      job.spec = *better;
+      job.spec.report_rays = 0;
+      job.pass = pass;
+      job.integrator.reset();
+      const auto t0 = std::chrono::steady_clock::now();
+      job.integrator = make_integrator(job.spec, occluders_, topology_, job.request, &accel_);
+      job.setup_seconds = seconds_since(t0);
+      job.integrator_description = job.integrator->description();
+      if (hooks.ready) hooks.ready(job);
+      which[j] = any = true;
+    }
+    if (!any) return;
+    bake(which);
+    if (hooks.baked) hooks.baked();
+    check(monitor, hooks, which);  // the corrected jobs; the others keep their reports
   }
-  if (!any) return;
-  bake(which);
-  if (hooks.baked) hooks.baked();
-  check(monitor, hooks, which);  // the corrected jobs; the others keep their reports
+}
+
+std::string correction_text(const BakeJob& job, const IntegratorSpec& better) {
+  return std::string("the check puts the bake's error above the target: baking again with ") + to_string(better.kind) +
+         " at " + better.knob_text() +  " (was " + job.spec.knob_text() + "; correction " + std::to_string(job.pass + 1) +
+         ": the knob raised by the measured error, at the pilot's convergence rate or the checks', if slower)";
 }
 
 void BakePipeline::plan_check(BakeJob& job, double check_cpu, const Monitor& monitor) {

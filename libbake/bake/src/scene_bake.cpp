@@ -348,8 +348,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       log(l);
   };
   hooks.correcting = [&](const BakeJob& job, const IntegratorSpec& better) {
-    log(job.name + ": the check puts the error above the target: baking again with " + to_string(better.kind) + " at " +
-        better.knob_text() + " (was " + job.spec.knob_text() + "; the pilot's rate from the check's measured error; once)");
+    log(job.name + ": " + correction_text(job, better));
   };
   pipeline.run(monitor, hooks);
   if (rows.rows_only) return out;

@@ -224,31 +224,44 @@ std::vector<std::string> target_check_lines(const ErrorReport& report, double ta
   return out;
 }
 
-std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, std::span<const TargetVerdict> verdicts) {
+std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, const IntegratorSpec& baked,
+                                             std::span<const TargetVerdict> verdicts, const CheckedPlan* previous) {
   const ChooserOptions defaults;
   const bool silhouette = choice.spec.kind == IntegratorKind::Silhouette;
   if (!silhouette && choice.spec.kind != IntegratorKind::Qmc) return std::nullopt;
+  if (baked.kind != choice.spec.kind) return std::nullopt;
+  const auto knob = [&](const IntegratorSpec& s) { return silhouette ? double(s.isolines()) : double(s.qmc_rays); };
   const double aim = (silhouette ? defaults.safety_silhouette : defaults.safety_qmc) * choice.target;
   double ratio = 0;  // the worst product's error over the aim, where it is (likely) above E
+  const TargetVerdict* worst = nullptr;
   for (const TargetVerdict& v : verdicts)
-    if (v.not_met || ((v.noise_measured || v.extrapolated) && v.error > choice.target)) ratio = std::max(ratio, v.error / aim);
+    if ((v.not_met || ((v.noise_measured || v.extrapolated) && v.error > choice.target)) && v.error / aim > ratio)
+      ratio = v.error / aim, worst = &v;
   if (!(ratio > 1)) return std::nullopt;
   const Prediction* pred = nullptr;
   for (const Prediction& p : choice.predictions)
     if (p.kind == choice.spec.kind) pred = &p;
   if (!pred) return std::nullopt;
-  // The model's rate, at least Monte Carlo's 1/2 (a slower one would promise a smaller step).
-  const double rate = std::max(pred->exponent, 0.5);
+  // The model's rate, at least Monte Carlo's 1/2 (a slower one would promise a smaller step) ...
+  double rate = std::max(pred->exponent, 0.5);
+  // ... or, slower, the rate the last two checks measured on the same product (the model is the
+  // worst product's fit on the pilot's points, which can promise more than the check then sees).
+  if (previous && previous->spec.kind == baked.kind && knob(previous->spec) < knob(baked))
+    for (const TargetVerdict& v : previous->verdicts)
+      if (v.product == worst->product && v.error > 0 && worst->error > 0) {
+        const double measured = std::log(v.error / worst->error) / std::log(knob(baked) / knob(previous->spec));
+        if (std::isfinite(measured)) rate = std::clamp(measured, 0.5, rate);
+      }
   const double factor = std::pow(ratio, 1.0 / rate);
-  IntegratorSpec spec = choice.spec;
+  IntegratorSpec spec = baked;
   const double bound = pred->bound > 0 ? double(pred->bound) : std::numeric_limits<double>::infinity();
   if (silhouette) {
-    const double N = double(choice.spec.isolines());
+    const double N = knob(baked);
     const double raised = std::min(std::ceil(N * factor / 2) * 2, bound);
     if (!(raised > N)) return std::nullopt;
     spec.set_samples(uint32_t(raised) * uint32_t(raised));
   } else {
-    const double R = double(choice.spec.qmc_rays);
+    const double R = knob(baked);
     const double raised = std::min(std::ceil(R * factor), std::min(bound, double(kMaxRays)));
     if (!(raised > R)) return std::nullopt;
     spec.set_samples(uint32_t(raised));

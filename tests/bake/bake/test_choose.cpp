@@ -641,26 +641,46 @@ TEST(Choose, ACheckThatFindsTheTargetMissedRaisesTheKnobByTheModelsRate) {
   TargetVerdict fine;
   fine.product = Product::Ao, fine.noise_measured = true, fine.error = 2e-4, fine.error_hi = 3e-4, fine.met = true;
   std::vector<TargetVerdict> v = {fine, missed};
-  std::optional<IntegratorSpec> s = corrected_plan(c, v);
+  std::optional<IntegratorSpec> s = corrected_plan(c, c.spec, v);
   ASSERT_TRUE(s.has_value());
   EXPECT_EQ(s->kind, IntegratorKind::Silhouette);
   EXPECT_EQ(s->isolines(), 296) << "148 × (1.4e-3 / 7e-4)^(1/1)";
+  // A second correction starts from the plan the check measured (296), not the pilot's (148).
+  IntegratorSpec corrected = *s;
+  std::vector<TargetVerdict> again = {fine, missed};
+  again[1].error = 1.2e-3;
+  ASSERT_TRUE(corrected_plan(c, corrected, again).has_value());
+  EXPECT_EQ(corrected_plan(c, corrected, again)->isolines(), 508) << "296 × (1.2e-3 / 7e-4), rounded up to even";
+  // With the check of the plan it corrected (148 at 1.4e-3), the rate the two checks measured
+  // (log(1.4/1.2) / log 2 = 0.22) is slower than the model's 1: it rules, at least 1/2.
+  const CheckedPlan first{c.spec, v};
+  EXPECT_EQ(corrected_plan(c, corrected, again, &first)->isolines(), 870) << "296 × (1.2e-3 / 7e-4)^2, even";
+  // Measured faster than the model (1.4e-2 → 1.01e-3 over 148 → 296, rate 3.8): the model's 1 stays.
+  again[1].error = 1.01e-3;
+  std::vector<TargetVerdict> steep = {fine, missed};
+  steep[1].error = 1.4e-2;
+  const CheckedPlan fast{c.spec, steep};
+  EXPECT_EQ(corrected_plan(c, corrected, again, &fast)->isolines(), corrected_plan(c, corrected, again)->isolines());
+  // A plan of another kind than the choice's has no model here.
+  IntegratorSpec other = corrected;
+  other.kind = IntegratorKind::Qmc;
+  EXPECT_FALSE(corrected_plan(c, other, again).has_value());
   // The bound holds.
   c.predictions[0].bound = 200;
-  EXPECT_EQ(corrected_plan(c, v)->isolines(), 200);
+  EXPECT_EQ(corrected_plan(c, c.spec, v)->isolines(), 200);
   // A best estimate above E whose range straddles it (not verifiable) is corrected too; met is not.
   v[1].not_met = false, v[1].error = 1.05e-3;
-  ASSERT_TRUE(corrected_plan(c, v).has_value());
+  ASSERT_TRUE(corrected_plan(c, c.spec, v).has_value());
   v[1].error = 9e-4;
-  EXPECT_FALSE(corrected_plan(c, v).has_value()) << "its best estimate is within E";
+  EXPECT_FALSE(corrected_plan(c, c.spec, v).has_value()) << "its best estimate is within E";
   v[1].met = true;
-  EXPECT_FALSE(corrected_plan(c, v).has_value());
+  EXPECT_FALSE(corrected_plan(c, c.spec, v).has_value());
   // QMC: 1,024 rays, rate 0.3 taken as 1/2, e = 2 × aim 8e-4: 1,024 × 2² = 4,096 rays.
   c.spec.kind = IntegratorKind::Qmc;
   c.spec.set_samples(1024);
   v[1].met = false, v[1].not_met = true, v[1].error = 1.6e-3;
-  ASSERT_TRUE(corrected_plan(c, v).has_value());
-  EXPECT_EQ(corrected_plan(c, v)->samples(), 4096u);
+  ASSERT_TRUE(corrected_plan(c, c.spec, v).has_value());
+  EXPECT_EQ(corrected_plan(c, c.spec, v)->samples(), 4096u);
 }
 
 TEST(Choose, ThePilotsRelativeErrorsDivideByAnEstimateOfTheMeshsRms) {

@@ -363,3 +363,48 @@ TEST(Pipeline, ARelativeErrorDividesByTheProductsRmsOverEveryRow) {
   EXPECT_NEAR(v.measured, pooled.rmse / mesh_rms, 1e-12 * v.measured);
   EXPECT_GT(v.measured, 0.0);
 }
+
+TEST(Pipeline, CorrectionsRaiseTheKnobFromTheLastCheckedPlanAtMostMaxCorrectionsTimes) {
+  // A planted plan far too coarse for E: silhouette N = 8 for AO over two_sets at E = 3e-3 (AO's
+  // error is ~9e-3 at N = 8–14 here), with a model rate of 20 so that the first correction raises
+  // N by (e/aim)^(1/20), one step of 2, and E stays missed. The second must start from the plan
+  // the first check measured (not the pilot's), and the job stops after max_corrections = 2.
+  const Ground g;
+  PipelineSettings settings;
+  settings.target_error = 3e-3;
+  settings.counted_costs = true;  // the check's rays from counted work: the same on any machine
+  settings.integrator.report_points = 32;
+  settings.max_corrections = 2;
+  std::vector<BakeJob> jobs = one_job(g);
+  IntegratorChoice c;
+  c.target = settings.target_error;
+  c.spec.kind = IntegratorKind::Silhouette;
+  c.spec.set_samples(8 * 8);
+  c.spec.report_points = 32;
+  Prediction sil;
+  sil.kind = IntegratorKind::Silhouette, sil.exponent = 20.0, sil.bound = 4096;
+  c.predictions = {sil};
+  jobs[0].choice = c;
+  BakePipeline pipeline(g.mesh, g.topology, g.accel, settings, std::move(jobs));
+  std::vector<uint32_t> from, to;
+  std::vector<std::string> said;
+  PipelineHooks hooks;
+  hooks.correcting = [&](const BakeJob& j, const IntegratorSpec& better) {
+    from.push_back(j.spec.isolines());
+    to.push_back(better.isolines());
+    said.push_back(correction_text(j, better));
+  };
+  pipeline.run({}, hooks);
+  ASSERT_EQ(from.size(), 2u);
+  EXPECT_EQ(from[0], 8u);
+  EXPECT_EQ(to[0], 10u) << "8 × (9e-3 / 2.1e-3)^(1/20), up to even";
+  EXPECT_EQ(from[1], to[0]) << "the second correction starts from the plan the first check measured";
+  EXPECT_GT(to[1], from[1]);
+  for (size_t i = 0; i < said.size(); ++i)
+    EXPECT_NE(said[i].find("correction " + std::to_string(i + 1) + ":"), std::string::npos) << said[i];
+  const BakeJob& job = pipeline.jobs().front();
+  EXPECT_EQ(job.pass, 2);
+  EXPECT_EQ(job.spec.isolines(), to.back()) << "the rows are the last correction's";
+  ASSERT_TRUE(job.last_checked.has_value());
+  EXPECT_EQ(job.last_checked->spec.isolines(), from.back());
+}

@@ -390,11 +390,21 @@ std::vector<TargetVerdict> target_verdicts(const ErrorReport& report, double tar
 // The correction after a check (the chooser's pilot under-predicts where the error sits on a few
 // vertices it did not sample; the check's 128 vertices saw them): when some product is NOT met, or
 // its best estimate (noise measured and taken out) is above E though the range straddles it,
-// the chosen kind's knob raised by its model's rate (Prediction::exponent, at least 1/2) so that
-// the worst such product's measured error falls to its safety·E — N·(e/aim)^(1/a) isolines (even)
-// or R·(e/aim)^(1/a) rays — within the kind's bound (Prediction::bound). nullopt when nothing is
-// above E or the knob cannot rise. Tools bake it once more and check again; once.
-std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, std::span<const TargetVerdict> verdicts);
+// the knob of `baked` (the plan that made the checked rows: the choice's, or an earlier
+// correction's) raised by the kind's model rate (Prediction::exponent, at least 1/2) so that the
+// worst such product's measured error falls to its safety·E — N·(e/aim)^(1/a) isolines (even) or
+// R·(e/aim)^(1/a) rays — within the kind's bound (Prediction::bound). nullopt when nothing is above
+// E, `baked` is not the choice's kind, or the knob cannot rise. With `previous` (the plan an
+// earlier check measured, below `baked`'s knob), the rate is the slower of the model's and the
+// one the two checks measured on the worst product, at least 1/2. The pipeline bakes the plan and
+// checks again, at most PipelineSettings::max_corrections times.
+struct CheckedPlan {
+  IntegratorSpec spec;
+  std::vector<TargetVerdict> verdicts;
+};
+std::optional<IntegratorSpec> corrected_plan(const IntegratorChoice& choice, const IntegratorSpec& baked,
+                                             std::span<const TargetVerdict> verdicts,
+                                             const CheckedPlan* previous = nullptr);
 
 // Pools reports of disjoint point sets: each of `add`'s products is merged into `into`'s entry of
 // the same product (appended when new), as if one report had compared all their values: values
