@@ -178,6 +178,46 @@ TEST(Shards, FilterIntegratorAcrossChunkBorders) {
   EXPECT_TRUE(leftovers(dir, out).empty());
 }
 
+// prtbake texel: the valid texels' rows go through the same chunks. bunny_ground in its own UVs
+// at 96 x 96 with AO and order-3 transfer (chunks of 512 texels): --resume, --shard I/2 +
+// --merge and the filter integrator (its neighbours are texels, across chunk borders) give the
+// single-process --reproducible bytes; chunks of another atlas (another --resolution) are refused.
+std::string texels(const std::string& integrator, int resolution = 96) {
+  return "texel " + kData + "/bunny_ground.obj --ao --transfer 3 --resolution " + std::to_string(resolution) +
+         " --integrator " + integrator + " --samples " + (integrator == "filter" ? "8" : "64") +
+         " --threads 1 --chunk-rows 512 --report 4";
+}
+
+TEST(ShardsTexel, ResumeAndWorkersGiveTheReproducibleBytes) {
+  const fs::path dir = dir_for("texel"), out = dir / "out.prt.h5";
+  for (const std::string integrator : {"silhouette", "filter"}) {
+    const std::string ref = reference(texels(integrator), out);
+    const auto r = prtbake(texels(integrator) + " --resume -o " + out.string(), dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(read_bytes(out) == ref) << integrator << ", --resume";
+    EXPECT_GT(resumed_of(r.out).computed, 2) << r.out;
+    EXPECT_TRUE(leftovers(dir, out).empty());
+    fs::remove(out);
+    for (int i = 0; i < 2; ++i) {
+      const auto w = prtbake(texels(integrator) + " --shard " + std::to_string(i) + "/2 -o " + out.string(), dir);
+      ASSERT_EQ(w.code, 0) << w.err;
+      EXPECT_NE(w.out.find("texels"), std::string::npos) << w.out;
+      EXPECT_FALSE(fs::exists(out));
+    }
+    const auto m = prtbake(texels(integrator) + " --merge -o " + out.string(), dir);
+    ASSERT_EQ(m.code, 0) << m.err;
+    EXPECT_TRUE(read_bytes(out) == ref) << integrator << ", --shard I/2 + --merge";
+    EXPECT_TRUE(leftovers(dir, out).empty());
+    fs::remove(out);
+  }
+  // A worker's chunks of a 96 x 96 atlas, then a merge of a 64 x 64 one: refused, nothing written.
+  ASSERT_EQ(prtbake(texels("silhouette") + " --shard 0/1 -o " + out.string(), dir).code, 0);
+  const auto m = prtbake(texels("silhouette", 64) + " --merge -o " + out.string(), dir);
+  EXPECT_EQ(m.code, 1) << m.out << m.err;
+  EXPECT_NE(m.err.find("another bake"), std::string::npos) << m.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 namespace {
 // Chunk `name` of the bake `args` (which writes dir/out.prt.h5; its chunks committed in
 // dir/out.prt.h5.chunks, another bake's in dir/other) flipped, then replaced by the other bake's,
@@ -458,6 +498,12 @@ TEST(ShardsFiv, MpirunMatrixIsByteIdentical) {
   const std::string ref = reference(fiv_bake(), dir / "out.prt.h5");
   for (int n = 1; n <= 4; ++n)
     for (const std::string claim : {"static", "dynamic"}) expect_mpirun_bytes(fiv_bake(), ref, n, claim, dir);
+}
+
+TEST(ShardsTexel, MpirunIsByteIdentical) {
+  const fs::path dir = dir_for("mpirun_texel"), out = dir / "out.prt.h5";
+  const std::string ref = reference(texels("silhouette"), out);
+  for (const int n : {2, 3}) expect_mpirun_bytes(texels("silhouette"), ref, n, n == 2 ? "static" : "dynamic", dir);
 }
 
 TEST(Shards, MpirunSceneIsByteIdentical) {

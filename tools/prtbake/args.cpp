@@ -341,7 +341,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
                "with a target error: print the pilot's table (each run's error and\n"
                "cost, each integrator's model) instead of one line.")
       ->excludes("--quiet");
-  if (!texel) tool::add_shard_options(cmd, a.shard, "vertices");
+  tool::add_shard_options(cmd, a.shard, texel ? "texels" : "vertices");
   cmd.footer(texel ? std::string("Examples:\n  prtbake texel scene.glb --resolution 512 --ao -o scene.prt.h5\n"
                                  "  prtbake texel 2CylinderEngine.glb --density 0.5 --ao -o engine.prt.h5   (generated UVs)\n"
                                  "  prtbake texel asset.obj --unwrap --resolution 1024 --ao -o asset.prt.h5\n\n") +

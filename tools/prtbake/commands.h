@@ -14,6 +14,8 @@
 
 #include <functional>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace prt::tool {
 
@@ -43,12 +45,20 @@ struct ReceiverConsole {
   bool written = false;   // the file holds a bake
   bool rebaking = false;  // a correction's rows are being made (the file holds the first bake and its report)
   bake::PipelineHooks hooks(const Args& a, const RunContext& run, std::function<void()> write);
+  // Runs the pipeline's one job over its one receiver set with `hooks`; when this process is a
+  // shard worker (a.worker), its rows first go to chunks (shards.h) under a manifest of
+  // `manifest_lines` (what the rows depend on; the plan's integrator, samples, seed, width and the
+  // chunk rows are added), and only the merging process goes on, its rows read back from them.
+  // Ctrl-C after the file was first written keeps it (exit 130, saying what it holds); before,
+  // Cancelled propagates. Returns the exit code.
+  int run(const Args& a, const RunContext& run, bake::BakePipeline& pipeline, bake::PipelineHooks& hooks,
+          std::optional<ShardedRows>& shards, std::vector<std::string> manifest_lines);
 };
 
 // The bakes. `shards`: emplaced when the bake is sharded, so that prtbake_main can report its
 // committed chunks on Ctrl-C (ShardedRows::kept_after_cancel).
 int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
-int run_texel(const Args& a, const RunContext& run);  // not sharded (yet)
+int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards);
 

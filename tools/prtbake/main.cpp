@@ -78,7 +78,7 @@ int prtbake_main(int argc, char** argv) {
   try {
     return a.command == "fiv"     ? tool::run_fiv(a, run, shards)
            : a.command == "scene" ? tool::run_scene(a, run, shards)
-           : a.command == "texel" ? tool::run_texel(a, run)
+           : a.command == "texel" ? tool::run_texel(a, run, shards)
                                   : tool::run_vertex(a, run, shards);
   } catch (const bake::Cancelled&) {
     // A sharded or resumable bake keeps what it committed: say so, and how to go on.

@@ -82,7 +82,7 @@ uint32_t side_for_density(const bake::Mesh& mesh, const bake::UvSet& uv, double 
 
 } // namespace
 
-int run_texel(const Args& a, const RunContext& run) {
+int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& shards) {
   const bake::Mesh mesh = load_receiver_mesh(a, run.say);
   const bake::Topology topo = bake::build_topology(mesh);
   warn_inward(bake::winding_facts(mesh, topo), a.flip_normals);
@@ -218,20 +218,16 @@ int run_texel(const Args& a, const RunContext& run) {
   ReceiverConsole console;
   bake::PipelineHooks hooks = console.hooks(a, run, write_bake);
   hooks.set_baked = [&](const bake::BakeJob& j, size_t) {
-    if (run.say) print_rows_baked(j, false);
+    if (run.say) print_rows_baked(j, shards && shards->threads_of_chunks() == 0);
   };
-  try {
-    pipeline.run(run.progress, hooks);
-  } catch (const bake::Cancelled&) {
-    if (!console.written) throw;
-    std::fprintf(stderr,
-                 console.rebaking ? "prtbake: cancelled while baking again: %s holds the first bake and its error report\n"
-                                  : "prtbake: cancelled during the error check: %s holds the finished bake without its "
-                                    "error report (--report 0 skips the check)\n",
-                 a.output.c_str());
-    return tool::kExitCancelled;
-  }
-  return 0;
+  // Sharded, the chunks are the valid texels' rows in texel order; the atlas they belong to is
+  // in the manifest (a chunk of another atlas, UV set or texel count is refused).
+  return console.run(a, run, pipeline, hooks, shards,
+                     {"texel", kToolkitVersion, a.command_line, mesh.source_sha256,
+                      env ? env->info().sha256 : "no environment",
+                      std::to_string(atlas.width) + "x" + std::to_string(atlas.height) + " texels in UV set " + uv.name +
+                          ", " + std::to_string(valid.size()) + " of " + std::to_string(atlas.samples.size()) +
+                          " covered texels baked"});
 }
 
 } // namespace prt::tool

@@ -51,7 +51,6 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
   jobs[0].sets.push_back(bake::vertex_receivers(mesh, topo, a.input));
   bake::BakePipeline pipeline(mesh, topo, accel, std::move(settings), std::move(jobs));
   const bake::BakeJob& job = pipeline.jobs().front();
-  const std::vector<bake::ShadePoint>& points = job.sets.front().points;
 
   // ---- the file (formats/SCHEMA.md): written once the bake is whole, again with its report ----
   namespace F = prt::formats;
@@ -79,46 +78,8 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
     if (run.say) print_rows_baked(j, shards && shards->threads_of_chunks() == 0);
   };
 
-  try {
-    pipeline.plan(run.progress, hooks);
-    if (a.worker) {
-      // Sharded: every worker computes chunks of the rows; the merging process reads them back
-      // (shards.h). The manifest names the plan, so that chunks of another plan are refused.
-      const bake::IntegratorSpec& spec = job.spec;
-      const std::string manifest = tool::manifest_of(
-          {"vertex", kToolkitVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment",
-           job.integrator_description, bake::to_string(spec.kind), std::to_string(spec.samples()),
-           std::to_string(spec.seed), std::to_string(job.integrator->layout().width), std::to_string(a.shard.chunk_rows)});
-      shards.emplace(*a.worker, run.mpi, a.shard, a.output, manifest, std::vector<uint64_t>{points.size()},
-                     std::vector<uint32_t>{uint32_t(job.integrator->layout().width)}, a.quiet);
-      bake::PipelineHooks work;
-      work.rows_only = true;
-      work.rows = [&](const bake::BakeJob& j, size_t, const bake::Monitor&) {
-        shards->work([&](const bake::ChunkRange& r, const bake::Monitor& monitor) {
-          return tool::bake_chunk(points, r, *j.integrator, monitor);
-        });
-        return bake::VertexBake{};
-      };
-      if (!shards->run([&] { pipeline.run(run.progress, work); })) return 0;
-      hooks.rows = [&](const bake::BakeJob& j, size_t, const bake::Monitor&) {
-        return shards->merge(0, j.integrator->layout());
-      };
-    }
-    pipeline.run(run.progress, hooks);
-  } catch (const bake::Cancelled&) {
-    if (!console.written) throw;  // nothing written yet
-    if (console.rebaking)
-      std::fprintf(stderr, "prtbake: cancelled while baking again: %s holds the first bake and its error report\n",
-                   a.output.c_str());
-    else
-      std::fprintf(stderr,
-                   "prtbake: cancelled during the error check: %s holds the finished bake without its error report "
-                   "(--report 0 skips the check)\n",
-                   a.output.c_str());
-    return tool::kExitCancelled;
-  }
-  if (shards) shards->finish();
-  return 0;
+  return console.run(a, run, pipeline, hooks, shards,
+                     {"vertex", kToolkitVersion, a.command_line, mesh_sha, env ? env->info().sha256 : "no environment"});
 }
 
 } // namespace prt::tool

@@ -17,6 +17,8 @@
 // the next unclaimed chunk (claim files of this run, bake/core/chunks.h). A run is one launch: mpirun
 // (rank 0 picks a run id and broadcasts it), a SLURM array (its job id) or --run-id; claims of
 // another run are stale by definition, so a rerun recomputes what a dead run claimed.
+// Vertex and texel bakes: one row set, the vertices or the valid texels of the lightmap (in texel
+// order; the atlas is in the manifest).
 // FIV bakes: row set 0 is the DifMap's texels, row set 1 the environment FIV (one row), row set
 // 2 + k shell k's samples, each cut into slabs of rows. Where the shells stop depends on the shells themselves (bake/bake/fiv.h FivShellRows::stops_after), so workers take chunks shell
 // after shell without waiting for each other and read the stopping rule from committed chunks:
