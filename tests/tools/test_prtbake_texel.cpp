@@ -148,7 +148,7 @@ TEST(PrtbakeTexel, UvMistakesExit1NamingTheFile) {
                                scratch("capture"));
   EXPECT_EQ(run.code, 1);
   EXPECT_NE(run.err.find("spider.obj: its UV set vt overlaps itself: "), std::string::npos) << run.err;
-  EXPECT_NE(run.err.find("pass --unwrap"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("prtbake texel --unwrap"), std::string::npos) << run.err;
   // wuson.obj's vt is one repeated (0, 0): a set, but no lightmap.
   run = prt::testing::run_tool(PRT_PRTBAKE,
                                "texel '" + std::string(PRT_DATA_DIR) + "/wuson.obj' --resolution 16 --ao --samples 64 -o '" +

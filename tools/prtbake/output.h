@@ -7,6 +7,7 @@
 #include <bake/bake/diagnostics.h>
 #include <bake/bake/pipeline.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/unwrap.h>
 #include <formats/asset.h>
 
 #include "args.h"
@@ -59,6 +60,9 @@ void print_baking(const Args& a, const bake::BakeJob& job, int threads);
 void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
 void print_error_report(const bake::BakeJob& job);
 void print_error_verdict(const bake::BakeJob& job, double target);  // target 0: what the RMSE means
+// The line a generated lightmap UV set gets on stderr: who (the file, a scene object), why it was
+// generated ("--unwrap", "no UV set"), its charts, utilisation, stretch and size.
+void print_generated_uvs(const std::string& who, const char* why, const std::string& set, const bake::UnwrapReport& r);
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better);
 
 // The root attributes every file carries (formats/SCHEMA.md).
