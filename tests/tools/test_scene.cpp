@@ -2,14 +2,18 @@
 // "Data path"). One test per rule, each checking what the file does and does not contain; then the
 // scene-file errors a user can make, each named with the file and the line and column (syntax) or
 // the key path (everything else).
+#include <formats/asset.h>
 #include <formats/prtfile.h>
 
 #include <gtest/gtest.h>
 #include <run_tool.h>
+#include <unit_box_ao.h>
+#include <unit_box_obj.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <regex>
 #include <string>
 
@@ -351,5 +355,112 @@ INSTANTIATE_TEST_SUITE_P(
                  scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "material": {"phong_exponent": 100000}})"),
                  "needs more than 64 SH bands"},
         BadScene{"missing_mesh", scene_text("", "", R"({"mesh": "nothere.obj", "role": "both"})"), "nothere.obj: no such file (object 'nothere' of "},
-        BadScene{"newer_version", "{\"prtbake_scene\": 2, \"objects\": []}", "prtbake_scene version 2 is newer"}),
+        BadScene{"newer_version", "{\"prtbake_scene\": 2, \"objects\": []}", "prtbake_scene version 2 is newer"},
+        // Lightmaps (SceneObject::lightmap): one size, known keys, and a mesh whose set cannot be one.
+        BadScene{"lightmap_two_sizes",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "lightmap": {"resolution": 64, "density": 2}})"),
+                 "objects[0].lightmap needs one of \"resolution\" (texels) and \"density\" (texels per unit)"},
+        BadScene{"lightmap_unknown_key",
+                 scene_text("", "\"lightmap\": {\"resolution\": 64, \"gutters\": 2}", kGround),
+                 "unknown key \"gutters\" in bake.lightmap"},
+        BadScene{"lightmap_true", scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "lightmap": true})"),
+                 "objects[0].lightmap must be an object"},
+        BadScene{"lightmap_no_such_set",
+                 scene_text("", "", R"({"mesh": "ground.obj", "role": "both", "lightmap": {"resolution": 16, "uv": "TEXCOORD_1"}})"),
+                 "has no UV set 'TEXCOORD_1' (it has none)"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return std::string(i.param.name); });
+
+// Receivers per texel in a scene (bake/bake/scene.h "lightmap"): a receiver-only floor with its own
+// UVs (vt) under a box that only occludes. The floor texels outside the box's foot hold the
+// closed-form AO, 1 − (1/π) Σ_faces ∫ n·ω over the box's faces the texel sees (Lambert's formula;
+// silhouette at N = 1536 errs by < 1e-4 there, tests/tools/test_prtbake_texel.cpp, plus the file's
+// float32); the texels under the foot are inside the box (the union the enclosure test sees) and
+// filled. The box, an occluder, gets no lightmap (left out, said in the plan), and a bake.lightmap
+// default is overridden by an object's "lightmap": false.
+
+TEST(SceneTexels, AReceiverFloorUnderAnOccluderBoxBakesToTheClosedFormPerTexel) {
+  const fs::path d = dir_for("texels_floor_box");
+  // The floor [−2, 2]² at z = 0 (normal +z) with vt ((x + 2)/4, 1 − (y + 2)/4), and the box.
+  write_text(d / "floor.obj", "v -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nvt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\n"
+                              "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+  {
+    std::ofstream box(d / "box.obj");
+    box << "vt 0 0\n";
+    prt::testing::write_unit_box_obj(box, 1, 1);
+  }
+  write_text(d / "scene.json", R"({"prtbake_scene": 1, "up": "z",
+    "bake": {"products": ["ao"], "integrator": "silhouette", "samples": 2359296, "report": 0,
+             "lightmap": {"resolution": 32, "padding": 0}},
+    "objects": [{"name": "floor", "mesh": "floor.obj", "role": "receiver"},
+                {"name": "box", "mesh": "box.obj", "role": "occluder", "moves": false},
+                {"name": "floor2", "mesh": "floor.obj", "role": "receiver", "lightmap": false,
+                 "transform": {"translate": [0, 0, -5]}}]})");
+  const auto run = prt::testing::run_tool(
+      PRT_PRTBAKE, "scene '" + (d / "scene.json").string() + "' -o '" + (d / "out.prt.h5").string() + "'", d);
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.out.find("lightmap: the products below per texel instead of per vertex, 32x32 texels"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("lightmap: occluder only"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("floor: lightmap 32x32 texels in UV set vt: 1024 covered, 1 charts; 64 inside the geometry"),
+            std::string::npos) << run.out;
+  const F::Asset a = F::read_asset(d / "out.prt.h5");
+  ASSERT_EQ(a.objects.size(), 3u);
+  auto set_of = [&](const std::string& name) -> const F::VertexSet& {
+    for (const F::SceneObject& o : a.objects)
+      if (o.name == name) return o.set;
+    ADD_FAILURE() << "no object " << name;
+    return a.objects.front().set;
+  };
+  const F::VertexSet& floor_set = set_of("floor");
+  ASSERT_TRUE(floor_set.lightmap && floor_set.lightmap->ao);
+  EXPECT_FALSE(floor_set.ao) << "per texel instead of per vertex";
+  EXPECT_FALSE(set_of("box").lightmap) << "an occluder has no lightmap";
+  EXPECT_TRUE(set_of("floor2").ao && !set_of("floor2").lightmap) << "\"lightmap\": false bakes per vertex";
+  const F::Lightmap& lm = *floor_set.lightmap;
+  ASSERT_EQ(lm.width, 32u);
+  size_t baked = 0, filled = 0;
+  double worst = 0;
+  for (uint32_t r = 0; r < 32; ++r)
+    for (uint32_t c = 0; c < 32; ++c) {
+      const size_t t = r * 32 + c;
+      // Texel (c, r) centres at u = (c + ½)/32, glTF v = (r + ½)/32: x = 4u − 2, y = 4v − 2.
+      const double x = 4 * (c + 0.5) / 32 - 2, y = 4 * (r + 0.5) / 32 - 2;
+      const bool under = std::abs(x) < 0.5 && std::abs(y) < 0.5;
+      if (under) {
+        EXPECT_EQ(lm.state.values[t], 2) << "texel " << c << "," << r << " lies inside the box: filled";
+        ++filled;
+        continue;
+      }
+      ASSERT_EQ(lm.state.values[t], 1) << c << "," << r;
+      ++baked;
+      const double e = std::abs(double(lm.ao->values[t]) - prt::testing::ao_closed_form(prt::testing::Vector3d(x, y, 0)));
+      worst = std::max(worst, e);
+      EXPECT_LT(e, 1e-4) << "texel " << c << "," << r;
+    }
+  EXPECT_EQ(filled, 64u);
+  EXPECT_EQ(baked, 960u);
+  std::printf("worst |AO - closed form| over %zu floor texels: %.2e\n", baked, worst);
+}
+
+// A scene of one object per texel bakes the bytes prtbake texel bakes for its mesh: the same
+// atlas, the same shade points (a corner texel is the union's vertex), the same rows.
+TEST(SceneTexels, OneObjectsLightmapIsPrtbakeTexelsForItsMesh) {
+  const fs::path d = dir_for("texels_same");
+  write_text(d / "scene.json", "{\"prtbake_scene\": 1, \"environment\": \"" + kSunset + R"(",
+    "bake": {"products": ["ao", "radiance"], "integrator": "silhouette", "samples": 4096, "report": 0},
+    "objects": [{"mesh": ")" + (kData / "bunny_ground.obj").string() + R"(", "role": "both", "lightmap": {"resolution": 64}}]})");
+  ASSERT_EQ(prt::testing::run_tool(PRT_PRTBAKE, "scene '" + (d / "scene.json").string() + "' --reproducible -o '" +
+                                                    (d / "scene.prt.h5").string() + "'", d).code, 0);
+  const auto t = prt::testing::run_tool(PRT_PRTBAKE, "texel '" + (kData / "bunny_ground.obj").string() +
+                                                         "' --ao --radiance '" + kSunset + "' --resolution 64 --samples 4096 "
+                                                         "--report 0 --reproducible -o '" + (d / "texel.prt.h5").string() + "'", d);
+  ASSERT_EQ(t.code, 0) << t.err;
+  const F::Asset scene = F::read_asset(d / "scene.prt.h5"), texel = F::read_asset(d / "texel.prt.h5");
+  ASSERT_EQ(scene.objects.size(), 1u);
+  const F::Lightmap& a = *scene.objects[0].set.lightmap;
+  const F::Lightmap& b = *texel.vertices.lightmap;
+  EXPECT_EQ(a.state.values, b.state.values);
+  ASSERT_TRUE(a.ao && b.ao && a.radiance_band1 && b.radiance_band1);
+  EXPECT_EQ(a.ao->values, b.ao->values);
+  EXPECT_EQ(a.radiance_band1->values, b.radiance_band1->values);
+  EXPECT_EQ(scene.objects[0].set.uv->values, texel.vertices.uv->values);
+}

@@ -166,6 +166,14 @@ void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& 
   m.radiance_shadowed = std::move(products.radiance_shadowed);
 }
 
+bake::Lightmap lightmap_image(const bake::Mesh& mesh, const bake::Topology& topology,
+                              const bake::LightmapReceivers& texels, const bake::LightmapSpec& spec,
+                              const bake::VertexBake& rows, bake::SeamStitch& stitch) {
+  bake::Lightmap image = texels.image(rows.values, rows.layout.width, spec.padding);
+  stitch = spec.stitch ? bake::stitch_seams(image, texels.atlas, mesh, topology, texels.uv) : bake::SeamStitch{};
+  return image;
+}
+
 F::Light light_of(const bake::AreaLight& light) {
   F::Light l;
   l.name = light.name;

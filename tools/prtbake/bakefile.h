@@ -7,6 +7,7 @@
 #include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/lightmap.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/mesh/texels.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
@@ -43,6 +44,13 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
 void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& uv, const bake::TexelAtlas& atlas,
                   const bake::Lightmap& image, const bake::ProductLayout& layout, const ProductInfo& info,
                   uint32_t padding);
+
+// The lightmap image of the valid texels' rows of `texels` (LightmapReceivers::image: placed,
+// filled, padded `spec.padding` rings), its UV seams stitched unless `spec.stitch` is false
+// (bake/bake/lightmap.h stitch_seams; `stitch` receives its numbers, edges 0 when not stitched).
+bake::Lightmap lightmap_image(const bake::Mesh& mesh, const bake::Topology& topology,
+                              const bake::LightmapReceivers& texels, const bake::LightmapSpec& spec,
+                              const bake::VertexBake& rows, bake::SeamStitch& stitch);
 
 // An area light as the file stores it (/lights/<name>: world-space faces, radiance, two_sided).
 F::Light light_of(const bake::AreaLight& light);

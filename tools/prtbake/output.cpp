@@ -247,6 +247,14 @@ void print_generated_uvs(const std::string& who, const char* why, const std::str
                r.utilisation, r.worst_stretch, r.mean_stretch, r.width, r.height, r.density, r.seconds);
 }
 
+void print_stitch(const bake::SeamStitch& seams, const std::string& who) {
+  std::printf("%sseams: %zu UV seam edges, %zu points looked up from both sides (%zu reach an empty texel or another "
+              "chart's: left out), %zu texels moved (a baked one by %.2e at most): mean |difference| %.2e -> %.2e, "
+              "largest %.2e -> %.2e\n",
+              who.empty() ? "" : (who + ": ").c_str(), seams.edges, seams.points, seams.skipped_points, seams.texels,
+              seams.baked_moved_max, seams.mean_before, seams.mean_after, seams.max_before, seams.max_after);
+}
+
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better) {
   std::printf("%s\n", bake::correction_text(job, better).c_str());
   std::fflush(stdout);

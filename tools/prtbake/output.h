@@ -5,6 +5,7 @@
 
 #include <bake/bake/choose.h>
 #include <bake/bake/diagnostics.h>
+#include <bake/bake/lightmap.h>
 #include <bake/bake/pipeline.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/unwrap.h>
@@ -60,6 +61,8 @@ void print_baking(const Args& a, const bake::BakeJob& job, int threads);
 void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
 void print_error_report(const bake::BakeJob& job);
 void print_error_verdict(const bake::BakeJob& job, double target);  // target 0: what the RMSE means
+// The line of a lightmap's stitched seams (bake/bake/lightmap.h), prefixed by `who` ("who: ") when given.
+void print_stitch(const bake::SeamStitch& seams, const std::string& who = "");
 // The line a generated lightmap UV set gets on stderr: who (the file, a scene object), why it was
 // generated ("--unwrap", "no UV set"), its charts, utilisation, stretch and size.
 void print_generated_uvs(const std::string& who, const char* why, const std::string& set, const bake::UnwrapReport& r);

@@ -156,6 +156,34 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                            const bake::Monitor&) { return shards->merge(uint32_t(set), integrator.layout()); };
   }
   namespace F = prt::formats;
+  // The lightmaps of the receivers baked per texel, made (and their seams stitched) once per bake
+  // of their rows.
+  std::vector<std::optional<bake::Lightmap>> images(scene.objects.size());
+  constexpr size_t kLightmapLines = 5;  // receivers per texel whose atlas and seams are printed without -v
+  auto make_images = [&](const bake::SceneBake& result) {
+    size_t lightmaps = 0;
+    for (const bake::ObjectBake& ob : result.objects) lightmaps += ob.lightmap && ob.values ? 1 : 0;
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const bake::ObjectBake& ob = result.objects[i];
+      if (!ob.lightmap || !ob.values) continue;
+      bake::SeamStitch seams;
+      images[i] = lightmap_image(meshes[i], bake::build_topology(meshes[i]), *ob.lightmap, *scene.objects[i].lightmap,
+                                 *ob.values, seams);
+      if (!run.say || !(lightmaps <= kLightmapLines || a.verbose)) continue;
+      const std::string who = scene_object_label(scene.objects[i]);
+      const bake::TexelAtlas& atlas = ob.lightmap->atlas;
+      if (ob.lightmap->generated)
+        print_generated_uvs(who, ob.lightmap->unwrap_asked ? "\"unwrap\": true" : "no UV set", ob.lightmap->uv.name,
+                            *ob.lightmap->generated);
+      std::printf("%s: lightmap %ux%u texels in UV set %s: %zu covered, %u charts; %zu inside the geometry, filled "
+                  "from their charts\n",
+                  who.c_str(), atlas.width, atlas.height, ob.lightmap->uv.name.c_str(), atlas.samples.size(), atlas.charts,
+                  atlas.samples.size() - ob.lightmap->valid.size());
+      if (seams.edges > 0) print_stitch(seams, who);
+    }
+    if (run.say && lightmaps > kLightmapLines && !a.verbose)
+      std::printf("%zu receivers baked per texel into lightmaps (-v prints each one's atlas and seams)\n", lightmaps);
+  };
   // The file from a bake (with its reports once they are made).
   auto write_scene = [&](const bake::SceneBake& result) {
     F::Asset asset;
@@ -203,11 +231,20 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
       if (o.material.glossy()) obj.specular = std::vector<double>(o.material.specular.begin(), o.material.specular.end());
       if (ob.values) obj.closed_form_vertices = int64_t(ob.closed_form_vertices);
       tool::set_mesh(obj.set, meshes[i]);
-      if (ob.values) {
-        tool::set_products(obj.set, *ob.values,
-                           {std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
-                            ob.integrator.samples(), ob.integrator.seed,
-                            p.transfer_order, p.visibility_order, env ? &*env : nullptr, env_path});
+      const ProductInfo products{std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
+                                 ob.integrator.samples(), ob.integrator.seed, p.transfer_order, p.visibility_order,
+                                 env ? &*env : nullptr, env_path};
+      if (ob.values && ob.lightmap) {
+        // Per texel: the lightmap (made when the rows were baked), its report's rows named by texel.
+        tool::set_lightmap(obj.set, meshes[i], ob.lightmap->uv, ob.lightmap->atlas, *images[i], ob.values->layout, products,
+                           o.lightmap->padding);
+        if (ob.report) {
+          bake::ErrorReport by_texel = *ob.report;
+          for (uint32_t& r : by_texel.vertices) r = ob.lightmap->atlas.samples[ob.lightmap->valid[r]].texel;
+          obj.set.report = tool::report_of(by_texel, ob.values->seconds, ob.lightmap->valid.size(), a.reproducible);
+        }
+      } else if (ob.values) {
+        tool::set_products(obj.set, *ob.values, products);
         if (ob.report)
           obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
       }
@@ -257,9 +294,11 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                    no_sky.size(), first.c_str(), no_sky.size() - 3);
     }
     if (run.say)
-      std::printf("baked %llu receiver vertices in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
-                  (unsigned long long)result.vertices, result.vertex_seconds, result.setup_seconds, result.fiv_seconds,
-                  result.environment_seconds);
+      std::printf("baked %llu receiver vertices%s in %.2f s (setup %.2f s), FIV %.2f s (environment %.2f s)\n",
+                  (unsigned long long)result.vertices,
+                  result.texels ? (" and " + std::to_string(result.texels) + " lightmap texels").c_str() : "",
+                  result.vertex_seconds, result.setup_seconds, result.fiv_seconds, result.environment_seconds);
+    make_images(result);
 
     write_scene(result);
     written = true;

@@ -49,8 +49,8 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   const bake::MeshAccel accel(mesh, topo);
   // The texels (bake/bake/lightmap_receivers.h): the UV set, generated when the mesh has none (and
   // --uv names none) or on --unwrap; the atlas; the texels inside the geometry, left out.
-  const bake::LightmapReceivers texels =
-      bake::lightmap_receivers(mesh, topo, lightmap_spec(a), *accel.rays(), a.input);
+  const bake::LightmapSpec spec = lightmap_spec(a);
+  const bake::LightmapReceivers texels = bake::lightmap_receivers(mesh, topo, spec, *accel.rays(), a.input);
   const bake::TexelAtlas& atlas = texels.atlas;
   const bake::UvSet& uv = texels.uv;
   if (run.say && texels.generated)
@@ -82,16 +82,9 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   namespace F = prt::formats;
   auto write_bake = [&] {
     const bake::VertexBake& result = job.rows.front();
-    bake::Lightmap image = texels.image(result.values, result.layout.width, a.padding);
-    if (!a.no_stitch) {
-      const bake::SeamStitch seams = bake::stitch_seams(image, atlas, mesh, topo, uv);
-      if (run.say && seams.edges > 0)
-        std::printf("seams: %zu UV seam edges, %zu points looked up from both sides (%zu reach an empty texel or another chart's: "
-                    "left out), %zu texels moved (a baked one by %.2e at most): mean |difference| %.2e -> %.2e, "
-                    "largest %.2e -> %.2e\n",
-                    seams.edges, seams.points, seams.skipped_points, seams.texels, seams.baked_moved_max, seams.mean_before,
-                    seams.mean_after, seams.max_before, seams.max_after);
-    }
+    bake::SeamStitch seams;
+    const bake::Lightmap image = lightmap_image(mesh, topo, texels, spec, result, seams);
+    if (run.say && seams.edges > 0) print_stitch(seams);
     F::Asset asset;
     asset.root = root_info(a, mesh.source_sha256);
     tool::set_mesh(asset.vertices, mesh);

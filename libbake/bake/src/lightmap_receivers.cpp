@@ -73,7 +73,8 @@ Lightmap LightmapReceivers::image(std::span<const double> valid_rows, size_t cha
 }
 
 LightmapReceivers lightmap_receivers(const Mesh& mesh, const Topology& topology, const LightmapSpec& spec,
-                                     const RayCaster& rays, std::string name, const std::string& who) {
+                                     const RayCaster& rays, std::string name, const std::string& who,
+                                     const TexelRebase& rebase) {
   PRT_CHECK(spec.given());
   LightmapReceivers out;
   uint32_t width = spec.width, height = spec.height ? spec.height : spec.width;
@@ -117,6 +118,8 @@ LightmapReceivers lightmap_receivers(const Mesh& mesh, const Topology& topology,
                                       " texels lie inside triangles of two charts (a texture set that mirrors or "
                                       "reuses parts is no lightmap set); bake in generated lightmap UVs instead "
                                       "(prtbake texel --unwrap; \"unwrap\": true in a scene's lightmap)");
+  if (rebase)
+    for (size_t i = 0; i < atlas.samples.size(); ++i) rebase(atlas.samples[i], out.atlas.receivers.points[i]);
   // Texels inside the geometry: left out of the bake, filled from their chart afterwards.
   out.invalid.assign(atlas.samples.size(), 0);
   tbb::parallel_for(size_t(0), atlas.samples.size(),

@@ -44,6 +44,13 @@ std::string printf_string(const char* f, double a, double b = 0) {
 // The area lights' rows of every point ([point][integ.width()]) through the row loop
 // (bake/bake/vertex_bake.h); each row depends on its point only, so any thread count gives the
 // same numbers.
+// How a job's rows are counted in logs: its sets' noun when they share one, else "rows".
+std::string rows_noun_of(const BakeJob& job) {
+  for (const ReceiverSet& set : job.sets)
+    if (std::string(set.rows_noun) != job.sets.front().rows_noun) return "rows";
+  return job.sets.empty() ? "rows" : job.sets.front().rows_noun;
+}
+
 std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const AreaLightIntegrator& integ,
                                      const Monitor& monitor, const std::string& label) {
   tbb::enumerable_thread_specific<AreaLightIntegrator::Workspace> workspaces;
@@ -102,6 +109,32 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     return set;
   };
 
+  // A receiver baked per texel (SceneObject::lightmap): its lightmap's valid texels as the set
+  // (bake/bake/lightmap_receivers.h), kept in its ObjectBake for the image. The enclosure test
+  // sees the union, and a texel at a corner is that vertex's shade point in the union (its ring
+  // decided as the vertex bake decides it); for a receiver-only object, whose triangles are not
+  // in the union, every texel is a free point, as its vertices are.
+  auto texels_of = [&](size_t i) {
+    const Mesh& m = meshes[i];
+    const std::string name = label_of(scene.objects[i]);
+    const TexelRebase rebase = [&](const TexelSample& sample, ShadePoint& sp) {
+      if (sp.welded < 0) return;
+      int corner = 0;
+      for (int k = 1; k < 3; ++k)
+        if (sample.barycentric[k] > sample.barycentric[corner]) corner = k;
+      if (plan.objects[i].occluder)
+        sp = vertex_shade_point(occluders, topo, uint32_t(base[i] + m.triangles[sample.triangle][size_t(corner)]));
+      else
+        sp.welded = -1;
+    };
+    ObjectBake& ob = out.objects[i];
+    ob.lightmap = lightmap_receivers(m, build_topology(m), *scene.objects[i].lightmap, *accel.rays(), name,
+                                     "object '" + name + "' of " + scene.file.string() + ": ", rebase);
+    ReceiverSet set = ob.lightmap->receivers();
+    set.tag = i;
+    return set;
+  };
+
   // One pipeline job per distinct product request (bake/bake/pipeline.h), over the receivers that
   // make it: with a target, one choice for them on their pooled shade points (bake/bake/scene.h
   // "target error": the target holds for their values together), one pilot and one report
@@ -122,14 +155,14 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const ProductRequest r = product_request(p, env);
     const auto [it, added] = job_of.emplace(key_of(r), jobs.size());
     if (added) jobs.emplace_back().request = r;
-    jobs[it->second].sets.push_back(receivers_of(i));
+    jobs[it->second].sets.push_back(p.texels ? texels_of(i) : receivers_of(i));
     shard_set[i] = receivers++;
   }
   // How the log names a job: its object, or "N receivers (V vertices, from <first>)".
   for (BakeJob& job : jobs)
     job.name = job.sets.size() == 1 ? job.sets.front().name
                                     : std::to_string(job.sets.size()) + " receivers (" + std::to_string(job.row_count()) +
-                                          " vertices, from " + job.sets.front().name + ")";
+                                          " " + rows_noun_of(job) + ", from " + job.sets.front().name + ")";
   PipelineSettings settings;
   settings.integrator = scene.integrator;
   settings.target_error = scene.target_error;
@@ -161,16 +194,16 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       const size_t n = job.row_count();
       const std::optional<double> per_row = pipeline.cpu_seconds_per_row(job, kEstimatePoints);
       if (!per_row) {
-        log(job.name + ": " + std::to_string(n) + " vertices; the " + to_string(job.spec.kind) +
+        log(job.name + ": " + std::to_string(n) + " " + rows_noun_of(job) + "; the " + to_string(job.spec.kind) +
             " integrator's cost is not estimated (it needs every vertex's rays)");
         continue;
       }
       const double cpu = *per_row * double(n);
       total += cpu / threads;
-      log(job.name + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(n) + " vertices with " +
+      log(job.name + ": about " + printf_string("%.3g CPU s to bake ", cpu) + std::to_string(n) + " " + rows_noun_of(job) + " with " +
           to_string(job.spec.kind) + " at " + job.spec.knob_text() + printf_string(", %.3g s on ", cpu / threads) +
           std::to_string(int(threads)) + " threads (timed on " + std::to_string(std::min(kEstimatePoints, n)) +
-          " seeded vertices)");
+          " seeded " + rows_noun_of(job) + ")");
       if (!target || job.spec.report_points == 0) continue;
       // The check the bake would plan (bake/bake/pipeline.h: as long as the bake, at least
       // kReportMinCpuSeconds), from the estimate.
@@ -305,16 +338,19 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     // A line per object for a scene of a few; an engine of 115 parts gets the progress stage and
     // the total (the file has every object's time).
     if (receivers <= kObjectLinesUpTo)
-      log(set.name + ": " + std::to_string(set.points.size()) + " vertices in " +
+      log(set.name + ": " + std::to_string(set.points.size()) + " " + set.rows_noun + " in " +
           printf_string("%.2f s", ob.values->seconds) +
           (ob.closed_form_vertices > 0 ? ", " + std::to_string(ob.closed_form_vertices) + " saw no contour edge (closed form)"
                                        : std::string()));
   };
   hooks.baked = [&] {
     out.vertex_seconds = 0;
-    out.vertices = 0;
+    out.vertices = out.texels = 0;
     for (const ObjectBake& ob : out.objects)
-      if (ob.values) out.vertex_seconds += ob.values->seconds, out.vertices += ob.values->values.size() / std::max<size_t>(ob.values->layout.width, 1);
+      if (ob.values) {
+        out.vertex_seconds += ob.values->seconds;
+        (ob.lightmap ? out.texels : out.vertices) += ob.values->values.size() / std::max<size_t>(ob.values->layout.width, 1);
+      }
     // The bake is whole: the caller may write it before the checks (which may be cancelled).
     if (rows.baked) rows.baked(out);
   };
@@ -328,7 +364,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     // In a job of several receivers, each holds a few of the report's vertices: its own RMSE says
     // little (it is in the file); the pooled lines say what was met.
     if (target && job.sets.size() > 1) return;
-    std::string line = set.name + ": error on " + std::to_string(ob.report->vertices.size()) + " seeded vertices:";
+    std::string line = set.name + ": error on " + std::to_string(ob.report->vertices.size()) + " seeded " + set.rows_noun + ":";
     for (const auto& e : ob.report->products)
       line += " " + std::string(product_label(e.product)) + printf_string(" RMSE %.3e (max %.3e; ", e.rmse, e.max_abs) +
               (ob.report->reference_noise_measured ? "reference's own noise, measured, " : "reference's own std. error ") +

@@ -120,6 +120,36 @@ void check_version(const Reader& r, const Json& root, const char* version_key, c
   if (v != 1) r.fail(std::string(version_key) + " version " + std::to_string(v) + " is newer than this prtbake reads (1)");
 }
 
+// A "lightmap" (`key`): an object, or false (per vertex: nullopt).
+std::optional<LightmapSpec> parse_lightmap(const Reader& r, const Json& v, const std::string& key) {
+  if (v.is_boolean() && !v.get<bool>()) return std::nullopt;
+  if (!v.is_object())
+    r.fail(key + " must be an object {\"resolution\": N} or {\"density\": T} (and \"uv\", \"unwrap\", \"gutter\", "
+                 "\"padding\", \"stitch\"), or false");
+  r.object(v, key, {"resolution", "density", "uv", "unwrap", "gutter", "padding", "stitch"});
+  LightmapSpec spec;
+  const Json* res = find_key(v, "resolution");
+  const Json* den = find_key(v, "density");
+  if ((res != nullptr) == (den != nullptr)) r.fail(key + " needs one of \"resolution\" (texels) and \"density\" (texels per unit)");
+  if (res && res->is_array()) {
+    if (res->size() != 2) r.fail(key + ".resolution must be N or [W, H]");
+    spec.width = uint32_t(r.integer((*res)[0], key + ".resolution[0]", 1, kMaxLightmapSide));
+    spec.height = uint32_t(r.integer((*res)[1], key + ".resolution[1]", 1, kMaxLightmapSide));
+  } else if (res) {
+    spec.width = spec.height = uint32_t(r.integer(*res, key + ".resolution", 1, kMaxLightmapSide));
+  } else {
+    spec.density = r.number(*den, key + ".density", 0, 1e12);
+    if (!(spec.density > 0)) r.fail(key + ".density must be > 0 (texels per unit)");
+  }
+  if (const Json* x = find_key(v, "uv")) spec.uv_set = r.string(*x, key + ".uv");
+  if (const Json* x = find_key(v, "unwrap")) spec.unwrap = r.boolean(*x, key + ".unwrap");
+  if (!spec.uv_set.empty() && spec.unwrap) r.fail(key + ": \"uv\" names the asset's set and \"unwrap\" generates one: give one");
+  if (const Json* x = find_key(v, "gutter")) spec.gutter = uint32_t(r.integer(*x, key + ".gutter", 0, 64));
+  if (const Json* x = find_key(v, "padding")) spec.padding = uint32_t(r.integer(*x, key + ".padding", 0, 64));
+  if (const Json* x = find_key(v, "stitch")) spec.stitch = r.boolean(*x, key + ".stitch");
+  return spec;
+}
+
 // "up", "environment" and "bake" of a scene file or a glTF scene's options (`file`).
 void parse_settings(const Reader& r, const Json& root, const std::filesystem::path& file, SceneDescription& sc) {
   if (const Json* up = find_key(root, "up")) {
@@ -130,7 +160,9 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
   if (const Json* env = find_key(root, "environment")) sc.environment = resolve_beside(file, r.string(*env, "environment"));
   if (const Json* bake = find_key(root, "bake")) {
     r.object(*bake, "bake",
-             {"products", "integrator", "samples", "seed", "report", "target_error", "sh_tolerance", "relight", "fiv"});
+             {"products", "integrator", "samples", "seed", "report", "target_error", "sh_tolerance", "relight", "fiv",
+              "lightmap"});
+    if (const Json* x = find_key(*bake, "lightmap")) sc.lightmap = parse_lightmap(r, *x, "bake.lightmap");
     if (const Json* p = find_key(*bake, "products")) {
       if (!p->is_array()) r.fail("bake.products must be an array of strings");
       sc.want_ao = sc.want_transfer = sc.want_radiance = sc.want_fiv = false;
@@ -336,7 +368,7 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
   for (size_t i = 0; i < objects->size(); ++i) {
     const Json& o = (*objects)[i];
     const std::string key = "objects[" + std::to_string(i) + "]";
-    r.object(o, key, {"name", "mesh", "role", "transform", "material", "moves"});
+    r.object(o, key, {"name", "mesh", "role", "transform", "material", "moves", "lightmap"});
     SceneObject obj;
     const Json* mesh = find_key(o, "mesh");
     if (mesh == nullptr) r.fail(key + " lacks \"mesh\" (the mesh file)");
@@ -364,6 +396,8 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
       obj.moves = r.boolean(*mv, key + ".moves");
       obj.moves_reason = std::string("\"moves\": ") + (obj.moves ? "true" : "false") + " in the scene file";
     }
+    const Json* lm = find_key(o, "lightmap");
+    obj.lightmap = lm ? parse_lightmap(r, *lm, key + ".lightmap") : sc.lightmap;
     sc.objects.push_back(std::move(obj));
   }
   return sc;
@@ -392,6 +426,7 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
   r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "lights", "objects"});
   check_version(r, root, "prtbake_gltf_scene", "the scene options", "options-file");
   parse_settings(r, root, *options, sc);
+  for (SceneObject& obj : sc.objects) obj.lightmap = sc.lightmap;  // bake.lightmap, unless an entry says otherwise
   if (const Json* lights = find_key(root, "lights")) sc.lights = parse_lights(r, *lights, options->string());
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) return sc;
@@ -403,17 +438,19 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
     std::optional<Role> role;
     std::optional<Material> material;
     std::optional<bool> moves;
+    std::optional<std::optional<LightmapSpec>> lightmap;
     bool used = false;
   };
   std::vector<Entry> entries;
   for (const auto& [key, value] : objects->items()) {
     const std::string path = "objects.\"" + key + "\"";
-    r.object(value, path, {"role", "material", "moves"});
+    r.object(value, path, {"role", "material", "moves", "lightmap"});
     Entry& e = entries.emplace_back();
     e.key = key;
     if (const Json* role = find_key(value, "role")) e.role = parse_role(r, *role, path + ".role");
     if (const Json* m = find_key(value, "material")) e.material = parse_material(r, *m, path + ".material", e.role.value_or(Role::Both));
     if (const Json* mv = find_key(value, "moves")) e.moves = r.boolean(*mv, path + ".moves");
+    if (const Json* lm = find_key(value, "lightmap")) e.lightmap = parse_lightmap(r, *lm, path + ".lightmap");
   }
   auto names = [](const std::string& instance, const std::string& key) {
     return instance.starts_with(key) && (instance.size() == key.size() || instance[key.size()] == '/' || instance[key.size()] == '#');
@@ -422,13 +459,16 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
     const Entry* role = nullptr;
     const Entry* material = nullptr;
     const Entry* moves = nullptr;
+    const Entry* lightmap = nullptr;
     for (Entry& e : entries) {
       if (!names(obj.node_path, e.key)) continue;
       e.used = true;
       if (e.role && (!role || e.key.size() > role->key.size())) role = &e;
       if (e.material && (!material || e.key.size() > material->key.size())) material = &e;
       if (e.moves && (!moves || e.key.size() > moves->key.size())) moves = &e;
+      if (e.lightmap && (!lightmap || e.key.size() > lightmap->key.size())) lightmap = &e;
     }
+    if (lightmap) obj.lightmap = *lightmap->lightmap;
     if (role) obj.role = *role->role;
     if (material) obj.material = *material->material;
     if (moves) {

@@ -15,6 +15,13 @@
 #include <vector>
 
 namespace prt::bake {
+namespace {
+std::string density_text(double d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", d);
+  return buf;
+}
+} // namespace
 
 ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
@@ -41,7 +48,17 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
     p.occluder = o.role != Role::Receiver;
     if (!p.receiver) {
       p.left_out.push_back("ao, transfer, radiance: occluder only (role \"occluder\"): nothing is shaded on it");
+      if (o.lightmap) p.left_out.push_back("lightmap: occluder only (role \"occluder\"): nothing is shaded on it");
     } else {
+      if (o.lightmap) {
+        const LightmapSpec& l = *o.lightmap;
+        p.texels = true;
+        p.baked.push_back(std::string("lightmap: the products below per texel instead of per vertex, ") +
+                          (l.width ? std::to_string(l.width) + "x" + std::to_string(l.height) + " texels"
+                                   : "at " + density_text(l.density) + " texels per unit") +
+                          (l.unwrap ? " in generated UVs" : l.uv_set.empty() ? "" : " in UV set " + l.uv_set) +
+                          (scene.lights.empty() ? "" : "; the area lights per vertex (not per texel yet)"));
+      }
       if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
       else p.left_out.push_back("ao: not in bake.products");
       const Material& m = o.material;

@@ -3,7 +3,7 @@
 //   AO(p) = 1 − (1/π) Σ_{box faces facing p} ∫_face (n·ω) dω,
 // the faces seen from p not overlapping (a convex solid), each entirely above p's horizon (the
 // side faces span z ∈ [0, 1], the floor is z = 0), so their cosine integrals have closed forms
-// (Lambert's vector irradiance, bake/sphere/spherical_polygon.h). Every floor texel outside the
+// (Lambert's formula, written apart from the library in tests/common/unit_box_ao.h). Every floor texel outside the
 // box's foot is checked, the row of texels next to its foot included (their samples 1/16 of a
 // unit from the box's walls).
 //
@@ -20,12 +20,12 @@
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/texels.h>
 #include <bake/mesh/unwrap.h>
-#include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/accel.h>
 #include <bake/visibility/enclosure.h>
 #include <bake/visibility/raycast.h>
 
 #include <gtest/gtest.h>
+#include <unit_box_ao.h>
 
 #include <array>
 #include <cmath>
@@ -39,8 +39,6 @@ using Eigen::Vector3d;
 using Eigen::Vector3f;
 
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 // The floor [−2, 2]² at z = 0, UVs ((x + 2)/4, (y + 2)/4), and the box [−½, ½]² × [0, 1] on it.
 struct FloorAndBox {
@@ -62,27 +60,9 @@ struct FloorAndBox {
   }
 };
 
-// The closed form of the file comment at a floor point p.
-double ao_closed_form(const Vector3d& p) {
-  const Vector3d n(0, 0, 1);
-  // The four side faces, each as its corners (outward normal, facing p when normal·(p − centre) > 0).
-  const std::array<std::array<Vector3d, 4>, 4> faces = {{
-      {{{0.5, -0.5, 0}, {0.5, 0.5, 0}, {0.5, 0.5, 1}, {0.5, -0.5, 1}}},
-      {{{-0.5, 0.5, 0}, {-0.5, -0.5, 0}, {-0.5, -0.5, 1}, {-0.5, 0.5, 1}}},
-      {{{0.5, 0.5, 0}, {-0.5, 0.5, 0}, {-0.5, 0.5, 1}, {0.5, 0.5, 1}}},
-      {{{-0.5, -0.5, 0}, {0.5, -0.5, 0}, {0.5, -0.5, 1}, {-0.5, -0.5, 1}}},
-  }};
-  const std::array<Vector3d, 4> normals = {Vector3d(1, 0, 0), Vector3d(-1, 0, 0), Vector3d(0, 1, 0), Vector3d(0, -1, 0)};
-  double blocked = 0;
-  for (size_t f = 0; f < 4; ++f) {
-    const Vector3d centre = (faces[f][0] + faces[f][2]) / 2;
-    if (normals[f].dot(p - centre) <= 0) continue;
-    std::vector<Vector3d> rel;
-    for (const Vector3d& v : faces[f]) rel.push_back((v - p).normalized());
-    blocked += std::abs(cosine_integral(rel, n));
-  }
-  return 1 - blocked / kPi;
-}
+// The closed form of the file comment at a floor point p (tests/common/unit_box_ao.h: written
+// apart from the library's spherical polygons).
+double ao_closed_form(const Vector3d& p) { return prt::testing::ao_closed_form(prt::testing::Vector3d(p.x(), p.y(), p.z())); }
 
 // AO of the atlas's texels through the pipeline, occluded by `mesh`, without a report.
 VertexBake bake_ao(const Mesh& mesh, const Topology& topo, const MeshAccel& accel, const TexelAtlas& atlas,

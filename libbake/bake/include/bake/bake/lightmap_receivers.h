@@ -27,6 +27,7 @@
 #include <bake/visibility/raycast.h>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -60,10 +61,14 @@ struct LightmapReceivers {
   Lightmap image(std::span<const double> valid_rows, size_t channels, uint32_t padding) const;
 };
 
-// `rays`: the occluders the enclosure test sees (the mesh's own, or a scene's union); the atlas's
-// shade points are the mesh's (bake/mesh/texels.h). `name` names the receiver set in logs; `who`
-// prefixes messages ("" for a lone mesh, "object 'x': " in a scene).
+// `rays`: the occluders the enclosure test sees (the mesh's own, or a scene's union). The atlas's
+// shade points are the mesh's (bake/mesh/texels.h); `rebase`, when given, is called on each
+// (with its sample) before the test, to make it a point of those occluders (in a scene, a corner
+// texel's point is its vertex's in the union: bake/bake/scene_bake.h). `name` names the receiver
+// set in logs; `who` prefixes messages ("" for a lone mesh, "object 'x': " in a scene).
+using TexelRebase = std::function<void(const TexelSample&, ShadePoint&)>;
 LightmapReceivers lightmap_receivers(const Mesh& mesh, const Topology& topology, const LightmapSpec& spec,
-                                     const RayCaster& rays, std::string name, const std::string& who = "");
+                                     const RayCaster& rays, std::string name, const std::string& who = "",
+                                     const TexelRebase& rebase = {});
 
 } // namespace prt::bake

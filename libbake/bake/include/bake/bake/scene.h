@@ -19,7 +19,8 @@
 //       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
 //       "relight": false,                      diffuse receivers also get transfer vectors
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/bake/fiv.h ShellSpec)
-//     },
+//       "lightmap": {...}                      every receiver per texel (below), unless its own says
+//     },                                       otherwise
 //     "lights": [ {                              optional: area lights (bake/lights/lights.h, paper 003)
 //       "name": "key",                           optional: default "light<i>"; unique
 //       "shape": "quad",  "centre", "u", "v"     the rectangle centre ± u/2 ± v/2, emitting towards u × v
@@ -40,6 +41,14 @@
 //                     its 3×3 part well-conditioned (σ_max/σ_min ≤ 1e8), else refused before any work,
 //       "material": {"albedo": [r,g,b], "phong_exponent": s, "specular": [r,g,b]},
 //       "moves": true                          optional: it may move at run time (FIV shells, below)
+//       "lightmap": {                          optional: a receiver's products per texel of a lightmap
+//         "resolution": N | [W, H],            instead of per vertex (bake/bake/lightmap_receivers.h);
+//         "density": T,                        one of the two: the atlas, or texels per unit
+//         "uv": "TEXCOORD_1",                  the asset's set (default TEXCOORD_1, else its only one)
+//         "unwrap": false,                     generate the set even when the mesh has one (a mesh
+//                                              without UVs gets one anyway)
+//         "gutter": 2, "padding": 2, "stitch": true }   as prtbake texel's --gutter, --padding, --no-stitch
+//                 | false                      per vertex, whatever bake.lightmap says
 //     } ]
 //   }
 // Unknown and duplicate keys are errors (a typo must not silently change a bake); every error
@@ -60,11 +69,13 @@
 //   {
 //     "prtbake_gltf_scene": 1,                   required: the options-file version
 //     "up", "environment", "bake":               as in a scene file (relative paths: to the options file)
-//     "objects": {"<node path or instance name>": {"role": ..., "material": {...}, "moves": true}}
+//     "objects": {"<node path or instance name>": {"role": ..., "material": {...}, "moves": true,
+//                                                   "lightmap": {...} | false}}
 //   }
 // An "objects" key names an instance ("root/engine#p1") or a node path, which covers every
 // instance of that node and of the nodes below it ("root/engine"); for each of role, material and moves
-// the most specific (longest) key that sets it wins; a material replaces the default one whole.
+// the most specific (longest) key that sets it wins; a material replaces the default one whole
+// (and so does a lightmap).
 // A key that names no instance is an error (a typo must not silently change a bake); the rest is
 // checked as in a scene file.
 //
@@ -102,6 +113,7 @@
 #pragma once
 
 #include <bake/bake/fiv.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/integrator.h>
 #include <bake/lights/lights.h>
@@ -143,6 +155,9 @@ struct SceneObject {
   // (docs/ARCHITECTURE.md §3 "Frames").
   Eigen::Matrix4d world_from_object = Eigen::Matrix4d::Identity();
   Material material;
+  // "lightmap" (its own, else bake.lightmap's): a receiver's products per texel of this lightmap
+  // instead of per vertex (bake/bake/lightmap_receivers.h). nullopt: per vertex.
+  std::optional<LightmapSpec> lightmap;
 };
 
 // What a scene file describes (load_scene): the objects, their roles and materials, the
@@ -164,6 +179,7 @@ struct SceneDescription {
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
+  std::optional<LightmapSpec> lightmap;  // bake.lightmap: every object's unless its own says otherwise
   std::vector<AreaLight> lights;  // "lights", in world space (bake/lights/lights.h), validated
   std::vector<SceneObject> objects;
 };
@@ -204,6 +220,7 @@ struct ObjectPlan {
   int transfer_order = 0;    // diffuse transfer T (0: none)
   int visibility_order = 0;  // visibility transfer U for the glossy lobe (0: none)
   int shadowed_order = 0;    // shadowed radiance S for the glossy lobe under the environment (0: none)
+  bool texels = false;           // per texel of SceneObject::lightmap instead of per vertex
   bool area_irradiance = false;  // area_lights/irradiance: E of every light, at unit radiance
   int area_sh_order = 0;         // area_lights/sh: the visible lights' SH at this order (0: none)
   std::vector<std::string> baked, left_out;  // "product: reason", one line each

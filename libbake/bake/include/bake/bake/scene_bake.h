@@ -6,6 +6,7 @@
 #include <bake/bake/choose.h>
 #include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/bake/scene.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/progress.h>
@@ -21,8 +22,10 @@
 namespace prt::bake {
 
 struct ObjectBake {
-  // Receivers: one row per vertex of the object's world mesh, in its layout.
+  // Receivers: one row per vertex of the object's world mesh, in its layout; or, for an object
+  // with a lightmap (SceneObject::lightmap), one per valid texel of `lightmap` (its `valid` order).
   std::optional<VertexBake> values;
+  std::optional<LightmapReceivers> lightmap;
   std::optional<ErrorReport> report;
   IntegratorSpec integrator;           // what baked the values: the scene's, or the target's choice
   std::optional<IntegratorChoice> choice;  // with a target error
@@ -44,7 +47,7 @@ struct SceneBake {
   std::vector<float> irradiance_cube;
   double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0, area_seconds = 0;
   double report_seconds = 0;  // the error reports' reference integrals (with a target)
-  uint64_t vertices = 0;  // receiver vertices integrated
+  uint64_t vertices = 0, texels = 0;  // receiver rows integrated: vertices, and texels of lightmaps
 };
 
 // Runs the plan. Visibility for every receiver is the union of the occluders ("occluder" and
