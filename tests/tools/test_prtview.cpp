@@ -914,3 +914,43 @@ TEST(PrtviewTexel, PerTexelIsCloserToTheReferenceThanPerVertexOnTheFloorAndBox) 
   fs::remove(scratch("texel_error.png"));
   fs::remove(scratch("vertex_error.png"));
 }
+
+TEST(PrtviewTexel, AScenesObjectBakedPerTexelIsDrawnAsTheSameLightmapAlone) {
+  // The floor and box as the one object of a scene, per texel (bake/bake/scene.h "lightmap": 64²,
+  // generated UVs; albedo 1 so the scene's "times its albedo" changes nothing), and the same mesh
+  // through prtbake texel: the lightmaps are the same bytes (tests/tools/test_scene.cpp
+  // SceneTexels), so prtview's scene render — each per-texel object sampled through its own
+  // mesh/uv, shaded by shade_band1 — must give the per-texel file's pixels exactly.
+  const FloorBox& b = floor_box();
+  const std::string sunset = (kData / "sunset.exr").string();
+  const fs::path scene = scratch("floor_box.scene.json"), scene_h5 = scratch("floor_box.scene.prt.h5"),
+                 texel_h5 = scratch("floor_box.band1.prt.h5");
+  std::ofstream(scene) << "{\"prtbake_scene\": 1, \"up\": \"z\", \"environment\": \"" << sunset
+                       << "\", \"bake\": {\"products\": [\"ao\", \"radiance\"], \"integrator\": \"silhouette\", "
+                          "\"samples\": 1024, \"report\": 0}, \"objects\": [{\"name\": \"floor_box\", \"mesh\": \""
+                       << b.obj.string()
+                       << "\", \"role\": \"both\", \"material\": {\"albedo\": [1, 1, 1]}, "
+                          "\"lightmap\": {\"resolution\": 64, \"unwrap\": true}}]}";
+  const Outcome s = run(PRT_PRTBAKE, "scene " + scene.string() + " --quiet -o " + scene_h5.string());
+  ASSERT_EQ(s.code, 0) << s.err;
+  const Outcome t = run(PRT_PRTBAKE, "texel " + b.obj.string() + " --up z --resolution 64 --unwrap --ao --radiance " + sunset +
+                                         " --integrator silhouette --samples 1024 --report 0 --quiet -o " + texel_h5.string());
+  ASSERT_EQ(t.code, 0) << t.err;
+  const fs::path a = scratch("floor_box.scene.exr"), c = scratch("floor_box.band1.exr");
+  const Outcome vs = view(scene_h5.string() + " " + kFloorCamera + " --size 96x72 -o " + a.string());
+  ASSERT_EQ(vs.code, 0) << vs.err;
+  EXPECT_NE(vs.out.find("floor_box: band-1 radiance per texel, 64x64 lightmap"), std::string::npos) << vs.out;
+  EXPECT_NE(vs.out.find("per-texel objects: 0 of "), std::string::npos) << vs.out;
+  const Outcome vt = view(texel_h5.string() + " " + kFloorCamera + " --size 96x72 --shade band1 -o " + c.string());
+  ASSERT_EQ(vt.code, 0) << vt.err;
+  int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+  const std::vector<float> from_scene = read_exr_rgb(a, w1, h1), alone = read_exr_rgb(c, w2, h2);
+  ASSERT_EQ(w1, w2);
+  ASSERT_EQ(h1, h2);
+  size_t lit = 0;
+  for (size_t k = 0; k < alone.size(); ++k) {
+    lit += alone[k] > 0 ? 1 : 0;
+    ASSERT_EQ(from_scene[k], alone[k]) << "value " << k;
+  }
+  EXPECT_GT(lit, alone.size() / 4) << "the view shows the floor and the box";
+}

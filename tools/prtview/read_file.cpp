@@ -129,11 +129,15 @@ void require_texel_kind(const F::Asset& f, const std::string& file, const std::s
 }
 TexelProduct read_texel_product(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env) {
   require_texel_kind(f, file, kind);
-  const F::VertexSet& s = f.vertices;
+  return read_texel_product(f.vertices, "", file, kind, env);
+}
+
+TexelProduct read_texel_product(const F::VertexSet& s, const std::string& prefix, const std::string& file,
+                                const std::string& kind, const bake::EnvMap& env) {
   const F::Lightmap& m = *s.lightmap;
-  if (!s.uv) throw InputError(file, "no dataset " + std::string(N::kUv) + " (the lightmap's UVs)");
+  if (!s.uv) throw InputError(file, "no dataset " + cat(prefix, N::kUv) + " (the lightmap's UVs)");
   if (!s.triangles || s.uv->values.size() != 2 * s.triangles->values.size())
-    throw InputError(file, std::string(N::kUv) + " does not hold one (u, v) per corner of " + std::string(N::kTriangles));
+    throw InputError(file, cat(prefix, N::kUv) + " does not hold one (u, v) per corner of " + cat(prefix, N::kTriangles));
   TexelProduct p;
   p.width = int(m.width);
   p.height = int(m.height);
@@ -146,17 +150,17 @@ TexelProduct read_texel_product(const F::Asset& f, const std::string& file, cons
     product = &*m.ao, path = N::kLightmapAo, p.channels = 1;
   } else if (kind == "transfer") {
     product = &*m.transfer_diffuse, path = N::kLightmapTransferDiffuse;
-    if (!product->sh_order) throw InputError(file, std::string(path) + " lacks the attribute " + quoted(N::kShOrder));
+    if (!product->sh_order) throw InputError(file, cat(prefix, path) + " lacks the attribute " + quoted(N::kShOrder));
     p.order = int(*product->sh_order);
     p.channels = size_t(p.order) * size_t(p.order);
   } else {
     product = &*m.radiance_band1, path = N::kLightmapRadianceBand1, p.channels = 9, p.order = 2;
-    check_same_environment(*product, std::string(path), env, file);
+    check_same_environment(*product, cat(prefix, path), env, file);
   }
   p.values = &product->values;
   const size_t texels = m.texel_count();
   if (m.width == 0 || m.height == 0 || m.state.values.size() != texels || product->values.size() != texels * p.channels)
-    throw InputError(file, std::string(path) + " does not hold [H][W][" + std::to_string(p.channels) + "] values of the " +
+    throw InputError(file, cat(prefix, path) + " does not hold [H][W][" + std::to_string(p.channels) + "] values of the " +
                                std::to_string(m.height) + " x " + std::to_string(m.width) + " lightmap");
   return p;
 }
@@ -168,6 +172,8 @@ std::string baked_environment(const F::Asset& f, const std::string& file) {
   if (env_path.empty() && f.irradiance_cube) env_path = f.irradiance_cube->environment.value_or("");
   if (env_path.empty() && f.vertices.radiance_band1) env_path = f.vertices.radiance_band1->environment.value_or("");
   if (env_path.empty() && f.vertices.radiance_shadowed) env_path = f.vertices.radiance_shadowed->environment.value_or("");
+  if (const auto& m = f.vertices.lightmap; env_path.empty() && m && m->radiance_band1)  // a texel bake's
+    env_path = m->radiance_band1->environment.value_or("");
   if (env_path.empty()) throw InputError(file, "holds no environment name: give one with --env ENV.exr");
   env_path = found_beside(env_path, file);
   if (const std::string sf = f.scene ? f.scene->scene_file.value_or("") : std::string(); !sf.empty())
@@ -378,6 +384,12 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     if (has_band1_in(s)) o.band1 = read_band1(f, file, baked.name, *env);
     else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
     else if (s.ao) o.ao = &s.ao->values;
+    else if (s.lightmap) {
+      // Baked per texel (a scene's "lightmap"): the first of band-1 radiance, transfer, AO.
+      const F::Lightmap& m = *s.lightmap;
+      const char* kind = m.radiance_band1 ? "band1" : m.transfer_diffuse ? "transfer" : m.ao ? "ao" : nullptr;
+      if (kind) o.texels = read_texel_product(s, prefix, file, kind, *env), o.texel_kind = kind;
+    }
     if (baked.phong_exponent.value_or(0) > 0 && (s.transfer_visibility || s.radiance_shadowed)) {
       auto sh_product = [&](const F::Product& p, std::string_view name) {
         if (!p.sh_order) throw InputError(file, cat(prefix, name) + " lacks the attribute " + quoted(N::kShOrder));

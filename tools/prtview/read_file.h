@@ -61,6 +61,9 @@ struct TexelProduct {
   std::string uv_set;
 };
 TexelProduct read_texel_product(const formats::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env);
+// The same of any vertex set (a scene object's: `prefix` names it in messages, "" for the root).
+TexelProduct read_texel_product(const formats::VertexSet& s, const std::string& prefix, const std::string& file,
+                                const std::string& kind, const bake::EnvMap& env);
 bake::UpAxis up_axis(const formats::Asset& f);
 // The environment the file names (the 'environment' of the scene, of the irradiance cube or of
 // the root band-1 radiance), found as given, next to the file, or next to the scene file. Throws
@@ -126,6 +129,9 @@ struct SceneObject {
   std::optional<Band1> band1;
   std::optional<Transfer> transfer;
   const std::vector<float>* ao = nullptr;
+  // Baked per texel (no per-vertex product): its lightmap's first of band1, transfer, ao.
+  std::optional<TexelProduct> texels;
+  std::string texel_kind;
   std::optional<BakedOccluder> shells;   // read when the file also holds the environment FIV
   bool glossy_only = false;              // visibility transfer only
   // Glossy objects (a phong_exponent > 0 and /transfer/visibility or /radiance/shadowed): the

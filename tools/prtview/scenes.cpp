@@ -15,6 +15,7 @@
 #include <prtshade/shade.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -337,6 +338,7 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       fiv_occluders.push_back(objects[k].shells->view);
     }
   std::vector<std::vector<float>> rgb_of(objects.size());  // E/pi per vertex (white); empty: per pixel
+  std::map<int, std::vector<float>> transfer_light;         // the environment's SH per transfer order (lightmaps)
   std::vector<std::string> how_of(objects.size());
   for (size_t k = 0; k < objects.size(); ++k) {
     const SceneObject& o = objects[k];
@@ -353,6 +355,16 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       if (!difmap && !exact) exact.emplace(env);
       rgb_of[k] = ao_colours(*o.ao, o.mesh, difmap ? &*difmap : nullptr, exact ? &*exact : nullptr, how_of[k]);
       how_of[k] += glossy_note;
+    } else if (o.texels) {
+      // Per texel: shaded per pixel from the lightmap (below), as render_texel_file shades a mesh.
+      how_of[k] = std::string(o.texel_kind == "band1" ? "band-1 radiance" : o.texel_kind == "transfer" ? "diffuse transfer" : "AO") +
+                  " per texel, " + std::to_string(o.texels->width) + "x" + std::to_string(o.texels->height) +
+                  " lightmap, bilinear through its mesh/uv" + glossy_note;
+      if (o.texel_kind == "transfer" && !transfer_light.count(o.texels->order)) {
+        std::string ignored;
+        transfer_light[o.texels->order] = environment_sh(env, o.texels->order, ignored);
+      }
+      if (o.texel_kind == "ao" && !exact) exact.emplace(env);
     } else if (o.shells) {
       how_of[k] = "FIV self-shadows per pixel minus the other FIV occluders' shadows (shade_fiv_member)" + glossy_note;
     } else {
@@ -391,15 +403,42 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
   }
   scene.mesh = bake::merge_meshes(parts, file);
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
-  return view::shade_mixed(scene.mesh, g, rgb, per_pixel, [&](const view::Fragment& fr, float* out) {
+  std::atomic<size_t> texel_pixels{0}, empty_hits{0};
+  view::Image image = view::shade_mixed(scene.mesh, g, rgb, per_pixel, [&](const view::Fragment& fr, float* out) {
     const size_t k = size_t(std::upper_bound(scene.first_triangle.begin(), scene.first_triangle.end(), size_t(fr.triangle)) -
                             scene.first_triangle.begin()) - 1;
     const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
     const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
     float e[3];
+    if (const auto& t = objects[k].texels) {
+      // The lightmap, sampled as an engine samples it (view/lightmap.h), shaded by prtshade.
+      const float* uv = t->corner_uv->data() + 6 * (size_t(fr.triangle) - scene.first_triangle[k]);
+      double u = 0, v = 0;
+      for (size_t c = 0; c < 3; ++c) u += double(fr.bary[c]) * double(uv[2 * c]), v += double(fr.bary[c]) * double(uv[2 * c + 1]);
+      float sample[64];
+      if (view::sample_lightmap({t->width, t->height, t->channels, *t->values, *t->state}, u, v, sample)) ++empty_hits;
+      ++texel_pixels;
+      if (objects[k].texel_kind == "band1") {
+        shade::shade_band1_vertices(n, sample, 1, e);
+        for (float& x : e) x *= float(std::numbers::inv_pi);
+      } else if (objects[k].texel_kind == "transfer") {
+        shade::shade_transfer_vertices(sample, 1, t->order, transfer_light.at(t->order).data(), e);
+      } else {
+        const bake::Rgb un = (*exact)(fr.n);
+        const double irr[3] = {un.r, un.g, un.b};
+        for (int c = 0; c < 3; ++c) e[c] = float(double(sample[0]) * irr[c] * std::numbers::inv_pi);
+      }
+      for (size_t c = 0; c < 3; ++c) out[c] = e[c] * objects[k].albedo[c];
+      return;
+    }
     shade::shade_fiv_member(env_fiv, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
     for (size_t c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi) * objects[k].albedo[c];
   });
+  scene.texel_pixels = texel_pixels, scene.empty_texel_pixels = empty_hits;
+  if (texel_pixels > 0)
+    scene.how += "\n  per-texel objects: " + std::to_string(empty_hits.load()) + " of " + std::to_string(texel_pixels.load()) +
+                 " of their pixels reached an empty texel";
+  return image;
 }
 
 view::Image render_glossy_scene(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
