@@ -301,6 +301,28 @@ TEST(GltfScene, OptionsSetRolesAndMaterialsByNodePathTheLongestMatchWinning) {
   EXPECT_LT(after, 0.99f) << "the occluder half still shadows the ground";
 }
 
+// Lightmaps by node path (bake/bake/scene.h "lightmap"): bake.lightmap puts every receiver per
+// texel (generated UVs: the glTF has no TEXCOORD_1), an entry's false keeps "stack/node2" per
+// vertex, and the more specific "stack/box#p1" entry's size wins over "stack"'s.
+TEST(GltfScene, OptionsPutReceiversPerTexelByNodePath) {
+  const fs::path d = dir_for("lightmaps");
+  const F::Asset a = bake_with_options(d, R"({"prtbake_gltf_scene": 1,
+      "bake": {"products": ["ao"], "samples": 1024, "report": 0, "lightmap": {"density": 16}},
+      "objects": {"stack": {"lightmap": {"resolution": 32}}, "stack/box#p1": {"lightmap": {"resolution": 24}},
+                  "stack/node2": {"lightmap": false}}})");
+  ASSERT_EQ(a.objects.size(), 4u);
+  auto lightmap = [&](const std::string& name) -> const std::optional<F::Lightmap>& { return a.find_object(name)->set.lightmap; };
+  ASSERT_TRUE(lightmap("ground") && lightmap("stack|box") && lightmap("stack|box#p1"));
+  EXPECT_EQ(lightmap("stack|box")->width, 32u);
+  EXPECT_EQ(lightmap("stack|box#p1")->width, 24u) << "the longest key wins";
+  EXPECT_FALSE(lightmap("stack|node2")) << "\"lightmap\": false: per vertex";
+  EXPECT_FALSE(ao_of(a, "stack|node2").empty());
+  EXPECT_TRUE(ao_of(a, "ground").empty()) << "per texel instead of per vertex";
+  ASSERT_TRUE(lightmap("ground")->ao);
+  for (float x : lightmap("ground")->ao->values) EXPECT_TRUE(std::isfinite(x) && x >= 0 && x <= 1) << x;
+  EXPECT_EQ(a.find_object("ground")->set.uv->uv_set, "prtbake_lightmap");
+}
+
 // FIV shells are for occluders that move (bake/bake/scene.h): a static glTF gets none; an animation
 // channel on "stack" moves its whole subtree (the box's two primitives and the quad), the options'
 // "moves" overrides per node path (the longest key wins), and "weights" (morph targets) is no move.
