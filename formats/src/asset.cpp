@@ -227,7 +227,9 @@ constexpr ProductSlot<Lightmap> kTexelProducts[] = {
     {N::kLightmapTransferDiffuse, DatasetKind::lightmap_transfer_diffuse, &Lightmap::transfer_diffuse, sh_axes},
     {N::kLightmapTransferVisibility, DatasetKind::lightmap_transfer_visibility, &Lightmap::transfer_visibility, sh_axes},
     {N::kLightmapRadianceBand1, DatasetKind::lightmap_radiance_band1, &Lightmap::radiance_band1, rgb_m_axes},
-    {N::kLightmapRadianceShadowed, DatasetKind::lightmap_radiance_shadowed, &Lightmap::radiance_shadowed, rgb_sh_axes}};
+    {N::kLightmapRadianceShadowed, DatasetKind::lightmap_radiance_shadowed, &Lightmap::radiance_shadowed, rgb_sh_axes},
+    {N::kLightmapAreaIrradiance, DatasetKind::lightmap_area_irradiance, &Lightmap::area_irradiance, light_axes},
+    {N::kLightmapAreaSh, DatasetKind::lightmap_area_sh, &Lightmap::area_sh, light_sh_axes}};
 
 // Writes the products `s` holds under `prefix`, each along `rows` and then its own axes.
 template <class S>

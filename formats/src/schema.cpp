@@ -174,7 +174,8 @@ public:
         {N::kLightmapAo, Kind::lightmap_ao},        {N::kLightmapTransferDiffuse, Kind::lightmap_transfer_diffuse},
         {N::kLightmapTransferVisibility, Kind::lightmap_transfer_visibility},
         {N::kLightmapRadianceBand1, Kind::lightmap_radiance_band1},
-        {N::kLightmapRadianceShadowed, Kind::lightmap_radiance_shadowed}};
+        {N::kLightmapRadianceShadowed, Kind::lightmap_radiance_shadowed},
+        {N::kLightmapAreaIrradiance, Kind::lightmap_area_irradiance}, {N::kLightmapAreaSh, Kind::lightmap_area_sh}};
     for (const auto& [name, kind] : kVertexSet)
       if (local == name) return kind;
     if (object) return Kind::unknown;
@@ -302,7 +303,7 @@ public:
 
 bool is_area_light_kind(Kind k) {
   return k == Kind::area_irradiance || k == Kind::area_sh || k == Kind::light_vertices || k == Kind::light_face_sizes ||
-         k == Kind::light_face_indices;
+         k == Kind::light_face_indices || k == Kind::lightmap_area_irradiance || k == Kind::lightmap_area_sh;
 }
 
 } // namespace
@@ -333,6 +334,7 @@ bool is_lightmap_kind(DatasetKind kind) {
   case Kind::uv: case Kind::lightmap_state: case Kind::lightmap_positions: case Kind::lightmap_normals:
   case Kind::lightmap_ao: case Kind::lightmap_transfer_diffuse: case Kind::lightmap_transfer_visibility:
   case Kind::lightmap_radiance_band1: case Kind::lightmap_radiance_shadowed:
+  case Kind::lightmap_area_irradiance: case Kind::lightmap_area_sh:
     return true;
   default:
     return false;
@@ -536,17 +538,21 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       break;
     }
     case Kind::area_irradiance:
-    case Kind::area_sh: {
+    case Kind::area_sh:
+    case Kind::lightmap_area_irradiance:
+    case Kind::lightmap_area_sh: {
       c.dtype(d, 0);
       const auto L = uint64_t(c.light_list(d, light_names).size());
-      if (k == Kind::area_irradiance) {
-        c.shape(d, {V, L}, "[V, L] with L = the lights named in '" + std::string(N::kLightOrder) + "'");
+      if (k == Kind::area_irradiance || k == Kind::lightmap_area_irradiance) {
+        c.shape(d, rows_and({L}), "[" + rows_rule + ", L] with L = the lights named in '" + std::string(N::kLightOrder) + "'");
         break;
       }
       const uint64_t n = c.sh_order(d);
-      c.shape(d, {V, L, n * n}, "[V, L, n*n] with L = the lights named in '" + std::string(N::kLightOrder) +
-                                    "' and n = " + std::string(N::kShOrder) + " = " + std::to_string(n));
-      const std::string irradiance = prefix + std::string(N::kAreaIrradiance);
+      c.shape(d, rows_and({L, n * n}), "[" + rows_rule + ", L, n*n] with L = the lights named in '" +
+                                           std::string(N::kLightOrder) + "' and n = " + std::string(N::kShOrder) + " = " +
+                                           std::to_string(n));
+      const std::string irradiance =
+          prefix + std::string(k == Kind::area_sh ? N::kAreaIrradiance : N::kLightmapAreaIrradiance);
       const Dataset* e = find_dataset(file, irradiance);
       const Attr* mine = find_attr(d.attrs, N::kLightOrder);
       const Attr* its = e ? find_attr(e->attrs, N::kLightOrder) : nullptr;

@@ -271,3 +271,43 @@ TEST(AssetLightmap, OnlyAFileWithAVersion5DatasetIsWrittenAsVersion5) {
   EXPECT_EQ(read_asset(dir / "uv.prt.h5"), a);
   EXPECT_EQ(written_format_version(to_file(asset(true))), 5);
 }
+
+// Area lights per texel (lightmap/area_lights/..., a scene object baked per texel): [H, W, L] and
+// [H, W, L, n*n], naming the file's lights; they survive a round trip, and an sh without the
+// irradiance beside it, or naming other lights, is refused.
+TEST(AssetLightmap, AreaLightsPerTexelSurviveAndFollowTheAreaRules) {
+  const fs::path dir = prt::testing::fresh_dir("asset_lightmap", "area");
+  Asset a = asset(true);
+  for (const char* name : {"key", "fill"}) {
+    Light& l = a.lights.emplace_back();
+    l.name = name;
+    l.shape = "quad";
+    l.radiance = {1, 1, 1};
+    l.two_sided = 0;
+    l.vertices.values = {-1, 4, -1, 1, 4, -1, 1, 4, 1, -1, 4, 1};
+    l.face_sizes.values = {4};
+    l.face_indices.values = {0, 1, 2, 3};
+  }
+  Lightmap& m = *a.objects[0].set.lightmap;
+  m.area_irradiance = product(2, std::nullopt, 5);
+  m.area_irradiance->lights = "key\nfill";
+  m.area_sh = product(2 * 4, 2, 6);
+  m.area_sh->lights = "key\nfill";
+  const fs::path path = dir / "area.prt.h5";
+  write_asset(path, a);
+  const Asset b = read_asset(path);
+  EXPECT_EQ(b.objects.at(0).set.lightmap, a.objects[0].set.lightmap);
+  EXPECT_EQ(b.lights.size(), a.lights.size());
+  EXPECT_EQ(b.objects, a.objects);
+  EXPECT_EQ(b.root, a.root);
+  const File f = to_file(a);
+  EXPECT_EQ(dataset(const_cast<File&>(f), "/objects/floor/lightmap/area_lights/irradiance").shape,
+            (std::vector<uint64_t>{kH, kW, 2}));
+  EXPECT_EQ(dataset(const_cast<File&>(f), "/objects/floor/lightmap/area_lights/sh").shape,
+            (std::vector<uint64_t>{kH, kW, 2, 4}));
+  // The sh names other lights than the irradiance beside it: refused.
+  Asset other = a;
+  other.objects[0].set.lightmap->area_sh->lights = "fill\nkey";
+  EXPECT_THROW(write_asset(dir / "other.prt.h5", other), std::exception);
+  EXPECT_FALSE(fs::exists(dir / "other.prt.h5"));
+}

@@ -1,10 +1,12 @@
 // bakefile.cpp — see bakefile.h.
 #include "bakefile.h"
 
+#include <bake/core/error.h>
 #include <formats/names.h>
 
 #include <cctype>
 #include <cmath>
+#include <span>
 #include <string>
 
 namespace prt::tool {
@@ -188,8 +190,10 @@ F::Light light_of(const bake::AreaLight& light) {
   return l;
 }
 
-void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
-                     int sh_order) {
+namespace {
+// area_lights/irradiance and, when sh_order > 0, area_lights/sh from rows [..][lights][1 + n²].
+void area_products(std::optional<F::Product>& irradiance, std::optional<F::Product>& sh, std::span<const double> rows,
+                   const std::vector<bake::AreaLight>& lights, int sh_order) {
   const size_t n2 = size_t(sh_order) * size_t(sh_order), per_light = 1 + n2;
   std::vector<std::string> names;
   for (const bake::AreaLight& l : lights) names.push_back(l.name);
@@ -204,12 +208,25 @@ void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const s
     p.lights = F::join_light_list(names);
     return p;
   };
-  set.area_irradiance = product(0, 1, "E_l = Int_{visible part of light l} max(n.w, 0) dw at unit radiance; diffuse "
-                                      "outgoing radiance = albedo/pi sum_l radiance_l E_l");
+  irradiance = product(0, 1, "E_l = Int_{visible part of light l} max(n.w, 0) dw at unit radiance; diffuse "
+                             "outgoing radiance = albedo/pi sum_l radiance_l E_l");
   if (sh_order > 0) {
-    set.area_sh = product(1, n2, "S_l,i = Int_{visible part of light l above the horizon} y_i(w) dw at unit radiance");
-    set.area_sh->sh_order = sh_order;
+    sh = product(1, n2, "S_l,i = Int_{visible part of light l above the horizon} y_i(w) dw at unit radiance");
+    sh->sh_order = sh_order;
   }
+}
+} // namespace
+
+void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
+                     int sh_order) {
+  area_products(set.area_irradiance, set.area_sh, rows, lights, sh_order);
+}
+
+void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<bake::AreaLight>& lights,
+                              int sh_order) {
+  PRT_CHECK(set.lightmap.has_value());
+  PRT_CHECK_OP(image.width, ==, set.lightmap->width);
+  area_products(set.lightmap->area_irradiance, set.lightmap->area_sh, image.values, lights, sh_order);
 }
 
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible) {

@@ -45,6 +45,11 @@ void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& 
                   const bake::Lightmap& image, const bake::ProductLayout& layout, const ProductInfo& info,
                   uint32_t padding);
 
+// area_lights/irradiance and /sh per texel (lightmap/area_lights/...) from the lightmap image of
+// the area lights' rows (channels [lights][1 + n²]), into a set whose lightmap set_lightmap wrote.
+void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<bake::AreaLight>& lights,
+                              int sh_order);
+
 // The lightmap image of the valid texels' rows of `texels` (LightmapReceivers::image: placed,
 // filled, padded `spec.padding` rings), its UV seams stitched unless `spec.stitch` is false
 // (bake/bake/lightmap.h stitch_seams; `stitch` receives its numbers, edges 0 when not stitched).

@@ -158,17 +158,26 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   namespace F = prt::formats;
   // The lightmaps of the receivers baked per texel, made (and their seams stitched) once per bake
   // of their rows.
-  std::vector<std::optional<bake::Lightmap>> images(scene.objects.size());
+  std::vector<std::optional<bake::Lightmap>> images(scene.objects.size()), area_images(scene.objects.size());
   constexpr size_t kLightmapLines = 5;  // receivers per texel whose atlas and seams are printed without -v
   auto make_images = [&](const bake::SceneBake& result) {
     size_t lightmaps = 0;
-    for (const bake::ObjectBake& ob : result.objects) lightmaps += ob.lightmap && ob.values ? 1 : 0;
+    for (const bake::ObjectBake& ob : result.objects) lightmaps += ob.lightmap && (ob.values || ob.area) ? 1 : 0;
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const bake::ObjectBake& ob = result.objects[i];
-      if (!ob.lightmap || !ob.values) continue;
+      if (!ob.lightmap || !(ob.values || ob.area)) continue;
       bake::SeamStitch seams;
-      images[i] = lightmap_image(meshes[i], bake::build_topology(meshes[i]), *ob.lightmap, *scene.objects[i].lightmap,
-                                 *ob.values, seams);
+      const bake::Topology topology = bake::build_topology(meshes[i]);
+      if (ob.values)
+        images[i] = lightmap_image(meshes[i], topology, *ob.lightmap, *scene.objects[i].lightmap, *ob.values, seams);
+      if (ob.area) {
+        // The area lights' rows per valid texel, filled, padded and stitched as the products are.
+        bake::VertexBake area;
+        area.layout.width = scene.lights.size() * (1 + size_t(plan.objects[i].area_sh_order * plan.objects[i].area_sh_order));
+        area.values = *ob.area;
+        bake::SeamStitch area_seams;
+        area_images[i] = lightmap_image(meshes[i], topology, *ob.lightmap, *scene.objects[i].lightmap, area, area_seams);
+      }
       if (!run.say || !(lightmaps <= kLightmapLines || a.verbose)) continue;
       const std::string who = scene_object_label(scene.objects[i]);
       const bake::TexelAtlas& atlas = ob.lightmap->atlas;
@@ -234,11 +243,13 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
       const ProductInfo products{std::string(bake::to_string(ob.integrator.kind)), ob.integrator_description,
                                  ob.integrator.samples(), ob.integrator.seed, p.transfer_order, p.visibility_order,
                                  env ? &*env : nullptr, env_path};
-      if (ob.values && ob.lightmap) {
-        // Per texel: the lightmap (made when the rows were baked), its report's rows named by texel.
-        tool::set_lightmap(obj.set, meshes[i], ob.lightmap->uv, ob.lightmap->atlas, *images[i], ob.values->layout, products,
+      if (ob.lightmap && (images[i] || area_images[i])) {
+        // Per texel: the lightmap (made when the rows were baked), its report's rows named by texel;
+        // with area lights alone, the texels and no other product.
+        tool::set_lightmap(obj.set, meshes[i], ob.lightmap->uv, ob.lightmap->atlas, images[i] ? *images[i] : *area_images[i],
+                           images[i] ? ob.values->layout : bake::ProductLayout(bake::ProductRequest{}), products,
                            o.lightmap->padding);
-        if (ob.report) {
+        if (ob.report && ob.values) {
           bake::ErrorReport by_texel = *ob.report;
           for (uint32_t& r : by_texel.vertices) r = ob.lightmap->atlas.samples[ob.lightmap->valid[r]].texel;
           obj.set.report = tool::report_of(by_texel, ob.values->seconds, ob.lightmap->valid.size(), a.reproducible);
@@ -248,7 +259,10 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         if (ob.report)
           obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
       }
-      if (ob.area) tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
+      if (ob.area && ob.lightmap && area_images[i])
+        tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);
+      else if (ob.area)
+        tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
       if (ob.shells) {
         F::Occluder& occluder =
             asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));

@@ -2,6 +2,7 @@
 
 #include "read_file.h"
 
+#include <view/lightmap.h>
 #include <view/raster.h>
 
 #include <bake/core/error.h>
@@ -9,9 +10,11 @@
 #include <formats/prtfile.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace prt::prtview {
 
@@ -60,20 +63,41 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   std::vector<float> rgb;
   std::vector<uint8_t> per_pixel;
   size_t baked = 0;
-  for (const SceneObject& o : objects) {
+  // Objects baked per texel: E per light in their lightmap, sampled per pixel through their UVs.
+  struct TexelE {
+    size_t object = 0;  // index in `objects`
+    const F::VertexSet* set = nullptr;
+    std::vector<const bake::AreaLight*> column;
+  };
+  std::vector<TexelE> texel_objects;
+  // Column l of E is the light named on line l of its `lights` attribute.
+  auto columns = [&](const SceneObject& o, const F::Product& e, std::string_view path) {
+    std::vector<const bake::AreaLight*> column;
+    for (const std::string& n : F::split_light_list(e.lights.value_or(""))) {
+      const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
+      if (it == lights.end())
+        throw InputError(file, "object '" + o.name + "': " + std::string(path).substr(1) + " names light '" + n + "', which " +
+                                   std::string(N::kLights) + " does not hold");
+      column.push_back(&*it);
+    }
+    return column;
+  };
+  for (size_t k = 0; k < objects.size(); ++k) {
+    const SceneObject& o = objects[k];
     const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
     const F::SceneObject* fo = f.find_object(o.name);
     const F::Product* e = fo && fo->set.area_irradiance ? &*fo->set.area_irradiance : nullptr;
+    if (!e && fo && fo->set.lightmap && fo->set.lightmap->area_irradiance && fo->set.uv && !exact) {
+      texel_objects.push_back({k, &fo->set, columns(o, *fo->set.lightmap->area_irradiance, N::kLightmapAreaIrradiance)});
+      rgb.insert(rgb.end(), 3 * V, 0.0f);
+      per_pixel.insert(per_pixel.end(), T, 2);
+      ++baked;
+      add_object(scene, o);
+      parts.push_back(o.mesh);
+      continue;
+    }
     if (e) {
-      // Column l of E is the light named on line l of its `lights` attribute.
-      const std::vector<std::string> names = F::split_light_list(e->lights.value_or(""));
-      std::vector<const bake::AreaLight*> column;
-      for (const std::string& n : names) {
-        const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
-        if (it == lights.end()) throw InputError(file, "object '" + o.name + "': " + std::string(N::kAreaIrradiance).substr(1) + " names light '" + n +
-                                                    "', which " + std::string(N::kLights) + " does not hold");
-        column.push_back(&*it);
-      }
+      const std::vector<const bake::AreaLight*> column = columns(o, *e, N::kAreaIrradiance);
       const size_t L = column.size();
       for (size_t v = 0; v < V; ++v) {
         float value[3];
@@ -101,8 +125,8 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   scene.mesh = bake::merge_meshes(parts, "scene");
   scene.what = "scene: " + std::to_string(objects.size()) + " objects, " + std::to_string(lights.size()) + " area light(s), their direct light only";
   scene.how = exact ? "per pixel: exact soft shadows of the stored lights (render_area_analytic), times the albedo / pi"
-                    : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated (" + std::to_string(baked) +
-                          " objects); objects without it per pixel, exactly";
+                    : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated, or per texel through "
+                      "the object's lightmap (" + std::to_string(baked) + " objects); objects without it per pixel, exactly";
   options.casts_shadow = scene.casts_shadow;
   options.triangle_albedo = scene.albedo;
   if (options.ggx) {
@@ -119,8 +143,35 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   if (exact) return analytic;
   view::Image img = view::interpolate_vertices(scene.mesh, g, rgb);
   for (size_t i = 0; i < g.triangle.size(); ++i)
-    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])])
+    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1)
       std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+  // Per texel: E per light sampled bilinearly through the object's mesh/uv (view/lightmap.h),
+  // times each light's radiance and the albedo / pi.
+  for (const TexelE& t : texel_objects) {
+    const F::Lightmap& m = *t.set->lightmap;
+    const size_t L = t.column.size();
+    std::vector<float> values(m.area_irradiance->values.begin(), m.area_irradiance->values.end());
+    const view::LightmapImage map{int(m.width), int(m.height), L, values, m.state.values};
+    const size_t first = scene.first_triangle[t.object], end = scene.first_triangle[t.object + 1];
+    const std::array<float, 3>& albedo = objects[t.object].albedo;
+    for (int y = 0; y < g.height; ++y)
+      for (int x = 0; x < g.width; ++x) {
+        const int32_t tri = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
+        if (tri < 0 || size_t(tri) < first || size_t(tri) >= end) continue;
+        const view::Fragment fr = view::make_fragment(scene.mesh, g, x, y);
+        const float* uv = t.set->uv->values.data() + 6 * (size_t(tri) - first);
+        double u = 0, v = 0;
+        for (size_t c = 0; c < 3; ++c) u += double(fr.bary[c]) * double(uv[2 * c]), v += double(fr.bary[c]) * double(uv[2 * c + 1]);
+        std::vector<float> sample(L);
+        view::sample_lightmap(map, u, v, sample.data());
+        float* out = img.at(x, y);
+        for (size_t c = 0; c < 3; ++c) {
+          double sum = 0;
+          for (size_t l = 0; l < L; ++l) sum += t.column[l]->radiance[c] * double(sample[l]);
+          out[c] = float(double(albedo[c]) * sum * std::numbers::inv_pi);
+        }
+      }
+  }
   return img;
 }
 

@@ -126,6 +126,7 @@ struct Lightmap {
   std::optional<Array<double>> positions;  // float32 on disk when exact, else float64 (as /mesh/positions)
   std::optional<Array<float>> normals;
   std::optional<Product> ao, transfer_diffuse, transfer_visibility, radiance_band1, radiance_shadowed;
+  std::optional<Product> area_irradiance, area_sh;  // the area lights, as a vertex set's, per texel
   std::size_t texel_count() const noexcept { return std::size_t(width * height); }
   bool operator==(const Lightmap&) const = default;
 };

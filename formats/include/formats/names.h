@@ -46,6 +46,8 @@ inline constexpr std::string_view kLightmapTransferDiffuse = "/lightmap/transfer
 inline constexpr std::string_view kLightmapTransferVisibility = "/lightmap/transfer/visibility";  // [H][W][L*L]
 inline constexpr std::string_view kLightmapRadianceBand1 = "/lightmap/radiance/band1";            // [H][W][3][3]
 inline constexpr std::string_view kLightmapRadianceShadowed = "/lightmap/radiance/shadowed";      // [H][W][3][L*L]
+inline constexpr std::string_view kLightmapAreaIrradiance = "/lightmap/area_lights/irradiance";   // [H][W][L]
+inline constexpr std::string_view kLightmapAreaSh = "/lightmap/area_lights/sh";                   // [H][W][L][n*n]
 // ---- FIV datasets ----
 inline constexpr std::string_view kFivEnvironment = "/fiv/environment";
 inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";

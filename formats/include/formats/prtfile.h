@@ -192,6 +192,7 @@ enum class DatasetKind {
   light_vertices, light_face_sizes, light_face_indices,
   uv, lightmap_state, lightmap_positions, lightmap_normals, lightmap_ao, lightmap_transfer_diffuse,  // v5
   lightmap_transfer_visibility, lightmap_radiance_band1, lightmap_radiance_shadowed,                // v5
+  lightmap_area_irradiance, lightmap_area_sh,                                                       // v5
   report, unknown
 };
 DatasetKind dataset_kind(std::string_view path);

@@ -267,14 +267,15 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i) {
     const ObjectPlan& p = plan.objects[i];
     if (!p.receiver || !p.area_irradiance) continue;
-    const ReceiverSet set = receivers_of(i);
     ObjectBake& ob = out.objects[i];
+    // Per texel for an object with a lightmap (its valid texels' rows, as its other products').
+    const ReceiverSet set = !p.texels ? receivers_of(i) : ob.lightmap ? ob.lightmap->receivers() : texels_of(i);
     const auto t0 = std::chrono::steady_clock::now();
     ob.area = bake_area_lights(set.points, *area_integrators.at(p.area_sh_order), monitor, "area lights on " + set.name);
     ob.area_seconds = seconds_since(t0);
     out.area_seconds += ob.area_seconds;
     log(set.name + ": " + std::to_string(scene.lights.size()) + " area light(s) at " + std::to_string(set.points.size()) +
-        " vertices in " + printf_string("%.2f s", ob.area_seconds) +
+        " " + set.rows_noun + " in " + printf_string("%.2f s", ob.area_seconds) +
         (p.area_sh_order > 0 ? ", SH order " + std::to_string(p.area_sh_order) : std::string()));
   }
   area_integrators.clear();

@@ -56,8 +56,7 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
         p.baked.push_back(std::string("lightmap: the products below per texel instead of per vertex, ") +
                           (l.width ? std::to_string(l.width) + "x" + std::to_string(l.height) + " texels"
                                    : "at " + density_text(l.density) + " texels per unit") +
-                          (l.unwrap ? " in generated UVs" : l.uv_set.empty() ? "" : " in UV set " + l.uv_set) +
-                          (scene.lights.empty() ? "" : "; the area lights per vertex (not per texel yet)"));
+                          (l.unwrap ? " in generated UVs" : l.uv_set.empty() ? "" : " in UV set " + l.uv_set));
       }
       if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
       else p.left_out.push_back("ao: not in bake.products");

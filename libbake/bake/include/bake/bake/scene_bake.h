@@ -36,7 +36,8 @@ struct ObjectBake {
   std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
   // Receivers with area lights: [V][lights][1 + n²] per vertex and light, E then the SH at
-  // order n = area_sh_order (AreaLightIntegrator's rows).
+  // order n = area_sh_order (AreaLightIntegrator's rows); per valid texel of `lightmap` for an
+  // object baked per texel.
   std::optional<std::vector<double>> area;
   double area_seconds = 0;
 };
