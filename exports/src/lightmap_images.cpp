@@ -35,6 +35,11 @@ std::vector<ProductRef> lightmap_products(const Lightmap& m) {
   add(names::kLightmapTransferVisibility, m.transfer_visibility, {width(m.transfer_visibility)});
   add(names::kLightmapRadianceBand1, m.radiance_band1, {3, 3});
   add(names::kLightmapRadianceShadowed, m.radiance_shadowed, {3, width(m.radiance_shadowed) / 3});
+  add(names::kLightmapAreaIrradiance, m.area_irradiance, {width(m.area_irradiance)});
+  if (m.area_sh) {
+    const uint64_t n2 = uint64_t(m.area_sh->sh_order.value_or(0) * m.area_sh->sh_order.value_or(0));
+    add(names::kLightmapAreaSh, m.area_sh, {n2 > 0 ? width(m.area_sh) / n2 : 0, n2});
+  }
   return out;
 }
 
@@ -68,6 +73,20 @@ std::vector<LightmapChannel> lightmap_channels(const Lightmap& m) {
   const uint64_t shadowed = width(m.radiance_shadowed);
   add(names::kLightmapRadianceShadowed, m.radiance_shadowed, shadowed, [&](uint64_t c) {
     return std::string("radiance.shadowed.") + kRgb[c / (shadowed / 3)] + ".c" + std::to_string(c % (shadowed / 3));
+  });
+  // The area lights per texel, a channel per light (and per light and SH coefficient), named by
+  // the light (its `lights` attribute, line l = column l).
+  auto light_names = [](const std::optional<Product>& p) {
+    return p ? formats::split_light_list(p->lights.value_or("")) : std::vector<std::string>{};
+  };
+  const std::vector<std::string> lit = light_names(m.area_irradiance);
+  add(names::kLightmapAreaIrradiance, m.area_irradiance, lit.empty() ? 0 : width(m.area_irradiance), [&](uint64_t c) {
+    return "area.irradiance." + (c < lit.size() ? lit[c] : std::to_string(c));
+  });
+  const std::vector<std::string> lit_sh = light_names(m.area_sh);
+  const uint64_t area_sh = width(m.area_sh), per_light = lit_sh.empty() ? 0 : area_sh / lit_sh.size();
+  add(names::kLightmapAreaSh, m.area_sh, per_light == 0 ? 0 : area_sh, [&](uint64_t c) {
+    return "area.sh." + lit_sh[c / per_light] + ".c" + std::to_string(c % per_light);
   });
   return out;
 }

@@ -681,3 +681,50 @@ TEST(Export, FormatNamesRoundTrip) {
 }
 
 } // namespace
+
+// Area lights per texel (lightmap/area_lights/..., a scene object baked per texel) go to the EXR
+// lightmap as one half channel per light, named by the light, and per light and SH coefficient:
+// each within half's rounding (2^-11 relative) of the file's value.
+TEST(ExportLightmap, AreaLightsPerTexelAreExrChannelsNamedByTheirLights) {
+  Asset a = lightmap_asset();
+  for (const char* name : {"key", "fill"}) {
+    Light& l = a.lights.emplace_back();
+    l.name = name;
+    l.shape = "quad";
+    l.radiance = {1, 1, 1};
+    l.two_sided = 0;
+    l.vertices.values = {-1, 4, -1, 1, 4, -1, 1, 4, 1, -1, 4, 1};
+    l.face_sizes.values = {4};
+    l.face_indices.values = {0, 1, 2, 3};
+  }
+  Lightmap& m = *a.objects[0].set.lightmap;
+  const size_t texels = m.texel_count();
+  m.area_irradiance = product(values(texels * 2, 1.6));
+  m.area_irradiance->lights = "key\nfill";
+  m.area_sh = product(values(texels * 2 * 4, 1.7), 2);
+  m.area_sh->lights = "key\nfill";
+  const fs::path dir = fresh_dir("lightmap_exr_area");
+  export_asset(a, "in.prt.h5", ExportFormat::Exr, dir / "scene.exr");
+  Imf::InputFile file((dir / "scene.a.exr").c_str());
+  const Imath::Box2i w = file.header().dataWindow();
+  ASSERT_EQ(size_t(w.max.x - w.min.x + 1) * size_t(w.max.y - w.min.y + 1), texels);
+  // (light, coefficient or -1 for E) → the channel and its column in the file's row.
+  const std::vector<std::tuple<std::string, const Product*, size_t, size_t>> want = {
+      {"area.irradiance.key", &*m.area_irradiance, 2, 0}, {"area.irradiance.fill", &*m.area_irradiance, 2, 1},
+      {"area.sh.key.c0", &*m.area_sh, 8, 0},              {"area.sh.fill.c3", &*m.area_sh, 8, 7}};
+  std::vector<std::vector<float>> got(want.size(), std::vector<float>(texels));
+  Imf::FrameBuffer frame;
+  for (size_t i = 0; i < want.size(); ++i) {
+    ASSERT_NE(file.header().channels().findChannel(std::get<0>(want[i]).c_str()), nullptr) << std::get<0>(want[i]);
+    frame.insert(std::get<0>(want[i]), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(got[i].data()), sizeof(float), sizeof(float) * m.width));
+  }
+  file.setFrameBuffer(frame);
+  file.readPixels(w.min.y, w.max.y);
+  for (size_t i = 0; i < want.size(); ++i) {
+    const auto& [name, product, width, column] = want[i];
+    for (size_t k = 0; k < texels; ++k) {
+      const double x = product->values[k * width + column];
+      EXPECT_NEAR(got[i][k], x, std::abs(x) * std::ldexp(1.0, -11) + std::ldexp(1.0, -25)) << name << " texel " << k;
+    }
+  }
+}
