@@ -22,6 +22,7 @@
 
 #include <engine_sh.h>
 #include <gtest/gtest.h>
+#include <quad_light.h>
 #include <run_tool.h>
 #include <scratch.h>
 
@@ -687,16 +688,7 @@ TEST(Export, FormatNamesRoundTrip) {
 // each within half's rounding (2^-11 relative) of the file's value.
 TEST(ExportLightmap, AreaLightsPerTexelAreExrChannelsNamedByTheirLights) {
   Asset a = lightmap_asset();
-  for (const char* name : {"key", "fill"}) {
-    Light& l = a.lights.emplace_back();
-    l.name = name;
-    l.shape = "quad";
-    l.radiance = {1, 1, 1};
-    l.two_sided = 0;
-    l.vertices.values = {-1, 4, -1, 1, 4, -1, 1, 4, 1, -1, 4, 1};
-    l.face_sizes.values = {4};
-    l.face_indices.values = {0, 1, 2, 3};
-  }
+  for (const char* name : {"key", "fill"}) a.lights.push_back(prt::testing::quad_light(name));
   Lightmap& m = *a.objects[0].set.lightmap;
   const size_t texels = m.texel_count();
   m.area_irradiance = product(values(texels * 2, 1.6));

@@ -8,6 +8,7 @@
 #include <formats/testing.h>
 
 #include <gtest/gtest.h>
+#include <quad_light.h>
 #include <run_tool.h>
 #include <schema_refusal.h>
 #include <scratch.h>
@@ -278,16 +279,7 @@ TEST(AssetLightmap, OnlyAFileWithAVersion5DatasetIsWrittenAsVersion5) {
 TEST(AssetLightmap, AreaLightsPerTexelSurviveAndFollowTheAreaRules) {
   const fs::path dir = prt::testing::fresh_dir("asset_lightmap", "area");
   Asset a = asset(true);
-  for (const char* name : {"key", "fill"}) {
-    Light& l = a.lights.emplace_back();
-    l.name = name;
-    l.shape = "quad";
-    l.radiance = {1, 1, 1};
-    l.two_sided = 0;
-    l.vertices.values = {-1, 4, -1, 1, 4, -1, 1, 4, 1, -1, 4, 1};
-    l.face_sizes.values = {4};
-    l.face_indices.values = {0, 1, 2, 3};
-  }
+  for (const char* name : {"key", "fill"}) a.lights.push_back(prt::testing::quad_light(name));
   Lightmap& m = *a.objects[0].set.lightmap;
   m.area_irradiance = product(2, std::nullopt, 5);
   m.area_irradiance->lights = "key\nfill";
