@@ -239,12 +239,14 @@ void print_error_verdict(const bake::BakeJob& job, double target) {
 void print_generated_uvs(const std::string& who, const char* why, const std::string& set, const bake::UnwrapReport& r) {
   std::fprintf(stderr,
                "prtbake: %s: %s: generated lightmap UVs %s: %zu charts%s, utilisation %.2f, worst stretch %.2f "
-               "(mean %.2f), %ux%u texels at %.4g texels per unit, %.1f s\n",
+               "(mean %.2f), %ux%u texels at %.4g texels per unit%s, %.1f s\n",
                who.c_str(), why, set.c_str(), r.charts,
                r.degenerate_triangles == 0
                    ? ""
                    : (" (and " + std::to_string(r.degenerate_triangles) + " zero-area triangles at UV (0, 0))").c_str(),
-               r.utilisation, r.worst_stretch, r.mean_stretch, r.width, r.height, r.density, r.seconds);
+               r.utilisation, r.worst_stretch, r.mean_stretch, r.width, r.height, r.density,
+               r.scaled_charts == 0 ? "" : (" (" + std::to_string(r.scaled_charts) + " thin charts denser, up to 4x)").c_str(),
+               r.seconds);
 }
 
 void print_stitch(const bake::SeamStitch& seams, const std::string& who) {

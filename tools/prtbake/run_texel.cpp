@@ -34,6 +34,7 @@ bake::LightmapSpec lightmap_spec(const Args& a) {
   s.uv_set = a.uv_set;
   s.unwrap = a.unwrap;
   s.gutter = a.gutter, s.padding = a.padding;
+  s.min_chart_texels = a.min_chart_texels;
   s.stitch = !a.no_stitch;
   return s;
 }

@@ -84,6 +84,7 @@ LightmapReceivers lightmap_receivers(const Mesh& mesh, const Topology& topology,
     o.height = width ? height : 0;
     o.density = width == 0 ? spec.density : 0;
     o.gutter = spec.gutter;
+    o.min_chart_texels = spec.min_chart_texels;
     o.max_side = kMaxLightmapSide;
     Unwrapped generated = unwrap(mesh, topology, o);
     out.uv = std::move(generated.uv);

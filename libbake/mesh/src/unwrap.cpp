@@ -525,6 +525,14 @@ void orient_chart(Chart& c) {
   c.extent = box.sizes();
 }
 
+// A chart's own density at the atlas's density s (UnwrapOptions::min_chart_texels): s, or more
+// for a chart narrower than `min_texels` texels across its short side, at most kMaxChartScale·s.
+constexpr double kMaxChartScale = 4;
+double chart_density(const Chart& c, double s, uint32_t min_texels) {
+  if (min_texels == 0 || !(c.extent.y() > 0)) return s;
+  return std::min(kMaxChartScale * s, std::max(s, double(min_texels) / c.extent.y()));
+}
+
 // A chart box's side in texels at density s for an extent in world units (header, step 3).
 uint32_t cells(double extent, double s) { return uint32_t(std::floor(extent * s + 2 * kMargin)) + 1; }
 
@@ -636,15 +644,16 @@ struct Placement {
 };
 
 // Horizon packing (header, step 3) at density s into W × H. False when a chart does not fit.
-bool pack(const std::vector<Chart>& charts, double s, uint32_t gutter, uint32_t W, uint32_t H,
+bool pack(const std::vector<Chart>& charts, double s, uint32_t min_texels, uint32_t gutter, uint32_t W, uint32_t H,
           std::vector<Footprint>& prints, std::vector<Placement>& where) {
   const int64_t G = gutter, near = G / 2, far = G - G / 2;  // border margins: near at 0, far at W, H
   const double side = std::max(W, H);
   prints.resize(charts.size());
   std::vector<uint32_t> order(charts.size());
   for (uint32_t i = 0; i < charts.size(); ++i) {
-    if (!(charts[i].extent.x() * s < side)) return false;  // in no rotation
-    prints[i] = footprint(charts[i], s);
+    const double sc = chart_density(charts[i], s, min_texels);
+    if (!(charts[i].extent.x() * sc < side)) return false;  // in no rotation
+    prints[i] = footprint(charts[i], sc);
     order[i] = i;
   }
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
@@ -732,7 +741,9 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
   // The density and the atlas (header, step 3).
   std::vector<Footprint> prints;
   std::vector<Placement> where;
-  auto fits = [&](double s, uint32_t W, uint32_t H) { return pack(charts, s, o.gutter, W, H, prints, where); };
+  auto fits = [&](double s, uint32_t W, uint32_t H) {
+    return pack(charts, s, o.min_chart_texels, o.gutter, W, H, prints, where);
+  };
   auto largest_density = [&](uint32_t W, uint32_t H) {
     double lo = 0, hi = std::sqrt(double(W) * double(H) / area);
     while (fits(hi, W, H)) lo = hi, hi *= 2;  // never in practice: the charts' cells exceed their area
@@ -778,18 +789,20 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
   for (size_t i = 0; i < charts.size(); ++i) {
     const Chart& c = charts[i];
     const Footprint& box = prints[i];
+    const double sc = chart_density(c, s, o.min_chart_texels);
+    r.scaled_charts += sc > s ? 1 : 0;
     std::vector<V2> texel(c.uv.size());
     for (size_t v = 0; v < c.uv.size(); ++v)
-      texel[v] = placed(box, where[i].rotation, box.inset + c.uv[v] * s, where[i].x, where[i].y);
+      texel[v] = placed(box, where[i].rotation, box.inset + c.uv[v] * sc, where[i].x, where[i].y);
     for (size_t k = 0; k < c.triangles.size(); ++k) {
       const uint32_t t = c.triangles[k];
       for (size_t j = 0; j < 3; ++j) {
         const V2& q = texel[c.corners[k][j]];
         out.uv.corners[3 * size_t(t) + j] = Eigen::Vector2f(float(q.x() / W), float(q.y() / H));
       }
-      // Sander's L2 stretch, the texture in world units (texels / s).
-      const std::array<V2, 3> q = {texel[c.corners[k][0]] / s, texel[c.corners[k][1]] / s, texel[c.corners[k][2]] / s};
-      uv_area += cross2(q[1] - q[0], q[2] - q[0]) / 2 * s * s;
+      // Sander's L2 stretch, the texture in world units (texels / the chart's density).
+      const std::array<V2, 3> q = {texel[c.corners[k][0]] / sc, texel[c.corners[k][1]] / sc, texel[c.corners[k][2]] / sc};
+      uv_area += cross2(q[1] - q[0], q[2] - q[0]) / 2 * sc * sc;
       const double l2sq = l2_stretch_squared(corners_of(mesh, t), q);
       r.worst_stretch = std::max(r.worst_stretch, std::sqrt(l2sq));
       weighted += l2sq * f.area[t];

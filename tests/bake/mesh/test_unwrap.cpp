@@ -279,3 +279,41 @@ TEST(Unwrap, ADensityChoosesTheSmallestSquareAndRefusesPastTheLimit) {
   o.width = o.height = 20000;
   EXPECT_THROW(unwrap(m, topo, o), InputError) << "past max_side";
 }
+
+TEST(Unwrap, ThinChartsGetMinChartTexelsAcrossAndStillPackCleanly) {
+  // A 4 × 4 × 0.25 slab: two 4 × 4 faces and four 4 × 0.25 sides, each side a chart of its own.
+  // At 64² the atlas's density s gives a side 0.25·s ≈ 1.5 texels across; with
+  // min_chart_texels = 3 each side gets its own density 3 / 0.25 (under the 4·s cap) and spans 3
+  // texels across (to the float rounding of its UVs, 2^-24 · 64), the big faces keep s, and the
+  // layout stays exact: no flip, no overlap, whole gutters.
+  const Mesh m = box({0, 0, 0}, {4, 4, 0.25f}, "slab");  // triangles 2f, 2f + 1: face f
+  const Topology topo = build_topology(m);
+  UnwrapOptions o;
+  o.width = o.height = 64;
+  auto short_side = [&](const Unwrapped& u, size_t f) {  // face f's smaller UV extent, in texels
+    float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
+    for (size_t k = 6 * f; k < 6 * f + 6; ++k)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], u.uv.corners[k][d] * 64), hi[d] = std::max(hi[d], u.uv.corners[k][d] * 64);
+    return std::min(hi[0] - lo[0], hi[1] - lo[1]);
+  };
+  const Unwrapped uniform = unwrap(m, topo, o);
+  o.min_chart_texels = 3;
+  const Unwrapped thin = unwrap(m, topo, o);
+  EXPECT_EQ(uniform.report.scaled_charts, 0u);
+  EXPECT_EQ(thin.report.scaled_charts, 4u);
+  EXPECT_LE(thin.report.density, uniform.report.density) << "the thin charts' texels can only cost the rest";
+  size_t sides = 0;
+  for (size_t f = 0; f < 6; ++f) {
+    const float before = short_side(uniform, f), after = short_side(thin, f);
+    if (before < 3) {
+      ++sides;
+      EXPECT_NEAR(after, 3.0f, 1e-4f) << "face " << f;
+    } else {
+      EXPECT_NEAR(after, 4 * thin.report.density, 1e-4) << "face " << f << " keeps the atlas's density";
+    }
+  }
+  EXPECT_EQ(sides, 4u) << "the premise: the sides were under 3 texels across";
+  EXPECT_NEAR(thin.report.worst_stretch, 1.0, 1e-12) << "a chart's own density scales it evenly";
+  EXPECT_EQ(check_layout(m, thin.uv), 0u);
+  expect_clean_atlas(m, topo, thin.uv, 64);
+}

@@ -43,6 +43,7 @@ struct LightmapSpec {
   std::string uv_set;              // the asset's set to bake in ("": TEXCOORD_1, else the only one)
   bool unwrap = false;             // generate the set even when the mesh has one
   uint32_t gutter = 2;             // a generated set's empty texels between charts
+  uint32_t min_chart_texels = 0;   // a generated set's thin charts at least this many texels across (unwrap.h)
   uint32_t padding = 2;            // the rings each chart is dilated into (bake/bake/lightmap.h)
   bool stitch = true;              // move the texels along UV seams until both sides agree
   bool given() const { return width > 0 || density > 0; }

@@ -86,6 +86,10 @@ struct UnwrapOptions {
   uint32_t width = 0, height = 0;  // the atlas in texels; 0 × 0: chosen from `density`
   double density = 0;              // texels per world unit; used when width = height = 0
   uint32_t gutter = 2;             // G: empty texels between two charts
+  // M > 0: a chart narrower than M texels across (its short side at the atlas's density) gets its
+  // own density, enough for M texels across, at most 4× the atlas's: a fin's rim or a knob's ring
+  // gets texels of its own instead of sharing one with its neighbours. 0: one density for all.
+  uint32_t min_chart_texels = 0;
   uint32_t max_side = 16384;       // the largest atlas side accepted or chosen
   double hard_edge_degrees = 50;   // neighbours' normals differ by at most this
   double cone_degrees = 65;        // every normal of a chart within this of its seed's
@@ -100,6 +104,7 @@ struct UnwrapReport {
   size_t planar_charts = 0, lscm_charts = 0, single_triangle_charts = 0;
   size_t splits = 0;                  // charts split: their flattening folded, failed or stretched
   size_t stretch_splits = 0;          // of those, because a triangle's L2 stretch exceeded 2
+  size_t scaled_charts = 0;           // charts given more than `density` (min_chart_texels)
   double utilisation = 0;             // Σ chart UV area / (W·H)
   double worst_stretch = 1, mean_stretch = 1;  // Sander's L2 (file comment)
   double seconds = 0;                 // wall time of unwrap()
