@@ -336,9 +336,10 @@ TEST(Stiff, BoundaryVertexOfAHalfPlane) {
 // (32, 64, 128), and with the culling off too; the same point moved 1e-4 of the way into its
 // triangle is right. The top face's contour arcs all lie within ~1e-6 rad of one great circle,
 // so their isoline crossings are ordered by rounding, not by the exact sides the contour search
-// gave them. On the engine at --density 0.125, 14 of 73,714 texels are of this kind (points on
-// an edge, next to a face seen edge-on) and hold 87% of the silhouette's squared AO error
-// (RMSE 0.0036 at N = 32; 0.0013 without them).
+// gave them. On the engine at --density 0.125, 14 of 73,714 texels have AO errors above 0.02 and
+// hold 87% of the silhouette's squared AO error (RMSE 0.0036 at N = 32; 0.0013 without them); the
+// 8 largest lie on an edge of their triangle, and the 3 examined closely are of this kind
+// (bench/RESULTS.md, "Texels per second per core").
 TEST(Stiff, DISABLED_FaceSeenEdgeOnFromAPointOnAConvexCrease) {
   const std::vector<std::array<Vector3f, 3>> tris = {
       {{{-238.352585, 9.44422054, 88.0000534}, {-238.352585, 9.44422054, 88.0000534}, {-241.299988, 16.668108, 80.0000916}}},
