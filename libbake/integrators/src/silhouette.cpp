@@ -76,6 +76,7 @@ struct Scratch {
   struct Node {
     Vector3d v, f;  // p → vertex (−n for the point's own vertex), world; the same in the frame
     uint32_t welded;
+    bool at_p;  // the vertex is at p: the point's own (welded) vertex, or one a free point lies on
   };
   std::vector<Node> nodes;
   std::vector<uint32_t> parent, size;  // union-find over nodes (by size, path halving)
@@ -605,8 +606,13 @@ struct SilhouetteIntegrator::Impl {
         k = int32_t(s.nodes.size());
         Scratch::Node nd;
         nd.welded = w;
-        const bool own = point.welded >= 0 && w == uint32_t(point.welded);
-        nd.v = own ? Vector3d(-point.n) : Vector3d(topo.welded_positions[w].cast<double>() - point.p);  // seen from p + εn
+        // A free point (welded = −1) may lie exactly on a vertex of another part (a texel's
+        // sample on its triangle's edge where a wall standing on the face has a corner): that
+        // vertex is at p as the point's own is, seen at −n from p + εn (p − p has no direction).
+        const Vector3d v = topo.welded_positions[w].cast<double>() - point.p;
+        const bool own = (point.welded >= 0 && w == uint32_t(point.welded)) || v == Vector3d::Zero();
+        nd.at_p = own;
+        nd.v = own ? Vector3d(-point.n) : v;  // seen from p + εn
         nd.f = frame_from_world * nd.v;
         s.below.push_back(cull && (own || certainly_below(point.n, nd.v)) ? 1 : 0);
         s.parent.push_back(uint32_t(k));
@@ -748,7 +754,7 @@ struct SilhouetteIntegrator::Impl {
       // through −n (where p lies on it) to b, in the plane of (b − a) × n: the limit of m. Both
       // halves keep that orientation. Collinear with p but not through it, it shrinks to a point
       // as ε → 0 and is crossed by no path.
-      const bool at_p = point.welded >= 0 && (e[0] == uint32_t(point.welded) || e[1] == uint32_t(point.welded));
+      const bool at_p = A.at_p || B.at_p;
       if (!at_p && da.cross(db).squaredNorm() == 0 &&
           collinear_exactly(topo.welded_positions[e[0]], topo.welded_positions[e[1]], point.p)) {
         if (da.dot(db) < 0) {

@@ -14,6 +14,7 @@
 #include <tbb/global_control.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -106,6 +107,43 @@ TEST(FilterCells, EqualProjectedAreaAndSolidAngles) {
       EXPECT_EQ(HemisphereCells::cell_of(HemisphereCells::direction(c, u, u)), c);
   }
   EXPECT_NEAR(omega, 2 * std::numbers::pi, 1e-13);  // the cells tile the hemisphere
+}
+
+TEST(FilterCells, SectorsAreTheAzimuthOctants) {
+  // cell_of bins by exact comparisons (no atan2): every direction off the octant boundaries lands
+  // in the sector floor(φ / 45°) of φ = atan2(y, x) in [0, 2π), and one on a boundary in the
+  // sector that starts there.
+  constexpr double kPi = std::numbers::pi;
+  auto atan2_sector = [&](double x, double y) {
+    double phi = std::atan2(y, x);
+    if (phi < 0) phi += 2 * kPi;
+    return std::clamp(int(phi * (8 / (2 * kPi))), 0, 7);
+  };
+  uint64_t state = 0x9e3779b97f4a7c15ull;
+  auto uniform = [&] {  // splitmix64 → [0, 1)
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return double((z ^ (z >> 31)) >> 11) * 0x1p-53;
+  };
+  for (int i = 0; i < 100000; ++i) {
+    const double phi = 2 * kPi * uniform(), s = std::sqrt(uniform());
+    const Vector3d v(s * std::cos(phi), s * std::sin(phi), std::sqrt(std::max(0.0, 1 - s * s)));
+    const int c = HemisphereCells::cell_of(v);
+    const int expected = atan2_sector(v.x(), v.y());
+    // Within 1e-12 rad of a boundary atan2's rounding may pick either side: those are checked below.
+    const double to_boundary = std::abs(std::remainder(std::atan2(v.y(), v.x()), kPi / 4));
+    if (to_boundary > 1e-12) {
+      EXPECT_EQ(c % 8, expected) << v.transpose();
+    }
+    EXPECT_EQ(c / 8, std::clamp(int((v.x() * v.x() + v.y() * v.y()) * 8), 0, 7));
+  }
+  // The boundaries: the axes and the diagonals, and the pole.
+  const double h = std::sqrt(0.5);
+  const std::pair<Vector3d, int> cases[] = {
+      {{1, 0, 0}, 0}, {{h, h, 0}, 1}, {{0, 1, 0}, 2}, {{-h, h, 0}, 3}, {{-1, 0, 0}, 4}, {{-1, -0.0, 0}, 4},
+      {{-h, -h, 0}, 5}, {{0, -1, 0}, 6}, {{h, -h, 0}, 7}, {{0, 0, 1}, 0}, {{1, -0.0, 0}, 0}};
+  for (const auto& [v, sector] : cases) EXPECT_EQ(HemisphereCells::cell_of(v) % 8, sector) << v.transpose();
 }
 
 TEST(Filter, UnoccludedIsExactClosedForm) {

@@ -118,7 +118,8 @@ struct FilterOptions {
 // The 8×8 hemisphere cells of equal projected area, in the receiver's local frame (+z = n).
 struct HemisphereCells {
   static constexpr int kRings = 8, kSectors = 8, kCount = kRings * kSectors;
-  // Cell of a local unit direction with z > 0 (ring from x² + y² = sin²θ, sector from atan2).
+  // Cell of a local unit direction with z > 0 (ring from x² + y² = sin²θ, sector: the octant of
+  // the azimuth atan2(y, x), decided by exact comparisons of x and y).
   static int cell_of(const Eigen::Vector3d& local);
   // A direction in cell c, (u0, u1) ∈ [0,1)², distributed as (n·ω) within the cell (equal
   // sin²θ and φ steps: the cosine-weighted map restricted to the cell).
