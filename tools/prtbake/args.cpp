@@ -246,7 +246,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
     cmd.add_option("--min-chart-texels", a.min_chart_texels,
                    "generated UVs: a chart narrower than M texels across (a fin's rim, a thin\n"
                    "ring) gets a density of its own, enough for M texels, at most 4x the atlas's\n"
-                   "(default 0: one density for every chart)")
+                   "(default 3; 0: one density for every chart)")
         ->option_text("M")
         ->check(tool::integer_in(0, 64));
     cmd.add_option("--padding", a.padding, "gutter rings each chart is dilated into, in texels (default 2)")

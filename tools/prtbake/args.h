@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bake/bake/fiv.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/integrator.h>
 
@@ -38,7 +39,7 @@ struct Args {
   std::string uv_set;
   bool unwrap = false;
   uint32_t gutter = 2;
-  uint32_t min_chart_texels = 0;  // --min-chart-texels (bake/mesh/unwrap.h UnwrapOptions)
+  uint32_t min_chart_texels = bake::LightmapSpec{}.min_chart_texels;  // --min-chart-texels (bake/mesh/unwrap.h)
   uint32_t padding = 2;
   bool no_stitch = false;
   int threads = 0;            // 0: all cores

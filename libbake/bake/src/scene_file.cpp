@@ -126,7 +126,7 @@ std::optional<LightmapSpec> parse_lightmap(const Reader& r, const Json& v, const
   if (!v.is_object())
     r.fail(key + " must be an object {\"resolution\": N} or {\"density\": T} (and \"uv\", \"unwrap\", \"gutter\", "
                  "\"padding\", \"stitch\"), or false");
-  r.object(v, key, {"resolution", "density", "uv", "unwrap", "gutter", "padding", "stitch"});
+  r.object(v, key, {"resolution", "density", "uv", "unwrap", "gutter", "padding", "stitch", "min_chart_texels"});
   LightmapSpec spec;
   const Json* res = find_key(v, "resolution");
   const Json* den = find_key(v, "density");
@@ -147,6 +147,8 @@ std::optional<LightmapSpec> parse_lightmap(const Reader& r, const Json& v, const
   if (const Json* x = find_key(v, "gutter")) spec.gutter = uint32_t(r.integer(*x, key + ".gutter", 0, 64));
   if (const Json* x = find_key(v, "padding")) spec.padding = uint32_t(r.integer(*x, key + ".padding", 0, 64));
   if (const Json* x = find_key(v, "stitch")) spec.stitch = r.boolean(*x, key + ".stitch");
+  if (const Json* x = find_key(v, "min_chart_texels"))
+    spec.min_chart_texels = uint32_t(r.integer(*x, key + ".min_chart_texels", 0, 64));
   return spec;
 }
 

@@ -47,7 +47,8 @@
 //         "uv": "TEXCOORD_1",                  the asset's set (default TEXCOORD_1, else its only one)
 //         "unwrap": false,                     generate the set even when the mesh has one (a mesh
 //                                              without UVs gets one anyway)
-//         "gutter": 2, "padding": 2, "stitch": true }   as prtbake texel's --gutter, --padding, --no-stitch
+//         "gutter": 2, "padding": 2, "stitch": true,   as prtbake texel's --gutter, --padding, --no-stitch
+//         "min_chart_texels": 3 }                      and --min-chart-texels
 //                 | false                      per vertex, whatever bake.lightmap says
 //     } ]
 //   }
