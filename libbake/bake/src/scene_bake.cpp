@@ -41,9 +41,6 @@ std::string printf_string(const char* f, double a, double b = 0) {
   return buf;
 }
 
-// The area lights' rows of every point ([point][integ.width()]) through the row loop
-// (bake/bake/vertex_bake.h); each row depends on its point only, so any thread count gives the
-// same numbers.
 // How a job's rows are counted in logs: its sets' noun when they share one, else "rows".
 std::string rows_noun_of(const BakeJob& job) {
   for (const ReceiverSet& set : job.sets)
@@ -51,6 +48,9 @@ std::string rows_noun_of(const BakeJob& job) {
   return job.sets.empty() ? "rows" : job.sets.front().rows_noun;
 }
 
+// The area lights' rows of every point ([point][integ.width()]) through the row loop
+// (bake/bake/vertex_bake.h); each row depends on its point only, so any thread count gives the
+// same numbers.
 std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const AreaLightIntegrator& integ,
                                      const Monitor& monitor, const std::string& label) {
   tbb::enumerable_thread_specific<AreaLightIntegrator::Workspace> workspaces;
