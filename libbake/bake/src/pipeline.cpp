@@ -149,7 +149,7 @@ void BakePipeline::run(const Monitor& monitor, const PipelineHooks& hooks) {
 
 std::string correction_text(const BakeJob& job, const IntegratorSpec& better) {
   return std::string("the check puts the bake's error above the target: baking again with ") + to_string(better.kind) +
-         " at " + better.knob_text() +  " (was " + job.spec.knob_text() + "; correction " + std::to_string(job.pass + 1) +
+         " at " + better.knob_text() + " (was " + job.spec.knob_text() + "; correction " + std::to_string(job.pass + 1) +
          ": the knob raised by the measured error, at the pilot's convergence rate or the checks', if slower)";
 }
 
