@@ -249,7 +249,9 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
                    "(default 3; 0: one density for every chart)")
         ->option_text("M")
         ->check(tool::integer_in(0, 64));
-    cmd.add_option("--padding", a.padding, "gutter rings each chart is dilated into, in texels (default 2)")
+    cmd.add_option("--padding", a.padding,
+                   "rings each chart is dilated into, in texels (default 16: bilinear lookups\n"
+                   "at mip levels 0-3 then reach no empty texel wherever the atlas has room)")
         ->option_text("P")
         ->check(tool::integer_in(0, 64));
     cmd.add_flag("--no-stitch", a.no_stitch,

@@ -40,7 +40,7 @@ struct Args {
   bool unwrap = false;
   uint32_t gutter = 2;
   uint32_t min_chart_texels = bake::LightmapSpec{}.min_chart_texels;  // --min-chart-texels (bake/mesh/unwrap.h)
-  uint32_t padding = 2;
+  uint32_t padding = bake::kDefaultPadding;
   bool no_stitch = false;
   int threads = 0;            // 0: all cores
   bake::UpAxis up = bake::UpAxis::Y;

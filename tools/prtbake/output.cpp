@@ -257,6 +257,14 @@ void print_stitch(const bake::SeamStitch& seams, const std::string& who) {
               seams.baked_moved_max, seams.mean_before, seams.mean_after, seams.max_before, seams.max_after);
 }
 
+void print_mip_check(const std::array<size_t, bake::kMipLevels + 1>& hits, const std::string& who) {
+  std::string levels;
+  for (size_t k = 0; k < hits.size(); ++k) levels += (k ? ", " : "") + std::to_string(hits[k]);
+  std::printf("%slightmap: surface points whose bilinear lookup reaches an empty texel at mip levels 0-%d: %s%s\n",
+              who.empty() ? "" : (who + ": ").c_str(), bake::kMipLevels, levels.c_str(),
+              hits.back() == 0 ? "" : " (more --padding, or a larger atlas, keeps them off)");
+}
+
 void print_correction(const bake::BakeJob& job, const bake::IntegratorSpec& better) {
   std::printf("%s\n", bake::correction_text(job, better).c_str());
   std::fflush(stdout);

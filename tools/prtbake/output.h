@@ -13,6 +13,7 @@
 
 #include "args.h"
 
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -61,6 +62,8 @@ void print_baking(const Args& a, const bake::BakeJob& job, int threads);
 void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
 void print_error_report(const bake::BakeJob& job);
 void print_error_verdict(const bake::BakeJob& job, double target);  // target 0: what the RMSE means
+// The line of the mip-level check of a lightmap (bake/bake/lightmap.h mip_empty_hits).
+void print_mip_check(const std::array<size_t, bake::kMipLevels + 1>& hits, const std::string& who = "");
 // The line of a lightmap's stitched seams (bake/bake/lightmap.h), prefixed by `who` ("who: ") when given.
 void print_stitch(const bake::SeamStitch& seams, const std::string& who = "");
 // The line a generated lightmap UV set gets on stderr: who (the file, a scene object), why it was

@@ -189,6 +189,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                   who.c_str(), atlas.width, atlas.height, ob.lightmap->uv.name.c_str(), atlas.samples.size(), atlas.charts,
                   atlas.samples.size() - ob.lightmap->valid.size());
       if (seams.edges > 0) print_stitch(seams, who);
+      if (images[i]) print_mip_check(bake::mip_empty_hits(*images[i], atlas, ob.lightmap->uv), who);
     }
     if (run.say && lightmaps > kLightmapLines && !a.verbose)
       std::printf("%zu receivers baked per texel into lightmaps (-v prints each one's atlas and seams)\n", lightmaps);

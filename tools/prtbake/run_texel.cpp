@@ -86,6 +86,7 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
     bake::SeamStitch seams;
     const bake::Lightmap image = lightmap_image(mesh, topo, texels, spec, result, seams);
     if (run.say && seams.edges > 0) print_stitch(seams);
+    if (run.say) print_mip_check(bake::mip_empty_hits(image, atlas, uv));
     F::Asset asset;
     asset.root = root_info(a, mesh.source_sha256);
     tool::set_mesh(asset.vertices, mesh);
@@ -102,7 +103,9 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
     tool::set_target_error(asset, a.target_error);
     write_file(a, asset);
     if (run.say && image.unfilled > 0)
-      std::printf("lightmap: %zu texels inside the geometry had no valid neighbour in their chart: left 0\n", image.unfilled);
+      std::printf("lightmap: %zu texels inside the geometry had no valid neighbour in their chart: padded from the "
+                  "charts around them\n",
+                  image.unfilled);
   };
 
   ReceiverConsole console;

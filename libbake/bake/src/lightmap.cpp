@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -94,23 +95,39 @@ Lightmap make_lightmap(const TexelAtlas& atlas, std::span<const double> rows, si
     m.filled += n;
   }
   m.unfilled = pending.size();
-  for (uint32_t r = 0; r < padding; ++r) {
-    // The empty texels next to a known one.
-    std::vector<size_t> ring;
-    for (size_t k = 0; k < texels; ++k) {
-      if (m.state[k] != uint8_t(TexelState::Empty) || m.chart[k] != Lightmap::kNoChart) continue;
-      const long x = long(k % W), y = long(k / W);
-      for (const auto& d : kNeighbours) {
-        const long nx = x + d[0], ny = y + d[1];
-        if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H)) continue;
-        if (known(m.state[size_t(ny) * W + size_t(nx)])) {
-          ring.push_back(k);
-          break;
+  // The padding: every empty texel within `padding` rings (Chebyshev distance, 8-neighbourhood) of
+  // a covered texel, and every invalid texel no valid texel of its chart reaches (a chart wholly
+  // inside the geometry: never seen, but never empty for a bilinear lookup or a mip level), takes
+  // in rounds the mean of its known neighbours of the lowest-numbered chart among them. Rings
+  // count from the charts' texels, baked or not, so a gutter beside a chart inside the geometry is
+  // padded as any other.
+  std::vector<uint32_t> ring(texels, std::numeric_limits<uint32_t>::max());
+  {
+    std::vector<size_t> frontier;
+    for (const TexelSample& s : atlas.samples) ring[s.texel] = 0, frontier.push_back(s.texel);
+    for (uint32_t r = 1; r <= padding && !frontier.empty(); ++r) {
+      std::vector<size_t> next;
+      for (size_t k : frontier) {
+        const long x = long(k % W), y = long(k / W);
+        for (const auto& d : kNeighbours) {
+          const long nx = x + d[0], ny = y + d[1];
+          if (nx < 0 || ny < 0 || nx >= long(W) || ny >= long(H)) continue;
+          const size_t j = size_t(ny) * W + size_t(nx);
+          if (ring[j] > r) ring[j] = r, next.push_back(j);
         }
       }
+      frontier = std::move(next);
     }
-    if (ring.empty()) break;
-    m.padded += round(ring, TexelState::Padded);
+  }
+  std::vector<size_t> targets;  // none without padding: the unfilled then stay empty
+  if (padding > 0)
+    for (size_t k = 0; k < texels; ++k)
+      if (m.state[k] == uint8_t(TexelState::Empty) && ring[k] <= padding) targets.push_back(k);
+  for (size_t k : pending) m.chart[k] = Lightmap::kNoChart;
+  while (!targets.empty()) {
+    const size_t n = round(targets, TexelState::Padded);
+    if (n == 0) break;
+    m.padded += n;
   }
   return m;
 }
@@ -136,6 +153,46 @@ Lookup lookup(double u, double v, size_t W, size_t H) {
 }
 
 } // namespace
+
+std::array<size_t, kMipLevels + 1> mip_empty_hits(const Lightmap& image, const TexelAtlas& atlas, const UvSet& uv) {
+  PRT_CHECK_OP(image.state.size(), ==, size_t(image.width) * image.height);
+  // The points: each sample's UV (its triangle's corner UVs at its barycentric weights), and
+  // every corner UV of a triangle some sample lies on.
+  std::vector<Eigen::Vector2d> points;
+  std::vector<uint8_t> seen(uv.corners.size() / 3, 0);
+  for (const TexelSample& s : atlas.samples) {
+    Eigen::Vector2d p = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) p += s.barycentric[k] * uv.corners[3 * size_t(s.triangle) + size_t(k)].cast<double>();
+    points.push_back(p);
+    if (!seen[s.triangle]) {
+      seen[s.triangle] = 1;
+      for (int k = 0; k < 3; ++k) points.push_back(uv.corners[3 * size_t(s.triangle) + size_t(k)].cast<double>());
+    }
+  }
+  std::array<size_t, kMipLevels + 1> hits{};
+  // Level k's empty flags, from level k − 1's.
+  size_t W = image.width, H = image.height;
+  std::vector<uint8_t> empty(W * H);
+  for (size_t t = 0; t < W * H; ++t) empty[t] = image.state[t] == uint8_t(TexelState::Empty);
+  for (int level = 0; level <= kMipLevels; ++level) {
+    if (level > 0) {
+      const size_t w = (W + 1) / 2, h = (H + 1) / 2;
+      std::vector<uint8_t> next(w * h, 0);
+      for (size_t y = 0; y < H; ++y)
+        for (size_t x = 0; x < W; ++x) next[(y / 2) * w + x / 2] |= empty[y * W + x];
+      empty = std::move(next), W = w, H = h;
+    }
+    for (const Eigen::Vector2d& p : points) {
+      const Lookup l = lookup(p.x(), p.y(), W, H);
+      for (int k = 0; k < 4; ++k)
+        if (l.weight[size_t(k)] > 0 && empty[l.texel[size_t(k)]]) {
+          ++hits[size_t(level)];
+          break;
+        }
+    }
+  }
+  return hits;
+}
 
 SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& mesh, const Topology& topology,
                         const UvSet& uv, double lambda) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 using namespace prt::bake;
@@ -121,4 +122,43 @@ TEST(Lightmap, SeamStitchMakesBothSidesOfASeamAgree) {
   for (size_t k = 0; k < image.values.size(); ++k) moved += image.values[k] != before.values[k];
   EXPECT_LE(moved, s.texels);
   EXPECT_GT(moved, 0u);
+}
+
+TEST(Lightmap, MipLevelsUpToThreeReachNoEmptyTexelWithTheDefaultPadding) {
+  // The square's chart covers texels 0..16 of a 64² atlas (UVs scaled by ¼). At mip level 3 a
+  // texel is an 8 × 8 block; the chart's edge at u = ¼ (x = 16) is looked up at level-3
+  // coordinate 16/8 − ½ = 1.5, half in block 2 (x 16..23). With 2 rings of padding block 2 still
+  // holds empty texels (x 19..23), so the edge's points reach an empty texel at levels 2 and 3;
+  // with kDefaultPadding (16) every block those lookups touch is full, at every level 0–3.
+  const Square sq(0.25f);
+  const TexelAtlas a = sq.atlas(64);
+  const std::vector<double> rows(a.samples.size(), 0.5);
+  const auto thin = mip_empty_hits(make_lightmap(a, rows, 1, {}, 2), a, sq.uv);
+  EXPECT_EQ(thin[0], 0u) << "two rings suffice at level 0";
+  EXPECT_GT(thin[3], 0u) << "the premise: two rings do not suffice at level 3";
+  const auto full = mip_empty_hits(make_lightmap(a, rows, 1, {}, kDefaultPadding), a, sq.uv);
+  for (int k = 0; k <= kMipLevels; ++k) EXPECT_EQ(full[size_t(k)], 0u) << "level " << k;
+}
+
+TEST(Lightmap, AnInvalidTexelItsChartCannotFillIsPaddedFromItsNeighbours) {
+  // Both charts of the diagonal square, every texel of chart 1 invalid (a chart wholly inside the
+  // geometry): nothing of its own chart can fill them. Without padding they stay empty (0); with
+  // it they are padded from chart 0 around them, so no lookup or mip level reads an empty texel.
+  const Square sq(1, 0.5f);
+  const TexelAtlas a = sq.atlas(8);
+  std::vector<double> rows;
+  std::vector<uint8_t> invalid;
+  for (const TexelSample& s : a.samples) rows.push_back(10.0), invalid.push_back(s.chart == 1 ? 1 : 0);
+  const size_t chart1 = size_t(std::count(invalid.begin(), invalid.end(), uint8_t(1)));
+  ASSERT_GT(chart1, 0u);
+  const Lightmap bare = make_lightmap(a, rows, 1, invalid, 0);
+  EXPECT_EQ(bare.unfilled, chart1);
+  const Lightmap padded = make_lightmap(a, rows, 1, invalid, kDefaultPadding);
+  EXPECT_EQ(padded.unfilled, chart1) << "counted as before";
+  for (size_t i = 0; i < a.samples.size(); ++i) {
+    if (!invalid[i]) continue;
+    EXPECT_EQ(bare.state[a.samples[i].texel], uint8_t(TexelState::Empty));
+    EXPECT_EQ(padded.state[a.samples[i].texel], uint8_t(TexelState::Padded));
+    EXPECT_EQ(padded.values[a.samples[i].texel], 10.0);
+  }
 }

@@ -7,8 +7,11 @@
 // previous round's texels, so the result does not depend on the order of the scan):
 //   fill     an invalid texel with at least one known neighbour of ITS chart (baked, or filled in
 //            an earlier round) takes their mean; until a round fills nothing. An invalid texel
-//            that no valid texel of its chart reaches keeps 0 and is counted (`unfilled`).
-//   padding  `padding` rounds: an empty texel with known neighbours (baked, filled or padded
+//            that no valid texel of its chart reaches is counted (`unfilled`) and left to the
+//            padding below, as an empty texel (0 without padding).
+//   padding  every empty texel within `padding` rings of a chart's texels (Chebyshev distance over
+//            the 8-neighbourhood, counted from the covered texels, baked or not), and the unfilled
+//            invalid texels, in rounds: one with known neighbours (baked, filled or padded
 //            earlier) takes the mean of those of the lowest-numbered chart among them and joins
 //            that chart, so a gutter between two charts is split between them, never mixed.
 #pragma once
@@ -16,6 +19,7 @@
 #include <bake/bake/vertex_bake.h>
 #include <bake/mesh/texels.h>
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -61,6 +65,18 @@ struct SeamStitch {
 constexpr double kSeamLambda = 1;
 SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& mesh, const Topology& topology,
                         const UvSet& uv, double lambda = kSeamLambda);
+
+// Mip levels (issue 30: "no empty texel reached by bilinear filtering at mip levels 0–3"): level
+// k halves level k − 1 (sides rounded up), each texel the 2 × 2 box of the level below, so a
+// level-k texel holds the 2^k × 2^k texels of level 0 it covers and is EMPTY when any of them is.
+// For every point of the surface the atlas samples (each covered texel's sample, and each
+// triangle's corners, in UV), the bilinear lookup at level k (SCHEMA's rule at that level's size)
+// is made, and points whose footprint gives weight > 0 to an empty level-k texel are counted,
+// per level 0 … kMipLevels. Padding (make_lightmap) of at least 2^(k+1) rings keeps level k clean
+// wherever the atlas has room (the default kDefaultPadding covers levels 0–3).
+inline constexpr int kMipLevels = 3;
+inline constexpr uint32_t kDefaultPadding = 16;
+std::array<size_t, kMipLevels + 1> mip_empty_hits(const Lightmap& image, const TexelAtlas& atlas, const UvSet& uv);
 
 // `rows`: one row of `channels` values per atlas sample (the pipeline's rows of atlas.receivers);
 // `invalid`: one flag per sample (empty: none). Throws ContractError on sizes that disagree.

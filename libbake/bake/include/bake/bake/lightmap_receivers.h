@@ -46,7 +46,7 @@ struct LightmapSpec {
   // A generated set's thin charts at least this many texels across (unwrap.h): 3 by default, which
   // took the engine's per-texel AO from NRMSE 0.042 to 0.011 at 1860² (bench/RESULTS.md).
   uint32_t min_chart_texels = 3;
-  uint32_t padding = 2;            // the rings each chart is dilated into (bake/bake/lightmap.h)
+  uint32_t padding = kDefaultPadding;  // the rings each chart is dilated into (bake/bake/lightmap.h)
   bool stitch = true;              // move the texels along UV seams until both sides agree
   bool given() const { return width > 0 || density > 0; }
 };
