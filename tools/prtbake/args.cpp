@@ -246,12 +246,13 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
     cmd.add_option("--min-chart-texels", a.min_chart_texels,
                    "generated UVs: a chart narrower than M texels across (a fin's rim, a thin\n"
                    "ring) gets a density of its own, enough for M texels, at most 4x the atlas's\n"
-                   "(default 3; 0: one density for every chart)")
+                   "(default " + std::to_string(bake::LightmapSpec{}.min_chart_texels) + "; 0: one density for every chart)")
         ->option_text("M")
         ->check(tool::integer_in(0, 64));
     cmd.add_option("--padding", a.padding,
-                   "rings each chart is dilated into, in texels (default 16: bilinear lookups\n"
-                   "at mip levels 0-3 then reach no empty texel wherever the atlas has room)")
+                   "rings each chart is dilated into, in texels (default " + std::to_string(bake::kDefaultPadding) +
+                       ": bilinear lookups\nat mip levels 0-" + std::to_string(bake::kMipLevels) +
+                       " then reach no empty texel wherever the atlas has room)")
         ->option_text("P")
         ->check(tool::integer_in(0, 64));
     cmd.add_flag("--no-stitch", a.no_stitch,

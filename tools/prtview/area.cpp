@@ -146,32 +146,34 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
     if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1)
       std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
   // Per texel: E per light sampled bilinearly through the object's mesh/uv (view/lightmap.h),
-  // times each light's radiance and the albedo / pi.
+  // times each light's radiance and the albedo / pi; one pass over the pixels.
+  if (texel_objects.empty()) return img;
+  std::vector<const TexelE*> texel_of(objects.size(), nullptr);
+  std::vector<view::LightmapImage> maps;
   for (const TexelE& t : texel_objects) {
+    texel_of[t.object] = &t;
     const F::Lightmap& m = *t.set->lightmap;
-    const size_t L = t.column.size();
-    std::vector<float> values(m.area_irradiance->values.begin(), m.area_irradiance->values.end());
-    const view::LightmapImage map{int(m.width), int(m.height), L, values, m.state.values};
-    const size_t first = scene.first_triangle[t.object], end = scene.first_triangle[t.object + 1];
-    const std::array<float, 3>& albedo = objects[t.object].albedo;
-    for (int y = 0; y < g.height; ++y)
-      for (int x = 0; x < g.width; ++x) {
-        const int32_t tri = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
-        if (tri < 0 || size_t(tri) < first || size_t(tri) >= end) continue;
-        const view::Fragment fr = view::make_fragment(scene.mesh, g, x, y);
-        const float* uv = t.set->uv->values.data() + 6 * (size_t(tri) - first);
-        double u = 0, v = 0;
-        for (size_t c = 0; c < 3; ++c) u += double(fr.bary[c]) * double(uv[2 * c]), v += double(fr.bary[c]) * double(uv[2 * c + 1]);
-        std::vector<float> sample(L);
-        view::sample_lightmap(map, u, v, sample.data());
-        float* out = img.at(x, y);
-        for (size_t c = 0; c < 3; ++c) {
-          double sum = 0;
-          for (size_t l = 0; l < L; ++l) sum += t.column[l]->radiance[c] * double(sample[l]);
-          out[c] = float(double(albedo[c]) * sum * std::numbers::inv_pi);
-        }
-      }
+    maps.push_back({int(m.width), int(m.height), t.column.size(), m.area_irradiance->values, m.state.values});
   }
+  std::vector<float> sample;
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const int32_t tri = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
+      if (tri < 0 || per_pixel[size_t(tri)] != 2) continue;
+      const size_t k = size_t(std::upper_bound(scene.first_triangle.begin(), scene.first_triangle.end(), size_t(tri)) -
+                              scene.first_triangle.begin()) - 1;
+      const TexelE& t = *texel_of[k];
+      const view::Fragment fr = view::make_fragment(scene.mesh, g, x, y);
+      const Eigen::Vector2d uv = view::fragment_uv(fr, t.set->uv->values, size_t(tri) - scene.first_triangle[k]);
+      sample.resize(t.column.size());
+      view::sample_lightmap(maps[size_t(&t - texel_objects.data())], uv.x(), uv.y(), sample.data());
+      float* out = img.at(x, y);
+      for (size_t c = 0; c < 3; ++c) {
+        double sum = 0;
+        for (size_t l = 0; l < t.column.size(); ++l) sum += t.column[l]->radiance[c] * double(sample[l]);
+        out[c] = float(double(objects[k].albedo[c]) * sum * std::numbers::inv_pi);
+      }
+    }
   return img;
 }
 

@@ -412,11 +412,11 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
     float e[3];
     if (const auto& t = objects[k].texels) {
       // The lightmap, sampled as an engine samples it (view/lightmap.h), shaded by prtshade.
-      const float* uv = t->corner_uv->data() + 6 * (size_t(fr.triangle) - scene.first_triangle[k]);
-      double u = 0, v = 0;
-      for (size_t c = 0; c < 3; ++c) u += double(fr.bary[c]) * double(uv[2 * c]), v += double(fr.bary[c]) * double(uv[2 * c + 1]);
-      float sample[64];
-      if (view::sample_lightmap({t->width, t->height, t->channels, *t->values, *t->state}, u, v, sample)) ++empty_hits;
+      const Eigen::Vector2d uv = view::fragment_uv(fr, *t->corner_uv, size_t(fr.triangle) - scene.first_triangle[k]);
+      thread_local std::vector<float> buffer;  // a pixel's sample (any transfer order's channels)
+      buffer.resize(t->channels);
+      float* sample = buffer.data();
+      if (view::sample_lightmap({t->width, t->height, t->channels, *t->values, *t->state}, uv.x(), uv.y(), sample)) ++empty_hits;
       ++texel_pixels;
       if (objects[k].texel_kind == "band1") {
         shade::shade_band1_vertices(n, sample, 1, e);

@@ -40,6 +40,14 @@ bool sample_lightmap(const LightmapImage& map, double u, double v, float* out) {
   return empty;
 }
 
+Eigen::Vector2d fragment_uv(const Fragment& f, std::span<const float> corner_uv, size_t triangle) {
+  PRT_CHECK_OP(6 * triangle + 6, <=, corner_uv.size());
+  const float* uv = corner_uv.data() + 6 * triangle;
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  for (size_t k = 0; k < 3; ++k) out += double(f.bary[k]) * Eigen::Vector2d(double(uv[2 * k]), double(uv[2 * k + 1]));
+  return out;
+}
+
 TexelRender shade_texels(const bake::Mesh& mesh, const GBuffer& g, std::span<const float> corner_uv, const LightmapImage& map,
                          const std::function<void(const Fragment&, const float* sample, float* rgb)>& shade) {
   PRT_CHECK_OP(corner_uv.size(), ==, 6 * mesh.triangles.size());
@@ -52,13 +60,8 @@ TexelRender shade_texels(const bake::Mesh& mesh, const GBuffer& g, std::span<con
     for (int x = 0; x < g.width; ++x) {
       if (g.triangle[size_t(y) * size_t(g.width) + size_t(x)] < 0) continue;
       const Fragment f = make_fragment(mesh, g, x, y);
-      const float* uv = corner_uv.data() + 6 * size_t(f.triangle);
-      double u = 0, v = 0;
-      for (size_t k = 0; k < 3; ++k) {
-        u += double(f.bary[k]) * double(uv[2 * k]);
-        v += double(f.bary[k]) * double(uv[2 * k + 1]);
-      }
-      if (sample_lightmap(map, u, v, sample.data())) ++row_empty;
+      const Eigen::Vector2d uv = fragment_uv(f, corner_uv, size_t(f.triangle));
+      if (sample_lightmap(map, uv.x(), uv.y(), sample.data())) ++row_empty;
       ++row_pixels;
       shade(f, sample.data(), out.image.at(x, y));
     }

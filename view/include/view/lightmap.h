@@ -40,6 +40,10 @@ struct LightmapImage {
   std::span<const uint8_t> state;
 };
 
+// The lightmap UV of fragment `f` on `triangle` of a set whose corner UVs are `corner_uv` (6 floats
+// per triangle): Σ_k β_k uv_k, in double (the rule above).
+Eigen::Vector2d fragment_uv(const Fragment& f, std::span<const float> corner_uv, size_t triangle);
+
 // Bilinear sample at (u, v) into out[channels] (the rule above). Returns true when the footprint
 // gives weight > 0 to an empty texel.
 bool sample_lightmap(const LightmapImage& map, double u, double v, float* out);
