@@ -10,6 +10,7 @@
 #include <unit_box_ao.h>
 #include <unit_box_obj.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -463,4 +464,24 @@ TEST(SceneTexels, OneObjectsLightmapIsPrtbakeTexelsForItsMesh) {
   EXPECT_EQ(a.ao->values, b.ao->values);
   EXPECT_EQ(a.radiance_band1->values, b.radiance_band1->values);
   EXPECT_EQ(scene.objects[0].set.uv->values, texel.vertices.uv->values);
+}
+
+// A receiver per texel wholly inside a closed box: every texel is inside the geometry, so there is
+// nothing to bake per texel; the bake stops with one line naming the object, the scene and what to
+// do (per vertex it would bake zeros and warn), and writes nothing.
+TEST(SceneTexels, AReceiverWhollyInsideAnotherObjectIsAnErrorNamingItAndTheWayOut) {
+  const fs::path d = dir_for("texels_enclosed");
+  write_meshes(d);  // box.obj: [-1, 1] × [1, 3] × [-1, 1], closed
+  write_text(d / "inner.obj", "v -0.5 2 -0.5\nv 0.5 2 -0.5\nv 0.5 2 0.5\nv -0.5 2 0.5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                              "f 1/1 4/4 3/3 2/2\n");
+  write_text(d / "scene.json", scene_text("", "\"products\": [\"ao\"]",
+                                          R"({"name": "inner", "mesh": "inner.obj", "role": "receiver", "lightmap": {"resolution": 8}}, )" +
+                                              kBoxOccluder));
+  const auto r = prt::testing::run_tool(
+      PRT_PRTBAKE, "scene '" + (d / "scene.json").string() + "' -o '" + (d / "out.prt.h5").string() + "'", d);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("object 'inner' of " + (d / "scene.json").string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\"lightmap\": false"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "out.prt.h5"));
 }

@@ -285,17 +285,22 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
     // and names the first.
     constexpr size_t kNoSkyListed = 5;
     std::vector<std::pair<std::string, bake::NoSkyCount>> no_sky;
+    std::vector<const char*> noun;  // of each: its rows (a receiver per texel counts texels)
     for (size_t i = 0; i < scene.objects.size(); ++i)
       if (const auto& values = result.objects[i].values) {
         const bake::NoSkyCount count = bake::count_no_sky(*values);
-        if (count.share() > 0.5) no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
+        if (count.share() > 0.5) {
+          no_sky.emplace_back(scene_object_label(scene.objects[i]), count);
+          noun.push_back(result.objects[i].lightmap ? "texels" : "vertices");
+        }
       }
     if (!no_sky.empty() && (no_sky.size() <= kNoSkyListed || a.verbose)) {
-      for (const auto& [name, count] : no_sky)
+      for (size_t k = 0; k < no_sky.size(); ++k)
         std::fprintf(stderr,
-                     "prtbake: warning: %s: %.1f%% of its vertices (%zu of %zu) see no sky at all: it is enclosed by "
+                     "prtbake: warning: %s: %.1f%% of its %s (%zu of %zu) see no sky at all: it is enclosed by "
                      "other objects, or its normals point inside (check its winding)\n",
-                     name.c_str(), 100 * count.share(), count.vertices, count.total);
+                     no_sky[k].first.c_str(), 100 * no_sky[k].second.share(), noun[k], no_sky[k].second.vertices,
+                     no_sky[k].second.total);
     } else if (!no_sky.empty()) {
       std::string first;
       for (size_t k = 0; k < 3; ++k) {
@@ -304,7 +309,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         first += (k ? ", " : "") + no_sky[k].first + share;
       }
       std::fprintf(stderr,
-                   "prtbake: warning: %zu receivers have more than half their vertices seeing no sky at all (enclosed by "
+                   "prtbake: warning: %zu receivers have more than half their vertices or texels seeing no sky at all (enclosed by "
                    "other objects, or normals pointing inside: check their winding): %s and %zu more (-v names each)\n",
                    no_sky.size(), first.c_str(), no_sky.size() - 3);
     }

@@ -128,9 +128,12 @@ LightmapReceivers lightmap_receivers(const Mesh& mesh, const Topology& topology,
   for (size_t i = 0; i < out.invalid.size(); ++i)
     if (!out.invalid[i]) out.valid.push_back(i);
   if (out.valid.empty())
-    throw InputError(mesh.source, who + "every texel its UV set " + uv.name +
-                                      " covers lies inside the geometry: nothing to bake (are its normals pointing "
-                                      "inside? see --flip-normals)");
+    throw InputError(mesh.source, who + "every texel its UV set " + uv.name + " covers lies inside the geometry: " +
+                                      (who.empty() ? std::string("nothing to bake (are its normals pointing inside? see "
+                                                                 "--flip-normals)")
+                                                   : std::string("nothing to bake per texel (is it inside another object, "
+                                                                 "or are its normals pointing inside?): bake it per "
+                                                                 "vertex (\"lightmap\": false) or leave it out")));
   return out;
 }
 
