@@ -561,3 +561,19 @@ TEST(ViewLightmap, BilinearAtTexelCoordinatesWithClampToEdgeAndTheEmptyTexelChec
   // (1.75, 0.75) in texel coordinates: 0.25*0.25*1 + 0.75*0.25*2 + 0.25*0.75*11 + 0.75*0.75*0
   EXPECT_FLOAT_EQ(out, float(0.0625 + 0.375 + 2.0625));
 }
+
+TEST(ViewLightmap, AnyChannelCountIsSampledLikeOneChannel) {
+  // A glossy lightmap holds 3 x order² floats per texel (363 at order 11). The same 3 x 2 map as
+  // above with 363 channels, channel c holding (10 y + x) + c: each channel's sample is the
+  // one-channel sample plus c (the weights sum to 1, exactly in binary at these fractions).
+  constexpr size_t C = 363;
+  const std::vector<float> base = {0, 1, 2, 10, 11, 20};
+  std::vector<float> values(base.size() * C);
+  for (size_t t = 0; t < base.size(); ++t)
+    for (size_t c = 0; c < C; ++c) values[t * C + c] = base[t] + float(c);
+  const std::vector<uint8_t> state(base.size(), 1);
+  const prt::view::LightmapImage map{3, 2, C, values, state};
+  std::vector<float> out(C, -1);
+  EXPECT_FALSE(prt::view::sample_lightmap(map, (0.5 + 0.25) / 3, (0.5 + 0.5) / 2, out.data()));
+  for (size_t c = 0; c < C; ++c) ASSERT_EQ(out[c], 5.25f + float(c)) << "channel " << c;
+}

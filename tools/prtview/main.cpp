@@ -116,7 +116,9 @@ WHAT IS DRAWN
     order): their specular lobes only, other objects black (they still cast shadows by their
     roles): per vertex specular x int L V H k_s(r.w) dw, k_s the normalised Phong lobe
     (s+1)/2pi max(t,0)^s about the reflection r of the direction to the eye, then the lobe band by
-    band (prtshade/glossy.h); Gouraud. Two routes, the one used printed per object:
+    band (prtshade/glossy.h); Gouraud. An object baked per texel (its /lightmap holds S or U) is
+    shaded per pixel instead: the bilinear sample at the pixel's UV, the pixel's normal and view
+    direction. Two routes, the one used printed per object:
       B  (when the object has radiance/shadowed; format_version 4) the baked shadowed radiance
          S = int L V H y dw (paper 001 sec. 4, material editing): exact shadows under the baked
          environment, any order (prt::shade::shade_glossy_radiance_vertices);
@@ -586,9 +588,7 @@ int run(const Args& a) {
         if (k != kind) also.push_back(label_of(k) + " (--shade " + k + ")");
       if (texel && !prtview::vertex_kinds(f).empty()) also.push_back("the per-vertex products (--per-vertex)");
     } else if (kind == "scene" || kind == "glossy" || area) {
-      const bool glossy = std::any_of(f.objects.begin(), f.objects.end(), [](const F::SceneObject& o) {
-        return o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed);
-      });
+      const bool glossy = std::any_of(f.objects.begin(), f.objects.end(), prtview::is_glossy);
       if (kind != "scene") also.push_back("the objects under the environment (no --shade)");
       if (glossy && kind != "glossy") also.push_back("glossy lobes (--shade glossy)");
       if (!f.lights.empty() && !area) also.push_back(std::to_string(f.lights.size()) + " area light(s) (--shade area, area-exact)");

@@ -153,6 +153,14 @@ TexelProduct read_texel_product(const F::VertexSet& s, const std::string& prefix
     if (!product->sh_order) throw InputError(file, cat(prefix, path) + " lacks the attribute " + quoted(N::kShOrder));
     p.order = int(*product->sh_order);
     p.channels = size_t(p.order) * size_t(p.order);
+  } else if (kind == "visibility" || kind == "shadowed") {
+    const bool shadowed = kind == "shadowed";
+    product = shadowed ? &*m.radiance_shadowed : &*m.transfer_visibility;
+    path = shadowed ? N::kLightmapRadianceShadowed : N::kLightmapTransferVisibility;
+    if (!product->sh_order) throw InputError(file, cat(prefix, path) + " lacks the attribute " + quoted(N::kShOrder));
+    p.order = int(*product->sh_order);
+    p.channels = (shadowed ? 3 : 1) * size_t(p.order) * size_t(p.order);
+    if (shadowed) check_same_environment(*product, cat(prefix, path), env, file);
   } else {
     product = &*m.radiance_band1, path = N::kLightmapRadianceBand1, p.channels = 9, p.order = 2;
     check_same_environment(*product, cat(prefix, path), env, file);
@@ -355,6 +363,12 @@ std::string occluder_mesh_path(const F::Asset& f, const std::string& file, const
   return mesh_path;
 }
 
+bool is_glossy(const F::SceneObject& o) {
+  const F::VertexSet& s = o.set;
+  const bool texels = s.lightmap && (s.lightmap->transfer_visibility || s.lightmap->radiance_shadowed);
+  return o.phong_exponent.value_or(0) > 0 && (s.transfer_visibility || s.radiance_shadowed || texels);
+}
+
 std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string& file, const bake::EnvMap* env) {
   if (env && f.scene) check_same_environment(*f.scene, std::string(N::kScene), *env, file);
   std::vector<SceneObject> objects;
@@ -390,7 +404,8 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
       const char* kind = m.radiance_band1 ? "band1" : m.transfer_diffuse ? "transfer" : m.ao ? "ao" : nullptr;
       if (kind) o.texels = read_texel_product(s, prefix, file, kind, *env), o.texel_kind = kind;
     }
-    if (baked.phong_exponent.value_or(0) > 0 && (s.transfer_visibility || s.radiance_shadowed)) {
+    if (is_glossy(baked)) {
+      const F::Lightmap* lightmap = s.lightmap ? &*s.lightmap : nullptr;
       auto sh_product = [&](const F::Product& p, std::string_view name) {
         if (!p.sh_order) throw InputError(file, cat(prefix, name) + " lacks the attribute " + quoted(N::kShOrder));
         return Transfer{int(*p.sh_order), p.values.data()};
@@ -400,6 +415,8 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
         check_same_environment(*s.radiance_shadowed, cat(prefix, N::kRadianceShadowed), *env, file);
         o.shadowed = sh_product(*s.radiance_shadowed, N::kRadianceShadowed);
       }
+      if (lightmap && lightmap->transfer_visibility) o.texel_visibility = read_texel_product(s, prefix, file, "visibility", *env);
+      if (lightmap && lightmap->radiance_shadowed) o.texel_shadowed = read_texel_product(s, prefix, file, "shadowed", *env);
       o.phong = *baked.phong_exponent;
       if (const auto& c = baked.specular) {
         if (c->size() != 3) throw InputError(file, prefix + ": " + quoted(N::kSpecular) + " must be 3 numbers");

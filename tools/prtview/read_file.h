@@ -49,12 +49,14 @@ std::string texel_kind_label(const formats::Asset& f, const std::string& kind);
 // Throws InputError naming the missing /lightmap dataset and the kinds the lightmap holds.
 void require_texel_kind(const formats::Asset& f, const std::string& file, const std::string& kind);
 // `kind`'s lightmap product of the root layout, checked: shape [H][W][channels] (ao 1, transfer
-// order², band1 3x3), /mesh/uv holding 6 floats per triangle, the state [H][W]; band1 baked under
-// `env` (SHA-256). Pointers into the asset.
+// order², band1 3x3; the glossy kinds of scene objects: visibility order² (/lightmap/transfer/
+// visibility), shadowed 3 x order² (/lightmap/radiance/shadowed)), /mesh/uv holding 6 floats per
+// triangle, the state [H][W]; band1 and shadowed baked under `env` (SHA-256). Pointers into the
+// asset.
 struct TexelProduct {
   int width = 0, height = 0;
   size_t channels = 0;
-  int order = 0;  // transfer: the SH order; band1: 2; ao: 0
+  int order = 0;  // transfer, visibility, shadowed: the SH order; band1: 2; ao: 0
   const std::vector<float>* values = nullptr;
   const std::vector<uint8_t>* state = nullptr;
   const std::vector<float>* corner_uv = nullptr;
@@ -139,9 +141,15 @@ struct SceneObject {
   // (checked; route B), whichever the file holds.
   std::optional<Transfer> visibility;
   std::optional<Transfer> shadowed;
+  // The same baked per texel (the object's lightmap holds them): shaded per pixel from the
+  // bilinear sample at the pixel's UV, with the pixel's normal and position.
+  std::optional<TexelProduct> texel_visibility, texel_shadowed;
   double phong = 0;
   std::array<float, 3> specular{1, 1, 1};  // white when the file names none
 };
+// A glossy object of a scene file: a phong_exponent > 0 and its U or S (/transfer/visibility,
+// /radiance/shadowed), per vertex or in its lightmap.
+bool is_glossy(const formats::SceneObject& o);
 // `env` null: geometry, roles and albedo only (no product that needs the environment, no check
 // that the file was baked under it): the area-light views.
 std::vector<SceneObject> read_scene_objects(const formats::Asset& f, const std::string& file, const bake::EnvMap* env);

@@ -215,7 +215,7 @@ FirstLook first_look_camera(const F::Asset& f, const std::string& file, const Fi
   };
   if (is_scene_file(f)) {
     for (const F::SceneObject& o : f.objects)
-      if (!glossy || (o.phong_exponent.value_or(0) > 0 && (o.set.transfer_visibility || o.set.radiance_shadowed))) add(o.set);
+      if (!glossy || is_glossy(o)) add(o.set);
     if (glossy && positions.empty())  // no glossy object: frame them all (the render says what is missing)
       for (const F::SceneObject& o : f.objects) add(o.set);
   } else {
@@ -444,64 +444,88 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
 view::Image render_glossy_scene(const F::Asset& f, const std::string& file, const bake::EnvMap& env, const view::Camera& cam,
                                 std::optional<double> phong, GlossyRoute route, RenderScene& scene) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, &env);
-  for (SceneObject& o : objects) o.receiver = o.visibility || o.shadowed;
+  for (SceneObject& o : objects) o.receiver = o.visibility || o.shadowed || o.texel_visibility || o.texel_shadowed;
   if (std::none_of(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; }))
     throw bake::InputError(file, "has no glossy object (one with a phong_exponent and " +
                                      std::string(F::names::kObjects) + "/<name>" + std::string(F::names::kTransferVisibility) +
                                      " or " + std::string(F::names::kRadianceShadowed.substr(1)) +
-                                     "): nothing to show with --shade glossy");
+                                     ", per vertex or in its lightmap): nothing to show with --shade glossy");
   std::stable_partition(objects.begin(), objects.end(), [](const SceneObject& o) { return o.receiver; });
   // One Gaunt table and one lit product matrix per order, shared by the objects of that order.
   std::map<int, std::unique_ptr<shade::GlossyLight>> lit_of;
+  const auto lit = [&](int order) -> const shade::GlossyLight& {
+    auto& l = lit_of[order];
+    if (!l) {
+      std::string unused;
+      const std::vector<float> light = environment_sh(env, order, unused);
+      l = std::make_unique<shade::GlossyLight>(shade::TripleProduct(order), light.data());
+    }
+    return *l;
+  };
+  // A glossy object baked per texel: its lightmap (U or S), shaded per pixel.
+  struct TexelGlossy {
+    const TexelProduct* map = nullptr;
+    bool route_b = false;
+    double phong = 0;
+  };
+  std::vector<TexelGlossy> texel_glossy(objects.size());
   std::vector<bake::Mesh> parts;
   std::vector<float> rgb;
+  std::vector<uint8_t> per_pixel;
   scene.first_triangle = {0};
-  scene.how = "specular lobes (normalised Phong about the reflected view direction) x specular colour, Gouraud, by\n"
+  scene.how = "specular lobes (normalised Phong about the reflected view direction) x specular colour, Gouraud per vertex or\n"
+              "  per pixel from a lightmap (bilinear through its mesh/uv), by\n"
               "  route B: prt::shade::shade_glossy_radiance_vertices on the baked radiance/shadowed (paper 001 sec. 4) or\n"
               "  route A: prt::shade::shade_glossy_vertices, environment SH x transfer/visibility by the triple product:";
   std::vector<std::string> glossy_names, glossy_how, others;
-  for (const SceneObject& o : objects) {
+  for (size_t k = 0; k < objects.size(); ++k) {
+    const SceneObject& o = objects[k];
     const size_t V = o.mesh.positions.size(), T = o.mesh.triangles.size();
     std::vector<float> colour(3 * V, 0.0f);
     const double s = o.receiver ? phong.value_or(o.phong) : 0.0;
+    const bool per_texel = o.texel_visibility || o.texel_shadowed;
     if (o.receiver) {
-      // Route B when the file holds S (unless --glossy-route a), else route A.
-      const bool route_b = route == GlossyRoute::B || (route == GlossyRoute::Auto && o.shadowed);
-      const std::optional<Transfer>& data = route_b ? o.shadowed : o.visibility;
-      if (!data)
-        throw bake::InputError(file, "object '" + o.name + "' has no " +
+      // Route B when the file holds S (unless --glossy-route a), else route A; per texel when the
+      // object's lightmap holds them.
+      const bool has_s = per_texel ? bool(o.texel_shadowed) : bool(o.shadowed);
+      const bool has_u = per_texel ? bool(o.texel_visibility) : bool(o.visibility);
+      const bool route_b = route == GlossyRoute::B || (route == GlossyRoute::Auto && has_s);
+      if (!(route_b ? has_s : has_u))
+        throw bake::InputError(file, "object '" + o.name + "' has no " + (per_texel ? "lightmap/" : "") +
                                          std::string((route_b ? F::names::kRadianceShadowed : F::names::kTransferVisibility).substr(1)) +
                                          " for --glossy-route " + (route_b ? "b" : "a"));
-      const int order = data->order, max_order = route_b ? shade::kMaxShadowedOrder : shade::kMaxGlossyOrder;
+      const int order = per_texel ? (route_b ? o.texel_shadowed : o.texel_visibility)->order
+                                  : (route_b ? o.shadowed : o.visibility)->order;
+      const int max_order = route_b ? shade::kMaxShadowedOrder : shade::kMaxGlossyOrder;
       if (order < 1 || order > max_order)
         throw bake::InputError(file, "object '" + o.name + "': " + (route_b ? "shadowed radiance" : "visibility transfer") +
                                          " of order " + std::to_string(order) + " (glossy shading takes orders 1 to " +
                                          std::to_string(max_order) + ")");
-      std::vector<float> pos(3 * V), nrm(3 * V);
-      for (size_t v = 0; v < V; ++v)
-        for (int c = 0; c < 3; ++c) pos[3 * v + size_t(c)] = o.mesh.positions[v][c], nrm[3 * v + size_t(c)] = o.mesh.normals[v][c];
-      const Vector3d eye_local = cam.eye - o.mesh.origin;
-      const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
-      if (route_b) {
-        shade::shade_glossy_radiance_vertices(data->coeffs, order, nrm.data(), pos.data(), V, eye, s, colour.data());
+      if (per_texel) {
+        texel_glossy[k] = {&*(route_b ? o.texel_shadowed : o.texel_visibility), route_b, s};
+        if (!route_b) lit(order);  // built here, read by the parallel shading below
       } else {
-        auto& lit = lit_of[order];
-        if (!lit) {
-          std::string unused;
-          const std::vector<float> light = environment_sh(env, order, unused);
-          lit = std::make_unique<shade::GlossyLight>(shade::TripleProduct(order), light.data());
-        }
-        shade::shade_glossy_vertices(*lit, data->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+        std::vector<float> pos(3 * V), nrm(3 * V);
+        for (size_t v = 0; v < V; ++v)
+          for (int c = 0; c < 3; ++c) pos[3 * v + size_t(c)] = o.mesh.positions[v][c], nrm[3 * v + size_t(c)] = o.mesh.normals[v][c];
+        const Vector3d eye_local = cam.eye - o.mesh.origin;
+        const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
+        if (route_b) shade::shade_glossy_radiance_vertices(o.shadowed->coeffs, order, nrm.data(), pos.data(), V, eye, s, colour.data());
+        else shade::shade_glossy_vertices(lit(order), o.visibility->coeffs, nrm.data(), pos.data(), V, eye, s, colour.data());
+        for (size_t v = 0; v < V; ++v)
+          for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
       }
-      for (size_t v = 0; v < V; ++v)
-        for (size_t c = 0; c < 3; ++c) colour[3 * v + c] *= o.specular[c];
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s", order, s, phong ? " (--phong)" : "",
-                    o.specular[0], o.specular[1], o.specular[2], route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)");
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "order %d, Phong %.4g%s, specular %.3g %.3g %.3g, route %s%s", order, s, phong ? " (--phong)" : "",
+                    o.specular[0], o.specular[1], o.specular[2], route_b ? "B (radiance/shadowed)" : "A (transfer/visibility)",
+                    per_texel ? (", per texel, " + std::to_string(texel_glossy[k].map->width) + "x" +
+                                 std::to_string(texel_glossy[k].map->height) + " lightmap").c_str()
+                              : ", per vertex");
       glossy_names.push_back(o.name);
       glossy_how.push_back(buf);
     }
     rgb.insert(rgb.end(), colour.begin(), colour.end());
+    per_pixel.insert(per_pixel.end(), T, texel_glossy[k].map ? 1 : 0);
     scene.phong.insert(scene.phong.end(), T, s);
     scene.specular.insert(scene.specular.end(), T, o.receiver ? o.specular : std::array<float, 3>{0, 0, 0});
     add_object(scene, o);
@@ -513,7 +537,31 @@ view::Image render_glossy_scene(const F::Asset& f, const std::string& file, cons
                " glossy (" + name_list(glossy_names, 50) + ")" +
                (others.empty() ? "" : ", " + std::to_string(others.size()) + " drawn black (" + name_list(others, 40) + ")");
   scene.mesh = bake::merge_meshes(parts, file);
-  return view::interpolate_vertices(scene.mesh, view::rasterize(scene.mesh, cam), rgb);
+  const view::GBuffer g = view::rasterize(scene.mesh, cam);
+  const Vector3d eye_local = cam.eye - scene.mesh.origin;  // the fragments' frame
+  const float eye[3] = {float(eye_local.x()), float(eye_local.y()), float(eye_local.z())};
+  std::atomic<size_t> texel_pixels{0}, empty_hits{0};
+  view::Image image = view::shade_mixed(scene.mesh, g, rgb, per_pixel, [&](const view::Fragment& fr, float* out) {
+    const size_t k = size_t(std::upper_bound(scene.first_triangle.begin(), scene.first_triangle.end(), size_t(fr.triangle)) -
+                            scene.first_triangle.begin()) - 1;
+    const TexelGlossy& tg = texel_glossy[k];
+    const TexelProduct& t = *tg.map;
+    const Eigen::Vector2d uv = view::fragment_uv(fr, *t.corner_uv, size_t(fr.triangle) - scene.first_triangle[k]);
+    thread_local std::vector<float> sample;
+    sample.resize(t.channels);
+    if (view::sample_lightmap({t.width, t.height, t.channels, *t.values, *t.state}, uv.x(), uv.y(), sample.data())) ++empty_hits;
+    ++texel_pixels;
+    const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
+    const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
+    if (tg.route_b) shade::shade_glossy_radiance_vertices(sample.data(), t.order, n, p, 1, eye, tg.phong, out);
+    else shade::shade_glossy_vertices(*lit_of.at(t.order), sample.data(), n, p, 1, eye, tg.phong, out);
+    for (size_t c = 0; c < 3; ++c) out[c] *= objects[k].specular[c];
+  });
+  scene.texel_pixels = texel_pixels, scene.empty_texel_pixels = empty_hits;
+  if (texel_pixels > 0)
+    scene.how += "\n  per-texel objects: " + std::to_string(empty_hits.load()) + " of " + std::to_string(texel_pixels.load()) +
+                 " of their pixels reached an empty texel";
+  return image;
 }
 
 } // namespace prt::prtview

@@ -106,7 +106,10 @@ view::Image render_scene_file(const formats::Asset& f, const std::string& file, 
 // prtshade/glossy.h's routes per object: B (shade_glossy_radiance_vertices on the baked
 // /radiance/shadowed, paper 001 §4 "material editing": shadows exact under the baked environment,
 // any order) when the object has S, else A (the environment's SH at the object's visibility order,
-// the triple product with each vertex's /transfer/visibility row). GlossyRoute::A or ::B forces
+// the triple product with each vertex's /transfer/visibility row). An object baked per texel
+// (lightmap/radiance/shadowed or lightmap/transfer/visibility) is shaded per pixel by the same
+// routes from the bilinear sample at the pixel's UV (view/lightmap.h), with the pixel's normal and
+// position: the lobe is evaluated where it is seen, not interpolated. GlossyRoute::A or ::B forces
 // one (an object without its data is an InputError). The glossy objects are the compared
 // receivers; the others are drawn black and cast shadows by their roles. `phong`: an exponent that
 // replaces every glossy object's own (the lobe may change at run time: neither U nor S depends on

@@ -26,17 +26,22 @@ bool sample_lightmap(const LightmapImage& map, double u, double v, float* out) {
   const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
   const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
   bool empty = false;
-  constexpr size_t kMaxChannels = 64;
-  double sum[kMaxChannels] = {};
-  PRT_CHECK_OP(map.channels, <=, kMaxChannels);
+  const float* value[4] = {};  // the texels with weight > 0, in the order k above
+  double weight[4] = {};
+  int used = 0;
   for (int k = 0; k < 4; ++k) {
     if (!(w[k] > 0)) continue;
     const size_t texel = size_t(ys[k]) * size_t(map.width) + size_t(xs[k]);
     if (map.state[texel] == 0) empty = true;
-    const float* value = map.values.data() + texel * map.channels;
-    for (size_t c = 0; c < map.channels; ++c) sum[c] += w[k] * double(value[c]);
+    value[used] = map.values.data() + texel * map.channels, weight[used++] = w[k];
   }
-  for (size_t c = 0; c < map.channels; ++c) out[c] = float(sum[c]);
+  // Any channel count (a glossy lightmap holds 3 x order² floats): each channel summed in double
+  // over the same texels in the same order, rounded once.
+  for (size_t c = 0; c < map.channels; ++c) {
+    double sum = 0;
+    for (int k = 0; k < used; ++k) sum += weight[k] * double(value[k][c]);
+    out[c] = float(sum);
+  }
   return empty;
 }
 
