@@ -753,9 +753,16 @@ struct SilhouetteIntegrator::Impl {
       // end welded to it) has a − p ∥ b − p. Seen from p + εn it is the great half circle from a
       // through −n (where p lies on it) to b, in the plane of (b − a) × n: the limit of m. Both
       // halves keep that orientation. Collinear with p but not through it, it shrinks to a point
-      // as ε → 0 and is crossed by no path.
+      // as ε → 0 and is crossed by no path. Collinearity is decided exactly: p exactly on the
+      // line (a texel's sample on its triangle's edge) still gives da, db rounded apart, so
+      // da × db is only near 0 and its direction is noise (an arc through the zenith instead of
+      // −n, crossing steps of either sign). The filter: if a − p ∥ b − p exactly, the rounded
+      // da, db (each coordinate within u = 2⁻⁵³ of its own) have |da × db| ≤ ~6.1u·|da||db| per
+      // component (the perturbation 4u, the two products' rounding 2u), so ≤ 11u·|da||db| in all;
+      // (16u)² bounds the square with room. Outside it they are certainly not parallel.
       const bool at_p = A.at_p || B.at_p;
-      if (!at_p && da.cross(db).squaredNorm() == 0 &&
+      constexpr double kParallel = 16 * 0x1p-53;
+      if (!at_p && da.cross(db).squaredNorm() <= kParallel * kParallel * da.squaredNorm() * db.squaredNorm() &&
           collinear_exactly(topo.welded_positions[e[0]], topo.welded_positions[e[1]], point.p)) {
         if (da.dot(db) < 0) {
           push(da, -n);

@@ -5,6 +5,7 @@
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/silhouette.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/predicates.h>
 #include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
 
@@ -13,6 +14,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 using namespace prt::bake;
 using prt::testing::grid;
@@ -327,20 +329,19 @@ TEST(Stiff, BoundaryVertexOfAHalfPlane) {
   EXPECT_LT(a[0], 0.99);
 }
 
-// KNOWN FAILURE, disabled (found by bench/texel_rate.sh, issue 30): a texel of 2CylinderEngine.glb
-// (texel (417, 308) at --density 0.125, row 60745) whose sample lies on a convex crease edge of a
-// block: the side face x ≈ −236.5 (its interpolated normal n ≈ +x) meets the top face z ≈ 88, which
-// is not quite planar (its corners' z differ by ~3e-5) and so passes through p + εn nearly edge-on
-// (n·n_top ≈ −2e-7). QMC sees the sky (AO 0.9995 from these 25 triangles, the engine's within 20
-// units of p); the silhouette integrator returns 0.004 with N/3 inconsistent isoline loops at any N
-// (32, 64, 128), and with the culling off too; the same point moved 1e-4 of the way into its
-// triangle is right. The top face's contour arcs all lie within ~1e-6 rad of one great circle,
-// so their isoline crossings are ordered by rounding, not by the exact sides the contour search
-// gave them. On the engine at --density 0.125, 14 of 73,714 texels have AO errors above 0.02 and
-// hold 87% of the silhouette's squared AO error (RMSE 0.0036 at N = 32; 0.0013 without them); the
-// 8 largest lie on an edge of their triangle, and the 3 examined closely are of this kind
-// (bench/RESULTS.md, "Texels per second per core").
-TEST(Stiff, DISABLED_FaceSeenEdgeOnFromAPointOnAConvexCrease) {
+// Found by bench/texel_rate.sh (issue 30): a texel of 2CylinderEngine.glb (texel (417, 308) at
+// --density 0.125, row 60745) whose sample lies EXACTLY on a convex crease edge of a block (λ =
+// 55655/65536 along it; bake/mesh/texels.h puts samples exactly on their triangle): the side face
+// x ≈ −236.5 (its interpolated normal n ≈ +x) meets the top face z ≈ 88, which is not quite planar
+// (corners' z differ by ~3e-5) and is seen nearly edge-on (n·n_top ≈ −2e-7). The crease edge's
+// line passes through p, so seen from p + εn it is the great half circle through −n (the
+// T-junction rule); but a − p and b − p, rounded, were not exactly parallel (|da × db| = 1.1e-16
+// for |da||db| = 3), so the "exactly parallel" test missed it and the arc took the rounding's
+// half circle, through the zenith: N/3 isoline loops inconsistent, AO 0.004 where QMC sees the
+// sky (0.9995 from these 25 triangles, the engine's within 20 units of p). Collinearity is now
+// filtered by a rounding bound and decided exactly (bake/integrators/silhouette.cpp). On the
+// engine at --density 0.125 such texels held 87% of the silhouette's squared AO error.
+TEST(Stiff, FaceSeenEdgeOnFromAPointOnAConvexCrease) {
   const std::vector<std::array<Vector3f, 3>> tris = {
       {{{-238.352585, 9.44422054, 88.0000534}, {-238.352585, 9.44422054, 88.0000534}, {-241.299988, 16.668108, 80.0000916}}},
       {{{-241.299988, 16.668108, 80.0000916}, {-238.352585, 9.44422054, 88.0000534}, {-238.352585, 9.44423103, 80.0000763}}},
@@ -389,4 +390,56 @@ TEST(Stiff, DISABLED_FaceSeenEdgeOnFromAPointOnAConvexCrease) {
   qmc.integrate(sp, 0, b, se);
   EXPECT_NEAR(a[0], b[0], 4 * se[0] + 1e-3);
   EXPECT_EQ(sil.silhouette_stats().inconsistent_loops, 0u);
+}
+
+TEST(Stiff, PointsExactlyOnARidgeWhoseRoundedDirectionsAreNotParallelSeeTheOpenHemisphere) {
+  // The engine case above in general: a ridge (two triangles folding down from a shared edge a-b,
+  // float corners with mixed magnitudes, as a CAD part far from the origin with a coordinate near
+  // 0) and a free point EXACTLY on the edge's line (p = a + λ(b − a) rounded once, λ = k/65536, kept only
+  // when exact predicates say collinear) where the rounded a − p and b − p are NOT exactly parallel.
+  // n is face 1's normal tilted 1e-7 towards face 2's (face 2 seen nearly edge-on, as the
+  // engine's top face); the ridge is convex, so its wedge lies below the horizon: AO = 1 up to a
+  // 1e-7 sliver and the tables' O(h²), and every isoline loop must close. Before the exact
+  // collinearity test the ridge edge took the rounding's half circle: AO 0.60–0.70 here.
+  std::mt19937_64 rng(12345);
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * double(rng() >> 11) * 0x1p-53; };
+  int tested = 0;
+  uint64_t inconsistent = 0;
+  for (int trial = 0; trial < 64 && tested < 24; ++trial) {
+    // As the engine's crease: one end's y several units, the other's within 1e-4 of 0, so b − a
+    // needs ~40 bits and λ(b − a) more than a double holds.
+    const Vector3f a(float(uniform(-300, 300)), float(uniform(2, 6)), float(uniform(50, 120)));
+    const Vector3f b(float(a.x() + uniform(-1, 1)), float(uniform(-1e-4, 1e-4)), float(a.z() + uniform(-1e-4, 1e-4)));
+    const Vector3d A = a.cast<double>(), B = b.cast<double>(), e = (B - A).normalized();
+    const Vector3d up = (Vector3d::UnitZ() - Vector3d::UnitZ().dot(e) * e).normalized(), side = e.cross(up);
+    const Vector3d mid = 0.5 * (A + B);
+    const Vector3f c1 = (mid - 2 * up + 3 * side).cast<float>(), c2 = (mid - 3 * up - 2 * side).cast<float>();
+    const Mesh m = make_mesh({a, b, c1, c2}, {{0, 1, 2}, {1, 0, 3}}, "ridge");
+    const Topology topo = build_topology(m);
+    ProductRequest req;
+    req.ao = true;
+    const SilhouetteIntegrator sil(m, topo, req, {kN, 1});
+    const Vector3d n1 = (B - A).cross(c1.cast<double>() - A).normalized(), n2 = (A - B).cross(c2.cast<double>() - B).normalized();
+    // Both faces are wound facing down. n: face 1's upward normal tilted 1e-7 towards face 2's,
+    // as the engine's (the point's own face's normal, the other face seen nearly edge-on).
+    const Vector3d n = -(n1 + 1e-7 * n2).normalized();
+    for (int k = 1; k < 65536; k += 2) {
+      Vector3d q;  // a + λ(b − a) rounded once (b − a is exact in double; fma rounds once)
+      for (int c = 0; c < 3; ++c) q[c] = std::fma(k / 65536.0, B[c] - A[c], A[c]);
+      bool on_line = true;
+      for (int c = 0; c < 3; ++c) on_line = on_line && orient3d_exact(A, B, q, q + Vector3d::Unit(c)) == 0;
+      if (!on_line || (A - q).cross(B - q).squaredNorm() == 0) continue;  // not the case under test
+      ShadePoint sp;
+      sp.p = q;
+      sp.n = n;
+      double ao = -1;
+      sil.integrate(sp, uint64_t(k), std::span(&ao, 1));
+      EXPECT_NEAR(ao, 1.0, kTol) << "trial " << trial << ", lambda " << k << "/65536";
+      ++tested;
+      break;
+    }
+    inconsistent += sil.silhouette_stats().inconsistent_loops;
+  }
+  EXPECT_GE(tested, 12) << "points exactly on the ridge whose rounded directions are not parallel";
+  EXPECT_EQ(inconsistent, 0u);
 }
