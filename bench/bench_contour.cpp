@@ -315,7 +315,7 @@ void texel_tables(const std::vector<TexelMesh>& meshes, const std::vector<long>&
 // min(vmin − δ_node, −δ_node − vmax), a record min(|v1|, |v2|) − δ_rec (0 when orient_eps decided
 // it), an always-tested edge min over its faces of |v| − δ_a (0 when any face was exact). The exact
 // values are 1-Lipschitz in q (unit plane normals), so an item's decision cannot change while the
-// path the shade point travels from where it was tested, Σ|q_i − q_{i−1}|₁, stays below its
+// path the shade point travels from where it was tested, Σ|q_i − q_{i−1}|₂, stays below its
 // margin. The probe keeps the items in a min-heap on margin + path length at the test and, at
 // the next point, re-tests only the items whose key the path has reached (a re-tested child
 // that now straddles is opened, never closed again), updating a persistent bitmap of contour
@@ -340,7 +340,15 @@ public:
   }
   void find(const bake::ShadePoint& point, bool restart, std::vector<bake::ContourEdge>& out);
   uint64_t restarts = 0, retests = 0, queries = 0, by_kind[3] = {0, 0, 0}, zero = 0;
-  size_t heap_size() const { return heap_.size(); }
+  uint64_t flips = 0;        // re-tests that changed an edge's decision
+  uint64_t local = 0;        // re-tested records with a corner within `near` of the point (world units)
+  double near = 0;
+  bool in_retest = false;
+  size_t heap_size() const {
+    size_t n = far_.size();
+    for (const auto& b : ring_) n += b.size();
+    return n;
+  }
 
 private:
   enum Kind : uint32_t { kChild, kRecord, kAlways };
@@ -356,6 +364,10 @@ private:
     pending_.push_back({margin + path_, id, kind});
   }
   void set(uint32_t e, int s) {
+    if (in_retest) {
+      const bool was = bits_[e >> 6] >> (e & 63) & 1;
+      flips += was != (s != 0) || (was && sums_[e] != s);
+    }
     if (s != 0) {
       sums_[e] = s;
       bits_[e >> 6] |= uint64_t(1) << (e & 63);
@@ -371,7 +383,22 @@ private:
   const bake::ContourFinder& f_;
   std::vector<uint64_t> bits_;
   std::vector<int32_t> sums_;
-  std::vector<Item> heap_, pending_;
+  // The items by key: a ring of kRing buckets of width w_ (keys below (next_ + kRing)·w_, bucket
+  // ⌊key / w_⌋ mod kRing) and a min-heap of the rest (far_), moved into the ring as the path
+  // advances; w_ is the first step's length.
+  static constexpr uint64_t kRing = 256;
+  void place(const Item& it) {
+    const double b = w_ > 0 ? std::floor(it.key / w_) : 1e300;
+    if (b < double(next_ + kRing)) ring_[uint64_t(b) % kRing].push_back(it);
+    else {
+      far_.push_back(it);
+      std::push_heap(far_.begin(), far_.end(), later);
+    }
+  }
+  void retest(const Item& it);
+  std::vector<Item> ring_[kRing], far_, pending_, keep_;
+  uint64_t next_ = 0;
+  double w_ = 0;
   double path_ = 0, prev_q_[3] = {0, 0, 0};
   // The query's values (find_impl's).
   double p_[3], n_[3], q_[3];
@@ -424,6 +451,11 @@ void CoherentContour::record(uint32_t block, int j) {
     margin = 0;
   }
   if (a == 1e38f && b == 1e38f) return;  // padding lane
+  if (in_retest && near > 0) {
+    const auto& c = f_.corners_[size_t(block) * 4 + size_t(j)];
+    const double d = std::hypot(c.a[0] - p_[0], c.a[1] - p_[1], c.a[2] - p_[2]);
+    local += d < near;
+  }
   set(edge, s);
   push(margin, 4 * block + uint32_t(j), kRecord);
 }
@@ -449,6 +481,32 @@ void CoherentContour::always(uint32_t i) {
   push(margin, i, kAlways);
 }
 
+void CoherentContour::retest(const Item& it) {
+  in_retest = true;
+  struct Off {
+    bool& b;
+    ~Off() { b = false; }
+  } off{in_retest};
+  ++retests;
+  ++by_kind[it.kind];
+  if (it.kind == kRecord) record(it.id / 4, int(it.id % 4));
+  else if (it.kind == kAlways) always(it.id);
+  else {  // the child's bound at this point
+    const uint32_t w = it.id / 4;
+    const int k = int(it.id % 4);
+    const auto& node = f_.wide_[w];
+    pf4 vmin = pload(node.dlo), vmax = pload(node.dhi);
+    const pf4 q3[3] = {qx_, qy_, qz_};
+    for (int i = 0; i < 3; ++i) {
+      const pf4 x = q3[i] - pload(node.c[i]);
+      const pf4 a = x * pload(node.nlo[i]), b = x * pload(node.nhi[i]);
+      vmin += a < b ? a : b;
+      vmax += b > a ? b : a;
+    }
+    child(w, k, vmin[k], vmax[k]);
+  }
+}
+
 void CoherentContour::find(const bake::ShadePoint& point, bool restart, std::vector<bake::ContourEdge>& out) {
   ++queries;
   const auto& o = f_.origin_;
@@ -465,47 +523,62 @@ void CoherentContour::find(const bake::ShadePoint& point, bool restart, std::vec
   da_ = float(f_.always_coef_ * (aq + f_.always_max_a_));
   qx_ = psplat(float(q_[0])), qy_ = psplat(float(q_[1])), qz_ = psplat(float(q_[2]));
   pending_.clear();
-  if (restart) {
+  if (restart || w_ == 0) {
     ++restarts;
     std::fill(bits_.begin(), bits_.end(), 0);
-    heap_.clear();
+    for (auto& b : ring_) b.clear();
+    far_.clear();
     path_ = 0;
+    next_ = 0;
     if (!f_.wide_.empty()) open(0);
     for (uint32_t i = 0; i < f_.always_.size(); ++i) always(i);
-    heap_.swap(pending_);
-    std::make_heap(heap_.begin(), heap_.end(), later);
+    if (w_ <= 0) {  // until the first step is known: everything far
+      far_.swap(pending_);
+      std::make_heap(far_.begin(), far_.end(), later);
+    } else {
+      for (const Item& it : pending_)
+        if (it.key < double(kRing) * w_) ring_[uint64_t(it.key / w_) % kRing].push_back(it);
+        else far_.push_back(it);
+      std::make_heap(far_.begin(), far_.end(), later);
+    }
+    w_ = w_ == 0 ? -1 : w_;
   } else {
-    // Path length in q, rounded up: the exact points are within ~u·|q| of the computed ones.
+    // Path length in q (Euclidean: the unit normals make the exact values 1-Lipschitz in it),
+    // rounded up: the exact points are within ~u·|q| of the computed ones.
     const double prev = std::abs(prev_q_[0]) + std::abs(prev_q_[1]) + std::abs(prev_q_[2]);
-    path_ += (std::abs(q_[0] - prev_q_[0]) + std::abs(q_[1] - prev_q_[1]) + std::abs(q_[2] - prev_q_[2])) * (1 + 1e-12) +
-             1e-14 * (aq + prev);
-    while (!heap_.empty() && heap_.front().key <= path_) {
-      std::pop_heap(heap_.begin(), heap_.end(), later);
-      const Item it = heap_.back();
-      heap_.pop_back();
-      ++retests;
-      ++by_kind[it.kind];
-      if (it.kind == kRecord) record(it.id / 4, int(it.id % 4));
-      else if (it.kind == kAlways) always(it.id);
-      else {  // the child's bound at this point
-        const uint32_t w = it.id / 4;
-        const int k = int(it.id % 4);
-        const auto& node = f_.wide_[w];
-        pf4 vmin = pload(node.dlo), vmax = pload(node.dhi);
-        const pf4 q3[3] = {qx_, qy_, qz_};
-        for (int i = 0; i < 3; ++i) {
-          const pf4 x = q3[i] - pload(node.c[i]);
-          const pf4 a = x * pload(node.nlo[i]), b = x * pload(node.nhi[i]);
-          vmin += a < b ? a : b;
-          vmax += b > a ? b : a;
-        }
-        child(w, k, vmin[k], vmax[k]);
-      }
+    const double dx = q_[0] - prev_q_[0], dy = q_[1] - prev_q_[1], dz = q_[2] - prev_q_[2];
+    const double step = std::sqrt(dx * dx + dy * dy + dz * dz) * (1 + 1e-12) + 1e-14 * (aq + prev);
+    path_ += step;
+    if (w_ < 0 && step > 0) {  // the first step sets the bucket width; the far heap is sorted into the ring
+      w_ = step;
+      std::vector<Item> all;
+      all.swap(far_);
+      for (const Item& it : all) place(it);
     }
-    for (const Item& it : pending_) {
-      heap_.push_back(it);
-      std::push_heap(heap_.begin(), heap_.end(), later);
+    const uint64_t last = w_ > 0 ? uint64_t(std::floor(path_ / w_)) : 0;
+    // Buckets before `last` are due entirely; bucket `last` up to path_; far items up to path_.
+    for (uint64_t i = next_; w_ > 0 && i <= last && i < next_ + kRing; ++i) {
+      auto& b = ring_[i % kRing];
+      keep_.clear();
+      for (const Item& it : b)
+        if (it.key <= path_) retest(it);
+        else keep_.push_back(it);
+      b.swap(keep_);
     }
+    while (!far_.empty() && far_.front().key <= path_) {
+      std::pop_heap(far_.begin(), far_.end(), later);
+      const Item it = far_.back();
+      far_.pop_back();
+      retest(it);
+    }
+    next_ = last;
+    while (w_ > 0 && !far_.empty() && far_.front().key < double(next_ + kRing) * w_) {
+      std::pop_heap(far_.begin(), far_.end(), later);
+      const Item it = far_.back();
+      far_.pop_back();
+      ring_[uint64_t(std::floor(it.key / w_)) % kRing].push_back(it);
+    }
+    for (const Item& it : pending_) place(it);
   }
   prev_q_[0] = q_[0], prev_q_[1] = q_[1], prev_q_[2] = q_[2];
   out.clear();
@@ -522,9 +595,14 @@ void CoherentContour::find(const bake::ShadePoint& point, bool restart, std::vec
 void texel_timing(const std::vector<TexelMesh>& meshes, const std::vector<long>& sizes) {
   const size_t count = size_t(bench::env_long("PRT_BENCH_WINDOW", 20000));
   const long runs = bench::env_long("PRT_BENCH_REPEAT", 5);
+  // PRT_BENCH_RESTART: 0 (default) a full walk whenever the texel is not its predecessor's right
+  // neighbour in the same chart; 1 only when the chart changes (the path then includes the jumps
+  // back to the next row's start).
+  const long policy = bench::env_long("PRT_BENCH_RESTART", 0);
   std::printf("\n| mesh | atlas | texels timed | texels per run (restart) | find µs | probe µs | probe / find | "
-              "items re-tested per query | frontier items | contour edges |\n");
-  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+              "find: node tests + leaf lanes + always-tested edges | probe: items re-tested | decisions changed | "
+              "frontier items | contour edges |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const TexelMesh& m : meshes) {
     const bake::ContourFinder finder(m.mesh, m.topology);
     for (const long side : sizes) {
@@ -539,14 +617,22 @@ void texel_timing(const std::vector<TexelMesh>& meshes, const std::vector<long>&
       std::vector<uint8_t> restart(n, 1);
       for (size_t k = 1; k < n; ++k) {
         const auto &a = atlas.samples[start + k - 1], &b = atlas.samples[start + k];
-        restart[k] = !(b.texel == a.texel + 1 && b.texel % atlas.width != 0 && b.chart == a.chart);
+        restart[k] = policy == 0 ? !(b.texel == a.texel + 1 && b.texel % atlas.width != 0 && b.chart == a.chart)
+                                 : b.chart != a.chart;
       }
       const bake::ShadePoint* pts = atlas.receivers.points.data() + start;
       std::vector<bake::ContourEdge> out, ref;
       double edges = 0;
       CoherentContour check(finder);
+      {  // "near": 3 mean edge lengths
+        double sum = 0;
+        for (const auto& [a, b] : m.topology.edges)
+          sum += (m.topology.welded_positions[a] - m.topology.welded_positions[b]).cast<double>().norm();
+        check.near = 3 * sum / double(m.topology.edges.size());
+      }
+      bake::ContourQueryStats fs;
       for (size_t k = 0; k < n; ++k) {
-        finder.find(pts[k], ref);
+        finder.find(pts[k], ref, &fs);
         check.find(pts[k], restart[k] != 0, out);
         if (out != ref)
           throw std::runtime_error(m.name + " " + std::to_string(side) + ": the probe differs from find() at texel " +
@@ -564,14 +650,16 @@ void texel_timing(const std::vector<TexelMesh>& meshes, const std::vector<long>&
         best_probe = std::min(best_probe, bake::thread_cpu_seconds() - t0);
       }
       const double nq = double(n);
-      std::printf("| %s | %ld² | %zu | %.1f | %.2f | %.2f | %.2f | %.1f | %zu | %.0f |\n", m.name.c_str(), side, n,
-                  nq / double(check.restarts), 1e6 * best_find / nq, 1e6 * best_probe / nq, best_probe / best_find,
-                  double(check.retests) / nq, check.heap_size(), edges / nq);
+      std::printf("| %s | %ld² | %zu | %.1f | %.2f | %.2f | %.2f | %.0f + %.0f + %.0f | %.1f | %.2f | %zu | %.0f |\n",
+                  m.name.c_str(), side, n, nq / double(check.restarts), 1e6 * best_find / nq, 1e6 * best_probe / nq,
+                  best_probe / best_find, double(fs.nodes) / nq, double(fs.records) / nq, double(fs.always) / nq,
+                  double(check.retests) / nq, double(check.flips) / nq, check.heap_size(), edges / nq);
       std::fflush(stdout);
       if (bench::env_long("PRT_BENCH_DEBUG", 0) != 0)
-        std::printf("debug: retests child %.1f record %.1f always %.1f, zero-margin pushes %.1f per query\n",
-                    double(check.by_kind[0]) / nq, double(check.by_kind[1]) / nq, double(check.by_kind[2]) / nq,
-                    double(check.zero) / nq);
+        std::printf("debug: retests child %.1f record %.1f (within 3 mean edges %.1f) always %.1f, zero-margin pushes "
+                    "%.1f, decisions changed %.2f per query\n",
+                    double(check.by_kind[0]) / nq, double(check.by_kind[1]) / nq, double(check.local) / nq,
+                    double(check.by_kind[2]) / nq, double(check.zero) / nq, double(check.flips) / nq);
     }
   }
 }
