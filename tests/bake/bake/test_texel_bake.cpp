@@ -25,9 +25,12 @@
 #include <bake/visibility/raycast.h>
 
 #include <gtest/gtest.h>
+#include <test_scenes.h>
 #include <unit_box_ao.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -260,4 +263,155 @@ TEST(TexelBake, TexelsOnACurvedSurfaceLieOnTheirTrianglesAndSeeWhatIsAboveTheirF
   sil.kind = IntegratorKind::Silhouette;
   sil.set_samples(256 * 256);
   check(sil, 1e-3, 0.0, "silhouette");
+}
+
+namespace {
+// AO at a floor point (normal +z) of a convex solid standing on the floor, exactly: 1 − Σ over
+// the faces facing p of Lambert's polygon form factor (the faces seen from a point outside a
+// convex solid do not overlap; every face is above the floor's plane).
+double convex_solid_ao(const Vector3d& p, const std::vector<std::vector<Vector3d>>& faces) {
+  double blocked = 0;
+  for (const auto& f : faces) {
+    const Vector3d n = (f[1] - f[0]).cross(f[2] - f[0]);
+    if (n.dot(p - f[0]) > 0) blocked += prt::testing::polygon_form_factor(p, Vector3d::UnitZ(), f);
+  }
+  return 1 - blocked;
+}
+} // namespace
+
+// Issue 30's exact case: a wall (a closed slab 0.2 × 2 × 1, counter-clockwise outward) standing
+// on the floor with NO shared vertices: its foot's corners lie inside the floor's triangles
+// (T-junctions in both directions). The floor's texels next to the wall match the closed form
+// (no texel darker than it: the wall's foot does not leak its inside out), and the texels under
+// the foot are exactly those enclosed (no light leak under it: they are filled from their chart's
+// valid texels, never baked as lit). The slab's bottom face lies in the floor's plane (a coincident
+// sheet) across the floor's diagonal. At 32² (spacing 1/8) two columns of 16 texel centres lie
+// under the foot (x = ±1/16) and two beside its faces (x = ±3/16, 0.0875 from them). Silhouette at
+// N = 1536 (the error bound of this file's comment, ~0.1/N = 6.5e-5, within 1e-4); QMC within 4
+// standard errors.
+TEST(TexelBake, AWallStandingOnTheFloorWithNoSharedVerticesMatchesTheClosedFormBesideItAndLeaksNothingUnderIt) {
+  const FloorAndBox s;  // its floor and UVs only
+  std::vector<Vector3f> c;
+  for (int k = 0; k < 8; ++k) c.emplace_back(k & 1 ? 0.1f : -0.1f, k & 2 ? 1.0f : -1.0f, k & 4 ? 1.0f : 0.0f);
+  const std::vector<std::array<uint32_t, 3>> box_faces = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                                          {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  const Mesh wall = make_mesh(c, box_faces, "wall");
+  const Mesh both = merge_meshes(std::vector<Mesh>{s.floor, wall}, "floor and wall");
+  std::vector<std::vector<Vector3d>> faces;  // the slab's six faces as quads (outward)
+  for (size_t t = 0; t < box_faces.size(); t += 2) {
+    const auto& a = box_faces[t];
+    const auto& b = box_faces[t + 1];
+    std::vector<uint32_t> q = {a[0], a[1], a[2]};
+    for (uint32_t v : b)
+      if (std::find(q.begin(), q.end(), v) == q.end()) q.insert(q.begin() + 2, v);  // a, b's far corner, the rest
+    std::vector<Vector3d> poly;
+    for (uint32_t v : q) poly.push_back(c[v].cast<double>());
+    faces.push_back(poly);
+  }
+  const TexelAtlas atlas = texel_atlas(s.floor, build_topology(s.floor), s.uv, 32, 32, "floor");
+  const Topology topo = build_topology(both);
+  const MeshAccel accel(both, topo);
+  const RayCaster rays(both, topo);
+  size_t under = 0, beside = 0;
+  std::vector<size_t> outside;
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const Vector3d& p = atlas.receivers.points[i].p;
+    const bool in_foot = std::abs(p.x()) < 0.1 && std::abs(p.y()) < 1;
+    EXPECT_EQ(enclosed(atlas.receivers.points[i], rays), in_foot) << "texel " << atlas.samples[i].texel << " at " << p.transpose();
+    under += in_foot;
+    if (!in_foot) outside.push_back(i);
+    beside += !in_foot && std::abs(p.x()) < 0.1875 + 1e-9 && std::abs(p.y()) < 1;
+  }
+  EXPECT_EQ(under, 32u);
+  EXPECT_EQ(beside, 32u) << "the two columns of texels beside the wall's faces are checked";
+
+  IntegratorSpec sil;
+  sil.kind = IntegratorKind::Silhouette;
+  sil.silhouette_k = 1536 * 1536;
+  const std::vector<double> a = bake_ao(both, topo, accel, atlas, sil).values;
+  // The lightmap: the enclosed texels filled from the valid ones, never brighter than the
+  // brightest nor darker than the darkest valid texel of the chart (means of valid neighbours).
+  std::vector<uint8_t> invalid(atlas.samples.size());
+  double lowest = 1, highest = 0;
+  for (size_t i = 0; i < atlas.samples.size(); ++i) invalid[i] = enclosed(atlas.receivers.points[i], rays);
+  for (size_t i : outside) lowest = std::min(lowest, a[i]), highest = std::max(highest, a[i]);
+  const Lightmap m = make_lightmap(atlas, a, 1, invalid, 0);
+  EXPECT_EQ(m.filled, 32u);
+  EXPECT_EQ(m.unfilled, 0u);
+  for (size_t i = 0; i < atlas.samples.size(); ++i)
+    if (invalid[i]) {
+      EXPECT_LT(a[i], 1e-12) << "an enclosed point sees nothing";
+      const size_t k = atlas.samples[i].texel;
+      EXPECT_GE(m.values[k], lowest) << "texel " << k;
+      EXPECT_LE(m.values[k], highest) << "texel " << k;
+    }
+  double worst = 0;
+  for (size_t i : outside) {
+    const Vector3d& p = atlas.receivers.points[i].p;
+    const double exact = convex_solid_ao(p, faces);
+    EXPECT_NEAR(a[i], exact, 1e-4) << "texel " << atlas.samples[i].texel << " at " << p.transpose();
+    worst = std::max(worst, std::abs(a[i] - exact));
+  }
+  IntegratorSpec qmc;
+  qmc.kind = IntegratorKind::Qmc;
+  qmc.qmc_rays = 1024;
+  const VertexBake q = bake_ao(both, topo, accel, atlas, qmc);
+  for (size_t i : outside)
+    EXPECT_NEAR(q.values[i], convex_solid_ao(atlas.receivers.points[i].p, faces), 4 * q.std_error[i] + 1e-12)
+        << "texel " << atlas.samples[i].texel;
+  std::printf("wall on floor: %zu texels, silhouette's worst |error| %.2e\n", outside.size(), worst);
+}
+
+// Issue 30's exact case: a double-sided panel made of two coincident sheets (the same four
+// positions twice, wound opposite ways: no shared vertex index, welded together by position, so
+// its four edges each carry four faces), 1/2 above a floor [−2, 2]², baked per texel in one atlas
+// (the top sheet in u < 1/2, the bottom one in u > 1/2). Seen from p + εn each sheet's texels
+// have the other sheet in their own plane, never in front: the top sheet sees the whole sky (AO
+// = 1 exactly), the bottom sheet sees the floor below, AO = 1 − Lambert's form factor of the
+// floor's square from p with n = −z (nothing else is in view). Silhouette at N = 1536 within
+// 1e-4 (this file's bound); QMC within 4 standard errors.
+TEST(TexelBake, ADoubleSidedPanelOfTwoCoincidentSheetsSeesTheSkyAboveAndTheFloorBelow) {
+  const FloorAndBox s;  // its floor only
+  const std::vector<Vector3f> q = {{-1, -1, 0.5f}, {1, -1, 0.5f}, {1, 1, 0.5f}, {-1, 1, 0.5f}};
+  std::vector<Vector3f> pos = q;
+  pos.insert(pos.end(), q.begin(), q.end());
+  const Mesh panel = make_mesh(pos, {{{0, 1, 2}}, {{0, 2, 3}}, {{4, 6, 5}}, {{4, 7, 6}}}, "panel");
+  ASSERT_GT(panel.normals[0].z(), 0.99f);
+  ASSERT_LT(panel.normals[4].z(), -0.99f);
+  UvSet uv;
+  uv.name = "uv";
+  for (size_t t = 0; t < panel.triangles.size(); ++t)
+    for (uint32_t v : panel.triangles[t]) {
+      const Vector3f& p = panel.positions[v];
+      uv.corners.emplace_back((t < 2 ? 0.0f : 0.5f) + (p.x() + 1) / 4, (p.y() + 1) / 2);
+    }
+  const Mesh both = merge_meshes(std::vector<Mesh>{panel, s.floor}, "panel over floor");
+  const TexelAtlas atlas = texel_atlas(panel, build_topology(panel), uv, 64, 32, "panel");
+  ASSERT_EQ(atlas.samples.size(), 64u * 32u);
+  const Topology topo = build_topology(both);
+  const MeshAccel accel(both, topo);
+  const std::vector<Vector3d> floor = {{-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}};
+  const auto exact = [&](const ShadePoint& sp) {
+    return sp.n.z() > 0 ? 1.0 : 1 - prt::testing::polygon_form_factor(sp.p, -Vector3d::UnitZ(), floor);
+  };
+  IntegratorSpec sil;
+  sil.kind = IntegratorKind::Silhouette;
+  sil.silhouette_k = 1536 * 1536;
+  const std::vector<double> a = bake_ao(both, topo, accel, atlas, sil).values;
+  size_t top = 0, bottom = 0;
+  for (size_t i = 0; i < atlas.samples.size(); ++i) {
+    const ShadePoint& sp = atlas.receivers.points[i];
+    ASSERT_NEAR(std::abs(sp.n.z()), 1.0, 1e-6) << "texel " << atlas.samples[i].texel;
+    EXPECT_NEAR(a[i], exact(sp), 1e-4) << "texel " << atlas.samples[i].texel << " at " << sp.p.transpose() << " n "
+                                       << sp.n.transpose();
+    (sp.n.z() > 0 ? top : bottom) += 1;
+  }
+  EXPECT_EQ(top, 1024u);
+  EXPECT_EQ(bottom, 1024u);
+  IntegratorSpec qmc;
+  qmc.kind = IntegratorKind::Qmc;
+  qmc.qmc_rays = 1024;
+  const VertexBake r = bake_ao(both, topo, accel, atlas, qmc);
+  for (size_t i = 0; i < atlas.samples.size(); ++i)
+    EXPECT_NEAR(r.values[i], exact(atlas.receivers.points[i]), 4 * r.std_error[i] + 1e-12) << "texel " << atlas.samples[i].texel;
 }
