@@ -1,0 +1,130 @@
+// Interreflections through prtbake (bake/bake/bounce.h, formats/SCHEMA.md "Bounces"): albedo 0
+// gives the direct bake's values, every bounce adds energy, any thread count gives the same bytes,
+// the attributes say what the transfer holds, and bad albedos and missing options are usage
+// errors (exit 2) that name the problem and write nothing.
+#include "run_tool.h"
+#include "scratch.h"
+
+#include <formats/prtfile.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+using prt::testing::run_tool;
+
+namespace {
+
+const std::string kData = PRT_DATA_DIR;
+// The bunny on its ground: the ground lights the bunny's underside and the bunny the ground.
+const std::string kBake = "vertex " + kData + "/bunny_ground.obj --transfer 3 --integrator qmc --samples 64 --report 0";
+
+fs::path dir_for(const std::string& name) { return prt::testing::fresh_dir("bounces", name); }
+
+std::vector<float> transfer(const fs::path& file) {
+  const F::File f = F::read_file(file);
+  const F::Dataset* d = F::find_dataset(f, "/transfer/diffuse");
+  EXPECT_NE(d, nullptr);
+  return d ? std::get<std::vector<float>>(d->data) : std::vector<float>{};
+}
+
+F::AttrValue attr(const fs::path& file, const std::string& name) {
+  const F::File f = F::read_file(file);
+  const F::Attr* a = F::find_attr(F::find_dataset(f, "/transfer/diffuse")->attrs, name);
+  EXPECT_NE(a, nullptr) << name;
+  return a ? a->value : F::AttrValue{};
+}
+
+fs::path bake(const fs::path& d, const std::string& name, const std::string& extra) {
+  const fs::path out = d / (name + ".prt.h5");
+  const auto r = run_tool(PRT_PRTBAKE, kBake + " " + extra + " -q -o " + out.string(), d / "capture");
+  EXPECT_EQ(r.code, 0) << r.err;
+  return out;
+}
+
+} // namespace
+
+// (a) Albedo 0: the file's transfer has the direct bake's values exactly (every bounce is zero), and
+// its attributes say what was asked.
+TEST(Bounces, ZeroAlbedoGivesTheDirectValues) {
+  const fs::path d = dir_for("zero");
+  const fs::path direct = bake(d, "direct", ""), zero = bake(d, "zero", "--bounces 3 --albedo 0");
+  EXPECT_TRUE(transfer(zero) == transfer(direct));
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounces")), 1);  // the first bounce added nothing: stopped
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounces_requested")), 3);
+  EXPECT_EQ(std::get<std::vector<double>>(attr(zero, "albedo")), (std::vector<double>{0, 0, 0}));
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounce_rays")), 256);
+}
+
+// (b) Under a uniform (non-negative) sky every bounce adds non-negative light: T_00 at every vertex
+// never falls from B to B + 1 (float rounding is monotone), and its mean grows.
+TEST(Bounces, EveryBounceAddsEnergy) {
+  const fs::path d = dir_for("energy");
+  std::vector<float> before = transfer(bake(d, "b0", ""));
+  const size_t n = 9, V = before.size() / n;
+  double mean_before = 0;
+  for (size_t v = 0; v < V; ++v) mean_before += before[v * n];
+  for (int B = 1; B <= 3; ++B) {
+    const fs::path out = bake(d, "b" + std::to_string(B), "--bounces " + std::to_string(B) + " --albedo 0.7 --bounce-rays 64");
+    EXPECT_EQ(std::get<int64_t>(attr(out, "bounces")), B);
+    const std::vector<float> now = transfer(out);
+    ASSERT_EQ(now.size(), before.size());
+    double mean = 0;
+    for (size_t v = 0; v < V; ++v) {
+      EXPECT_GE(now[v * n], before[v * n]) << "vertex " << v << ", B = " << B;
+      ASSERT_TRUE(std::isfinite(now[v * n]));
+      mean += now[v * n];
+    }
+    EXPECT_GT(mean, mean_before) << "B = " << B;
+    mean_before = mean;
+    before = now;
+  }
+}
+
+// (d) The same bytes with one thread and with two.
+TEST(Bounces, SameBytesWhateverTheThreads) {
+  const fs::path d = dir_for("threads");
+  const std::string args = "--bounces 2 --albedo 0.5,0.5,0.5 --bounce-rays 32 --reproducible";
+  // The same output path both times: the command line, stored in the file, names it.
+  const std::string one = prt::testing::read_bytes(bake(d, "x", args + " --threads 1"));
+  fs::remove(d / "x.prt.h5");
+  const std::string two = prt::testing::read_bytes(bake(d, "x", args + " --threads 2"));
+  EXPECT_FALSE(one.empty());
+  EXPECT_TRUE(one == two);
+}
+
+// (e) Bad albedos, a missing one and what this version does not bounce: exit 2 before any work,
+// the message naming the problem, no file.
+TEST(Bounces, BadOptionsAreUsageErrors) {
+  const fs::path d = dir_for("bad"), out = d / "x.prt.h5";
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {"--bounces 2 --albedo 1", "an albedo must be below 1"},
+      {"--bounces 2 --albedo 1.5,1.5,1.5", "an albedo must be below 1"},
+      {"--bounces 2 --albedo -0.2", "-0.2 is negative"},
+      {"--bounces 2 --albedo grey", "expects R or R,G,B"},
+      {"--bounces 2 --albedo 0.5,0.5", "expects R or R,G,B"},
+      {"--bounces 2 --albedo 0.8,0.5,0.3", "a coloured albedo is not supported yet"},
+      {"--bounces 2", "--bounces 2 needs --albedo R[,G,B]"},
+      {"--albedo 0.5", "--albedo applies with --bounces"},
+      {"--bounce-rays 64", "--bounce-rays applies with --bounces"},
+      {"--bounces 2 --albedo 0.5 --radiance " + kData + "/sunset.exr", "band-1 and shadowed radiance with bounces"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_tool(PRT_PRTBAKE, kBake + " " + c.args + " -o " + out.string(), d / "capture");
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  const auto ao = run_tool(PRT_PRTBAKE,
+                           "vertex " + kData + "/bunny_ground.obj --ao --bounces 2 --albedo 0.5 -o " + out.string(),
+                           d / "capture");
+  EXPECT_EQ(ao.code, 2);
+  EXPECT_NE(ao.err.find("give --transfer L"), std::string::npos) << ao.err;
+}
