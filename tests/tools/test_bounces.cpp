@@ -115,6 +115,7 @@ TEST(Bounces, BadOptionsAreUsageErrors) {
       {"--albedo 0.5", "--albedo applies with --bounces"},
       {"--bounce-rays 64", "--bounce-rays applies with --bounces"},
       {"--bounces 2 --albedo 0.5 --radiance " + kData + "/sunset.exr", "band-1 and shadowed radiance with bounces"},
+      {"--bounces 2 --albedo 0.5 --shard 0/2", "--bounces 2 in a sharded bake: not implemented yet"},
   };
   for (const auto& c : cases) {
     const auto r = run_tool(PRT_PRTBAKE, kBake + " " + c.args + " -o " + out.string(), d / "capture");
