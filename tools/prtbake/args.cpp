@@ -89,6 +89,7 @@ constexpr const char* kVertexExamples =
     "EXAMPLES\n"
     "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
     "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
+    "  prtbake vertex data/bunny_ground.obj --transfer 3 --bounces 3 --albedo 0.6 -o bunny.prt.h5   # interreflections\n"
     "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
     "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";

@@ -213,6 +213,7 @@ void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spe
               result.applied, spec.bounces, spec.bounces == 1 ? "" : "s", albedo);
   for (const double r : result.relative_rms) std::printf(" %.3g", r);
   std::printf(")%s\n", result.applied < spec.bounces ? "; stopped early: the last one added less than 1e-4" : "");
+  std::printf("the file's transfer/diffuse holds direct + bounces; the error check measures the direct pass\n");
   double bounce_seconds = 0;
   for (const double s : result.seconds) bounce_seconds += s;
   std::printf("gather: %u rays per vertex cast once in %.2f s (cached hits %.1f MB); the bounces took %.3f s (%.3f s "
