@@ -162,6 +162,41 @@ TEST(Bounce, IntegratingSphereClosedForm) {
   }
 }
 
+// The same closed form with the direct pass baked (QMC, cosine-weighted, N rays): the composition
+// of a real integrator's rows with the bounces. Only the mean over the vertices is compared: the
+// direct pass's per-vertex standard error is at most y_00 √(f(1 − f)/N), and each bounce carries
+// the direct errors of the vertices it gathers from, so the mean's is at most (that × Σ_b
+// (ρ(1 − f))^b + the bounces' σ above)/√V; 5× that, plus the tessellation bound (which moves the
+// direct term too: it is closed_total's first term).
+TEST(Bounce, IntegratingSphereWithItsDirectPassBaked) {
+  const double theta_hole = 0.6435011087932844;  // f = 0.1
+  const int n_theta = 32, n_phi = 64, B = 6;
+  const uint32_t N = 256;
+  const double f = (1 - std::cos(theta_hole)) / 2, rho = 0.8;
+  BounceSpec spec = spec_of(256, B, 0);
+  const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec);
+  const VertexBake direct = direct_bake(g, false, 1, QmcOptions{N, 11});
+  const std::vector<double> albedo(g.mesh.triangles.size(), rho);
+  const BounceResult r = bounce_transfer(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+  const size_t V = g.mesh.positions.size();
+  double mean = 0, mean_direct = 0;
+  for (size_t v = 0; v < V; ++v) {
+    mean += r.values[v] / double(V);
+    mean_direct += direct.values[v] / double(V);
+  }
+  double series = 0, sigma_bounces = 0;
+  for (int b = 0; b <= B; ++b) series += std::pow(rho * (1 - f), b);
+  for (int b = 0; b < B; ++b) sigma_bounces += 1.5 * rho * kY00 * f * std::pow(rho * (1 - f), b);
+  sigma_bounces *= std::sqrt(f * (1 - f) / spec.rays);
+  const double sigma = (kY00 * std::sqrt(f * (1 - f) / N) * series + sigma_bounces) / std::sqrt(double(V));
+  const double delta_f = 4 * f * std::pow(2 * pi / n_phi, 2) / 6, expect = closed_total(f, rho, B);
+  const double tess = std::max(std::abs(closed_total(f + delta_f, rho, B) - expect),
+                               std::abs(closed_total(f - delta_f, rho, B) - expect));
+  std::printf("direct mean %.6f (closed form %.6f); with %d bounces %.6f (closed form %.6f, error %.2e, bound %.2e)\n",
+              mean_direct, kY00 * f, B, mean, expect, mean - expect, 5 * sigma + tess);
+  EXPECT_LE(std::abs(mean - expect), 5 * sigma + tess);
+}
+
 // (a) Albedo 0: the rows keep every bit of the direct bake (a real one, with its signs and its
 // negative zeros), whatever the bounces asked for.
 TEST(Bounce, ZeroAlbedoKeepsTheDirectBits) {
