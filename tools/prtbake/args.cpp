@@ -210,12 +210,13 @@ std::string silhouette_k_help(bool with_default) {
 void add_bounces(CLI::App& cmd, Args& a) {
   const std::string group = "Interreflections";
   cmd.add_option("--bounces", a.bounces,
-                 "add B bounces of diffuse interreflection to the transfer (--transfer):\n"
-                 "light from the environment reflected between the mesh's own surfaces,\n"
-                 "Lambertian, of albedo --albedo (needed); back faces are black. Stops early\n"
-                 "once a bounce adds < 1e-4 of the direct pass's RMS. The file's\n"
-                 "transfer/diffuse then holds direct + bounces (attrs bounces,\n"
-                 "bounces_requested, albedo, bounce_rays); shading is unchanged.")
+                 "add B bounces of diffuse interreflection to the transfer (--transfer) and\n"
+                 "the band-1 radiance (--radiance): light from the environment reflected\n"
+                 "between the mesh's own surfaces, Lambertian, of albedo --albedo (needed);\n"
+                 "back faces are black. Stops early once a bounce adds < 1e-4 of the direct\n"
+                 "pass's RMS. transfer/diffuse and radiance/band1 then hold direct + bounces\n"
+                 "(attrs bounces, bounces_requested, albedo, bounce_rays); shading is\n"
+                 "unchanged. AO, --visibility stay direct; not with --shadowed.")
       ->option_text("B")
       ->check(tool::integer_in(0, 100))
       ->group(group);
@@ -548,11 +549,12 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
       const std::string b = "--bounces " + std::to_string(a.bounces);
       if (a.albedo.empty())
         fail(b + " needs --albedo R[,G,B]: the surfaces' albedo (a single mesh file gives no material)");
-      if (!a.transfer)
-        fail(b + " bounces the diffuse transfer: give --transfer L (AO and visibility transfer stay direct)");
-      if (!a.environment.empty())
-        fail(b + " with --radiance: band-1 and shadowed radiance with bounces are not implemented yet; bake the "
-                 "transfer with --transfer L --bounces and shade it under the environment's SH");
+      if (!a.transfer && a.environment.empty())
+        fail(b + " bounces the diffuse transfer and the band-1 radiance: give --transfer L or --radiance ENV (AO "
+                 "and visibility transfer stay direct)");
+      if (a.shadowed)
+        fail(b + " with --shadowed: shadowed radiance with bounces is not implemented yet (band-1 radiance, "
+                 "--radiance, and the transfer bounce)");
       if (a.worker)
         fail(b + " in a sharded bake: not implemented yet (a bounce needs every vertex's previous bounce); bake in "
                  "one process");

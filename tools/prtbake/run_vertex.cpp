@@ -54,8 +54,9 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
   const bake::BakeJob& job = pipeline.jobs().front();
 
   // ---- interreflections (bake/bake/bounce.h): the gather rays are cast once, after the first
-  // bake; the rows of every bake (a correction's too) are bounced from their cached hits. The
-  // error check measures the direct pass (the rows the integrator made); the file gets the sum.
+  // bake; the rows of every bake (a correction's too) are bounced from their cached hits (the
+  // diffuse transfer and band-1 radiance). The error check measures the direct pass (the rows the
+  // integrator made); the file gets the sum.
   bake::BounceSpec bounce_spec;
   bounce_spec.bounces = a.bounces;
   bounce_spec.rays = a.bounce_rays ? a.bounce_rays : bake::BounceSpec::kDefaultRays;
@@ -65,13 +66,13 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
   std::optional<bake::VertexBake> bounced;  // the direct rows with the bounces added
   int bounces_applied = 0;
   auto bounce = [&](const bake::VertexBake& direct, const std::vector<bake::ShadePoint>& points) {
-    if (!hits) hits = bake::gather(*accel.rays(), points, bounce_spec, run.progress);
+    if (!hits) hits = bake::gather(*accel.rays(), points, bounce_spec, direct.layout.radiance_count > 0, run.progress);
     bake::BounceResult r =
-        bake::bounce_transfer(mesh, *hits, albedo, direct.layout, direct.values, bounce_spec, run.progress);
+        bake::bounce_rows(mesh, *hits, albedo, direct.layout, direct.values, bounce_spec, run.progress);
     bounced = direct;
     bounced->values = std::move(r.values);
     bounces_applied = r.applied;
-    if (run.say) print_bounces(r, bounce_spec, a.albedo[0], *hits);
+    if (run.say) print_bounces(r, bounce_spec, a.albedo[0], *hits, direct.layout);
   };
 
   // ---- the file (formats/SCHEMA.md): written once the bake is whole, again with its report ----
@@ -85,7 +86,10 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
     tool::set_products(asset.vertices, result,
                        {job.integrator->name(), job.integrator_description, job.spec.samples(), job.spec.seed, a.transfer,
                         a.visibility, env ? &*env : nullptr, a.environment});
-    if (bounced) tool::set_bounces(*asset.vertices.transfer_diffuse, bounces_applied, bounce_spec, a.albedo);
+    if (bounced && asset.vertices.transfer_diffuse)
+      tool::set_bounces(*asset.vertices.transfer_diffuse, false, bounces_applied, bounce_spec, a.albedo);
+    if (bounced && asset.vertices.radiance_band1)
+      tool::set_bounces(*asset.vertices.radiance_band1, true, bounces_applied, bounce_spec, a.albedo);
     if (const auto& report = job.reports.front())
       asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
     tool::set_target_error(asset, a.target_error);

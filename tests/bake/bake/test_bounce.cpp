@@ -70,10 +70,18 @@ double closed_total(double f, double rho, int bounces) {
   return sum;
 }
 
-ProductLayout transfer_layout(int order) {
+// Transfer at `order`, and with `radiance` band-1 radiance after it (the layout a request with an
+// environment has; the rows here are made without one).
+ProductLayout transfer_layout(int order, bool radiance = false) {
   ProductRequest req;
   req.transfer_order = order;
-  return ProductLayout(req);
+  ProductLayout layout(req);
+  if (radiance) {
+    layout.radiance_count = 9;
+    layout.shadowed = layout.radiance + 9;
+    layout.width = layout.shadowed;
+  }
+  return layout;
 }
 
 BounceSpec spec_of(uint32_t rays, int bounces, double tolerance) {
@@ -90,12 +98,12 @@ struct Gathered {
   std::vector<ShadePoint> points;
   GatherHits hits;
 };
-Gathered gathered(Mesh mesh, const BounceSpec& spec) {
+Gathered gathered(Mesh mesh, const BounceSpec& spec, bool radiance = false) {
   Gathered g{std::move(mesh), {}, {}, {}};
   g.topology = build_topology(g.mesh);
   g.points = vertex_shade_points(g.mesh, g.topology);
   const RayCaster rays(g.mesh, g.topology);
-  g.hits = gather(rays, g.points, spec);
+  g.hits = gather(rays, g.points, spec, radiance);
   return g;
 }
 
@@ -123,44 +131,77 @@ VertexBake direct_bake(const Gathered& g, bool ao, int order, const QmcOptions& 
 // falls short of the circle's by (2π/n_phi)²/6 relatively; 4× that on f bounds the difference of
 // its form factor (the rim's segments are seen at the grazing angles where the cosine weight is
 // least). A uniform B^b interpolates exactly, so nothing else enters.
-TEST(Bounce, IntegratingSphereClosedForm) {
+//
+// With R (the mixture gather, eqs. (3'), (5')), the direct rows are R_c,m(v) = s_c π f y_1m(n_v),
+// whose irradiance (4) at the vertex's normal is s_c π f, the direct irradiance under a uniform
+// sky of radiance s_c (R's other directions do not enter a bounce: only E at the hit does). What
+// is compared is E_c after B bounces, eq. (4) at each vertex, against s_c π f Σ_{b≤B} (ρ(1 − f))^b,
+// and T_00 as above. The mixture's weight ((n·ω)/π)/p is at most 2, so a ray's standard
+// deviation is at most √(2(1 − f)) in place of √(f(1 − f)).
+static void check_integrating_sphere(bool radiance) {
   const double theta_hole = 0.6435011087932844;  // cos = 0.8: f = 0.1
   const int n_theta = 64, n_phi = 128;
-  const double f = (1 - std::cos(theta_hole)) / 2, rho = 0.8;
+  const double f = (1 - std::cos(theta_hole)) / 2, rho = 0.8, scale[3] = {1.0, 0.5, 0.25};
   BounceSpec spec = spec_of(256, 0, 0);  // tolerance 0: every bounce asked for
   spec.seed = 7;
-  const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec);
+  const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec, radiance);
   const size_t V = g.mesh.positions.size();
+  const ProductLayout layout = transfer_layout(1, radiance);
+  const size_t W = layout.width;
   const std::vector<double> albedo(g.mesh.triangles.size(), rho);
-  const std::vector<double> direct = closed_direct(V, f);
+  std::vector<double> direct(V * W);
+  std::vector<std::array<double, 3>> y1(V);
+  for (size_t v = 0; v < V; ++v) {
+    direct[v * W] = kY00 * f;
+    const Eigen::Vector3d n = g.mesh.normals[v].cast<double>().normalized();
+    double y[4];
+    prt::sh::eval(2, n.x(), n.y(), n.z(), y);
+    y1[v] = {y[1], y[2], y[3]};
+    if (radiance)
+      for (size_t c = 0; c < 3; ++c)
+        for (size_t m = 0; m < 3; ++m) direct[v * W + layout.radiance + 3 * c + m] = scale[c] * pi * f * y[1 + m];
+  }
   const double delta_f = 4 * f * std::pow(2 * pi / n_phi, 2) / 6;
+  const double per_ray = radiance ? std::sqrt(2 * (1 - f)) : std::sqrt(f * (1 - f));
   for (const int B : {1, 2, 4, 8}) {
     spec.bounces = B;
-    const BounceResult r = bounce_transfer(g.mesh, g.hits, albedo, transfer_layout(1), direct, spec);
+    const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, layout, direct, spec);
     ASSERT_EQ(r.applied, B);
-    const double expect = closed_total(f, rho, B);
-    double sigma = 0;
-    for (int b = 0; b < B; ++b) sigma += 1.5 * rho * kY00 * f * std::pow(rho * (1 - f), b);  // 1.5 ρ c_b
-    sigma *= std::sqrt(f * (1 - f) / spec.rays);
-    // The closed form with the hole's fraction off by delta_f either way.
-    const double tess = std::max(std::abs(closed_total(f + delta_f, rho, B) - expect),
-                                 std::abs(closed_total(f - delta_f, rho, B) - expect));
-    double mean = 0, worst = 0;
-    for (size_t v = 0; v < V; ++v) {
-      const double err = r.values[v] - expect;
-      mean += err / double(V);
-      worst = std::max(worst, std::abs(err));
+    // T_00 (c = −1), then E of each channel: value, closed form and its scale against T_00's.
+    for (int c = -1; c < (radiance ? 3 : 0); ++c) {
+      const double unit = c < 0 ? 1.0 : scale[c] * pi / kY00;  // E_c = unit × (T_00's closed form)
+      const double expect = unit * closed_total(f, rho, B);
+      double sigma = 0;
+      for (int b = 0; b < B; ++b) sigma += 1.5 * rho * unit * kY00 * f * std::pow(rho * (1 - f), b);  // 1.5 ρ c_b
+      sigma *= per_ray / std::sqrt(double(spec.rays));
+      // The closed form with the hole's fraction off by delta_f either way.
+      const double tess = unit * std::max(std::abs(closed_total(f + delta_f, rho, B) - closed_total(f, rho, B)),
+                                           std::abs(closed_total(f - delta_f, rho, B) - closed_total(f, rho, B)));
+      double mean = 0, worst = 0;
+      for (size_t v = 0; v < V; ++v) {
+        double value = r.values[v * W];
+        if (c >= 0) {  // eq. (4)
+          value = 0;
+          for (size_t m = 0; m < 3; ++m) value += y1[v][m] * r.values[v * W + layout.radiance + 3 * size_t(c) + m];
+          value *= 4 * pi / 3;
+        }
+        const double err = value - expect;
+        mean += err / double(V);
+        worst = std::max(worst, std::abs(err));
+      }
+      std::printf("B=%d %s: closed form %.6f, mean %.6f (error %.2e; bound %.2e = MC %.2e + tessellation %.2e), "
+                  "worst vertex %.2e (bound %.2e)\n",
+                  B, c < 0 ? "T_00" : ("E_" + std::to_string(c)).c_str(), expect, expect + mean, mean,
+                  5 * sigma / std::sqrt(double(V)) + tess, 5 * sigma / std::sqrt(double(V)), tess, worst,
+                  5 * sigma + tess);
+      EXPECT_LE(std::abs(mean), 5 * sigma / std::sqrt(double(V)) + tess) << "B = " << B << ", c = " << c;
+      EXPECT_LE(worst, 5 * sigma + tess) << "B = " << B << ", c = " << c;
     }
-    std::printf("B=%d: closed form %.6f, mean %.6f (error %.2e; bound %.2e = MC %.2e + tessellation %.2e), "
-                "worst vertex %.2e (bound %.2e); bounce RMS / direct:",
-                B, expect, expect + mean, mean, 5 * sigma / std::sqrt(double(V)) + tess,
-                5 * sigma / std::sqrt(double(V)), tess, worst, 5 * sigma + tess);
-    for (const double x : r.relative_rms) std::printf(" %.4f", x);
-    std::printf("\n");
-    EXPECT_LE(std::abs(mean), 5 * sigma / std::sqrt(double(V)) + tess) << "B = " << B;
-    EXPECT_LE(worst, 5 * sigma + tess) << "B = " << B;
   }
 }
+
+TEST(Bounce, IntegratingSphereClosedForm) { check_integrating_sphere(false); }
+TEST(Bounce, IntegratingSphereClosedFormWithRadiance) { check_integrating_sphere(true); }
 
 // The same closed form with the direct pass baked (QMC, cosine-weighted, N rays): the composition
 // of a real integrator's rows with the bounces. Only the mean over the vertices is compared: the
@@ -177,7 +218,7 @@ TEST(Bounce, IntegratingSphereWithItsDirectPassBaked) {
   const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec);
   const VertexBake direct = direct_bake(g, false, 1, QmcOptions{N, 11});
   const std::vector<double> albedo(g.mesh.triangles.size(), rho);
-  const BounceResult r = bounce_transfer(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+  const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
   const size_t V = g.mesh.positions.size();
   double mean = 0, mean_direct = 0;
   for (size_t v = 0; v < V; ++v) {
@@ -204,7 +245,7 @@ TEST(Bounce, ZeroAlbedoKeepsTheDirectBits) {
   const Gathered g = gathered(integrating_sphere(1.0, 12, 24), spec);
   const VertexBake direct = direct_bake(g, true, 3, QmcOptions{128, 3});
   const std::vector<double> albedo(g.mesh.triangles.size(), 0.0);
-  const BounceResult r = bounce_transfer(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+  const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
   ASSERT_EQ(r.values.size(), direct.values.size());
   EXPECT_EQ(std::memcmp(r.values.data(), direct.values.data(), r.values.size() * sizeof(double)), 0);
   EXPECT_EQ(r.applied, 1);  // the first bounce adds nothing: below any tolerance
@@ -223,7 +264,7 @@ TEST(Bounce, EveryBounceAddsEnergy) {
   for (size_t v = 0; v < V; ++v) mean_before += (before[v] = direct.values[v * W]) / double(V);
   for (int B = 1; B <= 4; ++B) {
     spec.bounces = B;
-    const BounceResult r = bounce_transfer(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+    const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
     double mean = 0;
     for (size_t v = 0; v < V; ++v) {
       EXPECT_GE(r.values[v * W], before[v]) << "vertex " << v << ", B = " << B;
@@ -247,7 +288,7 @@ TEST(Bounce, SameBytesWhateverTheThreads) {
     BounceResult r;
     arena.execute([&] {
       const Gathered g = gathered(mesh, spec);
-      r = bounce_transfer(g.mesh, g.hits, albedo, transfer_layout(1), direct, spec);
+      r = bounce_rows(g.mesh, g.hits, albedo, transfer_layout(1), direct, spec);
     });
     return r.values;
   };
