@@ -215,7 +215,9 @@ void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spe
   std::printf("bounced the %s: %d of %d bounce%s at albedo %g (each bounce's RMS / the direct pass's:", what.c_str(),
               result.applied, spec.bounces, spec.bounces == 1 ? "" : "s", albedo);
   for (const double r : result.relative_rms) std::printf(" %.3g", r);
-  std::printf(")%s\n", result.applied < spec.bounces ? "; stopped early: the last one added less than 1e-4" : "");
+  if (result.applied < spec.bounces)
+    std::printf("; stopped early: the last one added at most %g of the direct pass's RMS", spec.tolerance);
+  std::printf(")\n");
   std::printf("the file holds direct + bounces; the error check measures the direct pass\n");
   double bounce_seconds = 0;
   for (const double s : result.seconds) bounce_seconds += s;
