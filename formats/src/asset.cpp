@@ -94,7 +94,11 @@ constexpr Field<Product> kProductFields[] = {
     {N::kSamples, &Product::samples},
     {N::kSeed, &Product::seed},
     {N::kVisibility, &Product::visibility},
-    {N::kLightOrder, &Product::lights}};
+    {N::kLightOrder, &Product::lights},
+    {N::kBounces, &Product::bounces},
+    {N::kBouncesRequested, &Product::bounces_requested},
+    {N::kAlbedo, &Product::albedo},
+    {N::kBounceRays, &Product::bounce_rays}};
 
 constexpr Field<ReportRow> kReportFields[] = {
     {N::kColumns, &ReportRow::columns},

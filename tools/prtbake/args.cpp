@@ -2,6 +2,7 @@
 // options of each subcommand, and the checks that need no file.
 #include "args.h"
 
+#include <bake/bake/bounce.h>
 #include <bake/bake/choose.h>
 #include <bake/bake/scene.h>
 #include <prtshade/sh.h>
@@ -11,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -87,6 +89,7 @@ constexpr const char* kVertexExamples =
     "EXAMPLES\n"
     "  prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5\n"
     "  prtbake vertex asset.obj --visibility 6 --samples 4096 --threads 8 -o asset.prt.h5\n"
+    "  prtbake vertex data/bunny_ground.obj --transfer 3 --bounces 3 --albedo 0.6 -o bunny.prt.h5   # interreflections\n"
     "  mpirun -n 8 prtbake vertex big.obj --ao --samples 4096 -o big.prt.h5   # 8 workers, rank 0 merges\n"
     "  prtbake vertex big.obj --ao --samples 4096 --shard auto -o big.prt.h5  # a SLURM array task; then --merge\n"
     "  prtdump bunny.prt.h5            # what was baked, statistics, the error report\n\n";
@@ -201,6 +204,63 @@ std::string silhouette_k_help(bool with_default) {
   const bake::IntegratorSpec d;
   return "k = N, the number of spherical samples\n(sqrt(k) u-isolines, rounded to even" +
          (with_default ? "; default " + std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2" : "");
+}
+
+// --bounces, --albedo and --bounce-rays (vertex): interreflected diffuse transfer (bake/bake/bounce.h).
+void add_bounces(CLI::App& cmd, Args& a) {
+  const std::string group = "Interreflections";
+  cmd.add_option("--bounces", a.bounces,
+                 "add B bounces of diffuse interreflection to the transfer (--transfer) and\n"
+                 "the band-1 radiance (--radiance): light from the environment reflected\n"
+                 "between the mesh's own surfaces, Lambertian, of albedo --albedo (needed);\n"
+                 "back faces are black. Stops early once a bounce adds < 1e-4 of the direct\n"
+                 "pass's RMS. transfer/diffuse and radiance/band1 then hold direct + bounces\n"
+                 "(attrs bounces, bounces_requested, albedo, bounce_rays); shading is\n"
+                 "unchanged. AO, --visibility stay direct; not with --shadowed.")
+      ->option_text("B")
+      ->check(tool::integer_in(0, 100))
+      ->group(group);
+  cmd.add_option_function<std::string>(
+         "--albedo",
+         [&a](const std::string& text) {
+           std::vector<double> rgb;
+           size_t start = 0;
+           for (;;) {
+             const size_t comma = text.find(',', start);
+             const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+             char* end = nullptr;
+             const double x = std::strtod(part.c_str(), &end);
+             if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
+               throw CLI::ValidationError("--albedo", "expects R or R,G,B (numbers in [0, 1)), got '" + text + "'");
+             if (x < 0)
+               throw CLI::ValidationError("--albedo", "'" + text + "': an albedo is a reflectance in [0, 1), " +
+                                                          part + " is negative");
+             if (x >= 1)
+               throw CLI::ValidationError("--albedo", "'" + text + "': an albedo must be below 1 (at " + part +
+                                                          " light bounced inside an enclosure never dies out: the "
+                                                          "bounces would not converge)");
+             rgb.push_back(x);
+             if (comma == std::string::npos) break;
+             start = comma + 1;
+           }
+           if (rgb.size() == 1) rgb.assign(3, rgb[0]);
+           if (rgb.size() != 3)
+             throw CLI::ValidationError("--albedo", "expects R or R,G,B (numbers in [0, 1)), got '" + text + "'");
+           if (rgb[0] != rgb[1] || rgb[0] != rgb[2])
+             throw CLI::ValidationError("--albedo", "'" + text + "': a coloured albedo is not supported yet: the "
+                                                    "bounced transfer is grey in this version (give one value, or R = G = B)");
+           a.albedo = rgb;
+         },
+         "the surfaces' diffuse albedo for --bounces: R or R,G,B, each in [0, 1);\n"
+         "grey in this version (R = G = B)")
+      ->option_text("R[,G,B]")
+      ->group(group);
+  cmd.add_option("--bounce-rays", a.bounce_rays,
+                 "gather rays per vertex for --bounces, cast once; every bounce reuses\n"
+                 "their hits (default " + std::to_string(bake::BounceSpec::kDefaultRays) + ")")
+      ->option_text("K")
+      ->check(tool::integer_in(1, 1 << 16))
+      ->group(group);
 }
 
 // `name`: "vertex", or "texel" (the same products per texel of a lightmap).
@@ -325,6 +385,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
                  "and --samples, or use --reproducible, for the same bytes anywhere.")
       ->option_text("E")
       ->check(tool::number_in(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
+  if (!texel) add_bounces(cmd, a);
   const bake::IntegratorSpec d;
   add_sampling(cmd, a, samples,
                "silhouette: " + silhouette_k_help(false) +
@@ -484,6 +545,23 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
       fail("nothing to bake: give at least one of --ao, --transfer L, --visibility L, --radiance ENV (or --env ENV)");
     if (a.shadowed && a.environment.empty())
       fail("--shadowed L needs --radiance ENV (or --env ENV): the environment it is baked under");
+    if (a.bounces > 0) {
+      const std::string b = "--bounces " + std::to_string(a.bounces);
+      if (a.albedo.empty())
+        fail(b + " needs --albedo R[,G,B]: the surfaces' albedo (a single mesh file gives no material)");
+      if (!a.transfer && a.environment.empty())
+        fail(b + " bounces the diffuse transfer and the band-1 radiance: give --transfer L or --radiance ENV (AO "
+                 "and visibility transfer stay direct)");
+      if (a.shadowed)
+        fail(b + " with --shadowed: shadowed radiance with bounces is not implemented yet (band-1 radiance, "
+                 "--radiance, and the transfer bounce)");
+      if (a.worker)
+        fail(b + " in a sharded bake: not implemented yet (a bounce needs every vertex's previous bounce); bake in "
+                 "one process");
+    } else {
+      if (!a.albedo.empty()) fail("--albedo applies with --bounces B (B >= 1)");
+      if (a.bounce_rays != 0) fail("--bounce-rays applies with --bounces B (B >= 1)");
+    }
   }
   if (samples != 0) a.integrator.set_samples(samples);
   if (a.integrator.kind == bake::IntegratorKind::Silhouette &&

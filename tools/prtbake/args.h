@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace prt::tool {
 
@@ -48,6 +49,11 @@ struct Args {
   bool verbose = false;  // vertex: the pilot's whole table, not its one-line summary
   bool flip_normals = false;  // vertex: reverse every triangle and file normal
   double target_error = 0;    // vertex: --target-error E (0: not given; bake/bake/choose.h)
+  // vertex: interreflections of the diffuse transfer (bake/bake/bounce.h): --bounces B, --albedo
+  // (grey in this version: one value, or R = G = B; empty: not given) and --bounce-rays K.
+  int bounces = 0;
+  std::vector<double> albedo;
+  uint32_t bounce_rays = 0;  // 0: not given (bake::BounceSpec::kDefaultRays)
   bool integrator_given = false;  // vertex: --integrator was given (the chooser then keeps its kind)
   std::string command_line;  // what determines the file's contents (no --threads/--quiet)
   tool::ExportArgs exported;  // export: a baked file in another format (export.h)

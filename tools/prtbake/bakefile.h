@@ -4,6 +4,7 @@
 // attributes whichever command baked it (docs/ARCHITECTURE.md §4).
 #pragma once
 
+#include <bake/bake/bounce.h>
 #include <bake/bake/error_report.h>
 #include <bake/bake/fiv.h>
 #include <bake/bake/lightmap.h>
@@ -36,6 +37,12 @@ struct ProductInfo {
 };
 // ao, transfer_diffuse, transfer_visibility, radiance_band1: whatever the layout holds.
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info);
+
+// The attributes of a product with interreflections (formats/SCHEMA.md "Bounces"): the bounces
+// applied and asked for, the albedo (RGB) and the gather rays; the integrand says it (`radiance`:
+// the band-1 radiance's recursion, else the diffuse transfer's).
+void set_bounces(F::Product& product, bool radiance, int applied, const bake::BounceSpec& spec,
+                 const std::vector<double>& albedo);
 
 // The lightmap of a texel bake (format v5): /mesh/uv from the UV set, /lightmap/state from the
 // image's texel states (its `padding`), the texels' shade points as world positions and normals

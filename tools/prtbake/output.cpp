@@ -207,6 +207,26 @@ void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads) {
                 result.threads == 1 ? "" : "s");
 }
 
+void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, double albedo,
+                   const bake::GatherHits& hits, const bake::ProductLayout& layout) {
+  const std::string what = layout.transfer_count && layout.radiance_count ? "diffuse transfer and band-1 radiance"
+                           : layout.transfer_count                        ? "diffuse transfer"
+                                                                          : "band-1 radiance";
+  std::printf("bounced the %s: %d of %d bounce%s at albedo %g (each bounce's RMS / the direct pass's:", what.c_str(),
+              result.applied, spec.bounces, spec.bounces == 1 ? "" : "s", albedo);
+  for (const double r : result.relative_rms) std::printf(" %.3g", r);
+  if (result.applied < spec.bounces)
+    std::printf("; stopped early: the last one added at most %g of the direct pass's RMS", spec.tolerance);
+  std::printf(")\n");
+  std::printf("the file holds direct + bounces; the error check measures the direct pass\n");
+  double bounce_seconds = 0;
+  for (const double s : result.seconds) bounce_seconds += s;
+  std::printf("gather: %u rays per vertex (%s) cast once in %.2f s (cached hits %.1f MB); the bounces took %.3f s "
+              "(%.3f s each)\n",
+              hits.rays, hits.mixture ? "half cosine, half uniform" : "cosine", hits.seconds,
+              double(hits.bytes()) / 1e6, bounce_seconds, result.applied ? bounce_seconds / result.applied : 0.0);
+}
+
 void print_error_report(const bake::BakeJob& job) {
   const bake::ErrorReport& report = *job.reports.front();
   std::printf("error against a %u-ray QMC reference on %zu seeded %s (reference took %.2f s, not "

@@ -77,6 +77,10 @@ struct Product {
   std::optional<int64_t> samples, seed;  // samples: rays per vertex (qmc) or k (silhouette)
   std::optional<std::string> visibility;  // the visibility convention in words
   std::optional<std::string> lights;      // area-light products: names::kLightOrder
+  // Interreflections (transfer/diffuse; SCHEMA.md "Bounces"): the bounces summed into the values,
+  // those asked for, the albedo (RGB) they were bounced with and the gather rays per receiver.
+  std::optional<int64_t> bounces, bounces_requested, bounce_rays;
+  std::optional<std::vector<double>> albedo;
   ExtraAttrs extra;
   bool operator==(const Product&) const = default;
 };

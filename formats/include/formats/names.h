@@ -84,6 +84,10 @@ inline constexpr std::string_view kIntegratorDescription = "integrator_descripti
 inline constexpr std::string_view kSamples = "samples";
 inline constexpr std::string_view kSeed = "seed";
 inline constexpr std::string_view kVisibility = "visibility";
+inline constexpr std::string_view kBounces = "bounces";                    // interreflections: applied
+inline constexpr std::string_view kBouncesRequested = "bounces_requested";
+inline constexpr std::string_view kBounceRays = "bounce_rays";
+// (and kAlbedo, below: RGB)
 // ---- lightmap attributes (v5) ----
 inline constexpr std::string_view kUvSet = "uv_set";    // on /mesh/uv: the set's name in the asset ("TEXCOORD_1", "vt")
 inline constexpr std::string_view kPadding = "padding";  // on /lightmap/state: gutter rings, in texels

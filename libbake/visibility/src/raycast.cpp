@@ -286,7 +286,7 @@ SegmentCrossing ring_crossing(const ShadePoint& point, const Vector3d& a, const 
   bool ambiguous = false;
   const bool blocks = occludes_from_above(point.p, a, b, point.n, d, &ambiguous, tie_break(point));
   if (!ambiguous) return blocks ? SegmentCrossing::Cross : SegmentCrossing::Miss;
-  const NearTriangles::Test test{point.p, a, b, orient_eps(point.p, a, b, point.p, point.n, tie_break(point))};
+  const NearTriangles::Test test{point.p, a, b, orient_eps(point.p, a, b, point.p, point.n, tie_break(point)), 0};
   if (test.side == 0) return SegmentCrossing::Miss;  // no area seen from the limit point
   return crosses_exactly(test, point, point.p + reach * d);
 }
@@ -317,7 +317,7 @@ NearTriangles RayCaster::near_triangles(const ShadePoint& point) const {
   for (const unsigned prim : query.prims) {
     const auto& t = mesh_.triangles[prim];
     NearTriangles::Test test{mesh_.positions[t[0]].cast<double>(), mesh_.positions[t[1]].cast<double>(),
-                             mesh_.positions[t[2]].cast<double>(), 0};
+                             mesh_.positions[t[2]].cast<double>(), 0, prim};
     if (!(squared_distance_to_triangle(point.p, test.a, test.b, test.c) <= keep)) continue;
     near.prims.push_back(prim);
     // side 0: a degenerate triangle, or p + εn in its plane: no area to cross, but Embree must
@@ -391,6 +391,62 @@ std::optional<double> RayCaster::first_hit(const ShadePoint& point, const NearTr
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) first = std::min(first, double(rh.ray.tfar));
   if (first == std::numeric_limits<double>::infinity()) return std::nullopt;
   return first;
+}
+
+std::optional<SurfaceHit> RayCaster::first_surface_hit(const ShadePoint& point, const NearTriangles& near,
+                                                       const Vector3d& d) const {
+  auto face_normal = [&](uint32_t f) {
+    const auto& t = mesh_.triangles[f];
+    const Vector3d a = mesh_.positions[t[0]].cast<double>();
+    return Vector3d((mesh_.positions[t[1]].cast<double>() - a).cross(mesh_.positions[t[2]].cast<double>() - a));
+  };
+  if (point.welded >= 0) {  // the 1-ring: blocked at p itself
+    const auto w = uint32_t(point.welded);
+    const double reach_ = reach(point);
+    for (uint32_t f : topo_.ring(w))
+      if (const auto ab = ring_far_corners(mesh_, topo_, f, w);
+          ab && ring_crossing(point, ab->first, ab->second, d, reach_) == SegmentCrossing::Cross) {
+        const auto& t = mesh_.triangles[f];
+        const int k = topo_.weld[t[0]] == w ? 0 : topo_.weld[t[1]] == w ? 1 : 2;
+        return SurfaceHit{f, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0, face_normal(f).dot(d) < 0};
+      }
+  }
+  // The near triangles, decided exactly; the nearest crossing in double.
+  double first = std::numeric_limits<double>::infinity();
+  const NearTriangles::Test* nearest = nullptr;
+  if (!near.tests.empty()) {
+    const Vector3d r = point.p + reach(point) * d;
+    for (const NearTriangles::Test& t : near.tests)
+      if (crosses_exactly(t, point, r) == SegmentCrossing::Cross) {
+        const Vector3d m = (t.b - t.a).cross(t.c - t.a);
+        const double s = std::max(0.0, m.dot(t.a - point.p) / m.dot(d));
+        if (s < first) first = s, nearest = &t;
+      }
+  }
+  RingContext ctx = ring_context(point, near, topo_.weld.data(), mesh_.triangles.data());
+  RTCRayHit rh{};
+  rh.ray = make_ray(point.p, d);
+  if (nearest) rh.ray.tfar = float(first);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rt_->scene, &ctx.base, &rh);
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID && !(nearest && double(rh.ray.tfar) >= first)) {
+    const double w1 = std::clamp(double(rh.hit.u), 0.0, 1.0), w2 = std::clamp(double(rh.hit.v), 0.0, 1.0 - w1);
+    return SurfaceHit{rh.hit.primID, w1, w2, face_normal(rh.hit.primID).dot(d) < 0};
+  }
+  if (!nearest) return std::nullopt;
+  // The point where the ray meets the near triangle's plane, as weights of its corners (areas of
+  // the sub-triangles against the normal), clamped to the triangle: it was crossed exactly.
+  const NearTriangles::Test& t = *nearest;
+  const Vector3d q = point.p + first * d, m = (t.b - t.a).cross(t.c - t.a);
+  const double mm = m.squaredNorm();
+  double w1 = std::max(0.0, (q - t.a).cross(t.c - t.a).dot(m) / mm);  // q = a + w1 (b − a) + w2 (c − a)
+  double w2 = std::max(0.0, (t.b - t.a).cross(q - t.a).dot(m) / mm);
+  if (w1 + w2 > 1) {
+    const double sum = w1 + w2;
+    w1 /= sum;
+    w2 /= sum;
+  }
+  return SurfaceHit{t.prim, w1, w2, m.dot(d) < 0};
 }
 
 bool RayCaster::occluded(const Vector3d& origin, const Vector3d& d, double tnear, double tfar) const {

@@ -58,6 +58,7 @@ struct NearTriangles {
   struct Test {                 // a near triangle with area as seen from p + εn, decided exactly
     Eigen::Vector3d a, b, c;
     int side;                   // orient_eps(a, b, c, p, n): the side of its plane p + εn is on (±1)
+    uint32_t prim;              // its index in the mesh's triangles
   };
   std::vector<uint32_t> prims;  // every near triangle, ascending: Embree skips them
   std::vector<Test> tests;      // those of them that can block (side ≠ 0), in the order of prims
@@ -67,6 +68,15 @@ struct NearTriangles {
 struct RayHit {
   uint32_t triangle;
   float t, u, v;  // distance along the unit direction; Embree's barycentrics (weights of corners 1, 2)
+};
+
+// Where the ray that visible() decides is blocked meets the surface: the first blocking triangle,
+// the point's barycentric weights there, and the side it is met from. The gather rays of
+// interreflection (bake/bake/bounce.h) read the surface's exit radiance at that point.
+struct SurfaceHit {
+  uint32_t triangle;
+  double w1, w2;  // barycentric weights of the triangle's corners 1 and 2 (corner 0: 1 − w1 − w2), each in [0, 1]
+  bool front;     // met from the side its winding's normal (c1 − c0) × (c2 − c0) points to
 };
 
 // The ray queries over one mesh (an Embree BVH built once, at construction).
@@ -88,6 +98,13 @@ public:
   // plane's distance, in double; any other at Embree's closest hit). The sparse rays of the
   // filter integrator (bake/integrators/filter.h), which need the occluder's depth.
   std::optional<double> first_hit(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const;
+  // The same first blocker as a point on the surface (nullopt exactly when visible() is true): a
+  // 1-ring triangle blocks at p itself (its corner at p, weight 1; the first in ring order); a near
+  // triangle where the ray meets its plane (double, the weights clamped to the triangle); any other
+  // at Embree's closest hit and barycentrics. The side is the sign of the face normal · d, so a
+  // ray that enters a closed object through its surface meets it from the front.
+  std::optional<SurfaceHit> first_surface_hit(const ShadePoint& point, const NearTriangles& near,
+                                              const Eigen::Vector3d& d) const;
   // Whether the point's 1-ring or one of its near triangles blocks d (the exact part of visible();
   // Embree is not asked): occluders at distance ~0, a crease or a contact.
   bool blocked_nearby(const ShadePoint& point, const NearTriangles& near, const Eigen::Vector3d& d) const {

@@ -1,0 +1,192 @@
+#include <bake/bake/bounce.h>
+#include <bake/bake/vertex_bake.h>
+#include <bake/core/error.h>
+#include <bake/sphere/sampling.h>
+
+#include <prtshade/sh.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <cstdio>
+#include <string>
+
+namespace prt::bake {
+
+namespace {
+// The gather's own stream of randomisation, apart from the direct pass's QMC points of the same
+// seed and row (bake/sphere/sampling.h RotatedHalton3).
+constexpr uint64_t kGatherStream = 0x6a09e667f3bcc909ull;
+// The most values a vertex gives a bounce: T at the largest order, and E's three channels.
+constexpr size_t kMaxSource = size_t(sh::kMaxOrder) * size_t(sh::kMaxOrder) + 3;
+} // namespace
+
+GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, const BounceSpec& spec, bool radiance,
+                  const Monitor& monitor, const std::string& label) {
+  PRT_CHECK_OP(spec.rays, >, 0u);
+  const auto t0 = std::chrono::steady_clock::now();
+  GatherHits hits;
+  hits.rays = spec.rays;
+  hits.mixture = radiance;
+  const size_t K = spec.rays;
+  hits.triangle.assign(points.size() * K, GatherHits::kNone);
+  hits.weights.assign(points.size() * K, {0.0f, 0.0f});
+  if (radiance) hits.estimator.assign(points.size() * K, {0.0f, 0.0f, 0.0f, 0.0f});
+  const uint64_t seed = mix64(spec.seed ^ kGatherStream);
+  constexpr double kInvPi = std::numbers::inv_pi;
+  Task progress(monitor, label, points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+    double y[4];
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      const ShadePoint& point = points[v];
+      PRT_CHECK(point.hemisphere);
+      const Frame frame(point.n);
+      const RotatedHalton3 halton(seed, v);
+      const NearTriangles near = rays.near_triangles(point);
+      for (size_t k = 0; k < K; ++k) {
+        const auto u = halton(k);
+        // The mixture picks its strategy by u0 (one strategy per ray, the balance heuristic's pdf).
+        const bool uniform = radiance && u[0] >= 0.5;
+        Eigen::Vector3d d =
+            frame.to_world(uniform ? uniform_hemisphere(u[1], u[2]) : cosine_hemisphere(u[1], u[2]));
+        d.normalize();
+        const double c = point.n.dot(d);
+        if (!(c > 0)) continue;  // on the horizon (a null set): no contribution
+        const auto hit = rays.first_surface_hit(point, near, d);
+        if (!hit || !hit->front) continue;  // the sky (the direct pass's), or a back face (black)
+        hits.triangle[v * K + k] = hit->triangle;
+        hits.weights[v * K + k] = {float(hit->w1), float(hit->w2)};
+        if (radiance) {
+          const double inv_p = 1.0 / (0.5 * c * kInvPi + 0.5 * (0.5 * kInvPi));  // (3'), (5')
+          sh::eval(2, d.x(), d.y(), d.z(), y);
+          hits.estimator[v * K + k] = {float(c * kInvPi * inv_p), float(y[1] * kInvPi * inv_p),
+                                       float(y[2] * kInvPi * inv_p), float(y[3] * kInvPi * inv_p)};
+        }
+      }
+    }
+    progress.advance(r.size());
+  });
+  progress.finish();
+  hits.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return hits;
+}
+
+void check_albedo(std::span<const double> albedo, const std::string& source) {
+  for (size_t t = 0; t < albedo.size(); ++t) {
+    const double a = albedo[t];
+    if (std::isfinite(a) && a >= 0 && a < 1) continue;
+    char value[64];
+    std::snprintf(value, sizeof value, "%.17g", a);
+    throw InputError(source, "albedo " + std::string(value) + " of triangle " + std::to_string(t) +
+                                 (a >= 1 ? " is 1 or more: the bounces would not converge (an albedo must be below 1)"
+                                  : a < 0 ? " is negative (an albedo is a reflectance in [0, 1))"
+                                          : " is not a number (an albedo is a reflectance in [0, 1))"));
+  }
+}
+
+BounceResult bounce_rows(const Mesh& mesh, const GatherHits& hits, std::span<const double> albedo,
+                         const ProductLayout& layout, std::span<const double> direct, const BounceSpec& spec,
+                         const Monitor& monitor, const std::string& label) {
+  const size_t V = mesh.positions.size(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
+  const bool radiance = layout.radiance_count > 0;
+  PRT_CHECK_OP(albedo.size(), ==, mesh.triangles.size());
+  PRT_CHECK_OP(direct.size(), ==, V * W);
+  PRT_CHECK_OP(hits.rows(), ==, V);
+  PRT_CHECK(!radiance || hits.mixture);  // R's estimator (5') needs the mixture's weights
+  PRT_CHECK(spec.bounces >= 0);
+  check_albedo(albedo, mesh.source);
+  BounceResult out;
+  out.values.assign(direct.begin(), direct.end());
+  if ((nt == 0 && !radiance) || spec.bounces == 0) return out;
+
+  // What a bounce gathers per vertex, [V][S]: T^b (nt values), then E^b_c (3, eq. (4) at the
+  // vertex's normal, when R bounces). What it makes per vertex, [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], 9).
+  const size_t S = nt + (radiance ? 3 : 0), B = nt + (radiance ? 9 : 0);
+  std::vector<std::array<double, 3>> y1(radiance ? V : 0);  // y_1m(n_v)
+  for (size_t v = 0; v < y1.size(); ++v) {
+    const Eigen::Vector3d n = mesh.normals[v].cast<double>().normalized();
+    double y[4];
+    sh::eval(2, n.x(), n.y(), n.z(), y);
+    y1[v] = {y[1], y[2], y[3]};
+  }
+  std::vector<double> source(V * S), made(V * B);
+  auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset) {
+    for (size_t v = 0; v < V; ++v) {
+      for (size_t i = 0; i < nt; ++i) source[v * S + i] = rows[v * width + t_offset + i];
+      if (radiance)
+        for (size_t c = 0; c < 3; ++c) {  // eq. (4)
+          double e = 0;
+          for (size_t m = 0; m < 3; ++m) e += y1[v][m] * rows[v * width + r_offset + 3 * c + m];
+          source[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;
+        }
+    }
+  };
+  take(direct, W, layout.transfer, layout.radiance);
+  // The direct pass's RMS per product, over the rows.
+  auto slice_rms = [&](std::span<const double> rows, size_t width, size_t offset, size_t count) {
+    double sum = 0;
+    for (size_t v = 0; v < V; ++v)
+      for (size_t i = 0; i < count; ++i) sum += rows[v * width + offset + i] * rows[v * width + offset + i];
+    return V * count > 0 ? std::sqrt(sum / double(V * count)) : 0.0;
+  };
+  const double direct_rms[2] = {slice_rms(direct, W, layout.transfer, nt),
+                                slice_rms(direct, W, layout.radiance, radiance ? 9 : 0)};
+
+  for (int b = 1; b <= spec.bounces; ++b) {
+    // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source interpolated at h) × its weights.
+    VertexBake pass = bake_rows(
+        0, V, B,
+        [&](size_t v, std::span<double> row, std::span<double>) {
+          double at_hit[kMaxSource];
+          for (size_t k = 0; k < K; ++k) {
+            const size_t ray = v * K + k;
+            const uint32_t t = hits.triangle[ray];
+            if (t == GatherHits::kNone) continue;
+            const double rho = albedo[t];
+            if (rho == 0) continue;
+            const auto& tri = mesh.triangles[t];
+            const double w1 = hits.weights[ray][0], w2 = hits.weights[ray][1];
+            const double w[3] = {1.0 - w1 - w2, w1, w2};
+            std::fill(at_hit, at_hit + S, 0.0);
+            for (int c = 0; c < 3; ++c) {
+              const double* src = &source[size_t(tri[size_t(c)]) * S];
+              for (size_t i = 0; i < S; ++i) at_hit[i] += w[c] * src[i];
+            }
+            const double wt = hits.mixture ? rho * double(hits.estimator[ray][0]) : rho;
+            for (size_t i = 0; i < nt; ++i) row[i] += wt * at_hit[i];
+            if (radiance)
+              for (size_t c = 0; c < 3; ++c)
+                for (size_t m = 0; m < 3; ++m)
+                  row[nt + 3 * c + m] += rho * at_hit[nt + c] * double(hits.estimator[ray][1 + m]);
+          }
+          for (size_t i = 0; i < B; ++i) row[i] /= double(K);
+        },
+        monitor, label + " (bounce " + std::to_string(b) + ")", "the bounce gather of " + mesh.source);
+    made = std::move(pass.values);
+    // Summed only where non-zero, so an albedo of 0 leaves the direct rows' bits (−0 included).
+    for (size_t v = 0; v < V; ++v) {
+      for (size_t i = 0; i < nt; ++i)
+        if (const double x = made[v * B + i]; x != 0) out.values[v * W + layout.transfer + i] += x;
+      if (radiance)
+        for (size_t i = 0; i < 9; ++i)
+          if (const double x = made[v * B + nt + i]; x != 0) out.values[v * W + layout.radiance + i] += x;
+    }
+    double r = 0;
+    if (direct_rms[0] > 0) r = std::max(r, slice_rms(made, B, 0, nt) / direct_rms[0]);
+    if (direct_rms[1] > 0) r = std::max(r, slice_rms(made, B, nt, radiance ? 9 : 0) / direct_rms[1]);
+    out.applied = b;
+    out.relative_rms.push_back(r);
+    out.seconds.push_back(pass.seconds);
+    if (r <= spec.tolerance || b == spec.bounces) break;
+    take(made, B, 0, nt);
+  }
+  for (const double x : out.values)
+    if (!std::isfinite(x)) throw ContractError("bounce_rows: a non-finite value in the bounced rows of " + mesh.source);
+  return out;
+}
+
+} // namespace prt::bake

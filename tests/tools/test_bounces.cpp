@@ -1,0 +1,166 @@
+// Interreflections through prtbake (bake/bake/bounce.h, formats/SCHEMA.md "Bounces"): albedo 0
+// gives the direct bake's values, every bounce adds energy, any thread count gives the same bytes,
+// the attributes say what the transfer holds, and bad albedos and missing options are usage
+// errors (exit 2) that name the problem and write nothing.
+#include "run_tool.h"
+#include "scratch.h"
+
+#include <formats/prtfile.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace F = prt::formats;
+using prt::testing::run_tool;
+
+namespace {
+
+const std::string kData = PRT_DATA_DIR;
+// The bunny on its ground: the ground lights the bunny's underside and the bunny the ground.
+const std::string kBake = "vertex " + kData + "/bunny_ground.obj --transfer 3 --integrator qmc --samples 64 --report 0";
+
+fs::path dir_for(const std::string& name) { return prt::testing::fresh_dir("bounces", name); }
+
+const std::string kEnv = " --radiance " + kData + "/sunset.exr";
+
+std::vector<float> dataset(const fs::path& file, const std::string& path) {
+  const F::File f = F::read_file(file);
+  const F::Dataset* d = F::find_dataset(f, path);
+  EXPECT_NE(d, nullptr) << path;
+  return d ? std::get<std::vector<float>>(d->data) : std::vector<float>{};
+}
+std::vector<float> transfer(const fs::path& file) { return dataset(file, "/transfer/diffuse"); }
+
+// The irradiance each vertex's band-1 radiance gives at its baked normal, E_c = (4π/3) Σ_m y_1m(n) R_c,m
+// (in double from the file's floats), [V][RGB].
+std::vector<double> irradiance(const fs::path& file) {
+  const std::vector<float> R = dataset(file, "/radiance/band1"), n = dataset(file, "/mesh/normals");
+  std::vector<double> E(n.size());
+  const double k = 0.4886025119029199 * 4 * std::acos(-1.0) / 3;  // y_1m(n) = 0.488603 (−n_y, n_z, −n_x)
+  for (size_t v = 0; v < n.size() / 3; ++v)
+    for (size_t c = 0; c < 3; ++c) {
+      const float* r = &R[9 * v + 3 * c];
+      E[3 * v + c] = k * (-double(n[3 * v + 1]) * r[0] + double(n[3 * v + 2]) * r[1] - double(n[3 * v]) * r[2]);
+    }
+  return E;
+}
+
+F::AttrValue attr(const fs::path& file, const std::string& name, const std::string& path = "/transfer/diffuse") {
+  const F::File f = F::read_file(file);
+  const F::Attr* a = F::find_attr(F::find_dataset(f, path)->attrs, name);
+  EXPECT_NE(a, nullptr) << name;
+  return a ? a->value : F::AttrValue{};
+}
+
+fs::path bake(const fs::path& d, const std::string& name, const std::string& extra) {
+  const fs::path out = d / (name + ".prt.h5");
+  const auto r = run_tool(PRT_PRTBAKE, kBake + " " + extra + " -q -o " + out.string(), d / "capture");
+  EXPECT_EQ(r.code, 0) << r.err;
+  return out;
+}
+
+} // namespace
+
+// (a) Albedo 0: the file's transfer has the direct bake's values exactly (every bounce is zero), and
+// its attributes say what was asked.
+TEST(Bounces, ZeroAlbedoGivesTheDirectValues) {
+  const fs::path d = dir_for("zero");
+  const fs::path direct = bake(d, "direct", kEnv), zero = bake(d, "zero", "--bounces 3 --albedo 0" + kEnv);
+  EXPECT_TRUE(transfer(zero) == transfer(direct));
+  EXPECT_TRUE(dataset(zero, "/radiance/band1") == dataset(direct, "/radiance/band1"));
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounces", "/radiance/band1")), 1);
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounces")), 1);  // the first bounce added nothing: stopped
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounces_requested")), 3);
+  EXPECT_EQ(std::get<std::vector<double>>(attr(zero, "albedo")), (std::vector<double>{0, 0, 0}));
+  EXPECT_EQ(std::get<int64_t>(attr(zero, "bounce_rays")), 256);
+}
+
+// (b) Under a non-negative environment every bounce adds non-negative light: T_00 (a uniform sky's
+// transfer) and the irradiance band-1 radiance gives at each vertex's normal never fall from B to
+// B + 1, and their means grow. (Exact in the bake; T_00 is compared as stored, since float rounding
+// is monotone, and E is formed from the stored floats, so it may fall by their rounding, 1e-6
+// relative, no more.)
+TEST(Bounces, EveryBounceAddsEnergy) {
+  const fs::path d = dir_for("energy");
+  const fs::path first = bake(d, "b0", kEnv);
+  std::vector<float> before = transfer(first);
+  std::vector<double> e_before = irradiance(first);
+  const size_t n = 9, V = before.size() / n;
+  double mean_before = 0, e_mean_before = 0;
+  for (size_t v = 0; v < V; ++v) mean_before += before[v * n];
+  for (const double e : e_before) e_mean_before += e;
+  for (int B = 1; B <= 3; ++B) {
+    const fs::path out =
+        bake(d, "b" + std::to_string(B), "--bounces " + std::to_string(B) + " --albedo 0.7 --bounce-rays 64" + kEnv);
+    EXPECT_EQ(std::get<int64_t>(attr(out, "bounces")), B);
+    const std::vector<float> now = transfer(out);
+    const std::vector<double> e_now = irradiance(out);
+    ASSERT_EQ(now.size(), before.size());
+    ASSERT_EQ(e_now.size(), e_before.size());
+    double mean = 0, e_mean = 0;
+    for (size_t v = 0; v < V; ++v) {
+      EXPECT_GE(now[v * n], before[v * n]) << "vertex " << v << ", B = " << B;
+      ASSERT_TRUE(std::isfinite(now[v * n]));
+      mean += now[v * n];
+    }
+    for (size_t i = 0; i < e_now.size(); ++i) {
+      EXPECT_GE(e_now[i], e_before[i] - 1e-6 * std::abs(e_before[i])) << "vertex " << i / 3 << ", B = " << B;
+      e_mean += e_now[i];
+    }
+    EXPECT_GT(mean, mean_before) << "B = " << B;
+    EXPECT_GT(e_mean, e_mean_before) << "B = " << B;
+    mean_before = mean;
+    e_mean_before = e_mean;
+    before = now;
+    e_before = e_now;
+  }
+}
+
+// (d) The same bytes with one thread and with two.
+TEST(Bounces, SameBytesWhateverTheThreads) {
+  const fs::path d = dir_for("threads");
+  const std::string args = "--bounces 2 --albedo 0.5,0.5,0.5 --bounce-rays 32 --reproducible" + kEnv;
+  // The same output path both times: the command line, stored in the file, names it.
+  const std::string one = prt::testing::read_bytes(bake(d, "x", args + " --threads 1"));
+  fs::remove(d / "x.prt.h5");
+  const std::string two = prt::testing::read_bytes(bake(d, "x", args + " --threads 2"));
+  EXPECT_FALSE(one.empty());
+  EXPECT_TRUE(one == two);
+}
+
+// (e) Bad albedos, a missing one and what this version does not bounce: exit 2 before any work,
+// the message naming the problem, no file.
+TEST(Bounces, BadOptionsAreUsageErrors) {
+  const fs::path d = dir_for("bad"), out = d / "x.prt.h5";
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {"--bounces 2 --albedo 1", "an albedo must be below 1"},
+      {"--bounces 2 --albedo 1.5,1.5,1.5", "an albedo must be below 1"},
+      {"--bounces 2 --albedo -0.2", "-0.2 is negative"},
+      {"--bounces 2 --albedo grey", "expects R or R,G,B"},
+      {"--bounces 2 --albedo 0.5,0.5", "expects R or R,G,B"},
+      {"--bounces 2 --albedo 0.8,0.5,0.3", "a coloured albedo is not supported yet"},
+      {"--bounces 2", "--bounces 2 needs --albedo R[,G,B]"},
+      {"--albedo 0.5", "--albedo applies with --bounces"},
+      {"--bounce-rays 64", "--bounce-rays applies with --bounces"},
+      {"--bounces 2 --albedo 0.5 --shadowed 3" + kEnv, "shadowed radiance with bounces is not implemented yet"},
+      {"--bounces 2 --albedo 0.5 --shard 0/2", "--bounces 2 in a sharded bake: not implemented yet"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_tool(PRT_PRTBAKE, kBake + " " + c.args + " -o " + out.string(), d / "capture");
+    EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  const auto ao = run_tool(PRT_PRTBAKE,
+                           "vertex " + kData + "/bunny_ground.obj --ao --bounces 2 --albedo 0.5 -o " + out.string(),
+                           d / "capture");
+  EXPECT_EQ(ao.code, 2);
+  EXPECT_NE(ao.err.find("give --transfer L or --radiance ENV"), std::string::npos) << ao.err;
+}
