@@ -360,9 +360,9 @@ TEST(PrtviewScene, GlossyLobesPerTexelFromTheLightmapBeatGouraudPerVertex) {
             std::string::npos) << t.out;
   EXPECT_NE(a.out.find("route A (transfer/visibility), per texel, 64x64 lightmap"), std::string::npos) << a.out;
   EXPECT_NE(t.out.find("per-texel objects: 0 of "), std::string::npos) << t.out;
-  const auto corrected = [](const std::string& out) {
-    const size_t at = out.find("noise-corrected NRMSE ");
-    return at == std::string::npos ? std::nan("") : std::strtod(out.c_str() + at + 22, nullptr);
+  const auto corrected = [](const std::string& text) {
+    const size_t at = text.find("noise-corrected NRMSE ");
+    return at == std::string::npos ? std::nan("") : std::strtod(text.c_str() + at + 22, nullptr);
   };
   const double ev = corrected(v.out), et = corrected(t.out), ea = corrected(a.out);
   ASSERT_TRUE(std::isfinite(ev) && std::isfinite(et) && std::isfinite(ea)) << v.out << t.out << a.out;

@@ -297,17 +297,10 @@ TEST(TexelBake, AWallStandingOnTheFloorWithNoSharedVerticesMatchesTheClosedFormB
                                                           {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   const Mesh wall = make_mesh(c, box_faces, "wall");
   const Mesh both = merge_meshes(std::vector<Mesh>{s.floor, wall}, "floor and wall");
-  std::vector<std::vector<Vector3d>> faces;  // the slab's six faces as quads (outward)
-  for (size_t t = 0; t < box_faces.size(); t += 2) {
-    const auto& a = box_faces[t];
-    const auto& b = box_faces[t + 1];
-    std::vector<uint32_t> q = {a[0], a[1], a[2]};
-    for (uint32_t v : b)
-      if (std::find(q.begin(), q.end(), v) == q.end()) q.insert(q.begin() + 2, v);  // a, b's far corner, the rest
-    std::vector<Vector3d> poly;
-    for (uint32_t v : q) poly.push_back(c[v].cast<double>());
-    faces.push_back(poly);
-  }
+  // The slab's six faces as quads, outward (the triangle pairs above, joined).
+  const std::array<std::array<uint32_t, 4>, 6> quads = {{{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
+  std::vector<std::vector<Vector3d>> faces;
+  for (const auto& q : quads) faces.push_back({c[q[0]].cast<double>(), c[q[1]].cast<double>(), c[q[2]].cast<double>(), c[q[3]].cast<double>()});
   const TexelAtlas atlas = texel_atlas(s.floor, build_topology(s.floor), s.uv, 32, 32, "floor");
   const Topology topo = build_topology(both);
   const MeshAccel accel(both, topo);
