@@ -643,6 +643,11 @@ Footprint footprint(const Chart& c, double s) {
 struct Shape {
   Bits texels;
   int32_t key_level = 0, key_row = 0, key_start = 0, key_length = 0;
+  // CORE: with k = core_level > 0 (the highest level at most h rows tall), the intersections of
+  // rows min(i·2^k, h − 2^k) … + 2^k − 1, i = 0, 1, …: every row is in one, and a core row
+  // tested against level k answers for 2^k rows of the shape at once.
+  int32_t core_level = 0;
+  Bits core;
 };
 
 // Bit image b transposed: texel (c, q) to (q, c), 64 × 64 blocks at a time.
@@ -695,15 +700,23 @@ Shape shape(const Bits& f, int r, int levels) {
   else s.texels = f;
   if (r == 1 || r == 2) mirror_columns(s.texels);
   if (r == 2 || r == 3) mirror_rows(s.texels);
-  // The key: level k's row y is the intersection of rows y … y + 2^k − 1.
+  // The key and the core: level k's row y is the intersection of rows y … y + 2^k − 1.
+  const int32_t h = s.texels.h;
+  while (levels > 1 && (int32_t(1) << (levels - 1)) > h) --levels;
   Bits level = s.texels;
   int64_t best = 0;
-  for (int k = 0; k < levels && (int32_t(1) << k) <= s.texels.h; ++k) {
+  for (int k = 0; k < levels; ++k) {
     const int32_t span = int32_t(1) << k, half = span / 2;
     if (k > 0)
-      for (int32_t y = 0; y + span <= s.texels.h; ++y)
+      for (int32_t y = 0; y + span <= h; ++y)
         for (int32_t i = 0; i < level.words; ++i) level.row(y)[i] &= level.row(y + half)[i];
-    for (int32_t y = 0; y + span <= s.texels.h; ++y)
+    if (k > 0 && k == levels - 1) {
+      s.core_level = k;
+      s.core.reset(level.w, (h + span - 1) / span);
+      for (int32_t i = 0; i < s.core.h; ++i)
+        std::copy_n(level.row(std::min(i * span, h - span)), level.words, s.core.row(i));
+    }
+    for (int32_t y = 0; y + span <= h; ++y)
       for (int64_t a = next_bit(level.row(y), level.words, 0, true); a < level.w;) {
         const int64_t b = std::min<int64_t>(level.w, next_bit(level.row(y), level.words, a, false));
         if ((b - a) * span > best) {
@@ -836,23 +849,33 @@ private:
   }
 
   // −1 when `s` fits with its box at (x, y); otherwise a column x' > x such that it collides at
-  // every column x … x' − 1 too: past the run of the shape's row that hit the first taken texel.
+  // every column x … x' − 1 too: past the run of the shape's (or core's) row that hit a taken
+  // texel. The core first: it rejects most positions of a large shape in a few rows.
   int64_t collision(const Shape& s, int64_t x, int64_t y) const {
     const Bits& t = s.texels;
     const int64_t k0 = x >> 6, n = ((x + t.w - 1) >> 6) - k0 + 1;
     const int shift = int(x & 63);
-    for (int64_t j = 0; j < t.h; ++j) {
-      const uint64_t* m = t.row(j);
-      const uint64_t* g = taken_[0].row(y + j) + k0;
+    auto hit = [&](const uint64_t* m, const uint64_t* g) -> int64_t {
+      g += k0;
       for (int64_t i = 0; i < n; ++i) {
         uint64_t v = i < t.words ? m[i] << shift : 0;
         if (shift != 0 && i > 0) v |= m[i - 1] >> (64 - shift);
-        if (const uint64_t hit = v & g[i]; hit != 0) {
-          const int64_t c = (k0 + i) * 64 + 63 - std::countl_zero(hit);  // the last hit in this word
+        if (const uint64_t both = v & g[i]; both != 0) {
+          const int64_t c = (k0 + i) * 64 + 63 - std::countl_zero(both);  // the last hit in this word
           return c - run_start(m, c - x) + 1;
         }
       }
+      return -1;
+    };
+    if (s.core_level > 0) {
+      const int64_t span = int64_t(1) << s.core_level;
+      for (int64_t i = 0; i < s.core.h; ++i)
+        if (const int64_t next = hit(s.core.row(i), taken_[size_t(s.core_level)].row(y + std::min(i * span, t.h - span)));
+            next >= 0)
+          return next;
     }
+    for (int64_t j = 0; j < t.h; ++j)
+      if (const int64_t next = hit(t.row(j), taken_[0].row(y + j)); next >= 0) return next;
     return -1;
   }
 };
