@@ -894,6 +894,23 @@ bool footprints(const std::vector<Chart>& charts, double s, uint32_t min_texels,
   return true;
 }
 
+// The texels within r of a footprint's (Chebyshev). Two charts' footprints lie more than G apart
+// and G/2 or more from the border, so their sets at r = G/2 are disjoint and inside the atlas:
+// their sum is at most W·H wherever the charts pack.
+int64_t dilated_texels(const Bits& b, int32_t r) {
+  const int32_t words = (b.w + 2 * r + 63) / 64;
+  std::vector<uint64_t> wide(size_t(b.h + 2 * r) * size_t(words), 0);  // rows widened by r, shifted by r
+  for (int32_t y = 0; y < b.h; ++y)
+    for (int64_t a = next_bit(b.row(y), b.words, 0, true); a < b.w;) {
+      const int64_t e = std::min<int64_t>(b.w, next_bit(b.row(y), b.words, a, false));
+      for (int32_t d = 0; d <= 2 * r; ++d) set_span(wide.data() + size_t(y + d) * size_t(words), a, e - 1 + 2 * r);
+      a = next_bit(b.row(y), b.words, e, true);
+    }
+  int64_t n = 0;
+  for (const uint64_t v : wide) n += std::popcount(v);
+  return n;
+}
+
 uint64_t hash(const Bits& b) {
   uint64_t h = 0xcbf29ce484222325ull;
   auto mix = [&](uint64_t v) { h = (h ^ v) * 0x100000001b3ull; };
@@ -911,8 +928,8 @@ bool pack(const std::vector<Footprint>& prints, uint32_t gutter, uint32_t W, uin
     return aa != ab ? aa > ab : a < b;
   });
   where.assign(prints.size(), {});
-  // Levels of 1 … 16 rows when they cost at most 16 MB.
-  Atlas atlas(W, H, gutter, uint64_t(W) * H <= (uint64_t(1) << 24) ? 5 : 1);
+  // Levels of 1 … 32 rows, fewer past 8192² texels (64 MB at most).
+  Atlas atlas(W, H, gutter, int(std::clamp<uint64_t>((uint64_t(1) << 29) / (uint64_t(W) * H), 1, 6)));
   // Taken texels are never freed, so a shape fits nowhere before the position where it last fitted
   // or the row after the last that found it none: a search resumes there (many charts repeat).
   struct Resume {
@@ -1004,6 +1021,9 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
       return true;
     }
     if (same(failed, W, H, prints)) return false;
+    int64_t least = 0;  // a bound that fails a density without packing (dilated_texels)
+    for (const Footprint& print : prints) least += dilated_texels(print.texels, int32_t(o.gutter / 2));
+    if (least > int64_t(W) * H) return false;
     const bool ok = pack(prints, o.gutter, W, H, where);
     Known& k = ok ? packed : failed;
     k.W = W, k.H = H, k.prints = prints, k.where = where;
