@@ -15,8 +15,8 @@
 #include <numbers>
 #include <numeric>
 #include <queue>
-#include <unordered_map>
 #include <span>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
