@@ -144,6 +144,16 @@ WHAT IS DRAWN
   estimate of the light the scene blocks), with --samples shadow rays per pixel and a per-pixel standard error.
   That is the standard rendering equation with visibility, the paper's "brute force" reference.
 
+  INTERREFLECTIONS (issue 31; environment lighting, area lights not yet). A per-vertex transfer or
+  band-1 radiance baked with 'prtbake vertex --bounces B --albedo A' holds the light the mesh
+  reflects onto itself; its exit radiance is A x sum T_i L_i. For such a file both pictures show
+  A x E/pi (the runtime's unchanged dot product times A) and the reference is path traced with the
+  file's B bounces and albedo A, said in the log and in the caption ("reference: path traced, 3
+  bounces, albedo 0.6"): at each path vertex the environment's direct light (the estimator above,
+  one sample) plus a cosine-weighted continuation ray, back faces black, cut at exactly B bounces
+  (view/reference.h). --bounces B and --albedo A override the file's (--bounces 0: the direct-only
+  reference, to see what the bounces add); scene files bounce with their objects' albedos.
+
 OUTPUT (-o; the extension picks the format: .png for people, .exr for numbers)
   (default)       the runtime render.
   --reference     the ray-traced reference instead.
@@ -183,6 +193,8 @@ EXAMPLES
   prtview bunny.fiv.prt.h5 --camera eye=0,22,24:at=0,0,2 --instance -4,0,0 --instance 4,0,0 --error -o e.png
   prtbake vertex data/bunny_ground.obj --transfer 3 -o default.prt.h5
   prtview default.prt.h5 --env data/sunset.exr --camera eye=0,14,26:at=0,3,0 --triptych -o t.png
+  prtbake vertex data/bunny_ground.obj --transfer 3 --bounces 3 --albedo 0.6 -o bounced.prt.h5
+  prtview bounced.prt.h5 --env data/sunset.exr --triptych -o bounced.png   against 3 path-traced bounces
   prtbake scene data/scene_example.json -o scene.prt.h5
   prtview scene.prt.h5 --camera eye=0,18,34:at=0,2,0 --size 320x240 --triptych -o scene.png
   prtview scene.prt.h5 --shade glossy --phong 128 --triptych -o statue.png
@@ -208,6 +220,8 @@ struct Args {
   bool quiet = false;
   bool per_vertex = false;  // --per-vertex: the per-vertex products even when the file has a lightmap
   int threads = 0;
+  std::optional<uint32_t> bounces;  // --bounces B: the reference's interreflections (default: the file's)
+  std::optional<double> albedo;     // --albedo A: a single mesh's grey albedo (default: the file's)
 };
 
 // "X,Y,Z" → a vector (an --instance).
@@ -272,6 +286,14 @@ std::optional<Args> parse(int argc, char** argv) {
   app.add_flag("--reference", reference, "write the ray-traced reference instead of the runtime render.");
   app.add_flag("--error", error, "write a false-colour map of |runtime - reference| and print NRMSE.");
   app.add_flag("--triptych", triptych, "write runtime | reference | error side by side and print NRMSE.");
+  app.add_option("--bounces", a.bounces,
+                 "reference: B bounces of diffuse interreflection, path traced (default: the 'bounces' the file's transfer or "
+                 "band-1 radiance was baked with, else 0; environment lighting only).")
+      ->check(CLI::Range(0, 64));
+  app.add_option("--albedo", a.albedo,
+                 "the grey albedo of a single-mesh file's surface (default: the file's 'albedo' attribute, that of its bounces): "
+                 "the picture and the reference show albedo x E/pi, and the reference bounces with it.")
+      ->check(CLI::Range(0.0, 0.999));
   app.add_option("--shade", a.shade,
                  "transfer | band1 | ao | fiv (default: fiv if the file has /fiv, else the best it holds of "
                  "band1, transfer, ao); scene files: glossy (the glossy objects' specular lobes), and with area "
@@ -393,10 +415,68 @@ void write_image(const std::string& path, const view::Image& linear, const view:
   else view::write_png(path, display);
 }
 
+// Interreflections (issue 31): how many bounces the reference traces and, for a single mesh, the
+// albedo both pictures carry. A per-vertex transfer or band-1 radiance baked with bounces
+// (SCHEMA.md "Bounces") holds the light of a surface of its 'albedo' attribute reflecting onto
+// itself: its exit radiance is albedo x sum T_i L_i (bake/bake/bounce.h eq. (1)). So when an
+// albedo is known (--albedo, else the product's attribute) the runtime picture is multiplied by it
+// and the reference gets it on every triangle (its pixels are albedo x E/pi, E with the bounces);
+// the reference's bounces are --bounces, else the product's 'bounces'. Scene files keep their
+// objects' albedos; FIV, glossy and area views take no bounces.
+struct Interreflection {
+  uint32_t bounces = 0;
+  std::optional<double> albedo;
+  std::string caption = "ray traced";  // "path traced, 3 bounces, albedo 0.6"
+  std::string why;
+};
+
+Interreflection interreflection(const Args& a, const F::Asset& f, const std::string& kind, bool texel, bool area,
+                                prtview::RenderScene& scene, view::Image& runtime) {
+  Interreflection r;
+  const bool single = kind == "transfer" || kind == "band1" || kind == "ao";
+  if ((kind == "fiv" || kind == "glossy" || area) && (a.bounces.value_or(0) > 0 || a.albedo))
+    throw UsageError("--bounces and --albedo apply to per-vertex, per-texel and scene files under an environment, not to " +
+                     std::string(area ? "area lights" : kind == "fiv" ? "FIV files" : "glossy lobes"));
+  if (kind == "scene" && a.albedo) throw UsageError("--albedo: the objects of a scene file carry their own albedo");
+  const F::Product* baked = nullptr;
+  if (!texel && kind == "transfer" && f.vertices.transfer_diffuse) baked = &*f.vertices.transfer_diffuse;
+  if (!texel && kind == "band1" && f.vertices.radiance_band1) baked = &*f.vertices.radiance_band1;
+  const int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
+  std::optional<double> file_albedo;
+  if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3) file_albedo = (*baked->albedo)[0];
+  r.bounces = a.bounces ? *a.bounces : uint32_t(std::max<int64_t>(0, file_bounces));
+  if (single) r.albedo = a.albedo ? a.albedo : file_albedo;
+  if (single && r.bounces > 0 && !r.albedo)
+    throw UsageError("--bounces " + std::to_string(r.bounces) + ": " + a.file +
+                     " names no albedo to bounce with (its products carry no bounces): give --albedo A");
+  char buf[256];
+  if (r.albedo) {
+    const float rho = float(*r.albedo);
+    scene.albedo.assign(scene.mesh.triangles.size(), {rho, rho, rho});
+    for (float& v : runtime.rgb) v *= rho;
+    std::snprintf(buf, sizeof buf, "; times the albedo %.3g (exit radiance albedo x E/pi)", *r.albedo);
+    scene.how += buf;
+  }
+  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "path traced, %u bounce%s, albedo %.3g", r.bounces, r.bounces == 1 ? "" : "s", *r.albedo);
+  else if (r.bounces > 0) std::snprintf(buf, sizeof buf, "path traced, %u bounce%s, the objects' albedos", r.bounces, r.bounces == 1 ? "" : "s");
+  else if (r.albedo) std::snprintf(buf, sizeof buf, "ray traced, direct light only, albedo %.3g", *r.albedo);
+  else std::snprintf(buf, sizeof buf, "ray traced");
+  r.caption = buf;
+  if (baked && baked->bounces)
+    std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %.3g%s", kind == "transfer" ? "transfer" : "band-1 radiance",
+                  static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s", file_albedo.value_or(0.0),
+                  a.bounces || a.albedo ? "; overridden on the command line" : "; --bounces B to change");
+  else
+    std::snprintf(buf, sizeof buf, "--bounces%s", a.albedo ? " and --albedo" : "");
+  r.why = buf;
+  return r;
+}
+
 // The environment reference (view/reference.h), read from or written to --reference-cache.
 view::ReferenceImage environment_reference(const Args& a, const prtview::RenderScene& scene, const bake::EnvMap& env,
-                                           const view::Camera& cam, bool say) {
+                                           const view::Camera& cam, uint32_t bounces, bool say) {
   view::ReferenceOptions ropt;
+  ropt.bounces = bounces;
   ropt.samples = a.samples;
   ropt.seed = a.seed;
   ropt.occluder_spheres = scene.spheres;
@@ -540,7 +620,7 @@ int run(const Args& a) {
     area_options.ggx = layer;
   }
   Timer t_run;
-  const view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
+  view::Image runtime = area ? prtview::render_area_file(f, a.file, lights, a.shade == "area-exact", cam, scene, area_options)
                               : kind == "scene" ? prtview::render_scene_file(f, a.file, *env, cam, scene)
                               : kind == "glossy" ? prtview::render_glossy_scene(f, a.file, *env, cam, a.phong,
                                                                                   a.glossy_route == "a"   ? prtview::GlossyRoute::A
@@ -551,6 +631,7 @@ int run(const Args& a) {
                               : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
   const double runtime_seconds = t_run.seconds();
+  const Interreflection reflect = interreflection(a, f, kind, texel, area, scene, runtime);
   if (!a.quiet && !scene.form.empty()) {  // which form was drawn, on stderr (the summary below says it too)
     if (texel)
       std::fprintf(stderr, "prtview: %s: drawn %s (bilinear through /mesh/uv); %zu of %zu pixels reached an empty texel\n",
@@ -606,6 +687,8 @@ int run(const Args& a) {
     if (given_camera) std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
     else std::printf("view: %dx%d, framing %s; to adjust:\n  --camera %s\n", a.width, a.height, look.framed.c_str(), view::to_string(cam).c_str());
     std::printf("runtime (%.3f s): %s\n", runtime_seconds, scene.how.c_str());
+    if (reflect.bounces > 0 || reflect.albedo)
+      std::printf("reference: %s (%s)\n", reflect.caption.c_str(), reflect.why.c_str());
     std::fflush(stdout);
   }
   for (float v : runtime.rgb)
@@ -669,7 +752,7 @@ int run(const Args& a) {
   }
 
   const view::ReferenceImage ref = area ? area_reference(a, scene, lights, area_options, cam, say)
-                                        : environment_reference(a, scene, *env, cam, say);
+                                        : environment_reference(a, scene, *env, cam, reflect.bounces, say);
   const view::GBuffer raster = view::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
   const std::string region =
@@ -743,7 +826,7 @@ int run(const Args& a) {
     const view::Panel panels[3] = {{view::tone_map(runtime, exposure),
                                                      "baked (" + caption + (scene.form.empty() ? "" : ", " + scene.form.substr(0, scene.form.find(','))) + ")",
                                                      std::nullopt},
-                                   {view::tone_map(ref.radiance, exposure), "reference (ray traced)", std::nullopt},
+                                   {view::tone_map(ref.radiance, exposure), "reference (" + reflect.caption + ")", std::nullopt},
                                    error_panel};
     std::vector<std::string> lines = footer;
     lines.front() += exposed;

@@ -170,13 +170,23 @@ GBuffer rasterize(const bake::Mesh& mesh, const Camera& camera) {
 }
 
 Fragment make_fragment(const bake::Mesh& mesh, const GBuffer& g, int x, int y) {
-  Fragment fr;
+  const size_t i = size_t(y) * size_t(g.width) + size_t(x);
+  if (g.triangle[i] < 0) {
+    Fragment fr;
+    fr.x = x;
+    fr.y = y;
+    return fr;
+  }
+  Fragment fr = surface_fragment(mesh, g.triangle[i], g.bary[i]);
   fr.x = x;
   fr.y = y;
-  const size_t i = size_t(y) * size_t(g.width) + size_t(x);
-  fr.triangle = g.triangle[i];
-  if (fr.triangle < 0) return fr;
-  fr.bary = g.bary[i];
+  return fr;
+}
+
+Fragment surface_fragment(const bake::Mesh& mesh, int32_t triangle, const std::array<float, 3>& bary) {
+  Fragment fr;
+  fr.triangle = triangle;
+  fr.bary = bary;
   const auto& t = mesh.triangles[size_t(fr.triangle)];
   Vector3d p = Vector3d::Zero(), n = Vector3d::Zero();
   for (size_t k = 0; k < 3; ++k) {

@@ -41,15 +41,17 @@ constexpr uint32_t kReplicates = 8;  // independent RQMC replicates per pixel
 // RGB terms to sum. The mean of the replicate means and its standard error, the spread of the
 // means / √B: an honest error for the RQMC estimate, which converges faster than 1/√N (the iid
 // sample variance would overstate it).
+// estimate(u, replicate, point, sum): the replicate and the point's number within it key any
+// further random numbers (PointStream below).
 template <class Estimate>
-void replicate_mean(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& estimate, double mean[3], double se[3]) {
+void replicate_mean_keyed(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& estimate, double mean[3], double se[3]) {
   const uint32_t B = std::min<uint32_t>(kReplicates, samples);
   const uint32_t per = std::max<uint32_t>(1, samples / B);
   double block_sum[3] = {0, 0, 0}, block_sum2[3] = {0, 0, 0};
   for (uint32_t b = 0; b < B; ++b) {
     const RotatedHalton3 halton(seed, index * kReplicates + b);
     double sum[3] = {0, 0, 0};
-    for (uint32_t i = 0; i < per; ++i) estimate(halton(i), sum);
+    for (uint32_t i = 0; i < per; ++i) estimate(halton(i), b, i, sum);
     for (int c = 0; c < 3; ++c) {
       const double m = sum[c] / per;
       block_sum[c] += m;
@@ -63,6 +65,25 @@ void replicate_mean(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& 
   }
 }
 
+template <class Estimate>
+void replicate_mean(uint32_t samples, uint64_t seed, uint64_t index, Estimate&& estimate, double mean[3], double se[3]) {
+  replicate_mean_keyed(
+      samples, seed, index, [&](const std::array<double, 3>& u, uint32_t, uint32_t, double sum[3]) { estimate(u, sum); }, mean, se);
+}
+
+// Uniform numbers in [0, 1) for one path: a counter hashed with the path's key (seed, pixel,
+// replicate, point), so a path's numbers do not depend on which thread traces it.
+class PointStream {
+public:
+  PointStream(uint64_t seed, uint64_t index, uint32_t replicate, uint32_t point) noexcept
+      : key_(mix64(mix64(seed ^ 0x5851f42d4c957f2dull) ^ mix64(index * kReplicates + replicate) ^ (uint64_t(point) << 32))) {}
+  double next() noexcept { return to_unit(mix64(key_ + 0x9e3779b97f4a7c15ull * ++counter_)); }
+
+private:
+  uint64_t key_;
+  uint64_t counter_ = 0;
+};
+
 } // namespace
 
 // The ray queries of the reference: libbake's RayCaster (bake/visibility/raycast.h) over the rendered mesh for
@@ -73,13 +94,17 @@ struct ReferenceRenderer::Rays {
   Mesh caster_mesh;  // same vertices, the casting triangles (used when `casters` is set)
   std::optional<Topology> caster_topology;
   std::unique_ptr<RayCaster> casters;
+  std::vector<uint32_t> caster_triangle;  // caster_mesh's triangle k is the mesh's caster_triangle[k]
   bool any_caster = true;
   Rays(const Mesh& mesh, std::span<const uint8_t> casts_shadow) : topology(build_topology(mesh)), every_triangle(mesh, topology) {
     if (casts_shadow.empty() || std::all_of(casts_shadow.begin(), casts_shadow.end(), [](uint8_t c) { return c != 0; })) return;
     caster_mesh = mesh;
     caster_mesh.triangles.clear();
     for (size_t t = 0; t < mesh.triangles.size(); ++t)
-      if (casts_shadow[t]) caster_mesh.triangles.push_back(mesh.triangles[t]);
+      if (casts_shadow[t]) {
+        caster_mesh.triangles.push_back(mesh.triangles[t]);
+        caster_triangle.push_back(uint32_t(t));
+      }
     any_caster = !caster_mesh.triangles.empty();
     if (!any_caster) return;
     caster_topology = build_topology(caster_mesh);
@@ -98,6 +123,14 @@ struct ReferenceRenderer::Rays {
     sp.p = o;
     return !shadow_caster().visible(sp, near_o, d);
   }
+  // The first casting triangle the ray o + t d meets (the mesh's index), or nothing (the sky).
+  std::optional<SurfaceHit> first_hit(const Vector3d& o, const bake::NearTriangles& near_o, const Vector3d& d) const {
+    ShadePoint sp;
+    sp.p = o;
+    auto hit = shadow_caster().first_surface_hit(sp, near_o, d);
+    if (hit && casters) hit->triangle = caster_triangle[hit->triangle];
+    return hit;
+  }
 };
 
 ReferenceRenderer::ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap& env, ReferenceOptions options)
@@ -107,6 +140,7 @@ ReferenceRenderer::ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap&
   PRT_CHECK(!mesh.triangles.empty());
   PRT_CHECK(options_.casts_shadow.empty() || options_.casts_shadow.size() == mesh.triangles.size());
   PRT_CHECK(options_.albedo.empty() || options_.albedo.size() == mesh.triangles.size());
+  PRT_CHECK(!options_.glossy || options_.bounces == 0);
   PRT_CHECK(!options_.glossy ||
             (options_.glossy->phong.size() == mesh.triangles.size() && options_.glossy->specular.size() == mesh.triangles.size()));
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -133,6 +167,9 @@ std::string ReferenceRenderer::description() const {
     os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
   }
   if (!options_.albedo.empty() && !options_.glossy) os << "; albedos";
+  if (options_.bounces > 0)
+    os << "; path traced, " << options_.bounces << (options_.bounces == 1 ? " bounce" : " bounces") << " (" << options_.samples
+       << " cosine paths/pixel, next-event estimation, truncated)";
   return os.str();
 }
 
@@ -248,6 +285,62 @@ void ReferenceRenderer::irradiance(const Fragment& f, uint64_t index, const Rgb&
   for (int c = 0; c < 3; ++c) E[c] = un[c] - occluded[c];
 }
 
+double ReferenceRenderer::albedo(int32_t triangle, int c) const {
+  return options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(triangle)][size_t(c)]);
+}
+
+uint64_t ReferenceRenderer::indirect(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const {
+  if (options_.bounces == 0 || !rt_->any_caster) {  // nothing reflects
+    for (int c = 0; c < 3; ++c) E[c] = std_error[c] = 0;
+    return 0;
+  }
+  constexpr double kInvPi = std::numbers::inv_pi;
+  const uint64_t seed = mix64(options_.seed ^ 0xb0b0b0b0b0b0b0b0ull);  // a rotation of its own: independent of E_direct
+  const Frame frame0(f.n);
+  const Vector3d o0 = f.p + epsilon_ * f.ng;
+  const bake::NearTriangles near0 = rt_->near(o0);
+  uint64_t rays = 0;
+  replicate_mean_keyed(options_.samples, seed, index, [&](const std::array<double, 3>& u, uint32_t b, uint32_t i, double sum[3]) {
+      PointStream rng(options_.seed, index, b, i);
+      double throughput[3] = {1, 1, 1};
+      Vector3d o = o0;
+      Vector3d d = frame0.to_world(cosine_hemisphere(u[0], u[1])).normalized();
+      std::optional<bake::NearTriangles> near_here;  // the current vertex's near triangles (after the first)
+      for (uint32_t depth = 1; depth <= options_.bounces; ++depth) {
+        ++rays;
+        const auto hit = rt_->first_hit(o, near_here ? *near_here : near0, d);
+        if (!hit || !hit->front) return;  // the sky (E_direct's), or a back face (black)
+        const Fragment h = surface_fragment(mesh_, int32_t(hit->triangle),
+                                            {float(1 - hit->w1 - hit->w2), float(hit->w1), float(hit->w2)});
+        for (int c = 0; c < 3; ++c) throughput[c] *= albedo(h.triangle, c);
+        if (!(throughput[0] > 0 || throughput[1] > 0 || throughput[2] > 0)) return;
+        // Next-event estimate of E_direct(h): one sample L V (n·ω) / p of the cosine + environment
+        // mixture (½ each; bounded by 2π L as p ≥ (n·ω)/(2π)).
+        o = h.p + epsilon_ * h.ng;
+        near_here = rt_->near(o);
+        const Frame frame(h.n);
+        double Ed[3] = {0, 0, 0};
+        const double s0 = rng.next(), s1 = rng.next(), s2 = rng.next();
+        Vector3d l = (s0 < 0.5 ? frame.to_world(cosine_hemisphere(s1, s2)) : env_.sample(s1, s2, nullptr)).normalized();
+        const double cn = h.n.dot(l);
+        if (cn > 0) {
+          ++rays;
+          if (!rt_->occluded(o, *near_here, l)) {
+            const double p = 0.5 * cn * kInvPi + 0.5 * env_.pdf(l);
+            const Rgb L = env_.radiance(l);
+            Ed[0] = L.r * cn / p;
+            Ed[1] = L.g * cn / p;
+            Ed[2] = L.b * cn / p;
+          }
+        }
+        for (int c = 0; c < 3; ++c) sum[c] += throughput[c] * Ed[c];
+        if (depth == options_.bounces) return;
+        d = frame.to_world(cosine_hemisphere(rng.next(), rng.next())).normalized();
+      }
+    }, E, std_error);
+  return rays;
+}
+
 void ReferenceRenderer::glossy(const Fragment& f, uint64_t index, double s, double out[3], double std_error[3]) const {
   PRT_CHECK(options_.glossy.has_value() && s >= 0);
   const Vector3d v = (options_.glossy->eye - f.p).normalized();
@@ -303,8 +396,9 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monit
     bar.advance();
   });
   std::atomic<uint64_t> pixels{0};
+  std::atomic<uint64_t> bounce_rays{0};
   tbb::parallel_for(0, camera.height, [&](int y) {
-    uint64_t n = 0;
+    uint64_t n = 0, path_rays = 0;
     for (int x = 0; x < camera.width; ++x) {
       const Fragment f = make_fragment(mesh_, out.gbuffer, x, y);
       if (f.triangle < 0) continue;
@@ -324,21 +418,31 @@ ReferenceImage ReferenceRenderer::render(const Camera& camera, const bake::Monit
       const Key key{f.n.x(), f.n.y(), f.n.z()};
       const size_t k = size_t(std::lower_bound(normals.begin(), normals.end(), key) - normals.begin());
       double E[3], se[3];
-      irradiance(f, uint64_t(y) * uint64_t(camera.width) + uint64_t(x), unocc[k], E, se);
+      const uint64_t index = uint64_t(y) * uint64_t(camera.width) + uint64_t(x);
+      irradiance(f, index, unocc[k], E, se);
+      if (options_.bounces > 0) {
+        double Ei[3], sei[3];
+        path_rays += indirect(f, index, Ei, sei);
+        for (int c = 0; c < 3; ++c) {
+          E[c] += Ei[c];
+          se[c] = std::sqrt(se[c] * se[c] + sei[c] * sei[c]);
+        }
+      }
       for (int c = 0; c < 3; ++c) {
-        const double albedo = options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(f.triangle)][size_t(c)]);
-        out.radiance.at(x, y)[c] = float(albedo * E[c] * std::numbers::inv_pi);
-        out.std_error.at(x, y)[c] = float(albedo * se[c] * std::numbers::inv_pi);
+        const double rho = albedo(f.triangle, c);
+        out.radiance.at(x, y)[c] = float(rho * E[c] * std::numbers::inv_pi);
+        out.std_error.at(x, y)[c] = float(rho * se[c] * std::numbers::inv_pi);
       }
       ++n;
     }
     pixels += n;
+    bounce_rays += path_rays;
     bar.advance();
   });
   bar.finish();
   const uint32_t B = std::min<uint32_t>(kReplicates, options_.samples);
   out.rays = uint64_t(camera.width) * uint64_t(camera.height) +
-             (rt_->any_caster ? pixels.load() * B * std::max<uint32_t>(1, options_.samples / B) : 0);
+             (rt_->any_caster ? pixels.load() * B * std::max<uint32_t>(1, options_.samples / B) : 0) + bounce_rays.load();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (float v : out.radiance.rgb)
     if (!std::isfinite(v)) throw ContractError("reference render produced a non-finite value");

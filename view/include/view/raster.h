@@ -66,6 +66,9 @@ struct Fragment {
   Eigen::Vector3d ng{0, 1, 0};  // unit geometric normal, turned to the side of n
 };
 Fragment make_fragment(const bake::Mesh& mesh, const GBuffer& g, int x, int y);
+// The same fragment at any point of a triangle (barycentric weights of its corners 0, 1, 2; x, y
+// left 0): the reference's path vertices (view/reference.h, bounces).
+Fragment surface_fragment(const bake::Mesh& mesh, int32_t triangle, const std::array<float, 3>& bary);
 
 // Calls shade(fragment, rgb) for every covered pixel (in parallel: `shade` must be thread-safe);
 // uncovered pixels are 0.

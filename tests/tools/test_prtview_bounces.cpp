@@ -1,0 +1,64 @@
+// prtview against the path-traced reference (view/reference.h BOUNCES; issue 31): a file baked
+// with bounces is compared with a reference that bounces as often, at the file's albedo, and
+// says so; that reference is closer to it than the direct-only one.
+#include "run_tool.h"
+#include "scratch.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace fs = std::filesystem;
+using prt::testing::run_tool;
+
+namespace {
+
+const std::string kData = PRT_DATA_DIR;
+
+// The value printed after "NRMSE " at the start of a line of `out` (negative if none).
+double printed_nrmse(const std::string& out) {
+  for (size_t at = 0; at < out.size();) {
+    const size_t end = out.find('\n', at);
+    const std::string line = out.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    double v = 0;
+    if (line.rfind("NRMSE ", 0) == 0 && std::sscanf(line.c_str() + 6, "%lf", &v) == 1) return v;
+    if (end == std::string::npos) break;
+    at = end + 1;
+  }
+  return -1;
+}
+
+} // namespace
+
+TEST(PrtviewBounces, BouncedBakeMatchesThePathTracedReference) {
+  // (c) The bunny on its ground, band-1 radiance under sunset.exr with 3 bounces at albedo 0.6
+  // (the exact all-frequency product: its only errors are the gather's noise, Gouraud
+  // interpolation and the reference's noise), seen from prtview's first look at 64x48.
+  // Measured (seed 1, 1,024 reference rays and paths per pixel, 1,765 pixels): NRMSE 0.0119
+  // against the 3-bounce path-traced reference (its own noise 0.0071, noise-corrected 0.0096),
+  // 0.0907 against the direct-only one (--bounces 0): the bounces lift the bunny's underside and
+  // the ground beside it. Bounds: 0.02 (the issue's 2 % bar; the measured value plus the
+  // reference's noise fits well below it) and a factor 4 between the two (measured 7.6).
+  const fs::path d = prt::testing::fresh_dir("prtview_bounces", "bunny");
+  const fs::path file = d / "bounced.prt.h5";
+  auto r = run_tool(PRT_PRTBAKE,
+                    "vertex " + kData + "/bunny_ground.obj --radiance " + kData +
+                        "/sunset.exr --bounces 3 --albedo 0.6 --report 0 -q -o " + file.string(),
+                    d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string view = file.string() + " --size 64x48 --samples 1024 --error -o " + (d / "e.exr").string();
+  r = run_tool(PRT_PRTVIEW, view, d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("reference: path traced, 3 bounces, albedo 0.6"), std::string::npos) << r.out;
+  const double bounced = printed_nrmse(r.out);
+  r = run_tool(PRT_PRTVIEW, view + " --bounces 0", d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("direct light only, albedo 0.6"), std::string::npos) << r.out;
+  const double direct = printed_nrmse(r.out);
+  std::printf("NRMSE against the 3-bounce reference %.5f, against the direct-only one %.5f\n", bounced, direct);
+  ASSERT_GE(bounced, 0.0);
+  EXPECT_LT(bounced, 0.02);
+  EXPECT_GT(direct, 4 * bounced);
+}
