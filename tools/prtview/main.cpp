@@ -181,7 +181,9 @@ ERROR NUMBERS
   renders see that object, over the same range (so NRMSE^2 = sum_k pixels_k/pixels NRMSE_k^2 but
   for the few silhouette pixels where the two renders see different receivers), and each
   object's mean runtime value. The reference's own noise is printed too
-  (RMS standard error / range) with the noise-corrected NRMSE sqrt(RMSE^2 - sigma^2)/range.
+  (RMS standard error / range) with the noise-corrected NRMSE sqrt(RMSE^2 - sigma^2)/range, and
+  the relative L2 error |runtime - reference| / |reference| (the same pixels and channels; the
+  issue-31 bar), also noise-corrected.
 
 EXAMPLES
   prtbake vertex data/bunny_ground.obj --ao --transfer 3 --radiance data/sunset.exr -o bunny.prt.h5
@@ -780,6 +782,8 @@ int run(const Args& a) {
               region.c_str(), e.pixels, e.rmse, e.ref_min, e.ref_max, e.max_abs);
   std::printf("reference noise %.5f (RMS standard error / range); noise-corrected NRMSE %.5f\n", e.ref_noise,
               e.nrmse_noise_corrected);
+  std::printf("relative L2 error %.5f (|runtime - reference| / |reference| over the same pixels and channels); "
+              "noise-corrected %.5f\n", e.relative_l2, e.relative_l2_noise_corrected);
   if (region != "all") std::printf("NRMSE over all covered pixels %.5f (%zu pixels)\n", all.nrmse, all.pixels);
   // Scene files: each receiver's share, RMSE over the pixels where both renders see that object,
   // divided by the same range (so NRMSE^2 = sum_k (pixels_k / pixels) NRMSE_k^2).

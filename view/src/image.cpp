@@ -209,7 +209,7 @@ ImageError compare_images(const Image& test, const Image& reference, std::span<c
   PRT_CHECK(mask.empty() || mask.size() == n);
   PRT_CHECK(!ref_std_error || ref_std_error->rgb.size() == reference.rgb.size());
   ImageError r;
-  double se2 = 0, noise2 = 0;
+  double se2 = 0, noise2 = 0, ref2 = 0;
   r.ref_min = std::numeric_limits<double>::infinity();
   r.ref_max = -r.ref_min;
   for (size_t i = 0; i < n; ++i) {
@@ -218,6 +218,7 @@ ImageError compare_images(const Image& test, const Image& reference, std::span<c
     for (size_t c = 0; c < 3; ++c) {
       const double ref = reference.rgb[3 * i + c], d = double(test.rgb[3 * i + c]) - ref;
       se2 += d * d;
+      ref2 += ref * ref;
       r.max_abs = std::max(r.max_abs, std::abs(d));
       r.ref_min = std::min(r.ref_min, ref);
       r.ref_max = std::max(r.ref_max, ref);
@@ -229,6 +230,10 @@ ImageError compare_images(const Image& test, const Image& reference, std::span<c
   r.rmse = std::sqrt(se2 / m);
   const double range = r.ref_max - r.ref_min;
   const double sigma = std::sqrt(noise2 / m);
+  if (ref2 > 0) {
+    r.relative_l2 = std::sqrt(se2 / ref2);
+    r.relative_l2_noise_corrected = std::sqrt(std::max(0.0, se2 - noise2) / ref2);
+  }
   if (range > 0) {
     r.nrmse = r.rmse / range;
     r.ref_noise = sigma / range;

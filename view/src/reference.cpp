@@ -168,8 +168,8 @@ std::string ReferenceRenderer::description() const {
   }
   if (!options_.albedo.empty() && !options_.glossy) os << "; albedos";
   if (options_.bounces > 0)
-    os << "; path traced, " << options_.bounces << (options_.bounces == 1 ? " bounce" : " bounces") << " (" << options_.samples
-       << " cosine paths/pixel, next-event estimation, truncated)";
+    os << "; " << options_.bounces << (options_.bounces == 1 ? " bounce" : " bounces") << " path traced, " << options_.samples
+       << " paths/pixel";
   return os.str();
 }
 

@@ -96,6 +96,9 @@ struct ImageError {
   double max_abs = 0;                // largest |test − ref| of any channel
   double ref_noise = 0;              // RMS of the reference's standard error / range (0 without it)
   double nrmse_noise_corrected = 0;  // sqrt(max(0, rmse² − σ_rms²)) / range
+  // The relative L2 error ‖test − ref‖ / ‖ref‖ over masked pixels and RGB (0 when ‖ref‖ = 0) and
+  // the same with the reference's noise taken out, sqrt(max(0, ‖test − ref‖² − Σ σ²)) / ‖ref‖.
+  double relative_l2 = 0, relative_l2_noise_corrected = 0;
 };
 // ref_std_error: empty or an image of per-channel standard errors of `reference`.
 // Throws bake::ContractError when the sizes differ or no pixel is masked.
