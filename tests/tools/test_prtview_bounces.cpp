@@ -66,3 +66,21 @@ TEST(PrtviewBounces, BouncedBakeMatchesThePathTracedReference) {
   EXPECT_LE(relative_l2, 0.02);
   EXPECT_GT(direct, 4 * bounced);
 }
+
+TEST(PrtviewBounces, ADirectFileNeedsAnAlbedoToBounceWith) {
+  // A file baked without bounces names no albedo: --bounces B alone is a usage error (exit 2) that
+  // says what to add and writes nothing; with --albedo the reference bounces at it and says so.
+  const fs::path d = prt::testing::fresh_dir("prtview_bounces", "direct");
+  const fs::path file = d / "direct.prt.h5";
+  auto r = run_tool(PRT_PRTBAKE, "vertex " + kData + "/bunny_ground.obj --radiance " + kData + "/sunset.exr --report 0 -q -o " +
+                                     file.string(), d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string view = file.string() + " --size 24x18 --samples 8 --error -o " + (d / "e.exr").string();
+  r = run_tool(PRT_PRTVIEW, view + " --bounces 2", d / "capture");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("give --albedo A"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "e.exr"));
+  r = run_tool(PRT_PRTVIEW, view + " --bounces 2 --albedo 0.5", d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("reference: path traced, 2 bounces, albedo 0.5 (--bounces and --albedo)"), std::string::npos) << r.out;
+}
