@@ -54,7 +54,7 @@ constexpr const char* kFooter = R"(
 WHAT IS DRAWN
   Every picture shows outgoing radiance of a white diffuse surface, E/pi (albedo 1), where E is
   the irradiance; a constant sky of radiance L shows as L (scene files: times each object's
-  albedo). Three kinds of file:
+  albedo; files baked with bounces: times their albedo, see INTERREFLECTIONS). Three kinds of file:
 
   per-vertex files (/mesh + /transfer/diffuse, /radiance/band1 or /ao, from 'prtbake vertex'):
     the mesh is rasterized (software, top-left fill rule, z-buffer, perspective-correct
