@@ -148,11 +148,12 @@ WHAT IS DRAWN
   band-1 radiance baked with 'prtbake vertex --bounces B --albedo A' holds the light the mesh
   reflects onto itself; its exit radiance is A x sum T_i L_i. For such a file both pictures show
   A x E/pi (the runtime's unchanged dot product times A) and the reference is path traced with the
-  file's B bounces and albedo A, said in the log and in the caption ("reference: path traced, 3
-  bounces, albedo 0.6"): at each path vertex the environment's direct light (the estimator above,
-  one sample) plus a cosine-weighted continuation ray, back faces black, cut at exactly B bounces
-  (view/reference.h). --bounces B and --albedo A override the file's (--bounces 0: the direct-only
-  reference, to see what the bounces add); scene files bounce with their objects' albedos.
+  file's B bounces and albedo A, said in the log ("reference: path traced, 3 bounces, albedo 0.6")
+  and above the triptych's panel, as reference (3 bounces, albedo 0.6). Each path vertex takes the
+  environment's direct light (the estimator above, one sample) and sends a cosine-weighted
+  continuation ray; back faces are black; the paths stop at exactly B bounces (view/reference.h).
+  --bounces B and --albedo A override the file's (--bounces 0: the direct-only reference, to see
+  what the bounces add); scene files bounce with their objects' albedos.
 
 OUTPUT (-o; the extension picks the format: .png for people, .exr for numbers)
   (default)       the runtime render.
@@ -429,6 +430,7 @@ struct Interreflection {
   uint32_t bounces = 0;
   std::optional<double> albedo;
   std::string caption = "ray traced";  // "path traced, 3 bounces, albedo 0.6"
+  std::string panel = "ray traced";    // the triptych's caption, short enough for a 256-pixel panel
   std::string why;
 };
 
@@ -464,6 +466,11 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   else if (r.albedo) std::snprintf(buf, sizeof buf, "ray traced, direct light only, albedo %.3g", *r.albedo);
   else std::snprintf(buf, sizeof buf, "ray traced");
   r.caption = buf;
+  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "%u bounce%s, albedo %.3g", r.bounces, r.bounces == 1 ? "" : "s", *r.albedo);
+  else if (r.bounces > 0) std::snprintf(buf, sizeof buf, "%u bounce%s", r.bounces, r.bounces == 1 ? "" : "s");
+  else if (r.albedo) std::snprintf(buf, sizeof buf, "direct, albedo %.3g", *r.albedo);
+  else std::snprintf(buf, sizeof buf, "ray traced");
+  r.panel = buf;
   if (baked && baked->bounces)
     std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %.3g%s", kind == "transfer" ? "transfer" : "band-1 radiance",
                   static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s", file_albedo.value_or(0.0),
@@ -830,7 +837,7 @@ int run(const Args& a) {
     const view::Panel panels[3] = {{view::tone_map(runtime, exposure),
                                                      "baked (" + caption + (scene.form.empty() ? "" : ", " + scene.form.substr(0, scene.form.find(','))) + ")",
                                                      std::nullopt},
-                                   {view::tone_map(ref.radiance, exposure), "reference (" + reflect.caption + ")", std::nullopt},
+                                   {view::tone_map(ref.radiance, exposure), "reference (" + reflect.panel + ")", std::nullopt},
                                    error_panel};
     std::vector<std::string> lines = footer;
     lines.front() += exposed;
