@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -16,7 +15,6 @@
 #include <numeric>
 #include <queue>
 #include <span>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -538,205 +536,103 @@ double chart_density(const Chart& c, double s, uint32_t min_texels) {
 // A chart box's side in texels at density s for an extent in world units (header, step 3).
 uint32_t cells(double extent, double s) { return uint32_t(std::floor(extent * s + 2 * kMargin)) + 1; }
 
-// The span of x over the points of triangle t whose y lies in [lo, hi] (its vertices there and its
-// edges' crossings of the two lines); empty: (+inf, −inf).
-std::pair<double, double> slab_span(const V2 (&t)[3], double lo, double hi) {
+// The span of coordinate 1 − a over the points of triangle t whose coordinate a lies in [lo, hi]
+// (its vertices there and its edges' crossings of the two lines); empty: (+inf, −inf).
+std::pair<double, double> slab_span(const V2 (&t)[3], int a, double lo, double hi) {
   double mn = std::numeric_limits<double>::infinity(), mx = -mn;
+  const int b = 1 - a;
   for (int k = 0; k < 3; ++k) {
     const V2 &p = t[k], &q = t[(k + 1) % 3];
-    if (p.y() >= lo && p.y() <= hi) mn = std::min(mn, p.x()), mx = std::max(mx, p.x());
-    for (const double y : {lo, hi})
-      if (p.y() != q.y() && (p.y() - y) * (q.y() - y) <= 0) {
-        const double w = (y - p.y()) / (q.y() - p.y()), x = p.x() + w * (q.x() - p.x());
-        mn = std::min(mn, x), mx = std::max(mx, x);
+    if (p[a] >= lo && p[a] <= hi) mn = std::min(mn, p[b]), mx = std::max(mx, p[b]);
+    for (const double x : {lo, hi})
+      if (p[a] != q[a] && (p[a] - x) * (q[a] - x) <= 0) {
+        const double w = (x - p[a]) / (q[a] - p[a]), y = p[b] + w * (q[b] - p[b]);
+        mn = std::min(mn, y), mx = std::max(mx, y);
       }
   }
   return {mn, mx};
 }
 
-// A bit image of w × h texels: texel (c, r) is bit c % 64 of word c / 64 of row r, each row
-// `words` words long.
-struct Bits {
-  int32_t w = 0, h = 0, words = 0;
-  std::vector<uint64_t> bits;
-
-  void reset(int32_t width, int32_t height) {
-    w = width, h = height, words = (width + 63) / 64;
-    bits.assign(size_t(h) * size_t(words), 0);
-  }
-  uint64_t* row(int64_t r) { return bits.data() + size_t(r) * size_t(words); }
-  const uint64_t* row(int64_t r) const { return bits.data() + size_t(r) * size_t(words); }
-  bool operator==(const Bits&) const = default;
-};
-
-// Sets columns a … b (a ≤ b) of a bit row.
-void set_span(uint64_t* row, int64_t a, int64_t b) {
-  const int64_t ka = a >> 6, kb = b >> 6;
-  const uint64_t first = ~uint64_t(0) << (a & 63), last = ~uint64_t(0) >> (63 - (b & 63));
-  if (ka == kb) {
-    row[ka] |= first & last;
-    return;
-  }
-  row[ka] |= first;
-  for (int64_t k = ka + 1; k < kb; ++k) row[k] = ~uint64_t(0);
-  row[kb] |= last;
-}
-
-// The first column at or after `from` whose bit is `value` in a row of `words` words; words·64
-// when there is none.
-int64_t next_bit(const uint64_t* row, int32_t words, int64_t from, bool value) {
-  int64_t k = from >> 6;
-  if (k >= words) return int64_t(words) * 64;
-  uint64_t v = (value ? row[k] : ~row[k]) & (~uint64_t(0) << (from & 63));
-  while (v == 0) {
-    if (++k == words) return int64_t(words) * 64;
-    v = value ? row[k] : ~row[k];
-  }
-  return k * 64 + std::countr_zero(v);
-}
-
-// The first column of the run of set bits that holds set column c.
-int64_t run_start(const uint64_t* row, int64_t c) {
-  int64_t k = c >> 6;
-  uint64_t v = ~row[k] & ((uint64_t(1) << (c & 63)) - 1);  // clear bits below c in its word
-  while (v == 0) {
-    if (--k < 0) return 0;
-    v = ~row[k];
-  }
-  return k * 64 + 64 - std::countl_zero(v);
-}
-
 // A chart's texels at density s in its box of w × h texels (the chart centred in it, header step
-// 3): per row, the union over its triangles of the columns each touches there. A superset of
-// texel_atlas's conservative coverage (bake/mesh/texels.h): each texel square is widened by
-// kSlack, more than the float rounding of a stored UV (2^-24 of 16384 texels, 1e-3) and less than
-// the chart's inset in its box (> kMargin), so the chart stays inside its box.
+// 3): per column the first and last row it touches, per row the first and last column. A
+// superset of texel_atlas's conservative coverage (bake/mesh/texels.h): each texel square is
+// widened by kSlack, more than the float rounding of a stored UV (2^-24 of 16384 texels, 1e-3)
+// and less than the chart's inset in its box (> kMargin), so the chart stays inside its box.
 constexpr double kSlack = 1.0 / 128;
 struct Footprint {
-  Bits texels;
-  V2 inset = V2::Zero();  // the chart's corner (0, 0) in its box, in texels
+  int32_t w = 0, h = 0;
+  std::vector<int32_t> top, bottom;  // per column
+  std::vector<int32_t> left, right;  // per row
+  V2 inset = V2::Zero();             // the chart's corner (0, 0) in its box, in texels
 };
 
 Footprint footprint(const Chart& c, double s) {
   Footprint f;
-  const int32_t w = int32_t(cells(c.extent.x(), s)), h = int32_t(cells(c.extent.y(), s));
-  f.texels.reset(w, h);
-  f.inset = V2((w - c.extent.x() * s) / 2, (h - c.extent.y() * s) / 2);
+  f.w = int32_t(cells(c.extent.x(), s));
+  f.h = int32_t(cells(c.extent.y(), s));
+  f.inset = V2((f.w - c.extent.x() * s) / 2, (f.h - c.extent.y() * s) / 2);
+  f.top.assign(size_t(f.w), f.h);
+  f.bottom.assign(size_t(f.w), -1);
+  f.left.assign(size_t(f.h), f.w);
+  f.right.assign(size_t(f.h), -1);
   for (const auto& k : c.corners) {
     const V2 t[3] = {f.inset + c.uv[k[0]] * s, f.inset + c.uv[k[1]] * s, f.inset + c.uv[k[2]] * s};
-    const double lo = std::min({t[0].y(), t[1].y(), t[2].y()}), hi = std::max({t[0].y(), t[1].y(), t[2].y()});
-    const int32_t first = std::max(0, int32_t(std::floor(lo - kSlack))), last = std::min(h - 1, int32_t(std::floor(hi + kSlack)));
-    for (int32_t r = first; r <= last; ++r) {
-      const auto [mn, mx] = slab_span(t, double(r) - kSlack, double(r) + 1 + kSlack);
-      if (mn > mx) continue;
-      const int32_t a = std::max(0, int32_t(std::floor(mn - kSlack))), b = std::min(w - 1, int32_t(std::floor(mx + kSlack)));
-      if (a <= b) set_span(f.texels.row(r), a, b);
+    for (int a = 0; a < 2; ++a) {
+      const double lo = std::min({t[0][a], t[1][a], t[2][a]}), hi = std::max({t[0][a], t[1][a], t[2][a]});
+      const int32_t n = a == 0 ? f.w : f.h, other = a == 0 ? f.h : f.w;
+      const int32_t first = std::max(0, int32_t(std::floor(lo - kSlack)));
+      const int32_t last = std::min(n - 1, int32_t(std::floor(hi + kSlack)));
+      std::vector<int32_t>& low = a == 0 ? f.top : f.left;
+      std::vector<int32_t>& high = a == 0 ? f.bottom : f.right;
+      for (int32_t i = first; i <= last; ++i) {
+        const auto [mn, mx] = slab_span(t, a, double(i) - kSlack, double(i) + 1 + kSlack);
+        if (mn > mx) continue;
+        low[size_t(i)] = std::min(low[size_t(i)], std::max(0, int32_t(std::floor(mn - kSlack))));
+        high[size_t(i)] = std::max(high[size_t(i)], std::min(other - 1, int32_t(std::floor(mx + kSlack))));
+      }
     }
   }
+  // A connected chart touches every column and row of its box; fill any gap conservatively.
+  for (int32_t col = 0; col < f.w; ++col)
+    if (f.bottom[size_t(col)] < 0) f.top[size_t(col)] = 0, f.bottom[size_t(col)] = f.h - 1;
+  for (int32_t r = 0; r < f.h; ++r)
+    if (f.right[size_t(r)] < 0) f.left[size_t(r)] = 0, f.right[size_t(r)] = f.w - 1;
   return f;
 }
 
-// A footprint turned by rotation r (0°, 90°, 180°, 270° about its box, each keeping windings:
-// header step 3; texel (c, q) of a w × h box goes to (c, q), (h − 1 − q, c), (w − 1 − c, h − 1 − q),
-// (q, w − 1 − c)), with its KEY: over 2^k rows from key_row (k < the atlas's levels), the longest
-// run of columns set in all of them, the one of most texels (then the least k, then the first).
-struct Shape {
-  Bits texels;
-  int32_t key_level = 0, key_row = 0, key_start = 0, key_length = 0;
-  // CORE: with k = core_level > 0 (the highest level at most h rows tall), the intersections of
-  // rows min(i·2^k, h − 2^k) … + 2^k − 1, i = 0, 1, …: every row is in one, and a core row
-  // tested against level k answers for 2^k rows of the shape at once.
-  int32_t core_level = 0;
-  Bits core;
+// A footprint's column profile turned by rotation r (0°, 90°, 180°, 270° about its box, each
+// keeping windings: header step 3): width, height, first and last row per column.
+struct Profile {
+  int32_t w = 0, h = 0;
+  std::vector<int32_t> top, bottom;
 };
 
-// Bit image b transposed: texel (c, q) to (q, c), 64 × 64 blocks at a time.
-Bits transposed(const Bits& b) {
-  Bits t;
-  t.reset(b.h, b.w);
-  uint64_t m[64];
-  for (int32_t by = 0; by < (b.h + 63) / 64; ++by)
-    for (int32_t bx = 0; bx < b.words; ++bx) {
-      for (int32_t i = 0; i < 64; ++i) m[i] = by * 64 + i < b.h ? b.row(by * 64 + i)[bx] : 0;
-      uint64_t mask = 0x00000000FFFFFFFFull;  // swap ever smaller blocks across the diagonal
-      for (int j = 32; j != 0; j >>= 1, mask ^= mask << j)
-        for (int k = 0; k < 64; k = ((k | j) + 1) & ~j) {
-          const uint64_t d = ((m[k] >> j) ^ m[k | j]) & mask;
-          m[k | j] ^= d;
-          m[k] ^= d << j;
-        }
-      for (int32_t i = 0; i < 64 && bx * 64 + i < t.h; ++i) t.row(bx * 64 + i)[by] = m[i];
+Profile profile(const Footprint& f, int r) {
+  Profile p;
+  const bool turned = r % 2 == 1;
+  p.w = turned ? f.h : f.w;
+  p.h = turned ? f.w : f.h;
+  p.top.resize(size_t(p.w));
+  p.bottom.resize(size_t(p.w));
+  for (int32_t c = 0; c < p.w; ++c) {
+    const size_t i = size_t(c), mirrored = size_t(p.w - 1 - c);
+    switch (r) {
+    case 0: p.top[i] = f.top[i], p.bottom[i] = f.bottom[i]; break;
+    case 1: p.top[i] = f.left[mirrored], p.bottom[i] = f.right[mirrored]; break;  // (u, v) -> (h − v, u)
+    case 2: p.top[i] = f.h - 1 - f.bottom[mirrored], p.bottom[i] = f.h - 1 - f.top[mirrored]; break;  // (w − u, h − v)
+    default: p.top[i] = f.w - 1 - f.right[i], p.bottom[i] = f.w - 1 - f.left[i]; break;  // (v, w − u)
     }
-  return t;
-}
-
-// Bit image b mirrored left to right (texel (c, q) to (w − 1 − c, q)).
-void mirror_columns(Bits& b) {
-  const int32_t pad = b.words * 64 - b.w;
-  std::vector<uint64_t> r(size_t(b.words) + 1);
-  for (int32_t y = 0; y < b.h; ++y) {
-    uint64_t* row = b.row(y);
-    for (int32_t i = 0; i < b.words; ++i) {
-      uint64_t v = row[b.words - 1 - i];
-      v = (v >> 1 & 0x5555555555555555ull) | (v & 0x5555555555555555ull) << 1;
-      v = (v >> 2 & 0x3333333333333333ull) | (v & 0x3333333333333333ull) << 2;
-      v = (v >> 4 & 0x0F0F0F0F0F0F0F0Full) | (v & 0x0F0F0F0F0F0F0F0Full) << 4;
-      r[size_t(i)] = __builtin_bswap64(v);
-    }
-    r[size_t(b.words)] = 0;
-    for (int32_t i = 0; i < b.words; ++i)  // bit c + pad of the reversed row to bit c
-      row[i] = pad == 0 ? r[size_t(i)] : r[size_t(i)] >> pad | r[size_t(i) + 1] << (64 - pad);
   }
+  return p;
 }
 
-// Bit image b mirrored top to bottom (texel (c, q) to (c, h − 1 − q)).
-void mirror_rows(Bits& b) {
-  for (int32_t y = 0; y < b.h / 2; ++y) std::swap_ranges(b.row(y), b.row(y) + b.words, b.row(b.h - 1 - y));
-}
-
-Shape shape(const Bits& f, int r, int levels) {
-  Shape s;
-  if (r % 2 == 1) s.texels = transposed(f);  // (q, c)
-  else s.texels = f;
-  if (r == 1 || r == 2) mirror_columns(s.texels);
-  if (r == 2 || r == 3) mirror_rows(s.texels);
-  // The key and the core: level k's row y is the intersection of rows y … y + 2^k − 1.
-  const int32_t h = s.texels.h;
-  while (levels > 1 && (int32_t(1) << (levels - 1)) > h) --levels;
-  Bits level = s.texels;
-  int64_t best = 0;
-  for (int k = 0; k < levels; ++k) {
-    const int32_t span = int32_t(1) << k, half = span / 2;
-    if (k > 0)
-      for (int32_t y = 0; y + span <= h; ++y)
-        for (int32_t i = 0; i < level.words; ++i) level.row(y)[i] &= level.row(y + half)[i];
-    if (k > 0 && k == levels - 1) {
-      s.core_level = k;
-      s.core.reset(level.w, (h + span - 1) / span);
-      for (int32_t i = 0; i < s.core.h; ++i)
-        std::copy_n(level.row(std::min(i * span, h - span)), level.words, s.core.row(i));
-    }
-    for (int32_t y = 0; y + span <= h; ++y)
-      for (int64_t a = next_bit(level.row(y), level.words, 0, true); a < level.w;) {
-        const int64_t b = std::min<int64_t>(level.w, next_bit(level.row(y), level.words, a, false));
-        if ((b - a) * span > best) {
-          best = (b - a) * span;
-          s.key_level = k, s.key_row = y, s.key_start = int32_t(a), s.key_length = int32_t(b - a);
-        }
-        a = next_bit(level.row(y), level.words, b, true);
-      }
-  }
-  return s;
-}
-
-// Texel position of point q of a footprint's box after rotation r (Shape), the box at (x, y).
+// Texel position of point q of a footprint's box after rotation r (Profile), the box at (x, y).
 V2 placed(const Footprint& f, int r, const V2& q, int64_t x, int64_t y) {
-  const double w = f.texels.w, h = f.texels.h;
   V2 p = q;
   switch (r) {
-  case 1: p = V2(h - q.y(), q.x()); break;
-  case 2: p = V2(w - q.x(), h - q.y()); break;
-  case 3: p = V2(q.y(), w - q.x()); break;
+  case 1: p = V2(f.h - q.y(), q.x()); break;
+  case 2: p = V2(f.w - q.x(), f.h - q.y()); break;
+  case 3: p = V2(q.y(), f.w - q.x()); break;
   default: break;
   }
   return p + V2(double(x), double(y));
@@ -747,219 +643,64 @@ struct Placement {
   int rotation = 0;
 };
 
-// The atlas being packed (header, step 3): a bit per texel, set where no chart's texel may go —
-// within G of a placed chart's texels (Chebyshev), or within the border margins. Level k holds,
-// per row y, the union of rows y … y + 2^k − 1 (rows past the last: all taken), with each row's
-// longest free run: a search tests a shape's key (Shape) there before testing the shape itself.
-// Levels only skip positions that cannot fit, so the result does not depend on their number.
-class Atlas {
-public:
-  Atlas(uint32_t W, uint32_t H, uint32_t gutter, int levels)
-      : W_(W), H_(H), G_(gutter), taken_(size_t(levels)), longest_(size_t(levels), std::vector<int64_t>(H)),
-        lowest_(size_t(levels), std::vector<int64_t>(size_t(W) + 1, 0)) {
-    for (Bits& b : taken_) b.reset(int32_t(W), int32_t(H));
-    const int64_t near = G_ / 2, far = G_ - G_ / 2;
-    for (int64_t y = 0; y < H_; ++y) {
-      uint64_t* row = taken_[0].row(y);
-      if (W_ % 64 != 0) row[taken_[0].words - 1] |= ~uint64_t(0) << (W_ % 64);  // past the last column
-      if (y < near || y >= H_ - far) set_span(row, 0, W_ - 1);
-      if (near > 0) set_span(row, 0, std::min(near, W_) - 1);
-      if (far > 0) set_span(row, std::max<int64_t>(0, W_ - far), W_ - 1);
-    }
-    update(0, H_ - 1);
-  }
-
-  int levels() const { return int(taken_.size()); }
-
-  // The first position (rows, then columns) from (x0, y0) on at which `s`'s box lies in the atlas
-  // with its top row at most y_last and none of its texels on a taken one; false when there is
-  // none.
-  bool find(const Shape& s, int64_t y_last, int64_t y0, int64_t x0, int64_t& fx, int64_t& fy) {
-    const Bits& t = s.texels;
-    if (t.w > W_ || t.h > H_ || s.key_length == 0) return false;
-    const std::vector<int64_t>& longest = longest_[size_t(s.key_level)];
-    const Bits& keys = taken_[size_t(s.key_level)];
-    int64_t& low = lowest_[size_t(s.key_level)][size_t(s.key_length)];  // no row above has such a run
-    while (low < H_ && longest[size_t(low)] < s.key_length) ++low;
-    y_last = std::min(y_last, H_ - t.h);
-    if (y0 < low - s.key_row) y0 = low - s.key_row, x0 = 0;
-    for (int64_t y = std::max<int64_t>(0, y0); y <= y_last; ++y) {
-      const int64_t key = y + s.key_row;
-      if (longest[size_t(key)] < s.key_length) continue;
-      const uint64_t* row = keys.row(key);
-      for (int64_t p = next_bit(row, keys.words, 0, false); p < W_;) {
-        const int64_t q = next_bit(row, keys.words, p, true);  // free columns p … q − 1
-        int64_t x = std::max<int64_t>(y == y0 ? x0 : 0, p - s.key_start);
-        const int64_t x_last = std::min(q - s.key_length - s.key_start, W_ - t.w);
-        while (x <= x_last) {
-          const int64_t next = collision(s, x, y);
-          if (next < 0) {
-            fx = x, fy = y;
-            return true;
-          }
-          x = std::max(x + 1, next);
-        }
-        p = next_bit(row, keys.words, q, false);
-      }
-    }
-    return false;
-  }
-
-  // Takes `s`'s texels with its box at (x, y), dilated by G.
-  void take(const Shape& s, int64_t x, int64_t y) {
-    const Bits& t = s.texels;
-    for (int64_t j = 0; j < t.h; ++j)
-      for (int64_t a = next_bit(t.row(j), t.words, 0, true); a < t.w;) {
-        const int64_t b = std::min<int64_t>(t.w, next_bit(t.row(j), t.words, a, false));
-        for (int64_t r = std::max<int64_t>(0, y + j - G_); r <= std::min(H_ - 1, y + j + G_); ++r)
-          set_span(taken_[0].row(r), std::max<int64_t>(0, x + a - G_), std::min(W_ - 1, x + b - 1 + G_));
-        a = next_bit(t.row(j), t.words, b, true);
-      }
-    update(std::max<int64_t>(0, y - G_), std::min(H_ - 1, y + t.h - 1 + G_));
-  }
-
-private:
-  int64_t W_, H_, G_;
-  std::vector<Bits> taken_;                   // per level
-  std::vector<std::vector<int64_t>> longest_;  // per level and row its longest run of free texels
-  std::vector<std::vector<int64_t>> lowest_;   // per level and run length n: no row above has n free
-
-  // Levels 1… and the longest runs after level 0 changed in rows r0 … r1.
-  void update(int64_t r0, int64_t r1) {
-    const int32_t words = taken_[0].words;
-    for (size_t k = 0; k < taken_.size(); ++k) {
-      const int64_t half = k == 0 ? 0 : int64_t(1) << (k - 1), first = std::max<int64_t>(0, r0 - 2 * half + (k == 0 ? 0 : 1));
-      for (int64_t r = first; r <= r1; ++r) {
-        uint64_t* row = taken_[k].row(r);
-        if (k > 0) {
-          const uint64_t* a = taken_[k - 1].row(r);
-          if (r + half >= H_) std::fill(row, row + words, ~uint64_t(0));
-          else
-            for (int32_t i = 0; i < words; ++i) row[i] = a[i] | taken_[k - 1].row(r + half)[i];
-        }
-        int64_t best = 0;
-        for (int64_t p = next_bit(row, words, 0, false); p < W_;) {
-          const int64_t q = next_bit(row, words, p, true);
-          best = std::max(best, q - p);
-          p = next_bit(row, words, q, false);
-        }
-        longest_[k][size_t(r)] = best;
-      }
-    }
-  }
-
-  // −1 when `s` fits with its box at (x, y); otherwise a column x' > x such that it collides at
-  // every column x … x' − 1 too: past the run of the shape's (or core's) row that hit a taken
-  // texel. The core first: it rejects most positions of a large shape in a few rows.
-  int64_t collision(const Shape& s, int64_t x, int64_t y) const {
-    const Bits& t = s.texels;
-    const int64_t k0 = x >> 6, n = ((x + t.w - 1) >> 6) - k0 + 1;
-    const int shift = int(x & 63);
-    auto hit = [&](const uint64_t* m, const uint64_t* g) -> int64_t {
-      g += k0;
-      for (int64_t i = 0; i < n; ++i) {
-        uint64_t v = i < t.words ? m[i] << shift : 0;
-        if (shift != 0 && i > 0) v |= m[i - 1] >> (64 - shift);
-        if (const uint64_t both = v & g[i]; both != 0) {
-          const int64_t c = (k0 + i) * 64 + 63 - std::countl_zero(both);  // the last hit in this word
-          return c - run_start(m, c - x) + 1;
-        }
-      }
-      return -1;
-    };
-    if (s.core_level > 0) {
-      const int64_t span = int64_t(1) << s.core_level;
-      for (int64_t i = 0; i < s.core.h; ++i)
-        if (const int64_t next = hit(s.core.row(i), taken_[size_t(s.core_level)].row(y + std::min(i * span, t.h - span)));
-            next >= 0)
-          return next;
-    }
-    for (int64_t j = 0; j < t.h; ++j)
-      if (const int64_t next = hit(t.row(j), taken_[0].row(y + j)); next >= 0) return next;
-    return -1;
-  }
-};
-
-// The charts' footprints at density s (header, step 3); false when a chart is wider than the
-// atlas's larger side in every rotation.
-bool footprints(const std::vector<Chart>& charts, double s, uint32_t min_texels, uint32_t W, uint32_t H,
-                std::vector<Footprint>& prints) {
+// Horizon packing (header, step 3) at density s into W × H. False when a chart does not fit.
+bool pack(const std::vector<Chart>& charts, double s, uint32_t min_texels, uint32_t gutter, uint32_t W, uint32_t H,
+          std::vector<Footprint>& prints, std::vector<Placement>& where) {
+  const int64_t G = gutter, near = G / 2, far = G - G / 2;  // border margins: near at 0, far at W, H
   const double side = std::max(W, H);
   prints.resize(charts.size());
-  for (size_t i = 0; i < charts.size(); ++i) {
+  std::vector<uint32_t> order(charts.size());
+  for (uint32_t i = 0; i < charts.size(); ++i) {
     const double sc = chart_density(charts[i], s, min_texels);
-    if (!(charts[i].extent.x() * sc < side)) return false;
+    if (!(charts[i].extent.x() * sc < side)) return false;  // in no rotation
     prints[i] = footprint(charts[i], sc);
+    order[i] = i;
   }
-  return true;
-}
-
-// The texels within r of a footprint's (Chebyshev). Two charts' footprints lie more than G apart
-// and G/2 or more from the border, so their sets at r = G/2 are disjoint and inside the atlas:
-// their sum is at most W·H wherever the charts pack.
-int64_t dilated_texels(const Bits& b, int32_t r) {
-  const int32_t words = (b.w + 2 * r + 63) / 64;
-  std::vector<uint64_t> wide(size_t(b.h + 2 * r) * size_t(words), 0);  // rows widened by r, shifted by r
-  for (int32_t y = 0; y < b.h; ++y)
-    for (int64_t a = next_bit(b.row(y), b.words, 0, true); a < b.w;) {
-      const int64_t e = std::min<int64_t>(b.w, next_bit(b.row(y), b.words, a, false));
-      for (int32_t d = 0; d <= 2 * r; ++d) set_span(wide.data() + size_t(y + d) * size_t(words), a, e - 1 + 2 * r);
-      a = next_bit(b.row(y), b.words, e, true);
-    }
-  int64_t n = 0;
-  for (const uint64_t v : wide) n += std::popcount(v);
-  return n;
-}
-
-uint64_t hash(const Bits& b) {
-  uint64_t h = 0xcbf29ce484222325ull;
-  auto mix = [&](uint64_t v) { h = (h ^ v) * 0x100000001b3ull; };
-  mix(uint64_t(b.w)), mix(uint64_t(b.h));
-  for (const uint64_t v : b.bits) mix(v);
-  return h;
-}
-
-// Bitmap packing (header, step 3) of the footprints into W × H. False when a chart does not fit.
-bool pack(const std::vector<Footprint>& prints, uint32_t gutter, uint32_t W, uint32_t H, std::vector<Placement>& where) {
-  std::vector<uint32_t> order(prints.size());
-  std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-    const int64_t aa = int64_t(prints[a].texels.w) * prints[a].texels.h, ab = int64_t(prints[b].texels.w) * prints[b].texels.h;
+    const int64_t aa = int64_t(prints[a].w) * prints[a].h, ab = int64_t(prints[b].w) * prints[b].h;
     return aa != ab ? aa > ab : a < b;
   });
-  where.assign(prints.size(), {});
-  // Levels of 1 … 32 rows, fewer past 8192² texels (64 MB at most).
-  Atlas atlas(W, H, gutter, int(std::clamp<uint64_t>((uint64_t(1) << 29) / (uint64_t(W) * H), 1, 6)));
-  // Taken texels are never freed, so a shape fits nowhere before the position where it last fitted
-  // or the row after the last that found it none: a search resumes there (many charts repeat).
-  struct Resume {
-    Bits texels;
-    int64_t y = 0, x = 0;
-  };
-  std::unordered_map<uint64_t, std::vector<Resume>> resume;
-  Shape best_shape;
+  where.assign(charts.size(), {});
+  std::vector<int64_t> horizon(W, 0);  // per column one past the lowest texel taken; 0: none yet
+  std::vector<int64_t> dilated;
   for (uint32_t i : order) {
     int64_t best_bottom = std::numeric_limits<int64_t>::max(), best_x = 0, best_y = 0;
     int best_r = -1;
     for (int r = 0; r < 4; ++r) {
-      Shape sh = shape(prints[i].texels, r, atlas.levels());
-      std::vector<Resume>& same = resume[hash(sh.texels)];
-      auto it = std::find_if(same.begin(), same.end(), [&](const Resume& m) { return m.texels == sh.texels; });
-      if (it == same.end()) it = same.insert(same.end(), {sh.texels, 0, 0});
-      int64_t x = 0, y = 0;
-      const int64_t y_last = best_r < 0 ? int64_t(H) : best_bottom - sh.texels.h;
-      const bool found = atlas.find(sh, y_last, it->y, it->x, x, y);
-      it->y = found ? y : std::max(it->y, y_last + 1), it->x = found ? x : 0;
-      if (!found) continue;
-      const int64_t bottom = y + sh.texels.h;
-      if (bottom < best_bottom || (bottom == best_bottom && x < best_x)) {
-        best_bottom = bottom, best_x = x, best_y = y, best_r = r;
-        best_shape = std::move(sh);
+      const Profile p = profile(prints[i], r);
+      if (p.w + near + far > int64_t(W) || p.h + near + far > int64_t(H)) continue;
+      int64_t top_min = p.h, bottom_max = 0;
+      for (int32_t c = 0; c < p.w; ++c) {
+        top_min = std::min<int64_t>(top_min, p.top[size_t(c)]);
+        bottom_max = std::max<int64_t>(bottom_max, p.bottom[size_t(c)]);
+      }
+      // The profile's top dilated by G: column d − G (d = 0 … w + 2G − 1) takes the least top of
+      // the columns within G of it, less G.
+      dilated.assign(size_t(p.w + 2 * G), std::numeric_limits<int64_t>::max());
+      for (int32_t c = 0; c < p.w; ++c)
+        for (int64_t d = c; d <= c + 2 * G; ++d) dilated[size_t(d)] = std::min(dilated[size_t(d)], int64_t(p.top[size_t(c)]) - G);
+      // The lowest bottom any position can give: nothing can beat it, so the scan stops there.
+      const int64_t floor_bottom = near - top_min + bottom_max;
+      const int64_t probes[3] = {G, G + p.w / 2, G + p.w - 1};  // profile columns for a cheap lower bound
+      for (int64_t x = near; x + p.w + far <= int64_t(W) && best_bottom > floor_bottom; ++x) {
+        int64_t y = near - top_min;
+        for (const int64_t d : probes)
+          if (const int64_t h = horizon[size_t(x - G + d)]; h != 0) y = std::max(y, h - dilated[size_t(d)]);
+        // A lower bound already no better, or past the atlas's bottom.
+        if (y + bottom_max >= best_bottom || y + bottom_max + far >= int64_t(H)) continue;
+        const int64_t d0 = std::max<int64_t>(0, G - x), d1 = std::min<int64_t>(p.w + 2 * G, int64_t(W) - x + G);
+        for (int64_t d = d0; d < d1; ++d)
+          if (const int64_t h = horizon[size_t(x - G + d)]; h != 0) y = std::max(y, h - dilated[size_t(d)]);
+        const int64_t bottom = y + bottom_max;
+        if (bottom + far >= int64_t(H)) continue;
+        if (bottom < best_bottom) best_bottom = bottom, best_x = x, best_y = y, best_r = r;
       }
     }
     if (best_r < 0) return false;
     where[i] = {best_x, best_y, best_r};
-    atlas.take(best_shape, best_x, best_y);
+    const Profile best = profile(prints[i], best_r);
+    for (int32_t c = 0; c < best.w; ++c)
+      horizon[size_t(best_x + c)] = std::max(horizon[size_t(best_x + c)], best_y + best.bottom[size_t(c)] + 1);
   }
   return true;
 }
@@ -1000,34 +741,8 @@ Unwrapped unwrap(const Mesh& mesh, const Topology& topo, const UnwrapOptions& o)
   // The density and the atlas (header, step 3).
   std::vector<Footprint> prints;
   std::vector<Placement> where;
-  // The packing is a function of the footprints and W × H alone, so a density whose footprints
-  // equal those of the last one that packed (or failed) in the same atlas is not packed again:
-  // late bisection steps rarely move a texel.
-  struct Known {
-    uint32_t W = 0, H = 0;
-    std::vector<Footprint> prints;
-    std::vector<Placement> where;
-  } packed, failed;
-  auto same = [](const Known& k, uint32_t W, uint32_t H, const std::vector<Footprint>& p) {
-    if (k.W != W || k.H != H || k.prints.size() != p.size()) return false;
-    for (size_t i = 0; i < p.size(); ++i)
-      if (!(k.prints[i].texels == p[i].texels)) return false;
-    return true;
-  };
   auto fits = [&](double s, uint32_t W, uint32_t H) {
-    if (!footprints(charts, s, o.min_chart_texels, W, H, prints)) return false;
-    if (same(packed, W, H, prints)) {
-      where = packed.where;
-      return true;
-    }
-    if (same(failed, W, H, prints)) return false;
-    int64_t least = 0;  // a bound that fails a density without packing (dilated_texels)
-    for (const Footprint& print : prints) least += dilated_texels(print.texels, int32_t(o.gutter / 2));
-    if (least > int64_t(W) * H) return false;
-    const bool ok = pack(prints, o.gutter, W, H, where);
-    Known& k = ok ? packed : failed;
-    k.W = W, k.H = H, k.prints = prints, k.where = where;
-    return ok;
+    return pack(charts, s, o.min_chart_texels, o.gutter, W, H, prints, where);
   };
   auto largest_density = [&](uint32_t W, uint32_t H) {
     double lo = 0, hi = std::sqrt(double(W) * double(H) / area);

@@ -127,41 +127,6 @@ TexelAtlas expect_clean_atlas(const Mesh& m, const Topology& topo, const UvSet& 
   return a;
 }
 
-// The packer's gutter rule checked on the texels texel_atlas counts (conservative coverage, exact
-// separating axes): a covered texel is more than G texels (Chebyshev) from every covered texel of
-// another chart and at least G/2 (G − G/2 on the far sides) from the border. Returns how many
-// covered texels break it.
-size_t gutter_violations(const TexelAtlas& a, uint32_t gutter) {
-  const int64_t W = a.width, H = a.height, G = gutter, near = G / 2, far = G - G / 2;
-  std::vector<int64_t> chart(size_t(W * H), -1);
-  for (const TexelSample& t : a.samples) chart[t.texel] = t.chart;
-  size_t bad = 0;
-  for (int64_t y = 0; y < H; ++y)
-    for (int64_t x = 0; x < W; ++x) {
-      const int64_t c = chart[size_t(y * W + x)];
-      if (c < 0) continue;
-      bool ok = x >= near && y >= near && x < W - far && y < H - far;
-      for (int64_t ny = std::max<int64_t>(0, y - G); ny <= std::min(H - 1, y + G); ++ny)
-        for (int64_t nx = std::max<int64_t>(0, x - G); nx <= std::min(W - 1, x + G); ++nx) {
-          const int64_t d = chart[size_t(ny * W + nx)];
-          ok = ok && (d < 0 || d == c);
-        }
-      bad += !ok;
-    }
-  return bad;
-}
-
-// Boxes of assorted sizes side by side: six planar charts each, of many shapes.
-Mesh boxes(int count) {
-  std::vector<Mesh> parts;
-  for (int i = 0; i < count; ++i) {
-    const Vector3f lo(float(3 * i), 0, 0);
-    const Vector3f size(1 + 0.37f * float(i % 5), 0.3f + 0.5f * float(i % 3), 0.2f + 0.13f * float(i % 7));
-    parts.push_back(box(lo, lo + size, "box"));
-  }
-  return merge_meshes(parts, "boxes");
-}
-
 } // namespace
 
 TEST(Unwrap, ExactOrientationIsCalibrated) {
@@ -249,8 +214,8 @@ TEST(Unwrap, ASphereHasNoFoldAndNoOverlap) {
   // The unwrapper splits a chart with a triangle stretched past 2 (unwrap.h), so none may be;
   // exactly 2 is allowed (the split is on "exceeds").
   EXPECT_LE(u.report.worst_stretch, 2.0);
-  // A loose floor, not a target: a handful of round caps fill about half of the atlas; below 0.3
-  // the packing would be broken.
+  // A loose floor, not a target: a handful of round caps, each in a square-ish profile, packed
+  // by the horizon packer fill about half of the atlas; below 0.3 the packing would be broken.
   EXPECT_GT(u.report.utilisation, 0.3);
 }
 
@@ -262,7 +227,7 @@ TEST(Unwrap, TheBunnyHasNoFoldAndNoOverlapAndTheSameBytesTwice) {
   const Unwrapped u = unwrap(m, topo, o);
   EXPECT_EQ(u.uv.corners.size(), 3 * m.triangles.size());
   EXPECT_EQ(check_layout(m, u.uv), 0u);
-  EXPECT_EQ(gutter_violations(expect_clean_atlas(m, topo, u.uv, 512), o.gutter), 0u);
+  expect_clean_atlas(m, topo, u.uv, 512);
   const Unwrapped again = unwrap(m, topo, o);
   ASSERT_EQ(again.uv.corners.size(), u.uv.corners.size());
   EXPECT_EQ(std::memcmp(again.uv.corners.data(), u.uv.corners.data(), u.uv.corners.size() * sizeof(Vector2f)), 0);
@@ -351,75 +316,4 @@ TEST(Unwrap, ThinChartsGetMinChartTexelsAcrossAndStillPackCleanly) {
   EXPECT_NEAR(thin.report.worst_stretch, 1.0, 1e-12) << "a chart's own density scales it evenly";
   EXPECT_EQ(check_layout(m, thin.uv), 0u);
   expect_clean_atlas(m, topo, thin.uv, 64);
-}
-
-TEST(Unwrap, ManyChartsKeepTheirGuttersAndTheSameBytesTwice) {
-  // 40 boxes of 15 sizes: 240 planar charts. Each gutter, even and odd, holds on the texels that
-  // texel_atlas counts, every chart lies inside the atlas, and a second run gives the same bytes.
-  const Mesh m = boxes(40);
-  const Topology topo = build_topology(m);
-  for (const uint32_t gutter : {2u, 3u, 0u}) {
-    UnwrapOptions o;
-    o.width = o.height = 256;
-    o.gutter = gutter;
-    const Unwrapped u = unwrap(m, topo, o);
-    EXPECT_EQ(u.report.charts, 240u);
-    EXPECT_EQ(check_layout(m, u.uv), 0u) << "gutter " << gutter;
-    const TexelAtlas a = expect_clean_atlas(m, topo, u.uv, 256);
-    EXPECT_EQ(a.charts, 240u);
-    EXPECT_EQ(gutter_violations(a, gutter), 0u) << "gutter " << gutter;
-    if (gutter > 0) {
-      EXPECT_GT(gutter_violations(a, gutter + 4), 0u) << "the check can fail: the charts lie closer than that";
-    }
-    const Unwrapped again = unwrap(m, topo, o);
-    EXPECT_EQ(std::memcmp(again.uv.corners.data(), u.uv.corners.data(), u.uv.corners.size() * sizeof(Vector2f)), 0);
-  }
-}
-
-TEST(Unwrap, ASmallChartGoesIntoTheHoleOfAFrame) {
-  // A 4 × 4 square frame around a 2 × 2 hole (12 unit cells) and, apart in the same plane, a unit
-  // square: two planar charts. At 10 texels per unit the frame's box is floor(40 + 2/64) + 1 = 41
-  // texels with the frame inset by ½: the hole's edges lie at 10.5 and 30.5, so the frame touches
-  // columns (rows) up to 10 and from 30, and 13 … 27 (15 texels) lie more than G = 2 from it. The
-  // square's box is 11 texels. Nested, the smallest atlas is the frame's, 1 + 41 + 1 = 43, so 44
-  // (a multiple of 4); a packer that puts no chart inside another (the horizon packer before this
-  // one) needs 1 + 41 + 2 + 11 + 1 = 56 along one side: utilisation 1300 / 56² = 0.41 against
-  // 1300 / 44² = 0.67.
-  std::vector<Vector3f> p;
-  std::vector<std::array<uint32_t, 3>> t;
-  for (int j = 0; j <= 4; ++j)
-    for (int i = 0; i <= 4; ++i) p.emplace_back(float(i), float(j), 0);
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) {
-      if ((i == 1 || i == 2) && (j == 1 || j == 2)) continue;
-      const uint32_t a = uint32_t(5 * j + i), b = a + 1, c = a + 6, d = a + 5;
-      t.push_back({a, b, c});
-      t.push_back({a, c, d});
-    }
-  const uint32_t q = uint32_t(p.size());
-  for (const Vector3f& v : {Vector3f(8, 0, 0), Vector3f(9, 0, 0), Vector3f(9, 1, 0), Vector3f(8, 1, 0)}) p.push_back(v);
-  t.push_back({q, q + 1, q + 2});
-  t.push_back({q, q + 2, q + 3});
-  const Mesh m = make_mesh(std::move(p), std::move(t), "frame");
-  const Topology topo = build_topology(m);
-  UnwrapOptions o;
-  o.density = 10;
-  const Unwrapped u = unwrap(m, topo, o);
-  EXPECT_EQ(u.report.charts, 2u);
-  EXPECT_EQ(u.report.width, 44u);
-  EXPECT_EQ(u.report.height, 44u);
-  EXPECT_NEAR(u.report.utilisation, 1300.0 / (44.0 * 44.0), 1e-9);
-  // The square's UVs lie inside the frame's hole: between the frame's inner edges, 1 and 3 units
-  // (10 and 30 texels) from its outer ones.
-  float lo[2] = {1e9f, 1e9f}, hi[2] = {-1e9f, -1e9f};
-  for (size_t k = 0; k < 3 * 24; ++k)
-    for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], u.uv.corners[k][d] * 44), hi[d] = std::max(hi[d], u.uv.corners[k][d] * 44);
-  ASSERT_NEAR(hi[0] - lo[0], 40, 1e-3);
-  for (size_t k = 3 * 24; k < 3 * 26; ++k)
-    for (int d = 0; d < 2; ++d) {
-      EXPECT_GT(u.uv.corners[k][d] * 44, lo[d] + 10) << "corner " << k;
-      EXPECT_LT(u.uv.corners[k][d] * 44, hi[d] - 10) << "corner " << k;
-    }
-  EXPECT_EQ(check_layout(m, u.uv), 0u);
-  EXPECT_EQ(gutter_violations(expect_clean_atlas(m, topo, u.uv, 44), o.gutter), 0u);
 }

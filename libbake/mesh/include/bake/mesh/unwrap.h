@@ -47,36 +47,21 @@
 //    texel), likewise h, the chart centred in it, so it lies strictly inside its box and its float
 //    UVs cannot reach the next texel. Its FOOTPRINT is the texels it touches, as texel_atlas
 //    (bake/mesh/texels.h) counts them, each texel square widened by 1/128 texel (more than the
-//    float rounding of a UV at 16384 texels): a bit per texel of the box, per row the union over
-//    the chart's triangles of the columns each touches in that row's slab (in double), so a
-//    chart's notches and holes stay free. BITMAP PACKING: the atlas is a bit per texel (64 to a
-//    word), set on the border margins and, as each chart is placed, on every texel within G of
-//    its footprint (Chebyshev). Charts by box area (largest first, then chart order); each is
-//    tried in 4 rotations (multiples of 90°, windings kept), in each at the first position, rows
-//    then columns, where its footprint meets no set bit (word-wise ANDs): under another chart's
-//    overhang, in its notch or hole as well as beside it. The rotation whose box ends highest
-//    wins (then leftmost, then the first rotation). So at least G empty texels lie between the
-//    texels of two charts (Chebyshev distance > G), and G/2 (G − G/2 at the far sides) between a
-//    chart and the atlas border, so a REPEAT sampler does not mix charts either. The search is
-//    exhaustive; it is fast because it skips only positions that cannot fit, so its result
-//    does not depend on how: the atlas keeps, per row, the union of the 2^k rows from it
-//    (k = 0 … 5; fewer above 8192² texels) and each union's longest free run, a footprint its
-//    longest run of columns set in 2^k consecutive rows (its key) and the intersections of its
-//    rows in blocks of 2^k (its core); rows whose run is too short are skipped, a position is
-//    tested on the core before the rows, a failed test moves past the run that hit, and a
-//    footprint's search resumes where an identical one last fitted (taken texels are never
-//    freed; CAD models repeat their parts).
+//    float rounding of a UV at 16384 texels): per column of the box its first and last row, per
+//    row its first and last column (in double, per triangle over each column's and row's slab).
+//    HORIZON PACKING: charts by box area (largest first, then chart order); each is
+//    tried in 4 rotations (multiples of 90°, windings kept) at every integer column x, resting on
+//    the horizon — per atlas column one past the lowest texel taken — with its column profile's
+//    top dilated by G (over the G columns on either side, less G rows); it goes where its lowest
+//    texel ends highest (then leftmost, then the first rotation). So at least G empty texels lie
+//    between the texels of two charts (Chebyshev distance > G), and G/2 (G − G/2 at the far
+//    sides) between a chart and the atlas border, so a REPEAT sampler does not mix charts either.
 //    With a given W × H the largest density that packs is found by bisection (40 steps from
-//    sqrt(W·H / surface area), which no packing reaches). A step fails without packing when the
-//    footprints dilated by G/2 (disjoint and inside the atlas in any packing) hold more than W·H
-//    texels; the packing depends on the footprints alone, so a step whose footprints all equal
-//    those of the last density that packed (or failed) takes that answer without packing. With
-//    a given density the atlas is the smallest square whose side is a multiple of 4
-//    (block-compression friendly) that packs, found by bisection, at most max_side. UV = texel
-//    position / W (/ H), stored as float; v is glTF's (row 0 of the image at v = 0). On the bunny the charts cover 2/3 of the atlas, the
-//    footprints dilated by G/2 under 0.7 (irregular charts leave room between them); on a CAD
-//    model of thousands of small charts those cover 0.94 of it, the gutters and the texels each
-//    chart touches only in part costing nearly as much as the charts (bench/RESULTS.md).
+//    sqrt(W·H / surface area), which no packing reaches); with a given density the atlas is the
+//    smallest square whose side is a multiple of 4 (block-compression friendly) that packs,
+//    found by bisection, at most max_side. UV = texel position / W (/ H), stored as float; v is
+//    glTF's (row 0 of the image at v = 0). Charts under another's overhang are not nested: the
+//    packing fills about 60% of the atlas with footprints on a scanned mesh (bench/RESULTS.md).
 //
 // REPORT (UnwrapReport): the chart count (degenerate triangles apart), the density, the
 // utilisation Σ chart UV areas / (W·H) (geometric, in texels: the fraction of the atlas that the
@@ -90,9 +75,7 @@
 // side is outside 1..max_side, the density is not finite and > 0, every triangle is degenerate,
 // the charts do not fit even at the smallest density (each needs (1 + G)² texels), or the
 // density needs an atlas larger than max_side (the message says the largest density that fits).
-// Memory O(triangles) plus the atlas's bits (6 levels up to 8192², 64 MB at most); time
-// O(T log T) for charts plus the sparse solves plus, per bisection step, the footprints (O(T +
-// their texels)) and the packing's searches (bench/RESULTS.md: seconds for 11,588 charts).
+// Memory O(triangles); time O(T log T) for charts and packing plus the sparse solves.
 #pragma once
 
 #include <bake/mesh/mesh.h>
