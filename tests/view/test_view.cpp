@@ -183,6 +183,17 @@ TEST(Nrmse, IdenticalIsZeroAndOffsetIsClosedForm) {
   e = compare_images(test, ref, {}, &se);
   EXPECT_NEAR(e.ref_noise, 0.3 / 23.0, 1e-7);  // float 0.3
   EXPECT_NEAR(e.nrmse_noise_corrected, 0.4 / 23.0, 1e-7);
+  // Relative L2 (issue 31's measure): a test 1.25 × the reference is off by exactly 0.25 of it
+  // (x · 1.25 is exact in float for these small integers); with the reference's noise σ = 0.25 x
+  // per value the squared error 0.0625 Σx² less Σσ² = 0.0625 Σx² leaves 0.
+  Image scaled(8, 8), se_scaled(8, 8);
+  for (size_t i = 0; i < ref.rgb.size(); ++i) scaled.rgb[i] = 1.25f * ref.rgb[i], se_scaled.rgb[i] = 0.25f * ref.rgb[i];
+  e = compare_images(scaled, ref);
+  EXPECT_NEAR(e.relative_l2, 0.25, 1e-12);
+  e = compare_images(scaled, ref, {}, &se_scaled);
+  EXPECT_NEAR(e.relative_l2, 0.25, 1e-12);
+  EXPECT_NEAR(e.relative_l2_noise_corrected, 0.0, 1e-6);
+  EXPECT_EQ(compare_images(ref, ref).relative_l2, 0.0);
 }
 
 // ---- camera -----------------------------------------------------------------------------------------
