@@ -149,8 +149,8 @@ TEST(Bounces, BadOptionsAreUsageErrors) {
       {"--bounces 2", "--bounces 2 needs --albedo R[,G,B]"},
       {"--albedo 0.5", "--albedo applies with --bounces"},
       {"--bounce-rays 64", "--bounce-rays applies with --bounces"},
-      {"--bounces 2 --albedo 0.5 --shadowed 3" + kEnv, "shadowed radiance with bounces is not implemented yet"},
-      {"--bounces 2 --albedo 0.5 --shard 0/2", "--bounces 2 in a sharded bake: not implemented yet"},
+      {"--bounces 2 --albedo 0.5 --shadowed 3" + kEnv, "the shadowed radiance S is baked without bounces in this version"},
+      {"--bounces 2 --albedo 0.5 --shard 0/2", "--bounces 2 in a sharded bake: a bounce needs every vertex's previous bounce"},
   };
   for (const auto& c : cases) {
     const auto r = run_tool(PRT_PRTBAKE, kBake + " " + c.args + " -o " + out.string(), d / "capture");
