@@ -68,7 +68,7 @@ void run(int level, uint32_t rays, int bounces) {
   const bake::GatherHits hits = bake::gather(*accel.rays(), points, spec, false);
   const std::vector<double> albedo(s.mesh.triangles.size(), 0.6);
   const bake::BounceResult r =
-      bake::bounce_rows(s.mesh, hits, albedo, direct.layout, direct.values, spec);
+      bake::bounce_rows(bake::VertexField(s.mesh), points, hits, albedo, direct.layout, direct.values, spec, s.mesh.source);
   double per_bounce = 0;
   for (const double x : r.seconds) per_bounce += x / double(r.seconds.size());
   std::printf("  gather (%u rays per vertex, once):   %8.3f s  = %.3fx silhouette, %.3fx qmc\n", rays, hits.seconds,

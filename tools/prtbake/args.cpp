@@ -206,8 +206,9 @@ std::string silhouette_k_help(bool with_default) {
          (with_default ? "; default " + std::to_string(d.silhouette_k) + " = " + std::to_string(d.isolines()) + "^2" : "");
 }
 
-// --bounces, --albedo and --bounce-rays (vertex): interreflected diffuse transfer (bake/bake/bounce.h).
-void add_bounces(CLI::App& cmd, Args& a) {
+// --bounces, --albedo and --bounce-rays (vertex, texel): interreflected diffuse transfer
+// (bake/bake/bounce.h). `noun`: the receivers ("vertex", "texel").
+void add_bounces(CLI::App& cmd, Args& a, const std::string& noun) {
   const std::string group = "Interreflections";
   cmd.add_option("--bounces", a.bounces,
                  "add B bounces of diffuse interreflection to the transfer (--transfer) and\n"
@@ -256,7 +257,7 @@ void add_bounces(CLI::App& cmd, Args& a) {
       ->option_text("R[,G,B]")
       ->group(group);
   cmd.add_option("--bounce-rays", a.bounce_rays,
-                 "gather rays per vertex for --bounces, cast once; every bounce reuses\n"
+                 "gather rays per " + noun + " for --bounces, cast once; every bounce reuses\n"
                  "their hits (default " + std::to_string(bake::BounceSpec::kDefaultRays) + ")")
       ->option_text("K")
       ->check(tool::integer_in(1, 1 << 16))
@@ -385,7 +386,7 @@ void add_vertex(CLI::App& app, Args& a, uint32_t& samples, const std::string& co
                  "and --samples, or use --reproducible, for the same bytes anywhere.")
       ->option_text("E")
       ->check(tool::number_in(bake::ChooserOptions::kMinTarget, bake::ChooserOptions::kMaxTarget));
-  if (!texel) add_bounces(cmd, a);
+  add_bounces(cmd, a, texel ? "texel" : "vertex");
   const bake::IntegratorSpec d;
   add_sampling(cmd, a, samples,
                "silhouette: " + silhouette_k_help(false) +

@@ -208,7 +208,7 @@ void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads) {
 }
 
 void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, double albedo,
-                   const bake::GatherHits& hits, const bake::ProductLayout& layout) {
+                   const bake::GatherHits& hits, const bake::ProductLayout& layout, const char* noun) {
   const std::string what = layout.transfer_count && layout.radiance_count ? "diffuse transfer and band-1 radiance"
                            : layout.transfer_count                        ? "diffuse transfer"
                                                                           : "band-1 radiance";
@@ -221,9 +221,9 @@ void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spe
   std::printf("the file holds direct + bounces; the error check measures the direct pass\n");
   double bounce_seconds = 0;
   for (const double s : result.seconds) bounce_seconds += s;
-  std::printf("gather: %u rays per vertex (%s) cast once in %.2f s (cached hits %.1f MB); the bounces took %.3f s "
+  std::printf("gather: %u rays per %s (%s) cast once in %.2f s (cached hits %.1f MB); the bounces took %.3f s "
               "(%.3f s each)\n",
-              hits.rays, hits.mixture ? "half cosine, half uniform" : "cosine", hits.seconds,
+              hits.rays, noun, hits.mixture ? "half cosine, half uniform" : "cosine", hits.seconds,
               double(hits.bytes()) / 1e6, bounce_seconds, result.applied ? bounce_seconds / result.applied : 0.0);
 }
 

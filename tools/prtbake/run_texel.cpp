@@ -15,6 +15,7 @@
 #include <formats/asset.h>
 
 #include "bakefile.h"
+#include "bounces.h"
 #include "commands.h"
 #include "output.h"
 #include "tool_main.h"
@@ -80,9 +81,15 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   bake::BakePipeline pipeline(mesh, topo, accel, std::move(settings), std::move(jobs));
   const bake::BakeJob& job = pipeline.jobs().front();
 
+  // ---- interreflections (tools/prtbake/bounces.h): over the lightmap's texels. A hit reads the
+  // previous bounce's lightmap (filled and padded, 2 rings: all a bilinear lookup at level 0 reaches
+  // from a chart's surface) at its UV.
+  ReceiverBounces bounces(a, mesh.triangles.size());
+  const bake::TexelField field(mesh, texels, 2);
+
   namespace F = prt::formats;
   auto write_bake = [&] {
-    const bake::VertexBake& result = job.rows.front();
+    const bake::VertexBake& result = bounces.rows(job.rows.front());
     bake::SeamStitch seams;
     const bake::Lightmap image = lightmap_image(mesh, topo, texels, spec, result, seams);
     if (run.say && seams.edges > 0) print_stitch(seams);
@@ -95,6 +102,9 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                        {job.integrator->name(), job.integrator_description, job.spec.samples(), job.spec.seed, a.transfer,
                         a.visibility, env ? &*env : nullptr, a.environment},
                        a.padding);
+    F::Lightmap& lm = *asset.vertices.lightmap;
+    bounces.set_attributes(lm.transfer_diffuse ? &*lm.transfer_diffuse : nullptr,
+                           lm.radiance_band1 ? &*lm.radiance_band1 : nullptr);
     if (const auto& report = job.reports.front()) {
       bake::ErrorReport by_texel = *report;  // its rows are valid texels: named by their texels
       for (uint32_t& r : by_texel.vertices) r = atlas.samples[texels.valid[r]].texel;
@@ -112,6 +122,8 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   bake::PipelineHooks hooks = console.hooks(a, run, write_bake);
   hooks.set_baked = [&](const bake::BakeJob& j, size_t) {
     if (run.say) print_rows_baked(j, shards && shards->threads_of_chunks() == 0);
+    if (bounces.asked())
+      bounces.bounce(field, *accel.rays(), j.rows.front(), j.sets.front().points, mesh.source, run, "texel");
   };
   // Sharded, the chunks are the valid texels' rows in texel order; the atlas they belong to is
   // in the manifest (a chunk of another atlas, UV set or texel count is refused).

@@ -1,6 +1,5 @@
 // tools/prtbake/run_vertex.cpp — `prtbake vertex` (commands.h): per-vertex products of a mesh, one
 // job of the bake pipeline (bake/bake/pipeline.h); this file says what it does and writes the file.
-#include <bake/bake/bounce.h>
 #include <bake/bake/choose.h>
 #include <bake/bake/diagnostics.h>
 #include <bake/bake/error_report.h>
@@ -13,6 +12,7 @@
 #include <formats/asset.h>
 
 #include "bakefile.h"
+#include "bounces.h"
 #include "commands.h"
 #include "output.h"
 #include "shards.h"
@@ -53,27 +53,9 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
   bake::BakePipeline pipeline(mesh, topo, accel, std::move(settings), std::move(jobs));
   const bake::BakeJob& job = pipeline.jobs().front();
 
-  // ---- interreflections (bake/bake/bounce.h): the gather rays are cast once, after the first
-  // bake; the rows of every bake (a correction's too) are bounced from their cached hits (the
-  // diffuse transfer and band-1 radiance). The error check measures the direct pass (the rows the
-  // integrator made); the file gets the sum.
-  bake::BounceSpec bounce_spec;
-  bounce_spec.bounces = a.bounces;
-  bounce_spec.rays = a.bounce_rays ? a.bounce_rays : bake::BounceSpec::kDefaultRays;
-  bounce_spec.seed = a.integrator.seed;
-  const std::vector<double> albedo(mesh.triangles.size(), a.albedo.empty() ? 0.0 : a.albedo[0]);
-  std::optional<bake::GatherHits> hits;
-  std::optional<bake::VertexBake> bounced;  // the direct rows with the bounces added
-  int bounces_applied = 0;
-  auto bounce = [&](const bake::VertexBake& direct, const std::vector<bake::ShadePoint>& points) {
-    if (!hits) hits = bake::gather(*accel.rays(), points, bounce_spec, direct.layout.radiance_count > 0, run.progress);
-    bake::BounceResult r =
-        bake::bounce_rows(mesh, *hits, albedo, direct.layout, direct.values, bounce_spec, run.progress);
-    bounced = direct;
-    bounced->values = std::move(r.values);
-    bounces_applied = r.applied;
-    if (run.say) print_bounces(r, bounce_spec, a.albedo[0], *hits, direct.layout);
-  };
+  // ---- interreflections (tools/prtbake/bounces.h): over the mesh's vertices.
+  ReceiverBounces bounces(a, mesh.triangles.size());
+  const bake::VertexField field(mesh);
 
   // ---- the file (formats/SCHEMA.md): written once the bake is whole, again with its report ----
   namespace F = prt::formats;
@@ -82,14 +64,12 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
     asset.root = root_info(a, mesh_sha);
     tool::set_mesh(asset.vertices, mesh);
     if (a.flip_normals) *asset.vertices.normals->source += ", flipped";
-    const bake::VertexBake& result = bounced ? *bounced : job.rows.front();
+    const bake::VertexBake& result = bounces.rows(job.rows.front());
     tool::set_products(asset.vertices, result,
                        {job.integrator->name(), job.integrator_description, job.spec.samples(), job.spec.seed, a.transfer,
                         a.visibility, env ? &*env : nullptr, a.environment});
-    if (bounced && asset.vertices.transfer_diffuse)
-      tool::set_bounces(*asset.vertices.transfer_diffuse, false, bounces_applied, bounce_spec, a.albedo);
-    if (bounced && asset.vertices.radiance_band1)
-      tool::set_bounces(*asset.vertices.radiance_band1, true, bounces_applied, bounce_spec, a.albedo);
+    bounces.set_attributes(asset.vertices.transfer_diffuse ? &*asset.vertices.transfer_diffuse : nullptr,
+                           asset.vertices.radiance_band1 ? &*asset.vertices.radiance_band1 : nullptr);
     if (const auto& report = job.reports.front())
       asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
     tool::set_target_error(asset, a.target_error);
@@ -103,7 +83,8 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
                 a.flip_normals);
     // Chunks of other workers or runs: their threads are not recorded.
     if (run.say) print_rows_baked(j, shards && shards->threads_of_chunks() == 0);
-    if (a.bounces > 0) bounce(result, j.sets.front().points);
+    if (bounces.asked())
+      bounces.bounce(field, *accel.rays(), result, j.sets.front().points, mesh.source, run, "vertex");
   };
 
   return console.run(a, run, pipeline, hooks, shards,

@@ -442,9 +442,12 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
     throw UsageError("--bounces and --albedo apply to per-vertex, per-texel and scene files under an environment, not to " +
                      std::string(area ? "area lights" : kind == "fiv" ? "FIV files" : "glossy lobes"));
   if (kind == "scene" && a.albedo) throw UsageError("--albedo: the objects of a scene file carry their own albedo");
+  // The product drawn: per vertex, or the lightmap's per texel.
   const F::Product* baked = nullptr;
-  if (!texel && kind == "transfer" && f.vertices.transfer_diffuse) baked = &*f.vertices.transfer_diffuse;
-  if (!texel && kind == "band1" && f.vertices.radiance_band1) baked = &*f.vertices.radiance_band1;
+  const std::optional<F::Product>& transfer = texel ? f.vertices.lightmap->transfer_diffuse : f.vertices.transfer_diffuse;
+  const std::optional<F::Product>& band1 = texel ? f.vertices.lightmap->radiance_band1 : f.vertices.radiance_band1;
+  if (kind == "transfer" && transfer) baked = &*transfer;
+  if (kind == "band1" && band1) baked = &*band1;
   const int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
   std::optional<double> file_albedo;
   if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3) file_albedo = (*baked->albedo)[0];

@@ -23,6 +23,26 @@ namespace {
 constexpr uint64_t kGatherStream = 0x6a09e667f3bcc909ull;
 // The most values a vertex gives a bounce: T at the largest order, and E's three channels.
 constexpr size_t kMaxSource = size_t(sh::kMaxOrder) * size_t(sh::kMaxOrder) + 3;
+constexpr double kInvPi = std::numbers::inv_pi;
+
+// Ray k of a row whose frame and rotated sequence are given: cosine-weighted, or with `mixture`
+// cosine or uniform by u0 (one strategy per ray, the balance heuristic's pdf). The gather and
+// every bounce make it the same way, so the bounce's weights belong to the ray that was cast.
+Eigen::Vector3d gather_direction(const Frame& frame, const RotatedHalton3& halton, size_t k, bool mixture) {
+  const auto u = halton(k);
+  const bool uniform = mixture && u[0] >= 0.5;
+  Eigen::Vector3d d = frame.to_world(uniform ? uniform_hemisphere(u[1], u[2]) : cosine_hemisphere(u[1], u[2]));
+  return d.normalized();
+}
+
+// The weights of (3') and (5') for direction d about normal n: ((n·ω)/π, y_1m(ω)/π) / p(ω).
+std::array<double, 4> mixture_weights(const Eigen::Vector3d& n, const Eigen::Vector3d& d) {
+  const double c = n.dot(d);
+  const double inv_p = 1.0 / (0.5 * c * kInvPi + 0.5 * (0.5 * kInvPi));
+  double y[4];
+  sh::eval(2, d.x(), d.y(), d.z(), y);
+  return {c * kInvPi * inv_p, y[1] * kInvPi * inv_p, y[2] * kInvPi * inv_p, y[3] * kInvPi * inv_p};
+}
 } // namespace
 
 GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, const BounceSpec& spec, bool radiance,
@@ -35,37 +55,22 @@ GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, con
   const size_t K = spec.rays;
   hits.triangle.assign(points.size() * K, GatherHits::kNone);
   hits.weights.assign(points.size() * K, {0.0f, 0.0f});
-  if (radiance) hits.estimator.assign(points.size() * K, {0.0f, 0.0f, 0.0f, 0.0f});
-  const uint64_t seed = mix64(spec.seed ^ kGatherStream);
-  constexpr double kInvPi = std::numbers::inv_pi;
+  hits.seed = mix64(spec.seed ^ kGatherStream);
   Task progress(monitor, label, points.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-    double y[4];
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const ShadePoint& point = points[v];
       PRT_CHECK(point.hemisphere);
       const Frame frame(point.n);
-      const RotatedHalton3 halton(seed, v);
+      const RotatedHalton3 halton(hits.seed, v);
       const NearTriangles near = rays.near_triangles(point);
       for (size_t k = 0; k < K; ++k) {
-        const auto u = halton(k);
-        // The mixture picks its strategy by u0 (one strategy per ray, the balance heuristic's pdf).
-        const bool uniform = radiance && u[0] >= 0.5;
-        Eigen::Vector3d d =
-            frame.to_world(uniform ? uniform_hemisphere(u[1], u[2]) : cosine_hemisphere(u[1], u[2]));
-        d.normalize();
-        const double c = point.n.dot(d);
-        if (!(c > 0)) continue;  // on the horizon (a null set): no contribution
+        const Eigen::Vector3d d = gather_direction(frame, halton, k, radiance);
+        if (!(point.n.dot(d) > 0)) continue;  // on the horizon (a null set): no contribution
         const auto hit = rays.first_surface_hit(point, near, d);
         if (!hit || !hit->front) continue;  // the sky (the direct pass's), or a back face (black)
         hits.triangle[v * K + k] = hit->triangle;
         hits.weights[v * K + k] = {float(hit->w1), float(hit->w2)};
-        if (radiance) {
-          const double inv_p = 1.0 / (0.5 * c * kInvPi + 0.5 * (0.5 * kInvPi));  // (3'), (5')
-          sh::eval(2, d.x(), d.y(), d.z(), y);
-          hits.estimator[v * K + k] = {float(c * kInvPi * inv_p), float(y[1] * kInvPi * inv_p),
-                                       float(y[2] * kInvPi * inv_p), float(y[3] * kInvPi * inv_p)};
-        }
       }
     }
     progress.advance(r.size());
@@ -88,42 +93,111 @@ void check_albedo(std::span<const double> albedo, const std::string& source) {
   }
 }
 
-BounceResult bounce_rows(const Mesh& mesh, const GatherHits& hits, std::span<const double> albedo,
-                         const ProductLayout& layout, std::span<const double> direct, const BounceSpec& spec,
-                         const Monitor& monitor, const std::string& label) {
-  const size_t V = mesh.positions.size(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
+void VertexField::spread(std::span<const double> rows, size_t width, std::span<double> entries) const {
+  PRT_CHECK_OP(rows.size(), ==, this->rows() * width);
+  PRT_CHECK_OP(entries.size(), ==, rows.size());
+  std::copy(rows.begin(), rows.end(), entries.begin());
+}
+
+FieldTaps VertexField::taps(uint32_t triangle, double w1, double w2) const {
+  const auto& tri = mesh_.triangles[triangle];
+  FieldTaps t;
+  t.count = 3;
+  t.entry = {tri[0], tri[1], tri[2], 0};
+  t.weight = {1.0 - w1 - w2, w1, w2, 0.0};
+  return t;
+}
+
+TexelField::TexelField(const Mesh& mesh, const LightmapReceivers& texels, uint32_t padding)
+    : mesh_(mesh), texels_(texels), padding_(padding) {
+  PRT_CHECK_OP(texels.uv.corners.size(), ==, 3 * mesh.triangles.size());
+}
+
+void TexelField::spread(std::span<const double> rows, size_t width, std::span<double> entries) const {
+  PRT_CHECK_OP(entries.size(), ==, this->entries() * width);
+  const Lightmap image = texels_.image(rows, width, padding_);
+  std::copy(image.values.begin(), image.values.end(), entries.begin());
+}
+
+FieldTaps TexelField::taps(uint32_t triangle, double w1, double w2) const {
+  const Eigen::Vector2f* c = &texels_.uv.corners[3 * size_t(triangle)];
+  const double w0 = 1.0 - w1 - w2;
+  const double u = w0 * double(c[0].x()) + w1 * double(c[1].x()) + w2 * double(c[2].x());
+  const double v = w0 * double(c[0].y()) + w1 * double(c[1].y()) + w2 * double(c[2].y());
+  const BilinearLookup l = bilinear_lookup(u, v, texels_.atlas.width, texels_.atlas.height);
+  FieldTaps t;
+  t.count = 4;
+  t.entry = l.texel;
+  t.weight = l.weight;
+  return t;
+}
+
+void SceneField::add(const BounceField& field, uint32_t first_triangle, uint32_t triangles) {
+  PRT_CHECK(parts_.empty() || parts_.back().first_triangle + parts_.back().triangles <= first_triangle);
+  parts_.push_back({&field, first_triangle, triangles, rows_, entries_});
+  rows_ += field.rows();
+  entries_ += field.entries();
+}
+
+void SceneField::spread(std::span<const double> rows, size_t width, std::span<double> entries) const {
+  PRT_CHECK_OP(rows.size(), ==, rows_ * width);
+  PRT_CHECK_OP(entries.size(), ==, entries_ * width);
+  for (const Part& part : parts_)
+    part.field->spread(rows.subspan(part.first_row * width, part.field->rows() * width), width,
+                       entries.subspan(part.first_entry * width, part.field->entries() * width));
+}
+
+FieldTaps SceneField::taps(uint32_t triangle, double w1, double w2) const {
+  // The last part that starts at or before `triangle`.
+  auto it = std::upper_bound(parts_.begin(), parts_.end(), triangle,
+                             [](uint32_t t, const Part& part) { return t < part.first_triangle; });
+  if (it == parts_.begin()) return {};
+  const Part& part = *(it - 1);
+  if (triangle - part.first_triangle >= part.triangles) return {};
+  FieldTaps t = part.field->taps(triangle - part.first_triangle, w1, w2);
+  for (int k = 0; k < t.count; ++k) t.entry[size_t(k)] += part.first_entry;
+  return t;
+}
+
+BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
+                         std::span<const double> albedo, const ProductLayout& layout, std::span<const double> direct,
+                         const BounceSpec& spec, const std::string& source, const Monitor& monitor,
+                         const std::string& label) {
+  const size_t V = field.rows(), E = field.entries(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
   const bool radiance = layout.radiance_count > 0;
-  PRT_CHECK_OP(albedo.size(), ==, mesh.triangles.size());
+  PRT_CHECK_OP(points.size(), ==, V);
   PRT_CHECK_OP(direct.size(), ==, V * W);
   PRT_CHECK_OP(hits.rows(), ==, V);
   PRT_CHECK(!radiance || hits.mixture);  // R's estimator (5') needs the mixture's weights
   PRT_CHECK(spec.bounces >= 0);
-  check_albedo(albedo, mesh.source);
+  check_albedo(albedo, source);
   BounceResult out;
   out.values.assign(direct.begin(), direct.end());
   if ((nt == 0 && !radiance) || spec.bounces == 0) return out;
 
-  // What a bounce gathers per vertex, [V][S]: T^b (nt values), then E^b_c (3, eq. (4) at the
-  // vertex's normal, when R bounces). What it makes per vertex, [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], 9).
+  // What a bounce gathers per row, [V][S]: T^b (nt values), then E^b_c (3, eq. (4) at the row's
+  // normal, when R bounces), spread over the field's entries [E][S]. What it makes per row,
+  // [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], 9).
   const size_t S = nt + (radiance ? 3 : 0), B = nt + (radiance ? 9 : 0);
-  std::vector<std::array<double, 3>> y1(radiance ? V : 0);  // y_1m(n_v)
+  std::vector<std::array<double, 3>> y1(radiance ? V : 0);  // y_1m(n_r)
   for (size_t v = 0; v < y1.size(); ++v) {
-    const Eigen::Vector3d n = mesh.normals[v].cast<double>().normalized();
+    const Eigen::Vector3d n = points[v].n.normalized();
     double y[4];
     sh::eval(2, n.x(), n.y(), n.z(), y);
     y1[v] = {y[1], y[2], y[3]};
   }
-  std::vector<double> source(V * S), made(V * B);
+  std::vector<double> source_rows(V * S), field_values(E * S), made(V * B);
   auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset) {
     for (size_t v = 0; v < V; ++v) {
-      for (size_t i = 0; i < nt; ++i) source[v * S + i] = rows[v * width + t_offset + i];
+      for (size_t i = 0; i < nt; ++i) source_rows[v * S + i] = rows[v * width + t_offset + i];
       if (radiance)
         for (size_t c = 0; c < 3; ++c) {  // eq. (4)
           double e = 0;
           for (size_t m = 0; m < 3; ++m) e += y1[v][m] * rows[v * width + r_offset + 3 * c + m];
-          source[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;
+          source_rows[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;
         }
     }
+    field.spread(source_rows, S, field_values);
   };
   take(direct, W, layout.transfer, layout.radiance);
   // The direct pass's RMS per product, over the rows.
@@ -137,35 +211,36 @@ BounceResult bounce_rows(const Mesh& mesh, const GatherHits& hits, std::span<con
                                 slice_rms(direct, W, layout.radiance, radiance ? 9 : 0)};
 
   for (int b = 1; b <= spec.bounces; ++b) {
-    // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source interpolated at h) × its weights.
+    // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source at h, as the field reads it) × its weights.
     VertexBake pass = bake_rows(
         0, V, B,
         [&](size_t v, std::span<double> row, std::span<double>) {
           double at_hit[kMaxSource];
+          const Frame frame(points[v].n);
+          const RotatedHalton3 halton(hits.seed, v);
           for (size_t k = 0; k < K; ++k) {
             const size_t ray = v * K + k;
             const uint32_t t = hits.triangle[ray];
             if (t == GatherHits::kNone) continue;
             const double rho = albedo[t];
             if (rho == 0) continue;
-            const auto& tri = mesh.triangles[t];
-            const double w1 = hits.weights[ray][0], w2 = hits.weights[ray][1];
-            const double w[3] = {1.0 - w1 - w2, w1, w2};
+            const FieldTaps taps = field.taps(t, hits.weights[ray][0], hits.weights[ray][1]);
+            if (taps.count == 0) continue;
             std::fill(at_hit, at_hit + S, 0.0);
-            for (int c = 0; c < 3; ++c) {
-              const double* src = &source[size_t(tri[size_t(c)]) * S];
-              for (size_t i = 0; i < S; ++i) at_hit[i] += w[c] * src[i];
+            for (size_t c = 0; c < size_t(taps.count); ++c) {
+              const double* src = &field_values[taps.entry[c] * S];
+              for (size_t i = 0; i < S; ++i) at_hit[i] += taps.weight[c] * src[i];
             }
-            const double wt = hits.mixture ? rho * double(hits.estimator[ray][0]) : rho;
-            for (size_t i = 0; i < nt; ++i) row[i] += wt * at_hit[i];
+            std::array<double, 4> weight{1, 0, 0, 0};  // the cosine gather's: T's weight is 1
+            if (hits.mixture) weight = mixture_weights(points[v].n, gather_direction(frame, halton, k, true));
+            for (size_t i = 0; i < nt; ++i) row[i] += rho * weight[0] * at_hit[i];
             if (radiance)
               for (size_t c = 0; c < 3; ++c)
-                for (size_t m = 0; m < 3; ++m)
-                  row[nt + 3 * c + m] += rho * at_hit[nt + c] * double(hits.estimator[ray][1 + m]);
+                for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho * at_hit[nt + c] * weight[1 + m];
           }
           for (size_t i = 0; i < B; ++i) row[i] /= double(K);
         },
-        monitor, label + " (bounce " + std::to_string(b) + ")", "the bounce gather of " + mesh.source);
+        monitor, label + " (bounce " + std::to_string(b) + ")", "the bounce gather of " + source);
     made = std::move(pass.values);
     // Summed only where non-zero, so an albedo of 0 leaves the direct rows' bits (−0 included).
     for (size_t v = 0; v < V; ++v) {
@@ -185,7 +260,7 @@ BounceResult bounce_rows(const Mesh& mesh, const GatherHits& hits, std::span<con
     take(made, B, 0, nt);
   }
   for (const double x : out.values)
-    if (!std::isfinite(x)) throw ContractError("bounce_rows: a non-finite value in the bounced rows of " + mesh.source);
+    if (!std::isfinite(x)) throw ContractError("bounce_rows: a non-finite value in the bounced rows of " + source);
   return out;
 }
 

@@ -132,27 +132,17 @@ Lightmap make_lightmap(const TexelAtlas& atlas, std::span<const double> rows, si
   return m;
 }
 
-namespace {
-
-// The bilinear lookup at UV (u, v) (formats/SCHEMA.md): four texels and their weights, clamped
-// to the image.
-struct Lookup {
-  std::array<size_t, 4> texel{};
-  std::array<double, 4> weight{};
-};
-Lookup lookup(double u, double v, size_t W, size_t H) {
+BilinearLookup bilinear_lookup(double u, double v, size_t W, size_t H) {
   const double x = u * double(W) - 0.5, y = v * double(H) - 0.5;
   const double fx0 = std::floor(x), fy0 = std::floor(y);
   const double fx = x - fx0, fy = y - fy0;
   auto clampi = [](double c, size_t n) { return size_t(std::clamp(c, 0.0, double(n - 1))); };
   const size_t x0 = clampi(fx0, W), x1 = clampi(fx0 + 1, W), y0 = clampi(fy0, H), y1 = clampi(fy0 + 1, H);
-  Lookup l;
+  BilinearLookup l;
   l.texel = {y0 * W + x0, y0 * W + x1, y1 * W + x0, y1 * W + x1};
   l.weight = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
   return l;
 }
-
-} // namespace
 
 std::array<size_t, kMipLevels + 1> mip_empty_hits(const Lightmap& image, const TexelAtlas& atlas, const UvSet& uv) {
   PRT_CHECK_OP(image.state.size(), ==, size_t(image.width) * image.height);
@@ -183,7 +173,7 @@ std::array<size_t, kMipLevels + 1> mip_empty_hits(const Lightmap& image, const T
       empty = std::move(next), W = w, H = h;
     }
     for (const Eigen::Vector2d& p : points) {
-      const Lookup l = lookup(p.x(), p.y(), W, H);
+      const BilinearLookup l = bilinear_lookup(p.x(), p.y(), W, H);
       for (int k = 0; k < 4; ++k)
         if (l.weight[size_t(k)] > 0 && empty[l.texel[size_t(k)]]) {
           ++hits[size_t(level)];
@@ -210,7 +200,7 @@ SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& me
       if (a != b) edges[std::minmax(a, b)].push_back({t, c});
     }
   struct Point {
-    Lookup side[2];
+    BilinearLookup side[2];
   };
   std::vector<Point> points;
   auto uv_at = [&](uint32_t t, int c) { return uv.corners[size_t(3 * t + uint32_t(c))].cast<double>(); };
@@ -250,7 +240,7 @@ SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& me
       bool usable = true;
       for (int s = 0; s < 2; ++s) {
         const Eigen::Vector2d q = (1 - f) * end[size_t(s)][0] + f * end[size_t(s)][1];
-        p.side[s] = lookup(q.x(), q.y(), W, H);
+        p.side[s] = bilinear_lookup(q.x(), q.y(), W, H);
         const uint32_t own = atlas.triangle_chart[sides[size_t(s)].first];
         for (const size_t tx : p.side[s].texel)
           usable = usable && image.state[tx] != uint8_t(TexelState::Empty) && image.chart[tx] == own;
@@ -264,7 +254,7 @@ SeamStitch stitch_seams(Lightmap& image, const TexelAtlas& atlas, const Mesh& me
   // The unknowns: the texels the points touch, in texel order.
   std::map<size_t, int> index;
   for (const Point& p : points)
-    for (const Lookup& l : p.side)
+    for (const BilinearLookup& l : p.side)
       for (const size_t tx : l.texel) index.emplace(tx, 0);
   int n = 0;
   for (auto& [tx, i] : index) i = n++;

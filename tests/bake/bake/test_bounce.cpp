@@ -165,7 +165,7 @@ static void check_integrating_sphere(bool radiance) {
   const double per_ray = radiance ? std::sqrt(2 * (1 - f)) : std::sqrt(f * (1 - f));
   for (const int B : {1, 2, 4, 8}) {
     spec.bounces = B;
-    const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, layout, direct, spec);
+    const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, layout, direct, spec, g.mesh.source);
     ASSERT_EQ(r.applied, B);
     // T_00 (c = −1), then E of each channel: value, closed form and its scale against T_00's.
     for (int c = -1; c < (radiance ? 3 : 0); ++c) {
@@ -218,7 +218,7 @@ TEST(Bounce, IntegratingSphereWithItsDirectPassBaked) {
   const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec);
   const VertexBake direct = direct_bake(g, false, 1, QmcOptions{N, 11});
   const std::vector<double> albedo(g.mesh.triangles.size(), rho);
-  const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+  const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, direct.layout, direct.values, spec, g.mesh.source);
   const size_t V = g.mesh.positions.size();
   double mean = 0, mean_direct = 0;
   for (size_t v = 0; v < V; ++v) {
@@ -245,7 +245,7 @@ TEST(Bounce, ZeroAlbedoKeepsTheDirectBits) {
   const Gathered g = gathered(integrating_sphere(1.0, 12, 24), spec);
   const VertexBake direct = direct_bake(g, true, 3, QmcOptions{128, 3});
   const std::vector<double> albedo(g.mesh.triangles.size(), 0.0);
-  const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+  const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, direct.layout, direct.values, spec, g.mesh.source);
   ASSERT_EQ(r.values.size(), direct.values.size());
   EXPECT_EQ(std::memcmp(r.values.data(), direct.values.data(), r.values.size() * sizeof(double)), 0);
   EXPECT_EQ(r.applied, 1);  // the first bounce adds nothing: below any tolerance
@@ -264,7 +264,7 @@ TEST(Bounce, EveryBounceAddsEnergy) {
   for (size_t v = 0; v < V; ++v) mean_before += (before[v] = direct.values[v * W]) / double(V);
   for (int B = 1; B <= 4; ++B) {
     spec.bounces = B;
-    const BounceResult r = bounce_rows(g.mesh, g.hits, albedo, direct.layout, direct.values, spec);
+    const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, direct.layout, direct.values, spec, g.mesh.source);
     double mean = 0;
     for (size_t v = 0; v < V; ++v) {
       EXPECT_GE(r.values[v * W], before[v]) << "vertex " << v << ", B = " << B;
@@ -288,7 +288,7 @@ TEST(Bounce, SameBytesWhateverTheThreads) {
     BounceResult r;
     arena.execute([&] {
       const Gathered g = gathered(mesh, spec);
-      r = bounce_rows(g.mesh, g.hits, albedo, transfer_layout(1), direct, spec);
+      r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, transfer_layout(1), direct, spec, g.mesh.source);
     });
     return r.values;
   };

@@ -1,6 +1,7 @@
-// bake/bake/bounce.h — interreflections (issue 31, first slice): the direct pass's rows of diffuse
-// transfer T and band-1 radiance R plus B bounces of light between the surfaces of one mesh, for
-// receivers that are the mesh's own vertices (`prtbake vertex`). The idea is the "interreflected
+// bake/bake/bounce.h — interreflections (issue 31): the direct pass's rows of diffuse transfer T and
+// band-1 radiance R plus B bounces of light between surfaces, for receivers that are a mesh's own
+// vertices (`prtbake vertex`) or its lightmap's texels (`prtbake texel`), or both side by side over
+// a scene's union (the fields below). The idea is the "interreflected
 // transfer" of PRT (Sloan, Kautz and Snyder 2002, §5; not among ../shared/papers, so the derivation
 // is given here in full): each bounce gathers the previous bounce's transfer at the points the rays
 // hit, weighted by albedo.
@@ -28,9 +29,10 @@
 // integrand over the pdf is ρ(h) T^b_i(h) (1 − V), so every bounce is a sparse product over the
 // cached hits, with no new rays:
 //   T^{b+1}_i(p) ≈ (1/K) Σ_k ρ(h_k) T^b_i(h_k),   T^b_i(h) = Σ_c w_c T^b_i(vertex c of h's triangle)  (3)
-// (a sky ray adds nothing: the sky is the direct pass's). T^b at the hit is interpolated from the
-// triangle's corner rows by the hit's barycentric weights w_c, so the receivers must be the mesh's
-// own vertices (row r = vertex r). The directions are a 3D Halton sequence with a Cranley–Patterson
+// (a sky ray adds nothing: the sky is the direct pass's). T^b at the hit is what the baked file
+// gives there: for vertex receivers the triangle's corner rows at the hit's barycentric weights
+// w_c (written above), for texel receivers the bilinear lookup of the previous bounce's lightmap
+// at the hit's UV (BounceField below). The directions are a 3D Halton sequence with a Cranley–Patterson
 // rotation per receiver from (seed, row) (bake/sphere/sampling.h, as the QMC integrator's), in a
 // stream of its own: the values are a function of (mesh, rows, seed, K) whatever the thread count,
 // and each row sums its rays in ray order.
@@ -52,7 +54,9 @@
 //   T^{b+1}_i(p) ≈ (1/K) Σ_k ρ(h_k) T^b_i(h_k) ((n·ω_k)/π)/p(ω_k)               (3')
 //   R^{b+1}_c,m(p) ≈ (1/K) Σ_k ρ(h_k) E^b_c(h_k) (y_1m(ω_k)/π)/p(ω_k)           (5')
 // both bounded (the weights are at most 2 and 4 · 0.4886 ≈ 1.95: p ≥ 1/(4π)). The per-ray weights are
-// cached beside the hits. Shadowed radiance S bounces by (5) with y_i in place of y_1m (E at the
+// made again from the ray's direction at every bounce (GatherHits: the direction is a function of
+// the seed, the row and k), so the cache holds 12 bytes a ray.
+// Shadowed radiance S bounces by (5) with y_i in place of y_1m (E at the
 // hit is still all it needs), but its weights are one per coefficient: not in this slice (the tool
 // refuses S with bounces, so S's band 1 keeps equalling R).
 //
@@ -76,6 +80,7 @@
 #pragma once
 
 #include <bake/core/progress.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/integrators/products.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/shade_point.h>
@@ -99,21 +104,20 @@ struct BounceSpec {
   double tolerance = kDefaultTolerance;  // a bounce whose RMS ≤ tolerance × the direct RMS is the last
 };
 
-// The cached hits of the gather rays: ray k of row r at index r·rays + k.
+// The cached hits of the gather rays: ray k of row r at index r·rays + k (12 bytes a ray).
 struct GatherHits {
   static constexpr uint32_t kNone = 0xffffffffu;  // the sky, or a triangle met from behind
   uint32_t rays = 0;
   bool mixture = false;                         // cosine and uniform half and half (R's gather), else cosine
   std::vector<uint32_t> triangle;               // [rows][rays]
   std::vector<std::array<float, 2>> weights;    // [rows][rays]: barycentric weights of corners 1, 2
-  // With `mixture`, [rows][rays]: ((n·ω)/π, y_1,−1(ω)/π, y_1,0(ω)/π, y_1,1(ω)/π) / p(ω), the
-  // weights of (3') and (5'); empty for the cosine gather, where T's weight is 1.
-  std::vector<std::array<float, 4>> estimator;
+  // The rays' directions are not stored: ray k of row r is a function of (seed, r, k) and the row's
+  // normal (gather_direction), so a bounce makes it again for the weights of (3') and (5').
+  uint64_t seed = 0;                            // the gather's, from BounceSpec::seed
   double seconds = 0;                           // wall time of the gather
   size_t rows() const { return rays ? triangle.size() / rays : 0; }
   size_t bytes() const {
-    return triangle.size() * sizeof(uint32_t) + weights.size() * sizeof(weights[0]) +
-           estimator.size() * sizeof(estimator[0]);
+    return triangle.size() * sizeof(uint32_t) + weights.size() * sizeof(weights[0]);
   }
 };
 
@@ -128,6 +132,85 @@ GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, con
 // finite).
 void check_albedo(std::span<const double> albedo, const std::string& source);
 
+// WHERE A HIT TAKES THE PREVIOUS BOUNCE FROM. The rows of a bounce are per receiver; a hit needs
+// the value of the surface it lands on. A field spreads the rows over the places a hit reads
+// ("entries") and tells which entries a hit reads, with what weights — the run-time's own
+// reconstruction of the surface from the baked file, so a bounce gathers exactly what an engine
+// would shade at the hit:
+//   VertexField  receivers = the mesh's vertices (row r = vertex r): a hit reads its triangle's
+//                three corners at its barycentric weights (Gouraud).
+//   TexelField   receivers = the valid texels of a lightmap (bake/bake/lightmap_receivers.h): the
+//                rows become the lightmap image (filled inside the geometry, padded, as the file's:
+//                bake/bake/lightmap.h, without the seam stitch), and a hit reads the bilinear lookup
+//                at its UV (formats/SCHEMA.md's rule) — four texels.
+//   SceneField   several fields side by side over one union of meshes: the hit's triangle picks
+//                the part (by triangle range); a triangle of no part (an occluder that receives
+//                nothing, so has no rows) reads nothing — it reflects no light.
+struct FieldTaps {
+  std::array<size_t, 4> entry{};
+  std::array<double, 4> weight{};
+  int count = 0;
+};
+class BounceField {
+ public:
+  virtual ~BounceField() = default;
+  virtual size_t rows() const = 0;     // receivers whose rows it takes
+  virtual size_t entries() const = 0;  // places a hit reads
+  // rows [rows()][width] → entries [entries()][width] (every entry written).
+  virtual void spread(std::span<const double> rows, size_t width, std::span<double> entries) const = 0;
+  // The entries a hit on `triangle` (of the geometry the gather rays met) at barycentric weights
+  // (1 − w1 − w2, w1, w2) reads; count 0 when it reads none.
+  virtual FieldTaps taps(uint32_t triangle, double w1, double w2) const = 0;
+};
+
+class VertexField final : public BounceField {
+ public:
+  explicit VertexField(const Mesh& mesh) : mesh_(mesh) {}
+  size_t rows() const override { return mesh_.positions.size(); }
+  size_t entries() const override { return mesh_.positions.size(); }
+  void spread(std::span<const double> rows, size_t width, std::span<double> entries) const override;
+  FieldTaps taps(uint32_t triangle, double w1, double w2) const override;
+
+ private:
+  const Mesh& mesh_;
+};
+
+class TexelField final : public BounceField {
+ public:
+  // `texels` of `mesh` (its UV set and atlas); the image padded `padding` rings.
+  TexelField(const Mesh& mesh, const LightmapReceivers& texels, uint32_t padding);
+  size_t rows() const override { return texels_.valid.size(); }
+  size_t entries() const override { return size_t(texels_.atlas.width) * texels_.atlas.height; }
+  void spread(std::span<const double> rows, size_t width, std::span<double> entries) const override;
+  FieldTaps taps(uint32_t triangle, double w1, double w2) const override;
+
+ private:
+  const Mesh& mesh_;
+  const LightmapReceivers& texels_;
+  uint32_t padding_;
+};
+
+class SceneField final : public BounceField {
+ public:
+  // Adds `field` for the union's triangles [first_triangle, first_triangle + triangles) (the
+  // field's own triangles 0 …, in order), after the parts added before (rows and entries follow
+  // theirs). Parts must be added in increasing, disjoint triangle ranges.
+  void add(const BounceField& field, uint32_t first_triangle, uint32_t triangles);
+  size_t rows() const override { return rows_; }
+  size_t entries() const override { return entries_; }
+  void spread(std::span<const double> rows, size_t width, std::span<double> entries) const override;
+  FieldTaps taps(uint32_t triangle, double w1, double w2) const override;
+
+ private:
+  struct Part {
+    const BounceField* field;
+    uint32_t first_triangle, triangles;
+    size_t first_row, first_entry;
+  };
+  std::vector<Part> parts_;
+  size_t rows_ = 0, entries_ = 0;
+};
+
 struct BounceResult {
   std::vector<double> values;         // [rows][layout.width]: the direct rows, T's and R's slices with the bounces added
   int applied = 0;                    // bounces summed (≤ spec.bounces)
@@ -137,15 +220,17 @@ struct BounceResult {
   std::vector<double> seconds;        // per bounce summed: wall time of its sparse product
 };
 
-// The direct rows `direct` ([rows][layout.width], row r = vertex r of `mesh`, its normal
-// mesh.normals[r]) with up to `spec.bounces` bounces of the diffuse transfer (3) and of the band-1
-// radiance (5) added, from the cached `hits` (of the same rows; a layout with R needs the mixture
-// gather: contract) and an albedo per triangle of `mesh` (checked: check_albedo(albedo,
-// mesh.source)). Other products are copied. A bounce that is zero everywhere (albedo 0) leaves
-// every value's bits as they were. ContractError if a value is not finite. Progress stage
-// `label`, one task per bounce.
-BounceResult bounce_rows(const Mesh& mesh, const GatherHits& hits, std::span<const double> albedo,
-                         const ProductLayout& layout, std::span<const double> direct, const BounceSpec& spec,
-                         const Monitor& monitor = {}, const std::string& label = "bouncing light");
+// The direct rows `direct` ([rows][layout.width], row r at shade point points[r], whose normal
+// E's eq. (4) takes) with up to `spec.bounces` bounces of the diffuse transfer (3) and of the
+// band-1 radiance (5) added, from the cached `hits` (of the same rows; a layout with R needs the
+// mixture gather: contract), the `field` the hits read the previous bounce from (rows() = the
+// rows), and an albedo per triangle of the geometry the hits met (checked: check_albedo(albedo,
+// source)). Other products are copied. A bounce that is zero everywhere (albedo 0) leaves every
+// value's bits as they were. ContractError if a value is not finite. Progress stage `label`, one
+// task per bounce.
+BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
+                         std::span<const double> albedo, const ProductLayout& layout, std::span<const double> direct,
+                         const BounceSpec& spec, const std::string& source, const Monitor& monitor = {},
+                         const std::string& label = "bouncing light");
 
 } // namespace prt::bake

@@ -37,6 +37,15 @@ struct Lightmap {
   static constexpr uint32_t kNoChart = 0xffffffffu;
 };
 
+// The bilinear lookup at UV (u, v) of a width × height image (formats/SCHEMA.md's rule: texel
+// coordinates (u·W − ½, v·H − ½)): four texels (row-major indices) and their weights, clamped to
+// the image. The runtime's filtering, and what a bounce reads at a hit (bake/bake/bounce.h).
+struct BilinearLookup {
+  std::array<size_t, 4> texel{};
+  std::array<double, 4> weight{};
+};
+BilinearLookup bilinear_lookup(double u, double v, size_t width, size_t height);
+
 // Seams (issue 30: "texels on the two sides of a UV seam must agree where the surface is
 // continuous"). A seam edge is an edge two triangles share through welded corners whose UVs differ
 // on the two sides (a cut of the UV set over a continuous surface). Along it, k points (about two

@@ -1,0 +1,35 @@
+#include "bounces.h"
+
+#include "bakefile.h"
+#include "output.h"
+
+#include <utility>
+
+namespace prt::tool {
+
+ReceiverBounces::ReceiverBounces(const Args& a, size_t triangles) : albedo_rgb_(a.albedo) {
+  spec_.bounces = a.bounces;
+  spec_.rays = a.bounce_rays ? a.bounce_rays : bake::BounceSpec::kDefaultRays;
+  spec_.seed = a.integrator.seed;
+  albedo_.assign(triangles, a.albedo.empty() ? 0.0 : a.albedo[0]);
+}
+
+void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCaster& rays,
+                             const bake::VertexBake& direct, std::span<const bake::ShadePoint> points,
+                             const std::string& source, const RunContext& run, const char* noun) {
+  if (!hits_) hits_ = bake::gather(rays, points, spec_, direct.layout.radiance_count > 0, run.progress);
+  bake::BounceResult r = bake::bounce_rows(field, points, *hits_, albedo_, direct.layout, direct.values, spec_, source,
+                                           run.progress);
+  bounced_ = direct;
+  bounced_->values = std::move(r.values);
+  applied_ = r.applied;
+  if (run.say) print_bounces(r, spec_, albedo_rgb_.at(0), *hits_, direct.layout, noun);
+}
+
+void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance) const {
+  if (!bounced_) return;
+  if (transfer) set_bounces(*transfer, false, applied_, spec_, albedo_rgb_);
+  if (radiance) set_bounces(*radiance, true, applied_, spec_, albedo_rgb_);
+}
+
+} // namespace prt::tool
