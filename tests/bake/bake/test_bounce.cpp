@@ -1,6 +1,7 @@
 // Tests of interreflected diffuse transfer (bake/bake/bounce.h): the integrating sphere's closed
 // form, albedo 0, energy that only grows with the bounces, thread-count independence, albedo checks.
 #include <bake/bake/bounce.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>
 #include <bake/integrators/qmc.h>
@@ -202,6 +203,69 @@ static void check_integrating_sphere(bool radiance) {
 
 TEST(Bounce, IntegratingSphereClosedForm) { check_integrating_sphere(false); }
 TEST(Bounce, IntegratingSphereClosedFormWithRadiance) { check_integrating_sphere(true); }
+
+// The closed form per texel: the integrating sphere unwrapped (generated UVs, 128²), its valid
+// texels the receivers, a hit reading the previous bounce's lightmap bilinearly at its UV
+// (TexelField). The direct rows are the closed form's constant, and a lightmap of a constant
+// reads back that constant wherever a lookup's four texels are baked, filled or padded, so any
+// lookup that reached an empty texel (too little padding) would show as a dark bounce. What
+// differs from the vertex case: texel points lie on the flat facets, inside the sphere by at most
+// the sag s = 1 − cos(π/n_phi)·cos(Δθ/2) of a facet's centre; from such a point the hole's form
+// factor moves by O(s) relatively, and 4·s·f is added to the tessellation's δf (measured: the
+// error stays within the Monte Carlo part, see the printed line).
+TEST(Bounce, IntegratingSphereClosedFormPerTexel) {
+  const double theta_hole = 0.6435011087932844;  // f = 0.1
+  const int n_theta = 48, n_phi = 96;
+  const double f = (1 - std::cos(theta_hole)) / 2, rho = 0.8;
+  // Moved off the origin: at (0, 0, 0) the rings' corners at φ = π/2 have x = 0.6 cos(π/2) = 4e-17,
+  // and a texel on an edge from such a corner to one of x = −0.04 cannot be put exactly on its
+  // triangle (bake/mesh/texels.h inexact_samples; no double lies on that segment but its ends), so
+  // it sees its own triangle from behind and gathers nothing — a defect of the texel sampler, not
+  // of the bounces, recorded in bench/RESULTS.md and left for its own fix.
+  Mesh moved = integrating_sphere(theta_hole, n_theta, n_phi);
+  for (Vector3f& p : moved.positions) p += Vector3f(3, 3, 3);
+  const Mesh mesh = make_mesh(moved.positions, moved.triangles, "integrating_sphere", moved.normals);
+  const Topology topology = build_topology(mesh);
+  const RayCaster rays(mesh, topology);
+  LightmapSpec lm;
+  lm.width = lm.height = 128;
+  lm.unwrap = true;
+  const LightmapReceivers texels = lightmap_receivers(mesh, topology, lm, rays, "sphere texels");
+  ASSERT_EQ(texels.atlas.inexact_samples, 0u);
+  const ReceiverSet set = texels.receivers();
+  const size_t V = set.points.size();
+  ASSERT_GT(V, 1000u);
+  BounceSpec spec = spec_of(256, 0, 0);
+  spec.seed = 5;
+  const GatherHits hits = gather(rays, set.points, spec, false);
+  const ProductLayout layout = transfer_layout(1);
+  const std::vector<double> direct(V * layout.width, kY00 * f), albedo(mesh.triangles.size(), rho);
+  const TexelField field(mesh, texels, 2);
+  const double sag = 1 - std::cos(pi / n_phi) * std::cos((pi - theta_hole) / n_theta / 2);
+  const double delta_f = 4 * f * (std::pow(2 * pi / n_phi, 2) / 6 + sag);
+  for (const int B : {1, 3}) {
+    spec.bounces = B;
+    const BounceResult r = bounce_rows(field, set.points, hits, albedo, layout, direct, spec, mesh.source);
+    const double expect = closed_total(f, rho, B);
+    double sigma = 0;
+    for (int b = 0; b < B; ++b) sigma += 1.5 * rho * kY00 * f * std::pow(rho * (1 - f), b);
+    sigma *= std::sqrt(f * (1 - f) / spec.rays);
+    const double tess = std::max(std::abs(closed_total(f + delta_f, rho, B) - expect),
+                                 std::abs(closed_total(f - delta_f, rho, B) - expect));
+    double mean = 0, worst = 0;
+    for (size_t v = 0; v < V; ++v) {
+      const double err = r.values[v * layout.width] - expect;
+      mean += err / double(V);
+      worst = std::max(worst, std::abs(err));
+    }
+    std::printf("B=%d per texel (%zu texels): closed form %.6f, mean error %.2e (bound %.2e = MC %.2e + tessellation "
+                "%.2e), worst texel %.2e (bound %.2e)\n",
+                B, V, expect, mean, 5 * sigma / std::sqrt(double(V)) + tess, 5 * sigma / std::sqrt(double(V)), tess,
+                worst, 5 * sigma + tess);
+    EXPECT_LE(std::abs(mean), 5 * sigma / std::sqrt(double(V)) + tess) << "B = " << B;
+    EXPECT_LE(worst, 5 * sigma + tess) << "B = " << B;
+  }
+}
 
 // The same closed form with the direct pass baked (QMC, cosine-weighted, N rays): the composition
 // of a real integrator's rows with the bounces. Only the mean over the vertices is compared: the
