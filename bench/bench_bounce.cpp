@@ -10,9 +10,12 @@
 //   PRT_BENCH_LEVELS   subdivision levels (default 0,1)
 //   PRT_BENCH_RAYS     gather rays per vertex (default 256)
 //   PRT_BENCH_BOUNCES  bounces (default 4; the tolerance is 0 so every one runs)
+//   PRT_BENCH_TEXELS   1 (default): also per texel, data/bunny_ground.obj at 8 texels per unit and
+//                      data/cornell_room.obj at 32 (generated lightmap UVs; bake/bake/bounce.h TexelField)
 #include "bench_common.h"
 
 #include <bake/bake/bounce.h>
+#include <bake/bake/lightmap_receivers.h>
 #include <bake/bake/vertex_bake.h>
 #include <bake/integrators/registry.h>
 #include <bake/mesh/receivers.h>
@@ -34,14 +37,12 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void run(int level, uint32_t rays, int bounces) {
-  const bench::Scene& s = bench::scene(level);
-  const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(s.mesh, s.topology);
-  const bake::MeshAccel accel(s.mesh, s.topology);
+// The direct pass, the gather and the bounces over `points` of `mesh` whose rows `field` spreads.
+void measure(const bake::Mesh& mesh, const bake::Topology& topology, const bake::MeshAccel& accel,
+             const std::vector<bake::ShadePoint>& points, const bake::BounceField& field, const char* noun,
+             uint32_t rays, int bounces) {
   bake::ProductRequest request;
   request.transfer_order = 3;
-  std::printf("\nlevel %d: %zu vertices, %zu triangles; transfer order 3\n", level, s.mesh.positions.size(),
-              s.mesh.triangles.size());
 
   // The direct pass, both integrators at their defaults (the trees built before the clock starts).
   accel.rays();
@@ -53,7 +54,7 @@ void run(int level, uint32_t rays, int bounces) {
     bake::IntegratorSpec spec;
     spec.kind = kinds[i];
     const auto t0 = std::chrono::steady_clock::now();
-    const auto integrator = bake::make_integrator(spec, s.mesh, s.topology, request, &accel);
+    const auto integrator = bake::make_integrator(spec, mesh, topology, request, &accel);
     bake::VertexBake rows = bake::bake_points(points, *integrator);
     direct_seconds[i] = seconds_since(t0);
     std::printf("  direct, %-10s (%s %u):  %8.3f s\n", bake::to_string(kinds[i]),
@@ -66,15 +67,15 @@ void run(int level, uint32_t rays, int bounces) {
   spec.rays = rays;
   spec.tolerance = 0;
   const bake::GatherHits hits = bake::gather(*accel.rays(), points, spec, false);
-  const std::vector<double> albedo(s.mesh.triangles.size(), 0.6);
+  const std::vector<double> albedo(mesh.triangles.size(), 0.6);
   const bake::BounceResult r =
-      bake::bounce_rows(bake::VertexField(s.mesh), points, hits, albedo, direct.layout, direct.values, spec, s.mesh.source);
+      bake::bounce_rows(field, points, hits, albedo, direct.layout, direct.values, spec, mesh.source);
   double per_bounce = 0;
   for (const double x : r.seconds) per_bounce += x / double(r.seconds.size());
-  std::printf("  gather (%u rays per vertex, once):   %8.3f s  = %.3fx silhouette, %.3fx qmc\n", rays, hits.seconds,
+  std::printf("  gather (%u rays per %s, once):   %8.3f s  = %.3fx silhouette, %.3fx qmc\n", rays, noun, hits.seconds,
               hits.seconds / direct_seconds[0], hits.seconds / direct_seconds[1]);
-  std::printf("  cached hits: %.2f MB (%.1f bytes per vertex; %zu bytes per ray)\n", double(hits.bytes()) / 1e6,
-              double(hits.bytes()) / double(points.size()), sizeof(uint32_t) + sizeof(hits.weights[0]));
+  std::printf("  cached hits: %.2f MB (%.1f bytes per %s; %zu bytes per ray)\n", double(hits.bytes()) / 1e6,
+              double(hits.bytes()) / double(points.size()), noun, sizeof(uint32_t) + sizeof(hits.weights[0]));
   for (size_t b = 0; b < r.seconds.size(); ++b)
     std::printf("  bounce %zu (sparse product):          %8.4f s  = %.4fx silhouette, %.4fx qmc  (RMS / direct %.4f)\n",
                 b + 1, r.seconds[b], r.seconds[b] / direct_seconds[0], r.seconds[b] / direct_seconds[1],
@@ -82,6 +83,30 @@ void run(int level, uint32_t rays, int bounces) {
   std::printf("  first bounce (gather + product): %.3fx silhouette; each bounce after it: %.4fx silhouette, %.4fx qmc\n",
               (hits.seconds + r.seconds.front()) / direct_seconds[0], per_bounce / direct_seconds[0],
               per_bounce / direct_seconds[1]);
+}
+
+void run(int level, uint32_t rays, int bounces) {
+  const bench::Scene& s = bench::scene(level);
+  const std::vector<bake::ShadePoint> points = bake::vertex_shade_points(s.mesh, s.topology);
+  const bake::MeshAccel accel(s.mesh, s.topology);
+  std::printf("\nlevel %d: %zu vertices, %zu triangles; transfer order 3\n", level, s.mesh.positions.size(),
+              s.mesh.triangles.size());
+  measure(s.mesh, s.topology, accel, points, bake::VertexField(s.mesh), "vertex", rays, bounces);
+}
+
+// Per texel: `file`'s generated lightmap at `density` texels per unit; a bounce reads the previous
+// one's lightmap (filled and padded 2 rings) at each hit's UV.
+void run_texels(const std::string& file, double density, uint32_t rays, int bounces) {
+  const bake::Mesh mesh = bake::load_mesh(std::string(PRT_DATA_DIR) + "/" + file);
+  const bake::Topology topology = bake::build_topology(mesh);
+  const bake::MeshAccel accel(mesh, topology);
+  bake::LightmapSpec lm;
+  lm.density = density;
+  const bake::LightmapReceivers texels = bake::lightmap_receivers(mesh, topology, lm, *accel.rays(), file);
+  const bake::ReceiverSet set = texels.receivers();
+  std::printf("\n%s per texel: %ux%u lightmap at %g texels per unit, %zu texels baked; transfer order 3\n",
+              file.c_str(), texels.atlas.width, texels.atlas.height, density, set.points.size());
+  measure(mesh, topology, accel, set.points, bake::TexelField(mesh, texels, 2), "texel", rays, bounces);
 }
 
 } // namespace
@@ -94,6 +119,10 @@ int main() {
   tbb::task_arena arena(1);
   arena.execute([&] {
     for (const long level : levels) run(int(level), rays, bounces);
+    if (bench::env_long("PRT_BENCH_TEXELS", 1)) {
+      run_texels("bunny_ground.obj", 8, rays, bounces);
+      run_texels("cornell_room.obj", 32, rays, bounces);
+    }
   });
   return 0;
 }
