@@ -67,7 +67,7 @@ void measure(const bake::Mesh& mesh, const bake::Topology& topology, const bake:
   spec.rays = rays;
   spec.tolerance = 0;
   const bake::GatherHits hits = bake::gather(*accel.rays(), points, spec, false);
-  const std::vector<double> albedo(mesh.triangles.size(), 0.6);
+  const std::vector<bake::Albedo> albedo(mesh.triangles.size(), bake::Albedo{0.6, 0.6, 0.6});
   const bake::BounceResult r =
       bake::bounce_rows(field, points, hits, albedo, direct.layout, direct.values, spec, mesh.source);
   double per_bounce = 0;

@@ -159,6 +159,39 @@ TEST(Bounces, PerTexelZeroAlbedoIsDirectAndEachBounceAddsEnergy) {
   EXPECT_GT(gained, 0);
 }
 
+// A coloured albedo bounces the band-1 radiance per channel (bake/bake/bounce.h "COLOUR"): each
+// channel's bounces see only that channel's light and albedo, so with one bounce at (0.6, 0.3, 0)
+// red is bit for bit the grey 0.6 bake's red, blue is the direct bake's, and green's bounce is half
+// of the grey bake's green bounce (linear in ρ; to the float rounding of the stored values, a few
+// ulps of the largest value: 1e-6 of it).
+TEST(Bounces, ColouredAlbedoBouncesEachChannelWithItsOwn) {
+  const fs::path d = dir_for("colour");
+  const std::string radiance_only = "vertex " + kData + "/bunny_ground.obj --integrator qmc --samples 64 --report 0" + kEnv;
+  auto bake_r = [&](const std::string& name, const std::string& extra) {
+    const fs::path out = d / (name + ".prt.h5");
+    const auto r = run_tool(PRT_PRTBAKE, radiance_only + " " + extra + " -q -o " + out.string(), d / "capture");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return dataset(out, "/radiance/band1");
+  };
+  const std::vector<float> direct = bake_r("direct", ""),
+                           grey = bake_r("grey", "--bounces 1 --albedo 0.6 --bounce-rays 64"),
+                           colour = bake_r("colour", "--bounces 1 --albedo 0.6,0.3,0 --bounce-rays 64");
+  ASSERT_EQ(direct.size(), colour.size());
+  ASSERT_EQ(grey.size(), colour.size());
+  float largest = 0;
+  for (const float x : grey) largest = std::max(largest, std::abs(x));
+  double green_bounce = 0;
+  for (size_t v = 0; v < direct.size() / 9; ++v)
+    for (size_t m = 0; m < 3; ++m) {
+      const size_t r = 9 * v + m, g = 9 * v + 3 + m, b = 9 * v + 6 + m;
+      EXPECT_EQ(colour[r], grey[r]) << v;
+      EXPECT_EQ(colour[b], direct[b]) << v;
+      EXPECT_NEAR(colour[g] - direct[g], 0.5 * (grey[g] - direct[g]), 1e-6 * largest) << v;
+      green_bounce += std::abs(colour[g] - direct[g]);
+    }
+  EXPECT_GT(green_bounce, 0);
+}
+
 // (d) The same bytes with one thread and with two.
 TEST(Bounces, SameBytesWhateverTheThreads) {
   const fs::path d = dir_for("threads");
@@ -183,7 +216,7 @@ TEST(Bounces, BadOptionsAreUsageErrors) {
       {"--bounces 2 --albedo -0.2", "-0.2 is negative"},
       {"--bounces 2 --albedo grey", "expects R or R,G,B"},
       {"--bounces 2 --albedo 0.5,0.5", "expects R or R,G,B"},
-      {"--bounces 2 --albedo 0.8,0.5,0.3", "a coloured albedo is not supported yet"},
+      {"--bounces 2 --albedo 0.8,0.5,0.3", "bounces with a grey albedo only"},
       {"--bounces 2", "--bounces 2 needs --albedo R[,G,B]"},
       {"--albedo 0.5", "--albedo applies with --bounces"},
       {"--bounce-rays 64", "--bounce-rays applies with --bounces"},

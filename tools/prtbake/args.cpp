@@ -247,13 +247,11 @@ void add_bounces(CLI::App& cmd, Args& a, const std::string& noun) {
            if (rgb.size() == 1) rgb.assign(3, rgb[0]);
            if (rgb.size() != 3)
              throw CLI::ValidationError("--albedo", "expects R or R,G,B (numbers in [0, 1)), got '" + text + "'");
-           if (rgb[0] != rgb[1] || rgb[0] != rgb[2])
-             throw CLI::ValidationError("--albedo", "'" + text + "': a coloured albedo is not supported yet: the "
-                                                    "bounced transfer is grey in this version (give one value, or R = G = B)");
            a.albedo = rgb;
          },
          "the surfaces' diffuse albedo for --bounces: R or R,G,B, each in [0, 1);\n"
-         "grey in this version (R = G = B)")
+         "the band-1 radiance bounces per channel, the transfer (--transfer) only\n"
+         "with a grey one (R = G = B: it is one vector for all channels)")
       ->option_text("R[,G,B]")
       ->group(group);
   cmd.add_option("--bounce-rays", a.bounce_rays,
@@ -553,6 +551,10 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
       if (!a.transfer && a.environment.empty())
         fail(b + " bounces the diffuse transfer and the band-1 radiance: give --transfer L or --radiance ENV (AO "
                  "and visibility transfer stay direct)");
+      if (a.transfer && !a.albedo.empty() && (a.albedo[0] != a.albedo[1] || a.albedo[0] != a.albedo[2]))
+        fail(b + " with --transfer and a coloured --albedo: the diffuse transfer is one vector for all channels, so it "
+                 "bounces with a grey albedo only (give one value, or R = G = B); the band-1 radiance (--radiance) "
+                 "bounces per channel");
       if (a.shadowed)
         fail(b + " with --shadowed: the shadowed radiance S is baked without bounces in this version; bounce the "
                  "band-1 radiance (--radiance) and the transfer (--transfer L) instead");

@@ -3,6 +3,7 @@
 #include "bakefile.h"
 #include "output.h"
 
+#include <cstdio>
 #include <utility>
 
 namespace prt::tool {
@@ -11,7 +12,9 @@ ReceiverBounces::ReceiverBounces(const Args& a, size_t triangles) : albedo_rgb_(
   spec_.bounces = a.bounces;
   spec_.rays = a.bounce_rays ? a.bounce_rays : bake::BounceSpec::kDefaultRays;
   spec_.seed = a.integrator.seed;
-  albedo_.assign(triangles, a.albedo.empty() ? 0.0 : a.albedo[0]);
+  bake::Albedo rgb{0, 0, 0};
+  for (size_t c = 0; c < 3 && c < a.albedo.size(); ++c) rgb[c] = a.albedo[c];
+  albedo_.assign(triangles, rgb);
 }
 
 void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCaster& rays,
@@ -23,7 +26,13 @@ void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCast
   bounced_ = direct;
   bounced_->values = std::move(r.values);
   applied_ = r.applied;
-  if (run.say) print_bounces(r, spec_, albedo_rgb_.at(0), *hits_, direct.layout, noun);
+  if (run.say) {
+    char text[96];
+    const auto& c = albedo_rgb_;
+    if (c.at(0) == c.at(1) && c.at(0) == c.at(2)) std::snprintf(text, sizeof text, "%g", c[0]);
+    else std::snprintf(text, sizeof text, "%g,%g,%g", c[0], c[1], c[2]);
+    print_bounces(r, spec_, text, *hits_, direct.layout, noun);
+  }
 }
 
 void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance) const {

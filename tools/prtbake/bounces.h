@@ -39,7 +39,7 @@ class ReceiverBounces {
  private:
   bake::BounceSpec spec_;
   std::vector<double> albedo_rgb_;  // --albedo
-  std::vector<double> albedo_;      // per triangle
+  std::vector<bake::Albedo> albedo_;  // per triangle
   std::optional<bake::GatherHits> hits_;
   std::optional<bake::VertexBake> bounced_;
   int applied_ = 0;

@@ -207,13 +207,13 @@ void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads) {
                 result.threads == 1 ? "" : "s");
 }
 
-void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, double albedo,
+void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, const std::string& albedo,
                    const bake::GatherHits& hits, const bake::ProductLayout& layout, const char* noun) {
   const std::string what = layout.transfer_count && layout.radiance_count ? "diffuse transfer and band-1 radiance"
                            : layout.transfer_count                        ? "diffuse transfer"
                                                                           : "band-1 radiance";
-  std::printf("bounced the %s: %d of %d bounce%s at albedo %g (each bounce's RMS / the direct pass's:", what.c_str(),
-              result.applied, spec.bounces, spec.bounces == 1 ? "" : "s", albedo);
+  std::printf("bounced the %s: %d of %d bounce%s at albedo %s (each bounce's RMS / the direct pass's:", what.c_str(),
+              result.applied, spec.bounces, spec.bounces == 1 ? "" : "s", albedo.c_str());
   for (const double r : result.relative_rms) std::printf(" %.3g", r);
   if (result.applied < spec.bounces)
     std::printf("; stopped early: the last one added at most %g of the direct pass's RMS", spec.tolerance);

@@ -63,7 +63,7 @@ void print_baking(const Args& a, const bake::BakeJob& job, int threads);
 void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads);
 // The interreflections: the bounces applied of those asked, each one's RMS against the direct
 // pass's, the gather (rays, time, the cached hits' memory) and each bounce's time.
-void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, double albedo,
+void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spec, const std::string& albedo,
                    const bake::GatherHits& hits, const bake::ProductLayout& layout, const char* noun);
 void print_error_report(const bake::BakeJob& job);
 void print_error_verdict(const bake::BakeJob& job, double target);  // target 0: what the RMSE means

@@ -428,7 +428,7 @@ void write_image(const std::string& path, const view::Image& linear, const view:
 // objects' albedos; FIV, glossy and area views take no bounces.
 struct Interreflection {
   uint32_t bounces = 0;
-  std::optional<double> albedo;
+  std::optional<std::array<double, 3>> albedo;  // RGB
   std::string caption = "ray traced";  // "path traced, 3 bounces, albedo 0.6"
   std::string panel = "ray traced";    // the triptych's caption, short enough for a 256-pixel panel
   std::string why;
@@ -449,34 +449,45 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   if (kind == "transfer" && transfer) baked = &*transfer;
   if (kind == "band1" && band1) baked = &*band1;
   const int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
-  std::optional<double> file_albedo;
-  if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3) file_albedo = (*baked->albedo)[0];
+  std::optional<std::array<double, 3>> file_albedo;
+  if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3)
+    file_albedo = {(*baked->albedo)[0], (*baked->albedo)[1], (*baked->albedo)[2]};
   r.bounces = a.bounces ? *a.bounces : uint32_t(std::max<int64_t>(0, file_bounces));
-  if (single) r.albedo = a.albedo ? a.albedo : file_albedo;
+  if (single && a.albedo) r.albedo = {*a.albedo, *a.albedo, *a.albedo};
+  else if (single) r.albedo = file_albedo;
   if (single && r.bounces > 0 && !r.albedo)
     throw UsageError("--bounces " + std::to_string(r.bounces) + ": " + a.file +
                      " names no albedo to bounce with (its products carry no bounces): give --albedo A");
   char buf[256];
+  auto rgb_text = [](const std::array<double, 3>& c) {  // "0.6" or "0.8,0.5,0.3"
+    char t[64];
+    if (c[0] == c[1] && c[0] == c[2]) std::snprintf(t, sizeof t, "%.3g", c[0]);
+    else std::snprintf(t, sizeof t, "%.3g,%.3g,%.3g", c[0], c[1], c[2]);
+    return std::string(t);
+  };
+  const std::string albedo_text = r.albedo ? rgb_text(*r.albedo) : "";
+  const char* albedo = albedo_text.c_str();
   if (r.albedo) {
-    const float rho = float(*r.albedo);
-    scene.albedo.assign(scene.mesh.triangles.size(), {rho, rho, rho});
-    for (float& v : runtime.rgb) v *= rho;
-    std::snprintf(buf, sizeof buf, "; times the albedo %.3g (exit radiance albedo x E/pi)", *r.albedo);
+    const auto& c = *r.albedo;
+    scene.albedo.assign(scene.mesh.triangles.size(), {float(c[0]), float(c[1]), float(c[2])});
+    for (size_t i = 0; i < runtime.rgb.size(); ++i) runtime.rgb[i] *= float(c[i % 3]);
+    std::snprintf(buf, sizeof buf, "; times the albedo %s (exit radiance albedo x E/pi)", albedo);
     scene.how += buf;
   }
-  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "path traced, %u bounce%s, albedo %.3g", r.bounces, r.bounces == 1 ? "" : "s", *r.albedo);
+  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "path traced, %u bounce%s, albedo %s", r.bounces, r.bounces == 1 ? "" : "s", albedo);
   else if (r.bounces > 0) std::snprintf(buf, sizeof buf, "path traced, %u bounce%s, the objects' albedos", r.bounces, r.bounces == 1 ? "" : "s");
-  else if (r.albedo) std::snprintf(buf, sizeof buf, "ray traced, direct light only, albedo %.3g", *r.albedo);
+  else if (r.albedo) std::snprintf(buf, sizeof buf, "ray traced, direct light only, albedo %s", albedo);
   else std::snprintf(buf, sizeof buf, "ray traced");
   r.caption = buf;
-  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "%u bounce%s, albedo %.3g", r.bounces, r.bounces == 1 ? "" : "s", *r.albedo);
+  if (r.bounces > 0 && r.albedo) std::snprintf(buf, sizeof buf, "%u bounce%s, albedo %s", r.bounces, r.bounces == 1 ? "" : "s", albedo);
   else if (r.bounces > 0) std::snprintf(buf, sizeof buf, "%u bounce%s", r.bounces, r.bounces == 1 ? "" : "s");
-  else if (r.albedo) std::snprintf(buf, sizeof buf, "direct, albedo %.3g", *r.albedo);
+  else if (r.albedo) std::snprintf(buf, sizeof buf, "direct, albedo %s", albedo);
   else std::snprintf(buf, sizeof buf, "ray traced");
   r.panel = buf;
   if (baked && baked->bounces)
-    std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %.3g%s", kind == "transfer" ? "transfer" : "band-1 radiance",
-                  static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s", file_albedo.value_or(0.0),
+    std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %s%s", kind == "transfer" ? "transfer" : "band-1 radiance",
+                  static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s",
+                  file_albedo ? rgb_text(*file_albedo).c_str() : "?",
                   a.bounces || a.albedo ? "; overridden on the command line" : "; --bounces B to change");
   else
     std::snprintf(buf, sizeof buf, "--bounces%s", a.albedo ? " and --albedo" : "");

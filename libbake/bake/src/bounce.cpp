@@ -80,17 +80,20 @@ GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, con
   return hits;
 }
 
-void check_albedo(std::span<const double> albedo, const std::string& source) {
-  for (size_t t = 0; t < albedo.size(); ++t) {
-    const double a = albedo[t];
-    if (std::isfinite(a) && a >= 0 && a < 1) continue;
-    char value[64];
-    std::snprintf(value, sizeof value, "%.17g", a);
-    throw InputError(source, "albedo " + std::string(value) + " of triangle " + std::to_string(t) +
-                                 (a >= 1 ? " is 1 or more: the bounces would not converge (an albedo must be below 1)"
-                                  : a < 0 ? " is negative (an albedo is a reflectance in [0, 1))"
-                                          : " is not a number (an albedo is a reflectance in [0, 1))"));
-  }
+void check_albedo(std::span<const Albedo> albedo, const std::string& source) {
+  static const char* const kChannel[3] = {"R", "G", "B"};
+  for (size_t t = 0; t < albedo.size(); ++t)
+    for (size_t c = 0; c < 3; ++c) {
+      const double a = albedo[t][c];
+      if (std::isfinite(a) && a >= 0 && a < 1) continue;
+      char value[64];
+      std::snprintf(value, sizeof value, "%.17g", a);
+      throw InputError(source, "albedo " + std::string(value) + " (" + kChannel[c] + ") of triangle " +
+                                   std::to_string(t) +
+                                   (a >= 1 ? " is 1 or more: the bounces would not converge (an albedo must be below 1)"
+                                    : a < 0 ? " is negative (an albedo is a reflectance in [0, 1))"
+                                            : " is not a number (an albedo is a reflectance in [0, 1))"));
+    }
 }
 
 void VertexField::spread(std::span<const double> rows, size_t width, std::span<double> entries) const {
@@ -160,7 +163,7 @@ FieldTaps SceneField::taps(uint32_t triangle, double w1, double w2) const {
 }
 
 BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
-                         std::span<const double> albedo, const ProductLayout& layout, std::span<const double> direct,
+                         std::span<const Albedo> albedo, const ProductLayout& layout, std::span<const double> direct,
                          const BounceSpec& spec, const std::string& source, const Monitor& monitor,
                          const std::string& label) {
   const size_t V = field.rows(), E = field.entries(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
@@ -171,6 +174,12 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   PRT_CHECK(!radiance || hits.mixture);  // R's estimator (5') needs the mixture's weights
   PRT_CHECK(spec.bounces >= 0);
   check_albedo(albedo, source);
+  if (nt > 0)
+    for (size_t t = 0; t < albedo.size(); ++t)
+      if (albedo[t][0] != albedo[t][1] || albedo[t][0] != albedo[t][2])
+        throw InputError(source, "triangle " + std::to_string(t) + "'s albedo is coloured: the diffuse transfer is one "
+                                 "vector for all channels, so it bounces with a grey albedo only (R = G = B); the band-1 "
+                                 "radiance bounces per channel");
   BounceResult out;
   out.values.assign(direct.begin(), direct.end());
   if ((nt == 0 && !radiance) || spec.bounces == 0) return out;
@@ -222,8 +231,8 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
             const size_t ray = v * K + k;
             const uint32_t t = hits.triangle[ray];
             if (t == GatherHits::kNone) continue;
-            const double rho = albedo[t];
-            if (rho == 0) continue;
+            const Albedo& rho = albedo[t];
+            if (rho[0] == 0 && rho[1] == 0 && rho[2] == 0) continue;
             const FieldTaps taps = field.taps(t, hits.weights[ray][0], hits.weights[ray][1]);
             if (taps.count == 0) continue;
             std::fill(at_hit, at_hit + S, 0.0);
@@ -233,10 +242,10 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
             }
             std::array<double, 4> weight{1, 0, 0, 0};  // the cosine gather's: T's weight is 1
             if (hits.mixture) weight = mixture_weights(points[v].n, gather_direction(frame, halton, k, true));
-            for (size_t i = 0; i < nt; ++i) row[i] += rho * weight[0] * at_hit[i];
+            for (size_t i = 0; i < nt; ++i) row[i] += rho[0] * weight[0] * at_hit[i];  // grey (checked)
             if (radiance)
               for (size_t c = 0; c < 3; ++c)
-                for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho * at_hit[nt + c] * weight[1 + m];
+                for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho[c] * at_hit[nt + c] * weight[1 + m];
           }
           for (size_t i = 0; i < B; ++i) row[i] /= double(K);
         },

@@ -149,7 +149,7 @@ static void check_integrating_sphere(bool radiance) {
   const size_t V = g.mesh.positions.size();
   const ProductLayout layout = transfer_layout(1, radiance);
   const size_t W = layout.width;
-  const std::vector<double> albedo(g.mesh.triangles.size(), rho);
+  const std::vector<Albedo> albedo(g.mesh.triangles.size(), Albedo{rho, rho, rho});
   std::vector<double> direct(V * W);
   std::vector<std::array<double, 3>> y1(V);
   for (size_t v = 0; v < V; ++v) {
@@ -239,7 +239,8 @@ TEST(Bounce, IntegratingSphereClosedFormPerTexel) {
   spec.seed = 5;
   const GatherHits hits = gather(rays, set.points, spec, false);
   const ProductLayout layout = transfer_layout(1);
-  const std::vector<double> direct(V * layout.width, kY00 * f), albedo(mesh.triangles.size(), rho);
+  const std::vector<double> direct(V * layout.width, kY00 * f);
+  const std::vector<Albedo> albedo(mesh.triangles.size(), Albedo{rho, rho, rho});
   const TexelField field(mesh, texels, 2);
   const double sag = 1 - std::cos(pi / n_phi) * std::cos((pi - theta_hole) / n_theta / 2);
   const double delta_f = 4 * f * (std::pow(2 * pi / n_phi, 2) / 6 + sag);
@@ -281,7 +282,7 @@ TEST(Bounce, IntegratingSphereWithItsDirectPassBaked) {
   BounceSpec spec = spec_of(256, B, 0);
   const Gathered g = gathered(integrating_sphere(theta_hole, n_theta, n_phi), spec);
   const VertexBake direct = direct_bake(g, false, 1, QmcOptions{N, 11});
-  const std::vector<double> albedo(g.mesh.triangles.size(), rho);
+  const std::vector<Albedo> albedo(g.mesh.triangles.size(), Albedo{rho, rho, rho});
   const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, direct.layout, direct.values, spec, g.mesh.source);
   const size_t V = g.mesh.positions.size();
   double mean = 0, mean_direct = 0;
@@ -308,7 +309,7 @@ TEST(Bounce, ZeroAlbedoKeepsTheDirectBits) {
   const BounceSpec spec = spec_of(64, 3, BounceSpec::kDefaultTolerance);
   const Gathered g = gathered(integrating_sphere(1.0, 12, 24), spec);
   const VertexBake direct = direct_bake(g, true, 3, QmcOptions{128, 3});
-  const std::vector<double> albedo(g.mesh.triangles.size(), 0.0);
+  const std::vector<Albedo> albedo(g.mesh.triangles.size(), Albedo{0, 0, 0});
   const BounceResult r = bounce_rows(VertexField(g.mesh), g.points, g.hits, albedo, direct.layout, direct.values, spec, g.mesh.source);
   ASSERT_EQ(r.values.size(), direct.values.size());
   EXPECT_EQ(std::memcmp(r.values.data(), direct.values.data(), r.values.size() * sizeof(double)), 0);
@@ -321,7 +322,7 @@ TEST(Bounce, EveryBounceAddsEnergy) {
   BounceSpec spec = spec_of(128, 0, 0);
   const Gathered g = gathered(integrating_sphere(0.5, 16, 32), spec);
   const VertexBake direct = direct_bake(g, false, 2, QmcOptions{256, 5});
-  const std::vector<double> albedo(g.mesh.triangles.size(), 0.6);
+  const std::vector<Albedo> albedo(g.mesh.triangles.size(), Albedo{0.6, 0.6, 0.6});
   const size_t V = g.mesh.positions.size(), W = direct.layout.width;
   std::vector<double> before(V);
   double mean_before = 0;
@@ -346,7 +347,7 @@ TEST(Bounce, SameBytesWhateverTheThreads) {
   const BounceSpec spec = spec_of(64, 3, 0);
   const Mesh mesh = integrating_sphere(0.8, 16, 32);
   const std::vector<double> direct = closed_direct(mesh.positions.size(), 0.2);
-  const std::vector<double> albedo(mesh.triangles.size(), 0.7);
+  const std::vector<Albedo> albedo(mesh.triangles.size(), Albedo{0.7, 0.7, 0.7});
   auto run = [&](int threads) {
     tbb::task_arena arena(threads);
     BounceResult r;
@@ -363,7 +364,9 @@ TEST(Bounce, SameBytesWhateverTheThreads) {
 
 // (e) Albedos that are no material, or whose series may diverge, are refused by name.
 TEST(Bounce, RefusesAlbedoOutsideZeroToOne) {
-  auto message = [](std::vector<double> albedo) {
+  auto message = [](std::vector<double> grey) {
+    std::vector<Albedo> albedo;
+    for (const double a : grey) albedo.push_back({a, a, a});
     try {
       check_albedo(albedo, "room.obj");
     } catch (const InputError& e) {
@@ -372,8 +375,8 @@ TEST(Bounce, RefusesAlbedoOutsideZeroToOne) {
     return std::string();
   };
   EXPECT_EQ(message({0.0, 0.5, 0.999}), "");
-  EXPECT_NE(message({0.5, 1.0}).find("room.obj: albedo 1 of triangle 1 is 1 or more"), std::string::npos);
-  EXPECT_NE(message({-0.25}).find("albedo -0.25 of triangle 0 is negative"), std::string::npos);
+  EXPECT_NE(message({0.5, 1.0}).find("room.obj: albedo 1 (R) of triangle 1 is 1 or more"), std::string::npos);
+  EXPECT_NE(message({-0.25}).find("albedo -0.25 (R) of triangle 0 is negative"), std::string::npos);
   EXPECT_NE(message({std::numeric_limits<double>::quiet_NaN()}).find("is not a number"), std::string::npos);
 }
 

@@ -60,10 +60,11 @@
 // hit is still all it needs), but its weights are one per coefficient: not in this slice (the tool
 // refuses S with bounces, so S's band 1 keeps equalling R).
 //
-// COLOUR. This slice is grey: one albedo per triangle, so T stays one transfer vector per vertex
-// ([V][L²], the direct pass's layout and dataset). A coloured albedo makes the transfer per
-// channel ([V][3][L²], the recursion (2) run once per channel); the tool refuses one until the
-// schema and prtshade carry it. R is per channel already: (5) would take ρ_c as it is.
+// COLOUR. R is per channel already, and (5) takes ρ_c as it is: R bounces with a coloured albedo.
+// T stays one transfer vector per vertex ([V][L²], the direct pass's layout and dataset), so it
+// bounces only with grey albedos: a coloured albedo makes the transfer per channel ([V][3][L²],
+// the recursion (2) run once per channel), which the schema and prtshade do not carry yet, and is
+// refused (InputError) rather than made grey.
 //
 // BACK FACES ARE BLACK. The rows are the exit radiance of the side a vertex's normal points to; the
 // other side of a triangle has no rows. A gather ray that meets a triangle from behind (the
@@ -128,9 +129,10 @@ struct GatherHits {
 GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, const BounceSpec& spec, bool radiance,
                   const Monitor& monitor = {}, const std::string& label = "casting bounce rays");
 
-// Throws InputError(source, …) naming the first triangle whose albedo is not in [0, 1) (or not
-// finite).
-void check_albedo(std::span<const double> albedo, const std::string& source);
+// An albedo per triangle, RGB (linear). Throws InputError(source, …) naming the first triangle
+// whose albedo has a channel not in [0, 1) (or not finite).
+using Albedo = std::array<double, 3>;
+void check_albedo(std::span<const Albedo> albedo, const std::string& source);
 
 // WHERE A HIT TAKES THE PREVIOUS BOUNCE FROM. The rows of a bounce are per receiver; a hit needs
 // the value of the surface it lands on. A field spreads the rows over the places a hit reads
@@ -225,11 +227,13 @@ struct BounceResult {
 // band-1 radiance (5) added, from the cached `hits` (of the same rows; a layout with R needs the
 // mixture gather: contract), the `field` the hits read the previous bounce from (rows() = the
 // rows), and an albedo per triangle of the geometry the hits met (checked: check_albedo(albedo,
-// source)). Other products are copied. A bounce that is zero everywhere (albedo 0) leaves every
+// source)). R bounces per channel with ρ_c; T is one transfer for all channels, so a layout with T
+// needs grey albedos (R = G = B on every triangle; InputError(source, …) naming the first that is
+// not). Other products are copied. A bounce that is zero everywhere (albedo 0) leaves every
 // value's bits as they were. ContractError if a value is not finite. Progress stage `label`, one
 // task per bounce.
 BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
-                         std::span<const double> albedo, const ProductLayout& layout, std::span<const double> direct,
+                         std::span<const Albedo> albedo, const ProductLayout& layout, std::span<const double> direct,
                          const BounceSpec& spec, const std::string& source, const Monitor& monitor = {},
                          const std::string& label = "bouncing light");
 
