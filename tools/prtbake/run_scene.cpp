@@ -260,6 +260,18 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         if (ob.report)
           obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
       }
+      if (ob.bounced_radiance || ob.bounced_transfer) {
+        // The bounces (bake/bake/scene.h rule "bounces"); `albedo` is this object's (the others'
+        // are their objects' albedo attributes).
+        bake::BounceSpec spec;
+        spec.bounces = scene.bounces;
+        spec.rays = result.bounce_rays;
+        F::VertexSet& set = obj.set;
+        std::optional<F::Product>& t = set.lightmap ? set.lightmap->transfer_diffuse : set.transfer_diffuse;
+        std::optional<F::Product>& r = set.lightmap ? set.lightmap->radiance_band1 : set.radiance_band1;
+        if (ob.bounced_transfer && t) tool::set_bounces(*t, false, result.bounces_applied, spec, *obj.albedo);
+        if (ob.bounced_radiance && r) tool::set_bounces(*r, true, result.bounces_applied, spec, *obj.albedo);
+      }
       if (ob.area && ob.lightmap && area_images[i])
         tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);
       else if (ob.area)

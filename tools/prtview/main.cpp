@@ -448,7 +448,16 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   const std::optional<F::Product>& band1 = texel ? f.vertices.lightmap->radiance_band1 : f.vertices.radiance_band1;
   if (kind == "transfer" && transfer) baked = &*transfer;
   if (kind == "band1" && band1) baked = &*band1;
-  const int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
+  int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
+  // A scene: the most bounces any object's band-1 radiance or transfer carries (all are bounced
+  // together, bake/bake/scene.h rule "bounces").
+  if (kind == "scene")
+    for (const F::SceneObject& o : f.objects)
+      for (const std::optional<F::Product>* p :
+           {&o.set.transfer_diffuse, &o.set.radiance_band1,
+            o.set.lightmap ? &o.set.lightmap->transfer_diffuse : nullptr,
+            o.set.lightmap ? &o.set.lightmap->radiance_band1 : nullptr})
+        if (p && *p && (*p)->bounces) file_bounces = std::max(file_bounces, *(*p)->bounces);
   std::optional<std::array<double, 3>> file_albedo;
   if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3)
     file_albedo = {(*baked->albedo)[0], (*baked->albedo)[1], (*baked->albedo)[2]};
@@ -484,7 +493,10 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   else if (r.albedo) std::snprintf(buf, sizeof buf, "direct, albedo %s", albedo);
   else std::snprintf(buf, sizeof buf, "ray traced");
   r.panel = buf;
-  if (baked && baked->bounces)
+  if (kind == "scene" && file_bounces > 0)
+    std::snprintf(buf, sizeof buf, "the scene's products hold %lld bounce%s%s", static_cast<long long>(file_bounces),
+                  file_bounces == 1 ? "" : "s", a.bounces ? "; overridden on the command line" : "; --bounces B to change");
+  else if (baked && baked->bounces)
     std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %s%s", kind == "transfer" ? "transfer" : "band-1 radiance",
                   static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s",
                   file_albedo ? rgb_text(*file_albedo).c_str() : "?",

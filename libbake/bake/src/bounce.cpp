@@ -136,7 +136,11 @@ FieldTaps TexelField::taps(uint32_t triangle, double w1, double w2) const {
 }
 
 void SceneField::add(const BounceField& field, uint32_t first_triangle, uint32_t triangles) {
-  PRT_CHECK(parts_.empty() || parts_.back().first_triangle + parts_.back().triangles <= first_triangle);
+  if (triangles > 0) {
+    PRT_CHECK(tapped_.empty() ||
+              parts_[tapped_.back()].first_triangle + parts_[tapped_.back()].triangles <= first_triangle);
+    tapped_.push_back(parts_.size());
+  }
   parts_.push_back({&field, first_triangle, triangles, rows_, entries_});
   rows_ += field.rows();
   entries_ += field.entries();
@@ -151,11 +155,11 @@ void SceneField::spread(std::span<const double> rows, size_t width, std::span<do
 }
 
 FieldTaps SceneField::taps(uint32_t triangle, double w1, double w2) const {
-  // The last part that starts at or before `triangle`.
-  auto it = std::upper_bound(parts_.begin(), parts_.end(), triangle,
-                             [](uint32_t t, const Part& part) { return t < part.first_triangle; });
-  if (it == parts_.begin()) return {};
-  const Part& part = *(it - 1);
+  // The last part with triangles that starts at or before `triangle`.
+  auto it = std::upper_bound(tapped_.begin(), tapped_.end(), triangle,
+                             [&](uint32_t t, size_t part) { return t < parts_[part].first_triangle; });
+  if (it == tapped_.begin()) return {};
+  const Part& part = parts_[*(it - 1)];
   if (triangle - part.first_triangle >= part.triangles) return {};
   FieldTaps t = part.field->taps(triangle - part.first_triangle, w1, w2);
   for (int k = 0; k < t.count; ++k) t.entry[size_t(k)] += part.first_entry;

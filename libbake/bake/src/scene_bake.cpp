@@ -3,6 +3,7 @@
 #include <bake/bake/error_report.h>
 #include <bake/bake/pipeline.h>
 #include <bake/bake/scene_bake.h>
+#include <bake/bake/bounce.h>
 #include <bake/core/error.h>
 #include <bake/lights/area_bake.h>
 
@@ -326,10 +327,114 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       const ReceiverSet& set = job.sets[s];
       return rows.rows(shard_set[set.tag], set.points, *job.integrator, stage);
     };
+  // ---- interreflections (plan rule "bounces"; bake/bake/bounce.h) ----
+  // Every receiver's direct rows are kept: a correction re-bakes some, and the bounces are always
+  // made from the direct rows of all of them (never from rows that already carry bounces).
+  std::vector<std::optional<VertexBake>> direct_rows(scene.objects.size());
+  std::optional<GatherHits> gather_hits;  // cast once, reused after a correction
+  auto bounce_receivers = [&] {
+    std::vector<size_t> gatherers;
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if ((plan.objects[i].bounce_radiance || plan.objects[i].bounce_transfer) && direct_rows[i]) gatherers.push_back(i);
+    if (gatherers.empty()) return;
+    // The union's triangle ranges: occluders in object order (merge_meshes).
+    std::vector<uint32_t> first_triangle(scene.objects.size(), 0);
+    std::vector<Albedo> albedo(occluders.triangles.size(), Albedo{0, 0, 0});
+    for (size_t i = 0, t = 0; i < scene.objects.size(); ++i)
+      if (plan.objects[i].occluder) {
+        first_triangle[i] = uint32_t(t);
+        if (plan.objects[i].bounce_reflects)
+          std::fill_n(albedo.begin() + std::ptrdiff_t(t), meshes[i].triangles.size(), scene.objects[i].material.albedo);
+        t += meshes[i].triangles.size();
+      }
+    // The rows side by side: T (when it bounces, at its one order) and R, per gatherer in order.
+    int order = 0;
+    bool radiance = false;
+    for (const size_t i : gatherers) {
+      if (plan.objects[i].bounce_transfer) order = plan.objects[i].transfer_order;
+      radiance = radiance || plan.objects[i].bounce_radiance;
+    }
+    ProductRequest q;
+    q.transfer_order = order;
+    q.radiance = radiance ? env : nullptr;
+    const ProductLayout layout(q);
+    std::vector<ShadePoint> points;
+    std::vector<std::unique_ptr<BounceField>> fields;
+    SceneField field;
+    for (const size_t i : gatherers) {
+      const ObjectBake& ob = out.objects[i];
+      const ReceiverSet set = ob.lightmap ? ob.lightmap->receivers() : receivers_of(i);
+      points.insert(points.end(), set.points.begin(), set.points.end());
+      if (ob.lightmap) fields.push_back(std::make_unique<TexelField>(meshes[i], *ob.lightmap, 2));
+      else fields.push_back(std::make_unique<VertexField>(meshes[i]));
+      field.add(*fields.back(), first_triangle[i],
+                plan.objects[i].occluder ? uint32_t(meshes[i].triangles.size()) : 0u);
+    }
+    std::vector<double> direct(points.size() * layout.width, 0.0);
+    size_t row = 0;
+    for (const size_t i : gatherers) {
+      const VertexBake& d = *direct_rows[i];
+      const size_t n = d.values.size() / d.layout.width;
+      for (size_t r = 0; r < n; ++r, ++row) {
+        double* to = &direct[row * layout.width];
+        const double* from = &d.values[r * d.layout.width];
+        if (plan.objects[i].bounce_transfer)
+          std::copy_n(from + d.layout.transfer, layout.transfer_count, to + layout.transfer);
+        if (plan.objects[i].bounce_radiance) std::copy_n(from + d.layout.radiance, 9, to + layout.radiance);
+      }
+    }
+    PRT_CHECK_OP(row, ==, points.size());
+    BounceSpec spec;
+    spec.bounces = scene.bounces;
+    spec.rays = scene.bounce_rays ? scene.bounce_rays : BounceSpec::kDefaultRays;
+    spec.seed = scene.integrator.seed;
+    if (!gather_hits) gather_hits = gather(*accel.rays(), points, spec, radiance, monitor, "casting bounce rays");
+    const BounceResult r = bounce_rows(field, points, *gather_hits, albedo, layout, direct, spec, scene.file.string(),
+                                       monitor, "bouncing light");
+    row = 0;
+    for (const size_t i : gatherers) {
+      ObjectBake& ob = out.objects[i];
+      ob.values = direct_rows[i];
+      VertexBake& v = *ob.values;
+      const size_t n = v.values.size() / v.layout.width;
+      for (size_t k = 0; k < n; ++k, ++row) {
+        double* to = &v.values[k * v.layout.width];
+        const double* from = &r.values[row * layout.width];
+        if (plan.objects[i].bounce_transfer) std::copy_n(from + layout.transfer, layout.transfer_count, to + v.layout.transfer);
+        if (plan.objects[i].bounce_radiance) std::copy_n(from + layout.radiance, 9, to + v.layout.radiance);
+      }
+      ob.bounced_radiance = plan.objects[i].bounce_radiance;
+      ob.bounced_transfer = plan.objects[i].bounce_transfer;
+    }
+    size_t met = 0;
+    for (const uint32_t t : gather_hits->triangle)
+      if (t != GatherHits::kNone && (albedo[t][0] > 0 || albedo[t][1] > 0 || albedo[t][2] > 0)) ++met;
+    out.bounces_applied = r.applied;
+    out.bounce_relative_rms = r.relative_rms;
+    out.bounce_rays = spec.rays;
+    out.gather_seconds = gather_hits->seconds;
+    out.bounce_seconds = 0;
+    for (const double x : r.seconds) out.bounce_seconds += x;
+    out.gather_bytes = gather_hits->bytes();
+    out.reflecting_share = gather_hits->triangle.empty() ? 0 : double(met) / double(gather_hits->triangle.size());
+    std::string rms;
+    for (const double x : r.relative_rms) rms += printf_string(" %.3g", x);
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "bounces: %d of %d over %zu receiver rows of %zu object(s) (each bounce's RMS / the direct pass's:%s); "
+                  "%u gather rays per row in %.2f s (cached hits %.1f MB), %.1f%% of them met a reflecting surface; the "
+                  "bounces took %.3f s",
+                  r.applied, scene.bounces, points.size(), gatherers.size(), rms.c_str(), spec.rays, out.gather_seconds,
+                  double(out.gather_bytes) / 1e6, 100 * out.reflecting_share, out.bounce_seconds);
+    log(std::string(line) +
+        (met == 0 ? " — no ray met a reflecting surface: these bounces add nothing (a convex object alone)" : ""));
+  };
+
   hooks.set_baked = [&](const BakeJob& job, size_t s) {
     const ReceiverSet& set = job.sets[s];
     ObjectBake& ob = out.objects[set.tag];
     ob.values = job.rows[s];
+    direct_rows[set.tag] = job.rows[s];
     ob.report.reset();
     ob.integrator = job.spec;
     ob.choice = job.choice;
@@ -345,6 +450,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
                                        : std::string()));
   };
   hooks.baked = [&] {
+    if (plan.bounces && !rows.rows_only) bounce_receivers();
     out.vertex_seconds = 0;
     out.vertices = out.texels = 0;
     for (const ObjectBake& ob : out.objects)

@@ -163,7 +163,7 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
   if (const Json* bake = find_key(root, "bake")) {
     r.object(*bake, "bake",
              {"products", "integrator", "samples", "seed", "report", "target_error", "sh_tolerance", "relight", "fiv",
-              "lightmap"});
+              "lightmap", "bounces", "bounce_rays"});
     if (const Json* x = find_key(*bake, "lightmap")) sc.lightmap = parse_lightmap(r, *x, "bake.lightmap");
     if (const Json* p = find_key(*bake, "products")) {
       if (!p->is_array()) r.fail("bake.products must be an array of strings");
@@ -203,6 +203,11 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
       if (!(sc.sh_tolerance > 0)) r.fail("bake.sh_tolerance must be > 0");
     }
     if (const Json* x = find_key(*bake, "relight")) sc.relight = r.boolean(*x, "bake.relight");
+    if (const Json* x = find_key(*bake, "bounces")) sc.bounces = int(r.integer(*x, "bake.bounces", 0, 100));
+    if (const Json* x = find_key(*bake, "bounce_rays")) {
+      sc.bounce_rays = uint32_t(r.integer(*x, "bake.bounce_rays", 1, 1 << 16));
+      if (sc.bounces == 0) r.fail("bake.bounce_rays applies with bake.bounces >= 1");
+    }
     if (const Json* f = find_key(*bake, "fiv")) {
       r.object(*f, "bake.fiv", {"shells", "cube", "fraction"});
       if (const Json* x = find_key(*f, "shells")) {

@@ -1,6 +1,7 @@
 // scene_plan.cpp — what a scene needs baked, per object and scene-wide, each decision with its
 // reason (bake/bake/scene.h, the rules of plan_scene).
 #include <bake/bake/fiv.h>
+#include <bake/bake/bounce.h>
 #include <bake/bake/scene.h>
 #include <bake/core/error.h>
 #include <bake/sphere/zonal.h>
@@ -11,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,87 @@ std::string density_text(double d) {
   std::snprintf(buf, sizeof buf, "%g", d);
   return buf;
 }
+} // namespace
+
+namespace {
+
+std::string rgb_text(const std::array<double, 3>& c) {
+  std::ostringstream os;
+  if (c[0] == c[1] && c[0] == c[2]) os << c[0];
+  else os << c[0] << "," << c[1] << "," << c[2];
+  return os.str();
+}
+
+// The rule "bounces" (scene.h): who gathers, who reflects, whether the transfer bounces.
+void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
+  if (scene.bounces <= 0) return;
+  const std::string b = "bounces: ";
+  std::vector<size_t> reflect;
+  bool gathers = false, grey = true;
+  std::set<int> orders;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& o = scene.objects[i];
+    ObjectPlan& p = plan.objects[i];
+    if (!p.receiver) {
+      p.left_out.push_back(b + "occluder only: it casts shadows but has no rows, so it reflects no light (role \"both\" "
+                               "with a diffuse albedo to have it reflect)");
+      continue;
+    }
+    if (!p.radiance && p.transfer_order == 0) {
+      p.left_out.push_back(b + "no band-1 radiance or diffuse transfer to bounce (no diffuse albedo, or none asked)");
+      continue;
+    }
+    gathers = true;
+    if (p.transfer_order > 0) orders.insert(p.transfer_order);
+    if (!p.occluder) {
+      p.left_out.push_back(b + "receiver only: it is not in the occluders' union, so no ray meets it: it gathers the "
+                               "others' light but reflects none");
+    } else if (o.material.diffuse()) {
+      for (size_t c = 0; c < 3; ++c)
+        if (!(o.material.albedo[c] < 1))
+          throw InputError(scene.file.string(), "object '" + o.name + "': albedo " + rgb_text(o.material.albedo) +
+                                                    " with bake.bounces: an albedo must be below 1, or the bounces "
+                                                    "would not converge");
+      p.bounce_reflects = true;
+      reflect.push_back(i);
+      grey = grey && o.material.albedo[0] == o.material.albedo[1] && o.material.albedo[0] == o.material.albedo[2];
+    }
+  }
+  if (!gathers || reflect.empty()) {
+    plan.notes.push_back(b + std::to_string(scene.bounces) + " asked, none baked: " +
+                         (!gathers ? "no receiver has band-1 radiance or diffuse transfer"
+                                   : "no surface reflects (a reflecting surface is a \"both\" object with a diffuse "
+                                     "albedo)"));
+    return;
+  }
+  plan.bounces = true;
+  const bool transfer = !orders.empty() && grey && orders.size() == 1;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    ObjectPlan& p = plan.objects[i];
+    if (!p.receiver || (!p.radiance && p.transfer_order == 0)) continue;
+    p.bounce_radiance = p.radiance;
+    p.bounce_transfer = transfer && p.transfer_order > 0;
+    std::string what = p.radiance && p.bounce_transfer ? "radiance/band1 and transfer/diffuse"
+                       : p.radiance                    ? "radiance/band1"
+                                                       : p.bounce_transfer ? "transfer/diffuse" : "";
+    if (!what.empty())
+      p.baked.push_back(b + what + " with " + std::to_string(scene.bounces) + " bounce(s) of the light the " +
+                        std::to_string(reflect.size()) + " reflecting object(s) send" +
+                        (p.bounce_reflects ? " (this one at albedo " + rgb_text(scene.objects[i].material.albedo) + ")"
+                                           : ""));
+    if (p.transfer_order > 0 && !p.bounce_transfer)
+      p.left_out.push_back(b + "transfer/diffuse stays direct: " +
+                           (!grey ? std::string("a reflecting object's albedo is coloured and the transfer is one vector "
+                                                "for all channels")
+                                  : std::string("the receivers' transfers have different orders")));
+  }
+  std::string names;
+  for (const size_t i : reflect) names += (names.empty() ? "" : ", ") + scene.objects[i].name;
+  plan.notes.push_back(b + std::to_string(scene.bounces) + " of diffuse interreflection, " +
+                       std::to_string(scene.bounce_rays ? scene.bounce_rays : BounceSpec::kDefaultRays) +
+                       " gather rays per receiver row; reflecting: " + names);
+}
+
 } // namespace
 
 ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes) {
@@ -171,6 +255,7 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
     }
     plan.fiv_environment = plan.fiv_environment || p.fiv;
   }
+  plan_bounces(scene, plan);
   if (plan.fiv_environment) plan.notes.push_back("fiv/environment and fiv/irradiance_cube: some occluder has shells");
   else plan.notes.push_back("fiv/environment and fiv/irradiance_cube: left out, no occluder has shells");
   return plan;

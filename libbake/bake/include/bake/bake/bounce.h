@@ -196,7 +196,8 @@ class SceneField final : public BounceField {
  public:
   // Adds `field` for the union's triangles [first_triangle, first_triangle + triangles) (the
   // field's own triangles 0 …, in order), after the parts added before (rows and entries follow
-  // theirs). Parts must be added in increasing, disjoint triangle ranges.
+  // theirs). Parts with triangles must come in increasing, disjoint triangle ranges; a part with
+  // none (receivers no ray can meet: not in the union) has rows that no hit reads.
   void add(const BounceField& field, uint32_t first_triangle, uint32_t triangles);
   size_t rows() const override { return rows_; }
   size_t entries() const override { return entries_; }
@@ -210,6 +211,7 @@ class SceneField final : public BounceField {
     size_t first_row, first_entry;
   };
   std::vector<Part> parts_;
+  std::vector<size_t> tapped_;  // the parts with triangles, in triangle order
   size_t rows_ = 0, entries_ = 0;
 };
 

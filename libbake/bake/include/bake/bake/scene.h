@@ -18,6 +18,9 @@
 //                                              and "target_error": target 1e-3, report 32
 //       "sh_tolerance": 0.01,                  BRDF energy allowed beyond the chosen SH order
 //       "relight": false,                      diffuse receivers also get transfer vectors
+//       "bounces": 0, "bounce_rays": 256,      B bounces of diffuse interreflection in the diffuse
+//                                              transfer and band-1 radiance (bake/bake/bounce.h;
+//                                              the rule below), K gather rays per receiver row
 //       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001}   (bake/bake/fiv.h ShellSpec)
 //       "lightmap": {...}                      every receiver per texel (below), unless its own says
 //     },                                       otherwise
@@ -104,6 +107,17 @@
 //     case C, wholly below the horizon, occludes nothing);
 //   * the environment's FIV and DifMap only when some occluder gets shells;
 //   * vertices that see no contour edge get closed forms (bake/integrators/silhouette.h, bake/sphere/zonal.h);
+//   * bounces (bake.bounces B ≥ 1; bake/bake/bounce.h): light reflected between the objects'
+//     surfaces (Lambertian, each object's material albedo, back faces black) is added to the
+//     band-1 radiance and the diffuse transfer of every receiver that has them ("gathers"). A
+//     surface reflects when the gather rays can meet it and its light is known: a "both" object
+//     with a diffuse albedo and band-1 radiance or transfer. An occluder-only object has no rows,
+//     so it casts shadows but reflects nothing; a receiver-only object is not in the union, so no
+//     ray meets it (it casts no shadow, and reflects nothing). The transfer bounces only when every
+//     reflecting surface's albedo is grey and every gatherer's transfer has one order (it is one
+//     vector for all channels), else it stays direct and the plan says why; the band-1 radiance
+//     bounces per channel. Each decision is a line of the plan; the bake then logs the share of
+//     gather rays that met a reflecting surface (0: nothing to bounce — a convex object alone);
 //   * area lights ("lights"; none: nothing of them is written): every receiver gets each light's
 //     irradiance at unit radiance, E = ∫ visible light max(n·ω, 0) dω (area_lights/irradiance,
 //     exact diffuse shading for any radiance the runtime gives the light); a receiver that gets
@@ -177,6 +191,8 @@ struct SceneDescription {
   bool counted_costs = false;     // not in the file: the tool's --reproducible (ChooserOptions)
   double sh_tolerance = 0.01;
   bool relight = false;
+  int bounces = 0;           // "bounces": interreflections (the plan rule "bounces")
+  uint32_t bounce_rays = 0;  // "bounce_rays" (0: BounceSpec::kDefaultRays)
   // "fiv": shells, cube, fraction; the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
@@ -224,6 +240,9 @@ struct ObjectPlan {
   bool texels = false;           // per texel of SceneObject::lightmap instead of per vertex
   bool area_irradiance = false;  // area_lights/irradiance: E of every light, at unit radiance
   int area_sh_order = 0;         // area_lights/sh: the visible lights' SH at this order (0: none)
+  // Interreflections (the rule "bounces"): its band-1 radiance / transfer get the bounces; it
+  // reflects light onto the others (and itself).
+  bool bounce_radiance = false, bounce_transfer = false, bounce_reflects = false;
   std::vector<std::string> baked, left_out;  // "product: reason", one line each
   // The products of a vertex integrator (bake/integrators/integrator.h); the area lights are not among them.
   bool any_vertex_product() const {
@@ -237,6 +256,7 @@ ProductRequest product_request(const ObjectPlan& plan, const EnvMap* env);
 struct ScenePlan {
   std::vector<ObjectPlan> objects;  // parallel to SceneDescription::objects
   bool fiv_environment = false;     // /fiv/environment and /fiv/irradiance_cube
+  bool bounces = false;             // some receiver gathers and some surface reflects
   std::vector<std::string> notes;   // scene-wide decisions
 };
 

@@ -40,6 +40,9 @@ struct ObjectBake {
   // object baked per texel.
   std::optional<std::vector<double>> area;
   double area_seconds = 0;
+  // Interreflections (scene.h rule "bounces"): `values` hold direct + SceneBake::bounces_applied
+  // bounces in these products.
+  bool bounced_radiance = false, bounced_transfer = false;
 };
 
 struct SceneBake {
@@ -48,6 +51,14 @@ struct SceneBake {
   std::vector<float> irradiance_cube;
   double setup_seconds = 0, vertex_seconds = 0, fiv_seconds = 0, environment_seconds = 0, area_seconds = 0;
   double report_seconds = 0;  // the error reports' reference integrals (with a target)
+  // Interreflections (plan.bounces): the bounces summed, each one's RMS over the direct pass's
+  // (BounceResult), the gather rays per receiver row, the gather's and the bounces' wall time,
+  // the cached hits' bytes, and the share of gather rays that met a reflecting surface.
+  int bounces_applied = 0;
+  std::vector<double> bounce_relative_rms;
+  uint32_t bounce_rays = 0;
+  double gather_seconds = 0, bounce_seconds = 0, reflecting_share = 0;
+  size_t gather_bytes = 0;
   uint64_t vertices = 0, texels = 0;  // receiver rows integrated: vertices, and texels of lightmaps
 };
 
@@ -57,7 +68,10 @@ struct SceneBake {
 // In order: the area lights' rows (exact), the environment's FIV and the occluders' FIV shells,
 // then the receivers' per-vertex products through the bake pipeline (bake/bake/pipeline.h: one job
 // per distinct product request over the receivers that make it; choose, integrate, check,
-// correct), then the FIV shells' error reports. Every row is the same for any thread count.
+// correct) — with plan.bounces, once every receiver's rows are baked, the bounces over all of them
+// together (bake/bake/bounce.h: one gather over every gathering receiver's rows against the
+// union, a SceneField of their vertices and lightmaps; the error reports measure the direct rows)
+// — then the FIV shells' error reports. Every row is the same for any thread count.
 // `env` must be the scene's environment (nullptr if none). `log` receives one line per step.
 //
 // How bake_scene integrates receiver rows, for sharded bakes (bake/core/chunks.h), and what it
