@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -190,6 +191,65 @@ TEST(Bounces, ColouredAlbedoBouncesEachChannelWithItsOwn) {
       green_bounce += std::abs(colour[g] - direct[g]);
     }
   EXPECT_GT(green_bounce, 0);
+}
+
+// A scene of one "both" object bounces as the single mesh does (bake/bake/scene.h rule "bounces"):
+// its vertices are the union's shade points, the gather is seeded alike, the field is its own
+// vertices, so with the same integrator, seed, albedo and rays its band-1 radiance is the vertex
+// bake's, value for value. And the plan says who reflects and who does not.
+TEST(Bounces, ASceneOfOneObjectBouncesAsTheMeshAlone) {
+  const fs::path d = dir_for("scene");
+  const std::string mesh = kData + "/bunny_ground.obj";
+  std::ofstream(d / "scene.json")
+      << R"({"prtbake_scene": 1, "environment": ")" << kData << R"(/sunset.exr",
+             "bake": {"products": ["radiance"], "integrator": "qmc", "samples": 64, "report": 0, "bounces": 2,
+                      "bounce_rays": 64},
+             "objects": [{"name": "b", "mesh": ")" << mesh << R"(", "role": "both", "material": {"albedo": [0.6, 0.6, 0.6]}}]})";
+  const fs::path scene_out = d / "scene.prt.h5", vertex_out = d / "vertex.prt.h5";
+  const auto s = run_tool(PRT_PRTBAKE, "scene " + (d / "scene.json").string() + " -o " + scene_out.string(), d / "capture");
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_NE(s.out.find("bounces: radiance/band1 with 2 bounce(s)"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("bounces: 2 of 2 over 4240 receiver rows"), std::string::npos) << s.out;
+  const auto v = run_tool(PRT_PRTBAKE,
+                          "vertex " + mesh + kEnv + " --integrator qmc --samples 64 --report 0 --bounces 2 --albedo 0.6 "
+                          "--bounce-rays 64 -q -o " + vertex_out.string(),
+                          d / "capture");
+  ASSERT_EQ(v.code, 0) << v.err;
+  const std::vector<float> scene_r = dataset(scene_out, "/objects/b/radiance/band1"),
+                           vertex_r = dataset(vertex_out, "/radiance/band1");
+  ASSERT_EQ(scene_r.size(), vertex_r.size());
+  EXPECT_TRUE(scene_r == vertex_r);
+  EXPECT_EQ(std::get<int64_t>(attr(scene_out, "bounces", "/objects/b/radiance/band1")), 2);
+}
+
+// The plan says who gathers and who reflects (bake/bake/scene.h rule "bounces"), and refuses an
+// albedo of 1 on a reflecting object by name.
+TEST(Bounces, TheScenePlanSaysWhoReflects) {
+  const fs::path d = dir_for("plan");
+  auto scene = [&](const std::string& albedo) {
+    std::ofstream(d / "scene.json")
+        << R"({"prtbake_scene": 1, "environment": ")" << kData << R"(/sunset.exr", "bake": {"bounces": 3},
+               "objects": [{"name": "bunny", "mesh": ")" << kData << R"(/bunny.obj", "role": "both",
+                            "material": {"albedo": )" << albedo << R"(}},
+                           {"name": "ground", "mesh": ")" << kData << R"(/ground.obj", "role": "receiver"},
+                           {"name": "spider", "mesh": ")" << kData << R"(/spider.obj", "role": "occluder"}]})";
+    return run_tool(PRT_PRTBAKE, "scene " + (d / "scene.json").string() + " --dry-run", d / "capture");
+  };
+  const auto r = scene("[0.6, 0.5, 0.4]");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* line :
+       {"bounces: radiance/band1 with 3 bounce(s) of the light the 1 reflecting object(s) send (this one at albedo "
+        "0.6,0.5,0.4)",
+        "bounces: receiver only: it is not in the occluders' union, so no ray meets it: it gathers the others' light "
+        "but reflects none",
+        "bounces: occluder only: it casts shadows but has no rows, so it reflects no light",
+        "bounces: 3 of diffuse interreflection, 256 gather rays per receiver row; reflecting: bunny"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  const auto one = scene("[1, 0.5, 0.4]");
+  EXPECT_NE(one.code, 0);
+  EXPECT_NE(one.err.find("object 'bunny': albedo 1,0.5,0.4 with bake.bounces: an albedo must be below 1"),
+            std::string::npos)
+      << one.err;
 }
 
 // (d) The same bytes with one thread and with two.
