@@ -558,9 +558,6 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
       if (a.shadowed)
         fail(b + " with --shadowed: the shadowed radiance S is baked without bounces in this version; bounce the "
                  "band-1 radiance (--radiance) and the transfer (--transfer L) instead");
-      if (a.worker)
-        fail(b + " in a sharded bake: a bounce needs every vertex's previous bounce, which shards do not share; "
-                 "bake with bounces in one process");
     } else {
       if (!a.albedo.empty()) fail("--albedo applies with --bounces B (B >= 1)");
       if (a.bounce_rays != 0) fail("--bounce-rays applies with --bounces B (B >= 1)");
