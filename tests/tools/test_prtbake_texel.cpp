@@ -181,3 +181,28 @@ TEST(PrtbakeTexel, AMeshWithoutUvsBakesInGeneratedOnes) {
   ASSERT_TRUE(a.vertices.uv);
   EXPECT_EQ(a.vertices.uv->uv_set, "prtbake_lightmap");
 }
+
+// A ring of triangles whose corner at φ = π/2 has x = 0.6 cos(π/2) = 3.7e-17 beside corners of
+// x = ±0.42: a texel on an edge from it cannot be put exactly on its triangle (no double lies on
+// that segment but its ends; bake/mesh/texels.h), and such a point may see its own triangle from
+// behind. The bake says so on stderr, naming the file and the count, and still writes the file.
+TEST(PrtbakeTexel, TexelsThatCannotLieExactlyOnTheirTrianglesAreReported) {
+  const fs::path obj = scratch("noisy_ring.obj"), out = scratch("noisy_ring.prt.h5");
+  {
+    std::ofstream f(obj);
+    f.precision(17);
+    const double pi = std::acos(-1.0);
+    for (int i = 0; i < 8; ++i)
+      f << "v " << 0.6 * std::cos(2 * pi * i / 8) << " " << 0.6 * std::sin(2 * pi * i / 8) << " 0.8\n";
+    f << "v 0 0 0.2\n";
+    for (int i = 0; i < 8; ++i) f << "f " << i + 1 << " 9 " << (i + 1) % 8 + 1 << "\n";
+  }
+  const auto run = prt::testing::run_tool(
+      PRT_PRTBAKE, "texel '" + obj.string() + "' --resolution 64 --ao --integrator qmc --samples 16 --report 0 -o '" +
+                       out.string() + "'",
+      scratch("capture"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: " + obj.string() + ": "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("texels could not be put exactly on their triangles"), std::string::npos) << run.err;
+  EXPECT_TRUE(fs::exists(out));
+}

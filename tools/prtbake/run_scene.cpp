@@ -178,8 +178,9 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         bake::SeamStitch area_seams;
         area_images[i] = lightmap_image(meshes[i], topology, *ob.lightmap, *scene.objects[i].lightmap, area, area_seams);
       }
-      if (!run.say || !(lightmaps <= kLightmapLines || a.verbose)) continue;
       const std::string who = scene_object_label(scene.objects[i]);
+      warn_inexact_texels(ob.lightmap->atlas, who);
+      if (!run.say || !(lightmaps <= kLightmapLines || a.verbose)) continue;
       const bake::TexelAtlas& atlas = ob.lightmap->atlas;
       if (ob.lightmap->generated)
         print_generated_uvs(who, ob.lightmap->unwrap_asked ? "\"unwrap\": true" : "no UV set", ob.lightmap->uv.name,

@@ -62,6 +62,7 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                  "prtbake: warning: %s: %zu texels of the %ux%u lightmap are touched by two charts of UV set %s: too "
                  "little gutter at this resolution (bilinear filtering bleeds one chart into the other)\n",
                  a.input.c_str(), atlas.shared_texels, atlas.width, atlas.height, uv.name.c_str());
+  warn_inexact_texels(atlas, a.input);
   if (run.say)
     std::printf("lightmap: %ux%u texels in UV set %s: %zu covered (%zu by the nearest point of a triangle touching "
                 "the texel, not its centre), %u charts; %zu inside the geometry, filled from their charts\n",
