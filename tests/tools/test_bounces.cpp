@@ -273,6 +273,35 @@ TEST(Bounces, ShardedBakesGiveTheOneProcessBytes) {
   EXPECT_TRUE(prt::testing::read_bytes(out) == one);
 }
 
+// The shadowed radiance S bounces by (5') with y_i in place of y_1m (bake/bake/bounce.h): its band 1
+// is the band-1 radiance's integral, so what the bounces add to S's band 1 is what they add to R
+// (the same rays and products; compared through the stored floats, to 1e-6 of the largest value),
+// and S_00 (∫ L V H y_00, every bounce adds ρ E y_00 ≥ 0 to it) grows at every vertex.
+TEST(Bounces, ShadowedRadianceBouncesWithBandOneEqualToR) {
+  const fs::path d = dir_for("shadowed");
+  const std::string args = " --shadowed 3" + kEnv;
+  const fs::path direct = bake(d, "direct", args), bounced = bake(d, "bounced", "--bounces 2 --albedo 0.6 --bounce-rays 64" + args);
+  const std::vector<float> s0 = dataset(direct, "/radiance/shadowed"), s2 = dataset(bounced, "/radiance/shadowed"),
+                           r0 = dataset(direct, "/radiance/band1"), r2 = dataset(bounced, "/radiance/band1");
+  ASSERT_EQ(s0.size(), s2.size());
+  ASSERT_EQ(s0.size() / 27, r0.size() / 9);
+  float largest = 0;
+  for (const float x : s2) largest = std::max(largest, std::abs(x));
+  double added = 0;
+  for (size_t v = 0; v < r0.size() / 9; ++v)
+    for (size_t c = 0; c < 3; ++c) {
+      const size_t s00 = 27 * v + 9 * c;
+      EXPECT_GE(s2[s00], s0[s00]) << "vertex " << v << ", channel " << c;
+      added += s2[s00] - s0[s00];
+      for (size_t m = 0; m < 3; ++m)
+        EXPECT_NEAR(double(s2[s00 + 1 + m]) - s0[s00 + 1 + m], double(r2[9 * v + 3 * c + m]) - r0[9 * v + 3 * c + m],
+                    1e-6 * largest)
+            << "vertex " << v << ", channel " << c << ", m " << m;
+    }
+  EXPECT_GT(added, 0);
+  EXPECT_EQ(std::get<int64_t>(attr(bounced, "bounces", "/radiance/shadowed")), 2);
+}
+
 // (d) The same bytes with one thread and with two.
 TEST(Bounces, SameBytesWhateverTheThreads) {
   const fs::path d = dir_for("threads");
@@ -301,7 +330,6 @@ TEST(Bounces, BadOptionsAreUsageErrors) {
       {"--bounces 2", "--bounces 2 needs --albedo R[,G,B]"},
       {"--albedo 0.5", "--albedo applies with --bounces"},
       {"--bounce-rays 64", "--bounce-rays applies with --bounces"},
-      {"--bounces 2 --albedo 0.5 --shadowed 3" + kEnv, "the shadowed radiance S is baked without bounces in this version"},
   };
   for (const auto& c : cases) {
     const auto r = run_tool(PRT_PRTBAKE, kBake + " " + c.args + " -o " + out.string(), d / "capture");

@@ -217,7 +217,7 @@ void add_bounces(CLI::App& cmd, Args& a, const std::string& noun) {
                  "back faces are black. Stops early once a bounce adds < 1e-4 of the direct\n"
                  "pass's RMS. transfer/diffuse and radiance/band1 then hold direct + bounces\n"
                  "(attrs bounces, bounces_requested, albedo, bounce_rays); shading is\n"
-                 "unchanged. AO, --visibility stay direct; not with --shadowed.")
+                 "unchanged; --shadowed's S bounces too. AO and --visibility stay direct.")
       ->option_text("B")
       ->check(tool::integer_in(0, 100))
       ->group(group);
@@ -555,9 +555,6 @@ void validate(Args& a, const CLI::App& app, uint32_t samples, const tool::MpiSes
         fail(b + " with --transfer and a coloured --albedo: the diffuse transfer is one vector for all channels, so it "
                  "bounces with a grey albedo only (give one value, or R = G = B); the band-1 radiance (--radiance) "
                  "bounces per channel");
-      if (a.shadowed)
-        fail(b + " with --shadowed: the shadowed radiance S is baked without bounces in this version; bounce the "
-                 "band-1 radiance (--radiance) and the transfer (--transfer L) instead");
     } else {
       if (!a.albedo.empty()) fail("--albedo applies with --bounces B (B >= 1)");
       if (a.bounce_rays != 0) fail("--bounce-rays applies with --bounces B (B >= 1)");

@@ -83,16 +83,17 @@ void set_mesh(F::VertexSet& set, const bake::Mesh& mesh) {
   set.source_position = F::Array<uint32_t>{mesh.source_position, {}};
 }
 
-void set_bounces(F::Product& product, bool radiance, int applied, const bake::BounceSpec& spec,
+void set_bounces(F::Product& product, Bounced which, int applied, const bake::BounceSpec& spec,
                  const std::vector<double>& albedo) {
   product.bounces = applied;
   product.bounces_requested = spec.bounces;
   product.albedo = albedo;
   product.bounce_rays = int64_t(spec.rays);
   if (product.integrand)
-    *product.integrand += radiance
-                              ? " + bounces: R^{b+1}_c,m(p) = Int (1 - V) H (albedo/pi) E^b_c(hit) y_1m dw, b < bounces"
-                              : " + bounces: T^{b+1}_i(p) = (1/pi) Int (1 - V) H albedo T^b_i(hit) (n.w) dw, b < bounces";
+    *product.integrand +=
+        which == Bounced::Band1      ? " + bounces: R^{b+1}_c,m(p) = Int (1 - V) H (albedo/pi) E^b_c(hit) y_1m dw, b < bounces"
+        : which == Bounced::Shadowed ? " + bounces: S^{b+1}_c,i(p) = Int (1 - V) H (albedo/pi) E^b_c(hit) y_i dw, b < bounces"
+                                     : " + bounces: T^{b+1}_i(p) = (1/pi) Int (1 - V) H albedo T^b_i(hit) (n.w) dw, b < bounces";
 }
 
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info) {

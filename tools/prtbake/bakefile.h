@@ -39,9 +39,9 @@ struct ProductInfo {
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info);
 
 // The attributes of a product with interreflections (formats/SCHEMA.md "Bounces"): the bounces
-// applied and asked for, the albedo (RGB) and the gather rays; the integrand says it (`radiance`:
-// the band-1 radiance's recursion, else the diffuse transfer's).
-void set_bounces(F::Product& product, bool radiance, int applied, const bake::BounceSpec& spec,
+// applied and asked for, the albedo (RGB) and the gather rays; the integrand says which recursion.
+enum class Bounced { Transfer, Band1, Shadowed };
+void set_bounces(F::Product& product, Bounced which, int applied, const bake::BounceSpec& spec,
                  const std::vector<double>& albedo);
 
 // The lightmap of a texel bake (format v5): /mesh/uv from the UV set, /lightmap/state from the

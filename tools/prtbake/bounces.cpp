@@ -20,7 +20,9 @@ ReceiverBounces::ReceiverBounces(const Args& a, size_t triangles) : albedo_rgb_(
 void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCaster& rays,
                              const bake::VertexBake& direct, std::span<const bake::ShadePoint> points,
                              const std::string& source, const RunContext& run, const char* noun) {
-  if (!hits_) hits_ = bake::gather(rays, points, spec_, direct.layout.radiance_count > 0, run.progress);
+  if (!hits_)
+    hits_ = bake::gather(rays, points, spec_, direct.layout.radiance_count > 0 || direct.layout.shadowed_count > 0,
+                         run.progress);
   bake::BounceResult r = bake::bounce_rows(field, points, *hits_, albedo_, direct.layout, direct.values, spec_, source,
                                            run.progress);
   bounced_ = direct;
@@ -35,10 +37,12 @@ void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCast
   }
 }
 
-void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance) const {
+void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance,
+                                     formats::Product* shadowed) const {
   if (!bounced_) return;
-  if (transfer) set_bounces(*transfer, false, applied_, spec_, albedo_rgb_);
-  if (radiance) set_bounces(*radiance, true, applied_, spec_, albedo_rgb_);
+  if (transfer) set_bounces(*transfer, Bounced::Transfer, applied_, spec_, albedo_rgb_);
+  if (radiance) set_bounces(*radiance, Bounced::Band1, applied_, spec_, albedo_rgb_);
+  if (shadowed) set_bounces(*shadowed, Bounced::Shadowed, applied_, spec_, albedo_rgb_);
 }
 
 } // namespace prt::tool

@@ -33,8 +33,8 @@ class ReceiverBounces {
               const char* noun);
   // The rows to write: the bounced ones once bounce() ran, else `direct`.
   const bake::VertexBake& rows(const bake::VertexBake& direct) const { return bounced_ ? *bounced_ : direct; }
-  // The bounce attributes of the products that bounced (either may be null).
-  void set_attributes(formats::Product* transfer, formats::Product* radiance) const;
+  // The bounce attributes of the products that bounced (any may be null).
+  void set_attributes(formats::Product* transfer, formats::Product* radiance, formats::Product* shadowed) const;
 
  private:
   bake::BounceSpec spec_;

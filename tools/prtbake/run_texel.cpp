@@ -105,7 +105,8 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                        a.padding);
     F::Lightmap& lm = *asset.vertices.lightmap;
     bounces.set_attributes(lm.transfer_diffuse ? &*lm.transfer_diffuse : nullptr,
-                           lm.radiance_band1 ? &*lm.radiance_band1 : nullptr);
+                           lm.radiance_band1 ? &*lm.radiance_band1 : nullptr,
+                           lm.radiance_shadowed ? &*lm.radiance_shadowed : nullptr);
     if (const auto& report = job.reports.front()) {
       bake::ErrorReport by_texel = *report;  // its rows are valid texels: named by their texels
       for (uint32_t& r : by_texel.vertices) r = atlas.samples[texels.valid[r]].texel;

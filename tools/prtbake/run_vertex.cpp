@@ -68,8 +68,10 @@ int run_vertex(const Args& a, const RunContext& run, std::optional<ShardedRows>&
     tool::set_products(asset.vertices, result,
                        {job.integrator->name(), job.integrator_description, job.spec.samples(), job.spec.seed, a.transfer,
                         a.visibility, env ? &*env : nullptr, a.environment});
-    bounces.set_attributes(asset.vertices.transfer_diffuse ? &*asset.vertices.transfer_diffuse : nullptr,
-                           asset.vertices.radiance_band1 ? &*asset.vertices.radiance_band1 : nullptr);
+    F::VertexSet& v = asset.vertices;
+    bounces.set_attributes(v.transfer_diffuse ? &*v.transfer_diffuse : nullptr,
+                           v.radiance_band1 ? &*v.radiance_band1 : nullptr,
+                           v.radiance_shadowed ? &*v.radiance_shadowed : nullptr);
     if (const auto& report = job.reports.front())
       asset.vertices.report = tool::report_of(*report, result.seconds, mesh.positions.size(), a.reproducible);
     tool::set_target_error(asset, a.target_error);

@@ -36,9 +36,11 @@ Eigen::Vector3d gather_direction(const Frame& frame, const RotatedHalton3& halto
 }
 
 // The weights of (3') and (5') for direction d about normal n: ((n·ω)/π, y_1m(ω)/π) / p(ω).
-std::array<double, 4> mixture_weights(const Eigen::Vector3d& n, const Eigen::Vector3d& d) {
+// `inv_p`, when given, receives 1/p(ω) (S's weights, y_i(ω)/π/p(ω), are made the same way).
+std::array<double, 4> mixture_weights(const Eigen::Vector3d& n, const Eigen::Vector3d& d, double* inv_p_out = nullptr) {
   const double c = n.dot(d);
   const double inv_p = 1.0 / (0.5 * c * kInvPi + 0.5 * (0.5 * kInvPi));
+  if (inv_p_out) *inv_p_out = inv_p;
   double y[4];
   sh::eval(2, d.x(), d.y(), d.z(), y);
   return {c * kInvPi * inv_p, y[1] * kInvPi * inv_p, y[2] * kInvPi * inv_p, y[3] * kInvPi * inv_p};
@@ -171,11 +173,16 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
                          const BounceSpec& spec, const std::string& source, const Monitor& monitor,
                          const std::string& label) {
   const size_t V = field.rows(), E = field.entries(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
-  const bool radiance = layout.radiance_count > 0;
+  // R (9 values, [c][m]) and S (3 L_s² values, [c][i]); either needs E at the hit, eq. (4), from R
+  // or from S's band 1 (R_c,m = S_c,(2+m): the same integral).
+  const size_t nr = layout.radiance_count, ns = layout.shadowed_count, ls2 = ns / 3;
+  const int ls = layout.shadowed_order;
+  const bool radiance = nr > 0 || ns > 0;
   PRT_CHECK_OP(points.size(), ==, V);
   PRT_CHECK_OP(direct.size(), ==, V * W);
   PRT_CHECK_OP(hits.rows(), ==, V);
-  PRT_CHECK(!radiance || hits.mixture);  // R's estimator (5') needs the mixture's weights
+  PRT_CHECK(!radiance || hits.mixture);  // the estimators (5') need the mixture's weights
+  PRT_CHECK(ns == 0 || (ls >= 2 && ls2 == size_t(ls) * size_t(ls)));
   PRT_CHECK(spec.bounces >= 0);
   check_albedo(albedo, source);
   if (nt > 0)
@@ -189,9 +196,9 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   if ((nt == 0 && !radiance) || spec.bounces == 0) return out;
 
   // What a bounce gathers per row, [V][S]: T^b (nt values), then E^b_c (3, eq. (4) at the row's
-  // normal, when R bounces), spread over the field's entries [E][S]. What it makes per row,
-  // [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], 9).
-  const size_t S = nt + (radiance ? 3 : 0), B = nt + (radiance ? 9 : 0);
+  // normal, when R or S bounces), spread over the field's entries [E][S]. What it makes per row,
+  // [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], nr), S^{b+1} ([c][i], ns).
+  const size_t S = nt + (radiance ? 3 : 0), B = nt + nr + ns;
   std::vector<std::array<double, 3>> y1(radiance ? V : 0);  // y_1m(n_r)
   for (size_t v = 0; v < y1.size(); ++v) {
     const Eigen::Vector3d n = points[v].n.normalized();
@@ -200,19 +207,21 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
     y1[v] = {y[1], y[2], y[3]};
   }
   std::vector<double> source_rows(V * S), field_values(E * S), made(V * B);
-  auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset) {
+  // `rows` of `width`, T at t_offset, R at r_offset (when nr), else S at s_offset (band 1 at 1..3).
+  auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset, size_t s_offset) {
     for (size_t v = 0; v < V; ++v) {
       for (size_t i = 0; i < nt; ++i) source_rows[v * S + i] = rows[v * width + t_offset + i];
       if (radiance)
         for (size_t c = 0; c < 3; ++c) {  // eq. (4)
+          const double* band1 = nr ? &rows[v * width + r_offset + 3 * c] : &rows[v * width + s_offset + ls2 * c + 1];
           double e = 0;
-          for (size_t m = 0; m < 3; ++m) e += y1[v][m] * rows[v * width + r_offset + 3 * c + m];
+          for (size_t m = 0; m < 3; ++m) e += y1[v][m] * band1[m];
           source_rows[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;
         }
     }
     field.spread(source_rows, S, field_values);
   };
-  take(direct, W, layout.transfer, layout.radiance);
+  take(direct, W, layout.transfer, layout.radiance, layout.shadowed);
   // The direct pass's RMS per product, over the rows.
   auto slice_rms = [&](std::span<const double> rows, size_t width, size_t offset, size_t count) {
     double sum = 0;
@@ -220,15 +229,17 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
       for (size_t i = 0; i < count; ++i) sum += rows[v * width + offset + i] * rows[v * width + offset + i];
     return V * count > 0 ? std::sqrt(sum / double(V * count)) : 0.0;
   };
-  const double direct_rms[2] = {slice_rms(direct, W, layout.transfer, nt),
-                                slice_rms(direct, W, layout.radiance, radiance ? 9 : 0)};
+  const double direct_rms[3] = {slice_rms(direct, W, layout.transfer, nt), slice_rms(direct, W, layout.radiance, nr),
+                                slice_rms(direct, W, layout.shadowed, ns)};
 
   for (int b = 1; b <= spec.bounces; ++b) {
-    // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source at h, as the field reads it) × its weights.
+    // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source at h, as the field reads it) × its
+    // weights; S's weights are (5') with y_i in place of y_1m.
     VertexBake pass = bake_rows(
         0, V, B,
         [&](size_t v, std::span<double> row, std::span<double>) {
           double at_hit[kMaxSource];
+          double ys[sh::kMaxOrder * sh::kMaxOrder];
           const Frame frame(points[v].n);
           const RotatedHalton3 halton(hits.seed, v);
           for (size_t k = 0; k < K; ++k) {
@@ -245,11 +256,24 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
               for (size_t i = 0; i < S; ++i) at_hit[i] += taps.weight[c] * src[i];
             }
             std::array<double, 4> weight{1, 0, 0, 0};  // the cosine gather's: T's weight is 1
-            if (hits.mixture) weight = mixture_weights(points[v].n, gather_direction(frame, halton, k, true));
+            double inv_p = 0;
+            Eigen::Vector3d d = Eigen::Vector3d::Zero();
+            if (hits.mixture) {
+              d = gather_direction(frame, halton, k, true);
+              weight = mixture_weights(points[v].n, d, &inv_p);
+            }
             for (size_t i = 0; i < nt; ++i) row[i] += rho[0] * weight[0] * at_hit[i];  // grey (checked)
-            if (radiance)
+            if (nr)
               for (size_t c = 0; c < 3; ++c)
                 for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho[c] * at_hit[nt + c] * weight[1 + m];
+            if (ns) {  // the mixture (checked above): d and inv_p are the ray's
+              sh::eval(ls, d.x(), d.y(), d.z(), ys);
+              for (size_t c = 0; c < 3; ++c) {
+                const double e = rho[c] * at_hit[nt + c];
+                if (e == 0) continue;
+                for (size_t i = 0; i < ls2; ++i) row[nt + nr + ls2 * c + i] += e * (ys[i] * kInvPi * inv_p);
+              }
+            }
           }
           for (size_t i = 0; i < B; ++i) row[i] /= double(K);
         },
@@ -259,18 +283,20 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
     for (size_t v = 0; v < V; ++v) {
       for (size_t i = 0; i < nt; ++i)
         if (const double x = made[v * B + i]; x != 0) out.values[v * W + layout.transfer + i] += x;
-      if (radiance)
-        for (size_t i = 0; i < 9; ++i)
-          if (const double x = made[v * B + nt + i]; x != 0) out.values[v * W + layout.radiance + i] += x;
+      for (size_t i = 0; i < nr; ++i)
+        if (const double x = made[v * B + nt + i]; x != 0) out.values[v * W + layout.radiance + i] += x;
+      for (size_t i = 0; i < ns; ++i)
+        if (const double x = made[v * B + nt + nr + i]; x != 0) out.values[v * W + layout.shadowed + i] += x;
     }
     double r = 0;
-    if (direct_rms[0] > 0) r = std::max(r, slice_rms(made, B, 0, nt) / direct_rms[0]);
-    if (direct_rms[1] > 0) r = std::max(r, slice_rms(made, B, nt, radiance ? 9 : 0) / direct_rms[1]);
+    const size_t offsets[3] = {0, nt, nt + nr}, counts[3] = {nt, nr, ns};
+    for (size_t p = 0; p < 3; ++p)
+      if (direct_rms[p] > 0) r = std::max(r, slice_rms(made, B, offsets[p], counts[p]) / direct_rms[p]);
     out.applied = b;
     out.relative_rms.push_back(r);
     out.seconds.push_back(pass.seconds);
     if (r <= spec.tolerance || b == spec.bounces) break;
-    take(made, B, 0, nt);
+    take(made, B, 0, nt, nt + nr);
   }
   for (const double x : out.values)
     if (!std::isfinite(x)) throw ContractError("bounce_rows: a non-finite value in the bounced rows of " + source);

@@ -56,9 +56,10 @@
 // both bounded (the weights are at most 2 and 4 · 0.4886 ≈ 1.95: p ≥ 1/(4π)). The per-ray weights are
 // made again from the ray's direction at every bounce (GatherHits: the direction is a function of
 // the seed, the row and k), so the cache holds 12 bytes a ray.
-// Shadowed radiance S bounces by (5) with y_i in place of y_1m (E at the
-// hit is still all it needs), but its weights are one per coefficient: not in this slice (the tool
-// refuses S with bounces, so S's band 1 keeps equalling R).
+// Shadowed radiance S bounces by (5) with y_i in place of y_1m — E at the hit is still all it
+// needs (from R, or from S's own band 1 when the layout has no R: R_c,m = S_c,(2+m)) — with the
+// weights (y_i(ω)/π)/p(ω), bounded by 4 max|y_i| under the mixture; its band 1 gets exactly R's
+// bounces (the same rays and products).
 //
 // COLOUR. R is per channel already, and (5) takes ρ_c as it is: R bounces with a coloured albedo.
 // T stays one transfer vector per vertex ([V][L²], the direct pass's layout and dataset), so it
@@ -76,7 +77,7 @@
 // once one adds, as the RMS of its values over the rows, at most `tolerance` × the direct pass's
 // RMS, for each product it bounces (that bounce is still added; `applied` counts the bounces summed).
 //
-// T and R bounce; AO, visibility transfer U and shadowed radiance S stay direct.
+// T, R and S bounce; AO and the visibility transfer U stay direct.
 // Silent, cancellable through the Monitor, parallel by oneTBB, deterministic.
 #pragma once
 
