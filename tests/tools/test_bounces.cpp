@@ -302,6 +302,41 @@ TEST(Bounces, ShadowedRadianceBouncesWithBandOneEqualToR) {
   EXPECT_EQ(std::get<int64_t>(attr(bounced, "bounces", "/radiance/shadowed")), 2);
 }
 
+// Area lights bounce too (bake/bake/scene.h rule "bounces"): E_l of each receiver row, at unit
+// radiance, gets the light the surfaces reflect of that light, by the transfer's recursion with a
+// grey albedo. A quad light above the bunny on its ground, no environment: with 2 bounces E never
+// falls at any vertex (every bounce adds ρ E ≥ 0; the stored floats are compared), grows in all,
+// and the product says so; the plan names it.
+TEST(Bounces, AreaLightIrradianceBouncesInScenes) {
+  const fs::path d = dir_for("area");
+  auto bake_scene = [&](const std::string& name, int bounces) {
+    std::ofstream(d / (name + ".json"))
+        << R"({"prtbake_scene": 1, "bake": {"integrator": "qmc", "samples": 64, "report": 0, "bounces": )" << bounces
+        << R"(, "products": ["radiance"]}, "lights": [{"name": "key", "shape": "quad", "centre": [0, 15, 0],
+               "u": [10, 0, 0], "v": [0, 0, 10], "radiance": [10, 10, 10]}],
+             "objects": [{"name": "b", "mesh": ")" << kData << R"(/bunny_ground.obj", "role": "both",
+                          "material": {"albedo": [0.6, 0.6, 0.6]}}]})";
+    const fs::path out = d / (name + ".prt.h5");
+    const auto r = run_tool(PRT_PRTBAKE, "scene " + (d / (name + ".json")).string() + " -o " + out.string(), d / "capture");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return std::pair{out, r.out};
+  };
+  const auto [direct, direct_log] = bake_scene("direct", 0);
+  const auto [bounced, log] = bake_scene("bounced", 2);
+  EXPECT_NE(log.find("bounces: area_lights/irradiance with 2 bounce(s)"), std::string::npos) << log;
+  const std::vector<float> e0 = dataset(direct, "/objects/b/area_lights/irradiance"),
+                           e2 = dataset(bounced, "/objects/b/area_lights/irradiance");
+  ASSERT_EQ(e0.size(), e2.size());
+  ASSERT_EQ(e0.size(), 4240u);
+  double added = 0;
+  for (size_t v = 0; v < e0.size(); ++v) {
+    EXPECT_GE(e2[v], e0[v]) << "vertex " << v;
+    added += e2[v] - e0[v];
+  }
+  EXPECT_GT(added, 0);
+  EXPECT_EQ(std::get<int64_t>(attr(bounced, "bounces", "/objects/b/area_lights/irradiance")), 2);
+}
+
 // (d) The same bytes with one thread and with two.
 TEST(Bounces, SameBytesWhateverTheThreads) {
   const fs::path d = dir_for("threads");

@@ -93,6 +93,8 @@ void set_bounces(F::Product& product, Bounced which, int applied, const bake::Bo
     *product.integrand +=
         which == Bounced::Band1      ? " + bounces: R^{b+1}_c,m(p) = Int (1 - V) H (albedo/pi) E^b_c(hit) y_1m dw, b < bounces"
         : which == Bounced::Shadowed ? " + bounces: S^{b+1}_c,i(p) = Int (1 - V) H (albedo/pi) E^b_c(hit) y_i dw, b < bounces"
+        : which == Bounced::AreaIrradiance
+            ? " + bounces: E^{b+1}_l(p) = (1/pi) Int (1 - V) H albedo E^b_l(hit) (n.w) dw, b < bounces"
                                      : " + bounces: T^{b+1}_i(p) = (1/pi) Int (1 - V) H albedo T^b_i(hit) (n.w) dw, b < bounces";
 }
 

@@ -40,7 +40,7 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
 
 // The attributes of a product with interreflections (formats/SCHEMA.md "Bounces"): the bounces
 // applied and asked for, the albedo (RGB) and the gather rays; the integrand says which recursion.
-enum class Bounced { Transfer, Band1, Shadowed };
+enum class Bounced { Transfer, Band1, Shadowed, AreaIrradiance };
 void set_bounces(F::Product& product, Bounced which, int applied, const bake::BounceSpec& spec,
                  const std::vector<double>& albedo);
 

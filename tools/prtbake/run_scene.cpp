@@ -277,6 +277,13 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);
       else if (ob.area)
         tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
+      if (ob.bounced_area) {
+        bake::BounceSpec spec;
+        spec.bounces = scene.bounces;
+        spec.rays = result.bounce_rays;
+        std::optional<F::Product>& e = obj.set.lightmap ? obj.set.lightmap->area_irradiance : obj.set.area_irradiance;
+        if (e) tool::set_bounces(*e, Bounced::AreaIrradiance, result.bounces_applied, spec, *obj.albedo);
+      }
       if (ob.shells) {
         F::Occluder& occluder =
             asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));

@@ -332,10 +332,19 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   // made from the direct rows of all of them (never from rows that already carry bounces).
   std::vector<std::optional<VertexBake>> direct_rows(scene.objects.size());
   std::optional<GatherHits> gather_hits;  // cast once, reused after a correction
+  // The area lights' direct rows, kept the same way (ObjectBake::area is replaced by the bounced).
+  std::vector<std::optional<std::vector<double>>> direct_area(scene.objects.size());
   auto bounce_receivers = [&] {
+    const size_t nl = scene.lights.size();
     std::vector<size_t> gatherers;
-    for (size_t i = 0; i < scene.objects.size(); ++i)
-      if ((plan.objects[i].bounce_radiance || plan.objects[i].bounce_transfer) && direct_rows[i]) gatherers.push_back(i);
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const ObjectPlan& p = plan.objects[i];
+      if (!p.bounce_radiance && !p.bounce_transfer && !p.bounce_area) continue;
+      if ((p.bounce_radiance || p.bounce_transfer) && !direct_rows[i]) continue;
+      if (p.bounce_area && !direct_area[i]) direct_area[i] = out.objects[i].area;
+      if (p.bounce_area && !direct_area[i]) continue;
+      gatherers.push_back(i);
+    }
     if (gatherers.empty()) return;
     // The union's triangle ranges: occluders in object order (merge_meshes).
     std::vector<uint32_t> first_triangle(scene.objects.size(), 0);
@@ -347,17 +356,25 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
           std::fill_n(albedo.begin() + std::ptrdiff_t(t), meshes[i].triangles.size(), scene.objects[i].material.albedo);
         t += meshes[i].triangles.size();
       }
-    // The rows side by side: T (when it bounces, at its one order) and R, per gatherer in order.
+    // The rows side by side, per gatherer in order: T (when it bounces, at its one order) and each
+    // light's E_l after it, in the transfer's slot — E_l's recursion is T's, eq. (2) with a scalar
+    // for y_i: E^{b+1}_l(p) = ∫ (1 − V) H (ρ/π) E^b_l(h) (n·ω) dω, grey ρ (the plan's rule) — then R.
     int order = 0;
-    bool radiance = false;
+    bool radiance = false, area = false;
     for (const size_t i : gatherers) {
       if (plan.objects[i].bounce_transfer) order = plan.objects[i].transfer_order;
       radiance = radiance || plan.objects[i].bounce_radiance;
+      area = area || plan.objects[i].bounce_area;
     }
+    const size_t nt = size_t(order) * size_t(order), na = area ? nl : 0;
     ProductRequest q;
-    q.transfer_order = order;
     q.radiance = radiance ? env : nullptr;
-    const ProductLayout layout(q);
+    ProductLayout layout(q);  // R at 0; then T and E_l put before it
+    layout.transfer = 0;
+    layout.transfer_count = nt + na;
+    layout.visibility = layout.radiance = nt + na;
+    layout.shadowed = layout.radiance + layout.radiance_count;
+    layout.width = layout.shadowed;
     std::vector<ShadePoint> points;
     std::vector<std::unique_ptr<BounceField>> fields;
     SceneField field;
@@ -370,17 +387,23 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       field.add(*fields.back(), first_triangle[i],
                 plan.objects[i].occluder ? uint32_t(meshes[i].triangles.size()) : 0u);
     }
+    auto area_stride = [&](size_t i) { return 1 + size_t(plan.objects[i].area_sh_order) * size_t(plan.objects[i].area_sh_order); };
     std::vector<double> direct(points.size() * layout.width, 0.0);
     size_t row = 0;
-    for (const size_t i : gatherers) {
-      const VertexBake& d = *direct_rows[i];
-      const size_t n = d.values.size() / d.layout.width;
+    for (size_t g = 0; g < gatherers.size(); ++g) {
+      const size_t i = gatherers[g];
+      const ObjectPlan& p = plan.objects[i];
+      const size_t n = fields[g]->rows();
       for (size_t r = 0; r < n; ++r, ++row) {
         double* to = &direct[row * layout.width];
-        const double* from = &d.values[r * d.layout.width];
-        if (plan.objects[i].bounce_transfer)
-          std::copy_n(from + d.layout.transfer, layout.transfer_count, to + layout.transfer);
-        if (plan.objects[i].bounce_radiance) std::copy_n(from + d.layout.radiance, 9, to + layout.radiance);
+        if (p.bounce_transfer || p.bounce_radiance) {
+          const VertexBake& d = *direct_rows[i];
+          const double* from = &d.values[r * d.layout.width];
+          if (p.bounce_transfer) std::copy_n(from + d.layout.transfer, nt, to);
+          if (p.bounce_radiance) std::copy_n(from + d.layout.radiance, 9, to + layout.radiance);
+        }
+        if (p.bounce_area)
+          for (size_t l = 0; l < nl; ++l) to[nt + l] = (*direct_area[i])[(r * nl + l) * area_stride(i)];
       }
     }
     PRT_CHECK_OP(row, ==, points.size());
@@ -392,19 +415,27 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     const BounceResult r = bounce_rows(field, points, *gather_hits, albedo, layout, direct, spec, scene.file.string(),
                                        monitor, "bouncing light");
     row = 0;
-    for (const size_t i : gatherers) {
+    for (size_t g = 0; g < gatherers.size(); ++g) {
+      const size_t i = gatherers[g];
       ObjectBake& ob = out.objects[i];
-      ob.values = direct_rows[i];
-      VertexBake& v = *ob.values;
-      const size_t n = v.values.size() / v.layout.width;
+      const ObjectPlan& p = plan.objects[i];
+      const size_t n = fields[g]->rows();
+      if (p.bounce_transfer || p.bounce_radiance) ob.values = direct_rows[i];
+      if (p.bounce_area) ob.area = direct_area[i];
       for (size_t k = 0; k < n; ++k, ++row) {
-        double* to = &v.values[k * v.layout.width];
         const double* from = &r.values[row * layout.width];
-        if (plan.objects[i].bounce_transfer) std::copy_n(from + layout.transfer, layout.transfer_count, to + v.layout.transfer);
-        if (plan.objects[i].bounce_radiance) std::copy_n(from + layout.radiance, 9, to + v.layout.radiance);
+        if (p.bounce_transfer || p.bounce_radiance) {
+          VertexBake& v = *ob.values;
+          double* to = &v.values[k * v.layout.width];
+          if (p.bounce_transfer) std::copy_n(from, nt, to + v.layout.transfer);
+          if (p.bounce_radiance) std::copy_n(from + layout.radiance, 9, to + v.layout.radiance);
+        }
+        if (p.bounce_area)
+          for (size_t l = 0; l < nl; ++l) (*ob.area)[(k * nl + l) * area_stride(i)] = from[nt + l];
       }
-      ob.bounced_radiance = plan.objects[i].bounce_radiance;
-      ob.bounced_transfer = plan.objects[i].bounce_transfer;
+      ob.bounced_radiance = p.bounce_radiance;
+      ob.bounced_transfer = p.bounce_transfer;
+      ob.bounced_area = p.bounce_area;
     }
     size_t met = 0;
     for (const uint32_t t : gather_hits->triangle)

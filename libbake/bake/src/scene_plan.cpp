@@ -50,8 +50,8 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
                                "with a diffuse albedo to have it reflect)");
       continue;
     }
-    if (!p.radiance && p.transfer_order == 0) {
-      p.left_out.push_back(b + "no band-1 radiance or diffuse transfer to bounce (no diffuse albedo, or none asked)");
+    if (!p.radiance && p.transfer_order == 0 && !p.area_irradiance) {
+      p.left_out.push_back(b + "no band-1 radiance, diffuse transfer or area-light irradiance to bounce");
       continue;
     }
     gathers = true;
@@ -72,7 +72,7 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
   }
   if (!gathers || reflect.empty()) {
     plan.notes.push_back(b + std::to_string(scene.bounces) + " asked, none baked: " +
-                         (!gathers ? "no receiver has band-1 radiance or diffuse transfer"
+                         (!gathers ? "no receiver has band-1 radiance, diffuse transfer or area-light irradiance"
                                    : "no surface reflects (a reflecting surface is a \"both\" object with a diffuse "
                                      "albedo)"));
     return;
@@ -81,12 +81,15 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
   const bool transfer = !orders.empty() && grey && orders.size() == 1;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     ObjectPlan& p = plan.objects[i];
-    if (!p.receiver || (!p.radiance && p.transfer_order == 0)) continue;
+    if (!p.receiver || (!p.radiance && p.transfer_order == 0 && !p.area_irradiance)) continue;
     p.bounce_radiance = p.radiance;
     p.bounce_transfer = transfer && p.transfer_order > 0;
-    std::string what = p.radiance && p.bounce_transfer ? "radiance/band1 and transfer/diffuse"
-                       : p.radiance                    ? "radiance/band1"
-                                                       : p.bounce_transfer ? "transfer/diffuse" : "";
+    p.bounce_area = grey && p.area_irradiance;
+    std::string what;
+    for (const auto& [on, name] : {std::pair{p.bounce_radiance, "radiance/band1"},
+                                   std::pair{p.bounce_transfer, "transfer/diffuse"},
+                                   std::pair{p.bounce_area, "area_lights/irradiance"}})
+      if (on) what += (what.empty() ? "" : ", ") + std::string(name);
     if (!what.empty())
       p.baked.push_back(b + what + " with " + std::to_string(scene.bounces) + " bounce(s) of the light the " +
                         std::to_string(reflect.size()) + " reflecting object(s) send" +
@@ -97,6 +100,9 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
                            (!grey ? std::string("a reflecting object's albedo is coloured and the transfer is one vector "
                                                 "for all channels")
                                   : std::string("the receivers' transfers have different orders")));
+    if (p.area_irradiance && !p.bounce_area)
+      p.left_out.push_back(b + "area_lights/irradiance stays direct: a reflecting object's albedo is coloured and E_l "
+                               "is one value for all channels");
   }
   std::string names;
   for (const size_t i : reflect) names += (names.empty() ? "" : ", ") + scene.objects[i].name;

@@ -42,7 +42,7 @@ struct ObjectBake {
   double area_seconds = 0;
   // Interreflections (scene.h rule "bounces"): `values` hold direct + SceneBake::bounces_applied
   // bounces in these products.
-  bool bounced_radiance = false, bounced_transfer = false;
+  bool bounced_radiance = false, bounced_transfer = false, bounced_area = false;  // `area` too
 };
 
 struct SceneBake {
