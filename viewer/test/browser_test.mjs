@@ -1,0 +1,195 @@
+#!/usr/bin/env node
+// viewer/test/browser_test.mjs — the web viewer in a real browser (issue 34; ctest viewer_browser).
+//
+// For the bunny on its ground, the statue (wuson.obj, the statue of data/scene_example.json) and
+// the CAD engine (2CylinderEngine.glb): bake AO + diffuse transfer (order 3), `prtbake export
+// --to web`, then in Debian's Chromium (headless, WebGL through SwiftShader, driven by
+// puppeteer-core: no browser download) render prtview's first-look camera at three environment
+// rotations and compare each picture with `prtview --shade transfer --env-rotate DEG` of the same
+// view at the same exposure. Both are 8-bit sRGB; NRMSE = RMSE over the pixels either covers and
+// the three channels / the reference's range there (view/image.h's definition).
+//   kMaxNrmse = 0.01 (the issue's bound): the two compute the same per-vertex colours (the same
+//   formulas, float in both) and interpolate them perspective-correctly with the same pixel-centre
+//   rule; what remains is 8-bit rounding of values that differ in the last float bits (±1 level)
+//   and the pixels on silhouettes and depth ties that the two rasterisers decide differently.
+// Also: a glb that is not one and a file without the product asked for show a message in the page
+// (not a blank canvas), and the frame time per asset (640x480, the environment turning one degree
+// a frame, each frame waited for) is printed. Exit 0 pass, 1 fail, 77 when Chromium cannot start
+// (ctest SKIP_RETURN_CODE).
+//
+// node browser_test.mjs --prtbake B --prtview V --data DIR --engine GLB --out DIR [--images DIR]
+//   --images DIR also writes the README's pictures (docs/images/viewer_<asset>.png: the page with the
+//   unshadowed surface side by side, 640x360).
+import http from 'node:http';
+import fs from 'node:fs';
+import path from 'node:path';
+import { spawnSync } from 'node:child_process';
+
+const SKIP = 77;
+const kMaxNrmse = 0.01;
+const kRotations = [0, 120, 240];
+const kSize = '320x240';
+
+const opt = {};
+for (let i = 2; i < process.argv.length; i += 2) opt[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
+for (const k of ['prtbake', 'prtview', 'data', 'engine', 'out'])
+  if (!opt[k]) { console.error(`browser_test: --${k} is required`); process.exit(2); }
+
+let puppeteer;
+try {
+  puppeteer = (await import('puppeteer-core')).default;
+} catch (e) {
+  console.error(`browser_test: puppeteer-core is not installed (npm ci in viewer/, as tools/run.sh does): ${e.message}`);
+  process.exit(1);
+}
+
+function run(cmd, argv) {
+  const r = spawnSync(cmd, argv, { encoding: 'utf8', maxBuffer: 1 << 26 });
+  if (r.status !== 0) throw new Error(`${path.basename(cmd)} ${argv.join(' ')}: exit ${r.status}\n${r.stderr}${r.error || ''}`);
+  return r.stdout + r.stderr;
+}
+
+const out = path.resolve(opt.out);
+fs.rmSync(out, { recursive: true, force: true });
+fs.mkdirSync(out, { recursive: true });
+const sunset = path.join(opt.data, 'sunset.exr');
+const assets = [
+  { name: 'bunny', mesh: path.join(opt.data, 'bunny_ground.obj'), samples: 256, extra: ['--radiance', sunset] },
+  { name: 'statue', mesh: path.join(opt.data, 'wuson.obj'), samples: 256, extra: [] },
+  { name: 'engine', mesh: opt.engine, samples: 64, extra: [] },
+];
+
+// Chromium first: without it there is nothing to test (skip, saying why).
+let browser;
+const chromium = process.env.PRT_CHROMIUM || '/usr/bin/chromium';
+try {
+  if (!fs.existsSync(chromium)) throw new Error(`${chromium} does not exist (Debian package chromium)`);
+  browser = await puppeteer.launch({
+    executablePath: chromium,
+    headless: true,
+    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--disable-gpu-vsync'],
+  });
+} catch (e) {
+  console.log(`SKIP: Chromium cannot start: ${e.message.split('\n')[0]}`);
+  process.exit(SKIP);
+}
+
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.json': 'application/json', '.png': 'image/png', '.glsl': 'text/plain', '.inc': 'text/plain' };
+const server = http.createServer((req, res) => {
+  const rel = decodeURIComponent(new URL(req.url, 'http://localhost').pathname);
+  const file = path.join(out, rel.endsWith('/') ? rel + 'index.html' : rel);
+  if (!file.startsWith(out)) { res.writeHead(403); res.end(); return; }
+  fs.readFile(file, (err, data) => {
+    if (err) { res.writeHead(404); res.end(); return; }
+    res.writeHead(200, { 'Content-Type': types[path.extname(file)] || 'application/octet-stream' });
+    res.end(data);
+  });
+});
+await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+const base = `http://127.0.0.1:${server.address().port}`;
+
+// Opens a page of an export; returns { page, ready, error, message (the text shown) }.
+async function open(dir, query, viewport = { width: 1000, height: 700 }) {
+  const page = await browser.newPage();
+  await page.setViewport(viewport);
+  const logs = [];
+  page.on('console', (m) => logs.push(m.text()));
+  page.on('pageerror', (e) => logs.push(String(e)));
+  await page.goto(`${base}/${dir}/index.html?${query}`);
+  await page.waitForFunction('window.prtViewer && (window.prtViewer.ready || window.prtViewer.error)', { timeout: 60000 });
+  const s = await page.evaluate(() => ({
+    ready: window.prtViewer.ready,
+    error: window.prtViewer.error,
+    message: getComputedStyle(document.getElementById('message')).display !== 'none' ? document.getElementById('message').textContent : '',
+  }));
+  return { page, logs, ...s };
+}
+
+const failures = [];
+const check = (ok, what) => {
+  if (!ok) failures.push(what);
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+};
+const rows = [], frames = [];
+try {
+  for (const a of assets) {
+    const t0 = Date.now();
+    const h5 = path.join(out, `${a.name}.prt.h5`);
+    run(opt.prtbake, ['vertex', a.mesh, '--ao', '--transfer', '3', ...a.extra, '--integrator', 'qmc', '--samples', String(a.samples),
+                      '--report', '0', '--reproducible', '-q', '-o', h5]);
+    run(opt.prtbake, ['export', h5, '--to', 'web', '--env', sunset, '-o', path.join(out, a.name)]);
+    const info = JSON.parse(fs.readFileSync(path.join(out, a.name, 'viewer.json'), 'utf8'));
+    const exposure = info.environments.find((e) => e.name === 'sunset.exr').exposure;
+    // prtview's first look chooses the camera; both renderers then use it.
+    const look = run(opt.prtview, [h5, '--shade', 'transfer', '--env', sunset, '--size', kSize, '-o', path.join(out, `${a.name}_look.png`)]);
+    const camera = look.match(/--camera (\S+)/)[1];
+    const vertices = info.file.vertex_sets.reduce((n, s) => n + s.vertices, 0);
+    const triangles = info.file.vertex_sets.reduce((n, s) => n + (s.triangles || 0), 0);
+    for (const deg of kRotations) {
+      const ref = `ref_${deg}.png`;
+      run(opt.prtview, [h5, '--shade', 'transfer', '--env', sunset, '--size', kSize, '--camera', camera, '--exposure', String(exposure),
+                        '--env-rotate', String(deg), '-q', '-o', path.join(out, a.name, ref)]);
+      const q = new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', rotate: deg, exposure, camera, size: kSize });
+      const p = await open(a.name, q.toString());
+      check(p.ready && !p.error, `${a.name} at ${deg} deg: the page draws (${p.error || 'no error'})`);
+      if (p.ready) {
+        const c = await p.page.evaluate((u) => window.prtViewer.compare(u), ref);
+        const png = await p.page.evaluate(() => window.prtViewer.png());
+        fs.writeFileSync(path.join(out, a.name, `page_${deg}.png`), Buffer.from(png.split(',')[1], 'base64'));
+        rows.push({ asset: a.name, deg, vertices, triangles, ...c });
+        check(c.nrmse <= kMaxNrmse, `${a.name} at ${deg} deg: NRMSE ${c.nrmse.toFixed(5)} <= ${kMaxNrmse} against prtview ` +
+                                   `(${c.pixels} px, max |diff| ${c.max_abs}/255, ${c.pixels_off_by_more_than_2} px off by more than 2)`);
+      }
+      await p.page.close();
+    }
+    const f = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '640x480' }).toString());
+    if (f.ready) {
+      const ms = await f.page.evaluate(() => window.prtViewer.measure(30));
+      frames.push({ asset: a.name, vertices, triangles, ms, fps: 1000 / ms });
+    }
+    if (opt.images && f.ready) {
+      const shot = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '640x360', split: '1', rotate: 40 }).toString());
+      const png = await shot.page.evaluate(() => window.prtViewer.png());
+      fs.mkdirSync(opt.images, { recursive: true });
+      fs.writeFileSync(path.join(opt.images, `viewer_${a.name}.png`), Buffer.from(png.split(',')[1], 'base64'));
+      await shot.page.close();
+    }
+    await f.page.close();
+    console.log(`     ${a.name}: ${vertices} vertices, ${triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  }
+
+  // Errors show in the page. A glb that is not one:
+  fs.cpSync(path.join(out, 'bunny'), path.join(out, 'bad_glb'), { recursive: true });
+  fs.writeFileSync(path.join(out, 'bad_glb', 'asset.glb'), 'this is not a glb');
+  let p = await open('bad_glb', 'mode=transfer');
+  check(!p.ready && /asset\.glb/.test(p.message), `a bad glb shows a message in the page: "${p.message.slice(0, 120)}"`);
+  await p.page.close();
+  // A file without the product asked for (the statue has no band-1 radiance):
+  p = await open('statue', 'mode=band1');
+  check(!p.ready && /\/radiance\/band1/.test(p.message), `a file without the product shows a message in the page: "${p.message.slice(0, 120)}"`);
+  await p.page.close();
+  // The bunny's default page (band-1 radiance, the file's own environment) draws.
+  p = await open('bunny', '');
+  check(p.ready && !p.error, `the bunny's default view (band-1 radiance) draws (${p.error || 'no error'})`);
+  await p.page.close();
+} catch (e) {
+  failures.push(String(e.stack || e));
+  console.log(`FAIL ${e.stack || e}`);
+} finally {
+  await browser.close();
+  server.close();
+}
+
+console.log('\n| asset | vertices | triangles | rotation | NRMSE vs prtview | max abs diff (of 255) | pixels off by > 2 of compared |');
+console.log('|---|---|---|---|---|---|---|');
+for (const r of rows)
+  console.log(`| ${r.asset} | ${r.vertices} | ${r.triangles} | ${r.deg}° | ${r.nrmse.toFixed(5)} | ${r.max_abs} | ${r.pixels_off_by_more_than_2} of ${r.pixels} |`);
+console.log('\n| asset | vertices | triangles | ms per frame (640x480) | frames per second |');
+console.log('|---|---|---|---|---|');
+for (const f of frames) console.log(`| ${f.asset} | ${f.vertices} | ${f.triangles} | ${f.ms.toFixed(1)} | ${f.fps.toFixed(1)} |`);
+fs.writeFileSync(path.join(out, 'results.json'), JSON.stringify({ rows, frames, failures }, null, 1));
+if (failures.length) {
+  console.log(`\n${failures.length} check(s) failed`);
+  process.exit(1);
+}
+console.log('\nall checks passed');

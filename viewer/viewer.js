@@ -1,0 +1,434 @@
+// viewer/viewer.js — the web viewer of a baked file (issue 34), shipped by
+// `prtbake export FILE --to web -o DIR` with three.js (npm, copied at build time) beside it.
+//
+// What it draws: the glb that `prtbake export` writes (asset.glb: per vertex set a mesh whose
+// _PRT_* attributes hold the baked rows, asset.extras.prtbake maps them, formats/SCHEMA.md
+// "Exports"), shaded per vertex and interpolated (Gouraud, perspective-correct) exactly as prtview
+// draws a per-vertex file, then tone mapped as prtview's PNGs are (view/image.h: 8-bit sRGB of
+// exposure x value, clipped at 1). The shading math is not written here: the vertex shader is
+// runtime/shaders/sh.inc and shade.inc, the bodies of the GLSL/HLSL mirrors of prtshade, compiled
+// as GLSL ES 3.00 through prt_lang.webgl.glsl. Modes:
+//   band1       E/pi = prt_shade_band1(n, R) / pi at the baked normal: exact under the environment
+//               the file was baked with; it does not turn with the environment (the sky is in R).
+//   transfer    prt_shade_transfer: sum_i T_i L_i, L = the chosen environment's SH at the file's
+//               order, turned about +Y by the rotation (prtshade's sh::Rotation, precomputed per
+//               degree at export: viewer.json), so the shadows follow the sky.
+//   ao          AO x the unshadowed irradiance / pi of the environment (order 3).
+//   unshadowed  the same surface without any visibility: sum_i (A_l y_i(n) / pi) L_i through the
+//               same prt_shade_transfer (A_l: the clamped-cosine factors from viewer.json).
+// URL parameters (the browser test uses them): mode, env (name or index), rotate (degrees),
+// exposure, camera (prtview's form eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]), size (WxH), split=1.
+// window.prtViewer: ready, error, and the test's hooks (measure, compare, png).
+// Any failure (a missing file, a bad glb, a file without the product asked for, a shader that does
+// not compile) is shown as a message over the canvas, never as a blank canvas.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+
+const $ = (id) => document.getElementById(id);
+const params = new URLSearchParams(location.search);
+const state = { ready: false, error: null };
+window.prtViewer = state;
+
+function fail(text) {
+  if (state.error) return;
+  state.error = String(text);
+  const m = $('message');
+  m.textContent = 'prtbake viewer: ' + state.error;
+  m.style.display = 'block';
+}
+window.addEventListener('error', (e) => fail(e.message));
+window.addEventListener('unhandledrejection', (e) => fail(e.reason && e.reason.message ? e.reason.message : e.reason));
+
+async function fetchOk(url, what) {
+  let r;
+  try {
+    r = await fetch(url);
+  } catch (e) {
+    throw new Error(`cannot load ${url} (${what}): ${e.message}`);
+  }
+  if (!r.ok) throw new Error(`cannot load ${url} (${what}): HTTP ${r.status}`);
+  return r;
+}
+
+// A shared shading body as GLSL ES source: comments and #include lines removed (WebGL has no
+// #include; the page puts the bodies in order itself). What is left must be ASCII.
+function shaderBody(name, text) {
+  const body = text.replace(/\/\*[\s\S]*?\*\//g, '').replace(/\/\/.*$/gm, '').replace(/^[ \t]*#include.*$/gm, '');
+  if (/[^\x00-\x7f]/.test(body)) throw new Error(`shaders/${name}: non-ASCII characters outside comments`);
+  return body;
+}
+
+const MODES = {
+  band1: { label: 'band-1 radiance (baked environment)', dataset: 'radiance/band1' },
+  transfer: { label: 'diffuse transfer (any environment)', dataset: 'transfer/diffuse' },
+  ao: { label: 'ambient occlusion x unshadowed', dataset: 'ao' },
+  unshadowed: { label: 'unshadowed (no visibility)', dataset: null },
+};
+
+// The GLSL lines that copy a product's attributes into the float array `dst` (components in the
+// row's order, SCHEMA.md "Exports": attribute k holds components 4k..4k+3).
+function attributeCopy(product, dst) {
+  const C = product.shape.reduce((a, b) => a * b, 1);
+  const decl = [], copy = [];
+  product.attributes.forEach((name, k) => {
+    const n = Math.min(4, C - 4 * k);
+    const id = name.toLowerCase();
+    decl.push(`in ${n === 1 ? 'float' : 'vec' + n} ${id};`);
+    for (let j = 0; j < n; ++j) copy.push(`${dst}[${4 * k + j}] = ${id}${n === 1 ? '' : '.' + 'xyzw'[j]};`);
+  });
+  return { decl: decl.join('\n'), copy: copy.join('\n  '), components: C };
+}
+
+function vertexShader(mode, set, lib, order) {
+  const p = (ds) => set.products.find((q) => q.dataset === ds);
+  let decl = '', body = '';
+  if (mode === 'band1') {
+    const a = attributeCopy(p('radiance/band1'), 'r');
+    decl = a.decl;
+    body = `float r[9];\n  ${a.copy}\n  v_rgb = prt_shade_band1(normal, r) / PI;`;
+  } else if (mode === 'transfer') {
+    const a = attributeCopy(p('transfer/diffuse'), 'prt_t');
+    decl = a.decl;
+    body = `${a.copy}\n  v_rgb = prt_shade_transfer(0u, ${order});`;
+  } else {
+    const ao = mode === 'ao';
+    decl = ao ? 'in float _ao;' : '';
+    body = `float y[PRT_SH_MAX_COEFFS];
+  prt_sh_eval(${order}, normalize(normal), y);
+  for (int i = 0; i < ${order * order}; ++i) prt_t[i] = y[i] * prt_cosine[i] / PI;
+  v_rgb = ${ao ? '_ao * ' : ''}prt_shade_transfer(0u, ${order});`;
+  }
+  return `precision highp float;
+precision highp int;
+#define PRT_SH_MAX_ORDER ${Math.max(order, 3)}
+#define PI 3.14159265358979323846
+uniform mat4 modelViewMatrix;
+uniform mat4 projectionMatrix;
+uniform float prt_light[${3 * order * order}];
+uniform float prt_cosine[${order * order}];
+in vec3 position;
+in vec3 normal;
+${decl}
+out vec3 v_rgb;
+float prt_t[PRT_SH_MAX_ORDER * PRT_SH_MAX_ORDER];
+#define PRT_TRANSFER(i) prt_t[(i)]
+#define PRT_LIGHT(i) prt_light[(i)]
+${lib}
+void main() {
+  ${body}
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}
+`;
+}
+
+// prtview's tone map (view/image.h): v = clamp(exposure x, 0, 1), then the sRGB transfer function.
+const fragmentShader = `precision highp float;
+in vec3 v_rgb;
+uniform float exposure;
+out vec4 out_colour;
+float srgb(float x) {
+  float v = clamp(exposure * x, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+void main() { out_colour = vec4(srgb(v_rgb.r), srgb(v_rgb.g), srgb(v_rgb.b), 1.0); }
+`;
+
+function parseCamera(spec) {
+  const cam = { up: [0, 1, 0], fov: 45 };
+  for (const part of spec.split(':')) {
+    const [key, value] = part.split('=');
+    const nums = value ? value.split(',').map(Number) : [];
+    if (key === 'fov') cam.fov = nums[0];
+    else if ((key === 'eye' || key === 'at' || key === 'up') && nums.length === 3 && nums.every(Number.isFinite)) cam[key] = nums;
+    else throw new Error(`camera '${spec}': cannot read '${part}' (eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG])`);
+  }
+  if (!cam.eye || !cam.at) throw new Error(`camera '${spec}': needs eye and at`);
+  return cam;
+}
+
+async function main() {
+  const [info, langText, shText, shadeText] = await Promise.all([
+    fetchOk('viewer.json', 'the export\'s description').then((r) => r.json()),
+    ...['prt_lang.webgl.glsl', 'sh.inc', 'shade.inc'].map((f) => fetchOk('shaders/' + f, 'a shader body').then((r) => r.text())),
+  ]);
+  const lib = [shaderBody('prt_lang.webgl.glsl', langText), shaderBody('sh.inc', shText), shaderBody('shade.inc', shadeText)].join('\n');
+  $('meta').textContent = JSON.stringify(info.file, null, 1);
+
+  const glbBytes = await (await fetchOk(info.glb, 'the baked mesh')).arrayBuffer();
+  let gltf;
+  try {
+    gltf = await new GLTFLoader().parseAsync(glbBytes, './');
+  } catch (e) {
+    throw new Error(`${info.glb} is not a glb prtbake export wrote: ${e.message || e}`);
+  }
+  const extras = gltf.asset && gltf.asset.extras && gltf.asset.extras.prtbake;
+  if (!extras || !Array.isArray(extras.sets)) throw new Error(`${info.glb} has no asset.extras.prtbake: not written by prtbake export`);
+
+  // The meshes with their vertex set's products.
+  const drawn = [];
+  gltf.scene.traverse((o) => {
+    if (!o.isMesh) return;
+    const a = gltf.parser.associations.get(o);
+    const set = a && extras.sets.find((s) => s.mesh === a.meshes);
+    if (set && o.geometry.getAttribute('normal')) drawn.push({ mesh: o, set });
+  });
+  if (drawn.length === 0) throw new Error(`${info.glb} holds no triangle mesh with normals to shade`);
+  const has = (set, mode) => !MODES[mode].dataset || set.products.some((p) => p.dataset === MODES[mode].dataset);
+  const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (m !== 'unshadowed' || info.environments.length));
+  const envNeeded = (m) => m !== 'band1';
+
+  const requested = params.get('mode');
+  let mode = requested || available.find((m) => m !== 'unshadowed') || null;
+  if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed)`);
+  if (!mode || mode === 'unshadowed' && !requested) throw new Error(`${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao: nothing to shade`);
+  if (!drawn.some((d) => has(d.set, mode)))
+    throw new Error(`${info.source}: the file has no /${MODES[mode].dataset} (its products: ${[...new Set(drawn.flatMap((d) => d.set.products.map((p) => p.dataset)))].join(', ') || 'none'})`);
+  if (envNeeded(mode) && info.environments.length === 0)
+    throw new Error(`${info.source}: '${mode}' needs an environment and the export has none (prtbake export ... --to web --env ENV.exr)`);
+
+  // Sizes, camera, renderer.
+  const size = (params.get('size') || '640x480').split('x').map(Number);
+  if (size.length !== 2 || !size.every((v) => Number.isInteger(v) && v > 0 && v <= 8192)) throw new Error(`size '${params.get('size')}': expects WxH`);
+  const canvas = $('canvas');
+  canvas.width = size[0];
+  canvas.height = size[1];
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true, powerPreference: 'high-performance' });
+  renderer.setPixelRatio(1);
+  renderer.setSize(size[0], size[1], false);
+  renderer.setClearColor(0x000000, 1);
+  renderer.autoClear = false;
+  renderer.debug.onShaderError = (gl, program, vs, fs) => {
+    fail('a shader did not compile: ' + (gl.getShaderInfoLog(vs) || '') + (gl.getShaderInfoLog(fs) || '') + (gl.getProgramInfoLog(program) || ''));
+  };
+
+  const scene = new THREE.Scene();
+  scene.add(gltf.scene);
+  gltf.scene.updateMatrixWorld(true);
+  const box = new THREE.Box3().setFromObject(gltf.scene);
+  const centre = box.getCenter(new THREE.Vector3()), radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-6);
+  let cam;
+  if (params.get('camera')) cam = parseCamera(params.get('camera'));
+  else {
+    const d = radius / Math.sin((22.5 * Math.PI) / 180) * 1.05, dir = new THREE.Vector3(0.35, 0.5, 1).normalize();
+    cam = { eye: centre.clone().addScaledVector(dir, d).toArray(), at: centre.toArray(), up: [0, 1, 0], fov: 45 };
+  }
+  const camera = new THREE.PerspectiveCamera(cam.fov, size[0] / size[1], 1, 2);
+  const target = new THREE.Vector3(...cam.at);
+  camera.position.set(...cam.eye);
+  camera.up.set(...cam.up);
+  const placeCamera = () => {
+    camera.lookAt(target);
+    const dist = camera.position.distanceTo(target);
+    camera.near = Math.max(1e-3 * dist, dist - centre.distanceTo(target) - 2 * radius);  // depth precision
+    camera.far = dist + centre.distanceTo(target) + 2 * radius;
+    camera.updateProjectionMatrix();
+  };
+  placeCamera();
+
+  // Environments: [rotation degree][3 * order^2] channel-major, from viewer.json.
+  const envIndex = (() => {
+    const e = params.get('env');
+    if (e === null) return Math.max(0, info.environments.findIndex((x) => x.baked));
+    const i = info.environments.findIndex((x, k) => x.name === e || String(k) === e);
+    if (i < 0) throw new Error(`environment '${e}' is not in the export (${info.environments.map((x) => x.name).join(', ')})`);
+    return i;
+  })();
+  const ui = {
+    mode,
+    env: envIndex,
+    rotate: Number(params.get('rotate') || 0),
+    exposure: params.get('exposure') ? Number(params.get('exposure')) : null,
+    split: params.get('split') === '1',
+  };
+  if (!Number.isFinite(ui.rotate)) throw new Error(`rotate '${params.get('rotate')}': expects degrees`);
+  if (ui.exposure !== null && !(ui.exposure > 0)) throw new Error(`exposure '${params.get('exposure')}': expects a number > 0`);
+
+  const materials = new Map();  // key: mode|set index
+  function material(m, k) {
+    const key = m + '|' + k;
+    if (!materials.has(key)) {
+      const set = drawn[k].set;
+      const transfer = set.products.find((p) => p.dataset === 'transfer/diffuse');
+      // transfer and unshadowed: the file's order (unshadowed: 3 without transfer); AO: 3.
+      const order = m === 'band1' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
+      const mat = new THREE.RawShaderMaterial({
+        glslVersion: THREE.GLSL3,
+        vertexShader: vertexShader(m, set, lib, order),
+        fragmentShader,
+        side: THREE.DoubleSide,
+        uniforms: { prt_light: { value: new Float32Array(3 * order * order) }, prt_cosine: { value: new Float32Array(order * order) }, exposure: { value: 1 } },
+      });
+      mat.userData.order = order;
+      materials.set(key, mat);
+    }
+    return materials.get(key);
+  }
+  function updateUniforms(mat) {
+    const order = mat.userData.order, n = order * order;
+    const env = info.environments[ui.env];
+    if (env) {
+      const deg = ((Math.round(ui.rotate) % 360) + 360) % 360, N = env.order * env.order;
+      const row = env.sh_by_degree[deg];
+      const light = mat.uniforms.prt_light.value;
+      for (let c = 0; c < 3; ++c) for (let i = 0; i < n; ++i) light[c * n + i] = row[c * N + i];
+    }
+    for (let l = 0; l < order; ++l) for (let m = -l; m <= l; ++m) mat.uniforms.prt_cosine.value[l * (l + 1) + m] = info.clamped_cosine[l];
+    mat.uniforms.exposure.value = exposure();
+  }
+  const exposure = () => ui.exposure ?? (info.environments[ui.env] ? info.environments[ui.env].exposure : 1);
+
+  function drawWith(m) {
+    drawn.forEach((d, k) => {
+      const mm = has(d.set, m) ? m : 'unshadowed';
+      d.mesh.material = material(mm, k);
+      updateUniforms(d.mesh.material);
+    });
+    renderer.render(scene, camera);
+  }
+  function render() {
+    renderer.setScissorTest(false);
+    renderer.setViewport(0, 0, size[0], size[1]);
+    renderer.clear();
+    if (!ui.split) {
+      camera.aspect = size[0] / size[1];
+      camera.updateProjectionMatrix();
+      drawWith(ui.mode);
+    } else {
+      const half = Math.floor(size[0] / 2);
+      camera.aspect = half / size[1];
+      camera.updateProjectionMatrix();
+      renderer.setScissorTest(true);
+      for (const [x, m] of [[0, ui.mode], [half, 'unshadowed']]) {
+        renderer.setViewport(x, 0, half, size[1]);
+        renderer.setScissor(x, 0, half, size[1]);
+        drawWith(m);
+      }
+      renderer.setScissorTest(false);
+    }
+    const cr = $('cap-right');
+    $('cap-left').style.display = cr.style.display = ui.split ? 'block' : 'none';
+    cr.style.left = Math.floor(size[0] / 2) + 4 + 'px';
+    $('cap-left').textContent = MODES[ui.mode].label;
+    $('rotate-value').textContent = `${((Math.round(ui.rotate) % 360) + 360) % 360}°` + (ui.mode === 'band1' ? ' (band-1 radiance holds the baked sky: it does not turn)' : '');
+    $('exposure-value').textContent = exposure().toPrecision(4);
+    const missing = drawn.filter((d) => !has(d.set, ui.mode)).map((d) => d.set.name);
+    $('status').textContent = missing.length ? `${missing.length} vertex set(s) without ${MODES[ui.mode].dataset}, drawn unshadowed: ${missing.slice(0, 4).join(', ')}` : '';
+  }
+  let pending = false;
+  const redraw = () => {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => {
+      pending = false;
+      if (!state.error) render();
+    });
+  };
+
+  // Controls.
+  for (const m of available) $('mode').add(new Option(MODES[m].label, m, false, m === ui.mode));
+  info.environments.forEach((e, k) => $('env').add(new Option(e.name + (e.baked ? ' (baked with)' : ''), String(k), false, k === ui.env)));
+  $('mode').onchange = (e) => { ui.mode = e.target.value; redraw(); };
+  $('env').onchange = (e) => { ui.env = Number(e.target.value); if ($('exposure').value === '0') ui.exposure = null; redraw(); };
+  $('rotate').value = String(ui.rotate);
+  $('rotate').oninput = (e) => { ui.rotate = Number(e.target.value); redraw(); };
+  $('exposure').oninput = (e) => {
+    const base = info.environments[ui.env] ? info.environments[ui.env].exposure : 1;
+    ui.exposure = base * Math.pow(2, Number(e.target.value));
+    redraw();
+  };
+  $('split').checked = ui.split;
+  $('split').onchange = (e) => { ui.split = e.target.checked; redraw(); };
+  let drag = null;
+  canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+  canvas.addEventListener('pointerdown', (e) => { drag = { x: e.clientX, y: e.clientY, orbit: e.shiftKey || e.button === 2 }; canvas.setPointerCapture(e.pointerId); });
+  canvas.addEventListener('pointerup', () => { drag = null; });
+  canvas.addEventListener('pointermove', (e) => {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    drag.x = e.clientX;
+    drag.y = e.clientY;
+    if (!drag.orbit) {
+      ui.rotate = (((ui.rotate + dx * 0.5) % 360) + 360) % 360;
+      $('rotate').value = String(Math.round(ui.rotate));
+    } else {
+      const offset = camera.position.clone().sub(target);
+      const s = new THREE.Spherical().setFromVector3(offset);
+      s.theta -= dx * 0.01;
+      s.phi = Math.min(Math.PI - 1e-3, Math.max(1e-3, s.phi - dy * 0.01));
+      camera.position.copy(target).add(new THREE.Vector3().setFromSpherical(s));
+      camera.up.set(0, 1, 0);
+      placeCamera();
+    }
+    redraw();
+  });
+  canvas.addEventListener('wheel', (e) => {
+    e.preventDefault();
+    camera.position.sub(target).multiplyScalar(Math.exp(e.deltaY * 1e-3)).add(target);
+    placeCamera();
+    redraw();
+  }, { passive: false });
+
+  render();
+  if (state.error) return;
+
+  // The browser test's hooks.
+  const gl = renderer.getContext();
+  const sync = () => gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
+  // Mean milliseconds per frame over `frames` frames, the environment turning one degree a frame
+  // (each frame waited for: readPixels of one pixel).
+  state.measure = (frames) => {
+    render();
+    sync();
+    const start = ui.rotate, t0 = performance.now();
+    for (let i = 0; i < frames; ++i) {
+      ui.rotate = start + i + 1;
+      render();
+      sync();
+    }
+    const ms = (performance.now() - t0) / frames;
+    ui.rotate = start;
+    render();
+    return ms;
+  };
+  state.png = () => canvas.toDataURL('image/png');
+  // NRMSE of this picture against a reference image (prtview's PNG of the same view), both in
+  // 8-bit sRGB scaled to [0, 1]: RMSE over the pixels either picture covers (not black) and the
+  // three channels, over the reference's range there (max - min) — view/image.h's definition.
+  state.compare = async (url) => {
+    render();
+    const blob = await (await fetchOk(url, 'the reference picture')).blob();
+    const bitmap = await createImageBitmap(blob, { colorSpaceConversion: 'none', premultiplyAlpha: 'none' });
+    if (bitmap.width !== size[0] || bitmap.height !== size[1]) throw new Error(`${url} is ${bitmap.width}x${bitmap.height}, the view ${size[0]}x${size[1]}`);
+    const c2 = document.createElement('canvas');
+    c2.width = size[0];
+    c2.height = size[1];
+    const ctx = c2.getContext('2d', { willReadFrequently: true });
+    ctx.drawImage(bitmap, 0, 0);
+    const ref = ctx.getImageData(0, 0, size[0], size[1]).data;
+    const ours = new Uint8Array(size[0] * size[1] * 4);
+    gl.readPixels(0, 0, size[0], size[1], gl.RGBA, gl.UNSIGNED_BYTE, ours);
+    let sum = 0, count = 0, lo = 255, hi = 0, worst = 0, off2 = 0;
+    for (let y = 0; y < size[1]; ++y)
+      for (let x = 0; x < size[0]; ++x) {
+        const r = 4 * (y * size[0] + x), o = 4 * ((size[1] - 1 - y) * size[0] + x);  // readPixels: bottom row first
+        const covered = ref[r] | ref[r + 1] | ref[r + 2] | ours[o] | ours[o + 1] | ours[o + 2];
+        if (!covered) continue;
+        ++count;
+        let px = 0;
+        for (let c = 0; c < 3; ++c) {
+          const d = ours[o + c] - ref[r + c];
+          sum += d * d;
+          px = Math.max(px, Math.abs(d));
+          lo = Math.min(lo, ref[r + c]);
+          hi = Math.max(hi, ref[r + c]);
+        }
+        worst = Math.max(worst, px);
+        if (px > 2) ++off2;
+      }
+    const rmse = Math.sqrt(sum / Math.max(1, 3 * count)) / 255;
+    return { nrmse: hi > lo ? rmse / ((hi - lo) / 255) : rmse, rmse, pixels: count, max_abs: worst, pixels_off_by_more_than_2: off2 };
+  };
+  state.ready = true;
+}
+
+main().catch((e) => fail(e && e.message ? e.message : e));
