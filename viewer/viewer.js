@@ -393,7 +393,9 @@ async function main() {
   state.png = () => canvas.toDataURL('image/png');
   // NRMSE of this picture against a reference image (prtview's PNG of the same view), both in
   // 8-bit sRGB scaled to [0, 1]: RMSE over the pixels either picture covers (not black) and the
-  // three channels, over the reference's range there (max - min) — view/image.h's definition.
+  // three channels, over the reference's range there (max - min) — view/image.h's definition;
+  // nrmse_interior the same over the pixels inside both silhouettes (the pixel and its 8
+  // neighbours covered in both), where the two rasterisers cannot disagree about coverage.
   state.compare = async (url) => {
     render();
     const blob = await (await fetchOk(url, 'the reference picture')).blob();
@@ -407,26 +409,43 @@ async function main() {
     const ref = ctx.getImageData(0, 0, size[0], size[1]).data;
     const ours = new Uint8Array(size[0] * size[1] * 4);
     gl.readPixels(0, 0, size[0], size[1], gl.RGBA, gl.UNSIGNED_BYTE, ours);
-    let sum = 0, count = 0, lo = 255, hi = 0, worst = 0, off2 = 0;
-    for (let y = 0; y < size[1]; ++y)
-      for (let x = 0; x < size[0]; ++x) {
-        const r = 4 * (y * size[0] + x), o = 4 * ((size[1] - 1 - y) * size[0] + x);  // readPixels: bottom row first
-        const covered = ref[r] | ref[r + 1] | ref[r + 2] | ours[o] | ours[o + 1] | ours[o + 2];
-        if (!covered) continue;
-        ++count;
-        let px = 0;
+    const W = size[0], H = size[1];
+    const refAt = (x, y) => 4 * (y * W + x), oursAt = (x, y) => 4 * ((H - 1 - y) * W + x);  // readPixels: bottom row first
+    const lit = (a, i) => (a[i] | a[i + 1] | a[i + 2]) !== 0;
+    // A pixel inside the silhouettes of both pictures: it and its 8 neighbours covered in both.
+    const inside = (x, y) => {
+      for (let v = y - 1; v <= y + 1; ++v)
+        for (let u = x - 1; u <= x + 1; ++u)
+          if (u < 0 || v < 0 || u >= W || v >= H || !lit(ref, refAt(u, v)) || !lit(ours, oursAt(u, v))) return false;
+      return true;
+    };
+    const all = { sum: 0, count: 0 }, interior = { sum: 0, count: 0 };
+    let lo = 255, hi = 0, worst = 0, off2 = 0;
+    for (let y = 0; y < H; ++y)
+      for (let x = 0; x < W; ++x) {
+        const r = refAt(x, y), o = oursAt(x, y);
+        if (!lit(ref, r) && !lit(ours, o)) continue;
+        let px = 0, sq = 0;
         for (let c = 0; c < 3; ++c) {
           const d = ours[o + c] - ref[r + c];
-          sum += d * d;
+          sq += d * d;
           px = Math.max(px, Math.abs(d));
           lo = Math.min(lo, ref[r + c]);
           hi = Math.max(hi, ref[r + c]);
         }
+        all.sum += sq;
+        ++all.count;
+        if (inside(x, y)) {
+          interior.sum += sq;
+          ++interior.count;
+        }
         worst = Math.max(worst, px);
         if (px > 2) ++off2;
       }
-    const rmse = Math.sqrt(sum / Math.max(1, 3 * count)) / 255;
-    return { nrmse: hi > lo ? rmse / ((hi - lo) / 255) : rmse, rmse, pixels: count, max_abs: worst, pixels_off_by_more_than_2: off2 };
+    const range = hi > lo ? (hi - lo) / 255 : 1;
+    const rmse = (a) => Math.sqrt(a.sum / Math.max(1, 3 * a.count)) / 255;
+    return { nrmse: rmse(all) / range, nrmse_interior: rmse(interior) / range, rmse: rmse(all), pixels: all.count,
+             interior_pixels: interior.count, max_abs: worst, pixels_off_by_more_than_2: off2 };
   };
   state.ready = true;
 }
