@@ -6,8 +6,10 @@
 // "Exports"), shaded per vertex and interpolated (Gouraud, perspective-correct) exactly as prtview
 // draws a per-vertex file, then tone mapped as prtview's PNGs are (view/image.h: 8-bit sRGB of
 // exposure x value, clipped at 1). The shading math is not written here: the vertex shader is
-// runtime/shaders/sh.inc and shade.inc, the bodies of the GLSL/HLSL mirrors of prtshade, compiled
-// as GLSL ES 3.00 through prt_lang.webgl.glsl. Modes:
+// runtime/shaders/prt_lang.glsl, sh.inc and shade.inc — the GLSL mirror of prtshade that
+// tests/shaders holds to the C++ core — compiled as GLSL ES 3.00 as they are (their comments and
+// #include lines removed; the SSBOs prt_lang.glsl can declare are not: PRT_TRANSFER and PRT_LIGHT
+// are defined first, a vertex's row from its attributes and a uniform array). Modes:
 //   band1       E/pi = prt_shade_band1(n, R) / pi at the baked normal: exact under the environment
 //               the file was baked with; it does not turn with the environment (the sky is in R).
 //   transfer    prt_shade_transfer: sum_i T_i L_i, L = the chosen environment's SH at the file's
@@ -149,9 +151,9 @@ function parseCamera(spec) {
 async function main() {
   const [info, langText, shText, shadeText] = await Promise.all([
     fetchOk('viewer.json', 'the export\'s description').then((r) => r.json()),
-    ...['prt_lang.webgl.glsl', 'sh.inc', 'shade.inc'].map((f) => fetchOk('shaders/' + f, 'a shader body').then((r) => r.text())),
+    ...['prt_lang.glsl', 'sh.inc', 'shade.inc'].map((f) => fetchOk('shaders/' + f, 'a shader body').then((r) => r.text())),
   ]);
-  const lib = [shaderBody('prt_lang.webgl.glsl', langText), shaderBody('sh.inc', shText), shaderBody('shade.inc', shadeText)].join('\n');
+  const lib = [shaderBody('prt_lang.glsl', langText), shaderBody('sh.inc', shText), shaderBody('shade.inc', shadeText)].join('\n');
   $('meta').textContent = JSON.stringify(info.file, null, 1);
 
   const glbBytes = await (await fetchOk(info.glb, 'the baked mesh')).arrayBuffer();
