@@ -29,7 +29,10 @@
 //
 // node browser_test.mjs --prtbake B --prtview V --data DIR --engine GLB --out DIR [--images DIR]
 //   --images DIR also writes the README's pictures (docs/images/viewer_<asset>.png: the page with the
-//   unshadowed surface side by side, 640x360).
+//   unshadowed surface side by side, 960x360).
+// node browser_test.mjs ... --sweep MESH,MESH,...   only the frame times of these meshes (AO and
+//   transfer order 3 by QMC at 16 rays: the page's cost does not depend on the bake's quality);
+//   bench/viewer_frames.sh runs it.
 import http from 'node:http';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -65,7 +68,8 @@ const out = path.resolve(opt.out);
 fs.rmSync(out, { recursive: true, force: true });
 fs.mkdirSync(out, { recursive: true });
 const sunset = path.join(opt.data, 'sunset.exr');
-const assets = [
+const sweep = opt.sweep ? opt.sweep.split(',').map((m, k) => ({ name: `sweep${k}`, mesh: m, samples: 16, extra: [], framesOnly: true })) : null;
+const assets = sweep || [
   { name: 'bunny', mesh: path.join(opt.data, 'bunny_ground.obj'), samples: 256, extra: ['--radiance', sunset] },
   { name: 'statue', mesh: path.join(opt.data, 'wuson.obj'), samples: 256, extra: [] },
   { name: 'engine', mesh: opt.engine, samples: 64, extra: [], size: '640x480', maxInterior: kMaxNrmseEngine },
@@ -139,7 +143,7 @@ try {
     fs.writeFileSync(path.join(out, `${a.name}_camera.txt`), camera);
     const vertices = info.file.vertex_sets.reduce((n, s) => n + s.vertices, 0);
     const triangles = info.file.vertex_sets.reduce((n, s) => n + (s.triangles || 0), 0);
-    for (const deg of kRotations) {
+    for (const deg of a.framesOnly ? [] : kRotations) {
       const ref = `ref_${deg}.png`;
       run(opt.prtview, [h5, '--shade', 'transfer', '--env', sunset, '--size', size, '--camera', camera, '--exposure', String(exposure),
                         '--env-rotate', String(deg), '-q', '-o', path.join(out, a.name, ref)]);
@@ -162,10 +166,10 @@ try {
     const f = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '640x480' }).toString());
     if (f.ready) {
       const ms = await f.page.evaluate(() => window.prtViewer.measure(30));
-      frames.push({ asset: a.name, vertices, triangles, ms, fps: 1000 / ms });
+      frames.push({ asset: a.framesOnly ? path.basename(a.mesh) : a.name, vertices, triangles, ms, fps: 1000 / ms });
     }
     if (opt.images && f.ready) {
-      const shot = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '640x360', split: '1', rotate: 40 }).toString());
+      const shot = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '960x360', split: '1', rotate: 40 }).toString());
       const png = await shot.page.evaluate(() => window.prtViewer.png());
       fs.mkdirSync(opt.images, { recursive: true });
       fs.writeFileSync(path.join(opt.images, `viewer_${a.name}.png`), Buffer.from(png.split(',')[1], 'base64'));
@@ -175,31 +179,33 @@ try {
     console.log(`     ${a.name}: ${vertices} vertices, ${triangles} triangles, ${((Date.now() - t0) / 1000).toFixed(1)} s`);
   }
 
-  // The comparison can fail: the bunny turned by 120 degrees against prtview's picture at 0.
-  {
-    const info = JSON.parse(fs.readFileSync(path.join(out, 'bunny', 'viewer.json'), 'utf8'));
-    const look = fs.readFileSync(path.join(out, 'bunny_camera.txt'), 'utf8');
-    const exposure = info.environments.find((e) => e.name === 'sunset.exr').exposure;
-    const q = new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', rotate: 120, exposure, camera: look, size: kSize });
-    const p = await open('bunny', q.toString());
-    const c = p.ready ? await p.page.evaluate((u) => window.prtViewer.compare(u), 'ref_0.png') : { nrmse_interior: 0 };
-    check(c.nrmse_interior > 5 * kMaxNrmse, `the bunny turned 120 deg against prtview at 0 deg: NRMSE ${c.nrmse_interior.toFixed(4)} > ${5 * kMaxNrmse} (the check can fail)`);
+  if (!sweep) {
+    // The comparison can fail: the bunny turned by 120 degrees against prtview's picture at 0.
+    {
+      const info = JSON.parse(fs.readFileSync(path.join(out, 'bunny', 'viewer.json'), 'utf8'));
+      const look = fs.readFileSync(path.join(out, 'bunny_camera.txt'), 'utf8');
+      const exposure = info.environments.find((e) => e.name === 'sunset.exr').exposure;
+      const q = new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', rotate: 120, exposure, camera: look, size: kSize });
+      const p = await open('bunny', q.toString());
+      const c = p.ready ? await p.page.evaluate((u) => window.prtViewer.compare(u), 'ref_0.png') : { nrmse_interior: 0 };
+      check(c.nrmse_interior > 5 * kMaxNrmse, `the bunny turned 120 deg against prtview at 0 deg: NRMSE ${c.nrmse_interior.toFixed(4)} > ${5 * kMaxNrmse} (the check can fail)`);
+      await p.page.close();
+    }
+    // Errors show in the page. A glb that is not one:
+    fs.cpSync(path.join(out, 'bunny'), path.join(out, 'bad_glb'), { recursive: true });
+    fs.writeFileSync(path.join(out, 'bad_glb', 'asset.glb'), 'this is not a glb');
+    let p = await open('bad_glb', 'mode=transfer');
+    check(!p.ready && /asset\.glb/.test(p.message), `a bad glb shows a message in the page: "${p.message.slice(0, 120)}"`);
+    await p.page.close();
+    // A file without the product asked for (the statue has no band-1 radiance):
+    p = await open('statue', 'mode=band1');
+    check(!p.ready && /\/radiance\/band1/.test(p.message), `a file without the product shows a message in the page: "${p.message.slice(0, 120)}"`);
+    await p.page.close();
+    // The bunny's default page (band-1 radiance, the file's own environment) draws.
+    p = await open('bunny', '');
+    check(p.ready && !p.error, `the bunny's default view (band-1 radiance) draws (${p.error || 'no error'})`);
     await p.page.close();
   }
-  // Errors show in the page. A glb that is not one:
-  fs.cpSync(path.join(out, 'bunny'), path.join(out, 'bad_glb'), { recursive: true });
-  fs.writeFileSync(path.join(out, 'bad_glb', 'asset.glb'), 'this is not a glb');
-  let p = await open('bad_glb', 'mode=transfer');
-  check(!p.ready && /asset\.glb/.test(p.message), `a bad glb shows a message in the page: "${p.message.slice(0, 120)}"`);
-  await p.page.close();
-  // A file without the product asked for (the statue has no band-1 radiance):
-  p = await open('statue', 'mode=band1');
-  check(!p.ready && /\/radiance\/band1/.test(p.message), `a file without the product shows a message in the page: "${p.message.slice(0, 120)}"`);
-  await p.page.close();
-  // The bunny's default page (band-1 radiance, the file's own environment) draws.
-  p = await open('bunny', '');
-  check(p.ready && !p.error, `the bunny's default view (band-1 radiance) draws (${p.error || 'no error'})`);
-  await p.page.close();
 } catch (e) {
   failures.push(String(e.stack || e));
   console.log(`FAIL ${e.stack || e}`);
