@@ -22,7 +22,8 @@
 //   surface in one picture and background in the other, is 2-11% of the covered pixels at these
 //   sizes (0.012-0.029 measured). A wrong rotation, a shifted camera or a wrong formula shows as
 //   0.1 and more in both figures.
-// Also: a glb that is not one and a file without the product asked for show a message in the page
+// The bunny, baked with band-1 radiance too, is compared in that mode as well (prtview --shade band1,
+// the same bounds). Also: a glb that is not one and a file without the product asked for show a message in the page
 // (not a blank canvas), and the frame time per asset (640x480, the environment turning one degree
 // a frame, each frame waited for) is printed. Exit 0 pass, 1 fail, 77 when Chromium cannot start
 // (ctest SKIP_RETURN_CODE).
@@ -163,6 +164,16 @@ try {
       }
       await p.page.close();
     }
+    if (a.extra.includes('--radiance')) {  // band-1 radiance: the baked sky, prtview --shade band1
+      run(opt.prtview, [h5, '--shade', 'band1', '--size', size, '--camera', camera, '--exposure', String(exposure), '-q',
+                        '-o', path.join(out, a.name, 'ref_band1.png')]);
+      const p = await open(a.name, new URLSearchParams({ mode: 'band1', exposure, camera, size }).toString());
+      const c = p.ready ? await p.page.evaluate((u) => window.prtViewer.compare(u), 'ref_band1.png') : { nrmse_interior: 1, nrmse: 1 };
+      rows.push({ asset: a.name, deg: 'band-1', vertices, triangles, ...c });
+      check(c.nrmse_interior <= kMaxNrmse && c.nrmse <= kMaxNrmseAll,
+            `${a.name} band-1 radiance: NRMSE ${c.nrmse_interior.toFixed(5)} <= ${kMaxNrmse} inside both silhouettes, ${c.nrmse.toFixed(5)} <= ${kMaxNrmseAll} over all`);
+      await p.page.close();
+    }
     const f = await open(a.name, new URLSearchParams({ mode: 'transfer', env: 'sunset.exr', camera, size: '640x480' }).toString());
     if (f.ready) {
       const ms = await f.page.evaluate(() => window.prtViewer.measure(30));
@@ -217,7 +228,7 @@ try {
 console.log('\n| asset | vertices | triangles | rotation | NRMSE inside both silhouettes (px) | NRMSE, all covered px (px) | pixels off by > 2 of 255 |');
 console.log('|---|---|---|---|---|---|---|');
 for (const r of rows)
-  console.log(`| ${r.asset} | ${r.vertices} | ${r.triangles} | ${r.deg}° | ${r.nrmse_interior.toFixed(5)} (${r.interior_pixels}) | ${r.nrmse.toFixed(5)} (${r.pixels}) | ${r.pixels_off_by_more_than_2} |`);
+  console.log(`| ${r.asset} | ${r.vertices} | ${r.triangles} | ${typeof r.deg === 'number' ? r.deg + '°' : r.deg} | ${r.nrmse_interior.toFixed(5)} (${r.interior_pixels}) | ${r.nrmse.toFixed(5)} (${r.pixels}) | ${r.pixels_off_by_more_than_2} |`);
 console.log('\n| asset | vertices | triangles | ms per frame (640x480) | frames per second |');
 console.log('|---|---|---|---|---|');
 for (const f of frames) console.log(`| ${f.asset} | ${f.vertices} | ${f.triangles} | ${f.ms.toFixed(1)} | ${f.fps.toFixed(1)} |`);
