@@ -18,6 +18,10 @@
 //   ao          AO x the unshadowed irradiance / pi of the environment (order 3).
 //   unshadowed  the same surface without any visibility: sum_i (A_l y_i(n) / pi) L_i through the
 //               same prt_shade_transfer (A_l: the clamped-cosine factors from viewer.json).
+//   area        sum_l radiance_l E_l / pi, E_l the baked irradiance of area light l at unit
+//               radiance (/area_lights/irradiance), radiance_l the file's times the page's colour
+//               and intensity for that light (prtview --shade area, per vertex).
+// Every mode is times the set's albedo (viewer.json: a scene object's, or the bounces'), as prtview.
 // URL parameters (the browser test uses them): mode, env (name or index), rotate (degrees),
 // exposure, camera (prtview's form eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]), size (WxH), split=1.
 // window.prtViewer: ready, error, and the test's hooks (measure, compare, png).
@@ -65,6 +69,7 @@ const MODES = {
   transfer: { label: 'diffuse transfer (any environment)', dataset: 'transfer/diffuse' },
   ao: { label: 'ambient occlusion x unshadowed', dataset: 'ao' },
   unshadowed: { label: 'unshadowed (no visibility)', dataset: null },
+  area: { label: 'area lights (baked E per light)', dataset: 'area_lights/irradiance' },
 };
 
 // The GLSL lines that copy a product's attributes into the float array `dst` (components in the
@@ -84,7 +89,13 @@ function attributeCopy(product, dst) {
 function vertexShader(mode, set, lib, order) {
   const p = (ds) => set.products.find((q) => q.dataset === ds);
   let decl = '', body = '';
-  if (mode === 'band1') {
+  if (mode === 'none') {
+    body = 'v_rgb = vec3(0.0);';
+  } else if (mode === 'area') {
+    const a = attributeCopy(p('area_lights/irradiance'), 'e');
+    decl = `${a.decl}\nuniform vec3 prt_area[${a.components}];`;
+    body = `float e[${a.components}];\n  ${a.copy}\n  v_rgb = vec3(0.0);\n  for (int l = 0; l < ${a.components}; ++l) v_rgb += prt_area[l] * e[l];\n  v_rgb /= PI;`;
+  } else if (mode === 'band1') {
     const a = attributeCopy(p('radiance/band1'), 'r');
     decl = a.decl;
     body = `float r[9];\n  ${a.copy}\n  v_rgb = prt_shade_band1(normal, r) / PI;`;
@@ -108,6 +119,7 @@ uniform mat4 modelViewMatrix;
 uniform mat4 projectionMatrix;
 uniform float prt_light[${3 * order * order}];
 uniform float prt_cosine[${order * order}];
+uniform vec3 prt_albedo;
 in vec3 position;
 in vec3 normal;
 ${decl}
@@ -118,6 +130,7 @@ float prt_t[PRT_SH_MAX_ORDER * PRT_SH_MAX_ORDER];
 ${lib}
 void main() {
   ${body}
+  v_rgb *= prt_albedo;
   gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
 }
 `;
@@ -177,12 +190,12 @@ async function main() {
   if (drawn.length === 0) throw new Error(`${info.glb} holds no triangle mesh with normals to shade`);
   const has = (set, mode) => !MODES[mode].dataset || set.products.some((p) => p.dataset === MODES[mode].dataset);
   const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (m !== 'unshadowed' || info.environments.length));
-  const envNeeded = (m) => m !== 'band1';
+  const envNeeded = (m) => m !== 'band1' && m !== 'area';
 
   const requested = params.get('mode');
   let mode = requested || available.find((m) => m !== 'unshadowed') || null;
-  if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed)`);
-  if (!mode || mode === 'unshadowed' && !requested) throw new Error(`${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao: nothing to shade`);
+  if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed, area)`);
+  if (!mode || mode === 'unshadowed' && !requested) throw new Error(`${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao, /area_lights/irradiance: nothing to shade`);
   if (!drawn.some((d) => has(d.set, mode)))
     throw new Error(`${info.source}: the file has no /${MODES[mode].dataset} (its products: ${[...new Set(drawn.flatMap((d) => d.set.products.map((p) => p.dataset)))].join(', ') || 'none'})`);
   if (envNeeded(mode) && info.environments.length === 0)
@@ -245,6 +258,44 @@ async function main() {
   if (!Number.isFinite(ui.rotate)) throw new Error(`rotate '${params.get('rotate')}': expects degrees`);
   if (ui.exposure !== null && !(ui.exposure > 0)) throw new Error(`exposure '${params.get('exposure')}': expects a number > 0`);
 
+  // Area lights: the file's (viewer.json) with the page's colour and intensity per light; a set's
+  // columns of /area_lights/irradiance name its lights (the product's "lights", one per line).
+  const lights = (info.lights || []).map((l) => ({ ...l, colour: [1, 1, 1], intensity: 1 }));
+  const lightColumns = (set) => {
+    const names = (set.products.find((q) => q.dataset === 'area_lights/irradiance').lights || '').split('\n');
+    return names.map((n) => {
+      const l = lights.find((x) => x.name === n);
+      if (!l) throw new Error(`${info.glb}: set ${set.name} names the light '${n}', which the file does not hold`);
+      return l;
+    });
+  };
+  const lightRadiance = (l) => [0, 1, 2].map((c) => l.radiance[c] * l.colour[c] * l.intensity);
+  const albedoOf = (k) => {
+    const meta = info.file.vertex_sets[extras.sets.indexOf(drawn[k].set)];
+    return meta && meta.albedo ? meta.albedo : [1, 1, 1];
+  };
+  // prtview's exposure of area lights: 1 / the 99th percentile of the baked per-vertex luminance.
+  const areaExposure = (() => {
+    const lum = [];
+    drawn.forEach((d, k) => {
+      if (!has(d.set, 'area')) return;
+      const cols = lightColumns(d.set), product = d.set.products.find((q) => q.dataset === 'area_lights/irradiance');
+      const attrs = product.attributes.map((a) => d.mesh.geometry.getAttribute(a.toLowerCase()));
+      const alb = albedoOf(k), n = d.mesh.geometry.getAttribute('position').count;
+      for (let v = 0; v < n; ++v) {
+        const rgb = [0, 0, 0];
+        cols.forEach((l, j) => {
+          const a = attrs[j >> 2], e = a.array[v * a.itemSize + (j & 3)];
+          for (let c = 0; c < 3; ++c) rgb[c] += l.radiance[c] * e;
+        });
+        lum.push((0.2126 * rgb[0] * alb[0] + 0.7152 * rgb[1] * alb[1] + 0.0722 * rgb[2] * alb[2]) / Math.PI);
+      }
+    });
+    lum.sort((a, b) => a - b);
+    const p99 = lum.length ? lum[Math.min(lum.length - 1, Math.floor(0.99 * lum.length))] : 0;
+    return p99 > 0 ? Number((1 / p99).toPrecision(4)) : 1;
+  })();
+
   const materials = new Map();  // key: mode|set index
   function material(m, k) {
     const key = m + '|' + k;
@@ -252,15 +303,23 @@ async function main() {
       const set = drawn[k].set;
       const transfer = set.products.find((p) => p.dataset === 'transfer/diffuse');
       // transfer and unshadowed: the file's order (unshadowed: 3 without transfer); AO: 3.
-      const order = m === 'band1' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
+      const order = m === 'band1' || m === 'area' || m === 'none' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
       const mat = new THREE.RawShaderMaterial({
         glslVersion: THREE.GLSL3,
         vertexShader: vertexShader(m, set, lib, order),
         fragmentShader,
         side: THREE.DoubleSide,
-        uniforms: { prt_light: { value: new Float32Array(3 * order * order) }, prt_cosine: { value: new Float32Array(order * order) }, exposure: { value: 1 } },
+        uniforms: {
+          prt_light: { value: new Float32Array(3 * order * order) },
+          prt_cosine: { value: new Float32Array(order * order) },
+          prt_albedo: { value: new THREE.Vector3(...albedoOf(k)) },
+          prt_area: { value: [] },
+          exposure: { value: 1 },
+        },
       });
       mat.userData.order = order;
+      mat.userData.columns = m === 'area' ? lightColumns(set) : [];
+      mat.uniforms.prt_area.value = mat.userData.columns.map(() => new THREE.Vector3());
       materials.set(key, mat);
     }
     return materials.get(key);
@@ -275,13 +334,14 @@ async function main() {
       for (let c = 0; c < 3; ++c) for (let i = 0; i < n; ++i) light[c * n + i] = row[c * N + i];
     }
     for (let l = 0; l < order; ++l) for (let m = -l; m <= l; ++m) mat.uniforms.prt_cosine.value[l * (l + 1) + m] = info.clamped_cosine[l];
+    mat.userData.columns.forEach((l, j) => mat.uniforms.prt_area.value[j].set(...lightRadiance(l)));
     mat.uniforms.exposure.value = exposure();
   }
-  const exposure = () => ui.exposure ?? (info.environments[ui.env] ? info.environments[ui.env].exposure : 1);
+  const exposure = () => ui.exposure ?? (ui.mode === 'area' ? areaExposure : info.environments[ui.env] ? info.environments[ui.env].exposure : 1);
 
   function drawWith(m) {
     drawn.forEach((d, k) => {
-      const mm = has(d.set, m) ? m : 'unshadowed';
+      const mm = has(d.set, m) ? m : info.environments.length ? 'unshadowed' : 'none';
       d.mesh.material = material(mm, k);
       updateUniforms(d.mesh.material);
     });
@@ -314,7 +374,7 @@ async function main() {
     $('rotate-value').textContent = `${((Math.round(ui.rotate) % 360) + 360) % 360}°` + (ui.mode === 'band1' ? ' (band-1 radiance holds the baked sky: it does not turn)' : '');
     $('exposure-value').textContent = exposure().toPrecision(4);
     const missing = drawn.filter((d) => !has(d.set, ui.mode)).map((d) => d.set.name);
-    $('status').textContent = missing.length ? `${missing.length} vertex set(s) without ${MODES[ui.mode].dataset}, drawn unshadowed: ${missing.slice(0, 4).join(', ')}` : '';
+    $('status').textContent = missing.length ? `${missing.length} vertex set(s) without ${MODES[ui.mode].dataset}, drawn ${info.environments.length ? 'unshadowed' : 'black'}: ${missing.slice(0, 4).join(', ')}` : '';
   }
   let pending = false;
   const redraw = () => {
@@ -338,6 +398,16 @@ async function main() {
     ui.exposure = base * Math.pow(2, Number(e.target.value));
     redraw();
   };
+  for (const l of lights) {
+    const row = document.createElement('label');
+    row.textContent = `light ${l.name} `;
+    const colour = Object.assign(document.createElement('input'), { type: 'color', value: '#ffffff' });
+    const gain = Object.assign(document.createElement('input'), { type: 'range', min: -4, max: 4, step: 0.1, value: 0 });
+    colour.oninput = () => { l.colour = [1, 3, 5].map((i) => parseInt(colour.value.slice(i, i + 2), 16) / 255); redraw(); };
+    gain.oninput = () => { l.intensity = Math.pow(2, Number(gain.value)); redraw(); };
+    row.append(colour, gain);
+    $('lights').append(row);
+  }
   $('split').checked = ui.split;
   $('split').onchange = (e) => { ui.split = e.target.checked; redraw(); };
   let drag = null;
@@ -393,6 +463,7 @@ async function main() {
     return ms;
   };
   state.png = () => canvas.toDataURL('image/png');
+  state.exposure = () => exposure();
   // NRMSE of this picture against a reference image (prtview's PNG of the same view), both in
   // 8-bit sRGB scaled to [0, 1]: RMSE over the pixels either picture covers (not black) and the
   // three channels, over the reference's range there (max - min) — view/image.h's definition;

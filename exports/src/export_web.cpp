@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -105,6 +106,19 @@ json product_json(const ProductRef& p) {
   return j;
 }
 
+// The albedo the pictures multiply by (prtview's rule): a scene object's when any channel is > 0,
+// the root's when its transfer or band-1 radiance carries bounces (light reflected at that
+// albedo), else white.
+std::array<double, 3> albedo_of(const Asset& asset, const SetRef& ref) {
+  std::optional<std::vector<double>> a;
+  for (const SceneObject& o : asset.objects)
+    if (&o.set == ref.set) a = o.albedo;
+  for (const std::optional<Product>* p : {&ref.set->transfer_diffuse, &ref.set->radiance_band1})
+    if (ref.prefix.empty() && *p && (*p)->bounces.value_or(0) > 0) a = (*p)->albedo;
+  if (!a || a->size() != 3 || std::none_of(a->begin(), a->end(), [](double v) { return v > 0; })) return {1, 1, 1};
+  return {std::max(0.0, (*a)[0]), std::max(0.0, (*a)[1]), std::max(0.0, (*a)[2])};
+}
+
 json metadata(const Asset& asset, const std::filesystem::path& source) {
   const formats::RootInfo& r = asset.root;
   json file{{"file", source.filename().string()}, {"source", r.source},         {"source_sha256", r.source_sha256},
@@ -112,7 +126,7 @@ json metadata(const Asset& asset, const std::filesystem::path& source) {
             {"up_axis", r.up_axis},               {"sh_convention", r.sh_convention}};
   json sets = json::array();
   for (const SetRef& ref : vertex_sets(asset)) {
-    json set{{"name", ref.name}, {"vertices", ref.set->vertex_count()}};
+    json set{{"name", ref.name}, {"vertices", ref.set->vertex_count()}, {"albedo", albedo_of(asset, ref)}};
     if (ref.set->triangles) set["triangles"] = ref.set->triangles->values.size() / 3;
     json products = json::array();
     for (const ProductRef& p : detail::products(*ref.set)) products.push_back(product_json(p));
@@ -139,12 +153,13 @@ void check_shadeable(const Asset& asset, const std::filesystem::path& source) {
     const VertexSet& s = *ref.set;
     if (!s.triangles || !s.normals) continue;
     mesh = true;
-    product = product || s.ao || s.transfer_diffuse || s.radiance_band1;
+    product = product || s.ao || s.transfer_diffuse || s.radiance_band1 || s.area_irradiance;
   }
   if (!mesh) throw FormatError(source.string(), "has no vertex set with triangles and normals: the viewer has nothing to draw");
   if (!product)
     throw FormatError(source.string(),
-                      "has none of /ao, /transfer/diffuse, /radiance/band1 in a vertex set: nothing the viewer shades");
+                      "has none of /ao, /transfer/diffuse, /radiance/band1, /area_lights/irradiance in a vertex set: "
+                      "nothing the viewer shades");
 }
 
 } // namespace
@@ -200,6 +215,9 @@ std::vector<std::filesystem::path> export_web(const formats::Asset& asset, const
   for (int l = 0; l < std::max(order, 3); ++l) cosine.push_back(detail::clamped_cosine(l));
   info["clamped_cosine"] = std::move(cosine);
   info["environments"] = std::move(envs);
+  nlohmann::json lights = nlohmann::json::array();
+  for (const formats::Light& l : asset.lights) lights.push_back({{"name", l.name}, {"shape", l.shape}, {"radiance", l.radiance}});
+  info["lights"] = std::move(lights);
   detail::write_bytes(staged / "viewer.json", info.dump() + "\n", dir);
   return staging.commit();
 }

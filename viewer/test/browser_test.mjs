@@ -191,6 +191,43 @@ try {
   }
 
   if (!sweep) {
+    // Area lights: two quad lights of different colours over a box on a ground (the geometry of
+    // tests/tools/test_scene_area_lights.cpp), both objects baked per vertex: against prtview
+    // --shade area (E per light x its radiance x albedo / pi, Gouraud), and the page's default
+    // exposure is prtview's (1 / the 99th percentile of the baked lighting, 4 digits).
+    {
+    const d = path.join(out, 'area_scene');
+    fs.mkdirSync(d);
+    let g = '';
+    for (let z = -3; z <= 3; ++z) for (let x = -3; x <= 3; ++x) g += `v ${x} 0 ${z}\n`;
+    for (let j = 0; j < 6; ++j) for (let i = 0; i < 6; ++i) { const q = j * 7 + i + 1; g += `f ${q} ${q + 7} ${q + 8} ${q + 1}\n`; }
+    fs.writeFileSync(path.join(d, 'ground.obj'), g);
+    fs.writeFileSync(path.join(d, 'box.obj'), 'v -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\nv -0.5 0.5 0.5\n' +
+      'v 0.5 0.5 0.5\nv -0.5 1.5 0.5\nv 0.5 1.5 0.5\nf 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n');
+    fs.writeFileSync(path.join(d, 'scene.json'), JSON.stringify({
+      prtbake_scene: 1, bake: { products: ['ao'], samples: 1024, report: 0 },
+      lights: [{ name: 'key', shape: 'quad', centre: [0.7, 4, 0.3], u: [2, 0, 0], v: [0, 0, 2], radiance: [10, 9, 7] },
+               { name: 'fill', shape: 'quad', centre: [-3, 2, 0], u: [0, 0, 1.5], v: [0, 1.5, 0], radiance: [1, 2, 4] }],
+      objects: [{ mesh: 'ground.obj', role: 'both', material: { albedo: [0.6, 0.5, 0.4] } },
+                { mesh: 'box.obj', role: 'both', material: { albedo: [0.8, 0.8, 0.8] } }] }));
+    const h5 = path.join(d, 'area.prt.h5');
+    run(opt.prtbake, ['scene', path.join(d, 'scene.json'), '-q', '-o', h5]);
+    run(opt.prtbake, ['export', h5, '--to', 'web', '-o', path.join(out, 'area')]);
+    const look = run(opt.prtview, [h5, '--shade', 'area', '--size', kSize, '-o', path.join(out, 'area', 'ref_area.png')]);
+    const camera = look.match(/--camera (\S+)/)[1], exposure = Number(look.match(/exposure ([0-9.e+-]+) \(/)[1]);
+    const p = await open('area', new URLSearchParams({ mode: 'area', camera, size: kSize }).toString());
+    check(p.ready && !p.error, `area lights: the page draws (${p.error || 'no error'})`);
+    if (p.ready) {
+      const c = await p.page.evaluate((u) => window.prtViewer.compare(u), 'ref_area.png');
+      const ours = await p.page.evaluate(() => window.prtViewer.exposure());
+      rows.push({ asset: 'area lights', deg: '-', vertices: 57, triangles: 84, ...c });
+      check(ours === exposure, `area lights: the page's default exposure ${ours} is prtview's ${exposure}`);
+      check(c.nrmse_interior <= kMaxNrmse && c.nrmse <= kMaxNrmseAll,
+            `area lights: NRMSE ${c.nrmse_interior.toFixed(5)} <= ${kMaxNrmse} inside both silhouettes, ${c.nrmse.toFixed(5)} <= ${kMaxNrmseAll} over all`);
+    }
+    await p.page.close();
+    }
+
     // The comparison can fail: the bunny turned by 120 degrees against prtview's picture at 0.
     {
       const info = JSON.parse(fs.readFileSync(path.join(out, 'bunny', 'viewer.json'), 'utf8'));

@@ -92,14 +92,16 @@ const char* web_viewer_missing() noexcept;
 // replaced; any other existing path is refused): index.html, viewer.js, the shading bodies of the
 // GLSL mirrors under shaders/, three.js under three/, the glb (asset.glb, export_asset's Glb) and
 // viewer.json: the file's metadata (root attributes, per vertex set its products with their
-// integrator, samples and environment, its error report) and per environment the radiance SH
+// integrator, samples and environment, its error report, the albedo prtview multiplies by), the
+// area lights (name, shape, radiance) and per environment the radiance SH
 // turned about +Y by every whole degree d in [0, 360) (prt::sh::Rotation of R_y(d): (x, z) →
 // (x cos d + z sin d, −x sin d + z cos d)), channel-major [3][order²], each number rounded to 9
 // significant digits, the clamped-cosine factors Â_l for the unshadowed view and a default
 // exposure: 1 / max over 4,096 normals (spherical Fibonacci) of the luminance of the order-3
 // unshadowed irradiance / π, to 4 digits — prtview's rule (view/exposure.h) on the SH-band-limited
 // sky. Staged beside `out` and renamed into place. Needs a vertex set with triangles and normals
-// and at least one of /ao, /transfer/diffuse, /radiance/band1 (FormatError naming `source`);
+// and at least one of /ao, /transfer/diffuse, /radiance/band1, /area_lights/irradiance
+// (FormatError naming `source`);
 // environments are not required (band-1 radiance shades without one). Deterministic: the same
 // inputs give the same bytes. FormatError also when the build has no viewer (web_viewer_missing).
 std::vector<std::filesystem::path> export_web(const formats::Asset& asset, const std::filesystem::path& source,
