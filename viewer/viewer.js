@@ -22,6 +22,12 @@
 //               radiance (/area_lights/irradiance), radiance_l the file's times the page's colour
 //               and intensity for that light (prtview --shade area, per vertex).
 // Every mode is times the set's albedo (viewer.json: a scene object's, or the bounces'), as prtview.
+// Per texel (a set with a lightmap, `prtbake texel`; the default where there is one, form=vertex
+// for the per-vertex products): the same formulas per pixel in the fragment shader, the lightmap's
+// values (the glb's float buffer views, RGBA32F textures of four channels each) sampled by
+// SCHEMA's bilinear rule as prtview does (view/lightmap.h: (u W - 1/2, v H - 1/2), the four
+// texels around it by texelFetch, clamped to the edge), band-1 and AO at the pixel's
+// interpolated normal.
 // URL parameters (the browser test uses them): mode, env (name or index), rotate (degrees),
 // exposure, camera (prtview's form eye=X,Y,Z:at=X,Y,Z[:up=X,Y,Z][:fov=DEG]), size (WxH), split=1.
 // window.prtViewer: ready, error, and the test's hooks (measure, compare, png).
@@ -137,16 +143,79 @@ void main() {
 }
 
 // prtview's tone map (view/image.h): v = clamp(exposure x, 0, 1), then the sRGB transfer function.
-const fragmentShader = `precision highp float;
-in vec3 v_rgb;
-uniform float exposure;
+const toneMap = `uniform float exposure;
 out vec4 out_colour;
 float srgb(float x) {
   float v = clamp(exposure * x, 0.0, 1.0);
   return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
 }
-void main() { out_colour = vec4(srgb(v_rgb.r), srgb(v_rgb.g), srgb(v_rgb.b), 1.0); }
+void show(vec3 rgb) { out_colour = vec4(srgb(rgb.r), srgb(rgb.g), srgb(rgb.b), 1.0); }
 `;
+const fragmentShader = `precision highp float;
+in vec3 v_rgb;
+${toneMap}
+void main() { show(v_rgb); }
+`;
+
+// Per texel: a pass-through vertex shader and the shading in the fragment shader.
+const texelVertexShader = `precision highp float;
+uniform mat4 modelViewMatrix;
+uniform mat4 projectionMatrix;
+in vec3 position;
+in vec3 normal;
+in vec2 uv1;
+out vec2 v_uv;
+out vec3 v_normal;
+void main() {
+  v_uv = uv1;
+  v_normal = normal;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}
+`;
+function texelFragmentShader(mode, maps, channels, lib, order) {
+  const samplers = Array.from({ length: maps }, (_, j) => `uniform highp sampler2D prt_map${j};`).join('\n');
+  const fill = (dst) => Array.from({ length: maps }, (_, j) => {
+    const n = Math.min(4, channels - 4 * j);
+    return `  s = bilinear(prt_map${j});\n` + Array.from({ length: n }, (_, k) => `  ${dst}[${4 * j + k}] = s.${'xyzw'[k]};`).join('\n');
+  }).join('\n');
+  let body;
+  if (mode === 'band1') body = `float r[9];\n${fill('r')}\n  rgb = prt_shade_band1(normalize(v_normal), r) / PI;`;
+  else if (mode === 'transfer') body = `${fill('prt_t')}\n  rgb = prt_shade_transfer(0u, ${order});`;
+  else body = `float a[1];\n${fill('a')}
+  float y[PRT_SH_MAX_COEFFS];
+  prt_sh_eval(${order}, normalize(v_normal), y);
+  for (int i = 0; i < ${order * order}; ++i) prt_t[i] = y[i] * prt_cosine[i] / PI;
+  rgb = a[0] * prt_shade_transfer(0u, ${order});`;
+  return `precision highp float;
+precision highp int;
+#define PRT_SH_MAX_ORDER ${Math.max(order, 3)}
+#define PI 3.14159265358979323846
+uniform float prt_light[${3 * order * order}];
+uniform float prt_cosine[${order * order}];
+uniform vec3 prt_albedo;
+uniform ivec2 prt_map_size;
+${samplers}
+in vec2 v_uv;
+in vec3 v_normal;
+float prt_t[PRT_SH_MAX_ORDER * PRT_SH_MAX_ORDER];
+#define PRT_TRANSFER(i) prt_t[(i)]
+#define PRT_LIGHT(i) prt_light[(i)]
+${lib}
+${toneMap}
+vec4 texel(highp sampler2D m, ivec2 p) { return texelFetch(m, clamp(p, ivec2(0), prt_map_size - 1), 0); }
+vec4 bilinear(highp sampler2D m) {
+  vec2 st = v_uv * vec2(prt_map_size) - 0.5, c = floor(st), f = st - c;
+  ivec2 p = ivec2(c);
+  return mix(mix(texel(m, p), texel(m, p + ivec2(1, 0)), f.x), mix(texel(m, p + ivec2(0, 1)), texel(m, p + ivec2(1, 1)), f.x), f.y);
+}
+void main() {
+  vec4 s;
+  vec3 rgb;
+${body}
+  show(rgb * prt_albedo);
+}
+`;
+}
 
 function parseCamera(spec) {
   const cam = { up: [0, 1, 0], fov: 45 };
@@ -178,6 +247,7 @@ async function main() {
   }
   const extras = gltf.asset && gltf.asset.extras && gltf.asset.extras.prtbake;
   if (!extras || !Array.isArray(extras.sets)) throw new Error(`${info.glb} has no asset.extras.prtbake: not written by prtbake export`);
+  for (const set of extras.sets) set.products = set.products || [];  // an empty list is written as null
 
   // The meshes with their vertex set's products.
   const drawn = [];
@@ -188,7 +258,39 @@ async function main() {
     if (set && o.geometry.getAttribute('normal')) drawn.push({ mesh: o, set });
   });
   if (drawn.length === 0) throw new Error(`${info.glb} holds no triangle mesh with normals to shade`);
-  const has = (set, mode) => !MODES[mode].dataset || set.products.some((p) => p.dataset === MODES[mode].dataset);
+  // A set's lightmap dataset of a mode's product ({dataset, shape, bufferView}), if any.
+  const texelData = (set, mode) => {
+    const ds = MODES[mode].dataset;
+    if (!ds || mode === 'area' || !set.lightmap || !Array.isArray(set.lightmap.datasets)) return null;
+    return set.lightmap.datasets.find((d) => d.dataset === 'lightmap/' + ds || d.dataset.endsWith('/lightmap/' + ds)) || null;
+  };
+  const hasVertex = (set, mode) => !MODES[mode].dataset || set.products.some((p) => p.dataset === MODES[mode].dataset);
+  const has = (set, mode) => hasVertex(set, mode) || texelData(set, mode) !== null;
+  // The lightmap's float images as RGBA32F textures of four channels each (loaded once per dataset).
+  const textures = new Map();
+  async function lightmapTextures(d) {
+    if (textures.has(d.bufferView)) return textures.get(d.bufferView);
+    if (d.dtype !== 'float32') throw new Error(`${info.glb}: ${d.dataset} is ${d.dtype}, the viewer reads float32 lightmaps`);
+    const [H, W] = d.shape, C = d.shape.slice(2).reduce((a, b) => a * b, 1);
+    const view = await gltf.parser.getDependency('bufferView', d.bufferView);
+    const values = new Float32Array(view.slice(0));
+    if (values.length !== H * W * C) throw new Error(`${info.glb}: ${d.dataset} holds ${values.length} floats, not ${H}x${W}x${C}`);
+    const maps = [];
+    for (let j = 0; 4 * j < C; ++j) {
+      const data = new Float32Array(H * W * 4);
+      for (let t = 0; t < H * W; ++t) for (let k = 0; k < 4 && 4 * j + k < C; ++k) data[4 * t + k] = values[t * C + 4 * j + k];
+      const tex = new THREE.DataTexture(data, W, H, THREE.RGBAFormat, THREE.FloatType);
+      tex.minFilter = tex.magFilter = THREE.NearestFilter;
+      tex.generateMipmaps = false;
+      tex.needsUpdate = true;
+      maps.push(tex);
+    }
+    const out = { maps, size: new THREE.Vector2(W, H), channels: C };
+    textures.set(d.bufferView, out);
+    return out;
+  }
+  for (const d of drawn) for (const m of Object.keys(MODES)) { const t = texelData(d.set, m); if (t) await lightmapTextures(t); }
+  const anyTexel = drawn.some((d) => Object.keys(MODES).some((m) => texelData(d.set, m)));
   const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (m !== 'unshadowed' || info.environments.length));
   const envNeeded = (m) => m !== 'band1' && m !== 'area';
 
@@ -254,6 +356,7 @@ async function main() {
     rotate: Number(params.get('rotate') || 0),
     exposure: params.get('exposure') ? Number(params.get('exposure')) : null,
     split: params.get('split') === '1',
+    texel: params.get('form') !== 'vertex',
   };
   if (!Number.isFinite(ui.rotate)) throw new Error(`rotate '${params.get('rotate')}': expects degrees`);
   if (ui.exposure !== null && !(ui.exposure > 0)) throw new Error(`exposure '${params.get('exposure')}': expects a number > 0`);
@@ -298,9 +401,11 @@ async function main() {
 
   const materials = new Map();  // key: mode|set index
   function material(m, k) {
+    const set = drawn[k].set;
+    const td = texelData(set, m);
+    if (td && (ui.texel || !hasVertex(set, m))) return texelMaterial(m, k, td);
     const key = m + '|' + k;
     if (!materials.has(key)) {
-      const set = drawn[k].set;
       const transfer = set.products.find((p) => p.dataset === 'transfer/diffuse');
       // transfer and unshadowed: the file's order (unshadowed: 3 without transfer); AO: 3.
       const order = m === 'band1' || m === 'area' || m === 'none' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
@@ -324,6 +429,34 @@ async function main() {
     }
     return materials.get(key);
   }
+  function texelMaterial(m, k, td) {
+    const key = 'texel|' + m + '|' + k;
+    if (!materials.has(key)) {
+      const set = drawn[k].set, tex = textures.get(td.bufferView);
+      const transfer = m === 'transfer' ? td.shape[2] : 0;
+      const order = m === 'band1' ? 1 : m === 'transfer' ? Math.round(Math.sqrt(transfer)) : 3;
+      const uniforms = {
+        prt_light: { value: new Float32Array(3 * order * order) },
+        prt_cosine: { value: new Float32Array(order * order) },
+        prt_albedo: { value: new THREE.Vector3(...albedoOf(k)) },
+        prt_map_size: { value: tex.size },
+        exposure: { value: 1 },
+      };
+      tex.maps.forEach((t, j) => { uniforms['prt_map' + j] = { value: t }; });
+      const mat = new THREE.RawShaderMaterial({
+        glslVersion: THREE.GLSL3,
+        vertexShader: texelVertexShader,
+        fragmentShader: texelFragmentShader(m, tex.maps.length, tex.channels, lib, order),
+        side: THREE.DoubleSide,
+        uniforms,
+      });
+      mat.userData.order = order;
+      mat.userData.columns = [];
+      materials.set(key, mat);
+      if (!drawn[k].mesh.geometry.getAttribute('uv1')) throw new Error(`${info.glb}: set ${set.name} has a lightmap but no TEXCOORD_1`);
+    }
+    return materials.get(key);
+  }
   function updateUniforms(mat) {
     const order = mat.userData.order, n = order * order;
     const env = info.environments[ui.env];
@@ -334,7 +467,7 @@ async function main() {
       for (let c = 0; c < 3; ++c) for (let i = 0; i < n; ++i) light[c * n + i] = row[c * N + i];
     }
     for (let l = 0; l < order; ++l) for (let m = -l; m <= l; ++m) mat.uniforms.prt_cosine.value[l * (l + 1) + m] = info.clamped_cosine[l];
-    mat.userData.columns.forEach((l, j) => mat.uniforms.prt_area.value[j].set(...lightRadiance(l)));
+    if (mat.uniforms.prt_area) mat.userData.columns.forEach((l, j) => mat.uniforms.prt_area.value[j].set(...lightRadiance(l)));
     mat.uniforms.exposure.value = exposure();
   }
   const exposure = () => ui.exposure ?? (ui.mode === 'area' ? areaExposure : info.environments[ui.env] ? info.environments[ui.env].exposure : 1);
@@ -408,6 +541,9 @@ async function main() {
     row.append(colour, gain);
     $('lights').append(row);
   }
+  $('texel').checked = ui.texel;
+  $('texel-row').style.display = anyTexel ? 'block' : 'none';
+  $('texel').onchange = (e) => { ui.texel = e.target.checked; redraw(); };
   $('split').checked = ui.split;
   $('split').onchange = (e) => { ui.split = e.target.checked; redraw(); };
   let drag = null;

@@ -154,12 +154,13 @@ void check_shadeable(const Asset& asset, const std::filesystem::path& source) {
     if (!s.triangles || !s.normals) continue;
     mesh = true;
     product = product || s.ao || s.transfer_diffuse || s.radiance_band1 || s.area_irradiance;
+    if (const auto& m = s.lightmap; m && s.uv) product = product || m->ao || m->transfer_diffuse || m->radiance_band1;
   }
   if (!mesh) throw FormatError(source.string(), "has no vertex set with triangles and normals: the viewer has nothing to draw");
   if (!product)
     throw FormatError(source.string(),
-                      "has none of /ao, /transfer/diffuse, /radiance/band1, /area_lights/irradiance in a vertex set: "
-                      "nothing the viewer shades");
+                      "has none of /ao, /transfer/diffuse, /radiance/band1, /area_lights/irradiance in a vertex set "
+                      "or its lightmap: nothing the viewer shades");
 }
 
 } // namespace

@@ -150,14 +150,19 @@ std::vector<exports::WebEnvironment> web_environments(const ExportArgs& args, co
   const bake::UpAxis up = asset.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y;
   int order = 3;
   std::optional<std::string> baked_name;
+  std::set<std::string> recorded = recorded_environments(asset);
+  auto scan_products = [&](const std::optional<formats::Product>& transfer, const std::optional<formats::Product>& band1) {
+    if (transfer && transfer->sh_order) order = std::max(order, int(*transfer->sh_order));
+    if (band1 && band1->environment && !baked_name) baked_name = *band1->environment;
+    if (band1 && band1->environment_sha256) recorded.insert(*band1->environment_sha256);
+  };
   auto scan = [&](const formats::VertexSet& s) {
-    if (s.transfer_diffuse && s.transfer_diffuse->sh_order) order = std::max(order, int(*s.transfer_diffuse->sh_order));
-    if (!baked_name && s.radiance_band1 && s.radiance_band1->environment) baked_name = *s.radiance_band1->environment;
+    scan_products(s.transfer_diffuse, s.radiance_band1);
+    if (s.lightmap) scan_products(s.lightmap->transfer_diffuse, s.lightmap->radiance_band1);  // per texel
   };
   scan(asset.vertices);
   for (const formats::SceneObject& o : asset.objects) scan(o.set);
   if (!baked_name && asset.scene && asset.scene->environment) baked_name = *asset.scene->environment;
-  const std::set<std::string> recorded = recorded_environments(asset);
   std::vector<std::string> paths;
   if (baked_name) {
     const std::filesystem::path named(*baked_name), beside = std::filesystem::path(args.input).parent_path() / named.filename();

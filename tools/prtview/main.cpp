@@ -348,7 +348,7 @@ std::optional<Args> parse(int argc, char** argv) {
   CLI::Option* rotate_opt = app.add_option("--env-rotate", a.env_rotate,
                  "DEG: turn the environment about +Y by DEG degrees before shading (its SH turned by "
                  "prt::sh::Rotation, (x, z) -> (x cos + z sin, -x sin + z cos), as the web viewer turns it); "
-                 "per-vertex --shade transfer only, runtime picture only.");
+                 "--shade transfer (per vertex or per texel) only, runtime picture only.");
   app.add_flag("-q,--quiet", a.quiet, "only errors.");
   for (CLI::Option* o : app.get_options()) o->description(wrap(o->get_description()));
   if (argc <= 1) throw UsageError("no file given");
@@ -649,7 +649,7 @@ int run(const Args& a) {
                                                                                                           : prtview::GlossyRoute::Auto,
                                                                                   scene)
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
-                              : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene)
+                              : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene, a.env_rotate)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene, a.env_rotate);
   const double runtime_seconds = t_run.seconds();
   const Interreflection reflect = interreflection(a, f, kind, texel, area, scene, runtime);

@@ -164,7 +164,7 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
 }
 
 view::Image render_texel_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
-                              const view::Camera& cam, RenderScene& scene) {
+                              const view::Camera& cam, RenderScene& scene, double env_rotate_degrees) {
   scene.mesh = read_mesh(f, file, "");
   const TexelProduct p = read_texel_product(f, file, kind, env);
   const view::LightmapImage map{p.width, p.height, p.channels, *p.values, *p.state};
@@ -179,6 +179,7 @@ view::Image render_texel_file(const F::Asset& f, const std::string& file, const 
   std::unique_ptr<bake::UnshadowedIrradiance> exact;
   if (kind == "transfer") {
     light = environment_sh(env, p.order, scene.how);
+    if (env_rotate_degrees != 0) turn_light(light, p.order, env_rotate_degrees);
     shade = [&](const view::Fragment&, const float* t, float* rgb) { shade::shade_transfer_vertices(t, 1, p.order, light.data(), rgb); };
   } else if (kind == "band1") {
     scene.how = "prt::shade::shade_band1 (E/pi) at the pixel's interpolated normal";

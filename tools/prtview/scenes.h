@@ -75,7 +75,8 @@ void turn_light(std::vector<float>& light, int order, double degrees);
 // pixel's interpolated normal where the formula takes one (band1's y_1m(n), AO's unshadowed
 // irradiance).
 view::Image render_texel_file(const formats::Asset& f, const std::string& file, const std::string& kind,
-                              const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
+                              const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene,
+                              double env_rotate_degrees = 0);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
 struct FivView {

@@ -23,7 +23,8 @@
 //   sizes (0.012-0.029 measured). A wrong rotation, a shifted camera or a wrong formula shows as
 //   0.1 and more in both figures.
 // The bunny, baked with band-1 radiance too, is compared in that mode as well (prtview --shade band1,
-// the same bounds). Also: a glb that is not one and a file without the product asked for show a message in the page
+// the same bounds); so is the bunny baked per texel (prtbake texel, a 256x256 lightmap), which
+// both draw per pixel from the lightmap. Also: a glb that is not one and a file without the product asked for show a message in the page
 // (not a blank canvas), and the frame time per asset (640x480, the environment turning one degree
 // a frame, each frame waited for) is printed. Exit 0 pass, 1 fail, 77 when Chromium cannot start
 // (ctest SKIP_RETURN_CODE).
@@ -74,6 +75,9 @@ const assets = sweep || [
   { name: 'bunny', mesh: path.join(opt.data, 'bunny_ground.obj'), samples: 256, extra: ['--radiance', sunset] },
   { name: 'statue', mesh: path.join(opt.data, 'wuson.obj'), samples: 256, extra: [] },
   { name: 'engine', mesh: opt.engine, samples: 64, extra: [], size: '640x480', maxInterior: kMaxNrmseEngine },
+  // Per texel: the bunny alone with a generated 256x256 lightmap (prtbake texel), drawn per pixel
+  // from it by both (SCHEMA's bilinear rule).
+  { name: 'bunny_texel', mesh: path.join(opt.data, 'bunny.obj'), samples: 64, extra: ['--radiance', sunset], texel: '256' },
 ];
 
 // Chromium first: without it there is nothing to test (skip, saying why).
@@ -132,8 +136,8 @@ try {
   for (const a of assets) {
     const t0 = Date.now();
     const h5 = path.join(out, `${a.name}.prt.h5`);
-    run(opt.prtbake, ['vertex', a.mesh, '--ao', '--transfer', '3', ...a.extra, '--integrator', 'qmc', '--samples', String(a.samples),
-                      '--report', '0', '--reproducible', '-q', '-o', h5]);
+    run(opt.prtbake, [a.texel ? 'texel' : 'vertex', a.mesh, ...(a.texel ? ['--resolution', a.texel] : []), '--ao', '--transfer', '3',
+                      ...a.extra, '--integrator', 'qmc', '--samples', String(a.samples), '--report', '0', '--reproducible', '-q', '-o', h5]);
     run(opt.prtbake, ['export', h5, '--to', 'web', '--env', sunset, '-o', path.join(out, a.name)]);
     const info = JSON.parse(fs.readFileSync(path.join(out, a.name, 'viewer.json'), 'utf8'));
     const exposure = info.environments.find((e) => e.name === 'sunset.exr').exposure;
