@@ -249,6 +249,15 @@ try {
     let p = await open('bad_glb', 'mode=transfer');
     check(!p.ready && /asset\.glb/.test(p.message), `a bad glb shows a message in the page: "${p.message.slice(0, 120)}"`);
     await p.page.close();
+    // Opened as a file (double-clicked): browsers refuse its module scripts; the page says to serve it.
+    {
+      const page = await browser.newPage();
+      await page.goto(`file://${path.join(out, 'bunny', 'index.html')}`);
+      await page.waitForFunction('window.prtViewer && (window.prtViewer.ready || window.prtViewer.error)', { timeout: 60000 });
+      const m = await page.evaluate(() => getComputedStyle(document.getElementById('message')).display !== 'none' ? document.getElementById('message').textContent : '');
+      check(/http\.server/.test(m), `the folder opened as a file says to serve it: "${m.slice(0, 100)}"`);
+      await page.close();
+    }
     // A file without the product asked for (the statue has no band-1 radiance):
     p = await open('statue', 'mode=band1');
     check(!p.ready && /\/radiance\/band1/.test(p.message), `a file without the product shows a message in the page: "${p.message.slice(0, 120)}"`);
