@@ -21,7 +21,11 @@
 //   area        sum_l radiance_l E_l / pi, E_l the baked irradiance of area light l at unit
 //               radiance (/area_lights/irradiance), radiance_l the file's times the page's colour
 //               and intensity for that light (prtview --shade area, per vertex).
-// Every mode is times the set's albedo (viewer.json: a scene object's, or the bounces'), as prtview.
+//   glossy      route B of glossy.inc: prt_shade_glossy_radiance of the vertex's /radiance/shadowed
+//               row (read from a float texture by gl_VertexID) with the normalised Phong lobe about
+//               the reflected view direction, times the object's specular colour (prtview --shade
+//               glossy; objects without it black); the exponent changes at run time. The baked sky.
+// Every mode but glossy is times the set's albedo (viewer.json: a scene object's, or the bounces'), as prtview.
 // Per texel (a set with a lightmap, `prtbake texel`; the default where there is one, form=vertex
 // for the per-vertex products): the same formulas per pixel in the fragment shader, the lightmap's
 // values (the glb's float buffer views, RGBA32F textures of four channels each) sampled by
@@ -76,6 +80,7 @@ const MODES = {
   ao: { label: 'ambient occlusion x unshadowed', dataset: 'ao' },
   unshadowed: { label: 'unshadowed (no visibility)', dataset: null },
   area: { label: 'area lights (baked E per light)', dataset: 'area_lights/irradiance' },
+  glossy: { label: 'glossy lobes (route B: radiance/shadowed)', dataset: 'radiance/shadowed' },
 };
 
 // The GLSL lines that copy a product's attributes into the float array `dst` (components in the
@@ -92,6 +97,7 @@ function attributeCopy(product, dst) {
   return { decl: decl.join('\n'), copy: copy.join('\n  '), components: C };
 }
 
+const kRowWidth = 4096;  // the width of the shadowed-radiance texture (rows of all vertices, flat)
 function vertexShader(mode, set, lib, order) {
   const p = (ds) => set.products.find((q) => q.dataset === ds);
   let decl = '', body = '';
@@ -101,6 +107,11 @@ function vertexShader(mode, set, lib, order) {
     const a = attributeCopy(p('area_lights/irradiance'), 'e');
     decl = `${a.decl}\nuniform vec3 prt_area[${a.components}];`;
     body = `float e[${a.components}];\n  ${a.copy}\n  v_rgb = vec3(0.0);\n  for (int l = 0; l < ${a.components}; ++l) v_rgb += prt_area[l] * e[l];\n  v_rgb /= PI;`;
+  } else if (mode === 'glossy') {
+    body = `float scales[PRT_SH_MAX_ORDER];
+  prt_phong_band_scales(prt_phong, ${order}, scales);
+  vec3 r = prt_glossy_reflection(normal, position, prt_eye);
+  v_rgb = prt_shade_glossy_radiance(uint(gl_VertexID) * ${3 * order * order}u, ${order}, scales, r);`;
   } else if (mode === 'band1') {
     const a = attributeCopy(p('radiance/band1'), 'r');
     decl = a.decl;
@@ -126,6 +137,9 @@ uniform mat4 projectionMatrix;
 uniform float prt_light[${3 * order * order}];
 uniform float prt_cosine[${order * order}];
 uniform vec3 prt_albedo;
+uniform highp sampler2D prt_s;
+uniform float prt_phong;
+uniform vec3 prt_eye;
 in vec3 position;
 in vec3 normal;
 ${decl}
@@ -133,6 +147,9 @@ out vec3 v_rgb;
 float prt_t[PRT_SH_MAX_ORDER * PRT_SH_MAX_ORDER];
 #define PRT_TRANSFER(i) prt_t[(i)]
 #define PRT_LIGHT(i) prt_light[(i)]
+#define PRT_SHADOWED(i) texelFetch(prt_s, ivec2(int(i) % ${kRowWidth}, int(i) / ${kRowWidth}), 0).r
+#define PRT_VISIBILITY(i) 0.0
+#define PRT_GLOSSY_MATRIX(i) 0.0
 ${lib}
 void main() {
   ${body}
@@ -200,6 +217,9 @@ in vec3 v_normal;
 float prt_t[PRT_SH_MAX_ORDER * PRT_SH_MAX_ORDER];
 #define PRT_TRANSFER(i) prt_t[(i)]
 #define PRT_LIGHT(i) prt_light[(i)]
+#define PRT_SHADOWED(i) 0.0
+#define PRT_VISIBILITY(i) 0.0
+#define PRT_GLOSSY_MATRIX(i) 0.0
 ${lib}
 ${toneMap}
 vec4 texel(highp sampler2D m, ivec2 p) { return texelFetch(m, clamp(p, ivec2(0), prt_map_size - 1), 0); }
@@ -231,11 +251,12 @@ function parseCamera(spec) {
 }
 
 async function main() {
-  const [info, langText, shText, shadeText] = await Promise.all([
+  const [info, langText, shText, shadeText, glossyText] = await Promise.all([
     fetchOk('viewer.json', 'the export\'s description').then((r) => r.json()),
-    ...['prt_lang.glsl', 'sh.inc', 'shade.inc'].map((f) => fetchOk('shaders/' + f, 'a shader body').then((r) => r.text())),
+    ...['prt_lang.glsl', 'sh.inc', 'shade.inc', 'glossy.inc'].map((f) => fetchOk('shaders/' + f, 'a shader body').then((r) => r.text())),
   ]);
-  const lib = [shaderBody('prt_lang.glsl', langText), shaderBody('sh.inc', shText), shaderBody('shade.inc', shadeText)].join('\n');
+  const lib = [shaderBody('prt_lang.glsl', langText), shaderBody('sh.inc', shText), shaderBody('shade.inc', shadeText),
+               shaderBody('glossy.inc', glossyText)].join('\n');
   $('meta').textContent = JSON.stringify(info.file, null, 1);
 
   const glbBytes = await (await fetchOk(info.glb, 'the baked mesh')).arrayBuffer();
@@ -261,7 +282,7 @@ async function main() {
   // A set's lightmap dataset of a mode's product ({dataset, shape, bufferView}), if any.
   const texelData = (set, mode) => {
     const ds = MODES[mode].dataset;
-    if (!ds || mode === 'area' || !set.lightmap || !Array.isArray(set.lightmap.datasets)) return null;
+    if (!ds || mode === 'area' || mode === 'glossy' || !set.lightmap || !Array.isArray(set.lightmap.datasets)) return null;
     return set.lightmap.datasets.find((d) => d.dataset === 'lightmap/' + ds || d.dataset.endsWith('/lightmap/' + ds)) || null;
   };
   const hasVertex = (set, mode) => !MODES[mode].dataset || set.products.some((p) => p.dataset === MODES[mode].dataset);
@@ -292,11 +313,11 @@ async function main() {
   for (const d of drawn) for (const m of Object.keys(MODES)) { const t = texelData(d.set, m); if (t) await lightmapTextures(t); }
   const anyTexel = drawn.some((d) => Object.keys(MODES).some((m) => texelData(d.set, m)));
   const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (m !== 'unshadowed' || info.environments.length));
-  const envNeeded = (m) => m !== 'band1' && m !== 'area';
+  const envNeeded = (m) => m !== 'band1' && m !== 'area' && m !== 'glossy';
 
   const requested = params.get('mode');
   let mode = requested || available.find((m) => m !== 'unshadowed') || null;
-  if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed, area)`);
+  if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed, area, glossy)`);
   if (!mode || mode === 'unshadowed' && !requested) throw new Error(`${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao, /area_lights/irradiance: nothing to shade`);
   if (!drawn.some((d) => has(d.set, mode)))
     throw new Error(`${info.source}: the file has no /${MODES[mode].dataset} (its products: ${[...new Set(drawn.flatMap((d) => d.set.products.map((p) => p.dataset)))].join(', ') || 'none'})`);
@@ -357,6 +378,7 @@ async function main() {
     exposure: params.get('exposure') ? Number(params.get('exposure')) : null,
     split: params.get('split') === '1',
     texel: params.get('form') !== 'vertex',
+    phong: params.get('phong') ? Number(params.get('phong')) : null,
   };
   if (!Number.isFinite(ui.rotate)) throw new Error(`rotate '${params.get('rotate')}': expects degrees`);
   if (ui.exposure !== null && !(ui.exposure > 0)) throw new Error(`exposure '${params.get('exposure')}': expects a number > 0`);
@@ -399,6 +421,28 @@ async function main() {
     return p99 > 0 ? Number((1 / p99).toPrecision(4)) : 1;
   })();
 
+  // Glossy objects: the lobe's exponent and specular colour (viewer.json), and a set's
+  // /radiance/shadowed rows as one R32F texture, kRowWidth floats a row (vertex v's row at
+  // v * 3 order^2), read by the vertex shader's PRT_SHADOWED.
+  const metaOf = (k) => info.file.vertex_sets[extras.sets.indexOf(drawn[k].set)] || {};
+  const phongOf = (k) => metaOf(k).phong_exponent || 0;
+  const specularOf = (k) => metaOf(k).specular || [1, 1, 1];
+  const blank = new THREE.DataTexture(new Float32Array(1), 1, 1, THREE.RedFormat, THREE.FloatType);
+  blank.needsUpdate = true;
+  function shadowedTexture(k, order) {
+    const d = drawn[k], product = d.set.products.find((q) => q.dataset === 'radiance/shadowed');
+    const C = 3 * order * order, V = d.mesh.geometry.getAttribute('position').count;
+    const rows = Math.ceil((V * C) / kRowWidth), data = new Float32Array(rows * kRowWidth);
+    product.attributes.forEach((name, j) => {
+      const a = d.mesh.geometry.getAttribute(name.toLowerCase());
+      for (let v = 0; v < V; ++v) for (let c = 0; c < a.itemSize; ++c) data[v * C + 4 * j + c] = a.array[v * a.itemSize + c];
+    });
+    const tex = new THREE.DataTexture(data, kRowWidth, rows, THREE.RedFormat, THREE.FloatType);
+    tex.minFilter = tex.magFilter = THREE.NearestFilter;
+    tex.needsUpdate = true;
+    return tex;
+  }
+
   const materials = new Map();  // key: mode|set index
   function material(m, k) {
     const set = drawn[k].set;
@@ -408,7 +452,8 @@ async function main() {
     if (!materials.has(key)) {
       const transfer = set.products.find((p) => p.dataset === 'transfer/diffuse');
       // transfer and unshadowed: the file's order (unshadowed: 3 without transfer); AO: 3.
-      const order = m === 'band1' || m === 'area' || m === 'none' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
+      const shadowed = set.products.find((p) => p.dataset === 'radiance/shadowed');
+      const order = m === 'glossy' ? shadowed.sh_order : m === 'band1' || m === 'area' || m === 'none' ? 1 : m === 'ao' || !transfer ? 3 : transfer.sh_order;
       const mat = new THREE.RawShaderMaterial({
         glslVersion: THREE.GLSL3,
         vertexShader: vertexShader(m, set, lib, order),
@@ -419,9 +464,15 @@ async function main() {
           prt_cosine: { value: new Float32Array(order * order) },
           prt_albedo: { value: new THREE.Vector3(...albedoOf(k)) },
           prt_area: { value: [] },
+          prt_s: { value: m === 'glossy' ? shadowedTexture(k, order) : blank },
+          prt_phong: { value: 0 },
+          prt_eye: { value: new THREE.Vector3() },
           exposure: { value: 1 },
         },
       });
+      if (m === 'glossy') mat.uniforms.prt_albedo.value.set(...specularOf(k));
+      mat.userData.phong = m === 'glossy' ? phongOf(k) : 0;
+      mat.userData.mesh = drawn[k].mesh;
       mat.userData.order = order;
       mat.userData.columns = m === 'area' ? lightColumns(set) : [];
       mat.uniforms.prt_area.value = mat.userData.columns.map(() => new THREE.Vector3());
@@ -467,6 +518,11 @@ async function main() {
       for (let c = 0; c < 3; ++c) for (let i = 0; i < n; ++i) light[c * n + i] = row[c * N + i];
     }
     for (let l = 0; l < order; ++l) for (let m = -l; m <= l; ++m) mat.uniforms.prt_cosine.value[l * (l + 1) + m] = info.clamped_cosine[l];
+    if (mat.uniforms.prt_phong) {
+      mat.uniforms.prt_phong.value = ui.phong ?? mat.userData.phong;
+      mat.userData.mesh.updateMatrixWorld(true);
+      mat.uniforms.prt_eye.value.copy(camera.position).applyMatrix4(mat.userData.mesh.matrixWorld.clone().invert());
+    }
     if (mat.uniforms.prt_area) mat.userData.columns.forEach((l, j) => mat.uniforms.prt_area.value[j].set(...lightRadiance(l)));
     mat.uniforms.exposure.value = exposure();
   }
@@ -474,7 +530,7 @@ async function main() {
 
   function drawWith(m) {
     drawn.forEach((d, k) => {
-      const mm = has(d.set, m) ? m : info.environments.length ? 'unshadowed' : 'none';
+      const mm = has(d.set, m) ? m : m !== 'glossy' && info.environments.length ? 'unshadowed' : 'none';
       d.mesh.material = material(mm, k);
       updateUniforms(d.mesh.material);
     });
@@ -541,6 +597,8 @@ async function main() {
     row.append(colour, gain);
     $('lights').append(row);
   }
+  $('phong-row').style.display = available.includes('glossy') ? 'block' : 'none';
+  $('phong').oninput = (e) => { ui.phong = Math.pow(2, Number(e.target.value)); $('phong-value').textContent = ui.phong.toPrecision(3); redraw(); };
   $('texel').checked = ui.texel;
   $('texel-row').style.display = anyTexel ? 'block' : 'none';
   $('texel').onchange = (e) => { ui.texel = e.target.checked; redraw(); };

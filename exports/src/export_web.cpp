@@ -127,6 +127,11 @@ json metadata(const Asset& asset, const std::filesystem::path& source) {
   json sets = json::array();
   for (const SetRef& ref : vertex_sets(asset)) {
     json set{{"name", ref.name}, {"vertices", ref.set->vertex_count()}, {"albedo", albedo_of(asset, ref)}};
+    for (const SceneObject& o : asset.objects)  // glossy objects: the lobe's exponent and colour
+      if (&o.set == ref.set && o.phong_exponent && *o.phong_exponent > 0) {
+        set["phong_exponent"] = *o.phong_exponent;
+        if (o.specular) set["specular"] = *o.specular;
+      }
     if (ref.set->triangles) set["triangles"] = ref.set->triangles->values.size() / 3;
     json products = json::array();
     for (const ProductRef& p : detail::products(*ref.set)) products.push_back(product_json(p));

@@ -22,7 +22,9 @@
 //   surface in one picture and background in the other, is 2-11% of the covered pixels at these
 //   sizes (0.012-0.029 measured). A wrong rotation, a shifted camera or a wrong formula shows as
 //   0.1 and more in both figures.
-// The bunny, baked with band-1 radiance too, is compared in that mode as well (prtview --shade band1,
+// Also compared: glossy lobes by route B (a glossy statue, prtview --shade glossy, at the file's
+// Phong exponent and at 128) and two area lights (prtview --shade area). The bunny, baked with
+// band-1 radiance too, is compared in that mode as well (prtview --shade band1,
 // the same bounds); so is the bunny baked per texel (prtbake texel, a 256x256 lightmap), which
 // both draw per pixel from the lightmap. Also: a glb that is not one and a file without the product asked for show a message in the page
 // (not a blank canvas), and the frame time per asset (640x480, the environment turning one degree
@@ -230,6 +232,34 @@ try {
             `area lights: NRMSE ${c.nrmse_interior.toFixed(5)} <= ${kMaxNrmse} inside both silhouettes, ${c.nrmse.toFixed(5)} <= ${kMaxNrmseAll} over all`);
     }
     await p.page.close();
+    }
+
+    // Glossy lobes, route B: the statue as a glossy scene object (Phong 24, order-11 shadowed
+    // radiance under sunset.exr) against prtview --shade glossy, at its own exponent and at 128
+    // (--phong: the lobe changes at run time).
+    {
+      const d = path.join(out, 'glossy_scene');
+      fs.mkdirSync(d);
+      fs.writeFileSync(path.join(d, 'scene.json'), JSON.stringify({
+        prtbake_scene: 1, environment: sunset, bake: { integrator: 'qmc', samples: 64, report: 0 },
+        objects: [{ mesh: path.join(opt.data, 'wuson.obj'), role: 'both', material: { albedo: [0.5, 0.5, 0.5], phong_exponent: 24, specular: [0.8, 0.7, 0.5] } }] }));
+      const h5 = path.join(d, 'glossy.prt.h5');
+      run(opt.prtbake, ['scene', path.join(d, 'scene.json'), '-q', '-o', h5]);
+      run(opt.prtbake, ['export', h5, '--to', 'web', '-o', path.join(out, 'glossy')]);
+      for (const phong of [null, 128]) {
+        const ref = `ref_glossy_${phong || 'file'}.png`;
+        const look = run(opt.prtview, [h5, '--shade', 'glossy', '--size', kSize, ...(phong ? ['--phong', String(phong)] : []),
+                                       '-o', path.join(out, 'glossy', ref)]);
+        const camera = look.match(/--camera (\S+)/)[1], exposure = Number(look.match(/exposure ([0-9.e+-]+) \(/)[1]);
+        const q = new URLSearchParams({ mode: 'glossy', camera, exposure, size: kSize, ...(phong ? { phong } : {}) });
+        const p = await open('glossy', q.toString());
+        const c = p.ready ? await p.page.evaluate((u) => window.prtViewer.compare(u), ref) : { nrmse_interior: 1, nrmse: 1 };
+        rows.push({ asset: `glossy statue, Phong ${phong || 24}`, deg: '-', vertices: 2117, triangles: 3732, ...c });
+        check(p.ready && c.nrmse_interior <= kMaxNrmse && c.nrmse <= kMaxNrmseAll,
+              `glossy lobes at Phong ${phong || 24}: NRMSE ${c.nrmse_interior.toFixed(5)} <= ${kMaxNrmse} inside both silhouettes, ` +
+              `${c.nrmse.toFixed(5)} <= ${kMaxNrmseAll} over all (${p.error || 'drawn'})`);
+        await p.page.close();
+      }
     }
 
     // The comparison can fail: the bunny turned by 120 degrees against prtview's picture at 0.
