@@ -706,7 +706,7 @@ TEST(ExportWeb, FolderHoldsThePageTheBodiesAndTheTurnedEnvironments) {
   export_web(a, "in.prt.h5", dir / "web", {lobe});
   EXPECT_EQ(listing(dir), (std::vector<std::string>{"web"}));  // no staging left
   for (const char* f : {"index.html", "viewer.js", "asset.glb", "viewer.json", "shaders/prt_lang.glsl", "shaders/sh.inc",
-                        "shaders/shade.inc", "three/build/three.module.js", "three/build/three.core.js",
+                        "shaders/shade.inc", "shaders/glossy.inc", "three/build/three.module.js", "three/build/three.core.js",
                         "three/examples/jsm/loaders/GLTFLoader.js", "three/LICENSE"})
     EXPECT_TRUE(fs::is_regular_file(dir / "web" / f)) << f;
   auto bytes = [](const fs::path& p) { return prt::testing::read_bytes(p); };
