@@ -312,13 +312,18 @@ async function main() {
   }
   for (const d of drawn) for (const m of Object.keys(MODES)) { const t = texelData(d.set, m); if (t) await lightmapTextures(t); }
   const anyTexel = drawn.some((d) => Object.keys(MODES).some((m) => texelData(d.set, m)));
-  const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (m !== 'unshadowed' || info.environments.length));
   const envNeeded = (m) => m !== 'band1' && m !== 'area' && m !== 'glossy';
+  // The modes the export can draw: some set has the product, and an environment when it needs one.
+  const available = Object.keys(MODES).filter((m) => drawn.some((d) => has(d.set, m)) && (!envNeeded(m) || info.environments.length));
 
   const requested = params.get('mode');
   let mode = requested || available.find((m) => m !== 'unshadowed') || null;
   if (requested && !MODES[requested]) throw new Error(`unknown mode '${requested}' (band1, transfer, ao, unshadowed, area, glossy)`);
-  if (!mode || mode === 'unshadowed' && !requested) throw new Error(`${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao, /area_lights/irradiance: nothing to shade`);
+  if (!mode) {
+    const lacking = ['transfer', 'ao'].find((m) => drawn.some((d) => has(d.set, m)));
+    throw new Error(lacking ? `${info.source}: its /${MODES[lacking].dataset} needs an environment and the export has none (prtbake export ... --to web --env ENV.exr)`
+                            : `${info.source}: the file holds none of /radiance/band1, /transfer/diffuse, /ao, /area_lights/irradiance, /radiance/shadowed: nothing to shade`);
+  }
   if (!drawn.some((d) => has(d.set, mode)))
     throw new Error(`${info.source}: the file has no /${MODES[mode].dataset} (its products: ${[...new Set(drawn.flatMap((d) => d.set.products.map((p) => p.dataset)))].join(', ') || 'none'})`);
   if (envNeeded(mode) && info.environments.length === 0)
@@ -602,6 +607,8 @@ async function main() {
   $('texel').checked = ui.texel;
   $('texel-row').style.display = anyTexel ? 'block' : 'none';
   $('texel').onchange = (e) => { ui.texel = e.target.checked; redraw(); };
+  if (!info.environments.length)  // nothing to turn, no unshadowed surface to set beside
+    for (const id of ['env', 'rotate', 'split']) $(id).closest('label').style.display = 'none';
   $('split').checked = ui.split;
   $('split').onchange = (e) => { ui.split = e.target.checked; redraw(); };
   let drag = null;

@@ -228,6 +228,9 @@ try {
       const ours = await p.page.evaluate(() => window.prtViewer.exposure());
       rows.push({ asset: 'area lights', deg: '-', vertices: 57, triangles: 84, ...c });
       check(ours === exposure, `area lights: the page's default exposure ${ours} is prtview's ${exposure}`);
+      const dflt = await open('area', '');  // an export without environments opens on what it can draw
+      check(dflt.ready && !dflt.error, `area lights: the default view of an export without environments draws (${dflt.error || 'no error'})`);
+      await dflt.page.close();
       check(c.nrmse_interior <= kMaxNrmse && c.nrmse <= kMaxNrmseAll,
             `area lights: NRMSE ${c.nrmse_interior.toFixed(5)} <= ${kMaxNrmse} inside both silhouettes, ${c.nrmse.toFixed(5)} <= ${kMaxNrmseAll} over all`);
     }
