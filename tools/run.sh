@@ -10,8 +10,8 @@
 #                       targets (fuzz preset: clang 14, ASan + UBSan) and run each briefly
 #                       (tests/fuzz/run.sh short: its saved regression inputs, then 20 s from its
 #                       seeds). This is what CI runs (.ci/run).
-#   tools/run.sh deps   only install the Debian packages of `test` (apt-get; needs root or sudo);
-#                       `tools/run.sh deps tools` only those of `demo`.
+#   tools/run.sh deps   only install the Debian packages of `test` (apt-get; needs root or sudo) and
+#                       the web viewer's npm packages; `tools/run.sh deps tools` only those of `demo`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,12 +26,14 @@ TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libhdf5-dev
 # h5py (files read by other HDF5 clients); zlib (chunk filter tests); the shader tests' compiler
 # and Vulkan device; the public models of the mesh and glTF tests; mpirun for sharded bakes;
 # Blender for the glTF round trip; clang 14 and its sanitizer runtimes, and GNU time, for the
-# fuzz targets.
+# fuzz targets; Node.js and Chromium for the web viewer's browser test (viewer/test: puppeteer-core
+# drives the system Chromium, headless; npm installs three.js and puppeteer-core, see npm_deps).
 TEST_PACKAGES=(libopenmesh-dev libgtest-dev hdf5-tools openexr python3-h5py python3-numpy zlib1g-dev
                glslc libvulkan-dev mesa-vulkan-drivers
                assimp-testmodels
                openmpi-bin libopenmpi-dev blender
-               clang-14 libclang-rt-14-dev time)
+               clang-14 libclang-rt-14-dev time
+               nodejs chromium)
 JOBS=${JOBS:-$(nproc)}
 
 install_deps() {  # $@ = the packages
@@ -47,6 +49,14 @@ install_deps() {  # $@ = the packages
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# The web viewer's npm packages (viewer/package-lock.json: three.js, which `prtbake export --to web`
+# ships and the build copies in, and puppeteer-core for the browser test) into viewer/node_modules.
+# Debian's nodejs comes without npm (NodeSource's includes it): the npm package when it is missing.
+npm_deps() {  # $@ = extra npm ci options
+  command -v npm >/dev/null || install_deps npm
+  (cd viewer && npm ci --no-audit --no-fund "$@")
+}
+
 build() {  # $1 = preset
   cmake --preset "$1" >/dev/null
   cmake --build --preset "$1" -j "$JOBS"
@@ -55,7 +65,7 @@ build() {  # $1 = preset
 case "${1:-}" in
   deps)
     if [ "${2:-}" = tools ]; then install_deps "${TOOLS_PACKAGES[@]}"
-    else install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"; fi ;;
+    else install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"; npm_deps; fi ;;
   demo)
     install_deps "${TOOLS_PACKAGES[@]}"
     build tools
@@ -70,6 +80,7 @@ case "${1:-}" in
     ;;
   test)
     install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+    npm_deps
     build ci
     ctest --preset ci
     build fuzz

@@ -19,7 +19,7 @@ constexpr struct {
   const char* name;
 } kFormatNames[] = {{ExportFormat::Gltf, "gltf"},   {ExportFormat::Glb, "glb"},     {ExportFormat::Binary, "bin"},
                     {ExportFormat::Unity, "unity"}, {ExportFormat::Godot, "godot"}, {ExportFormat::Filament, "filament"},
-                    {ExportFormat::Exr, "exr"}};
+                    {ExportFormat::Exr, "exr"},     {ExportFormat::Web, "web"}};
 
 std::string relative(std::string_view path) { return std::string(path.substr(1)); }
 
@@ -146,6 +146,7 @@ ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::p
   case ExportFormat::Glb: summary.written = detail::export_gltf(asset, out, format == ExportFormat::Glb); break;
   case ExportFormat::Binary: summary.written = detail::export_binary(asset, out); break;
   case ExportFormat::Exr: summary.written = detail::export_exr(asset, source, out); break;
+  case ExportFormat::Web: throw std::invalid_argument("the web export is export_web (it takes environments)");
   case ExportFormat::Unity:
   case ExportFormat::Godot:
   case ExportFormat::Filament: detail::export_probes(asset, source, format, out, environment, summary); break;

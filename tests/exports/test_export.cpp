@@ -676,9 +676,94 @@ TEST(ExportLightmap, GodotLayersShadeToTheBakedIrradianceAtTheNormalInGodotsFram
 
 TEST(Export, FormatNamesRoundTrip) {
   for (ExportFormat f : {ExportFormat::Gltf, ExportFormat::Glb, ExportFormat::Binary, ExportFormat::Unity,
-                         ExportFormat::Godot, ExportFormat::Filament, ExportFormat::Exr})
+                         ExportFormat::Godot, ExportFormat::Filament, ExportFormat::Exr, ExportFormat::Web})
     EXPECT_EQ(parse_export_format(to_string(f)), f);
   EXPECT_EQ(parse_export_format("fbx"), std::nullopt);
+}
+
+// The web viewer's folder (export_web): the page, three.js, the shading bodies as runtime/shaders
+// holds them, the glb and viewer.json, whose environments are turned by R_y per degree. An
+// environment that is a lobe along +x (band 1 only: (−y, z, −x)·k, so c = (0, 0, −k)) points along
+// −z after 90° ((x, z) → (x cos + z sin, −x sin + z cos)) and along −x after 180°: exact up to the
+// 9-digit rounding of the file (half a unit in the 9th digit: 5e-9 relative). The clamped-cosine factors are π, 2π/3, π/4, 0,
+// −π/24 (Ramamoorthi & Hanrahan's closed form). The same inputs give the same bytes; a folder
+// that is not an earlier export is not replaced; a file without a product the page shades is
+// refused naming it.
+TEST(ExportWeb, FolderHoldsThePageTheBodiesAndTheTurnedEnvironments) {
+  if (const char* why = web_viewer_missing()) GTEST_SKIP() << "this build has no web viewer: " << why;
+  const fs::path dir = fresh_dir("web");
+  WebEnvironment lobe;
+  lobe.name = "lobe.exr";
+  lobe.sha256 = std::string(64, 'c');
+  lobe.order = 5;
+  lobe.radiance.assign(25 * 3, 0.0);
+  const double k = 0.75;
+  for (size_t c = 0; c < 3; ++c) {
+    lobe.radiance[0 * 3 + c] = 1.0 + double(c);
+    lobe.radiance[3 * 3 + c] = -k * double(c + 1);  // coefficient (1, 1): -x
+  }
+  const Asset a = vertex_asset();
+  export_web(a, "in.prt.h5", dir / "web", {lobe});
+  EXPECT_EQ(listing(dir), (std::vector<std::string>{"web"}));  // no staging left
+  for (const char* f : {"index.html", "viewer.js", "asset.glb", "viewer.json", "shaders/prt_lang.glsl", "shaders/sh.inc",
+                        "shaders/shade.inc", "shaders/glossy.inc", "three/build/three.module.js", "three/build/three.core.js",
+                        "three/examples/jsm/loaders/GLTFLoader.js", "three/LICENSE"})
+    EXPECT_TRUE(fs::is_regular_file(dir / "web" / f)) << f;
+  auto bytes = [](const fs::path& p) { return prt::testing::read_bytes(p); };
+  EXPECT_EQ(bytes(dir / "web/shaders/sh.inc"), bytes(fs::path(PRT_SOURCE_TESTS) / "../runtime/shaders/sh.inc"));
+  check_gltf(load(dir / "web/asset.glb", true), a);
+
+  const nlohmann::json info = nlohmann::json::parse(bytes(dir / "web/viewer.json"));
+  ASSERT_EQ(info["environments"].size(), 1u);
+  const nlohmann::json& e = info["environments"][0];
+  EXPECT_EQ(e["order"], 5);
+  ASSERT_EQ(e["sh_by_degree"].size(), 360u);
+  constexpr double kRounding = 5e-9;  // 9 significant digits
+  for (int deg : {0, 90, 180}) {
+    const nlohmann::json& row = e["sh_by_degree"][size_t(deg)];
+    ASSERT_EQ(row.size(), 75u);
+    for (size_t c = 0; c < 3; ++c) {
+      const double kc = k * double(c + 1);
+      std::vector<double> want(25, 0.0);
+      want[0] = 1.0 + double(c);
+      if (deg == 0) want[3] = -kc;   // along +x
+      if (deg == 90) want[2] = -kc;  // along -z: (-y, z, -x) = (0, -1, 0)
+      if (deg == 180) want[3] = kc;  // along -x
+      for (size_t i = 0; i < 25; ++i)
+        EXPECT_NEAR(row[c * 25 + i].get<double>(), want[i], kRounding * std::max(1.0, std::abs(want[i]))) << deg << " deg, channel " << c << ", i " << i;
+    }
+  }
+  const std::vector<double> cosine = info["clamped_cosine"].get<std::vector<double>>();
+  ASSERT_EQ(cosine.size(), 5u);
+  for (auto [l, want] : {std::pair{0, kPi}, {1, 2 * kPi / 3}, {2, kPi / 4}, {3, 0.0}, {4, -kPi / 24}})
+    EXPECT_NEAR(cosine[size_t(l)], want, 1e-15) << l;
+  EXPECT_EQ(info["file"]["vertex_sets"][0]["vertices"], 7);
+
+  // Deterministic: the same inputs, the same bytes (the earlier export is replaced).
+  const std::string first = bytes(dir / "web/viewer.json"), glb = bytes(dir / "web/asset.glb");
+  export_web(a, "in.prt.h5", dir / "web", {lobe});
+  EXPECT_EQ(bytes(dir / "web/viewer.json"), first);
+  EXPECT_EQ(bytes(dir / "web/asset.glb"), glb);
+
+  // A folder that is not an earlier export stays as it is.
+  fs::create_directories(dir / "mine");
+  std::ofstream(dir / "mine/notes.txt") << "keep";
+  EXPECT_THROW(export_web(a, "in.prt.h5", dir / "mine", {lobe}), FormatError);
+  EXPECT_TRUE(fs::exists(dir / "mine/notes.txt"));
+
+  // Nothing to shade: refused naming the input.
+  Asset bare = a;
+  bare.vertices.ao.reset();
+  bare.vertices.transfer_diffuse.reset();
+  bare.vertices.radiance_band1.reset();
+  try {
+    export_web(bare, "bare.prt.h5", dir / "bare", {});
+    FAIL() << "exported a file without a product the page shades";
+  } catch (const FormatError& err) {
+    EXPECT_NE(std::string(err.what()).find("bare.prt.h5"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("/transfer/diffuse"), std::string::npos) << err.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "bare"));
 }
 
 } // namespace

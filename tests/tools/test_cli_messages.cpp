@@ -66,7 +66,7 @@ TEST(CliMessages, CommandLineMistakesExitTwoBeforeAnyFileIsRead) {
       {"scene " + q(kData / "scene_example.json") + " --options " + q(d / "missing.json") + " -o " + q(out),
        "scene: --options " + (d / "missing.json").string() + " applies to a glTF scene (.gltf, .glb) only"},
       {"export " + q(d / "missing.prt.h5") + " --to gltf --env " + q(env) + " -o " + q(d / "x.gltf"),
-       "export: --env writes an environment probe: it needs --to unity, godot or filament, not gltf"},
+       "export: --env writes an environment probe: it needs --to unity, godot, filament or web, not gltf"},
   };
   for (const Case& c : cases) {
     const Outcome r = prtbake(d, c.args);
@@ -154,7 +154,7 @@ TEST(CliMessages, UnknownCommandsAndOptionsGetTheNearestName) {
       {"vertex m.obj --ao -o o.prt.h5 --radiance",
        "prtbake: vertex: --radiance needs a value (--radiance ENV) (try 'prtbake vertex --help')\n"},
       {"export f.prt.h5 -o x.json --to untiy",
-       "prtbake: export: --to: expects gltf, glb, bin, unity, godot, filament or exr, got 'untiy'; did you mean unity? "
+       "prtbake: export: --to: expects gltf, glb, bin, unity, godot, filament, exr or web, got 'untiy'; did you mean unity? "
        "(try 'prtbake export --help')\n"},
       {"vertex m.obj --ao -o o.prt.h5 --integrator qcm",
        "prtbake: vertex: --integrator: unknown integrator 'qcm'; did you mean qmc? (available: silhouette, qmc, "

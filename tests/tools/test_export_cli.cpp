@@ -121,6 +121,27 @@ TEST(ExportCli, EnvironmentProbeMustBeTheBakesEnvironment) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("--env writes an environment probe"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "x.glb"));
+  // A probe format writes one environment probe.
+  r = run_tool(PRT_PRTBAKE, export_args(ao_bake(), "unity", d / "two.json") + " --env '" + data + "/forest.exr' --env '" + data + "/studio.exr'", d);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("give --env once"), std::string::npos) << r.err;
+}
+
+// --to web: a folder with the page and every --env as an environment (the browser test,
+// viewer/test/browser_test.mjs, looks at it); the line printed says how to open it.
+TEST(ExportCli, WebWritesAFolderWithEachEnvironment) {
+  const fs::path d = fresh("web");
+  const std::string data = PRT_DATA_DIR;
+  const auto r = run_tool(PRT_PRTBAKE, export_args(ao_bake(), "web", d / "site") + " --env '" + data + "/forest.exr' --env '" +
+                                           data + "/studio.exr'", d);
+  if (r.code == 2 && r.err.find("built without the web viewer") != std::string::npos) GTEST_SKIP() << r.err;
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("environments: forest.exr, studio.exr"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("python3 -m http.server -d"), std::string::npos) << r.out;
+  const auto info = nlohmann::json::parse(prt::testing::read_bytes(d / "site" / "viewer.json"));
+  ASSERT_EQ(info["environments"].size(), 2u);
+  EXPECT_EQ(info["environments"][0]["order"], 3);  // an AO-only file: order 3 (AO x the unshadowed irradiance)
+  EXPECT_TRUE(fs::is_regular_file(d / "site" / "index.html"));
 }
 
 TEST(ExportCli, AFileAnnotatedWithH5pyExportsTheSameBytes) {
@@ -169,7 +190,7 @@ TEST(ExportCli, UnknownFormatIsACommandLineError) {
   const fs::path d = fresh("usage");
   const auto r = run_tool(PRT_PRTBAKE, export_args(ao_bake(), "fbx", d / "x.fbx"), d);
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("expects gltf, glb, bin, unity, godot, filament or exr"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("expects gltf, glb, bin, unity, godot, filament, exr or web"), std::string::npos) << r.err;
   EXPECT_TRUE(listing(d).empty());
 }
 

@@ -10,6 +10,7 @@
 #include <formats/asset.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <set>
 #include <utility>
@@ -61,32 +62,35 @@ constexpr const char* kExportExamples =
     "  prtbake texel floor.obj --resolution 256 --ao --radiance data/sunset.exr -o floor.prt.h5\n"
     "  prtbake export floor.prt.h5 --to glb -o floor.glb        # AO on TEXCOORD_1\n"
     "  prtbake export floor.prt.h5 --to exr -o floor            # floor.exr\n"
-    "  prtbake export floor.prt.h5 --to godot -o floor.json     # + floor.lightmap.exr\n\n";
+    "  prtbake export floor.prt.h5 --to godot -o floor.json     # + floor.lightmap.exr\n"
+    "  prtbake export bunny.prt.h5 --to web --env data/forest.exr --env data/studio.exr -o bunny_web\n\n";
 
 } // namespace
 
 void add_export(CLI::App& app, ExportArgs& args) {
   CLI::App& cmd = *app.add_subcommand("export", kExportHelp);
   cmd.add_option("FILE", args.input, "the baked file (.prt.h5)")->required()->type_name("");
-  cmd.add_option("--to", args.format, "gltf, glb, bin, unity, godot, filament or exr (see above)")
+  cmd.add_option("--to", args.format, "gltf, glb, bin, unity, godot, filament, exr or web (see above)")
       ->option_text("FORMAT")
       ->required()
       ->check([](const std::string& s) -> std::string {
         if (exports::parse_export_format(s)) return "";
-        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament", "exr"});
-        return "expects gltf, glb, bin, unity, godot, filament or exr, got '" + s + "'" +
+        const auto near = closest(s, {"gltf", "glb", "bin", "unity", "godot", "filament", "exr", "web"});
+        return "expects gltf, glb, bin, unity, godot, filament, exr or web, got '" + s + "'" +
                (near ? "; did you mean " + *near + "?" : std::string());
       });
   cmd.add_option("-o,--output", args.output,
                  "the file to write (gltf: also <stem>.bin beside it; exr: a directory or a\n"
-                 "file prefix). Written to a staging directory first and renamed, so OUT is\n"
-                 "never half-written.")
+                 "file prefix; web: the folder, replaced when it holds an earlier web export).\n"
+                 "Written to a staging directory first and renamed, so OUT is never half-written.")
       ->option_text("OUT")
       ->required();
-  cmd.add_option("--env", args.env,
+  cmd.add_option("--env", args.envs,
                  "unity, godot, filament: also write the probe of this environment map (OpenEXR\n"
                  "lat-long or cube, read in the file's up axis) as \"environment\"; it must be the\n"
-                 "map the file's lighting was baked with, when the file names one.")
+                 "map the file's lighting was baked with, when the file names one.\n"
+                 "web: an environment the viewer offers (repeat for more; SH at the file's\n"
+                 "transfer order, at least 3).")
       ->option_text("ENV");
   cmd.footer(std::string(kExportExamples) + kExitStatusHelp);
 }
@@ -94,10 +98,17 @@ void add_export(CLI::App& app, ExportArgs& args) {
 void check_export_args(const ExportArgs& args) {
   const std::optional<exports::ExportFormat> format = exports::parse_export_format(args.format);
   PRT_CHECK(format.has_value());  // the --to check
-  if (!args.env.empty() && !exports::is_probe_format(*format))
-    throw UsageError("export: --env writes an environment probe: it needs --to unity, godot or filament, not " +
+  if (*format == exports::ExportFormat::Web) {
+    if (const char* why = exports::web_viewer_missing())
+      throw UsageError(std::string("export: --to web: this prtbake was built without the web viewer: ") + why, "prtbake export");
+    return;
+  }
+  if (!args.envs.empty() && !exports::is_probe_format(*format))
+    throw UsageError("export: --env writes an environment probe: it needs --to unity, godot, filament or web, not " +
                          args.format,
                      "prtbake export");
+  if (args.envs.size() > 1)
+    throw UsageError("export: --to " + args.format + " writes one environment probe: give --env once", "prtbake export");
 }
 
 namespace {
@@ -132,6 +143,62 @@ exports::EnvironmentProbe environment_probe(const std::string& path, const forma
   return probe;
 }
 
+// The web viewer's environments: the one the file was baked with (where the file names it, else
+// beside the file; a warning when neither exists), then each --env not already among them, each
+// projected to SH at the file's largest transfer order (at least 3).
+std::vector<exports::WebEnvironment> web_environments(const ExportArgs& args, const formats::Asset& asset) {
+  const bake::UpAxis up = asset.root.up_axis == "z" ? bake::UpAxis::Z : bake::UpAxis::Y;
+  int order = 3;
+  std::optional<std::string> baked_name;
+  std::set<std::string> recorded = recorded_environments(asset);
+  auto scan_products = [&](const std::optional<formats::Product>& transfer, const std::optional<formats::Product>& band1) {
+    if (transfer && transfer->sh_order) order = std::max(order, int(*transfer->sh_order));
+    if (band1 && band1->environment && !baked_name) baked_name = *band1->environment;
+    if (band1 && band1->environment_sha256) recorded.insert(*band1->environment_sha256);
+  };
+  auto scan = [&](const formats::VertexSet& s) {
+    scan_products(s.transfer_diffuse, s.radiance_band1);
+    if (s.lightmap) scan_products(s.lightmap->transfer_diffuse, s.lightmap->radiance_band1);  // per texel
+  };
+  scan(asset.vertices);
+  for (const formats::SceneObject& o : asset.objects) scan(o.set);
+  if (!baked_name && asset.scene && asset.scene->environment) baked_name = *asset.scene->environment;
+  std::vector<std::string> paths;
+  if (baked_name) {
+    const std::filesystem::path named(*baked_name), beside = std::filesystem::path(args.input).parent_path() / named.filename();
+    if (std::filesystem::exists(named)) paths.push_back(named.string());
+    else if (std::filesystem::exists(beside)) paths.push_back(beside.string());
+    else
+      std::fprintf(stderr, "prtbake: warning: export: %s was baked under %s, which is neither there nor beside the file: "
+                   "give it as --env to relight with it\n", args.input.c_str(), baked_name->c_str());
+  }
+  paths.insert(paths.end(), args.envs.begin(), args.envs.end());
+  std::vector<exports::WebEnvironment> out;
+  for (const std::string& path : paths) {
+    const bake::EnvMap env = bake::EnvMap::load(path, up);
+    if (std::any_of(out.begin(), out.end(), [&](const exports::WebEnvironment& e) { return e.sha256 == env.info().sha256; }))
+      continue;
+    exports::WebEnvironment e;
+    e.name = std::filesystem::path(path).filename().string();
+    e.sha256 = env.info().sha256;
+    e.order = order;
+    e.radiance = env.project_sh(order);
+    e.baked = recorded.count(e.sha256) > 0;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+int run_export_web(const ExportArgs& args, const formats::Asset& asset) {
+  const std::vector<exports::WebEnvironment> envs = web_environments(args, asset);
+  exports::export_web(asset, args.input, args.output, envs);
+  std::string names;
+  for (const exports::WebEnvironment& e : envs) names += (names.empty() ? "" : ", ") + e.name + (e.baked ? " (baked with)" : "");
+  std::printf("exported %s to %s/ (web; environments: %s)\n  to look at it: python3 -m http.server -d %s 8000, then open http://localhost:8000/\n",
+              args.input.c_str(), args.output.c_str(), names.empty() ? "none" : names.c_str(), args.output.c_str());
+  return 0;
+}
+
 } // namespace
 
 int run_export(const ExportArgs& args) {
@@ -139,8 +206,9 @@ int run_export(const ExportArgs& args) {
   const formats::Asset asset = formats::read_asset(args.input);
   for (const formats::SkippedAttr& s : asset.skipped_attrs)  // another tool's; no export carries it
     std::fprintf(stderr, "prtbake: warning: export: %s: %s\n", args.input.c_str(), formats::describe(s).c_str());
+  if (format == exports::ExportFormat::Web) return run_export_web(args, asset);
   std::optional<exports::EnvironmentProbe> environment;
-  if (!args.env.empty()) environment = environment_probe(args.env, asset, args.input);
+  if (!args.envs.empty()) environment = environment_probe(args.envs.front(), asset, args.input);
   const exports::ExportSummary summary = exports::export_asset(asset, args.input, format, args.output, environment);
   // The sets left out, one line per reason naming them ("<name>: <why>" each).
   std::vector<std::pair<std::string, std::vector<std::string>>> by_reason;

@@ -1,17 +1,20 @@
 // tools/prtbake/export.h — `prtbake export`: a baked file in formats engines load without HDF5
 // (glTF, a plain binary + JSON header, per-vertex light probes in Unity / Godot / Filament SH
-// conventions). The command line only; the formats are exports/export.h and formats/SCHEMA.md
+// conventions, a folder with the web viewer). The command line only; the formats are exports/export.h and formats/SCHEMA.md
 // "Exports".
 #pragma once
 
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <vector>
 
 namespace prt::tool {
 
 struct ExportArgs {
-  std::string input, output, format, env;  // env: an environment map for the probe formats' sky probe
+  std::string input, output, format;
+  // --env: the probe formats' sky probe (one map), or the web viewer's environments (any number).
+  std::vector<std::string> envs;
 };
 
 // Adds the `export` subcommand to `app`, parsing into `args`.

@@ -225,6 +225,7 @@ struct Args {
   int threads = 0;
   std::optional<uint32_t> bounces;  // --bounces B: the reference's interreflections (default: the file's)
   std::optional<double> albedo;     // --albedo A: a single mesh's grey albedo (default: the file's)
+  double env_rotate = 0;            // --env-rotate DEG: the environment turned about +Y (--shade transfer)
 };
 
 // "X,Y,Z" → a vector (an --instance).
@@ -344,6 +345,10 @@ std::optional<Args> parse(int argc, char** argv) {
                "per-vertex and per-texel files: draw the per-vertex products (Gouraud) even when the file has a "
                "lightmap (/lightmap, 'prtbake texel'), which is drawn per texel by default.");
   app.add_option("--threads", a.threads, "worker threads (default: all cores).")->check(CLI::Range(1, 4096));
+  CLI::Option* rotate_opt = app.add_option("--env-rotate", a.env_rotate,
+                 "DEG: turn the environment about +Y by DEG degrees before shading (its SH turned by "
+                 "prt::sh::Rotation, (x, z) -> (x cos + z sin, -x sin + z cos), as the web viewer turns it); "
+                 "--shade transfer (per vertex or per texel) only, runtime picture only.");
   app.add_flag("-q,--quiet", a.quiet, "only errors.");
   for (CLI::Option* o : app.get_options()) o->description(wrap(o->get_description()));
   if (argc <= 1) throw UsageError("no file given");
@@ -397,6 +402,13 @@ std::optional<Args> parse(int argc, char** argv) {
     if (a.shade != "glossy") throw UsageError("--phong applies to --shade glossy only");
     if (!(phong_value > 0 && std::isfinite(phong_value))) throw UsageError("--phong must be a finite number > 0");
     a.phong = phong_value;
+  }
+  if (rotate_opt->count()) {
+    if (!std::isfinite(a.env_rotate)) throw UsageError("--env-rotate expects a finite number of degrees");
+    if (a.shade != "transfer")
+      throw UsageError("--env-rotate turns the environment of diffuse transfer: it needs --shade transfer (band-1 radiance and "
+                       "AO hold the baked sky)");
+    if (a.mode != Output::Runtime) throw UsageError("--env-rotate: the reference does not turn the environment yet; write the runtime picture");
   }
   a.fiv.overlap = !no_overlap;
   a.fiv.partial = !no_partial;
@@ -663,8 +675,8 @@ int run(const Args& a) {
                                                                                                           : prtview::GlossyRoute::Auto,
                                                                                   scene)
                               : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
-                              : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene)
-                                                : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene);
+                              : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene, a.env_rotate)
+                                                : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene, a.env_rotate);
   const double runtime_seconds = t_run.seconds();
   const Interreflection reflect = interreflection(a, f, kind, texel, area, scene, runtime);
   if (!a.quiet && !scene.form.empty()) {  // which form was drawn, on stderr (the summary below says it too)

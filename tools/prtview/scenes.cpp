@@ -13,6 +13,7 @@
 #include <formats/names.h>
 #include <prtshade/glossy.h>
 #include <prtshade/shade.h>
+#include <prtshade/sh.h>
 
 #include <algorithm>
 #include <atomic>
@@ -23,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <span>
 
 namespace prt::prtview {
 
@@ -56,9 +58,16 @@ std::vector<float> environment_sh(const bake::EnvMap& env, int order, std::strin
   return light;
 }
 
-// Per-vertex E/pi from diffuse transfer (any environment) or band-1 radiance (the baked one).
-std::vector<float> transfer_colours(const Transfer& t, const bake::EnvMap& env, size_t V, std::string& how) {
-  const std::vector<float> light = environment_sh(env, t.order, how);
+// Per-vertex E/pi from diffuse transfer (any environment, turned about +Y by `degrees`) or band-1
+// radiance (the baked one).
+std::vector<float> transfer_colours(const Transfer& t, const bake::EnvMap& env, size_t V, std::string& how, double degrees = 0) {
+  std::vector<float> light = environment_sh(env, t.order, how);
+  if (degrees != 0) {
+    turn_light(light, t.order, degrees);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, ", the environment turned %g degrees about +Y", degrees);
+    how += buf;
+  }
   std::vector<float> colour(3 * V);
   shade::shade_transfer_vertices(t.coeffs, V, t.order, light.data(), colour.data());
   return colour;
@@ -123,14 +132,26 @@ void add_grouped(std::string& how, const std::vector<std::string>& names, const 
   for (const auto& [h, n] : groups) how += "\n  " + std::to_string(n.size()) + " x " + h + ": " + name_list(n, 60);
 }
 
+void turn_light(std::vector<float>& light, int order, double degrees) {
+  const double a = degrees * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  const double R[3][3] = {{c, 0, s}, {0, 1, 0}, {-s, 0, c}};
+  const sh::Rotation rotation(R, order);
+  const size_t n = size_t(order) * size_t(order);
+  std::vector<float> in(n);
+  for (size_t ch = 0; ch < 3; ++ch) {
+    std::copy_n(light.begin() + std::ptrdiff_t(ch * n), n, in.begin());
+    rotation.apply(std::span<const float>(in), std::span<float>(light.data() + ch * n, n));
+  }
+}
+
 view::Image render_vertex_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
-                               const view::Camera& cam, RenderScene& scene) {
+                               const view::Camera& cam, RenderScene& scene, double env_rotate_degrees) {
   scene.mesh = read_mesh(f, file, "");
   const size_t V = scene.mesh.positions.size();
   scene.what = "mesh: " + std::to_string(V) + " vertices, " + std::to_string(scene.mesh.triangles.size()) + " triangles";
   std::vector<float> colour;
   if (kind == "transfer") {
-    colour = transfer_colours(read_transfer(f, file, ""), env, V, scene.how);
+    colour = transfer_colours(read_transfer(f, file, ""), env, V, scene.how, env_rotate_degrees);
   } else if (kind == "band1") {
     colour = band1_colours(read_band1(f, file, "", env), V, scene.how);
   } else {
@@ -143,7 +164,7 @@ view::Image render_vertex_file(const F::Asset& f, const std::string& file, const
 }
 
 view::Image render_texel_file(const F::Asset& f, const std::string& file, const std::string& kind, const bake::EnvMap& env,
-                              const view::Camera& cam, RenderScene& scene) {
+                              const view::Camera& cam, RenderScene& scene, double env_rotate_degrees) {
   scene.mesh = read_mesh(f, file, "");
   const TexelProduct p = read_texel_product(f, file, kind, env);
   const view::LightmapImage map{p.width, p.height, p.channels, *p.values, *p.state};
@@ -158,6 +179,7 @@ view::Image render_texel_file(const F::Asset& f, const std::string& file, const 
   std::unique_ptr<bake::UnshadowedIrradiance> exact;
   if (kind == "transfer") {
     light = environment_sh(env, p.order, scene.how);
+    if (env_rotate_degrees != 0) turn_light(light, p.order, env_rotate_degrees);
     shade = [&](const view::Fragment&, const float* t, float* rgb) { shade::shade_transfer_vertices(t, 1, p.order, light.data(), rgb); };
   } else if (kind == "band1") {
     scene.how = "prt::shade::shade_band1 (E/pi) at the pixel's interpolated normal";

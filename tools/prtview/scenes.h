@@ -59,9 +59,15 @@ std::string name_list(const std::vector<std::string>& names, size_t budget);
 // "  N x how: names" per distinct how.
 void add_grouped(std::string& how, const std::vector<std::string>& names, const std::vector<std::string>& how_of);
 
-// Per-vertex files: kind "transfer", "band1" or "ao".
+// Per-vertex files: kind "transfer", "band1" or "ao". transfer: the environment's SH turned about
+// +Y by `env_rotate_degrees` first (turn_light).
 view::Image render_vertex_file(const formats::Asset& f, const std::string& file, const std::string& kind,
-                               const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
+                               const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene,
+                               double env_rotate_degrees = 0);
+// SH lighting [3][order²] (channel-major) turned about +Y by `degrees`: prt::sh::Rotation of
+// R_y = ((cos, 0, sin), (0, 1, 0), (−sin, 0, cos)), i.e. (x, z) → (x cos + z sin, −x sin + z cos)
+// — the rotation `prtbake export --to web` tabulates per degree for the web viewer.
+void turn_light(std::vector<float>& light, int order, double degrees);
 
 // Per-texel files (/lightmap, 'prtbake texel'): `kind` "transfer", "band1" or "ao" of the
 // lightmap, each pixel sampled bilinearly through its triangle's interpolated UV
@@ -69,7 +75,8 @@ view::Image render_vertex_file(const formats::Asset& f, const std::string& file,
 // pixel's interpolated normal where the formula takes one (band1's y_1m(n), AO's unshadowed
 // irradiance).
 view::Image render_texel_file(const formats::Asset& f, const std::string& file, const std::string& kind,
-                              const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene);
+                              const bake::EnvMap& env, const view::Camera& cam, RenderScene& scene,
+                              double env_rotate_degrees = 0);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
 struct FivView {

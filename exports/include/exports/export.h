@@ -43,9 +43,9 @@
 
 namespace prt::exports {
 
-enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament, Exr };
+enum class ExportFormat { Gltf, Glb, Binary, Unity, Godot, Filament, Exr, Web };
 
-// "gltf", "glb", "bin", "unity", "godot", "filament", "exr" (nullopt for anything else).
+// "gltf", "glb", "bin", "unity", "godot", "filament", "exr", "web" (nullopt for anything else).
 std::optional<ExportFormat> parse_export_format(std::string_view name);
 const char* to_string(ExportFormat format) noexcept;
 // Unity, Godot, Filament: the light-probe formats (the ones an EnvironmentProbe may join).
@@ -71,8 +71,41 @@ struct ExportSummary {
 
 // Writes `asset` (read from `source`, named in messages about what it lacks) as `format` to `out`;
 // `environment` adds the environment probe (probe formats only; std::invalid_argument otherwise).
+// Web is export_web (std::invalid_argument here: it takes environments).
 ExportSummary export_asset(const formats::Asset& asset, const std::filesystem::path& source, ExportFormat format,
                   const std::filesystem::path& out, const std::optional<EnvironmentProbe>& environment = std::nullopt);
+
+// ---- the web viewer (issue 34) ----
+// An environment for the viewer: its radiance SH of order `order` in the file's frame, [i*3 + c]
+// (index l(l+1)+m, as bake::EnvMap::project_sh gives it), its name and SHA-256, and whether the
+// file's lighting was baked with it.
+struct WebEnvironment {
+  std::string name, sha256;
+  int order = 0;
+  std::vector<double> radiance;  // [order²][RGB]
+  bool baked = false;
+};
+// Whether this build carries the viewer (three.js was installed by npm when it was built), and
+// why not: nullptr when it does.
+const char* web_viewer_missing() noexcept;
+// Writes the folder `out` (created; a folder holding an earlier web export, i.e. viewer.json, is
+// replaced; any other existing path is refused): index.html, viewer.js, the shading bodies of the
+// GLSL mirrors under shaders/, three.js under three/, the glb (asset.glb, export_asset's Glb) and
+// viewer.json: the file's metadata (root attributes, per vertex set its products with their
+// integrator, samples and environment, its error report, the albedo prtview multiplies by), the
+// area lights (name, shape, radiance) and per environment the radiance SH
+// turned about +Y by every whole degree d in [0, 360) (prt::sh::Rotation of R_y(d): (x, z) →
+// (x cos d + z sin d, −x sin d + z cos d)), channel-major [3][order²], each number rounded to 9
+// significant digits, the clamped-cosine factors Â_l for the unshadowed view and a default
+// exposure: 1 / max over 4,096 normals (spherical Fibonacci) of the luminance of the order-3
+// unshadowed irradiance / π, to 4 digits — prtview's rule (view/exposure.h) on the SH-band-limited
+// sky. Staged beside `out` and renamed into place. Needs a vertex set with triangles and normals
+// and at least one of /ao, /transfer/diffuse, /radiance/band1, /area_lights/irradiance
+// (FormatError naming `source`);
+// environments are not required (band-1 radiance shades without one). Deterministic: the same
+// inputs give the same bytes. FormatError also when the build has no viewer (web_viewer_missing).
+std::vector<std::filesystem::path> export_web(const formats::Asset& asset, const std::filesystem::path& source,
+                                              const std::filesystem::path& out, const std::vector<WebEnvironment>& environments);
 
 // The binary format's magic (8 bytes) and version (SCHEMA.md "Exports").
 inline constexpr char kBinaryMagic[8] = {'P', 'R', 'T', 'B', 'I', 'N', '\0', '\0'};
