@@ -98,7 +98,8 @@ constexpr Field<Product> kProductFields[] = {
     {N::kBounces, &Product::bounces},
     {N::kBouncesRequested, &Product::bounces_requested},
     {N::kAlbedo, &Product::albedo},
-    {N::kBounceRays, &Product::bounce_rays}};
+    {N::kBounceRays, &Product::bounce_rays},
+    {N::kBounceStdError, &Product::bounce_std_error}};
 
 constexpr Field<ReportRow> kReportFields[] = {
     {N::kColumns, &ReportRow::columns},

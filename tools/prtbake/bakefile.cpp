@@ -84,7 +84,8 @@ void set_mesh(F::VertexSet& set, const bake::Mesh& mesh) {
 }
 
 void set_bounces(F::Product& product, Bounced which, int applied, const bake::BounceSpec& spec,
-                 const std::vector<double>& albedo) {
+                 const std::vector<double>& albedo, double relative_std_error) {
+  product.bounce_std_error = relative_std_error;
   product.bounces = applied;
   product.bounces_requested = spec.bounces;
   product.albedo = albedo;

@@ -42,7 +42,7 @@ void set_products(F::VertexSet& set, const bake::VertexBake& bake, const Product
 // applied and asked for, the albedo (RGB) and the gather rays; the integrand says which recursion.
 enum class Bounced { Transfer, Band1, Shadowed, AreaIrradiance };
 void set_bounces(F::Product& product, Bounced which, int applied, const bake::BounceSpec& spec,
-                 const std::vector<double>& albedo);
+                 const std::vector<double>& albedo, double relative_std_error);
 
 // The lightmap of a texel bake (format v5): /mesh/uv from the UV set, /lightmap/state from the
 // image's texel states (its `padding`), the texels' shade points as world positions and normals

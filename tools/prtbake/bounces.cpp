@@ -28,6 +28,7 @@ void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCast
   bounced_ = direct;
   bounced_->values = std::move(r.values);
   applied_ = r.applied;
+  std_error_ = r.total_relative_std_error();
   if (run.say) {
     char text[96];
     const auto& c = albedo_rgb_;
@@ -40,9 +41,9 @@ void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCast
 void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance,
                                      formats::Product* shadowed) const {
   if (!bounced_) return;
-  if (transfer) set_bounces(*transfer, Bounced::Transfer, applied_, spec_, albedo_rgb_);
-  if (radiance) set_bounces(*radiance, Bounced::Band1, applied_, spec_, albedo_rgb_);
-  if (shadowed) set_bounces(*shadowed, Bounced::Shadowed, applied_, spec_, albedo_rgb_);
+  if (transfer) set_bounces(*transfer, Bounced::Transfer, applied_, spec_, albedo_rgb_, std_error_);
+  if (radiance) set_bounces(*radiance, Bounced::Band1, applied_, spec_, albedo_rgb_, std_error_);
+  if (shadowed) set_bounces(*shadowed, Bounced::Shadowed, applied_, spec_, albedo_rgb_, std_error_);
 }
 
 } // namespace prt::tool

@@ -43,6 +43,7 @@ class ReceiverBounces {
   std::optional<bake::GatherHits> hits_;
   std::optional<bake::VertexBake> bounced_;
   int applied_ = 0;
+  double std_error_ = 0;  // BounceResult::total_relative_std_error
 };
 
 } // namespace prt::tool

@@ -227,7 +227,8 @@ void print_bounces(const bake::BounceResult& result, const bake::BounceSpec& spe
   for (const double r : result.relative_rms) std::printf(" %.3g", r);
   if (result.applied < spec.bounces)
     std::printf("; stopped early: the last one added at most %g of the direct pass's RMS", spec.tolerance);
-  std::printf(")\n");
+  std::printf("); their Monte Carlo error, from the two halves of the rays: %.2g of the direct pass's RMS\n",
+              result.total_relative_std_error());
   std::printf("the file holds direct + bounces; the error check measures the direct pass\n");
   double bounce_seconds = 0;
   for (const double s : result.seconds) bounce_seconds += s;

@@ -270,8 +270,10 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         F::VertexSet& set = obj.set;
         std::optional<F::Product>& t = set.lightmap ? set.lightmap->transfer_diffuse : set.transfer_diffuse;
         std::optional<F::Product>& r = set.lightmap ? set.lightmap->radiance_band1 : set.radiance_band1;
-        if (ob.bounced_transfer && t) tool::set_bounces(*t, Bounced::Transfer, result.bounces_applied, spec, *obj.albedo);
-        if (ob.bounced_radiance && r) tool::set_bounces(*r, Bounced::Band1, result.bounces_applied, spec, *obj.albedo);
+        if (ob.bounced_transfer && t) tool::set_bounces(*t, Bounced::Transfer, result.bounces_applied, spec, *obj.albedo,
+                                                    result.bounce_relative_std_error);
+        if (ob.bounced_radiance && r) tool::set_bounces(*r, Bounced::Band1, result.bounces_applied, spec, *obj.albedo,
+                                                    result.bounce_relative_std_error);
       }
       if (ob.area && ob.lightmap && area_images[i])
         tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);
@@ -282,7 +284,8 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         spec.bounces = scene.bounces;
         spec.rays = result.bounce_rays;
         std::optional<F::Product>& e = obj.set.lightmap ? obj.set.lightmap->area_irradiance : obj.set.area_irradiance;
-        if (e) tool::set_bounces(*e, Bounced::AreaIrradiance, result.bounces_applied, spec, *obj.albedo);
+        if (e) tool::set_bounces(*e, Bounced::AreaIrradiance, result.bounces_applied, spec, *obj.albedo,
+                                                    result.bounce_relative_std_error);
       }
       if (ob.shells) {
         F::Occluder& occluder =

@@ -81,6 +81,7 @@ struct Product {
   // those asked for, the albedo (RGB) they were bounced with and the gather rays per receiver.
   std::optional<int64_t> bounces, bounces_requested, bounce_rays;
   std::optional<std::vector<double>> albedo;
+  std::optional<double> bounce_std_error;  // the bounces' Monte Carlo error relative to the direct RMS
   ExtraAttrs extra;
   bool operator==(const Product&) const = default;
 };

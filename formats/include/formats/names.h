@@ -87,6 +87,7 @@ inline constexpr std::string_view kVisibility = "visibility";
 inline constexpr std::string_view kBounces = "bounces";                    // interreflections: applied
 inline constexpr std::string_view kBouncesRequested = "bounces_requested";
 inline constexpr std::string_view kBounceRays = "bounce_rays";
+inline constexpr std::string_view kBounceStdError = "bounce_std_error";
 // (and kAlbedo, below: RGB)
 // ---- lightmap attributes (v5) ----
 inline constexpr std::string_view kUvSet = "uv_set";    // on /mesh/uv: the set's name in the asset ("TEXCOORD_1", "vt")

@@ -235,9 +235,11 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   for (int b = 1; b <= spec.bounces; ++b) {
     // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source at h, as the field reads it) × its
     // weights; S's weights are (5') with y_i in place of y_1m.
+    // Each row sums its even and its odd rays apart ([0, B) and [B, 2B)): their sum over K is the
+    // bounce, their difference over K its Monte Carlo standard error (two halves of the rays).
     VertexBake pass = bake_rows(
-        0, V, B,
-        [&](size_t v, std::span<double> row, std::span<double>) {
+        0, V, 2 * B,
+        [&](size_t v, std::span<double> both, std::span<double>) {
           double at_hit[kMaxSource];
           double ys[sh::kMaxOrder * sh::kMaxOrder];
           const Frame frame(points[v].n);
@@ -246,6 +248,7 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
             const size_t ray = v * K + k;
             const uint32_t t = hits.triangle[ray];
             if (t == GatherHits::kNone) continue;
+            const std::span<double> row = both.subspan((k % 2) * B, B);
             const Albedo& rho = albedo[t];
             if (rho[0] == 0 && rho[1] == 0 && rho[2] == 0) continue;
             const FieldTaps taps = field.taps(t, hits.weights[ray][0], hits.weights[ray][1]);
@@ -275,10 +278,15 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
               }
             }
           }
-          for (size_t i = 0; i < B; ++i) row[i] /= double(K);
         },
         monitor, label + " (bounce " + std::to_string(b) + ")", "the bounce gather of " + source);
-    made = std::move(pass.values);
+    std::vector<double> half_difference(V * B);
+    for (size_t v = 0; v < V; ++v)
+      for (size_t i = 0; i < B; ++i) {
+        const double h0 = pass.values[v * 2 * B + i], h1 = pass.values[v * 2 * B + B + i];
+        made[v * B + i] = (h0 + h1) / double(K);
+        half_difference[v * B + i] = (h0 - h1) / double(K);
+      }
     // Summed only where non-zero, so an albedo of 0 leaves the direct rows' bits (−0 included).
     for (size_t v = 0; v < V; ++v) {
       for (size_t i = 0; i < nt; ++i)
@@ -288,12 +296,16 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
       for (size_t i = 0; i < ns; ++i)
         if (const double x = made[v * B + nt + nr + i]; x != 0) out.values[v * W + layout.shadowed + i] += x;
     }
-    double r = 0;
+    double r = 0, e = 0;
     const size_t offsets[3] = {0, nt, nt + nr}, counts[3] = {nt, nr, ns};
     for (size_t p = 0; p < 3; ++p)
-      if (direct_rms[p] > 0) r = std::max(r, slice_rms(made, B, offsets[p], counts[p]) / direct_rms[p]);
+      if (direct_rms[p] > 0) {
+        r = std::max(r, slice_rms(made, B, offsets[p], counts[p]) / direct_rms[p]);
+        e = std::max(e, slice_rms(half_difference, B, offsets[p], counts[p]) / direct_rms[p]);
+      }
     out.applied = b;
     out.relative_rms.push_back(r);
+    out.relative_std_error.push_back(e);
     out.seconds.push_back(pass.seconds);
     if (r <= spec.tolerance || b == spec.bounces) break;
     take(made, B, 0, nt, nt + nr);

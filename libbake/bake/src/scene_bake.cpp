@@ -442,6 +442,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       if (t != GatherHits::kNone && (albedo[t][0] > 0 || albedo[t][1] > 0 || albedo[t][2] > 0)) ++met;
     out.bounces_applied = r.applied;
     out.bounce_relative_rms = r.relative_rms;
+    out.bounce_relative_std_error = r.total_relative_std_error();
     out.bounce_rays = spec.rays;
     out.gather_seconds = gather_hits->seconds;
     out.bounce_seconds = 0;
@@ -452,10 +453,12 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     for (const double x : r.relative_rms) rms += printf_string(" %.3g", x);
     char line[512];
     std::snprintf(line, sizeof line,
-                  "bounces: %d of %d over %zu receiver rows of %zu object(s) (each bounce's RMS / the direct pass's:%s); "
+                  "bounces: %d of %d over %zu receiver rows of %zu object(s) (each bounce's RMS / the direct pass's:%s; "
+                  "their Monte Carlo error %.2g of it); "
                   "%u gather rays per row in %.2f s (cached hits %.1f MB), %.1f%% of them met a reflecting surface; the "
                   "bounces took %.3f s",
-                  r.applied, scene.bounces, points.size(), gatherers.size(), rms.c_str(), spec.rays, out.gather_seconds,
+                  r.applied, scene.bounces, points.size(), gatherers.size(), rms.c_str(), out.bounce_relative_std_error,
+                  spec.rays, out.gather_seconds,
                   double(out.gather_bytes) / 1e6, 100 * out.reflecting_share, out.bounce_seconds);
     log(std::string(line) +
         (met == 0 ? " — no ray met a reflecting surface: these bounces add nothing (a convex object alone)" : ""));

@@ -178,7 +178,7 @@ static void check_integrating_sphere(bool radiance) {
       // The closed form with the hole's fraction off by delta_f either way.
       const double tess = unit * std::max(std::abs(closed_total(f + delta_f, rho, B) - closed_total(f, rho, B)),
                                            std::abs(closed_total(f - delta_f, rho, B) - closed_total(f, rho, B)));
-      double mean = 0, worst = 0;
+      double mean = 0, worst = 0, sum2 = 0;
       for (size_t v = 0; v < V; ++v) {
         double value = r.values[v * W];
         if (c >= 0) {  // eq. (4)
@@ -188,7 +188,21 @@ static void check_integrating_sphere(bool radiance) {
         }
         const double err = value - expect;
         mean += err / double(V);
+        sum2 += err * err;
         worst = std::max(worst, std::abs(err));
+      }
+      // The bounces' own error estimate (two halves of the rays, relative to the direct RMS, the
+      // larger over the products): T_00's measured RMS error, less the tessellation's bias, is at
+      // most 3× it (an estimate from one bake of a standard error, and QMC halves are not
+      // independent halves); with T alone it is also at most 3× T's error (with R it is R's, larger).
+      if (c < 0) {
+        const double measured = std::sqrt(sum2 / double(V)) / (kY00 * f), bias = tess / (kY00 * f);
+        std::printf("B=%d T_00: measured RMS error / direct %.3e, estimated %.3e\n", B, measured,
+                    r.total_relative_std_error());
+        EXPECT_LE(measured, 3 * r.total_relative_std_error() + bias) << "B = " << B;
+        if (!radiance) {
+          EXPECT_LE(r.total_relative_std_error(), 3 * (measured + bias)) << "B = " << B;
+        }
       }
       std::printf("B=%d %s: closed form %.6f, mean %.6f (error %.2e; bound %.2e = MC %.2e + tessellation %.2e), "
                   "worst vertex %.2e (bound %.2e)\n",

@@ -222,6 +222,16 @@ struct BounceResult {
   // Per bounce summed: the RMS of its values over the rows over the direct pass's, the larger of
   // T's and R's (each product against itself).
   std::vector<double> relative_rms;
+  // Per bounce summed: its Monte Carlo standard error, estimated from the two halves of the rays
+  // (even and odd k: |S_even − S_odd| / K for a sum (S_even + S_odd) / K), as an RMS over the rows
+  // relative to the direct pass's RMS, the larger over the products. Their sum bounds the error of
+  // all the bounces together whatever their correlation (the rays are reused by every bounce).
+  std::vector<double> relative_std_error;
+  double total_relative_std_error() const {
+    double sum = 0;
+    for (const double e : relative_std_error) sum += e;
+    return sum;
+  }
   std::vector<double> seconds;        // per bounce summed: wall time of its sparse product
 };
 

@@ -56,6 +56,7 @@ struct SceneBake {
   // the cached hits' bytes, and the share of gather rays that met a reflecting surface.
   int bounces_applied = 0;
   std::vector<double> bounce_relative_rms;
+  double bounce_relative_std_error = 0;  // BounceResult::total_relative_std_error
   uint32_t bounce_rays = 0;
   double gather_seconds = 0, bounce_seconds = 0, reflecting_share = 0;
   size_t gather_bytes = 0;
