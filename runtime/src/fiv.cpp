@@ -216,6 +216,19 @@ inline float phi_coordinate(float phi, float n_phi) {
   return clamp_nan_safe(phi / kTwoPiF * n_phi, 0.0f, n_phi);
 }
 
+// acc[e] += w · v[e] for the 9 values of an FIV: SSE2 for the first eight where present, the same
+// float operations per element either way (so the sums do not depend on it).
+inline void add_weighted_fiv(float acc[9], float w, const float* v) {
+#if defined(__SSE2__)
+  const __m128 wv = _mm_set1_ps(w);
+  _mm_storeu_ps(acc, _mm_add_ps(_mm_loadu_ps(acc), _mm_mul_ps(wv, _mm_loadu_ps(v))));
+  _mm_storeu_ps(acc + 4, _mm_add_ps(_mm_loadu_ps(acc + 4), _mm_mul_ps(wv, _mm_loadu_ps(v + 4))));
+  acc[8] += w * v[8];
+#else
+  for (int e = 0; e < 9; ++e) acc[e] += w * v[e];
+#endif
+}
+
 // The trilinear lookup of the shells at grid coordinates t (θ), u (φ) and distance ρ (header
 // comment): ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside;
 // neighbours with valid == 0 at weight 0 and the rest renormalised.
@@ -234,14 +247,26 @@ void sample_shells(const FivOccluder& occ, float t, float u, double rho, float o
     k0 = k1 = last;
     falloff = float((occ.radii[last] / rho) * (occ.radii[last] / rho));
   } else {
-    k1 = int(std::upper_bound(occ.radii, occ.radii + occ.n_rho, float(rho)) - occ.radii);
-    k1 = std::clamp(k1, 1, last);
+    // The last radius <= ρ by a search without data-dependent branches (the loop runs
+    // ceil(log2 Nρ) times for every lookup), then k1 = k0 + 1: std::upper_bound's partition.
+    const float r = float(rho);
+    const float* base = occ.radii;
+    for (int len = occ.n_rho; len > 1;) {
+      const int half = len / 2;
+      base = base[half] <= r ? base + half : base;
+      len -= half;
+    }
+    k1 = std::clamp(int(base - occ.radii) + 1, 1, last);
     k0 = k1 - 1;
     fr = clamp_nan_safe(float((rho - occ.radii[k0]) / (double(occ.radii[k1]) - occ.radii[k0])), 0.0f, 1.0f);
   }
 
-  const int ks[2] = {k0, k1}, is[2] = {i0, i0 + 1}, js[2] = {j0, j1};
   const float wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  // Sample (k, i, j) sits at row (k Nθ + i) Nφ + j; rows of the two layers and two θ rings.
+  const size_t nt = size_t(occ.n_theta), np = size_t(occ.n_phi);
+  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
+                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
+  const size_t js[2] = {size_t(j0), size_t(j1)};
   // Inside the first shell and beyond the last, k0 == k1 and fr == 0: the second layer's weights
   // are 0 and skipping it changes no bit. The plain trilinear value is needed only when no valid
   // neighbour carries weight, so it is summed only then.
@@ -251,12 +276,11 @@ void sample_shells(const FivOccluder& occ, float t, float u, double rho, float o
   for (int a = 0; a < layers; ++a)
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
-        const size_t idx = sample_index(occ, ks[a], is[b], js[c]);
+        const size_t idx = rows[a][b] + js[c];
         if (occ.valid[idx] == 0) continue;
         const float w = wk[a] * wi[b] * wj[c];
-        const float* v = occ.shells + idx * 9;
         masked_weight += w;
-        for (int e = 0; e < 9; ++e) masked[e] += w * v[e];
+        add_weighted_fiv(masked, w, occ.shells + idx * 9);
       }
   if (masked_weight > 0) {
     const float inv = 1.0f / masked_weight;
@@ -268,7 +292,7 @@ void sample_shells(const FivOccluder& occ, float t, float u, double rho, float o
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
         const float w = wk[a] * wi[b] * wj[c];
-        const float* v = occ.shells + sample_index(occ, ks[a], is[b], js[c]) * 9;
+        const float* v = occ.shells + (rows[a][b] + js[c]) * 9;
         for (int e = 0; e < 9; ++e) plain[e] += w * v[e];
       }
   for (int e = 0; e < 9; ++e) out[e] = plain[e] * falloff;
@@ -438,6 +462,23 @@ struct PairBatch {
   }
 };
 
+// Pass 2 of shade_fiv_fast over the n candidates: shell coordinates t (θ) and u (φ) of the unit
+// offsets d, and cos α, α of the discs from sin α. Separate arrays (restrict), so that it vectorises.
+void shell_coordinates_and_discs(int n, const float* __restrict dx, const float* __restrict dy, const float* __restrict dz,
+                                 const float* __restrict last_t, const float* __restrict n_phi,
+                                 const float* __restrict sin_alpha, float* __restrict t, float* __restrict u,
+                                 float* __restrict cos_alpha, float* __restrict alpha) {
+  for (int k = 0; k < n; ++k) {
+    // θ from atan2(|d_xz|, d_y), not acos(d_y) (lookup_fiv_at says why).
+    const float theta = poly_atan2(std::sqrt(dx[k] * dx[k] + dz[k] * dz[k]), dy[k]);
+    t[k] = theta_coordinate(theta, last_t[k]);
+    u[k] = phi_coordinate(poly_atan2(dx[k], dz[k]), n_phi[k]);
+    const float c = std::sqrt(std::max(0.0f, (1.0f - sin_alpha[k]) * (1.0f + sin_alpha[k])));
+    cos_alpha[k] = c;
+    alpha[k] = poly_atan2(sin_alpha[k], c);
+  }
+}
+
 void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n_in[3],
                     const FivShadeOptions& options, float out[3]) {
   const UnitNormal unit(n_in);
@@ -485,14 +526,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     }
   }
   // Pass 2: shell coordinates and discs for all candidates at once (vectorised).
-  for (int k = 0; k < candidates; ++k) {
-    // θ from atan2(|d_xz|, d_y), not acos(d_y) (lookup_fiv_at says why).
-    const float theta = poly_atan2(std::sqrt(dx[k] * dx[k] + dz[k] * dz[k]), dy[k]);
-    t[k] = theta_coordinate(theta, last_t[k]);
-    u[k] = phi_coordinate(poly_atan2(dx[k], dz[k]), n_phi[k]);
-    cos_alpha[k] = std::sqrt(std::max(0.0f, (1.0f - sin_alpha[k]) * (1.0f + sin_alpha[k])));
-    alpha[k] = poly_atan2(sin_alpha[k], cos_alpha[k]);
-  }
+  shell_coordinates_and_discs(candidates, dx, dy, dz, last_t, n_phi, sin_alpha, t, u, cos_alpha, alpha);
   // Pass 3: shell samples and I; the candidates that hide something become active.
   int active = 0;
   for (int k = 0; k < candidates; ++k) {
