@@ -462,6 +462,9 @@ struct PairBatch {
   }
 };
 
+// prtshade/fiv.h tells engines (fibers, small thread stacks) what shade_fiv keeps on the stack.
+static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 18 * 1024, "fiv.h says shade_fiv uses about 17 KB of stack");
+
 // Pass 2 of shade_fiv_fast over the n candidates: shell coordinates t (θ) and u (φ) of the unit
 // offsets d, and cos α, α of the discs from sin α. Separate arrays (restrict), so that it vectorises.
 void shell_coordinates_and_discs(int n, const float* __restrict dx, const float* __restrict dy, const float* __restrict dz,

@@ -73,7 +73,8 @@
 // normals of any length and NaN offsets given to lookup_fiv (treated as ρ = 0).
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
-// nothing except shade_fiv for more than 128 occluders. Thread-safe (no shared state).
+// nothing except shade_fiv for more than 128 occluders. shade_fiv keeps its per-receiver arrays
+// on the stack (about 17 KB). Thread-safe (no shared state).
 #pragma once
 
 #include <cstdint>
