@@ -363,8 +363,9 @@ void shade_fiv_self_unit(const float env_fiv[9], const FivOccluder& occ, const f
 //   2. for all the others at once, in float: the shell coordinates (θ, φ by poly_atan2) and the
 //      occluders' discs (axis, α) — a loop over plain arrays, which the compiler vectorises;
 //   3. per occluder, the shell samples and I (eq. 10); those that hide nothing are dropped;
-//   4. the overlap pairs (eq. 13–14) that a grid over the discs' bounding boxes leaves, their O_ij
-//      in batches (vectorised), added in double in the order of the all-pairs loop.
+//   4. the overlap correction (eq. 13–14): every pair of discs tested four at a time (spatial
+//      culling of the pairs was measured and lost at 100 occluders, bench/RESULTS.md), the O_ij of
+//      those that may overlap formed in batches (vectorised), summed per disc in double.
 
 // Lens area of two planar discs of radii r1, r2 whose centres are d apart (lens_area in float):
 // r1² θ1 + r2² θ2 − ½√k with the half-angles θ_i = atan2(√k, d² + r_i² − r_j²), the shader
@@ -399,9 +400,13 @@ inline float overlap_float(float alpha_i, float alpha_j, float cos_gamma, float 
 inline unsigned disc_pairs_may_overlap(const float* x, const float* y, const float* z, const float* c, const float* s,
                                        float xi, float yi, float zi, float ci, float si) {
 #if defined(__SSE2__)
-  const __m128 cos_gamma = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(xi), _mm_loadu_ps(x)), _mm_mul_ps(_mm_set1_ps(yi), _mm_loadu_ps(y))),
-                                      _mm_mul_ps(_mm_set1_ps(zi), _mm_loadu_ps(z)));
-  const __m128 cos_sum = _mm_sub_ps(_mm_mul_ps(_mm_set1_ps(ci), _mm_loadu_ps(c)), _mm_mul_ps(_mm_set1_ps(si), _mm_loadu_ps(s)));
+  const __m128 xx = _mm_mul_ps(_mm_set1_ps(xi), _mm_loadu_ps(x));
+  const __m128 yy = _mm_mul_ps(_mm_set1_ps(yi), _mm_loadu_ps(y));
+  const __m128 zz = _mm_mul_ps(_mm_set1_ps(zi), _mm_loadu_ps(z));
+  const __m128 cos_gamma = _mm_add_ps(_mm_add_ps(xx, yy), zz);
+  const __m128 cc = _mm_mul_ps(_mm_set1_ps(ci), _mm_loadu_ps(c));
+  const __m128 ss = _mm_mul_ps(_mm_set1_ps(si), _mm_loadu_ps(s));
+  const __m128 cos_sum = _mm_sub_ps(cc, ss);
   return unsigned(_mm_movemask_ps(_mm_cmpge_ps(cos_gamma, cos_sum)));
 #else
   unsigned mask = 0;
@@ -415,7 +420,12 @@ inline unsigned disc_pairs_may_overlap(const float* x, const float* y, const flo
 constexpr int kStackOccluders = 128;
 
 struct Candidates {
-  enum Field { kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha, kI0, kI1, kI2, kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha, kFields };
+  enum Field {
+    kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha,  // per candidate
+    kI0, kI1, kI2,                                                                              // per candidate
+    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha,                      // per active disc
+    kFields
+  };
   static constexpr int kPadding = 4;  // the packed discs are read four at a time
   std::array<float, size_t(kStackOccluders + kPadding) * kFields> stack_floats;
   std::array<double, 2 * kStackOccluders> stack_doubles;
@@ -496,8 +506,10 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   float* const factor = c.field[F::kFactor];
   float *const dx = c.field[F::kDx], *const dy = c.field[F::kDy], *const dz = c.field[F::kDz];
   float *const ax = c.field[F::kAx], *const ay = c.field[F::kAy], *const az = c.field[F::kAz];
-  float *const sin_alpha = c.field[F::kSinAlpha], *const cos_alpha = c.field[F::kCosAlpha], *const alpha = c.field[F::kAlpha];
-  float *const last_t = c.field[F::kLastT], *const n_phi = c.field[F::kNPhi], *const t = c.field[F::kT], *const u = c.field[F::kU];
+  float *const sin_alpha = c.field[F::kSinAlpha], *const cos_alpha = c.field[F::kCosAlpha];
+  float *const alpha = c.field[F::kAlpha];
+  float *const last_t = c.field[F::kLastT], *const n_phi = c.field[F::kNPhi];
+  float *const t = c.field[F::kT], *const u = c.field[F::kU];
   float* const I[3] = {c.field[F::kI0], c.field[F::kI1], c.field[F::kI2]};
 
   // Pass 1: offset, case and distance in double (finite for any finite input).
