@@ -5,11 +5,16 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace prt::shade {
 namespace {
@@ -17,10 +22,39 @@ namespace {
 constexpr double kPi = 3.14159265358979323846264338327950288;
 constexpr float kPiF = 3.14159265358979323846f;
 constexpr float kTwoPiF = 6.28318530717958647692f;
+constexpr float kHalfPiF = 1.57079632679489661923f;
+
+// atan2(y, x) in (−π, π] (atan2(0, 0) = 0) by the odd polynomial of Abramowitz & Stegun 4.4.49
+// on [0, 1] (|error| <= 2e-8 rad, plus float rounding) and the octant reduction: the shader
+// mirrors' prt_atan2 (runtime/shaders/fiv.inc), here without branches. shade_fiv takes its angles
+// from it (glibc's atan2f was a quarter of shade_fiv's time); the slow reference keeps std::atan2.
+inline float poly_atan2(float y, float x) {
+  const float ax = std::fabs(x), ay = std::fabs(y);
+  const float mx = std::max(ax, ay), mn = std::min(ax, ay);
+  const float a = mn / (mx > 0 ? mx : 1.0f);  // the divisor selected, not the quotient: a division
+  const float a2 = a * a;                      // under a condition would keep loops from vectorising
+  float q = 0.0028662257f;
+  q = q * a2 - 0.0161657367f;
+  q = q * a2 + 0.0429096138f;
+  q = q * a2 - 0.0752896400f;
+  q = q * a2 + 0.1065626393f;
+  q = q * a2 - 0.1420889944f;
+  q = q * a2 + 0.1999355085f;
+  q = q * a2 - 0.3333314528f;
+  q = q * a2 + 1.0f;
+  float r = a * q;
+  r = ay > ax ? kHalfPiF - r : r;
+  r = x < 0 ? kPiF - r : r;
+  return y < 0 ? -r : r;
+}
 
 // Clamp that maps NaN to lo (fmax/fmin ignore a NaN operand), so a float-to-int conversion after
 // it is always defined.
-inline float clamp_nan_safe(float x, float lo, float hi) { return std::fmin(std::fmax(x, lo), hi); }
+// Written as selects (not fmin/fmax calls) so that loops over it vectorise.
+inline float clamp_nan_safe(float x, float lo, float hi) {
+  const float above = x >= lo ? x : lo;
+  return above <= hi ? above : hi;
+}
 
 // Bilinear coordinate of one face axis: texel centres at 2(q + ½)/S − 1, clamped to the outer ones.
 inline void face_coordinate(float s, int size, int& q0, int& q1, float& f) {
@@ -67,34 +101,6 @@ inline float plane_height(const FivOccluder& occ, const float p[3], const float 
   double s[3];
   offset_from_centre(occ, p, s);
   return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
-}
-
-// Occluder i as seen from p for the overlap correction: axis a, angular radius α (radians) and
-// sin/cos of α for the cheap disjointness test.
-struct DiscView {
-  float axis[3];
-  float alpha, sin_alpha, cos_alpha;
-};
-
-DiscView disc_view(const FivOccluder& occ, const float p[3], const float n[3]) {
-  const double dx = double(occ.centre[0]) - p[0], dy = double(occ.centre[1]) - p[1], dz = double(occ.centre[2]) - p[2];
-  const double D = std::sqrt(dx * dx + dy * dy + dz * dz);
-  DiscView v{};
-  const double R = occ.radius;
-  if (!(D > 0)) {  // p at the centre (or NaN): the occluder covers the hemisphere around n
-    v.axis[0] = n[0], v.axis[1] = n[1], v.axis[2] = n[2];
-    v.sin_alpha = R > 0 ? 1.0f : 0.0f;
-  } else {
-    v.axis[0] = float(dx / D), v.axis[1] = float(dy / D), v.axis[2] = float(dz / D);
-    v.sin_alpha = float(std::min(1.0, R / D));
-  }
-  v.alpha = std::asin(v.sin_alpha);
-  v.cos_alpha = std::sqrt(std::max(0.0f, 1.0f - v.sin_alpha * v.sin_alpha));
-  return v;
-}
-
-void add_scaled(double acc[3], const float a[3], const float b[3], double w) {
-  for (int c = 0; c < 3; ++c) acc[c] += w * (double(a[c]) + double(b[c]));
 }
 
 inline bool hides_something(const float I[3]) { return I[0] > 0 || I[1] > 0 || I[2] > 0; }
@@ -200,6 +206,100 @@ void lookup_difmap(const DifMap& map, const float n[3], float out[3]) {
 
 namespace {
 
+// kPolyAngles: θ and φ from poly_atan2 (shade_fiv) instead of std::atan2 (lookup_fiv and the
+// slow reference); the two differ by the polynomial's 2e-8 rad and float rounding.
+// Grid coordinate along θ (clamped, poles included; last_t = Nθ − 1) and φ (wraps; u == Nφ is
+// φ == 2π) of a direction's angles.
+inline float theta_coordinate(float theta, float last_t) { return clamp_nan_safe(theta / kPiF * last_t, 0.0f, last_t); }
+inline float phi_coordinate(float phi, float n_phi) {
+  phi = phi < 0 ? phi + kTwoPiF : phi;
+  return clamp_nan_safe(phi / kTwoPiF * n_phi, 0.0f, n_phi);
+}
+
+// acc[e] += w · v[e] for the 9 values of an FIV: SSE2 for the first eight where present, the same
+// float operations per element either way (so the sums do not depend on it).
+inline void add_weighted_fiv(float acc[9], float w, const float* v) {
+#if defined(__SSE2__)
+  const __m128 wv = _mm_set1_ps(w);
+  _mm_storeu_ps(acc, _mm_add_ps(_mm_loadu_ps(acc), _mm_mul_ps(wv, _mm_loadu_ps(v))));
+  _mm_storeu_ps(acc + 4, _mm_add_ps(_mm_loadu_ps(acc + 4), _mm_mul_ps(wv, _mm_loadu_ps(v + 4))));
+  acc[8] += w * v[8];
+#else
+  for (int e = 0; e < 9; ++e) acc[e] += w * v[e];
+#endif
+}
+
+// The trilinear lookup of the shells at grid coordinates t (θ), u (φ) and distance ρ (header
+// comment): ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside;
+// neighbours with valid == 0 at weight 0 and the rest renormalised.
+void sample_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+  const int i0 = std::min(int(t), occ.n_theta - 2);
+  const float ft = t - float(i0);
+  const int ju = std::min(int(u), occ.n_phi);
+  const float fu = u - float(ju);
+  const int j0 = ju % occ.n_phi, j1 = (ju + 1) % occ.n_phi;
+  const int last = occ.n_rho - 1;
+  int k0 = 0, k1 = 0;
+  float fr = 0, falloff = 1;
+  if (rho <= occ.radii[0] || last == 0) {
+    if (last == 0 && rho > occ.radii[0]) falloff = float((occ.radii[0] / rho) * (occ.radii[0] / rho));
+  } else if (rho >= occ.radii[last]) {
+    k0 = k1 = last;
+    falloff = float((occ.radii[last] / rho) * (occ.radii[last] / rho));
+  } else {
+    // The last radius <= ρ by a search without data-dependent branches (the loop runs
+    // ceil(log2 Nρ) times for every lookup), then k1 = k0 + 1: std::upper_bound's partition.
+    const float r = float(rho);
+    const float* base = occ.radii;
+    for (int len = occ.n_rho; len > 1;) {
+      const int half = len / 2;
+      base = base[half] <= r ? base + half : base;
+      len -= half;
+    }
+    k1 = std::clamp(int(base - occ.radii) + 1, 1, last);
+    k0 = k1 - 1;
+    fr = clamp_nan_safe(float((rho - occ.radii[k0]) / (double(occ.radii[k1]) - occ.radii[k0])), 0.0f, 1.0f);
+  }
+
+  const float wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  // Sample (k, i, j) sits at row (k Nθ + i) Nφ + j; rows of the two layers and two θ rings.
+  const size_t nt = size_t(occ.n_theta), np = size_t(occ.n_phi);
+  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
+                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
+  const size_t js[2] = {size_t(j0), size_t(j1)};
+  // Inside the first shell and beyond the last, k0 == k1 and fr == 0: the second layer's weights
+  // are 0 and skipping it changes no bit. The plain trilinear value is needed only when no valid
+  // neighbour carries weight, so it is summed only then.
+  const int layers = k1 == k0 ? 1 : 2;
+  float masked[9] = {};
+  float masked_weight = 0;
+  for (int a = 0; a < layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const size_t idx = rows[a][b] + js[c];
+        if (occ.valid[idx] == 0) continue;
+        const float w = wk[a] * wi[b] * wj[c];
+        masked_weight += w;
+        add_weighted_fiv(masked, w, occ.shells + idx * 9);
+      }
+  if (masked_weight > 0) {
+    const float inv = 1.0f / masked_weight;
+    for (int e = 0; e < 9; ++e) out[e] = masked[e] * inv * falloff;
+    return;
+  }
+  float plain[9] = {};
+  for (int a = 0; a < layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const float w = wk[a] * wi[b] * wj[c];
+        const float* v = occ.shells + (rows[a][b] + js[c]) * 9;
+        for (int e = 0; e < 9; ++e) plain[e] += w * v[e];
+      }
+  for (int e = 0; e < 9; ++e) out[e] = plain[e] * falloff;
+}
+
+// F(s) with the angles from std::atan2: lookup_fiv, occluded_irradiance and the slow reference.
+// (shade_fiv forms the same coordinates with poly_atan2 for all its occluders at once.)
 void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
   // Direction and distance, formed in double: |s| never overflows and d is unit to float precision.
   const double sx = s[0], sy = s[1], sz = s[2];
@@ -212,70 +312,27 @@ void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
     // the weight). The GLSL mirror (runtime/shaders/fiv.glsl) computes θ the same way.
     theta = std::atan2(float(std::sqrt(sx * sx + sz * sz) / rho), dy);
     phi = std::atan2(dx, dz);
-    if (phi < 0) phi += kTwoPiF;
   } else {
     rho = 0;  // ρ == 0 (or NaN): d = +Y, θ = 0
   }
+  sample_shells(occ, theta_coordinate(theta, float(occ.n_theta - 1)), phi_coordinate(phi, float(occ.n_phi)), rho, out);
+}
 
-  // θ: clamped, poles included.
-  const float t = clamp_nan_safe(theta / kPiF * float(occ.n_theta - 1), 0.0f, float(occ.n_theta - 1));
-  const int i0 = std::min(int(t), occ.n_theta - 2);
-  const float ft = t - float(i0);
-  // φ: wraps.
-  const float u = clamp_nan_safe(phi / kTwoPiF * float(occ.n_phi), 0.0f, float(occ.n_phi));
-  const int ju = std::min(int(u), occ.n_phi);
-  const float fu = u - float(ju);
-  const int j0 = ju % occ.n_phi, j1 = (ju + 1) % occ.n_phi;
-  // ρ: linear between the bracketing radii, clamped inside, 1/ρ² falloff outside.
-  const int last = occ.n_rho - 1;
-  int k0 = 0, k1 = 0;
-  float fr = 0, falloff = 1;
-  if (rho <= occ.radii[0] || last == 0) {
-    if (last == 0 && rho > occ.radii[0]) falloff = float((occ.radii[0] / rho) * (occ.radii[0] / rho));
-  } else if (rho >= occ.radii[last]) {
-    k0 = k1 = last;
-    falloff = float((occ.radii[last] / rho) * (occ.radii[last] / rho));
-  } else {
-    k1 = int(std::upper_bound(occ.radii, occ.radii + occ.n_rho, float(rho)) - occ.radii);
-    k1 = std::clamp(k1, 1, last);
-    k0 = k1 - 1;
-    fr = clamp_nan_safe(float((rho - occ.radii[k0]) / (double(occ.radii[k1]) - occ.radii[k0])), 0.0f, 1.0f);
-  }
-
-  const int ks[2] = {k0, k1}, is[2] = {i0, i0 + 1}, js[2] = {j0, j1};
-  const float wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
-  float plain[9] = {}, masked[9] = {};
-  float masked_weight = 0;
-  for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) {
-        const float w = wk[a] * wi[b] * wj[c];
-        const size_t idx = sample_index(occ, ks[a], is[b], js[c]);
-        const float* v = occ.shells + idx * 9;
-        for (int e = 0; e < 9; ++e) plain[e] += w * v[e];
-        if (occ.valid[idx] != 0) {
-          masked_weight += w;
-          for (int e = 0; e < 9; ++e) masked[e] += w * v[e];
-        }
-      }
-  if (masked_weight > 0) {
-    const float inv = 1.0f / masked_weight;
-    for (int e = 0; e < 9; ++e) out[e] = masked[e] * inv * falloff;
-  } else {
-    for (int e = 0; e < 9; ++e) out[e] = plain[e] * falloff;
-  }
+// Factor of the case an occluder is in at height h = n·(centre − p) over the receiver's plane:
+// case C 0; with partial occluders case A 1 and case B (h + R)/(2R), without them 1.
+inline float case_factor(float h, float R, bool partial) {
+  if (!(h > -R)) return 0.0f;  // case C
+  if (!partial || h >= R) return 1.0f;
+  return clamp_nan_safe((h + R) / (2.0f * R), 0.0f, 1.0f);
 }
 
 float partial_factor_unit(const FivOccluder& occ, const float p[3], const float n[3]) {
-  const float h = plane_height(occ, p, n), R = occ.radius;
-  if (!(h > -R)) return 0.0f;  // case C
-  if (h >= R) return 1.0f;     // case A
-  return clamp_nan_safe((h + R) / (2.0f * R), 0.0f, 1.0f);  // case B
+  return case_factor(plane_height(occ, p, n), occ.radius, true);
 }
 
 // occluded_irradiance for a unit n.
 void occluded_irradiance_unit(const FivOccluder& occ, const float p[3], const float n[3], bool partial, float out[3]) {
-  const float factor = partial ? partial_factor_unit(occ, p, n) : (plane_height(occ, p, n) > -occ.radius ? 1.0f : 0.0f);
+  const float factor = case_factor(plane_height(occ, p, n), occ.radius, partial);
   if (factor == 0) {
     out[0] = out[1] = out[2] = 0;
     return;
@@ -299,6 +356,261 @@ void shade_fiv_self_unit(const float env_fiv[9], const FivOccluder& occ, const f
   for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, total[c] - occluded[c]);
 }
 
+// ---------------------------------------------------------------------------------------------
+// shade_fiv's fast path, per receiver in four passes:
+//   1. per occluder, in double: the offset s = p − centre, the case (A/B/C) and ρ = |s|; occluders
+//      in case C are dropped here;
+//   2. for all the others at once, in float: the shell coordinates (θ, φ by poly_atan2) and the
+//      occluders' discs (axis, α) — a loop over plain arrays, which the compiler vectorises;
+//   3. per occluder, the shell samples and I (eq. 10); those that hide nothing are dropped;
+//   4. the overlap correction (eq. 13–14): every pair of discs tested four at a time (spatial
+//      culling of the pairs was measured and lost at 100 occluders, bench/RESULTS.md), the O_ij of
+//      those that may overlap formed in batches (vectorised), summed per disc in double.
+
+// Lens area of two planar discs of radii r1, r2 whose centres are d apart (lens_area in float):
+// r1² θ1 + r2² θ2 − ½√k with the half-angles θ_i = atan2(√k, d² + r_i² − r_j²), the shader
+// mirrors' prt_fiv_lens_area. One √k is shared by all terms, so the cancellation at tangency is
+// first-order exact: the error stays a few float ε of π min(r)². Branch-free (every case is
+// formed, then one is selected) so that a loop over it vectorises.
+inline float lens_area_float(float r1, float r2, float d) {
+  const float rmin = std::min(r1, r2);
+  const float contained = kPiF * rmin * rmin;
+  const float k = std::max(0.0f, (-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2));
+  const float sk = std::sqrt(k);
+  const float area = r1 * r1 * poly_atan2(sk, d * d + r1 * r1 - r2 * r2) +
+                     r2 * r2 * poly_atan2(sk, d * d + r2 * r2 - r1 * r1) - 0.5f * sk;
+  const float lens = std::min(std::max(area, 0.0f), contained);
+  return d >= r1 + r2 ? 0.0f : (d <= std::fabs(r1 - r2) ? contained : lens);
+}
+
+// O_ij of eq. 14 for discs of angular radii alpha_i, alpha_j whose axes a, b have a·b = cos_gamma
+// and |a×b|² = sin2_gamma; γ = atan2(|a×b|, a·b), accurate for small angles, where acos(a·b)
+// loses half the digits.
+inline float overlap_float(float alpha_i, float alpha_j, float cos_gamma, float sin2_gamma) {
+  const float gamma = poly_atan2(std::sqrt(sin2_gamma), cos_gamma);
+  const float denom = kPiF * (alpha_i * alpha_i + alpha_j * alpha_j);
+  const float lens = lens_area_float(alpha_i, alpha_j, gamma);
+  return denom > 0 ? lens / (denom > 0 ? denom : 1.0f) : 0.0f;
+}
+
+// Four pair tests at once: bit k is set when the disc (x[k], y[k], z[k]) of angular radius α_k
+// (cos α_k = c[k], sin α_k = s[k]) may overlap the disc (xi, yi, zi) of radius α_i, i.e. when
+// cos γ = a_i·a_k >= cos(α_i + α_k) = ci c[k] − si s[k]. SSE2 (every x86-64) where present, the
+// same float operations in the same order otherwise.
+inline unsigned disc_pairs_may_overlap(const float* x, const float* y, const float* z, const float* c, const float* s,
+                                       float xi, float yi, float zi, float ci, float si) {
+#if defined(__SSE2__)
+  const __m128 xx = _mm_mul_ps(_mm_set1_ps(xi), _mm_loadu_ps(x));
+  const __m128 yy = _mm_mul_ps(_mm_set1_ps(yi), _mm_loadu_ps(y));
+  const __m128 zz = _mm_mul_ps(_mm_set1_ps(zi), _mm_loadu_ps(z));
+  const __m128 cos_gamma = _mm_add_ps(_mm_add_ps(xx, yy), zz);
+  const __m128 cc = _mm_mul_ps(_mm_set1_ps(ci), _mm_loadu_ps(c));
+  const __m128 ss = _mm_mul_ps(_mm_set1_ps(si), _mm_loadu_ps(s));
+  const __m128 cos_sum = _mm_sub_ps(cc, ss);
+  return unsigned(_mm_movemask_ps(_mm_cmpge_ps(cos_gamma, cos_sum)));
+#else
+  unsigned mask = 0;
+  for (int k = 0; k < 4; ++k) mask |= (xi * x[k] + yi * y[k] + zi * z[k] >= ci * c[k] - si * s[k] ? 1u : 0u) << k;
+  return mask;
+#endif
+}
+
+// The per-receiver arrays of the occluders that passed pass 1 ("candidates"), indexed by
+// candidate; on the stack up to kStackOccluders occluders, on the heap beyond.
+constexpr int kStackOccluders = 128;
+
+struct Candidates {
+  enum Field {
+    kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha,  // per candidate
+    kI0, kI1, kI2,                                                                              // per candidate
+    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha,                      // per active disc
+    kFields
+  };
+  static constexpr int kPadding = 4;  // the packed discs are read four at a time
+  std::array<float, size_t(kStackOccluders + kPadding) * kFields> stack_floats;
+  std::array<double, 2 * kStackOccluders> stack_doubles;
+  std::array<int, 2 * kStackOccluders> stack_ints;
+  std::vector<float> heap_floats;
+  std::vector<double> heap_doubles;
+  std::vector<int> heap_ints;
+  float* field[kFields];
+  double* rho;
+  double* weight;  // per active disc: W_i = Σ_j O_ij
+  int* index;   // the occluder of candidate c
+  int* active;  // the candidates that hide something, in order
+
+  explicit Candidates(int count) {
+    float* floats = stack_floats.data();
+    rho = stack_doubles.data();
+    index = stack_ints.data();
+    size_t stride = kStackOccluders;
+    if (count > kStackOccluders) {
+      stride = size_t(count);
+      heap_floats.resize((stride + kPadding) * kFields);
+      heap_doubles.resize(2 * stride);
+      heap_ints.resize(2 * stride);
+      floats = heap_floats.data(), rho = heap_doubles.data(), index = heap_ints.data();
+    }
+    for (int f = 0; f < kFields; ++f) field[f] = floats + size_t(f) * (stride + kPadding);
+    active = index + stride;
+    weight = rho + stride;
+  }
+  Candidates(const Candidates&) = delete;
+  Candidates& operator=(const Candidates&) = delete;
+};
+
+// Pairs whose discs may overlap wait in a batch; their O_ij are then formed in one loop over plain
+// arrays, which the compiler vectorises, and added in the order they came.
+struct PairBatch {
+  static constexpr int kSize = 64;
+  int count = 0;
+  int i[kSize], j[kSize];
+  float alpha_i[kSize], alpha_j[kSize], cos_gamma[kSize], sin2_gamma[kSize], o[kSize];
+
+  void overlaps() {
+    for (int k = 0; k < count; ++k) o[k] = overlap_float(alpha_i[k], alpha_j[k], cos_gamma[k], sin2_gamma[k]);
+  }
+};
+
+// prtshade/fiv.h tells engines (fibers, small thread stacks) what shade_fiv keeps on the stack.
+static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 18 * 1024, "fiv.h says shade_fiv uses about 17 KB of stack");
+
+// Pass 2 of shade_fiv_fast over the n candidates: shell coordinates t (θ) and u (φ) of the unit
+// offsets d, and cos α, α of the discs from sin α. Separate arrays (restrict), so that it vectorises.
+void shell_coordinates_and_discs(int n, const float* __restrict dx, const float* __restrict dy, const float* __restrict dz,
+                                 const float* __restrict last_t, const float* __restrict n_phi,
+                                 const float* __restrict sin_alpha, float* __restrict t, float* __restrict u,
+                                 float* __restrict cos_alpha, float* __restrict alpha) {
+  for (int k = 0; k < n; ++k) {
+    // θ from atan2(|d_xz|, d_y), not acos(d_y) (lookup_fiv_at says why).
+    const float theta = poly_atan2(std::sqrt(dx[k] * dx[k] + dz[k] * dz[k]), dy[k]);
+    t[k] = theta_coordinate(theta, last_t[k]);
+    u[k] = phi_coordinate(poly_atan2(dx[k], dz[k]), n_phi[k]);
+    const float c = std::sqrt(std::max(0.0f, (1.0f - sin_alpha[k]) * (1.0f + sin_alpha[k])));
+    cos_alpha[k] = c;
+    alpha[k] = poly_atan2(sin_alpha[k], c);
+  }
+}
+
+void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n_in[3],
+                    const FivShadeOptions& options, float out[3]) {
+  const UnitNormal unit(n_in);
+  const float* n = unit.v;
+  // Accumulated in double: with hundreds of occluders and pair terms, float sums would drift by
+  // ~count·ε·E_tot; the per-occluder work stays in float.
+  float tot[3];
+  lookup_difmap(map, n, tot);
+  double acc[3] = {tot[0], tot[1], tot[2]};
+  Candidates c(count);
+  using F = Candidates::Field;
+  float* const factor = c.field[F::kFactor];
+  float *const dx = c.field[F::kDx], *const dy = c.field[F::kDy], *const dz = c.field[F::kDz];
+  float *const ax = c.field[F::kAx], *const ay = c.field[F::kAy], *const az = c.field[F::kAz];
+  float *const sin_alpha = c.field[F::kSinAlpha], *const cos_alpha = c.field[F::kCosAlpha];
+  float *const alpha = c.field[F::kAlpha];
+  float *const last_t = c.field[F::kLastT], *const n_phi = c.field[F::kNPhi];
+  float *const t = c.field[F::kT], *const u = c.field[F::kU];
+  float* const I[3] = {c.field[F::kI0], c.field[F::kI1], c.field[F::kI2]};
+
+  // Pass 1: offset, case and distance in double (finite for any finite input).
+  int candidates = 0;
+  for (int i = 0; i < count; ++i) {
+    const FivOccluder& occ = occluders[i];
+    double s[3];
+    offset_from_centre(occ, p, s);
+    const float h = float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
+    const float f = case_factor(h, occ.radius, options.partial_occluders);
+    if (f == 0) continue;
+    const int k = candidates++;
+    c.index[k] = i;
+    factor[k] = f;
+    last_t[k] = float(occ.n_theta - 1);
+    n_phi[k] = float(occ.n_phi);
+    const double rho = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    if (rho > 0 && std::isfinite(rho)) {
+      const double inv = 1.0 / rho;
+      c.rho[k] = rho;
+      dx[k] = float(s[0] * inv), dy[k] = float(s[1] * inv), dz[k] = float(s[2] * inv);
+      ax[k] = -dx[k], ay[k] = -dy[k], az[k] = -dz[k];  // centre − p = −s
+      sin_alpha[k] = float(std::min(1.0, double(occ.radius) * inv));
+    } else {  // p at the centre: the lookup's d = +Y; the disc covers the hemisphere around n
+      c.rho[k] = 0;
+      dx[k] = 0, dy[k] = 1, dz[k] = 0;
+      ax[k] = n[0], ay[k] = n[1], az[k] = n[2];
+      sin_alpha[k] = 1;
+    }
+  }
+  // Pass 2: shell coordinates and discs for all candidates at once (vectorised).
+  shell_coordinates_and_discs(candidates, dx, dy, dz, last_t, n_phi, sin_alpha, t, u, cos_alpha, alpha);
+  // Pass 3: shell samples and I; the candidates that hide something become active.
+  int active = 0;
+  for (int k = 0; k < candidates; ++k) {
+    float fv[9], e[3];
+    sample_shells(occluders[c.index[k]], t[k], u[k], c.rho[k], fv);
+    project_fiv(fv, n, e);
+    bool hides = false;
+    for (int ch = 0; ch < 3; ++ch) {
+      I[ch][k] = std::max(0.0f, factor[k] * e[ch]);
+      acc[ch] -= I[ch][k];
+      hides = hides || I[ch][k] > 0;
+    }
+    if (hides) c.active[active++] = k;
+  }
+  // Pass 4: the overlap correction, Σ_{i<j} O_ij (I_i + I_j) = Σ_i W_i I_i with W_i = Σ_{j≠i} O_ij
+  // summed in double.
+  if (options.overlap_correction && active > 1) {
+    // The active discs packed in order, so that the test of one disc against all later ones runs
+    // over contiguous arrays (vectorised).
+    float* const pax = c.field[F::kPackedAx];
+    float* const pay = c.field[F::kPackedAy];
+    float* const paz = c.field[F::kPackedAz];
+    float* const pcos = c.field[F::kPackedCos];
+    float* const psin = c.field[F::kPackedSin];
+    float* const palpha = c.field[F::kPackedAlpha];
+    for (int a = 0; a < active; ++a) {
+      const int k = c.active[a];
+      pax[a] = ax[k], pay[a] = ay[k], paz[a] = az[k];
+      pcos[a] = cos_alpha[k], psin[a] = sin_alpha[k], palpha[a] = alpha[k];
+      c.weight[a] = 0;
+    }
+    // Padding that never passes: cos γ = 0 < 4 (cos α_i + sin α_i) <= cos_sum.
+    for (int a = active; a < active + Candidates::kPadding; ++a) pax[a] = pay[a] = paz[a] = 0, pcos[a] = 4, psin[a] = -4;
+    PairBatch batch;
+    const auto flush = [&] {
+      batch.overlaps();
+      for (int b = 0; b < batch.count; ++b) {
+        c.weight[batch.i[b]] += double(batch.o[b]);
+        c.weight[batch.j[b]] += double(batch.o[b]);
+      }
+      batch.count = 0;
+    };
+    for (int i = 0; i + 1 < active; ++i) {
+      const float xi = pax[i], yi = pay[i], zi = paz[i], ci = pcos[i], si = psin[i];
+      for (int j0 = i + 1; j0 < active; j0 += 4) {
+        // Disjoint discs (γ >= α_i + α_j, both angles in [0, π/2]) have cos γ < cos(α_i + α_j)
+        // and no lens; the few others go to the batch.
+        for (unsigned m = disc_pairs_may_overlap(pax + j0, pay + j0, paz + j0, pcos + j0, psin + j0, xi, yi, zi, ci, si);
+             m != 0; m &= m - 1) {
+          const int j = j0 + std::countr_zero(m);
+          const float cx = yi * paz[j] - zi * pay[j];
+          const float cy = zi * pax[j] - xi * paz[j];
+          const float cz = xi * pay[j] - yi * pax[j];
+          const int b = batch.count++;
+          batch.i[b] = i, batch.j[b] = j;
+          batch.alpha_i[b] = palpha[i], batch.alpha_j[b] = palpha[j];
+          batch.cos_gamma[b] = xi * pax[j] + yi * pay[j] + zi * paz[j];
+          batch.sin2_gamma[b] = cx * cx + cy * cy + cz * cz;
+          if (batch.count == PairBatch::kSize) flush();
+        }
+      }
+    }
+    flush();
+    for (int a = 0; a < active; ++a)
+      for (int ch = 0; ch < 3; ++ch) acc[ch] += c.weight[a] * double(I[ch][c.active[a]]);
+  }
+  for (int ch = 0; ch < 3; ++ch) out[ch] = float(std::max(0.0, acc[ch]));
+}
+
 } // namespace
 
 void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
@@ -317,56 +629,9 @@ void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n
   occluded_irradiance_unit(occ, p, UnitNormal(n).v, partial, out);
 }
 
-void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n_in[3],
+void shade_fiv(const DifMap& map, const FivOccluder* occluders, int count, const float p[3], const float n[3],
                const FivShadeOptions& options, float out[3]) {
-  const UnitNormal unit(n_in);
-  const float* n = unit.v;
-  // Accumulated in double: with hundreds of occluders and pair terms, float sums would drift by
-  // ~count·ε·E_tot; the per-occluder work stays in float.
-  float tot[3];
-  lookup_difmap(map, n, tot);
-  double acc[3] = {tot[0], tot[1], tot[2]};
-  struct State {
-    float I[3];
-    DiscView disc;
-  };
-  constexpr int kStack = 128;
-  std::array<State, kStack> stack_states;
-  std::vector<State> heap_states;
-  State* st = stack_states.data();
-  if (count > kStack) {
-    heap_states.resize(size_t(count));
-    st = heap_states.data();
-  }
-  int active = 0;  // occluders that hide something are compacted to st[0 .. active)
-  for (int i = 0; i < count; ++i) {
-    State& s = st[active];
-    occluded_irradiance_unit(occluders[i], p, n, options.partial_occluders, s.I);
-    if (!hides_something(s.I)) continue;
-    for (int c = 0; c < 3; ++c) acc[c] -= s.I[c];
-    if (options.overlap_correction) s.disc = disc_view(occluders[i], p, n);
-    ++active;
-  }
-  if (options.overlap_correction) {
-    for (int i = 0; i < active; ++i) {
-      const DiscView& a = st[i].disc;
-      for (int j = i + 1; j < active; ++j) {
-        const DiscView& b = st[j].disc;
-        // Disjoint discs (γ >= α_i + α_j, both angles in [0, π]) have no lens: skip without acos.
-        const float cos_gamma = a.axis[0] * b.axis[0] + a.axis[1] * b.axis[1] + a.axis[2] * b.axis[2];
-        const float cos_sum = a.cos_alpha * b.cos_alpha - a.sin_alpha * b.sin_alpha;
-        if (cos_gamma < cos_sum) continue;
-        // γ from atan2(|a×b|, a·b): accurate for small angles, where acos(a·b) loses half the digits.
-        const float cx = a.axis[1] * b.axis[2] - a.axis[2] * b.axis[1];
-        const float cy = a.axis[2] * b.axis[0] - a.axis[0] * b.axis[2];
-        const float cz = a.axis[0] * b.axis[1] - a.axis[1] * b.axis[0];
-        const float gamma = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), cos_gamma);
-        const double o = overlap_fraction(a.alpha, b.alpha, gamma);
-        if (o > 0) add_scaled(acc, st[i].I, st[j].I, o);
-      }
-    }
-  }
-  for (int c = 0; c < 3; ++c) out[c] = float(std::max(0.0, acc[c]));
+  shade_fiv_fast(map, occluders, count, p, n, options, out);
 }
 
 void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float p[3], const float n[3], float out[3]) {

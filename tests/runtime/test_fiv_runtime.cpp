@@ -9,8 +9,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -429,6 +432,72 @@ TEST(ShadeFiv, FastPathMatchesSlowReference) {
     }
   }
   EXPECT_GT(pairs_overlapping, 50);  // the overlap path was exercised
+}
+
+// The fast path against the slow reference where it is meant to be fast: 100 and 200 (the heap
+// path) instances of one asset scattered over a ground, receivers on the ground with tilted
+// normals, cases A, B and C and ~1.5 overlapping pairs per occluder. The two differ in
+//  - the shell angles: the fast path's polynomial atan2 (2e-8 rad) on float arguments, within
+//    kAngle = 7e-7 rad of the reference's, i.e. <= 7e-7 · 32/(2π) < 4e-6 grid steps here; the
+//    shell values change by <= 1 per step, so n·F moves by <= √3 · 4e-6 < kLookup = 1e-5 per
+//    occluder (with the float rounding of the 8-sample sum);
+//  - O_ij, in float with γ and α within kAngle: the lens area moves by at most its chord (<= 2
+//    min α) per radian, so O by <= kAngle / (π min(α_i, α_j)) per pair, times I_i + I_j;
+//  - the final rounding of E to float (4 ε E).
+// The bound is formed per receiver from the reference's own terms.
+TEST(ShadeFiv, ScatteredOccludersMatchTheSlowReference) {
+  constexpr double kAngle = 7e-7, kLookup = 1e-5;
+  std::mt19937 rng(33);
+  std::uniform_real_distribution<float> u01(0, 1);
+  Shells asset(12, 17, 32, [&](int, int, int, int) { return u01(rng); });
+  const std::vector<float> cube = flat_cube(4, 400.0f);
+  for (const int count : {100, 200}) {
+    std::vector<FivOccluder> views;
+    for (int i = 0; i < count; ++i) {
+      FivOccluder v = asset.view();
+      v.centre[0] = 40 * u01(rng) - 20, v.centre[1] = 5.5f * u01(rng) - 1.5f, v.centre[2] = 40 * u01(rng) - 20;
+      v.radius = 0.5f + u01(rng);
+      views.push_back(v);
+    }
+    double worst = 0;
+    int overlapping = 0;
+    for (int trial = 0; trial < 100; ++trial) {
+      const float p[3] = {40 * u01(rng) - 20, 0, 40 * u01(rng) - 20};
+      float n[3] = {u01(rng) - 0.5f, 1.0f, u01(rng) - 0.5f};
+      const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+      float fast[3], slow[3];
+      shade::shade_fiv({4, cube.data()}, views.data(), count, p, n, {}, fast);
+      shade::shade_fiv_reference({4, cube.data()}, views.data(), count, p, n, {}, slow);
+      // The reference's terms: I_i, and the discs of the occluders that hide something.
+      std::vector<std::array<double, 3>> I;
+      std::vector<std::array<double, 4>> disc;  // axis, α
+      for (const FivOccluder& v : views) {
+        float i3[3];
+        shade::occluded_irradiance(v, p, n, true, i3);
+        if (!(i3[0] > 0 || i3[1] > 0 || i3[2] > 0)) continue;
+        I.push_back({i3[0], i3[1], i3[2]});
+        const double d[3] = {double(v.centre[0]) - p[0], double(v.centre[1]) - p[1], double(v.centre[2]) - p[2]};
+        const double D = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        disc.push_back({d[0] / D, d[1] / D, d[2] / D, std::asin(std::min(1.0, double(v.radius) / D))});
+      }
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_GT(slow[c], 0.0f) << "the scene must not clamp E to 0, or nothing is compared";
+        double tolerance = 4 * double(FLT_EPSILON) * slow[c] + kLookup * double(I.size());
+        for (size_t i = 0; i < I.size(); ++i)
+          for (size_t j = i + 1; j < I.size(); ++j) {
+            const double cos_gamma = disc[i][0] * disc[j][0] + disc[i][1] * disc[j][1] + disc[i][2] * disc[j][2];
+            if (std::acos(std::clamp(cos_gamma, -1.0, 1.0)) >= disc[i][3] + disc[j][3] + kAngle) continue;
+            overlapping += c == 0;
+            tolerance += kAngle / (kPi * std::min(disc[i][3], disc[j][3])) * (I[i][size_t(c)] + I[j][size_t(c)]);
+          }
+        EXPECT_NEAR(fast[c], slow[c], tolerance) << count << " " << trial << " " << c << " " << len;
+        worst = std::max(worst, std::fabs(double(fast[c]) - slow[c]) / tolerance);
+      }
+    }
+    EXPECT_GT(overlapping, 100 * count / 4);  // the overlap pass was exercised
+    std::printf("%d occluders: %.1f overlapping pairs per receiver, largest |fast - reference| / bound = %.2g\n", count,
+                overlapping / 100.0, worst);
+  }
 }
 
 TEST(ShadeFiv, ManyOccludersUseTheHeapPathAndStayFinite) {

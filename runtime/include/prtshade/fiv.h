@@ -58,7 +58,12 @@
 // Numerics: inputs and outputs are float; shade_fiv sums its terms in double (hundreds of
 // occluders and pair terms would otherwise drift by count·ε·E_tot); s = p − centre, |s| and the
 // plane height n·(centre − p) are formed in double (no overflow for any finite float input), the
-// angles in float. Only the direction of a normal counts: the shading functions use n/|n| (|n| in
+// angles in float. shade_fiv takes its angles (θ, φ, α, γ) from the shader mirrors' polynomial
+// atan2 (Abramowitz & Stegun 4.4.49, 2e-8 rad) and forms O_ij in float with their lens formula;
+// lookup_fiv, occluded_irradiance and shade_fiv_reference use std::atan2 and double. The two stay
+// within 7e-7 rad of each other's angles, so n·F differs by at most 7e-7 rad times the shells'
+// change per radian (plus float rounding), and O_ij by at most 7e-7 / (π min(α_i, α_j)) per
+// overlapping pair (tests/runtime/test_fiv_runtime.cpp ScatteredOccludersMatchTheSlowReference). Only the direction of a normal counts: the shading functions use n/|n| (|n| in
 // double), and a zero or non-finite normal is +Y, the direction lookup_difmap gives it.
 // Irradiance data (shell values, DifMap texels, the environment FIV) must be finite with
 // magnitude <= kFivValueLimit = 2^64 (the validate_* functions refuse more; no light reaches it):
@@ -68,7 +73,8 @@
 // normals of any length and NaN offsets given to lookup_fiv (treated as ρ = 0).
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
-// nothing except shade_fiv for more than 128 occluders. Thread-safe (no shared state).
+// nothing except shade_fiv for more than 128 occluders. shade_fiv keeps its per-receiver arrays
+// on the stack (about 17 KB). Thread-safe (no shared state).
 #pragma once
 
 #include <cstdint>
