@@ -368,3 +368,15 @@ TEST(SceneAreaLights, PrtviewAddsAGgxLayerThroughLtcAndRefusesItOnBakedVertices)
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_FALSE(fs::exists(d / "no.png"));
 }
+
+// `prtbake scene --help` names every light shape the scene file takes, with its keys (the parser's
+// list in libbake/bake/src/scene_file.cpp), so a user finds lights without the README.
+TEST(SceneAreaLights, SceneHelpNamesTheLightShapesAndTheirKeys) {
+  const auto r = prt::testing::run_tool(PRT_PRTBAKE, "scene --help", fresh_dir("help") / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"\"lights\"", "{\"shape\": \"quad\", \"centre\", \"u\", \"v\"}", "{\"shape\": \"polygon\", \"vertices\"",
+                        "{\"shape\": \"disc\", \"centre\", \"normal\", \"radius\"", "{\"shape\": \"box\", \"centre\", \"size\"",
+                        "{\"shape\": \"cylinder\", \"centre\", \"radius\", \"height\"", "{\"shape\": \"sphere\", \"centre\", \"radius\"",
+                        "\"radiance\": [r,g,b] (required)", "\"two_sided\"", "\"bounces\": B"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}
