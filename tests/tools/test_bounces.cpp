@@ -232,7 +232,9 @@ TEST(Bounces, TheScenePlanSaysWhoReflects) {
                "objects": [{"name": "bunny", "mesh": ")" << kData << R"(/bunny.obj", "role": "both",
                             "material": {"albedo": )" << albedo << R"(}},
                            {"name": "ground", "mesh": ")" << kData << R"(/ground.obj", "role": "receiver"},
-                           {"name": "spider", "mesh": ")" << kData << R"(/spider.obj", "role": "occluder"}]})";
+                           {"name": "spider", "mesh": ")" << kData << R"(/spider.obj", "role": "occluder"},
+                           {"name": "statue", "mesh": ")" << kData << R"(/wuson.obj", "role": "both",
+                            "material": {"phong_exponent": 4, "specular": [0.5, 0.5, 0.5]}}]})";
     return run_tool(PRT_PRTBAKE, "scene " + (d / "scene.json").string() + " --dry-run", d / "capture");
   };
   const auto r = scene("[0.6, 0.5, 0.4]");
@@ -243,7 +245,8 @@ TEST(Bounces, TheScenePlanSaysWhoReflects) {
         "bounces: receiver only: it is not in the occluders' union, so no ray meets it: it gathers the others' light "
         "but reflects none",
         "bounces: occluder only: it casts shadows but has no rows, so it reflects no light",
-        "bounces: 3 of diffuse interreflection, 256 gather rays per receiver row; reflecting: bunny"})
+        "bounces: 3 of diffuse interreflection, 256 gather rays per receiver row; reflecting: bunny",
+        "bounces: radiance/shadowed with 3 bounce(s) of the light the 1 reflecting object(s) send\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
   const auto one = scene("[1, 0.5, 0.4]");
   EXPECT_NE(one.code, 0);

@@ -261,7 +261,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         if (ob.report)
           obj.set.report = tool::report_of(*ob.report, ob.values->seconds, meshes[i].positions.size(), a.reproducible);
       }
-      if (ob.bounced_radiance || ob.bounced_transfer) {
+      if (ob.bounced_radiance || ob.bounced_transfer || ob.bounced_shadowed) {
         // The bounces (bake/bake/scene.h rule "bounces"); `albedo` is this object's (the others'
         // are their objects' albedo attributes).
         bake::BounceSpec spec;
@@ -274,6 +274,10 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                                                     result.bounce_relative_std_error);
         if (ob.bounced_radiance && r) tool::set_bounces(*r, Bounced::Band1, result.bounces_applied, spec, *obj.albedo,
                                                     result.bounce_relative_std_error);
+        std::optional<F::Product>& sh = set.lightmap ? set.lightmap->radiance_shadowed : set.radiance_shadowed;
+        if (ob.bounced_shadowed && sh)
+          tool::set_bounces(*sh, Bounced::Shadowed, result.bounces_applied, spec, *obj.albedo,
+                            result.bounce_relative_std_error);
       }
       if (ob.area && ob.lightmap && area_images[i])
         tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);

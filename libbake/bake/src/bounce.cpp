@@ -182,7 +182,7 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   PRT_CHECK_OP(direct.size(), ==, V * W);
   PRT_CHECK_OP(hits.rows(), ==, V);
   PRT_CHECK(!radiance || hits.mixture);  // the estimators (5') need the mixture's weights
-  PRT_CHECK(ns == 0 || (ls >= 2 && ls2 == size_t(ls) * size_t(ls)));
+  PRT_CHECK(ns == 0 || (ls2 == size_t(ls) * size_t(ls) && (nr > 0 || ls >= 2)));  // E from R, or S's band 1
   PRT_CHECK(spec.bounces >= 0);
   check_albedo(albedo, source);
   if (nt > 0)

@@ -339,8 +339,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     std::vector<size_t> gatherers;
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectPlan& p = plan.objects[i];
-      if (!p.bounce_radiance && !p.bounce_transfer && !p.bounce_area) continue;
-      if ((p.bounce_radiance || p.bounce_transfer) && !direct_rows[i]) continue;
+      if (!p.bounce_radiance && !p.bounce_transfer && !p.bounce_area && !p.bounce_shadowed) continue;
+      if ((p.bounce_radiance || p.bounce_transfer || p.bounce_shadowed) && !direct_rows[i]) continue;
       if (p.bounce_area && !direct_area[i]) direct_area[i] = out.objects[i].area;
       if (p.bounce_area && !direct_area[i]) continue;
       gatherers.push_back(i);
@@ -359,22 +359,28 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     // The rows side by side, per gatherer in order: T (when it bounces, at its one order) and each
     // light's E_l after it, in the transfer's slot — E_l's recursion is T's, eq. (2) with a scalar
     // for y_i: E^{b+1}_l(p) = ∫ (1 − V) H (ρ/π) E^b_l(h) (n·ω) dω, grey ρ (the plan's rule) — then R.
-    int order = 0;
+    // S at the largest order among them; an object of a lower order takes its first L² of each
+    // channel's coefficients (the rest are zeros in, dropped out).
+    int order = 0, s_order = 0;
     bool radiance = false, area = false;
     for (const size_t i : gatherers) {
       if (plan.objects[i].bounce_transfer) order = plan.objects[i].transfer_order;
+      if (plan.objects[i].bounce_shadowed) s_order = std::max(s_order, plan.objects[i].shadowed_order);
       radiance = radiance || plan.objects[i].bounce_radiance;
       area = area || plan.objects[i].bounce_area;
     }
     const size_t nt = size_t(order) * size_t(order), na = area ? nl : 0;
     ProductRequest q;
     q.radiance = radiance ? env : nullptr;
-    ProductLayout layout(q);  // R at 0; then T and E_l put before it
+    if (s_order > 0) q.shadowed = env, q.shadowed_order = s_order;
+    ProductLayout layout(q);  // R at 0, S after it; then T and E_l put before them
     layout.transfer = 0;
     layout.transfer_count = nt + na;
     layout.visibility = layout.radiance = nt + na;
     layout.shadowed = layout.radiance + layout.radiance_count;
-    layout.width = layout.shadowed;
+    layout.width = layout.shadowed + layout.shadowed_count;
+    const size_t ls2 = size_t(s_order) * size_t(s_order);
+    auto s_count = [&](size_t i) { return size_t(plan.objects[i].shadowed_order) * size_t(plan.objects[i].shadowed_order); };
     std::vector<ShadePoint> points;
     std::vector<std::unique_ptr<BounceField>> fields;
     SceneField field;
@@ -396,11 +402,14 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       const size_t n = fields[g]->rows();
       for (size_t r = 0; r < n; ++r, ++row) {
         double* to = &direct[row * layout.width];
-        if (p.bounce_transfer || p.bounce_radiance) {
+        if (p.bounce_transfer || p.bounce_radiance || p.bounce_shadowed) {
           const VertexBake& d = *direct_rows[i];
           const double* from = &d.values[r * d.layout.width];
           if (p.bounce_transfer) std::copy_n(from + d.layout.transfer, nt, to);
           if (p.bounce_radiance) std::copy_n(from + d.layout.radiance, 9, to + layout.radiance);
+          if (p.bounce_shadowed)
+            for (size_t c = 0; c < 3; ++c)
+              std::copy_n(from + d.layout.shadowed + c * s_count(i), s_count(i), to + layout.shadowed + c * ls2);
         }
         if (p.bounce_area)
           for (size_t l = 0; l < nl; ++l) to[nt + l] = (*direct_area[i])[(r * nl + l) * area_stride(i)];
@@ -411,7 +420,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     spec.bounces = scene.bounces;
     spec.rays = scene.bounce_rays ? scene.bounce_rays : BounceSpec::kDefaultRays;
     spec.seed = scene.integrator.seed;
-    if (!gather_hits) gather_hits = gather(*accel.rays(), points, spec, radiance, monitor, "casting bounce rays");
+    if (!gather_hits)
+      gather_hits = gather(*accel.rays(), points, spec, radiance || s_order > 0, monitor, "casting bounce rays");
     const BounceResult r = bounce_rows(field, points, *gather_hits, albedo, layout, direct, spec, scene.file.string(),
                                        monitor, "bouncing light");
     row = 0;
@@ -420,15 +430,18 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ObjectBake& ob = out.objects[i];
       const ObjectPlan& p = plan.objects[i];
       const size_t n = fields[g]->rows();
-      if (p.bounce_transfer || p.bounce_radiance) ob.values = direct_rows[i];
+      if (p.bounce_transfer || p.bounce_radiance || p.bounce_shadowed) ob.values = direct_rows[i];
       if (p.bounce_area) ob.area = direct_area[i];
       for (size_t k = 0; k < n; ++k, ++row) {
         const double* from = &r.values[row * layout.width];
-        if (p.bounce_transfer || p.bounce_radiance) {
+        if (p.bounce_transfer || p.bounce_radiance || p.bounce_shadowed) {
           VertexBake& v = *ob.values;
           double* to = &v.values[k * v.layout.width];
           if (p.bounce_transfer) std::copy_n(from, nt, to + v.layout.transfer);
           if (p.bounce_radiance) std::copy_n(from + layout.radiance, 9, to + v.layout.radiance);
+          if (p.bounce_shadowed)
+            for (size_t c = 0; c < 3; ++c)
+              std::copy_n(from + layout.shadowed + c * ls2, s_count(i), to + v.layout.shadowed + c * s_count(i));
         }
         if (p.bounce_area)
           for (size_t l = 0; l < nl; ++l) (*ob.area)[(k * nl + l) * area_stride(i)] = from[nt + l];
@@ -436,6 +449,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
       ob.bounced_radiance = p.bounce_radiance;
       ob.bounced_transfer = p.bounce_transfer;
       ob.bounced_area = p.bounce_area;
+      ob.bounced_shadowed = p.bounce_shadowed;
     }
     size_t met = 0;
     for (const uint32_t t : gather_hits->triangle)

@@ -50,8 +50,9 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
                                "with a diffuse albedo to have it reflect)");
       continue;
     }
-    if (!p.radiance && p.transfer_order == 0 && !p.area_irradiance) {
-      p.left_out.push_back(b + "no band-1 radiance, diffuse transfer or area-light irradiance to bounce");
+    if (!p.radiance && p.transfer_order == 0 && !p.area_irradiance && p.shadowed_order == 0) {
+      p.left_out.push_back(b + "no band-1 radiance, diffuse transfer, shadowed radiance or area-light irradiance to "
+                               "bounce");
       continue;
     }
     gathers = true;
@@ -72,7 +73,8 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
   }
   if (!gathers || reflect.empty()) {
     plan.notes.push_back(b + std::to_string(scene.bounces) + " asked, none baked: " +
-                         (!gathers ? "no receiver has band-1 radiance, diffuse transfer or area-light irradiance"
+                         (!gathers ? "no receiver has band-1 radiance, diffuse transfer, shadowed radiance or "
+                                     "area-light irradiance"
                                    : "no surface reflects (a reflecting surface is a \"both\" object with a diffuse "
                                      "albedo)"));
     return;
@@ -81,13 +83,15 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
   const bool transfer = !orders.empty() && grey && orders.size() == 1;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     ObjectPlan& p = plan.objects[i];
-    if (!p.receiver || (!p.radiance && p.transfer_order == 0 && !p.area_irradiance)) continue;
+    if (!p.receiver || (!p.radiance && p.transfer_order == 0 && !p.area_irradiance && p.shadowed_order == 0)) continue;
     p.bounce_radiance = p.radiance;
+    p.bounce_shadowed = p.shadowed_order > 0;
     p.bounce_transfer = transfer && p.transfer_order > 0;
     p.bounce_area = grey && p.area_irradiance;
     std::string what;
     for (const auto& [on, name] : {std::pair{p.bounce_radiance, "radiance/band1"},
                                    std::pair{p.bounce_transfer, "transfer/diffuse"},
+                                   std::pair{p.bounce_shadowed, "radiance/shadowed"},
                                    std::pair{p.bounce_area, "area_lights/irradiance"}})
       if (on) what += (what.empty() ? "" : ", ") + std::string(name);
     if (!what.empty())

@@ -118,7 +118,8 @@
 //     vector for all channels), else it stays direct and the plan says why; the band-1 radiance
 //     bounces per channel. The area lights' irradiance E_l (at unit radiance, one value for all
 //     channels) bounces as the transfer does, with grey albedos only; their SH (area_lights/sh,
-//     glossy receivers) stays direct. Each decision is a line of the plan; the bake then logs the share of
+//     glossy receivers) stays direct. A glossy receiver's shadowed radiance S bounces per channel
+//     (it gathers; it reflects only with a diffuse albedo). Each decision is a line of the plan; the bake then logs the share of
 //     gather rays that met a reflecting surface (0: nothing to bounce — a convex object alone);
 //   * area lights ("lights"; none: nothing of them is written): every receiver gets each light's
 //     irradiance at unit radiance, E = ∫ visible light max(n·ω, 0) dω (area_lights/irradiance,
@@ -244,7 +245,8 @@ struct ObjectPlan {
   int area_sh_order = 0;         // area_lights/sh: the visible lights' SH at this order (0: none)
   // Interreflections (the rule "bounces"): its band-1 radiance / transfer get the bounces; it
   // reflects light onto the others (and itself).
-  bool bounce_radiance = false, bounce_transfer = false, bounce_area = false, bounce_reflects = false;
+  bool bounce_radiance = false, bounce_transfer = false, bounce_area = false, bounce_shadowed = false;
+  bool bounce_reflects = false;
   std::vector<std::string> baked, left_out;  // "product: reason", one line each
   // The products of a vertex integrator (bake/integrators/integrator.h); the area lights are not among them.
   bool any_vertex_product() const {

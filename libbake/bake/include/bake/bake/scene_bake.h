@@ -43,6 +43,7 @@ struct ObjectBake {
   // Interreflections (scene.h rule "bounces"): `values` hold direct + SceneBake::bounces_applied
   // bounces in these products.
   bool bounced_radiance = false, bounced_transfer = false, bounced_area = false;  // `area` too
+  bool bounced_shadowed = false;
 };
 
 struct SceneBake {
