@@ -29,13 +29,8 @@ void ReceiverBounces::bounce(const bake::BounceField& field, const bake::RayCast
   bounced_->values = std::move(r.values);
   applied_ = r.applied;
   std_error_ = r.total_relative_std_error();
-  if (run.say) {
-    char text[96];
-    const auto& c = albedo_rgb_;
-    if (c.at(0) == c.at(1) && c.at(0) == c.at(2)) std::snprintf(text, sizeof text, "%g", c[0]);
-    else std::snprintf(text, sizeof text, "%g,%g,%g", c[0], c[1], c[2]);
-    print_bounces(r, spec_, text, *hits_, direct.layout, noun);
-  }
+  if (run.say) print_bounces(r, spec_, bake::albedo_text(albedo_.empty() ? bake::Albedo{0, 0, 0} : albedo_[0]), *hits_,
+                             direct.layout, noun);
 }
 
 void ReceiverBounces::set_attributes(formats::Product* transfer, formats::Product* radiance,

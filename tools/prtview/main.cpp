@@ -16,6 +16,7 @@
 #include <view/reference.h>
 #include <view/text.h>
 
+#include <bake/bake/bounce.h>
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>
 #include <bake/environment/envmap.h>
@@ -480,14 +481,8 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
     throw UsageError("--bounces " + std::to_string(r.bounces) + ": " + a.file +
                      " names no albedo to bounce with (its products carry no bounces): give --albedo A");
   char buf[256];
-  auto rgb_text = [](const std::array<double, 3>& c) {  // "0.6" or "0.8,0.5,0.3"
-    char t[64];
-    if (c[0] == c[1] && c[0] == c[2]) std::snprintf(t, sizeof t, "%.3g", c[0]);
-    else std::snprintf(t, sizeof t, "%.3g,%.3g,%.3g", c[0], c[1], c[2]);
-    return std::string(t);
-  };
-  const std::string albedo_text = r.albedo ? rgb_text(*r.albedo) : "";
-  const char* albedo = albedo_text.c_str();
+  const std::string albedo_caption = r.albedo ? bake::albedo_text(*r.albedo) : "";
+  const char* albedo = albedo_caption.c_str();
   if (r.albedo) {
     const auto& c = *r.albedo;
     scene.albedo.assign(scene.mesh.triangles.size(), {float(c[0]), float(c[1]), float(c[2])});
@@ -511,7 +506,7 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   else if (baked && baked->bounces)
     std::snprintf(buf, sizeof buf, "the file's %s holds %lld bounce%s at albedo %s%s", kind == "transfer" ? "transfer" : "band-1 radiance",
                   static_cast<long long>(file_bounces), file_bounces == 1 ? "" : "s",
-                  file_albedo ? rgb_text(*file_albedo).c_str() : "?",
+                  file_albedo ? bake::albedo_text(*file_albedo).c_str() : "?",
                   a.bounces || a.albedo ? "; overridden on the command line" : "; --bounces B to change");
   else
     std::snprintf(buf, sizeof buf, "--bounces%s", a.albedo ? " and --albedo" : "");

@@ -98,6 +98,13 @@ void check_albedo(std::span<const Albedo> albedo, const std::string& source) {
     }
 }
 
+std::string albedo_text(const Albedo& c) {
+  char text[96];
+  if (c[0] == c[1] && c[0] == c[2]) std::snprintf(text, sizeof text, "%g", c[0]);
+  else std::snprintf(text, sizeof text, "%g,%g,%g", c[0], c[1], c[2]);
+  return text;
+}
+
 void VertexField::spread(std::span<const double> rows, size_t width, std::span<double> entries) const {
   PRT_CHECK_OP(rows.size(), ==, this->rows() * width);
   PRT_CHECK_OP(entries.size(), ==, rows.size());

@@ -28,13 +28,6 @@ std::string density_text(double d) {
 
 namespace {
 
-std::string rgb_text(const std::array<double, 3>& c) {
-  std::ostringstream os;
-  if (c[0] == c[1] && c[0] == c[2]) os << c[0];
-  else os << c[0] << "," << c[1] << "," << c[2];
-  return os.str();
-}
-
 // The rule "bounces" (scene.h): who gathers, who reflects, whether the transfer bounces.
 void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
   if (scene.bounces <= 0) return;
@@ -63,7 +56,7 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
     } else if (o.material.diffuse()) {
       for (size_t c = 0; c < 3; ++c)
         if (!(o.material.albedo[c] < 1))
-          throw InputError(scene.file.string(), "object '" + o.name + "': albedo " + rgb_text(o.material.albedo) +
+          throw InputError(scene.file.string(), "object '" + o.name + "': albedo " + albedo_text(o.material.albedo) +
                                                     " with bake.bounces: an albedo must be below 1, or the bounces "
                                                     "would not converge");
       p.bounce_reflects = true;
@@ -97,7 +90,7 @@ void plan_bounces(const SceneDescription& scene, ScenePlan& plan) {
     if (!what.empty())
       p.baked.push_back(b + what + " with " + std::to_string(scene.bounces) + " bounce(s) of the light the " +
                         std::to_string(reflect.size()) + " reflecting object(s) send" +
-                        (p.bounce_reflects ? " (this one at albedo " + rgb_text(scene.objects[i].material.albedo) + ")"
+                        (p.bounce_reflects ? " (this one at albedo " + albedo_text(scene.objects[i].material.albedo) + ")"
                                            : ""));
     if (p.transfer_order > 0 && !p.bounce_transfer)
       p.left_out.push_back(b + "transfer/diffuse stays direct: " +

@@ -134,6 +134,8 @@ GatherHits gather(const RayCaster& rays, std::span<const ShadePoint> points, con
 // whose albedo has a channel not in [0, 1) (or not finite).
 using Albedo = std::array<double, 3>;
 void check_albedo(std::span<const Albedo> albedo, const std::string& source);
+// An albedo as logs and captions write it: "0.6" when grey, else "0.8,0.5,0.3" (%g each).
+std::string albedo_text(const Albedo& albedo);
 
 // WHERE A HIT TAKES THE PREVIOUS BOUNCE FROM. The rows of a bounce are per receiver; a hit needs
 // the value of the surface it lands on. A field spreads the rows over the places a hit reads
