@@ -210,10 +210,11 @@ void print_rows_baked(const bake::BakeJob& job, bool shards_without_threads) {
 void warn_inexact_texels(const bake::TexelAtlas& atlas, const std::string& who) {
   if (atlas.inexact_samples == 0) return;
   std::fprintf(stderr,
-               "prtbake: warning: %s: %zu of %zu texels could not be put exactly on their triangles (corners whose "
-               "coordinates differ in scale by more than 2^29, such as 4e-17 beside 0.04): such a texel may lie a "
-               "rounding behind its own triangle and see it from behind (dark); moving the mesh off the origin, or "
-               "snapping coordinates that are zero up to rounding, avoids it\n",
+               "prtbake: warning: %s: %zu of %zu texels could not be put exactly on their triangles, nor a few "
+               "roundings in front of them (corners whose coordinates differ in scale by more than 2^29, such as "
+               "4e-17 beside 0.04, on a crease too thin to step out of): such a texel may see its own triangle from "
+               "behind (dark); moving the mesh off the origin, or snapping coordinates that are zero up to rounding, "
+               "avoids it\n",
                who.c_str(), atlas.inexact_samples, atlas.samples.size());
 }
 

@@ -43,10 +43,10 @@ void warn_no_sky(const bake::NoSkyCount& count, const bake::WindingFacts& facts,
 // A target the chooser could not reach within its bounds: it baked the best plan it had
 // (bake/bake/choose.h, step 5); say so on stderr, with the options that go further.
 void warn_unreached(const bake::IntegratorChoice& choice, const std::string& object);
-// On stderr, when a lightmap has texels whose surface point could not be put exactly on its
-// triangle (bake/mesh/texels.h TexelAtlas::inexact_samples: corners whose coordinates differ in
-// scale by more than 2^29, e.g. 4e-17 beside 0.04): such a point may lie a rounding behind its own
-// triangle and see it as a roof (a dark texel). `who`: the file or the scene object.
+// On stderr, when a lightmap has texels whose surface point could neither be put exactly on its
+// triangle nor lifted strictly in front of it (bake/mesh/texels.h TexelAtlas::inexact_samples):
+// such a point may lie a rounding behind its own triangle and see it as a roof (a dark texel).
+// `who`: the file or the scene object.
 void warn_inexact_texels(const bake::TexelAtlas& atlas, const std::string& who);
 
 // The error report's reference for a target (bake/bake/choose.h plan_report_reference), with -v.

@@ -63,11 +63,16 @@ int run_texel(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                  "little gutter at this resolution (bilinear filtering bleeds one chart into the other)\n",
                  a.input.c_str(), atlas.shared_texels, atlas.width, atlas.height, uv.name.c_str());
   warn_inexact_texels(atlas, a.input);
-  if (run.say)
+  if (run.say) {
     std::printf("lightmap: %ux%u texels in UV set %s: %zu covered (%zu by the nearest point of a triangle touching "
                 "the texel, not its centre), %u charts; %zu inside the geometry, filled from their charts\n",
                 atlas.width, atlas.height, uv.name.c_str(), atlas.samples.size(), atlas.texels_off_centre(), atlas.charts,
                 atlas.samples.size() - texels.valid.size());
+    if (atlas.lifted_samples > 0)
+      std::printf("lightmap: %zu texels lie a few roundings in front of their triangles, not on them (corners whose "
+                  "coordinates differ in scale by more than 2^29 leave no double on the surface there)\n",
+                  atlas.lifted_samples);
+  }
 
   bake::PipelineSettings settings;
   settings.integrator = a.integrator;

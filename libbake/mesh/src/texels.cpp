@@ -1,6 +1,7 @@
 // texels.cpp — a lightmap atlas's covered texels and their shade points (bake/mesh/texels.h).
 #include <bake/mesh/texels.h>
 #include <bake/core/error.h>
+#include <bake/mesh/predicates.h>
 #include <bake/mesh/receivers.h>
 
 #include "error_free.h"
@@ -11,8 +12,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <utility>
+#include <vector>
 
 namespace prt::bake {
 namespace {
@@ -91,6 +94,54 @@ bool exact_point_on(const Eigen::Vector3d& o, std::span<const Eigen::Vector3d> q
     }
     if (exact) {
       for (size_t k = 0; k < q.size(); ++k) w[k] = wr[k];
+      return true;
+    }
+  }
+  return false;
+}
+
+// A sample that cannot lie exactly on its triangles (exact_point_on failed) is put strictly in
+// front of each of them instead: of the doubles within `r` = 1, 2, 3, 4 steps (nextafter) of `p`
+// in each coordinate, the nearest to p (ties: the first in x, y, z order) that every triangle of
+// `on` sees on the side the normal n points to (orient3d_exact, so the decision is exact; a
+// triangle whose winding normal is perpendicular to n asks nothing). The point is then a free
+// point a few roundings above its surface: no triangle it was meant to lie on is seen from
+// behind, and those of a crease through it are decided exactly as seen from there. False (p
+// unchanged) when no such double is that near: a sliver of a crease thinner than the steps.
+bool lift_in_front(const Mesh& mesh, std::span<const uint32_t> on, const Eigen::Vector3d& n, Eigen::Vector3d& p) {
+  std::vector<std::pair<std::array<Eigen::Vector3d, 3>, int>> want;  // corners, orient3d_exact's sign in front
+  for (uint32_t f : on) {
+    const auto& tv = mesh.triangles[f];
+    const std::array<Eigen::Vector3d, 3> c = {mesh.positions[tv[0]].cast<double>(), mesh.positions[tv[1]].cast<double>(),
+                                              mesh.positions[tv[2]].cast<double>()};
+    const double facing = (c[1] - c[0]).cross(c[2] - c[0]).dot(n);
+    // det(a − p, b − p, c − p) < 0 for p on the side of the winding normal (b − a) × (c − a).
+    if (facing != 0 && std::isfinite(facing)) want.push_back({c, facing > 0 ? -1 : 1});
+  }
+  const auto in_front = [&](const Eigen::Vector3d& q) {
+    for (const auto& [c, side] : want)
+      if (orient3d_exact(c[0], c[1], c[2], q) != side) return false;
+    return true;
+  };
+  if (in_front(p)) return true;
+  const auto step = [](double x, int k) {
+    for (; k > 0; --k) x = std::nextafter(x, std::numeric_limits<double>::infinity());
+    for (; k < 0; ++k) x = std::nextafter(x, -std::numeric_limits<double>::infinity());
+    return x;
+  };
+  for (int r = 1; r <= 4; ++r) {
+    std::optional<Eigen::Vector3d> best;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    for (int i = -r; i <= r; ++i)
+      for (int j = -r; j <= r; ++j)
+        for (int k = -r; k <= r; ++k) {
+          if (std::max({std::abs(i), std::abs(j), std::abs(k)}) != r) continue;  // the shell of radius r
+          const Eigen::Vector3d q(step(p.x(), i), step(p.y(), j), step(p.z(), k));
+          const double d2 = (q - p).squaredNorm();
+          if (d2 < best_d2 && in_front(q)) best = q, best_d2 = d2;
+        }
+    if (best) {
+      p = *best;
       return true;
     }
   }
@@ -261,6 +312,7 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
     const Eigen::Vector3d corner = mesh.positions[tv[size_t(o)]].cast<double>();
     ShadePoint sp;
     Eigen::Vector3d exact_p;
+    bool inexact = false;
     if (nq == 0) {
       s.barycentric = Eigen::Vector3d::Zero();
       s.barycentric[o] = 1;
@@ -272,7 +324,7 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
         for (size_t j = 0; j < nq; ++j) s.barycentric[qi[j]] = w[j], rest -= w[j];
         s.barycentric[o] = rest;
       } else {
-        ++out.inexact_samples;
+        inexact = true;
         exact_p = Eigen::Vector3d::Zero();
         for (int i = 0; i < 3; ++i) exact_p += s.barycentric[i] * mesh.positions[tv[size_t(i)]].cast<double>();
       }
@@ -295,6 +347,16 @@ TexelAtlas texel_atlas(const Mesh& mesh, const Topology& topology, const UvSet& 
       Eigen::Vector3d into = centroid - sp.p;
       into -= sp.n.dot(into) * sp.n;
       if (const double len = into.norm(); len > 0 && std::isfinite(len)) sp.t = into / len;
+      if (inexact) {
+        // The triangles the intended point lies on: its own and, on an edge, every triangle of that edge.
+        std::vector<uint32_t> on = {t};
+        if (nq == 1)
+          if (const auto e = topology.find_edge(topology.weld[tv[size_t(o)]], topology.weld[tv[size_t(qi[0])]]))
+            for (uint32_t f : topology.faces_of_edge(*e))
+              if (f != t) on.push_back(f);
+        if (lift_in_front(mesh, on, sp.n, sp.p)) ++out.lifted_samples;
+        else ++out.inexact_samples;
+      }
     }
     out.coverage[k] = 1;
     out.samples.push_back(s);

@@ -231,14 +231,12 @@ TEST(Bounce, IntegratingSphereClosedFormPerTexel) {
   const double theta_hole = 0.6435011087932844;  // f = 0.1
   const int n_theta = 48, n_phi = 96;
   const double f = (1 - std::cos(theta_hole)) / 2, rho = 0.8;
-  // Moved off the origin: at (0, 0, 0) the rings' corners at φ = π/2 have x = 0.6 cos(π/2) = 4e-17,
-  // and a texel on an edge from such a corner to one of x = −0.04 cannot be put exactly on its
-  // triangle (bake/mesh/texels.h inexact_samples; no double lies on that segment but its ends), so
-  // it sees its own triangle from behind and gathers nothing — a defect of the texel sampler, not
-  // of the bounces, recorded in bench/RESULTS.md and left for its own fix.
-  Mesh moved = integrating_sphere(theta_hole, n_theta, n_phi);
-  for (Vector3f& p : moved.positions) p += Vector3f(3, 3, 3);
-  const Mesh mesh = make_mesh(moved.positions, moved.triangles, "integrating_sphere", moved.normals);
+  // At the origin the rings' corners at φ = π/2 have x = 0.6 cos(π/2) = 4e-17, and a texel on an
+  // edge from such a corner to one of x = −0.04 cannot be put exactly on its triangle (no double
+  // lies on that segment but its ends): it is lifted a few roundings in front of its triangles
+  // (bake/mesh/texels.h lifted_samples). Before that fix those texels saw their own triangle from
+  // behind and gathered nothing (274 of 8,847 at 128²), which the worst-texel bound below catches.
+  const Mesh mesh = integrating_sphere(theta_hole, n_theta, n_phi);
   const Topology topology = build_topology(mesh);
   const RayCaster rays(mesh, topology);
   LightmapSpec lm;
@@ -246,6 +244,7 @@ TEST(Bounce, IntegratingSphereClosedFormPerTexel) {
   lm.unwrap = true;
   const LightmapReceivers texels = lightmap_receivers(mesh, topology, lm, rays, "sphere texels");
   ASSERT_EQ(texels.atlas.inexact_samples, 0u);
+  EXPECT_GT(texels.atlas.lifted_samples, 0u);  // the hard case is in this test
   const ReceiverSet set = texels.receivers();
   const size_t V = set.points.size();
   ASSERT_GT(V, 1000u);

@@ -70,9 +70,15 @@ struct TexelAtlas {
   // in), and texels whose centre lies inside triangles of two charts (overlapping charts: a
   // lightmap set must have none; a texture set that mirrors or reuses parts has them).
   size_t shared_texels = 0, overlapping_texels = 0;
-  // Samples whose surface point could not be put exactly on its triangle (texels.cpp
-  // exact_point_on: corners too far apart in scale for double) and carry the interpolation's
-  // rounding instead. 0 on every mesh we have seen.
+  // Samples whose surface point cannot be put exactly on its triangle (texels.cpp exact_point_on:
+  // corners whose coordinates differ in scale by more than 2^29, such as 4e-17 beside 0.04, leave
+  // no double on an edge but its ends). Such a point, rounded, could lie behind its own triangle
+  // and see it from behind; it is LIFTED instead: moved by at most 4 roundings per coordinate to
+  // the nearest double strictly in front of every triangle it was meant to lie on (its own, and
+  // on an edge that edge's others), decided by exact orientation (texels.cpp lift_in_front).
+  // inexact_samples counts those for which no such double is near (a sliver crease): they keep
+  // the interpolation's rounding and may see their triangle from behind.
+  size_t lifted_samples = 0;
   size_t inexact_samples = 0;
 };
 
