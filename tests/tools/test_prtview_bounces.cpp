@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -65,6 +66,21 @@ TEST(PrtviewBounces, BouncedBakeMatchesThePathTracedReference) {
   EXPECT_GE(relative_l2, 0.0);
   EXPECT_LE(relative_l2, 0.02);
   EXPECT_GT(direct, 4 * bounced);
+  // The triptych of a bounced file gets the direct light first: direct | baked | reference |
+  // error, four 64-pixel panels side by side, and prints the direct light's error against the
+  // bounced reference (the same pixels: its relative L2 is the bounces' share, several times the
+  // bake's own).
+  const fs::path png = d / "t.png";
+  r = run_tool(PRT_PRTVIEW, file.string() + " --size 64x48 --samples 1024 --triptych -o " + png.string(), d / "capture");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double direct_l2 = printed(r.out, "direct light alone (no bounces) against the reference: relative L2 ");
+  EXPECT_GT(direct_l2, 3 * relative_l2) << r.out;
+  std::ifstream in(png, std::ios::binary);
+  unsigned char header[24] = {};
+  in.read(reinterpret_cast<char*>(header), sizeof header);
+  const uint32_t width = uint32_t(header[16]) << 24 | uint32_t(header[17]) << 16 | uint32_t(header[18]) << 8 | header[19];
+  EXPECT_GE(width, 4u * 64u);  // four panels (plus gaps)
+  EXPECT_LT(width, 5u * 64u);
 }
 
 TEST(PrtviewBounces, ADirectFileNeedsAnAlbedoToBounceWith) {

@@ -163,6 +163,9 @@ OUTPUT (-o; the extension picks the format: .png for people, .exr for numbers)
                   --error-scale x the reference's range; grey = not compared. EXR: the signed
                   difference runtime - reference in float) and prints NRMSE.
   --triptych      runtime | reference | error side by side (same exposure), prints NRMSE.
+                  With bounces (a file baked with --bounces, or --bounces B), a fourth panel
+                  first: the direct light alone, ray traced, and its error against the reference
+                  is printed: direct | baked with bounces | reference | error.
   PNG: 8-bit sRGB of (exposure x value), clipped at 1. --exposure X, default: fixed by the
   environment, never by the pixels, so a file gives the same exposure alone, in a triptych and
   under any camera: 1 / the brightest unshadowed white surface, max over normals n of the
@@ -516,7 +519,7 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
 
 // The environment reference (view/reference.h), read from or written to --reference-cache.
 view::ReferenceImage environment_reference(const Args& a, const prtview::RenderScene& scene, const bake::EnvMap& env,
-                                           const view::Camera& cam, uint32_t bounces, bool say) {
+                                           const view::Camera& cam, uint32_t bounces, bool say, const std::string& cache) {
   view::ReferenceOptions ropt;
   ropt.bounces = bounces;
   ropt.samples = a.samples;
@@ -524,18 +527,25 @@ view::ReferenceImage environment_reference(const Args& a, const prtview::RenderS
   ropt.occluder_spheres = scene.spheres;
   ropt.casts_shadow = scene.casts_shadow;
   ropt.albedo = scene.albedo;
+  if (!scene.reflectance.empty() && bounces > 0) {
+    // A scene file: each object reflects with its diffuse albedo as the bake's, and where some
+    // object's picture carries bounces, only those pixels gather (the others show direct light by
+    // design); a direct-only scene with --bounces gathers everywhere, to show what bounces add.
+    ropt.reflectance = scene.reflectance;
+    if (std::find(scene.gathers.begin(), scene.gathers.end(), uint8_t(1)) != scene.gathers.end()) ropt.gathers = scene.gathers;
+  }
   if (!scene.phong.empty()) ropt.glossy = view::ReferenceOptions::Glossy{cam.eye - scene.mesh.origin, scene.phong, scene.specular};
   const view::ReferenceRenderer rr(scene.mesh, env, ropt);
   std::optional<view::ReferenceImage> cached;
   const std::string key = rr.cache_key(cam);
-  if (!a.reference_cache.empty()) cached = view::load_reference(a.reference_cache, key);
+  if (!cache.empty()) cached = view::load_reference(cache, key);
   const tool::ProgressBar bar(a.quiet ? tool::ProgressStyle::Quiet : tool::ProgressStyle::Auto);
   view::ReferenceImage ref = cached ? std::move(*cached) : rr.render(cam, bar.monitor(&tool::interrupt_token()));
-  if (say && cached) std::printf("reference: %s: read from %s\n", rr.description().c_str(), a.reference_cache.c_str());
+  if (say && cached) std::printf("reference: %s: read from %s\n", rr.description().c_str(), cache.c_str());
   if (say && !cached)
     std::printf("reference: %s: %.2f s, %.2f M rays/s\n", rr.description().c_str(), ref.seconds,
                 double(ref.rays) / ref.seconds / 1e6);
-  if (!cached && !a.reference_cache.empty()) view::save_reference(a.reference_cache, ref, key);
+  if (!cached && !cache.empty()) view::save_reference(cache, ref, key);
   return ref;
 }
 
@@ -794,7 +804,7 @@ int run(const Args& a) {
   }
 
   const view::ReferenceImage ref = area ? area_reference(a, scene, lights, area_options, cam, say)
-                                        : environment_reference(a, scene, *env, cam, reflect.bounces, say);
+                                        : environment_reference(a, scene, *env, cam, reflect.bounces, say, a.reference_cache);
   const view::GBuffer raster = view::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
   const std::string region =
@@ -867,11 +877,23 @@ int run(const Args& a) {
   } else {
     char exposed[48];
     std::snprintf(exposed, sizeof exposed, ", exposure %.4g", exposure);
-    const view::Panel panels[3] = {{view::tone_map(runtime, exposure),
-                                                     "baked (" + caption + (scene.form.empty() ? "" : ", " + scene.form.substr(0, scene.form.find(','))) + ")",
-                                                     std::nullopt},
-                                   {view::tone_map(ref.radiance, exposure), "reference (" + reflect.panel + ")", std::nullopt},
-                                   error_panel};
+    std::vector<view::Panel> panels;
+    if (reflect.bounces > 0 && !area) {
+      // Interreflections: the direct light alone (ray traced, no bounces) before the bake with its
+      // bounces and the path-traced reference, so the picture shows what the bounces add and how
+      // close the bake comes. Cached beside the reference's cache, under its own key.
+      const view::ReferenceImage direct =
+          environment_reference(a, scene, *env, cam, 0, say, a.reference_cache.empty() ? "" : a.reference_cache + ".direct");
+      const view::ImageError d = view::compare_images(direct.radiance, ref.radiance, mask, &ref.std_error);
+      std::printf("direct light alone (no bounces) against the reference: relative L2 %.5f (noise-corrected %.5f): what the "
+                  "bounces add\n", d.relative_l2, d.relative_l2_noise_corrected);
+      panels.push_back({view::tone_map(direct.radiance, exposure), "direct only (ray traced)", std::nullopt});
+    }
+    panels.push_back({view::tone_map(runtime, exposure),
+                      "baked (" + caption + (scene.form.empty() ? "" : ", " + scene.form.substr(0, scene.form.find(','))) + ")",
+                      std::nullopt});
+    panels.push_back({view::tone_map(ref.radiance, exposure), "reference (" + reflect.panel + ")", std::nullopt});
+    panels.push_back(error_panel);
     std::vector<std::string> lines = footer;
     lines.front() += exposed;
     view::write_png(a.output, view::labelled_row(panels, lines));

@@ -372,6 +372,7 @@ bool is_glossy(const F::SceneObject& o) {
 std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string& file, const bake::EnvMap* env) {
   if (env && f.scene) check_same_environment(*f.scene, std::string(N::kScene), *env, file);
   std::vector<SceneObject> objects;
+  std::vector<bool> bounced_objects;  // per object: some product of it carries bounces
   for (const F::SceneObject& baked : f.objects) {
     if (!baked.set.positions) continue;  // not a vertex set
     SceneObject o;
@@ -389,20 +390,32 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     }
     o.mesh = read_mesh(f, file, baked.name);
     const F::VertexSet& s = baked.set;
+    const auto bounced = [](const std::optional<F::Product>& p) { return p && p->bounces.value_or(0) > 0; };
+    const F::Lightmap* m = s.lightmap ? &*s.lightmap : nullptr;
+    const bool any_bounced = bounced(s.radiance_band1) || bounced(s.transfer_diffuse) || bounced(s.radiance_shadowed) ||
+                             (m && (bounced(m->radiance_band1) || bounced(m->transfer_diffuse) || bounced(m->radiance_shadowed)));
+    if (o.role == "both" && baked.albedo && baked.albedo->size() == 3)
+      for (size_t c = 0; c < 3; ++c) o.reflectance[c] = float(std::max(0.0, (*baked.albedo)[c]));
+    bounced_objects.push_back(any_bounced);
     o.glossy_only = s.transfer_visibility && !s.radiance_band1 && !s.transfer_diffuse;
     // The per-vertex product the runtime shades it with: the first of band-1 radiance, transfer, AO.
     if (!env) {
       objects.push_back(std::move(o));
       continue;
     }
-    if (has_band1_in(s)) o.band1 = read_band1(f, file, baked.name, *env);
-    else if (s.transfer_diffuse) o.transfer = read_transfer(f, file, baked.name);
-    else if (s.ao) o.ao = &s.ao->values;
-    else if (s.lightmap) {
+    if (has_band1_in(s)) {
+      o.band1 = read_band1(f, file, baked.name, *env);
+      o.drawn_bounced = s.radiance_band1 ? bounced(s.radiance_band1) : bounced(s.radiance_shadowed);
+    } else if (s.transfer_diffuse) {
+      o.transfer = read_transfer(f, file, baked.name);
+      o.drawn_bounced = bounced(s.transfer_diffuse);
+    } else if (s.ao) {
+      o.ao = &s.ao->values;
+    } else if (m) {
       // Baked per texel (a scene's "lightmap"): the first of band-1 radiance, transfer, AO.
-      const F::Lightmap& m = *s.lightmap;
-      const char* kind = m.radiance_band1 ? "band1" : m.transfer_diffuse ? "transfer" : m.ao ? "ao" : nullptr;
+      const char* kind = m->radiance_band1 ? "band1" : m->transfer_diffuse ? "transfer" : m->ao ? "ao" : nullptr;
       if (kind) o.texels = read_texel_product(s, prefix, file, kind, *env), o.texel_kind = kind;
+      o.drawn_bounced = m->radiance_band1 ? bounced(m->radiance_band1) : m->transfer_diffuse && bounced(m->transfer_diffuse);
     }
     if (is_glossy(baked)) {
       const F::Lightmap* lightmap = s.lightmap ? &*s.lightmap : nullptr;
@@ -428,6 +441,11 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
   }
   if (objects.empty())
     throw InputError(file, "is a scene file without objects (no " + cat(prefix_of("<name>"), N::kPositions) + ")");
+  // A scene baked with bounces: an object none of whose products carries them was left out of the
+  // bake's reflecting set (no rows to bounce), so it reflects nothing.
+  if (std::find(bounced_objects.begin(), bounced_objects.end(), true) != bounced_objects.end())
+    for (size_t k = 0; k < objects.size(); ++k)
+      if (!bounced_objects[k]) objects[k].reflectance = {0, 0, 0};
   return objects;
 }
 

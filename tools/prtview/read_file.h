@@ -127,6 +127,12 @@ struct SceneObject {
   std::string name, role;
   bool receiver = false, casts_shadow = false;
   std::array<float, 3> albedo{1, 1, 1};  // white when the file's albedo is zero
+  // Interreflections (bake/bake/scene.h rule "bounces"): the albedo the object reflects with (0
+  // unless it is "both" with a diffuse albedo; in a scene baked with bounces, also 0 when none of
+  // its products carries them: the bake left it out), and whether the product it is drawn from
+  // carries bounces (AO never does).
+  std::array<float, 3> reflectance{0, 0, 0};
+  bool drawn_bounced = false;
   bake::Mesh mesh;                       // world space
   std::optional<Band1> band1;
   std::optional<Transfer> transfer;

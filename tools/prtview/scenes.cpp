@@ -329,6 +329,8 @@ void add_object(RenderScene& scene, const SceneObject& o) {
   if (scene.first_triangle.empty()) scene.first_triangle = {0};
   scene.casts_shadow.insert(scene.casts_shadow.end(), T, o.casts_shadow ? 1 : 0);
   scene.albedo.insert(scene.albedo.end(), T, o.albedo);
+  scene.reflectance.insert(scene.reflectance.end(), T, o.reflectance);
+  scene.gathers.insert(scene.gathers.end(), T, o.drawn_bounced ? 1 : 0);
   scene.object_names.push_back(o.name);
   scene.object_receiver.push_back(o.receiver);
   scene.first_triangle.push_back(scene.first_triangle.back() + T);

@@ -37,6 +37,10 @@ struct RenderScene {
   // and the objects' triangle ranges: object k owns [first_triangle[k], first_triangle[k + 1]).
   std::vector<uint8_t> casts_shadow;
   std::vector<std::array<float, 3>> albedo;
+  // ... and, for the bounces, the albedo each triangle reflects with in the bake and whether its
+  // pixels show a bounced product (view::ReferenceOptions::reflectance, gathers).
+  std::vector<std::array<float, 3>> reflectance;
+  std::vector<uint8_t> gathers;
   std::vector<std::string> object_names;
   std::vector<bool> object_receiver;
   std::vector<size_t> first_triangle;

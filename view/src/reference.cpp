@@ -140,6 +140,8 @@ ReferenceRenderer::ReferenceRenderer(const bake::Mesh& mesh, const bake::EnvMap&
   PRT_CHECK(!mesh.triangles.empty());
   PRT_CHECK(options_.casts_shadow.empty() || options_.casts_shadow.size() == mesh.triangles.size());
   PRT_CHECK(options_.albedo.empty() || options_.albedo.size() == mesh.triangles.size());
+  PRT_CHECK(options_.reflectance.empty() || options_.reflectance.size() == mesh.triangles.size());
+  PRT_CHECK(options_.gathers.empty() || options_.gathers.size() == mesh.triangles.size());
   PRT_CHECK(!options_.glossy || options_.bounces == 0);
   PRT_CHECK(!options_.glossy ||
             (options_.glossy->phong.size() == mesh.triangles.size() && options_.glossy->specular.size() == mesh.triangles.size()));
@@ -167,9 +169,14 @@ std::string ReferenceRenderer::description() const {
     os << "; shadows cast by " << n << " of " << mesh_.triangles.size() << " triangles";
   }
   if (!options_.albedo.empty() && !options_.glossy) os << "; albedos";
-  if (options_.bounces > 0)
+  if (options_.bounces > 0) {
     os << "; " << options_.bounces << (options_.bounces == 1 ? " bounce" : " bounces") << " path traced, " << options_.samples
        << " paths/pixel";
+    if (!options_.gathers.empty()) {
+      const auto n = std::count_if(options_.gathers.begin(), options_.gathers.end(), [](uint8_t c) { return c != 0; });
+      os << " from " << n << " of " << mesh_.triangles.size() << " triangles";
+    }
+  }
   return os.str();
 }
 
@@ -181,6 +188,12 @@ std::string ReferenceRenderer::cache_key(const Camera& cam) const {
   for (const auto& t : mesh_.triangles) put(t.data(), 3 * sizeof(uint32_t));
   put(options_.casts_shadow.data(), options_.casts_shadow.size());
   for (const auto& c : options_.albedo) put(c.data(), 3 * sizeof(float));
+  if (!options_.reflectance.empty() || !options_.gathers.empty()) {
+    bytes += "|reflectance";
+    for (const auto& c : options_.reflectance) put(c.data(), 3 * sizeof(float));
+    bytes += "|gathers";
+    put(options_.gathers.data(), options_.gathers.size());
+  }
   char buf[512];
   std::snprintf(buf, sizeof buf, "|eye %.17g %.17g %.17g at %.17g %.17g %.17g up %.17g %.17g %.17g fov %.17g near %.17g %dx%d",
                 cam.eye.x(), cam.eye.y(), cam.eye.z(), cam.at.x(), cam.at.y(), cam.at.z(), cam.up.x(), cam.up.y(), cam.up.z(),
@@ -289,8 +302,13 @@ double ReferenceRenderer::albedo(int32_t triangle, int c) const {
   return options_.albedo.empty() ? 1.0 : double(options_.albedo[size_t(triangle)][size_t(c)]);
 }
 
+double ReferenceRenderer::reflectance(int32_t triangle, int c) const {
+  return options_.reflectance.empty() ? albedo(triangle, c) : double(options_.reflectance[size_t(triangle)][size_t(c)]);
+}
+
 uint64_t ReferenceRenderer::indirect(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const {
-  if (options_.bounces == 0 || !rt_->any_caster) {  // nothing reflects
+  if (options_.bounces == 0 || !rt_->any_caster || (!options_.gathers.empty() && !options_.gathers[size_t(f.triangle)])) {
+    // nothing reflects, or the pixel's product holds direct light only
     for (int c = 0; c < 3; ++c) E[c] = std_error[c] = 0;
     return 0;
   }
@@ -312,7 +330,7 @@ uint64_t ReferenceRenderer::indirect(const Fragment& f, uint64_t index, double E
         if (!hit || !hit->front) return;  // the sky (E_direct's), or a back face (black)
         const Fragment h = surface_fragment(mesh_, int32_t(hit->triangle),
                                             {float(1 - hit->w1 - hit->w2), float(hit->w1), float(hit->w2)});
-        for (int c = 0; c < 3; ++c) throughput[c] *= albedo(h.triangle, c);
+        for (int c = 0; c < 3; ++c) throughput[c] *= reflectance(h.triangle, c);
         if (!(throughput[0] > 0 || throughput[1] > 0 || throughput[2] > 0)) return;
         // Next-event estimate of E_direct(h): one sample L V (n·ω) / p of the cosine + environment
         // mixture (½ each; bounded by 2π L as p ≥ (n·ω)/(2π)).

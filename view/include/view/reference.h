@@ -109,6 +109,16 @@ struct ReferenceOptions {
   std::optional<Glossy> glossy;
   // Diffuse interreflection: bounces of light between the triangles (BOUNCES above); 0 = direct only.
   uint32_t bounces = 0;
+  // Scenes with bounces, one entry per triangle (empty: every triangle reflects with albedo[t] and
+  // gathers). They make the reference hold the light the bake claims, object by object:
+  //   reflectance[t]: the albedo a path continues with when it meets triangle t (0: absorbs). A
+  //     scene object that reflects nothing in the bake (an occluder only, or one with no diffuse
+  //     albedo, whose picture is drawn white) reflects nothing here either, while albedo[t] stays
+  //     its picture's tint.
+  //   gathers[t] == 0: triangle t's pixels show direct light only (its product is direct by design:
+  //     AO, FIV shells, flat grey), so no indirect path is traced from it.
+  std::vector<std::array<float, 3>> reflectance;
+  std::vector<uint8_t> gathers;
 };
 
 struct ReferenceImage {
@@ -148,6 +158,7 @@ private:
   // E_ind(f) of BOUNCES and its standard error; returns the rays cast.
   uint64_t indirect(const Fragment& f, uint64_t index, double E[3], double std_error[3]) const;
   double albedo(int32_t triangle, int c) const;
+  double reflectance(int32_t triangle, int c) const;  // ReferenceOptions::reflectance, else albedo
   struct Rays;  // bake/visibility/raycast.h RayCaster over the mesh
   const bake::Mesh& mesh_;
   const bake::EnvMap& env_;
