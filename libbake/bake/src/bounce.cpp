@@ -178,7 +178,7 @@ FieldTaps SceneField::taps(uint32_t triangle, double w1, double w2) const {
 BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
                          std::span<const Albedo> albedo, const ProductLayout& layout, std::span<const double> direct,
                          const BounceSpec& spec, const std::string& source, const Monitor& monitor,
-                         const std::string& label) {
+                         const std::string& label, std::span<const uint8_t> shadowed_rows) {
   const size_t V = field.rows(), E = field.entries(), W = layout.width, nt = layout.transfer_count, K = hits.rays;
   // R (9 values, [c][m]) and S (3 L_s² values, [c][i]); either needs E at the hit, eq. (4), from R
   // or from S's band 1 (R_c,m = S_c,(2+m): the same integral).
@@ -203,9 +203,18 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   if ((nt == 0 && !radiance) || spec.bounces == 0) return out;
 
   // What a bounce gathers per row, [V][S]: T^b (nt values), then E^b_c (3, eq. (4) at the row's
-  // normal, when R or S bounces), spread over the field's entries [E][S]. What it makes per row,
-  // [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], nr), S^{b+1} ([c][i], ns).
-  const size_t S = nt + (radiance ? 3 : 0), B = nt + nr + ns;
+  // normal, when R or S bounces), spread over the field's entries [E][S]. What it makes: per row,
+  // [V][B]: T^{b+1} (nt), R^{b+1} ([c][m], nr); per row that carries S (shadowed_rows), [V_s][ns]:
+  // S^{b+1} ([c][i]). S is kept apart so that a scene whose few glossy objects carry S does not
+  // give every other row S's width (at order 8, 192 doubles a row).
+  const size_t S = nt + (radiance ? 3 : 0), B = nt + nr;
+  std::vector<uint32_t> s_rows;  // the rows that carry S, ascending
+  if (ns > 0) {
+    PRT_CHECK(shadowed_rows.empty() || shadowed_rows.size() == V);
+    for (size_t v = 0; v < V; ++v)
+      if (shadowed_rows.empty() || shadowed_rows[v]) s_rows.push_back(uint32_t(v));
+  }
+  const size_t VS = s_rows.size();
   std::vector<std::array<double, 3>> y1(radiance ? V : 0);  // y_1m(n_r)
   for (size_t v = 0; v < y1.size(); ++v) {
     const Eigen::Vector3d n = points[v].n.normalized();
@@ -213,109 +222,150 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
     sh::eval(2, n.x(), n.y(), n.z(), y);
     y1[v] = {y[1], y[2], y[3]};
   }
-  std::vector<double> source_rows(V * S), field_values(E * S), made(V * B);
-  // `rows` of `width`, T at t_offset, R at r_offset (when nr), else S at s_offset (band 1 at 1..3).
-  auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset, size_t s_offset) {
-    for (size_t v = 0; v < V; ++v) {
+  std::vector<double> source_rows(V * S), field_values(E * S), made(V * B), made_s(VS * ns);
+  // E^b per row from R^b ([V][B] at r_offset, when nr) or else from S's band 1 (ss: [V_s][ns]).
+  auto take = [&](std::span<const double> rows, size_t width, size_t t_offset, size_t r_offset, std::span<const double> ss,
+                  size_t ss_width, size_t ss_offset) {
+    for (size_t v = 0, j = 0; v < V; ++v) {
       for (size_t i = 0; i < nt; ++i) source_rows[v * S + i] = rows[v * width + t_offset + i];
-      if (radiance)
-        for (size_t c = 0; c < 3; ++c) {  // eq. (4)
-          const double* band1 = nr ? &rows[v * width + r_offset + 3 * c] : &rows[v * width + s_offset + ls2 * c + 1];
-          double e = 0;
+      if (!radiance) continue;
+      const double* s_row = nullptr;
+      if (!nr && j < s_rows.size() && s_rows[j] == v) s_row = &ss[j++ * ss_width + ss_offset];
+      for (size_t c = 0; c < 3; ++c) {  // eq. (4)
+        const double* band1 = nr ? &rows[v * width + r_offset + 3 * c] : s_row ? s_row + ls2 * c + 1 : nullptr;
+        double e = 0;
+        if (band1)
           for (size_t m = 0; m < 3; ++m) e += y1[v][m] * band1[m];
-          source_rows[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;
-        }
+        source_rows[v * S + nt + c] = (4 * std::numbers::pi / 3) * e;  // a row with neither R nor S: none
+      }
     }
     field.spread(source_rows, S, field_values);
   };
-  take(direct, W, layout.transfer, layout.radiance, layout.shadowed);
-  // The direct pass's RMS per product, over the rows.
-  auto slice_rms = [&](std::span<const double> rows, size_t width, size_t offset, size_t count) {
+  // The direct S rows, compacted.
+  std::vector<double> direct_s(VS * ns);
+  for (size_t j = 0; j < VS; ++j)
+    std::copy_n(&direct[size_t(s_rows[j]) * W + layout.shadowed], ns, &direct_s[j * ns]);
+  take(direct, W, layout.transfer, layout.radiance, direct_s, ns, 0);
+  // The direct pass's RMS per product, over the rows that carry it.
+  auto slice_rms = [](std::span<const double> rows, size_t n, size_t width, size_t offset, size_t count) {
     double sum = 0;
-    for (size_t v = 0; v < V; ++v)
+    for (size_t v = 0; v < n; ++v)
       for (size_t i = 0; i < count; ++i) sum += rows[v * width + offset + i] * rows[v * width + offset + i];
-    return V * count > 0 ? std::sqrt(sum / double(V * count)) : 0.0;
+    return n * count > 0 ? std::sqrt(sum / double(n * count)) : 0.0;
   };
-  const double direct_rms[3] = {slice_rms(direct, W, layout.transfer, nt), slice_rms(direct, W, layout.radiance, nr),
-                                slice_rms(direct, W, layout.shadowed, ns)};
+  const double direct_rms[3] = {slice_rms(direct, V, W, layout.transfer, nt), slice_rms(direct, V, W, layout.radiance, nr),
+                                slice_rms(direct_s, VS, ns, 0, ns)};
+
+  // Every ray of row v that meets a reflecting surface the field reads: visit(k, ρ(h), the source
+  // at h, the estimator's weights (T's, then R's y_1m), the ray's direction and 1/pdf).
+  auto for_each_ray = [&](size_t v, auto&& visit) {
+    double at_hit[kMaxSource];
+    const Frame frame(points[v].n);
+    const RotatedHalton3 halton(hits.seed, v);
+    for (size_t k = 0; k < K; ++k) {
+      const size_t ray = v * K + k;
+      const uint32_t t = hits.triangle[ray];
+      if (t == GatherHits::kNone) continue;
+      const Albedo& rho = albedo[t];
+      if (rho[0] == 0 && rho[1] == 0 && rho[2] == 0) continue;
+      const FieldTaps taps = field.taps(t, hits.weights[ray][0], hits.weights[ray][1]);
+      if (taps.count == 0) continue;
+      std::fill(at_hit, at_hit + S, 0.0);
+      for (size_t c = 0; c < size_t(taps.count); ++c) {
+        const double* src = &field_values[taps.entry[c] * S];
+        for (size_t i = 0; i < S; ++i) at_hit[i] += taps.weight[c] * src[i];
+      }
+      std::array<double, 4> weight{1, 0, 0, 0};  // the cosine gather's: T's weight is 1
+      double inv_p = 0;
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      if (hits.mixture) {
+        d = gather_direction(frame, halton, k, true);
+        weight = mixture_weights(points[v].n, d, &inv_p);
+      }
+      visit(k, rho, static_cast<const double*>(at_hit), weight, d, inv_p);
+    }
+  };
 
   for (int b = 1; b <= spec.bounces; ++b) {
     // Eqs. (3) / (3') and (5'): each ray adds ρ(h) × (the source at h, as the field reads it) × its
     // weights; S's weights are (5') with y_i in place of y_1m.
     // Each row sums its even and its odd rays apart ([0, B) and [B, 2B)): their sum over K is the
     // bounce, their difference over K its Monte Carlo standard error (two halves of the rays).
-    VertexBake pass = bake_rows(
-        0, V, 2 * B,
-        [&](size_t v, std::span<double> both, std::span<double>) {
-          double at_hit[kMaxSource];
-          double ys[sh::kMaxOrder * sh::kMaxOrder];
-          const Frame frame(points[v].n);
-          const RotatedHalton3 halton(hits.seed, v);
-          for (size_t k = 0; k < K; ++k) {
-            const size_t ray = v * K + k;
-            const uint32_t t = hits.triangle[ray];
-            if (t == GatherHits::kNone) continue;
-            const std::span<double> row = both.subspan((k % 2) * B, B);
-            const Albedo& rho = albedo[t];
-            if (rho[0] == 0 && rho[1] == 0 && rho[2] == 0) continue;
-            const FieldTaps taps = field.taps(t, hits.weights[ray][0], hits.weights[ray][1]);
-            if (taps.count == 0) continue;
-            std::fill(at_hit, at_hit + S, 0.0);
-            for (size_t c = 0; c < size_t(taps.count); ++c) {
-              const double* src = &field_values[taps.entry[c] * S];
-              for (size_t i = 0; i < S; ++i) at_hit[i] += taps.weight[c] * src[i];
-            }
-            std::array<double, 4> weight{1, 0, 0, 0};  // the cosine gather's: T's weight is 1
-            double inv_p = 0;
-            Eigen::Vector3d d = Eigen::Vector3d::Zero();
-            if (hits.mixture) {
-              d = gather_direction(frame, halton, k, true);
-              weight = mixture_weights(points[v].n, d, &inv_p);
-            }
-            for (size_t i = 0; i < nt; ++i) row[i] += rho[0] * weight[0] * at_hit[i];  // grey (checked)
-            if (nr)
-              for (size_t c = 0; c < 3; ++c)
-                for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho[c] * at_hit[nt + c] * weight[1 + m];
-            if (ns) {  // the mixture (checked above): d and inv_p are the ray's
+    const std::string stage = label + " (bounce " + std::to_string(b) + ")", what = "the bounce gather of " + source;
+    double seconds = 0;
+    std::vector<double> half_difference(V * B), half_difference_s(VS * ns);
+    if (B > 0) {
+      VertexBake pass = bake_rows(
+          0, V, 2 * B,
+          [&](size_t v, std::span<double> both, std::span<double>) {
+            for_each_ray(v, [&](size_t k, const Albedo& rho, const double* at_hit, const std::array<double, 4>& weight,
+                                const Eigen::Vector3d&, double) {
+              const std::span<double> row = both.subspan((k % 2) * B, B);
+              for (size_t i = 0; i < nt; ++i) row[i] += rho[0] * weight[0] * at_hit[i];  // grey (checked)
+              if (nr)
+                for (size_t c = 0; c < 3; ++c)
+                  for (size_t m = 0; m < 3; ++m) row[nt + 3 * c + m] += rho[c] * at_hit[nt + c] * weight[1 + m];
+            });
+          },
+          monitor, stage, what);
+      seconds += pass.seconds;
+      for (size_t v = 0; v < V; ++v)
+        for (size_t i = 0; i < B; ++i) {
+          const double h0 = pass.values[v * 2 * B + i], h1 = pass.values[v * 2 * B + B + i];
+          made[v * B + i] = (h0 + h1) / double(K);
+          half_difference[v * B + i] = (h0 - h1) / double(K);
+        }
+    }
+    if (VS > 0) {  // the mixture (checked above): d and inv_p are the ray's
+      VertexBake pass = bake_rows(
+          0, VS, 2 * ns,
+          [&](size_t j, std::span<double> both, std::span<double>) {
+            double ys[sh::kMaxOrder * sh::kMaxOrder];
+            for_each_ray(s_rows[j], [&](size_t k, const Albedo& rho, const double* at_hit, const std::array<double, 4>&,
+                                        const Eigen::Vector3d& d, double inv_p) {
+              const std::span<double> row = both.subspan((k % 2) * ns, ns);
               sh::eval(ls, d.x(), d.y(), d.z(), ys);
               for (size_t c = 0; c < 3; ++c) {
                 const double e = rho[c] * at_hit[nt + c];
                 if (e == 0) continue;
-                for (size_t i = 0; i < ls2; ++i) row[nt + nr + ls2 * c + i] += e * (ys[i] * kInvPi * inv_p);
+                for (size_t i = 0; i < ls2; ++i) row[ls2 * c + i] += e * (ys[i] * kInvPi * inv_p);
               }
-            }
-          }
-        },
-        monitor, label + " (bounce " + std::to_string(b) + ")", "the bounce gather of " + source);
-    std::vector<double> half_difference(V * B);
-    for (size_t v = 0; v < V; ++v)
-      for (size_t i = 0; i < B; ++i) {
-        const double h0 = pass.values[v * 2 * B + i], h1 = pass.values[v * 2 * B + B + i];
-        made[v * B + i] = (h0 + h1) / double(K);
-        half_difference[v * B + i] = (h0 - h1) / double(K);
-      }
+            });
+          },
+          monitor, stage + (B > 0 ? ", shadowed radiance" : ""), what);
+      seconds += pass.seconds;
+      for (size_t j = 0; j < VS; ++j)
+        for (size_t i = 0; i < ns; ++i) {
+          const double h0 = pass.values[j * 2 * ns + i], h1 = pass.values[j * 2 * ns + ns + i];
+          made_s[j * ns + i] = (h0 + h1) / double(K);
+          half_difference_s[j * ns + i] = (h0 - h1) / double(K);
+        }
+    }
     // Summed only where non-zero, so an albedo of 0 leaves the direct rows' bits (−0 included).
     for (size_t v = 0; v < V; ++v) {
       for (size_t i = 0; i < nt; ++i)
         if (const double x = made[v * B + i]; x != 0) out.values[v * W + layout.transfer + i] += x;
       for (size_t i = 0; i < nr; ++i)
         if (const double x = made[v * B + nt + i]; x != 0) out.values[v * W + layout.radiance + i] += x;
-      for (size_t i = 0; i < ns; ++i)
-        if (const double x = made[v * B + nt + nr + i]; x != 0) out.values[v * W + layout.shadowed + i] += x;
     }
+    for (size_t j = 0; j < VS; ++j)
+      for (size_t i = 0; i < ns; ++i)
+        if (const double x = made_s[j * ns + i]; x != 0) out.values[size_t(s_rows[j]) * W + layout.shadowed + i] += x;
+    const double rms[3] = {slice_rms(made, V, B, 0, nt), slice_rms(made, V, B, nt, nr), slice_rms(made_s, VS, ns, 0, ns)};
+    const double err[3] = {slice_rms(half_difference, V, B, 0, nt), slice_rms(half_difference, V, B, nt, nr),
+                           slice_rms(half_difference_s, VS, ns, 0, ns)};
     double r = 0, e = 0;
-    const size_t offsets[3] = {0, nt, nt + nr}, counts[3] = {nt, nr, ns};
     for (size_t p = 0; p < 3; ++p)
       if (direct_rms[p] > 0) {
-        r = std::max(r, slice_rms(made, B, offsets[p], counts[p]) / direct_rms[p]);
-        e = std::max(e, slice_rms(half_difference, B, offsets[p], counts[p]) / direct_rms[p]);
+        r = std::max(r, rms[p] / direct_rms[p]);
+        e = std::max(e, err[p] / direct_rms[p]);
       }
     out.applied = b;
     out.relative_rms.push_back(r);
     out.relative_std_error.push_back(e);
-    out.seconds.push_back(pass.seconds);
+    out.seconds.push_back(seconds);
     if (r <= spec.tolerance || b == spec.bounces) break;
-    take(made, B, 0, nt, nt + nr);
+    take(made, B, 0, nt, made_s, ns, 0);
   }
   for (const double x : out.values)
     if (!std::isfinite(x)) throw ContractError("bounce_rows: a non-finite value in the bounced rows of " + source);

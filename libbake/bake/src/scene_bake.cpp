@@ -395,6 +395,10 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     }
     auto area_stride = [&](size_t i) { return 1 + size_t(plan.objects[i].area_sh_order) * size_t(plan.objects[i].area_sh_order); };
     std::vector<double> direct(points.size() * layout.width, 0.0);
+    std::vector<uint8_t> shadowed_rows;  // the rows whose S bounces (empty: no S)
+    if (s_order > 0)
+      for (size_t g = 0; g < gatherers.size(); ++g)
+        shadowed_rows.insert(shadowed_rows.end(), fields[g]->rows(), plan.objects[gatherers[g]].bounce_shadowed ? 1 : 0);
     size_t row = 0;
     for (size_t g = 0; g < gatherers.size(); ++g) {
       const size_t i = gatherers[g];
@@ -423,7 +427,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     if (!gather_hits)
       gather_hits = gather(*accel.rays(), points, spec, radiance || s_order > 0, monitor, "casting bounce rays");
     const BounceResult r = bounce_rows(field, points, *gather_hits, albedo, layout, direct, spec, scene.file.string(),
-                                       monitor, "bouncing light");
+                                       monitor, "bouncing light", shadowed_rows);
     row = 0;
     for (size_t g = 0; g < gatherers.size(); ++g) {
       const size_t i = gatherers[g];

@@ -246,10 +246,14 @@ struct BounceResult {
 // needs grey albedos (R = G = B on every triangle; InputError(source, …) naming the first that is
 // not). Other products are copied. A bounce that is zero everywhere (albedo 0) leaves every
 // value's bits as they were. ContractError if a value is not finite. Progress stage `label`, one
-// task per bounce.
+// task per bounce (two when S bounces beside T or R).
+// `shadowed_rows` (empty: all; else one flag per row): the rows whose S (layout.shadowed) bounces;
+// the others' S slots are copied, and the bounce's working memory for S is kept for those rows
+// only (a scene where one glossy object carries S at order 8 beside a lightmap of 10^5 texels).
+// S without R takes E from S's band 1: a row that carries neither reflects nothing.
 BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> points, const GatherHits& hits,
                          std::span<const Albedo> albedo, const ProductLayout& layout, std::span<const double> direct,
                          const BounceSpec& spec, const std::string& source, const Monitor& monitor = {},
-                         const std::string& label = "bouncing light");
+                         const std::string& label = "bouncing light", std::span<const uint8_t> shadowed_rows = {});
 
 } // namespace prt::bake
