@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -177,6 +178,49 @@ bool disjoint(const Cap& x, const Cap& y) {
 
 }  // namespace
 
+namespace {
+
+// The pieces of edge e = (a, b) of polygons[i] that bound V, appended to out (the per-edge step
+// of the header's method). for_others(f) calls f(j) for the occluders j ≥ 1, j ≠ i, ascending,
+// that may overlap e: every other one must give an empty interval (up to rounding) and share no
+// piece of e's great circle with e. Occluder edges are first clipped to the light (the caller
+// has checked in[1] of the light when i ≠ 0: passed as `in_light`).
+template <class ForOthers>
+void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const V3& b, const Interval* in_light,
+                 ForOthers&& for_others, std::vector<Interval>& pieces, std::vector<Arc>& out) {
+  // The side of e that may border V: left for the light, right for an occluder.
+  const int which = i == 0 ? 0 : 1;
+  Interval in[2];
+  pieces.assign(1, i == 0 ? Interval{{0.0, a}, {1.0, b}, false} : *in_light);
+  for_others([&](size_t j) {
+    if (pieces.empty()) return;
+    inside_intervals(a, b, polygons[j], i < j, in);
+    subtract(pieces, in[which]);
+  });
+  // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
+  auto collinear = [&](size_t j) {
+    if (pieces.empty() || j >= i) return;
+    const Polygon other = polygons[j];
+    for (size_t f = 0; f < other.size(); ++f) {
+      const V3& c = other[f];
+      const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
+      if (side(c, d, a) != 0 || side(c, d, b) != 0) continue;
+      subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)));
+    }
+  };
+  if (i != 0) collinear(0);
+  for_others(collinear);
+  for (const Interval& p : pieces) {
+    if (i == 0) {
+      out.push_back({p.lo.x, p.hi.x});
+    } else {
+      out.push_back({p.hi.x, p.lo.x});
+    }
+  }
+}
+
+}  // namespace
+
 void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> occluders, std::vector<Arc>& out) {
   out.clear();
   if (light.size() < 3) return;
@@ -193,41 +237,279 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
       const V3& a = poly[k];
       const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
       if (a == b) continue;
-      // The side of e that may border V: left for the light, right for an occluder.
-      const int which = i == 0 ? 0 : 1;
-      Interval in[2];
       const V3 ends[2] = {a, b};
       const Cap edge_cap = cap_of(ends);
-      pieces.assign(1, Interval{{0.0, a}, {1.0, b}, false});
+      Interval in[2];
       if (i != 0) {  // an occluder edge borders V only inside the light
         if (disjoint(edge_cap, caps[0])) continue;
         inside_intervals(a, b, light, false, in);
         if (in[1].empty) continue;
-        pieces.assign(1, in[1]);
       }
-      for (size_t j = 1; j < polygons.size() && !pieces.empty(); ++j) {
-        if (j == i || disjoint(edge_cap, caps[j])) continue;
-        inside_intervals(a, b, polygons[j], i < j, in);
-        subtract(pieces, in[which]);
+      edge_pieces(polygons, i, a, b, &in[1], [&](auto&& f) {
+        for (size_t j = 1; j < polygons.size(); ++j)
+          if (j != i && !disjoint(edge_cap, caps[j])) f(j);
+      }, pieces, out);
+    }
+  }
+}
+
+// ---- the sparse variant: chosen boundary edges, a grid over the light's gnomonic chart --------
+
+namespace {
+
+// Chart margin: the gnomonic coordinates of a direction err by a few ulps of their magnitude
+// (divided by c·ω̂ > kFrontCos); 1e-9 of the chart's scale is far above that.
+constexpr double kChartMargin = 1e-9;
+constexpr double kFrontCos = 1e-3;  // a polygon with a vertex at c·ω̂ ≤ this is not charted
+constexpr double kChartCos = 0.1;   // the chart is used when every light vertex has c·ω̂ > this
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kMaxGrid = 48;
+
+// The gnomonic chart about c (ω ↦ (e1·ω, e2·ω)/(c·ω)): great circles map to lines, so an arc
+// maps to the chord of its end points and a convex polygon in c's open hemisphere to the convex
+// hull of its vertices' points. A uniform grid of cells over the light's box.
+struct Chart {
+  V3 c, e1, e2;
+  double lo[2] = {0, 0}, hi[2] = {0, 0}, cell[2] = {1, 1}, margin = 0;
+  uint32_t n[2] = {1, 1};
+
+  void at(const V3& w, double g[2]) const {
+    const double z = c.dot(w);
+    g[0] = e1.dot(w) / z;
+    g[1] = e2.dot(w) / z;
+  }
+  // Cells [c0, c1] along axis for coordinates [x0, x1] (with margins), clamped; false when the
+  // range misses the grid. Monotone in x0 and x1, so overlapping ranges share a cell.
+  bool cells(int axis, double x0, double x1, uint32_t& c0, uint32_t& c1) const {
+    if (x1 < lo[axis] || x0 > hi[axis]) return false;
+    const double top = double(n[axis] - 1);
+    c0 = uint32_t(std::clamp(std::floor((x0 - lo[axis]) / cell[axis]), 0.0, top));
+    c1 = uint32_t(std::clamp(std::floor((x1 - lo[axis]) / cell[axis]), 0.0, top));
+    return true;
+  }
+};
+
+struct Box {
+  double lo[2], hi[2];
+  bool in = false;
+};
+
+}  // namespace
+
+struct RegionScratch::Impl {
+  Chart chart;
+  std::vector<Polygon> polygons;
+  std::vector<Cap> caps;
+  std::vector<Box> boxes;
+  std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
+  uint32_t mark = 0;
+  std::vector<Interval> pieces;
+};
+
+RegionScratch::RegionScratch() : impl_(std::make_unique<Impl>()) {}
+RegionScratch::~RegionScratch() = default;
+RegionScratch::RegionScratch(const RegionScratch&) : impl_(std::make_unique<Impl>()) {}
+RegionScratch& RegionScratch::operator=(const RegionScratch&) { return *this; }
+
+void visible_region_sparse(std::span<const V3> light, std::span<const std::vector<V3>> occluders,
+                           std::span<const uint8_t> boundary, std::vector<Arc>& out, RegionScratch& scratch) {
+  out.clear();
+  scratch.boundary_edges = 0;
+  scratch.charted = false;
+  if (light.size() < 3) return;
+  PRT_CHECK(boundary.size() == occluders.size());
+  RegionScratch::Impl& s = *scratch.impl_;
+  // Polygon numbering as visible_region's: the light, then the occluders (one with < 3 vertices
+  // an empty span that meets nothing), so the "listed first" rules decide alike.
+  s.polygons.clear();
+  s.polygons.emplace_back(light);
+  for (const auto& o : occluders) s.polygons.emplace_back(o.size() >= 3 ? Polygon(o) : Polygon());
+  const std::span<const Polygon> polygons(s.polygons);
+  const size_t count = polygons.size();
+
+  // The chart about the light's cap centre: every light vertex at c·ω̂ > 0.1, so every point of
+  // the (convex) light has c·ω > 0.
+  Chart& chart = s.chart;
+  const Cap light_cap = cap_of(light);
+  bool charted = !light_cap.all;
+  for (const V3& v : light) charted = charted && light_cap.c.dot(v.normalized()) > kChartCos;
+  s.wide.clear();
+  if (s.stamp.size() < count) s.stamp.resize(count, 0);
+  if (charted) {
+    chart.c = light_cap.c;
+    chart.e1 = chart.c.unitOrthogonal();
+    chart.e2 = chart.c.cross(chart.e1);
+    double scale = 1;
+    for (int a = 0; a < 2; ++a) chart.lo[a] = kInf, chart.hi[a] = -kInf;
+    for (const V3& v : light) {
+      double g[2];
+      chart.at(v, g);
+      for (int a = 0; a < 2; ++a) {
+        chart.lo[a] = std::min(chart.lo[a], g[a]);
+        chart.hi[a] = std::max(chart.hi[a], g[a]);
+        scale = std::max(scale, 1 + std::abs(g[a]));
       }
-      // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
-      for (size_t j = 0; j < i && !pieces.empty(); ++j) {
-        if (disjoint(edge_cap, caps[j])) continue;
-        const Polygon other = polygons[j];
-        for (size_t f = 0; f < other.size(); ++f) {
-          const V3& c = other[f];
-          const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
-          if (side(c, d, a) != 0 || side(c, d, b) != 0) continue;
-          subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)));
+    }
+    chart.margin = kChartMargin * scale;
+    for (int a = 0; a < 2; ++a) chart.lo[a] -= 2 * chart.margin, chart.hi[a] += 2 * chart.margin;
+    // Occluder boxes; an occluder reaching out of c's front hemisphere is `wide` (always tested)
+    // unless its cap misses the light's.
+    s.boxes.resize(count);
+    size_t in_chart = 0;
+    for (size_t j = 1; j < count; ++j) {
+      const Polygon poly = polygons[j];
+      Box& box = s.boxes[j];
+      box.in = false;
+      if (poly.empty()) continue;
+      bool front = true;
+      for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.norm();
+      if (!front) {
+        if (!disjoint(cap_of(poly), light_cap)) s.wide.push_back(uint32_t(j));
+        continue;
+      }
+      for (int a = 0; a < 2; ++a) box.lo[a] = kInf, box.hi[a] = -kInf;
+      for (const V3& v : poly) {
+        double g[2];
+        chart.at(v, g);
+        for (int a = 0; a < 2; ++a) box.lo[a] = std::min(box.lo[a], g[a]), box.hi[a] = std::max(box.hi[a], g[a]);
+      }
+      box.in = true;
+      for (int a = 0; a < 2; ++a) {
+        box.lo[a] -= chart.margin;
+        box.hi[a] += chart.margin;
+        box.in = box.in && box.hi[a] >= chart.lo[a] && box.lo[a] <= chart.hi[a];
+      }
+      in_chart += box.in;
+    }
+    const auto side_cells = uint32_t(std::clamp(std::ceil(std::sqrt(double(in_chart))), 1.0, double(kMaxGrid)));
+    for (int a = 0; a < 2; ++a) {
+      chart.n[a] = side_cells;
+      chart.cell[a] = (chart.hi[a] - chart.lo[a]) / side_cells;
+      charted = charted && chart.cell[a] > 0;
+    }
+  }
+  if (charted) {
+    // Counting sort of (cell, occluder) pairs, occluders ascending within a cell; an occluder
+    // over more than a quarter of the cells is `wide`.
+    const size_t cells = size_t(chart.n[0]) * chart.n[1];
+    const size_t wide_limit = std::max<size_t>(cells / 4, 4);
+    s.cell_start.assign(cells + 1, 0);
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t j = 1; j < count; ++j) {
+        const Box& box = s.boxes[j];
+        if (!box.in) continue;
+        uint32_t x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+        chart.cells(0, box.lo[0], box.hi[0], x0, x1);
+        chart.cells(1, box.lo[1], box.hi[1], y0, y1);
+        if (size_t(x1 - x0 + 1) * (y1 - y0 + 1) > wide_limit) {
+          if (pass == 0) s.wide.push_back(uint32_t(j));
+          continue;
         }
+        for (uint32_t y = y0; y <= y1; ++y)
+          for (uint32_t x = x0; x <= x1; ++x) {
+            const size_t cell = size_t(y) * chart.n[0] + x;
+            if (pass == 0) {
+              ++s.cell_start[cell + 1];
+            } else {
+              s.cell_items[s.cell_fill[cell]++] = uint32_t(j);
+            }
+          }
       }
-      for (const Interval& p : pieces) {
-        if (i == 0) {
-          out.push_back({p.lo.x, p.hi.x});
-        } else {
-          out.push_back({p.hi.x, p.lo.x});
+      if (pass == 0) {
+        for (size_t c = 0; c < cells; ++c) s.cell_start[c + 1] += s.cell_start[c];
+        s.cell_items.resize(s.cell_start[cells]);
+        s.cell_fill.assign(s.cell_start.begin(), s.cell_start.end() - 1);
+      }
+    }
+    std::sort(s.wide.begin(), s.wide.end());
+  } else {
+    s.caps.clear();
+    for (const Polygon poly : polygons) s.caps.push_back(poly.empty() ? Cap{} : cap_of(poly));
+  }
+  scratch.charted = charted;
+
+  // s.near = the occluders that may meet the arc from x to y (both in the light, so c·ω > 0):
+  // those in the cells the chord of their chart points passes (row by row, with margins) and
+  // the wide ones, ascending.
+  auto near = [&](const V3& x, const V3& y) {
+    s.near.clear();
+    if (s.mark == std::numeric_limits<uint32_t>::max()) {
+      std::fill(s.stamp.begin(), s.stamp.end(), 0);
+      s.mark = 0;
+    }
+    const uint32_t mark = ++s.mark;
+    double gx[2], gy[2];
+    chart.at(x, gx);
+    chart.at(y, gy);
+    const double m = chart.margin, dy = gy[1] - gx[1];
+    uint32_t r0 = 0, r1 = 0;
+    if (chart.cells(1, std::min(gx[1], gy[1]) - m, std::max(gx[1], gy[1]) + m, r0, r1)) {
+      for (uint32_t r = r0; r <= r1; ++r) {
+        // The chord's part with its y in this row (± margin; the outer rows unbounded outwards).
+        const double ylo = r == 0 ? -kInf : chart.lo[1] + r * chart.cell[1] - m;
+        const double yhi = r + 1 == chart.n[1] ? kInf : chart.lo[1] + (r + 1) * chart.cell[1] + m;
+        double t0 = 0, t1 = 1;
+        if (dy != 0) {
+          double ta = (ylo - gx[1]) / dy, tb = (yhi - gx[1]) / dy;
+          if (ta > tb) std::swap(ta, tb);
+          t0 = std::max(0.0, ta);
+          t1 = std::min(1.0, tb);
+          if (t0 > t1) continue;
+        } else if (gx[1] < ylo || gx[1] > yhi) {
+          continue;
         }
+        const double xa = gx[0] + t0 * (gy[0] - gx[0]), xb = gx[0] + t1 * (gy[0] - gx[0]);
+        uint32_t c0 = 0, c1 = 0;
+        if (!chart.cells(0, std::min(xa, xb) - m, std::max(xa, xb) + m, c0, c1)) continue;
+        const size_t row = size_t(r) * chart.n[0];
+        for (size_t cell = row + c0; cell <= row + c1; ++cell)
+          for (uint32_t at = s.cell_start[cell]; at < s.cell_start[cell + 1]; ++at) {
+            const uint32_t j = s.cell_items[at];
+            if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
+          }
       }
+    }
+    for (uint32_t j : s.wide)
+      if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
+    std::sort(s.near.begin(), s.near.end());
+  };
+
+  auto run = [&](size_t i, const V3& a, const V3& b, const Interval* in_light) {
+    if (charted) {
+      near(in_light ? in_light->lo.x : a, in_light ? in_light->hi.x : b);
+      edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
+        for (uint32_t j : s.near)
+          if (j != i) f(j);
+      }, s.pieces, out);
+      return;
+    }
+    const V3 ends[2] = {a, b};
+    const Cap edge_cap = cap_of(ends);
+    edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
+      for (size_t j = 1; j < count; ++j)
+        if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j])) f(j);
+    }, s.pieces, out);
+  };
+  for (size_t k = 0; k < light.size(); ++k) {
+    const V3& a = light[k];
+    const V3& b = light[k + 1 == light.size() ? 0 : k + 1];
+    if (a != b) run(0, a, b, nullptr);
+  }
+  for (size_t i = 1; i < count; ++i) {
+    const Polygon poly = polygons[i];
+    const unsigned mask = boundary[i - 1];
+    for (size_t k = 0; k < poly.size(); ++k) {
+      if (k < 8 && !(mask & (1u << k))) continue;
+      const V3& a = poly[k];
+      const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
+      if (a == b) continue;
+      const V3 ends[2] = {a, b};
+      if (disjoint(cap_of(ends), light_cap)) continue;
+      Interval in[2];
+      inside_intervals(a, b, light, false, in);
+      if (in[1].empty) continue;
+      ++scratch.boundary_edges;
+      run(i, a, b, &in[1]);
     }
   }
 }

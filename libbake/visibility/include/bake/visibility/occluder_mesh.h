@@ -38,6 +38,7 @@
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/shade_point.h>
 #include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/visible_region.h>
 
 #include <Eigen/Core>
 
@@ -69,6 +70,22 @@ public:
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
     size_t image_count = 0;
+    // The contour path's scratch: per image its triangle, kind and boundary-edge mask; per
+    // triangle the query that last kept it and its image's orientation (0: not a whole triangle).
+    std::vector<uint32_t> image_triangle, tri_stamp;
+    std::vector<uint8_t> image_kind, boundary;
+    std::vector<int8_t> tri_side;
+    uint32_t stamp = 0;
+    int last_side = 0;
+    RegionScratch region;
+    // Counters of the contour path, summed over this workspace's queries (never reset here).
+    struct Stats {
+      size_t queries = 0;         // queries that reached the union (light not empty)
+      size_t kept = 0;            // triangles kept by culling
+      size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
+      size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
+      size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
+    } stats;
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -84,13 +101,20 @@ public:
   // dropped by the depth test).
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
-    return query(light, point, out, ws, true);
+    return query(light, point, out, ws, Method::contour);
+  }
+  // The per-triangle method (paper 003 §4.4; the fast path before issue 32): the same culling
+  // and images, then visible_region over every kept image's edges, O(E²). The slow reference of
+  // the contour path: the same arcs' integrals.
+  size_t visible_light_per_triangle(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                                    std::vector<Arc>& out, Workspace& ws) const {
+    return query(light, point, out, ws, Method::per_triangle);
   }
   // Reference: no tree and no pyramid culling (every triangle goes through the exact depth test
-  // and the image rule above). The same arcs' integrals as visible_light.
+  // and the image rule above), then the per-triangle method. The same arcs' integrals.
   size_t visible_light_reference(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
                                  std::vector<Arc>& out, Workspace& ws) const {
-    return query(light, point, out, ws, false);
+    return query(light, point, out, ws, Method::reference);
   }
 
   size_t triangle_count() const { return triangles_.size(); }
@@ -102,18 +126,24 @@ private:
     uint32_t count;  // leaf: triangle count (> 0); inner: 0
   };
   struct LightFrame;
+  enum class Method { contour, per_triangle, reference };
+  enum class ImageKind : uint8_t { none, triangle, special };  // special: clipped or an ε-limit cone
 
   uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
   bool prepare(std::span<const Eigen::Vector3d> light, const ShadePoint& point, Workspace& ws, LightFrame& frame) const;
-  void add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
+  ImageKind add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
-               bool culled) const;
+               Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
   std::vector<uint32_t> order_;  // triangle indices, leaves' ranges
   std::vector<Node> nodes_;
+  // Edge → faces: slot 3t + k is edge (t[k], t[k+1]); edge_slots_ sorted by unordered vertex
+  // pair, group g = edge_slots_[edge_group_start_[g] .. edge_group_start_[g + 1]).
+  std::vector<uint32_t> edge_slots_, slot_group_, edge_group_start_;
+  std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
 };
 
 } // namespace prt::bake

@@ -44,6 +44,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -53,6 +54,44 @@ namespace prt::bake {
 // the shade point (points relative to it will do).
 void visible_region(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
                     std::vector<Arc>& out);
+
+// Scratch for visible_region_sparse, reused across calls (one per thread); copying one gives a
+// fresh scratch. After a call: the occluder edges it cut (those of `boundary` reaching inside the
+// light) and whether the chart below was used (false: every pair filtered by caps only).
+class RegionScratch {
+public:
+  RegionScratch();
+  ~RegionScratch();
+  RegionScratch(const RegionScratch&);
+  RegionScratch& operator=(const RegionScratch&);
+
+  size_t boundary_edges = 0;
+  bool charted = false;
+
+private:
+  struct Impl;
+  friend void visible_region_sparse(std::span<const Eigen::Vector3d>, std::span<const std::vector<Eigen::Vector3d>>,
+                                    std::span<const uint8_t>, std::vector<Arc>&, RegionScratch&);
+  std::unique_ptr<Impl> impl_;
+};
+
+// The same boundary arcs as visible_region(light, occluders), cutting only the occluder edges
+// that may bound the union (issue 32; paper 003 §3.3: the union's boundary lies on silhouette
+// edges). boundary[k] has bit e set when edge e (vertices e, e + 1) of occluders[k] may bound it
+// (edges e ≥ 8 always do). Precondition: an edge left out emits nothing in visible_region, i.e.
+// its right side is inside another occluder along the whole edge (e.g. a mesh edge whose two
+// faces' images lie on opposite sides of it). Given that, the arcs equal visible_region's
+// bit for bit up to the order of the pieces. Each edge (the light's, and the in-light part of each
+// boundary edge) meets only the occluders near it, found in a uniform grid over the gnomonic
+// chart about the light's cap centre (great circles map to lines, convex polygons to the hulls of
+// their vertices' points; boxes and chords with a margin of 1e-9 of the chart's scale, far above
+// the rounding of the chart points; occluders reaching out of the chart's hemisphere are tested
+// by every edge). The grid is a filter: an occluder it leaves out has an empty interval on the
+// edge and no piece of its great circle, exactly as the caps of visible_region. A light of
+// ≥ 84° radius (a vertex at c·ω̂ ≤ 0.1) is not charted: then every pair is filtered by caps.
+// Cost: O(P + B·k) for P occluders, B boundary edges in the light and k occluders near an edge.
+void visible_region_sparse(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
+                           std::span<const uint8_t> boundary, std::vector<Arc>& out, RegionScratch& scratch);
 
 // A convex polyhedron (an occluder or a convex emitter) and its silhouette loop seen from a point
 // (paper 003 §3.3, Alg. 2 SphPolySilhouette). Faces are planar, counter-clockwise seen from
