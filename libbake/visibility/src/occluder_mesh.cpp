@@ -94,7 +94,7 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
 
 uint32_t OccluderMesh::build(uint32_t first, uint32_t count, std::vector<V3>& centroids) {
   const uint32_t at = uint32_t(nodes_.size());
-  nodes_.push_back({V3::Zero(), V3::Zero(), 0, 0});
+  nodes_.push_back({V3::Zero(), V3::Zero(), 0, 0, first, count});
   V3 lo = V3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   V3 clo = lo, chi = hi;
   for (uint32_t i = first; i < first + count; ++i) {
@@ -309,7 +309,9 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
         const uint32_t other = edge_slots_[at], t2 = other / 3;
         if (t2 == t || ws.tri_stamp[t2] != stamp || ws.tri_side[t2] == 0) continue;
         const int side2 = welded_[triangles_[t2][other % 3]] == u ? ws.tri_side[t2] : -ws.tri_side[t2];
-        interior = side2 * sigma < 0;
+        // Opposite sides: t2 covers e's right side. The same side with t2 listed first (a fold:
+        // a contour edge): t2's image edge is the same arc and owns it (visible_region's rule).
+        interior = side2 * sigma < 0 || t2 < t;
       }
       if (!interior) mask = uint8_t(mask | (1u << e));
     }
@@ -327,14 +329,20 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
 
 void OccluderMesh::cull(Workspace& ws) const {
   if (nodes_.empty()) return;
-  auto box_outside = [&](const Node& node) {
+  // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
+  // margin (so is every triangle in it); 0: neither.
+  auto box_test = [&](const Node& node) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
+    bool inside = true;
     for (const auto& plane : ws.planes) {
       const V3 r = centre - plane.o;
-      const double top = plane.m.dot(r) + plane.m.cwiseAbs().dot(half);
-      if (top < -plane.margin_coef * (r.norm() + half.norm())) return true;
+      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
+      // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
+      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
+      if (mid + spread < -margin) return -1;
+      inside = inside && mid - spread > margin;
     }
-    return false;
+    return inside ? 1 : 0;
   };
   auto triangle_outside = [&](uint32_t t) {
     for (const auto& plane : ws.planes) {
@@ -342,7 +350,7 @@ void OccluderMesh::cull(Workspace& ws) const {
       for (uint32_t v : triangles_[t]) {
         const V3 r = positions_[v] - plane.o;
         top = std::max(top, plane.m.dot(r));
-        reach = std::max(reach, r.norm());
+        reach = std::max(reach, r.cwiseAbs().sum());
       }
       if (top < -plane.margin_coef * reach) return true;
     }
@@ -353,7 +361,12 @@ void OccluderMesh::cull(Workspace& ws) const {
     const uint32_t at = ws.stack.back();
     const Node& node = nodes_[at];
     ws.stack.pop_back();
-    if (box_outside(node)) continue;
+    const int test = box_test(node);
+    if (test < 0) continue;
+    if (test > 0) {
+      ws.kept.insert(ws.kept.end(), order_.begin() + node.first, order_.begin() + node.first + node.total);
+      continue;
+    }
     if (node.count == 0) {
       ws.stack.push_back(node.index);
       ws.stack.push_back(at + 1);

@@ -70,14 +70,19 @@ V3 cut_point(const V3& a, const V3& b, const V3& c, const V3& d) {
 // of e with an edge f is computed the same way whichever of the two is being cut (from the edge
 // of the polygon listed first, e's own when e_first), so the pieces of both share it bit for bit
 // and the boundary arcs close exactly.
-void inside_intervals(const V3& a, const V3& b, Polygon poly, bool e_first, Interval (&out)[2]) {
+// collinear (if given) gets bit k for each edge k < 32 of poly whose great circle holds e; it is
+// left incomplete only when e misses poly's interior, and then e shares no arc with its edges.
+void inside_intervals(const V3& a, const V3& b, Polygon poly, bool e_first, Interval (&out)[2],
+                      uint32_t* collinear = nullptr) {
   out[0] = out[1] = Interval{{0.0, a}, {1.0, b}, false};
   const size_t n = poly.size();
+  if (collinear) *collinear = 0;
   for (size_t k = 0; k < n; ++k) {
     const V3& c = poly[k];
     const V3& d = poly[k + 1 == n ? 0 : k + 1];
     const int sa = side(c, d, a), sb = side(c, d, b);
     if (sa == 0 && sb == 0) {  // e lies on f's great circle: the sides are e's two sides
+      if (collinear && k < 32) *collinear |= 1u << k;
       const int s = same_direction(a, b, c, d, poly);
       out[s > 0 ? 1 : 0].empty = true;
       if (s == 0) out[1].empty = true;
@@ -128,10 +133,10 @@ Interval collinear_overlap(const V3& a, const V3& b, const V3& c, const V3& d, i
   return out;
 }
 
-// pieces −= cut (pieces sorted and disjoint).
-void subtract(std::vector<Interval>& pieces, const Interval& cut) {
+// pieces −= cut (pieces sorted and disjoint); out is scratch.
+void subtract(std::vector<Interval>& pieces, const Interval& cut, std::vector<Interval>& out) {
   if (cut.empty) return;
-  std::vector<Interval> out;
+  out.clear();
   for (const Interval& p : pieces) {
     if (!(cut.lo.t < p.hi.t && p.lo.t < cut.hi.t)) {
       out.push_back(p);
@@ -140,7 +145,7 @@ void subtract(std::vector<Interval>& pieces, const Interval& cut) {
     if (p.lo.t < cut.lo.t) out.push_back({p.lo, cut.lo, false});
     if (cut.hi.t < p.hi.t) out.push_back({cut.hi, p.hi, false});
   }
-  pieces = std::move(out);
+  std::swap(pieces, out);
 }
 
 // A spherical cap {ω : ω̂·c ≥ cos r} holding a polygon or an arc, enlarged by a margin far above
@@ -180,36 +185,49 @@ bool disjoint(const Cap& x, const Cap& y) {
 
 namespace {
 
+constexpr uint32_t kUnknownSides = ~0u;
+
+// Scratch of edge_pieces.
+struct EdgeScratch {
+  std::vector<Interval> pieces, tmp;
+  std::vector<std::pair<uint32_t, uint32_t>> collinear;  // (occluder j < i, its edges on e's circle)
+};
+
 // The pieces of edge e = (a, b) of polygons[i] that bound V, appended to out (the per-edge step
 // of the header's method). for_others(f) calls f(j) for the occluders j ≥ 1, j ≠ i, ascending,
 // that may overlap e: every other one must give an empty interval (up to rounding) and share no
 // piece of e's great circle with e. Occluder edges are first clipped to the light (the caller
-// has checked in[1] of the light when i ≠ 0: passed as `in_light`).
+// has found in[1] of the light when i ≠ 0: passed as `in_light`).
 template <class ForOthers>
 void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const V3& b, const Interval* in_light,
-                 ForOthers&& for_others, std::vector<Interval>& pieces, std::vector<Arc>& out) {
+                 ForOthers&& for_others, EdgeScratch& s, std::vector<Arc>& out) {
   // The side of e that may border V: left for the light, right for an occluder.
   const int which = i == 0 ? 0 : 1;
   Interval in[2];
+  std::vector<Interval>& pieces = s.pieces;
   pieces.assign(1, i == 0 ? Interval{{0.0, a}, {1.0, b}, false} : *in_light);
+  s.collinear.clear();
   for_others([&](size_t j) {
     if (pieces.empty()) return;
-    inside_intervals(a, b, polygons[j], i < j, in);
-    subtract(pieces, in[which]);
+    uint32_t collinear = 0;
+    inside_intervals(a, b, polygons[j], i < j, in, &collinear);
+    subtract(pieces, in[which], s.tmp);
+    if ((collinear != 0 || polygons[j].size() > 32) && j < i) s.collinear.emplace_back(uint32_t(j), collinear);
   });
   // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
-  auto collinear = [&](size_t j) {
-    if (pieces.empty() || j >= i) return;
+  auto collinear = [&](size_t j, uint32_t mask) {
     const Polygon other = polygons[j];
-    for (size_t f = 0; f < other.size(); ++f) {
+    for (size_t f = 0; f < other.size() && !pieces.empty(); ++f) {
+      const bool unknown = mask == kUnknownSides || f >= 32;  // else mask says it
+      if (!unknown && !(mask & (1u << f))) continue;
       const V3& c = other[f];
       const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
-      if (side(c, d, a) != 0 || side(c, d, b) != 0) continue;
-      subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)));
+      if (unknown && (side(c, d, a) != 0 || side(c, d, b) != 0)) continue;
+      subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)), s.tmp);
     }
   };
-  if (i != 0) collinear(0);
-  for_others(collinear);
+  if (i != 0 && !pieces.empty()) collinear(0, kUnknownSides);
+  for (const auto& [j, mask] : s.collinear) collinear(j, mask);
   for (const Interval& p : pieces) {
     if (i == 0) {
       out.push_back({p.lo.x, p.hi.x});
@@ -230,7 +248,7 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
 
   std::vector<Cap> caps;
   for (const Polygon poly : polygons) caps.push_back(cap_of(poly));
-  std::vector<Interval> pieces;
+  EdgeScratch scratch;
   for (size_t i = 0; i < polygons.size(); ++i) {
     const Polygon poly = polygons[i];
     for (size_t k = 0; k < poly.size(); ++k) {
@@ -248,7 +266,7 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
       edge_pieces(polygons, i, a, b, &in[1], [&](auto&& f) {
         for (size_t j = 1; j < polygons.size(); ++j)
           if (j != i && !disjoint(edge_cap, caps[j])) f(j);
-      }, pieces, out);
+      }, scratch, out);
     }
   }
 }
@@ -303,7 +321,7 @@ struct RegionScratch::Impl {
   std::vector<Box> boxes;
   std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
   uint32_t mark = 0;
-  std::vector<Interval> pieces;
+  EdgeScratch edge;
 };
 
 RegionScratch::RegionScratch() : impl_(std::make_unique<Impl>()) {}
@@ -471,6 +489,27 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     }
     for (uint32_t j : s.wide)
       if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
+    // Keep those whose box meets the chord's box and straddles its line (separating axes).
+    const double box_lo[2] = {std::min(gx[0], gy[0]) - m, std::min(gx[1], gy[1]) - m};
+    const double box_hi[2] = {std::max(gx[0], gy[0]) + m, std::max(gx[1], gy[1]) + m};
+    const double nx = gx[1] - gy[1], ny = gy[0] - gx[0];
+    const double slack = m * (std::abs(nx) + std::abs(ny));
+    size_t kept = 0;
+    for (uint32_t j : s.near) {
+      const Box& box = s.boxes[j];
+      bool keep = !box.in;
+      if (!keep) {
+        keep = box.lo[0] <= box_hi[0] && box.hi[0] >= box_lo[0] && box.lo[1] <= box_hi[1] && box.hi[1] >= box_lo[1];
+        if (keep) {
+          const double cx = 0.5 * (box.lo[0] + box.hi[0]) - gx[0], cy = 0.5 * (box.lo[1] + box.hi[1]) - gx[1];
+          const double centre = nx * cx + ny * cy;
+          const double reach = 0.5 * (std::abs(nx) * (box.hi[0] - box.lo[0]) + std::abs(ny) * (box.hi[1] - box.lo[1]));
+          keep = std::abs(centre) <= reach + slack;
+        }
+      }
+      if (keep) s.near[kept++] = j;
+    }
+    s.near.resize(kept);
     std::sort(s.near.begin(), s.near.end());
   };
 
@@ -480,7 +519,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
         for (uint32_t j : s.near)
           if (j != i) f(j);
-      }, s.pieces, out);
+      }, s.edge, out);
       return;
     }
     const V3 ends[2] = {a, b};
@@ -488,7 +527,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
       for (size_t j = 1; j < count; ++j)
         if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j])) f(j);
-    }, s.pieces, out);
+    }, s.edge, out);
   };
   for (size_t k = 0; k < light.size(); ++k) {
     const V3& a = light[k];

@@ -124,6 +124,7 @@ private:
     Eigen::Vector3d lo, hi;
     uint32_t index;  // leaf: first entry of order_; inner: right child (left child is this + 1)
     uint32_t count;  // leaf: triangle count (> 0); inner: 0
+    uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
   enum class Method { contour, per_triangle, reference };
