@@ -29,6 +29,19 @@ constexpr uint32_t kLeafSize = 4;
 struct OccluderMesh::LightFrame {
   V3 a, b, c;
   int p_side = 0;  // orient3d_exact(a, b, c, p) ≠ 0
+  V3 m;            // −p_side·(b − a)×(c − a): m·(x − a) > 0 on p's side
+  double bound_coef = 0;
+
+  // orient3d_exact(a, b, c, x)·p_side (> 0: x on p's side), by a filter first: m·(x − a) in
+  // double errs by less than 8u |b − a|₁|c − a|₁|x − a|₁ (u = 2⁻⁵³); beyond 1e-14 of that
+  // product its sign is the exact one.
+  int depth_side(const V3& x) const {
+    const V3 r = x - a;
+    const double v = m.dot(r), bound = bound_coef * r.cwiseAbs().sum();
+    if (v > bound) return 1;
+    if (v < -bound) return -1;
+    return orient3d_exact(a, b, c, x) * p_side;
+  }
 };
 
 namespace {
@@ -164,6 +177,8 @@ bool OccluderMesh::prepare(std::span<const V3> light, const ShadePoint& point, W
   const V3 ab = frame.b - frame.a, ac = frame.c - frame.a;
   // det(a − p, b − p, c − p) = −N·(p − a) with N = (b − a)×(c − a): p's side has −p_side·N·(x − a) > 0.
   ws.planes.push_back({-double(frame.p_side) * ab.cross(ac), frame.a, kMargin * ab.norm() * ac.norm()});
+  frame.m = ws.planes.back().m;
+  frame.bound_coef = 1e-14 * ab.cwiseAbs().sum() * ac.cwiseAbs().sum();
   return true;
 }
 
@@ -175,7 +190,7 @@ OccluderMesh::ImageKind OccluderMesh::add_image(uint32_t triangle, const ShadePo
   int s[3];
   bool any_front = false, any_back = false;
   for (int k = 0; k < 3; ++k) {
-    s[k] = orient3d_exact(frame.a, frame.b, frame.c, *x[k]) * frame.p_side;
+    s[k] = frame.depth_side(*x[k]);
     any_front = any_front || s[k] > 0;
     any_back = any_back || s[k] < 0;
   }
@@ -344,15 +359,16 @@ void OccluderMesh::cull(Workspace& ws) const {
     }
     return inside ? 1 : 0;
   };
+  // A triangle of a leaf is outside a plane when its highest vertex is below −margin, the
+  // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
+  std::vector<double>& leaf_margin = ws.margins;
+  leaf_margin.assign(ws.planes.size(), 0.0);
   auto triangle_outside = [&](uint32_t t) {
-    for (const auto& plane : ws.planes) {
-      double top = -std::numeric_limits<double>::infinity(), reach = 0;
-      for (uint32_t v : triangles_[t]) {
-        const V3 r = positions_[v] - plane.o;
-        top = std::max(top, plane.m.dot(r));
-        reach = std::max(reach, r.cwiseAbs().sum());
-      }
-      if (top < -plane.margin_coef * reach) return true;
+    for (size_t k = 0; k < ws.planes.size(); ++k) {
+      const auto& plane = ws.planes[k];
+      double top = -std::numeric_limits<double>::infinity();
+      for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
+      if (top < -leaf_margin[k]) return true;
     }
     return false;
   };
@@ -372,6 +388,9 @@ void OccluderMesh::cull(Workspace& ws) const {
       ws.stack.push_back(at + 1);
       continue;
     }
+    const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
+    for (size_t k = 0; k < ws.planes.size(); ++k)
+      leaf_margin[k] = ws.planes[k].margin_coef * ((centre - ws.planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
       if (!triangle_outside(order_[i])) ws.kept.push_back(order_[i]);
   }

@@ -6,6 +6,8 @@
 #include <bake/visibility/contour.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -22,9 +24,18 @@ using Polygon = std::span<const V3>;
 // A shared vertex (x bitwise c or d: adjacent triangles of a mesh, front and back faces of one
 // edge) is 0 at once; the floating-point filter cannot decide an exact zero and would evaluate
 // the expansion.
-int side(const V3& c, const V3& d, const V3& x) {
+// A floating-point filter first: det(c, d, x) = (c × d)·x computed in double errs by less than
+// 8u |c|₁|d|₁|x|₁ (u = 2⁻⁵³); beyond 1e-14 of that product its sign is the exact one.
+int side_filtered(const V3& m, double cd, const V3& c, const V3& d, const V3& x) {
   if (x == c || x == d) return 0;
+  const double v = m.dot(x), bound = 1e-14 * cd * x.cwiseAbs().sum();
+  if (v > bound) return 1;
+  if (v < -bound) return -1;
   return orient3d_exact(c, d, x, V3::Zero());
+}
+
+int side(const V3& c, const V3& d, const V3& x) {
+  return side_filtered(c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum(), c, d, x);
 }
 
 // A position along the edge being cut: parameter τ ∈ [0, 1] (monotone along the arc) and point.
@@ -282,6 +293,7 @@ constexpr double kFrontCos = 1e-3;  // a polygon with a vertex at c·ω̂ ≤ th
 constexpr double kChartCos = 0.1;   // the chart is used when every light vertex has c·ω̂ > this
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kMaxGrid = 48;
+const double kGridDensity = getenv("GRIDD") ? atof(getenv("GRIDD")) : 1.0;  // cells per side / √(charted occluders)
 
 // The gnomonic chart about c (ω ↦ (e1·ω, e2·ω)/(c·ω)): great circles map to lines, so an arc
 // maps to the chord of its end points and a convex polygon in c's open hemisphere to the convex
@@ -292,9 +304,9 @@ struct Chart {
   uint32_t n[2] = {1, 1};
 
   void at(const V3& w, double g[2]) const {
-    const double z = c.dot(w);
-    g[0] = e1.dot(w) / z;
-    g[1] = e2.dot(w) / z;
+    const double z = 1 / c.dot(w);
+    g[0] = e1.dot(w) * z;
+    g[1] = e2.dot(w) * z;
   }
   // Cells [c0, c1] along axis for coordinates [x0, x1] (with margins), clamped; false when the
   // range misses the grid. Monotone in x0 and x1, so overlapping ranges share a cell.
@@ -309,7 +321,8 @@ struct Chart {
 
 struct Box {
   double lo[2], hi[2];
-  bool in = false;
+  bool in = false;    // charted and meeting the chart's box
+  uint32_t first = 0;  // its vertices' chart points: RegionScratch::Impl::points[first, first + size)
 };
 
 }  // namespace
@@ -319,6 +332,7 @@ struct RegionScratch::Impl {
   std::vector<Polygon> polygons;
   std::vector<Cap> caps;
   std::vector<Box> boxes;
+  std::vector<std::array<double, 2>> points;
   std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
   uint32_t mark = 0;
   EdgeScratch edge;
@@ -353,11 +367,11 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   for (const V3& v : light) charted = charted && light_cap.c.dot(v.normalized()) > kChartCos;
   s.wide.clear();
   if (s.stamp.size() < count) s.stamp.resize(count, 0);
+  double scale = 1;  // the chart's: 1 + the largest |coordinate| of the light's points
   if (charted) {
     chart.c = light_cap.c;
     chart.e1 = chart.c.unitOrthogonal();
     chart.e2 = chart.c.cross(chart.e1);
-    double scale = 1;
     for (int a = 0; a < 2; ++a) chart.lo[a] = kInf, chart.hi[a] = -kInf;
     for (const V3& v : light) {
       double g[2];
@@ -373,6 +387,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     // Occluder boxes; an occluder reaching out of c's front hemisphere is `wide` (always tested)
     // unless its cap misses the light's.
     s.boxes.resize(count);
+    s.points.clear();
     size_t in_chart = 0;
     for (size_t j = 1; j < count; ++j) {
       const Polygon poly = polygons[j];
@@ -380,15 +395,16 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       box.in = false;
       if (poly.empty()) continue;
       bool front = true;
-      for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.norm();
+      for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.cwiseAbs().sum();  // |v|₁ ≥ |v|
       if (!front) {
         if (!disjoint(cap_of(poly), light_cap)) s.wide.push_back(uint32_t(j));
         continue;
       }
       for (int a = 0; a < 2; ++a) box.lo[a] = kInf, box.hi[a] = -kInf;
+      box.first = uint32_t(s.points.size());
       for (const V3& v : poly) {
-        double g[2];
-        chart.at(v, g);
+        auto& g = s.points.emplace_back();
+        chart.at(v, g.data());
         for (int a = 0; a < 2; ++a) box.lo[a] = std::min(box.lo[a], g[a]), box.hi[a] = std::max(box.hi[a], g[a]);
       }
       box.in = true;
@@ -399,7 +415,8 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       }
       in_chart += box.in;
     }
-    const auto side_cells = uint32_t(std::clamp(std::ceil(std::sqrt(double(in_chart))), 1.0, double(kMaxGrid)));
+    const auto side_cells =
+        uint32_t(std::clamp(std::ceil(kGridDensity * std::sqrt(double(in_chart))), 1.0, double(kMaxGrid)));
     for (int a = 0; a < 2; ++a) {
       chart.n[a] = side_cells;
       chart.cell[a] = (chart.hi[a] - chart.lo[a]) / side_cells;
@@ -449,7 +466,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   // s.near = the occluders that may meet the arc from x to y (both in the light, so c·ω > 0):
   // those in the cells the chord of their chart points passes (row by row, with margins) and
   // the wide ones, ascending.
-  auto near = [&](const V3& x, const V3& y) {
+  auto near = [&](size_t i, const V3& a, const V3& b, const V3& x, const V3& y) {
     s.near.clear();
     if (s.mark == std::numeric_limits<uint32_t>::max()) {
       std::fill(s.stamp.begin(), s.stamp.end(), 0);
@@ -489,36 +506,47 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     }
     for (uint32_t j : s.wide)
       if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
-    // Keep those whose box meets the chord's box and straddles its line (separating axes).
+    // Keep those whose box meets the chord's box along both axes and whose vertices' chart
+    // points may lie on the side of e's great circle that matters (the light's left, an
+    // occluder edge's right) and on or across it; or, for an earlier occluder, two of them on
+    // it (a shared arc). The circle m·ω = 0 (m = a × b) is the chart line f(g) = 0 with
+    // f(g) = m·(g₀e1 + g₁e2 + c) = m·ω/(c·ω): f > 0 is det(a, b, ω) > 0, left of e. A point
+    // within the slack (the chart points' margin and the rounding of m, both far above their
+    // errors) may be on either side or on it.
     const double box_lo[2] = {std::min(gx[0], gy[0]) - m, std::min(gx[1], gy[1]) - m};
     const double box_hi[2] = {std::max(gx[0], gy[0]) + m, std::max(gx[1], gy[1]) + m};
-    const double nx = gx[1] - gy[1], ny = gy[0] - gx[0];
-    const double slack = m * (std::abs(nx) + std::abs(ny));
+    const V3 normal = a.cross(b);
+    const double nx = normal.dot(chart.e1), ny = normal.dot(chart.e2), nz = normal.dot(chart.c);
+    const double slack = 4 * m * normal.cwiseAbs().sum() + 1e-13 * a.cwiseAbs().sum() * b.cwiseAbs().sum() * scale;
     size_t kept = 0;
     for (uint32_t j : s.near) {
+      if (j == i) continue;
       const Box& box = s.boxes[j];
       bool keep = !box.in;
-      if (!keep) {
-        keep = box.lo[0] <= box_hi[0] && box.hi[0] >= box_lo[0] && box.lo[1] <= box_hi[1] && box.hi[1] >= box_lo[1];
-        if (keep) {
-          const double cx = 0.5 * (box.lo[0] + box.hi[0]) - gx[0], cy = 0.5 * (box.lo[1] + box.hi[1]) - gx[1];
-          const double centre = nx * cx + ny * cy;
-          const double reach = 0.5 * (std::abs(nx) * (box.hi[0] - box.lo[0]) + std::abs(ny) * (box.hi[1] - box.lo[1]));
-          keep = std::abs(centre) <= reach + slack;
+      if (!keep && box.lo[0] <= box_hi[0] && box.hi[0] >= box_lo[0] && box.lo[1] <= box_hi[1] &&
+          box.hi[1] >= box_lo[1]) {
+        int left = 0, right = 0, unsure = 0;
+        for (size_t k = 0; k < polygons[j].size(); ++k) {
+          const auto& g = s.points[box.first + k];
+          const double f = nx * g[0] + ny * g[1] + nz;
+          left += f > slack;
+          right += f < -slack;
+          unsure += !(f > slack) && !(f < -slack);
         }
+        keep = i == 0 ? left + unsure > 0 && right + unsure > 0
+                      : (right + unsure > 0 && left + unsure > 0) || (j < i && unsure >= 2);
+        // (an occluder's right side: a point right and one left or on; the light's left likewise)
       }
       if (keep) s.near[kept++] = j;
     }
     s.near.resize(kept);
-    std::sort(s.near.begin(), s.near.end());
   };
 
   auto run = [&](size_t i, const V3& a, const V3& b, const Interval* in_light) {
     if (charted) {
-      near(in_light ? in_light->lo.x : a, in_light ? in_light->hi.x : b);
+      near(i, a, b, in_light ? in_light->lo.x : a, in_light ? in_light->hi.x : b);
       edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
-        for (uint32_t j : s.near)
-          if (j != i) f(j);
+        for (uint32_t j : s.near) f(j);
       }, s.edge, out);
       return;
     }

@@ -66,6 +66,7 @@ public:
       double margin_coef;  // margin = margin_coef · (|x − o| bound)
     };
     std::vector<Plane> planes;
+    std::vector<double> margins;  // per plane, of the leaf being culled
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
