@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -293,7 +292,7 @@ constexpr double kFrontCos = 1e-3;  // a polygon with a vertex at c·ω̂ ≤ th
 constexpr double kChartCos = 0.1;   // the chart is used when every light vertex has c·ω̂ > this
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kMaxGrid = 48;
-const double kGridDensity = getenv("GRIDD") ? atof(getenv("GRIDD")) : 1.0;  // cells per side / √(charted occluders)
+constexpr double kGridDensity = 1.0;  // cells per side / √(charted occluders) (bench_area: 0.5–1 alike)
 
 // The gnomonic chart about c (ω ↦ (e1·ω, e2·ω)/(c·ω)): great circles map to lines, so an arc
 // maps to the chord of its end points and a convex polygon in c's open hemisphere to the convex

@@ -76,20 +76,27 @@ private:
 };
 
 // The same boundary arcs as visible_region(light, occluders), cutting only the occluder edges
-// that may bound the union (issue 32; paper 003 §3.3: the union's boundary lies on silhouette
-// edges). boundary[k] has bit e set when edge e (vertices e, e + 1) of occluders[k] may bound it
-// (edges e ≥ 8 always do). Precondition: an edge left out emits nothing in visible_region, i.e.
-// its right side is inside another occluder along the whole edge (e.g. a mesh edge whose two
-// faces' images lie on opposite sides of it). Given that, the arcs equal visible_region's
-// bit for bit up to the order of the pieces. Each edge (the light's, and the in-light part of each
-// boundary edge) meets only the occluders near it, found in a uniform grid over the gnomonic
-// chart about the light's cap centre (great circles map to lines, convex polygons to the hulls of
-// their vertices' points; boxes and chords with a margin of 1e-9 of the chart's scale, far above
-// the rounding of the chart points; occluders reaching out of the chart's hemisphere are tested
-// by every edge). The grid is a filter: an occluder it leaves out has an empty interval on the
-// edge and no piece of its great circle, exactly as the caps of visible_region. A light of
-// ≥ 84° radius (a vertex at c·ω̂ ≤ 0.1) is not charted: then every pair is filtered by caps.
-// Cost: O(P + B·k) for P occluders, B boundary edges in the light and k occluders near an edge.
+// that may bound the union, each against the occluders near it (issue 32; paper 003 §3.3: the
+// union's boundary lies on silhouette edges). boundary[k] has bit e set when edge e (vertices
+// e, e + 1) of occluders[k] may bound it (edges e ≥ 8 always do). Precondition: an edge left out
+// emits nothing in visible_region — its right side is inside another occluder along the whole
+// edge (a mesh edge whose two faces' images lie on opposite sides of it), or it is the same arc
+// as an edge of an occluder listed before it (a fold: that edge owns the arc). Then the arcs are
+// visible_region's, up to cuts of rounding size.
+// Each edge (the light's, and the in-light part of each boundary edge) meets only the occluders
+// near it, found in a uniform grid (≈ √P cells a side) over the gnomonic chart about the light's
+// cap centre c (ω ↦ (e1·ω, e2·ω)/(c·ω); great circles map to lines, convex polygons to the
+// hulls of their vertices' points, orientation kept): the occluders in the cells the edge's chord
+// passes, whose boxes meet the chord's box, and whose vertices' points may lie on the side that
+// matters (the light edge's left, an occluder edge's right) as well as on or across the edge's
+// great circle (or, for an earlier occluder, two on it: a shared arc). Boxes carry a margin of
+// 1e-9 of the chart's scale and sides a slack far above the rounding of the chart points and of
+// a × b, so every occluder the exact predicates could find is kept: the grid is a filter like
+// visible_region's caps. Occluders reaching out of c's hemisphere (c·ω̂ ≤ 1e-3) are tested by
+// every edge; a light of ≥ 84° radius (a vertex at c·ω̂ ≤ 0.1) is not charted, and then every
+// pair is filtered by caps only (RegionScratch::charted = false).
+// Cost: O(P + G + B·k) for P occluders, G grid entries, B boundary edges reaching into the light
+// and k occluders near each (bench/bench_area.cpp BM_BunnyQuad).
 void visible_region_sparse(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
                            std::span<const uint8_t> boundary, std::vector<Arc>& out, RegionScratch& scratch);
 
