@@ -36,7 +36,7 @@ constexpr double kExact = 1e-9;
 constexpr int kOrder = 4;
 
 struct Totals {
-  size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0;
+  size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0, special = 0, uncharted = 0;
 };
 
 // E and the order-4 SH of the visible light by both methods at s; EXPECTs their agreement.
@@ -59,6 +59,8 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   totals.shadowed += e_slow < s.n.dot(prt::bake::vector_irradiance(bare)) - 1e-6 * scale;
   totals.boundary_edges += ws_fast.stats.boundary_edges;
   totals.kept += kept;
+  totals.special += ws_fast.stats.special;
+  totals.uncharted += ws_fast.stats.uncharted;
 }
 
 std::vector<V3> positions_of(const prt::bake::Mesh& m) {
@@ -119,6 +121,7 @@ TEST(OccluderContour, BunnyOwnVerticesEqualPerTriangle) {
   for (size_t v = 0; v < points.size(); v += 7) compare(mesh, kBunnyLight, points[v], "vertex " + std::to_string(v), totals);
   EXPECT_GT(totals.points, 250u);
   EXPECT_GT(totals.shadowed, 20u);
+  EXPECT_GT(totals.special, totals.points / 2);  // the own 1-ring's ε-limit cones were cut
 }
 
 TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
@@ -267,6 +270,25 @@ TEST(OccluderContour, LightCrossingTheHorizon) {
     compare(mesh, kBunnyLight, {.p = V3(-6 + 0.3 * k, 0, 0.1 * k - 2), .n = n}, "horizon " + std::to_string(k), totals);
   }
   EXPECT_GT(totals.shadowed, 5u);
+}
+
+TEST(OccluderContour, LightTooWideForTheChart) {
+  // A 6 × 6 light 0.3 above the points (its corners at c·ω̂ < 0.1 from the cap centre): the
+  // chart is not used and every pair is filtered by caps; still the per-triangle arcs.
+  std::mt19937_64 rng(3);
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  add_sheet(pos, tris, rng, false);
+  for (V3& v : pos) v.z() = 0.1 + 0.1 * (v.z() - 1);
+  const OccluderMesh mesh(pos, tris);
+  const Poly light{{-3, -3, 0.3}, {3, -3, 0.3}, {3, 3, 0.3}, {-3, 3, 0.3}};
+  std::uniform_real_distribution<double> u(0, 1);
+  Totals totals;
+  for (int k = 0; k < 60; ++k)
+    compare(mesh, light, {.p = V3(2 * u(rng) - 1, 2 * u(rng) - 1, 0), .n = V3(u(rng) - 0.5, u(rng) - 0.5, 1).normalized()},
+            "wide " + std::to_string(k), totals);
+  EXPECT_EQ(totals.uncharted, totals.points);
+  EXPECT_GT(totals.shadowed, 50u);
 }
 
 }  // namespace
