@@ -82,15 +82,28 @@ V3 cut_point(const V3& a, const V3& b, const V3& c, const V3& d) {
 // and the boundary arcs close exactly.
 // collinear (if given) gets bit k for each edge k < 32 of poly whose great circle holds e; it is
 // left incomplete only when e misses poly's interior, and then e shares no arc with its edges.
+// normals (if given): per edge k of poly, c × d and |c|₁|d|₁ (the filter of side_filtered).
+struct EdgeNormal {
+  V3 m;
+  double cd;
+};
+
 void inside_intervals(const V3& a, const V3& b, Polygon poly, bool e_first, Interval (&out)[2],
-                      uint32_t* collinear = nullptr) {
+                      uint32_t* collinear = nullptr, const EdgeNormal* normals = nullptr) {
   out[0] = out[1] = Interval{{0.0, a}, {1.0, b}, false};
   const size_t n = poly.size();
   if (collinear) *collinear = 0;
   for (size_t k = 0; k < n; ++k) {
     const V3& c = poly[k];
     const V3& d = poly[k + 1 == n ? 0 : k + 1];
-    const int sa = side(c, d, a), sb = side(c, d, b);
+    int sa = 0, sb = 0;
+    if (normals) {
+      sa = side_filtered(normals[k].m, normals[k].cd, c, d, a);
+      sb = side_filtered(normals[k].m, normals[k].cd, c, d, b);
+    } else {
+      sa = side(c, d, a);
+      sb = side(c, d, b);
+    }
     if (sa == 0 && sb == 0) {  // e lies on f's great circle: the sides are e's two sides
       if (collinear && k < 32) *collinear |= 1u << k;
       const int s = same_direction(a, b, c, d, poly);
@@ -208,9 +221,9 @@ struct EdgeScratch {
 // that may overlap e: every other one must give an empty interval (up to rounding) and share no
 // piece of e's great circle with e. Occluder edges are first clipped to the light (the caller
 // has found in[1] of the light when i ≠ 0: passed as `in_light`).
-template <class ForOthers>
+template <class ForOthers, class NormalsOf>
 void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const V3& b, const Interval* in_light,
-                 ForOthers&& for_others, EdgeScratch& s, std::vector<Arc>& out) {
+                 ForOthers&& for_others, NormalsOf&& normals_of, EdgeScratch& s, std::vector<Arc>& out) {
   // The side of e that may border V: left for the light, right for an occluder.
   const int which = i == 0 ? 0 : 1;
   Interval in[2];
@@ -220,7 +233,7 @@ void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const
   for_others([&](size_t j) {
     if (pieces.empty()) return;
     uint32_t collinear = 0;
-    inside_intervals(a, b, polygons[j], i < j, in, &collinear);
+    inside_intervals(a, b, polygons[j], i < j, in, &collinear, normals_of(j));
     subtract(pieces, in[which], s.tmp);
     if ((collinear != 0 || polygons[j].size() > 32) && j < i) s.collinear.emplace_back(uint32_t(j), collinear);
   });
@@ -276,7 +289,7 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
       edge_pieces(polygons, i, a, b, &in[1], [&](auto&& f) {
         for (size_t j = 1; j < polygons.size(); ++j)
           if (j != i && !disjoint(edge_cap, caps[j])) f(j);
-      }, scratch, out);
+      }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, scratch, out);
     }
   }
 }
@@ -299,7 +312,7 @@ constexpr double kGridDensity = 1.0;  // cells per side / √(charted occluders)
 // hull of its vertices' points. A uniform grid of cells over the light's box.
 struct Chart {
   V3 c, e1, e2;
-  double lo[2] = {0, 0}, hi[2] = {0, 0}, cell[2] = {1, 1}, margin = 0;
+  double lo[2] = {0, 0}, hi[2] = {0, 0}, cell[2] = {1, 1}, inverse[2] = {1, 1}, margin = 0;
   uint32_t n[2] = {1, 1};
 
   void at(const V3& w, double g[2]) const {
@@ -312,8 +325,9 @@ struct Chart {
   bool cells(int axis, double x0, double x1, uint32_t& c0, uint32_t& c1) const {
     if (x1 < lo[axis] || x0 > hi[axis]) return false;
     const double top = double(n[axis] - 1);
-    c0 = uint32_t(std::clamp(std::floor((x0 - lo[axis]) / cell[axis]), 0.0, top));
-    c1 = uint32_t(std::clamp(std::floor((x1 - lo[axis]) / cell[axis]), 0.0, top));
+    // Clamped to [0, top] first, so truncation is the floor.
+    c0 = uint32_t(std::clamp((x0 - lo[axis]) * inverse[axis], 0.0, top));
+    c1 = uint32_t(std::clamp((x1 - lo[axis]) * inverse[axis], 0.0, top));
     return true;
   }
 };
@@ -322,6 +336,7 @@ struct Box {
   double lo[2], hi[2];
   bool in = false;    // charted and meeting the chart's box
   uint32_t first = 0;  // its vertices' chart points: RegionScratch::Impl::points[first, first + size)
+  uint32_t cells[4];   // x0, x1, y0, y1 (when in and not wide)
 };
 
 }  // namespace
@@ -332,6 +347,7 @@ struct RegionScratch::Impl {
   std::vector<Cap> caps;
   std::vector<Box> boxes;
   std::vector<std::array<double, 2>> points;
+  std::vector<EdgeNormal> normals;  // per polygon vertex k: its edge (k, k + 1), from boxes[j].first
   std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
   uint32_t mark = 0;
   EdgeScratch edge;
@@ -387,12 +403,21 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     // unless its cap misses the light's.
     s.boxes.resize(count);
     s.points.clear();
+    s.normals.clear();
     size_t in_chart = 0;
     for (size_t j = 1; j < count; ++j) {
       const Polygon poly = polygons[j];
       Box& box = s.boxes[j];
       box.in = false;
       if (poly.empty()) continue;
+      // Points and normals share the index base: one slot per vertex (points only for charted).
+      box.first = uint32_t(s.normals.size());
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V3& c = poly[k];
+        const V3& d = poly[k + 1 == poly.size() ? 0 : k + 1];
+        s.normals.push_back({c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum()});
+      }
+      s.points.resize(s.normals.size());
       bool front = true;
       for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.cwiseAbs().sum();  // |v|₁ ≥ |v|
       if (!front) {
@@ -400,9 +425,9 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
         continue;
       }
       for (int a = 0; a < 2; ++a) box.lo[a] = kInf, box.hi[a] = -kInf;
-      box.first = uint32_t(s.points.size());
-      for (const V3& v : poly) {
-        auto& g = s.points.emplace_back();
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V3& v = poly[k];
+        auto& g = s.points[box.first + k];
         chart.at(v, g.data());
         for (int a = 0; a < 2; ++a) box.lo[a] = std::min(box.lo[a], g[a]), box.hi[a] = std::max(box.hi[a], g[a]);
       }
@@ -419,7 +444,8 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     for (int a = 0; a < 2; ++a) {
       chart.n[a] = side_cells;
       chart.cell[a] = (chart.hi[a] - chart.lo[a]) / side_cells;
-      charted = charted && chart.cell[a] > 0;
+      chart.inverse[a] = 1 / chart.cell[a];
+      charted = charted && chart.cell[a] > 0 && std::isfinite(chart.inverse[a]);
     }
   }
   if (charted) {
@@ -428,17 +454,22 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     const size_t cells = size_t(chart.n[0]) * chart.n[1];
     const size_t wide_limit = std::max<size_t>(cells / 4, 4);
     s.cell_start.assign(cells + 1, 0);
+    for (size_t j = 1; j < count; ++j) {
+      Box& box = s.boxes[j];
+      if (!box.in) continue;
+      uint32_t* c = box.cells;
+      chart.cells(0, box.lo[0], box.hi[0], c[0], c[1]);
+      chart.cells(1, box.lo[1], box.hi[1], c[2], c[3]);
+      if (size_t(c[1] - c[0] + 1) * (c[3] - c[2] + 1) > wide_limit) {
+        s.wide.push_back(uint32_t(j));
+        c[0] = c[2] = 1, c[1] = c[3] = 0;  // no cells
+      }
+    }
     for (int pass = 0; pass < 2; ++pass) {
       for (size_t j = 1; j < count; ++j) {
         const Box& box = s.boxes[j];
         if (!box.in) continue;
-        uint32_t x0 = 0, x1 = 0, y0 = 0, y1 = 0;
-        chart.cells(0, box.lo[0], box.hi[0], x0, x1);
-        chart.cells(1, box.lo[1], box.hi[1], y0, y1);
-        if (size_t(x1 - x0 + 1) * (y1 - y0 + 1) > wide_limit) {
-          if (pass == 0) s.wide.push_back(uint32_t(j));
-          continue;
-        }
+        const uint32_t x0 = box.cells[0], x1 = box.cells[1], y0 = box.cells[2], y1 = box.cells[3];
         for (uint32_t y = y0; y <= y1; ++y)
           for (uint32_t x = x0; x <= x1; ++x) {
             const size_t cell = size_t(y) * chart.n[0] + x;
@@ -546,7 +577,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       near(i, a, b, in_light ? in_light->lo.x : a, in_light ? in_light->hi.x : b);
       edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
         for (uint32_t j : s.near) f(j);
-      }, s.edge, out);
+      }, [&](size_t j) { return s.normals.data() + s.boxes[j].first; }, s.edge, out);
       return;
     }
     const V3 ends[2] = {a, b};
@@ -554,7 +585,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
       for (size_t j = 1; j < count; ++j)
         if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j])) f(j);
-    }, s.edge, out);
+    }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, s.edge, out);
   };
   for (size_t k = 0; k < light.size(); ++k) {
     const V3& a = light[k];
