@@ -72,7 +72,11 @@ V3 cut_point(const V3& a, const V3& b, const V3& c, const V3& d) {
   const bool swap = std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3);
   const V3& lo = swap ? b : a;
   const V3& hi = swap ? a : b;
-  return abs_det(c, d, hi) * lo + abs_det(c, d, lo) * hi;
+  const double at_hi = abs_det(c, d, hi), at_lo = abs_det(c, d, lo);
+  // Both ends within rounding of the circle (a near-degenerate edge (c, d)): the middle, as the
+  // parameter 0.5 that inside_intervals then takes.
+  if (at_hi == 0 && at_lo == 0) return lo + hi;
+  return at_hi * lo + at_lo * hi;
 }
 
 // Where the left side [0] and the right side [1] of e = (a, b) are strictly inside the convex
@@ -381,6 +385,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   bool charted = !light_cap.all;
   for (const V3& v : light) charted = charted && light_cap.c.dot(v.normalized()) > kChartCos;
   s.wide.clear();
+  s.caps.clear();
   if (s.stamp.size() < count) s.stamp.resize(count, 0);
   double scale = 1;  // the chart's: 1 + the largest |coordinate| of the light's points
   if (charted) {
@@ -573,12 +578,27 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   };
 
   auto run = [&](size_t i, const V3& a, const V3& b, const Interval* in_light) {
-    if (charted) {
-      near(i, a, b, in_light ? in_light->lo.x : a, in_light ? in_light->hi.x : b);
+    // The chord of e's part in the light, from its parameters (the point at t is
+    // (1 − t)·a + t·b, as inside_intervals orders cuts): the cut points' own x may lie on the
+    // other edge when that one is near-degenerate (e.g. a horizon-clipped light vertex pair).
+    V3 x = a, y = b;
+    if (in_light) {
+      x = (1 - in_light->lo.t) * a + in_light->lo.t * b;
+      y = (1 - in_light->hi.t) * a + in_light->hi.t * b;
+    }
+    const bool chord_in_chart = charted && chart.c.dot(x) > kFrontCos * x.cwiseAbs().sum() &&
+                                chart.c.dot(y) > kFrontCos * y.cwiseAbs().sum();
+    if (chord_in_chart) {
+      near(i, a, b, x, y);
       edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
         for (uint32_t j : s.near) f(j);
       }, [&](size_t j) { return s.normals.data() + s.boxes[j].first; }, s.edge, out);
       return;
+    }
+    // Not charted (or this chord leaves the chart's hemisphere): caps only.
+    if (charted && s.caps.size() != count) {
+      s.caps.clear();
+      for (const Polygon poly : polygons) s.caps.push_back(poly.empty() ? Cap{} : cap_of(poly));
     }
     const V3 ends[2] = {a, b};
     const Cap edge_cap = cap_of(ends);

@@ -49,6 +49,17 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   mesh.visible_light_per_triangle(light, s, slow, ws_slow);
   OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
   const double scale = std::abs(prt::bake::solid_angle(bare));
+  // Every arc end a direction (a zero vector was a cut point of a near-degenerate edge).
+  auto directions = [&](const std::vector<Arc>& arcs, const char* which) {
+    for (const Arc& arc : arcs)
+      if (!(arc.a.norm() > 0) || !(arc.b.norm() > 0)) {
+        ADD_FAILURE() << what << ": " << which << " has an arc end of zero length";
+        return false;
+      }
+    return true;
+  };
+  const bool fast_ok = directions(fast, "contour path"), slow_ok = directions(slow, "per triangle");
+  if (!fast_ok || !slow_ok) return;
   const double e_fast = s.n.dot(prt::bake::vector_irradiance(fast)), e_slow = s.n.dot(prt::bake::vector_irradiance(slow));
   EXPECT_NEAR(e_fast, e_slow, kExact * scale) << what;
   std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
@@ -270,6 +281,36 @@ TEST(OccluderContour, LightCrossingTheHorizon) {
     compare(mesh, kBunnyLight, {.p = V3(-6 + 0.3 * k, 0, 0.1 * k - 2), .n = n}, "horizon " + std::to_string(k), totals);
   }
   EXPECT_GT(totals.shadowed, 5u);
+}
+
+TEST(OccluderContour, IntegerGridSoupsFullOfTies) {
+  // Triangles with corners on a small integer grid (and shade points on it too): shared great
+  // circles, edges through p, p on faces, edges and vertices, coincident and T-junction faces,
+  // vertices on the light's plane and its pyramid's faces — every tie the exact predicates decide.
+  std::mt19937_64 rng(2026);
+  std::uniform_int_distribution<int> xy(-3, 3), z(0, 4), pick(0, 99);
+  const Poly light{{-2, -2, 4}, {2, -2, 4}, {2, 2, 4}, {-2, 2, 4}};
+  Totals totals;
+  for (int scene = 0; scene < 1000; ++scene) {
+    std::vector<V3> pos;
+    for (int v = 0; v < 40; ++v) pos.emplace_back(xy(rng), xy(rng), z(rng));
+    std::vector<Tri> tris;
+    std::uniform_int_distribution<uint32_t> any(0, 39);
+    for (int t = 0; t < 60; ++t) {
+      const Tri tri{any(rng), any(rng), any(rng)};
+      tris.push_back(tri);
+      if (pick(rng) < 20) tris.push_back({tri[1], tri[0], tri[2]});  // the same face wound back
+      if (pick(rng) < 20) tris.push_back({tri[0], tri[1], any(rng)});  // a fan on one edge
+    }
+    const OccluderMesh mesh(pos, tris);
+    for (int k = 0; k < 8; ++k) {
+      const V3 p = pick(rng) < 50 ? pos[any(rng)] : V3(xy(rng), xy(rng), z(rng) - 1);
+      const V3 n = V3(xy(rng), xy(rng), 3).normalized();
+      compare(mesh, light, {.p = p, .n = n}, "grid scene " + std::to_string(scene) + " point " + std::to_string(k), totals);
+    }
+  }
+  EXPECT_GT(totals.shadowed, 100u);
+  EXPECT_GT(totals.special, 20u);
 }
 
 TEST(OccluderContour, LightTooWideForTheChart) {
