@@ -18,7 +18,8 @@
 //   BM_ThreeLightsThreeBoxesMesh/culled:0  the same through the unculled reference
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
-//                 (on_bunny:0) or ~460–512 of the bunny's own vertices (on_bunny:1), Loop-
+//                 (on_bunny:0) or the bunny's own vertices (on_bunny:1: every 8th, 230, at
+//                 level 0; ~515 from level 1 on), Loop-
 //                 subdivided 0–3 times (loop), by the contour path (contour:1, issue 32) or the
 //                 per-triangle method (contour:0), side by side
 #include <bake/lights/lights.h>
@@ -219,7 +220,8 @@ void BM_ThreeLightsThreeBoxesMesh(benchmark::State& state) {
 BENCHMARK(BM_ThreeLightsThreeBoxesMesh)->ArgName("culled")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 // The bunny's quad light and receivers: the 256 ground points (the floor points mapped to y = 0,
-// normals about +y), or every 8th vertex of the (subdivided) bunny itself (ON the occluder).
+// normals about +y), or every max(8, V/512)-th vertex of the (subdivided) bunny itself (ON the
+// occluder).
 const std::vector<V3> kBunnyLight{{-3, 12, -2}, {3, 12, -2}, {3, 12, 2}, {-3, 12, 2}};
 
 std::vector<ShadePoint> bunny_ground_points() {

@@ -55,9 +55,9 @@
 // Cost: culling and the images are linear in the triangles inside the light's pyramid; the
 // contour path then costs the chart's grid over them plus, per edge cut, the images near it
 // (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: contour path": the bunny
-// under a quad light: 6.8k ground points/s and 44k of its own vertices/s per core, against 554
-// and 5.3k per triangle; over Loop levels 0–3 the ground rate falls as T^-0.88 while the edges
-// cut grow as T^0.45: the part linear in the kept triangles dominates).
+// under a quad light: 6.2–6.8k ground points/s and 44–47k of its own vertices/s per core,
+// 9–13x the per-triangle method; over Loop levels 0–3 the ground rate falls as T^-0.9 while the
+// edges cut grow as T^0.45: the part linear in the kept triangles dominates).
 #pragma once
 
 #include <bake/mesh/mesh.h>
