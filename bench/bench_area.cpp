@@ -18,8 +18,14 @@
 //   BM_ThreeLightsThreeBoxesMesh/culled:0  the same through the unculled reference
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
+//                 (on_bunny:0) or the bunny's own vertices (on_bunny:1: every 8th, 230, at
+//                 level 0; ~515 from level 1 on), Loop-
+//                 subdivided 0–3 times (loop), by the contour path (contour:1, issue 32) or the
+//                 per-triangle method (contour:0), side by side
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
+#include <bake/mesh/receivers.h>
+#include <bake/mesh/subdivide.h>
 #include <bake/sphere/polygon_sh.h>
 #include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/occluder_mesh.h>
@@ -31,6 +37,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -212,21 +219,96 @@ void BM_ThreeLightsThreeBoxesMesh(benchmark::State& state) {
 }
 BENCHMARK(BM_ThreeLightsThreeBoxesMesh)->ArgName("culled")->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
-void BM_BunnyQuad(benchmark::State& state) {
-  const prt::bake::OccluderMesh mesh(prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj"));
-  const std::vector<std::vector<V3>> light{{{-3, 12, -2}, {3, 12, -2}, {3, 12, 2}, {-3, 12, 2}}};
+// The bunny's quad light and receivers: the 256 ground points (the floor points mapped to y = 0,
+// normals about +y), or every max(8, V/512)-th vertex of the (subdivided) bunny itself (ON the
+// occluder).
+const std::vector<V3> kBunnyLight{{-3, 12, -2}, {3, 12, -2}, {3, 12, 2}, {-3, 12, 2}};
+
+std::vector<ShadePoint> bunny_ground_points() {
   std::vector<ShadePoint> points;
-  for (const ShadePoint& s : shade_points()) {  // the floor points mapped to y = 0, normals about +y
+  for (const ShadePoint& s : shade_points()) {
     if (points.size() == 256) break;
     points.push_back({V3(4 * s.p.x(), 0, 3 * s.p.y()), V3(s.n.x(), s.n.z(), s.n.y())});
   }
+  return points;
+}
+
+const prt::bake::Mesh& bunny(int levels) {
+  static std::vector<std::unique_ptr<prt::bake::Mesh>> meshes;
+  static const prt::bake::Mesh base = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  while (meshes.size() <= size_t(levels))
+    meshes.push_back(std::make_unique<prt::bake::Mesh>(prt::bake::loop_subdivide(base, int(meshes.size()))));
+  return *meshes[size_t(levels)];
+}
+
+std::vector<V3> positions_of(const prt::bake::Mesh& m) {
+  std::vector<V3> p;
+  for (const auto& x : m.positions) p.push_back(x.cast<double>());
+  return p;
+}
+
+// Shade points per CPU second, one quad light over the bunny (Loop-subdivided `levels` times):
+// the contour path (OccluderMesh::visible_light, issue 32) or the per-triangle method
+// (visible_light_per_triangle), receivers on the ground or the bunny's own vertices. Counters
+// (untimed pass): kept triangles and cut edges (contour edges reaching into the light) per
+// query; `special`: share of queries with a clipped or ε-limit image (the point's own 1-ring:
+// all its edges cut, still the contour path); `uncharted`: share whose light was too wide for the
+// chart (caps filter only); `fallback`: share answered by the per-triangle method (none: the
+// contour path has no such fallback).
+void BM_BunnyQuad(benchmark::State& state) {
+  const bool contour = state.range(0) != 0;
+  const bool on_bunny = state.range(1) != 0;
+  const int levels = int(state.range(2));
+  const prt::bake::Mesh& m = bunny(levels);
+  const prt::bake::OccluderMesh mesh(positions_of(m), m.triangles);
+  std::vector<ShadePoint> points;
+  if (on_bunny) {
+    const auto vertices = prt::bake::vertex_shade_points(m, prt::bake::build_topology(m));
+    const size_t stride = std::max<size_t>(8, vertices.size() / 512);
+    for (size_t v = 0; v < vertices.size(); v += stride) points.push_back({vertices[v].p, vertices[v].n});
+  } else {
+    points = bunny_ground_points();
+  }
   prt::bake::OccluderMesh::Workspace ws;
   std::vector<prt::bake::Arc> arcs;
-  run_mesh_bench(state, points, 1, [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
-    return shade_past_mesh(mesh, light, true, s, ws, arcs, kept, shadowed);
-  });
+  auto shade = [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
+    const prt::bake::ShadePoint point{.p = s.p, .n = s.n};
+    kept += contour ? mesh.visible_light(kBunnyLight, point, arcs, ws)
+                    : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
+    shadowed += arcs.size() != ws.clipped.size();
+    return s.n.dot(prt::bake::vector_irradiance(arcs));
+  };
+  run_mesh_bench(state, points, 1, shade);
+  if (contour) {
+    // The untimed pass's counters only (the workspace's sums over it).
+    prt::bake::OccluderMesh::Workspace fresh;
+    ws = fresh;
+    size_t k = 0, h = 0;
+    for (const ShadePoint& s : points) shade(s, k, h);
+    const auto& st = ws.stats;
+    const double q = double(std::max<size_t>(st.queries, 1));
+    state.counters["cut_edges"] = double(st.boundary_edges) / q;
+    state.counters["special"] = double(st.special) / q;
+    state.counters["uncharted"] = double(st.uncharted) / q;
+  }
+  state.counters["fallback"] = 0;
+  state.counters["triangles"] = double(m.triangles.size());
+  state.counters["points"] = double(points.size());
 }
-BENCHMARK(BM_BunnyQuad)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BunnyQuad)
+    ->ArgNames({"contour", "on_bunny", "loop"})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({0, 0, 1})
+    ->Args({1, 0, 1})
+    ->Args({1, 0, 2})
+    ->Args({1, 0, 3})
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 2})
+    ->Args({1, 1, 3})
+    ->Unit(benchmark::kMicrosecond);
 
 // Cost against the silhouette's size: one quad light (kQuad) and one convex occluder, an N-gon
 // prism (radius 0.3, height 0.2, axis +z, centred at height 1), so that its silhouette from the

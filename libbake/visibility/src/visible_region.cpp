@@ -6,7 +6,9 @@
 #include <bake/visibility/contour.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
@@ -21,9 +23,18 @@ using Polygon = std::span<const V3>;
 // A shared vertex (x bitwise c or d: adjacent triangles of a mesh, front and back faces of one
 // edge) is 0 at once; the floating-point filter cannot decide an exact zero and would evaluate
 // the expansion.
-int side(const V3& c, const V3& d, const V3& x) {
+// A floating-point filter first: det(c, d, x) = (c × d)·x computed in double errs by less than
+// 8u |c|₁|d|₁|x|₁ (u = 2⁻⁵³); beyond 1e-14 of that product its sign is the exact one.
+int side_filtered(const V3& m, double cd, const V3& c, const V3& d, const V3& x) {
   if (x == c || x == d) return 0;
+  const double v = m.dot(x), bound = 1e-14 * cd * x.cwiseAbs().sum();
+  if (v > bound) return 1;
+  if (v < -bound) return -1;
   return orient3d_exact(c, d, x, V3::Zero());
+}
+
+int side(const V3& c, const V3& d, const V3& x) {
+  return side_filtered(c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum(), c, d, x);
 }
 
 // A position along the edge being cut: parameter τ ∈ [0, 1] (monotone along the arc) and point.
@@ -61,7 +72,11 @@ V3 cut_point(const V3& a, const V3& b, const V3& c, const V3& d) {
   const bool swap = std::lexicographical_compare(b.data(), b.data() + 3, a.data(), a.data() + 3);
   const V3& lo = swap ? b : a;
   const V3& hi = swap ? a : b;
-  return abs_det(c, d, hi) * lo + abs_det(c, d, lo) * hi;
+  const double at_hi = abs_det(c, d, hi), at_lo = abs_det(c, d, lo);
+  // Both ends within rounding of the circle (a near-degenerate edge (c, d)): the middle, as the
+  // parameter 0.5 that inside_intervals then takes.
+  if (at_hi == 0 && at_lo == 0) return lo + hi;
+  return at_hi * lo + at_lo * hi;
 }
 
 // Where the left side [0] and the right side [1] of e = (a, b) are strictly inside the convex
@@ -69,14 +84,32 @@ V3 cut_point(const V3& a, const V3& b, const V3& c, const V3& d) {
 // of e with an edge f is computed the same way whichever of the two is being cut (from the edge
 // of the polygon listed first, e's own when e_first), so the pieces of both share it bit for bit
 // and the boundary arcs close exactly.
-void inside_intervals(const V3& a, const V3& b, Polygon poly, bool e_first, Interval (&out)[2]) {
+// collinear (if given) gets bit k for each edge k < 32 of poly whose great circle holds e; it is
+// left incomplete only when e misses poly's interior, and then e shares no arc with its edges.
+// normals (if given): per edge k of poly, c × d and |c|₁|d|₁ (the filter of side_filtered).
+struct EdgeNormal {
+  V3 m;
+  double cd;
+};
+
+void inside_intervals(const V3& a, const V3& b, Polygon poly, bool e_first, Interval (&out)[2],
+                      uint32_t* collinear = nullptr, const EdgeNormal* normals = nullptr) {
   out[0] = out[1] = Interval{{0.0, a}, {1.0, b}, false};
   const size_t n = poly.size();
+  if (collinear) *collinear = 0;
   for (size_t k = 0; k < n; ++k) {
     const V3& c = poly[k];
     const V3& d = poly[k + 1 == n ? 0 : k + 1];
-    const int sa = side(c, d, a), sb = side(c, d, b);
+    int sa = 0, sb = 0;
+    if (normals) {
+      sa = side_filtered(normals[k].m, normals[k].cd, c, d, a);
+      sb = side_filtered(normals[k].m, normals[k].cd, c, d, b);
+    } else {
+      sa = side(c, d, a);
+      sb = side(c, d, b);
+    }
     if (sa == 0 && sb == 0) {  // e lies on f's great circle: the sides are e's two sides
+      if (collinear && k < 32) *collinear |= 1u << k;
       const int s = same_direction(a, b, c, d, poly);
       out[s > 0 ? 1 : 0].empty = true;
       if (s == 0) out[1].empty = true;
@@ -127,10 +160,10 @@ Interval collinear_overlap(const V3& a, const V3& b, const V3& c, const V3& d, i
   return out;
 }
 
-// pieces −= cut (pieces sorted and disjoint).
-void subtract(std::vector<Interval>& pieces, const Interval& cut) {
+// pieces −= cut (pieces sorted and disjoint); out is scratch.
+void subtract(std::vector<Interval>& pieces, const Interval& cut, std::vector<Interval>& out) {
   if (cut.empty) return;
-  std::vector<Interval> out;
+  out.clear();
   for (const Interval& p : pieces) {
     if (!(cut.lo.t < p.hi.t && p.lo.t < cut.hi.t)) {
       out.push_back(p);
@@ -139,7 +172,7 @@ void subtract(std::vector<Interval>& pieces, const Interval& cut) {
     if (p.lo.t < cut.lo.t) out.push_back({p.lo, cut.lo, false});
     if (cut.hi.t < p.hi.t) out.push_back({cut.hi, p.hi, false});
   }
-  pieces = std::move(out);
+  std::swap(pieces, out);
 }
 
 // A spherical cap {ω : ω̂·c ≥ cos r} holding a polygon or an arc, enlarged by a margin far above
@@ -177,6 +210,62 @@ bool disjoint(const Cap& x, const Cap& y) {
 
 }  // namespace
 
+namespace {
+
+constexpr uint32_t kUnknownSides = ~0u;
+
+// Scratch of edge_pieces.
+struct EdgeScratch {
+  std::vector<Interval> pieces, tmp;
+  std::vector<std::pair<uint32_t, uint32_t>> collinear;  // (occluder j < i, its edges on e's circle)
+};
+
+// The pieces of edge e = (a, b) of polygons[i] that bound V, appended to out (the per-edge step
+// of the header's method). for_others(f) calls f(j) for the occluders j ≥ 1, j ≠ i, ascending,
+// that may overlap e: every other one must give an empty interval (up to rounding) and share no
+// piece of e's great circle with e. Occluder edges are first clipped to the light (the caller
+// has found in[1] of the light when i ≠ 0: passed as `in_light`).
+template <class ForOthers, class NormalsOf>
+void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const V3& b, const Interval* in_light,
+                 ForOthers&& for_others, NormalsOf&& normals_of, EdgeScratch& s, std::vector<Arc>& out) {
+  // The side of e that may border V: left for the light, right for an occluder.
+  const int which = i == 0 ? 0 : 1;
+  Interval in[2];
+  std::vector<Interval>& pieces = s.pieces;
+  pieces.assign(1, i == 0 ? Interval{{0.0, a}, {1.0, b}, false} : *in_light);
+  s.collinear.clear();
+  for_others([&](size_t j) {
+    if (pieces.empty()) return;
+    uint32_t collinear = 0;
+    inside_intervals(a, b, polygons[j], i < j, in, &collinear, normals_of(j));
+    subtract(pieces, in[which], s.tmp);
+    if ((collinear != 0 || polygons[j].size() > 32) && j < i) s.collinear.emplace_back(uint32_t(j), collinear);
+  });
+  // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
+  auto collinear = [&](size_t j, uint32_t mask) {
+    const Polygon other = polygons[j];
+    for (size_t f = 0; f < other.size() && !pieces.empty(); ++f) {
+      const bool unknown = mask == kUnknownSides || f >= 32;  // else mask says it
+      if (!unknown && !(mask & (1u << f))) continue;
+      const V3& c = other[f];
+      const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
+      if (unknown && (side(c, d, a) != 0 || side(c, d, b) != 0)) continue;
+      subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)), s.tmp);
+    }
+  };
+  if (i != 0 && !pieces.empty()) collinear(0, kUnknownSides);
+  for (const auto& [j, mask] : s.collinear) collinear(j, mask);
+  for (const Interval& p : pieces) {
+    if (i == 0) {
+      out.push_back({p.lo.x, p.hi.x});
+    } else {
+      out.push_back({p.hi.x, p.lo.x});
+    }
+  }
+}
+
+}  // namespace
+
 void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> occluders, std::vector<Arc>& out) {
   out.clear();
   if (light.size() < 3) return;
@@ -186,48 +275,358 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
 
   std::vector<Cap> caps;
   for (const Polygon poly : polygons) caps.push_back(cap_of(poly));
-  std::vector<Interval> pieces;
+  EdgeScratch scratch;
   for (size_t i = 0; i < polygons.size(); ++i) {
     const Polygon poly = polygons[i];
     for (size_t k = 0; k < poly.size(); ++k) {
       const V3& a = poly[k];
       const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
       if (a == b) continue;
-      // The side of e that may border V: left for the light, right for an occluder.
-      const int which = i == 0 ? 0 : 1;
-      Interval in[2];
       const V3 ends[2] = {a, b};
       const Cap edge_cap = cap_of(ends);
-      pieces.assign(1, Interval{{0.0, a}, {1.0, b}, false});
+      Interval in[2];
       if (i != 0) {  // an occluder edge borders V only inside the light
         if (disjoint(edge_cap, caps[0])) continue;
         inside_intervals(a, b, light, false, in);
         if (in[1].empty) continue;
-        pieces.assign(1, in[1]);
       }
-      for (size_t j = 1; j < polygons.size() && !pieces.empty(); ++j) {
-        if (j == i || disjoint(edge_cap, caps[j])) continue;
-        inside_intervals(a, b, polygons[j], i < j, in);
-        subtract(pieces, in[which]);
+      edge_pieces(polygons, i, a, b, &in[1], [&](auto&& f) {
+        for (size_t j = 1; j < polygons.size(); ++j)
+          if (j != i && !disjoint(edge_cap, caps[j])) f(j);
+      }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, scratch, out);
+    }
+  }
+}
+
+// ---- the sparse variant: chosen boundary edges, a grid over the light's gnomonic chart --------
+
+namespace {
+
+// Chart margin: the gnomonic coordinates of a direction err by a few ulps of their magnitude
+// (divided by c·ω̂ > kFrontCos); 1e-9 of the chart's scale is far above that.
+constexpr double kChartMargin = 1e-9;
+constexpr double kFrontCos = 1e-3;  // a polygon with a vertex at c·ω̂ ≤ this is not charted
+constexpr double kChartCos = 0.1;   // the chart is used when every light vertex has c·ω̂ > this
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint32_t kMaxGrid = 48;
+constexpr double kGridDensity = 1.0;  // cells per side / √(charted occluders) (bench_area: 0.5–1 alike)
+
+// The gnomonic chart about c (ω ↦ (e1·ω, e2·ω)/(c·ω)): great circles map to lines, so an arc
+// maps to the chord of its end points and a convex polygon in c's open hemisphere to the convex
+// hull of its vertices' points. A uniform grid of cells over the light's box.
+struct Chart {
+  V3 c, e1, e2;
+  double lo[2] = {0, 0}, hi[2] = {0, 0}, cell[2] = {1, 1}, inverse[2] = {1, 1}, margin = 0;
+  uint32_t n[2] = {1, 1};
+
+  void at(const V3& w, double g[2]) const {
+    const double z = 1 / c.dot(w);
+    g[0] = e1.dot(w) * z;
+    g[1] = e2.dot(w) * z;
+  }
+  // Cells [c0, c1] along axis for coordinates [x0, x1] (with margins), clamped; false when the
+  // range misses the grid. Monotone in x0 and x1, so overlapping ranges share a cell.
+  bool cells(int axis, double x0, double x1, uint32_t& c0, uint32_t& c1) const {
+    if (x1 < lo[axis] || x0 > hi[axis]) return false;
+    const double top = double(n[axis] - 1);
+    // Clamped to [0, top] first, so truncation is the floor.
+    c0 = uint32_t(std::clamp((x0 - lo[axis]) * inverse[axis], 0.0, top));
+    c1 = uint32_t(std::clamp((x1 - lo[axis]) * inverse[axis], 0.0, top));
+    return true;
+  }
+};
+
+struct Box {
+  double lo[2], hi[2];
+  bool in = false;    // charted and meeting the chart's box
+  uint32_t first = 0;  // its vertices' chart points: RegionScratch::Impl::points[first, first + size)
+  uint32_t cells[4];   // x0, x1, y0, y1 (when in and not wide)
+};
+
+}  // namespace
+
+struct RegionScratch::Impl {
+  Chart chart;
+  std::vector<Polygon> polygons;
+  std::vector<Cap> caps;
+  std::vector<Box> boxes;
+  std::vector<std::array<double, 2>> points;
+  std::vector<EdgeNormal> normals;  // per polygon vertex k: its edge (k, k + 1), from boxes[j].first
+  std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
+  uint32_t mark = 0;
+  EdgeScratch edge;
+};
+
+RegionScratch::RegionScratch() : impl_(std::make_unique<Impl>()) {}
+RegionScratch::~RegionScratch() = default;
+RegionScratch::RegionScratch(const RegionScratch&) : impl_(std::make_unique<Impl>()) {}
+RegionScratch& RegionScratch::operator=(const RegionScratch&) { return *this; }
+
+void visible_region_sparse(std::span<const V3> light, std::span<const std::vector<V3>> occluders,
+                           std::span<const uint8_t> boundary, std::vector<Arc>& out, RegionScratch& scratch) {
+  out.clear();
+  scratch.boundary_edges = 0;
+  scratch.charted = false;
+  if (light.size() < 3) return;
+  PRT_CHECK(boundary.size() == occluders.size());
+  RegionScratch::Impl& s = *scratch.impl_;
+  // Polygon numbering as visible_region's: the light, then the occluders (one with < 3 vertices
+  // an empty span that meets nothing), so the "listed first" rules decide alike.
+  s.polygons.clear();
+  s.polygons.emplace_back(light);
+  for (const auto& o : occluders) s.polygons.emplace_back(o.size() >= 3 ? Polygon(o) : Polygon());
+  const std::span<const Polygon> polygons(s.polygons);
+  const size_t count = polygons.size();
+
+  // The chart about the light's cap centre: every light vertex at c·ω̂ > 0.1, so every point of
+  // the (convex) light has c·ω > 0.
+  Chart& chart = s.chart;
+  const Cap light_cap = cap_of(light);
+  bool charted = !light_cap.all;
+  for (const V3& v : light) charted = charted && light_cap.c.dot(v.normalized()) > kChartCos;
+  s.wide.clear();
+  s.caps.clear();
+  if (s.stamp.size() < count) s.stamp.resize(count, 0);
+  double scale = 1;  // the chart's: 1 + the largest |coordinate| of the light's points
+  if (charted) {
+    chart.c = light_cap.c;
+    chart.e1 = chart.c.unitOrthogonal();
+    chart.e2 = chart.c.cross(chart.e1);
+    for (int a = 0; a < 2; ++a) chart.lo[a] = kInf, chart.hi[a] = -kInf;
+    for (const V3& v : light) {
+      double g[2];
+      chart.at(v, g);
+      for (int a = 0; a < 2; ++a) {
+        chart.lo[a] = std::min(chart.lo[a], g[a]);
+        chart.hi[a] = std::max(chart.hi[a], g[a]);
+        scale = std::max(scale, 1 + std::abs(g[a]));
       }
-      // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
-      for (size_t j = 0; j < i && !pieces.empty(); ++j) {
-        if (disjoint(edge_cap, caps[j])) continue;
-        const Polygon other = polygons[j];
-        for (size_t f = 0; f < other.size(); ++f) {
-          const V3& c = other[f];
-          const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
-          if (side(c, d, a) != 0 || side(c, d, b) != 0) continue;
-          subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)));
+    }
+    chart.margin = kChartMargin * scale;
+    for (int a = 0; a < 2; ++a) chart.lo[a] -= 2 * chart.margin, chart.hi[a] += 2 * chart.margin;
+    // Occluder boxes; an occluder reaching out of c's front hemisphere is `wide` (always tested)
+    // unless its cap misses the light's.
+    s.boxes.resize(count);
+    s.points.clear();
+    s.normals.clear();
+    size_t in_chart = 0;
+    for (size_t j = 1; j < count; ++j) {
+      const Polygon poly = polygons[j];
+      Box& box = s.boxes[j];
+      box.in = false;
+      if (poly.empty()) continue;
+      // Points and normals share the index base: one slot per vertex (points only for charted).
+      box.first = uint32_t(s.normals.size());
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V3& c = poly[k];
+        const V3& d = poly[k + 1 == poly.size() ? 0 : k + 1];
+        s.normals.push_back({c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum()});
+      }
+      s.points.resize(s.normals.size());
+      bool front = true;
+      for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.cwiseAbs().sum();  // |v|₁ ≥ |v|
+      if (!front) {
+        if (!disjoint(cap_of(poly), light_cap)) s.wide.push_back(uint32_t(j));
+        continue;
+      }
+      for (int a = 0; a < 2; ++a) box.lo[a] = kInf, box.hi[a] = -kInf;
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V3& v = poly[k];
+        auto& g = s.points[box.first + k];
+        chart.at(v, g.data());
+        for (int a = 0; a < 2; ++a) box.lo[a] = std::min(box.lo[a], g[a]), box.hi[a] = std::max(box.hi[a], g[a]);
+      }
+      box.in = true;
+      for (int a = 0; a < 2; ++a) {
+        box.lo[a] -= chart.margin;
+        box.hi[a] += chart.margin;
+        box.in = box.in && box.hi[a] >= chart.lo[a] && box.lo[a] <= chart.hi[a];
+      }
+      in_chart += box.in;
+    }
+    const auto side_cells =
+        uint32_t(std::clamp(std::ceil(kGridDensity * std::sqrt(double(in_chart))), 1.0, double(kMaxGrid)));
+    for (int a = 0; a < 2; ++a) {
+      chart.n[a] = side_cells;
+      chart.cell[a] = (chart.hi[a] - chart.lo[a]) / side_cells;
+      chart.inverse[a] = 1 / chart.cell[a];
+      charted = charted && chart.cell[a] > 0 && std::isfinite(chart.inverse[a]);
+    }
+  }
+  if (charted) {
+    // Counting sort of (cell, occluder) pairs, occluders ascending within a cell; an occluder
+    // over more than a quarter of the cells is `wide`.
+    const size_t cells = size_t(chart.n[0]) * chart.n[1];
+    const size_t wide_limit = std::max<size_t>(cells / 4, 4);
+    s.cell_start.assign(cells + 1, 0);
+    for (size_t j = 1; j < count; ++j) {
+      Box& box = s.boxes[j];
+      if (!box.in) continue;
+      uint32_t* c = box.cells;
+      chart.cells(0, box.lo[0], box.hi[0], c[0], c[1]);
+      chart.cells(1, box.lo[1], box.hi[1], c[2], c[3]);
+      if (size_t(c[1] - c[0] + 1) * (c[3] - c[2] + 1) > wide_limit) {
+        s.wide.push_back(uint32_t(j));
+        c[0] = c[2] = 1, c[1] = c[3] = 0;  // no cells
+      }
+    }
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t j = 1; j < count; ++j) {
+        const Box& box = s.boxes[j];
+        if (!box.in) continue;
+        const uint32_t x0 = box.cells[0], x1 = box.cells[1], y0 = box.cells[2], y1 = box.cells[3];
+        for (uint32_t y = y0; y <= y1; ++y)
+          for (uint32_t x = x0; x <= x1; ++x) {
+            const size_t cell = size_t(y) * chart.n[0] + x;
+            if (pass == 0) {
+              ++s.cell_start[cell + 1];
+            } else {
+              s.cell_items[s.cell_fill[cell]++] = uint32_t(j);
+            }
+          }
+      }
+      if (pass == 0) {
+        for (size_t c = 0; c < cells; ++c) s.cell_start[c + 1] += s.cell_start[c];
+        s.cell_items.resize(s.cell_start[cells]);
+        s.cell_fill.assign(s.cell_start.begin(), s.cell_start.end() - 1);
+      }
+    }
+    std::sort(s.wide.begin(), s.wide.end());
+  } else {
+    s.caps.clear();
+    for (const Polygon poly : polygons) s.caps.push_back(poly.empty() ? Cap{} : cap_of(poly));
+  }
+  scratch.charted = charted;
+
+  // s.near = the occluders that may meet the arc from x to y (both in the light, so c·ω > 0):
+  // those in the cells the chord of their chart points passes (row by row, with margins) and
+  // the wide ones, ascending.
+  auto near = [&](size_t i, const V3& a, const V3& b, const V3& x, const V3& y) {
+    s.near.clear();
+    if (s.mark == std::numeric_limits<uint32_t>::max()) {
+      std::fill(s.stamp.begin(), s.stamp.end(), 0);
+      s.mark = 0;
+    }
+    const uint32_t mark = ++s.mark;
+    double gx[2], gy[2];
+    chart.at(x, gx);
+    chart.at(y, gy);
+    const double m = chart.margin, dy = gy[1] - gx[1];
+    uint32_t r0 = 0, r1 = 0;
+    if (chart.cells(1, std::min(gx[1], gy[1]) - m, std::max(gx[1], gy[1]) + m, r0, r1)) {
+      for (uint32_t r = r0; r <= r1; ++r) {
+        // The chord's part with its y in this row (± margin; the outer rows unbounded outwards).
+        const double ylo = r == 0 ? -kInf : chart.lo[1] + r * chart.cell[1] - m;
+        const double yhi = r + 1 == chart.n[1] ? kInf : chart.lo[1] + (r + 1) * chart.cell[1] + m;
+        double t0 = 0, t1 = 1;
+        if (dy != 0) {
+          double ta = (ylo - gx[1]) / dy, tb = (yhi - gx[1]) / dy;
+          if (ta > tb) std::swap(ta, tb);
+          t0 = std::max(0.0, ta);
+          t1 = std::min(1.0, tb);
+          if (t0 > t1) continue;
+        } else if (gx[1] < ylo || gx[1] > yhi) {
+          continue;
         }
+        const double xa = gx[0] + t0 * (gy[0] - gx[0]), xb = gx[0] + t1 * (gy[0] - gx[0]);
+        uint32_t c0 = 0, c1 = 0;
+        if (!chart.cells(0, std::min(xa, xb) - m, std::max(xa, xb) + m, c0, c1)) continue;
+        const size_t row = size_t(r) * chart.n[0];
+        for (size_t cell = row + c0; cell <= row + c1; ++cell)
+          for (uint32_t at = s.cell_start[cell]; at < s.cell_start[cell + 1]; ++at) {
+            const uint32_t j = s.cell_items[at];
+            if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
+          }
       }
-      for (const Interval& p : pieces) {
-        if (i == 0) {
-          out.push_back({p.lo.x, p.hi.x});
-        } else {
-          out.push_back({p.hi.x, p.lo.x});
+    }
+    for (uint32_t j : s.wide)
+      if (s.stamp[j] != mark) s.stamp[j] = mark, s.near.push_back(j);
+    // Keep those whose box meets the chord's box along both axes and whose vertices' chart
+    // points may lie on the side of e's great circle that matters (the light's left, an
+    // occluder edge's right) and on or across it; or, for an earlier occluder, two of them on
+    // it (a shared arc). The circle m·ω = 0 (m = a × b) is the chart line f(g) = 0 with
+    // f(g) = m·(g₀e1 + g₁e2 + c) = m·ω/(c·ω): f > 0 is det(a, b, ω) > 0, left of e. A point
+    // within the slack (the chart points' margin and the rounding of m, both far above their
+    // errors) may be on either side or on it.
+    const double box_lo[2] = {std::min(gx[0], gy[0]) - m, std::min(gx[1], gy[1]) - m};
+    const double box_hi[2] = {std::max(gx[0], gy[0]) + m, std::max(gx[1], gy[1]) + m};
+    const V3 normal = a.cross(b);
+    const double nx = normal.dot(chart.e1), ny = normal.dot(chart.e2), nz = normal.dot(chart.c);
+    const double slack = 4 * m * normal.cwiseAbs().sum() + 1e-13 * a.cwiseAbs().sum() * b.cwiseAbs().sum() * scale;
+    size_t kept = 0;
+    for (uint32_t j : s.near) {
+      if (j == i) continue;
+      const Box& box = s.boxes[j];
+      bool keep = !box.in;
+      if (!keep && box.lo[0] <= box_hi[0] && box.hi[0] >= box_lo[0] && box.lo[1] <= box_hi[1] &&
+          box.hi[1] >= box_lo[1]) {
+        int left = 0, right = 0, unsure = 0;
+        for (size_t k = 0; k < polygons[j].size(); ++k) {
+          const auto& g = s.points[box.first + k];
+          const double f = nx * g[0] + ny * g[1] + nz;
+          left += f > slack;
+          right += f < -slack;
+          unsure += !(f > slack) && !(f < -slack);
         }
+        keep = i == 0 ? left + unsure > 0 && right + unsure > 0
+                      : (right + unsure > 0 && left + unsure > 0) || (j < i && unsure >= 2);
+        // (an occluder's right side: a point right and one left or on; the light's left likewise)
       }
+      if (keep) s.near[kept++] = j;
+    }
+    s.near.resize(kept);
+  };
+
+  auto run = [&](size_t i, const V3& a, const V3& b, const Interval* in_light) {
+    // The chord of e's part in the light, from its parameters (the point at t is
+    // (1 − t)·a + t·b, as inside_intervals orders cuts): the cut points' own x may lie on the
+    // other edge when that one is near-degenerate (e.g. a horizon-clipped light vertex pair).
+    V3 x = a, y = b;
+    if (in_light) {
+      x = (1 - in_light->lo.t) * a + in_light->lo.t * b;
+      y = (1 - in_light->hi.t) * a + in_light->hi.t * b;
+    }
+    const bool chord_in_chart = charted && chart.c.dot(x) > kFrontCos * x.cwiseAbs().sum() &&
+                                chart.c.dot(y) > kFrontCos * y.cwiseAbs().sum();
+    if (chord_in_chart) {
+      near(i, a, b, x, y);
+      edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
+        for (uint32_t j : s.near) f(j);
+      }, [&](size_t j) { return s.normals.data() + s.boxes[j].first; }, s.edge, out);
+      return;
+    }
+    // Not charted (or this chord leaves the chart's hemisphere): caps only.
+    if (charted && s.caps.size() != count) {
+      s.caps.clear();
+      for (const Polygon poly : polygons) s.caps.push_back(poly.empty() ? Cap{} : cap_of(poly));
+    }
+    const V3 ends[2] = {a, b};
+    const Cap edge_cap = cap_of(ends);
+    edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
+      for (size_t j = 1; j < count; ++j)
+        if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j])) f(j);
+    }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, s.edge, out);
+  };
+  for (size_t k = 0; k < light.size(); ++k) {
+    const V3& a = light[k];
+    const V3& b = light[k + 1 == light.size() ? 0 : k + 1];
+    if (a != b) run(0, a, b, nullptr);
+  }
+  for (size_t i = 1; i < count; ++i) {
+    const Polygon poly = polygons[i];
+    const unsigned mask = boundary[i - 1];
+    for (size_t k = 0; k < poly.size(); ++k) {
+      if (k < 8 && !(mask & (1u << k))) continue;
+      const V3& a = poly[k];
+      const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
+      if (a == b) continue;
+      const V3 ends[2] = {a, b};
+      if (disjoint(cap_of(ends), light_cap)) continue;
+      Interval in[2];
+      inside_intervals(a, b, light, false, in);
+      if (in[1].empty) continue;
+      ++scratch.boundary_edges;
+      run(i, a, b, &in[1]);
     }
   }
 }

@@ -1,7 +1,8 @@
 // bake/visibility/occluder_mesh.h — the visible part of a planar area light past an arbitrary triangle mesh
 // (non-convex, open, non-manifold: any triangle soup), seen from a shade point in the ε-limit
-// p + εn, as the boundary arcs of bake/visibility/visible_region.h (paper 003 §3.5 "GetBetween" culling and
-// §4.4 the per-triangle variant; issue 13; docs/ARCHITECTURE.md "Conventions").
+// p + εn, as the boundary arcs of bake/visibility/visible_region.h (paper 003 §3.5 "GetBetween" culling,
+// §3.1 silhouette edges and §4.4 the per-triangle variant; issues 13 and 32;
+// docs/ARCHITECTURE.md "Conventions").
 //
 // Method: the light polygon (world coordinates, planar, convex, either winding) is seen from p,
 // oriented positively and clipped to the horizon n·ω ≥ 0 (bake/sphere/spherical_polygon.h). Only the
@@ -25,19 +26,44 @@
 //    d ∈ cone(v_i − p, v_{i+1} − p, −n), as bake/visibility/raycast.h occludes_from_above); when n lies in the
 //    face's plane that cone has no interior and is dropped (ShadePoint::t is not used: such a face
 //    blocks nothing, as with t = 0).
-// Then visible_region(light, images) gives V = light \ ∪ images exactly (every orientation
-// decided by orient3d_exact; unions counted once). Triangles are passed in index order whatever
-// the tree's walk, so the culled query and the reference below make the same decisions on ties.
-// Cost: the walk is output-sensitive; visible_region is O(E²) in the kept edges E (3 per kept
-// triangle), so the cost grows with the square of the triangles inside the light's pyramid
-// (bench/bench_area.cpp: three boxes as one mesh ≥ 17k shade points/s for 3 lights; the bunny
-// under a quad light, ~280 kept triangles, some 10² shade points/s: a contour-loop variant
-// linear in the silhouette is not built yet).
+// Then V = light \ ∪ images exactly (every orientation decided by orient3d_exact, after a
+// floating-point filter whose bound is far above its error; unions counted once), by one of two
+// methods that give the same arcs up to cuts of rounding size. Triangles are passed in index
+// order whatever the tree's walk, so both and the unculled reference make the same decisions on ties.
+//  * The contour path (visible_light; issue 32): the boundary of the union of images lies only on
+//    image edges whose far side (right of the edge, away from its own image) is not covered along
+//    the edge by the image of another face on the same mesh edge (paper 003 §3.1: silhouette
+//    edges; §4.4 and [OZ06]: about √e of them). The mesh's edge → faces map is built once
+//    (vertices welded by bitwise-equal position, since equal positions give equal images). An
+//    edge of a whole-triangle image (kept, not clipped, p off its plane) is left out when another
+//    such face on that mesh edge has its opposite vertex strictly on the other side of the plane
+//    through p and the edge (known from both faces' orientations: no new predicate), since that
+//    image covers the far side along the whole edge; or when such a face lies on the same side
+//    and is listed first (a fold seen twice: its edge is the same arc and owns it). What remains
+//    is cut by bake/visibility/visible_region.h visible_region_sparse, each edge only against the
+//    images near it: contour edges (faces of different facing), boundary and non-manifold edges,
+//    T-junctions and coincident sheets (no shared vertex index after welding), edges next to a
+//    culled, dropped, clipped or ε-limit face, and every edge of a clipped image or of an
+//    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). None of these
+//    falls back to the per-triangle method: there is no fallback; the only degraded case is a
+//    light of ≥ 84° radius seen from p, where the chart is not used and each edge meets every
+//    image whose cap meets its own (Workspace::stats counts it, and the queries with clipped or
+//    ε-limit images).
+//  * The per-triangle method (visible_light_per_triangle; visible_light_reference without the
+//    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
+//    reference the tests hold the contour path to (1e-9 of the light's solid angle, E and SH).
+// Cost: culling and the images are linear in the triangles inside the light's pyramid; the
+// contour path then costs the chart's grid over them plus, per edge cut, the images near it
+// (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: contour path": the bunny
+// under a quad light: 6.2–6.8k ground points/s and 44–47k of its own vertices/s per core,
+// 9–13x the per-triangle method; over Loop levels 0–3 the ground rate falls as T^-0.9 while the
+// edges cut grow as T^0.45: the part linear in the kept triangles dominates).
 #pragma once
 
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/shade_point.h>
 #include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/visible_region.h>
 
 #include <Eigen/Core>
 
@@ -55,7 +81,8 @@ public:
   explicit OccluderMesh(const Mesh& mesh);
   OccluderMesh(std::vector<Eigen::Vector3d> positions, std::vector<std::array<uint32_t, 3>> triangles);
 
-  // Per-thread scratch buffers, reused across queries (visible_region still allocates its own).
+  // Per-thread scratch buffers, reused across queries (the per-triangle visible_region still
+  // allocates its own).
   // After a query, `clipped` holds the light as visible_region got it (directions from p,
   // positively oriented, clipped to the horizon; empty when the query returned no light): its
   // integrals are the unshadowed values.
@@ -65,10 +92,27 @@ public:
       double margin_coef;  // margin = margin_coef · (|x − o| bound)
     };
     std::vector<Plane> planes;
+    std::vector<double> margins;  // per plane, of the leaf being culled
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
     size_t image_count = 0;
+    // The contour path's scratch: per image its triangle, kind and boundary-edge mask; per
+    // triangle the query that last kept it and its image's orientation (0: not a whole triangle).
+    std::vector<uint32_t> image_triangle, tri_stamp;
+    std::vector<uint8_t> image_kind, boundary;
+    std::vector<int8_t> tri_side;
+    uint32_t stamp = 0;
+    int last_side = 0;
+    RegionScratch region;
+    // Counters of the contour path, summed over this workspace's queries (never reset here).
+    struct Stats {
+      size_t queries = 0;         // queries that reached the union (light not empty)
+      size_t kept = 0;            // triangles kept by culling
+      size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
+      size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
+      size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
+    } stats;
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -77,20 +121,28 @@ public:
   // one-sided light's back side is the caller's decision). Empty when p lies in the light's plane
   // or nothing of it is above the horizon. Integrate with point.n·vector_irradiance(out) (the
   // irradiance from unit radiance) and PolygonSH::project(out) (bake/sphere/polygon_sh.h).
-  // Returns the number of triangles kept after culling (those passed to visible_region).
+  // By the contour path (file comment). Returns the number of triangles kept after culling
+  // (those whose images are passed on).
   // Thread-safe (const) with one Workspace per thread. A convex emitter (box, cylinder, sphere as
   // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
   // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
   // dropped by the depth test).
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
-    return query(light, point, out, ws, true);
+    return query(light, point, out, ws, Method::contour);
+  }
+  // The per-triangle method (paper 003 §4.4; the fast path before issue 32): the same culling
+  // and images, then visible_region over every kept image's edges, O(E²). The slow reference of
+  // the contour path: the same arcs' integrals.
+  size_t visible_light_per_triangle(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                                    std::vector<Arc>& out, Workspace& ws) const {
+    return query(light, point, out, ws, Method::per_triangle);
   }
   // Reference: no tree and no pyramid culling (every triangle goes through the exact depth test
-  // and the image rule above). The same arcs' integrals as visible_light.
+  // and the image rule above), then the per-triangle method. The same arcs' integrals.
   size_t visible_light_reference(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
                                  std::vector<Arc>& out, Workspace& ws) const {
-    return query(light, point, out, ws, false);
+    return query(light, point, out, ws, Method::reference);
   }
 
   size_t triangle_count() const { return triangles_.size(); }
@@ -100,20 +152,27 @@ private:
     Eigen::Vector3d lo, hi;
     uint32_t index;  // leaf: first entry of order_; inner: right child (left child is this + 1)
     uint32_t count;  // leaf: triangle count (> 0); inner: 0
+    uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
+  enum class Method { contour, per_triangle, reference };
+  enum class ImageKind : uint8_t { none, triangle, special };  // special: clipped or an ε-limit cone
 
   uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
   bool prepare(std::span<const Eigen::Vector3d> light, const ShadePoint& point, Workspace& ws, LightFrame& frame) const;
-  void add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
+  ImageKind add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
-               bool culled) const;
+               Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
   std::vector<uint32_t> order_;  // triangle indices, leaves' ranges
   std::vector<Node> nodes_;
+  // Edge → faces: slot 3t + k is edge (t[k], t[k+1]); edge_slots_ sorted by unordered vertex
+  // pair, group g = edge_slots_[edge_group_start_[g] .. edge_group_start_[g + 1]).
+  std::vector<uint32_t> edge_slots_, slot_group_, edge_group_start_;
+  std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
 };
 
 } // namespace prt::bake

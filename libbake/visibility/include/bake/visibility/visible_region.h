@@ -44,6 +44,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -53,6 +54,51 @@ namespace prt::bake {
 // the shade point (points relative to it will do).
 void visible_region(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
                     std::vector<Arc>& out);
+
+// Scratch for visible_region_sparse, reused across calls (one per thread); copying one gives a
+// fresh scratch. After a call: the occluder edges it cut (those of `boundary` reaching inside the
+// light) and whether the chart below was used (false: every pair filtered by caps only).
+class RegionScratch {
+public:
+  RegionScratch();
+  ~RegionScratch();
+  RegionScratch(const RegionScratch&);
+  RegionScratch& operator=(const RegionScratch&);
+
+  size_t boundary_edges = 0;
+  bool charted = false;
+
+private:
+  struct Impl;
+  friend void visible_region_sparse(std::span<const Eigen::Vector3d>, std::span<const std::vector<Eigen::Vector3d>>,
+                                    std::span<const uint8_t>, std::vector<Arc>&, RegionScratch&);
+  std::unique_ptr<Impl> impl_;
+};
+
+// The same boundary arcs as visible_region(light, occluders), cutting only the occluder edges
+// that may bound the union, each against the occluders near it (issue 32; paper 003 §3.3: the
+// union's boundary lies on silhouette edges). boundary[k] has bit e set when edge e (vertices
+// e, e + 1) of occluders[k] may bound it (edges e ≥ 8 always do). Precondition: an edge left out
+// emits nothing in visible_region — its right side is inside another occluder along the whole
+// edge (a mesh edge whose two faces' images lie on opposite sides of it), or it is the same arc
+// as an edge of an occluder listed before it (a fold: that edge owns the arc). Then the arcs are
+// visible_region's, up to cuts of rounding size.
+// Each edge (the light's, and the in-light part of each boundary edge) meets only the occluders
+// near it, found in a uniform grid (≈ √P cells a side) over the gnomonic chart about the light's
+// cap centre c (ω ↦ (e1·ω, e2·ω)/(c·ω); great circles map to lines, convex polygons to the
+// hulls of their vertices' points, orientation kept): the occluders in the cells the edge's chord
+// passes, whose boxes meet the chord's box, and whose vertices' points may lie on the side that
+// matters (the light edge's left, an occluder edge's right) as well as on or across the edge's
+// great circle (or, for an earlier occluder, two on it: a shared arc). Boxes carry a margin of
+// 1e-9 of the chart's scale and sides a slack far above the rounding of the chart points and of
+// a × b, so every occluder the exact predicates could find is kept: the grid is a filter like
+// visible_region's caps. Occluders reaching out of c's hemisphere (c·ω̂ ≤ 1e-3) are tested by
+// every edge; a light of ≥ 84° radius (a vertex at c·ω̂ ≤ 0.1) is not charted, and then every
+// pair is filtered by caps only (RegionScratch::charted = false).
+// Cost: O(P + G + B·k) for P occluders, G grid entries, B boundary edges reaching into the light
+// and k occluders near each (bench/bench_area.cpp BM_BunnyQuad).
+void visible_region_sparse(std::span<const Eigen::Vector3d> light, std::span<const std::vector<Eigen::Vector3d>> occluders,
+                           std::span<const uint8_t> boundary, std::vector<Arc>& out, RegionScratch& scratch);
 
 // A convex polyhedron (an occluder or a convex emitter) and its silhouette loop seen from a point
 // (paper 003 §3.3, Alg. 2 SphPolySilhouette). Faces are planar, counter-clockwise seen from

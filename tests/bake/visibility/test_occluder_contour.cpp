@@ -1,0 +1,335 @@
+// The contour path of bake/visibility/occluder_mesh.h (issue 32: only the image edges that may bound
+// the occluders' union are cut, each against the images near it) against the per-triangle method
+// it replaced (OccluderMesh::visible_light_per_triangle, paper 003 §4.4), on the bunny under a
+// quad light (ground points, the bunny's own vertices, a ground plane in the mesh), open single
+// sheets facing either way, a non-manifold edge, overlapping and coincident sheets, a
+// T-junction, a light corner on an occluder's silhouette, occluder edges through the shade point
+// and lights crossing the horizon.
+#include <bake/mesh/mesh.h>
+#include <bake/mesh/receivers.h>
+#include <bake/sphere/polygon_sh.h>
+#include <bake/sphere/spherical_polygon.h>
+#include <bake/visibility/occluder_mesh.h>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using prt::bake::Arc;
+using prt::bake::OccluderMesh;
+using prt::bake::ShadePoint;
+using V3 = Eigen::Vector3d;
+using Poly = std::vector<V3>;
+using Tri = std::array<uint32_t, 3>;
+
+// The contour path equals the per-triangle method to this, relative to the light's solid angle
+// from p (|E| and every |S_i|·√(4π) are at most that): both decide every side exactly and differ
+// only by the rounding of crossing points and of sums over different arc sets (~1e-15).
+constexpr double kExact = 1e-9;
+constexpr int kOrder = 4;
+
+struct Totals {
+  size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0, special = 0, uncharted = 0;
+};
+
+// E and the order-4 SH of the visible light by both methods at s; EXPECTs their agreement.
+void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, const std::string& what,
+             Totals& totals) {
+  static const prt::bake::PolygonSH sh(kOrder);
+  OccluderMesh::Workspace ws_fast, ws_slow, ws_bare;
+  std::vector<Arc> fast, slow, bare;
+  const size_t kept = mesh.visible_light(light, s, fast, ws_fast);
+  mesh.visible_light_per_triangle(light, s, slow, ws_slow);
+  OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
+  const double scale = std::abs(prt::bake::solid_angle(bare));
+  // Every arc end a direction (a zero vector was a cut point of a near-degenerate edge).
+  auto directions = [&](const std::vector<Arc>& arcs, const char* which) {
+    for (const Arc& arc : arcs)
+      if (!(arc.a.norm() > 0) || !(arc.b.norm() > 0)) {
+        ADD_FAILURE() << what << ": " << which << " has an arc end of zero length";
+        return false;
+      }
+    return true;
+  };
+  const bool fast_ok = directions(fast, "contour path"), slow_ok = directions(slow, "per triangle");
+  if (!fast_ok || !slow_ok) return;
+  const double e_fast = s.n.dot(prt::bake::vector_irradiance(fast)), e_slow = s.n.dot(prt::bake::vector_irradiance(slow));
+  EXPECT_NEAR(e_fast, e_slow, kExact * scale) << what;
+  std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
+  sh.project(std::span<const Arc>(fast), a);
+  sh.project(std::span<const Arc>(slow), b);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], kExact * scale) << what << " SH " << i;
+  ++totals.points;
+  totals.shadowed += e_slow < s.n.dot(prt::bake::vector_irradiance(bare)) - 1e-6 * scale;
+  totals.boundary_edges += ws_fast.stats.boundary_edges;
+  totals.kept += kept;
+  totals.special += ws_fast.stats.special;
+  totals.uncharted += ws_fast.stats.uncharted;
+}
+
+std::vector<V3> positions_of(const prt::bake::Mesh& m) {
+  std::vector<V3> p;
+  for (const auto& x : m.positions) p.push_back(x.cast<double>());
+  return p;
+}
+
+// A flat n × n grid on [x0, x1] × [z0, z1] at height y, counter-clockwise seen from +y
+// (flip: from −y), appended to pos/tris.
+void add_grid(std::vector<V3>& pos, std::vector<Tri>& tris, double x0, double x1, double z0, double z1, double y,
+              int n, bool flip) {
+  const auto base = uint32_t(pos.size());
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) pos.emplace_back(x0 + (x1 - x0) * i / n, y, z0 + (z1 - z0) * j / n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = base + uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+      // (a, c, d) runs counter-clockwise seen from +y (x right, z towards the viewer).
+      if (flip) {
+        tris.push_back({a, d, c});
+        tris.push_back({a, b, d});
+      } else {
+        tris.push_back({a, c, d});
+        tris.push_back({a, d, b});
+      }
+    }
+}
+
+const Poly kBunnyLight{{-3, 12, -2}, {3, 12, -2}, {3, 12, 2}, {-3, 12, 2}};
+
+TEST(OccluderContour, BunnyGroundPointsEqualPerTriangle) {
+  // 300 ground points (|x| ≤ 8, |z| ≤ 6, normals tilted up to 70° so the light often crosses
+  // the horizon) under the bunny: many are partly shadowed, and the contour path cuts far
+  // fewer edges than the per-triangle method's 3 per kept triangle.
+  const prt::bake::Mesh bunny = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  const OccluderMesh mesh(positions_of(bunny), bunny.triangles);
+  std::mt19937_64 rng(32);
+  std::uniform_real_distribution<double> u(0, 1);
+  Totals totals;
+  for (int k = 0; k < 300; ++k) {
+    const double tilt = 1.2 * u(rng), phi = 6.283185307179586 * u(rng);
+    const ShadePoint s{.p = V3(16 * u(rng) - 8, 0, 12 * u(rng) - 6),
+                       .n = V3(std::sin(tilt) * std::cos(phi), std::cos(tilt), std::sin(tilt) * std::sin(phi))};
+    compare(mesh, kBunnyLight, s, "ground point " + std::to_string(k), totals);
+  }
+  EXPECT_GT(totals.shadowed, 60u);
+  EXPECT_LT(totals.boundary_edges * 4, totals.kept * 3);  // < a quarter of the per-triangle edges
+}
+
+TEST(OccluderContour, BunnyOwnVerticesEqualPerTriangle) {
+  // Every 7th vertex of the bunny as a receiver ON the occluder (its own 1-ring is seen in the
+  // ε-limit through −n): self-shadowing by the ears and the back.
+  const prt::bake::Mesh bunny = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  const OccluderMesh mesh(positions_of(bunny), bunny.triangles);
+  const auto points = prt::bake::vertex_shade_points(bunny, prt::bake::build_topology(bunny));
+  Totals totals;
+  for (size_t v = 0; v < points.size(); v += 7) compare(mesh, kBunnyLight, points[v], "vertex " + std::to_string(v), totals);
+  EXPECT_GT(totals.points, 250u);
+  EXPECT_GT(totals.shadowed, 20u);
+  EXPECT_GT(totals.special, totals.points / 2);  // the own 1-ring's ε-limit cones were cut
+}
+
+TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
+  // The bunny and a 16 × 16 ground grid as ONE occluder mesh; receivers: ground vertices, points
+  // on ground edges and faces (all on the mesh), and bunny vertices.
+  const prt::bake::Mesh bunny = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  std::vector<V3> pos = positions_of(bunny);
+  std::vector<Tri> tris = bunny.triangles;
+  add_grid(pos, tris, -8, 8, -8, 8, 0, 16, false);
+  const OccluderMesh mesh(pos, tris);
+  Totals totals;
+  for (int i = -7; i <= 7; i += 2)
+    for (int j = -7; j <= 7; j += 2) {
+      const V3 n = V3(0.1 * i, 1, -0.05 * j).normalized();
+      compare(mesh, kBunnyLight, {.p = V3(i, 0, j), .n = n}, "ground vertex", totals);
+      compare(mesh, kBunnyLight, {.p = V3(i + 0.5, 0, j), .n = n}, "ground edge", totals);
+      compare(mesh, kBunnyLight, {.p = V3(i + 0.25, 0, j + 0.5), .n = n}, "ground face", totals);
+    }
+  const auto points = prt::bake::vertex_shade_points(bunny, prt::bake::build_topology(bunny));
+  for (size_t v = 3; v < points.size(); v += 41) compare(mesh, kBunnyLight, points[v], "vertex", totals);
+  EXPECT_GT(totals.shadowed, 40u);
+}
+
+// Light z = 3 (2 × 2), p near the origin: a random selection of points and normals, the same for
+// every small scene below.
+void compare_scene(const std::vector<V3>& pos, const std::vector<Tri>& tris, const std::string& what, uint64_t seed,
+                   size_t min_shadowed) {
+  const OccluderMesh mesh(pos, tris);
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  Totals totals;
+  for (int k = 0; k < 200; ++k) {
+    const ShadePoint s{.p = V3(3 * u(rng) - 1.5, 3 * u(rng) - 1.5, 0.4 * u(rng) - 0.2),
+                       .n = V3(2 * u(rng) - 1, 2 * u(rng) - 1, 0.6).normalized()};
+    compare(mesh, light, s, what + " " + std::to_string(k), totals);
+  }
+  EXPECT_GE(totals.shadowed, min_shadowed) << what;
+}
+
+// A crumpled open n × n sheet over [-1.2, 1.2]² at heights 1–2.
+void add_sheet(std::vector<V3>& pos, std::vector<Tri>& tris, std::mt19937_64& rng, bool flip) {
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto base = uint32_t(pos.size());
+  const int n = 5;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) pos.emplace_back(-1.2 + 2.4 * i / n, -1.2 + 2.4 * j / n, 1 + u(rng));
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = base + uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+      if (flip) {
+        tris.push_back({a, d, b});
+        tris.push_back({a, c, d});
+      } else {
+        tris.push_back({a, b, d});
+        tris.push_back({a, d, c});
+      }
+    }
+}
+
+TEST(OccluderContour, OpenSheetsFacingEitherWay) {
+  // A crumpled open sheet (it folds over itself as seen from below: contour edges inside it, and
+  // its boundary edges) wound either way; then the same with a hole.
+  for (int flip = 0; flip < 2; ++flip) {
+    std::mt19937_64 rng(5);
+    std::vector<V3> pos;
+    std::vector<Tri> tris;
+    add_sheet(pos, tris, rng, flip != 0);
+    compare_scene(pos, tris, flip ? "sheet facing down" : "sheet facing up", 11, 100);
+    tris.erase(tris.begin() + 22, tris.begin() + 26);
+    compare_scene(pos, tris, "sheet with a hole", 12, 80);
+  }
+}
+
+TEST(OccluderContour, NonManifoldEdgeAndInconsistentWinding) {
+  // Three triangles on one edge (a "book"), a fourth wound against its neighbour, and a fan of
+  // four triangles around a vertical edge.
+  std::vector<V3> pos{{-1, 0, 1.5}, {1, 0, 1.5}, {0, 1, 1.2}, {0, -1, 1.2}, {0, 0.3, 2.2}, {0.5, -1.5, 2}};
+  std::vector<Tri> tris{{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {3, 1, 5}};
+  const auto base = uint32_t(pos.size());
+  pos.insert(pos.end(), {{0.3, 0.3, 1}, {0.3, 0.3, 2.5}, {0.9, 0.3, 1.6}, {0.3, 0.9, 1.7}, {-0.2, 0.4, 1.8}});
+  for (uint32_t k = 2; k < 5; ++k) tris.push_back({base, base + 1, base + k});
+  compare_scene(pos, tris, "non-manifold", 21, 60);
+}
+
+TEST(OccluderContour, OverlappingCoincidentAndTJunctionSheets) {
+  std::mt19937_64 rng(9);
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  add_sheet(pos, tris, rng, false);
+  // An overlapping second sheet, shifted, and the first sheet's triangles once more: as the same
+  // vertex indices (coincident faces) and as copied vertices (coincident sheets, not connected).
+  std::vector<V3> shifted;
+  std::vector<Tri> more;
+  add_sheet(shifted, more, rng, true);
+  const auto base = uint32_t(pos.size());
+  for (V3& v : shifted) pos.push_back(v + V3(0.4, 0.3, 0.2));
+  for (const Tri& t : more) tris.push_back({base + t[0], base + t[1], base + t[2]});
+  for (size_t t = 0; t < 10; ++t) tris.push_back(tris[t]);
+  const auto copy = uint32_t(pos.size());
+  for (uint32_t v = 0; v < 36; ++v) pos.push_back(pos[v]);
+  for (size_t t = 10; t < 20; ++t) tris.push_back({copy + tris[t][0], copy + tris[t][1], copy + tris[t][2]});
+  // A T-junction: a big triangle whose edge runs along two small ones' edges, through their
+  // shared vertex (1, 0, 1.5) without sharing it.
+  const auto tj = uint32_t(pos.size());
+  pos.insert(pos.end(), {{0, 0, 1.5}, {1, 0, 1.5}, {2, 0, 1.5}, {0.5, 0.8, 1.5}, {1.5, 0.8, 1.5}, {1, -1, 1.5}});
+  tris.push_back({tj, tj + 1, tj + 3});
+  tris.push_back({tj + 1, tj + 2, tj + 4});
+  tris.push_back({tj, tj + 5, tj + 2});
+  compare_scene(pos, tris, "overlapping", 31, 120);
+}
+
+TEST(OccluderContour, LightCornerOnASilhouetteAndEdgesThroughThePoint) {
+  // p = origin, n = +z; the light's corner (1, 1, 3) seen from p lies exactly on the image of an
+  // occluder edge ((0.5, 0.5, 1.5) → (0.5, 0.5, 1.5) + t(1, 1, 3) is the corner's ray; the edge
+  // from (0.5, 0.5, 1.5) to (−0.5, 0.7, 1.5) starts on it); a closed tetrahedron whose silhouette
+  // vertex is on the corner's ray; a triangle whose edge's line passes through p (its image is a
+  // point); and p on an occluder edge (two triangles meeting at a line through p).
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  std::vector<V3> pos{{0.5, 0.5, 1.5}, {-0.5, 0.7, 1.5}, {0.2, -0.4, 1.4},
+                      // tetrahedron, apex on the ray through (−1, −1, 3)
+                      {-0.5, -0.5, 1.5}, {-0.1, -0.9, 1.3}, {-0.9, -0.1, 1.3}, {-0.5, -0.5, 1.0},
+                      // a triangle with the edge (0, 0, 1) → (0, 0, 2) on the line through p
+                      {0, 0, 1}, {0, 0, 2}, {0.6, -0.6, 1.6},
+                      // p on the edge (−1, 0, 0) → (1, 0, 0): two faces rising from it
+                      {-1, 0, 0}, {1, 0, 0}, {0, 0.8, 0.9}, {0, -0.8, 0.9}};
+  std::vector<Tri> tris{{0, 1, 2}, {3, 4, 5}, {3, 6, 4}, {4, 6, 5}, {5, 6, 3}, {7, 8, 9}, {10, 11, 12}, {11, 10, 13}};
+  const OccluderMesh mesh(pos, tris);
+  Totals totals;
+  for (const V3& n : {V3(0, 0, 1), V3(0.3, -0.2, 1).normalized(), V3(1, 0, 0.2).normalized()})
+    compare(mesh, light, {.p = V3(0, 0, 0), .n = n}, "stiff", totals);
+  // p on the line of the light's diagonal corner ray, below the tetrahedron's apex.
+  compare(mesh, light, {.p = V3(0.25, 0.25, 0.75), .n = V3(0, 0, 1)}, "on the corner ray", totals);
+  EXPECT_EQ(totals.shadowed, totals.points);
+}
+
+TEST(OccluderContour, LightCrossingTheHorizon) {
+  // The bunny with receivers whose horizon cuts the light (normals nearly horizontal), and a
+  // light below the horizon of some of them (nothing left).
+  const prt::bake::Mesh bunny = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  const OccluderMesh mesh(positions_of(bunny), bunny.triangles);
+  Totals totals;
+  for (int k = 0; k < 40; ++k) {
+    const double phi = 0.157 * k;
+    const V3 n = V3(std::cos(phi), 0.35 - 0.02 * k, std::sin(phi)).normalized();
+    compare(mesh, kBunnyLight, {.p = V3(-6 + 0.3 * k, 0, 0.1 * k - 2), .n = n}, "horizon " + std::to_string(k), totals);
+  }
+  EXPECT_GT(totals.shadowed, 5u);
+}
+
+TEST(OccluderContour, IntegerGridSoupsFullOfTies) {
+  // Triangles with corners on a small integer grid (and shade points on it too): shared great
+  // circles, edges through p, p on faces, edges and vertices, coincident and T-junction faces,
+  // vertices on the light's plane and its pyramid's faces — every tie the exact predicates decide.
+  std::mt19937_64 rng(2026);
+  std::uniform_int_distribution<int> xy(-3, 3), z(0, 4), pick(0, 99);
+  const Poly light{{-2, -2, 4}, {2, -2, 4}, {2, 2, 4}, {-2, 2, 4}};
+  Totals totals;
+  for (int scene = 0; scene < 1000; ++scene) {
+    std::vector<V3> pos;
+    for (int v = 0; v < 40; ++v) pos.emplace_back(xy(rng), xy(rng), z(rng));
+    std::vector<Tri> tris;
+    std::uniform_int_distribution<uint32_t> any(0, 39);
+    for (int t = 0; t < 60; ++t) {
+      const Tri tri{any(rng), any(rng), any(rng)};
+      tris.push_back(tri);
+      if (pick(rng) < 20) tris.push_back({tri[1], tri[0], tri[2]});  // the same face wound back
+      if (pick(rng) < 20) tris.push_back({tri[0], tri[1], any(rng)});  // a fan on one edge
+    }
+    const OccluderMesh mesh(pos, tris);
+    for (int k = 0; k < 8; ++k) {
+      const V3 p = pick(rng) < 50 ? pos[any(rng)] : V3(xy(rng), xy(rng), z(rng) - 1);
+      const V3 n = V3(xy(rng), xy(rng), 3).normalized();
+      compare(mesh, light, {.p = p, .n = n}, "grid scene " + std::to_string(scene) + " point " + std::to_string(k), totals);
+    }
+  }
+  EXPECT_GT(totals.shadowed, 100u);
+  EXPECT_GT(totals.special, 20u);
+}
+
+TEST(OccluderContour, LightTooWideForTheChart) {
+  // A 6 × 6 light 0.3 above the points (its corners at c·ω̂ < 0.1 from the cap centre): the
+  // chart is not used and every pair is filtered by caps; still the per-triangle arcs.
+  std::mt19937_64 rng(3);
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  add_sheet(pos, tris, rng, false);
+  for (V3& v : pos) v.z() = 0.1 + 0.1 * (v.z() - 1);
+  const OccluderMesh mesh(pos, tris);
+  const Poly light{{-3, -3, 0.3}, {3, -3, 0.3}, {3, 3, 0.3}, {-3, 3, 0.3}};
+  std::uniform_real_distribution<double> u(0, 1);
+  Totals totals;
+  for (int k = 0; k < 60; ++k)
+    compare(mesh, light, {.p = V3(2 * u(rng) - 1, 2 * u(rng) - 1, 0), .n = V3(u(rng) - 0.5, u(rng) - 0.5, 1).normalized()},
+            "wide " + std::to_string(k), totals);
+  EXPECT_EQ(totals.uncharted, totals.points);
+  EXPECT_GT(totals.shadowed, 50u);
+}
+
+}  // namespace
