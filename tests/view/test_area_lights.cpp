@@ -17,6 +17,7 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -169,6 +170,71 @@ TEST(AreaLightRender, TheGlossyReferenceAgreesWithTheLtcRenderWithinTheFitsBound
   // tolerance here, while a reference with α off by 17% (0.25) reaches 1.37 (and fails this).
   // Half the tolerance separates the two.
   EXPECT_LT(worst, 0.5);
+}
+
+TEST(AreaLightRender, TheReferenceBouncesOnlyWhereAndAsTheOptionsSay) {
+  // view/area_lights.h AreaReferenceOptions::bounces (issue 31): a reflectance of 0 everywhere
+  // gives the direct bytes whatever the bounces; gathers = 0 on the ground gives its pixels the
+  // direct bytes; with albedo 0.6 the box's faces send light onto the ground beside it, so the
+  // bounced ground is brighter there (never darker than the direct beyond 4 standard errors); the
+  // same bytes with one thread and with two.
+  const Scene s;
+  const view::GBuffer g = view::rasterize(s.mesh, s.camera);
+  view::AreaReferenceOptions direct;
+  direct.samples = 64;
+  direct.render.albedo = {0.6, 0.6, 0.6};
+  const view::AreaReferenceImage d = view::render_area_reference(s.mesh, g, s.lights, direct);
+  view::AreaReferenceOptions absorb = direct;
+  absorb.bounces = 3;
+  absorb.reflectance.assign(s.mesh.triangles.size(), {0, 0, 0});
+  const view::AreaReferenceImage a = view::render_area_reference(s.mesh, g, s.lights, absorb);
+  EXPECT_EQ(a.radiance.rgb, d.radiance.rgb);
+  EXPECT_EQ(a.std_error.rgb, d.std_error.rgb);
+
+  view::AreaReferenceOptions bounced = direct;
+  bounced.bounces = 2;
+  view::AreaReferenceImage b1, b2;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    b1 = view::render_area_reference(s.mesh, g, s.lights, bounced);
+  }
+  b2 = view::render_area_reference(s.mesh, g, s.lights, bounced);
+  EXPECT_EQ(b1.radiance.rgb, b2.radiance.rgb);
+  const size_t ground = prt::testing::grid(2, 2.0f).triangles.size();  // the first triangles
+  // Over the ground's pixels the light added is positive by more than 4 standard errors of its
+  // mean (the pixels' errors are independent: their randomisations are keyed per pixel), and no
+  // pixel loses light beyond 4.5 of its own.
+  size_t darker = 0, ground_pixels = 0;
+  double added_sum = 0, se2_sum = 0;
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const int32_t t = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
+      if (t < 0 || size_t(t) >= ground) continue;
+      ++ground_pixels;
+      const double added = double(b1.radiance.at(x, y)[0]) - double(d.radiance.at(x, y)[0]);
+      const double se = std::hypot(double(b1.std_error.at(x, y)[0]), double(d.std_error.at(x, y)[0]));
+      added_sum += added;
+      se2_sum += se * se;
+      if (added < -4.5 * se - 1e-7) ++darker;
+    }
+  EXPECT_GT(ground_pixels, 500u);
+  EXPECT_GT(added_sum, 4 * std::sqrt(se2_sum)) << "the box's faces light the ground beside it";
+  EXPECT_LE(darker, ground_pixels / 100) << "a bounce adds light";
+
+  view::AreaReferenceOptions only_box = bounced;
+  only_box.gathers.assign(s.mesh.triangles.size(), 1);
+  std::fill_n(only_box.gathers.begin(), ground, uint8_t(0));
+  const view::AreaReferenceImage o = view::render_area_reference(s.mesh, g, s.lights, only_box);
+  size_t checked = 0;
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const int32_t t = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
+      if (t < 0) continue;
+      const view::Image& want = size_t(t) < ground ? d.radiance : b1.radiance;
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(o.radiance.at(x, y)[c], want.at(x, y)[c]) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 1000u);
 }
 
 TEST(AreaLightRender, TheSameBytesForAnyThreadCount) {

@@ -123,7 +123,9 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   if (!exact && baked == 0)
     throw InputError(file, "holds no " + std::string(N::kAreaIrradiance) + " for any object: use --shade area-exact");
   scene.mesh = bake::merge_meshes(parts, "scene");
-  scene.what = "scene: " + std::to_string(objects.size()) + " objects, " + std::to_string(lights.size()) + " area light(s), their direct light only";
+  const bool bounced = !exact && std::any_of(objects.begin(), objects.end(), [](const SceneObject& o) { return o.area_bounced; });
+  scene.what = "scene: " + std::to_string(objects.size()) + " objects, " + std::to_string(lights.size()) + " area light(s), " +
+               (bounced ? "their direct light and its bounces (baked)" : "their direct light only");
   scene.how = exact ? "per pixel: exact soft shadows of the stored lights (render_area_analytic), times the albedo / pi"
                     : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated, or per texel through "
                       "the object's lightmap (" + std::to_string(baked) + " objects); objects without it per pixel, exactly";

@@ -145,7 +145,7 @@ WHAT IS DRAWN
   estimate of the light the scene blocks), with --samples shadow rays per pixel and a per-pixel standard error.
   That is the standard rendering equation with visibility, the paper's "brute force" reference.
 
-  INTERREFLECTIONS (issue 31; environment lighting, area lights not yet). A per-vertex transfer or
+  INTERREFLECTIONS (issue 31). A per-vertex transfer or
   band-1 radiance baked with 'prtbake vertex --bounces B --albedo A' holds the light the mesh
   reflects onto itself; its exit radiance is A x sum T_i L_i. For such a file both pictures show
   A x E/pi (the runtime's unchanged dot product times A) and the reference is path traced with the
@@ -154,7 +154,10 @@ WHAT IS DRAWN
   environment's direct light (the estimator above, one sample) and sends a cosine-weighted
   continuation ray; back faces are black; the paths stop at exactly B bounces (view/reference.h).
   --bounces B and --albedo A override the file's (--bounces 0: the direct-only reference, to see
-  what the bounces add); scene files bounce with their objects' albedos.
+  what the bounces add); scene files bounce with their objects' albedos, each object as the bake
+  bounced it (one that reflects nothing there reflects nothing here; a pixel drawn from AO gathers
+  nothing). Area views (--shade area) path-trace the area lights' bounces the same way, each path
+  vertex sampling every light once, when the scene's area-light irradiance carries bounces.
 
 OUTPUT (-o; the extension picks the format: .png for people, .exr for numbers)
   (default)       the runtime render.
@@ -454,9 +457,10 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
                                 prtview::RenderScene& scene, view::Image& runtime) {
   Interreflection r;
   const bool single = kind == "transfer" || kind == "band1" || kind == "ao";
-  if ((kind == "fiv" || kind == "glossy" || area) && (a.bounces.value_or(0) > 0 || a.albedo))
-    throw UsageError("--bounces and --albedo apply to per-vertex, per-texel and scene files under an environment, not to " +
-                     std::string(area ? "area lights" : kind == "fiv" ? "FIV files" : "glossy lobes"));
+  if ((kind == "fiv" || kind == "glossy") && (a.bounces.value_or(0) > 0 || a.albedo))
+    throw UsageError("--bounces and --albedo apply to per-vertex, per-texel and scene files, not to " +
+                     std::string(kind == "fiv" ? "FIV files" : "glossy lobes"));
+  if (area && a.albedo) throw UsageError("--albedo: the objects of a scene file carry their own albedo");
   if (kind == "scene" && a.albedo) throw UsageError("--albedo: the objects of a scene file carry their own albedo");
   // The product drawn: per vertex, or the lightmap's per texel.
   const F::Product* baked = nullptr;
@@ -467,12 +471,18 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   int64_t file_bounces = baked && baked->bounces ? *baked->bounces : 0;
   // A scene: the most bounces any object's band-1 radiance or transfer carries (all are bounced
   // together, bake/bake/scene.h rule "bounces").
-  if (kind == "scene")
+  // Area views: the most bounces any object's area-light irradiance carries.
+  if (kind == "scene" && !area)
     for (const F::SceneObject& o : f.objects)
       for (const std::optional<F::Product>* p :
            {&o.set.transfer_diffuse, &o.set.radiance_band1,
             o.set.lightmap ? &o.set.lightmap->transfer_diffuse : nullptr,
             o.set.lightmap ? &o.set.lightmap->radiance_band1 : nullptr})
+        if (p && *p && (*p)->bounces) file_bounces = std::max(file_bounces, *(*p)->bounces);
+  if (area)
+    for (const F::SceneObject& o : f.objects)
+      for (const std::optional<F::Product>* p :
+           {&o.set.area_irradiance, o.set.lightmap ? &o.set.lightmap->area_irradiance : nullptr})
         if (p && *p && (*p)->bounces) file_bounces = std::max(file_bounces, *(*p)->bounces);
   std::optional<std::array<double, 3>> file_albedo;
   if (baked && baked->bounces && baked->albedo && baked->albedo->size() == 3)
@@ -503,7 +513,10 @@ Interreflection interreflection(const Args& a, const F::Asset& f, const std::str
   else if (r.albedo) std::snprintf(buf, sizeof buf, "direct, albedo %s", albedo);
   else std::snprintf(buf, sizeof buf, "ray traced");
   r.panel = buf;
-  if (kind == "scene" && file_bounces > 0)
+  if (area && file_bounces > 0)
+    std::snprintf(buf, sizeof buf, "the scene's area-light irradiance holds %lld bounce%s%s", static_cast<long long>(file_bounces),
+                  file_bounces == 1 ? "" : "s", a.bounces ? "; overridden on the command line" : "; --bounces B to change");
+  else if (kind == "scene" && file_bounces > 0)
     std::snprintf(buf, sizeof buf, "the scene's products hold %lld bounce%s%s", static_cast<long long>(file_bounces),
                   file_bounces == 1 ? "" : "s", a.bounces ? "; overridden on the command line" : "; --bounces B to change");
   else if (baked && baked->bounces)
@@ -551,11 +564,18 @@ view::ReferenceImage environment_reference(const Args& a, const prtview::RenderS
 
 // The area lights' reference (view/area_lights.h): light sampling over the rasterized pixels.
 view::ReferenceImage area_reference(const Args& a, const prtview::RenderScene& scene, const std::vector<bake::AreaLight>& lights,
-                                    const view::AreaRenderOptions& options, const view::Camera& cam, bool say) {
+                                    const view::AreaRenderOptions& options, const view::Camera& cam, uint32_t bounces,
+                                    bool say) {
   view::AreaReferenceOptions ro;
   ro.samples = a.samples;
   ro.seed = a.seed;
   ro.render = options;
+  ro.bounces = bounces;
+  if (bounces > 0 && !scene.reflectance.empty()) {  // as environment_reference: each object as the bake bounced it
+    ro.reflectance = scene.reflectance;
+    if (std::find(scene.area_gathers.begin(), scene.area_gathers.end(), uint8_t(1)) != scene.area_gathers.end())
+      ro.gathers = scene.area_gathers;
+  }
   view::ReferenceImage ref;
   ref.gbuffer = view::rasterize(scene.mesh, cam);
   Timer t;
@@ -565,8 +585,12 @@ view::ReferenceImage area_reference(const Args& a, const prtview::RenderScene& s
   ref.std_error = std::move(r.std_error);
   ref.rays = uint64_t(ref.gbuffer.covered()) * lights.size() * a.samples;
   if (say)
-    std::printf("reference: Embree light sampling, %u shadow rays per pixel and light (8 replicates), seed %llu: %.2f s, %.2f M "
-                "rays/s\n", a.samples, (unsigned long long)a.seed, ref.seconds, double(ref.rays) / std::max(ref.seconds, 1e-9) / 1e6);
+    std::printf("reference: Embree light sampling, %u shadow rays per pixel and light (8 replicates)%s, seed %llu: %.2f s, %.2f M "
+                "rays/s\n", a.samples,
+                bounces > 0 ? (", " + std::to_string(bounces) + " bounce" + (bounces == 1 ? "" : "s") + " path traced with " +
+                               std::to_string(a.samples) + " paths per pixel").c_str()
+                            : "",
+                (unsigned long long)a.seed, ref.seconds, double(ref.rays) / std::max(ref.seconds, 1e-9) / 1e6);
   return ref;
 }
 
@@ -803,7 +827,7 @@ int run(const Args& a) {
     return 0;
   }
 
-  const view::ReferenceImage ref = area ? area_reference(a, scene, lights, area_options, cam, say)
+  const view::ReferenceImage ref = area ? area_reference(a, scene, lights, area_options, cam, reflect.bounces, say)
                                         : environment_reference(a, scene, *env, cam, reflect.bounces, say, a.reference_cache);
   const view::GBuffer raster = view::rasterize(scene.mesh, cam);
   // Compared pixels: both renders see geometry (and, for 'receiver', both see the receiver).
@@ -878,12 +902,13 @@ int run(const Args& a) {
     char exposed[48];
     std::snprintf(exposed, sizeof exposed, ", exposure %.4g", exposure);
     std::vector<view::Panel> panels;
-    if (reflect.bounces > 0 && !area) {
+    if (reflect.bounces > 0) {
       // Interreflections: the direct light alone (ray traced, no bounces) before the bake with its
       // bounces and the path-traced reference, so the picture shows what the bounces add and how
       // close the bake comes. Cached beside the reference's cache, under its own key.
       const view::ReferenceImage direct =
-          environment_reference(a, scene, *env, cam, 0, say, a.reference_cache.empty() ? "" : a.reference_cache + ".direct");
+          area ? area_reference(a, scene, lights, area_options, cam, 0, say)
+               : environment_reference(a, scene, *env, cam, 0, say, a.reference_cache.empty() ? "" : a.reference_cache + ".direct");
       const view::ImageError d = view::compare_images(direct.radiance, ref.radiance, mask, &ref.std_error);
       std::printf("direct light alone (no bounces) against the reference: relative L2 %.5f (noise-corrected %.5f): what the "
                   "bounces add\n", d.relative_l2, d.relative_l2_noise_corrected);

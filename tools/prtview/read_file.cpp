@@ -393,7 +393,10 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
     const auto bounced = [](const std::optional<F::Product>& p) { return p && p->bounces.value_or(0) > 0; };
     const F::Lightmap* m = s.lightmap ? &*s.lightmap : nullptr;
     const bool any_bounced = bounced(s.radiance_band1) || bounced(s.transfer_diffuse) || bounced(s.radiance_shadowed) ||
-                             (m && (bounced(m->radiance_band1) || bounced(m->transfer_diffuse) || bounced(m->radiance_shadowed)));
+                             bounced(s.area_irradiance) ||
+                             (m && (bounced(m->radiance_band1) || bounced(m->transfer_diffuse) ||
+                                    bounced(m->radiance_shadowed) || bounced(m->area_irradiance)));
+    o.area_bounced = bounced(s.area_irradiance) || (m && bounced(m->area_irradiance));
     if (o.role == "both" && baked.albedo && baked.albedo->size() == 3)
       for (size_t c = 0; c < 3; ++c) o.reflectance[c] = float(std::max(0.0, (*baked.albedo)[c]));
     bounced_objects.push_back(any_bounced);

@@ -133,6 +133,7 @@ struct SceneObject {
   // carries bounces (AO never does).
   std::array<float, 3> reflectance{0, 0, 0};
   bool drawn_bounced = false;
+  bool area_bounced = false;  // its area-light irradiance carries bounces (the area views draw it)
   bake::Mesh mesh;                       // world space
   std::optional<Band1> band1;
   std::optional<Transfer> transfer;

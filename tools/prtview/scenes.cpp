@@ -331,6 +331,7 @@ void add_object(RenderScene& scene, const SceneObject& o) {
   scene.albedo.insert(scene.albedo.end(), T, o.albedo);
   scene.reflectance.insert(scene.reflectance.end(), T, o.reflectance);
   scene.gathers.insert(scene.gathers.end(), T, o.drawn_bounced ? 1 : 0);
+  scene.area_gathers.insert(scene.area_gathers.end(), T, o.area_bounced ? 1 : 0);
   scene.object_names.push_back(o.name);
   scene.object_receiver.push_back(o.receiver);
   scene.first_triangle.push_back(scene.first_triangle.back() + T);

@@ -40,7 +40,7 @@ struct RenderScene {
   // ... and, for the bounces, the albedo each triangle reflects with in the bake and whether its
   // pixels show a bounced product (view::ReferenceOptions::reflectance, gathers).
   std::vector<std::array<float, 3>> reflectance;
-  std::vector<uint8_t> gathers;
+  std::vector<uint8_t> gathers, area_gathers;  // the environment's products; the area lights' E
   std::vector<std::string> object_names;
   std::vector<bool> object_receiver;
   std::vector<size_t> first_triangle;

@@ -179,6 +179,8 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
                                          const AreaReferenceOptions& options) {
   check_inputs(mesh, lights, options.render);
   PRT_CHECK(options.samples > 0 && (options.samples < kReplicates || options.samples % kReplicates == 0));
+  PRT_CHECK(options.reflectance.empty() || options.reflectance.size() == mesh.triangles.size());
+  PRT_CHECK(options.gathers.empty() || options.gathers.size() == mesh.triangles.size());
   const bake::Mesh blockers = casters(mesh, options.render);
   const bake::Topology topology = bake::build_topology(blockers);
   const bake::RayCaster rays(blockers, topology);
@@ -186,6 +188,65 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
   for (const auto& l : lights) surfaces.emplace_back(l, mesh.origin);
   const double epsilon = area_shading_offset(mesh);
   const uint32_t B = std::min(kReplicates, options.samples), per = options.samples / B;
+  // The blockers' triangles in the mesh's numbering (casters() keeps their order).
+  std::vector<uint32_t> mesh_triangle;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    if (options.render.casts_shadow.empty() || options.render.casts_shadow[t]) mesh_triangle.push_back(uint32_t(t));
+  PRT_CHECK_OP(mesh_triangle.size(), ==, blockers.triangles.size());
+  const auto reflectance = [&](uint32_t t, size_t c) {
+    if (!options.reflectance.empty()) return double(options.reflectance[t][c]);
+    return options.render.triangle_albedo.empty() ? options.render.albedo[c] : double(options.render.triangle_albedo[t][c]);
+  };
+  // One light sample per light at h (normal n): Σ_l radiance_l,c · (an unbiased estimate of E_l(h)).
+  const auto next_event = [&](const Vector3d& h, const Vector3d& n, auto&& next, std::array<double, 3>& out) {
+    out = {0, 0, 0};
+    for (size_t l = 0; l < lights.size(); ++l) {
+      const LightSurface& s = surfaces[l];
+      double u0 = 0;
+      const LightSurface::Triangle& t = s.pick(next(), u0);
+      const double r0 = std::sqrt(u0), u2 = next();
+      const Vector3d y = t.a + r0 * (1 - u2) * t.ab + r0 * u2 * t.ac;
+      const Vector3d d = y - h;
+      const double r2 = d.squaredNorm(), r = std::sqrt(r2);
+      if (!(r > 0)) continue;
+      const Vector3d w = d / r;
+      const double cos_p = n.dot(w);
+      const double cos_l = s.two_sided ? std::abs(t.normal.dot(w)) : -t.normal.dot(w);
+      if (!(cos_p > 0) || !(cos_l > 0)) continue;
+      if (rays.occluded(h, w, 0.0, r * (1 - 1e-7))) continue;
+      const double e = s.area() * cos_p * cos_l / r2;
+      for (size_t c = 0; c < 3; ++c) out[c] += lights[l].radiance[c] * e;
+    }
+  };
+  // The indirect irradiance (Σ_l radiance_l,c E_l^ind) along one path from the pixel's point.
+  const auto indirect = [&](const bake::ShadePoint& sp, auto&& next, std::array<double, 3>& out) {
+    out = {0, 0, 0};
+    std::array<double, 3> throughput{1, 1, 1};
+    Vector3d o = sp.p, n = sp.n;
+    for (uint32_t depth = 1; depth <= options.bounces; ++depth) {
+      const double s0 = next(), s1 = next();
+      const Vector3d d = bake::Frame(n).to_world(bake::cosine_hemisphere(s0, s1)).normalized();
+      const std::optional<bake::RayHit> hit = rays.closest_hit(o, d, 0.0);
+      if (!hit) return;  // no light comes from the sky here
+      const auto& tv = blockers.triangles[hit->triangle];
+      const Vector3d a = blockers.positions[tv[0]].cast<double>(), b = blockers.positions[tv[1]].cast<double>(),
+                     c = blockers.positions[tv[2]].cast<double>();
+      const Vector3d ng = (b - a).cross(c - a);
+      if (!(ng.dot(d) < 0)) return;  // a back face: black
+      const double w1 = hit->u, w2 = hit->v, w0 = 1 - w1 - w2;
+      const Vector3d h = w0 * a + w1 * b + w2 * c;
+      Vector3d nh = (w0 * blockers.normals[tv[0]] + w1 * blockers.normals[tv[1]] + w2 * blockers.normals[tv[2]]).cast<double>();
+      nh = nh.norm() > 0 && nh.dot(ng) > 0 ? Vector3d(nh.normalized()) : Vector3d(ng.normalized());
+      const uint32_t t = mesh_triangle[hit->triangle];
+      for (size_t k = 0; k < 3; ++k) throughput[k] *= reflectance(t, k);
+      if (!(throughput[0] > 0 || throughput[1] > 0 || throughput[2] > 0)) return;
+      o = h + epsilon * ng.normalized();
+      n = nh;
+      std::array<double, 3> e;
+      next_event(o, n, next, e);
+      for (size_t k = 0; k < 3; ++k) out[k] += throughput[k] * e[k];
+    }
+  };
 
   AreaReferenceImage out;
   out.std_error = Image(g.width, g.height);
@@ -229,6 +290,21 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
           means[b * 3 + c] += channel(lights[l], estimate, options.render, albedo_of(f, options.render, c), c);
       }
     }
+    if (options.bounces > 0 && (options.gathers.empty() || options.gathers[size_t(f.triangle)]))
+      for (uint32_t b = 0; b < B; ++b) {
+        std::array<double, 3> sum{0, 0, 0}, e;
+        for (uint32_t i = 0; i < per; ++i) {
+          // A path's numbers: a counter hashed with (seed, pixel, replicate, path), whatever the thread.
+          const uint64_t key = bake::mix64(bake::mix64(options.seed ^ 0xa5a5a5a5a5a5a5a5ull) ^
+                                           bake::mix64((pixel * kReplicates + b) * uint64_t(per) + i));
+          uint64_t counter = 0;
+          auto next = [&] { return bake::to_unit(bake::mix64(key + 0x9e3779b97f4a7c15ull * ++counter)); };
+          indirect(sp, next, e);
+          for (size_t c = 0; c < 3; ++c) sum[c] += e[c];
+        }
+        for (size_t c = 0; c < 3; ++c)
+          means[b * 3 + c] += albedo_of(f, options.render, c) * sum[c] / per * std::numbers::inv_pi;
+      }
     for (size_t c = 0; c < 3; ++c) {
       double mean = 0;
       for (uint32_t b = 0; b < B; ++b) mean += means[b * 3 + c];

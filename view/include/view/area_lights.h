@@ -72,6 +72,20 @@ struct AreaReferenceOptions {
   uint32_t samples = 64;  // shadow rays per pixel and light: 1..7, or a multiple of 8 (replicates)
   uint64_t seed = 1;
   AreaRenderOptions render;
+  // Diffuse interreflection (issue 31), the area lights' counterpart of view/reference.h BOUNCES:
+  // the diffuse term's E_l gets E_l^ind = ∫ (ρ(h)/π) E_l(h) max(n·ω, 0) dω over the hemisphere, h
+  // the first casting surface along ω, E_l(h) its own direct + indirect irradiance, cut at exactly
+  // `bounces` reflections. Per replicate, `samples`/8 paths per pixel: cosine-distributed
+  // directions (the pdf cancels the cosine, so a path vertex adds ρ(h_1)…ρ(h_k) · E_l(h_k)); at each
+  // vertex h on a casting triangle's FRONT face (back faces are black, as the bake's), one light
+  // sample per light estimates E_l(h) as above (next-event estimation). Per channel: the light's
+  // radiance and the reflectances are RGB. The glossy layer takes no indirect light.
+  //   reflectance[t] (one per triangle of the mesh, empty: the picture's albedo): the albedo a
+  //     path continues with at triangle t (0: absorbs; view/reference.h's rule);
+  //   gathers[t] == 0 (empty: all gather): triangle t's pixels get the direct light only.
+  uint32_t bounces = 0;
+  std::vector<std::array<float, 3>> reflectance;
+  std::vector<uint8_t> gathers;
 };
 struct AreaReferenceImage {
   Image radiance;
