@@ -256,6 +256,17 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
   const double direct_rms[3] = {slice_rms(direct, V, W, layout.transfer, nt), slice_rms(direct, V, W, layout.radiance, nr),
                                 slice_rms(direct_s, VS, ns, 0, ns)};
 
+  // A pass's rows hold their even rays' sums in [0, n) and their odd rays' in [n, 2n): the bounce
+  // is their sum over K, its standard error their difference over K.
+  auto split_halves = [K](std::span<const double> both, size_t rows, size_t n, std::vector<double>& sum,
+                          std::vector<double>& half_difference) {
+    for (size_t v = 0; v < rows; ++v)
+      for (size_t i = 0; i < n; ++i) {
+        const double h0 = both[v * 2 * n + i], h1 = both[v * 2 * n + n + i];
+        sum[v * n + i] = (h0 + h1) / double(K);
+        half_difference[v * n + i] = (h0 - h1) / double(K);
+      }
+  };
   // Every ray of row v that meets a reflecting surface the field reads: visit(k, ρ(h), the source
   // at h, the estimator's weights (T's, then R's y_1m), the ray's direction and 1/pdf).
   auto for_each_ray = [&](size_t v, auto&& visit) {
@@ -309,12 +320,7 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
           },
           monitor, stage, what);
       seconds += pass.seconds;
-      for (size_t v = 0; v < V; ++v)
-        for (size_t i = 0; i < B; ++i) {
-          const double h0 = pass.values[v * 2 * B + i], h1 = pass.values[v * 2 * B + B + i];
-          made[v * B + i] = (h0 + h1) / double(K);
-          half_difference[v * B + i] = (h0 - h1) / double(K);
-        }
+      split_halves(pass.values, V, B, made, half_difference);
     }
     if (VS > 0) {  // the mixture (checked above): d and inv_p are the ray's
       VertexBake pass = bake_rows(
@@ -334,12 +340,7 @@ BounceResult bounce_rows(const BounceField& field, std::span<const ShadePoint> p
           },
           monitor, stage + (B > 0 ? ", shadowed radiance" : ""), what);
       seconds += pass.seconds;
-      for (size_t j = 0; j < VS; ++j)
-        for (size_t i = 0; i < ns; ++i) {
-          const double h0 = pass.values[j * 2 * ns + i], h1 = pass.values[j * 2 * ns + ns + i];
-          made_s[j * ns + i] = (h0 + h1) / double(K);
-          half_difference_s[j * ns + i] = (h0 - h1) / double(K);
-        }
+      split_halves(pass.values, VS, ns, made_s, half_difference_s);
     }
     // Summed only where non-zero, so an albedo of 0 leaves the direct rows' bits (−0 included).
     for (size_t v = 0; v < V; ++v) {
