@@ -37,6 +37,7 @@ std::vector<bake::AreaLight> read_area_lights(const F::Asset& f, const std::stri
   if (f.lights.empty()) throw InputError(file, "has no area lights (" + std::string(N::kLights) + "): nothing for --shade area to draw");
   std::vector<bake::AreaLight> out;
   for (const F::Light& l : f.lights) {  // the schema check has bounded the indices and sizes
+    if (N::is_punctual_shape(l.shape)) continue;  // no geometry: drawn from their baked E only
     bake::AreaLight a;
     a.name = l.name;
     a.shape = shape_of(l, file);
@@ -67,15 +68,16 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   struct TexelE {
     size_t object = 0;  // index in `objects`
     const F::VertexSet* set = nullptr;
-    std::vector<const bake::AreaLight*> column;
+    std::vector<const F::Light*> column;
   };
   std::vector<TexelE> texel_objects;
-  // Column l of E is the light named on line l of its `lights` attribute.
+  // Column l of E is the light named on line l of its `lights` attribute: an area light or a
+  // punctual one (its `radiance` is its intensity: E scales the same way).
   auto columns = [&](const SceneObject& o, const F::Product& e, std::string_view path) {
-    std::vector<const bake::AreaLight*> column;
+    std::vector<const F::Light*> column;
     for (const std::string& n : F::split_light_list(e.lights.value_or(""))) {
-      const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
-      if (it == lights.end())
+      const auto it = std::find_if(f.lights.begin(), f.lights.end(), [&](const F::Light& l) { return l.name == n; });
+      if (it == f.lights.end())
         throw InputError(file, "object '" + o.name + "': " + std::string(path).substr(1) + " names light '" + n + "', which " +
                                    std::string(N::kLights) + " does not hold");
       column.push_back(&*it);
@@ -97,7 +99,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
       continue;
     }
     if (e) {
-      const std::vector<const bake::AreaLight*> column = columns(o, *e, N::kAreaIrradiance);
+      const std::vector<const F::Light*> column = columns(o, *e, N::kAreaIrradiance);
       const size_t L = column.size();
       for (size_t v = 0; v < V; ++v) {
         float value[3];
