@@ -10,6 +10,7 @@
 #include <bake/mesh/receivers.h>
 #include <bake/visibility/raycast.h>
 
+#include <prtshade/lights.h>
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>
@@ -289,6 +290,31 @@ TEST(Punctual, ABulbAndASunDiscApproachTheirPunctualLimits) {
   c.n = -sun.direction;
   b.integrate(c, srow, ws);
   EXPECT_NEAR(srow[0] * disc.radiance[0], 3, 3 * 1e-12);
+}
+
+TEST(Punctual, TheRuntimesUnshadowedLightIsTheBakesWhereNothingShadows) {
+  // prtshade/lights.h evaluates a light the bake did not see: where nothing occludes it gives the
+  // baked E (the same formula, the same falloff), for every kind, at points all around the light.
+  const std::vector<PunctualLight> lights = {point_light(Vector3d(0.3, 2, -0.4)),
+                                             spot(Vector3d(-1, 3, 0.5), Vector3d(0.2, -1, 0.1), 0.25, 0.7),
+                                             directional(Vector3d(-0.3, -1, 0.6))};
+  const PunctualLightIntegrator integ(lights, nullptr, Vector3d::Zero(), 0);
+  for (int k = 0; k < 64; ++k) {
+    ShadePoint s;
+    s.p = Vector3d(std::sin(k * 1.3) * 3, std::cos(k * 0.7), std::sin(k * 2.1) * 2);
+    s.n = Vector3d(std::sin(k * 0.37), 1 + std::cos(k * 0.9), std::cos(k * 1.7)).normalized();
+    const std::vector<double> row = row_of(integ, s);
+    for (size_t l = 0; l < lights.size(); ++l) {
+      prt::shade::PunctualLight r;
+      r.kind = prt::shade::PunctualKind(int(lights[l].kind == PunctualKind::Directional ? 0 : lights[l].kind == PunctualKind::Point ? 1 : 2));
+      r.position = {lights[l].position.x(), lights[l].position.y(), lights[l].position.z()};
+      r.direction = {lights[l].direction.x(), lights[l].direction.y(), lights[l].direction.z()};
+      r.inner_cone = lights[l].inner_cone;
+      r.outer_cone = lights[l].outer_cone;
+      const double e = prt::shade::unshadowed_punctual(r, {s.p.x(), s.p.y(), s.p.z()}, {s.n.x(), s.n.y(), s.n.z()});
+      EXPECT_NEAR(row[l], e, kRounding * std::max(1.0, e)) << k << " " << l;
+    }
+  }
 }
 
 } // namespace
