@@ -330,3 +330,114 @@ TEST(ScenePunctualLights, AGltfSpotWithItsConesCrossedIsRefusedNamingTheLight) {
             std::string::npos)
       << r.err;
 }
+
+namespace {
+
+// The exposure prtview prints for --shade area: "(1 / X, the 99th percentile of the baked area
+// lighting E/pi ...)"; X, or -1 when the line is missing.
+double baked_percentile(const std::string& out) {
+  const std::string key = "(1 / ";
+  const size_t at = out.find(key);
+  if (at == std::string::npos || out.find("the 99th percentile of the baked area lighting", at) == std::string::npos) return -1;
+  return std::stod(out.substr(at + key.size()));
+}
+
+} // namespace
+
+TEST(ScenePunctualLights, PrtviewShadesThemFromTheBakedIrradianceTimesTheirIntensity) {
+  // Only a spot and a sun: prtview draws the baked E times each light's stored intensity, so
+  // doubling both intensities doubles what it draws (its exposure's percentile, printed).
+  double percentile[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const fs::path d = fresh_dir("prtview" + std::to_string(k));
+    const std::string s = std::to_string(k + 1);
+    const fs::path out = bake(d, 2,
+                              R"("lights": [{"name": "cone", "shape": "spot", "position": [0, 4, 0], "direction": [0, -1, 0], "outer_cone_angle": 60, "intensity": [)" +
+                                  s + ", " + s + ", " + s + R"(]}, {"name": "sun", "shape": "directional", "direction": [0.5, -1, 0.25], "intensity": [)" + s +
+                                  ", " + s + ", " + s + "]}]");
+    const auto r = prt::testing::run_tool(PRT_PRTVIEW, "'" + out.string() + "' --shade area -o '" + (d / "v.png").string() + "'", d / "capture");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(d / "v.png"));
+    percentile[k] = baked_percentile(r.out + r.err);
+    ASSERT_GT(percentile[k], 0) << r.out << r.err;
+    // Per pixel, exactly, prtview integrates area lights only: it says so, and exits non-zero.
+    const auto exact = prt::testing::run_tool(PRT_PRTVIEW, "'" + out.string() + "' --shade area-exact -o '" + (d / "x.png").string() + "'", d / "capture");
+    EXPECT_NE(exact.code, 0);
+    EXPECT_NE(exact.err.find("holds punctual lights only (no area light)"), std::string::npos) << exact.err;
+  }
+  EXPECT_NEAR(percentile[1] / percentile[0], 2.0, 2e-3) << "prtview prints the percentile to 4 digits";
+}
+
+namespace {
+
+// Whether the segment p → q meets the box [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2] (slabs), with a
+// margin: a texel within `margin` of deciding either way is left out of the comparison.
+bool near_or_through_box(const Vector3d& p, const Vector3d& q, double margin) {
+  const Vector3d lo(-0.5 - margin, 0.5 - margin, -0.5 - margin), hi(0.5 + margin, 1.5 + margin, 0.5 + margin);
+  double t0 = 0, t1 = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double d = q[k] - p[k];
+    if (d == 0) {
+      if (p[k] < lo[k] || p[k] > hi[k]) return false;
+      continue;
+    }
+    double a = (lo[k] - p[k]) / d, b = (hi[k] - p[k]) / d;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a), t1 = std::min(t1, b);
+  }
+  return t0 <= t1;
+}
+
+} // namespace
+
+TEST(ScenePunctualLights, PerTexelTheyAreTheClosedFormsToo) {
+  // The ground baked per texel of a 24 × 24 lightmap: every texel baked at its own sample (state 1)
+  // gets the point light's E = cos/d², or 0 when the box stands between (texels near the shadow's
+  // edge, where a texel's sample and the closed form's rounding may disagree, are left out).
+  const fs::path d = fresh_dir("texels");
+  write_meshes(d);
+  std::string scene = scene_text(lights_json());
+  const std::string ground = R"("material": {"albedo": [0.5, 0.5, 0.5]}})";
+  scene.replace(scene.find(ground), ground.size(), R"("material": {"albedo": [0.5, 0.5, 0.5]}, "lightmap": {"resolution": 24}})");
+  std::ofstream(d / "scene.json") << scene;
+  const fs::path out = d / "out.prt.h5";
+  const auto r = prtbake(d, "scene '" + (d / "scene.json").string() + "' -o '" + out.string() + "' -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const F::Asset a = F::read_asset(out);
+  const F::SceneObject* g = a.find_object("ground");
+  ASSERT_NE(g, nullptr);
+  ASSERT_TRUE(g->set.lightmap.has_value());
+  const F::Lightmap& m = *g->set.lightmap;
+  ASSERT_TRUE(m.area_irradiance.has_value() && m.positions.has_value());
+  EXPECT_EQ(m.area_irradiance->lights.value_or(""), "key\nbulb\ncone\nsun");
+  size_t lit = 0, shadowed = 0;
+  for (size_t t = 0; t < m.texel_count(); ++t) {
+    if (m.state.values[t] != 1) continue;
+    const Vector3d p(m.positions->values[3 * t], m.positions->values[3 * t + 1], m.positions->values[3 * t + 2]);
+    const float e = m.area_irradiance->values[4 * t + 1];
+    if (near_or_through_box(p, kPoint, 0.02)) {
+      if (!near_or_through_box(p, kPoint, -0.02)) continue;
+      EXPECT_EQ(e, 0.0f) << p.transpose();
+      ++shadowed;
+    } else {
+      EXPECT_NEAR(e, point_e(kPoint, p), kFloat * point_e(kPoint, p) + 1e-7) << p.transpose();
+      ++lit;
+    }
+  }
+  EXPECT_GT(lit, 100u);
+  EXPECT_GT(shadowed, 3u);
+}
+
+// `prtbake scene --help` names the punctual kinds and their keys (the parser's list in
+// libbake/bake/src/scene_file.cpp), and how a glTF's lights get an extent.
+TEST(ScenePunctualLights, SceneHelpNamesThePunctualKindsAndTheirKeys) {
+  const fs::path d = fresh_dir("help");
+  const auto r = prtbake(d, "scene --help");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* s : {"{\"shape\": \"point\", \"position\"}", "\"radius\"", "\"subdivisions\": 3",
+                        "{\"shape\": \"spot\", \"position\", \"direction\", \"inner_cone_angle\": 0, \"outer_cone_angle\": 45}",
+                        "{\"shape\": \"directional\", \"direction\"}", "\"angle\"", "\"segments\": 64",
+                        "\"intensity\": [r,g,b] (required, >= 0: candela, or lux for directional)", "\"gltf_lights\"",
+                        "KHR_lights_punctual"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+}

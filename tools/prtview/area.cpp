@@ -140,13 +140,20 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
 
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   const bool any_per_pixel = std::find(per_pixel.begin(), per_pixel.end(), 1) != per_pixel.end();
+  // Per pixel (exactly) only area lights: punctual ones have no geometry to integrate, they are
+  // drawn from their baked E. A file of punctual lights alone draws its objects without E black.
+  if (exact && lights.empty())
+    throw InputError(file, "holds punctual lights only (no area light): --shade area-exact integrates area lights per "
+                           "pixel; --shade area draws every light's baked E");
   view::Image analytic;
-  if (exact || any_per_pixel) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
+  if (exact || (any_per_pixel && !lights.empty())) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
   if (exact) return analytic;
   view::Image img = view::interpolate_vertices(scene.mesh, g, rgb);
   for (size_t i = 0; i < g.triangle.size(); ++i)
-    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1)
-      std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1) {
+      if (analytic.rgb.empty()) std::fill_n(img.rgb.begin() + std::ptrdiff_t(3 * i), 3, 0.0f);
+      else std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+    }
   // Per texel: E per light sampled bilinearly through the object's mesh/uv (view/lightmap.h),
   // times each light's radiance and the albedo / pi; one pass over the pixels.
   if (texel_objects.empty()) return img;

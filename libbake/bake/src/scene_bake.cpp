@@ -76,6 +76,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
                      const OnChoice& on_choice) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
+  for (const PunctualLight& l : scene.punctual_lights)
+    PRT_CHECK(l.angular_diameter == 0);  // a sun with an angle is an area light: place_suns first
   SceneBake out;
   out.objects.resize(scene.objects.size());
   const auto t_setup = std::chrono::steady_clock::now();
