@@ -56,6 +56,23 @@ std::vector<bake::AreaLight> read_area_lights(const F::Asset& f, const std::stri
   return out;
 }
 
+std::vector<bake::PunctualLight> read_punctual_lights(const F::Asset& f) {
+  std::vector<bake::PunctualLight> out;
+  for (const F::Light& l : f.lights) {  // the schema check has checked their attributes
+    if (!N::is_punctual_shape(l.shape)) continue;
+    bake::PunctualLight p;
+    p.name = l.name;
+    p.kind = l.shape == "point" ? bake::PunctualKind::Point : l.shape == "spot" ? bake::PunctualKind::Spot : bake::PunctualKind::Directional;
+    if (l.position) p.position = Eigen::Vector3d((*l.position)[0], (*l.position)[1], (*l.position)[2]);
+    if (l.direction) p.direction = Eigen::Vector3d((*l.direction)[0], (*l.direction)[1], (*l.direction)[2]).normalized();
+    p.intensity = l.radiance;
+    p.inner_cone = l.inner_cone_angle.value_or(0);
+    p.outer_cone = l.outer_cone_angle.value_or(p.outer_cone);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 view::Image render_area_file(const F::Asset& f, const std::string& file, const std::vector<bake::AreaLight>& lights, bool exact,
                              const view::Camera& cam, RenderScene& scene, view::AreaRenderOptions& options) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, nullptr);
@@ -130,6 +147,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
                     : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated, or per texel through "
                       "the object's lightmap (" + std::to_string(baked) + " objects); objects without it per pixel, exactly";
   options.casts_shadow = scene.casts_shadow;
+  options.punctual = read_punctual_lights(f);
   options.triangle_albedo = scene.albedo;
   if (options.ggx) {
     options.ggx->eye -= scene.mesh.origin;
@@ -140,13 +158,10 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
 
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   const bool any_per_pixel = std::find(per_pixel.begin(), per_pixel.end(), 1) != per_pixel.end();
-  // Per pixel (exactly) only area lights: punctual ones have no geometry to integrate, they are
-  // drawn from their baked E. A file of punctual lights alone draws its objects without E black.
-  if (exact && lights.empty())
-    throw InputError(file, "holds punctual lights only (no area light): --shade area-exact integrates area lights per "
-                           "pixel; --shade area draws every light's baked E");
+  // Per pixel, exactly: the area lights' closed forms and the punctual lights' shadow rays
+  // (AreaRenderOptions::punctual, read from the file's /lights above).
   view::Image analytic;
-  if (exact || (any_per_pixel && !lights.empty())) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
+  if (exact || any_per_pixel) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
   if (exact) return analytic;
   view::Image img = view::interpolate_vertices(scene.mesh, g, rgb);
   for (size_t i = 0; i < g.triangle.size(); ++i)
