@@ -243,7 +243,7 @@ fs::path write_gltf(const fs::path& d, double inner = 0.2, double outer = 0.6) {
   g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   g.doc["extensions"] = {{"KHR_lights_punctual",
                           {{"lights",
-                            {{{"name", "lamp"}, {"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}},
+                            {{{"name", "lamp"}, {"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}, {"range", 40}},
                              {{"name", "cone"}, {"type", "spot"}, {"intensity", 50}, {"spot", {{"innerConeAngle", inner}, {"outerConeAngle", outer}}}},
                              {{"name", "sun"}, {"type", "directional"}, {"intensity", 3}}}}}}};
   g.node({{"name", "lamp_node"}, {"translation", {0.5, 2, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}, true);
@@ -261,6 +261,7 @@ TEST(ScenePunctualLights, KhrLightsPunctualFromAGltfWithNodeTransforms) {
   const auto r = prtbake(d, "scene '" + gltf.string() + "' -o '" + out.string() + "' -q --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find("not baked"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("light 0 (\"lamp\"): its range 40.000000 is not applied"), std::string::npos) << r.err;
   const F::Asset a = F::read_asset(out);
   ASSERT_EQ(a.lights.size(), 3u);
   const F::Light* lamp = a.find_light("lamp");
