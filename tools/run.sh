@@ -4,7 +4,7 @@
 #                       three tools only (preset tools: Release, no tests or benchmarks), bake the
 #                       default scene (data/bunny_ground.obj under data/sunset.exr) to
 #                       out/default.prt.h5, show what was baked, then bake data/scene_example.json
-#                       to out/scene.prt.h5.
+#                       to out/scene.prt.h5 and data/scene_lights.json to out/lights.prt.h5.
 #   tools/run.sh test   install everything (TOOLS_PACKAGES and TEST_PACKAGES), build (ci preset:
 #                       warnings are errors), run every test with ctest, then build the fuzz
 #                       targets (fuzz preset: clang 14, ASan + UBSan) and run each briefly
@@ -77,6 +77,9 @@ case "${1:-}" in
     # A scene file: several objects, roles and materials; prtbake bakes what the scene needs
     # and prints what it leaves out and why (README "Scene files").
     $B/prtbake scene data/scene_example.json -o out/scene.prt.h5
+    # Lights: a quad, a disc, a 0.53-degree sun (soft shadows) and a spot (hard shadows) over
+    # the bunny (README "Scene files", punctual lights).
+    $B/prtbake scene data/scene_lights.json -o out/lights.prt.h5
     ;;
   test)
     install_deps "${TOOLS_PACKAGES[@]}" "${TEST_PACKAGES[@]}"

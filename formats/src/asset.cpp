@@ -138,7 +138,13 @@ constexpr Field<Occluder> kShellsFields[] = {
     {N::kGrid, &Occluder::grid}};
 
 constexpr Field<Light> kLightFields[] = {
-    {N::kShape, &Light::shape}, {N::kRadiance, &Light::radiance}, {N::kTwoSided, &Light::two_sided}};
+    {N::kShape, &Light::shape},
+    {N::kRadiance, &Light::radiance},
+    {N::kTwoSided, &Light::two_sided},
+    {N::kPosition, &Light::position},
+    {N::kDirection, &Light::direction},
+    {N::kInnerConeAngle, &Light::inner_cone_angle},
+    {N::kOuterConeAngle, &Light::outer_cone_angle}};
 
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
 
@@ -315,6 +321,7 @@ void add_occluder(File& f, const Occluder& o) {
 }
 
 void add_light(File& f, const Light& l) {
+  if (N::is_punctual_shape(l.shape)) return;  // v6: attributes only
   const std::string dir = light_dir(l.name) + "/";
   add_array(f, cat(dir, N::kLightVertices), {l.vertices.values.size() / 3, 3}, l.vertices.values, l.vertices.extra);
   add_array(f, cat(dir, N::kLightFaceSizes), {l.face_sizes.values.size()}, l.face_sizes.values, l.face_sizes.extra);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -18,6 +19,16 @@ namespace {
 using detail::valid_utf8;
 
 namespace N = names;
+
+// Whether a /lights/<name> group's attributes make it a punctual light (v6).
+bool is_punctual_group(const std::string& group, const std::vector<Attr>& attrs) {
+  const std::string dir = std::string(N::kLights) + "/";
+  if (!group.starts_with(dir) || group.find('/', dir.size()) != std::string::npos) return false;
+  const Attr* shape = find_attr(attrs, N::kShape);
+  const auto* s = shape ? std::get_if<std::string>(&shape->value) : nullptr;
+  return s != nullptr && N::is_punctual_shape(*s);
+}
+
 
 constexpr std::array<std::string_view, 7> kRequiredRootStrings = {
     N::kGenerator, N::kCreated, N::kCommandLine, N::kSource, N::kSourceSha256, N::kUpAxis, N::kShConvention};
@@ -256,11 +267,23 @@ public:
     const std::string dir = std::string(N::kLights) + "/";
     for (const Dataset& d : file.datasets)
       if (d.path.starts_with(dir)) names.insert(d.path.substr(dir.size(), d.path.find('/', dir.size()) - dir.size()));
+    std::set<std::string> punctual;
     for (const auto& [g, list] : file.group_attrs)
-      if (g.starts_with(dir) && g.find('/', dir.size()) == std::string::npos && !names.count(g.substr(dir.size())))
-        fail("group '" + g + "' has no '" + std::string(N::kLightVertices) + "' dataset: a light needs its geometry");
-    if (!names.empty() && version < 3)
+      if (g.starts_with(dir) && g.find('/', dir.size()) == std::string::npos) {
+        const std::string name = g.substr(dir.size());
+        if (is_punctual_group(g, list)) {
+          if (names.count(name)) fail("punctual light '" + g + "' has datasets: a point, spot or directional light has none");
+          punctual.insert(name);
+        } else if (!names.count(name)) {
+          fail("group '" + g + "' has no '" + std::string(N::kLightVertices) + "' dataset: a light needs its geometry");
+        }
+      }
+    if ((!names.empty() || !punctual.empty()) && version < 3)
       fail("the file has " + std::string(N::kLights) + ", which needs format_version 3");
+    if (!punctual.empty() && version < 6)
+      fail("the file has punctual lights in " + std::string(N::kLights) + ", which need format_version 6 (the file says " +
+           std::to_string(version) + ")");
+    for (const std::string& name : punctual) punctual_light(*find_group_attrs(file, dir + name), dir + name);
     for (const std::string& name : names) {
       const std::string g = dir + name;
       for (std::string_view leaf : {N::kLightVertices, N::kLightFaceSizes, N::kLightFaceIndices})
@@ -295,7 +318,41 @@ public:
       if (t == nullptr || (*t != 0 && *t != 1))
         fail("group '" + g + "' needs attribute '" + std::string(N::kTwoSided) + "': the integer 0 or 1");
     }
+    names.insert(punctual.begin(), punctual.end());
     return names;
+  }
+
+  // A punctual light's attributes (v6): its shape, radiance (its intensity) >= 0, position (point,
+  // spot), a non-zero direction (spot, directional), the spot's cones 0 <= inner < outer <= pi/2.
+  void punctual_light(const std::vector<Attr>& attrs, const std::string& g) const {
+    const std::string shape = required_string(attrs, N::kShape, "group '" + g + "'");
+    auto vec3 = [&](std::string_view name, const char* what) {
+      const Attr* a = find_attr(attrs, name);
+      const auto* v = a ? std::get_if<std::vector<double>>(&a->value) : nullptr;
+      if (v == nullptr || v->size() != 3 || !std::all_of(v->begin(), v->end(), [](double x) { return std::isfinite(x); }))
+        fail("group '" + g + "' (a " + shape + " light) needs attribute '" + std::string(name) + "': " + what);
+      return *v;
+    };
+    auto number = [&](std::string_view name) {
+      const Attr* a = find_attr(attrs, name);
+      const auto* v = a ? std::get_if<double>(&a->value) : nullptr;
+      if (v == nullptr || !std::isfinite(*v))
+        fail("group '" + g + "' (a spot light) needs attribute '" + std::string(name) + "': a finite double (radians)");
+      return *v;
+    };
+    const std::vector<double> rgb = vec3(N::kRadiance, "3 doubles >= 0 (its intensity, RGB)");
+    if (!std::all_of(rgb.begin(), rgb.end(), [](double x) { return x >= 0; }))
+      fail("group '" + g + "' needs attribute '" + std::string(N::kRadiance) + "': 3 doubles >= 0 (its intensity, RGB)");
+    if (shape != "directional") vec3(N::kPosition, "3 finite doubles (world space)");
+    if (shape != "point") {
+      const std::vector<double> d = vec3(N::kDirection, "3 finite doubles, a unit vector");
+      if (!(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 0)) fail("group '" + g + "' has a zero direction");
+    }
+    if (shape == "spot") {
+      const double inner = number(N::kInnerConeAngle), outer = number(N::kOuterConeAngle);
+      if (!(inner >= 0 && inner < outer && outer <= std::numbers::pi / 2 + 1e-12))
+        fail("group '" + g + "' needs 0 <= inner_cone_angle < outer_cone_angle <= pi/2");
+    }
   }
 
   const std::string file_;
@@ -342,9 +399,12 @@ bool is_lightmap_kind(DatasetKind kind) {
 }
 
 int64_t written_format_version(const File& file) {
+  if (std::any_of(file.group_attrs.begin(), file.group_attrs.end(),
+                  [](const auto& g) { return is_punctual_group(g.first, g.second); }))
+    return kFormatVersion;
   const bool lightmap = std::any_of(file.datasets.begin(), file.datasets.end(),
                                     [](const Dataset& d) { return is_lightmap_kind(dataset_kind(d.path)); });
-  return lightmap ? kFormatVersion : kFormatVersionWithoutLightmaps;
+  return lightmap ? kFormatVersionWithLightmaps : kFormatVersionWithoutLightmaps;
 }
 
 bool is_per_vertex_path(std::string_view path) {

@@ -4,6 +4,8 @@
 
 #include <prtshade/fiv.h>
 #include <prtshade/glossy.h>
+#include <prtshade/lights.h>
+#include <prtshade/ltc.h>
 #include <prtshade/sh.h>
 #include <prtshade/shade.h>
 
@@ -352,6 +354,85 @@ prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, con
     for (size_t k = 0; k < count; ++k)
       prt::shade::shade_fiv_member(scene->environment, scene->views.data(), int(scene->views.size()), index,
                                    positions + 3 * k, normals + 3 * k, partial != 0, out + 3 * k);
+  });
+}
+
+prt_status prt_shade_lights(const float* irradiance, size_t count, size_t lights, const float* emission,
+                            const float* albedo, int albedo_per_receiver, float* out) {
+  return guarded(__func__, [&] {
+    require(out != nullptr && albedo != nullptr && (count == 0 || lights == 0 || irradiance != nullptr) &&
+                (lights == 0 || emission != nullptr),
+            "null pointer");
+    for (size_t k = 0; k < 3 * lights; ++k)
+      require(std::isfinite(emission[k]) && emission[k] >= 0, "emission must be finite and >= 0");
+    for (size_t k = 0; k < count * lights; ++k) require(std::isfinite(irradiance[k]), "irradiance is not finite");
+    const size_t albedos = albedo_per_receiver ? count : 1;
+    for (size_t k = 0; k < 3 * albedos; ++k) require(std::isfinite(albedo[k]), "albedo is not finite");
+    prt::shade::shade_lights(irradiance, count, lights, emission, albedo, albedo_per_receiver ? 3 : 0, out);
+  });
+}
+
+prt_status prt_punctual_irradiance(const prt_punctual_light* light, const float p[3], const float n[3], float* out) {
+  return guarded(__func__, [&] {
+    require(light != nullptr && p != nullptr && n != nullptr && out != nullptr, "null pointer");
+    require(light->kind >= PRT_PUNCTUAL_DIRECTIONAL && light->kind <= PRT_PUNCTUAL_SPOT, "kind is not a prt_punctual_kind");
+    prt::shade::PunctualLight l;
+    l.kind = prt::shade::PunctualKind(light->kind);
+    for (int k = 0; k < 3; ++k) {
+      require(std::isfinite(light->position[k]) && std::isfinite(light->direction[k]) && std::isfinite(p[k]),
+              "position, direction or p is not finite");
+      l.position[size_t(k)] = light->position[k];
+      l.direction[size_t(k)] = light->direction[k];
+    }
+    const double d2 = l.direction[0] * l.direction[0] + l.direction[1] * l.direction[1] + l.direction[2] * l.direction[2];
+    require(l.kind == prt::shade::PunctualKind::Point || d2 > 0, "direction is zero");
+    l.inner_cone = light->inner_cone_angle;
+    l.outer_cone = light->outer_cone_angle;
+    if (l.kind == prt::shade::PunctualKind::Spot)
+      require(l.inner_cone >= 0 && l.inner_cone < l.outer_cone && l.outer_cone <= 1.5707963705062866,
+              "cone angles need 0 <= inner < outer <= pi/2");
+    const double r2 = double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2];
+    require(std::isfinite(r2) && std::fabs(r2 - 1.0) <= 1e-4, "n is not unit length (to 1e-4)");
+    *out = float(prt::shade::unshadowed_punctual(l, {p[0], p[1], p[2]}, {n[0], n[1], n[2]}));
+  });
+}
+
+prt_status prt_ltc_ggx(const float n[3], const float v[3], float alpha, float f0, const float* arcs, size_t count,
+                       float* out) {
+  return guarded(__func__, [&] {
+    namespace ltc = prt::shade::ltc;
+    require(n != nullptr && v != nullptr && out != nullptr && (count == 0 || arcs != nullptr), "null pointer");
+    auto unit = [](const float* x) {
+      const double r2 = double(x[0]) * x[0] + double(x[1]) * x[1] + double(x[2]) * x[2];
+      return std::isfinite(r2) && std::fabs(r2 - 1.0) <= 1e-4;
+    };
+    require(unit(n) && unit(v), "n and v must be unit length (to 1e-4)");
+    require(std::isfinite(alpha) && alpha > 0, "alpha must be finite and > 0");
+    require(f0 >= 0 && f0 <= 1, "f0 must be in [0, 1]");
+    const ltc::Vec3 nd{n[0], n[1], n[2]}, vd{v[0], v[1], v[2]};
+    std::vector<ltc::Arc> region(count);
+    for (size_t k = 0; k < count; ++k) {
+      const float* a = arcs + 6 * k;
+      for (int i = 0; i < 6; ++i) require(std::isfinite(a[i]), "an arc is not finite");
+      region[k] = {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}};
+      for (const ltc::Vec3& w : {region[k].a, region[k].b}) {
+        const double len = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        require(len > 0, "an arc's endpoint is zero");
+        require(nd[0] * w[0] + nd[1] * w[1] + nd[2] * w[2] >= -1e-6 * len, "an arc's endpoint is below n's horizon");
+      }
+    }
+    const ltc::Lobe lobe = ltc::ggx_lobe(ltc::ggx_table(), nd, vd, alpha);
+    *out = float(lobe.scale(f0) * ltc::integrate(lobe, region));
+  });
+}
+
+prt_status prt_ltc_ggx_error_bound(float alpha, float cos_theta, float f0, float* out) {
+  return guarded(__func__, [&] {
+    require(out != nullptr, "null pointer");
+    require(std::isfinite(alpha) && alpha > 0, "alpha must be finite and > 0");
+    require(cos_theta >= 0 && cos_theta <= 1, "cos_theta must be in [0, 1]");
+    require(f0 >= 0 && f0 <= 1, "f0 must be in [0, 1]");
+    *out = float(prt::shade::ltc::error_bound(prt::shade::ltc::ggx_table(), alpha, cos_theta, f0));
   });
 }
 

@@ -38,6 +38,16 @@ Vec3 horizon_crossing(const Vec3& a, const Vec3& b) {
 
 } // namespace
 
+std::size_t packed_table_floats(const Table& t) { return 4 + std::size_t(t.n_alpha) * std::size_t(t.n_theta) * Table::kValuesPerNode; }
+
+void pack_table(const Table& t, std::span<float> out) {
+  out[0] = float(t.n_alpha);
+  out[1] = float(t.n_theta);
+  out[2] = float(t.sqrt_alpha_min);
+  out[3] = float(t.theta_max);
+  for (std::size_t k = 4; k < packed_table_floats(t); ++k) out[k] = float(t.values[k - 4]);
+}
+
 double ggx_ndf(double cos_h, double alpha) {
   const double a2 = alpha * alpha, q = cos_h * cos_h * (a2 - 1) + 1;
   return a2 / (std::numbers::pi * q * q);

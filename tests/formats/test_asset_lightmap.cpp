@@ -71,7 +71,7 @@ VertexSet lightmap_set(double offset = 0) {
 
 Asset asset(bool scene, double offset = 0) {
   Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
+  a.root = {kFormatVersionWithLightmaps, "test", "2024-01-02T03:04:05Z", "prtbake x", "x.obj", std::string(64, 'a'),
             "y", "real orthonormal", {}};
   if (!scene) {
     a.vertices = lightmap_set(offset);

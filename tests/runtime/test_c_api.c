@@ -214,3 +214,50 @@ int prt_c_check_fiv(char* msg, size_t size) {
   prt_fiv_scene_destroy(scene);
   return 0;
 }
+
+/* The baked lights' shading (emission · E, area and punctual alike), an unshadowed punctual light
+ * against its closed forms, and LTC GGX over a polygon (a tight lobe inside a wide light: its
+ * albedo), with their argument errors. */
+int prt_c_check_lights(char* msg, size_t size) {
+  const float E[4] = {0.5f, 0.25f, 1.0f, 0.0f}; /* [2 receivers][2 lights] */
+  const float emission[6] = {10, 10, 10, 4, 2, 0};
+  const float grey[3] = {0.5f, 0.5f, 0.5f};
+  float out[6];
+  CHECK_STATUS(prt_shade_lights(E, 2, 2, emission, grey, 0, out), PRT_OK);
+  /* float sums of a few terms: 1e-6 relative */
+  CHECK_NEAR(out[0], 0.5 / PI * (10 * 0.5 + 4 * 0.25), 1e-6, "shade_lights r of receiver 0");
+  CHECK_NEAR(out[2], 0.5 / PI * (10 * 0.5), 1e-6, "shade_lights b of receiver 0");
+  CHECK_NEAR(out[4], 0.5 / PI * 10, 1e-6, "shade_lights g of receiver 1");
+  const float bad_emission[6] = {10, 10, 10, -1, 0, 0};
+  CHECK_STATUS(prt_shade_lights(E, 2, 2, bad_emission, grey, 0, out), PRT_ERROR_INVALID_ARGUMENT);
+
+  const float origin[3] = {0, 0, 0}, up[3] = {0, 0, 1}, side[3] = {2, 0, 0};
+  prt_punctual_light light = {PRT_PUNCTUAL_POINT, {0, 0, 2}, {0, 0, -1}, 0.2f, 0.6f};
+  float e = -1;
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
+  CHECK_NEAR(e, 0.25, 1e-7, "point light: cos/d^2");
+  light.kind = PRT_PUNCTUAL_SPOT;
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
+  CHECK_NEAR(e, 0.25, 1e-7, "spot on its axis");
+  CHECK_STATUS(prt_punctual_irradiance(&light, side, up, &e), PRT_OK);
+  CHECK_NEAR(e, 0.0, 0.0, "spot outside its outer cone");
+  light.kind = PRT_PUNCTUAL_DIRECTIONAL;
+  CHECK_STATUS(prt_punctual_irradiance(&light, side, up, &e), PRT_OK);
+  CHECK_NEAR(e, 1.0, 1e-7, "directional straight down");
+  light.kind = PRT_PUNCTUAL_SPOT;
+  light.inner_cone_angle = 0.7f;
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_ERROR_INVALID_ARGUMENT);
+
+  /* A square light spanning 45 degrees about n on every side; v = n, alpha 0.05: the lobe lies in
+   * it, so the integral is the lobe's albedo at normal incidence (the table's A, near 1). */
+  const float arcs[24] = {-1, -1, 1, 1, -1, 1, 1, -1, 1, 1, 1, 1, 1, 1, 1, -1, 1, 1, -1, 1, 1, -1, -1, 1};
+  float g = -1, bound = -1;
+  CHECK_STATUS(prt_ltc_ggx(up, up, 0.05f, 1.0f, arcs, 4, &g), PRT_OK);
+  CHECK_STATUS(prt_ltc_ggx_error_bound(0.05f, 1.0f, 1.0f, &bound), PRT_OK);
+  if (!(bound > 0 && bound < 0.2)) return fail(msg, size, "LTC error bound", bound, 0.05);
+  if (!(g > 0.85 && g <= 1.0 + bound)) return fail(msg, size, "LTC GGX over a wide light, alpha 0.05", g, 1.0);
+  const float below[6] = {1, 0, -0.5f, 0, 1, 0.5f};
+  CHECK_STATUS(prt_ltc_ggx(up, up, 0.05f, 1.0f, below, 1, &g), PRT_ERROR_INVALID_ARGUMENT);
+  CHECK_STATUS(prt_ltc_ggx(up, up, 0.0f, 1.0f, arcs, 4, &g), PRT_ERROR_INVALID_ARGUMENT);
+  return 0;
+}

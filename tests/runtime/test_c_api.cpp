@@ -8,6 +8,7 @@ int prt_c_check_errors(char* msg, size_t size);
 int prt_c_check_shading(char* msg, size_t size);
 int prt_c_check_fiv(char* msg, size_t size);
 int prt_c_check_glossy(char* msg, size_t size);
+int prt_c_check_lights(char* msg, size_t size);
 }
 
 namespace {
@@ -30,6 +31,11 @@ TEST(CApi, FivSceneShading) {
 TEST(CApi, GlossyShadingBothRoutes) {
   char msg[512] = "";
   EXPECT_EQ(prt_c_check_glossy(msg, sizeof msg), 0) << msg;
+}
+
+TEST(CApi, BakedLightsPunctualAndLtc) {
+  char msg[512] = "";
+  EXPECT_EQ(prt_c_check_lights(msg, sizeof msg), 0) << msg;
 }
 
 } // namespace

@@ -262,3 +262,68 @@ TEST(AreaLightRender, TheSameBytesForAnyThreadCount) {
 }
 
 } // namespace
+
+namespace {
+
+// Whether the segment p → q meets the box [−0.4, 0.3] × [−0.3, 0.4] × [0, 0.8] of Scene, with a
+// margin (negative: the box shrunk).
+bool meets_box(const Vector3d& p, const Vector3d& q, double margin) {
+  const Vector3d lo(-0.4 - margin, -0.3 - margin, 0 - margin), hi(0.3 + margin, 0.4 + margin, 0.8 + margin);
+  double t0 = 0, t1 = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double d = q[k] - p[k];
+    if (d == 0) {
+      if (p[k] < lo[k] || p[k] > hi[k]) return false;
+      continue;
+    }
+    double a = (lo[k] - p[k]) / d, b = (hi[k] - p[k]) / d;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a), t1 = std::min(t1, b);
+  }
+  return t0 <= t1;
+}
+
+} // namespace
+
+TEST(AreaLightRender, PunctualLightsArePerPixelClosedFormsWithHardShadowsInBothRenders) {
+  // A point light alone (no area light) over Scene's ground and box: each ground pixel is
+  // albedo/π · I · cos/d² at its shading point, or 0 where the box hides the light (pixels within
+  // 0.01 of the shadow's edge left out); the reference adds the same exact term.
+  const Scene s;
+  const view::GBuffer g = view::rasterize(s.mesh, s.camera);
+  bake::PunctualLight bulb;
+  bulb.name = "bulb";
+  bulb.kind = bake::PunctualKind::Point;
+  bulb.position = Vector3d(0.6, 0.5, 1.5);
+  bulb.intensity = {2, 3, 4};
+  view::AreaRenderOptions o;
+  o.punctual = {bulb};
+  const view::Image img = view::render_area_analytic(s.mesh, g, {}, o);
+  view::AreaReferenceOptions ro;
+  ro.samples = 8;
+  ro.render = o;
+  const view::AreaReferenceImage ref = view::render_area_reference(s.mesh, g, {}, ro);
+  const double eps = view::area_shading_offset(s.mesh);
+  size_t lit = 0, shadowed = 0;
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const int32_t t = g.triangle[size_t(y) * size_t(g.width) + size_t(x)];
+      if (t < 0) continue;
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(img.at(x, y)[c], ref.radiance.at(x, y)[c]) << x << "," << y;
+      const view::Fragment f = view::make_fragment(s.mesh, g, x, y);
+      if (std::abs(f.ng.z() - 1) > 1e-9 || f.p.z() != 0) continue;  // the ground only
+      const Vector3d p = f.p + eps * f.ng, to = bulb.position - p;
+      if (meets_box(p, bulb.position, 0.01)) {
+        if (meets_box(p, bulb.position, -0.01)) {
+          EXPECT_EQ(img.at(x, y)[0], 0.0f) << x << "," << y;
+          ++shadowed;
+        }
+        continue;
+      }
+      const double e = f.n.dot(to.normalized()) / to.squaredNorm();
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.at(x, y)[c], bulb.intensity[size_t(c)] * e / std::numbers::pi, 1e-6) << x << "," << y;
+      ++lit;
+    }
+  EXPECT_GT(lit, 200u);
+  EXPECT_GT(shadowed, 10u);
+}

@@ -206,13 +206,27 @@ F::Light light_of(const bake::AreaLight& light) {
   return l;
 }
 
+F::Light light_of(const bake::PunctualLight& light) {
+  F::Light l;
+  l.name = light.name;
+  l.shape = bake::punctual_kind_name(light.kind);
+  l.radiance = light.intensity;
+  const Eigen::Vector3d d = light.direction.normalized();
+  if (light.kind != bake::PunctualKind::Directional)
+    l.position = std::vector<double>{light.position.x(), light.position.y(), light.position.z()};
+  if (light.kind != bake::PunctualKind::Point) l.direction = std::vector<double>{d.x(), d.y(), d.z()};
+  if (light.kind == bake::PunctualKind::Spot) {
+    l.inner_cone_angle = light.inner_cone;
+    l.outer_cone_angle = light.outer_cone;
+  }
+  return l;
+}
+
 namespace {
 // area_lights/irradiance and, when sh_order > 0, area_lights/sh from rows [..][lights][1 + n²].
 void area_products(std::optional<F::Product>& irradiance, std::optional<F::Product>& sh, std::span<const double> rows,
-                   const std::vector<bake::AreaLight>& lights, int sh_order) {
+                   const std::vector<std::string>& names, int sh_order) {
   const size_t n2 = size_t(sh_order) * size_t(sh_order), per_light = 1 + n2;
-  std::vector<std::string> names;
-  for (const bake::AreaLight& l : lights) names.push_back(l.name);
   auto product = [&](size_t offset, size_t count, std::string integrand) {
     F::Product p;
     p.values.reserve(rows.size() / per_light * count);
@@ -233,12 +247,12 @@ void area_products(std::optional<F::Product>& irradiance, std::optional<F::Produ
 }
 } // namespace
 
-void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
+void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<std::string>& lights,
                      int sh_order) {
   area_products(set.area_irradiance, set.area_sh, rows, lights, sh_order);
 }
 
-void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<bake::AreaLight>& lights,
+void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<std::string>& lights,
                               int sh_order) {
   PRT_CHECK(set.lightmap.has_value());
   PRT_CHECK_OP(image.width, ==, set.lightmap->width);

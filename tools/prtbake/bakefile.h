@@ -13,6 +13,7 @@
 #include <bake/bake/vertex_bake.h>
 #include <bake/environment/envmap.h>
 #include <bake/lights/lights.h>
+#include <bake/lights/punctual.h>
 #include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 
@@ -54,7 +55,7 @@ void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& 
 
 // area_lights/irradiance and /sh per texel (lightmap/area_lights/...) from the lightmap image of
 // the area lights' rows (channels [lights][1 + n²]), into a set whose lightmap set_lightmap wrote.
-void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<bake::AreaLight>& lights,
+void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<std::string>& lights,
                               int sh_order);
 
 // The lightmap image of the valid texels' rows of `texels` (LightmapReceivers::image: placed,
@@ -66,9 +67,12 @@ bake::Lightmap lightmap_image(const bake::Mesh& mesh, const bake::Topology& topo
 
 // An area light as the file stores it (/lights/<name>: world-space faces, radiance, two_sided).
 F::Light light_of(const bake::AreaLight& light);
+// A punctual light as the file stores it (v6: /lights/<name> attributes: shape, its intensity as
+// `radiance`, position, direction, the spot's cone angles in radians).
+F::Light light_of(const bake::PunctualLight& light);
 // area_lights/irradiance [V][lights] and, when sh_order > 0, area_lights/sh [V][lights][n²] from
 // AreaLightIntegrator rows ([V][lights][1 + n²], bake/lights/area_bake.h); `lights` in column order.
-void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<bake::AreaLight>& lights,
+void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<std::string>& lights,
                      int sh_order);
 
 // The error report of a vertex bake: one row per product (rmse, max_abs, reference_rms,

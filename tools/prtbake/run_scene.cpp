@@ -48,6 +48,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   std::vector<std::string> warnings;
   const std::vector<bake::Mesh> meshes = bake::load_scene_meshes(scene, warnings);
   print_warnings(warnings);
+  bake::place_suns(scene, meshes);  // directional lights with an "angle": sun discs beyond the scene
   std::optional<bake::EnvMap> env;
   if (scene.environment) env = bake::EnvMap::load(*scene.environment, scene.up);
   const bake::ScenePlan plan = bake::plan_scene(scene, meshes);
@@ -101,6 +102,9 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
     for (const auto& l : scene.lights)
       std::printf("  light %s (%s): %zu face(s), radiance %g %g %g%s\n", l.name.c_str(), bake::light_shape_name(l.shape),
                   l.faces.size(), l.radiance[0], l.radiance[1], l.radiance[2], l.two_sided ? ", two-sided" : "");
+    for (const auto& l : scene.punctual_lights)
+      std::printf("  light %s (%s): intensity %g %g %g, hard shadows\n", l.name.c_str(), bake::punctual_kind_name(l.kind),
+                  l.intensity[0], l.intensity[1], l.intensity[2]);
     for (const auto& n : plan.notes) std::printf("  %s\n", n.c_str());
     std::fflush(stdout);
   }
@@ -173,7 +177,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
       if (ob.area) {
         // The area lights' rows per valid texel, filled, padded and stitched as the products are.
         bake::VertexBake area;
-        area.layout.width = scene.lights.size() * (1 + size_t(plan.objects[i].area_sh_order * plan.objects[i].area_sh_order));
+        area.layout.width = scene.light_count() * (1 + size_t(plan.objects[i].area_sh_order * plan.objects[i].area_sh_order));
         area.values = *ob.area;
         bake::SeamStitch area_seams;
         area_images[i] = lightmap_image(meshes[i], topology, *ob.lightmap, *scene.objects[i].lightmap, area, area_seams);
@@ -280,9 +284,9 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                             result.bounce_relative_std_error);
       }
       if (ob.area && ob.lightmap && area_images[i])
-        tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.lights, p.area_sh_order);
+        tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.light_names(), p.area_sh_order);
       else if (ob.area)
-        tool::set_area_lights(obj.set, *ob.area, scene.lights, p.area_sh_order);
+        tool::set_area_lights(obj.set, *ob.area, scene.light_names(), p.area_sh_order);
       if (ob.bounced_area) {
         bake::BounceSpec spec;
         spec.bounces = scene.bounces;
@@ -298,6 +302,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
       }
     }
     for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));
+    for (const bake::PunctualLight& light : scene.punctual_lights) asset.lights.push_back(tool::light_of(light));
     if (plan.fiv_environment)
       tool::set_fiv_environment(asset, env->info(), env_path, result.environment_fiv, result.irradiance_cube, scene.fiv.cube);
     tool::set_target_error(asset, scene.target_error);

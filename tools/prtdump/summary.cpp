@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <numbers>
 #include <optional>
 #include <tuple>
 #include <vector>
@@ -49,13 +50,30 @@ void scene_text(std::ostream& os, const pf::Asset& a) {
 // The area lights, and the irradiance each gives every vertex set that receives them.
 void lights_text(std::ostream& os, const pf::Asset& a) {
   if (a.lights.empty()) return;
-  os << "\nArea lights (world space; E at unit radiance per vertex set: min, max, mean)\n";
+  const bool punctual = std::any_of(a.lights.begin(), a.lights.end(), [](const pf::Light& l) { return pf::names::is_punctual_shape(l.shape); });
+  os << (punctual ? "\nLights (world space; E at unit radiance or intensity per vertex set: min, max, mean)\n"
+                  : "\nArea lights (world space; E at unit radiance per vertex set: min, max, mean)\n");
   std::size_t w = 0;
   for (const pf::Light& l : a.lights) w = std::max(w, l.name.size());
-  for (const pf::Light& l : a.lights)
+  auto vec = [](const std::optional<std::vector<double>>& v) {
+    return v && v->size() == 3 ? "[" + num((*v)[0]) + ", " + num((*v)[1]) + ", " + num((*v)[2]) + "]" : std::string("-");
+  };
+  for (const pf::Light& l : a.lights) {
+    if (pf::names::is_punctual_shape(l.shape)) {
+      os << "  " << pad(l.name, w + 2) << l.shape << ", intensity [" << num(l.radiance[0]) << ", " << num(l.radiance[1])
+         << ", " << num(l.radiance[2]) << "]";
+      if (l.position) os << ", position " << vec(l.position);
+      if (l.direction) os << ", direction " << vec(l.direction);
+      if (l.inner_cone_angle && l.outer_cone_angle)
+        os << ", cone " << num(float(*l.inner_cone_angle * 180 / std::numbers::pi)) << " to "
+           << num(float(*l.outer_cone_angle * 180 / std::numbers::pi)) << " degrees";
+      os << ", hard shadows\n";
+      continue;
+    }
     os << "  " << pad(l.name, w + 2) << l.shape << ", " << l.face_sizes.values.size() << " face(s), "
        << l.vertices.values.size() / 3 << " vertices, radiance [" << num(l.radiance[0]) << ", " << num(l.radiance[1])
        << ", " << num(l.radiance[2]) << "], " << (l.two_sided.value_or(0) ? "two-sided" : "one-sided") << '\n';
+  }
   auto set_lines = [&](const std::string& where, const pf::VertexSet& set) {
     if (!set.area_irradiance || !set.area_irradiance->lights) return;
     const std::vector<std::string> order = pf::split_light_list(*set.area_irradiance->lights);

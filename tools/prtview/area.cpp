@@ -37,6 +37,7 @@ std::vector<bake::AreaLight> read_area_lights(const F::Asset& f, const std::stri
   if (f.lights.empty()) throw InputError(file, "has no area lights (" + std::string(N::kLights) + "): nothing for --shade area to draw");
   std::vector<bake::AreaLight> out;
   for (const F::Light& l : f.lights) {  // the schema check has bounded the indices and sizes
+    if (N::is_punctual_shape(l.shape)) continue;  // no geometry: drawn from their baked E only
     bake::AreaLight a;
     a.name = l.name;
     a.shape = shape_of(l, file);
@@ -55,6 +56,23 @@ std::vector<bake::AreaLight> read_area_lights(const F::Asset& f, const std::stri
   return out;
 }
 
+std::vector<bake::PunctualLight> read_punctual_lights(const F::Asset& f) {
+  std::vector<bake::PunctualLight> out;
+  for (const F::Light& l : f.lights) {  // the schema check has checked their attributes
+    if (!N::is_punctual_shape(l.shape)) continue;
+    bake::PunctualLight p;
+    p.name = l.name;
+    p.kind = l.shape == "point" ? bake::PunctualKind::Point : l.shape == "spot" ? bake::PunctualKind::Spot : bake::PunctualKind::Directional;
+    if (l.position) p.position = Eigen::Vector3d((*l.position)[0], (*l.position)[1], (*l.position)[2]);
+    if (l.direction) p.direction = Eigen::Vector3d((*l.direction)[0], (*l.direction)[1], (*l.direction)[2]).normalized();
+    p.intensity = l.radiance;
+    p.inner_cone = l.inner_cone_angle.value_or(0);
+    p.outer_cone = l.outer_cone_angle.value_or(p.outer_cone);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 view::Image render_area_file(const F::Asset& f, const std::string& file, const std::vector<bake::AreaLight>& lights, bool exact,
                              const view::Camera& cam, RenderScene& scene, view::AreaRenderOptions& options) {
   std::vector<SceneObject> objects = read_scene_objects(f, file, nullptr);
@@ -67,15 +85,16 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
   struct TexelE {
     size_t object = 0;  // index in `objects`
     const F::VertexSet* set = nullptr;
-    std::vector<const bake::AreaLight*> column;
+    std::vector<const F::Light*> column;
   };
   std::vector<TexelE> texel_objects;
-  // Column l of E is the light named on line l of its `lights` attribute.
+  // Column l of E is the light named on line l of its `lights` attribute: an area light or a
+  // punctual one (its `radiance` is its intensity: E scales the same way).
   auto columns = [&](const SceneObject& o, const F::Product& e, std::string_view path) {
-    std::vector<const bake::AreaLight*> column;
+    std::vector<const F::Light*> column;
     for (const std::string& n : F::split_light_list(e.lights.value_or(""))) {
-      const auto it = std::find_if(lights.begin(), lights.end(), [&](const bake::AreaLight& l) { return l.name == n; });
-      if (it == lights.end())
+      const auto it = std::find_if(f.lights.begin(), f.lights.end(), [&](const F::Light& l) { return l.name == n; });
+      if (it == f.lights.end())
         throw InputError(file, "object '" + o.name + "': " + std::string(path).substr(1) + " names light '" + n + "', which " +
                                    std::string(N::kLights) + " does not hold");
       column.push_back(&*it);
@@ -97,7 +116,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
       continue;
     }
     if (e) {
-      const std::vector<const bake::AreaLight*> column = columns(o, *e, N::kAreaIrradiance);
+      const std::vector<const F::Light*> column = columns(o, *e, N::kAreaIrradiance);
       const size_t L = column.size();
       for (size_t v = 0; v < V; ++v) {
         float value[3];
@@ -130,6 +149,7 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
                     : "baked E per light x its stored radiance x albedo / pi per vertex, interpolated, or per texel through "
                       "the object's lightmap (" + std::to_string(baked) + " objects); objects without it per pixel, exactly";
   options.casts_shadow = scene.casts_shadow;
+  options.punctual = read_punctual_lights(f);
   options.triangle_albedo = scene.albedo;
   if (options.ggx) {
     options.ggx->eye -= scene.mesh.origin;
@@ -140,13 +160,17 @@ view::Image render_area_file(const F::Asset& f, const std::string& file, const s
 
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   const bool any_per_pixel = std::find(per_pixel.begin(), per_pixel.end(), 1) != per_pixel.end();
+  // Per pixel, exactly: the area lights' closed forms and the punctual lights' shadow rays
+  // (AreaRenderOptions::punctual, read from the file's /lights above).
   view::Image analytic;
   if (exact || any_per_pixel) analytic = view::render_area_analytic(scene.mesh, g, lights, options);
   if (exact) return analytic;
   view::Image img = view::interpolate_vertices(scene.mesh, g, rgb);
   for (size_t i = 0; i < g.triangle.size(); ++i)
-    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1)
-      std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+    if (g.triangle[i] >= 0 && per_pixel[size_t(g.triangle[i])] == 1) {
+      if (analytic.rgb.empty()) std::fill_n(img.rgb.begin() + std::ptrdiff_t(3 * i), 3, 0.0f);
+      else std::copy_n(analytic.rgb.begin() + std::ptrdiff_t(3 * i), 3, img.rgb.begin() + std::ptrdiff_t(3 * i));
+    }
   // Per texel: E per light sampled bilinearly through the object's mesh/uv (view/lightmap.h),
   // times each light's radiance and the albedo / pi; one pass over the pixels.
   if (texel_objects.empty()) return img;

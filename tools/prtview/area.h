@@ -20,6 +20,7 @@
 #include <view/image.h>
 
 #include <bake/lights/lights.h>
+#include <bake/lights/punctual.h>
 #include <formats/asset.h>
 
 #include <string>
@@ -30,6 +31,9 @@ namespace prt::prtview {
 // The file's /lights as the bake saw them (world space), sorted by name; an InputError naming the
 // file when it has none or one is malformed.
 std::vector<bake::AreaLight> read_area_lights(const formats::Asset& f, const std::string& file);
+// The file's punctual lights (/lights/<name> of shape point, spot, directional), for the per-pixel
+// renders (view::AreaRenderOptions::punctual).
+std::vector<bake::PunctualLight> read_punctual_lights(const formats::Asset& f);
 
 // Fills `scene` (mesh, receivers, casters, albedo, objects) and returns the runtime picture.
 // `exact`: area-exact (above), else area. `options` gets the casters and albedos for the reference;

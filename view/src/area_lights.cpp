@@ -2,6 +2,7 @@
 
 #include <bake/core/error.h>
 #include <bake/lights/area_bake.h>
+#include <bake/lights/punctual.h>
 #include <bake/sphere/sampling.h>
 #include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/contour.h>
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 namespace prt::view {
@@ -76,7 +78,7 @@ struct LightSurface {
 };
 
 void check_inputs(const bake::Mesh& mesh, std::span<const bake::AreaLight> lights, const AreaRenderOptions& o) {
-  PRT_CHECK(!lights.empty());
+  PRT_CHECK(!lights.empty() || !o.punctual.empty());
   for (const auto& l : lights) PRT_CHECK(!l.faces.empty());
   PRT_CHECK(o.casts_shadow.empty() || o.casts_shadow.size() == mesh.triangles.size());
   PRT_CHECK(o.triangle_albedo.empty() || o.triangle_albedo.size() == mesh.triangles.size());
@@ -143,6 +145,36 @@ Image render_glossy_analytic(const bake::Mesh& mesh, const bake::Mesh& blockers,
   });
 }
 
+// Adds the punctual lights' radiance (AreaRenderOptions::punctual) to `img`, per covered pixel.
+void add_punctual(const bake::Mesh& mesh, const bake::Mesh& blockers, const GBuffer& g, const AreaRenderOptions& o,
+                  double epsilon, Image& img) {
+  if (o.punctual.empty()) return;
+  const bake::Topology topology = bake::build_topology(blockers);
+  std::optional<bake::RayCaster> rays;
+  if (!blockers.triangles.empty()) rays.emplace(blockers, topology);
+  const bake::PunctualLightIntegrator integ(o.punctual, rays ? &*rays : nullptr, mesh.origin, 0);
+  const Image extra = shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
+    const bake::ShadePoint sp = shading_point(f, epsilon);
+    const Vector3d v = o.ggx ? view_direction(*o.ggx, sp.p) : Vector3d::Zero();
+    std::array<double, 3> rgb{};
+    for (size_t k = 0; k < o.punctual.size(); ++k) {
+      Vector3d l;
+      const double w = integ.direction_to(sp, k, l), cosine = sp.n.dot(l);
+      if (!(w > 0) || !(cosine > 0) || !integ.visible(sp, k, l)) continue;
+      const double e = w * cosine;
+      for (size_t c = 0; c < 3; ++c) {
+        double value = albedo_of(f, o, c) * e * std::numbers::inv_pi;
+        if (o.ggx)
+          value += ltc::ggx_brdf({sp.n.x(), sp.n.y(), sp.n.z()}, {v.x(), v.y(), v.z()}, {l.x(), l.y(), l.z()}, o.ggx->alpha,
+                                 o.ggx->f0[c]) * e;
+        rgb[c] += o.punctual[k].intensity[c] * value;
+      }
+    }
+    for (size_t c = 0; c < 3; ++c) out[c] = float(rgb[c]);
+  });
+  for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] += extra.rgb[i];
+}
+
 } // namespace
 
 double area_shading_offset(const bake::Mesh& mesh) {
@@ -160,11 +192,15 @@ Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<c
   check_inputs(mesh, lights, options);
   const bake::Mesh blockers = casters(mesh, options);
   const double epsilon = area_shading_offset(mesh);
-  if (options.ggx) return render_glossy_analytic(mesh, blockers, g, lights, options, epsilon);
+  if (options.ggx) {
+    Image img = render_glossy_analytic(mesh, blockers, g, lights, options, epsilon);
+    add_punctual(mesh, blockers, g, options, epsilon, img);
+    return img;
+  }
   const bake::AreaLightIntegrator integrator(lights, blockers, 0);
   tbb::enumerable_thread_specific<bake::AreaLightIntegrator::Workspace> workspaces;
   tbb::enumerable_thread_specific<std::vector<double>> rows([&] { return std::vector<double>(integrator.width()); });
-  return shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
+  Image img = shade_pixels(mesh, g, [&](const Fragment& f, float* out) {
     std::vector<double>& row = rows.local();
     integrator.integrate(shading_point(f, epsilon), row, workspaces.local());
     for (size_t c = 0; c < 3; ++c) {
@@ -173,6 +209,8 @@ Image render_area_analytic(const bake::Mesh& mesh, const GBuffer& g, std::span<c
       out[c] = float(albedo_of(f, options, c) * v * std::numbers::inv_pi);
     }
   });
+  add_punctual(mesh, blockers, g, options, epsilon, img);
+  return img;
 }
 
 AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& g, std::span<const bake::AreaLight> lights,
@@ -317,6 +355,7 @@ AreaReferenceImage render_area_reference(const bake::Mesh& mesh, const GBuffer& 
       }
     }
   });
+  add_punctual(mesh, blockers, g, options.render, epsilon, out.radiance);  // exact: no sampling error
   return out;
 }
 

@@ -47,7 +47,7 @@ template <class T> struct Array {
 // The root attributes (all required except the extras; format/format_version are the writer's).
 struct RootInfo {
   // As read. write_asset ignores it and writes written_format_version (prtfile.h): 5 for an asset
-  // with a lightmap or UV set, else 4, so a round trip keeps it only when it is that version.
+  // with a lightmap or UV set, 6 with a punctual light, else 4, so a round trip keeps it only when it is that version.
   int64_t format_version = kFormatVersion;
   std::string generator, created, command_line, source, source_sha256, up_axis, sh_convention;
   ExtraAttrs extra;
@@ -209,12 +209,20 @@ struct Occluder {
 // (solids: outwards), as face_sizes [F] and face_indices [sum of sizes] into vertices [N][3]
 // (float64: far from the origin a light keeps its digits); RGB radiance, constant over the
 // surface; two_sided: planar lights emitting from both sides.
+//
+// Punctual lights (v6): shape "point", "spot" or "directional", no geometry datasets; `radiance`
+// holds their intensity per channel (candela; lux for directional), the factor their E columns
+// are multiplied by exactly as an area light's radiance is (so a runtime shades every light
+// alike: albedo/π · Σ_l radiance_l · E_l); position (point, spot), direction (spot,
+// directional: unit, where the light travels), the spot's cone angles in radians.
 struct Light {
   std::string name;
-  std::string shape;  // "quad", "polygon", "disc", "box", "cylinder", "sphere"
+  std::string shape;  // "quad", "polygon", "disc", "box", "cylinder", "sphere"; "point", "spot", "directional"
   std::array<double, 3> radiance{};
-  std::optional<int64_t> two_sided;  // 0 / 1; required by the schema
-  Array<double> vertices;            // [N][3]
+  std::optional<int64_t> two_sided;  // 0 / 1; required by the schema for area lights
+  std::optional<std::vector<double>> position, direction;    // punctual lights: 3 doubles each
+  std::optional<double> inner_cone_angle, outer_cone_angle;  // spot lights
+  Array<double> vertices;            // [N][3]; area lights
   Array<uint32_t> face_sizes, face_indices;
   ExtraAttrs extra;  // of the group
   bool operator==(const Light&) const = default;

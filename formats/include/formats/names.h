@@ -108,6 +108,18 @@ inline constexpr std::string_view kShape = "shape";          // /lights/<name>: 
 inline constexpr std::string_view kRadiance = "radiance";    // /lights/<name>: RGB, 3 doubles >= 0
 inline constexpr std::string_view kTwoSided = "two_sided";   // /lights/<name>: 0 / 1
 inline constexpr std::string_view kLightOrder = "lights";    // area_lights/*: the lights' names, one per line, in column order
+// ---- punctual-light attributes (v6: /lights/<name> of shape "point", "spot", "directional"; no datasets) ----
+inline constexpr std::string_view kPosition = "position";                // point, spot: 3 doubles, world space
+inline constexpr std::string_view kDirection = "direction";              // spot, directional: unit, where the light travels
+inline constexpr std::string_view kInnerConeAngle = "inner_cone_angle";  // spot: radians
+inline constexpr std::string_view kOuterConeAngle = "outer_cone_angle";  // spot: radians, > inner, <= pi/2
+// The shapes of punctual lights.
+inline constexpr std::string_view kPunctualShapes[] = {"point", "spot", "directional"};
+inline bool is_punctual_shape(std::string_view shape) {
+  for (std::string_view s : kPunctualShapes)
+    if (s == shape) return true;
+  return false;
+}
 
 // ---- report attributes ----
 inline constexpr std::string_view kColumns = "columns";

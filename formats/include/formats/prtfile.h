@@ -86,10 +86,13 @@
 namespace prt::formats {
 
 // The newest schema version this library reads, and the one it writes for a file that holds a
-// version-5 dataset (written_format_version; policy: SCHEMA.md "Versioning"). 5 added lightmaps
-// (/mesh/uv, /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights (/lights,
-// area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 5;
+// punctual light (written_format_version; policy: SCHEMA.md "Versioning"). 6 added punctual
+// lights (/lights/<name> of shape point, spot or directional: attributes, no geometry); 5
+// lightmaps (/mesh/uv, /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights
+// (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
+inline constexpr int kFormatVersion = 6;
+// The version written for a file with a lightmap and no punctual light.
+inline constexpr int kFormatVersionWithLightmaps = 5;
 // The version written for a file without any version-5 dataset: such a file is byte for byte
 // what this library wrote before version 5 existed, and version-4 readers open it.
 inline constexpr int kFormatVersionWithoutLightmaps = 4;
@@ -169,8 +172,9 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersion when a dataset of it is of a
-// version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
+// The format_version write_file gives `file`: kFormatVersion when it holds a punctual light (a
+// /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps when a
+// dataset of it is of a version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
 int64_t written_format_version(const File& file);
 
 // Lookups; nullptr when absent.

@@ -6,6 +6,8 @@
 #include <bake/bake/bounce.h>
 #include <bake/core/error.h>
 #include <bake/lights/area_bake.h>
+#include <bake/lights/punctual.h>
+#include <bake/visibility/raycast.h>
 
 #include <tbb/global_control.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -49,16 +51,21 @@ std::string rows_noun_of(const BakeJob& job) {
   return job.sets.empty() ? "rows" : job.sets.front().rows_noun;
 }
 
-// The area lights' rows of every point ([point][integ.width()]) through the row loop
-// (bake/bake/vertex_bake.h); each row depends on its point only, so any thread count gives the
-// same numbers.
-std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const AreaLightIntegrator& integ,
-                                     const Monitor& monitor, const std::string& label) {
+// The lights' rows of every point ([point][area.width() + punctual.width()]: the area lights'
+// columns, then the punctual lights') through the row loop (bake/bake/vertex_bake.h); each row
+// depends on its point only, so any thread count gives the same numbers.
+std::vector<double> bake_area_lights(std::span<const ShadePoint> points, const AreaLightIntegrator& area,
+                                     const PunctualLightIntegrator& punctual, const Monitor& monitor,
+                                     const std::string& label) {
   tbb::enumerable_thread_specific<AreaLightIntegrator::Workspace> workspaces;
+  const size_t split = area.width();
   VertexBake rows = bake_rows(
-      0, points.size(), integ.width(),
-      [&](size_t v, std::span<double> values, std::span<double>) { integ.integrate(points[v], values, workspaces.local()); },
-      monitor, label, "the area lights (" + label + ")");
+      0, points.size(), split + punctual.width(),
+      [&](size_t v, std::span<double> values, std::span<double>) {
+        area.integrate(points[v], values.first(split), workspaces.local());
+        punctual.integrate(points[v], values.subspan(split));
+      },
+      monitor, label, "the lights (" + label + ")");
   return std::move(rows.values);
 }
 
@@ -69,6 +76,8 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
                      const OnChoice& on_choice) {
   PRT_CHECK_OP(meshes.size(), ==, scene.objects.size());
   PRT_CHECK_OP(plan.objects.size(), ==, scene.objects.size());
+  for (const PunctualLight& l : scene.punctual_lights)
+    PRT_CHECK(l.angular_diameter == 0);  // a sun with an angle is an area light: place_suns first
   SceneBake out;
   out.objects.resize(scene.objects.size());
   const auto t_setup = std::chrono::steady_clock::now();
@@ -261,9 +270,14 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   // ---- area lights: exact, no choice or check; the receivers' shade points through the row loop ----
   // One integrator per SH order the receivers need (the lights moved into the occluders' frame once).
   std::map<int, std::unique_ptr<AreaLightIntegrator>> area_integrators;
+  std::map<int, std::unique_ptr<PunctualLightIntegrator>> punctual_integrators;
+  const RayCaster* shadow_rays = occluders.triangles.empty() ? nullptr : accel.rays().get();
   for (const ObjectPlan& p : plan.objects)
-    if (p.receiver && p.area_irradiance && !area_integrators.count(p.area_sh_order))
+    if (p.receiver && p.area_irradiance && !area_integrators.count(p.area_sh_order)) {
       area_integrators.emplace(p.area_sh_order, std::make_unique<AreaLightIntegrator>(scene.lights, occluders, p.area_sh_order));
+      punctual_integrators.emplace(p.area_sh_order, std::make_unique<PunctualLightIntegrator>(
+                                                        scene.punctual_lights, shadow_rays, occluders.origin, p.area_sh_order));
+    }
   out.setup_seconds = seconds_since(t_setup);
   for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i) {
     const ObjectPlan& p = plan.objects[i];
@@ -272,14 +286,18 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     // Per texel for an object with a lightmap (its valid texels' rows, as its other products').
     const ReceiverSet set = !p.texels ? receivers_of(i) : ob.lightmap ? ob.lightmap->receivers() : texels_of(i);
     const auto t0 = std::chrono::steady_clock::now();
-    ob.area = bake_area_lights(set.points, *area_integrators.at(p.area_sh_order), monitor, "area lights on " + set.name);
+    ob.area = bake_area_lights(set.points, *area_integrators.at(p.area_sh_order), *punctual_integrators.at(p.area_sh_order),
+                               monitor, "lights on " + set.name);
     ob.area_seconds = seconds_since(t0);
     out.area_seconds += ob.area_seconds;
-    log(set.name + ": " + std::to_string(scene.lights.size()) + " area light(s) at " + std::to_string(set.points.size()) +
+    log(set.name + ": " + std::to_string(scene.lights.size()) + " area light(s)" +
+        (scene.punctual_lights.empty() ? std::string() : " and " + std::to_string(scene.punctual_lights.size()) + " punctual") +
+        " at " + std::to_string(set.points.size()) +
         " " + set.rows_noun + " in " + printf_string("%.2f s", ob.area_seconds) +
         (p.area_sh_order > 0 ? ", SH order " + std::to_string(p.area_sh_order) : std::string()));
   }
   area_integrators.clear();
+  punctual_integrators.clear();
 
   // ---- FIV: the environment's, and shells per occluder that needs them ----
   if (plan.fiv_environment && !rows.rows_only) {
@@ -335,7 +353,7 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   // The area lights' direct rows, kept the same way (ObjectBake::area is replaced by the bounced).
   std::vector<std::optional<std::vector<double>>> direct_area(scene.objects.size());
   auto bounce_receivers = [&] {
-    const size_t nl = scene.lights.size();
+    const size_t nl = scene.light_count();
     std::vector<size_t> gatherers;
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectPlan& p = plan.objects[i];

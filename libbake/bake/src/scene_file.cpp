@@ -13,8 +13,10 @@
 #include <cctype>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <set>
+#include <span>
 #include <sstream>
 #include <vector>
 
@@ -261,17 +263,31 @@ Material parse_material(const Reader& r, const Json& m, const std::string& key, 
   return material;
 }
 
-// "lights" (bake/lights/lights.h shapes): every light validated, names unique ("light<i>" by default).
-std::vector<AreaLight> parse_lights(const Reader& r, const Json& v, const std::string& file) {
+constexpr const char* kLightShapes = "quad, polygon, disc, box, cylinder, sphere, point, spot or directional";
+
+// "lights" (bake/lights/lights.h shapes and bake/lights/punctual.h kinds): every light validated,
+// names unique ("light<i>" by default). An error names the light by its index and, when it has
+// one, its name.
+void parse_lights(const Reader& r, const Json& v, const std::string& file, SceneDescription& sc) {
   if (!v.is_array()) r.fail("lights must be an array of light objects");
-  std::vector<AreaLight> out;
+  std::vector<AreaLight>& out = sc.lights;
+  out.clear();
+  sc.punctual_lights.clear();
   std::set<std::string> names;
   for (size_t i = 0; i < v.size(); ++i) {
     const Json& l = v[i];
-    const std::string key = "lights[" + std::to_string(i) + "]";
+    std::string key = "lights[" + std::to_string(i) + "]";
     if (!l.is_object()) r.fail(key + " must be an object, not " + l.type_name());
+    std::string light_name = "light" + std::to_string(i);
+    if (const Json* n = find_key(l, "name")) {
+      light_name = r.string(*n, key + ".name");
+      if (!valid_name(light_name)) r.fail(key + ".name \"" + light_name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
+    }
+    if (!names.insert(light_name).second) r.fail(key + ": the name \"" + light_name + "\" is already used by another light");
+    // How messages name it: its index, and its name when the file gives one.
+    const std::string who = find_key(l, "name") ? key + " (light \"" + light_name + "\")" : key;
     const Json* shape = find_key(l, "shape");
-    if (shape == nullptr) r.fail(key + " lacks \"shape\": quad, polygon, disc, box, cylinder or sphere");
+    if (shape == nullptr) r.fail(who + " lacks \"shape\": " + kLightShapes);
     const std::string& kind = r.string(*shape, key + ".shape");
     auto need = [&](const char* member) -> const Json& {
       const Json* x = find_key(l, member);
@@ -299,17 +315,80 @@ std::vector<AreaLight> parse_lights(const Reader& r, const Json& v, const std::s
       }
       return R;
     };
-    const std::initializer_list<std::string_view> common = {"name", "shape", "radiance", "two_sided"};
+    const bool punctual = kind == "point" || kind == "spot" || kind == "directional";
+    static constexpr std::string_view kAreaKeys[] = {"name", "shape", "radiance", "two_sided"};
+    static constexpr std::string_view kPunctualKeys[] = {"name", "shape", "intensity"};
+    const std::span<const std::string_view> common = punctual ? std::span<const std::string_view>(kPunctualKeys)
+                                                              : std::span<const std::string_view>(kAreaKeys);
     auto allow = [&](std::initializer_list<std::string_view> own) {
-      std::vector<std::string_view> all(common);
+      std::vector<std::string_view> all(common.begin(), common.end());
       all.insert(all.end(), own.begin(), own.end());
       for (const auto& [k, member] : l.items())
         if (std::find(all.begin(), all.end(), k) == all.end()) {
           std::string list;
           for (std::string_view a : all) list += (list.empty() ? "" : ", ") + std::string(a);
-          r.fail("unknown key \"" + k + "\" in " + key + " (a " + kind + " light takes " + list + ")");
+          r.fail("unknown key \"" + k + "\" in " + who + " (a " + kind + " light takes " + list + ")");
         }
     };
+    auto degrees = [&](const char* member, double fallback, double lo, double hi) {
+      const Json* x = find_key(l, member);
+      const double deg = x ? r.number(*x, key + "." + member, -kHuge, kHuge) : fallback;
+      if (!(deg >= lo && deg <= hi)) {
+        std::ostringstream os;
+        os << who << ": " << member << " must be in [" << lo << ", " << hi << "] degrees, got " << deg;
+        r.fail(os.str());
+      }
+      return deg * (std::numbers::pi / 180);
+    };
+    if (punctual) {
+      PunctualLight p;
+      p.name = light_name;
+      const auto intensity = r.vec3(need("intensity"), key + ".intensity", -kHuge, kHuge);
+      for (size_t c = 0; c < 3; ++c)
+        if (!(intensity[c] >= 0))
+          r.fail(who + ": intensity[" + std::to_string(c) + "] must be >= 0 (" +
+                 (kind == "directional" ? "lux" : "candela") + " per channel)");
+      p.intensity = intensity;
+      auto direction = [&] {
+        const Eigen::Vector3d d = point("direction");
+        if (!(d.norm() > 0)) r.fail(who + ": direction must not be zero");
+        return Eigen::Vector3d(d.normalized());
+      };
+      if (kind == "point") {
+        allow({"position", "radius", "subdivisions"});
+        p.kind = PunctualKind::Point;
+        p.position = point("position");
+        if (find_key(l, "radius")) {
+          validate_punctual_light(p, file, who);
+          AreaLight bulb = bulb_light(p, positive("radius"), count("subdivisions", 0, kMaxSphereSubdivisions, 3));
+          validate_light(bulb, file, who);
+          out.push_back(std::move(bulb));
+          continue;
+        }
+        if (find_key(l, "subdivisions")) r.fail(who + ": \"subdivisions\" needs \"radius\" (a sphere light)");
+      } else if (kind == "spot") {
+        allow({"position", "direction", "inner_cone_angle", "outer_cone_angle"});
+        p.kind = PunctualKind::Spot;
+        p.position = point("position");
+        p.direction = direction();
+        p.inner_cone = degrees("inner_cone_angle", 0, 0, 90);
+        p.outer_cone = degrees("outer_cone_angle", 45, 0, 90);
+      } else {
+        allow({"direction", "angle", "segments"});
+        p.kind = PunctualKind::Directional;
+        p.direction = direction();
+        if (find_key(l, "angle")) {
+          p.angular_diameter = degrees("angle", 0, 0, 90);
+          if (!(p.angular_diameter > 0)) r.fail(who + ": angle must be > 0 degrees (the sun's angular diameter)");
+          p.segments = count("segments", kMinSegments, kMaxSegments, 64);
+        } else if (find_key(l, "segments")) {
+          r.fail(who + ": \"segments\" needs \"angle\" (a sun disc)");
+        }
+      }
+      validate_punctual_light(p, file, who);
+      sc.punctual_lights.push_back(std::move(p));
+      continue;
+    }
     AreaLight light;
     if (kind == "quad") {
       allow({"centre", "u", "v"});
@@ -343,20 +422,14 @@ std::vector<AreaLight> parse_lights(const Reader& r, const Json& v, const std::s
       allow({"centre", "radius", "subdivisions"});
       light = make_sphere_light(point("centre"), positive("radius"), count("subdivisions", 0, kMaxSphereSubdivisions, 3));
     } else {
-      r.fail(key + ".shape must be quad, polygon, disc, box, cylinder or sphere, not \"" + kind + "\"");
+      r.fail(key + ".shape must be " + kLightShapes + ", not \"" + kind + "\"");
     }
     light.radiance = r.vec3(need("radiance"), key + ".radiance", 0, kHuge);
     if (const Json* x = find_key(l, "two_sided")) light.two_sided = r.boolean(*x, key + ".two_sided");
-    light.name = "light" + std::to_string(i);
-    if (const Json* n = find_key(l, "name")) {
-      light.name = r.string(*n, key + ".name");
-      if (!valid_name(light.name)) r.fail(key + ".name \"" + light.name + "\" must be 1-128 characters of A-Z a-z 0-9 _ - .");
-    }
-    if (!names.insert(light.name).second) r.fail(key + ": the name \"" + light.name + "\" is already used by another light");
+    light.name = light_name;
     validate_light(light, file, key);
     out.push_back(std::move(light));
   }
-  return out;
 }
 
 SceneDescription load_json_scene(const std::filesystem::path& file) {
@@ -367,7 +440,7 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
   sc.file = file;
   check_version(r, root, "prtbake_scene", "the scene", "scene-file");
   parse_settings(r, root, file, sc);
-  if (const Json* lights = find_key(root, "lights")) sc.lights = parse_lights(r, *lights, file.string());
+  if (const Json* lights = find_key(root, "lights")) parse_lights(r, *lights, file.string(), sc);
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) r.fail("the scene lacks \"objects\" (an array of one or more objects)");
   if (!objects->is_array() || objects->empty()) r.fail("objects must be a non-empty array");
@@ -411,11 +484,81 @@ SceneDescription load_json_scene(const std::filesystem::path& file) {
 }
 
 // A glTF scene (bake/bake/scene.h "glTF scenes"): one object per instance, then the options file.
+// A glTF's KHR_lights_punctual lights (bake/bake/scene.h "glTF scenes"): each instance a punctual
+// light named by the light's name (made a valid name; "light<index>" without one; "_2", "_3", ...
+// when taken), validated; the options' "gltf_lights" give a point light a radius (a sphere light)
+// or a directional light an angle (a sun), or skip one. Appended after the options' own lights.
+void add_gltf_lights(const std::filesystem::path& file, const std::vector<GltfLight>& lights, const Json* extents,
+                     const Reader& r, SceneDescription& sc) {
+  std::set<std::string> names;
+  for (const std::string& n : sc.light_names()) names.insert(n);
+  struct Extent {
+    const Json* value;
+    bool used = false;
+  };
+  std::map<std::string, Extent> given;
+  if (extents != nullptr) {
+    if (!extents->is_object()) r.fail("gltf_lights must be an object {\"<light name>\": {\"radius\": r} | {\"angle\": degrees} | {\"skip\": true}}");
+    for (const auto& [k, v] : extents->items()) given.emplace(k, Extent{&v});
+  }
+  for (const GltfLight& g : lights) {
+    std::string name = g.name.empty() ? "light" + std::to_string(g.index) : g.name;
+    for (char& c : name)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) c = '_';
+    if (name.size() > 120) name.resize(120);
+    if (!valid_name(name)) name = "light" + std::to_string(g.index);
+    const std::string base = name;
+    for (int k = 2; names.count(name); ++k) name = base + "_" + std::to_string(k);
+    names.insert(name);
+    const std::string who = "KHR_lights_punctual light " + std::to_string(g.index) + " \"" + name + "\" (node " + g.node_path + ")";
+    PunctualLight p;
+    p.name = name;
+    p.kind = g.type == "directional" ? PunctualKind::Directional : g.type == "spot" ? PunctualKind::Spot : PunctualKind::Point;
+    p.position = g.position;
+    p.direction = g.direction;
+    for (size_t c = 0; c < 3; ++c) p.intensity[c] = g.color[c] * g.intensity;
+    p.inner_cone = g.inner_cone;
+    p.outer_cone = g.outer_cone;
+    validate_punctual_light(p, file.string(), who);
+    const auto it = given.find(name);
+    if (it != given.end()) {
+      it->second.used = true;
+      const Json& e = *it->second.value;
+      const std::string key = "gltf_lights.\"" + name + "\"";
+      r.object(e, key, {"radius", "subdivisions", "angle", "segments", "skip"});
+      if (const Json* skip = find_key(e, "skip"); skip && r.boolean(*skip, key + ".skip")) continue;
+      if (const Json* radius = find_key(e, "radius")) {
+        if (p.kind != PunctualKind::Point) r.fail(key + ": \"radius\" is for a point light (this is a " + g.type + " light)");
+        const double rad = r.number(*radius, key + ".radius", 0, kHuge);
+        if (!(rad > 0)) r.fail(key + ".radius must be > 0");
+        const Json* sub = find_key(e, "subdivisions");
+        AreaLight bulb = bulb_light(p, rad, sub ? int(r.integer(*sub, key + ".subdivisions", 0, kMaxSphereSubdivisions)) : 3);
+        validate_light(bulb, file.string(), who);
+        sc.lights.push_back(std::move(bulb));
+        continue;
+      }
+      if (const Json* angle = find_key(e, "angle")) {
+        if (p.kind != PunctualKind::Directional) r.fail(key + ": \"angle\" is for a directional light (this is a " + g.type + " light)");
+        const double deg = r.number(*angle, key + ".angle", 0, 90);
+        if (!(deg > 0)) r.fail(key + ".angle must be > 0 degrees (the sun's angular diameter)");
+        p.angular_diameter = deg * (std::numbers::pi / 180);
+        if (const Json* seg = find_key(e, "segments")) p.segments = int(r.integer(*seg, key + ".segments", kMinSegments, kMaxSegments));
+      }
+    }
+    sc.punctual_lights.push_back(std::move(p));
+  }
+  std::string unknown;
+  for (const auto& [k, e] : given)
+    if (!e.used) unknown += (unknown.empty() ? "\"" : ", \"") + k + "\"";
+  if (!unknown.empty()) r.fail("gltf_lights: " + unknown + " names no KHR_lights_punctual light of " + file.string());
+}
+
 SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::optional<std::filesystem::path>& options) {
   SceneDescription sc;
   sc.file = file;
   sc.options = options;
-  for (const MeshInstance& in : load_mesh_instances(file).instances) {
+  MeshInstances instances = load_mesh_instances(file);
+  for (const MeshInstance& in : instances.instances) {
     SceneObject& obj = sc.objects.emplace_back();
     obj.name = in.name;
     std::replace(obj.name.begin(), obj.name.end(), '/', '|');
@@ -427,14 +570,18 @@ SceneDescription load_gltf_scene(const std::filesystem::path& file, const std::o
     if (in.base_color)
       for (size_t c = 0; c < 3; ++c) obj.material.albedo[c] = std::clamp((*in.base_color)[c], 0.0, 1.0);
   }
-  if (!options) return sc;
+  if (!options) {
+    add_gltf_lights(file, instances.lights, nullptr, Reader(file.string()), sc);
+    return sc;
+  }
   const Json root = parse_json_file(*options);
   const Reader r(options->string());
-  r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "lights", "objects"});
+  r.object(root, "the scene options", {"prtbake_gltf_scene", "up", "environment", "bake", "lights", "gltf_lights", "objects"});
   check_version(r, root, "prtbake_gltf_scene", "the scene options", "options-file");
   parse_settings(r, root, *options, sc);
   for (SceneObject& obj : sc.objects) obj.lightmap = sc.lightmap;  // bake.lightmap, unless an entry says otherwise
-  if (const Json* lights = find_key(root, "lights")) sc.lights = parse_lights(r, *lights, options->string());
+  if (const Json* lights = find_key(root, "lights")) parse_lights(r, *lights, options->string(), sc);
+  add_gltf_lights(file, instances.lights, find_key(root, "gltf_lights"), r, sc);
   const Json* objects = find_key(root, "objects");
   if (objects == nullptr) return sc;
   if (!objects->is_object()) r.fail(std::string("objects must be an object {\"<node path>\": {\"role\": ..., \"material\": ...}}, not ") + objects->type_name());

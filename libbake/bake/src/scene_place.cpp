@@ -93,4 +93,36 @@ Mesh place_scene_object(const Mesh& file_mesh, const SceneObject& object, const 
   return m;
 }
 
+std::vector<std::string> SceneDescription::light_names() const {
+  std::vector<std::string> names;
+  for (const AreaLight& l : lights) names.push_back(l.name);
+  for (const PunctualLight& l : punctual_lights) names.push_back(l.name);
+  return names;
+}
+
+void place_suns(SceneDescription& scene, std::span<const Mesh> meshes) {
+  // The ball about the world-space bounds of every mesh (the origin added back in double).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Mesh& m : meshes)
+    for (const Eigen::Vector3f& p : m.positions) {
+      const Eigen::Vector3d w = m.origin + p.cast<double>();
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+  const bool empty = !(lo.x() <= hi.x());
+  const Eigen::Vector3d centre = empty ? Eigen::Vector3d::Zero() : Eigen::Vector3d((lo + hi) / 2);
+  // At least 1 unit: a scene of one flat point still gets a sun beyond it.
+  const double radius = std::max(1.0, empty ? 0.0 : (hi - lo).norm() / 2);
+  std::vector<PunctualLight> rest;
+  for (PunctualLight& l : scene.punctual_lights) {
+    if (l.kind == PunctualKind::Directional && l.angular_diameter > 0) {
+      AreaLight sun = sun_light(l, centre, radius);
+      validate_light(sun, scene.file.string(), "the sun \"" + l.name + "\"");
+      scene.lights.push_back(std::move(sun));
+    } else {
+      rest.push_back(std::move(l));
+    }
+  }
+  scene.punctual_lights = std::move(rest);
+}
+
 } // namespace prt::bake

@@ -148,10 +148,15 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
       if (scene.want_ao) p.ao = true, p.baked.push_back("ao: requested");
       else p.left_out.push_back("ao: not in bake.products");
       const Material& m = o.material;
-      if (!scene.lights.empty()) {
+      if (scene.light_count() > 0) {
         p.area_irradiance = true;
-        p.baked.push_back("area_lights/irradiance: " + std::to_string(scene.lights.size()) +
-                          " area light(s), exact soft shadows (paper 003)");
+        std::string what;
+        if (!scene.lights.empty())
+          what = std::to_string(scene.lights.size()) + " area light(s), exact soft shadows (paper 003)";
+        if (!scene.punctual_lights.empty())
+          what += (what.empty() ? "" : "; ") + std::to_string(scene.punctual_lights.size()) +
+                  " punctual light(s), exact hard shadows (one shadow ray in the vertex limit)";
+        p.baked.push_back("area_lights/irradiance: " + what);
         if (!m.glossy()) p.left_out.push_back("area_lights/sh: no glossy lobe (irradiance is exact for a diffuse receiver)");
       }
       if (m.diffuse()) {
@@ -180,7 +185,7 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
         else if (!env) p.left_out.push_back("radiance/shadowed: the scene has no environment");
         if (!scene.want_transfer) {
           p.left_out.push_back("transfer/visibility: not in bake.products");
-          if (!scene.lights.empty())
+          if (scene.light_count() > 0)
             p.left_out.push_back("area_lights/sh: transfer/visibility is not baked (not in bake.products)");
         }
         if (scene.want_transfer || shadowed) {
@@ -213,7 +218,7 @@ ScenePlan plan_scene(const SceneDescription& scene, std::span<const Mesh> meshes
                               (shadowed ? " (relightable: the lighting may change or rotate; radiance/shadowed "
                                           "serves the fixed environment)"
                                         : ""));
-            if (!scene.lights.empty()) {
+            if (scene.light_count() > 0) {
               p.area_sh_order = L;
               p.baked.push_back("area_lights/sh: order " + std::to_string(L) + ", the glossy lobe's (transfer/visibility)");
             }

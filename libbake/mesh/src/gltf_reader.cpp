@@ -451,6 +451,7 @@ class Reader {
         if (node.skin >= 0) ++skinned_instances_;
         add_mesh(entry.node, world, entry.path, entry.animated);
       }
+      add_light(node, world, entry.path);
       stack.push_back({entry.node, world, true, {}, false});
       push_nodes(node.children, world, name, entry.path, entry.animated);
     }
@@ -461,7 +462,7 @@ class Reader {
                                " point or line primitive instance(s) skipped (only triangles are baked)");
     // KHR_lights_punctual: points, spots and suns have no area, so nothing of them is baked; the
     // user must hear it, not find the lights missing in the engine's shading.
-    if (!model_.lights.empty())
+    if (!model_.lights.empty() && !keep_lights_)
       file_.warnings.push_back(std::to_string(model_.lights.size()) +
                                " punctual light(s) (KHR_lights_punctual) are not baked: they have no area, and "
                                "prtbake bakes the environment's light");
@@ -495,6 +496,43 @@ class Reader {
       }
     }
     return std::move(out_);
+  }
+
+  void keep_lights(bool keep) { keep_lights_ = keep; }
+  const std::vector<GltfLight>& lights() const { return lights_; }
+
+  // A node's KHR_lights_punctual light ({"extensions": {"KHR_lights_punctual": {"light": i}}}),
+  // placed by the node's world transform.
+  void add_light(const tinygltf::Node& node, const Eigen::Matrix4d& world, const std::string& path) {
+    const auto ext = node.extensions.find("KHR_lights_punctual");
+    if (ext == node.extensions.end() || !keep_lights_) return;
+    const tinygltf::Value& v = ext->second;
+    if (!v.IsObject() || !v.Has("light") || !v.Get("light").IsNumber())
+      fail("node " + path + ": KHR_lights_punctual needs \"light\", the index of a light");
+    const double index = v.Get("light").GetNumberAsDouble();
+    if (!(index >= 0 && index < double(model_.lights.size())) || index != std::floor(index))
+      fail("node " + path + " refers to light " + std::to_string(index) + ", which does not exist (" +
+           std::to_string(model_.lights.size()) + " lights)");
+    const tinygltf::Light& l = model_.lights[size_t(index)];
+    GltfLight& out = lights_.emplace_back();
+    out.name = l.name;
+    out.index = size_t(index);
+    out.node_path = path;
+    out.type = l.type;
+    if (l.type != "directional" && l.type != "point" && l.type != "spot")
+      fail("light " + std::to_string(out.index) + " (\"" + l.name + "\"): type \"" + l.type +
+           "\" is not one of KHR_lights_punctual's directional, point, spot");
+    out.position = world.topRightCorner<3, 1>();
+    const Eigen::Vector3d d = world.topLeftCorner<3, 3>() * Eigen::Vector3d(0, 0, -1);
+    out.direction = d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::Zero();
+    if (l.color.size() >= 3) out.color = {l.color[0], l.color[1], l.color[2]};
+    out.intensity = l.intensity;
+    out.inner_cone = l.spot.innerConeAngle;
+    out.outer_cone = l.spot.outerConeAngle;
+    out.range = l.range;
+    if (l.range > 0)
+      file_.warnings.push_back("light " + std::to_string(out.index) + " (\"" + l.name + "\"): its range " + std::to_string(l.range) +
+                               " is not applied (the inverse-square law is baked; a range is a runtime's culling hint)");
   }
 
   std::vector<GltfInstance> read_instances() {
@@ -567,6 +605,8 @@ class Reader {
   const SourceFile& file_;
   Polygons out_;
   std::vector<Instance> instances_;
+  bool keep_lights_ = false;
+  std::vector<GltfLight> lights_;
   // TEXCOORD_n's values by n, one per row of out_ up to the last instance that has the set.
   std::map<int, std::vector<Eigen::Vector2f>> texcoord_rows_;
   bool all_have_normals_ = true;
@@ -656,8 +696,13 @@ Polygons read_gltf(std::string_view bytes, const SourceFile& file) {
   return Reader(parse(bytes, file), file).read();
 }
 
-std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file) {
-  return Reader(parse(bytes, file), file).read_instances();
+std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file, std::vector<GltfLight>* lights) {
+  const tinygltf::Model model = parse(bytes, file);  // the reader keeps a reference to it
+  Reader reader(model, file);
+  reader.keep_lights(lights != nullptr);
+  std::vector<GltfInstance> instances = reader.read_instances();
+  if (lights != nullptr) *lights = reader.lights();
+  return instances;
 }
 
 } // namespace prt::bake::mesh_readers

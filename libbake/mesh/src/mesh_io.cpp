@@ -312,7 +312,7 @@ MeshInstances read_instances(const std::filesystem::path& path, const std::strin
   std::vector<std::string> referenced;
   const FormatEntry gltf{".gltf", mesh_readers::read_gltf, bytes.substr(0, 4) != "glTF"};
   std::vector<mesh_readers::GltfInstance> instances =
-      mesh_readers::read_gltf_instances(reader_bytes(bytes, gltf, file), {path, file, result.warnings, &referenced});
+      mesh_readers::read_gltf_instances(reader_bytes(bytes, gltf, file), {path, file, result.warnings, &referenced}, &result.lights);
   result.source_sha256 = source_digest(bytes, referenced);
   result.warnings = named(file, std::move(result.warnings));
   for (mesh_readers::GltfInstance& in : instances) {

@@ -48,6 +48,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <span>
 
 namespace prt::shade::ltc {
@@ -76,6 +77,12 @@ struct Table {
 
 // The table in prtshade (runtime/src/ltc_ggx_table.cpp, generated).
 const Table& ggx_table();
+
+// The table as the shader mirrors read it (runtime/shaders/lights.inc PRT_LTC_TABLE): floats
+// {n_alpha, n_theta, sqrt_alpha_min, theta_max} then the n_alpha·n_theta·kValuesPerNode values in
+// the table's order, rounded to float once; packed_table_floats(table) of them.
+std::size_t packed_table_floats(const Table& table);
+void pack_table(const Table& table, std::span<float> out);  // out.size() >= packed_table_floats(table)
 
 // D(h) of the file comment at n·h = cos_h.
 double ggx_ndf(double cos_h, double alpha);

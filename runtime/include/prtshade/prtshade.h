@@ -3,7 +3,8 @@
  * It mirrors the C++ core one to one (the core's headers are the contract; docs/ARCHITECTURE.md
  * §2): <prtshade/sh.h> (SH rotation),
  * <prtshade/shade.h> (lat-long projection, transfer · light, band-1 shading) and
- * <prtshade/fiv.h> (paper 004 §4.3 FIV shading). Conventions, units, frames and the papers and
+ * <prtshade/fiv.h> (paper 004 §4.3 FIV shading), <prtshade/lights.h> (the baked lights' E) and
+ * <prtshade/ltc.h> (GGX over a spherical polygon through LTC). Conventions, units, frames and the papers and
  * equations each function implements are stated in those headers; this one states the C
  * contract only.
  *
@@ -147,6 +148,43 @@ prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const
  * case-B factor to the others). */
 prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, const float* positions,
                                       const float* normals, size_t count, int partial, float* out);
+
+/* ---- baked lights (<prtshade/lights.h>) and LTC GGX (<prtshade/ltc.h>) ------------------- */
+
+/* out[v][c] = albedo_c/π · Σ_l emission[l][c] · irradiance[v][l] for `count` receivers:
+ * irradiance [count][lights] (an area_lights/irradiance product: area and punctual lights alike),
+ * emission [lights][3] (each /lights/<name>'s `radiance`: an area light's radiance, a punctual
+ * light's intensity), albedo [3] (albedo_per_receiver 0) or [count][3] (nonzero), out [count][3].
+ * Non-finite or negative emission, or non-finite irradiance, is an invalid argument. */
+prt_status prt_shade_lights(const float* irradiance, size_t count, size_t lights, const float* emission,
+                            const float* albedo, int albedo_per_receiver, float* out);
+
+typedef enum prt_punctual_kind {
+  PRT_PUNCTUAL_DIRECTIONAL = 0,
+  PRT_PUNCTUAL_POINT = 1,
+  PRT_PUNCTUAL_SPOT = 2
+} prt_punctual_kind;
+/* A punctual light as /lights/<name> stores it (radians; direction: where the light travels). */
+typedef struct prt_punctual_light {
+  int kind; /* prt_punctual_kind */
+  float position[3];
+  float direction[3];
+  float inner_cone_angle, outer_cone_angle;
+} prt_punctual_light;
+/* *out = E at (p, n) from the light at unit intensity, unshadowed (KHR_lights_punctual's falloff
+ * and inverse-square law; the baked E where nothing shadows); n unit (to 1e-4). A spot needs
+ * 0 <= inner < outer <= pi/2. */
+prt_status prt_punctual_irradiance(const prt_punctual_light* light, const float p[3], const float n[3], float* out);
+
+/* *out = the LTC approximation of ∫_P f_GGX F (n·ω) dω over the region P bounded by `count` great
+ * arcs arcs[k] = {a_x, a_y, a_z, b_x, b_y, b_z} (world directions from the shade point, the region
+ * on their left, every endpoint above n's horizon; e.g. a light's visible part clipped to the
+ * horizon), at unit n and v (towards the eye, to 1e-4), roughness alpha > 0 (clamped to the
+ * table's range) and Schlick F0 in [0, 1]. Times the light's radiance it is the reflected radiance. */
+prt_status prt_ltc_ggx(const float n[3], const float v[3], float alpha, float f0, const float* arcs, size_t count,
+                       float* out);
+/* *out = the measured bound on |prt_ltc_ggx − ∫_P f F cos| for any region P at (alpha, cos θ_v, F0). */
+prt_status prt_ltc_ggx_error_bound(float alpha, float cos_theta, float f0, float* out);
 
 #ifdef __cplusplus
 } /* extern "C" */

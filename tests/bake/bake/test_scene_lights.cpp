@@ -61,7 +61,7 @@ TEST(SceneLights, EveryShapeParsesWithItsRadianceAndName) {
 TEST(SceneLights, MistakesAreRefusedNamingTheKey) {
   const std::pair<std::string, std::string> cases[] = {
       {R"({"shape": "quad"})", "lights must be an array"},
-      {R"([{"shape": "spot", "radiance": [1, 1, 1]}])", "lights[0].shape must be quad, polygon, disc, box, cylinder or sphere, not \"spot\""},
+      {R"([{"shape": "tube", "radiance": [1, 1, 1]}])", "lights[0].shape must be quad, polygon, disc, box, cylinder, sphere, point, spot or directional, not \"tube\""},
       {R"([{"radiance": [1, 1, 1]}])", "lights[0] lacks \"shape\""},
       {R"([{"shape": "quad", "centre": [0, 1, 0], "u": [1, 0, 0], "v": [0, 0, 1]}])", "lights[0] (quad) lacks \"radiance\""},
       {R"([{"shape": "quad", "centre": [0, 1, 0], "u": [1, 0, 0], "v": [0, 0, 1], "radiance": [1, -1, 1]}])",

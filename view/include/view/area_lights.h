@@ -36,6 +36,7 @@
 #include <view/raster.h>
 
 #include <bake/lights/lights.h>
+#include <bake/lights/punctual.h>
 #include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
@@ -62,6 +63,11 @@ struct AreaRenderOptions {
   // but blocks no light (a bake's "receiver" objects); triangle_albedo[t] replaces `albedo` there.
   std::vector<uint8_t> casts_shadow;
   std::vector<std::array<float, 3>> triangle_albedo;
+  // Punctual lights (bake/lights/punctual.h, world space), added to both renders alike and
+  // exactly (they have no area to sample): intensity · E with its one shadow ray from p'
+  // (PunctualLightIntegrator over the shadow-casting triangles), times the albedo / π, and with
+  // the GGX layer f(v, l) · E.
+  std::vector<bake::PunctualLight> punctual;
 };
 
 // Exact: E per light from the closed forms (above); the glossy layer through LTC.

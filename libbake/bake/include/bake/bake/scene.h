@@ -34,6 +34,13 @@
 //              | "sphere", "centre", "radius", "subdivisions": 3                    (an icosphere)
 //       "radiance": [r,g,b],                     required, ≥ 0, constant over the surface
 //       "two_sided": false                       planar shapes only
+//     } | {                                      or a punctual light (bake/lights/punctual.h), hard shadows:
+//       "shape": "point",  "position",           with "radius": a sphere light (bulb_light; "subdivisions": 3)
+//              | "spot", "position", "direction", "inner_cone_angle": 0, "outer_cone_angle": 45   (degrees)
+//              | "directional", "direction",     where the light travels; with "angle" (degrees, the
+//                                                angular diameter, "segments": 64): a sun disc (sun_light)
+//       "intensity": [r,g,b]                     required, ≥ 0: candela (lux for directional), the
+//                                                factor of its E as an area light's radiance is
 //     } ],                                       (also in a glTF scene's options file)
 //     "objects": [ {                             one or more
 //       "name": "bunny",                         optional: default the mesh file's stem; unique
@@ -69,10 +76,17 @@
 //             [0, 1]; 0.8 grey, as a scene file's default, when it has no material. No glossy
 //             lobe (roughness has no exact Phong counterpart), metallic is ignored, no texture is
 //             decoded (a base colour texture's colours are not applied).
+// LIGHTS: the KHR_lights_punctual lights its default scene's nodes instance (bake/mesh/mesh.h
+// GltfLight: the node's world position and −Z) are punctual lights, intensity = color × intensity,
+// named by the light's name (else "light<index>"; "_2", ... when a name is taken), after the
+// options' own "lights".
 // Optional OPTIONS (a JSON file given with the glTF; `prtbake scene --options`), every member too:
 //   {
 //     "prtbake_gltf_scene": 1,                   required: the options-file version
-//     "up", "environment", "bake":               as in a scene file (relative paths: to the options file)
+//     "up", "environment", "bake", "lights":     as in a scene file (relative paths: to the options file)
+//     "gltf_lights": {"<light name>": {"radius": r, "subdivisions": 3}   a point light as a sphere light
+//                                   | {"angle": degrees, "segments": 64} a directional one as a sun disc
+//                                   | {"skip": true}},                   not baked
 //     "objects": {"<node path or instance name>": {"role": ..., "material": {...}, "moves": true,
 //                                                   "lightmap": {...} | false}}
 //   }
@@ -135,6 +149,7 @@
 #include <bake/environment/envmap.h>
 #include <bake/integrators/integrator.h>
 #include <bake/lights/lights.h>
+#include <bake/lights/punctual.h>
 #include <bake/mesh/mesh.h>
 
 #include <Eigen/Core>
@@ -201,8 +216,22 @@ struct SceneDescription {
   ShellSpec fiv;
   std::optional<LightmapSpec> lightmap;  // bake.lightmap: every object's unless its own says otherwise
   std::vector<AreaLight> lights;  // "lights", in world space (bake/lights/lights.h), validated
+  // "lights" of shape point, spot or directional (bake/lights/punctual.h), validated: exact hard
+  // shadows. A point light with a "radius" is a sphere light in `lights`; a directional light
+  // with an "angle" stays here until place_suns makes it a sun disc in `lights`.
+  std::vector<PunctualLight> punctual_lights;
   std::vector<SceneObject> objects;
+
+  // Every light's name in the light products' column order: `lights`, then `punctual_lights`.
+  std::vector<std::string> light_names() const;
+  size_t light_count() const noexcept { return lights.size() + punctual_lights.size(); }
 };
+
+// The directional lights with an angular size become sun discs (bake/lights/punctual.h
+// sun_light) about the ball that holds the scene's meshes (the world-space meshes of
+// scene.objects: their frame's origin plus their bounds), appended to scene.lights in order.
+// The tools call it once the meshes are loaded, before plan_scene.
+void place_suns(SceneDescription& scene, std::span<const Mesh> meshes);
 
 // Parses and validates a scene file (InputError naming the file and the line and column or the
 // key), or reads a glTF scene and its options file (the "glTF scenes" paragraph above). Options

@@ -28,6 +28,9 @@ struct GltfInstance {
   bool animated = false;  // an animation channel (translation, rotation, scale) targets its node or an ancestor
   Polygons polygons;
 };
-std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file);
+// `lights` (optional): the KHR_lights_punctual lights the default scene's nodes instance
+// (bake/mesh/mesh.h GltfLight), in walk order.
+std::vector<GltfInstance> read_gltf_instances(std::string_view bytes, const SourceFile& file,
+                                              std::vector<GltfLight>* lights = nullptr);
 
 } // namespace prt::bake::mesh_readers

@@ -222,8 +222,24 @@ struct MeshInstance {
   bool animated = false;
   Mesh mesh;
 };
+// A KHR_lights_punctual light as a node of the default scene instances it (the extension's
+// "Lights" and "Adding Light Instances to Nodes"): the light shines from the node's world position
+// along the node's world −Z; its units are the extension's (candela, lux for directional).
+// Validity is the caller's (bake/lights/punctual.h validate_punctual_light): values as written.
+struct GltfLight {
+  std::string name;       // the light's "name" ("" when it has none)
+  size_t index = 0;       // in the extension's "lights"
+  std::string node_path;  // the instancing node's path (the instance naming rule above)
+  std::string type;       // "directional", "point" or "spot" (anything else is refused by the reader)
+  Eigen::Vector3d position{0, 0, 0}, direction{0, 0, -1};  // world; direction normalised (zero if the node's scale is)
+  std::array<double, 3> color{1, 1, 1};
+  double intensity = 1;
+  double inner_cone = 0, outer_cone = 0.7853981633974483;  // spot, radians (the extension's defaults)
+  double range = 0;                                        // 0: none given (not applied: bake/lights/punctual.h)
+};
 struct MeshInstances {
   std::vector<MeshInstance> instances;
+  std::vector<GltfLight> lights;  // KHR_lights_punctual instances of the default scene, in walk order
   std::vector<std::string> warnings;  // the file's (skipped primitives, skins), one line each, "<file>: <finding>"
   std::string source_sha256;          // of the file's bytes
 };
