@@ -1,7 +1,7 @@
 // bench_area_engine — issue 32's CAD-engine measurement: exact area-light soft shadows
 // (bake/lights/area_bake.h AreaLightIntegrator, the contour path of bake/visibility/occluder_mesh.h)
 // over 2CylinderEngine.glb (121,496 triangles, read by prtbake's own glTF reader, load_mesh) against
-// Embree light sampling (bake/visibility/raycast.h RayCaster::occluded, shadow rays to uniform
+// Embree light sampling (bake/visibility/raycast.h RayCaster, shadow rays to uniform
 // points of the light: the estimator of view/area_lights.h render_area_reference), side by side in
 // one run.
 //
@@ -9,15 +9,23 @@
 //   * a ground grid (GX × GZ points, default 64 × 48, square cells) at y = lo.y − 1% of the
 //     engine's height, over its x extent widened by 35% on each side and centred on it in z,
 //     normal +y (the ground is no occluder: nothing lies below it);
-//   * a sample of the engine's own vertices (about 512, every k-th), normal the vertex normal.
-// Every receiver is evaluated by both methods at the same free point p' = p + ε n (ε of
-// view/area_lights.h area_shading_offset, welded = −1), as the viewer's two renders do, so that
-// both compute the same integral and neither meets the surface the point lies on.
+//   * a sample of the engine's own vertices (about 512, every k-th): their shade points as a
+//     vertex bake has them (bake/mesh/receivers.h: on the surface, welded, with the tie-break t).
+// Both methods evaluate the same limit p + εn, ε → 0+: the exact path by its own rules; the rays
+// of ground points by Embree's segment test (the ground point is a free point 1% of the engine's
+// height below it), those of engine vertices by RayCaster::visible (its 1-ring and near triangles
+// decided by the same exact ε-limit predicates, Embree for the rest). An earlier version moved
+// vertices off the surface by view/area_lights.h's ε along the vertex normal: on this CAD model
+// 7 of 514 vertex points then lay exactly in the plane of an occluder perpendicular to the
+// surface (a wall at a floor's edge), which the exact path lets pass (its rule for p in an
+// occluder's plane: a zero-area image, with t = 0 no tie-break) and Embree's float test blocks
+// at t = 0 (1M rays: 0 against up to 35% of the light): a disagreement of the set-up, not of
+// either method.
 // Lights, each baked per receiver as E = ∫_{visible light} max(n·ω, 0) dω at unit radiance:
 //   * quad: 0.45 × 0.45 of the footprint, 0.9 × the engine's height above its top, emitting down
-//     (soft shadows several cm wide on the ground);
+//     (penumbrae tens of units wide on the ground; the model is 743 units long);
 //   * sun: a 0.53°-wide disc (a regular 64-gon whose area is the disc's) at distance
-//     D = 1e4 × the engine's diagonal in the direction s = (0.35, 1, 0.2)/|·| (elevation 77°),
+//     D = 1e4 × the engine's diagonal in the direction s = (0.35, 1, 0.2)/|·| (elevation 69°),
 //     facing −s. Far enough: seen from any receiver (all within one diagonal d of the scene's
 //     centre) the disc's direction differs from s by ≤ d/D = 1e-4 rad (1.1% of the sun's 9.25e-3
 //     rad width) and its solid angle (∝ 1/distance²) by ≤ 2d/D = 2e-4 relative — both methods see
@@ -54,7 +62,6 @@
 //   PRT_BENCH_ENGINE_VERTICES 512, PRT_BENCH_ENGINE_REF 16384, PRT_BENCH_ENGINE_MAX_RAYS 32768)
 #include "bench_common.h"
 
-#include <view/area_lights.h>
 #include <view/image.h>
 #include <view/text.h>
 
@@ -120,8 +127,23 @@ struct Surface {
 
 // One light's Embree estimate at p' with normal n: `rays` shadow rays in R replicates; returns the
 // mean, and the standard error of the mean in *se (0 when R < 2).
-double embree_estimate(const bake::RayCaster& caster, const Surface& s, const Vector3d& p, const Vector3d& n,
-                       uint64_t seed, uint64_t key, uint32_t rays, uint32_t R, double* se) {
+struct Receiver {
+  bake::ShadePoint sp;
+  const bake::NearTriangles* near = nullptr;  // engine vertices: their near triangles (the ε-limit rules)
+};
+
+// A shadow ray from the receiver in unit direction w to a light point at distance r: ground points
+// by Embree's segment test; engine vertices by RayCaster::visible (the same ε-limit as the exact
+// path: 1-ring and near triangles decided exactly, Embree for the rest), whose ray is unbounded —
+// the same answer here, since no triangle lies beyond either light (both are above the engine).
+bool blocked(const bake::RayCaster& caster, const Receiver& rc, const Vector3d& w, double r) {
+  return rc.near ? !caster.visible(rc.sp, *rc.near, w) : caster.occluded(rc.sp.p, w, 0.0, r * (1 - 1e-7));
+}
+
+double embree_estimate(const bake::RayCaster& caster, const Surface& s, const Receiver& rc, uint64_t seed, uint64_t key,
+                       uint32_t rays, uint32_t R, double* se) {
+  const Vector3d& p = rc.sp.p;
+  const Vector3d& n = rc.sp.n;
   const uint32_t per = rays / R;
   std::array<double, 64> means{};
   for (uint32_t b = 0; b < R; ++b) {
@@ -142,7 +164,7 @@ double embree_estimate(const bake::RayCaster& caster, const Surface& s, const Ve
       const Vector3d w = d / r;
       const double cos_p = n.dot(w), cos_l = -s.normal.dot(w);
       if (!(cos_p > 0) || !(cos_l > 0)) continue;
-      if (caster.occluded(p, w, 0.0, r * (1 - 1e-7))) continue;
+      if (blocked(caster, rc, w, r)) continue;
       acc += s.area() * cos_p * cos_l / r2;
     }
     means[b] = acc / per;
@@ -154,10 +176,6 @@ double embree_estimate(const bake::RayCaster& caster, const Surface& s, const Ve
   if (se) *se = R > 1 ? std::sqrt(var / (R - 1) / R) : 0.0;
   return mean;
 }
-
-struct Receiver {
-  Vector3d p, n;  // p': already moved off the surface
-};
 
 } // namespace
 
@@ -198,7 +216,6 @@ int main(int argc, char** argv) {
   for (const auto& q : mesh.positions) box.extend(q.cast<double>());
   const Vector3d lo = box.min(), hi = box.max(), ext = hi - lo, centre = box.center();
   const double diag = ext.norm();
-  const double eps = view::area_shading_offset(mesh);
 
   // Receivers.
   std::vector<Receiver> receivers;
@@ -207,14 +224,24 @@ int main(int argc, char** argv) {
   // Square cells: the z range follows from the x spacing, centred on the engine.
   const double cell = (x1 - x0) / GX, z0 = centre.z() - 0.5 * cell * GZ, z1 = centre.z() + 0.5 * cell * GZ;
   for (int j = 0; j < GZ; ++j)
-    for (int i = 0; i < GX; ++i)
-      receivers.push_back({Vector3d(x0 + (x1 - x0) * (i + 0.5) / GX, ground_y + eps, z0 + (z1 - z0) * (j + 0.5) / GZ), Vector3d::UnitY()});
+    for (int i = 0; i < GX; ++i) {
+      Receiver rc;
+      rc.sp.p = Vector3d(x0 + (x1 - x0) * (i + 0.5) / GX, ground_y, z0 + (z1 - z0) * (j + 0.5) / GZ);
+      rc.sp.n = Vector3d::UnitY();
+      receivers.push_back(rc);
+    }
   const size_t ground_points = receivers.size();
   const bake::Topology topology = bake::build_topology(mesh);
+  const bake::RayCaster caster(mesh, topology);
+  std::vector<bake::NearTriangles> nears;
   {
     const std::vector<bake::ShadePoint> vs = bake::vertex_shade_points(mesh, topology);
     const size_t stride = std::max<size_t>(1, vs.size() / size_t(std::max(vertex_count, 1L)));
-    for (size_t v = 0; v < vs.size() && vertex_count > 0; v += stride) receivers.push_back({vs[v].p + eps * vs[v].n, vs[v].n});
+    for (size_t v = 0; v < vs.size() && vertex_count > 0; v += stride) {
+      receivers.push_back({vs[v], nullptr});
+      nears.push_back(caster.near_triangles(vs[v]));
+    }
+    for (size_t k = 0; k < nears.size(); ++k) receivers[receivers.size() - nears.size() + k].near = &nears[k];
   }
   const size_t P = receivers.size();
 
@@ -235,8 +262,8 @@ int main(int argc, char** argv) {
   for (const auto& l : lights) bake::validate_light(l, "bench_area_engine", l.name);
   const char* light_names[2] = {"quad", "sun 0.53 deg"};
 
-  std::printf("2CylinderEngine.glb (%s): %zu triangles, %zu vertices, bounds (%.1f %.1f %.1f)-(%.1f %.1f %.1f), diagonal %.1f, eps %.2e\n",
-              engine.c_str(), mesh.triangles.size(), mesh.positions.size(), lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), diag, eps);
+  std::printf("2CylinderEngine.glb (%s): %zu triangles, %zu vertices, bounds (%.1f %.1f %.1f)-(%.1f %.1f %.1f), diagonal %.1f\n",
+              engine.c_str(), mesh.triangles.size(), mesh.positions.size(), lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), diag);
   std::printf("receivers: %zu ground points (%d x %d) + %zu engine vertices; quad %.1f x %.1f at height %.1f above the ground; "
               "sun: 64-gon of radius %.4g at distance %.4g (1e4 diagonals), solid angle %.4e sr\n\n",
               ground_points, GX, GZ, P - ground_points, 0.45 * ext.x(), 0.45 * ext.z(), quad_centre.y() - ground_y, r_poly, D,
@@ -254,10 +281,7 @@ int main(int argc, char** argv) {
     double row[1];
     const double c = thread_cpu();
     for (size_t i = 0; i < P; ++i) {
-      bake::ShadePoint sp;
-      sp.p = receivers[i].p;
-      sp.n = receivers[i].n;
-      integrator.integrate(sp, row, ws);
+      integrator.integrate(receivers[i].sp, row, ws);
       exact[i * 2 + l] = row[0];
     }
     t_exact[l] = thread_cpu() - c;
@@ -265,13 +289,12 @@ int main(int argc, char** argv) {
     std::vector<Vector3d> rel, clipped;
     for (size_t i = 0; i < P; ++i) {
       rel.clear();
-      for (uint32_t v : lights[l].faces[0]) rel.push_back(lights[l].vertices[v] - mesh.origin - receivers[i].p);
-      bake::clip_to_horizon(rel, receivers[i].n, clipped);
-      unshadowed[i * 2 + l] = clipped.size() < 3 ? 0.0 : std::abs(bake::cosine_integral(clipped, receivers[i].n));
+      for (uint32_t v : lights[l].faces[0]) rel.push_back(lights[l].vertices[v] - mesh.origin - receivers[i].sp.p);
+      bake::clip_to_horizon(rel, receivers[i].sp.n, clipped);
+      unshadowed[i * 2 + l] = clipped.size() < 3 ? 0.0 : std::abs(bake::cosine_integral(clipped, receivers[i].sp.n));
     }
   }
 
-  const bake::RayCaster caster(mesh, topology);
   const std::vector<Surface> surfaces = {Surface(quad, mesh.origin), Surface(sun, mesh.origin)};
 
   // Converged reference, every thread.
@@ -280,7 +303,7 @@ int main(int argc, char** argv) {
   const double c_ref = process_cpu();
   tbb::parallel_for(size_t(0), P, [&](size_t i) {
     for (size_t l = 0; l < 2; ++l)
-      ref[i * 2 + l] = embree_estimate(caster, surfaces[l], receivers[i].p, receivers[i].n, 99, i * 2 + l, ref_rays, kRefReplicates, &ref_se[i * 2 + l]);
+      ref[i * 2 + l] = embree_estimate(caster, surfaces[l], receivers[i], 99, i * 2 + l, ref_rays, kRefReplicates, &ref_se[i * 2 + l]);
   });
   const double ref_cpu = process_cpu() - c_ref;
   const double ref_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
@@ -298,16 +321,17 @@ int main(int argc, char** argv) {
   std::printf("Converged Embree reference: %u rays per point and light (32 replicates, seed 99), %.1f s wall, %.1f s CPU on all threads.\n\n",
               ref_rays, ref_wall, ref_cpu);
   std::printf("| light | receivers | shadowed (exact < 99.9%% of unshadowed) | exact: CPU s | points/s per core | kept triangles / query | edges cut / query | special | uncharted |"
-              " reference rel. RMS vs exact | max abs z | beyond 3 sigma | beyond 4.5 sigma + float bound (of which sigma = 0) | of those, within it at 64x rays |\n");
+              " reference rel. RMS vs exact | max abs z | beyond 3 sigma | beyond 4.5 sigma + float bound (of which sigma = 0) | of those, within it at 64x rays (at 1024x) |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   std::vector<std::string> seconds;
+  size_t third_looks = 0;
   auto fmt = [](double v) {
     char b[32];
     std::snprintf(b, sizeof b, "%.3g", v);
     return std::string(b);
   };
   for (size_t l = 0; l < 2; ++l) {
-    size_t shadowed = 0, beyond3 = 0, fail = 0, zero_sigma = 0, second_ok = 0;
+    size_t shadowed = 0, beyond3 = 0, fail = 0, zero_sigma = 0, second_ok = 0, third_ok = 0;
     double max_z = 0;
     std::vector<double> r(P);
     for (size_t i = 0; i < P; ++i) {
@@ -327,23 +351,34 @@ int main(int argc, char** argv) {
         // missed, or a real disagreement.
         ++fail;
         double se2 = 0;
-        const double m2 = embree_estimate(caster, surfaces[l], receivers[i].p, receivers[i].n, 4242, i * 2 + l, ref_rays * 64,
+        const double m2 = embree_estimate(caster, surfaces[l], receivers[i], 4242, i * 2 + l, ref_rays * 64,
                                           kRefReplicates, &se2);
         const double d2 = std::abs(e - m2);
         const bool ok2 = d2 <= 4.5 * se2 + bound;
         second_ok += ok2;
+        // Still outside (at most 4 points): a third look with 1024x the reference's rays.
+        std::string third;
+        if (!ok2 && third_looks < 4) {
+          ++third_looks;
+          double se3 = 0;
+          const double m3 = embree_estimate(caster, surfaces[l], receivers[i], 4343, i * 2 + l, ref_rays * 1024, kRefReplicates, &se3);
+          const double d3 = std::abs(e - m3);
+          third_ok += d3 <= 4.5 * se3 + bound;
+          third = "; with " + std::to_string(size_t(ref_rays) * 1024) + " rays: " + fmt(m3) + " +- " + fmt(se3) + " (z " +
+                  fmt(se3 > 0 ? d3 / se3 : 0.0) + ")" + (d3 <= 4.5 * se3 + bound ? "" : " STILL OUTSIDE");
+        }
         seconds.push_back("  " + std::string(light_names[l]) + ": receiver " + std::to_string(i) +
                           (i < ground_points ? " (ground)" : " (engine vertex)") + ": E_exact " + fmt(e) + " (" + fmt(e / u) +
                           " of unshadowed), Embree " + fmt(m) + " +- " + fmt(se) + "; with " + std::to_string(ref_rays * 64) +
                           " rays: " + fmt(m2) + " +- " + fmt(se2) + " (z " + fmt(se2 > 0 ? d2 / se2 : 0.0) + ")" +
-                          (ok2 ? "" : " STILL OUTSIDE"));
+                          (ok2 ? "" : " STILL OUTSIDE") + third);
       }
     }
     const auto& st = stats[l];
     const double q = double(std::max<size_t>(st.queries, 1));
-    std::printf("| %s | %zu | %zu | %.2f | %.0f | %.0f | %.1f | %.3f | %.3f | %.2e | %.2f | %zu | %zu (%zu) | %zu |\n", light_names[l], P, shadowed,
+    std::printf("| %s | %zu | %zu | %.2f | %.0f | %.0f | %.1f | %.3f | %.3f | %.2e | %.2f | %zu | %zu (%zu) | %zu (%zu) |\n", light_names[l], P, shadowed,
                 t_exact[l], double(P) / t_exact[l], double(st.kept) / q, double(st.boundary_edges) / q, double(st.special) / q,
-                double(st.uncharted) / q, rel_rms(r, l), max_z, beyond3, fail, zero_sigma, second_ok);
+                double(st.uncharted) / q, rel_rms(r, l), max_z, beyond3, fail, zero_sigma, second_ok, third_ok);
   }
   for (const auto& line : seconds) std::printf("%s\n", line.c_str());
   std::printf("\nWhole bake, exact path: %.2f CPU s for %zu receivers x 2 lights (%.0f points/s per core over both lights), "
@@ -362,7 +397,7 @@ int main(int argc, char** argv) {
     std::vector<double> est(P);
     const uint32_t R = std::min<uint32_t>(8, n);
     const double c = thread_cpu();
-    for (size_t i = 0; i < P; ++i) est[i] = embree_estimate(caster, surfaces[l], receivers[i].p, receivers[i].n, seed, i * 2 + l, n, R, nullptr);
+    for (size_t i = 0; i < P; ++i) est[i] = embree_estimate(caster, surfaces[l], receivers[i], seed, i * 2 + l, n, R, nullptr);
     const double t = thread_cpu() - c;
     return Rung{n, t, rel_rms(est, l)};
   };
@@ -394,7 +429,7 @@ int main(int argc, char** argv) {
     const double n_target = double(lo_r.n) * std::pow(1e-3 / lo_r.err, 1 / slope);
     const bool extrapolated = hi_r.err > 1e-3;
     const double t_target = a + b * n_target;
-    std::printf("| %s | %.2f | %u | %.2f | %.2e | %.0f%s (slope %.2f) | %.1f | %.0fx |\n", light_names[l], t_exact[l], eq.n, eq.t, eq.err, n_target,
+    std::printf("| %s | %.2f | %u | %.2f | %.2e | %.0f%s (slope %.2f) | %.1f | %.2fx |\n", light_names[l], t_exact[l], eq.n, eq.t, eq.err, n_target,
                 extrapolated ? " (extrapolated)" : "", slope, t_target, t_target / t_exact[l]);
   }
 
