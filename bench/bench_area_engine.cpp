@@ -274,7 +274,7 @@ int main(int argc, char** argv) {
 
   // Exact, single thread, per light.
   std::vector<double> exact(P * 2), unshadowed(P * 2);
-  double t_exact[2] = {0, 0}, t_setup[2] = {0, 0};
+  double t_exact[2] = {0, 0}, t_setup[2] = {0, 0}, t_ground[2] = {0, 0};
   bake::OccluderMesh::Workspace::Stats stats[2];
   for (size_t l = 0; l < 2; ++l) {
     const double c0 = thread_cpu();
@@ -284,10 +284,12 @@ int main(int argc, char** argv) {
     double row[1];
     const double c = thread_cpu();
     for (size_t i = 0; i < P; ++i) {
+      if (i == ground_points) t_ground[l] = thread_cpu() - c;
       integrator.integrate(receivers[i].sp, row, ws);
       exact[i * 2 + l] = row[0];
     }
     t_exact[l] = thread_cpu() - c;
+    if (ground_points == P) t_ground[l] = t_exact[l];
     stats[l] = ws.occluders.stats;
     std::vector<Vector3d> rel, clipped;
     for (size_t i = 0; i < P; ++i) {
@@ -387,6 +389,10 @@ int main(int argc, char** argv) {
                 double(st.uncharted) / q, rel_rms(r, l), with_sigma, max_z, beyond3, fail, zero_sigma, second_ok, third_ok);
   }
   for (const auto& line : seconds) std::printf("%s\n", line.c_str());
+  for (size_t l = 0; l < 2; ++l)
+    std::printf("%s, exact path by receiver kind: %zu ground points %.2f s (%.0f points/s per core), %zu engine vertices %.2f s (%.0f points/s per core)\n",
+                light_names[l], ground_points, t_ground[l], double(ground_points) / std::max(t_ground[l], 1e-12), P - ground_points,
+                t_exact[l] - t_ground[l], double(P - ground_points) / std::max(t_exact[l] - t_ground[l], 1e-12));
   std::printf("\nWhole bake, exact path: %.2f CPU s for %zu receivers x 2 lights (%.0f points/s per core over both lights), "
               "plus %.2f + %.2f s to build the occluder mesh (edge map, tree) per integrator.\n\n",
               t_exact[0] + t_exact[1], P, double(P) / (t_exact[0] + t_exact[1]), t_setup[0], t_setup[1]);
