@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <mesh_files.h>
 #include <run_tool.h>
+#include <segment_box.h>
 
 #include <algorithm>
 #include <cmath>
@@ -372,22 +373,10 @@ TEST(ScenePunctualLights, PrtviewShadesThemFromTheBakedIrradianceTimesTheirInten
 
 namespace {
 
-// Whether the segment p → q meets the box [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2] (slabs), with a
-// margin: a texel within `margin` of deciding either way is left out of the comparison.
+// Whether the segment p → q meets the box [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2], with a margin: a
+// texel within `margin` of deciding either way is left out of the comparison.
 bool near_or_through_box(const Vector3d& p, const Vector3d& q, double margin) {
-  const Vector3d lo(-0.5 - margin, 0.5 - margin, -0.5 - margin), hi(0.5 + margin, 1.5 + margin, 0.5 + margin);
-  double t0 = 0, t1 = 1;
-  for (int k = 0; k < 3; ++k) {
-    const double d = q[k] - p[k];
-    if (d == 0) {
-      if (p[k] < lo[k] || p[k] > hi[k]) return false;
-      continue;
-    }
-    double a = (lo[k] - p[k]) / d, b = (hi[k] - p[k]) / d;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a), t1 = std::min(t1, b);
-  }
-  return t0 <= t1;
+  return prt::testing::segment_meets_box(p, q, Vector3d(-0.5, 0.5, -0.5), Vector3d(0.5, 1.5, 0.5), margin);
 }
 
 } // namespace

@@ -13,6 +13,7 @@
 #include <prtshade/ltc.h>
 
 #include <gtest/gtest.h>
+#include <segment_box.h>
 #include <test_scenes.h>
 
 #include <tbb/global_control.h>
@@ -268,19 +269,7 @@ namespace {
 // Whether the segment p → q meets the box [−0.4, 0.3] × [−0.3, 0.4] × [0, 0.8] of Scene, with a
 // margin (negative: the box shrunk).
 bool meets_box(const Vector3d& p, const Vector3d& q, double margin) {
-  const Vector3d lo(-0.4 - margin, -0.3 - margin, 0 - margin), hi(0.3 + margin, 0.4 + margin, 0.8 + margin);
-  double t0 = 0, t1 = 1;
-  for (int k = 0; k < 3; ++k) {
-    const double d = q[k] - p[k];
-    if (d == 0) {
-      if (p[k] < lo[k] || p[k] > hi[k]) return false;
-      continue;
-    }
-    double a = (lo[k] - p[k]) / d, b = (hi[k] - p[k]) / d;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a), t1 = std::min(t1, b);
-  }
-  return t0 <= t1;
+  return prt::testing::segment_meets_box(p, q, Vector3d(-0.4, -0.3, 0), Vector3d(0.3, 0.4, 0.8), margin);
 }
 
 } // namespace
