@@ -11,6 +11,7 @@
 #include <formats/asset.h>
 
 #include <gtest/gtest.h>
+#include <ground_and_box.h>
 #include <mesh_files.h>
 #include <run_tool.h>
 #include <test_scenes.h>
@@ -29,24 +30,10 @@ namespace {
 
 fs::path fresh_dir(const std::string& name) { return prt::testing::test_dir("lit_scenes/" + name); }
 
-// Ground: integer grid [-3, 3]² at y = 0 facing +y (quads, counter-clockwise from above).
-// Box: [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2], outward. Every coordinate is a float exactly, so
-// the meshes the bake reads are the geometry of the closed forms.
-const Vector3d kBoxLo(-0.5, 0.5, -0.5), kBoxHi(0.5, 1.5, 0.5);
+// The ground and the box (tests/common/ground_and_box.h).
+const Vector3d kBoxLo = prt::testing::kGroundBoxLo, kBoxHi = prt::testing::kGroundBoxHi;
 
-void write_meshes(const fs::path& d) {
-  std::ofstream g(d / "ground.obj");
-  for (int z = -3; z <= 3; ++z)
-    for (int x = -3; x <= 3; ++x) g << "v " << x << " 0 " << z << "\n";
-  for (int j = 0; j < 6; ++j)
-    for (int i = 0; i < 6; ++i) {
-      const int a = j * 7 + i + 1;
-      g << "f " << a << " " << a + 7 << " " << a + 8 << " " << a + 1 << "\n";
-    }
-  std::ofstream(d / "box.obj") << "v -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\n"
-                                  "v -0.5 0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 1.5 0.5\nv 0.5 1.5 0.5\n"
-                                  "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
-}
+void write_meshes(const fs::path& d) { prt::testing::write_ground_and_box(d); }
 
 struct Setup {
   bool light = true;  // the quad light [-1, 1]² at y = 4 facing down (u × v = -y), radiance 10

@@ -10,6 +10,7 @@
 #include <formats/asset.h>
 
 #include <gltf_builder.h>
+#include <ground_and_box.h>
 #include <gtest/gtest.h>
 #include <mesh_files.h>
 #include <run_tool.h>
@@ -36,20 +37,8 @@ fs::path fresh_dir(const std::string& name) {
 // Stored as float32: a value of the order of 1 keeps 2^-24 of itself.
 constexpr double kFloat = 1e-6;
 
-// Ground: integer grid [-3, 3]² at y = 0 facing +y. Box [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2].
-void write_meshes(const fs::path& d) {
-  std::ofstream g(d / "ground.obj");
-  for (int z = -3; z <= 3; ++z)
-    for (int x = -3; x <= 3; ++x) g << "v " << x << " 0 " << z << "\n";
-  for (int j = 0; j < 6; ++j)
-    for (int i = 0; i < 6; ++i) {
-      const int a = j * 7 + i + 1;
-      g << "f " << a << " " << a + 7 << " " << a + 8 << " " << a + 1 << "\n";
-    }
-  std::ofstream(d / "box.obj") << "v -0.5 0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\n"
-                                  "v -0.5 0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 1.5 0.5\nv 0.5 1.5 0.5\n"
-                                  "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
-}
+// The ground and the box (tests/common/ground_and_box.h).
+void write_meshes(const fs::path& d) { prt::testing::write_ground_and_box(d); }
 
 const Vector3d kPoint(0.25, 3, 0.125), kSpot(0, 4, 0), kSpotAxis(0, -1, 0), kSun(0.5, -1, 0.25);
 const double kInner = 20, kOuter = 40;  // degrees
@@ -376,7 +365,7 @@ namespace {
 // Whether the segment p → q meets the box [-1/2, 1/2] × [1/2, 3/2] × [-1/2, 1/2], with a margin: a
 // texel within `margin` of deciding either way is left out of the comparison.
 bool near_or_through_box(const Vector3d& p, const Vector3d& q, double margin) {
-  return prt::testing::segment_meets_box(p, q, Vector3d(-0.5, 0.5, -0.5), Vector3d(0.5, 1.5, 0.5), margin);
+  return prt::testing::segment_meets_box(p, q, prt::testing::kGroundBoxLo, prt::testing::kGroundBoxHi, margin);
 }
 
 } // namespace
