@@ -431,11 +431,58 @@ TEST(PrtviewScene, WrongEnvironmentAndFivOptionsAreRefused) {
   EXPECT_EQ(w.code, 1);
   EXPECT_NE(w.err.find("forest.exr: is not the environment " + h5.string()), std::string::npos) << w.err;
   EXPECT_NE(w.err.find("/scene was baked under"), std::string::npos) << w.err;
-  // FIV-file options mean nothing for a scene file.
-  const Outcome o = view(h5.string() + " " + kSceneCamera + " --instance 1,0,0 -o " + out.string());
+  // FIV-file options mean nothing for a scene file drawn as a scene.
+  const Outcome o = view(h5.string() + " " + kSceneCamera + " --ground 0 -o " + out.string());
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("do not apply to scene files (" + h5.string() + ")"), std::string::npos) << o.err;
+  // Drawn as an FIV scene (--instance), the occluders' meshes are the objects': no --occluder-mesh.
+  const Outcome m = view(h5.string() + " " + kSceneCamera + " --instance 1,0,0 --occluder-mesh " + plane_obj().string() + " -o " +
+                         out.string());
+  EXPECT_EQ(m.code, 2);
+  EXPECT_NE(m.err.find("--occluder-mesh does not apply to scene files"), std::string::npos) << m.err;
   expect_no_output(out);
+}
+
+TEST(PrtviewScene, DynamicCopiesOfTheScenesFivOccludersFromFlagsOrAnInstanceList) {
+  // The scene's box has FIV shells: --instance places copies of it on a ground (paper 004's
+  // dynamic occluders), named or not (the scene's only FIV occluder), or from a JSON list.
+  const fs::path h5 = bake_scene("dyn", 0.5), a = scratch("dyn_a.exr"), b = scratch("dyn_b.exr"), list = scratch("dyn.json");
+  const std::string cam = "--camera eye=0,9,11:at=0,1,0:fov=50 --size 40x30 --samples 16";
+  const Outcome r = view(h5.string() + " " + cam + " --instance box@-2.5,0,0 --instance 2.5,0,1 --triptych -o " + scratch("dyn.png").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 copies"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::isfinite(nrmse(r.out))) << r.out;
+  EXPECT_NE(r.out.find("frame: "), std::string::npos) << r.out;
+  // The same copies from a list: the same picture, value for value.
+  std::ofstream(list) << R"({"instances": [{"occluder": "box", "translate": [-2.5, 0, 0]}, {"translate": [2.5, 0, 1]}]})";
+  ASSERT_EQ(view(h5.string() + " " + cam + " --instance box@-2.5,0,0 --instance 2.5,0,1 -o " + a.string()).code, 0);
+  const Outcome l = view(h5.string() + " " + cam + " --instances " + list.string() + " -o " + b.string());
+  ASSERT_EQ(l.code, 0) << l.err;
+  EXPECT_EQ(slurp(a), slurp(b));
+  // --shade fiv alone: each FIV occluder once where it was baked.
+  const Outcome one = view(h5.string() + " " + cam + " --shade fiv -o " + a.string());
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_NE(one.out.find("1 copy"), std::string::npos) << one.out;
+  // Bad lists and names: exit 1, naming the file, the entry and what the scene holds.
+  const auto refused = [&](const std::string& args, const std::string& says) {
+    const Outcome e = view(h5.string() + " " + cam + " " + args + " -o " + scratch("dyn_bad.png").string());
+    EXPECT_NE(e.code, 0) << args;
+    EXPECT_NE(e.err.find(says), std::string::npos) << args << "\n" << e.err;
+    expect_no_output(scratch("dyn_bad.png"));
+  };
+  refused("--instance ball@0,0,0", "has no FIV occluder 'ball' to place (it holds: box)");
+  refused("--instance @0,0,0", "--instance expects NAME@X,Y,Z or X,Y,Z");
+  refused("--instance box@0,0", "--instance expects [NAME@]X,Y,Z");
+  std::ofstream(list) << R"({"instances": [{"occluder": "box", "translate": [0, 0]}]})";
+  refused("--instances " + list.string(), list.string() + ": instances[0].translate must be [X, Y, Z]");
+  std::ofstream(list) << R"({"instances": [{"occluder": "box", "move": [0, 0, 0]}]})";
+  refused("--instances " + list.string(), "instances[0]: unknown key 'move'");
+  std::ofstream(list) << "{not json";
+  refused("--instances " + list.string(), list.string() + ": is not JSON");
+  refused("--instances " + scratch("nowhere.json").string(), "cannot open the instance list");
+  fs::remove(a);
+  fs::remove(b);
+  fs::remove(list);
 }
 
 TEST(Prtview, DamagedAndOldFormatFilesGiveOneLineNeverACrash) {

@@ -23,6 +23,7 @@
 #include <formats/asset.h>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -32,6 +33,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -90,6 +92,13 @@ WHAT IS DRAWN
     the partial-occluder factor, overlap correction for several occluders: paper 004 sec. 4.3.1),
     the occluder with prt::shade::shade_fiv_member: its self-shadows (shade_fiv_self, sec. 4.3.2)
     minus the other copies' shadows.
+  FIV scenes (dynamic occluders): a scene file whose objects have FIV shells, with --shade fiv or
+    --instance/--instances: those objects are the occluders, placed as copies moved from where
+    they were baked (default: each once, in place), on a ground plane, shaded as above. The
+    frame's cost (rasterise + shade, the file's reading not counted) is printed. E.g. 50 copies
+    of three occluders (data/scene_fiv_occluders.json, data/fiv_instances50.json):
+      prtbake scene data/scene_fiv_occluders.json -o occ.prt.h5
+      prtview occ.prt.h5 --instances data/fiv_instances50.json --triptych -o fiv50.png
 
   scene files (/objects/<name>/ and /scene from 'prtbake scene', schema v2-3): every object, in world
     space, in one z-buffer, each shaded with what the file holds for it, times its diffuse albedo
@@ -107,10 +116,10 @@ WHAT IS DRAWN
                 shells, eq. 11: the same composition as the copies of an FIV file), else
       flat      grey: 0.5 x the environment's mean radiance.
     The environment must be the one of /scene (checked by SHA-256); default: its 'environment'.
-    --shade, --instance, --occluder(-mesh), --ground(-size), --no-overlap/--no-partial do not
-    apply. The reference renders the same objects: "occluder" and "both" objects cast shadows,
-    "receiver" objects do not (not even on themselves: the scene semantics, bake/bake/scene.h), and a
-    pixel shows albedo x E/pi.
+    --shade (but glossy, area, area-exact, and fiv: FIV scenes below), --occluder-mesh,
+    --ground(-size), --no-overlap/--no-partial do not apply. The reference renders the same
+    objects: "occluder" and "both" objects cast shadows, "receiver" objects do not (not even on
+    themselves: the scene semantics, bake/bake/scene.h), and a pixel shows albedo x E/pi.
 
   glossy objects of scene files (--shade glossy; objects with a phong_exponent, whose
     /objects/<name>/radiance/shadowed or transfer/visibility the scene plan baked at the lobe's
@@ -235,21 +244,67 @@ struct Args {
   double env_rotate = 0;            // --env-rotate DEG: the environment turned about +Y (--shade transfer)
 };
 
-// "X,Y,Z" → a vector (an --instance).
-Vector3d parse_offset(const std::string& t) {
-  Vector3d d;
+// "[NAME@]X,Y,Z" → a copy of occluder NAME (empty: the default one) moved by (X,Y,Z) (an --instance).
+prtview::FivInstance parse_instance(const std::string& text) {
+  prtview::FivInstance out;
+  const size_t at = text.find('@');
+  if (at != std::string::npos) {
+    out.occluder = text.substr(0, at);
+    if (out.occluder.empty()) throw UsageError("--instance expects NAME@X,Y,Z or X,Y,Z, got '" + text + "'");
+  }
+  const std::string t = at == std::string::npos ? text : text.substr(at + 1);
   size_t start = 0;
   for (int k = 0; k < 3; ++k) {
     const size_t comma = t.find(',', start);
-    if ((k < 2) != (comma != std::string::npos)) throw UsageError("--instance expects X,Y,Z, got '" + t + "'");
+    if ((k < 2) != (comma != std::string::npos)) throw UsageError("--instance expects [NAME@]X,Y,Z, got '" + text + "'");
     const std::string s = t.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     char* end = nullptr;
-    d[k] = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(d[k]))
-      throw UsageError("--instance expects a number, got '" + s + "'");
+    out.offset[k] = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(out.offset[k]))
+      throw UsageError("--instance expects a number, got '" + s + "' in '" + text + "'");
     start = comma + 1;
   }
-  return d;
+  return out;
+}
+
+// --instances FILE: {"instances": [{"occluder": NAME, "translate": [X, Y, Z]}, ...]} ("occluder"
+// optional: the default one). Errors name the file and the entry.
+std::vector<prtview::FivInstance> read_instances(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw bake::InputError(path, "cannot open the instance list");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw bake::InputError(path, std::string("is not JSON: ") + e.what());
+  }
+  if (!j.is_object() || !j.contains("instances") || !j["instances"].is_array())
+    throw bake::InputError(path, "expected {\"instances\": [{\"occluder\": NAME, \"translate\": [X, Y, Z]}, ...]}");
+  std::vector<prtview::FivInstance> out;
+  for (size_t k = 0; k < j["instances"].size(); ++k) {
+    const nlohmann::json& e = j["instances"][k];
+    const std::string where = "instances[" + std::to_string(k) + "]";
+    if (!e.is_object()) throw bake::InputError(path, where + " is not an object");
+    for (const auto& [key, value] : e.items())
+      if (key != "occluder" && key != "translate")
+        throw bake::InputError(path, where + ": unknown key '" + key + "' (known: occluder, translate)");
+    prtview::FivInstance i;
+    if (e.contains("occluder")) {
+      if (!e["occluder"].is_string() || e["occluder"].get<std::string>().empty())
+        throw bake::InputError(path, where + ".occluder must be a non-empty string");
+      i.occluder = e["occluder"].get<std::string>();
+    }
+    const nlohmann::json* t = e.contains("translate") ? &e["translate"] : nullptr;
+    if (!t || !t->is_array() || t->size() != 3) throw bake::InputError(path, where + ".translate must be [X, Y, Z]");
+    for (int c = 0; c < 3; ++c) {
+      if (!(*t)[size_t(c)].is_number() || !std::isfinite((*t)[size_t(c)].get<double>()))
+        throw bake::InputError(path, where + ".translate must hold three finite numbers");
+      i.offset[c] = (*t)[size_t(c)].get<double>();
+    }
+    out.push_back(i);
+  }
+  if (out.empty()) throw bake::InputError(path, "lists no instance");
+  return out;
 }
 
 // `text` broken at spaces into lines of at most `width` characters (CLI11 indents each line).
@@ -281,6 +336,7 @@ std::optional<Args> parse(int argc, char** argv) {
   std::string size, shade_kind, region;
   double phong_value = 0;
   std::vector<std::string> instances;
+  std::string instances_file;
   bool reference = false, error = false, triptych = false, no_overlap = false, no_partial = false;
   double exposure = 0, ground = 0, ground_size = 0;
   app.add_option("file", a.file, "the baked file (FILE.prt.h5)");
@@ -339,9 +395,13 @@ std::optional<Args> parse(int argc, char** argv) {
                  "directory, else to FILE's directory).");
   app.add_option("--occluder", a.fiv.occluder, "FIV files: which /fiv/occluders/NAME (default: the only one).");
   app.add_option("--instance", instances,
-                 "FIV files: X,Y,Z: place a copy of the occluder moved by (X,Y,Z); repeat for several copies "
-                 "(default: one copy where it was baked). Copies share the baked shells.")
+                 "FIV files and scene files with FIV shells: [NAME@]X,Y,Z: place a copy of occluder NAME (default: "
+                 "--occluder, else the only one) moved by (X,Y,Z) from where it was baked; repeat for several copies "
+                 "(default: each occluder once where it was baked). Copies share the baked shells: dynamic occluders.")
       ->allow_extra_args(false);
+  app.add_option("--instances", instances_file,
+                 "FILE.json: many copies at once, {\"instances\": [{\"occluder\": NAME, \"translate\": [X, Y, Z]}, "
+                 "...]}; added after the --instance ones (data/fiv_instances50.json places 50 copies of the occluders of data/scene_fiv_occluders.json).");
   CLI::Option* ground_opt = app.add_option(
       "--ground", ground, "FIV files: height of the ground plane (default: 1% of the bounding radius R below the lowest copy).");
   CLI::Option* ground_size_opt =
@@ -395,7 +455,9 @@ std::optional<Args> parse(int argc, char** argv) {
   if (!(a.error_scale > 0 && std::isfinite(a.error_scale))) throw UsageError("--error-scale must be > 0");
   if (!a.reference_cache.empty() && fs::path(a.reference_cache).extension() != ".exr")
     throw UsageError("--reference-cache expects a FILE.exr");
-  for (const std::string& t : instances) a.fiv.instances.push_back(parse_offset(t));
+  for (const std::string& t : instances) a.fiv.instances.push_back(parse_instance(t));
+  if (!instances_file.empty())
+    for (const prtview::FivInstance& i : read_instances(instances_file)) a.fiv.instances.push_back(i);
   if (ground_opt->count()) {
     if (!std::isfinite(ground)) throw UsageError("--ground expects a finite number");
     a.fiv.ground = ground;
@@ -618,6 +680,7 @@ int run(const Args& a) {
     std::fprintf(stderr, "prtview: warning: %s: %s\n", a.file.c_str(), F::describe(s).c_str());
   const bool area = a.shade == "area" || a.shade == "area-exact";
   std::string kind = a.shade;
+  prtview::FivView fiv = a.fiv;  // plus whether a scene file is drawn as an FIV scene
   std::string skipped;  // why the first look did not take the best product
   if (area) {
     if (!prtview::is_scene_file(f))
@@ -625,7 +688,14 @@ int run(const Args& a) {
     if (!a.env.empty() || !a.reference_cache.empty())
       throw UsageError("--env and --reference-cache do not apply to --shade " + a.shade + " (the lights' direct light only)");
   } else if (prtview::is_scene_file(f)) {
-    kind = a.shade == "glossy" ? "glossy" : "scene";
+    // A scene file's objects with FIV shells, placed as dynamic occluders on a ground: --shade fiv,
+    // or any --instance.
+    fiv.scene = prtview::has_fiv(f) && (a.shade == "fiv" || !a.fiv.instances.empty());
+    if ((a.shade == "fiv" || !a.fiv.instances.empty()) && !fiv.scene)
+      throw bake::InputError(a.file, "has no FIV shells to draw (--shade fiv, --instance): bake it with the 'fiv' product");
+    kind = fiv.scene ? "fiv" : a.shade == "glossy" ? "glossy" : "scene";
+    if (fiv.scene && !a.fiv.occluder_mesh.empty())
+      throw UsageError("--occluder-mesh does not apply to scene files (" + a.file + "): each occluder's mesh is its object's");
   } else if (a.shade == "glossy") {
     throw UsageError("--shade glossy: " + a.file + " is not a scene file; glossy objects are baked by 'prtbake scene'");
   }
@@ -659,13 +729,13 @@ int run(const Args& a) {
     else prtview::require_vertex_kind(f, a.file, kind);
   }
   const prtview::FirstLook look = given_camera ? prtview::FirstLook{*given_camera, ""}
-                                               : prtview::first_look_camera(f, a.file, a.fiv, a.width, a.height, kind == "glossy");
+                                               : prtview::first_look_camera(f, a.file, fiv, a.width, a.height, kind == "glossy");
   const view::Camera& cam = look.camera;
   // AO needs an environment only to weigh it: without one (AO files name none), a white sky.
   const bool white_sky = kind == "ao" && a.env.empty();
   if ((kind == "scene" || kind == "glossy" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
                                     !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
-    throw UsageError("--shade (except glossy, area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
+    throw UsageError("--shade (except glossy, area, area-exact, fiv), --occluder(-mesh), --ground(-size), --no-overlap and "
                      "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
                      "'prtview --help')");
   const std::string env_path = area || white_sky ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
@@ -703,7 +773,7 @@ int run(const Args& a) {
                                                                                   : a.glossy_route == "b" ? prtview::GlossyRoute::B
                                                                                                           : prtview::GlossyRoute::Auto,
                                                                                   scene)
-                              : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, a.fiv, *env, cam, scene)
+                              : kind == "fiv"   ? prtview::render_fiv_file(f, a.file, fiv, *env, cam, scene)
                               : texel           ? prtview::render_texel_file(f, a.file, kind, *env, cam, scene, a.env_rotate)
                                                 : prtview::render_vertex_file(f, a.file, kind, *env, cam, scene, a.env_rotate);
   const double runtime_seconds = t_run.seconds();
@@ -763,6 +833,9 @@ int run(const Args& a) {
     if (given_camera) std::printf("view: %dx%d, %s\n", a.width, a.height, a.camera.c_str());
     else std::printf("view: %dx%d, framing %s; to adjust:\n  --camera %s\n", a.width, a.height, look.framed.c_str(), view::to_string(cam).c_str());
     std::printf("runtime (%.3f s): %s\n", runtime_seconds, scene.how.c_str());
+    if (kind == "fiv")
+      std::printf("frame: %.4f s for %dx%d pixels on %d thread%s (rasterise + shade; reading the file and meshes not counted)\n",
+                  scene.frame_seconds, a.width, a.height, threads, threads == 1 ? "" : "s");
     if (reflect.bounces > 0 || reflect.albedo)
       std::printf("reference: %s (%s)\n", reflect.caption.c_str(), reflect.why.c_str());
     std::fflush(stdout);

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -24,6 +25,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <set>
 #include <span>
 
 namespace prt::prtview {
@@ -210,19 +212,86 @@ view::Image render_texel_file(const F::Asset& f, const std::string& file, const 
   return std::move(r.image);
 }
 
+namespace {
+
+// The occluders an FIV view can place: name → its shells and the mesh they were baked from (world
+// space, where the shells' centre is). An FIV file: its occluder with the mesh of --occluder-mesh
+// or the file's source; a scene file: its objects that have shells, with their meshes.
+struct PlaceableOccluder {
+  BakedOccluder baked;
+  bake::Mesh mesh;
+  std::string mesh_from;  // where the mesh came from, for the summary
+  double lowest = 0;      // the mesh's lowest y
+};
+
+std::map<std::string, PlaceableOccluder> placeable_occluders(const F::Asset& f, const std::string& file, const FivView& options,
+                                                              const bake::EnvMap& env, const std::set<std::string>& wanted) {
+  std::map<std::string, PlaceableOccluder> out;
+  if (options.scene) {
+    for (SceneObject& o : read_scene_objects(f, file, &env)) {
+      if (!o.shells || !wanted.count(o.name)) continue;
+      PlaceableOccluder p{std::move(*o.shells), std::move(o.mesh), "/objects/" + o.name, 0};
+      out.emplace(o.name, std::move(p));
+    }
+  } else {
+    const std::string name = choose_occluder(f, file, options.occluder);
+    const std::string mesh_path = occluder_mesh_path(f, file, options.occluder_mesh);
+    bake::MeshLoadOptions mopt;
+    mopt.use_file_normals = false;
+    for (const std::string& w : wanted)
+      if (w != name) throw bake::InputError(file, "has no occluder '" + w + "' to place (it holds '" + name + "')");
+    out.emplace(name, PlaceableOccluder{read_occluder(f, file, name, env), bake::load_mesh(mesh_path, mopt), mesh_path, 0});
+  }
+  for (const std::string& w : wanted)
+    if (!out.count(w)) {
+      std::string names;
+      for (const F::Occluder& o : f.occluders) names += (names.empty() ? "" : ", ") + o.name;
+      throw bake::InputError(file, "has no FIV occluder '" + w + "' to place (" + (names.empty() ? "it holds none" : "it holds: " + names) +
+                                 ")");
+    }
+  for (auto& [name, p] : out) {
+    p.lowest = std::numeric_limits<double>::infinity();
+    for (const auto& v : p.mesh.positions) p.lowest = std::min(p.lowest, double(v.y()));
+  }
+  return out;
+}
+
+// The copies an FIV view draws, each with its occluder's name resolved: the given ones, else each
+// placeable occluder once where it was baked.
+std::vector<FivInstance> resolved_instances(const F::Asset& f, const std::string& file, const FivView& options) {
+  std::vector<FivInstance> inst = options.instances;
+  if (inst.empty()) {
+    if (options.scene) {
+      for (const F::Occluder& o : f.occluders) inst.push_back({o.name, Vector3d::Zero()});
+      if (inst.empty()) throw bake::InputError(file, "holds no FIV occluder to draw: no object of it has FIV shells");
+    } else {
+      inst.push_back({});
+    }
+  }
+  std::string fallback;
+  for (FivInstance& i : inst)
+    if (i.occluder.empty()) {
+      if (fallback.empty()) fallback = choose_occluder(f, file, options.occluder);
+      i.occluder = fallback;
+    }
+  return inst;
+}
+
+} // namespace
+
 FirstLook first_look_camera(const F::Asset& f, const std::string& file, const FivView& options, int width, int height,
                             bool glossy) {
   const Vector3d up = up_axis(f) == bake::UpAxis::Z ? Vector3d::UnitZ() : Vector3d::UnitY();
-  if (has_fiv(f) && !is_scene_file(f)) {  // the occluder copies, widened by R so that their shadows show
+  if (has_fiv(f) && (!is_scene_file(f) || options.scene)) {  // the occluder copies, widened by R so that their shadows show
     Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    const F::Occluder* o = f.find_occluder(choose_occluder(f, file, options.occluder));
-    const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
-    const std::vector<Vector3d> inst = options.instances.empty() ? std::vector<Vector3d>{Vector3d::Zero()} : options.instances;
-    for (const Vector3d& t : inst) {
-      lo = lo.cwiseMin(c + t - Vector3d::Constant(2 * o->radius));
-      hi = hi.cwiseMax(c + t + Vector3d::Constant(2 * o->radius));
+    for (const FivInstance& t : resolved_instances(f, file, options)) {
+      const F::Occluder* o = f.find_occluder(t.occluder);
+      if (!o) throw bake::InputError(file, "has no FIV occluder '" + t.occluder + "' to place");
+      const Vector3d c(o->centre[0], o->centre[1], o->centre[2]);
+      lo = lo.cwiseMin(c + t.offset - Vector3d::Constant(2 * o->radius));
+      hi = hi.cwiseMax(c + t.offset + Vector3d::Constant(2 * o->radius));
     }
-    return {view::frame_box(lo, hi, up, width, height), "the occluder and its shadow"};
+    return {view::frame_box(lo, hi, up, width, height), options.scene ? "the occluders and their shadows" : "the occluder and its shadow"};
   }
   // Per-vertex files: the mesh; scene files: every object (--shade glossy: the glossy ones), in
   // world space, as one mesh; framed without their large flat parts (view::focus_box).
@@ -258,71 +327,92 @@ FirstLook first_look_camera(const F::Asset& f, const std::string& file, const Fi
 
 view::Image render_fiv_file(const F::Asset& f, const std::string& file, const FivView& options, const bake::EnvMap& env,
                             const view::Camera& cam, RenderScene& scene) {
-  const std::string name = choose_occluder(f, file, options.occluder);
-  const BakedOccluder baked = read_occluder(f, file, name, env);
-  const auto& centre = baked.centre;
-  const double R = baked.radius;
+  const std::vector<FivInstance> inst = resolved_instances(f, file, options);
+  std::set<std::string> wanted;
+  for (const FivInstance& i : inst) wanted.insert(i.occluder);
+  const std::map<std::string, PlaceableOccluder> kinds = placeable_occluders(f, file, options, env, wanted);
   const float* env_fiv = read_environment_fiv(f, file, env, true);
   const shade::DifMap difmap = *read_difmap(f, file, env, true);
-  // The occluder's mesh: the one the shells were baked from.
-  const std::string mesh_path = occluder_mesh_path(f, file, options.occluder_mesh);
-  bake::MeshLoadOptions mopt;
-  mopt.use_file_normals = false;
-  const bake::Mesh occ = bake::load_mesh(mesh_path, mopt);
 
-  std::vector<Vector3d> inst = options.instances.empty() ? std::vector<Vector3d>{Vector3d::Zero()} : options.instances;
-  const Vector3d c0(centre[0], centre[1], centre[2]);
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const auto& p : occ.positions) lowest = std::min(lowest, double(p.y()));
-  double min_offset_y = inst[0].y();
-  Vector3d mean = Vector3d::Zero();
-  double spread = 0;
-  for (const auto& t : inst) {
-    min_offset_y = std::min(min_offset_y, t.y());
-    mean += t;
+  // The ground: 1% of the lowest copy's bounding radius below it, a square around the copies'
+  // centres reaching 4R past each.
+  double ground_y = std::numeric_limits<double>::infinity(), gap = 0;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const FivInstance& i : inst) {
+    const PlaceableOccluder& k = kinds.at(i.occluder);
+    if (k.lowest + i.offset.y() < ground_y) ground_y = k.lowest + i.offset.y(), gap = 0.01 * k.baked.radius;
+    mean += Eigen::Vector2d(k.baked.centre[0] + i.offset.x(), k.baked.centre[2] + i.offset.z());
   }
   mean /= double(inst.size());
-  for (const auto& t : inst) spread = std::max(spread, Eigen::Vector2d(t.x() - mean.x(), t.z() - mean.z()).norm());
-  const double ground_y = options.ground ? *options.ground : lowest + min_offset_y - 0.01 * R;
-  const double half = options.ground_size ? *options.ground_size : 4 * R + spread;
-
-  std::vector<bake::Mesh> parts = {view::ground_quad(ground_y, c0.x() + mean.x(), c0.z() + mean.z(), half)};
-  std::vector<shade::FivOccluder> occluders;
-  for (size_t k = 0; k < inst.size(); ++k) {
-    parts.push_back(view::translated(occ, inst[k], name + "#" + std::to_string(k)));
-    shade::FivOccluder o = baked.view;
-    for (int c = 0; c < 3; ++c) o.centre[c] = float(centre[size_t(c)] + inst[k][c]);
-    occluders.push_back(o);
-    scene.spheres.push_back({c0 + inst[k], R});
+  double half = 0;
+  for (const FivInstance& i : inst) {
+    const PlaceableOccluder& k = kinds.at(i.occluder);
+    const Eigen::Vector2d c(k.baked.centre[0] + i.offset.x(), k.baked.centre[2] + i.offset.z());
+    half = std::max(half, (c - mean).norm() + 4 * k.baked.radius);
   }
+  ground_y = options.ground ? *options.ground : ground_y - gap;
+  half = options.ground_size ? *options.ground_size : half;
+
+  std::vector<bake::Mesh> parts = {view::ground_quad(ground_y, mean.x(), mean.y(), half)};
+  std::vector<shade::FivOccluder> occluders;
+  std::vector<size_t> first_triangle;  // copy k owns [first_triangle[k], first_triangle[k + 1]) past the ground
+  size_t triangles = 0;
+  for (size_t k = 0; k < inst.size(); ++k) {
+    const PlaceableOccluder& kind = kinds.at(inst[k].occluder);
+    parts.push_back(view::translated(kind.mesh, inst[k].offset, inst[k].occluder + "#" + std::to_string(k)));
+    shade::FivOccluder o = kind.baked.view;
+    for (int c = 0; c < 3; ++c) o.centre[c] = float(kind.baked.centre[size_t(c)] + inst[k].offset[c]);
+    occluders.push_back(o);
+    const Vector3d c0(kind.baked.centre[0], kind.baked.centre[1], kind.baked.centre[2]);
+    scene.spheres.push_back({c0 + inst[k].offset, kind.baked.radius});
+    first_triangle.push_back(triangles);
+    triangles += kind.mesh.triangles.size();
+  }
+  first_triangle.push_back(triangles);
   scene.receiver_triangles = parts.front().triangles.size();
   scene.mesh = bake::merge_meshes(parts, "fiv scene");
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "FIV occluder '%s' (%s, shells %dx%dx%d, R %.4g), %zu cop%s, ground y = %.4g, half-size %.4g",
-                name.c_str(), mesh_path.c_str(), occluders[0].n_phi, occluders[0].n_theta, occluders[0].n_rho, R,
-                inst.size(), inst.size() == 1 ? "y" : "ies", ground_y, half);
+  char buf[512];
+  if (kinds.size() == 1) {
+    const auto& [name, kind] = *kinds.begin();
+    std::snprintf(buf, sizeof buf, "FIV occluder '%s' (%s, shells %dx%dx%d, R %.4g), %zu cop%s, ground y = %.4g, half-size %.4g",
+                  name.c_str(), kind.mesh_from.c_str(), kind.baked.view.n_phi, kind.baked.view.n_theta, kind.baked.view.n_rho,
+                  kind.baked.radius, inst.size(), inst.size() == 1 ? "y" : "ies", ground_y, half);
+  } else {
+    std::string list;
+    for (const auto& [name, kind] : kinds) {
+      const size_t copies = size_t(std::count_if(inst.begin(), inst.end(), [&](const FivInstance& i) { return i.occluder == name; }));
+      char one[160];
+      std::snprintf(one, sizeof one, "%s'%s' x%zu (shells %dx%dx%d, R %.4g)", list.empty() ? "" : ", ", name.c_str(), copies,
+                    kind.baked.view.n_phi, kind.baked.view.n_theta, kind.baked.view.n_rho, kind.baked.radius);
+      list += one;
+    }
+    std::snprintf(buf, sizeof buf, "FIV scene: %zu copies of %zu occluders (%s), ground y = %.4g, half-size %.4g", inst.size(),
+                  kinds.size(), list.c_str(), ground_y, half);
+  }
   scene.what = buf;
   scene.how = std::string("prt::shade::shade_fiv per pixel (overlap correction ") + (options.overlap ? "on" : "off") +
               ", partial-occluder factor " + (options.partial ? "on" : "off") +
               "), shade_fiv_member on the occluders (self-shadows minus the other copies' shadows)";
 
   const shade::FivShadeOptions opts{options.partial, options.overlap};
-  const size_t tri_per_copy = occ.triangles.size();
+  const auto frame_start = std::chrono::steady_clock::now();
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
-  return view::shade_pixels(scene.mesh, g, [&](const view::Fragment& fr, float* out) {
+  view::Image image = view::shade_pixels(scene.mesh, g, [&](const view::Fragment& fr, float* out) {
     const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
     const float n[3] = {float(fr.n.x()), float(fr.n.y()), float(fr.n.z())};
     float e[3];
     if (size_t(fr.triangle) < scene.receiver_triangles) {
       shade::shade_fiv(difmap, occluders.data(), int(occluders.size()), p, n, opts, e);
     } else {
-      const size_t k = (size_t(fr.triangle) - scene.receiver_triangles) / tri_per_copy;
+      const size_t t = size_t(fr.triangle) - scene.receiver_triangles;
+      const size_t k = size_t(std::upper_bound(first_triangle.begin(), first_triangle.end(), t) - first_triangle.begin()) - 1;
       shade::shade_fiv_member(env_fiv, occluders.data(), int(occluders.size()), int(k), p, n, options.partial, e);
     }
     for (int c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi);
   });
+  scene.frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+  return image;
 }
-
 
 void add_object(RenderScene& scene, const SceneObject& o) {
   const size_t T = o.mesh.triangles.size();

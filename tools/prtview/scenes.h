@@ -52,6 +52,9 @@ struct RenderScene {
   // objects with baked area_lights/irradiance (both --shade area and area-exact): what the file
   // says about the picture's brightness, the basis of its exposure.
   std::vector<float> baked_luminance;
+  // FIV views: the frame's cost, the rasterisation and the shading of every pixel (what an engine
+  // spends per frame; the file's reading and the meshes' loading are not in it).
+  double frame_seconds = 0;
 };
 
 // Log lines stay short whatever the scene: a list of names is cut to about `budget` characters
@@ -83,9 +86,19 @@ view::Image render_texel_file(const formats::Asset& f, const std::string& file, 
                               double env_rotate_degrees = 0);
 
 // FIV files: the occluder (copies at `instances`, default one where it was baked) on a ground square.
+// One copy of a baked occluder placed at run time, moved by `offset` from where it was baked
+// (paper 004's dynamic occluders: shells travel with their object). `occluder` names
+// /fiv/occluders/<name>; empty: --occluder, else the file's only one.
+struct FivInstance {
+  std::string occluder;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
 struct FivView {
   std::string occluder, occluder_mesh;
-  std::vector<Eigen::Vector3d> instances;
+  std::vector<FivInstance> instances;
+  // A scene file drawn as an FIV scene (--shade fiv or --instance/--instances on it): its objects
+  // with FIV shells are the occluders (default: each once where it was baked), on a ground plane.
+  bool scene = false;
   std::optional<double> ground, ground_size;
   bool overlap = true, partial = true;
 };
