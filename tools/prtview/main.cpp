@@ -834,8 +834,9 @@ int run(const Args& a) {
     else std::printf("view: %dx%d, framing %s; to adjust:\n  --camera %s\n", a.width, a.height, look.framed.c_str(), view::to_string(cam).c_str());
     std::printf("runtime (%.3f s): %s\n", runtime_seconds, scene.how.c_str());
     if (kind == "fiv")
-      std::printf("frame: %.4f s for %dx%d pixels on %d thread%s (rasterise + shade; reading the file and meshes not counted)\n",
-                  scene.frame_seconds, a.width, a.height, threads, threads == 1 ? "" : "s");
+      std::printf("frame: %.4f s wall, %.4f s CPU for %dx%d pixels on %d thread%s (rasterise + shade; reading the file and meshes "
+                  "not counted)\n",
+                  scene.frame_seconds, scene.frame_cpu_seconds, a.width, a.height, threads, threads == 1 ? "" : "s");
     if (reflect.bounces > 0 || reflect.albedo)
       std::printf("reference: %s (%s)\n", reflect.caption.c_str(), reflect.why.c_str());
     std::fflush(stdout);

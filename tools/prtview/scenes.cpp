@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <map>
@@ -396,6 +397,7 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
 
   const shade::FivShadeOptions opts{options.partial, options.overlap};
   const auto frame_start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   view::Image image = view::shade_pixels(scene.mesh, g, [&](const view::Fragment& fr, float* out) {
     const float p[3] = {float(fr.p.x()), float(fr.p.y()), float(fr.p.z())};
@@ -411,6 +413,7 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
     for (int c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi);
   });
   scene.frame_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frame_start).count();
+  scene.frame_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
   return image;
 }
 

@@ -55,6 +55,7 @@ struct RenderScene {
   // FIV views: the frame's cost, the rasterisation and the shading of every pixel (what an engine
   // spends per frame; the file's reading and the meshes' loading are not in it).
   double frame_seconds = 0;
+  double frame_cpu_seconds = 0;  // the same in CPU time over all threads (steady under load)
 };
 
 // Log lines stay short whatever the scene: a list of names is cut to about `budget` characters
