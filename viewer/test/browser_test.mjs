@@ -23,7 +23,7 @@
 //   sizes (0.012-0.029 measured). A wrong rotation, a shifted camera or a wrong formula shows as
 //   0.1 and more in both figures.
 // Also compared: glossy lobes by route B (a glossy statue, prtview --shade glossy, at the file's
-// Phong exponent and at 128) and two area lights (prtview --shade area). The bunny, baked with
+// Phong exponent and at 128) and two area lights with a spot and a sun (prtview --shade area). The bunny, baked with
 // band-1 radiance too, is compared in that mode as well (prtview --shade band1,
 // the same bounds); so is the bunny baked per texel (prtbake texel, a 256x256 lightmap), which
 // both draw per pixel from the lightmap. Also: a glb that is not one and a file without the product asked for show a message in the page
@@ -197,7 +197,8 @@ try {
   }
 
   if (!sweep) {
-    // Area lights: two quad lights of different colours over a box on a ground (the geometry of
+    // Area and punctual lights: two quad lights of different colours, a spot and a sun (punctual:
+    // hard shadows) over a box on a ground (the geometry of
     // tests/tools/test_scene_area_lights.cpp), both objects baked per vertex: against prtview
     // --shade area (E per light x its radiance x albedo / pi, Gouraud), and the page's default
     // exposure is prtview's (1 / the 99th percentile of the baked lighting, 4 digits).
@@ -213,7 +214,12 @@ try {
     fs.writeFileSync(path.join(d, 'scene.json'), JSON.stringify({
       prtbake_scene: 1, bake: { products: ['ao'], samples: 1024, report: 0 },
       lights: [{ name: 'key', shape: 'quad', centre: [0.7, 4, 0.3], u: [2, 0, 0], v: [0, 0, 2], radiance: [10, 9, 7] },
-               { name: 'fill', shape: 'quad', centre: [-3, 2, 0], u: [0, 0, 1.5], v: [0, 1.5, 0], radiance: [1, 2, 4] }],
+               { name: 'fill', shape: 'quad', centre: [-3, 2, 0], u: [0, 0, 1.5], v: [0, 1.5, 0], radiance: [1, 2, 4] },
+               // punctual lights (KHR_lights_punctual's kinds): stored as more columns, their
+               // intensity in place of a radiance, so the page recolours them the same way
+               { name: 'spot', shape: 'spot', position: [2.5, 3.5, 2], direction: [-0.55, -1, -0.45], inner_cone_angle: 12,
+                 outer_cone_angle: 30, intensity: [9, 7, 5] },
+               { name: 'sun', shape: 'directional', direction: [0.35, -1, 0.25], intensity: [0.3, 0.35, 0.45] }],
       objects: [{ mesh: 'ground.obj', role: 'both', material: { albedo: [0.6, 0.5, 0.4] } },
                 { mesh: 'box.obj', role: 'both', material: { albedo: [0.8, 0.8, 0.8] } }] }));
     const h5 = path.join(d, 'area.prt.h5');
