@@ -270,6 +270,9 @@ TEST(ScenePunctualLights, KhrLightsPunctualFromAGltfWithNodeTransforms) {
   const F::VertexSet& set = a.objects[0].set;
   ASSERT_TRUE(set.area_irradiance.has_value());
   EXPECT_EQ(set.area_irradiance->lights.value_or(""), "lamp\ncone\nsun");
+  EXPECT_NE(set.area_irradiance->integrand.value_or("").find("the last 3 columns (punctual lights"), std::string::npos)
+      << set.area_irradiance->integrand.value_or("");
+  EXPECT_EQ(set.area_irradiance->integrator.value_or(""), "punctual lights: one exact shadow ray each");
   for (const Vector3d& p : {Vector3d(0, 0, 0), Vector3d(1, 0, -2), Vector3d(-3, 0, 3)}) {
     const size_t v = vertex_at(set, p);
     EXPECT_NEAR(set.area_irradiance->values[v * 3 + 0], point_e(Vector3d(0.5, 2, 0), p), kFloat) << p.transpose();
@@ -293,6 +296,10 @@ TEST(ScenePunctualLights, GltfOptionsGiveABulbARadiusAndTheSunAnAngle) {
   EXPECT_EQ(a.find_light("cone")->shape, "spot");
   const F::VertexSet& set = a.objects[0].set;
   EXPECT_EQ(set.area_irradiance->lights.value_or(""), "lamp\nsun\ncone");  // area lights first
+  // The product says which columns are punctual and what their integrand is.
+  EXPECT_NE(set.area_irradiance->integrand.value_or("").find("the last column (punctual lights"), std::string::npos)
+      << set.area_irradiance->integrand.value_or("");
+  EXPECT_EQ(set.area_irradiance->integrator.value_or(""), "area lights: exact visible polygons (paper 003); punctual lights: one exact shadow ray each");
   // Far from the bulb and facing the sun, the extended lights give their punctual limits: the
   // icosphere's area deficit (0.5%) and the sun's disc (its cosine's spread over 0.27°).
   const F::Light& lamp = *a.find_light("lamp");

@@ -224,8 +224,10 @@ F::Light light_of(const bake::PunctualLight& light) {
 
 namespace {
 // area_lights/irradiance and, when sh_order > 0, area_lights/sh from rows [..][lights][1 + n²].
+// The last `punctual` columns are punctual lights (bake/lights/punctual.h): their integrands are
+// said too.
 void area_products(std::optional<F::Product>& irradiance, std::optional<F::Product>& sh, std::span<const double> rows,
-                   const std::vector<std::string>& names, int sh_order) {
+                   const std::vector<std::string>& names, int sh_order, size_t punctual) {
   const size_t n2 = size_t(sh_order) * size_t(sh_order), per_light = 1 + n2;
   auto product = [&](size_t offset, size_t count, std::string integrand) {
     F::Product p;
@@ -233,30 +235,41 @@ void area_products(std::optional<F::Product>& irradiance, std::optional<F::Produ
     for (size_t row = 0; row < rows.size(); row += per_light)
       for (size_t c = 0; c < count; ++c) p.values.push_back(float(rows[row + offset + c]));
     p.integrand = std::move(integrand);
-    p.integrator = "area lights: exact visible polygons (paper 003)";
+    p.integrator = punctual == 0 ? "area lights: exact visible polygons (paper 003)"
+                                 : punctual == names.size() ? "punctual lights: one exact shadow ray each"
+                                                            : "area lights: exact visible polygons (paper 003); punctual lights: one exact "
+                                                              "shadow ray each";
     p.visibility = kVisibilityLimit;
     p.lights = F::join_light_list(names);
     return p;
   };
-  irradiance = product(0, 1, "E_l = Int_{visible part of light l} max(n.w, 0) dw at unit radiance; diffuse "
-                             "outgoing radiance = albedo/pi sum_l radiance_l E_l");
+  const std::string last = punctual == 1 ? std::string("the last column") : "the last " + std::to_string(punctual) + " columns";
+  const std::string punctual_e = punctual == 0 ? std::string()
+                                               : "; " + last + " (punctual lights: /lights/<name> of shape point, spot or "
+                                                 "directional): V f_spot max(n.l, 0) / d^2 at unit intensity (directional: V "
+                                                 "max(n.l, 0)), l towards the light, V one shadow ray";
+  const std::string punctual_s = punctual == 0 ? std::string()
+                                               : "; " + last + " (punctual lights): V f_spot [n.l > 0] y_i(l) / d^2 at unit "
+                                                 "intensity (directional: without f_spot and d^2)";
+  irradiance = product(0, 1, "E_l = Int_{visible part of light l} max(n.w, 0) dw at unit radiance" + punctual_e +
+                                 "; diffuse outgoing radiance = albedo/pi sum_l radiance_l E_l");
   if (sh_order > 0) {
-    sh = product(1, n2, "S_l,i = Int_{visible part of light l above the horizon} y_i(w) dw at unit radiance");
+    sh = product(1, n2, "S_l,i = Int_{visible part of light l above the horizon} y_i(w) dw at unit radiance" + punctual_s);
     sh->sh_order = sh_order;
   }
 }
 } // namespace
 
 void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<std::string>& lights,
-                     int sh_order) {
-  area_products(set.area_irradiance, set.area_sh, rows, lights, sh_order);
+                     int sh_order, size_t punctual) {
+  area_products(set.area_irradiance, set.area_sh, rows, lights, sh_order, punctual);
 }
 
 void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<std::string>& lights,
-                              int sh_order) {
+                              int sh_order, size_t punctual) {
   PRT_CHECK(set.lightmap.has_value());
   PRT_CHECK_OP(image.width, ==, set.lightmap->width);
-  area_products(set.lightmap->area_irradiance, set.lightmap->area_sh, image.values, lights, sh_order);
+  area_products(set.lightmap->area_irradiance, set.lightmap->area_sh, image.values, lights, sh_order, punctual);
 }
 
 F::Report report_of(const bake::ErrorReport& report, double bake_seconds, size_t points, bool reproducible) {

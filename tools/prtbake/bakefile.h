@@ -54,9 +54,10 @@ void set_lightmap(F::VertexSet& set, const bake::Mesh& mesh, const bake::UvSet& 
                   uint32_t padding);
 
 // area_lights/irradiance and /sh per texel (lightmap/area_lights/...) from the lightmap image of
-// the area lights' rows (channels [lights][1 + n²]), into a set whose lightmap set_lightmap wrote.
+// the area lights' rows (channels [lights][1 + n²]), into a set whose lightmap set_lightmap wrote;
+// the last `punctual` of `lights` are punctual lights (their integrands are said too).
 void set_lightmap_area_lights(F::VertexSet& set, const bake::Lightmap& image, const std::vector<std::string>& lights,
-                              int sh_order);
+                              int sh_order, size_t punctual);
 
 // The lightmap image of the valid texels' rows of `texels` (LightmapReceivers::image: placed,
 // filled, padded `spec.padding` rings), its UV seams stitched unless `spec.stitch` is false
@@ -71,9 +72,10 @@ F::Light light_of(const bake::AreaLight& light);
 // `radiance`, position, direction, the spot's cone angles in radians).
 F::Light light_of(const bake::PunctualLight& light);
 // area_lights/irradiance [V][lights] and, when sh_order > 0, area_lights/sh [V][lights][n²] from
-// AreaLightIntegrator rows ([V][lights][1 + n²], bake/lights/area_bake.h); `lights` in column order.
+// AreaLightIntegrator rows ([V][lights][1 + n²], bake/lights/area_bake.h); `lights` in column order,
+// the last `punctual` of them punctual lights (bake/lights/punctual.h; their integrands are said too).
 void set_area_lights(F::VertexSet& set, const std::vector<double>& rows, const std::vector<std::string>& lights,
-                     int sh_order);
+                     int sh_order, size_t punctual);
 
 // The error report of a vertex bake: one row per product (rmse, max_abs, reference_rms,
 // bake_std_error, reference_std_error) and the vertices compared. Wall times are kept unless

@@ -284,9 +284,10 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
                             result.bounce_relative_std_error);
       }
       if (ob.area && ob.lightmap && area_images[i])
-        tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.light_names(), p.area_sh_order);
+        tool::set_lightmap_area_lights(obj.set, *area_images[i], scene.light_names(), p.area_sh_order,
+                                        scene.punctual_lights.size());
       else if (ob.area)
-        tool::set_area_lights(obj.set, *ob.area, scene.light_names(), p.area_sh_order);
+        tool::set_area_lights(obj.set, *ob.area, scene.light_names(), p.area_sh_order, scene.punctual_lights.size());
       if (ob.bounced_area) {
         bake::BounceSpec spec;
         spec.bounces = scene.bounces;
