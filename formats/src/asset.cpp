@@ -144,7 +144,8 @@ constexpr Field<Light> kLightFields[] = {
     {N::kPosition, &Light::position},
     {N::kDirection, &Light::direction},
     {N::kInnerConeAngle, &Light::inner_cone_angle},
-    {N::kOuterConeAngle, &Light::outer_cone_angle}};
+    {N::kOuterConeAngle, &Light::outer_cone_angle},
+    {N::kRange, &Light::range}};
 
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
 

@@ -353,6 +353,12 @@ public:
       if (!(inner >= 0 && inner < outer && outer <= std::numbers::pi / 2 + 1e-12))
         fail("group '" + g + "' needs 0 <= inner_cone_angle < outer_cone_angle <= pi/2");
     }
+    if (const Attr* a = find_attr(attrs, N::kRange)) {
+      const auto* v = std::get_if<double>(&a->value);
+      if (shape == "directional") fail("group '" + g + "' (a directional light) has a '" + std::string(N::kRange) + "': only point and spot lights have one");
+      if (v == nullptr || !std::isfinite(*v) || !(*v > 0))
+        fail("group '" + g + "' has attribute '" + std::string(N::kRange) + "' that is not a finite double > 0");
+    }
   }
 
   const std::string file_;

@@ -2,7 +2,7 @@
 // and of the LTC GGX polygon integral of runtime/include/prtshade/ltc.h (the contracts):
 //   float prt_spot_falloff(float cos_angle, float inner, float outer)      prt::shade::spot_falloff
 //   float prt_punctual_irradiance(int kind, vec3 position, vec3 direction, float inner, float outer,
-//                                 vec3 p, vec3 n)                       prt::shade::unshadowed_punctual
+//                                 float range, vec3 p, vec3 n)          prt::shade::unshadowed_punctual
 //   float prt_ltc_ggx(vec3 n, vec3 v, float alpha, float f0, uint first_arc, uint arc_count)
 //                      ltc::ggx_lobe(ggx_table(), n, v, alpha), ltc::integrate over the arcs, × scale(f0)
 // The formulas and numerics are in lights.inc, the body this file shares with lights.hlsl.

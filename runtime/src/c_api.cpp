@@ -391,6 +391,9 @@ prt_status prt_punctual_irradiance(const prt_punctual_light* light, const float 
     if (l.kind == prt::shade::PunctualKind::Spot)
       require(l.inner_cone >= 0 && l.inner_cone < l.outer_cone && l.outer_cone <= 1.5707963705062866,
               "cone angles need 0 <= inner < outer <= pi/2");
+    require(std::isfinite(light->range) && light->range >= 0, "range must be finite and >= 0 (0: none)");
+    require(light->range == 0 || l.kind != prt::shade::PunctualKind::Directional, "a directional light has no range");
+    l.range = light->range;
     const double r2 = double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2];
     require(std::isfinite(r2) && std::fabs(r2 - 1.0) <= 1e-4, "n is not unit length (to 1e-4)");
     *out = float(prt::shade::unshadowed_punctual(l, {p[0], p[1], p[2]}, {n[0], n[1], n[2]}));

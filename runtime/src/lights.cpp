@@ -15,6 +15,12 @@ double spot_falloff(double cos_angle, double inner_cone, double outer_cone) {
   return a * a;
 }
 
+double range_window(double distance, double range) {
+  if (!(range > 0)) return 1;
+  const double x = distance / range, x2 = x * x;
+  return std::clamp(1 - x2 * x2, 0.0, 1.0);
+}
+
 double unshadowed_punctual(const PunctualLight& light, const std::array<double, 3>& p, const std::array<double, 3>& n) {
   const auto& d = light.direction;
   const double dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -29,7 +35,7 @@ double unshadowed_punctual(const PunctualLight& light, const std::array<double, 
   const double l[3] = {t[0] / len, t[1] / len, t[2] / len};
   const double cosine = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
   if (!(cosine > 0)) return 0;
-  double w = 1 / d2;
+  double w = range_window(len, light.range) / d2;
   if (light.kind == PunctualKind::Spot) {
     if (!(dn > 0)) return 0;
     w *= spot_falloff(-(d[0] * l[0] + d[1] * l[1] + d[2] * l[2]) / dn, light.inner_cone, light.outer_cone);

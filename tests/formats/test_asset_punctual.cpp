@@ -37,7 +37,7 @@ Light punctual(const std::string& name, const std::string& shape) {
   l.radiance = {5, 4, 3};
   if (shape != "directional") l.position = std::vector<double>{0.25, 3, 0.125};
   if (shape != "point") l.direction = std::vector<double>{0, -1, 0};
-  if (shape == "spot") l.inner_cone_angle = 0.2, l.outer_cone_angle = 0.6;
+  if (shape == "spot") l.inner_cone_angle = 0.2, l.outer_cone_angle = 0.6, l.range = 7.5;  // KHR's optional range
   return l;
 }
 
@@ -113,4 +113,7 @@ TEST(AssetPunctual, ValidateRefusesBadPunctualLights) {
   edit("/lights/bulb", "position", std::string(), "group '/lights/bulb' (a point light) needs attribute 'position'");
   edit("/lights/sun", "direction", std::vector<double>{0, 0, 0}, "group '/lights/sun' has a zero direction");
   edit("/lights/cone", "outer_cone_angle", std::string(), "group '/lights/cone' (a spot light) needs attribute 'outer_cone_angle'");
+  edit("/lights/cone", "range", 0.0, "group '/lights/cone' has attribute 'range' that is not a finite double > 0");
+  edit("/lights/cone", "range", std::string("far"), "group '/lights/cone' has attribute 'range' that is not a finite double > 0");
+  edit("/lights/sun", "range", 10.0, "group '/lights/sun' (a directional light) has a 'range': only point and spot lights have one");
 }

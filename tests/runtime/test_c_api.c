@@ -232,10 +232,19 @@ int prt_c_check_lights(char* msg, size_t size) {
   CHECK_STATUS(prt_shade_lights(E, 2, 2, bad_emission, grey, 0, out), PRT_ERROR_INVALID_ARGUMENT);
 
   const float origin[3] = {0, 0, 0}, up[3] = {0, 0, 1}, side[3] = {2, 0, 0};
-  prt_punctual_light light = {PRT_PUNCTUAL_POINT, {0, 0, 2}, {0, 0, -1}, 0.2f, 0.6f};
+  prt_punctual_light light = {PRT_PUNCTUAL_POINT, {0, 0, 2}, {0, 0, -1}, 0.2f, 0.6f, 0.0f};
   float e = -1;
   CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
   CHECK_NEAR(e, 0.25, 1e-7, "point light: cos/d^2");
+  light.range = 4.0f; /* KHR's window at d = 2: 1 - (2/4)^4 = 15/16 */
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
+  CHECK_NEAR(e, 0.25 * 15 / 16, 1e-7, "point light with a range: the window");
+  light.range = 2.0f;
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
+  CHECK_NEAR(e, 0.0, 0.0, "point light at its range: 0");
+  light.range = -1.0f;
+  CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_ERROR_INVALID_ARGUMENT);
+  light.range = 0.0f;
   light.kind = PRT_PUNCTUAL_SPOT;
   CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_OK);
   CHECK_NEAR(e, 0.25, 1e-7, "spot on its axis");
@@ -244,6 +253,9 @@ int prt_c_check_lights(char* msg, size_t size) {
   light.kind = PRT_PUNCTUAL_DIRECTIONAL;
   CHECK_STATUS(prt_punctual_irradiance(&light, side, up, &e), PRT_OK);
   CHECK_NEAR(e, 1.0, 1e-7, "directional straight down");
+  light.range = 5.0f;
+  CHECK_STATUS(prt_punctual_irradiance(&light, side, up, &e), PRT_ERROR_INVALID_ARGUMENT);
+  light.range = 0.0f;
   light.kind = PRT_PUNCTUAL_SPOT;
   light.inner_cone_angle = 0.7f;
   CHECK_STATUS(prt_punctual_irradiance(&light, origin, up, &e), PRT_ERROR_INVALID_ARGUMENT);

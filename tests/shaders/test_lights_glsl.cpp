@@ -49,6 +49,7 @@ struct Case {
   int kind;
   float inner, outer, cos_angle;
   V3 position, direction, p;
+  float range = 0;  // point and spot: three in four have a range, from 0.6 to 1.6 times its distance
 };
 
 TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
@@ -96,6 +97,10 @@ TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
     c.position = as_float({2 * u(rng), 2 + u(rng), 2 * u(rng)});
     c.direction = as_float(random_unit());
     c.p = as_float({u(rng), u(rng), u(rng)});
+    if (c.kind != 0 && cases.size() % 4 != 0) {
+      const V3 to{c.position[0] - c.p[0], c.position[1] - c.p[1], c.position[2] - c.p[2]};
+      c.range = float(std::sqrt(dot(to, to)) * (0.6 + u01(rng)));
+    }
     cases.push_back(c);
   }
   const prt::shade::ltc::Table& table = prt::shade::ltc::ggx_table();
@@ -108,7 +113,7 @@ TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
                             float(c.first), float(c.count), float(c.kind), c.inner,
                             float(c.position[0]), float(c.position[1]), float(c.position[2]), c.outer,
                             float(c.direction[0]), float(c.direction[1]), float(c.direction[2]), c.cos_angle,
-                            float(c.p[0]), float(c.p[1]), float(c.p[2]), 0.0f};
+                            float(c.p[0]), float(c.p[1]), float(c.p[2]), c.range};
     in.insert(in.end(), rows, rows + 24);
   }
   auto b_table = prt::test::to_bytes(packed), b_arcs = prt::test::to_bytes(arcs), b_in = prt::test::to_bytes(in);
@@ -117,7 +122,7 @@ TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
   ASSERT_TRUE(prt::test::run_kernel(kernel("lights_eval"), {&b_table, &b_arcs, &b_in, &b_out}, prt::test::push_bytes(count), count));
   const auto out = prt::test::from_bytes<float>(b_out);
   double worst_ltc = 0;
-  size_t clipped = 0, lit = 0;
+  size_t clipped = 0, lit = 0, windowed = 0;
   for (size_t k = 0; k < cases.size(); ++k) {
     const Case& c = cases[k];
     namespace ltc = prt::shade::ltc;
@@ -138,8 +143,10 @@ TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
     l.direction = c.direction;
     l.inner_cone = c.inner;
     l.outer_cone = c.outer;
+    l.range = c.range;
     const double e = prt::shade::unshadowed_punctual(l, c.p, c.n);
     const V3 to{c.position[0] - c.p[0], c.position[1] - c.p[1], c.position[2] - c.p[2]};
+    windowed += c.range > 0 && e > 0 && prt::shade::range_window(std::sqrt(dot(to, to)), c.range) < 1;
     const double scale = c.kind == 0 ? 1 : 1 / dot(to, to);
     EXPECT_NEAR(out[4 * k + 1], e, kPunctualTolerance * (e + scale)) << language() << " punctual case " << k;
     const double f = prt::shade::spot_falloff(c.cos_angle, c.inner, c.outer);
@@ -148,6 +155,7 @@ TEST_P(LightsMirror, LtcPunctualAndFalloffMatchTheCore) {
   }
   EXPECT_GT(clipped, 0u) << "no case exercises the clip against the cosine space's horizon";
   EXPECT_GT(lit, cases.size() / 4) << "too few cases with a visible lobe";
+  EXPECT_GT(windowed, 16u) << "too few lit cases inside a range window";
   RecordProperty("worst_ltc_relative", std::to_string(worst_ltc));
   std::printf("%s: worst LTC difference %.3g (relative to 1 + |value|), %zu arc endpoints below the cosine horizon\n",
               language(), worst_ltc, clipped);

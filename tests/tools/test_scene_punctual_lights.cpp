@@ -7,6 +7,7 @@
 // a glTF's KHR_lights_punctual lights are read with their node transforms, and the options'
 // gltf_lights make a point light a sphere light and a directional light a sun disc; bad lights
 // are refused naming the file and the light.
+#include <bake/lights/punctual.h>
 #include <formats/asset.h>
 
 #include <gltf_builder.h>
@@ -198,6 +199,12 @@ TEST(ScenePunctualLights, BadLightsAreRefusedNamingTheFileAndTheLight) {
        "lights[0] (light \"nowhere\"): direction must not be zero"},
       {R"({"name": "typo", "shape": "point", "positon": [0, 1, 0], "intensity": [1, 1, 1]})",
        "unknown key \"positon\" in lights[0] (light \"typo\")"},
+      {R"({"name": "near", "shape": "point", "position": [0, 1, 0], "range": 0, "intensity": [1, 1, 1]})",
+       "lights[0].range must be > 0"},
+      {R"({"name": "bulb", "shape": "point", "position": [0, 1, 0], "radius": 0.1, "range": 5, "intensity": [1, 1, 1]})",
+       "lights[0] (light \"bulb\"): \"range\" is for a point light; with \"radius\" it is a sphere light, which has none"},
+      {R"({"name": "sunset", "shape": "directional", "direction": [0, -1, 0], "range": 5, "intensity": [1, 1, 1]})",
+       "unknown key \"range\" in lights[0] (light \"sunset\")"},
   };
   for (const Case& c : cases) {
     std::ofstream(d / "scene.json") << scene_text("\"lights\": [" + c.light + "]");
@@ -233,7 +240,7 @@ fs::path write_gltf(const fs::path& d, double inner = 0.2, double outer = 0.6) {
   g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   g.doc["extensions"] = {{"KHR_lights_punctual",
                           {{"lights",
-                            {{{"name", "lamp"}, {"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}, {"range", 40}},
+                            {{{"name", "lamp"}, {"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}, {"range", 3}},
                              {{"name", "cone"}, {"type", "spot"}, {"intensity", 50}, {"spot", {{"innerConeAngle", inner}, {"outerConeAngle", outer}}}},
                              {{"name", "sun"}, {"type", "directional"}, {"intensity", 3}}}}}}};
   g.node({{"name", "lamp_node"}, {"translation", {0.5, 2, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}, true);
@@ -251,7 +258,7 @@ TEST(ScenePunctualLights, KhrLightsPunctualFromAGltfWithNodeTransforms) {
   const auto r = prtbake(d, "scene '" + gltf.string() + "' -o '" + out.string() + "' -q --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find("not baked"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("light 0 (\"lamp\"): its range 40.000000 is not applied"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("range"), std::string::npos) << "the lamp's range is applied, nothing to warn of\n" << r.err;
   const F::Asset a = F::read_asset(out);
   ASSERT_EQ(a.lights.size(), 3u);
   const F::Light* lamp = a.find_light("lamp");
@@ -259,6 +266,7 @@ TEST(ScenePunctualLights, KhrLightsPunctualFromAGltfWithNodeTransforms) {
   EXPECT_EQ(lamp->shape, "point");
   EXPECT_EQ(lamp->radiance, (std::array<double, 3>{8, 4, 2}));
   EXPECT_EQ(*lamp->position, (std::vector<double>{0.5, 2, 0}));
+  EXPECT_EQ(lamp->range, 3.0);
   const F::Light* cone = a.find_light("cone");
   ASSERT_NE(cone, nullptr);
   EXPECT_NEAR((*cone->direction)[1], -1, 1e-15);
@@ -275,7 +283,10 @@ TEST(ScenePunctualLights, KhrLightsPunctualFromAGltfWithNodeTransforms) {
   EXPECT_EQ(set.area_irradiance->integrator.value_or(""), "punctual lights: one exact shadow ray each");
   for (const Vector3d& p : {Vector3d(0, 0, 0), Vector3d(1, 0, -2), Vector3d(-3, 0, 3)}) {
     const size_t v = vertex_at(set, p);
-    EXPECT_NEAR(set.area_irradiance->values[v * 3 + 0], point_e(Vector3d(0.5, 2, 0), p), kFloat) << p.transpose();
+    // The lamp's range of 3 (KHR's window clamp(1 - (d/3)^4, 0, 1)): 0.78 at the origin (d = 2.06),
+    // 0.16 at (1, 0, -2) (d = 2.87), 0 at (-3, 0, 3) (d = 5.02, beyond the range).
+    const double window = prt::bake::range_window((Vector3d(0.5, 2, 0) - p).norm(), 3);
+    EXPECT_NEAR(set.area_irradiance->values[v * 3 + 0], window * point_e(Vector3d(0.5, 2, 0), p), kFloat) << p.transpose();
     const Vector3d l = (Vector3d(0, 3, 0) - p).normalized();
     const double spot = spot_falloff(l.y(), 0.2, 0.6) * point_e(Vector3d(0, 3, 0), p);
     EXPECT_NEAR(set.area_irradiance->values[v * 3 + 1], spot, kFloat) << p.transpose();

@@ -219,6 +219,7 @@ F::Light light_of(const bake::PunctualLight& light) {
     l.inner_cone_angle = light.inner_cone;
     l.outer_cone_angle = light.outer_cone;
   }
+  if (light.range > 0) l.range = light.range;
   return l;
 }
 

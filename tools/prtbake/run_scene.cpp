@@ -45,7 +45,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
   Args file_args = a;  // the root attributes follow the scene file
   file_args.up = scene.up;
 
-  std::vector<std::string> warnings;
+  std::vector<std::string> warnings = scene.warnings;
   const std::vector<bake::Mesh> meshes = bake::load_scene_meshes(scene, warnings);
   print_warnings(warnings);
   bake::place_suns(scene, meshes);  // directional lights with an "angle": sun discs beyond the scene

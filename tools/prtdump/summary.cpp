@@ -67,6 +67,7 @@ void lights_text(std::ostream& os, const pf::Asset& a) {
       if (l.inner_cone_angle && l.outer_cone_angle)
         os << ", cone " << num(float(*l.inner_cone_angle * 180 / std::numbers::pi)) << " to "
            << num(float(*l.outer_cone_angle * 180 / std::numbers::pi)) << " degrees";
+      if (l.range) os << ", range " << num(*l.range);
       os << ", hard shadows\n";
       continue;
     }

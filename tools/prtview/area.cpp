@@ -68,6 +68,7 @@ std::vector<bake::PunctualLight> read_punctual_lights(const F::Asset& f) {
     p.intensity = l.radiance;
     p.inner_cone = l.inner_cone_angle.value_or(0);
     p.outer_cone = l.outer_cone_angle.value_or(p.outer_cone);
+    p.range = l.range.value_or(0);
     out.push_back(std::move(p));
   }
   return out;

@@ -222,6 +222,7 @@ struct Light {
   std::optional<int64_t> two_sided;  // 0 / 1; required by the schema for area lights
   std::optional<std::vector<double>> position, direction;    // punctual lights: 3 doubles each
   std::optional<double> inner_cone_angle, outer_cone_angle;  // spot lights
+  std::optional<double> range;                               // point and spot lights, when given (> 0)
   Array<double> vertices;            // [N][3]; area lights
   Array<uint32_t> face_sizes, face_indices;
   ExtraAttrs extra;  // of the group

@@ -113,6 +113,7 @@ inline constexpr std::string_view kPosition = "position";                // poin
 inline constexpr std::string_view kDirection = "direction";              // spot, directional: unit, where the light travels
 inline constexpr std::string_view kInnerConeAngle = "inner_cone_angle";  // spot: radians
 inline constexpr std::string_view kOuterConeAngle = "outer_cone_angle";  // spot: radians, > inner, <= pi/2
+inline constexpr std::string_view kRange = "range";                      // point, spot (optional): > 0, KHR's range
 // The shapes of punctual lights.
 inline constexpr std::string_view kPunctualShapes[] = {"point", "spot", "directional"};
 inline bool is_punctual_shape(std::string_view shape) {

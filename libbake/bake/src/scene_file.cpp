@@ -355,10 +355,11 @@ void parse_lights(const Reader& r, const Json& v, const std::string& file, Scene
         return Eigen::Vector3d(d.normalized());
       };
       if (kind == "point") {
-        allow({"position", "radius", "subdivisions"});
+        allow({"position", "radius", "subdivisions", "range"});
         p.kind = PunctualKind::Point;
         p.position = point("position");
         if (find_key(l, "radius")) {
+          if (find_key(l, "range")) r.fail(who + ": \"range\" is for a point light; with \"radius\" it is a sphere light, which has none");
           validate_punctual_light(p, file, who);
           AreaLight bulb = bulb_light(p, positive("radius"), count("subdivisions", 0, kMaxSphereSubdivisions, 3));
           validate_light(bulb, file, who);
@@ -367,7 +368,7 @@ void parse_lights(const Reader& r, const Json& v, const std::string& file, Scene
         }
         if (find_key(l, "subdivisions")) r.fail(who + ": \"subdivisions\" needs \"radius\" (a sphere light)");
       } else if (kind == "spot") {
-        allow({"position", "direction", "inner_cone_angle", "outer_cone_angle"});
+        allow({"position", "direction", "inner_cone_angle", "outer_cone_angle", "range"});
         p.kind = PunctualKind::Spot;
         p.position = point("position");
         p.direction = direction();
@@ -385,6 +386,7 @@ void parse_lights(const Reader& r, const Json& v, const std::string& file, Scene
           r.fail(who + ": \"segments\" needs \"angle\" (a sun disc)");
         }
       }
+      if (find_key(l, "range")) p.range = positive("range");
       validate_punctual_light(p, file, who);
       sc.punctual_lights.push_back(std::move(p));
       continue;
@@ -519,6 +521,7 @@ void add_gltf_lights(const std::filesystem::path& file, const std::vector<GltfLi
     for (size_t c = 0; c < 3; ++c) p.intensity[c] = g.color[c] * g.intensity;
     p.inner_cone = g.inner_cone;
     p.outer_cone = g.outer_cone;
+    if (p.kind != PunctualKind::Directional) p.range = g.range;  // the extension allows none on a directional light
     validate_punctual_light(p, file.string(), who);
     const auto it = given.find(name);
     if (it != given.end()) {
@@ -532,6 +535,9 @@ void add_gltf_lights(const std::filesystem::path& file, const std::vector<GltfLi
         const double rad = r.number(*radius, key + ".radius", 0, kHuge);
         if (!(rad > 0)) r.fail(key + ".radius must be > 0");
         const Json* sub = find_key(e, "subdivisions");
+        if (p.range > 0)
+          sc.warnings.push_back(who + ": its range " + std::to_string(p.range) + " is not applied: with a radius (" + key +
+                                ") it is a sphere light, whose light follows its size, not a window");
         AreaLight bulb = bulb_light(p, rad, sub ? int(r.integer(*sub, key + ".subdivisions", 0, kMaxSphereSubdivisions)) : 3);
         validate_light(bulb, file.string(), who);
         sc.lights.push_back(std::move(bulb));

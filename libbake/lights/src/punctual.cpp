@@ -29,6 +29,12 @@ double spot_falloff(double cos_angle, double inner_cone, double outer_cone) {
   return a * a;
 }
 
+double range_window(double distance, double range) {
+  if (!(range > 0)) return 1;
+  const double x = distance / range, x2 = x * x;
+  return std::clamp(1 - x2 * x2, 0.0, 1.0);
+}
+
 void validate_punctual_light(const PunctualLight& l, const std::string& file, const std::string& what) {
   auto fail = [&](const std::string& defect) { throw InputError(file, what + ": " + defect); };
   auto number = [](double x) {
@@ -41,6 +47,8 @@ void validate_punctual_light(const PunctualLight& l, const std::string& file, co
     if (!(std::isfinite(c) && c >= 0)) fail("intensity must be finite and >= 0, got " + number(c));
   if (!l.position.allFinite()) fail("position is not finite");
   if (!l.direction.allFinite() || !(l.direction.norm() > 0)) fail("direction must be a finite non-zero vector");
+  if (!(std::isfinite(l.range) && l.range >= 0)) fail("range must be finite and > 0, got " + number(l.range));
+  if (l.range > 0 && l.kind == PunctualKind::Directional) fail("a directional light has no range (point and spot lights do)");
   if (l.kind == PunctualKind::Spot) {
     constexpr double kRightAngle = std::numbers::pi / 2;
     if (!(std::isfinite(l.inner_cone) && l.inner_cone >= 0))
@@ -96,7 +104,7 @@ double PunctualLightIntegrator::direction_to(const ShadePoint& point, size_t lig
     return 0;
   }
   l = to / std::sqrt(d2);
-  double w = 1 / d2;
+  double w = range_window(std::sqrt(d2), light_.range) / d2;
   if (light_.kind == PunctualKind::Spot) w *= spot_falloff(light_.direction.dot(-l), light_.inner_cone, light_.outer_cone);
   return w;
 }

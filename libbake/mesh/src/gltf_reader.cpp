@@ -530,9 +530,6 @@ class Reader {
     out.inner_cone = l.spot.innerConeAngle;
     out.outer_cone = l.spot.outerConeAngle;
     out.range = l.range;
-    if (l.range > 0)
-      file_.warnings.push_back("light " + std::to_string(out.index) + " (\"" + l.name + "\"): its range " + std::to_string(l.range) +
-                               " is not applied (the inverse-square law is baked; a range is a runtime's culling hint)");
   }
 
   std::vector<GltfInstance> read_instances() {

@@ -7,9 +7,10 @@
 // directional light's its illuminance (lux), as /lights/<name>'s `radiance` attribute stores them.
 //
 // For a light the bake did not see (moved, added at run time), unshadowed_punctual gives the
-// same E without shadows, KHR_lights_punctual's conventions: E = f_spot · max(n·l, 0) / d²
+// same E without shadows, KHR_lights_punctual's conventions: E = w_range · f_spot · max(n·l, 0) / d²
 // (directional: max(n·l, 0)), f_spot the extension's smooth cone falloff
 //   f = clamp((cos∠(axis, −l) − cos outer) / max(0.001, cos inner − cos outer), 0, 1)²
+// and w_range its recommended range window clamp(1 − (d/range)⁴, 0, 1) (1 without a range)
 // exactly as libbake computes it (bake/lights/punctual.h), so a baked light and one shaded live
 // agree wherever nothing shadows.
 //
@@ -29,10 +30,14 @@ struct PunctualLight {
   std::array<double, 3> position{0, 0, 0};   // point, spot
   std::array<double, 3> direction{0, -1, 0};  // spot, directional: where the light travels (unit)
   double inner_cone = 0, outer_cone = 0.7853981633974483;  // spot, radians
+  double range = 0;                                         // point, spot: > 0, or 0 for none (infinite)
 };
 
 // KHR_lights_punctual's angular attenuation at cos_angle = cos∠(axis, −l) (file comment).
 double spot_falloff(double cos_angle, double inner_cone, double outer_cone);
+
+// KHR_lights_punctual's recommended range window at distance d ≥ 0 (file comment); 1 when range is 0.
+double range_window(double distance, double range);
 
 // E at (p, n) (n unit) from `light` at unit intensity, unshadowed (file comment); 0 at the
 // light's own position.

@@ -164,16 +164,19 @@ typedef enum prt_punctual_kind {
   PRT_PUNCTUAL_POINT = 1,
   PRT_PUNCTUAL_SPOT = 2
 } prt_punctual_kind;
-/* A punctual light as /lights/<name> stores it (radians; direction: where the light travels). */
+/* A punctual light as /lights/<name> stores it (radians; direction: where the light travels;
+ * range: its `range`, or 0 when it has none). */
 typedef struct prt_punctual_light {
   int kind; /* prt_punctual_kind */
   float position[3];
   float direction[3];
   float inner_cone_angle, outer_cone_angle;
+  float range;
 } prt_punctual_light;
-/* *out = E at (p, n) from the light at unit intensity, unshadowed (KHR_lights_punctual's falloff
- * and inverse-square law; the baked E where nothing shadows); n unit (to 1e-4). A spot needs
- * 0 <= inner < outer <= pi/2. */
+/* *out = E at (p, n) from the light at unit intensity, unshadowed (KHR_lights_punctual's falloff,
+ * inverse-square law and recommended range window clamp(1 - (d/range)^4, 0, 1); the baked E where
+ * nothing shadows); n unit (to 1e-4). A spot needs 0 <= inner < outer <= pi/2; range must be finite
+ * and >= 0 (0: none), and 0 for a directional light. */
 prt_status prt_punctual_irradiance(const prt_punctual_light* light, const float p[3], const float n[3], float* out);
 
 /* *out = the LTC approximation of ∫_P f_GGX F (n·ω) dω over the region P bounded by `count` great

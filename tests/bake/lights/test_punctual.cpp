@@ -102,6 +102,46 @@ TEST(Punctual, APointLightOverAPlaneIsIntensityCosineOverDistanceSquared) {
   EXPECT_EQ(row_of(below, scene.floor(0, 0))[0], 0.0);
 }
 
+TEST(Punctual, ARangeIsKhrLightsPunctualsWindowAndZeroFromTheRangeOn) {
+  // KHR_lights_punctual's recommended window clamp(1 - (d/range)^4, 0, 1): the closed form over the
+  // plane, exactly 0 at and beyond the range, and the light untouched without one.
+  EXPECT_EQ(range_window(5, 0), 1.0);
+  EXPECT_EQ(range_window(0, 2), 1.0);
+  EXPECT_EQ(range_window(1, 2), 1 - 1.0 / 16);
+  EXPECT_EQ(range_window(2, 2), 0.0);
+  EXPECT_EQ(range_window(7, 2), 0.0);
+  const Scene scene;
+  const Vector3d x(0.7, -1.3, 2.5);
+  PunctualLight light = point_light(x);
+  light.range = 4;
+  PunctualLight cone = spot(x, Vector3d(0.1, 0.2, -1), 0.3, 0.9);
+  cone.range = 3.5;
+  const std::vector<PunctualLight> lights = {light, cone};
+  const PunctualLightIntegrator integ(lights, scene.rays.get(), Vector3d::Zero(), 2);
+  size_t inside = 0, beyond = 0;
+  for (double px : {-4.0, -2.5, 0.0, 0.5, 1.5, 3.0})
+    for (double py : {-3.5, -1.0, 0.0, 4.0}) {
+      const ShadePoint s = scene.floor(px, py);
+      const Vector3d to = x - s.p;
+      const double d = to.norm(), cos_theta = to.z() / d;
+      const double w = std::clamp(1 - std::pow(d / 4, 4), 0.0, 1.0);
+      const std::vector<double> row = row_of(integ, s);
+      EXPECT_NEAR(row[0], w * cos_theta / (d * d), kRounding) << px << " " << py;
+      const double f = spot_falloff(cone.direction.normalized().dot(-to / d), 0.3, 0.9);
+      const double wc = std::clamp(1 - std::pow(d / 3.5, 4), 0.0, 1.0);
+      EXPECT_NEAR(row[5], wc * f * cos_theta / (d * d), kRounding) << px << " " << py;
+      EXPECT_NEAR(row[1], w * 0.28209479177387814 / (d * d), kRounding) << px << " " << py;  // S_0 = w y_0 / d^2
+      inside += w > 0 && w < 1;
+      if (d >= 4) {
+        ++beyond;
+        EXPECT_EQ(row[0], 0.0);
+        for (size_t i = 0; i < 4; ++i) EXPECT_EQ(row[1 + i], 0.0);
+      }
+    }
+  EXPECT_GT(inside, 6u);
+  EXPECT_GT(beyond, 2u);
+}
+
 TEST(Punctual, TheSpotFalloffIsKhrLightsPunctualsAtItsConeEdges) {
   const double inner = 0.3, outer = 0.5;
   EXPECT_EQ(spot_falloff(std::cos(outer), inner, outer), 0.0);
@@ -249,7 +289,15 @@ TEST(Punctual, BadLightsAreInputErrorsNamingTheFileAndTheLight) {
   l.intensity[1] = 1;
   l.position.x() = std::nan("");
   EXPECT_NE(message(l).find("position is not finite"), std::string::npos) << message(l);
+  l.position.x() = 0;
+  l.range = -1;
+  EXPECT_NE(message(l).find("range must be finite and > 0, got -1"), std::string::npos) << message(l);
+  l.range = std::numeric_limits<double>::infinity();
+  EXPECT_NE(message(l).find("range must be finite"), std::string::npos) << message(l);
   PunctualLight d = directional(Vector3d(0, 0, -1));
+  d.range = 10;
+  EXPECT_NE(message(d).find("a directional light has no range"), std::string::npos) << message(d);
+  d.range = 0;
   d.direction = Vector3d::Zero();
   EXPECT_NE(message(d).find("direction must be a finite non-zero vector"), std::string::npos) << message(d);
 }
@@ -295,9 +343,10 @@ TEST(Punctual, ABulbAndASunDiscApproachTheirPunctualLimits) {
 TEST(Punctual, TheRuntimesUnshadowedLightIsTheBakesWhereNothingShadows) {
   // prtshade/lights.h evaluates a light the bake did not see: where nothing occludes it gives the
   // baked E (the same formula, the same falloff), for every kind, at points all around the light.
-  const std::vector<PunctualLight> lights = {point_light(Vector3d(0.3, 2, -0.4)),
-                                             spot(Vector3d(-1, 3, 0.5), Vector3d(0.2, -1, 0.1), 0.25, 0.7),
-                                             directional(Vector3d(-0.3, -1, 0.6))};
+  std::vector<PunctualLight> lights = {point_light(Vector3d(0.3, 2, -0.4)), point_light(Vector3d(0.3, 2, -0.4)),
+                                       spot(Vector3d(-1, 3, 0.5), Vector3d(0.2, -1, 0.1), 0.25, 0.7),
+                                       directional(Vector3d(-0.3, -1, 0.6))};
+  lights[1].range = 3;  // the same bulb with KHR's range window
   const PunctualLightIntegrator integ(lights, nullptr, Vector3d::Zero(), 0);
   for (int k = 0; k < 64; ++k) {
     ShadePoint s;
@@ -311,6 +360,7 @@ TEST(Punctual, TheRuntimesUnshadowedLightIsTheBakesWhereNothingShadows) {
       r.direction = {lights[l].direction.x(), lights[l].direction.y(), lights[l].direction.z()};
       r.inner_cone = lights[l].inner_cone;
       r.outer_cone = lights[l].outer_cone;
+      r.range = lights[l].range;
       const double e = prt::shade::unshadowed_punctual(r, {s.p.x(), s.p.y(), s.p.z()}, {s.n.x(), s.n.y(), s.n.z()});
       EXPECT_NEAR(row[l], e, kRounding * std::max(1.0, e)) << k << " " << l;
     }

@@ -40,7 +40,9 @@
 //              | "directional", "direction",     where the light travels; with "angle" (degrees, the
 //                                                angular diameter, "segments": 64): a sun disc (sun_light)
 //       "intensity": [r,g,b]                     required, ≥ 0: candela (lux for directional), the
-//                                                factor of its E as an area light's radiance is
+//                                                factor of its E as an area light's radiance is;
+//       "range": r                               point (without radius) and spot: > 0, KHR's range
+//                                                window (bake/lights/punctual.h); default none
 //     } ],                                       (also in a glTF scene's options file)
 //     "objects": [ {                             one or more
 //       "name": "bunny",                         optional: default the mesh file's stem; unique
@@ -221,6 +223,9 @@ struct SceneDescription {
   // with an "angle" stays here until place_suns makes it a sun disc in `lights`.
   std::vector<PunctualLight> punctual_lights;
   std::vector<SceneObject> objects;
+  // What the reading found worth saying but not refusing, one line each (a glTF light's range on
+  // a light the options give a radius); the tools print them.
+  std::vector<std::string> warnings;
 
   // Every light's name in the light products' column order: `lights`, then `punctual_lights`.
   std::vector<std::string> light_names() const;

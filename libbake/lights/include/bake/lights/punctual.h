@@ -15,9 +15,13 @@
 // f_spot is KHR_lights_punctual's angular attenuation (its "Inner and Outer Cone Angles"):
 //   scale = 1 / max(0.001, cos(inner) − cos(outer)),  offset = −cos(outer) · scale,
 //   f = clamp(cos∠(direction, −l) · scale + offset, 0, 1)²
-// so f = 0 at and outside the outer cone, 1 inside the inner cone, smooth between. Range
-// (KHR's optional "range") is not applied: the inverse-square law is exact, and a range cut-off
-// is a runtime's culling hint.
+// so f = 0 at and outside the outer cone, 1 inside the inner cone, smooth between.
+//
+// Range (KHR's optional "range", point and spot lights only): the light "must be considered zero"
+// at and beyond it, and within it follows the inverse-square law "as closely as possible"; the
+// extension's recommended window is applied, so a baked light matches an engine that follows it:
+//   w_range(d) = clamp(1 − (d/range)⁴, 0, 1)   (no range: 1),   E = V · w_range · f_spot · max(n·l, 0) / d²
+// (the window is 0.94 at half the range, 0.34 at 0.9 of it, 0 from the range on).
 //
 // Visibility V is ONE shadow ray from the shade point in direction l, in the ε-limit of the exact
 // ray cast (bake/visibility/raycast.h: the point's own 1-ring and its near triangles decided by the
@@ -59,6 +63,7 @@ struct PunctualLight {
   Eigen::Vector3d direction{0, -1, 0};  // unit, world space: where the light travels (spot axis, sun rays); glTF: the node's −Z
   // Per channel: colour × intensity, candela (point, spot) or lux (directional) in glTF's units.
   std::array<double, 3> intensity{1, 1, 1};
+  double range = 0;                               // point, spot: KHR's "range" (> 0), 0: none (infinite)
   double inner_cone = 0;                          // spot, radians: 0 ≤ inner < outer
   double outer_cone = std::numbers::pi / 4;       // spot, radians: 0 < outer ≤ π/2 (glTF's defaults)
   // A directional light with an angular size (scene files' "angle", glTF options): a sun, baked
@@ -69,10 +74,14 @@ struct PunctualLight {
 
 // KHR_lights_punctual's angular attenuation (the file comment) at cos_angle = cos∠(axis, −l).
 double spot_falloff(double cos_angle, double inner_cone, double outer_cone);
+// KHR_lights_punctual's recommended range window (the file comment) at distance d ≥ 0; 1 when
+// range is 0 (none).
+double range_window(double distance, double range);
 
 // Throws InputError(`file`, "<what>: <defect>") unless the light is valid: finite position,
-// a non-zero finite direction (normalised by the parsers), intensities finite and ≥ 0, and for a
-// spot 0 ≤ inner < outer ≤ π/2 (KHR_lights_punctual's ranges).
+// a non-zero finite direction (normalised by the parsers), intensities finite and ≥ 0, for a
+// spot 0 ≤ inner < outer ≤ π/2 (KHR_lights_punctual's ranges), a range finite and ≥ 0 (0: none),
+// and none on a directional light.
 void validate_punctual_light(const PunctualLight& light, const std::string& file, const std::string& what);
 
 // LIGHTS WITH AN EXTENT: a point light given a radius, a directional light given an angular size,
@@ -82,7 +91,7 @@ void validate_punctual_light(const PunctualLight& light, const std::string& file
 // about the position, of radiance I/(π r²) per channel: a sphere of radiance L is seen in every
 // direction with intensity π r² L, so beyond the bulb it matches the point light (to the
 // icosphere's area deficit, 0.48% at 3 subdivisions). A spot keeps its point: its cone is no
-// property of a constant-radiance emitter.
+// property of a constant-radiance emitter, nor is a range (the callers say so when one is given).
 AreaLight bulb_light(const PunctualLight& point, double radius, int subdivisions);
 //
 // A sun: a disc light (make_disc_light, `segments`-gon) facing the scene, centred at
@@ -117,8 +126,8 @@ public:
   // out[l·per_light()] = E_l, out[l·per_light() + 1 + i] = S_l,i (file comment). Thread-safe.
   void integrate(const ShadePoint& point, std::span<double> out) const;
 
-  // The unit direction l from the point to light `light` and its unshadowed weight w (f_spot / d²
-  // or 1; 0 when the point is at the light), so E = V · w · max(n·l, 0). For callers that shade
+  // The unit direction l from the point to light `light` and its unshadowed weight w (w_range ·
+  // f_spot / d², or 1; 0 when the point is at the light), so E = V · w · max(n·l, 0). For callers that shade
   // something else with it (a GGX lobe).
   double direction_to(const ShadePoint& point, size_t light, Eigen::Vector3d& l) const;
   // V for that direction (1 without occluders). Thread-safe.

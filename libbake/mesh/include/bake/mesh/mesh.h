@@ -235,7 +235,7 @@ struct GltfLight {
   std::array<double, 3> color{1, 1, 1};
   double intensity = 1;
   double inner_cone = 0, outer_cone = 0.7853981633974483;  // spot, radians (the extension's defaults)
-  double range = 0;                                        // 0: none given (not applied: bake/lights/punctual.h)
+  double range = 0;                                        // 0: none given (applied: bake/lights/punctual.h)
 };
 struct MeshInstances {
   std::vector<MeshInstance> instances;
