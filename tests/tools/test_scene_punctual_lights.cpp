@@ -300,6 +300,8 @@ TEST(ScenePunctualLights, GltfOptionsGiveABulbARadiusAndTheSunAnAngle) {
   std::ofstream(d / "options.json") << R"({"prtbake_gltf_scene": 1, "gltf_lights": {"lamp": {"radius": 0.05}, "sun": {"angle": 0.53}}})";
   const auto r = prtbake(d, "scene '" + gltf.string() + "' --options '" + (d / "options.json").string() + "' -o '" + out.string() + "' -q");
   ASSERT_EQ(r.code, 0) << r.err;
+  // The glTF lamp's range cannot window a sphere light: said, not dropped silently.
+  EXPECT_NE(r.err.find("\"lamp\" (node lamp_node): its range 3.000000 is not applied: with a radius"), std::string::npos) << r.err;
   const F::Asset a = F::read_asset(out);
   ASSERT_EQ(a.lights.size(), 3u);
   EXPECT_EQ(a.find_light("lamp")->shape, "sphere");
