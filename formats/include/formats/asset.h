@@ -187,7 +187,17 @@ struct OccluderValid {
   bool operator==(const OccluderValid&) const = default;
 };
 
+// /fiv/occluders/<name>/surface_radius (v7): r_surf per shell direction, [Ntheta][Nphi].
+struct OccluderSurfaceRadius {
+  std::vector<float> values;
+  std::optional<std::string> meaning;
+  ExtraAttrs extra;
+  bool operator==(const OccluderSurfaceRadius&) const = default;
+};
+
 // /fiv/occluders/<name>: FIVs on shells around an occluder's bounding sphere, and its report.
+// radial_scheme (v7) "surface": radii are offsets from the surface and surface_radius is there;
+// absent or "geometric": radii are the shell radii (SCHEMA.md).
 struct Occluder {
   std::string name;
   int n_rho = 0, n_theta = 0, n_phi = 0;
@@ -198,8 +208,11 @@ struct Occluder {
   std::optional<std::string> environment, environment_sha256, integrand, angular_convention, grid;
   std::optional<double> fraction;
   std::optional<int64_t> samples;  // silhouette k
+  std::optional<std::string> radial_scheme;  // (v7)
+  std::optional<double> first_offset;        // (v7) τ_0 / radius of the surface scheme
   ExtraAttrs extra;                // of the shells dataset
   std::optional<OccluderValid> valid;
+  std::optional<OccluderSurfaceRadius> surface_radius;  // (v7)
   std::optional<ReportRow> report;  // /report/fiv/<name> (its product is the name)
   bool operator==(const Occluder&) const = default;
 };
