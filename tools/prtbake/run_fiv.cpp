@@ -163,12 +163,13 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
   if (run.say) {
     std::printf("environment FIV and %dx%dx6 DifMap in %.2f s%s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds,
                 sharded ? " (both in the chunks)" : "");
-    std::printf("shells: %dx%dx%zu %s (of %d requested %s, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
-                "integrals/s)\n",
-                a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(),
-                std::string(bake::radial_scheme_name(shells.radial)).c_str(), a.shell_spec.n_rho,
-                shells.radial == bake::RadialScheme::surface ? "offsets from the surface" : "radii", shells.radii.front(),
-                shells.radii.back(), shells.radius, shells.seconds, double(shells.integrals) / shells.seconds);
+    const bool surface = shells.radial == bake::RadialScheme::surface;
+    std::printf("shells: %dx%dx%zu (of %d requested; %s scheme: %s %.3g to %.3g%s; bounding radius %.4g) in %.2f s "
+                "(%.0f integrals/s)\n",
+                a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho,
+                std::string(bake::radial_scheme_name(shells.radial)).c_str(), surface ? "offsets" : "radii",
+                shells.radii.front(), shells.radii.back(), surface ? " from the surface" : "", shells.radius,
+                shells.seconds, double(shells.integrals) / shells.seconds);
     if (shells.extrapolated > 0)
       std::printf("%zu samples found inside the occluder, extrapolated along their radial lines\n", shells.extrapolated);
   }
