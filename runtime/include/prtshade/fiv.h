@@ -38,9 +38,9 @@
 // as the shell samples, so r_s is continuous in the direction), τ = ρ − r_s; τ <= τ_0 clamps to
 // the first shell (offsets inside the outer hull), τ >= τ_last returns the last shell's value
 // times ((r_s + τ_last)/ρ)²; between, k0 = ⌊log(τ/τ_0)/log g⌋ (the closed-form inverse of the
-// grading, from a polynomial log2 and corrected against the stored radii so that float rounding
-// cannot pick the wrong bracket), fr = (τ − τ_k0)/(τ_k0+1 − τ_k0), and plain trilinear over the 8
-// neighbours: samples the bake found inside the occluder were extrapolated outwards along their
+// grading, its log2 estimated from the floats' bits to within 0.09, then the bracket moved against
+// the stored radii, so that neither the estimate nor rounding picks a wrong one),
+// fr = (τ − τ_k0)/(τ_k0+1 − τ_k0), and plain trilinear over the 8 neighbours: samples the bake found inside the occluder were extrapolated outwards along their
 // radial line (bake/bake/fiv.h), so there is no valid mask to renormalise by (valid is not read;
 // it may be null). At a grid direction the stored samples come back (up to float rounding of the
 // angles and of τ); the lookup is continuous everywhere (r_s and τ ↦ (k, fr) are continuous).
