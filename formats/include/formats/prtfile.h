@@ -175,7 +175,9 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersion when it holds a punctual light (a
+// The format_version write_file gives `file`: kFormatVersion when it holds surface-following FIV
+// shells (an occluder's surface_radius dataset, or a shells dataset with a radial_scheme or
+// first_offset attribute), else kFormatVersionWithPunctualLights when it holds a punctual light (a
 // /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps when a
 // dataset of it is of a version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
 int64_t written_format_version(const File& file);
