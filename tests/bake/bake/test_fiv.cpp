@@ -1,5 +1,6 @@
 // FIV products (bake/bake/fiv.h, paper 004 §3–4.2) against quadrature, QMC and closed forms.
 #include <bake/bake/fiv.h>
+#include <bake/bake/scene.h>
 #include <bake/core/error.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
@@ -12,6 +13,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <random>
@@ -448,4 +451,29 @@ TEST(FivSurface, SphereUnderAUniformSkyMatchesTheClosedForm) {
     }
   }
   std::printf("runtime lookup: largest |F - closed form| / bound = %.2g\n", worst);
+}
+
+// Scene files choose the scheme with bake.fiv.radial (bake/bake/scene.h); the default follows the
+// surface, and anything but "surface" or "geometric" is an input error naming the key.
+TEST(FivSurface, SceneFilesChooseTheRadialScheme) {
+  const std::filesystem::path dir = std::filesystem::path(PRT_TEST_TMP) / "fiv_scene_radial";
+  std::filesystem::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& bake) {
+    const std::filesystem::path p = dir / name;
+    std::ofstream(p) << R"({"prtbake_scene": 1, "bake": )" << bake << R"(, "objects": [{"role": "receiver", "mesh": ")"
+                     << (std::filesystem::path(PRT_DATA_DIR) / "bunny.obj").string() << R"("}]})";
+    return p;
+  };
+  EXPECT_EQ(load_scene(write("default.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.radial,
+            RadialScheme::surface);
+  EXPECT_EQ(load_scene(write("geometric.json", R"({"fiv": {"radial": "geometric"}})"), std::nullopt).fiv.radial,
+            RadialScheme::geometric);
+  EXPECT_EQ(load_scene(write("surface.json", R"({"fiv": {"radial": "surface"}})"), std::nullopt).fiv.radial,
+            RadialScheme::surface);
+  try {
+    load_scene(write("bad.json", R"({"fiv": {"radial": "spheres"}})"), std::nullopt);
+    ADD_FAILURE() << "\"spheres\" accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bake.fiv.radial"), std::string::npos) << e.what();
+  }
 }
