@@ -12,6 +12,10 @@
 //   BM_ShadeFiv/occluders:N         shade_fiv, 4096 receivers per iteration, both corrections on
 //   BM_ShadeFivReference/occluders:N  the slow reference on the same inputs
 //   BM_ShadeFivNoOverlap/occluders:N  shade_fiv without the overlap correction (its pair-loop share)
+//   BM_ShadeFivSurface/occluders:N  shade_fiv on the same scene with surface-following shells
+//                                   (prtshade/fiv.h "Surface-following shells", issue 33): the
+//                                   same samples, r_surf random in [0.3, 0.9] R, offsets τ_k
+//                                   0.005 R … 16 R geometric, no valid mask
 //
 // Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
 // "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
@@ -146,11 +150,11 @@ BENCHMARK(BM_ShadeBand1);
 
 struct FivScene {
   int n_phi = 64, n_theta = 33, n_rho = 30;
-  std::vector<float> radii, shells, cube, positions;
+  std::vector<float> radii, shells, cube, positions, surface, offsets;
   std::vector<uint8_t> valid;
   std::vector<prt::shade::FivOccluder> occluders;
 
-  explicit FivScene(int count) {
+  explicit FivScene(int count, bool surface_scheme = false) {
     std::mt19937 rng(42);
     std::uniform_real_distribution<float> u01(0, 1);
     for (int k = 0; k < n_rho; ++k) radii.push_back(0.5f * std::pow(32.0f, float(k) / float(n_rho - 1)));
@@ -165,6 +169,16 @@ struct FivScene {
       const float c[3] = {40 * u01(rng) - 20, 5.5f * u01(rng) - 1.5f, 40 * u01(rng) - 20};
       occluders.push_back({{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()});
     }
+    if (surface_scheme) {  // drawn after everything above, so the scene is the same
+      for (int k = 0; k < n_rho; ++k) offsets.push_back(0.005f * std::pow(3200.0f, float(k) / float(n_rho - 1)));
+      surface.resize(size_t(n_theta) * size_t(n_phi));
+      for (float& r : surface) r = 0.3f + 0.6f * u01(rng);
+      for (prt::shade::FivOccluder& o : occluders) {
+        o.radial_scheme = prt::shade::kFivRadialSurface;
+        o.radii = offsets.data();
+        o.surface_radius = surface.data();
+      }
+    }
     for (int p = 0; p < kItems; ++p) {
       positions.push_back(40 * u01(rng) - 20);
       positions.push_back(0);
@@ -175,9 +189,9 @@ struct FivScene {
 
 enum class FivPath { fast, reference };
 
-template <FivPath kPath, bool kOverlap = true>
+template <FivPath kPath, bool kOverlap = true, bool kSurface = false>
 void shade_fiv_case(benchmark::State& state) {
-  const FivScene scene(int(state.range(0)));
+  const FivScene scene(int(state.range(0)), kSurface);
   const prt::shade::DifMap map{32, scene.cube.data()};
   const float n[3] = {0, 1, 0};
   const prt::shade::FivShadeOptions options{true, kOverlap};
@@ -202,6 +216,8 @@ void BM_ShadeFivNoOverlap(benchmark::State& state) { shade_fiv_case<FivPath::fas
 BENCHMARK(BM_ShadeFiv)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivReference)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivNoOverlap)->ArgName("occluders")->Arg(10)->Arg(100);
+void BM_ShadeFivSurface(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true>(state); }
+BENCHMARK(BM_ShadeFivSurface)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 
 } // namespace
 

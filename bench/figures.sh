@@ -78,6 +78,7 @@ SUNSET=data/sunset.exr
 BUNNY=data/bunny.obj
 
 # ---- Figure 12: the bunny's shadow on the ground under forest.exr at three shell resolutions ----
+# (prtbake's default radial scheme: shells that follow the surface, issue 33)
 for s in 32x17x15 64x33x30 256x129x30; do
   run "$BAKE" fiv "$BUNNY" --env "$FOREST" --shells "$s" --report 0 --quiet -o "$work/bunny_$s.prt.h5"
 done
@@ -85,14 +86,19 @@ CAM12="eye=0,26,24:at=0,0,1:fov=45"
 paper12=(0.023 0.008 0.007)
 i=0
 for s in 32x17x15 64x33x30 256x129x30; do
-  view "Fig. 12: bunny shadow, shells $s (forest.exr)" "${paper12[$i]}" "$images/fig12_$s.png" \
+  view "Fig. 12: bunny shadow, shells $s following the surface (forest.exr)" "${paper12[$i]}" "$images/fig12_$s.png" \
     "$work/bunny_$s.prt.h5" --camera "$CAM12" --samples "$RAYS_FIG12" --reference-cache "$work/ref_fig12_$SIZE.exr"
   i=$((i + 1))
 done
-# Diagnostic: three times the radial shells at the 64x33 angular grid (what limits the contact shadow).
-run "$BAKE" fiv "$BUNNY" --env "$FOREST" --shells 64x33x90 --report 0 --quiet -o "$work/bunny_64x33x90.prt.h5"
-view "Fig. 12 diagnostic: shells 64x33x90 (3x the radii)" "-" "$images/fig12_64x33x90.png" \
-  "$work/bunny_64x33x90.prt.h5" --camera "$CAM12" --samples "$RAYS_FIG12" --reference-cache "$work/ref_fig12_$SIZE.exr"
+# The same memory with paper 004's spheres (--radial geometric), and the partial-occluder factor's
+# share of what is left (the bounding sphere's (h + R)/2R scales the whole ground shadow).
+run "$BAKE" fiv "$BUNNY" --env "$FOREST" --shells 64x33x30 --radial geometric --report 0 --quiet \
+  -o "$work/bunny_64x33x30_geometric.prt.h5"
+view "Fig. 12: shells 64x33x30 on paper 004's spheres (--radial geometric)" "0.008" "$images/fig12_64x33x30_geometric.png" \
+  "$work/bunny_64x33x30_geometric.prt.h5" --camera "$CAM12" --samples "$RAYS_FIG12" --reference-cache "$work/ref_fig12_$SIZE.exr"
+view "Fig. 12 diagnostic: shells 64x33x30 following the surface, partial-occluder factor off" "-" \
+  "$images/fig12_64x33x30_no_partial.png" "$work/bunny_64x33x30.prt.h5" --camera "$CAM12" --no-partial \
+  --samples "$RAYS_FIG12" --reference-cache "$work/ref_fig12_$SIZE.exr"
 
 # ---- two overlapping occluders, overlap correction on / off (paper 004 eq. 13-14, Fig. 15) ----
 CAM2="eye=0,30,30:at=0,0,1:fov=50"
@@ -165,13 +171,15 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   cat <<'NOTES'
 ## Reading the numbers
 
-- **Figure 12.** The coarse grid (32x17x15) is where the paper is (0.023); from 64x33x30 on, the
-  error no longer falls with the angular resolution: what is left is the contact shadow within
-  about one unit of the bunny's base (the error panels), where the occluded FIV varies on the
-  scale of the 0.07-unit gap between bunny and ground while the trilinear lookup interpolates
-  between shells ~0.6 units apart and drops the samples that fall inside the bunny (§4.3.2).
-  Three times the radial shells (64x33x90, diagnostic row) helps only a little. Away from the
-  base the runtime shadow matches the ray-traced one to the reference's own noise.
+- **Figure 12.** The shells follow the surface (issue 33; prtshade/fiv.h "Surface-following
+  shells"): each direction's samples start 0.005 R outside the bunny's outer surface along the
+  ray and grow geometrically, so the contact shadow within the 0.07-unit gap is sampled where
+  paper 004's spheres (~0.6 units apart there, their samples inside the bunny dropped, §4.3.2)
+  could not; the error falls with resolution again. At equal memory the spheres' row (64x33x30,
+  --radial geometric) shows the gain. Most of what is left is the partial-occluder factor: the
+  bunny's bounding sphere (R = 6.64, centre 4.8 above the ground) puts every ground receiver in
+  case B, and (h + R)/2R = 0.86 scales the whole shadow down; the diagnostic row without the
+  factor is the shells' own error (the rest: the ears' thin shadows at 64x33 directions).
 - **Overlap correction (eq. 13-14).** Here it makes things worse. The unit bounding discs are
   the bunnies' bounding spheres (R = 6.64, while the bunny is 9.65 tall and 7.5 deep), so from
   the ground between the two bunnies the discs overlap far more than the occluded parts of the

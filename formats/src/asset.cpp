@@ -135,7 +135,9 @@ constexpr Field<Occluder> kShellsFields[] = {
     {N::kAngularConvention, &Occluder::angular_convention},
     {N::kFraction, &Occluder::fraction},
     {N::kSamples, &Occluder::samples},
-    {N::kGrid, &Occluder::grid}};
+    {N::kGrid, &Occluder::grid},
+    {N::kRadialScheme, &Occluder::radial_scheme},
+    {N::kFirstOffset, &Occluder::first_offset}};
 
 constexpr Field<Light> kLightFields[] = {
     {N::kShape, &Light::shape},
@@ -148,6 +150,7 @@ constexpr Field<Light> kLightFields[] = {
     {N::kRange, &Light::range}};
 
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
+constexpr Field<OccluderSurfaceRadius> kSurfaceRadiusFields[] = {{N::kMeaning, &OccluderSurfaceRadius::meaning}};
 
 constexpr Field<SceneInfo> kSceneFields[] = {
     {N::kSceneFile, &SceneInfo::scene_file},
@@ -318,6 +321,9 @@ void add_occluder(File& f, const Occluder& o) {
   if (o.valid)
     add_array(f, cat(dir, N::kValid), grid, o.valid->values,
               attrs_of<OccluderValid>(*o.valid, kValidFields, o.valid->extra));
+  if (o.surface_radius)
+    add_array(f, cat(dir, N::kSurfaceRadius), {grid[1], grid[2]}, o.surface_radius->values,
+              attrs_of<OccluderSurfaceRadius>(*o.surface_radius, kSurfaceRadiusFields, o.surface_radius->extra));
   if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
 }
 
@@ -534,6 +540,13 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
       c.size = int(d.shape[1]);
       c.values = values<float>(d);
       take_attrs<IrradianceCube>(c, kCubeFields, d.attrs, c.extra);
+      break;
+    }
+    case DatasetKind::occluder_surface_radius: {
+      const std::string_view rest = after(d.path, occluders_dir);
+      Occluder& o = named(a.occluders, rest.substr(0, rest.find('/')));
+      o.surface_radius.emplace().values = values<float>(d);
+      take_attrs<OccluderSurfaceRadius>(*o.surface_radius, kSurfaceRadiusFields, d.attrs, o.surface_radius->extra);
       break;
     }
     case DatasetKind::occluder_shells:

@@ -85,7 +85,7 @@ std::string allowed_paths() {
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
          std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
-         std::string(N::kShells) + "," + std::string(N::kValid) + "}, " + std::string(N::kLights) + "/<name>/{" +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "," + std::string(N::kSurfaceRadius) + "}, " + std::string(N::kLights) + "/<name>/{" +
          std::string(N::kLightVertices) + "," + std::string(N::kLightFaceSizes) + "," +
          std::string(N::kLightFaceIndices) + "} and anything under " +
          std::string(N::kReport) + "/";
@@ -195,6 +195,7 @@ public:
     if (path.starts_with(occluders) && p.size() == split_path(N::kOccluders).size() + 2) {
       if (p.back() == N::kShells) return Kind::occluder_shells;
       if (p.back() == N::kValid) return Kind::occluder_valid;
+      if (p.back() == N::kSurfaceRadius) return Kind::occluder_surface_radius;
     }
     if (path.starts_with(std::string(N::kLights) + "/") && p.size() == split_path(N::kLights).size() + 2) {
       if (p.back() == N::kLightVertices) return Kind::light_vertices;
@@ -405,9 +406,18 @@ bool is_lightmap_kind(DatasetKind kind) {
 }
 
 int64_t written_format_version(const File& file) {
+  // Version 7: surface-following FIV shells (a surface_radius dataset, or the shells' radial_scheme
+  // or first_offset attribute).
+  if (std::any_of(file.datasets.begin(), file.datasets.end(), [](const Dataset& d) {
+        const Kind k = dataset_kind(d.path);
+        return k == Kind::occluder_surface_radius ||
+               (k == Kind::occluder_shells &&
+                (find_attr(d.attrs, N::kRadialScheme) != nullptr || find_attr(d.attrs, N::kFirstOffset) != nullptr));
+      }))
+    return kFormatVersion;
   if (std::any_of(file.group_attrs.begin(), file.group_attrs.end(),
                   [](const auto& g) { return is_punctual_group(g.first, g.second); }))
-    return kFormatVersion;
+    return kFormatVersionWithPunctualLights;
   const bool lightmap = std::any_of(file.datasets.begin(), file.datasets.end(),
                                     [](const Dataset& d) { return is_lightmap_kind(dataset_kind(d.path)); });
   return lightmap ? kFormatVersionWithLightmaps : kFormatVersionWithoutLightmaps;
@@ -466,6 +476,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
              std::to_string(version) + ")");
     if (is_lightmap_kind(k) && version < 5)
       c.fail("dataset '" + d.path + "' is a lightmap's, which needs format_version 5 (the file says " +
+             std::to_string(version) + ")");
+    if (k == Kind::occluder_surface_radius && version < 7)
+      c.fail("dataset '" + d.path + "' is a surface-following shell grid's, which needs format_version 7 (the file says " +
              std::to_string(version) + ")");
     kinds.push_back(k);
     prefixes.push_back(std::move(prefix));
@@ -684,13 +697,53 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
         c.fail("dataset '" + d.path + "' needs attribute '" + std::string(N::kRadii) + "': Nr = " +
                std::to_string(d.shape[0]) + " doubles (shell radii)");
       shells[d.path.substr(0, d.path.size() - N::kShells.size())] = &d;  // the occluder's directory + "/"
+      const Attr* scheme = find_attr(d.attrs, N::kRadialScheme);
+      const Attr* first = find_attr(d.attrs, N::kFirstOffset);
+      if ((scheme || first) && version < 7)
+        c.fail("dataset '" + d.path + "' has attribute '" + std::string(scheme ? N::kRadialScheme : N::kFirstOffset) +
+               "', which needs format_version 7 (the file says " + std::to_string(version) + ")");
+      const auto* sv = scheme ? std::get_if<std::string>(&scheme->value) : nullptr;
+      if (scheme && (sv == nullptr || (*sv != "geometric" && *sv != "surface")))
+        c.fail("dataset '" + d.path + "' attribute '" + std::string(N::kRadialScheme) +
+               "' must be the string \"geometric\" or \"surface\"");
+      const auto* fv = first ? std::get_if<double>(&first->value) : nullptr;
+      if (first && (fv == nullptr || !(*fv > 0) || !std::isfinite(*fv)))
+        c.fail("dataset '" + d.path + "' attribute '" + std::string(N::kFirstOffset) + "' must be a finite double > 0");
+      for (std::size_t q = 0; rv && sv && *sv == "surface" && q < rv->size(); ++q)
+        if (!((*rv)[q] > 0) || !std::isfinite((*rv)[q]) || (q > 0 && !((*rv)[q] > (*rv)[q - 1])))
+          c.fail("dataset '" + d.path + "' attribute '" + std::string(N::kRadii) +
+                 "' (offsets from the surface) must be finite, > 0 and increasing");
+      const bool surface = sv && *sv == "surface";
+      const std::string surface_path = d.path.substr(0, d.path.size() - N::kShells.size()) + std::string(N::kSurfaceRadius);
+      const bool has_surface = std::any_of(file.datasets.begin(), file.datasets.end(),
+                                           [&](const Dataset& e) { return e.path == surface_path; });
+      if (surface != has_surface)
+        c.fail(surface ? "dataset '" + d.path + "' has radial_scheme \"surface\" but no '" + surface_path + "' beside it"
+                       : "dataset '" + surface_path + "' needs radial_scheme \"surface\" on '" + d.path + "'");
       break;
     }
+    case Kind::occluder_surface_radius:
+      break;
     case Kind::occluder_valid:
     case Kind::report:
     case Kind::unknown:
       break;
     }
+  }
+  for (std::size_t i = 0; i < file.datasets.size(); ++i) {
+    const Dataset& d = file.datasets[i];
+    if (kinds[i] != Kind::occluder_surface_radius) continue;
+    c.dtype(d, 0);
+    const auto it = shells.find(d.path.substr(0, d.path.size() - N::kSurfaceRadius.size()));
+    if (it == shells.end())
+      c.fail("dataset '" + d.path + "' has no '" + std::string(N::kShells) + "' dataset beside it");
+    const auto& s = it->second->shape;
+    c.shape(d, {s[1], s[2]}, "[Ntheta, Nphi] of its shells");
+    const auto& r = std::get<std::vector<float>>(d.data);
+    for (std::size_t j = 0; j < r.size(); ++j)
+      if (!std::isfinite(r[j]) || r[j] < 0)
+        c.fail("dataset '" + d.path + "' must hold finite distances >= 0, not " + std::to_string(r[j]) + " at index " +
+               std::to_string(j));
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];

@@ -19,11 +19,16 @@
 //   PRT_FIV_OCCLUDERS_BINDING (2)  PrtFivOccluder prt_fiv_occluders[]   one per occluder, 48 bytes:
 //        struct PrtFivOccluder {          // std430 offsets
 //          vec4  centre_radius;           //  0: centre xyz (world), w = bounding radius R (> 0)
-//          ivec4 dims;                    // 16: n_rho (>= 1), n_theta (>= 2), n_phi (>= 1), unused
+//          ivec4 dims;                    // 16: n_rho (>= 1), n_theta (>= 2), n_phi (>= 1),
+//                                         //     radial scheme (0 geometric, 1 surface: prtshade/fiv.h)
 //          uvec4 offsets;                 // 32: first radius in prt_fiv_radii (floats),
 //        };                               //     first value in prt_fiv_shells (floats),
-//                                         //     first WORD in prt_fiv_valid (uints), unused
+//                                         //     first WORD in prt_fiv_valid (uints),
+//                                         //     surface scheme: first r_surf in prt_fiv_radii
 //   PRT_FIV_RADII_BINDING (3)      float prt_fiv_radii[]    each occluder's n_rho radii, increasing
+//                                  (surface scheme: the offsets τ_k from the surface), and for the
+//                                  surface scheme its [n_theta][n_phi] surface_radius (anywhere:
+//                                  offsets.w; the valid mask is then not read)
 //   PRT_FIV_SHELLS_BINDING (4)     float prt_fiv_shells[]   each occluder's [n_rho][n_theta][n_phi]
 //                                  [RGB][xyz] floats exactly as in /fiv/occluders/<name>/shells
 //   PRT_FIV_VALID_BINDING (5)      uint prt_fiv_valid[]     each occluder's uint8 valid mask

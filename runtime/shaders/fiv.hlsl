@@ -19,9 +19,10 @@
 // and descriptors are fiv.glsl's (see its header comment for every field):
 //   PRT_FIV_OCCLUDERS_BINDING (2)  StructuredBuffer<PrtFivOccluder> prt_fiv_occluders   48 bytes each:
 //        struct PrtFivOccluder { float4 centre_radius; int4 dims; uint4 offsets; }
-//        (centre xyz + bounding radius; n_rho, n_theta, n_phi, unused; first radius, first shell
-//        float, first valid WORD, unused)
+//        (centre xyz + bounding radius; n_rho, n_theta, n_phi, radial scheme (0 geometric, 1
+//        surface); first radius, first shell float, first valid WORD, first surface radius)
 //   PRT_FIV_RADII_BINDING (3)      StructuredBuffer<float> prt_fiv_radii    each occluder's radii
+//        (surface scheme: offsets from the surface) and, surface scheme, its surface_radius
 //   PRT_FIV_SHELLS_BINDING (4)     StructuredBuffer<float> prt_fiv_shells   [n_rho][n_theta][n_phi][RGB][xyz]
 //   PRT_FIV_VALID_BINDING (5)      StructuredBuffer<uint> prt_fiv_valid     the uint8 valid masks
 //        packed 4 per uint, little-endian, each occluder's from a word boundary

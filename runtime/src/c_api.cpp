@@ -31,6 +31,8 @@ static_assert(sizeof(prt_fiv_occluder_desc) == sizeof(prt::shade::FivOccluder));
 static_assert(offsetof(prt_fiv_occluder_desc, radius) == offsetof(prt::shade::FivOccluder, radius));
 static_assert(offsetof(prt_fiv_occluder_desc, n_phi) == offsetof(prt::shade::FivOccluder, n_phi));
 static_assert(offsetof(prt_fiv_occluder_desc, valid) == offsetof(prt::shade::FivOccluder, valid));
+static_assert(offsetof(prt_fiv_occluder_desc, radial_scheme) == offsetof(prt::shade::FivOccluder, radial_scheme));
+static_assert(offsetof(prt_fiv_occluder_desc, surface_radius) == offsetof(prt::shade::FivOccluder, surface_radius));
 
 struct prt_glossy {
   explicit prt_glossy(int order) : table(order) {}
@@ -46,7 +48,7 @@ namespace {
 
 // Owning copy of one occluder's arrays (its view lives in prt_fiv_scene::views).
 struct OwnedOccluder {
-  std::vector<float> radii, shells;
+  std::vector<float> radii, shells, surface_radius;
   std::vector<uint8_t> valid;
 };
 
@@ -258,17 +260,24 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
                               occluder->n_phi,
                               occluder->radii,
                               occluder->shells,
-                              occluder->valid};
+                              occluder->valid,
+                              occluder->radial_scheme,
+                              occluder->surface_radius};
     prt::shade::validate_occluder(v);
     require(scene->views.size() < size_t(1) << 30, "too many occluders");
     auto own = std::make_unique<OwnedOccluder>();
     const size_t samples = size_t(v.n_rho) * size_t(v.n_theta) * size_t(v.n_phi);
     own->radii.assign(v.radii, v.radii + v.n_rho);
     own->shells.assign(v.shells, v.shells + samples * 9);
-    own->valid.assign(v.valid, v.valid + samples);
+    // The surface scheme reads no valid mask (it may be null): an all-ones one stands in.
+    if (v.valid != nullptr) own->valid.assign(v.valid, v.valid + samples);
+    else own->valid.assign(samples, 1);
+    if (v.radial_scheme == prt::shade::kFivRadialSurface)
+      own->surface_radius.assign(v.surface_radius, v.surface_radius + size_t(v.n_theta) * size_t(v.n_phi));
     v.radii = own->radii.data();
     v.shells = own->shells.data();
     v.valid = own->valid.data();
+    v.surface_radius = own->surface_radius.empty() ? nullptr : own->surface_radius.data();
     scene->views.reserve(scene->views.size() + 1);
     scene->owned.push_back(std::move(own));
     scene->views.push_back(v);

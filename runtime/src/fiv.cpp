@@ -121,7 +121,12 @@ std::string value_text(float x) {
 } // namespace
 
 void validate_occluder(const FivOccluder& o) {
-  PRT_SHADE_REQUIRE(o.radii != nullptr && o.shells != nullptr && o.valid != nullptr, "occluder with a null array");
+  PRT_SHADE_REQUIRE(o.radial_scheme == kFivRadialGeometric || o.radial_scheme == kFivRadialSurface,
+                    "occluder radial scheme " + std::to_string(o.radial_scheme) + ": must be 0 (geometric) or 1 (surface)");
+  const bool surface = o.radial_scheme == kFivRadialSurface;
+  PRT_SHADE_REQUIRE(o.radii != nullptr && o.shells != nullptr && (surface || o.valid != nullptr) &&
+                        (!surface || o.surface_radius != nullptr),
+                    "occluder with a null array");
   PRT_SHADE_REQUIRE(o.n_rho >= 1 && o.n_theta >= 2 && o.n_phi >= 1,
                     "occluder grid " + std::to_string(o.n_rho) + "x" + std::to_string(o.n_theta) + "x" +
                         std::to_string(o.n_phi) + " (rho x theta x phi): need n_rho >= 1, n_theta >= 2, n_phi >= 1");
@@ -141,6 +146,21 @@ void validate_occluder(const FivOccluder& o) {
   for (size_t i = 0; i < n; ++i)
     PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]) && std::fabs(o.shells[i]) <= kFivValueLimit,
                       "shell value " + std::to_string(i) + " = " + value_text(o.shells[i]) + value_limit_text);
+  if (!surface) return;
+  const size_t directions = size_t(o.n_theta) * size_t(o.n_phi);
+  for (size_t i = 0; i < directions; ++i)
+    PRT_SHADE_REQUIRE(std::isfinite(o.surface_radius[i]) && o.surface_radius[i] >= 0 &&
+                          o.surface_radius[i] <= kFivValueLimit,
+                      "surface radius " + std::to_string(i) + " = " + value_text(o.surface_radius[i]) +
+                          ": must be finite, >= 0 and <= 2^64");
+  // The lookup inverts τ_k = τ_0 g^k in closed form: the offsets must be that grading.
+  const int last = o.n_rho - 1;
+  for (int k = 1; k < last; ++k) {
+    const double expected = double(o.radii[0]) * std::pow(double(o.radii[last]) / o.radii[0], double(k) / last);
+    PRT_SHADE_REQUIRE(std::fabs(double(o.radii[k]) - expected) <= 1e-4 * expected,
+                      "surface-scheme offset " + std::to_string(k) + " = " + value_text(o.radii[k]) +
+                          ": the offsets must grow geometrically (tau_k = tau_0 g^k)");
+  }
 }
 
 void validate_difmap(const DifMap& map) {
@@ -229,10 +249,70 @@ inline void add_weighted_fiv(float acc[9], float w, const float* v) {
 #endif
 }
 
+// log2(x) for a positive normal float, within 0.09: the bits of x read as an integer are
+// 2^23 (e + 127 + m − 1) for x = 2^e m, m ∈ [1, 2), and m − 1 differs from log2 m by at most
+// 0.0861. Only estimates a shell bracket that is then checked against the stored offsets.
+inline float approx_log2(float x) { return float(std::bit_cast<int32_t>(x)) * (1.0f / 8388608.0f) - 127.0f; }
+
+// The surface scheme's lookup (header comment "Surface-following shells") at grid coordinates
+// t (θ) and u (φ) and distance ρ: r_s bilinear, τ = ρ − r_s, the bracket of τ by the closed-form
+// inverse of the grading, plain trilinear (no valid mask).
+void sample_surface_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+  const int i0 = std::min(int(t), occ.n_theta - 2);
+  const float ft = t - float(i0);
+  const int ju = std::min(int(u), occ.n_phi);
+  const float fu = u - float(ju);
+  const int j0 = ju % occ.n_phi, j1 = (ju + 1) % occ.n_phi;
+  const size_t np = size_t(occ.n_phi);
+  const float* rs0 = occ.surface_radius + size_t(i0) * np;
+  const float* rs1 = rs0 + np;
+  const float wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  const float r_s = wi[0] * (wj[0] * rs0[j0] + wj[1] * rs0[j1]) + wi[1] * (wj[0] * rs1[j0] + wj[1] * rs1[j1]);
+  const double tau = rho - double(r_s);
+  const float* tk = occ.radii;
+  const int last = occ.n_rho - 1;
+  int k0 = 0, k1 = 0;
+  float fr = 0, falloff = 1;
+  if (!(tau > tk[0]) || last == 0) {  // inside the first shell (NaN too): clamped
+    if (last == 0 && tau > tk[0]) falloff = float(((double(r_s) + tk[0]) / rho) * ((double(r_s) + tk[0]) / rho));
+  } else if (tau >= tk[last]) {
+    k0 = k1 = last;
+    const double q = (double(r_s) + tk[last]) / rho;
+    falloff = float(q * q);
+  } else {
+    // τ_k = τ_0 g^k: k = log2(τ/τ_0) / log2(g), log2 g = log2(τ_last/τ_0) / last, each log2 within
+    // 0.09 (approx_log2); then the bracket moved against the stored offsets, a step or two at most
+    // unless g is within a few percent of 1.
+    const float log2_first = approx_log2(tk[0]);
+    const float kf = (approx_log2(float(tau)) - log2_first) * float(last) / (approx_log2(tk[last]) - log2_first);
+    k0 = std::clamp(int(kf), 0, last - 1);
+    while (k0 > 0 && tau < tk[k0]) --k0;
+    while (k0 < last - 1 && tau >= tk[k0 + 1]) ++k0;
+    k1 = k0 + 1;
+    fr = clamp_nan_safe(float((tau - tk[k0]) / (double(tk[k1]) - tk[k0])), 0.0f, 1.0f);
+  }
+  const float wk[2] = {1 - fr, fr};
+  const size_t nt = size_t(occ.n_theta);
+  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
+                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
+  const size_t js[2] = {size_t(j0), size_t(j1)};
+  const int layers = k1 == k0 ? 1 : 2;
+  float acc[9] = {};
+  for (int a = 0; a < layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) add_weighted_fiv(acc, wk[a] * wi[b] * wj[c], occ.shells + (rows[a][b] + js[c]) * 9);
+  for (int e = 0; e < 9; ++e) out[e] = acc[e] * falloff;
+}
+
 // The trilinear lookup of the shells at grid coordinates t (θ), u (φ) and distance ρ (header
 // comment): ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside;
-// neighbours with valid == 0 at weight 0 and the rest renormalised.
+// neighbours with valid == 0 at weight 0 and the rest renormalised. Surface-scheme occluders go
+// to sample_surface_shells.
 void sample_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+  if (occ.radial_scheme == kFivRadialSurface) {
+    sample_surface_shells(occ, t, u, rho, out);
+    return;
+  }
   const int i0 = std::min(int(t), occ.n_theta - 2);
   const float ft = t - float(i0);
   const int ju = std::min(int(u), occ.n_phi);

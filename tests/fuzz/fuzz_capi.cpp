@@ -279,6 +279,15 @@ void Program::add_occluder() {
   std::vector<uint8_t> valid(array_size(cells));
   for (uint8_t& v : valid) v = in_.ConsumeIntegralInRange<uint8_t>(0, 2);
   d.radii = maybe_null(radii), d.shells = maybe_null(shells), d.valid = maybe_null(valid);
+  // Sometimes the surface-following scheme (and sometimes a bad scheme): its surface radii.
+  std::vector<float> surface;
+  if (in_.ConsumeBool()) {
+    d.radial_scheme = small_int(-1, 2);
+    const double directions = std::fabs(double(d.n_theta) * d.n_phi);
+    if (too_big(directions)) return;
+    surface = floats(array_size(directions));
+    d.surface_radius = maybe_null(surface);
+  }
   int index = -7;
   const prt_status status = prt_fiv_scene_add_occluder(null_pointer() ? nullptr : scene_, null_pointer() ? nullptr : &d,
                                                        in_.ConsumeBool() ? &index : nullptr);

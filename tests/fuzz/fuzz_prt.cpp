@@ -53,6 +53,11 @@ void check_layout(const prt::shade::LoadedAsset& a) {
     require(o.n_rho > 0 && o.n_theta > 0 && o.n_phi > 0, "occluder grid sizes > 0");
     require(o.radii.size() == size_t(o.n_rho) && o.shells.size() == 9 * cells, "radii [Nrho], shells [..][3][3]");
     require(o.valid.empty() || o.valid.size() == cells, "valid [Nrho][Ntheta][Nphi]");
+    require(o.radial_scheme == prt::shade::kFivRadialGeometric
+                ? o.surface_radius.empty()
+                : o.radial_scheme == prt::shade::kFivRadialSurface &&
+                      o.surface_radius.size() == size_t(o.n_theta) * size_t(o.n_phi),
+            "surface_radius [Ntheta][Nphi] exactly for the surface scheme");
   }
   a.difmap();
   a.occluder_views();

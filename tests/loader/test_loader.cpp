@@ -97,6 +97,10 @@ TEST(Loader, ArraysAndViewsMatchTheFile) {
   EXPECT_EQ(o.radii, (std::vector<float>{0.375f, 1.5f}));
   EXPECT_EQ(o.grid, "theta from +Y, phi from +Z towards +X");
   EXPECT_EQ(o.valid[5], 0);
+  // No radial_scheme attribute (every file before version 7): paper 004's spheres.
+  EXPECT_EQ(o.radial_scheme, prt::shade::kFivRadialGeometric);
+  EXPECT_TRUE(o.surface_radius.empty());
+  EXPECT_EQ(o.view().surface_radius, nullptr);
 
   // Shading with the loaded views equals shading with views of the original arrays.
   const auto& shells = std::get<std::vector<float>>(f.datasets[8].data);
@@ -114,6 +118,41 @@ TEST(Loader, ArraysAndViewsMatchTheFile) {
   float b1[3];
   prt::shade::shade_band1(v->normals.data() + 6, v->radiance_band1.data() + 18, b1);
   for (float x : b1) EXPECT_TRUE(std::isfinite(x));
+}
+
+// A version-7 occluder with surface-following shells (formats/SCHEMA.md): the scheme and the
+// surface radii reach the view, which shades exactly like a view of the original arrays.
+TEST(Loader, SurfaceFollowingShellsReachTheView) {
+  File f = make_file(false);
+  for (Dataset& d : f.datasets)
+    if (d.path == "/fiv/occluders/rock/shells") {
+      d.attrs.push_back({"radial_scheme", std::string("surface")});
+      d.attrs.push_back({"first_offset", 0.5});
+    }
+  const std::vector<float> surface = {0.25f, 0.5f, 0.75f, 1.0f, 0.5f, 0.5f, 0.5f, 0.5f, 1.0f, 0.75f, 0.5f, 0.25f};
+  f.datasets.push_back({"/fiv/occluders/rock/surface_radius", {3, 4}, surface, {}});
+  const auto path = tmp("loader_surface.prt.h5");
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  EXPECT_EQ(a.format_version, 7);
+  ASSERT_EQ(a.occluders.size(), 1u);
+  const prt::shade::LoadedOccluder& o = a.occluders[0];
+  EXPECT_EQ(o.radial_scheme, prt::shade::kFivRadialSurface);
+  EXPECT_EQ(o.surface_radius, surface);
+  const prt::shade::FivOccluder v = o.view();
+  EXPECT_EQ(v.radial_scheme, prt::shade::kFivRadialSurface);
+  ASSERT_NE(v.surface_radius, nullptr);
+  const auto& shells = std::get<std::vector<float>>(f.datasets[8].data);
+  const std::vector<float> radii = {0.375f, 1.5f};
+  const prt::shade::FivOccluder direct{{0.5f, 2.0f, -1.0f}, 0.75f, 2, 3, 4, radii.data(), shells.data(), nullptr,
+                                       prt::shade::kFivRadialSurface, surface.data()};
+  for (const float s : {0.1f, 0.6f, 1.3f, 2.4f, 9.0f}) {
+    const float off[3] = {s, -0.3f * s, 0.2f};
+    float loaded[9], expect[9];
+    prt::shade::lookup_fiv(v, off, loaded);
+    prt::shade::lookup_fiv(direct, off, expect);
+    for (int e = 0; e < 9; ++e) EXPECT_EQ(loaded[e], expect[e]) << s;
+  }
 }
 
 TEST(Loader, SceneObjectsAreSeparateVertexSets) {

@@ -166,6 +166,7 @@ int prt_c_check_fiv(char* msg, size_t size) {
   desc.radius = 1.0f;
   desc.n_rho = NR, desc.n_theta = NT, desc.n_phi = NP;
   desc.radii = radii, desc.shells = shells, desc.valid = valid;
+  desc.radial_scheme = 0, desc.surface_radius = NULL; /* paper 004's spheres */
 
   CHECK_STATUS(prt_fiv_scene_create(S, cube, env, &scene), PRT_OK);
   CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, &index), PRT_OK);
@@ -211,6 +212,21 @@ int prt_c_check_fiv(char* msg, size_t size) {
   desc.radius = 1.0f;
   desc.n_theta = 1;
   CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, NULL), PRT_ERROR_INVALID_ARGUMENT);
+  desc.n_theta = NT;
+  /* Surface-following shells (radial_scheme 1): radii are offsets from surface_radius, no valid
+   * mask needed; the scene copies surface_radius too. Constant shells: the same F anywhere. */
+  {
+    static float surface[NT * NP];
+    for (i = 0; i < NT * NP; ++i) surface[i] = 0.5f;
+    desc.radial_scheme = 1, desc.surface_radius = surface, desc.valid = NULL;
+    CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, &index), PRT_OK);
+    for (i = 0; i < NT * NP; ++i) surface[i] = -1.0f; /* would be refused: the copy is used */
+    CHECK_STATUS(prt_fiv_scene_lookup_fiv(scene, index, p, out), PRT_OK);
+    CHECK_NEAR(out[4], 2.0, 2 * FLT_EPSILON * 2, "surface scheme lookup_fiv F_G,y");
+    CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, NULL), PRT_ERROR_INVALID_ARGUMENT);
+    desc.radial_scheme = 2;
+    CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, NULL), PRT_ERROR_INVALID_ARGUMENT);
+  }
   prt_fiv_scene_destroy(scene);
   return 0;
 }

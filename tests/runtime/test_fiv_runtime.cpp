@@ -750,4 +750,154 @@ TEST(Validate, RejectsBrokenOccludersAndMaps) {
   EXPECT_THROW(shade::validate_difmap({2, nullptr}), std::invalid_argument);
 }
 
+// ---- Surface-following shells (radial_scheme = kFivRadialSurface, issue 33) -------------------
+
+// Shells with a surface radius r_surf[i][j]: radii become the offsets τ_k = 0.5·2^k (geometric,
+// exact in float) and sample (k, i, j) sits at (r_surf[i][j] + τ_k) d(θ_i, φ_j).
+struct SurfaceShells : Shells {
+  std::vector<float> surface;
+  template <class F, class R>
+  SurfaceShells(int nr, int nt, int np, F value, R r_surf) : Shells(nr, nt, np, value) {
+    for (int i = 0; i < nt; ++i)
+      for (int j = 0; j < np; ++j) surface.push_back(r_surf(i, j));
+  }
+  float r(int i, int j) const { return surface[size_t(i) * size_t(n_phi) + size_t(j)]; }
+  FivOccluder view() const {
+    FivOccluder v = Shells::view();
+    v.radial_scheme = shade::kFivRadialSurface;
+    v.surface_radius = surface.data();
+    v.valid = nullptr;  // not read by the surface scheme
+    return v;
+  }
+};
+
+// A bumpy outer surface: r_surf between 0.3 and 1.5, different in every direction.
+float bumpy(int i, int j) { return 0.9f + 0.6f * float(std::sin(1.7 * i + 0.3) * std::cos(2.3 * j + 0.1)); }
+
+TEST(LookupFivSurface, GridPointsGiveTheStoredSamples) {
+  SurfaceShells o(4, 5, 8, linear_value, bumpy);
+  // Away from the poles, where every j is the same direction (a bake stores one value there).
+  for (int k = 0; k < o.n_rho; ++k)
+    for (int i = 1; i < o.n_theta - 1; ++i)
+      for (int j = 0; j < o.n_phi; ++j) {
+        float s[3], out[9];
+        offset_at(o, i, j, double(o.r(i, j)) + o.radii[size_t(k)], s);
+        shade::lookup_fiv(o.view(), s, out);
+        // The angles' float round trip (kAngleRoundTrip per unit slope of linear_value) moves r_s
+        // by up to 1.2 per grid unit as well: τ and so k move by ≤ 1e-6 · 1.2 / (τ_k+1 − τ_k).
+        for (int e = 0; e < 9; ++e) EXPECT_NEAR(out[e], o.at(k, i, j, e), kAngleRoundTrip * 8) << k << i << j;
+      }
+}
+
+TEST(LookupFivSurface, LinearInTheOffsetAndClampedInsideTheHull) {
+  SurfaceShells o(4, 5, 8, linear_value, bumpy);
+  const int i = 2, j = 2;  // θ = π/2, φ = π/2: direction +X, exact angles
+  auto at_rho = [&](double rho, float out[9]) {
+    const float s[3] = {float(rho), 0, 0};
+    shade::lookup_fiv(o.view(), s, out);
+  };
+  const double r = o.r(i, j);
+  float a[9];
+  // τ halfway between τ_1 = 1 and τ_2 = 2: the mean of the two shells (ρ rounded to float:
+  // ≤ 6e-8 · 3 of a 1-wide step, times the 0.5 slope).
+  at_rho(r + 1.5, a);
+  for (int e = 0; e < 9; ++e) EXPECT_NEAR(a[e], 0.5f * (o.at(1, i, j, e) + o.at(2, i, j, e)), 1e-6f);
+  // Inside the outer hull (τ < τ_0): the first shell; at the centre, that of d = +Y (the pole).
+  for (double rho : {r + 0.25, r - 0.2}) {
+    at_rho(rho, a);
+    for (int e = 0; e < 9; ++e) EXPECT_EQ(a[e], o.at(0, i, j, e)) << rho;
+  }
+  at_rho(0.0, a);
+  for (int e = 0; e < 9; ++e) EXPECT_EQ(a[e], o.at(0, 0, 0, e));
+  // Beyond the last offset: the last shell times ((r_s + τ_last)/ρ)².
+  const double far = r + o.radii.back();
+  at_rho(2 * far, a);
+  for (int e = 0; e < 9; ++e) EXPECT_NEAR(a[e], o.at(3, i, j, e) / 4.0f, 1e-6f * std::abs(o.at(3, i, j, e)));
+}
+
+// The lookup has no jumps: across the (θ, φ) cell edges (where the bilinear r_s changes its
+// weights) and across every shell offset, a step of δ changes F by at most a Lipschitz bound times
+// δ. linear_value changes by ≤ 1.2 per grid unit in k, i, j; r_s by ≤ 2 per grid unit; k by ≤ 1 / (the
+// smallest step 0.5) per unit of τ: |dF| <= (1.2 (1 + 2 / 0.5 · dρ/d(grid)) + …) — a jump of
+// a sample's size (≥ 0.125) would exceed the bound 50 δ by far.
+TEST(LookupFivSurface, ContinuousAcrossCellsAndShells) {
+  SurfaceShells o(5, 9, 16, linear_value, bumpy);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u01(0, 1);
+  const double delta = 1e-4;
+  double worst = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    // A point on a cell edge in u (integer u) or t, or on a shell (τ = τ_k), and its neighbour δ away.
+    double t = 1 + u01(rng) * (o.n_theta - 3), u = u01(rng) * o.n_phi, tau = 0.5 * std::pow(2.0, u01(rng) * 4);
+    switch (trial % 3) {
+      case 0: u = std::floor(u); break;
+      case 1: t = std::floor(t); break;
+      default: tau = 0.5 * std::pow(2.0, double(trial % 5)); break;
+    }
+    const int i0 = std::min(int(t), o.n_theta - 2), j0 = int(u) % o.n_phi, j1 = (j0 + 1) % o.n_phi;
+    const double ft = t - i0, fu = u - std::floor(u);
+    const double rs = (1 - ft) * ((1 - fu) * o.r(i0, j0) + fu * o.r(i0, j1)) + ft * ((1 - fu) * o.r(i0 + 1, j0) + fu * o.r(i0 + 1, j1));
+    float s0[3], s1[3], a[9], b[9];
+    offset_at(o, t - delta, u - delta, rs + tau - delta, s0);
+    offset_at(o, t + delta, u + delta, rs + tau + delta, s1);
+    shade::lookup_fiv(o.view(), s0, a);
+    shade::lookup_fiv(o.view(), s1, b);
+    for (int e = 0; e < 9; ++e) worst = std::max(worst, std::fabs(double(a[e]) - b[e]));
+  }
+  EXPECT_LT(worst, 50 * 2 * delta);
+  EXPECT_GT(worst, 0.0);
+}
+
+TEST(LookupFivSurface, ShadeFivMatchesTheSlowReferenceAndIgnoresValid) {
+  std::mt19937 rng(34);
+  std::uniform_real_distribution<float> u01(0, 1);
+  SurfaceShells asset(12, 17, 32, [&](int, int, int, int) { return u01(rng); }, bumpy);
+  const std::vector<float> cube = flat_cube(4, 400.0f);
+  std::vector<FivOccluder> views;
+  for (int i = 0; i < 30; ++i) {
+    FivOccluder v = asset.view();
+    v.centre[0] = 20 * u01(rng) - 10, v.centre[1] = 3 * u01(rng) - 0.5f, v.centre[2] = 20 * u01(rng) - 10;
+    v.radius = 1.5f + u01(rng);
+    views.push_back(v);
+  }
+  std::vector<uint8_t> zeros(asset.valid.size(), 0);
+  for (int trial = 0; trial < 100; ++trial) {
+    const float p[3] = {20 * u01(rng) - 10, 0, 20 * u01(rng) - 10}, n[3] = {0.1f, 1, -0.2f};
+    float fast[3], slow[3], masked[3];
+    shade::shade_fiv({4, cube.data()}, views.data(), int(views.size()), p, n, {}, fast);
+    shade::shade_fiv_reference({4, cube.data()}, views.data(), int(views.size()), p, n, {}, slow);
+    for (FivOccluder& v : views) v.valid = zeros.data();
+    shade::shade_fiv({4, cube.data()}, views.data(), int(views.size()), p, n, {}, masked);
+    for (FivOccluder& v : views) v.valid = nullptr;
+    for (int c = 0; c < 3; ++c) {
+      // ScatteredOccludersMatchTheSlowReference's bounds: 1e-5 per lookup (angles from the
+      // polynomial atan2) and 7e-7 rad of the overlap angles over ~α (here ≥ 0.1 rad).
+      EXPECT_NEAR(fast[c], slow[c], 4 * FLT_EPSILON * slow[c] + 1e-5 * 30 + 7e-7 / (kPi * 0.1) * 2 * 400 * 30);
+      EXPECT_EQ(masked[c], fast[c]) << "the surface scheme reads no valid mask";
+    }
+  }
+}
+
+TEST(Validate, SurfaceSchemeNeedsGeometricOffsetsAndFiniteSurfaceRadii) {
+  SurfaceShells o(4, 5, 8, linear_value, bumpy);
+  EXPECT_NO_THROW(shade::validate_occluder(o.view()));
+  FivOccluder v = o.view();
+  v.surface_radius = nullptr;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  v = o.view();
+  v.radial_scheme = 2;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  o.radii[2] = 2.5f;  // 0.5, 1, 2.5, 4: increasing but not geometric
+  EXPECT_THROW(shade::validate_occluder(o.view()), std::invalid_argument);
+  o.radii[2] = 2.0f;
+  o.surface[3] = -0.1f;
+  EXPECT_THROW(shade::validate_occluder(o.view()), std::invalid_argument);
+  o.surface[3] = std::numeric_limits<float>::infinity();
+  EXPECT_THROW(shade::validate_occluder(o.view()), std::invalid_argument);
+  // The geometric scheme still needs its valid mask.
+  v = o.Shells::view();
+  v.valid = nullptr;
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+}
+
 } // namespace

@@ -3,7 +3,8 @@
 // (prt::shade::lookup_fiv, lookup_difmap, partial_factor, occluded_irradiance, shade_fiv,
 // shade_fiv_self) and against a double-precision transcription of the contract
 // (<prtshade/fiv.h>), on synthetic occluders: random shells with invalid samples (one cell
-// wholly invalid), several grid sizes including the minimal 1 × 2 × 1, receivers at the poles,
+// wholly invalid), several grid sizes including the minimal 1 × 2 × 1, two with surface-following
+// shells (random r_surf; their valid masks must not be read), receivers at the poles,
 // across the φ seam, inside the first shell, at ρ = 0 and beyond the last shell.
 //
 // Tolerances. Both implementations round the same float inputs; their results differ through
@@ -43,9 +44,14 @@ struct SynthOccluder {
   int n_rho, n_theta, n_phi;
   std::vector<float> radii, shells;
   std::vector<uint8_t> valid;
+  int scheme = prt::shade::kFivRadialGeometric;
+  std::vector<float> surface;  // [n_theta][n_phi], surface scheme
   prt::shade::FivOccluder view() const {
-    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
+    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data(),
+            scheme, surface.empty() ? nullptr : surface.data()};
   }
+  float r_surf(int i, int j) const { return surface[static_cast<std::size_t>(i * n_phi + j)]; }
+  float max_surface() const { return surface.empty() ? 0.0f : *std::max_element(surface.begin(), surface.end()); }
   std::size_t sample(int k, int i, int j) const {
     return (static_cast<std::size_t>(k) * static_cast<std::size_t>(n_theta) + static_cast<std::size_t>(i)) *
                static_cast<std::size_t>(n_phi) +
@@ -80,6 +86,21 @@ SynthOccluder make_occluder(std::mt19937& rng, const std::array<float, 3>& centr
   return o;
 }
 
+// The same occluder with surface-following shells (prtshade/fiv.h): r_surf random in
+// [0.2 R, 0.9 R] (one value per pole row), the radii (geometric already) read as offsets; its
+// invalid samples stay in the mask, which the surface scheme must not read.
+SynthOccluder make_surface_occluder(std::mt19937& rng, const std::array<float, 3>& centre, float radius, int n_rho,
+                                    int n_theta, int n_phi) {
+  SynthOccluder o = make_occluder(rng, centre, radius, n_rho, n_theta, n_phi);
+  o.scheme = prt::shade::kFivRadialSurface;
+  std::uniform_real_distribution<float> uni(0.2f * radius, 0.9f * radius);
+  for (int i = 0; i < n_theta; ++i)
+    for (int j = 0; j < n_phi; ++j)
+      o.surface.push_back((i == 0 || i == n_theta - 1) && j > 0 ? o.surface[static_cast<std::size_t>(i * n_phi)] : uni(rng));
+  for (float& r : o.radii) r *= 0.05f;  // offsets from 0.025 R
+  return o;
+}
+
 // Packed buffers of fiv.glsl (its header comment): the occluder table (48 bytes each), radii,
 // shells, valid bytes packed 4 per uint (little-endian) from a word boundary, DifMap.
 struct GpuOccluder {
@@ -99,10 +120,12 @@ GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std:
   std::vector<uint8_t> valid;
   for (const SynthOccluder& o : occ) {
     GpuOccluder g{{o.centre[0], o.centre[1], o.centre[2], o.radius},
-                  {o.n_rho, o.n_theta, o.n_phi, 0},
-                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4), 0}};
+                  {o.n_rho, o.n_theta, o.n_phi, o.scheme},
+                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4),
+                   uint32_t(radii.size() + o.radii.size())}};
     table.push_back(g);
     radii.insert(radii.end(), o.radii.begin(), o.radii.end());
+    radii.insert(radii.end(), o.surface.begin(), o.surface.end());  // surface scheme: offsets.w
     shells.insert(shells.end(), o.shells.begin(), o.shells.end());
     valid.insert(valid.end(), o.valid.begin(), o.valid.end());
     valid.resize((valid.size() + 3) / 4 * 4, 0);  // next occluder starts on a word boundary
@@ -139,18 +162,25 @@ FivRef fiv_at(const SynthOccluder& o, double t, double u, double rho) {
   const double fu = u - ju;
   const int j0 = ju % o.n_phi, j1 = (ju + 1) % o.n_phi;
   const int last = o.n_rho - 1;
+  // Surface scheme: x = τ = ρ − r_s with r_s bilinear in the cell; geometric: x = ρ, r_s = 0.
+  const bool surface = o.scheme == prt::shade::kFivRadialSurface;
+  const double r_s = surface ? (1 - ft) * ((1 - fu) * o.r_surf(i0, j0) + fu * o.r_surf(i0, j1)) +
+                                   ft * ((1 - fu) * o.r_surf(i0 + 1, j0) + fu * o.r_surf(i0 + 1, j1))
+                             : 0.0;
+  const double x = rho - r_s;
   int k0 = 0, k1 = 0;
   double fr = 0, falloff = 1;
-  if (rho <= o.radii[0] || last == 0) {
-    if (rho > o.radii[0]) falloff = (o.radii[0] / rho) * (o.radii[0] / rho);
-  } else if (rho >= o.radii[static_cast<std::size_t>(last)]) {
+  if (x <= o.radii[0] || last == 0) {
+    if (x > o.radii[0]) falloff = ((r_s + o.radii[0]) / rho) * ((r_s + o.radii[0]) / rho);
+  } else if (x >= o.radii[static_cast<std::size_t>(last)]) {
     k0 = k1 = last;
-    falloff = (o.radii[static_cast<std::size_t>(last)] / rho) * (o.radii[static_cast<std::size_t>(last)] / rho);
+    const double q = (r_s + o.radii[static_cast<std::size_t>(last)]) / rho;
+    falloff = q * q;
   } else {
     k1 = 1;
-    while (o.radii[static_cast<std::size_t>(k1)] <= rho) ++k1;
+    while (o.radii[static_cast<std::size_t>(k1)] <= x) ++k1;
     k0 = k1 - 1;
-    fr = (rho - o.radii[static_cast<std::size_t>(k0)]) /
+    fr = (x - o.radii[static_cast<std::size_t>(k0)]) /
          (double(o.radii[static_cast<std::size_t>(k1)]) - o.radii[static_cast<std::size_t>(k0)]);
   }
   const int ks[2] = {k0, k1}, is[2] = {i0, i0 + 1}, js[2] = {j0, j1};
@@ -170,10 +200,11 @@ FivRef fiv_at(const SynthOccluder& o, double t, double u, double rho) {
         }
         if (o.valid[idx]) mw += w;
       }
+  if (surface) mw = 0, masked = plain;  // no valid mask: the plain trilinear value
   FivRef r;
   for (std::size_t e = 0; e < 9; ++e) r.v[e] = (mw > 0 ? masked[e] / mw : plain[e]) * falloff;
   r.max_sample = biggest * falloff;
-  r.plain = !(mw > 0);
+  r.plain = !surface && !(mw > 0);
   return r;
 }
 
@@ -204,12 +235,15 @@ Budget operator+(const Budget& a, const Budget& b) { return {a.theta + b.theta, 
 Fiv9 fiv_tolerance(const SynthOccluder& o, const float s[3], const Budget& b) {
   const Coords c = coords_of(o, s);
   const double dt = b.theta / kPi * (o.n_theta - 1), du = b.phi / (2 * kPi) * o.n_phi;
+  // Surface scheme: τ = ρ − r_s rounds within 8 ε max(r_surf) more (r_s's bilinear sums, the
+  // subtraction), which moves the radial coordinate like an error in ρ.
+  const double drho = b.rho + 8 * kFloatEps * o.max_surface();
   const FivRef centre = fiv_at(o, c.t, c.u, c.rho);
   Fiv9 tol{};
   double biggest = centre.max_sample;
   for (int corner = 0; corner < 8; ++corner) {
     const FivRef r = fiv_at(o, c.t + (corner & 1 ? dt : -dt), c.u + (corner & 2 ? du : -du),
-                            c.rho + (corner & 4 ? b.rho : -b.rho));
+                            c.rho + (corner & 4 ? drho : -drho));
     biggest = std::max(biggest, r.max_sample);
     for (std::size_t e = 0; e < 9; ++e) tol[e] = std::max(tol[e], 2 * std::abs(r.v[e] - centre.v[e]));
   }
@@ -314,7 +348,13 @@ Scene make_scene() {
   sc.occ.push_back(make_occluder(rng, {-0.2f, 0.4f, -1.1f}, 0.5f, 1, 2, 1));  // minimal grid
   sc.occ.push_back(sc.occ[0]);                                                 // a duplicate: O = ½
   sc.occ.push_back(make_occluder(rng, {-2.0f, 1.5f, 2.5f}, 0.3f, 5, 9, 16));
-  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}};
+  // Surface-following shells (occluders 5, 6), one with a wholly invalid cell the mask must not touch.
+  sc.occ.push_back(make_surface_occluder(rng, {0.8f, 0.3f, -0.6f}, 0.9f, 6, 9, 12));
+  for (int k = 0; k < 2; ++k)
+    for (int i = 3; i < 5; ++i)
+      for (int j = 2; j < 4; ++j) sc.occ[5].valid[sc.occ[5].sample(k, i, j)] = 0;
+  sc.occ.push_back(make_surface_occluder(rng, {-0.9f, 0.2f, 1.2f}, 0.6f, 1, 3, 4));  // one shell
+  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}, {5, 1}, {3, 4}, {0, 7}};
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   sc.texels.resize(6 * 5 * 5 * 3);
   for (float& t : sc.texels) t = 2.0f + 3.0f * uni(rng);
@@ -345,7 +385,7 @@ std::vector<Receiver> make_receivers(const Scene& sc) {
   uint32_t serial = 0;
   for (uint32_t o = 0; o < sc.occ.size(); ++o) {
     const SynthOccluder& oc = sc.occ[o];
-    const double r_last = oc.radii.back();
+    const double r_last = oc.radii.back() + oc.max_surface();
     // Random offsets: ρ from 0 to 2.5 × the last radius (inside the first shell, between
     // shells, beyond the last), random directions and normals.
     for (int i = 0; i < 400; ++i) {
@@ -455,7 +495,7 @@ Lookup lookup_case(const SynthOccluder& o, const float p[3]) {
 // transcription too (so a disagreement names the side that is off).
 TEST_P(FivMirror, LookupFivMatchesCoreAndReference) {
   double worst_core = 0, worst_ref = 0;
-  std::size_t checked = 0, ill_conditioned = 0, plain = 0, beyond = 0;
+  std::size_t checked = 0, ill_conditioned = 0, plain = 0, beyond = 0, surface = 0;
   std::vector<double> rel_tols;
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
@@ -469,6 +509,7 @@ TEST_P(FivMirror, LookupFivMatchesCoreAndReference) {
     const Fiv9 tol_core_ref = fiv_tolerance(o, s, core_budget(c));
     plain += ref.plain ? 1 : 0;
     beyond += c.rho > o.radii.back() ? 1 : 0;
+    surface += o.scheme == prt::shade::kFivRadialSurface ? 1 : 0;
     float core[9];
     prt::shade::lookup_fiv(o.view(), s, core);
     const float* got = result(r);
@@ -506,6 +547,7 @@ TEST_P(FivMirror, LookupFivMatchesCoreAndReference) {
   std::printf("lookup_fiv: %zu receivers in the plain-trilinear fallback, %zu beyond the last shell\n", plain, beyond);
   EXPECT_GE(plain, 20u);  // the wholly invalid cell was visited
   EXPECT_GT(beyond, 500u);
+  EXPECT_GE(surface, 2 * 640u);  // the surface-following occluders' receivers
 }
 
 TEST_P(FivMirror, LookupDifMapMatchesCoreAndReference) {

@@ -489,6 +489,22 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   // k = 32² against 65,536 QMC rays at 32 shell samples: the gap is a small fraction of |F_env|.
   EXPECT_LT(rv[0], 0.05f * rv[2]);
   for (float x : std::get<std::vector<float>>(F::find_dataset(f, "/fiv/irradiance_cube")->data)) EXPECT_GT(x, 0.0f);
+  // The default radial scheme follows the surface (format_version 7, formats/SCHEMA.md).
+  EXPECT_EQ(std::get<std::string>(F::find_attr(shells->attrs, "radial_scheme")->value), "surface");
+  const F::Dataset* surface = F::find_dataset(f, "/fiv/occluders/spider/surface_radius");
+  ASSERT_NE(surface, nullptr);
+  EXPECT_EQ(surface->shape, (std::vector<uint64_t>{5, 8}));
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(f.root_attrs, "format_version")->value), 7);
+  // --radial geometric: paper 004's spheres, the file as before version 7.
+  ASSERT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env " + (kData / "studio.exr").string() +
+                " --shells 8x5x4 --cube 2 --samples 1024 --radial geometric --report 0 --quiet -o " + out.string())
+                .code,
+            0);
+  const F::File g = F::read_file(out);
+  EXPECT_EQ(F::find_attr(F::find_dataset(g, "/fiv/occluders/spider/shells")->attrs, "radial_scheme"), nullptr);
+  EXPECT_EQ(F::find_dataset(g, "/fiv/occluders/spider/surface_radius"), nullptr);
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(g.root_attrs, "format_version")->value), 4);
+  EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --radial spherical -o " + out.string()).code, 2);
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " -o " + out.string()).code, 2) << "no --env";
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);
 }

@@ -353,13 +353,15 @@ std::string speck_mesh() {
 
 // That occluder under studio.exr: the 2x2x6 DifMap's 24 texels in one chunk, the environment FIV
 // in one, then 24x13 = 312 samples per shell in slabs of 80 (4 chunks a shell); the rule ends the
-// bake at shell kFivShells of 16. An error report of `report` points (a merge without one reads
+// bake at shell kFivShells of 16 (shells that follow the surface, the default: offsets from 0.005 R,
+// so more of them lie near the occluder than paper 004's spheres from 0.5 R, which stopped at 7).
+// An error report of `report` points (a merge without one reads
 // the environment's identity only, not its pixels).
 std::string fiv_bake(int samples = 256, int report = 4) {
   return "fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 24x13x16 --fraction 0.01 --cube 2 --samples " +
          std::to_string(samples) + " --threads 1 --chunk-rows 80 --report " + std::to_string(report);
 }
-constexpr int kFivShells = 7;
+constexpr int kFivShells = 13;
 constexpr int kFivChunks = 2 + 4 * kFivShells;
 
 // The shells a FIV bake printed it used ("shells: 24x13xK (of 16 ...").
@@ -453,7 +455,7 @@ TEST(ShardsFiv, EnvironmentFivChunkIsVerifiedAndRecomputed) {
 TEST(ShardsFiv, KillNineAndRerunResumes) {
   kill_nine_and_rerun("fiv " + speck_mesh() + " --env " + kData + "/studio.exr --shells 40x21x16 --fraction 0.01 --cube 2 "
                       "--samples 1024 --threads 1 --chunk-rows 210 --report 0",
-                      dir_for("fiv_kill"), 2 + 4 * 12);
+                      dir_for("fiv_kill"), 2 + 4 * 15);  // 15 of the 16 surface-following shells, 4 chunks each
 }
 
 #ifdef PRT_MPIRUN

@@ -459,6 +459,21 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
          "the shell grid: NPHI x NTHETA (poles included) directions on each of\nNRHO shells (default " +
              std::to_string(d.n_phi) + "x" + std::to_string(d.n_theta) + "x" + std::to_string(d.n_rho) + ")")
       ->option_text("NPHIxNTHETAxNRHO");
+  cmd.add_option_function<std::string>(
+         "--radial",
+         [&a](const std::string& r) {
+           if (!bake::parse_radial_scheme(r, a.shell_spec.radial))
+             throw CLI::ValidationError("--radial", "expects surface or geometric, got '" + r + "'");
+         },
+         "where the NRHO shells lie along each direction: surface (default) = at\n"
+         "offsets from the occluder's outer surface along the ray, graded from\n"
+         "0.005 R; geometric = spheres around the centre from 0.5 R (paper 004)")
+      ->option_text("surface|geometric");
+  cmd.add_option("--first-offset", a.shell_spec.first_offset,
+                 "the surface scheme's first offset from the surface, as a fraction of\n"
+                 "the bounding radius R (default 0.005; strictly between 0 and 1)")
+      ->option_text("FRACTION")
+      ->check(tool::number_between(0, 1));
   cmd.add_option("--cube", a.shell_spec.cube, "the DifMap's face size S (default " + std::to_string(d.cube) + ")")
       ->option_text("S")
       ->check(tool::integer_in(1, 1024));

@@ -339,6 +339,24 @@ F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const b
                          "j/Nphi from +Z towards +X, d = (sin theta sin phi, cos theta, sin theta cos phi)";
   o.fraction = fraction;
   o.samples = int64_t(silhouette_k);
+  if (shells.radial == bake::RadialScheme::surface) {
+    // Version 7 (formats/SCHEMA.md): radii are the offsets τ_k from the surface radius r_surf.
+    o.radial_scheme = std::string(bake::radial_scheme_name(shells.radial));
+    o.first_offset = shells.radii.front() / shells.radius;
+    o.angular_convention = "s = centre + (r_surf(theta_i, phi_j) + tau_k) d(theta_i, phi_j), tau_k = radii[k] (geometric), "
+                           "theta_i = pi i/(Ntheta-1) from +Y, phi_j = 2 pi j/Nphi from +Z towards +X, d = (sin theta "
+                           "sin phi, cos theta, sin theta cos phi)";
+    o.surface_radius = F::OccluderSurfaceRadius{
+        std::vector<float>(shells.surface_radius.begin(), shells.surface_radius.end()),
+        "r_surf [theta][phi]: the largest distance from the centre at which the ray centre + t d meets the occluder (0: "
+        "misses)",
+        {}};
+    o.valid = F::OccluderValid{std::move(shells.valid),
+                               "0: the integrator found the offset inside the occluder; its value is extrapolated "
+                               "along the radial line",
+                               {}};
+    return o;
+  }
   o.valid = F::OccluderValid{std::move(shells.valid), "0: the offset lies inside the occluder (nothing visible)", {}};
   return o;
 }

@@ -59,11 +59,18 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
   // What each set holds, its rows and width: chunks of another layout belong to another bake.
   std::string layout = "sets: DifMap texels, environment FIV, shell samples:";
   for (size_t s = 0; s < set_rows.size(); ++s) layout += " " + std::to_string(set_rows[s]) + "x" + std::to_string(widths[s]);
-  char spec[192];
+  char spec[256];
   std::snprintf(spec, sizeof spec, "%dx%dx%d inner %.17g fraction %.17g k %u cube %d", sp.n_phi, sp.n_theta, sp.n_rho,
                 sp.inner, sp.fraction, unsigned(sp.silhouette_k), sp.cube);
+  // Chunks of the geometric scheme keep their manifest (their bakes resume); the surface scheme's differ.
+  std::string spec_text = spec;
+  if (sp.radial == bake::RadialScheme::surface) {
+    char more[64];
+    std::snprintf(more, sizeof more, " radial surface first_offset %.17g", sp.first_offset);
+    spec_text += more;
+  }
   const std::string manifest = tool::manifest_of({"fiv", kToolkitVersion, a.command_line, mesh.source_sha256, env_info.sha256,
-                                                  spec, layout, std::to_string(a.shard.chunk_rows)});
+                                                  spec_text, layout, std::to_string(a.shard.chunk_rows)});
   tool::ShardedRows& shards = sharded.emplace(worker, mpi, a.shard, a.output, manifest, set_rows, widths, a.quiet);
   // The set of the first shell, in order, that is complete in the chunk directory and meets the rule.
   int checked = 0;
@@ -115,6 +122,7 @@ std::optional<ShardedFiv> sharded_fiv(const Args& a, const tool::Worker& worker,
     out.shells.seconds += rows.seconds;
     if (baker.stops_after(k, rows.values)) break;
   }
+  baker.finish(out.shells);
   return out;
 }
 
@@ -155,11 +163,15 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
   if (run.say) {
     std::printf("environment FIV and %dx%dx6 DifMap in %.2f s%s\n", a.shell_spec.cube, a.shell_spec.cube, env_seconds,
                 sharded ? " (both in the chunks)" : "");
-    std::printf("shells: %dx%dx%zu (of %d requested radii, %.3g to %.3g; bounding radius %.4g) in %.2f s (%.0f "
-                "integrals/s)\n",
-                a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho, shells.radii.front(),
-                shells.radii.back(), shells.radius, shells.seconds,
-                double(shells.integrals) / shells.seconds);
+    const bool surface = shells.radial == bake::RadialScheme::surface;
+    std::printf("shells: %dx%dx%zu (of %d requested; %s scheme: %s %.3g to %.3g%s; bounding radius %.4g) in %.2f s "
+                "(%.0f integrals/s)\n",
+                a.shell_spec.n_phi, a.shell_spec.n_theta, shells.radii.size(), a.shell_spec.n_rho,
+                std::string(bake::radial_scheme_name(shells.radial)).c_str(), surface ? "offsets" : "radii",
+                shells.radii.front(), shells.radii.back(), surface ? " from the surface" : "", shells.radius,
+                shells.seconds, double(shells.integrals) / shells.seconds);
+    if (shells.extrapolated > 0)
+      std::printf("%zu samples found inside the occluder, extrapolated along their radial lines\n", shells.extrapolated);
   }
 
   namespace F = prt::formats;

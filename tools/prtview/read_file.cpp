@@ -309,6 +309,12 @@ BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const st
   o.radii = b.radii.data();
   o.shells = baked->shells.data();
   o.valid = baked->valid->values.data();
+  // Version 7 (formats/SCHEMA.md): no radial_scheme attribute is the geometric scheme.
+  if (baked->radial_scheme.value_or("geometric") == "surface") {
+    if (!baked->surface_radius) throw InputError(file, "no dataset " + cat(occluder_dir(name) + "/", N::kSurfaceRadius));
+    o.radial_scheme = shade::kFivRadialSurface;
+    o.surface_radius = baked->surface_radius->values.data();
+  }
   try {
     shade::validate_occluder(o);
   } catch (const std::invalid_argument& e) {

@@ -47,7 +47,8 @@ template <class T> struct Array {
 // The root attributes (all required except the extras; format/format_version are the writer's).
 struct RootInfo {
   // As read. write_asset ignores it and writes written_format_version (prtfile.h): 5 for an asset
-  // with a lightmap or UV set, 6 with a punctual light, else 4, so a round trip keeps it only when it is that version.
+  // with a lightmap or UV set, 6 with a punctual light, 7 with surface-following FIV shells, else
+  // 4, so a round trip keeps it only when it is that version.
   int64_t format_version = kFormatVersion;
   std::string generator, created, command_line, source, source_sha256, up_axis, sh_convention;
   ExtraAttrs extra;
@@ -187,7 +188,17 @@ struct OccluderValid {
   bool operator==(const OccluderValid&) const = default;
 };
 
+// /fiv/occluders/<name>/surface_radius (v7): r_surf per shell direction, [Ntheta][Nphi].
+struct OccluderSurfaceRadius {
+  std::vector<float> values;
+  std::optional<std::string> meaning;
+  ExtraAttrs extra;
+  bool operator==(const OccluderSurfaceRadius&) const = default;
+};
+
 // /fiv/occluders/<name>: FIVs on shells around an occluder's bounding sphere, and its report.
+// radial_scheme (v7) "surface": radii are offsets from the surface and surface_radius is there;
+// absent or "geometric": radii are the shell radii (SCHEMA.md).
 struct Occluder {
   std::string name;
   int n_rho = 0, n_theta = 0, n_phi = 0;
@@ -198,8 +209,11 @@ struct Occluder {
   std::optional<std::string> environment, environment_sha256, integrand, angular_convention, grid;
   std::optional<double> fraction;
   std::optional<int64_t> samples;  // silhouette k
+  std::optional<std::string> radial_scheme;  // (v7)
+  std::optional<double> first_offset;        // (v7) τ_0 / radius of the surface scheme
   ExtraAttrs extra;                // of the shells dataset
   std::optional<OccluderValid> valid;
+  std::optional<OccluderSurfaceRadius> surface_radius;  // (v7)
   std::optional<ReportRow> report;  // /report/fiv/<name> (its product is the name)
   bool operator==(const Occluder&) const = default;
 };

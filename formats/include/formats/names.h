@@ -53,6 +53,7 @@ inline constexpr std::string_view kFivEnvironment = "/fiv/environment";
 inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";
 inline constexpr std::string_view kShells = "shells";  // leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kValid = "valid";    // leaf under /fiv/occluders/<name>/
+inline constexpr std::string_view kSurfaceRadius = "surface_radius";  // (v7) leaf under /fiv/occluders/<name>/
 // ---- area-light datasets (leaf under /lights/<name>/) ----
 inline constexpr std::string_view kLightVertices = "vertices";          // float64 [N][3], world space
 inline constexpr std::string_view kLightFaceSizes = "face_sizes";       // uint32 [F]
@@ -101,6 +102,8 @@ inline constexpr std::string_view kRadii = "radii";
 inline constexpr std::string_view kAngularConvention = "angular_convention";
 inline constexpr std::string_view kGrid = "grid";
 inline constexpr std::string_view kFraction = "fraction";
+inline constexpr std::string_view kRadialScheme = "radial_scheme";  // (v7) on /fiv/occluders/<name>/shells
+inline constexpr std::string_view kFirstOffset = "first_offset";    // (v7) on /fiv/occluders/<name>/shells
 inline constexpr std::string_view kMeaning = "meaning";
 
 // ---- area-light attributes ----

@@ -86,11 +86,14 @@
 namespace prt::formats {
 
 // The newest schema version this library reads, and the one it writes for a file that holds a
-// punctual light (written_format_version; policy: SCHEMA.md "Versioning"). 6 added punctual
-// lights (/lights/<name> of shape point, spot or directional: attributes, no geometry); 5
+// surface-following FIV shells (written_format_version; policy: SCHEMA.md "Versioning"). 7 added
+// surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the shells' radial_scheme
+// and first_offset attributes); 6 punctual lights (/lights/<name> of shape point, spot or directional: attributes, no geometry); 5
 // lightmaps (/mesh/uv, /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights
 // (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 6;
+inline constexpr int kFormatVersion = 7;
+// The version written for a file with a punctual light and no version-7 data.
+inline constexpr int kFormatVersionWithPunctualLights = 6;
 // The version written for a file with a lightmap and no punctual light.
 inline constexpr int kFormatVersionWithLightmaps = 5;
 // The version written for a file without any version-5 dataset: such a file is byte for byte
@@ -172,7 +175,9 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersion when it holds a punctual light (a
+// The format_version write_file gives `file`: kFormatVersion when it holds surface-following FIV
+// shells (an occluder's surface_radius dataset, or a shells dataset with a radial_scheme or
+// first_offset attribute), else kFormatVersionWithPunctualLights when it holds a punctual light (a
 // /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps when a
 // dataset of it is of a version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
 int64_t written_format_version(const File& file);
@@ -193,6 +198,7 @@ bool is_per_vertex_path(std::string_view path);
 enum class DatasetKind {
   positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
   radiance_band1, radiance_shadowed, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
+  occluder_surface_radius,  // v7
   light_vertices, light_face_sizes, light_face_indices,
   uv, lightmap_state, lightmap_positions, lightmap_normals, lightmap_ao, lightmap_transfer_diffuse,  // v5
   lightmap_transfer_visibility, lightmap_radiance_band1, lightmap_radiance_shadowed,                // v5

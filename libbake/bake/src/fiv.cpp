@@ -4,6 +4,7 @@
 #include <bake/environment/irradiance.h>
 #include <bake/integrators/qmc.h>
 #include <bake/sphere/sampling.h>
+#include <bake/visibility/raycast.h>
 
 #include <tbb/parallel_for.h>
 
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 namespace prt::bake {
 
@@ -93,6 +95,79 @@ std::vector<float> irradiance_cube_reference(const EnvMap& env, int size) {
 Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) {
   const double th = std::numbers::pi * i_theta / std::max(n_theta - 1, 1), ph = 2 * std::numbers::pi * j_phi / n_phi;
   return {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+}
+
+std::string_view radial_scheme_name(RadialScheme scheme) {
+  return scheme == RadialScheme::surface ? "surface" : "geometric";
+}
+
+bool parse_radial_scheme(std::string_view text, RadialScheme& scheme) {
+  if (text == "surface") scheme = RadialScheme::surface;
+  else if (text == "geometric") scheme = RadialScheme::geometric;
+  else return false;
+  return true;
+}
+
+Vector3d FivShells::sample_position(int k, int i, int j) const {
+  const Vector3d d = shell_direction(i, n_theta, j, n_phi);
+  const double r = radial == RadialScheme::surface
+                       ? surface_radius[size_t(i) * size_t(n_phi) + size_t(j)] + radii[size_t(k)]
+                       : radii[size_t(k)];
+  return centre + r * d;
+}
+
+namespace {
+// Where the line o + t d meets triangle (a, b, c), in double (Möller–Trumbore); nullopt when it
+// is parallel to the triangle's plane.
+std::optional<double> line_triangle(const Vector3d& o, const Vector3d& d, const Vector3d& a, const Vector3d& b,
+                                    const Vector3d& c) {
+  const Vector3d e1 = b - a, e2 = c - a, p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (det == 0) return std::nullopt;
+  const Vector3d q = (o - a).cross(e1);
+  return e2.dot(q) / det;
+}
+} // namespace
+
+std::vector<double> surface_radii(const Mesh& mesh, const Vector3d& centre, double radius, int n_theta, int n_phi) {
+  const Topology topology = build_topology(mesh);
+  const RayCaster caster(mesh, topology);
+  // Every vertex lies within `radius` of the centre: a ray from 2R + 1 out, cast inwards, meets the
+  // outermost surface first.
+  const double far = 2 * std::max(radius, 0.0) + 1;
+  std::vector<double> out(size_t(n_theta) * size_t(n_phi), 0.0);
+  tbb::parallel_for(size_t(0), out.size(), [&](size_t idx) {
+    const Vector3d d = shell_direction(int(idx / size_t(n_phi)), n_theta, int(idx % size_t(n_phi)), n_phi);
+    const Vector3d o = centre + far * d;
+    const std::optional<RayHit> hit = caster.closest_hit(o, -d, 0.0);
+    if (!hit) return;
+    // The hit again in double (Embree gives a float distance).
+    const auto& tri = mesh.triangles[hit->triangle];
+    double t = double(hit->t);
+    if (const auto td = line_triangle(o, -d, mesh.positions[tri[0]].cast<double>(), mesh.positions[tri[1]].cast<double>(),
+                                      mesh.positions[tri[2]].cast<double>()))
+      t = *td;
+    out[idx] = std::clamp(far - t, 0.0, far);
+  });
+  return out;
+}
+
+void extrapolate_inside_samples(FivShells& shells) {
+  if (shells.radial != RadialScheme::surface) return;
+  const size_t per_shell = size_t(shells.n_theta) * size_t(shells.n_phi), n_rho = shells.radii.size();
+  for (size_t ij = 0; ij < per_shell; ++ij)
+    for (size_t k = 0; k < n_rho; ++k) {
+      if (shells.valid[k * per_shell + ij] != 0) continue;
+      size_t from = n_rho;  // the nearest valid sample outwards, else inwards
+      for (size_t q = k + 1; q < n_rho && from == n_rho; ++q)
+        if (shells.valid[q * per_shell + ij] != 0) from = q;
+      for (size_t q = k; q-- > 0 && from == n_rho;)
+        if (shells.valid[q * per_shell + ij] != 0) from = q;
+      if (from == n_rho) continue;  // no valid sample on the line: F^env, as baked
+      std::copy_n(shells.values.begin() + std::ptrdiff_t((from * per_shell + ij) * 9), 9,
+                  shells.values.begin() + std::ptrdiff_t((k * per_shell + ij) * 9));
+      ++shells.extrapolated;
+    }
 }
 
 void bounding_sphere(const Mesh& mesh, Vector3d& centre, double& radius) {
@@ -199,10 +274,15 @@ FivShellRows::FivShellRows(const Mesh& occluder, const ShellSpec& spec) : spec_(
   frame_.origin = occluder.origin;
   frame_.n_phi = spec.n_phi;
   frame_.n_theta = spec.n_theta;
+  frame_.radial = spec.radial;
   const double R = std::max(frame_.radius, 1e-30);
-  const double rho0 = spec.inner * R, rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
+  const bool surface = spec.radial == RadialScheme::surface;
+  PRT_CHECK(!surface || spec.first_offset > 0);
+  const double rho0 = (surface ? spec.first_offset : spec.inner) * R,
+               rho_far = std::max(R / (2 * std::sqrt(spec.fraction)), 2 * rho0);
   const double g = spec.n_rho > 1 ? std::pow(rho_far / rho0, 1.0 / (spec.n_rho - 1)) : 1.0;
   for (int k = 0; k < spec.n_rho; ++k) radii_.push_back(rho0 * std::pow(g, k));
+  if (surface) frame_.surface_radius = surface_radii(occluder, frame_.centre, frame_.radius, spec.n_theta, spec.n_phi);
 }
 
 FivShellRows::~FivShellRows() = default;
@@ -222,10 +302,13 @@ std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task
   PRT_CHECK(integrator_ && begin <= end && end <= rows_per_shell());
   std::vector<double> out((end - begin) * kRowWidth, 0.0);
   const double rho = radius(shell);
+  const bool surface = spec_.radial == RadialScheme::surface;
   tbb::parallel_for(begin, end, [&](size_t idx) {
     const int i = int(idx / size_t(spec_.n_phi)), j = int(idx % size_t(spec_.n_phi));
     bool inside = false;
-    const Fiv f = occluded_fiv(*integrator_, frame_.centre + rho * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside);
+    // FivShells::sample_position without the radii of the shells not yet appended.
+    const double dist = surface ? frame_.surface_radius[idx] + rho : rho;
+    const Fiv f = occluded_fiv(*integrator_, frame_.centre + dist * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside);
     double r = 0;
     for (int c = 0; c < 3; ++c) {
       const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
@@ -241,8 +324,11 @@ std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task
   return out;
 }
 
-// Far enough (and outside the bounding sphere, so never inside the occluder).
+// Far enough (and outside the bounding sphere, so never inside the occluder): ρ_k >= R, or τ_k >= R
+// (then r_surf + τ_k >= R too).
 bool FivShellRows::may_stop_after(int shell) const { return radius(shell) >= std::max(frame_.radius, 1e-30); }
+
+void FivShellRows::finish(FivShells& shells) const { extrapolate_inside_samples(shells); }
 
 bool FivShellRows::stops_after(int shell, std::span<const double> rows) const {
   PRT_CHECK_OP(rows.size(), ==, rows_per_shell() * kRowWidth);
@@ -276,6 +362,7 @@ FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const 
     baker.append(out, k, rows);
     if (baker.stops_after(k, rows)) break;
   }
+  baker.finish(out);
   progress.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
@@ -335,7 +422,7 @@ FivErrorReport fiv_error_report(const Mesh& occluder, const Topology& topology, 
     const size_t idx = picks[q], k = idx / per_shell, ij = idx % per_shell;
     const int i = int(ij / size_t(shells.n_phi)), j = int(ij % size_t(shells.n_phi));
     Fiv se;
-    const Fiv ref = qmc_occluded_fiv(qmc, fenv, shells.centre + shells.radii[k] * shell_direction(i, shells.n_theta, j, shells.n_phi), idx, &se);
+    const Fiv ref = qmc_occluded_fiv(qmc, fenv, shells.sample_position(int(k), i, j), idx, &se);
     for (size_t x = 0; x < 9; ++x) {
       const double d = double(shells.values[idx * 9 + x]) - ref[x];
       err2[q] += d * d;

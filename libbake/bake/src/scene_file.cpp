@@ -211,7 +211,12 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
       if (sc.bounces == 0) r.fail("bake.bounce_rays applies with bake.bounces >= 1");
     }
     if (const Json* f = find_key(*bake, "fiv")) {
-      r.object(*f, "bake.fiv", {"shells", "cube", "fraction"});
+      r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial"});
+      if (const Json* x = find_key(*f, "radial")) {
+        const std::string& g = r.string(*x, "bake.fiv.radial");
+        if (!parse_radial_scheme(g, sc.fiv.radial))
+          r.fail("bake.fiv.radial must be \"surface\" or \"geometric\", not \"" + g + "\"");
+      }
       if (const Json* x = find_key(*f, "shells")) {
         const std::string& g = r.string(*x, "bake.fiv.shells");
         if (!parse_shell_grid(g, sc.fiv))

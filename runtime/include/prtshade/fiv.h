@@ -28,6 +28,23 @@
 //   not taken into account"); if the valid neighbours carry no weight (in particular all 8
 //   invalid), the plain trilinear value of the stored samples is used.
 //
+// Surface-following shells (radial_scheme == kFivRadialSurface; issue 33, replacing §4.1's
+// spheres): sample (k, i, j) sits at centre + (r_surf(i, j) + τ_k) d(θ_i, φ_j), where
+// r_surf(i, j) = surface_radius[i][j] is the largest distance from the centre at which the ray
+// centre + t d(θ_i, φ_j) meets the occluder (0 when it misses) and the offsets τ_k = radii[k]
+// grow geometrically, τ_k = τ_0 g^k (τ_0 a small fraction of R: the contact shadow within a gap
+// of a few hundredths of R is resolved where a sphere shell would pass through the occluder).
+// Lookup: the same (t, u) as above; r_s = bilinear of surface_radius at (t, u) (the same weights
+// as the shell samples, so r_s is continuous in the direction), τ = ρ − r_s; τ <= τ_0 clamps to
+// the first shell (offsets inside the outer hull), τ >= τ_last returns the last shell's value
+// times ((r_s + τ_last)/ρ)²; between, k0 = ⌊log(τ/τ_0)/log g⌋ (the closed-form inverse of the
+// grading, its log2 estimated from the floats' bits to within 0.09, then the bracket moved against
+// the stored radii, so that neither the estimate nor rounding picks a wrong one),
+// fr = (τ − τ_k0)/(τ_k0+1 − τ_k0), and plain trilinear over the 8 neighbours: samples the bake found inside the occluder were extrapolated outwards along their
+// radial line (bake/bake/fiv.h), so there is no valid mask to renormalise by (valid is not read;
+// it may be null). At a grid direction the stored samples come back (up to float rounding of the
+// angles and of τ); the lookup is continuous everywhere (r_s and τ ↦ (k, fr) are continuous).
+//
 // Cube map (DifMap): faces +X, −X, +Y, −Y, +Z, −Z in OpenGL's cube-map convention (not OpenEXR's,
 // which input environment cube maps use: docs/ARCHITECTURE.md §3 "Two cube conventions"); texel
 // (row r, column q) of a size-S face has s = 2(q + ½)/S − 1, t = 2(r + ½)/S − 1 and direction
@@ -81,9 +98,16 @@
 
 namespace prt::shade {
 
+// How an occluder's shells are placed along each direction (header comment; /fiv/occluders/<name>
+// attribute radial_scheme, formats/SCHEMA.md).
+inline constexpr int kFivRadialGeometric = 0;  // spheres ρ_k around the centre (paper 004 §4.1)
+inline constexpr int kFivRadialSurface = 1;    // r_surf(θ, φ) + τ_k, following the surface (issue 33)
+
 // Non-owning view of one baked occluder (/fiv/occluders/<name>): shells [n_rho][n_theta][n_phi]
 // [3 RGB][3 xyz], valid [n_rho][n_theta][n_phi], radii[n_rho] increasing, centre in world space,
-// radius R of the bounding sphere.
+// radius R of the bounding sphere. Geometric scheme: radii are the shell radii ρ_k. Surface
+// scheme: radii are the offsets τ_k from the surface (geometric: τ_k = τ_0 g^k), surface_radius
+// [n_theta][n_phi] is r_surf, and valid is not read.
 struct FivOccluder {
   float centre[3];
   float radius;
@@ -91,6 +115,8 @@ struct FivOccluder {
   const float* radii;
   const float* shells;
   const uint8_t* valid;
+  int radial_scheme = kFivRadialGeometric;
+  const float* surface_radius = nullptr;  // [n_theta][n_phi], surface scheme only
 };
 
 // The DifMap /fiv/irradiance_cube [6][size][size][3], faces +X,−X,+Y,−Y,+Z,−Z, OpenGL orientation
@@ -105,8 +131,10 @@ inline constexpr float kFivValueLimit = 0x1p64f;
 
 // Throw std::invalid_argument naming the problem unless: pointers non-null; n_rho >= 1,
 // n_theta >= 2, n_phi >= 1 and n_rho·n_theta·n_phi <= 2^26; centre finite; radius finite and > 0;
-// radii finite, > 0 and strictly increasing; every shell value finite, |value| <= kFivValueLimit.
-// O(size of the shells).
+// radii finite, > 0 and strictly increasing; every shell value finite, |value| <= kFivValueLimit;
+// radial_scheme one of the two; for kFivRadialSurface surface_radius non-null, finite and in
+// [0, 2^64], radii geometric (each τ_k within 1e-4 relative of τ_0 (τ_last/τ_0)^(k/(n_rho − 1)))
+// and valid may be null. O(size of the shells).
 void validate_occluder(const FivOccluder& occ);
 // size in [1, 2^13], texels non-null, finite and |texel| <= kFivValueLimit. O(6 size²).
 void validate_difmap(const DifMap& map);

@@ -101,7 +101,11 @@ prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const flo
 /* ---- FIV shading (<prtshade/fiv.h>, paper 004 §4.3) -------------------------------------- */
 
 /* One baked occluder, laid out as /fiv/occluders/<name>: shells [n_rho][n_theta][n_phi][3][3],
- * valid [n_rho][n_theta][n_phi], radii [n_rho]. */
+ * valid [n_rho][n_theta][n_phi], radii [n_rho]. radial_scheme (the file's attribute of that name):
+ * 0 geometric (radii are the shell radii; a zero-initialised desc is this), 1 surface (radii are
+ * the offsets from the surface, surface_radius [n_theta][n_phi] is /fiv/occluders/<name>/
+ * surface_radius, valid may be null); prtshade/fiv.h "Surface-following shells". Set every member
+ * (or zero-initialise the struct): the two last members came with format_version 7. */
 typedef struct prt_fiv_occluder_desc {
   float centre[3];
   float radius;
@@ -109,6 +113,8 @@ typedef struct prt_fiv_occluder_desc {
   const float* radii;
   const float* shells;
   const uint8_t* valid;
+  int radial_scheme;
+  const float* surface_radius;
 } prt_fiv_occluder_desc;
 
 typedef struct prt_fiv_options {

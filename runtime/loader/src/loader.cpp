@@ -51,6 +51,12 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   out.radii.assign(o.radii.begin(), o.radii.end());
   out.shells = o.shells;
   out.valid = o.valid->values;
+  // Version 7 (formats/SCHEMA.md): no radial_scheme attribute is the geometric scheme.
+  if (o.radial_scheme.value_or("geometric") == "surface") {
+    if (!o.surface_radius) throw FormatError(file, "occluder '" + o.name + "' has radial_scheme surface but no surface_radius");
+    out.radial_scheme = kFivRadialSurface;
+    out.surface_radius = o.surface_radius->values;
+  }
   out.grid = o.grid.value_or("");
   out.attrs = formats::shells_attrs(o);
   try {
@@ -64,8 +70,16 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
 } // namespace
 
 FivOccluder LoadedOccluder::view() const noexcept {
-  return FivOccluder{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi,
-                     radii.data(), shells.data(), valid.data()};
+  return FivOccluder{{centre[0], centre[1], centre[2]},
+                     radius,
+                     n_rho,
+                     n_theta,
+                     n_phi,
+                     radii.data(),
+                     shells.data(),
+                     valid.data(),
+                     radial_scheme,
+                     radial_scheme == kFivRadialSurface ? surface_radius.data() : nullptr};
 }
 
 const LoadedVertexSet* LoadedAsset::find_vertex_set(std::string_view name) const noexcept {

@@ -1,16 +1,23 @@
 // FIV products (bake/bake/fiv.h, paper 004 §3–4.2) against quadrature, QMC and closed forms.
 #include <bake/bake/fiv.h>
+#include <bake/bake/scene.h>
 #include <bake/core/error.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
 #include <bake/mesh/mesh.h>
+#include <prtshade/fiv.h>
 #include <prtshade/sh.h>
 
 #include <gtest/gtest.h>
 #include <test_scenes.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <numbers>
+#include <random>
 
 using namespace prt::bake;
 using prt::testing::box;
@@ -196,6 +203,7 @@ struct PlateUnderGreySky {
     s.n_rho = 12;
     s.silhouette_k = 64 * 64;  // 64 u-isolines
     s.fraction = 0.02;
+    s.radial = RadialScheme::geometric;  // paper 004's spheres (FivSurface tests: the surface scheme)
     return s;
   }();
 };
@@ -222,7 +230,9 @@ TEST(Fiv, ShellsHaveTheGridTheRadiiAndStopWhenFar) {
 // A merge's FivShellRows (the mesh and the spec only: no environment, no integrator) has the
 // integrating one's frame, radii and stopping rule, and appends the same shells from its rows.
 TEST(Fiv, FrameOnlyShellRowsAgreeWithTheIntegratingOnes) {
-  const PlateUnderGreySky p;
+ for (const RadialScheme scheme : {RadialScheme::geometric, RadialScheme::surface}) {
+  PlateUnderGreySky p;
+  p.spec.radial = scheme;
   const FivShellRows baker(p.m, p.topo, p.env, p.spec), frame(p.m, p.spec);
   ASSERT_EQ(frame.shell_count(), baker.shell_count());
   ASSERT_EQ(frame.rows_per_shell(), baker.rows_per_shell());
@@ -242,5 +252,228 @@ TEST(Fiv, FrameOnlyShellRowsAgreeWithTheIntegratingOnes) {
   EXPECT_EQ(b.values, whole.values);
   EXPECT_EQ(b.valid, whole.valid);
   EXPECT_EQ(a.values, whole.values);
+  EXPECT_EQ(b.surface_radius, whole.surface_radius);
+  EXPECT_EQ(b.surface_radius.empty(), scheme == RadialScheme::geometric);
   EXPECT_THROW((void)frame.rows(0, 0, 1), ContractError);  // nothing to integrate with
+ }
+}
+
+// ---- Surface-following shells (RadialScheme::surface, issue 33) --------------------------------
+
+// r_surf of a box [−1, 1]³ from its centre: the ray along d leaves it at t = 1 / max_a |d_a|.
+TEST(FivSurface, SurfaceRadiiOfABoxAreExact) {
+  const Mesh m = box({-1, -1, -1}, {1, 1, 1});
+  const std::vector<double> r = surface_radii(m, Vector3d::Zero(), std::sqrt(3.0), 9, 16);
+  ASSERT_EQ(r.size(), 9u * 16u);
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 16; ++j) {
+      const Vector3d d = shell_direction(i, 9, j, 16);
+      // The hit is recomputed in double: a few ulps of the 2R + 1 = 4.5 the ray starts from.
+      EXPECT_NEAR(r[size_t(i * 16 + j)], 1 / d.cwiseAbs().maxCoeff(), 1e-14) << i << " " << j;
+    }
+  // A ray that misses: an off-centre "centre" outside the box, directions pointing away.
+  const std::vector<double> away = surface_radii(m, Vector3d(0, 5, 0), 5.0, 3, 4);
+  EXPECT_EQ(away[0], 0.0);  // +Y from (0, 5, 0): nothing
+  EXPECT_NEAR(away[2 * 4], 6.0, 1e-14);  // −Y: through the box, leaving it at y = −1
+}
+
+TEST(FivSurface, ShellsStartJustOutsideThePlateAndNeverInsideIt) {
+  PlateUnderGreySky p;
+  p.spec.radial = RadialScheme::surface;
+  const FivShells s = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
+  EXPECT_EQ(s.radial, RadialScheme::surface);
+  ASSERT_GE(s.radii.size(), 2u);
+  EXPECT_NEAR(s.radii[0], p.spec.first_offset * s.radius, 1e-12);
+  for (size_t k = 2; k < s.radii.size(); ++k)  // geometric: the runtime inverts it in closed form
+    EXPECT_NEAR(s.radii[k] / s.radii[k - 1], s.radii[1] / s.radii[0], 1e-12);
+  ASSERT_EQ(s.surface_radius.size(), 5u * 8u);
+  // Poles: the plate's half-thickness 0.01; the equator: its edge (1 or √2 along the diagonals).
+  EXPECT_NEAR(s.surface_radius[0], 0.01, 1e-7);
+  EXPECT_NEAR(s.surface_radius[2 * 8 + 0], 1.0, 1e-7);
+  EXPECT_NEAR(s.surface_radius[2 * 8 + 1], std::sqrt(2.0), 1e-6);
+  // Every sample lies outside the plate along its ray: the equator samples the geometric scheme
+  // dropped are valid now, and nothing was extrapolated.
+  for (uint8_t v : s.valid) EXPECT_EQ(v, 1);
+  EXPECT_EQ(s.extrapolated, 0u);
+  // Just outside the plate's face, it hides almost half the sky: |F| → π ∫L/(4π)... = π for L = 1.
+  const size_t pole = 0;  // k = 0, θ = 0, φ = 0: 0.01 + 0.007 above the plate
+  EXPECT_GT(std::abs(s.values[pole * 9 + 1]), 0.9 * pi);
+}
+
+TEST(FivSurface, InsideSamplesTakeTheNearestValidOneOutwards) {
+  FivShells s;
+  s.radial = RadialScheme::surface;
+  s.n_theta = 2, s.n_phi = 1;
+  s.radii = {0.1, 0.2, 0.4, 0.8};
+  s.surface_radius = {1, 1};
+  // Direction 0: valid 0 1 0 1 → sample 0 from 1, sample 2 from 3. Direction 1: 1 0 0 0 → from 0.
+  // Values: 10 k + direction.
+  const uint8_t valid[4][2] = {{0, 1}, {1, 0}, {0, 0}, {1, 0}};
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < 2; ++d) {
+      s.valid.push_back(valid[k][d]);
+      for (int e = 0; e < 9; ++e) s.values.push_back(float(10 * k + d));
+    }
+  FivShells geometric = s;
+  geometric.radial = RadialScheme::geometric;
+  extrapolate_inside_samples(geometric);
+  EXPECT_EQ(geometric.values, s.values) << "the geometric scheme keeps its mask";
+  extrapolate_inside_samples(s);
+  const float expect[4][2] = {{10, 1}, {10, 1}, {30, 1}, {30, 1}};
+  for (int k = 0; k < 4; ++k)
+    for (int d = 0; d < 2; ++d)
+      for (int e = 0; e < 9; ++e) EXPECT_EQ(s.values[size_t((k * 2 + d) * 9 + e)], expect[k][d]) << k << " " << d;
+  EXPECT_EQ(s.extrapolated, 5u);
+}
+
+namespace {
+// A unit icosphere: the icosahedron subdivided `levels` times, vertices on the unit sphere.
+Mesh icosphere(int levels) {
+  const double g = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                             {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  for (Vector3d& x : v) x.normalize();
+  std::vector<std::array<uint32_t, 3>> t = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                                            {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                                            {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      const auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      return mid[key] = uint32_t(v.size() - 1);
+    };
+    std::vector<std::array<uint32_t, 3>> next;
+    for (const auto& f : t) {
+      const uint32_t a = midpoint(f[0], f[1]), b = midpoint(f[1], f[2]), c = midpoint(f[2], f[0]);
+      next.push_back({f[0], a, c}), next.push_back({f[1], b, a}), next.push_back({f[2], c, b}), next.push_back({a, b, c});
+    }
+    t = std::move(next);
+  }
+  std::vector<Vector3f> p;
+  for (const Vector3d& x : v) p.push_back(x.cast<float>());
+  return make_mesh(std::move(p), std::move(t), "icosphere");
+}
+
+// ∫_cap ω dω of the cap a sphere of radius a hides from distance ρ > a, under L = 1: π sin²α
+// towards the centre, sin α = a/ρ.
+Vector3d sphere_cap_fiv(double a, const Vector3d& s) {
+  const double rho = s.norm();
+  return -std::numbers::pi * (a / rho) * (a / rho) * s / rho;
+}
+} // namespace
+
+// Closed form: a sphere under a uniform sky (L = 1) hides the cap of half-angle asin(a/ρ), whose
+// occluded FIV is π (a/ρ)² towards the centre. The mesh is an icosphere between the spheres of
+// its inradius r_in and radius 1, so its hidden set lies between their caps and F differs from
+// either cap's by at most the solid angle between them, 2π (cos α_in − cos α_1). Baked samples
+// agree within that plus the silhouette integrator's discretisation at k = 128² (3e-3 of ∫L = 4π,
+// as OccludedFivMatchesQmcFullSphere's 2e-3 at 256²); the runtime lookup at any offset is a convex
+// combination of its 8 neighbours, so it lies within the largest difference between the closed
+// form at the offset and at those neighbours, plus the samples' own bound.
+TEST(FivSurface, SphereUnderAUniformSkyMatchesTheClosedForm) {
+  const Mesh m = icosphere(3);
+  const Topology topo = build_topology(m);
+  const EnvMap env = EnvMap::from_latlong(16, 8, std::vector<float>(16 * 8 * 3, 1.0f), UpAxis::Y, "grey");
+  ShellSpec spec;
+  spec.n_phi = 16, spec.n_theta = 9, spec.n_rho = 12;
+  spec.silhouette_k = 128 * 128;
+  spec.fraction = 0.01;
+  const FivShells s = bake_fiv_shells(m, topo, env, spec);
+  double r_in = 1;
+  for (const auto& f : m.triangles) {
+    const Vector3d a = m.positions[f[0]].cast<double>(), b = m.positions[f[1]].cast<double>(), c = m.positions[f[2]].cast<double>();
+    r_in = std::min(r_in, std::abs((b - a).cross(c - a).normalized().dot(a)));
+  }
+  const double discretisation = 3e-3 * 4 * pi;
+  auto cap_gap = [&](double rho) {
+    return 2 * pi * (std::sqrt(std::max(0.0, 1 - (r_in / rho) * (r_in / rho))) - std::sqrt(std::max(0.0, 1 - 1 / (rho * rho))));
+  };
+  const size_t per_shell = size_t(s.n_theta) * size_t(s.n_phi);
+  double worst_sample = 0;
+  for (size_t k = 0; k < s.radii.size(); ++k)
+    for (int i = 0; i < s.n_theta; ++i)
+      for (int j = 0; j < s.n_phi; ++j) {
+        const Vector3d p = s.sample_position(int(k), i, j) - s.centre;
+        const Vector3d f = sphere_cap_fiv(1.0, p);
+        const size_t idx = k * per_shell + size_t(i * s.n_phi + j);
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_NEAR(s.values[idx * 9 + size_t(a)], f[a], cap_gap(p.norm()) + discretisation) << k << " " << i << " " << j;
+          worst_sample = std::max(worst_sample, std::abs(s.values[idx * 9 + size_t(a)] - f[a]) / (cap_gap(p.norm()) + discretisation));
+        }
+      }
+  std::printf("%zu shells; samples: largest |F - closed form| / bound = %.2g\n", s.radii.size(), worst_sample);
+  // The runtime lookup (prtshade/fiv.h) of the baked grid at seeded offsets.
+  std::vector<float> radii(s.radii.begin(), s.radii.end()), surface(s.surface_radius.begin(), s.surface_radius.end());
+  prt::shade::FivOccluder o{{float(s.centre.x()), float(s.centre.y()), float(s.centre.z())}, float(s.radius), int(s.radii.size()),
+                            s.n_theta, s.n_phi, radii.data(), s.values.data(), s.valid.data(),
+                            prt::shade::kFivRadialSurface, surface.data()};
+  prt::shade::validate_occluder(o);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u01(0, 1);
+  double worst = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vector3d d = Vector3d(u01(rng) - 0.5, u01(rng) - 0.5, u01(rng) - 0.5).normalized();
+    const double rho = 1.0 + s.radii.front() + (s.radii.back() - s.radii.front()) * std::pow(u01(rng), 3.0);
+    const Vector3d off = rho * d;
+    const float sf[3] = {float(off.x()), float(off.y()), float(off.z())};
+    float out[9];
+    prt::shade::lookup_fiv(o, sf, out);
+    // The neighbours: the samples of the (θ, φ) cell of d on the two shells that bracket
+    // τ = ρ − r_s (r_s bilinear in the cell; the lookup's float angles may pick the next cell or
+    // shell within a few ulps, so both brackets' neighbours around the float ones are counted).
+    const double theta = std::atan2(std::hypot(d.x(), d.z()), d.y());
+    double phi = std::atan2(d.x(), d.z());
+    if (phi < 0) phi += 2 * pi;
+    const double t = theta / pi * (s.n_theta - 1), u = phi / (2 * pi) * s.n_phi;
+    const int i0 = std::min(int(t), s.n_theta - 2), j0 = int(u) % s.n_phi, j1 = (j0 + 1) % s.n_phi;
+    const double ft = t - i0, fu = u - std::floor(u);
+    auto rs = [&](int i, int j) { return s.surface_radius[size_t(i * s.n_phi + j)]; };
+    const double r_s = (1 - ft) * ((1 - fu) * rs(i0, j0) + fu * rs(i0, j1)) + ft * ((1 - fu) * rs(i0 + 1, j0) + fu * rs(i0 + 1, j1));
+    const double tau = rho - r_s;
+    size_t k0 = 0;
+    while (k0 + 1 < s.radii.size() && s.radii[k0 + 1] <= tau) ++k0;
+    const size_t k1 = std::min(k0 + 1, s.radii.size() - 1);
+    double spread = 0, bound = 0;
+    const Vector3d f = sphere_cap_fiv(1.0, off);
+    for (size_t kk : {k0, k1})
+      for (int di = 0; di < 2; ++di)
+        for (int j : {j0, j1}) {
+          const Vector3d q = s.sample_position(int(kk), i0 + di, j) - s.centre;
+          spread = std::max(spread, (sphere_cap_fiv(1.0, q) - f).cwiseAbs().maxCoeff());
+          bound = std::max(bound, cap_gap(q.norm()));
+        }
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(out[a], f[a], spread + bound + discretisation + 1e-5) << trial << " rho " << rho;
+      worst = std::max(worst, std::abs(out[a] - f[a]) / (spread + bound + discretisation + 1e-5));
+    }
+  }
+  std::printf("runtime lookup: largest |F - closed form| / bound = %.2g\n", worst);
+}
+
+// Scene files choose the scheme with bake.fiv.radial (bake/bake/scene.h); the default follows the
+// surface, and anything but "surface" or "geometric" is an input error naming the key.
+TEST(FivSurface, SceneFilesChooseTheRadialScheme) {
+  const std::filesystem::path dir = std::filesystem::path(PRT_TEST_TMP) / "fiv_scene_radial";
+  std::filesystem::create_directories(dir);
+  auto write = [&](const std::string& name, const std::string& bake) {
+    const std::filesystem::path p = dir / name;
+    std::ofstream(p) << R"({"prtbake_scene": 1, "bake": )" << bake << R"(, "objects": [{"role": "receiver", "mesh": ")"
+                     << (std::filesystem::path(PRT_DATA_DIR) / "bunny.obj").string() << R"("}]})";
+    return p;
+  };
+  EXPECT_EQ(load_scene(write("default.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.radial,
+            RadialScheme::surface);
+  EXPECT_EQ(load_scene(write("geometric.json", R"({"fiv": {"radial": "geometric"}})"), std::nullopt).fiv.radial,
+            RadialScheme::geometric);
+  EXPECT_EQ(load_scene(write("surface.json", R"({"fiv": {"radial": "surface"}})"), std::nullopt).fiv.radial,
+            RadialScheme::surface);
+  try {
+    load_scene(write("bad.json", R"({"fiv": {"radial": "spheres"}})"), std::nullopt);
+    ADD_FAILURE() << "\"spheres\" accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bake.fiv.radial"), std::string::npos) << e.what();
+  }
 }

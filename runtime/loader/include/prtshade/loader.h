@@ -67,6 +67,8 @@ struct LoadedOccluder {
   std::vector<float> radii;     // [Nρ]
   std::vector<float> shells;    // [Nρ][Nθ][Nφ][3][3]
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  int radial_scheme = kFivRadialGeometric;  // the file's radial_scheme (v7; absent: geometric)
+  std::vector<float> surface_radius;        // [Nθ][Nφ], surface scheme only
   std::string grid;             // the file's angular-convention string ("" if absent)
   std::vector<formats::Attr> attrs;  // every attribute of the shells dataset, as stored
 

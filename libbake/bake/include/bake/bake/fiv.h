@@ -20,6 +20,19 @@
 //   sun, a distant occluder still blocks the sun wholly from some shell directions, so the shells
 //   run out to the last radius: that shadow is real.)
 //   valid = 0 where the offset is inside closed geometry (nothing visible: F = F^env there).
+// Surface-following radii (RadialScheme::surface, the default; issue 33 — replaces §4.1's spheres,
+//   whose shells ~0.6 units apart near the bunny's base cannot hold a contact shadow that varies
+//   over its 0.07-unit gap, and whose samples inside the occluder are dropped):
+//   s(k, i, j) = centre + (r_surf(i, j) + τ_k) d(θ_i, φ_j), r_surf(i, j) the largest t at which the
+//   ray centre + t d(θ_i, φ_j) meets the occluder (0 when it misses; exact: the ray cast from
+//   outside inwards, its hit recomputed in double), τ_k geometric from τ_0 = first_offset · R to
+//   ρ_far (the geometric scheme's far radius) over Nρ shells. Every sample is outside the outer
+//   hull along its ray; a sample the integrator still finds inside (valid = 0: it sees nothing)
+//   takes the value of the nearest valid sample outwards on its radial line (the nearest inwards
+//   when there is none outwards; unchanged — F^env, all light hidden — when the line has no valid
+//   sample), so the runtime
+//   interpolates plainly, without a valid mask (prtshade/fiv.h "Surface-following shells"). The
+//   stopping rule is the same, from the first shell with τ_k >= R (all samples outside the sphere).
 //
 // Cube map of the DifMap, in OpenGL's cube-map convention — not OpenEXR's, which input cube maps
 // use (bake/environment/envmap.h; docs/ARCHITECTURE.md §3 "Two cube conventions"): faces +X, −X, +Y, −Y, +Z,
@@ -64,10 +77,17 @@ std::vector<float> irradiance_cube_reference(const EnvMap& env, int size);
 // convention (header comment), not EnvMap's OpenEXR cube.
 Eigen::Vector3d gl_cube_direction(int face, int row, int column, int size);
 
+// How the shells are placed along each direction (header comment): the file's radial_scheme.
+enum class RadialScheme { geometric, surface };
+std::string_view radial_scheme_name(RadialScheme scheme);  // "geometric", "surface"
+bool parse_radial_scheme(std::string_view text, RadialScheme& scheme);  // false (unchanged) otherwise
+
 // What an FIV bake computes, with its defaults (the same for `prtbake fiv` and scene files).
 struct ShellSpec {
   int n_phi = 128, n_theta = 65, n_rho = 30;
-  double inner = 0.5;      // ρ_0 / R: the first shell lies inside the bounding sphere (self-shadows)
+  RadialScheme radial = RadialScheme::surface;
+  double first_offset = 0.005;  // τ_0 / R of the surface scheme (0.033 for the bunny: half its 0.07 gap)
+  double inner = 0.5;      // ρ_0 / R of the geometric scheme: the first shell lies inside the bounding sphere
   double fraction = 1e-3;  // stop once |occluded FIV| is below this fraction of ∫ L dω
   // The silhouette integrator's k (silhouette_isolines(k) u-isolines, bake/integrators/integrator.h).
   uint32_t silhouette_k = IntegratorSpec::kDefaultSilhouetteK;
@@ -84,14 +104,27 @@ struct FivShells {
   Eigen::Vector3d world_centre() const { return add_origin(origin, centre); }
   double radius = 0;
   int n_phi = 0, n_theta = 0;
-  std::vector<double> radii;    // the shells baked (≤ n_rho)
+  RadialScheme radial = RadialScheme::geometric;
+  std::vector<double> radii;    // the shells baked (≤ n_rho): ρ_k, or τ_k of the surface scheme
   std::vector<float> values;    // occluded FIV F(s) per grid sample: [Nρ][Nθ][Nφ][RGB][xyz]
-  std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]; surface scheme: 0 = extrapolated (header comment)
+  std::vector<double> surface_radius;  // [Nθ][Nφ] r_surf, surface scheme only
+  size_t extrapolated = 0;      // surface scheme: samples filled from their radial line
+  // Where sample (k, i, j) sits, in the mesh's frame (header comment).
+  Eigen::Vector3d sample_position(int k, int i, int j) const;
   double seconds = 0;
   uint64_t integrals = 0;
 };
 
 Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi);
+
+// r_surf of every grid direction, [Nθ][Nφ] (header comment): the largest t >= 0 at which
+// centre + t d(θ_i, φ_j) meets a triangle of `mesh`, 0 where the ray misses it.
+std::vector<double> surface_radii(const Mesh& mesh, const Eigen::Vector3d& centre, double radius, int n_theta, int n_phi);
+// The surface scheme's fill (header comment): every valid == 0 sample of `shells` takes the value
+// of the nearest valid one outwards on its radial line, else inwards, else keeps its own (F^env:
+// all light hidden); counts them in shells.extrapolated. No-op for the geometric scheme.
+void extrapolate_inside_samples(FivShells& shells);
 
 // Bounding sphere used by the shells: the centre of the axis-aligned bounds and the largest
 // distance from it to a vertex.
@@ -140,6 +173,8 @@ public:
   bool stops_after(int shell, std::span<const double> rows) const;
   // Appends shell `shell` (all its rows) to `shells`, which starts as empty_shells().
   void append(FivShells& shells, int shell, std::span<const double> rows) const;
+  // After the last append: the surface scheme's extrapolation (extrapolate_inside_samples).
+  void finish(FivShells& shells) const;
   FivShells empty_shells() const;  // the frame (centre, radius, grid) without shells
 
 private:
