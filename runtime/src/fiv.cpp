@@ -103,7 +103,6 @@ inline float plane_height(const FivOccluder& occ, const float p[3], const float 
   return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
 }
 
-inline bool hides_something(const float I[3]) { return I[0] > 0 || I[1] > 0 || I[2] > 0; }
 
 } // namespace
 
@@ -141,6 +140,19 @@ void validate_occluder(const FivOccluder& o) {
   for (size_t i = 0; i < n; ++i)
     PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]) && std::fabs(o.shells[i]) <= kFivValueLimit,
                       "shell value " + std::to_string(i) + " = " + value_text(o.shells[i]) + value_limit_text);
+  if (o.cones != nullptr) {
+    constexpr double kMargin = 1.0 + 0x1p-10;
+    const size_t samples = sample_index(o, o.n_rho, 0, 0);
+    for (size_t i = 0; i < samples; ++i) {
+      const float* v = o.cones + 4 * i;
+      const double omega = v[3];
+      bool ok = std::isfinite(omega) && omega >= 0 && omega <= 4 * kPi * kMargin;
+      for (int e = 0; e < 3 && ok; ++e) ok = std::isfinite(v[e]) && std::fabs(double(v[e])) <= omega * kMargin + 0x1p-20;
+      PRT_SHADE_REQUIRE(ok, "cone sample " + std::to_string(i) + " = (" + value_text(v[0]) + ", " + value_text(v[1]) + ", " +
+                                value_text(v[2]) + ", " + value_text(v[3]) +
+                                "): needs a finite solid angle in [0, 4pi] and |m| components <= it");
+    }
+  }
 }
 
 void validate_difmap(const DifMap& map) {
@@ -229,10 +241,18 @@ inline void add_weighted_fiv(float acc[9], float w, const float* v) {
 #endif
 }
 
-// The trilinear lookup of the shells at grid coordinates t (θ), u (φ) and distance ρ (header
-// comment): ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside;
-// neighbours with valid == 0 at weight 0 and the rest renormalised.
-void sample_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+// The stencil of a lookup at grid coordinates t (θ), u (φ) and distance ρ (header comment): the
+// 8 (4 inside the first shell and beyond the last) neighbours' sample indices and trilinear
+// weights, ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside. Shared by
+// the shells (sample_shells) and the cone table (sample_cones), which live on the same grid.
+struct ShellStencil {
+  size_t idx[8];
+  float w[8];
+  int count;
+  float falloff;
+};
+
+void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellStencil& st) {
   const int i0 = std::min(int(t), occ.n_theta - 2);
   const float ft = t - float(i0);
   const int ju = std::min(int(u), occ.n_phi);
@@ -268,39 +288,58 @@ void sample_shells(const FivOccluder& occ, float t, float u, double rho, float o
                              {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
   const size_t js[2] = {size_t(j0), size_t(j1)};
   // Inside the first shell and beyond the last, k0 == k1 and fr == 0: the second layer's weights
-  // are 0 and skipping it changes no bit. The plain trilinear value is needed only when no valid
-  // neighbour carries weight, so it is summed only then.
+  // are 0 and skipping it changes no bit.
   const int layers = k1 == k0 ? 1 : 2;
-  float masked[9] = {};
-  float masked_weight = 0;
+  int q = 0;
   for (int a = 0; a < layers; ++a)
     for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) {
-        const size_t idx = rows[a][b] + js[c];
-        if (occ.valid[idx] == 0) continue;
-        const float w = wk[a] * wi[b] * wj[c];
-        masked_weight += w;
-        add_weighted_fiv(masked, w, occ.shells + idx * 9);
+      for (int c = 0; c < 2; ++c, ++q) {
+        st.idx[q] = rows[a][b] + js[c];
+        st.w[q] = wk[a] * wi[b] * wj[c];
       }
-  if (masked_weight > 0) {
-    const float inv = 1.0f / masked_weight;
-    for (int e = 0; e < 9; ++e) out[e] = masked[e] * inv * falloff;
-    return;
-  }
-  float plain[9] = {};
-  for (int a = 0; a < layers; ++a)
-    for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) {
-        const float w = wk[a] * wi[b] * wj[c];
-        const float* v = occ.shells + (rows[a][b] + js[c]) * 9;
-        for (int e = 0; e < 9; ++e) plain[e] += w * v[e];
-      }
-  for (int e = 0; e < 9; ++e) out[e] = plain[e] * falloff;
+  st.count = q;
+  st.falloff = falloff;
 }
 
-// F(s) with the angles from std::atan2: lookup_fiv, occluded_irradiance and the slow reference.
-// (shade_fiv forms the same coordinates with poly_atan2 for all its occluders at once.)
-void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
+// The masked trilinear value of a table of `width` floats per sample over a stencil: neighbours
+// with valid == 0 at weight 0 and the rest renormalised; the plain trilinear value only when no
+// valid neighbour carries weight (so it is summed only then); times the falloff.
+template <int kWidth>
+void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* table, float out[kWidth]) {
+  float masked[kWidth] = {};
+  float masked_weight = 0;
+  for (int q = 0; q < st.count; ++q) {
+    if (occ.valid[st.idx[q]] == 0) continue;
+    const float w = st.w[q];
+    masked_weight += w;
+    if constexpr (kWidth == 9) {
+      add_weighted_fiv(masked, w, table + st.idx[q] * 9);
+    } else {
+      for (int e = 0; e < kWidth; ++e) masked[e] += w * table[st.idx[q] * kWidth + size_t(e)];
+    }
+  }
+  if (masked_weight > 0) {
+    const float inv = 1.0f / masked_weight;
+    for (int e = 0; e < kWidth; ++e) out[e] = masked[e] * inv * st.falloff;
+    return;
+  }
+  float plain[kWidth] = {};
+  for (int q = 0; q < st.count; ++q) {
+    const float* v = table + st.idx[q] * kWidth;
+    for (int e = 0; e < kWidth; ++e) plain[e] += st.w[q] * v[e];
+  }
+  for (int e = 0; e < kWidth; ++e) out[e] = plain[e] * st.falloff;
+}
+
+// The trilinear lookup of the shells (header comment) at a stencil.
+inline void sample_shells(const FivOccluder& occ, const ShellStencil& st, float out[9]) { sample_table<9>(occ, st, occ.shells, out); }
+// The cone table (m, Ω) at the same stencil (header "Tight proxies").
+inline void sample_cones(const FivOccluder& occ, const ShellStencil& st, float out[4]) { sample_table<4>(occ, st, occ.cones, out); }
+
+// Grid coordinates (t, u) of an offset with the angles from std::atan2 and ρ = |s| (ρ = 0 for a
+// zero or NaN offset: d = +Y, θ = 0): lookup_fiv, lookup_cone, occluded_irradiance and the slow
+// reference. (shade_fiv forms the same coordinates with poly_atan2 for all its occluders at once.)
+void stencil_at(const FivOccluder& occ, const double s[3], ShellStencil& st) {
   // Direction and distance, formed in double: |s| never overflows and d is unit to float precision.
   const double sx = s[0], sy = s[1], sz = s[2];
   double rho = std::sqrt(sx * sx + sy * sy + sz * sz);
@@ -315,7 +354,14 @@ void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
   } else {
     rho = 0;  // ρ == 0 (or NaN): d = +Y, θ = 0
   }
-  sample_shells(occ, theta_coordinate(theta, float(occ.n_theta - 1)), phi_coordinate(phi, float(occ.n_phi)), rho, out);
+  shell_stencil(occ, theta_coordinate(theta, float(occ.n_theta - 1)), phi_coordinate(phi, float(occ.n_phi)), rho, st);
+}
+
+// F(s) with the angles from std::atan2 (stencil_at).
+void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
+  ShellStencil st;
+  stencil_at(occ, s, st);
+  sample_shells(occ, st, out);
 }
 
 // Factor of the case an occluder is in at height h = n·(centre − p) over the receiver's plane:
@@ -391,6 +437,29 @@ inline float overlap_float(float alpha_i, float alpha_j, float cos_gamma, float 
   const float denom = kPiF * (alpha_i * alpha_i + alpha_j * alpha_j);
   const float lens = lens_area_float(alpha_i, alpha_j, gamma);
   return denom > 0 ? lens / (denom > 0 ? denom : 1.0f) : 0.0f;
+}
+
+// K(x, α) of the header's "Tight proxies" in float with poly_atan2 (acos(q) = atan2(√(1 − q²), q)):
+// the fast path's cap_clamped_cosine. x = ν·a, ca = cos α.
+inline float cap_clamped_cosine_float(float x, float ca) {
+  x = clamp_nan_safe(x, -1.0f, 1.0f), ca = clamp_nan_safe(ca, -1.0f, 1.0f);
+  const bool complement = ca < 0;  // α > π/2: π − K(−x, π − α)
+  if (complement) x = -x, ca = -ca;
+  const float sa2 = (1 - ca) * (1 + ca), sa = std::sqrt(sa2);
+  float k;
+  if (x >= sa) {
+    k = kPiF * x * sa2;
+  } else if (x <= -sa) {
+    k = 0;
+  } else {  // |x| < sa <= 1: sa > 0 and y > 0
+    const float y = std::sqrt((1 - x) * (1 + x));
+    const float cot = ca / sa;
+    const float q = clamp_nan_safe(-cot * x / y, -1.0f, 1.0f);
+    const float sq = std::sqrt((1 - q) * (1 + q));
+    const float z = y * sq;
+    k = std::max(0.0f, (x * poly_atan2(sq, q) - cot * z) * sa2 + poly_atan2(z, cot));
+  }
+  return complement ? kPiF - k : k;
 }
 
 // Four pair tests at once: bit k is set when the disc (x[k], y[k], z[k]) of angular radius α_k
@@ -512,6 +581,14 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   float *const t = c.field[F::kT], *const u = c.field[F::kU];
   float* const I[3] = {c.field[F::kI0], c.field[F::kI1], c.field[F::kI2]};
 
+  // The tight proxy's partial correction needs the mean radiance from below, E_tot(−n)/π.
+  const bool use_cones = options.proxy == FivProxy::cone;
+  float below[3] = {0, 0, 0};
+  if (use_cones && options.partial_occluders) {
+    const float down[3] = {-n[0], -n[1], -n[2]};
+    lookup_difmap(map, down, below);
+    for (float& b : below) b /= kPiF;
+  }
   // Pass 1: offset, case and distance in double (finite for any finite input).
   int candidates = 0;
   for (int i = 0; i < count; ++i) {
@@ -519,7 +596,8 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     double s[3];
     offset_from_centre(occ, p, s);
     const float h = float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
-    const float f = case_factor(h, occ.radius, options.partial_occluders);
+    // A tight occluder's partial correction comes in pass 3; its case C is the sphere's.
+    const float f = case_factor(h, occ.radius, options.partial_occluders && !(use_cones && occ.cones));
     if (f == 0) continue;
     const int k = candidates++;
     c.index[k] = i;
@@ -545,9 +623,35 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   // Pass 3: shell samples and I; the candidates that hide something become active.
   int active = 0;
   for (int k = 0; k < candidates; ++k) {
+    const FivOccluder& occ = occluders[c.index[k]];
     float fv[9], e[3];
-    sample_shells(occluders[c.index[k]], t[k], u[k], c.rho[k], fv);
+    ShellStencil st;
+    shell_stencil(occ, t[k], u[k], c.rho[k], st);
+    sample_shells(occ, st, fv);
     project_fiv(fv, n, e);
+    if (use_cones && occ.cones) {
+      // The occluder's cone (header "Tight proxies"): axis m/|m| (towards the centre when m = 0).
+      float cone[4];
+      sample_cones(occ, st, cone);
+      const float ml = std::sqrt(cone[0] * cone[0] + cone[1] * cone[1] + cone[2] * cone[2]);
+      if (ml > 0) ax[k] = cone[0] / ml, ay[k] = cone[1] / ml, az[k] = cone[2] / ml;
+      const float ca = clamp_nan_safe(1.0f - cone[3] / kTwoPiF, -1.0f, 1.0f);
+      if (options.partial_occluders) {
+        const float x = n[0] * ax[k] + n[1] * ay[k] + n[2] * az[k];
+        const float sa = std::sqrt((1 - ca) * (1 + ca));
+        if (ca >= 0 && x <= -sa) {
+          e[0] = e[1] = e[2] = 0;  // the cap wholly below the horizon
+        } else {
+          const float K = cap_clamped_cosine_float(-x, ca);
+          for (int ch = 0; ch < 3; ++ch) e[ch] += below[ch] * K;
+        }
+      }
+      // The disc of eq. 13–14: the cap, α clamped to π/2 as the sphere's.
+      const float cd = std::max(ca, 0.0f);
+      cos_alpha[k] = cd;
+      sin_alpha[k] = std::sqrt((1 - cd) * (1 + cd));
+      alpha[k] = poly_atan2(sin_alpha[k], cd);
+    }
     bool hides = false;
     for (int ch = 0; ch < 3; ++ch) {
       I[ch][k] = std::max(0.0f, factor[k] * e[ch]);
@@ -618,6 +722,25 @@ void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
   lookup_fiv_at(occ, sd, out);
 }
 
+void lookup_cone(const FivOccluder& occ, const float s[3], float out[4]) {
+  const double sd[3] = {s[0], s[1], s[2]};
+  ShellStencil st;
+  stencil_at(occ, sd, st);
+  sample_cones(occ, st, out);
+}
+
+double cap_clamped_cosine(double x, double cos_alpha) {
+  x = std::clamp(x, -1.0, 1.0), cos_alpha = std::clamp(cos_alpha, -1.0, 1.0);
+  if (cos_alpha < 0) return kPi - cap_clamped_cosine(-x, -cos_alpha);
+  const double s2 = (1 - cos_alpha) * (1 + cos_alpha), s = std::sqrt(s2);
+  if (x >= s) return kPi * x * s2;
+  if (x <= -s) return 0.0;
+  const double y = std::sqrt((1 - x) * (1 + x)), cot = cos_alpha / s;
+  const double q = std::clamp(-cot * x / y, -1.0, 1.0);
+  const double z = y * std::sqrt((1 - q) * (1 + q));
+  return std::max(0.0, (x * std::acos(q) - cot * z) * s2 + std::atan2(z, cot));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Cases A/B/C, shadows, self-shadows
 
@@ -672,6 +795,42 @@ double overlap_fraction(double alpha_i, double alpha_j, double gamma) {
   return lens_area(alpha_i, alpha_j, gamma) / denom;
 }
 
+namespace {
+// One occluder's terms in the slow reference, in double: I (eq. 10 with the proxy's partial
+// correction) and its disc (axis, α) for eq. 13–14 (header "Tight proxies").
+void reference_terms(const FivOccluder& o, const float p[3], const float n[3], const FivShadeOptions& options,
+                     const double below[3], double I[3], double axis[3], double& alpha) {
+  const bool tight = options.proxy == FivProxy::cone && o.cones != nullptr;
+  float Ib[3];
+  occluded_irradiance_unit(o, p, n, options.partial_occluders && !tight, Ib);
+  for (int c = 0; c < 3; ++c) I[c] = Ib[c];
+  double v[3] = {double(o.centre[0]) - p[0], double(o.centre[1]) - p[1], double(o.centre[2]) - p[2]};
+  const double D = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  for (int k = 0; k < 3; ++k) axis[k] = D > 0 ? v[k] / D : double(n[k]);
+  alpha = D > 0 ? std::asin(std::min(1.0, double(o.radius) / D)) : (o.radius > 0 ? kPi / 2 : 0.0);
+  if (!tight) return;
+  double s[3];
+  offset_from_centre(o, p, s);
+  ShellStencil st;
+  stencil_at(o, s, st);
+  float cone[4];
+  sample_cones(o, st, cone);
+  const double ml = std::sqrt(double(cone[0]) * cone[0] + double(cone[1]) * cone[1] + double(cone[2]) * cone[2]);
+  if (ml > 0)
+    for (int k = 0; k < 3; ++k) axis[k] = cone[k] / ml;
+  const double ca = std::clamp(1.0 - double(cone[3]) / (2 * kPi), -1.0, 1.0);
+  alpha = std::acos(std::max(ca, 0.0));
+  if (!options.partial_occluders || !(plane_height(o, p, n) > -o.radius)) return;  // I as the sphere's case C gave it
+  float f[9], e[3];
+  sample_shells(o, st, f);
+  project_fiv(f, n, e);
+  const double x = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2];
+  const bool below_horizon = ca >= 0 && x <= -std::sqrt((1 - ca) * (1 + ca));
+  const double K = cap_clamped_cosine(-x, ca);
+  for (int c = 0; c < 3; ++c) I[c] = below_horizon ? 0.0 : std::max(0.0, double(e[c]) + below[c] * K);
+}
+} // namespace
+
 void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int count, const float p[3],
                          const float n_in[3], const FivShadeOptions& options, float out[3]) {
   const UnitNormal unit(n_in);
@@ -679,28 +838,32 @@ void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int co
   float tot[3];
   lookup_difmap(map, n, tot);
   double e[3] = {tot[0], tot[1], tot[2]};
-  std::vector<std::array<float, 3>> I(size_t(std::max(count, 0)));
-  for (int i = 0; i < count; ++i) {
-    occluded_irradiance(occluders[i], p, n, options.partial_occluders, I[size_t(i)].data());
-    for (int c = 0; c < 3; ++c) e[c] -= I[size_t(i)][size_t(c)];
+  double below[3] = {0, 0, 0};
+  {
+    const float down[3] = {-n[0], -n[1], -n[2]};
+    float b[3];
+    lookup_difmap(map, down, b);
+    for (int c = 0; c < 3; ++c) below[c] = double(b[c]) / kPi;
   }
-  auto axis_alpha = [&](const FivOccluder& o, double axis[3]) {
-    double v[3] = {double(o.centre[0]) - p[0], double(o.centre[1]) - p[1], double(o.centre[2]) - p[2]};
-    const double D = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; ++k) axis[k] = D > 0 ? v[k] / D : double(n[k]);
-    return D > 0 ? std::asin(std::min(1.0, double(o.radius) / D)) : (o.radius > 0 ? kPi / 2 : 0.0);
+  struct Terms {
+    double I[3], axis[3], alpha;
   };
+  std::vector<Terms> t(size_t(std::max(count, 0)));
+  for (int i = 0; i < count; ++i) {
+    Terms& ti = t[size_t(i)];
+    reference_terms(occluders[i], p, n, options, below, ti.I, ti.axis, ti.alpha);
+    for (int c = 0; c < 3; ++c) e[c] -= ti.I[c];
+  }
+  const auto hides = [](const Terms& x) { return x.I[0] > 0 || x.I[1] > 0 || x.I[2] > 0; };
   if (options.overlap_correction)
     for (int i = 0; i < count; ++i)
       for (int j = i + 1; j < count; ++j) {
-        const auto& Ii = I[size_t(i)];
-        const auto& Ij = I[size_t(j)];
-        if (!hides_something(Ii.data()) || !hides_something(Ij.data())) continue;
-        double ai[3], aj[3];
-        const double alpha_i = axis_alpha(occluders[i], ai), alpha_j = axis_alpha(occluders[j], aj);
-        const double gamma = std::acos(std::clamp(ai[0] * aj[0] + ai[1] * aj[1] + ai[2] * aj[2], -1.0, 1.0));
-        const double o = overlap_fraction(alpha_i, alpha_j, gamma);
-        for (int c = 0; c < 3; ++c) e[c] += o * (double(Ii[size_t(c)]) + Ij[size_t(c)]);
+        const Terms& ti = t[size_t(i)];
+        const Terms& tj = t[size_t(j)];
+        if (!hides(ti) || !hides(tj)) continue;
+        const double cg = ti.axis[0] * tj.axis[0] + ti.axis[1] * tj.axis[1] + ti.axis[2] * tj.axis[2];
+        const double o = overlap_fraction(ti.alpha, tj.alpha, std::acos(std::clamp(cg, -1.0, 1.0)));
+        for (int c = 0; c < 3; ++c) e[c] += o * (ti.I[c] + tj.I[c]);
       }
   for (int c = 0; c < 3; ++c) out[c] = float(std::max(0.0, e[c]));
 }
