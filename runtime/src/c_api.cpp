@@ -31,6 +31,7 @@ static_assert(sizeof(prt_fiv_occluder_desc) == sizeof(prt::shade::FivOccluder));
 static_assert(offsetof(prt_fiv_occluder_desc, radius) == offsetof(prt::shade::FivOccluder, radius));
 static_assert(offsetof(prt_fiv_occluder_desc, n_phi) == offsetof(prt::shade::FivOccluder, n_phi));
 static_assert(offsetof(prt_fiv_occluder_desc, valid) == offsetof(prt::shade::FivOccluder, valid));
+static_assert(offsetof(prt_fiv_occluder_desc, cones) == offsetof(prt::shade::FivOccluder, cones));
 
 struct prt_glossy {
   explicit prt_glossy(int order) : table(order) {}
@@ -46,7 +47,7 @@ namespace {
 
 // Owning copy of one occluder's arrays (its view lives in prt_fiv_scene::views).
 struct OwnedOccluder {
-  std::vector<float> radii, shells;
+  std::vector<float> radii, shells, cones;
   std::vector<uint8_t> valid;
 };
 
@@ -258,7 +259,8 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
                               occluder->n_phi,
                               occluder->radii,
                               occluder->shells,
-                              occluder->valid};
+                              occluder->valid,
+                              occluder->cones};
     prt::shade::validate_occluder(v);
     require(scene->views.size() < size_t(1) << 30, "too many occluders");
     auto own = std::make_unique<OwnedOccluder>();
@@ -269,6 +271,10 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
     v.radii = own->radii.data();
     v.shells = own->shells.data();
     v.valid = own->valid.data();
+    if (v.cones != nullptr) {
+      own->cones.assign(v.cones, v.cones + samples * 4);
+      v.cones = own->cones.data();
+    }
     scene->views.reserve(scene->views.size() + 1);
     scene->owned.push_back(std::move(own));
     scene->views.push_back(v);
@@ -324,6 +330,7 @@ prt_status prt_fiv_scene_shade(const prt_fiv_scene* scene, const float* position
     if (options != nullptr) {
       o.partial_occluders = options->partial_occluders != 0;
       o.overlap_correction = options->overlap_correction != 0;
+      o.proxy = options->sphere_proxy != 0 ? prt::shade::FivProxy::sphere : prt::shade::FivProxy::cone;
     }
     const prt::shade::DifMap map = scene->map();
     for (size_t k = 0; k < count; ++k)

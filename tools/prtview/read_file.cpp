@@ -309,6 +309,11 @@ BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const st
   o.radii = b.radii.data();
   o.shells = baked->shells.data();
   o.valid = baked->valid->values.data();
+  // The tight proxy where the file says so (v7; prtshade/fiv.h "Tight proxies"); older files: the sphere.
+  if (baked->proxy == std::string(N::kProxyCone)) {
+    if (!baked->cones) throw InputError(file, cat(occluder_dir(name), "") + " says proxy \"cone\" without a cone table");
+    o.cones = baked->cones->values.data();
+  }
   try {
     shade::validate_occluder(o);
   } catch (const std::invalid_argument& e) {

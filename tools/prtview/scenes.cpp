@@ -302,11 +302,14 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
                 name.c_str(), mesh_path.c_str(), occluders[0].n_phi, occluders[0].n_theta, occluders[0].n_rho, R,
                 inst.size(), inst.size() == 1 ? "y" : "ies", ground_y, half);
   scene.what = buf;
+  const bool cones = options.sphere_proxy ? false : occluders[0].cones != nullptr;
   scene.how = std::string("prt::shade::shade_fiv per pixel (overlap correction ") + (options.overlap ? "on" : "off") +
-              ", partial-occluder factor " + (options.partial ? "on" : "off") +
+              ", partial-occluder correction " + (options.partial ? "on" : "off") + ", proxy " +
+              (cones ? "cone (tight)" : "bounding sphere") +
               "), shade_fiv_member on the occluders (self-shadows minus the other copies' shadows)";
 
-  const shade::FivShadeOptions opts{options.partial, options.overlap};
+  const shade::FivShadeOptions opts{options.partial, options.overlap,
+                                    options.sphere_proxy ? shade::FivProxy::sphere : shade::FivProxy::cone};
   const size_t tri_per_copy = occ.triangles.size();
   const view::GBuffer g = view::rasterize(scene.mesh, cam);
   return view::shade_pixels(scene.mesh, g, [&](const view::Fragment& fr, float* out) {

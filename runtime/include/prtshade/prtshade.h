@@ -101,7 +101,9 @@ prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const flo
 /* ---- FIV shading (<prtshade/fiv.h>, paper 004 §4.3) -------------------------------------- */
 
 /* One baked occluder, laid out as /fiv/occluders/<name>: shells [n_rho][n_theta][n_phi][3][3],
- * valid [n_rho][n_theta][n_phi], radii [n_rho]. */
+ * valid [n_rho][n_theta][n_phi], radii [n_rho]; cones [n_rho][n_theta][n_phi][4] the tight proxy
+ * (/fiv/occluders/<name>/cones when its `proxy` is "cone"; fiv.h "Tight proxies") or NULL (the
+ * bounding sphere). */
 typedef struct prt_fiv_occluder_desc {
   float centre[3];
   float radius;
@@ -109,11 +111,14 @@ typedef struct prt_fiv_occluder_desc {
   const float* radii;
   const float* shells;
   const uint8_t* valid;
+  const float* cones;
 } prt_fiv_occluder_desc;
 
 typedef struct prt_fiv_options {
   int partial_occluders;  /* nonzero: the (h + R)/2R factor for case B (default 1) */
   int overlap_correction; /* nonzero: eq. 13–14 unit-bounding-disc correction (default 1) */
+  int sphere_proxy;       /* nonzero: the paper's bounding sphere for every occluder; 0 (default):
+                             the cone table where an occluder has one (fiv.h "Tight proxies") */
 } prt_fiv_options;
 
 typedef struct prt_fiv_scene prt_fiv_scene;

@@ -3,6 +3,7 @@
 #include <prtshade/loader.h>
 
 #include <formats/asset.h>
+#include <formats/names.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -51,6 +52,11 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   out.radii.assign(o.radii.begin(), o.radii.end());
   out.shells = o.shells;
   out.valid = o.valid->values;
+  if (o.proxy == std::string(formats::names::kProxyCone)) {
+    if (!o.cones) throw FormatError(file, "occluder '" + o.name + "' says proxy \"cone\" without a cone table");
+    out.proxy = o.proxy.value();
+    out.cones = o.cones->values;
+  }
   out.grid = o.grid.value_or("");
   out.attrs = formats::shells_attrs(o);
   try {
@@ -65,7 +71,7 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
 
 FivOccluder LoadedOccluder::view() const noexcept {
   return FivOccluder{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi,
-                     radii.data(), shells.data(), valid.data()};
+                     radii.data(), shells.data(), valid.data(), cones.empty() ? nullptr : cones.data()};
 }
 
 const LoadedVertexSet* LoadedAsset::find_vertex_set(std::string_view name) const noexcept {

@@ -67,6 +67,11 @@ struct LoadedOccluder {
   std::vector<float> radii;     // [Nρ]
   std::vector<float> shells;    // [Nρ][Nθ][Nφ][3][3]
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  // The proxy its corrections use (the group attribute `proxy`, v7): "sphere" (also for files
+  // without it) or "cone", with the cone table [Nρ][Nθ][Nφ][4] (empty for "sphere"; prtshade/fiv.h
+  // "Tight proxies").
+  std::string proxy = "sphere";
+  std::vector<float> cones;
   std::string grid;             // the file's angular-convention string ("" if absent)
   std::vector<formats::Attr> attrs;  // every attribute of the shells dataset, as stored
 

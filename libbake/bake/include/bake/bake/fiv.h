@@ -20,6 +20,10 @@
 //   sun, a distant occluder still blocks the sun wholly from some shell directions, so the shells
 //   run out to the last radius: that shadow is real.)
 //   valid = 0 where the offset is inside closed geometry (nothing visible: F = F^env there).
+//   Cones (the tight proxy, issue 33; prtshade/fiv.h "Tight proxies"): per sample the occluded
+//   moment and solid angle, m = ∫ (1 − V_O) ω dω and Ω = ∫ (1 − V_O) dω, from the same integral as
+//   F (visibility up to band 1: Ω from y_0, m from y_1m as F from band-1 radiance), so exact to the
+//   integrator's discretisation like F.
 //
 // Cube map of the DifMap, in OpenGL's cube-map convention — not OpenEXR's, which input cube maps
 // use (bake/environment/envmap.h; docs/ARCHITECTURE.md §3 "Two cube conventions"): faces +X, −X, +Y, −Y, +Z,
@@ -87,6 +91,7 @@ struct FivShells {
   std::vector<double> radii;    // the shells baked (≤ n_rho)
   std::vector<float> values;    // occluded FIV F(s) per grid sample: [Nρ][Nθ][Nφ][RGB][xyz]
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
+  std::vector<float> cones;     // occluded moment and solid angle (m_x, m_y, m_z, Ω): [Nρ][Nθ][Nφ][4]
   double seconds = 0;
   uint64_t integrals = 0;
 };
@@ -118,11 +123,11 @@ FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const En
 // The shell bake as rows, for bakes cut into chunks (sharded and resumable bakes): bake_fiv_shells
 // is this class's rows shell after shell, stopping where stops_after() says, so any cut of the
 // shells' rows gives the same numbers. Row r of shell k is grid sample r = i·Nφ + j, kRowWidth
-// doubles: the occluded FIV rounded to float (9), valid (0 or 1) and the sample's stopping
-// ratio max_c |F_c| / ∫ L_c dω (0 inside the geometry).
+// doubles: the occluded FIV rounded to float (9), valid (0 or 1), the sample's stopping
+// ratio max_c |F_c| / ∫ L_c dω (0 inside the geometry) and the cone (m, Ω) rounded to float (4).
 class FivShellRows {
 public:
-  static constexpr size_t kRowWidth = 11;
+  static constexpr size_t kRowWidth = 15;
   FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec);
   // The frame, radii and stopping rule only (a merge of committed rows): no integrator, no
   // environment; rows() is then a contract error.
@@ -150,10 +155,13 @@ private:
   std::unique_ptr<const SilhouetteIntegrator> integrator_;
 };
 
-// The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1}
-// in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
-// direction is visible.
-Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr);
+// The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1
+// or 2} in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
+// direction is visible, and `cone` to (m_x, m_y, m_z, Ω) (header comment) when given and the
+// integrator has visibility order >= 2 (left as it was otherwise).
+using Cone = std::array<double, 4>;
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr,
+                 Cone* cone = nullptr);
 
 // The same quantity from the QMC reference (an integrator built for {radiance = &env, visibility
 // order 1}) in full-sphere mode: F = F^env − ∫ V L ω dω with F^env = environment_fiv(env).
