@@ -19,12 +19,14 @@
 // and descriptors are fiv.glsl's (see its header comment for every field):
 //   PRT_FIV_OCCLUDERS_BINDING (2)  StructuredBuffer<PrtFivOccluder> prt_fiv_occluders   48 bytes each:
 //        struct PrtFivOccluder { float4 centre_radius; int4 dims; uint4 offsets; }
-//        (centre xyz + bounding radius; n_rho, n_theta, n_phi, unused; first radius, first shell
-//        float, first valid WORD, unused)
+//        (centre xyz + bounding radius; n_rho, n_theta, n_phi, 1 with a cone table else 0; first
+//        radius, first shell float, first valid WORD, first cone float)
 //   PRT_FIV_RADII_BINDING (3)      StructuredBuffer<float> prt_fiv_radii    each occluder's radii
 //   PRT_FIV_SHELLS_BINDING (4)     StructuredBuffer<float> prt_fiv_shells   [n_rho][n_theta][n_phi][RGB][xyz]
 //   PRT_FIV_VALID_BINDING (5)      StructuredBuffer<uint> prt_fiv_valid     the uint8 valid masks
 //        packed 4 per uint, little-endian, each occluder's from a word boundary
+//   PRT_FIV_CONES_BINDING (7)      StructuredBuffer<float> prt_fiv_cones    [n_rho][n_theta][n_phi][4]
+//        (m_x, m_y, m_z, Ω) of each cone occluder (prtshade/fiv.h "Tight proxies"), read where dims.w == 1
 //   PRT_FIV_DIFMAP_BINDING (6)     StructuredBuffer<float> prt_fiv_difmap   4 header words (word 0:
 //        the face size S as a uint, read with asuint) then /fiv/irradiance_cube [6][S][S][RGB]
 //        floats from word 4, faces +X, −X, +Y, −Y, +Z, −Z, OpenGL's cube orientation

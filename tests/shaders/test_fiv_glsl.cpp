@@ -43,8 +43,10 @@ struct SynthOccluder {
   int n_rho, n_theta, n_phi;
   std::vector<float> radii, shells;
   std::vector<uint8_t> valid;
+  std::vector<float> cones;  // the tight proxy's table [n_rho][n_theta][n_phi][4], or empty
   prt::shade::FivOccluder view() const {
-    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
+    return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data(),
+            cones.empty() ? nullptr : cones.data()};
   }
   std::size_t sample(int k, int i, int j) const {
     return (static_cast<std::size_t>(k) * static_cast<std::size_t>(n_theta) + static_cast<std::size_t>(i)) *
@@ -57,7 +59,7 @@ struct SynthOccluder {
 // occluded FIVs have), the pole rows constant in φ (they are one point), ~20% invalid samples.
 SynthOccluder make_occluder(std::mt19937& rng, const std::array<float, 3>& centre, float radius, int n_rho,
                             int n_theta, int n_phi) {
-  SynthOccluder o{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, {}, {}, {}};
+  SynthOccluder o{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, {}, {}, {}, {}};
   std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
   for (int k = 0; k < n_rho; ++k) o.radii.push_back(radius * 0.5f * std::pow(2.0f, float(k) * 3.0f / float(std::max(1, n_rho - 1))));
   o.shells.resize(o.sample(n_rho, 0, 0) * 9);
@@ -90,18 +92,19 @@ struct GpuOccluder {
 static_assert(sizeof(GpuOccluder) == 48, "std430 PrtFivOccluder is 48 bytes");
 
 struct GpuScene {
-  std::vector<std::byte> occluders, radii, shells, valid, difmap;
+  std::vector<std::byte> occluders, radii, shells, valid, difmap, cones;
 };
 
 GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std::vector<float>& texels) {
   std::vector<GpuOccluder> table;
-  std::vector<float> radii, shells;
+  std::vector<float> radii, shells, cones;
   std::vector<uint8_t> valid;
   for (const SynthOccluder& o : occ) {
     GpuOccluder g{{o.centre[0], o.centre[1], o.centre[2], o.radius},
-                  {o.n_rho, o.n_theta, o.n_phi, 0},
-                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4), 0}};
+                  {o.n_rho, o.n_theta, o.n_phi, o.cones.empty() ? 0 : 1},
+                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4), uint32_t(cones.size())}};
     table.push_back(g);
+    cones.insert(cones.end(), o.cones.begin(), o.cones.end());
     radii.insert(radii.end(), o.radii.begin(), o.radii.end());
     shells.insert(shells.end(), o.shells.begin(), o.shells.end());
     valid.insert(valid.end(), o.valid.begin(), o.valid.end());
@@ -112,6 +115,8 @@ GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std:
   s.radii = prt::test::to_bytes(radii);
   s.shells = prt::test::to_bytes(shells);
   s.valid = prt::test::to_bytes(valid);  // little-endian host: the bytes are the packed words
+  cones.resize(std::max<std::size_t>(cones.size(), 4), 0.0f);  // a buffer is bound even without cones
+  s.cones = prt::test::to_bytes(cones);
   const uint32_t header[4] = {uint32_t(difmap_size), 0, 0, 0};
   s.difmap.resize(16 + texels.size() * sizeof(float));
   std::memcpy(s.difmap.data(), header, 16);
@@ -293,6 +298,9 @@ struct PushBlock {
   float env[9];
 };
 
+// Occluders from this index on carry a cone table (make_scene).
+constexpr std::size_t kFirstCone = 5;
+
 struct Scene {
   std::vector<SynthOccluder> occ;
   int difmap_size = 5;
@@ -314,7 +322,25 @@ Scene make_scene() {
   sc.occ.push_back(make_occluder(rng, {-0.2f, 0.4f, -1.1f}, 0.5f, 1, 2, 1));  // minimal grid
   sc.occ.push_back(sc.occ[0]);                                                 // a duplicate: O = ½
   sc.occ.push_back(make_occluder(rng, {-2.0f, 1.5f, 2.5f}, 0.3f, 5, 9, 16));
-  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}};
+  // Occluders 5–7 carry a cone table (the tight proxy): the exact cone of a ball of radius 0.6 R
+  // about the centre (fiv.h "Tight proxies"); groups of them are checked by ShadeFivConeMatchesCore.
+  sc.occ.push_back(make_occluder(rng, {0.2f, 0.3f, 0.4f}, 1.0f, 4, 9, 16));
+  sc.occ.push_back(make_occluder(rng, {1.4f, 0.6f, -0.3f}, 0.8f, 3, 7, 12));
+  sc.occ.push_back(make_occluder(rng, {-0.9f, 0.2f, 1.2f}, 0.6f, 4, 9, 16));
+  for (std::size_t k = kFirstCone; k < sc.occ.size(); ++k) {
+    SynthOccluder& o = sc.occ[k];
+    const double r = 0.6 * o.radius;
+    for (int kr = 0; kr < o.n_rho; ++kr)
+      for (int i = 0; i < o.n_theta; ++i)
+        for (int j = 0; j < o.n_phi; ++j) {
+          const double th = kPi * i / (o.n_theta - 1), ph = 2 * kPi * j / o.n_phi, rho = o.radii[std::size_t(kr)];
+          const double sa = std::min(1.0, r / rho), ca = std::sqrt((1 - sa) * (1 + sa)), len = kPi * sa * sa;
+          const double d[3] = {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+          for (int e = 0; e < 3; ++e) o.cones.push_back(float(-len * d[e]));
+          o.cones.push_back(float(2 * kPi * (1 - ca)));
+        }
+  }
+  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}, {5, 3}, {5, 1}, {6, 2}};
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   sc.texels.resize(6 * 5 * 5 * 3);
   for (float& t : sc.texels) t = 2.0f + 3.0f * uni(rng);
@@ -415,7 +441,7 @@ protected:
       PushBlock push{uint32_t(receivers_->size()), {}};
       std::copy_n(scene_->env, 9, push.env);
       const bool ran = prt::test::run_kernel(kernel("fiv_eval"),
-                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res},
+                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res, &g.cones},
                                              prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
       results = new std::vector<float>(ran ? prt::test::from_bytes<float>(res) : std::vector<float>{});
     }
@@ -662,6 +688,7 @@ TEST_P(FivMirror, ShadeFivMatchesCore) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const uint32_t first = rc.info[1], count = rc.info[2];
+    if (first >= kFirstCone) continue;  // the cone groups: ShadeFivConeMatchesCore
     std::vector<prt::shade::FivOccluder> views;
     for (uint32_t i = 0; i < count; ++i) views.push_back(occ[first + i].view());
     const auto D = difmap_at(scene_->difmap_size, scene_->texels, std::array<double, 3>{rc.n[0], rc.n[1], rc.n[2]}.data());
@@ -746,6 +773,59 @@ TEST_P(FivMirror, ShadeFivMatchesCore) {
   std::printf("%s shade_fiv: worst shader-core %.3f x tol; %d overlapping pairs seen\n", language(), worst,
               pairs_overlapping);
   EXPECT_GT(pairs_overlapping, 100);  // the overlap correction was exercised
+}
+
+// shade_fiv with the cone proxy (occluders 5–7: exact ball cones) vs the C++ core, all four option
+// combinations. Both evaluate the same float formulas in the same order per occluder; they differ
+// by the angles (the shader's prt_atan2 on its own float rounding: within 64 ε ≈ 4e-6 rad of the
+// core's, like the sphere test's δα, δγ above) and by the summation order. The cone's axis and α
+// follow the table's lookup within that angle (the ball's table is smooth: Ω depends on ρ only, m
+// turns with the direction); I moves by at most the slope of n·F per radian (≤ Σ|F| of the
+// samples, here <= 3·max|shell|) plus below · (|∂K/∂x| + |∂K/∂α|) ≤ 3π below per radian, and each
+// O_ij by ≤ 2/(π min α) per radian times I_i + I_j; min α ≥ 0.03 in this scene. So
+//   tol = δ (Σ_i (3 max|shell| + 3π below) (1 + Σ_j 2/(π α_min))) + 16 ε (count + 2) (|E_tot| + 2 Σ I)
+// with δ = 64 ε (the final max(0, ·) is 1-Lipschitz: clamping adds nothing).
+TEST_P(FivMirror, ShadeFivConeMatchesCore) {
+  const std::vector<SynthOccluder>& occ = scene_->occ;
+  const double delta = 64 * kFloatEps;
+  double worst = 0;
+  int compared = 0;
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const uint32_t first = rc.info[1], count = rc.info[2];
+    if (first < kFirstCone) continue;
+    std::vector<prt::shade::FivOccluder> views;
+    double shell_max = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+      views.push_back(occ[first + i].view());
+      for (float v : occ[first + i].shells) shell_max = std::max(shell_max, double(std::abs(v)));
+    }
+    float tot[3], below[3];
+    const std::array<float, 3> sn = shading_normal(rc.n);
+    const float down[3] = {-sn[0], -sn[1], -sn[2]};
+    prt::shade::lookup_difmap(difmap(), sn.data(), tot);
+    prt::shade::lookup_difmap(difmap(), down, below);
+    for (int option = 0; option < 4; ++option) {
+      const bool partial = option < 2, overlap = option % 2 == 0;
+      float core[3], none[3];
+      prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, overlap}, core);
+      prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, false}, none);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const double per_occluder = 3 * shell_max + 3 * kPi * below[c] / kPi;
+        const double sum_I = std::max(0.0, double(tot[c]) - none[c]) + count * per_occluder;
+        const double tol = delta * count * per_occluder * (1 + (overlap ? count * 2 / (kPi * 0.03) : 0.0)) +
+                           16 * kFloatEps * (count + 2) * (std::abs(tot[c]) + 2 * sum_I);
+        const double got = result(r)[22 + 3 * static_cast<std::size_t>(option) + c];
+        ASSERT_TRUE(std::isfinite(got));
+        ASSERT_LE(std::abs(got - core[c]), tol) << "receiver " << r << " occluders " << first << "+" << count
+                                                << " option " << option << " channel " << c;
+        worst = std::max(worst, std::abs(got - core[c]) / tol);
+        ++compared;
+      }
+    }
+  }
+  std::printf("%s shade_fiv (cone proxy): worst shader-core %.3g x tol over %d values\n", language(), worst, compared);
+  EXPECT_GT(compared, 1000);
 }
 
 } // namespace
