@@ -331,6 +331,27 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* t
   for (int e = 0; e < kWidth; ++e) out[e] = plain[e] * st.falloff;
 }
 
+// Prefetches the samples a stencil reads (shells, valid, and the cone table when `cones`): a hint
+// only, no value depends on it.
+constexpr int kPrefetchBlock = 8;
+inline void prefetch_stencil(const FivOccluder& occ, const ShellStencil& st, bool cones) {
+#if defined(__GNUC__)
+  for (int q = 0; q < st.count; q += 2) {  // corners q, q + 1 are the φ neighbours j0, j1
+    const float* s = occ.shells + st.idx[q] * 9;
+    __builtin_prefetch(s);
+    __builtin_prefetch(s + 17);
+    __builtin_prefetch(occ.shells + st.idx[q + 1] * 9 + 8);
+    __builtin_prefetch(occ.valid + st.idx[q]);
+    if (cones && occ.cones) {
+      __builtin_prefetch(occ.cones + st.idx[q] * 4);
+      __builtin_prefetch(occ.cones + st.idx[q + 1] * 4 + 3);
+    }
+  }
+#else
+  (void)occ, (void)st, (void)cones;
+#endif
+}
+
 // The trilinear lookup of the shells (header comment) at a stencil.
 inline void sample_shells(const FivOccluder& occ, const ShellStencil& st, float out[9]) { sample_table<9>(occ, st, occ.shells, out); }
 // The cone table (m, Ω) at the same stencil (header "Tight proxies").
@@ -408,10 +429,12 @@ void shade_fiv_self_unit(const float env_fiv[9], const FivOccluder& occ, const f
 //      in case C are dropped here;
 //   2. for all the others at once, in float: the shell coordinates (θ, φ by poly_atan2) and the
 //      occluders' discs (axis, α) — a loop over plain arrays, which the compiler vectorises;
-//   3. per occluder, the shell samples and I (eq. 10); those that hide nothing are dropped;
-//   4. the overlap correction (eq. 13–14): every pair of discs tested four at a time (spatial
-//      culling of the pairs was measured and lost at 100 occluders, bench/RESULTS.md), the O_ij of
-//      those that may overlap formed in batches (vectorised), summed per disc in double.
+//   3. per occluder, the shell samples (prefetched a block ahead), a tight proxy's cone (its disc
+//      and partial correction) and I (eq. 10); those that hide nothing are dropped;
+//   4. the overlap correction (eq. 13–14): the discs ordered along a tangent by a counting sort of
+//      their extents' buckets, each tested four at a time against the later ones whose extent can
+//      meet its own (bench/RESULTS.md "Tight FIV proxies"), the O_ij of those that may overlap
+//      formed in batches (vectorised), summed per disc in double.
 
 // Lens area of two planar discs of radii r1, r2 whose centres are d apart (lens_area in float):
 // r1² θ1 + r2² θ2 − ½√k with the half-angles θ_i = atan2(√k, d² + r_i² − r_j²), the shader
@@ -492,13 +515,13 @@ struct Candidates {
   enum Field {
     kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha,  // per candidate
     kI0, kI1, kI2,                                                                              // per candidate
-    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha,                      // per active disc
+    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha, kPackedTight,        // per active disc
     kFields
   };
   static constexpr int kPadding = 4;  // the packed discs are read four at a time
   std::array<float, size_t(kStackOccluders + kPadding) * kFields> stack_floats;
   std::array<double, 2 * kStackOccluders> stack_doubles;
-  std::array<int, 2 * kStackOccluders> stack_ints;
+  std::array<int, 6 * kStackOccluders> stack_ints;
   std::vector<float> heap_floats;
   std::vector<double> heap_doubles;
   std::vector<int> heap_ints;
@@ -507,6 +530,10 @@ struct Candidates {
   double* weight;  // per active disc: W_i = Σ_j O_ij
   int* index;   // the occluder of candidate c
   int* active;  // the candidates that hide something, in order
+  int* lo_bucket;  // per active disc: the buckets of its extent along the sweep's tangent
+  int* hi_bucket;  // (indexed by active disc)
+  int* at;         // per sweep position: the candidate whose disc sits there
+  int* end;        // per sweep position: where that disc's pair tests stop
 
   explicit Candidates(int count) {
     float* floats = stack_floats.data();
@@ -517,11 +544,12 @@ struct Candidates {
       stride = size_t(count);
       heap_floats.resize((stride + kPadding) * kFields);
       heap_doubles.resize(2 * stride);
-      heap_ints.resize(2 * stride);
+      heap_ints.resize(6 * stride);
       floats = heap_floats.data(), rho = heap_doubles.data(), index = heap_ints.data();
     }
     for (int f = 0; f < kFields; ++f) field[f] = floats + size_t(f) * (stride + kPadding);
     active = index + stride;
+    lo_bucket = index + 2 * stride, hi_bucket = index + 3 * stride, at = index + 4 * stride, end = index + 5 * stride;
     weight = rho + stride;
   }
   Candidates(const Candidates&) = delete;
@@ -542,7 +570,14 @@ struct PairBatch {
 };
 
 // prtshade/fiv.h tells engines (fibers, small thread stacks) what shade_fiv keeps on the stack.
-static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 18 * 1024, "fiv.h says shade_fiv uses about 17 KB of stack");
+static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 21 * 1024, "fiv.h says shade_fiv uses about 21 KB of stack");
+
+// The sweep's buckets over a disc's extent [x − w, x + w] ⊂ [−2.5, 2.5] along a tangent (x in
+// [−1, 1], w <= √2 plus a margin), monotone in the coordinate.
+constexpr int kSweepBuckets = 64;
+inline int sweep_bucket(float v) {
+  return int(clamp_nan_safe((v + 2.5f) * (float(kSweepBuckets) / 5.0f), 0.0f, float(kSweepBuckets - 1)));
+}
 
 // Pass 2 of shade_fiv_fast over the n candidates: shell coordinates t (θ) and u (φ) of the unit
 // offsets d, and cos α, α of the discs from sin α. Separate arrays (restrict), so that it vectorises.
@@ -620,13 +655,22 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   }
   // Pass 2: shell coordinates and discs for all candidates at once (vectorised).
   shell_coordinates_and_discs(candidates, dx, dy, dz, last_t, n_phi, sin_alpha, t, u, cos_alpha, alpha);
-  // Pass 3: shell samples and I; the candidates that hide something become active.
+  // Pass 3: shell samples and I; the candidates that hide something become active. In blocks: the
+  // block's stencils first, their samples prefetched, then the samples read (the lookups are
+  // scattered over megabytes of shells; their cache misses then overlap instead of queueing).
   int active = 0;
+  ShellStencil block[kPrefetchBlock];
   for (int k = 0; k < candidates; ++k) {
+    const int slot = k % kPrefetchBlock;
+    if (slot == 0)
+      for (int b = 0; b < kPrefetchBlock && k + b < candidates; ++b) {
+        const FivOccluder& o = occluders[c.index[k + b]];
+        shell_stencil(o, t[k + b], u[k + b], c.rho[k + b], block[b]);
+        prefetch_stencil(o, block[b], use_cones);
+      }
     const FivOccluder& occ = occluders[c.index[k]];
     float fv[9], e[3];
-    ShellStencil st;
-    shell_stencil(occ, t[k], u[k], c.rho[k], st);
+    const ShellStencil& st = block[slot];
     sample_shells(occ, st, fv);
     project_fiv(fv, n, e);
     if (use_cones && occ.cones) {
@@ -663,34 +707,81 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   // Pass 4: the overlap correction, Σ_{i<j} O_ij (I_i + I_j) = Σ_i W_i I_i with W_i = Σ_{j≠i} O_ij
   // summed in double.
   if (options.overlap_correction && active > 1) {
-    // The active discs packed in order, so that the test of one disc against all later ones runs
-    // over contiguous arrays (vectorised).
+    // A sweep along a tangent t of the receiver's plane: disc k covers x = a_k·t ± w_k with
+    // w_k = 2 sin(α_k/2) = √(2(1 − cos α_k)) (the chord: |ω·t − a·t| <= |ω − a| for every ω in
+    // the disc; with a margin for float rounding). Two discs that overlap have |x_i − x_j| <=
+    // |a_i − a_j| = 2 sin(γ/2) < 2 sin((α_i + α_j)/2) <= w_i + w_j (sin is subadditive on [0, π]),
+    // so their extents meet. The discs are ordered by the bucket of their left end (a counting
+    // sort, no comparisons), and disc i is tested only against the later ones up to the last
+    // whose left end's bucket is at most its right end's — every overlapping pair among them.
+    const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
+                                                    : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
+    float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
+          tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
+    const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
+    tx /= tl, ty /= tl, tz /= tl;
+    int start[kSweepBuckets + 1] = {};
+    for (int a = 0; a < active; ++a) {
+      const int k = c.active[a];
+      const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
+      const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
+      c.lo_bucket[a] = sweep_bucket(x - w);
+      c.hi_bucket[a] = sweep_bucket(x + w);
+      ++start[c.lo_bucket[a] + 1];
+    }
+    for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
+    // The active discs packed in sweep order, so that the test of one disc against the later ones
+    // runs over contiguous arrays (vectorised); end[pos] is where disc pos's tests stop.
     float* const pax = c.field[F::kPackedAx];
     float* const pay = c.field[F::kPackedAy];
     float* const paz = c.field[F::kPackedAz];
     float* const pcos = c.field[F::kPackedCos];
     float* const psin = c.field[F::kPackedSin];
     float* const palpha = c.field[F::kPackedAlpha];
-    for (int a = 0; a < active; ++a) {
-      const int k = c.active[a];
-      pax[a] = ax[k], pay[a] = ay[k], paz[a] = az[k];
-      pcos[a] = cos_alpha[k], psin[a] = sin_alpha[k], palpha[a] = alpha[k];
-      c.weight[a] = 0;
+    float* const ptight = c.field[F::kPackedTight];  // 1: a tight proxy (its pairs with others such: the density form)
+    int* const end = c.end;
+    {
+      int next[kSweepBuckets];
+      std::copy_n(start, kSweepBuckets, next);
+      for (int a = 0; a < active; ++a) {
+        const int k = c.active[a];
+        const int pos = next[c.lo_bucket[a]]++;
+        c.at[pos] = k;
+        // The first position whose left end lies in a later bucket than this disc's right end.
+        end[pos] = start[c.hi_bucket[a] + 1];
+        pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
+        pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
+        ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
+        c.weight[pos] = 0;
+      }
     }
     // Padding that never passes: cos γ = 0 < 4 (cos α_i + sin α_i) <= cos_sum.
     for (int a = active; a < active + Candidates::kPadding; ++a) pax[a] = pay[a] = paz[a] = 0, pcos[a] = 4, psin[a] = -4;
     PairBatch batch;
+    // Pairs of two tight proxies add the lens times the lower of the two irradiance densities,
+    // O_ij (α_i² + α_j²) min_c(I_i/α_i², I_j/α_j²) (fiv.h "Tight proxies"); the others O_ij (I_i + I_j)
+    // as Σ_i W_i I_i.
+    double dense[3] = {0, 0, 0};
     const auto flush = [&] {
       batch.overlaps();
       for (int b = 0; b < batch.count; ++b) {
-        c.weight[batch.i[b]] += double(batch.o[b]);
-        c.weight[batch.j[b]] += double(batch.o[b]);
+        const int i = batch.i[b], j = batch.j[b];
+        if (ptight[i] != 0 && ptight[j] != 0) {
+          const double ai2 = double(palpha[i]) * palpha[i], aj2 = double(palpha[j]) * palpha[j];
+          if (!(ai2 > 0 && aj2 > 0)) continue;  // a disc of no area: no lens
+          const int ki = c.at[i], kj = c.at[j];
+          for (int ch = 0; ch < 3; ++ch)
+            dense[ch] += double(batch.o[b]) * (ai2 + aj2) * std::min(double(I[ch][ki]) / ai2, double(I[ch][kj]) / aj2);
+          continue;
+        }
+        c.weight[i] += double(batch.o[b]);
+        c.weight[j] += double(batch.o[b]);
       }
       batch.count = 0;
     };
     for (int i = 0; i + 1 < active; ++i) {
       const float xi = pax[i], yi = pay[i], zi = paz[i], ci = pcos[i], si = psin[i];
-      for (int j0 = i + 1; j0 < active; j0 += 4) {
+      for (int j0 = i + 1; j0 < end[i]; j0 += 4) {
         // Disjoint discs (γ >= α_i + α_j, both angles in [0, π/2]) have cos γ < cos(α_i + α_j)
         // and no lens; the few others go to the batch.
         for (unsigned m = disc_pairs_may_overlap(pax + j0, pay + j0, paz + j0, pcos + j0, psin + j0, xi, yi, zi, ci, si);
@@ -709,8 +800,9 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       }
     }
     flush();
-    for (int a = 0; a < active; ++a)
-      for (int ch = 0; ch < 3; ++ch) acc[ch] += c.weight[a] * double(I[ch][c.active[a]]);
+    for (int pos = 0; pos < active; ++pos)
+      for (int ch = 0; ch < 3; ++ch) acc[ch] += c.weight[pos] * double(I[ch][c.at[pos]]);
+    for (int ch = 0; ch < 3; ++ch) acc[ch] += dense[ch];
   }
   for (int ch = 0; ch < 3; ++ch) out[ch] = float(std::max(0.0, acc[ch]));
 }
@@ -847,11 +939,13 @@ void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int co
   }
   struct Terms {
     double I[3], axis[3], alpha;
+    bool tight;
   };
   std::vector<Terms> t(size_t(std::max(count, 0)));
   for (int i = 0; i < count; ++i) {
     Terms& ti = t[size_t(i)];
     reference_terms(occluders[i], p, n, options, below, ti.I, ti.axis, ti.alpha);
+    ti.tight = options.proxy == FivProxy::cone && occluders[i].cones != nullptr;
     for (int c = 0; c < 3; ++c) e[c] -= ti.I[c];
   }
   const auto hides = [](const Terms& x) { return x.I[0] > 0 || x.I[1] > 0 || x.I[2] > 0; };
@@ -862,7 +956,15 @@ void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int co
         const Terms& tj = t[size_t(j)];
         if (!hides(ti) || !hides(tj)) continue;
         const double cg = ti.axis[0] * tj.axis[0] + ti.axis[1] * tj.axis[1] + ti.axis[2] * tj.axis[2];
-        const double o = overlap_fraction(ti.alpha, tj.alpha, std::acos(std::clamp(cg, -1.0, 1.0)));
+        const double gamma = std::acos(std::clamp(cg, -1.0, 1.0));
+        if (ti.tight && tj.tight) {  // the lens times the lower density
+          const double Ai = kPi * ti.alpha * ti.alpha, Aj = kPi * tj.alpha * tj.alpha;
+          if (!(Ai > 0 && Aj > 0)) continue;
+          const double lens = lens_area(ti.alpha, tj.alpha, gamma);
+          for (int c = 0; c < 3; ++c) e[c] += lens * std::min(ti.I[c] / Ai, tj.I[c] / Aj);
+          continue;
+        }
+        const double o = overlap_fraction(ti.alpha, tj.alpha, gamma);
         for (int c = 0; c < 3; ++c) e[c] += o * (ti.I[c] + tj.I[c]);
       }
   for (int c = 0; c < 3; ++c) out[c] = float(std::max(0.0, e[c]));

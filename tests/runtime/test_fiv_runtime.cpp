@@ -851,10 +851,11 @@ TEST(LookupCone, SameStencilAsTheShells) {
 }
 
 TEST(ShadeFivCone, ABallsConeIsItsBoundingSphere) {
-  // Occluders whose cone table is the exact cone of their bounding ball: the overlap correction
-  // with the cone proxy equals the sphere's up to the table's interpolation (Ω and m linear
-  // between samples, the cap's α within ~1e-3 rad of asin(R/D) on this 64x33 grid of radii
-  // 1.05 R … 20 R) — and the cone proxy is exercised (the pairs overlap).
+  // Occluders whose cone table is the exact cone of their bounding ball: the cone proxy's discs
+  // are the sphere's up to the table's interpolation (Ω and m linear between samples, the cap's α
+  // within ~1e-3 rad of asin(R/D) on this 64x33 grid of radii 1.05 R … 20 R), and its overlap
+  // term is the lens times the lower density (fiv.h "Tight proxies") — formed here from the
+  // spheres' discs in double.
   const std::vector<float> cube = flat_cube(4, 40.0f);
   const DifMap map{4, cube.data()};
   const float f[3] = {0, 1, 0};
@@ -879,10 +880,29 @@ TEST(ShadeFivCone, ABallsConeIsItsBoundingSphere) {
   shade::shade_fiv(map, views.data(), 3, p, n, {false, true, shade::FivProxy::sphere}, sphere);
   shade::shade_fiv(map, views.data(), 3, p, n, {false, true, shade::FivProxy::cone}, cone);
   shade::shade_fiv(map, views.data(), 3, p, n, {false, false, shade::FivProxy::cone}, none);
-  // I = n·F = 1 per occluder; each O_ij moves by <= |∂O/∂α| Δα <= Δα/(π α_min) · 2 with α_min ≈ 0.33.
-  const float bound = 3 * 2 * float(1e-3 / (kPi * 0.33));
+  // I = n·F = 1 per occluder (the shells' y components); the expected E from the spheres' discs.
+  double axis[3][3], alpha[3];
+  for (int i = 0; i < 3; ++i) {
+    double d[3], D = 0;
+    for (int a = 0; a < 3; ++a) d[a] = double(centres[i][a]) - p[a], D += d[a] * d[a];
+    D = std::sqrt(D);
+    for (int a = 0; a < 3; ++a) axis[i][a] = d[a] / D;
+    alpha[i] = std::asin(1.0 / D);
+  }
+  double expect = 40.0 - 3.0, sphere_expect = 40.0 - 3.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      const double g = std::acos(axis[i][0] * axis[j][0] + axis[i][1] * axis[j][1] + axis[i][2] * axis[j][2]);
+      expect += shade::lens_area(alpha[i], alpha[j], g) * std::min(1 / (kPi * alpha[i] * alpha[i]), 1 / (kPi * alpha[j] * alpha[j]));
+      sphere_expect += 2 * shade::overlap_fraction(alpha[i], alpha[j], g);
+    }
+  // Each lens term moves by <= (its chord 2 α_min + the density's 2/α_min) Δα per unit I with
+  // Δα <= 1e-3 and α_min ≈ 0.3: <= 0.01 per pair, three pairs.
+  const double bound = 3 * 0.01;
   EXPECT_GT(sphere[1] - none[1], 0.3f);  // the overlap correction matters here
-  EXPECT_NEAR(cone[1], sphere[1], bound);
+  EXPECT_NEAR(sphere[1], sphere_expect, 1e-5);
+  EXPECT_NEAR(cone[1], expect, bound);
+  EXPECT_LT(cone[1], sphere[1]);  // the lower density: never more than eq. 14
 }
 
 TEST(ShadeFivCone, PartialCorrectionAddsTheCapBelowTheHorizon) {
@@ -938,8 +958,9 @@ TEST(ShadeFivCone, PartialCorrectionAddsTheCapBelowTheHorizon) {
 // test's terms (kLookup per occluder, 4 ε E), the cones differ by the grid angles' kAngle: Ω and
 // m move by <= their change per grid step (<= |∂Ω/∂θ| ≈ 2π sin α cos α ≤ π per radian of view
 // angle, times the lookups' 4e-6 steps) and α, a by <= kCone = 1e-5 rad (with α >= 0.03 here:
-// dα = dΩ/(2π sin α)); K then moves by <= π Δx + 2π Δα <= 3π kCone times L̄, and each O_ij by
-// kCone / (π min α) times I_i + I_j.
+// dα = dΩ/(2π sin α)); K then moves by <= π Δx + 2π Δα <= 3π kCone times L̄, and each pair's
+// term A_ij min(I_i/A_i, I_j/A_j) (<= O_ij (I_i + I_j)) by <= (2 min α for the lens + 4/min α for the
+// densities' α²) kCone times I_i + I_j <= 6 kCone / min α (I_i + I_j) (α <= π/2).
 TEST(ShadeFivCone, ScatteredOccludersMatchTheSlowReference) {
   constexpr double kLookup = 1e-5, kCone = 1e-5;
   std::mt19937 rng(34);
@@ -1000,7 +1021,7 @@ TEST(ShadeFivCone, ScatteredOccludersMatchTheSlowReference) {
           const double cg = disc[i][0] * disc[j][0] + disc[i][1] * disc[j][1] + disc[i][2] * disc[j][2];
           if (std::acos(std::clamp(cg, -1.0, 1.0)) >= disc[i][3] + disc[j][3] + 2 * kCone) continue;
           overlapping += c == 0;
-          tolerance += 2 * kCone / (kPi * std::min(disc[i][3], disc[j][3])) * (Ib[i][size_t(c)] + Ib[j][size_t(c)]);
+          tolerance += 6 * kCone / std::min(disc[i][3], disc[j][3]) * (Ib[i][size_t(c)] + Ib[j][size_t(c)]);
         }
       EXPECT_NEAR(fast[c], slow[c], tolerance) << trial << " " << c;
       worst = std::max(worst, std::fabs(double(fast[c]) - slow[c]) / tolerance);

@@ -782,14 +782,15 @@ TEST_P(FivMirror, ShadeFivMatchesCore) {
 // follow the table's lookup within that angle (the ball's table is smooth: Ω depends on ρ only, m
 // turns with the direction); I moves by at most the slope of n·F per radian (≤ Σ|F| of the
 // samples, here <= 3·max|shell|) plus below · (|∂K/∂x| + |∂K/∂α|) ≤ 3π below per radian, and each
-// O_ij by ≤ 2/(π min α) per radian times I_i + I_j; min α ≥ 0.03 in this scene. So
-//   tol = δ (Σ_i (3 max|shell| + 3π below) (1 + Σ_j 2/(π α_min))) + 16 ε (count + 2) (|E_tot| + 2 Σ I)
+// pair's term A_ij min(I_i/A_i, I_j/A_j) (fiv.h "Tight proxies") by ≤ 6/min α per radian times
+// I_i + I_j (as in test_fiv_runtime.cpp); min α ≥ 0.03 in this scene. So
+//   tol = δ (Σ_i (3 max|shell| + 3π below) (1 + Σ_j 6/α_min)) + 16 ε (count + 2) (|E_tot| + 2 Σ I)
 // with δ = 64 ε (the final max(0, ·) is 1-Lipschitz: clamping adds nothing).
 TEST_P(FivMirror, ShadeFivConeMatchesCore) {
   const std::vector<SynthOccluder>& occ = scene_->occ;
   const double delta = 64 * kFloatEps;
   double worst = 0;
-  int compared = 0;
+  int compared = 0, corrected = 0;
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const uint32_t first = rc.info[1], count = rc.info[2];
@@ -810,10 +811,11 @@ TEST_P(FivMirror, ShadeFivConeMatchesCore) {
       float core[3], none[3];
       prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, overlap}, core);
       prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, false}, none);
+      corrected += overlap && core[0] != none[0];
       for (std::size_t c = 0; c < 3; ++c) {
         const double per_occluder = 3 * shell_max + 3 * kPi * below[c] / kPi;
         const double sum_I = std::max(0.0, double(tot[c]) - none[c]) + count * per_occluder;
-        const double tol = delta * count * per_occluder * (1 + (overlap ? count * 2 / (kPi * 0.03) : 0.0)) +
+        const double tol = delta * count * per_occluder * (1 + (overlap ? count * 6 / 0.03 : 0.0)) +
                            16 * kFloatEps * (count + 2) * (std::abs(tot[c]) + 2 * sum_I);
         const double got = result(r)[22 + 3 * static_cast<std::size_t>(option) + c];
         ASSERT_TRUE(std::isfinite(got));
@@ -824,8 +826,10 @@ TEST_P(FivMirror, ShadeFivConeMatchesCore) {
       }
     }
   }
-  std::printf("%s shade_fiv (cone proxy): worst shader-core %.3g x tol over %d values\n", language(), worst, compared);
+  std::printf("%s shade_fiv (cone proxy): worst shader-core %.3g x tol over %d values; %d receivers with an overlap term\n",
+              language(), worst, compared, corrected);
   EXPECT_GT(compared, 1000);
+  EXPECT_GT(corrected, 100);  // pairs of tight proxies overlap: the density form was exercised
 }
 
 } // namespace

@@ -64,7 +64,15 @@
 //   occluder i is then the cap (its cone) of axis a = m/|m| (the direction towards the centre
 //   when m = 0) and half-angle α with 2π(1 − cos α) = Ω (the cap of the occluded solid angle,
 //   centred on the occluded directions' mean). With FivShadeOptions::proxy == cone:
-//   - overlap: the disc of eq. 13–14 is that cap, α clamped to π/2 as the sphere's is;
+//   - overlap: the disc of eq. 13–14 is that cap, α clamped to π/2 as the sphere's is; and a pair
+//     of two tight occluders adds back, per channel, the lens A_ij (eq. 14's lens_area) times the
+//     lower of the two irradiance densities, A_ij · min(I_i/(π α_i²), I_j/(π α_j²)), instead of
+//     O_ij (I_i + I_j) = A_ij (I_i + I_j)/(π α_i² + π α_j²). What is counted twice is the
+//     irradiance through the lens; eq. 14 gives the lens the caps' area-weighted mean density,
+//     which an occluder hiding a bright light (a sun) outside the lens inflates; the lens lies in
+//     both caps, so the lower density is the one the lens can count on. Never more than eq. 14
+//     ((A_i + A_j) min(d_i, d_j) <= A_i d_i + A_j d_j), equal to it for equal densities (two
+//     identical occluders still give I, not 2I). Pairs with a sphere keep eq. 14;
 //   - partial occluders, instead of the factor (h + R)/2R: n·F over the whole sphere counts the
 //     occluded directions below the horizon negatively, ∫_occ L n·ω = I_true − ∫_{occ, n·ω<0} L |n·ω|,
 //     so the missing part is added back, estimated as the cap's part below the horizon lit by
@@ -109,7 +117,7 @@
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
 // nothing except shade_fiv for more than 128 occluders. shade_fiv keeps its per-receiver arrays
-// on the stack (about 17 KB). Thread-safe (no shared state).
+// on the stack (about 21 KB). Thread-safe (no shared state).
 #pragma once
 
 #include <cstdint>
