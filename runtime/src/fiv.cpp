@@ -575,6 +575,7 @@ static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 21 * 1024, "fiv.h says s
 // The sweep's buckets over a disc's extent [x − w, x + w] ⊂ [−2.5, 2.5] along a tangent (x in
 // [−1, 1], w <= √2 plus a margin), monotone in the coordinate.
 constexpr int kSweepBuckets = 64;
+constexpr int kSweepMinDiscs = 32;
 inline int sweep_bucket(float v) {
   return int(clamp_nan_safe((v + 2.5f) * (float(kSweepBuckets) / 5.0f), 0.0f, float(kSweepBuckets - 1)));
 }
@@ -619,11 +620,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   // The tight proxy's partial correction needs the mean radiance from below, E_tot(−n)/π.
   const bool use_cones = options.proxy == FivProxy::cone;
   float below[3] = {0, 0, 0};
-  if (use_cones && options.partial_occluders) {
-    const float down[3] = {-n[0], -n[1], -n[2]};
-    lookup_difmap(map, down, below);
-    for (float& b : below) b /= kPiF;
-  }
+  bool below_looked_up = false;  // looked up at the first tight occluder (a receiver may have none)
   // Pass 1: offset, case and distance in double (finite for any finite input).
   int candidates = 0;
   for (int i = 0; i < count; ++i) {
@@ -681,6 +678,12 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       if (ml > 0) ax[k] = cone[0] / ml, ay[k] = cone[1] / ml, az[k] = cone[2] / ml;
       const float ca = clamp_nan_safe(1.0f - cone[3] / kTwoPiF, -1.0f, 1.0f);
       if (options.partial_occluders) {
+        if (!below_looked_up) {
+          const float down[3] = {-n[0], -n[1], -n[2]};
+          lookup_difmap(map, down, below);
+          for (float& b : below) b /= kPiF;
+          below_looked_up = true;
+        }
         const float x = n[0] * ax[k] + n[1] * ay[k] + n[2] * az[k];
         const float sa = std::sqrt((1 - ca) * (1 + ca));
         if (ca >= 0 && x <= -sa) {
@@ -714,22 +717,30 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     // so their extents meet. The discs are ordered by the bucket of their left end (a counting
     // sort, no comparisons), and disc i is tested only against the later ones up to the last
     // whose left end's bucket is at most its right end's — every overlapping pair among them.
-    const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
-                                                    : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
-    float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
-          tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
-    const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
-    tx /= tl, ty /= tl, tz /= tl;
+    // Below kSweepMinDiscs discs the sweep costs more than it saves (bench/RESULTS.md): one
+    // bucket, every pair.
+    const bool sweep = active >= kSweepMinDiscs;
     int start[kSweepBuckets + 1] = {};
-    for (int a = 0; a < active; ++a) {
-      const int k = c.active[a];
-      const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
-      const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
-      c.lo_bucket[a] = sweep_bucket(x - w);
-      c.hi_bucket[a] = sweep_bucket(x + w);
-      ++start[c.lo_bucket[a] + 1];
+    if (sweep) {
+      const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
+                                                      : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
+      float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
+            tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
+      const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
+      tx /= tl, ty /= tl, tz /= tl;
+      for (int a = 0; a < active; ++a) {
+        const int k = c.active[a];
+        const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
+        const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
+        c.lo_bucket[a] = sweep_bucket(x - w);
+        c.hi_bucket[a] = sweep_bucket(x + w);
+        ++start[c.lo_bucket[a] + 1];
+      }
+      for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
+    } else {
+      for (int a = 0; a < active; ++a) c.lo_bucket[a] = 0, c.hi_bucket[a] = kSweepBuckets - 1;
+      for (int b = 1; b <= kSweepBuckets; ++b) start[b] = active;
     }
-    for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
     // The active discs packed in sweep order, so that the test of one disc against the later ones
     // runs over contiguous arrays (vectorised); end[pos] is where disc pos's tests stop.
     float* const pax = c.field[F::kPackedAx];
