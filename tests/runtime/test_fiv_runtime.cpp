@@ -1031,3 +1031,63 @@ TEST(ShadeFivCone, ScatteredOccludersMatchTheSlowReference) {
   EXPECT_GT(partial, 20);      // and the partial correction
   std::printf("cones: %.1f overlapping pairs per receiver, largest |fast - reference| / bound = %.2g\n", overlapping / 100.0, worst);
 }
+
+TEST(ShadeFivCone, TheCApiCopiesTheConeTableAndHonoursSphereProxy) {
+  // prt_fiv_scene_add_occluder copies desc.cones; prt_fiv_options.sphere_proxy selects the sphere.
+  Cube cube(4);
+  const float f[3] = {0.3f, 0.7f, -0.2f};
+  std::vector<Shells> owners;
+  std::vector<std::vector<float>> tables;
+  const float centres[2][3] = {{0, 0.1f, 3.0f}, {0.8f, 0.6f, 3.4f}};
+  for (const auto& c : centres) {
+    Shells o(12, 17, 32, [&](int, int, int, int e) { return f[e % 3] * float(1 + e / 3); });
+    for (int k = 0; k < 12; ++k) o.radii[size_t(k)] = float(1.05 * std::pow(20.0 / 1.05, k / 11.0));
+    for (int a = 0; a < 3; ++a) o.centre[a] = c[a];
+    tables.push_back(cones::ball_cones(o, 0.8));
+    owners.push_back(o);
+  }
+  std::vector<FivOccluder> views;
+  prt_fiv_scene* scene = nullptr;
+  const float env[9] = {};
+  ASSERT_EQ(prt_fiv_scene_create(4, cube.texels.data(), env, &scene), PRT_OK);
+  for (size_t k = 0; k < owners.size(); ++k) {
+    views.push_back(owners[k].view());
+    views.back().cones = tables[k].data();
+    const FivOccluder& o = views.back();
+    const prt_fiv_occluder_desc d{{o.centre[0], o.centre[1], o.centre[2]}, o.radius, o.n_rho, o.n_theta, o.n_phi,
+                                  o.radii, o.shells, o.valid, o.cones};
+    ASSERT_EQ(prt_fiv_scene_add_occluder(scene, &d, nullptr), PRT_OK);
+  }
+  for (std::vector<float>& t : tables) std::fill(t.begin(), t.end(), 0.0f);  // the scene holds its own copy
+  const std::vector<std::vector<float>> copies = {cones::ball_cones(owners[0], 0.8), cones::ball_cones(owners[1], 0.8)};
+  for (size_t k = 0; k < views.size(); ++k) views[k].cones = copies[k].data();
+  const float points[6] = {0, 0, 0, 0.5f, 0, 0.4f}, normals[6] = {0, 1, 0, 0.1f, 1, 0};
+  for (const int sphere : {0, 1}) {
+    const prt_fiv_options options{1, 1, sphere};
+    float out[6], e[3];
+    ASSERT_EQ(prt_fiv_scene_shade(scene, points, normals, 2, &options, out), PRT_OK);
+    for (int k = 0; k < 2; ++k) {
+      shade::shade_fiv(cube.view(), views.data(), 2, points + 3 * k, normals + 3 * k,
+                       {true, true, sphere ? shade::FivProxy::sphere : shade::FivProxy::cone}, e);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]) << sphere << " " << k << " " << ch;
+    }
+  }
+  prt_fiv_scene_destroy(scene);
+}
+
+TEST(Validate, RejectsBrokenConeTables) {
+  const float f[3] = {1, 0, 0}, centre[3] = {0, 0, 0};
+  Shells o = constant_occluder(f, 1.0f, centre);
+  std::vector<float> table(o.shells.size() / 9 * 4, 0.0f);
+  for (size_t s = 0; s < table.size() / 4; ++s) table[4 * s + 2] = 0.5f, table[4 * s + 3] = 1.0f;  // |m| <= Ω
+  FivOccluder v = o.view();
+  v.cones = table.data();
+  EXPECT_NO_THROW(shade::validate_occluder(v));
+  for (const auto& [index, value] : std::vector<std::pair<size_t, float>>{
+           {3, -0.5f}, {3, 13.0f}, {3, std::numeric_limits<float>::quiet_NaN()}, {2, 1.5f}, {0, -std::numeric_limits<float>::infinity()}}) {
+    std::vector<float> bad = table;
+    bad[4 + index] = value;  // sample 1
+    v.cones = bad.data();
+    EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument) << index << " " << value;
+  }
+}
