@@ -246,10 +246,13 @@ inline void add_weighted_fiv(float acc[9], float w, const float* v) {
 // weights, ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside. Shared by
 // the shells (sample_shells) and the cone table (sample_cones), which live on the same grid.
 struct ShellStencil {
-  size_t idx[8];
-  float w[8];
-  int count;
+  size_t rows[2][2];  // [layer][θ ring]: the first sample of the ring
+  size_t js[2];       // the two φ columns
+  float wk[2], wi[2], wj[2];
+  int layers;         // 1 inside the first shell and beyond the last, else 2
   float falloff;
+  size_t index(int a, int b, int c) const { return rows[a][b] + js[c]; }
+  float weight(int a, int b, int c) const { return wk[a] * wi[b] * wj[c]; }
 };
 
 void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellStencil& st) {
@@ -281,23 +284,15 @@ void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellSt
     fr = clamp_nan_safe(float((rho - occ.radii[k0]) / (double(occ.radii[k1]) - occ.radii[k0])), 0.0f, 1.0f);
   }
 
-  const float wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  st.wk[0] = 1 - fr, st.wk[1] = fr, st.wi[0] = 1 - ft, st.wi[1] = ft, st.wj[0] = 1 - fu, st.wj[1] = fu;
   // Sample (k, i, j) sits at row (k Nθ + i) Nφ + j; rows of the two layers and two θ rings.
   const size_t nt = size_t(occ.n_theta), np = size_t(occ.n_phi);
-  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
-                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
-  const size_t js[2] = {size_t(j0), size_t(j1)};
+  st.rows[0][0] = (size_t(k0) * nt + size_t(i0)) * np, st.rows[0][1] = (size_t(k0) * nt + size_t(i0) + 1) * np;
+  st.rows[1][0] = (size_t(k1) * nt + size_t(i0)) * np, st.rows[1][1] = (size_t(k1) * nt + size_t(i0) + 1) * np;
+  st.js[0] = size_t(j0), st.js[1] = size_t(j1);
   // Inside the first shell and beyond the last, k0 == k1 and fr == 0: the second layer's weights
   // are 0 and skipping it changes no bit.
-  const int layers = k1 == k0 ? 1 : 2;
-  int q = 0;
-  for (int a = 0; a < layers; ++a)
-    for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c, ++q) {
-        st.idx[q] = rows[a][b] + js[c];
-        st.w[q] = wk[a] * wi[b] * wj[c];
-      }
-  st.count = q;
+  st.layers = k1 == k0 ? 1 : 2;
   st.falloff = falloff;
 }
 
@@ -308,26 +303,32 @@ template <int kWidth>
 void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* table, float out[kWidth]) {
   float masked[kWidth] = {};
   float masked_weight = 0;
-  for (int q = 0; q < st.count; ++q) {
-    if (occ.valid[st.idx[q]] == 0) continue;
-    const float w = st.w[q];
-    masked_weight += w;
-    if constexpr (kWidth == 9) {
-      add_weighted_fiv(masked, w, table + st.idx[q] * 9);
-    } else {
-      for (int e = 0; e < kWidth; ++e) masked[e] += w * table[st.idx[q] * kWidth + size_t(e)];
-    }
-  }
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const size_t idx = st.index(a, b, c);
+        if (occ.valid[idx] == 0) continue;
+        const float w = st.weight(a, b, c);
+        masked_weight += w;
+        if constexpr (kWidth == 9) {
+          add_weighted_fiv(masked, w, table + idx * 9);
+        } else {
+          for (int e = 0; e < kWidth; ++e) masked[e] += w * table[idx * kWidth + size_t(e)];
+        }
+      }
   if (masked_weight > 0) {
     const float inv = 1.0f / masked_weight;
     for (int e = 0; e < kWidth; ++e) out[e] = masked[e] * inv * st.falloff;
     return;
   }
   float plain[kWidth] = {};
-  for (int q = 0; q < st.count; ++q) {
-    const float* v = table + st.idx[q] * kWidth;
-    for (int e = 0; e < kWidth; ++e) plain[e] += st.w[q] * v[e];
-  }
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const float w = st.weight(a, b, c);
+        const float* v = table + st.index(a, b, c) * kWidth;
+        for (int e = 0; e < kWidth; ++e) plain[e] += w * v[e];
+      }
   for (int e = 0; e < kWidth; ++e) out[e] = plain[e] * st.falloff;
 }
 
@@ -336,17 +337,18 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* t
 constexpr int kPrefetchBlock = 8;
 inline void prefetch_stencil(const FivOccluder& occ, const ShellStencil& st, bool cones) {
 #if defined(__GNUC__)
-  for (int q = 0; q < st.count; q += 2) {  // corners q, q + 1 are the φ neighbours j0, j1
-    const float* s = occ.shells + st.idx[q] * 9;
-    __builtin_prefetch(s);
-    __builtin_prefetch(s + 17);
-    __builtin_prefetch(occ.shells + st.idx[q + 1] * 9 + 8);
-    __builtin_prefetch(occ.valid + st.idx[q]);
-    if (cones && occ.cones) {
-      __builtin_prefetch(occ.cones + st.idx[q] * 4);
-      __builtin_prefetch(occ.cones + st.idx[q + 1] * 4 + 3);
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b) {  // the φ neighbours j0, j1 of a ring
+      const size_t i0 = st.index(a, b, 0), i1 = st.index(a, b, 1);
+      __builtin_prefetch(occ.shells + i0 * 9);
+      __builtin_prefetch(occ.shells + i0 * 9 + 8);
+      __builtin_prefetch(occ.shells + i1 * 9 + 8);
+      __builtin_prefetch(occ.valid + i0);
+      if (cones && occ.cones) {
+        __builtin_prefetch(occ.cones + i0 * 4);
+        __builtin_prefetch(occ.cones + i1 * 4 + 3);
+      }
     }
-  }
 #else
   (void)occ, (void)st, (void)cones;
 #endif
@@ -717,30 +719,6 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     // so their extents meet. The discs are ordered by the bucket of their left end (a counting
     // sort, no comparisons), and disc i is tested only against the later ones up to the last
     // whose left end's bucket is at most its right end's — every overlapping pair among them.
-    // Below kSweepMinDiscs discs the sweep costs more than it saves (bench/RESULTS.md): one
-    // bucket, every pair.
-    const bool sweep = active >= kSweepMinDiscs;
-    int start[kSweepBuckets + 1] = {};
-    if (sweep) {
-      const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
-                                                      : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
-      float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
-            tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
-      const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
-      tx /= tl, ty /= tl, tz /= tl;
-      for (int a = 0; a < active; ++a) {
-        const int k = c.active[a];
-        const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
-        const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
-        c.lo_bucket[a] = sweep_bucket(x - w);
-        c.hi_bucket[a] = sweep_bucket(x + w);
-        ++start[c.lo_bucket[a] + 1];
-      }
-      for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
-    } else {
-      for (int a = 0; a < active; ++a) c.lo_bucket[a] = 0, c.hi_bucket[a] = kSweepBuckets - 1;
-      for (int b = 1; b <= kSweepBuckets; ++b) start[b] = active;
-    }
     // The active discs packed in sweep order, so that the test of one disc against the later ones
     // runs over contiguous arrays (vectorised); end[pos] is where disc pos's tests stop.
     float* const pax = c.field[F::kPackedAx];
@@ -751,20 +729,38 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     float* const palpha = c.field[F::kPackedAlpha];
     float* const ptight = c.field[F::kPackedTight];  // 1: a tight proxy (its pairs with others such: the density form)
     int* const end = c.end;
-    {
-      int next[kSweepBuckets];
-      std::copy_n(start, kSweepBuckets, next);
+    const auto pack = [&](int pos, int k, int stop) {
+      c.at[pos] = k;
+      end[pos] = stop;
+      pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
+      pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
+      ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
+      c.weight[pos] = 0;
+    };
+    if (active >= kSweepMinDiscs) {
+      const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
+                                                      : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
+      float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
+            tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
+      const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
+      tx /= tl, ty /= tl, tz /= tl;
+      int start[kSweepBuckets + 1] = {};
       for (int a = 0; a < active; ++a) {
         const int k = c.active[a];
-        const int pos = next[c.lo_bucket[a]]++;
-        c.at[pos] = k;
-        // The first position whose left end lies in a later bucket than this disc's right end.
-        end[pos] = start[c.hi_bucket[a] + 1];
-        pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
-        pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
-        ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
-        c.weight[pos] = 0;
+        const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
+        const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
+        c.lo_bucket[a] = sweep_bucket(x - w);
+        c.hi_bucket[a] = sweep_bucket(x + w);
+        ++start[c.lo_bucket[a] + 1];
       }
+      for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
+      int next[kSweepBuckets];
+      std::copy_n(start, kSweepBuckets, next);
+      // Each disc's tests stop at the first position whose left end lies in a later bucket than
+      // its right end.
+      for (int a = 0; a < active; ++a) pack(next[c.lo_bucket[a]]++, c.active[a], start[c.hi_bucket[a] + 1]);
+    } else {  // below kSweepMinDiscs the sweep costs more than it saves (bench/RESULTS.md): every pair
+      for (int a = 0; a < active; ++a) pack(a, c.active[a], active);
     }
     // Padding that never passes: cos γ = 0 < 4 (cos α_i + sin α_i) <= cos_sum.
     for (int a = active; a < active + Candidates::kPadding; ++a) pax[a] = pay[a] = paz[a] = 0, pcos[a] = 4, psin[a] = -4;
