@@ -672,7 +672,7 @@ int run(const Args& a) {
   const bool white_sky = kind == "ao" && a.env.empty();
   if ((kind == "scene" || kind == "glossy" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
                                     !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial || a.fiv.sphere_proxy))
-    throw UsageError("--shade (except glossy, area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap and "
+    throw UsageError("--shade (except glossy, area, area-exact), --instance, --occluder(-mesh), --ground(-size), --no-overlap, --proxy sphere and "
                      "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
                      "'prtview --help')");
   const std::string env_path = area || white_sky ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;
