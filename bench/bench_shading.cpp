@@ -16,6 +16,10 @@
 //                                   (prtshade/fiv.h "Surface-following shells", issue 33): the
 //                                   same samples, r_surf random in [0.3, 0.9] R, offsets τ_k
 //                                   0.005 R … 16 R geometric, no valid mask
+//   BM_ShadeFivCones/occluders:N    shade_fiv with the tight proxy (prtshade/fiv.h "Tight proxies"):
+//                                   the same scene, every occluder with a cone table (the exact
+//                                   cone of a ball of radius 0.7 R on the same grid)
+//   BM_ShadeFivSurfaceCones/occluders:N  both: what a default bake gives (surface shells, cone proxy)
 //
 // Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
 // "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
@@ -34,6 +38,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -150,11 +155,11 @@ BENCHMARK(BM_ShadeBand1);
 
 struct FivScene {
   int n_phi = 64, n_theta = 33, n_rho = 30;
-  std::vector<float> radii, shells, cube, positions, surface, offsets;
+  std::vector<float> radii, shells, cube, positions, surface, offsets, cones;
   std::vector<uint8_t> valid;
   std::vector<prt::shade::FivOccluder> occluders;
 
-  explicit FivScene(int count, bool surface_scheme = false) {
+  explicit FivScene(int count, bool surface_scheme = false, bool with_cones = false) {
     std::mt19937 rng(42);
     std::uniform_real_distribution<float> u01(0, 1);
     for (int k = 0; k < n_rho; ++k) radii.push_back(0.5f * std::pow(32.0f, float(k) / float(n_rho - 1)));
@@ -165,9 +170,21 @@ struct FivScene {
     for (size_t s = 0; s < size_t(n_theta) * size_t(n_phi); ++s) valid[s] = uint8_t(u01(rng) > 0.3f);  // inner shell partly inside
     cube.resize(size_t(6 * 32 * 32 * 3));
     for (float& x : cube) x = 5 + u01(rng);
+    // The cone of a ball of radius r = 0.7 (inside the bounding radius 1) from each sample.
+    for (int k = 0; k < n_rho; ++k)
+      for (int i = 0; i < n_theta; ++i)
+        for (int j = 0; j < n_phi; ++j) {
+          const double th = std::numbers::pi * i / (n_theta - 1), ph = 2 * std::numbers::pi * j / n_phi, rho = radii[size_t(k)];
+          const double sa = std::min(1.0, 0.7 / rho), ca = std::sqrt(1 - sa * sa), len = std::numbers::pi * sa * sa;
+          const double d[3] = {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+          for (int e = 0; e < 3; ++e) cones.push_back(float(-len * d[e]));
+          cones.push_back(float(2 * std::numbers::pi * (1 - ca)));
+        }
     for (int i = 0; i < count; ++i) {
       const float c[3] = {40 * u01(rng) - 20, 5.5f * u01(rng) - 1.5f, 40 * u01(rng) - 20};
-      occluders.push_back({{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()});
+      prt::shade::FivOccluder o{{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
+      o.cones = with_cones ? cones.data() : nullptr;
+      occluders.push_back(o);
     }
     if (surface_scheme) {  // drawn after everything above, so the scene is the same
       for (int k = 0; k < n_rho; ++k) offsets.push_back(0.005f * std::pow(3200.0f, float(k) / float(n_rho - 1)));
@@ -189,9 +206,9 @@ struct FivScene {
 
 enum class FivPath { fast, reference };
 
-template <FivPath kPath, bool kOverlap = true, bool kSurface = false>
+template <FivPath kPath, bool kOverlap = true, bool kSurface = false, bool kCones = false>
 void shade_fiv_case(benchmark::State& state) {
-  const FivScene scene(int(state.range(0)), kSurface);
+  const FivScene scene(int(state.range(0)), kSurface, kCones);
   const prt::shade::DifMap map{32, scene.cube.data()};
   const float n[3] = {0, 1, 0};
   const prt::shade::FivShadeOptions options{true, kOverlap};
@@ -213,11 +230,17 @@ void shade_fiv_case(benchmark::State& state) {
 void BM_ShadeFiv(benchmark::State& state) { shade_fiv_case<FivPath::fast>(state); }
 void BM_ShadeFivReference(benchmark::State& state) { shade_fiv_case<FivPath::reference>(state); }
 void BM_ShadeFivNoOverlap(benchmark::State& state) { shade_fiv_case<FivPath::fast, false>(state); }
+void BM_ShadeFivCones(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, false, true>(state); }
+void BM_ShadeFivConesReference(benchmark::State& state) { shade_fiv_case<FivPath::reference, true, false, true>(state); }
 BENCHMARK(BM_ShadeFiv)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivReference)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivNoOverlap)->ArgName("occluders")->Arg(10)->Arg(100);
 void BM_ShadeFivSurface(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true>(state); }
+void BM_ShadeFivSurfaceCones(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true, true>(state); }
 BENCHMARK(BM_ShadeFivSurface)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
+BENCHMARK(BM_ShadeFivCones)->ArgName("occluders")->Arg(10)->Arg(100);
+BENCHMARK(BM_ShadeFivConesReference)->ArgName("occluders")->Arg(10)->Arg(100);
+BENCHMARK(BM_ShadeFivSurfaceCones)->ArgName("occluders")->Arg(10)->Arg(100);
 
 } // namespace
 

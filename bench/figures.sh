@@ -100,21 +100,54 @@ view "Fig. 12 diagnostic: shells 64x33x30 following the surface, partial-occlude
   "$images/fig12_64x33x30_no_partial.png" "$work/bunny_64x33x30.prt.h5" --camera "$CAM12" --no-partial \
   --samples "$RAYS_FIG12" --reference-cache "$work/ref_fig12_$SIZE.exr"
 
-# ---- two overlapping occluders, overlap correction on / off (paper 004 eq. 13-14, Fig. 15) ----
+# ---- two overlapping occluders, overlap correction on / off (paper 004 eq. 13-14, Fig. 15), with the tight
+# proxy (the file's cone table, the default: prtshade/fiv.h "Tight proxies") and the paper's bounding sphere ----
 CAM2="eye=0,30,30:at=0,0,1:fov=50"
 TWO=(--instance -5.5,0,0 --instance 5.5,0,0)
-view "Two overlapping bunnies, overlap correction on" "0.019 (Fig. 15, on)" "$images/overlap_on.png" \
+view "Two overlapping bunnies, overlap correction on (cone proxy)" "0.019 (Fig. 15, on)" "$images/overlap_on.png" \
   "$work/bunny_64x33x30.prt.h5" --camera "$CAM2" "${TWO[@]}" --samples "$RAYS" --reference-cache "$work/ref_overlap_$SIZE.exr"
-view "Two overlapping bunnies, overlap correction off" "0.027 (Fig. 15, off)" "$images/overlap_off.png" \
+view "Two overlapping bunnies, overlap correction off (cone proxy)" "0.027 (Fig. 15, off)" "$images/overlap_off.png" \
   "$work/bunny_64x33x30.prt.h5" --camera "$CAM2" "${TWO[@]}" --no-overlap --samples "$RAYS" --reference-cache "$work/ref_overlap_$SIZE.exr"
+view "Two overlapping bunnies, overlap correction on (bounding sphere, the paper's)" "0.019 (Fig. 15, on)" "$images/overlap_on_sphere.png" \
+  "$work/bunny_64x33x30.prt.h5" --camera "$CAM2" "${TWO[@]}" --proxy sphere --samples "$RAYS" --reference-cache "$work/ref_overlap_$SIZE.exr"
+view "Two overlapping bunnies, overlap correction off (bounding sphere)" "0.027 (Fig. 15, off)" "$images/overlap_off_sphere.png" \
+  "$work/bunny_64x33x30.prt.h5" --camera "$CAM2" "${TWO[@]}" --proxy sphere --no-overlap --samples "$RAYS" --reference-cache "$work/ref_overlap_$SIZE.exr"
 
-# ---- an occluder partly below the receiver's horizon: sunk 2 units (of 9.65) into the ground ----
+# ---- an occluder partly below the receiver's horizon: sunk 2 units (of 9.65) into the ground; the cone
+# proxy's correction (the cap below the horizon, lit from below) and the paper's (h+R)/2R ----
 CAMP="eye=0,26,24:at=0,0,1:fov=45"
 SINK=(--instance 0,-2,0 --ground 0)
-view "Bunny partly below the ground, partial-occluder factor on" "0.019 (Fig. 17, on)" "$images/partial_on.png" \
+view "Bunny partly below the ground, partial-occluder correction on (cone proxy)" "0.019 (Fig. 17, on)" "$images/partial_on.png" \
   "$work/bunny_64x33x30.prt.h5" --camera "$CAMP" "${SINK[@]}" --samples "$RAYS" --reference-cache "$work/ref_partial_$SIZE.exr"
-view "Bunny partly below the ground, partial-occluder factor off" "0.026 (Fig. 17, off)" "$images/partial_off.png" \
+view "Bunny partly below the ground, partial-occluder correction off" "0.026 (Fig. 17, off)" "$images/partial_off.png" \
   "$work/bunny_64x33x30.prt.h5" --camera "$CAMP" "${SINK[@]}" --no-partial --samples "$RAYS" --reference-cache "$work/ref_partial_$SIZE.exr"
+view "Bunny partly below the ground, partial-occluder factor (h+R)/2R on (bounding sphere, the paper's)" "0.019 (Fig. 17, on)" "$images/partial_on_sphere.png" \
+  "$work/bunny_64x33x30.prt.h5" --camera "$CAMP" "${SINK[@]}" --proxy sphere --samples "$RAYS" --reference-cache "$work/ref_partial_$SIZE.exr"
+
+# ---- the paper's kind of scene (issue 33): Fig. 15, three bunnies in a row whose occluded cones overlap in
+# the sky under an overcast sky (uniform radiance above the horizon, eq. 14's own assumption); Fig. 17, the
+# sunk bunny under a bright ground (light from below the receiver's horizon matters). Two-tone
+# environments made by bench/sky_exr.py ----
+run python3 bench/sky_exr.py "$work/overcast.exr" 1,1,1 0.1,0.1,0.1
+run python3 bench/sky_exr.py "$work/bright_ground.exr" 0.6,0.7,0.9 2.0,1.8,1.5
+run "$BAKE" fiv "$BUNNY" --env "$work/overcast.exr" --shells 64x33x30 --report 0 --quiet -o "$work/bunny_overcast.prt.h5"
+run "$BAKE" fiv "$BUNNY" --env "$work/bright_ground.exr" --shells 64x33x30 --report 0 --quiet -o "$work/bunny_bright.prt.h5"
+CAMR="eye=34,24,0:at=0,0,0:fov=55"
+ROW=(--instance 0,0,-8 --instance 0,0,0 --instance 0,0,8)
+view "Paper's kind (Fig. 15): three bunnies in a row, overcast sky, overlap correction on (cone proxy)" "0.019 (Fig. 15, on)" "$images/overcast_on.png" \
+  "$work/bunny_overcast.prt.h5" --camera "$CAMR" "${ROW[@]}" --samples "$RAYS" --reference-cache "$work/ref_overcast_$SIZE.exr"
+view "Paper's kind (Fig. 15): overlap correction off (cone proxy)" "0.027 (Fig. 15, off)" "$images/overcast_off.png" \
+  "$work/bunny_overcast.prt.h5" --camera "$CAMR" "${ROW[@]}" --no-overlap --samples "$RAYS" --reference-cache "$work/ref_overcast_$SIZE.exr"
+view "Paper's kind (Fig. 15): overlap correction on (bounding sphere)" "0.019 (Fig. 15, on)" "$images/overcast_on_sphere.png" \
+  "$work/bunny_overcast.prt.h5" --camera "$CAMR" "${ROW[@]}" --proxy sphere --samples "$RAYS" --reference-cache "$work/ref_overcast_$SIZE.exr"
+view "Paper's kind (Fig. 15): overlap correction off (bounding sphere)" "0.027 (Fig. 15, off)" "$images/overcast_off_sphere.png" \
+  "$work/bunny_overcast.prt.h5" --camera "$CAMR" "${ROW[@]}" --proxy sphere --no-overlap --samples "$RAYS" --reference-cache "$work/ref_overcast_$SIZE.exr"
+view "Paper's kind (Fig. 17): bunny sunk 2 units, bright ground, partial-occluder correction on (cone proxy)" "0.019 (Fig. 17, on)" "$images/bright_on.png" \
+  "$work/bunny_bright.prt.h5" --camera "$CAMP" "${SINK[@]}" --samples "$RAYS" --reference-cache "$work/ref_bright_$SIZE.exr"
+view "Paper's kind (Fig. 17): partial-occluder correction off" "0.026 (Fig. 17, off)" "$images/bright_off.png" \
+  "$work/bunny_bright.prt.h5" --camera "$CAMP" "${SINK[@]}" --no-partial --samples "$RAYS" --reference-cache "$work/ref_bright_$SIZE.exr"
+view "Paper's kind (Fig. 17): factor (h+R)/2R on (bounding sphere)" "0.019 (Fig. 17, on)" "$images/bright_on_sphere.png" \
+  "$work/bunny_bright.prt.h5" --camera "$CAMP" "${SINK[@]}" --proxy sphere --samples "$RAYS" --reference-cache "$work/ref_bright_$SIZE.exr"
 
 # ---- the default scene: per-vertex transfer (orders 3 and 8) and band-1 under sunset.exr ----
 run "$BAKE" vertex data/bunny_ground.obj --transfer 3 --radiance "$SUNSET" --report 0 --quiet -o "$work/default_t3.prt.h5"
@@ -180,19 +213,22 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   bunny's bounding sphere (R = 6.64, centre 4.8 above the ground) puts every ground receiver in
   case B, and (h + R)/2R = 0.86 scales the whole shadow down; the diagnostic row without the
   factor is the shells' own error (the rest: the ears' thin shadows at 64x33 directions).
-- **Overlap correction (eq. 13-14).** Here it makes things worse. The unit bounding discs are
-  the bunnies' bounding spheres (R = 6.64, while the bunny is 9.65 tall and 7.5 deep), so from
-  the ground between the two bunnies the discs overlap far more than the occluded parts of the
-  sky do, and the correction adds back light that is in fact blocked. The paper's Figure 15
-  (0.027 -> 0.019) used occluders whose shadows overlap in the sky; a loose bounding sphere
-  turns the same formula into an over-correction. The runtime implements the formula as
-  specified (runtime/include/prtshade/fiv.h); this is the formula's limit, measured.
-- **Partial-occluder factor ((h + R)/2R).** Also worse here. The factor assumes that the part of
-  the FIV coming from below the receiver's horizon (which n.F subtracts) matters; under
-  forest.exr the lower hemisphere is dark, so n.F is already close to the true occluded
-  irradiance, and the bounding-sphere fraction (0.71 for the bunny sunk by 2 units) scales the
-  real shadow down. The paper's Figure 17 (a chess queen, 0.026 -> 0.019) is a case where the
-  light below the horizon is not negligible.
+- **Overlap correction (eq. 13-14) and the occluder proxy.** The paper's unit bounding discs are
+  the bounding spheres (R = 6.64 for the 9.65 x 7.5 bunny): from the ground between two bunnies
+  they overlap far more than the occluded parts of the sky do, and the correction adds back light
+  that is blocked (the "bounding sphere" rows). The baked files carry a tight proxy (issue 33,
+  prtshade/fiv.h "Tight proxies"): per shell sample the occluded solid angle and its mean
+  direction, integrated exactly with the shells; its cap is the disc, and a pair of such caps adds
+  back the lens times the lower of the two irradiance densities instead of eq. 14's area-weighted
+  mean. With it the correction lowers the error on both the two bunnies under forest.exr and the
+  paper's kind of scene (three bunnies whose cones overlap under an overcast sky).
+- **Partial occluders.** The paper's (h + R)/2R scales the whole shadow by the bounding sphere's
+  fraction above the plane, which both under forest.exr (dark below) and under a bright ground
+  takes the wrong direction: n.F over the full sphere already counts the occluded light below the
+  horizon negatively, so the true shadow is n.F plus that part. The cone proxy adds it back: the
+  cap's part below the horizon (a closed-form clamped cosine) lit by the receiver's mean radiance
+  from below, E_tot(-n)/pi from the DifMap — small under forest.exr, large under a bright ground
+  (the paper's kind of scene, Fig. 17's chess queen).
 - **Default scene.** Order-3 transfer cannot hold sunset.exr's sun (a lobe 4,000x the mean):
   NRMSE 0.03, mostly in the contact and self-shadows; order 8 and band-1 radiance (exact at the
   vertices; what is left is Gouraud interpolation between vertices) are within 0.006-0.008.

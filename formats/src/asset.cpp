@@ -151,6 +151,7 @@ constexpr Field<Light> kLightFields[] = {
 
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
 constexpr Field<OccluderSurfaceRadius> kSurfaceRadiusFields[] = {{N::kMeaning, &OccluderSurfaceRadius::meaning}};
+constexpr Field<OccluderCones> kConesFields[] = {{N::kIntegrand, &OccluderCones::integrand}};
 
 constexpr Field<SceneInfo> kSceneFields[] = {
     {N::kSceneFile, &SceneInfo::scene_file},
@@ -324,6 +325,9 @@ void add_occluder(File& f, const Occluder& o) {
   if (o.surface_radius)
     add_array(f, cat(dir, N::kSurfaceRadius), {grid[1], grid[2]}, o.surface_radius->values,
               attrs_of<OccluderSurfaceRadius>(*o.surface_radius, kSurfaceRadiusFields, o.surface_radius->extra));
+  if (o.cones)  // v7
+    add_array(f, cat(dir, N::kCones), {grid[0], grid[1], grid[2], 4}, o.cones->values,
+              attrs_of<OccluderCones>(*o.cones, kConesFields, o.cones->extra));
   if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
 }
 
@@ -502,6 +506,14 @@ File to_file(const Asset& a) {
   }
   for (const Light& l : a.lights) f.group_attrs.emplace_back(light_dir(l.name), attrs_of<Light>(l, kLightFields, l.extra));
   f.group_attrs.insert(f.group_attrs.end(), a.group_extras.begin(), a.group_extras.end());
+  // v7: an occluder's proxy, with the other attributes its group may have.
+  for (const Occluder& o : a.occluders) {
+    if (!o.proxy) continue;
+    const std::string dir = occluder_dir(o.name);
+    auto it = std::find_if(f.group_attrs.begin(), f.group_attrs.end(), [&](const auto& g) { return g.first == dir; });
+    if (it == f.group_attrs.end()) it = f.group_attrs.emplace(f.group_attrs.end(), dir, std::vector<Attr>{});
+    it->second.push_back({std::string(N::kProxy), *o.proxy});
+  }
   if (a.target_error) {  // /report's one typed attribute, first, before its extras (if any)
     const Attr target{std::string(N::kTargetError), *a.target_error};
     auto it = std::find_if(f.group_attrs.begin(), f.group_attrs.end(), [](const auto& g) { return g.first == N::kReport; });
@@ -550,9 +562,15 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
       break;
     }
     case DatasetKind::occluder_shells:
-    case DatasetKind::occluder_valid: {
+    case DatasetKind::occluder_valid:
+    case DatasetKind::occluder_cones: {
       const std::string_view rest = after(d.path, occluders_dir);
       Occluder& o = named(a.occluders, rest.substr(0, rest.find('/')));
+      if (kind == DatasetKind::occluder_cones) {
+        o.cones.emplace().values = values<float>(d);
+        take_attrs<OccluderCones>(*o.cones, kConesFields, d.attrs, o.cones->extra);
+        break;
+      }
       if (kind == DatasetKind::occluder_valid) {
         o.valid.emplace().values = values<uint8_t>(d);
         take_attrs<OccluderValid>(*o.valid, kValidFields, d.attrs, o.valid->extra);
@@ -595,6 +613,14 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
     } else if (!light.empty() && light.find('/') == std::string_view::npos) {
       Light& l = named(a.lights, light);
       take_attrs<Light>(l, kLightFields, attrs, l.extra);
+    } else if (const std::string_view occluder = after(group, occluders_dir);
+               !occluder.empty() && occluder.find('/') == std::string_view::npos && find_attr(attrs, N::kProxy) != nullptr) {
+      Occluder& o = named(a.occluders, occluder);
+      ExtraAttrs rest;
+      for (const Attr& at : attrs)
+        if (at.name == N::kProxy && std::holds_alternative<std::string>(at.value)) o.proxy = std::get<std::string>(at.value);
+        else rest.push_back(at);
+      if (!rest.empty()) a.group_extras.emplace_back(group, std::move(rest));
     } else if (group == N::kReport) {
       ExtraAttrs rest;
       for (const Attr& at : attrs)

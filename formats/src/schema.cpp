@@ -85,7 +85,7 @@ std::string allowed_paths() {
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
          std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
-         std::string(N::kShells) + "," + std::string(N::kValid) + "," + std::string(N::kSurfaceRadius) + "}, " + std::string(N::kLights) + "/<name>/{" +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "," + std::string(N::kSurfaceRadius) + "," + std::string(N::kCones) + "}, " + std::string(N::kLights) + "/<name>/{" +
          std::string(N::kLightVertices) + "," + std::string(N::kLightFaceSizes) + "," +
          std::string(N::kLightFaceIndices) + "} and anything under " +
          std::string(N::kReport) + "/";
@@ -196,6 +196,7 @@ public:
       if (p.back() == N::kShells) return Kind::occluder_shells;
       if (p.back() == N::kValid) return Kind::occluder_valid;
       if (p.back() == N::kSurfaceRadius) return Kind::occluder_surface_radius;
+      if (p.back() == N::kCones) return Kind::occluder_cones;
     }
     if (path.starts_with(std::string(N::kLights) + "/") && p.size() == split_path(N::kLights).size() + 2) {
       if (p.back() == N::kLightVertices) return Kind::light_vertices;
@@ -415,6 +416,11 @@ int64_t written_format_version(const File& file) {
                 (find_attr(d.attrs, N::kRadialScheme) != nullptr || find_attr(d.attrs, N::kFirstOffset) != nullptr));
       }))
     return kFormatVersion;
+  const bool cones = std::any_of(file.datasets.begin(), file.datasets.end(),
+                                 [](const Dataset& d) { return dataset_kind(d.path) == Kind::occluder_cones; }) ||
+                     std::any_of(file.group_attrs.begin(), file.group_attrs.end(),
+                                 [](const auto& g) { return find_attr(g.second, N::kProxy) != nullptr; });
+  if (cones) return kFormatVersionWithCones;
   if (std::any_of(file.group_attrs.begin(), file.group_attrs.end(),
                   [](const auto& g) { return is_punctual_group(g.first, g.second); }))
     return kFormatVersionWithPunctualLights;
@@ -479,6 +485,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
              std::to_string(version) + ")");
     if (k == Kind::occluder_surface_radius && version < 7)
       c.fail("dataset '" + d.path + "' is a surface-following shell grid's, which needs format_version 7 (the file says " +
+             std::to_string(version) + ")");
+    if (k == Kind::occluder_cones && version < 7)
+      c.fail("dataset '" + d.path + "' is an occluder's cone table, which needs format_version 7 (the file says " +
              std::to_string(version) + ")");
     kinds.push_back(k);
     prefixes.push_back(std::move(prefix));
@@ -725,6 +734,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     case Kind::occluder_surface_radius:
       break;
     case Kind::occluder_valid:
+    case Kind::occluder_cones:
     case Kind::report:
     case Kind::unknown:
       break;
@@ -744,6 +754,16 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       if (!std::isfinite(r[j]) || r[j] < 0)
         c.fail("dataset '" + d.path + "' must hold finite distances >= 0, not " + std::to_string(r[j]) + " at index " +
                std::to_string(j));
+  }
+  for (std::size_t i = 0; i < file.datasets.size(); ++i) {
+    const Dataset& d = file.datasets[i];
+    if (kinds[i] != Kind::occluder_cones) continue;
+    c.dtype(d, 0);
+    const auto it = shells.find(d.path.substr(0, d.path.size() - N::kCones.size()));
+    if (it == shells.end())
+      c.fail("dataset '" + d.path + "' has no '" + std::string(N::kShells) + "' dataset beside it");
+    const auto& s = it->second->shape;
+    c.shape(d, {s[0], s[1], s[2], 4}, "[Nr, Ntheta, Nphi] of its shells, 4 (m_x, m_y, m_z, solid angle)");
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];
@@ -804,6 +824,21 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       c.fail("group '" + g + "' is a scene object's, which needs format_version 2");
     if ((light || g.ends_with(N::kAreaLightsGroup)) && version < 3)
       c.fail("group '" + g + "' is an area light's, which needs format_version 3");
+    if (const Attr* proxy = find_attr(list, N::kProxy)) {
+      const bool occluder = under(N::kOccluders) && parts.size() == split_path(N::kOccluders).size() + 1;
+      const auto* value = std::get_if<std::string>(&proxy->value);
+      if (!occluder)
+        c.fail("attribute '" + std::string(N::kProxy) + "' on group '" + g + "': only " + std::string(N::kOccluders) +
+               "/<name> has one");
+      if (value == nullptr || (*value != N::kProxySphere && *value != N::kProxyCone))
+        c.fail("attribute '" + std::string(N::kProxy) + "' on group '" + g + "' must be the string \"" +
+               std::string(N::kProxySphere) + "\" or \"" + std::string(N::kProxyCone) + "\"");
+      if (version < 7)
+        c.fail("attribute '" + std::string(N::kProxy) + "' on group '" + g + "' needs format_version 7 (the file says " +
+               std::to_string(version) + ")");
+      if (*value == N::kProxyCone && !paths.count(g + "/" + std::string(N::kCones)))
+        c.fail("group '" + g + "' says proxy \"cone\" but has no '" + std::string(N::kCones) + "' dataset");
+    }
     if (!groups.insert(g).second) c.fail("group '" + g + "' is given twice in group_attrs");
     if (paths.count(g)) c.fail("group '" + g + "' is also a dataset path");
     for (std::size_t slash = g.find('/', 1); slash != std::string::npos;

@@ -16,15 +16,17 @@
 //
 // Buffers (std430 SSBOs, all readonly; set PRT_FIV_SET, default 0; bindings below, defaults 2–6
 // so that shade.glsl's defaults 0–1 fit beside them — #define any of them before including):
-//   PRT_FIV_OCCLUDERS_BINDING (2)  PrtFivOccluder prt_fiv_occluders[]   one per occluder, 48 bytes:
+//   PRT_FIV_OCCLUDERS_BINDING (2)  PrtFivOccluder prt_fiv_occluders[]   one per occluder, 64 bytes:
 //        struct PrtFivOccluder {          // std430 offsets
 //          vec4  centre_radius;           //  0: centre xyz (world), w = bounding radius R (> 0)
 //          ivec4 dims;                    // 16: n_rho (>= 1), n_theta (>= 2), n_phi (>= 1),
 //                                         //     radial scheme (0 geometric, 1 surface: prtshade/fiv.h)
 //          uvec4 offsets;                 // 32: first radius in prt_fiv_radii (floats),
-//        };                               //     first value in prt_fiv_shells (floats),
+//                                         //     first value in prt_fiv_shells (floats),
 //                                         //     first WORD in prt_fiv_valid (uints),
 //                                         //     surface scheme: first r_surf in prt_fiv_radii
+//          uvec4 extra;                   // 48: 1 when the occluder has a cone table, else 0,
+//        };                               //     first value in prt_fiv_cones (floats), 0, 0
 //   PRT_FIV_RADII_BINDING (3)      float prt_fiv_radii[]    each occluder's n_rho radii, increasing
 //                                  (surface scheme: the offsets τ_k from the surface), and for the
 //                                  surface scheme its [n_theta][n_phi] surface_radius (anywhere:
@@ -37,6 +39,10 @@
 //        (memcpy) on a little-endian host; each occluder's mask starts on a word boundary (pad
 //        the previous one to a multiple of 4 bytes). (std430 has no 8-bit arrays without
 //        GL_EXT_shader_8bit_storage, an optional feature; packing works everywhere.)
+//   PRT_FIV_CONES_BINDING (7)      float prt_fiv_cones[]    each cone occluder's [n_rho][n_theta][n_phi]
+//                                  [4] floats (m_x, m_y, m_z, Ω) as in /fiv/occluders/<name>/cones
+//                                  (prtshade/fiv.h "Tight proxies"; bind a buffer even when no
+//                                  occluder has one: it is read only where extra.x == 1)
 //   PRT_FIV_DIFMAP_BINDING (6)     uvec4 prt_difmap_header; float prt_difmap_texels[];
 //        header.x = face size S, header.yzw unused; texels from byte 16: /fiv/irradiance_cube
 //        [6][S][S][RGB] floats, faces +X, −X, +Y, −Y, +Z, −Z, OpenGL's cube orientation

@@ -33,6 +33,7 @@ static_assert(offsetof(prt_fiv_occluder_desc, n_phi) == offsetof(prt::shade::Fiv
 static_assert(offsetof(prt_fiv_occluder_desc, valid) == offsetof(prt::shade::FivOccluder, valid));
 static_assert(offsetof(prt_fiv_occluder_desc, radial_scheme) == offsetof(prt::shade::FivOccluder, radial_scheme));
 static_assert(offsetof(prt_fiv_occluder_desc, surface_radius) == offsetof(prt::shade::FivOccluder, surface_radius));
+static_assert(offsetof(prt_fiv_occluder_desc, cones) == offsetof(prt::shade::FivOccluder, cones));
 
 struct prt_glossy {
   explicit prt_glossy(int order) : table(order) {}
@@ -48,7 +49,7 @@ namespace {
 
 // Owning copy of one occluder's arrays (its view lives in prt_fiv_scene::views).
 struct OwnedOccluder {
-  std::vector<float> radii, shells, surface_radius;
+  std::vector<float> radii, shells, surface_radius, cones;
   std::vector<uint8_t> valid;
 };
 
@@ -262,7 +263,8 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
                               occluder->shells,
                               occluder->valid,
                               occluder->radial_scheme,
-                              occluder->surface_radius};
+                              occluder->surface_radius,
+                              occluder->cones};
     prt::shade::validate_occluder(v);
     require(scene->views.size() < size_t(1) << 30, "too many occluders");
     auto own = std::make_unique<OwnedOccluder>();
@@ -278,6 +280,10 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
     v.shells = own->shells.data();
     v.valid = own->valid.data();
     v.surface_radius = own->surface_radius.empty() ? nullptr : own->surface_radius.data();
+    if (v.cones != nullptr) {
+      own->cones.assign(v.cones, v.cones + samples * 4);
+      v.cones = own->cones.data();
+    }
     scene->views.reserve(scene->views.size() + 1);
     scene->owned.push_back(std::move(own));
     scene->views.push_back(v);
@@ -333,6 +339,7 @@ prt_status prt_fiv_scene_shade(const prt_fiv_scene* scene, const float* position
     if (options != nullptr) {
       o.partial_occluders = options->partial_occluders != 0;
       o.overlap_correction = options->overlap_correction != 0;
+      o.proxy = options->sphere_proxy != 0 ? prt::shade::FivProxy::sphere : prt::shade::FivProxy::cone;
     }
     const prt::shade::DifMap map = scene->map();
     for (size_t k = 0; k < count; ++k)

@@ -103,7 +103,6 @@ inline float plane_height(const FivOccluder& occ, const float p[3], const float 
   return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
 }
 
-inline bool hides_something(const float I[3]) { return I[0] > 0 || I[1] > 0 || I[2] > 0; }
 
 } // namespace
 
@@ -146,20 +145,34 @@ void validate_occluder(const FivOccluder& o) {
   for (size_t i = 0; i < n; ++i)
     PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]) && std::fabs(o.shells[i]) <= kFivValueLimit,
                       "shell value " + std::to_string(i) + " = " + value_text(o.shells[i]) + value_limit_text);
-  if (!surface) return;
-  const size_t directions = size_t(o.n_theta) * size_t(o.n_phi);
-  for (size_t i = 0; i < directions; ++i)
-    PRT_SHADE_REQUIRE(std::isfinite(o.surface_radius[i]) && o.surface_radius[i] >= 0 &&
-                          o.surface_radius[i] <= kFivValueLimit,
-                      "surface radius " + std::to_string(i) + " = " + value_text(o.surface_radius[i]) +
-                          ": must be finite, >= 0 and <= 2^64");
-  // The lookup inverts τ_k = τ_0 g^k in closed form: the offsets must be that grading.
-  const int last = o.n_rho - 1;
-  for (int k = 1; k < last; ++k) {
-    const double expected = double(o.radii[0]) * std::pow(double(o.radii[last]) / o.radii[0], double(k) / last);
-    PRT_SHADE_REQUIRE(std::fabs(double(o.radii[k]) - expected) <= 1e-4 * expected,
-                      "surface-scheme offset " + std::to_string(k) + " = " + value_text(o.radii[k]) +
-                          ": the offsets must grow geometrically (tau_k = tau_0 g^k)");
+  if (surface) {
+    const size_t directions = size_t(o.n_theta) * size_t(o.n_phi);
+    for (size_t i = 0; i < directions; ++i)
+      PRT_SHADE_REQUIRE(std::isfinite(o.surface_radius[i]) && o.surface_radius[i] >= 0 &&
+                            o.surface_radius[i] <= kFivValueLimit,
+                        "surface radius " + std::to_string(i) + " = " + value_text(o.surface_radius[i]) +
+                            ": must be finite, >= 0 and <= 2^64");
+    // The lookup inverts τ_k = τ_0 g^k in closed form: the offsets must be that grading.
+    const int last = o.n_rho - 1;
+    for (int k = 1; k < last; ++k) {
+      const double expected = double(o.radii[0]) * std::pow(double(o.radii[last]) / o.radii[0], double(k) / last);
+      PRT_SHADE_REQUIRE(std::fabs(double(o.radii[k]) - expected) <= 1e-4 * expected,
+                        "surface-scheme offset " + std::to_string(k) + " = " + value_text(o.radii[k]) +
+                            ": the offsets must grow geometrically (tau_k = tau_0 g^k)");
+    }
+  }
+  if (o.cones != nullptr) {
+    constexpr double kMargin = 1.0 + 0x1p-10;
+    const size_t samples = sample_index(o, o.n_rho, 0, 0);
+    for (size_t i = 0; i < samples; ++i) {
+      const float* v = o.cones + 4 * i;
+      const double omega = v[3];
+      bool ok = std::isfinite(omega) && omega >= 0 && omega <= 4 * kPi * kMargin;
+      for (int e = 0; e < 3 && ok; ++e) ok = std::isfinite(v[e]) && std::fabs(double(v[e])) <= omega * kMargin + 0x1p-20;
+      PRT_SHADE_REQUIRE(ok, "cone sample " + std::to_string(i) + " = (" + value_text(v[0]) + ", " + value_text(v[1]) + ", " +
+                                value_text(v[2]) + ", " + value_text(v[3]) +
+                                "): needs a finite solid angle in [0, 4pi] and |m| components <= it");
+    }
   }
 }
 
@@ -254,10 +267,25 @@ inline void add_weighted_fiv(float acc[9], float w, const float* v) {
 // 0.0861. Only estimates a shell bracket that is then checked against the stored offsets.
 inline float approx_log2(float x) { return float(std::bit_cast<int32_t>(x)) * (1.0f / 8388608.0f) - 127.0f; }
 
-// The surface scheme's lookup (header comment "Surface-following shells") at grid coordinates
+// The stencil of a lookup at grid coordinates t (θ), u (φ) and distance ρ (header comment): the
+// 8 (4 inside the first shell and beyond the last) neighbours' sample indices and trilinear
+// weights, ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside. Shared by
+// the shells (sample_shells) and the cone table (sample_cones), which live on the same grid.
+struct ShellStencil {
+  size_t rows[2][2];  // [layer][θ ring]: the first sample of the ring
+  size_t js[2];       // the two φ columns
+  float wk[2], wi[2], wj[2];
+  int layers;         // 1 inside the first shell and beyond the last, else 2
+  float falloff;
+  size_t index(int a, int b, int c) const { return rows[a][b] + js[c]; }
+  float weight(int a, int b, int c) const { return wk[a] * wi[b] * wj[c]; }
+};
+
+// The surface scheme's stencil (header comment "Surface-following shells") at grid coordinates
 // t (θ) and u (φ) and distance ρ: r_s bilinear, τ = ρ − r_s, the bracket of τ by the closed-form
-// inverse of the grading, plain trilinear (no valid mask).
-void sample_surface_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+// inverse of the grading; clamped inside the first shell, (r_s + τ_last)²/ρ² falloff beyond the
+// last. Its samples are all valid (extrapolated at bake time): sample_table uses no mask for it.
+void surface_stencil(const FivOccluder& occ, float t, float u, double rho, ShellStencil& st) {
   const int i0 = std::min(int(t), occ.n_theta - 2);
   const float ft = t - float(i0);
   const int ju = std::min(int(u), occ.n_phi);
@@ -266,8 +294,8 @@ void sample_surface_shells(const FivOccluder& occ, float t, float u, double rho,
   const size_t np = size_t(occ.n_phi);
   const float* rs0 = occ.surface_radius + size_t(i0) * np;
   const float* rs1 = rs0 + np;
-  const float wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
-  const float r_s = wi[0] * (wj[0] * rs0[j0] + wj[1] * rs0[j1]) + wi[1] * (wj[0] * rs1[j0] + wj[1] * rs1[j1]);
+  st.wi[0] = 1 - ft, st.wi[1] = ft, st.wj[0] = 1 - fu, st.wj[1] = fu;
+  const float r_s = st.wi[0] * (st.wj[0] * rs0[j0] + st.wj[1] * rs0[j1]) + st.wi[1] * (st.wj[0] * rs1[j0] + st.wj[1] * rs1[j1]);
   const double tau = rho - double(r_s);
   const float* tk = occ.radii;
   const int last = occ.n_rho - 1;
@@ -291,26 +319,18 @@ void sample_surface_shells(const FivOccluder& occ, float t, float u, double rho,
     k1 = k0 + 1;
     fr = clamp_nan_safe(float((tau - tk[k0]) / (double(tk[k1]) - tk[k0])), 0.0f, 1.0f);
   }
-  const float wk[2] = {1 - fr, fr};
+  st.wk[0] = 1 - fr, st.wk[1] = fr;
   const size_t nt = size_t(occ.n_theta);
-  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
-                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
-  const size_t js[2] = {size_t(j0), size_t(j1)};
-  const int layers = k1 == k0 ? 1 : 2;
-  float acc[9] = {};
-  for (int a = 0; a < layers; ++a)
-    for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) add_weighted_fiv(acc, wk[a] * wi[b] * wj[c], occ.shells + (rows[a][b] + js[c]) * 9);
-  for (int e = 0; e < 9; ++e) out[e] = acc[e] * falloff;
+  st.rows[0][0] = (size_t(k0) * nt + size_t(i0)) * np, st.rows[0][1] = (size_t(k0) * nt + size_t(i0) + 1) * np;
+  st.rows[1][0] = (size_t(k1) * nt + size_t(i0)) * np, st.rows[1][1] = (size_t(k1) * nt + size_t(i0) + 1) * np;
+  st.js[0] = size_t(j0), st.js[1] = size_t(j1);
+  st.layers = k1 == k0 ? 1 : 2;
+  st.falloff = falloff;
 }
 
-// The trilinear lookup of the shells at grid coordinates t (θ), u (φ) and distance ρ (header
-// comment): ρ linear between the bracketing radii, clamped inside, 1/ρ² falloff outside;
-// neighbours with valid == 0 at weight 0 and the rest renormalised. Surface-scheme occluders go
-// to sample_surface_shells.
-void sample_shells(const FivOccluder& occ, float t, float u, double rho, float out[9]) {
+void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellStencil& st) {
   if (occ.radial_scheme == kFivRadialSurface) {
-    sample_surface_shells(occ, t, u, rho, out);
+    surface_stencil(occ, t, u, rho, st);
     return;
   }
   const int i0 = std::min(int(t), occ.n_theta - 2);
@@ -341,46 +361,90 @@ void sample_shells(const FivOccluder& occ, float t, float u, double rho, float o
     fr = clamp_nan_safe(float((rho - occ.radii[k0]) / (double(occ.radii[k1]) - occ.radii[k0])), 0.0f, 1.0f);
   }
 
-  const float wk[2] = {1 - fr, fr}, wi[2] = {1 - ft, ft}, wj[2] = {1 - fu, fu};
+  st.wk[0] = 1 - fr, st.wk[1] = fr, st.wi[0] = 1 - ft, st.wi[1] = ft, st.wj[0] = 1 - fu, st.wj[1] = fu;
   // Sample (k, i, j) sits at row (k Nθ + i) Nφ + j; rows of the two layers and two θ rings.
   const size_t nt = size_t(occ.n_theta), np = size_t(occ.n_phi);
-  const size_t rows[2][2] = {{(size_t(k0) * nt + size_t(i0)) * np, (size_t(k0) * nt + size_t(i0) + 1) * np},
-                             {(size_t(k1) * nt + size_t(i0)) * np, (size_t(k1) * nt + size_t(i0) + 1) * np}};
-  const size_t js[2] = {size_t(j0), size_t(j1)};
+  st.rows[0][0] = (size_t(k0) * nt + size_t(i0)) * np, st.rows[0][1] = (size_t(k0) * nt + size_t(i0) + 1) * np;
+  st.rows[1][0] = (size_t(k1) * nt + size_t(i0)) * np, st.rows[1][1] = (size_t(k1) * nt + size_t(i0) + 1) * np;
+  st.js[0] = size_t(j0), st.js[1] = size_t(j1);
   // Inside the first shell and beyond the last, k0 == k1 and fr == 0: the second layer's weights
-  // are 0 and skipping it changes no bit. The plain trilinear value is needed only when no valid
-  // neighbour carries weight, so it is summed only then.
-  const int layers = k1 == k0 ? 1 : 2;
-  float masked[9] = {};
+  // are 0 and skipping it changes no bit.
+  st.layers = k1 == k0 ? 1 : 2;
+  st.falloff = falloff;
+}
+
+// The masked trilinear value of a table of `width` floats per sample over a stencil: neighbours
+// with valid == 0 at weight 0 and the rest renormalised; the plain trilinear value only when no
+// valid neighbour carries weight (so it is summed only then); times the falloff.
+template <int kWidth>
+void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* table, float out[kWidth]) {
+  float masked[kWidth] = {};
   float masked_weight = 0;
-  for (int a = 0; a < layers; ++a)
+  if (occ.radial_scheme != kFivRadialSurface)  // the surface scheme's samples are all valid: plain trilinear
+  for (int a = 0; a < st.layers; ++a)
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
-        const size_t idx = rows[a][b] + js[c];
+        const size_t idx = st.index(a, b, c);
         if (occ.valid[idx] == 0) continue;
-        const float w = wk[a] * wi[b] * wj[c];
+        const float w = st.weight(a, b, c);
         masked_weight += w;
-        add_weighted_fiv(masked, w, occ.shells + idx * 9);
+        if constexpr (kWidth == 9) {
+          add_weighted_fiv(masked, w, table + idx * 9);
+        } else {
+          for (int e = 0; e < kWidth; ++e) masked[e] += w * table[idx * kWidth + size_t(e)];
+        }
       }
   if (masked_weight > 0) {
     const float inv = 1.0f / masked_weight;
-    for (int e = 0; e < 9; ++e) out[e] = masked[e] * inv * falloff;
+    for (int e = 0; e < kWidth; ++e) out[e] = masked[e] * inv * st.falloff;
     return;
   }
-  float plain[9] = {};
-  for (int a = 0; a < layers; ++a)
+  float plain[kWidth] = {};
+  for (int a = 0; a < st.layers; ++a)
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
-        const float w = wk[a] * wi[b] * wj[c];
-        const float* v = occ.shells + (rows[a][b] + js[c]) * 9;
-        for (int e = 0; e < 9; ++e) plain[e] += w * v[e];
+        const float w = st.weight(a, b, c);
+        const float* v = table + st.index(a, b, c) * kWidth;
+        if constexpr (kWidth == 9) {
+          add_weighted_fiv(plain, w, v);  // the same float operations per element as the loop
+        } else {
+          for (int e = 0; e < kWidth; ++e) plain[e] += w * v[e];
+        }
       }
-  for (int e = 0; e < 9; ++e) out[e] = plain[e] * falloff;
+  for (int e = 0; e < kWidth; ++e) out[e] = plain[e] * st.falloff;
 }
 
-// F(s) with the angles from std::atan2: lookup_fiv, occluded_irradiance and the slow reference.
-// (shade_fiv forms the same coordinates with poly_atan2 for all its occluders at once.)
-void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
+// Prefetches the samples a stencil reads (shells, valid, and the cone table when `cones`): a hint
+// only, no value depends on it.
+constexpr int kPrefetchBlock = 8;
+inline void prefetch_stencil(const FivOccluder& occ, const ShellStencil& st, bool cones) {
+#if defined(__GNUC__)
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b) {  // the φ neighbours j0, j1 of a ring
+      const size_t i0 = st.index(a, b, 0), i1 = st.index(a, b, 1);
+      __builtin_prefetch(occ.shells + i0 * 9);
+      __builtin_prefetch(occ.shells + i0 * 9 + 8);
+      __builtin_prefetch(occ.shells + i1 * 9 + 8);
+      if (occ.valid) __builtin_prefetch(occ.valid + i0);
+      if (cones && occ.cones) {
+        __builtin_prefetch(occ.cones + i0 * 4);
+        __builtin_prefetch(occ.cones + i1 * 4 + 3);
+      }
+    }
+#else
+  (void)occ, (void)st, (void)cones;
+#endif
+}
+
+// The trilinear lookup of the shells (header comment) at a stencil.
+inline void sample_shells(const FivOccluder& occ, const ShellStencil& st, float out[9]) { sample_table<9>(occ, st, occ.shells, out); }
+// The cone table (m, Ω) at the same stencil (header "Tight proxies").
+inline void sample_cones(const FivOccluder& occ, const ShellStencil& st, float out[4]) { sample_table<4>(occ, st, occ.cones, out); }
+
+// Grid coordinates (t, u) of an offset with the angles from std::atan2 and ρ = |s| (ρ = 0 for a
+// zero or NaN offset: d = +Y, θ = 0): lookup_fiv, lookup_cone, occluded_irradiance and the slow
+// reference. (shade_fiv forms the same coordinates with poly_atan2 for all its occluders at once.)
+void stencil_at(const FivOccluder& occ, const double s[3], ShellStencil& st) {
   // Direction and distance, formed in double: |s| never overflows and d is unit to float precision.
   const double sx = s[0], sy = s[1], sz = s[2];
   double rho = std::sqrt(sx * sx + sy * sy + sz * sz);
@@ -395,7 +459,14 @@ void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
   } else {
     rho = 0;  // ρ == 0 (or NaN): d = +Y, θ = 0
   }
-  sample_shells(occ, theta_coordinate(theta, float(occ.n_theta - 1)), phi_coordinate(phi, float(occ.n_phi)), rho, out);
+  shell_stencil(occ, theta_coordinate(theta, float(occ.n_theta - 1)), phi_coordinate(phi, float(occ.n_phi)), rho, st);
+}
+
+// F(s) with the angles from std::atan2 (stencil_at).
+void lookup_fiv_at(const FivOccluder& occ, const double s[3], float out[9]) {
+  ShellStencil st;
+  stencil_at(occ, s, st);
+  sample_shells(occ, st, out);
 }
 
 // Factor of the case an occluder is in at height h = n·(centre − p) over the receiver's plane:
@@ -442,10 +513,12 @@ void shade_fiv_self_unit(const float env_fiv[9], const FivOccluder& occ, const f
 //      in case C are dropped here;
 //   2. for all the others at once, in float: the shell coordinates (θ, φ by poly_atan2) and the
 //      occluders' discs (axis, α) — a loop over plain arrays, which the compiler vectorises;
-//   3. per occluder, the shell samples and I (eq. 10); those that hide nothing are dropped;
-//   4. the overlap correction (eq. 13–14): every pair of discs tested four at a time (spatial
-//      culling of the pairs was measured and lost at 100 occluders, bench/RESULTS.md), the O_ij of
-//      those that may overlap formed in batches (vectorised), summed per disc in double.
+//   3. per occluder, the shell samples (prefetched a block ahead), a tight proxy's cone (its disc
+//      and partial correction) and I (eq. 10); those that hide nothing are dropped;
+//   4. the overlap correction (eq. 13–14): the discs ordered along a tangent by a counting sort of
+//      their extents' buckets, each tested four at a time against the later ones whose extent can
+//      meet its own (bench/RESULTS.md "Tight FIV proxies"), the O_ij of those that may overlap
+//      formed in batches (vectorised), summed per disc in double.
 
 // Lens area of two planar discs of radii r1, r2 whose centres are d apart (lens_area in float):
 // r1² θ1 + r2² θ2 − ½√k with the half-angles θ_i = atan2(√k, d² + r_i² − r_j²), the shader
@@ -471,6 +544,29 @@ inline float overlap_float(float alpha_i, float alpha_j, float cos_gamma, float 
   const float denom = kPiF * (alpha_i * alpha_i + alpha_j * alpha_j);
   const float lens = lens_area_float(alpha_i, alpha_j, gamma);
   return denom > 0 ? lens / (denom > 0 ? denom : 1.0f) : 0.0f;
+}
+
+// K(x, α) of the header's "Tight proxies" in float with poly_atan2 (acos(q) = atan2(√(1 − q²), q)):
+// the fast path's cap_clamped_cosine. x = ν·a, ca = cos α.
+inline float cap_clamped_cosine_float(float x, float ca) {
+  x = clamp_nan_safe(x, -1.0f, 1.0f), ca = clamp_nan_safe(ca, -1.0f, 1.0f);
+  const bool complement = ca < 0;  // α > π/2: π − K(−x, π − α)
+  if (complement) x = -x, ca = -ca;
+  const float sa2 = (1 - ca) * (1 + ca), sa = std::sqrt(sa2);
+  float k;
+  if (x >= sa) {
+    k = kPiF * x * sa2;
+  } else if (x <= -sa) {
+    k = 0;
+  } else {  // |x| < sa <= 1: sa > 0 and y > 0
+    const float y = std::sqrt((1 - x) * (1 + x));
+    const float cot = ca / sa;
+    const float q = clamp_nan_safe(-cot * x / y, -1.0f, 1.0f);
+    const float sq = std::sqrt((1 - q) * (1 + q));
+    const float z = y * sq;
+    k = std::max(0.0f, (x * poly_atan2(sq, q) - cot * z) * sa2 + poly_atan2(z, cot));
+  }
+  return complement ? kPiF - k : k;
 }
 
 // Four pair tests at once: bit k is set when the disc (x[k], y[k], z[k]) of angular radius α_k
@@ -503,13 +599,13 @@ struct Candidates {
   enum Field {
     kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha,  // per candidate
     kI0, kI1, kI2,                                                                              // per candidate
-    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha,                      // per active disc
+    kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha, kPackedTight,        // per active disc
     kFields
   };
   static constexpr int kPadding = 4;  // the packed discs are read four at a time
   std::array<float, size_t(kStackOccluders + kPadding) * kFields> stack_floats;
   std::array<double, 2 * kStackOccluders> stack_doubles;
-  std::array<int, 2 * kStackOccluders> stack_ints;
+  std::array<int, 6 * kStackOccluders> stack_ints;
   std::vector<float> heap_floats;
   std::vector<double> heap_doubles;
   std::vector<int> heap_ints;
@@ -518,6 +614,10 @@ struct Candidates {
   double* weight;  // per active disc: W_i = Σ_j O_ij
   int* index;   // the occluder of candidate c
   int* active;  // the candidates that hide something, in order
+  int* lo_bucket;  // per active disc: the buckets of its extent along the sweep's tangent
+  int* hi_bucket;  // (indexed by active disc)
+  int* at;         // per sweep position: the candidate whose disc sits there
+  int* end;        // per sweep position: where that disc's pair tests stop
 
   explicit Candidates(int count) {
     float* floats = stack_floats.data();
@@ -528,11 +628,12 @@ struct Candidates {
       stride = size_t(count);
       heap_floats.resize((stride + kPadding) * kFields);
       heap_doubles.resize(2 * stride);
-      heap_ints.resize(2 * stride);
+      heap_ints.resize(6 * stride);
       floats = heap_floats.data(), rho = heap_doubles.data(), index = heap_ints.data();
     }
     for (int f = 0; f < kFields; ++f) field[f] = floats + size_t(f) * (stride + kPadding);
     active = index + stride;
+    lo_bucket = index + 2 * stride, hi_bucket = index + 3 * stride, at = index + 4 * stride, end = index + 5 * stride;
     weight = rho + stride;
   }
   Candidates(const Candidates&) = delete;
@@ -553,7 +654,15 @@ struct PairBatch {
 };
 
 // prtshade/fiv.h tells engines (fibers, small thread stacks) what shade_fiv keeps on the stack.
-static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 18 * 1024, "fiv.h says shade_fiv uses about 17 KB of stack");
+static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 21 * 1024, "fiv.h says shade_fiv uses about 21 KB of stack");
+
+// The sweep's buckets over a disc's extent [x − w, x + w] ⊂ [−2.5, 2.5] along a tangent (x in
+// [−1, 1], w <= √2 plus a margin), monotone in the coordinate.
+constexpr int kSweepBuckets = 64;
+constexpr int kSweepMinDiscs = 32;
+inline int sweep_bucket(float v) {
+  return int(clamp_nan_safe((v + 2.5f) * (float(kSweepBuckets) / 5.0f), 0.0f, float(kSweepBuckets - 1)));
+}
 
 // Pass 2 of shade_fiv_fast over the n candidates: shell coordinates t (θ) and u (φ) of the unit
 // offsets d, and cos α, α of the discs from sin α. Separate arrays (restrict), so that it vectorises.
@@ -592,6 +701,10 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   float *const t = c.field[F::kT], *const u = c.field[F::kU];
   float* const I[3] = {c.field[F::kI0], c.field[F::kI1], c.field[F::kI2]};
 
+  // The tight proxy's partial correction needs the mean radiance from below, E_tot(−n)/π.
+  const bool use_cones = options.proxy == FivProxy::cone;
+  float below[3] = {0, 0, 0};
+  bool below_looked_up = false;  // looked up at the first tight occluder (a receiver may have none)
   // Pass 1: offset, case and distance in double (finite for any finite input).
   int candidates = 0;
   for (int i = 0; i < count; ++i) {
@@ -599,7 +712,8 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     double s[3];
     offset_from_centre(occ, p, s);
     const float h = float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
-    const float f = case_factor(h, occ.radius, options.partial_occluders);
+    // A tight occluder's partial correction comes in pass 3; its case C is the sphere's.
+    const float f = case_factor(h, occ.radius, options.partial_occluders && !(use_cones && occ.cones));
     if (f == 0) continue;
     const int k = candidates++;
     c.index[k] = i;
@@ -622,12 +736,53 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   }
   // Pass 2: shell coordinates and discs for all candidates at once (vectorised).
   shell_coordinates_and_discs(candidates, dx, dy, dz, last_t, n_phi, sin_alpha, t, u, cos_alpha, alpha);
-  // Pass 3: shell samples and I; the candidates that hide something become active.
+  // Pass 3: shell samples and I; the candidates that hide something become active. In blocks: the
+  // block's stencils first, their samples prefetched, then the samples read (the lookups are
+  // scattered over megabytes of shells; their cache misses then overlap instead of queueing).
   int active = 0;
+  ShellStencil block[kPrefetchBlock];
   for (int k = 0; k < candidates; ++k) {
+    const int slot = k % kPrefetchBlock;
+    if (slot == 0)
+      for (int b = 0; b < kPrefetchBlock && k + b < candidates; ++b) {
+        const FivOccluder& o = occluders[c.index[k + b]];
+        shell_stencil(o, t[k + b], u[k + b], c.rho[k + b], block[b]);
+        prefetch_stencil(o, block[b], use_cones);
+      }
+    const FivOccluder& occ = occluders[c.index[k]];
     float fv[9], e[3];
-    sample_shells(occluders[c.index[k]], t[k], u[k], c.rho[k], fv);
+    const ShellStencil& st = block[slot];
+    sample_shells(occ, st, fv);
     project_fiv(fv, n, e);
+    if (use_cones && occ.cones) {
+      // The occluder's cone (header "Tight proxies"): axis m/|m| (towards the centre when m = 0).
+      float cone[4];
+      sample_cones(occ, st, cone);
+      const float ml = std::sqrt(cone[0] * cone[0] + cone[1] * cone[1] + cone[2] * cone[2]);
+      if (ml > 0) ax[k] = cone[0] / ml, ay[k] = cone[1] / ml, az[k] = cone[2] / ml;
+      const float ca = clamp_nan_safe(1.0f - cone[3] / kTwoPiF, -1.0f, 1.0f);
+      if (options.partial_occluders) {
+        if (!below_looked_up) {
+          const float down[3] = {-n[0], -n[1], -n[2]};
+          lookup_difmap(map, down, below);
+          for (float& b : below) b /= kPiF;
+          below_looked_up = true;
+        }
+        const float x = n[0] * ax[k] + n[1] * ay[k] + n[2] * az[k];
+        const float sa = std::sqrt((1 - ca) * (1 + ca));
+        if (ca >= 0 && x <= -sa) {
+          e[0] = e[1] = e[2] = 0;  // the cap wholly below the horizon
+        } else {
+          const float K = cap_clamped_cosine_float(-x, ca);
+          for (int ch = 0; ch < 3; ++ch) e[ch] += below[ch] * K;
+        }
+      }
+      // The disc of eq. 13–14: the cap, α clamped to π/2 as the sphere's.
+      const float cd = std::max(ca, 0.0f);
+      cos_alpha[k] = cd;
+      sin_alpha[k] = std::sqrt((1 - cd) * (1 + cd));
+      alpha[k] = poly_atan2(sin_alpha[k], cd);
+    }
     bool hides = false;
     for (int ch = 0; ch < 3; ++ch) {
       I[ch][k] = std::max(0.0f, factor[k] * e[ch]);
@@ -639,34 +794,83 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
   // Pass 4: the overlap correction, Σ_{i<j} O_ij (I_i + I_j) = Σ_i W_i I_i with W_i = Σ_{j≠i} O_ij
   // summed in double.
   if (options.overlap_correction && active > 1) {
-    // The active discs packed in order, so that the test of one disc against all later ones runs
-    // over contiguous arrays (vectorised).
+    // A sweep along a tangent t of the receiver's plane: disc k covers x = a_k·t ± w_k with
+    // w_k = 2 sin(α_k/2) = √(2(1 − cos α_k)) (the chord: |ω·t − a·t| <= |ω − a| for every ω in
+    // the disc; with a margin for float rounding). Two discs that overlap have |x_i − x_j| <=
+    // |a_i − a_j| = 2 sin(γ/2) < 2 sin((α_i + α_j)/2) <= w_i + w_j (sin is subadditive on [0, π]),
+    // so their extents meet. The discs are ordered by the bucket of their left end (a counting
+    // sort, no comparisons), and disc i is tested only against the later ones up to the last
+    // whose left end's bucket is at most its right end's — every overlapping pair among them.
+    // The active discs packed in sweep order, so that the test of one disc against the later ones
+    // runs over contiguous arrays (vectorised); end[pos] is where disc pos's tests stop.
     float* const pax = c.field[F::kPackedAx];
     float* const pay = c.field[F::kPackedAy];
     float* const paz = c.field[F::kPackedAz];
     float* const pcos = c.field[F::kPackedCos];
     float* const psin = c.field[F::kPackedSin];
     float* const palpha = c.field[F::kPackedAlpha];
-    for (int a = 0; a < active; ++a) {
-      const int k = c.active[a];
-      pax[a] = ax[k], pay[a] = ay[k], paz[a] = az[k];
-      pcos[a] = cos_alpha[k], psin[a] = sin_alpha[k], palpha[a] = alpha[k];
-      c.weight[a] = 0;
+    float* const ptight = c.field[F::kPackedTight];  // 1: a tight proxy (its pairs with others such: the density form)
+    int* const end = c.end;
+    const auto pack = [&](int pos, int k, int stop) {
+      c.at[pos] = k;
+      end[pos] = stop;
+      pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
+      pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
+      ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
+      c.weight[pos] = 0;
+    };
+    if (active >= kSweepMinDiscs) {
+      const int e = std::fabs(n[0]) < std::fabs(n[1]) ? (std::fabs(n[0]) < std::fabs(n[2]) ? 0 : 2)
+                                                      : (std::fabs(n[1]) < std::fabs(n[2]) ? 1 : 2);
+      float tx = e == 0 ? 0 : (e == 1 ? n[2] : -n[1]), ty = e == 0 ? -n[2] : (e == 1 ? 0 : n[0]),
+            tz = e == 0 ? n[1] : (e == 1 ? -n[0] : 0);  // n × (the axis e), ⊥ n
+      const float tl = std::sqrt(tx * tx + ty * ty + tz * tz);
+      tx /= tl, ty /= tl, tz /= tl;
+      int start[kSweepBuckets + 1] = {};
+      for (int a = 0; a < active; ++a) {
+        const int k = c.active[a];
+        const float x = ax[k] * tx + ay[k] * ty + az[k] * tz;
+        const float w = std::sqrt(2 * (1 - cos_alpha[k])) * 1.0001f + 1e-4f;
+        c.lo_bucket[a] = sweep_bucket(x - w);
+        c.hi_bucket[a] = sweep_bucket(x + w);
+        ++start[c.lo_bucket[a] + 1];
+      }
+      for (int b = 0; b < kSweepBuckets; ++b) start[b + 1] += start[b];
+      int next[kSweepBuckets];
+      std::copy_n(start, kSweepBuckets, next);
+      // Each disc's tests stop at the first position whose left end lies in a later bucket than
+      // its right end.
+      for (int a = 0; a < active; ++a) pack(next[c.lo_bucket[a]]++, c.active[a], start[c.hi_bucket[a] + 1]);
+    } else {  // below kSweepMinDiscs the sweep costs more than it saves (bench/RESULTS.md): every pair
+      for (int a = 0; a < active; ++a) pack(a, c.active[a], active);
     }
     // Padding that never passes: cos γ = 0 < 4 (cos α_i + sin α_i) <= cos_sum.
     for (int a = active; a < active + Candidates::kPadding; ++a) pax[a] = pay[a] = paz[a] = 0, pcos[a] = 4, psin[a] = -4;
     PairBatch batch;
+    // Pairs of two tight proxies add the lens times the lower of the two irradiance densities,
+    // O_ij (α_i² + α_j²) min_c(I_i/α_i², I_j/α_j²) (fiv.h "Tight proxies"); the others O_ij (I_i + I_j)
+    // as Σ_i W_i I_i.
+    double dense[3] = {0, 0, 0};
     const auto flush = [&] {
       batch.overlaps();
       for (int b = 0; b < batch.count; ++b) {
-        c.weight[batch.i[b]] += double(batch.o[b]);
-        c.weight[batch.j[b]] += double(batch.o[b]);
+        const int i = batch.i[b], j = batch.j[b];
+        if (ptight[i] != 0 && ptight[j] != 0) {
+          const double ai2 = double(palpha[i]) * palpha[i], aj2 = double(palpha[j]) * palpha[j];
+          if (!(ai2 > 0 && aj2 > 0)) continue;  // a disc of no area: no lens
+          const int ki = c.at[i], kj = c.at[j];
+          for (int ch = 0; ch < 3; ++ch)
+            dense[ch] += double(batch.o[b]) * (ai2 + aj2) * std::min(double(I[ch][ki]) / ai2, double(I[ch][kj]) / aj2);
+          continue;
+        }
+        c.weight[i] += double(batch.o[b]);
+        c.weight[j] += double(batch.o[b]);
       }
       batch.count = 0;
     };
     for (int i = 0; i + 1 < active; ++i) {
       const float xi = pax[i], yi = pay[i], zi = paz[i], ci = pcos[i], si = psin[i];
-      for (int j0 = i + 1; j0 < active; j0 += 4) {
+      for (int j0 = i + 1; j0 < end[i]; j0 += 4) {
         // Disjoint discs (γ >= α_i + α_j, both angles in [0, π/2]) have cos γ < cos(α_i + α_j)
         // and no lens; the few others go to the batch.
         for (unsigned m = disc_pairs_may_overlap(pax + j0, pay + j0, paz + j0, pcos + j0, psin + j0, xi, yi, zi, ci, si);
@@ -685,8 +889,9 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       }
     }
     flush();
-    for (int a = 0; a < active; ++a)
-      for (int ch = 0; ch < 3; ++ch) acc[ch] += c.weight[a] * double(I[ch][c.active[a]]);
+    for (int pos = 0; pos < active; ++pos)
+      for (int ch = 0; ch < 3; ++ch) acc[ch] += c.weight[pos] * double(I[ch][c.at[pos]]);
+    for (int ch = 0; ch < 3; ++ch) acc[ch] += dense[ch];
   }
   for (int ch = 0; ch < 3; ++ch) out[ch] = float(std::max(0.0, acc[ch]));
 }
@@ -696,6 +901,25 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
 void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
   const double sd[3] = {s[0], s[1], s[2]};
   lookup_fiv_at(occ, sd, out);
+}
+
+void lookup_cone(const FivOccluder& occ, const float s[3], float out[4]) {
+  const double sd[3] = {s[0], s[1], s[2]};
+  ShellStencil st;
+  stencil_at(occ, sd, st);
+  sample_cones(occ, st, out);
+}
+
+double cap_clamped_cosine(double x, double cos_alpha) {
+  x = std::clamp(x, -1.0, 1.0), cos_alpha = std::clamp(cos_alpha, -1.0, 1.0);
+  if (cos_alpha < 0) return kPi - cap_clamped_cosine(-x, -cos_alpha);
+  const double s2 = (1 - cos_alpha) * (1 + cos_alpha), s = std::sqrt(s2);
+  if (x >= s) return kPi * x * s2;
+  if (x <= -s) return 0.0;
+  const double y = std::sqrt((1 - x) * (1 + x)), cot = cos_alpha / s;
+  const double q = std::clamp(-cot * x / y, -1.0, 1.0);
+  const double z = y * std::sqrt((1 - q) * (1 + q));
+  return std::max(0.0, (x * std::acos(q) - cot * z) * s2 + std::atan2(z, cot));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -752,6 +976,42 @@ double overlap_fraction(double alpha_i, double alpha_j, double gamma) {
   return lens_area(alpha_i, alpha_j, gamma) / denom;
 }
 
+namespace {
+// One occluder's terms in the slow reference, in double: I (eq. 10 with the proxy's partial
+// correction) and its disc (axis, α) for eq. 13–14 (header "Tight proxies").
+void reference_terms(const FivOccluder& o, const float p[3], const float n[3], const FivShadeOptions& options,
+                     const double below[3], double I[3], double axis[3], double& alpha) {
+  const bool tight = options.proxy == FivProxy::cone && o.cones != nullptr;
+  float Ib[3];
+  occluded_irradiance_unit(o, p, n, options.partial_occluders && !tight, Ib);
+  for (int c = 0; c < 3; ++c) I[c] = Ib[c];
+  double v[3] = {double(o.centre[0]) - p[0], double(o.centre[1]) - p[1], double(o.centre[2]) - p[2]};
+  const double D = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  for (int k = 0; k < 3; ++k) axis[k] = D > 0 ? v[k] / D : double(n[k]);
+  alpha = D > 0 ? std::asin(std::min(1.0, double(o.radius) / D)) : (o.radius > 0 ? kPi / 2 : 0.0);
+  if (!tight) return;
+  double s[3];
+  offset_from_centre(o, p, s);
+  ShellStencil st;
+  stencil_at(o, s, st);
+  float cone[4];
+  sample_cones(o, st, cone);
+  const double ml = std::sqrt(double(cone[0]) * cone[0] + double(cone[1]) * cone[1] + double(cone[2]) * cone[2]);
+  if (ml > 0)
+    for (int k = 0; k < 3; ++k) axis[k] = cone[k] / ml;
+  const double ca = std::clamp(1.0 - double(cone[3]) / (2 * kPi), -1.0, 1.0);
+  alpha = std::acos(std::max(ca, 0.0));
+  if (!options.partial_occluders || !(plane_height(o, p, n) > -o.radius)) return;  // I as the sphere's case C gave it
+  float f[9], e[3];
+  sample_shells(o, st, f);
+  project_fiv(f, n, e);
+  const double x = n[0] * axis[0] + n[1] * axis[1] + n[2] * axis[2];
+  const bool below_horizon = ca >= 0 && x <= -std::sqrt((1 - ca) * (1 + ca));
+  const double K = cap_clamped_cosine(-x, ca);
+  for (int c = 0; c < 3; ++c) I[c] = below_horizon ? 0.0 : std::max(0.0, double(e[c]) + below[c] * K);
+}
+} // namespace
+
 void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int count, const float p[3],
                          const float n_in[3], const FivShadeOptions& options, float out[3]) {
   const UnitNormal unit(n_in);
@@ -759,28 +1019,42 @@ void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int co
   float tot[3];
   lookup_difmap(map, n, tot);
   double e[3] = {tot[0], tot[1], tot[2]};
-  std::vector<std::array<float, 3>> I(size_t(std::max(count, 0)));
-  for (int i = 0; i < count; ++i) {
-    occluded_irradiance(occluders[i], p, n, options.partial_occluders, I[size_t(i)].data());
-    for (int c = 0; c < 3; ++c) e[c] -= I[size_t(i)][size_t(c)];
+  double below[3] = {0, 0, 0};
+  {
+    const float down[3] = {-n[0], -n[1], -n[2]};
+    float b[3];
+    lookup_difmap(map, down, b);
+    for (int c = 0; c < 3; ++c) below[c] = double(b[c]) / kPi;
   }
-  auto axis_alpha = [&](const FivOccluder& o, double axis[3]) {
-    double v[3] = {double(o.centre[0]) - p[0], double(o.centre[1]) - p[1], double(o.centre[2]) - p[2]};
-    const double D = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; ++k) axis[k] = D > 0 ? v[k] / D : double(n[k]);
-    return D > 0 ? std::asin(std::min(1.0, double(o.radius) / D)) : (o.radius > 0 ? kPi / 2 : 0.0);
+  struct Terms {
+    double I[3], axis[3], alpha;
+    bool tight;
   };
+  std::vector<Terms> t(size_t(std::max(count, 0)));
+  for (int i = 0; i < count; ++i) {
+    Terms& ti = t[size_t(i)];
+    reference_terms(occluders[i], p, n, options, below, ti.I, ti.axis, ti.alpha);
+    ti.tight = options.proxy == FivProxy::cone && occluders[i].cones != nullptr;
+    for (int c = 0; c < 3; ++c) e[c] -= ti.I[c];
+  }
+  const auto hides = [](const Terms& x) { return x.I[0] > 0 || x.I[1] > 0 || x.I[2] > 0; };
   if (options.overlap_correction)
     for (int i = 0; i < count; ++i)
       for (int j = i + 1; j < count; ++j) {
-        const auto& Ii = I[size_t(i)];
-        const auto& Ij = I[size_t(j)];
-        if (!hides_something(Ii.data()) || !hides_something(Ij.data())) continue;
-        double ai[3], aj[3];
-        const double alpha_i = axis_alpha(occluders[i], ai), alpha_j = axis_alpha(occluders[j], aj);
-        const double gamma = std::acos(std::clamp(ai[0] * aj[0] + ai[1] * aj[1] + ai[2] * aj[2], -1.0, 1.0));
-        const double o = overlap_fraction(alpha_i, alpha_j, gamma);
-        for (int c = 0; c < 3; ++c) e[c] += o * (double(Ii[size_t(c)]) + Ij[size_t(c)]);
+        const Terms& ti = t[size_t(i)];
+        const Terms& tj = t[size_t(j)];
+        if (!hides(ti) || !hides(tj)) continue;
+        const double cg = ti.axis[0] * tj.axis[0] + ti.axis[1] * tj.axis[1] + ti.axis[2] * tj.axis[2];
+        const double gamma = std::acos(std::clamp(cg, -1.0, 1.0));
+        if (ti.tight && tj.tight) {  // the lens times the lower density
+          const double Ai = kPi * ti.alpha * ti.alpha, Aj = kPi * tj.alpha * tj.alpha;
+          if (!(Ai > 0 && Aj > 0)) continue;
+          const double lens = lens_area(ti.alpha, tj.alpha, gamma);
+          for (int c = 0; c < 3; ++c) e[c] += lens * std::min(ti.I[c] / Ai, tj.I[c] / Aj);
+          continue;
+        }
+        const double o = overlap_fraction(ti.alpha, tj.alpha, gamma);
+        for (int c = 0; c < 3; ++c) e[c] += o * (ti.I[c] + tj.I[c]);
       }
   for (int c = 0; c < 3; ++c) out[c] = float(std::max(0.0, e[c]));
 }

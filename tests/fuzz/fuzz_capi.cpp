@@ -332,7 +332,7 @@ void Program::scene_shade() {
   const int index = small_int(-1, 4);
   switch (in_.ConsumeIntegralInRange<int>(0, 2)) {
   case 0: {
-    prt_fiv_options options{in_.ConsumeBool(), in_.ConsumeBool()};
+    prt_fiv_options options{in_.ConsumeBool(), in_.ConsumeBool(), in_.ConsumeBool()};
     check("prt_fiv_scene_shade",
           prt_fiv_scene_shade(scene, maybe_null(p), maybe_null(n), receivers, in_.ConsumeBool() ? &options : nullptr, maybe_null(out)),
           outputs, true);

@@ -145,7 +145,7 @@ TEST(Loader, SurfaceFollowingShellsReachTheView) {
   const auto& shells = std::get<std::vector<float>>(f.datasets[8].data);
   const std::vector<float> radii = {0.375f, 1.5f};
   const prt::shade::FivOccluder direct{{0.5f, 2.0f, -1.0f}, 0.75f, 2, 3, 4, radii.data(), shells.data(), nullptr,
-                                       prt::shade::kFivRadialSurface, surface.data()};
+                                       prt::shade::kFivRadialSurface, surface.data(), nullptr};
   for (const float s : {0.1f, 0.6f, 1.3f, 2.4f, 9.0f}) {
     const float off[3] = {s, -0.3f * s, 0.2f};
     float loaded[9], expect[9];
@@ -166,6 +166,55 @@ TEST(Loader, SceneObjectsAreSeparateVertexSets) {
   EXPECT_EQ(tree->ao, (std::vector<float>{0.125f, 1}));
   EXPECT_EQ(a.find_vertex_set("")->vertex_count(), 3u);
   EXPECT_EQ(a.find_vertex_set("nope"), nullptr);
+}
+
+TEST(Loader, ConeProxyIsReadWhereTheFileSaysSoAndOlderFilesAreTheSphere) {
+  // Schema v7 (formats/SCHEMA.md): /fiv/occluders/<name>/cones with the group attribute proxy.
+  // "cone": the view carries the table and shades as the core does with it; "sphere" or no
+  // attribute (every older file): no table, the bounding sphere.
+  File f = make_file(false);
+  const uint64_t nr = 2, nt = 3, np = 4;
+  std::vector<float> cones;
+  for (uint64_t k = 0; k < nr * nt * np; ++k) cones.insert(cones.end(), {0.0f, 0.25f, 0.5f, 1.0f});  // |m| <= Ω
+  f.datasets.push_back({"/fiv/occluders/rock/cones", {nr, nt, np, 4}, cones, {}});
+  f.group_attrs.push_back({"/fiv/occluders/rock", {{"proxy", std::string("cone")}}});
+  const auto path = tmp("loader_cones.prt.h5");
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  EXPECT_EQ(a.format_version, 7);
+  ASSERT_EQ(a.occluders.size(), 1u);
+  EXPECT_EQ(a.occluders[0].proxy, "cone");
+  EXPECT_EQ(a.occluders[0].cones, cones);
+  const std::vector<prt::shade::FivOccluder> views = a.occluder_views();
+  ASSERT_NE(views[0].cones, nullptr);
+  const float p[3] = {0.2f, 0.1f, -0.3f}, n[3] = {0, 1, 0};
+  float e_cone[3], e_sphere[3], e_old[3];
+  prt::shade::shade_fiv(a.difmap(), views.data(), 1, p, n, {}, e_cone);
+  prt::shade::shade_fiv(a.difmap(), views.data(), 1, p, n, {true, true, prt::shade::FivProxy::sphere}, e_sphere);
+  // The loaded view shades exactly as a view of the original arrays with their cone table.
+  const auto& shells = std::get<std::vector<float>>(f.datasets[8].data);
+  const auto& valid = std::get<std::vector<uint8_t>>(f.datasets[9].data);
+  const std::vector<float> radii = {0.375f, 1.5f};
+  const prt::shade::FivOccluder direct{{0.5f, 2.0f, -1.0f}, 0.75f, 2, 3, 4, radii.data(), shells.data(), valid.data(),
+                                       prt::shade::kFivRadialGeometric, nullptr, cones.data()};
+  float e_direct[3];
+  prt::shade::shade_fiv(a.difmap(), &direct, 1, p, n, {}, e_direct);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(e_cone[c], e_direct[c]);
+  // The same file saying "sphere": read without the table.
+  f.group_attrs.back().second[0].value = std::string("sphere");
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset b = prt::shade::load_prt(path);
+  EXPECT_EQ(b.occluders[0].proxy, "sphere");
+  EXPECT_TRUE(b.occluders[0].cones.empty());
+  EXPECT_EQ(b.occluder_views()[0].cones, nullptr);
+  // Without cones and proxy (the file ArraysAndViewsMatchTheFile writes): the sphere, version 4.
+  prt::formats::write_file(path, make_file(false));
+  const prt::shade::LoadedAsset old = prt::shade::load_prt(path);
+  EXPECT_EQ(old.format_version, 4);
+  EXPECT_EQ(old.occluders[0].proxy, "sphere");
+  const std::vector<prt::shade::FivOccluder> old_views = old.occluder_views();
+  prt::shade::shade_fiv(old.difmap(), old_views.data(), 1, p, n, {}, e_old);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(e_old[c], e_sphere[c]);  // the sphere, whatever the option
 }
 
 // `f` as a version-2 prtbake file at `path`, written without the writer's schema check.

@@ -155,7 +155,7 @@ int prt_c_check_fiv(char* msg, size_t size) {
   const float env[9] = {0, 3, 0, 0, 6, 0, 0, 9, 0};
   prt_fiv_scene* scene = NULL;
   prt_fiv_occluder_desc desc;
-  prt_fiv_options no_overlap = {1, 0};
+  prt_fiv_options no_overlap = {1, 0, 0};
   int i, c, index = -1, count = 0;
   float out[9], two_out[6];
   const float p[6] = {0, 0, 0, 0, 0, 0}, n[6] = {0, 1, 0, 0, 1, 0};
@@ -165,7 +165,7 @@ int prt_c_check_fiv(char* msg, size_t size) {
   desc.centre[0] = 0, desc.centre[1] = 3, desc.centre[2] = 0;
   desc.radius = 1.0f;
   desc.n_rho = NR, desc.n_theta = NT, desc.n_phi = NP;
-  desc.radii = radii, desc.shells = shells, desc.valid = valid;
+  desc.radii = radii, desc.shells = shells, desc.valid = valid, desc.cones = NULL;
   desc.radial_scheme = 0, desc.surface_radius = NULL; /* paper 004's spheres */
 
   CHECK_STATUS(prt_fiv_scene_create(S, cube, env, &scene), PRT_OK);

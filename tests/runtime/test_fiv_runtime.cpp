@@ -901,3 +901,343 @@ TEST(Validate, SurfaceSchemeNeedsGeometricOffsetsAndFiniteSurfaceRadii) {
 }
 
 } // namespace
+
+// ---- the tight proxy (prtshade/fiv.h "Tight proxies") -------------------------------------------
+
+namespace cones {
+
+// K(x, α) by the midpoint rule in the cap's own frame (polar angle t from the axis, azimuth q):
+// ν·ω = x cos t + √(1 − x²) sin t cos q, weight sin t. The integrand is Lipschitz with constant
+// <= 1 and its kink (ν·ω = 0) crosses ~M of the M × 2M cells, each off by <= its area times its
+// width: the rule errs by <= π²/M (4e-4 at M = 25,000 would do; 2,000 gives <= 5e-3, and the
+// observed error is far below since the kink's errors cancel in sign).
+double cap_by_quadrature(double x, double alpha, int M) {
+  const double y = std::sqrt(std::max(0.0, 1 - x * x));
+  double sum = 0;
+  for (int i = 0; i < M; ++i) {
+    const double t = (i + 0.5) / M * alpha;
+    double ring = 0;
+    for (int j = 0; j < 2 * M; ++j) {
+      const double q = (j + 0.5) / (2 * M) * 2 * kPi;
+      ring += std::max(0.0, x * std::cos(t) + y * std::sin(t) * std::cos(q));
+    }
+    sum += ring * std::sin(t);
+  }
+  return sum * (alpha / M) * (2 * kPi / (2 * M));
+}
+
+} // namespace cones
+
+TEST(CapClampedCosine, MatchesNumericalIntegration) {
+  constexpr int kM = 600;
+  constexpr double kQuadrature = kPi * kPi / kM;  // the midpoint rule's bound above
+  for (const double alpha : {0.05, 0.4, 1.0, kPi / 2, 2.2, 3.0})
+    for (const double x : {-0.99, -0.6, -0.2, 0.0, 0.15, 0.5, 0.93, 1.0}) {
+      const double closed = shade::cap_clamped_cosine(x, std::cos(alpha));
+      const double numeric = cones::cap_by_quadrature(x, alpha, kM);
+      EXPECT_NEAR(closed, numeric, kQuadrature * (1 - std::cos(alpha))) << "x " << x << " alpha " << alpha;
+    }
+}
+
+TEST(CapClampedCosine, CasesAndLimits) {
+  // Wholly above: π x sin²α; wholly below: 0; the hemisphere (α = π/2): π(1 + x)/2; the whole
+  // sphere: π; continuous where the horizon starts cutting (x = ±sin α), to double rounding.
+  const double a = 0.5, s = std::sin(a), c = std::cos(a);
+  EXPECT_NEAR(shade::cap_clamped_cosine(0.9, c), kPi * 0.9 * s * s, 1e-15);
+  EXPECT_EQ(shade::cap_clamped_cosine(-0.9, c), 0.0);
+  for (const double x : {-0.7, 0.0, 0.4})
+    EXPECT_NEAR(shade::cap_clamped_cosine(x, 0.0), kPi * (1 + x) / 2, 1e-14) << x;
+  EXPECT_NEAR(shade::cap_clamped_cosine(0.3, -1.0), kPi, 1e-14);
+  EXPECT_NEAR(shade::cap_clamped_cosine(s - 1e-9, c), kPi * s * s * s, 1e-7);
+  EXPECT_NEAR(shade::cap_clamped_cosine(-s + 1e-9, c), 0.0, 1e-7);
+  // The complement: K(x, α) + K(−x, π − α) = π.
+  EXPECT_NEAR(shade::cap_clamped_cosine(0.2, std::cos(2.5)) + shade::cap_clamped_cosine(-0.2, std::cos(kPi - 2.5)), kPi, 1e-14);
+}
+
+namespace cones {
+
+// The exact cone table of a ball of radius r about the centre, on the shells of `o`: from
+// distance ρ > r it hides the cap of sin α = r/ρ around −d, Ω = 2π(1 − cos α), m = π sin²α (−d);
+// inside (ρ <= r) the sample is invalid (the whole sphere, Ω = 4π, m = 0).
+std::vector<float> ball_cones(Shells& o, double r) {
+  std::vector<float> out;
+  for (int k = 0; k < o.n_rho; ++k)
+    for (int i = 0; i < o.n_theta; ++i)
+      for (int j = 0; j < o.n_phi; ++j) {
+        const double th = kPi * i / (o.n_theta - 1), ph = 2 * kPi * j / o.n_phi, rho = o.radii[size_t(k)];
+        const double d[3] = {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+        if (rho <= r) {
+          o.valid[o.index(k, i, j)] = 0;
+          out.insert(out.end(), {0.0f, 0.0f, 0.0f, float(4 * kPi)});
+          continue;
+        }
+        const double sa = r / rho, ca = std::sqrt(1 - sa * sa), len = kPi * sa * sa;
+        out.insert(out.end(), {float(-len * d[0]), float(-len * d[1]), float(-len * d[2]), float(2 * kPi * (1 - ca))});
+      }
+  return out;
+}
+
+} // namespace cones
+
+TEST(LookupCone, SameStencilAsTheShells) {
+  // A cone table holding the shells' first four components: lookup_cone returns lookup_fiv's
+  // first four values bit for bit (same weights, mask and falloff; the same float operations).
+  Shells o(4, 9, 16, linear_value);
+  std::vector<float> table;
+  for (size_t s = 0; s < o.shells.size() / 9; ++s)
+    for (int e = 0; e < 4; ++e) table.push_back(o.shells[s * 9 + size_t(e)]);
+  o.valid[o.index(1, 3, 5)] = 0, o.valid[o.index(2, 4, 7)] = 0;
+  FivOccluder v = o.view();
+  v.cones = table.data();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-6, 6);
+  for (int trial = 0; trial < 500; ++trial) {
+    const float s[3] = {u(rng), u(rng), u(rng)};
+    float f[9], c[4];
+    shade::lookup_fiv(v, s, f);
+    shade::lookup_cone(v, s, c);
+    for (int e = 0; e < 4; ++e) EXPECT_EQ(c[e], f[e]) << trial << " " << e;
+  }
+}
+
+TEST(ShadeFivCone, ABallsConeIsItsBoundingSphere) {
+  // Occluders whose cone table is the exact cone of their bounding ball: the cone proxy's discs
+  // are the sphere's up to the table's interpolation (Ω and m linear between samples, the cap's α
+  // within ~1e-3 rad of asin(R/D) on this 64x33 grid of radii 1.05 R … 20 R), and its overlap
+  // term is the lens times the lower density (fiv.h "Tight proxies") — formed here from the
+  // spheres' discs in double.
+  const std::vector<float> cube = flat_cube(4, 40.0f);
+  const DifMap map{4, cube.data()};
+  const float f[3] = {0, 1, 0};
+  std::vector<Shells> owners;
+  std::vector<std::vector<float>> tables;
+  const float centres[3][3] = {{0, 3, 0}, {1.2f, 3.2f, 0.4f}, {-0.8f, 2.6f, 1.0f}};
+  for (const auto& c : centres) {
+    Shells o = constant_occluder(f, 1.0f, c);
+    o = Shells(40, 33, 64, [&](int, int, int, int e) { return e % 3 == 1 ? 1.0f : 0.0f; });
+    for (int k = 0; k < 40; ++k) o.radii[size_t(k)] = float(1.05 * std::pow(20.0 / 1.05, k / 39.0));
+    for (int a = 0; a < 3; ++a) o.centre[a] = c[a];
+    tables.push_back(cones::ball_cones(o, 1.0));
+    owners.push_back(o);
+  }
+  std::vector<FivOccluder> views;
+  for (size_t k = 0; k < owners.size(); ++k) {
+    views.push_back(owners[k].view());
+    views.back().cones = tables[k].data();
+  }
+  const float p[3] = {0.1f, 0, -0.2f}, n[3] = {0, 1, 0};
+  float sphere[3], cone[3], none[3];
+  shade::shade_fiv(map, views.data(), 3, p, n, {false, true, shade::FivProxy::sphere}, sphere);
+  shade::shade_fiv(map, views.data(), 3, p, n, {false, true, shade::FivProxy::cone}, cone);
+  shade::shade_fiv(map, views.data(), 3, p, n, {false, false, shade::FivProxy::cone}, none);
+  // I = n·F = 1 per occluder (the shells' y components); the expected E from the spheres' discs.
+  double axis[3][3], alpha[3];
+  for (int i = 0; i < 3; ++i) {
+    double d[3], D = 0;
+    for (int a = 0; a < 3; ++a) d[a] = double(centres[i][a]) - p[a], D += d[a] * d[a];
+    D = std::sqrt(D);
+    for (int a = 0; a < 3; ++a) axis[i][a] = d[a] / D;
+    alpha[i] = std::asin(1.0 / D);
+  }
+  double expect = 40.0 - 3.0, sphere_expect = 40.0 - 3.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      const double g = std::acos(axis[i][0] * axis[j][0] + axis[i][1] * axis[j][1] + axis[i][2] * axis[j][2]);
+      expect += shade::lens_area(alpha[i], alpha[j], g) * std::min(1 / (kPi * alpha[i] * alpha[i]), 1 / (kPi * alpha[j] * alpha[j]));
+      sphere_expect += 2 * shade::overlap_fraction(alpha[i], alpha[j], g);
+    }
+  // Each lens term moves by <= (its chord 2 α_min + the density's 2/α_min) Δα per unit I with
+  // Δα <= 1e-3 and α_min ≈ 0.3: <= 0.01 per pair, three pairs.
+  const double bound = 3 * 0.01;
+  EXPECT_GT(sphere[1] - none[1], 0.3f);  // the overlap correction matters here
+  EXPECT_NEAR(sphere[1], sphere_expect, 1e-5);
+  EXPECT_NEAR(cone[1], expect, bound);
+  EXPECT_LT(cone[1], sphere[1]);  // the lower density: never more than eq. 14
+}
+
+TEST(ShadeFivCone, PartialCorrectionAddsTheCapBelowTheHorizon) {
+  // One ball occluder straddling the receiver's horizon, a DifMap whose lower half is brighter:
+  // with the cone proxy, I = max(0, n·F + L̄ K(−n·a, α)) with L̄ = E_tot(−n)/π (fiv.h "Tight
+  // proxies"); wholly above, I = n·F exactly; the sphere's case C still gives 0.
+  Cube cube(4);
+  const float f[3] = {0.3f, 0.7f, -0.2f};
+  const float c[3] = {0, 0.1f, 3.0f};
+  Shells o = constant_occluder(f, 1.0f, c);
+  o = Shells(40, 33, 64, [&](int, int, int, int e) { return f[e % 3] * float(1 + e / 3); });
+  for (int k = 0; k < 40; ++k) o.radii[size_t(k)] = float(1.05 * std::pow(20.0 / 1.05, k / 39.0));
+  for (int a = 0; a < 3; ++a) o.centre[a] = c[a];
+  const std::vector<float> table = cones::ball_cones(o, 1.0);
+  FivOccluder v = o.view();
+  v.cones = table.data();
+  const float p[3] = {0, 0, 0}, n[3] = {0, 1, 0};
+  float e_on[3], e_off[3], tot[3], below[3], F[9], cone[4];
+  shade::shade_fiv(cube.view(), &v, 1, p, n, {true, false, shade::FivProxy::cone}, e_on);
+  shade::shade_fiv(cube.view(), &v, 1, p, n, {false, false, shade::FivProxy::cone}, e_off);
+  shade::lookup_difmap(cube.view(), n, tot);
+  const float down[3] = {0, -1, 0};
+  shade::lookup_difmap(cube.view(), down, below);
+  const float s[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+  shade::lookup_fiv(v, s, F);
+  shade::lookup_cone(v, s, cone);
+  const double ml = std::sqrt(double(cone[0]) * cone[0] + double(cone[1]) * cone[1] + double(cone[2]) * cone[2]);
+  const double x = cone[1] / ml;  // n·a
+  const double K = shade::cap_clamped_cosine(-x, 1 - cone[3] / (2 * kPi));
+  ASSERT_GT(K, 0.01);  // the cap reaches below the horizon (K is small there: |n·ω| <= sin α below it)
+  for (int ch = 0; ch < 3; ++ch) {
+    const double nF = F[3 * ch + 1];
+    const double expect = tot[ch] - std::max(0.0, nF + below[ch] / kPi * K);
+    // The fast path's K and a in float with poly_atan2: within ~1e-5 of K; E in float.
+    EXPECT_NEAR(e_on[ch], expect, 1e-5 * (1 + below[ch]) + 4 * FLT_EPSILON * tot[ch]) << ch;
+    EXPECT_NEAR(e_off[ch], tot[ch] - std::max(0.0, nF), 4 * FLT_EPSILON * tot[ch]) << ch;
+  }
+  // Raised wholly above the horizon (h = 2.4 > sin α's reach): the correction vanishes exactly.
+  v.centre[1] = 2.4f;
+  float hi_on[3], hi_off[3];
+  shade::shade_fiv(cube.view(), &v, 1, p, n, {true, false, shade::FivProxy::cone}, hi_on);
+  shade::shade_fiv(cube.view(), &v, 1, p, n, {false, false, shade::FivProxy::cone}, hi_off);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(hi_on[ch], hi_off[ch]) << ch;
+  // Sunk below (h <= −R): case C.
+  v.centre[1] = -1.2f;
+  float lo[3];
+  shade::shade_fiv(cube.view(), &v, 1, p, n, {true, false, shade::FivProxy::cone}, lo);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(lo[ch], tot[ch]) << ch;
+}
+
+// The fast path against the slow reference with the cone proxy: 100 scattered instances of one
+// asset with an exact ball cone table (r = 0.7 R), receivers on the ground. Besides the sphere
+// test's terms (kLookup per occluder, 4 ε E), the cones differ by the grid angles' kAngle: Ω and
+// m move by <= their change per grid step (<= |∂Ω/∂θ| ≈ 2π sin α cos α ≤ π per radian of view
+// angle, times the lookups' 4e-6 steps) and α, a by <= kCone = 1e-5 rad (with α >= 0.03 here:
+// dα = dΩ/(2π sin α)); K then moves by <= π Δx + 2π Δα <= 3π kCone times L̄, and each pair's
+// term A_ij min(I_i/A_i, I_j/A_j) (<= O_ij (I_i + I_j)) by <= (2 min α for the lens + 4/min α for the
+// densities' α²) kCone times I_i + I_j <= 6 kCone / min α (I_i + I_j) (α <= π/2).
+TEST(ShadeFivCone, ScatteredOccludersMatchTheSlowReference) {
+  constexpr double kLookup = 1e-5, kCone = 1e-5;
+  std::mt19937 rng(34);
+  std::uniform_real_distribution<float> u01(0, 1);
+  Shells asset(12, 17, 32, [&](int, int, int, int) { return u01(rng); });
+  for (int k = 0; k < 12; ++k) asset.radii[size_t(k)] = float(0.75 * std::pow(40.0 / 0.75, k / 11.0));
+  const std::vector<float> table = cones::ball_cones(asset, 0.7);
+  Cube cube(4);
+  for (float& t : cube.texels) t += 300.0f;  // bright enough that E does not clamp to 0
+  const int count = 100;
+  std::vector<FivOccluder> views;
+  for (int i = 0; i < count; ++i) {
+    FivOccluder v = asset.view();
+    v.cones = table.data();
+    v.centre[0] = 40 * u01(rng) - 20, v.centre[1] = 3.0f * u01(rng) - 0.5f, v.centre[2] = 40 * u01(rng) - 20;
+    views.push_back(v);
+  }
+  double worst = 0;
+  int overlapping = 0, partial = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const float p[3] = {40 * u01(rng) - 20, 0, 40 * u01(rng) - 20};
+    float n[3] = {u01(rng) - 0.5f, 1.0f, u01(rng) - 0.5f};
+    float fast[3], slow[3], off[3];
+    shade::shade_fiv(cube.view(), views.data(), count, p, n, {}, fast);
+    shade::shade_fiv_reference(cube.view(), views.data(), count, p, n, {}, slow);
+    shade::shade_fiv_reference(cube.view(), views.data(), count, p, n, {false, true}, off);
+    partial += slow[0] != off[0];
+    // The reference's discs and I (the cone's axis and α from the table).
+    const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
+    const float nu[3] = {float(n[0] / len), float(n[1] / len), float(n[2] / len)};
+    float below[3];
+    const float down[3] = {-nu[0], -nu[1], -nu[2]};
+    shade::lookup_difmap(cube.view(), down, below);
+    std::vector<std::array<double, 4>> disc;
+    std::vector<std::array<double, 3>> Ib;  // I_i per channel as the reference forms it
+    for (const FivOccluder& v : views) {
+      if (!(double(nu[0]) * (v.centre[0] - p[0]) + double(nu[1]) * (v.centre[1] - p[1]) + double(nu[2]) * (v.centre[2] - p[2]) > -v.radius))
+        continue;
+      const float s[3] = {p[0] - v.centre[0], p[1] - v.centre[1], p[2] - v.centre[2]};
+      float c4[4], F[9];
+      shade::lookup_cone(v, s, c4);
+      shade::lookup_fiv(v, s, F);
+      const double ml = std::sqrt(double(c4[0]) * c4[0] + double(c4[1]) * c4[1] + double(c4[2]) * c4[2]);
+      disc.push_back({c4[0] / ml, c4[1] / ml, c4[2] / ml, std::acos(std::max(0.0, 1 - c4[3] / (2 * kPi)))});
+      const double x = nu[0] * disc.back()[0] + nu[1] * disc.back()[1] + nu[2] * disc.back()[2];
+      const double K = shade::cap_clamped_cosine(-x, 1 - c4[3] / (2 * kPi));
+      std::array<double, 3> I{};
+      for (int c = 0; c < 3; ++c)
+        I[size_t(c)] = std::max(0.0, nu[0] * F[3 * c] + nu[1] * F[3 * c + 1] + nu[2] * F[3 * c + 2] + below[c] / kPi * K);
+      Ib.push_back(I);
+    }
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_GT(slow[c], 0.0f) << "the scene must not clamp E to 0, or nothing is compared";
+      double tolerance = 4 * double(FLT_EPSILON) * slow[c] + kLookup * double(disc.size()) +
+                         3 * kPi * kCone * double(below[c]) / kPi * double(disc.size());
+      for (size_t i = 0; i < disc.size(); ++i)
+        for (size_t j = i + 1; j < disc.size(); ++j) {
+          const double cg = disc[i][0] * disc[j][0] + disc[i][1] * disc[j][1] + disc[i][2] * disc[j][2];
+          if (std::acos(std::clamp(cg, -1.0, 1.0)) >= disc[i][3] + disc[j][3] + 2 * kCone) continue;
+          overlapping += c == 0;
+          tolerance += 6 * kCone / std::min(disc[i][3], disc[j][3]) * (Ib[i][size_t(c)] + Ib[j][size_t(c)]);
+        }
+      EXPECT_NEAR(fast[c], slow[c], tolerance) << trial << " " << c;
+      worst = std::max(worst, std::fabs(double(fast[c]) - slow[c]) / tolerance);
+    }
+  }
+  EXPECT_GT(overlapping, 20);  // the overlap pass was exercised
+  EXPECT_GT(partial, 20);      // and the partial correction
+  std::printf("cones: %.1f overlapping pairs per receiver, largest |fast - reference| / bound = %.2g\n", overlapping / 100.0, worst);
+}
+
+TEST(ShadeFivCone, TheCApiCopiesTheConeTableAndHonoursSphereProxy) {
+  // prt_fiv_scene_add_occluder copies desc.cones; prt_fiv_options.sphere_proxy selects the sphere.
+  Cube cube(4);
+  const float f[3] = {0.3f, 0.7f, -0.2f};
+  std::vector<Shells> owners;
+  std::vector<std::vector<float>> tables;
+  const float centres[2][3] = {{0, 0.1f, 3.0f}, {0.8f, 0.6f, 3.4f}};
+  for (const auto& c : centres) {
+    Shells o(12, 17, 32, [&](int, int, int, int e) { return f[e % 3] * float(1 + e / 3); });
+    for (int k = 0; k < 12; ++k) o.radii[size_t(k)] = float(1.05 * std::pow(20.0 / 1.05, k / 11.0));
+    for (int a = 0; a < 3; ++a) o.centre[a] = c[a];
+    tables.push_back(cones::ball_cones(o, 0.8));
+    owners.push_back(o);
+  }
+  std::vector<FivOccluder> views;
+  prt_fiv_scene* scene = nullptr;
+  const float env[9] = {};
+  ASSERT_EQ(prt_fiv_scene_create(4, cube.texels.data(), env, &scene), PRT_OK);
+  for (size_t k = 0; k < owners.size(); ++k) {
+    views.push_back(owners[k].view());
+    views.back().cones = tables[k].data();
+    const FivOccluder& o = views.back();
+    const prt_fiv_occluder_desc d{{o.centre[0], o.centre[1], o.centre[2]}, o.radius, o.n_rho, o.n_theta, o.n_phi,
+                                  o.radii, o.shells, o.valid, o.cones};
+    ASSERT_EQ(prt_fiv_scene_add_occluder(scene, &d, nullptr), PRT_OK);
+  }
+  for (std::vector<float>& t : tables) std::fill(t.begin(), t.end(), 0.0f);  // the scene holds its own copy
+  const std::vector<std::vector<float>> copies = {cones::ball_cones(owners[0], 0.8), cones::ball_cones(owners[1], 0.8)};
+  for (size_t k = 0; k < views.size(); ++k) views[k].cones = copies[k].data();
+  const float points[6] = {0, 0, 0, 0.5f, 0, 0.4f}, normals[6] = {0, 1, 0, 0.1f, 1, 0};
+  for (const int sphere : {0, 1}) {
+    const prt_fiv_options options{1, 1, sphere};
+    float out[6], e[3];
+    ASSERT_EQ(prt_fiv_scene_shade(scene, points, normals, 2, &options, out), PRT_OK);
+    for (int k = 0; k < 2; ++k) {
+      shade::shade_fiv(cube.view(), views.data(), 2, points + 3 * k, normals + 3 * k,
+                       {true, true, sphere ? shade::FivProxy::sphere : shade::FivProxy::cone}, e);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]) << sphere << " " << k << " " << ch;
+    }
+  }
+  prt_fiv_scene_destroy(scene);
+}
+
+TEST(Validate, RejectsBrokenConeTables) {
+  const float f[3] = {1, 0, 0}, centre[3] = {0, 0, 0};
+  Shells o = constant_occluder(f, 1.0f, centre);
+  std::vector<float> table(o.shells.size() / 9 * 4, 0.0f);
+  for (size_t s = 0; s < table.size() / 4; ++s) table[4 * s + 2] = 0.5f, table[4 * s + 3] = 1.0f;  // |m| <= Ω
+  FivOccluder v = o.view();
+  v.cones = table.data();
+  EXPECT_NO_THROW(shade::validate_occluder(v));
+  for (const auto& [index, value] : std::vector<std::pair<size_t, float>>{
+           {3, -0.5f}, {3, 13.0f}, {3, std::numeric_limits<float>::quiet_NaN()}, {2, 1.5f}, {0, -std::numeric_limits<float>::infinity()}}) {
+    std::vector<float> bad = table;
+    bad[4 + index] = value;  // sample 1
+    v.cones = bad.data();
+    EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument) << index << " " << value;
+  }
+}

@@ -46,9 +46,10 @@ struct SynthOccluder {
   std::vector<uint8_t> valid;
   int scheme = prt::shade::kFivRadialGeometric;
   std::vector<float> surface;  // [n_theta][n_phi], surface scheme
+  std::vector<float> cones;    // the tight proxy's table [n_rho][n_theta][n_phi][4], or empty
   prt::shade::FivOccluder view() const {
     return {{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data(),
-            scheme, surface.empty() ? nullptr : surface.data()};
+            scheme, surface.empty() ? nullptr : surface.data(), cones.empty() ? nullptr : cones.data()};
   }
   float r_surf(int i, int j) const { return surface[static_cast<std::size_t>(i * n_phi + j)]; }
   float max_surface() const { return surface.empty() ? 0.0f : *std::max_element(surface.begin(), surface.end()); }
@@ -63,7 +64,7 @@ struct SynthOccluder {
 // occluded FIVs have), the pole rows constant in φ (they are one point), ~20% invalid samples.
 SynthOccluder make_occluder(std::mt19937& rng, const std::array<float, 3>& centre, float radius, int n_rho,
                             int n_theta, int n_phi) {
-  SynthOccluder o{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, {}, {}, {}};
+  SynthOccluder o{{centre[0], centre[1], centre[2]}, radius, n_rho, n_theta, n_phi, {}, {}, {}, {}};
   std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
   for (int k = 0; k < n_rho; ++k) o.radii.push_back(radius * 0.5f * std::pow(2.0f, float(k) * 3.0f / float(std::max(1, n_rho - 1))));
   o.shells.resize(o.sample(n_rho, 0, 0) * 9);
@@ -101,29 +102,32 @@ SynthOccluder make_surface_occluder(std::mt19937& rng, const std::array<float, 3
   return o;
 }
 
-// Packed buffers of fiv.glsl (its header comment): the occluder table (48 bytes each), radii,
+// Packed buffers of fiv.glsl (its header comment): the occluder table (64 bytes each), radii,
 // shells, valid bytes packed 4 per uint (little-endian) from a word boundary, DifMap.
 struct GpuOccluder {
   float centre_radius[4];
   int32_t dims[4];
   uint32_t offsets[4];
+  uint32_t extra[4];
 };
-static_assert(sizeof(GpuOccluder) == 48, "std430 PrtFivOccluder is 48 bytes");
+static_assert(sizeof(GpuOccluder) == 64, "std430 PrtFivOccluder is 64 bytes");
 
 struct GpuScene {
-  std::vector<std::byte> occluders, radii, shells, valid, difmap;
+  std::vector<std::byte> occluders, radii, shells, valid, difmap, cones;
 };
 
 GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std::vector<float>& texels) {
   std::vector<GpuOccluder> table;
-  std::vector<float> radii, shells;
+  std::vector<float> radii, shells, cones;
   std::vector<uint8_t> valid;
   for (const SynthOccluder& o : occ) {
     GpuOccluder g{{o.centre[0], o.centre[1], o.centre[2], o.radius},
                   {o.n_rho, o.n_theta, o.n_phi, o.scheme},
                   {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4),
-                   uint32_t(radii.size() + o.radii.size())}};
+                   uint32_t(radii.size() + o.radii.size())},
+                  {o.cones.empty() ? 0u : 1u, uint32_t(cones.size()), 0, 0}};
     table.push_back(g);
+    cones.insert(cones.end(), o.cones.begin(), o.cones.end());
     radii.insert(radii.end(), o.radii.begin(), o.radii.end());
     radii.insert(radii.end(), o.surface.begin(), o.surface.end());  // surface scheme: offsets.w
     shells.insert(shells.end(), o.shells.begin(), o.shells.end());
@@ -135,6 +139,8 @@ GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std:
   s.radii = prt::test::to_bytes(radii);
   s.shells = prt::test::to_bytes(shells);
   s.valid = prt::test::to_bytes(valid);  // little-endian host: the bytes are the packed words
+  cones.resize(std::max<std::size_t>(cones.size(), 4), 0.0f);  // a buffer is bound even without cones
+  s.cones = prt::test::to_bytes(cones);
   const uint32_t header[4] = {uint32_t(difmap_size), 0, 0, 0};
   s.difmap.resize(16 + texels.size() * sizeof(float));
   std::memcpy(s.difmap.data(), header, 16);
@@ -327,6 +333,9 @@ struct PushBlock {
   float env[9];
 };
 
+// Occluders from this index on carry a cone table (make_scene).
+constexpr std::size_t kFirstCone = 7;
+
 struct Scene {
   std::vector<SynthOccluder> occ;
   int difmap_size = 5;
@@ -354,7 +363,25 @@ Scene make_scene() {
     for (int i = 3; i < 5; ++i)
       for (int j = 2; j < 4; ++j) sc.occ[5].valid[sc.occ[5].sample(k, i, j)] = 0;
   sc.occ.push_back(make_surface_occluder(rng, {-0.9f, 0.2f, 1.2f}, 0.6f, 1, 3, 4));  // one shell
-  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}, {5, 1}, {3, 4}, {0, 7}};
+  // Occluders 7–9 carry a cone table (the tight proxy): the exact cone of a ball of radius 0.6 R
+  // about the centre (fiv.h "Tight proxies"); groups of them are checked by ShadeFivConeMatchesCore.
+  sc.occ.push_back(make_occluder(rng, {0.2f, 0.3f, 0.4f}, 1.0f, 4, 9, 16));
+  sc.occ.push_back(make_occluder(rng, {1.4f, 0.6f, -0.3f}, 0.8f, 3, 7, 12));
+  sc.occ.push_back(make_occluder(rng, {-0.9f, 0.2f, 1.2f}, 0.6f, 4, 9, 16));
+  for (std::size_t k = kFirstCone; k < sc.occ.size(); ++k) {
+    SynthOccluder& o = sc.occ[k];
+    const double r = 0.6 * o.radius;
+    for (int kr = 0; kr < o.n_rho; ++kr)
+      for (int i = 0; i < o.n_theta; ++i)
+        for (int j = 0; j < o.n_phi; ++j) {
+          const double th = kPi * i / (o.n_theta - 1), ph = 2 * kPi * j / o.n_phi, rho = o.radii[std::size_t(kr)];
+          const double sa = std::min(1.0, r / rho), ca = std::sqrt((1 - sa) * (1 + sa)), len = kPi * sa * sa;
+          const double d[3] = {std::sin(th) * std::sin(ph), std::cos(th), std::sin(th) * std::cos(ph)};
+          for (int e = 0; e < 3; ++e) o.cones.push_back(float(-len * d[e]));
+          o.cones.push_back(float(2 * kPi * (1 - ca)));
+        }
+  }
+  sc.groups = {{0, 1}, {0, 2}, {0, 4}, {0, 5}, {1, 4}, {4, 1}, {2, 1}, {5, 1}, {3, 4}, {0, 7}, {7, 3}, {7, 1}, {8, 2}};
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   sc.texels.resize(6 * 5 * 5 * 3);
   for (float& t : sc.texels) t = 2.0f + 3.0f * uni(rng);
@@ -455,7 +482,7 @@ protected:
       PushBlock push{uint32_t(receivers_->size()), {}};
       std::copy_n(scene_->env, 9, push.env);
       const bool ran = prt::test::run_kernel(kernel("fiv_eval"),
-                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res},
+                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res, &g.cones},
                                              prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
       results = new std::vector<float>(ran ? prt::test::from_bytes<float>(res) : std::vector<float>{});
     }
@@ -704,6 +731,7 @@ TEST_P(FivMirror, ShadeFivMatchesCore) {
   for (std::size_t r = 0; r < receivers_->size(); ++r) {
     const Receiver& rc = (*receivers_)[r];
     const uint32_t first = rc.info[1], count = rc.info[2];
+    if (first >= kFirstCone) continue;  // the cone groups: ShadeFivConeMatchesCore
     std::vector<prt::shade::FivOccluder> views;
     for (uint32_t i = 0; i < count; ++i) views.push_back(occ[first + i].view());
     const auto D = difmap_at(scene_->difmap_size, scene_->texels, std::array<double, 3>{rc.n[0], rc.n[1], rc.n[2]}.data());
@@ -788,6 +816,63 @@ TEST_P(FivMirror, ShadeFivMatchesCore) {
   std::printf("%s shade_fiv: worst shader-core %.3f x tol; %d overlapping pairs seen\n", language(), worst,
               pairs_overlapping);
   EXPECT_GT(pairs_overlapping, 100);  // the overlap correction was exercised
+}
+
+// shade_fiv with the cone proxy (occluders 7–9: exact ball cones) vs the C++ core, all four option
+// combinations. Both evaluate the same float formulas in the same order per occluder; they differ
+// by the angles (the shader's prt_atan2 on its own float rounding: within 64 ε ≈ 4e-6 rad of the
+// core's, like the sphere test's δα, δγ above) and by the summation order. The cone's axis and α
+// follow the table's lookup within that angle (the ball's table is smooth: Ω depends on ρ only, m
+// turns with the direction); I moves by at most the slope of n·F per radian (≤ Σ|F| of the
+// samples, here <= 3·max|shell|) plus below · (|∂K/∂x| + |∂K/∂α|) ≤ 3π below per radian, and each
+// pair's term A_ij min(I_i/A_i, I_j/A_j) (fiv.h "Tight proxies") by ≤ 6/min α per radian times
+// I_i + I_j (as in test_fiv_runtime.cpp); min α ≥ 0.03 in this scene. So
+//   tol = δ (Σ_i (3 max|shell| + 3π below) (1 + Σ_j 6/α_min)) + 16 ε (count + 2) (|E_tot| + 2 Σ I)
+// with δ = 64 ε (the final max(0, ·) is 1-Lipschitz: clamping adds nothing).
+TEST_P(FivMirror, ShadeFivConeMatchesCore) {
+  const std::vector<SynthOccluder>& occ = scene_->occ;
+  const double delta = 64 * kFloatEps;
+  double worst = 0;
+  int compared = 0, corrected = 0;
+  for (std::size_t r = 0; r < receivers_->size(); ++r) {
+    const Receiver& rc = (*receivers_)[r];
+    const uint32_t first = rc.info[1], count = rc.info[2];
+    if (first < kFirstCone) continue;
+    std::vector<prt::shade::FivOccluder> views;
+    double shell_max = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+      views.push_back(occ[first + i].view());
+      for (float v : occ[first + i].shells) shell_max = std::max(shell_max, double(std::abs(v)));
+    }
+    float tot[3], below[3];
+    const std::array<float, 3> sn = shading_normal(rc.n);
+    const float down[3] = {-sn[0], -sn[1], -sn[2]};
+    prt::shade::lookup_difmap(difmap(), sn.data(), tot);
+    prt::shade::lookup_difmap(difmap(), down, below);
+    for (int option = 0; option < 4; ++option) {
+      const bool partial = option < 2, overlap = option % 2 == 0;
+      float core[3], none[3];
+      prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, overlap}, core);
+      prt::shade::shade_fiv(difmap(), views.data(), int(count), rc.p, rc.n, {partial, false}, none);
+      corrected += overlap && core[0] != none[0];
+      for (std::size_t c = 0; c < 3; ++c) {
+        const double per_occluder = 3 * shell_max + 3 * kPi * below[c] / kPi;
+        const double sum_I = std::max(0.0, double(tot[c]) - none[c]) + count * per_occluder;
+        const double tol = delta * count * per_occluder * (1 + (overlap ? count * 6 / 0.03 : 0.0)) +
+                           16 * kFloatEps * (count + 2) * (std::abs(tot[c]) + 2 * sum_I);
+        const double got = result(r)[22 + 3 * static_cast<std::size_t>(option) + c];
+        ASSERT_TRUE(std::isfinite(got));
+        ASSERT_LE(std::abs(got - core[c]), tol) << "receiver " << r << " occluders " << first << "+" << count
+                                                << " option " << option << " channel " << c;
+        worst = std::max(worst, std::abs(got - core[c]) / tol);
+        ++compared;
+      }
+    }
+  }
+  std::printf("%s shade_fiv (cone proxy): worst shader-core %.3g x tol over %d values; %d receivers with an overlap term\n",
+              language(), worst, compared, corrected);
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(corrected, 100);  // pairs of tight proxies overlap: the density form was exercised
 }
 
 } // namespace

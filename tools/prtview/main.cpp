@@ -407,7 +407,13 @@ std::optional<Args> parse(int argc, char** argv) {
   CLI::Option* ground_size_opt =
       app.add_option("--ground-size", ground_size, "FIV files: half-size of the ground square (default 4R + the copies' spread).");
   app.add_flag("--no-overlap", no_overlap, "FIV files: switch off the overlap correction for several occluders (eq. 13-14).");
-  app.add_flag("--no-partial", no_partial, "FIV files: switch off the partial-occluder factor (h+R)/2R (case B).");
+  app.add_flag("--no-partial", no_partial, "FIV files: switch off the partial-occluder correction (case B).");
+  std::string proxy = "cone";
+  app.add_option("--proxy", proxy,
+                     "FIV files: the occluder proxy of the overlap and partial-occluder corrections: cone (default: the "
+                     "file's cone table where it has one, prtshade/fiv.h \"Tight proxies\") or sphere (the paper's "
+                     "bounding sphere).")
+      ->check(CLI::IsMember({"cone", "sphere"}));
   app.add_flag("--per-vertex", a.per_vertex,
                "per-vertex and per-texel files: draw the per-vertex products (Gouraud) even when the file has a "
                "lightmap (/lightmap, 'prtbake texel'), which is drawn per texel by default.");
@@ -481,6 +487,7 @@ std::optional<Args> parse(int argc, char** argv) {
   }
   a.fiv.overlap = !no_overlap;
   a.fiv.partial = !no_partial;
+  a.fiv.sphere_proxy = proxy == "sphere";
   if (a.file.empty()) throw UsageError("no FILE.prt.h5 given");
   if (a.output.empty()) throw UsageError("no output given (-o IMAGE.png or IMAGE.exr)");
   if (a.output == "-") throw UsageError("-o -: prtview writes image files, not standard output; give -o IMAGE.png or IMAGE.exr");
@@ -734,8 +741,8 @@ int run(const Args& a) {
   // AO needs an environment only to weigh it: without one (AO files name none), a white sky.
   const bool white_sky = kind == "ao" && a.env.empty();
   if ((kind == "scene" || kind == "glossy" || area) && ((kind == "scene" && !a.shade.empty()) || !a.fiv.instances.empty() || !a.fiv.occluder_mesh.empty() ||
-                                    !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial))
-    throw UsageError("--shade (except glossy, area, area-exact, fiv), --occluder(-mesh), --ground(-size), --no-overlap and "
+                                    !a.fiv.occluder.empty() || a.fiv.ground || a.fiv.ground_size || !a.fiv.overlap || !a.fiv.partial || a.fiv.sphere_proxy))
+    throw UsageError("--shade (except glossy, area, area-exact, fiv), --occluder(-mesh), --ground(-size), --no-overlap, --proxy sphere and "
                      "--no-partial do not apply to scene files (" + a.file + "): each object is shaded with what it holds (see "
                      "'prtview --help')");
   const std::string env_path = area || white_sky ? std::string() : a.env.empty() ? prtview::baked_environment(f, a.file) : a.env;

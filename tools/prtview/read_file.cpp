@@ -315,6 +315,11 @@ BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const st
     o.radial_scheme = shade::kFivRadialSurface;
     o.surface_radius = baked->surface_radius->values.data();
   }
+  // The tight proxy where the file says so (v7; prtshade/fiv.h "Tight proxies"); older files: the sphere.
+  if (baked->proxy == std::string(N::kProxyCone)) {
+    if (!baked->cones) throw InputError(file, cat(occluder_dir(name), "") + " says proxy \"cone\" without a cone table");
+    o.cones = baked->cones->values.data();
+  }
   try {
     shade::validate_occluder(o);
   } catch (const std::invalid_argument& e) {

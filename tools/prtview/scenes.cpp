@@ -391,11 +391,14 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
                   kinds.size(), list.c_str(), ground_y, half);
   }
   scene.what = buf;
+  const bool cones = !options.sphere_proxy && std::any_of(occluders.begin(), occluders.end(), [](const shade::FivOccluder& o) { return o.cones != nullptr; });
   scene.how = std::string("prt::shade::shade_fiv per pixel (overlap correction ") + (options.overlap ? "on" : "off") +
-              ", partial-occluder factor " + (options.partial ? "on" : "off") +
+              ", partial-occluder correction " + (options.partial ? "on" : "off") + ", proxy " +
+              (cones ? "cone (tight)" : "bounding sphere") +
               "), shade_fiv_member on the occluders (self-shadows minus the other copies' shadows)";
 
-  const shade::FivShadeOptions opts{options.partial, options.overlap};
+  const shade::FivShadeOptions opts{options.partial, options.overlap,
+                                    options.sphere_proxy ? shade::FivProxy::sphere : shade::FivProxy::cone};
   const auto frame_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   const view::GBuffer g = view::rasterize(scene.mesh, cam);

@@ -102,6 +102,7 @@ struct FivView {
   bool scene = false;
   std::optional<double> ground, ground_size;
   bool overlap = true, partial = true;
+  bool sphere_proxy = false;  // --proxy sphere: the paper's bounding sphere even where the file has cones
 };
 // The camera of a first look when none is given (view::frame_box) and what it frames: the objects
 // of a scene file (`glossy`: only its glossy objects, --shade glossy) or the mesh of a per-vertex

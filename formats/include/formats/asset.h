@@ -196,6 +196,15 @@ struct OccluderSurfaceRadius {
   bool operator==(const OccluderSurfaceRadius&) const = default;
 };
 
+// /fiv/occluders/<name>/cones (v7): the tight proxy, per shell sample the occluded moment and solid
+// angle (m_x, m_y, m_z, Ω), [Nrho][Ntheta][Nphi][4] (prtshade/fiv.h "Tight proxies").
+struct OccluderCones {
+  std::vector<float> values;
+  std::optional<std::string> integrand;
+  ExtraAttrs extra;
+  bool operator==(const OccluderCones&) const = default;
+};
+
 // /fiv/occluders/<name>: FIVs on shells around an occluder's bounding sphere, and its report.
 // radial_scheme (v7) "surface": radii are offsets from the surface and surface_radius is there;
 // absent or "geometric": radii are the shell radii (SCHEMA.md).
@@ -214,6 +223,10 @@ struct Occluder {
   ExtraAttrs extra;                // of the shells dataset
   std::optional<OccluderValid> valid;
   std::optional<OccluderSurfaceRadius> surface_radius;  // (v7)
+  std::optional<OccluderCones> cones;  // v7
+  // v7: the group attribute `proxy` of /fiv/occluders/<name>, "sphere" or "cone" (needs cones);
+  // absent (older files): the sphere.
+  std::optional<std::string> proxy;
   std::optional<ReportRow> report;  // /report/fiv/<name> (its product is the name)
   bool operator==(const Occluder&) const = default;
 };

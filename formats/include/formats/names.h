@@ -54,6 +54,11 @@ inline constexpr std::string_view kIrradianceCube = "/fiv/irradiance_cube";
 inline constexpr std::string_view kShells = "shells";  // leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kValid = "valid";    // leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kSurfaceRadius = "surface_radius";  // (v7) leaf under /fiv/occluders/<name>/
+inline constexpr std::string_view kCones = "cones";    // leaf under /fiv/occluders/<name>/ (v7): the tight proxy
+// Attribute of the group /fiv/occluders/<name> (v7): the proxy its corrections use, "sphere" or "cone".
+inline constexpr std::string_view kProxy = "proxy";
+inline constexpr std::string_view kProxySphere = "sphere";
+inline constexpr std::string_view kProxyCone = "cone";
 // ---- area-light datasets (leaf under /lights/<name>/) ----
 inline constexpr std::string_view kLightVertices = "vertices";          // float64 [N][3], world space
 inline constexpr std::string_view kLightFaceSizes = "face_sizes";       // uint32 [F]

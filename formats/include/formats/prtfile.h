@@ -86,12 +86,17 @@
 namespace prt::formats {
 
 // The newest schema version this library reads, and the one it writes for a file that holds a
-// surface-following FIV shells (written_format_version; policy: SCHEMA.md "Versioning"). 7 added
-// surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the shells' radial_scheme
-// and first_offset attributes); 6 punctual lights (/lights/<name> of shape point, spot or directional: attributes, no geometry); 5
-// lightmaps (/mesh/uv, /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights
-// (/lights, area_lights/*); 2 scene objects (/objects). Older files still read.
+// surface-following FIV shells and the FIV cone table (written_format_version; policy: SCHEMA.md
+// "Versioning"). 7 added surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the
+// shells' radial_scheme and first_offset attributes) and the tight occluder proxy
+// (/fiv/occluders/<name>/cones and the group attribute `proxy`); 6 punctual lights (/lights/<name>
+// of shape point, spot or directional: attributes, no geometry); 5 lightmaps (/mesh/uv,
+// /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights (/lights,
+// area_lights/*); 2 scene objects (/objects). Older files still read.
 inline constexpr int kFormatVersion = 7;
+// The version written for a file with FIV cones (/fiv/occluders/<name>/cones or a `proxy`
+// attribute: the tight occluder proxy) or surface-following shells.
+inline constexpr int kFormatVersionWithCones = 7;
 // The version written for a file with a punctual light and no version-7 data.
 inline constexpr int kFormatVersionWithPunctualLights = 6;
 // The version written for a file with a lightmap and no punctual light.
@@ -199,6 +204,7 @@ enum class DatasetKind {
   positions, normals, triangles, source_position, ao, transfer_diffuse, transfer_visibility,
   radiance_band1, radiance_shadowed, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
   occluder_surface_radius,  // v7
+  occluder_cones,  // v7
   light_vertices, light_face_sizes, light_face_indices,
   uv, lightmap_state, lightmap_positions, lightmap_normals, lightmap_ao, lightmap_transfer_diffuse,  // v5
   lightmap_transfer_visibility, lightmap_radiance_band1, lightmap_radiance_shadowed,                // v5

@@ -22,6 +22,7 @@ using Eigen::Vector3d;
 namespace {
 // y_{1,-1} = −k y, y_{1,0} = k z, y_{1,1} = −k x with k = √(3/4π): ω from band-1 rows [c][m].
 constexpr double kBand1 = 0.48860251190291992159;  // √(3 / 4π)
+constexpr double kBand0 = 0.28209479177387814347;  // √(1 / 4π)
 void omega_from_band1(const double* r, double* f) {
   for (int c = 0; c < 3; ++c) {
     f[3 * c + 0] = -r[3 * c + 2] / kBand1;
@@ -166,6 +167,9 @@ void extrapolate_inside_samples(FivShells& shells) {
       if (from == n_rho) continue;  // no valid sample on the line: F^env, as baked
       std::copy_n(shells.values.begin() + std::ptrdiff_t((from * per_shell + ij) * 9), 9,
                   shells.values.begin() + std::ptrdiff_t((k * per_shell + ij) * 9));
+      if (!shells.cones.empty())  // the tight proxy's cone, from the same sample
+        std::copy_n(shells.cones.begin() + std::ptrdiff_t((from * per_shell + ij) * 4), 4,
+                    shells.cones.begin() + std::ptrdiff_t((k * per_shell + ij) * 4));
       ++shells.extrapolated;
     }
 }
@@ -182,7 +186,7 @@ void bounding_sphere(const Mesh& mesh, Vector3d& centre, double& radius) {
   for (const auto& p : mesh.positions) radius = std::max(radius, (p.cast<double>() - centre).norm());
 }
 
-Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& position, bool* inside) {
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& position, bool* inside, Cone* cone) {
   const ProductLayout& L = integrator.layout();
   PRT_CHECK(L.radiance_count == 9 && L.visibility_count >= 1);
   std::vector<double> vis(L.width), all(L.width);
@@ -197,6 +201,14 @@ Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Vector3d& positio
   if (inside) *inside = vis[L.visibility] == 0.0;
   Fiv f{};
   omega_from_band1(occ, f.data());
+  if (cone && L.visibility_count >= 4) {
+    // ∫ (1 − V) y_i dω for i < 4: Ω = that of y_0 over y_0, m from band 1 as F's.
+    double band1[3];
+    for (int k = 0; k < 3; ++k) band1[k] = all[L.visibility + 1 + size_t(k)] - vis[L.visibility + 1 + size_t(k)];
+    const double y1[3] = {-band1[2] / kBand1, -band1[0] / kBand1, band1[1] / kBand1};
+    for (int k = 0; k < 3; ++k) (*cone)[size_t(k)] = y1[k];
+    (*cone)[3] = (all[L.visibility] - vis[L.visibility]) / kBand0;
+  }
   return f;
 }
 
@@ -239,10 +251,11 @@ bool parse_shell_grid(std::string_view text, ShellSpec& spec) {
 }
 
 namespace {
+// Band-1 radiance and visibility up to band 1 (order 2): the occluded FIV and the cone (Ω, m).
 ProductRequest band1_radiance(const EnvMap& env) {
   ProductRequest req;
   req.radiance = &env;
-  req.visibility_order = 1;
+  req.visibility_order = 2;
   return req;
 }
 } // namespace
@@ -295,6 +308,7 @@ FivShells FivShellRows::empty_shells() const {
   FivShells out = frame_;
   out.values.reserve(size_t(shell_count()) * rows_per_shell() * 9);
   out.valid.reserve(size_t(shell_count()) * rows_per_shell());
+  out.cones.reserve(size_t(shell_count()) * rows_per_shell() * 4);
   return out;
 }
 
@@ -308,7 +322,9 @@ std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task
     bool inside = false;
     // FivShells::sample_position without the radii of the shells not yet appended.
     const double dist = surface ? frame_.surface_radius[idx] + rho : rho;
-    const Fiv f = occluded_fiv(*integrator_, frame_.centre + dist * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside);
+    Cone cone{};
+    const Fiv f =
+        occluded_fiv(*integrator_, frame_.centre + dist * shell_direction(i, spec_.n_theta, j, spec_.n_phi), &inside, &cone);
     double r = 0;
     for (int c = 0; c < 3; ++c) {
       const double nf = std::sqrt(f[size_t(3 * c)] * f[size_t(3 * c)] + f[size_t(3 * c + 1)] * f[size_t(3 * c + 1)] +
@@ -319,6 +335,7 @@ std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task
     for (int q = 0; q < 9; ++q) row[q] = double(float(f[size_t(q)]));
     row[9] = inside ? 0.0 : 1.0;
     row[10] = inside ? 0.0 : r;  // offsets inside the geometry say nothing about distance
+    for (int q = 0; q < 4; ++q) row[11 + q] = double(float(cone[size_t(q)]));
     if (task) task->advance();
   });
   return out;
@@ -346,6 +363,7 @@ void FivShellRows::append(FivShells& shells, int shell, std::span<const double> 
     const double* row = rows.data() + idx * kRowWidth;
     for (int q = 0; q < 9; ++q) shells.values.push_back(float(row[q]));
     shells.valid.push_back(row[9] != 0.0 ? 1 : 0);
+    for (int q = 0; q < 4; ++q) shells.cones.push_back(float(row[11 + q]));
   }
   shells.integrals += rows_per_shell();
 }

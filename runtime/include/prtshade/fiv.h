@@ -69,6 +69,49 @@
 //   Two identical occluders give O = ½, so I_1 + I_2 − ½(2I) = I, not 2I; disjoint discs give
 //   O = 0. With three or more mutually overlapping occluders the truncation over-corrects
 //   (three identical ones give E_tot − 3I + 3I): the paper's approximation, kept as specified.
+// Tight proxies (issue 33; replaces the bounding sphere of §4.3.1 and eq. 13–14 where an occluder
+//   has them). The bounding sphere covers far more sky than a non-spherical object (the bunny:
+//   R = 6.64 for a 9.65 × 7.5 object), so its disc over-corrects the overlap and its (h + R)/2R
+//   scales real shadows down. An occluder may carry a cone table beside its shells,
+//   cones [n_rho][n_theta][n_phi][4] = (m_x, m_y, m_z, Ω) with the occluded solid angle and moment
+//     Ω(s) = ∫ (1 − V_O(s, ω)) dω,   m(s) = ∫ (1 − V_O(s, ω)) ω dω,
+//   baked exactly by the same integrals as the shells (bake/bake/fiv.h), on the same grid and
+//   looked up with the same stencil (the valid mask, renormalisation, clamp and (ρ_last/ρ)² falloff
+//   of the shells: both are integrals over the occluded set, so both fall off like it). From p,
+//   occluder i is then the cap (its cone) of axis a = m/|m| (the direction towards the centre
+//   when m = 0) and half-angle α with 2π(1 − cos α) = Ω (the cap of the occluded solid angle,
+//   centred on the occluded directions' mean). With FivShadeOptions::proxy == cone:
+//   - overlap: the disc of eq. 13–14 is that cap, α clamped to π/2 as the sphere's is; and a pair
+//     of two tight occluders adds back, per channel, the lens A_ij (eq. 14's lens_area) times the
+//     lower of the two irradiance densities, A_ij · min(I_i/(π α_i²), I_j/(π α_j²)), instead of
+//     O_ij (I_i + I_j) = A_ij (I_i + I_j)/(π α_i² + π α_j²). What is counted twice is the
+//     irradiance through the lens; eq. 14 gives the lens the caps' area-weighted mean density,
+//     which an occluder hiding a bright light (a sun) outside the lens inflates; the lens lies in
+//     both caps, so the lower density is the one the lens can count on. Never more than eq. 14
+//     ((A_i + A_j) min(d_i, d_j) <= A_i d_i + A_j d_j), equal to it for equal densities (two
+//     identical occluders still give I, not 2I). Pairs with a sphere keep eq. 14;
+//   - partial occluders, instead of the factor (h + R)/2R: n·F over the whole sphere counts the
+//     occluded directions below the horizon negatively, ∫_occ L n·ω = I_true − ∫_{occ, n·ω<0} L |n·ω|,
+//     so the missing part is added back, estimated as the cap's part below the horizon lit by
+//     the receiver's mean radiance from below, L̄_c = E_tot,c(−n)/π (the DifMap at −n is
+//     ∫_{n·ω<0} L |n·ω| dω; the mean of L under that weight is it over π):
+//       I_c = max(0, n·F_c + L̄_c · K(−n·a, α)),   K(x, α) = ∫_cap max(0, ν·ω) dω, ν·a = x,
+//     with K the clamped cosine over a cap cut by a horizon (cap_clamped_cosine below, closed
+//     form). An occluder wholly above the horizon (n·a >= sin α) keeps I = n·F exactly (K = 0),
+//     one wholly below (n·a <= −sin α) gives 0 — the cap's own cases A and C; the sphere's case
+//     C (h <= −R) still drops an occluder before any lookup. Without partial occluders I =
+//     max(0, n·F) for both proxies (case C by the sphere).
+//   Occluders without a table keep the sphere under either option. proxy == sphere is the paper's
+//   formulation for every occluder, for comparison. occluded_irradiance and shade_fiv_member take
+//   no DifMap and use the sphere.
+//   K(x, α) for α <= π/2 and s = sin α, c = cos α, y = √(1 − x²): x >= s (cap above): π x s²;
+//   x <= −s (below): 0; otherwise, with the cap's boundary circle cut by the horizon great
+//   circle, integrating ν·ω over the cap's part above it by Lambert's boundary form (the vector
+//   irradiance of a region is ½ ∮ of its boundary's tangent-cross terms, here one circle arc and
+//   one horizon arc) gives
+//     K = (x acos(q) − (c/s) z) s² + atan2(z, c/s),   q = −(c/s)(x/y),  z = y √(1 − q²);
+//   for α > π/2 the complement: K(x, α) = π − K(−x, π − α). Continuous at x = ±s; tested against
+//   numerical integration (tests/runtime/test_fiv_runtime.cpp CapClampedCosine).
 // Self-shadows (§4.3.2, eq. 12): a receiver ON occluder O sees unoccluded light only in its
 //   positive hemisphere, so E = max(0, n·F^env − n·F(p − centre)) per channel.
 //
@@ -91,7 +134,7 @@
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
 // nothing except shade_fiv for more than 128 occluders. shade_fiv keeps its per-receiver arrays
-// on the stack (about 17 KB). Thread-safe (no shared state).
+// on the stack (about 21 KB). Thread-safe (no shared state).
 #pragma once
 
 #include <cstdint>
@@ -117,6 +160,15 @@ struct FivOccluder {
   const uint8_t* valid;
   int radial_scheme = kFivRadialGeometric;
   const float* surface_radius = nullptr;  // [n_theta][n_phi], surface scheme only
+  // The tight proxy (header "Tight proxies"): cones [n_rho][n_theta][n_phi][4] = (m_x, m_y, m_z, Ω),
+  // or nullptr: the occluder's proxy is its bounding sphere.
+  const float* cones = nullptr;
+};
+
+// Which proxy the corrections use (header "Tight proxies").
+enum class FivProxy : int {
+  sphere = 0,  // the bounding sphere for every occluder (paper 004 §4.3.1, eq. 13–14)
+  cone = 1,    // the cone table where an occluder has one, else the sphere
 };
 
 // The DifMap /fiv/irradiance_cube [6][size][size][3], faces +X,−X,+Y,−Y,+Z,−Z, OpenGL orientation
@@ -134,7 +186,9 @@ inline constexpr float kFivValueLimit = 0x1p64f;
 // radii finite, > 0 and strictly increasing; every shell value finite, |value| <= kFivValueLimit;
 // radial_scheme one of the two; for kFivRadialSurface surface_radius non-null, finite and in
 // [0, 2^64], radii geometric (each τ_k within 1e-4 relative of τ_0 (τ_last/τ_0)^(k/(n_rho − 1)))
-// and valid may be null. O(size of the shells).
+// and valid may be null; cones (when present) finite with Ω in [0, 4π·(1 + 2^-10)] and |m_x|,
+// |m_y|, |m_z| <= Ω·(1 + 2^-10) + 2^-20 (a moment is never longer than its solid angle; the margins
+// are the bake's rounding). O(size of the shells).
 void validate_occluder(const FivOccluder& occ);
 // size in [1, 2^13], texels non-null, finite and |texel| <= kFivValueLimit. O(6 size²).
 void validate_difmap(const DifMap& map);
@@ -147,6 +201,14 @@ void lookup_difmap(const DifMap& map, const float n[3], float out[3]);
 // Occluded FIV F(s) [RGB][xyz] at offset s = p − centre (world units), see the header comment.
 void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]);
 
+// The cone table at offset s = p − centre: (m_x, m_y, m_z, Ω) by the shells' stencil (header
+// "Tight proxies"); occ.cones must be non-null.
+void lookup_cone(const FivOccluder& occ, const float s[3], float out[4]);
+
+// K(x, α) = ∫_cap max(0, ν·ω) dω over the cap of half-angle α (cos α = cos_alpha) whose axis a has
+// ν·a = x (header "Tight proxies"; arguments clamped to [−1, 1]). In double.
+double cap_clamped_cosine(double x, double cos_alpha);
+
 // Partial-occluder factor (§4.3.1 "Partial Occluders"): h = n·(centre − p); case C (h <= −R): 0;
 // case A (h >= R): 1; case B: (h + R) / (2R). n of any length (its direction, see "Numerics").
 float partial_factor(const FivOccluder& occ, const float p[3], const float n[3]);
@@ -158,6 +220,7 @@ void occluded_irradiance(const FivOccluder& occ, const float p[3], const float n
 struct FivShadeOptions {
   bool partial_occluders = true;
   bool overlap_correction = true;
+  FivProxy proxy = FivProxy::cone;
 };
 
 // Irradiance at a receiver point (eq. 11, 13, 14), see the header comment. count >= 0.
@@ -187,8 +250,8 @@ double lens_area(double r1, double r2, double d);
 // both radii are 0).
 double overlap_fraction(double alpha_i, double alpha_j, double gamma);
 
-// shade_fiv written straight from the formulas (double, every pair, γ = acos(clamp(a_i·a_j))): the
-// slow reference the fast path is tested against.
+// shade_fiv written straight from the formulas (double, every pair, γ = acos(clamp(a_i·a_j)), the
+// cones' α = acos(1 − Ω/2π) and K in double): the slow reference the fast path is tested against.
 void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int count, const float p[3],
                          const float n[3], const FivShadeOptions& options, float out[3]);
 

@@ -104,8 +104,10 @@ prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const flo
  * valid [n_rho][n_theta][n_phi], radii [n_rho]. radial_scheme (the file's attribute of that name):
  * 0 geometric (radii are the shell radii; a zero-initialised desc is this), 1 surface (radii are
  * the offsets from the surface, surface_radius [n_theta][n_phi] is /fiv/occluders/<name>/
- * surface_radius, valid may be null); prtshade/fiv.h "Surface-following shells". Set every member
- * (or zero-initialise the struct): the two last members came with format_version 7. */
+ * surface_radius, valid may be null); prtshade/fiv.h "Surface-following shells". cones
+ * [n_rho][n_theta][n_phi][4] the tight proxy (/fiv/occluders/<name>/cones when its `proxy` is
+ * "cone"; fiv.h "Tight proxies") or NULL (the bounding sphere). Set every member (or
+ * zero-initialise the struct): the three last members came with format_version 7. */
 typedef struct prt_fiv_occluder_desc {
   float centre[3];
   float radius;
@@ -115,11 +117,14 @@ typedef struct prt_fiv_occluder_desc {
   const uint8_t* valid;
   int radial_scheme;
   const float* surface_radius;
+  const float* cones;
 } prt_fiv_occluder_desc;
 
 typedef struct prt_fiv_options {
   int partial_occluders;  /* nonzero: the (h + R)/2R factor for case B (default 1) */
   int overlap_correction; /* nonzero: eq. 13–14 unit-bounding-disc correction (default 1) */
+  int sphere_proxy;       /* nonzero: the paper's bounding sphere for every occluder; 0 (default):
+                             the cone table where an occluder has one (fiv.h "Tight proxies") */
 } prt_fiv_options;
 
 typedef struct prt_fiv_scene prt_fiv_scene;

@@ -3,6 +3,7 @@
 #include <prtshade/loader.h>
 
 #include <formats/asset.h>
+#include <formats/names.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -57,6 +58,11 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
     out.radial_scheme = kFivRadialSurface;
     out.surface_radius = o.surface_radius->values;
   }
+  if (o.proxy == std::string(formats::names::kProxyCone)) {
+    if (!o.cones) throw FormatError(file, "occluder '" + o.name + "' says proxy \"cone\" without a cone table");
+    out.proxy = o.proxy.value();
+    out.cones = o.cones->values;
+  }
   out.grid = o.grid.value_or("");
   out.attrs = formats::shells_attrs(o);
   try {
@@ -79,7 +85,8 @@ FivOccluder LoadedOccluder::view() const noexcept {
                      shells.data(),
                      valid.data(),
                      radial_scheme,
-                     radial_scheme == kFivRadialSurface ? surface_radius.data() : nullptr};
+                     radial_scheme == kFivRadialSurface ? surface_radius.data() : nullptr,
+                     cones.empty() ? nullptr : cones.data()};
 }
 
 const LoadedVertexSet* LoadedAsset::find_vertex_set(std::string_view name) const noexcept {

@@ -69,6 +69,11 @@ struct LoadedOccluder {
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
   int radial_scheme = kFivRadialGeometric;  // the file's radial_scheme (v7; absent: geometric)
   std::vector<float> surface_radius;        // [Nθ][Nφ], surface scheme only
+  // The proxy its corrections use (the group attribute `proxy`, v7): "sphere" (also for files
+  // without it) or "cone", with the cone table [Nρ][Nθ][Nφ][4] (empty for "sphere"; prtshade/fiv.h
+  // "Tight proxies").
+  std::string proxy = "sphere";
+  std::vector<float> cones;
   std::string grid;             // the file's angular-convention string ("" if absent)
   std::vector<formats::Attr> attrs;  // every attribute of the shells dataset, as stored
 

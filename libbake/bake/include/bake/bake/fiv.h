@@ -33,6 +33,10 @@
 //   sample), so the runtime
 //   interpolates plainly, without a valid mask (prtshade/fiv.h "Surface-following shells"). The
 //   stopping rule is the same, from the first shell with τ_k >= R (all samples outside the sphere).
+//   Cones (the tight proxy, issue 33; prtshade/fiv.h "Tight proxies"): per sample the occluded
+//   moment and solid angle, m = ∫ (1 − V_O) ω dω and Ω = ∫ (1 − V_O) dω, from the same integral as
+//   F (visibility up to band 1: Ω from y_0, m from y_1m as F from band-1 radiance), so exact to the
+//   integrator's discretisation like F.
 //
 // Cube map of the DifMap, in OpenGL's cube-map convention — not OpenEXR's, which input cube maps
 // use (bake/environment/envmap.h; docs/ARCHITECTURE.md §3 "Two cube conventions"): faces +X, −X, +Y, −Y, +Z,
@@ -108,6 +112,7 @@ struct FivShells {
   std::vector<double> radii;    // the shells baked (≤ n_rho): ρ_k, or τ_k of the surface scheme
   std::vector<float> values;    // occluded FIV F(s) per grid sample: [Nρ][Nθ][Nφ][RGB][xyz]
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]; surface scheme: 0 = extrapolated (header comment)
+  std::vector<float> cones;     // occluded moment and solid angle (m_x, m_y, m_z, Ω): [Nρ][Nθ][Nφ][4]
   std::vector<double> surface_radius;  // [Nθ][Nφ] r_surf, surface scheme only
   size_t extrapolated = 0;      // surface scheme: samples filled from their radial line
   // Where sample (k, i, j) sits, in the mesh's frame (header comment).
@@ -151,11 +156,11 @@ FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const En
 // The shell bake as rows, for bakes cut into chunks (sharded and resumable bakes): bake_fiv_shells
 // is this class's rows shell after shell, stopping where stops_after() says, so any cut of the
 // shells' rows gives the same numbers. Row r of shell k is grid sample r = i·Nφ + j, kRowWidth
-// doubles: the occluded FIV rounded to float (9), valid (0 or 1) and the sample's stopping
-// ratio max_c |F_c| / ∫ L_c dω (0 inside the geometry).
+// doubles: the occluded FIV rounded to float (9), valid (0 or 1), the sample's stopping
+// ratio max_c |F_c| / ∫ L_c dω (0 inside the geometry) and the cone (m, Ω) rounded to float (4).
 class FivShellRows {
 public:
-  static constexpr size_t kRowWidth = 11;
+  static constexpr size_t kRowWidth = 15;
   FivShellRows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec);
   // The frame, radii and stopping rule only (a merge of committed rows): no integrator, no
   // environment; rows() is then a contract error.
@@ -185,10 +190,13 @@ private:
   std::unique_ptr<const SilhouetteIntegrator> integrator_;
 };
 
-// The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1}
-// in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
-// direction is visible.
-Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr);
+// The occluded FIV at one offset from an integrator built for {radiance = &env, visibility order 1
+// or 2} in full-sphere mode: F = unoccluded − visible (shared discretisation). Sets `inside` when no
+// direction is visible, and `cone` to (m_x, m_y, m_z, Ω) (header comment) when given and the
+// integrator has visibility order >= 2 (left as it was otherwise).
+using Cone = std::array<double, 4>;
+Fiv occluded_fiv(const SilhouetteIntegrator& integrator, const Eigen::Vector3d& position, bool* inside = nullptr,
+                 Cone* cone = nullptr);
 
 // The same quantity from the QMC reference (an integrator built for {radiance = &env, visibility
 // order 1}) in full-sphere mode: F = F^env − ∫ V L ω dω with F^env = environment_fiv(env).
