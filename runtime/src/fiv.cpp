@@ -313,7 +313,7 @@ void surface_stencil(const FivOccluder& occ, float t, float u, double rho, Shell
     // unless g is within a few percent of 1.
     const float log2_first = approx_log2(tk[0]);
     const float kf = (approx_log2(float(tau)) - log2_first) * float(last) / (approx_log2(tk[last]) - log2_first);
-    k0 = std::clamp(int(kf), 0, last - 1);
+    k0 = int(clamp_nan_safe(kf, 0.0f, float(last - 1)));  // clamped as a float: the int conversion is defined
     while (k0 > 0 && tau < tk[k0]) --k0;
     while (k0 < last - 1 && tau >= tk[k0 + 1]) ++k0;
     k1 = k0 + 1;
