@@ -103,7 +103,6 @@ inline float plane_height(const FivOccluder& occ, const float p[3], const float 
   return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
 }
 
-
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
