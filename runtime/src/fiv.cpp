@@ -103,7 +103,6 @@ inline float plane_height(const FivOccluder& occ, const float p[3], const float 
   return float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
 }
 
-
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -600,6 +599,7 @@ struct Candidates {
     kFactor, kDx, kDy, kDz, kAx, kAy, kAz, kSinAlpha, kLastT, kNPhi, kT, kU, kCosAlpha, kAlpha,  // per candidate
     kI0, kI1, kI2,                                                                              // per candidate
     kPackedAx, kPackedAy, kPackedAz, kPackedCos, kPackedSin, kPackedAlpha, kPackedTight,        // per active disc
+    kPackedInvA2,                                                                               // per active disc
     kFields
   };
   static constexpr int kPadding = 4;  // the packed discs are read four at a time
@@ -654,7 +654,7 @@ struct PairBatch {
 };
 
 // prtshade/fiv.h tells engines (fibers, small thread stacks) what shade_fiv keeps on the stack.
-static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 21 * 1024, "fiv.h says shade_fiv uses about 21 KB of stack");
+static_assert(sizeof(Candidates) + sizeof(PairBatch) <= 22 * 1024, "fiv.h says shade_fiv uses about 22 KB of stack");
 
 // The sweep's buckets over a disc's extent [x − w, x + w] ⊂ [−2.5, 2.5] along a tangent (x in
 // [−1, 1], w <= √2 plus a margin), monotone in the coordinate.
@@ -759,7 +759,10 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       float cone[4];
       sample_cones(occ, st, cone);
       const float ml = std::sqrt(cone[0] * cone[0] + cone[1] * cone[1] + cone[2] * cone[2]);
-      if (ml > 0) ax[k] = cone[0] / ml, ay[k] = cone[1] / ml, az[k] = cone[2] / ml;
+      if (ml > 0) {
+        const float inv = 1.0f / ml;
+        ax[k] = cone[0] * inv, ay[k] = cone[1] * inv, az[k] = cone[2] * inv;
+      }
       const float ca = clamp_nan_safe(1.0f - cone[3] / kTwoPiF, -1.0f, 1.0f);
       if (options.partial_occluders) {
         if (!below_looked_up) {
@@ -810,6 +813,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     float* const psin = c.field[F::kPackedSin];
     float* const palpha = c.field[F::kPackedAlpha];
     float* const ptight = c.field[F::kPackedTight];  // 1: a tight proxy (its pairs with others such: the density form)
+    float* const pinv = c.field[F::kPackedInvA2];    // 1/α² (0 for α = 0): the density form's I/α² by a product
     int* const end = c.end;
     const auto pack = [&](int pos, int k, int stop) {
       c.at[pos] = k;
@@ -817,6 +821,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
       pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
       ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
+      pinv[pos] = ptight[pos] != 0 && alpha[k] > 0 ? 1.0f / (alpha[k] * alpha[k]) : 0.0f;
       c.weight[pos] = 0;
     };
     if (active >= kSweepMinDiscs) {
@@ -856,11 +861,11 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       for (int b = 0; b < batch.count; ++b) {
         const int i = batch.i[b], j = batch.j[b];
         if (ptight[i] != 0 && ptight[j] != 0) {
-          const double ai2 = double(palpha[i]) * palpha[i], aj2 = double(palpha[j]) * palpha[j];
-          if (!(ai2 > 0 && aj2 > 0)) continue;  // a disc of no area: no lens
+          if (!(pinv[i] > 0 && pinv[j] > 0)) continue;  // a disc of no area: no lens
+          const double area = double(batch.o[b]) * (double(palpha[i]) * palpha[i] + double(palpha[j]) * palpha[j]);
           const int ki = c.at[i], kj = c.at[j];
           for (int ch = 0; ch < 3; ++ch)
-            dense[ch] += double(batch.o[b]) * (ai2 + aj2) * std::min(double(I[ch][ki]) / ai2, double(I[ch][kj]) / aj2);
+            dense[ch] += area * std::min(double(I[ch][ki]) * pinv[i], double(I[ch][kj]) * pinv[j]);
           continue;
         }
         c.weight[i] += double(batch.o[b]);

@@ -1205,7 +1205,7 @@ TEST(ShadeFivCone, TheCApiCopiesTheConeTableAndHonoursSphereProxy) {
     views.back().cones = tables[k].data();
     const FivOccluder& o = views.back();
     const prt_fiv_occluder_desc d{{o.centre[0], o.centre[1], o.centre[2]}, o.radius, o.n_rho, o.n_theta, o.n_phi,
-                                  o.radii, o.shells, o.valid, o.cones};
+                                  o.radii, o.shells, o.valid, o.radial_scheme, o.surface_radius, o.cones};
     ASSERT_EQ(prt_fiv_scene_add_occluder(scene, &d, nullptr), PRT_OK);
   }
   for (std::vector<float>& t : tables) std::fill(t.begin(), t.end(), 0.0f);  // the scene holds its own copy

@@ -47,8 +47,8 @@ template <class T> struct Array {
 // The root attributes (all required except the extras; format/format_version are the writer's).
 struct RootInfo {
   // As read. write_asset ignores it and writes written_format_version (prtfile.h): 5 for an asset
-  // with a lightmap or UV set, 6 with a punctual light, 7 with surface-following FIV shells, else
-  // 4, so a round trip keeps it only when it is that version.
+  // with a lightmap or UV set, 6 with a punctual light, 7 with surface-following FIV shells or an
+  // FIV cone table, else 4, so a round trip keeps it only when it is that version.
   int64_t format_version = kFormatVersion;
   std::string generator, created, command_line, source, source_sha256, up_axis, sh_convention;
   ExtraAttrs extra;

@@ -18,7 +18,9 @@
 //
 // Writer contract (write_file)
 //   * Validates the whole File against schema v5 (validate()) before touching the disk.
-//   * Adds format="prtbake" and format_version=written_format_version(file) itself: 5 when the
+//   * Adds format="prtbake" and format_version=written_format_version(file) itself: 7 when the
+//     file holds an FIV cone table (/fiv/occluders/<name>/cones or `proxy`), else 6 with a
+//     punctual light, else 5 when the
 //     file holds a version-5 dataset (/mesh/uv, /lightmap/..., in any vertex set), else 4, so a
 //     file that needs nothing of version 5 keeps the bytes version 4 gave it (SCHEMA.md,
 //     "Versioning"). The caller gives every other required root attribute (generator, created,
@@ -180,11 +182,12 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersion when it holds surface-following FIV
-// shells (an occluder's surface_radius dataset, or a shells dataset with a radial_scheme or
-// first_offset attribute), else kFormatVersionWithPunctualLights when it holds a punctual light (a
-// /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps when a
-// dataset of it is of a version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
+// The format_version write_file gives `file`: kFormatVersion (= kFormatVersionWithCones) when it
+// holds surface-following FIV shells (an occluder's surface_radius dataset, or a shells dataset
+// with a radial_scheme or first_offset attribute) or an FIV cone table (/fiv/occluders/<name>/cones
+// or a group attribute `proxy`), else kFormatVersionWithPunctualLights when it holds a punctual
+// light (a /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps
+// when a dataset of it is of a version-5 kind (is_lightmap_kind), else kFormatVersionWithoutLightmaps.
 int64_t written_format_version(const File& file);
 
 // Lookups; nullptr when absent.

@@ -134,7 +134,7 @@
 // Preconditions: the hot-path functions trust their FivOccluder/DifMap (call validate_occluder /
 // validate_difmap once when the data arrives — the C API and the loader do); they allocate
 // nothing except shade_fiv for more than 128 occluders. shade_fiv keeps its per-receiver arrays
-// on the stack (about 21 KB). Thread-safe (no shared state).
+// on the stack (about 22 KB). Thread-safe (no shared state).
 #pragma once
 
 #include <cstdint>

@@ -5,6 +5,7 @@
 #include <bake/environment/envmap.h>
 #include <bake/integrators/qmc.h>
 #include <bake/mesh/mesh.h>
+#include <bake/sphere/spherical_polygon.h>
 #include <prtshade/fiv.h>
 #include <prtshade/sh.h>
 
@@ -165,6 +166,50 @@ TEST(Fiv, OccludedFivMatchesQmcFullSphere) {
         EXPECT_NEAR(f[k], fq[k], 4 * se[k] + 2e-3 * scale) << "offset " << off.transpose() << " c" << ch << " a" << a;
       }
     }
+  }
+}
+
+TEST(Fiv, ConeIsTheBoxsSolidAngleAndMomentInClosedForm) {
+  // The cone (m, Ω) of the tight proxy (bake/bake/fiv.h) of a box seen from outside: its front
+  // faces tile the occluded set, so Ω = Σ Ω(face) and m = Σ Φ(face) over the faces seen from
+  // their front, each a spherical quad (bake/sphere/spherical_polygon.h, exact). The silhouette
+  // integral at k = 256 isolines discretises the boundary within cells of ~π/256: 2e-3 of 4π
+  // for Ω and of π for each component of m (the FIV test's 2e-3 of its scale above).
+  const EnvMap env = test_env();
+  const Mesh m = box({-1, -0.5f, -0.25f}, {1, 0.5f, 0.25f});
+  const Topology topo = build_topology(m);
+  ProductRequest req;
+  req.radiance = &env;
+  req.visibility_order = 2;
+  const SilhouetteIntegrator sil(m, topo, req, {256, 1});
+  const Vector3d lo(-1, -0.5, -0.25), hi(1, 0.5, 0.25);
+  for (const Vector3d& p : {Vector3d(2.5, 0.3, 0.4), Vector3d(-0.3, 1.7, -1.2), Vector3d(0.1, -0.2, 3.0)}) {
+    Cone cone{};
+    bool inside = true;
+    (void)occluded_fiv(sil, p, &inside, &cone);
+    EXPECT_FALSE(inside);
+    double omega = 0;
+    Vector3d moment(0, 0, 0);
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        const double plane = side ? hi[axis] : lo[axis];
+        if ((side ? p[axis] - plane : plane - p[axis]) <= 0) continue;  // seen from behind
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        std::vector<Vector3d> quad;
+        for (const auto& [a, b] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}, std::pair{0, 1}}) {
+          Vector3d corner;
+          corner[axis] = plane, corner[u] = a ? hi[u] : lo[u], corner[v] = b ? hi[v] : lo[v];
+          quad.push_back((corner - p).normalized());
+        }
+        double w = solid_angle(quad);
+        Vector3d phi = vector_irradiance(quad);
+        if (w < 0) w = -w, phi = -phi;  // the corners' order decides the sign
+        omega += w;
+        moment += phi;
+      }
+    EXPECT_NEAR(cone[3], omega, 2e-3 * 4 * std::numbers::pi) << p.transpose();
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(cone[size_t(a)], moment[a], 2e-3 * std::numbers::pi) << p.transpose() << " " << a;
+    EXPECT_GT(omega, 0.1);
   }
 }
 
