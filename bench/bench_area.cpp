@@ -256,7 +256,8 @@ std::vector<V3> positions_of(const prt::bake::Mesh& m) {
 // chart (caps filter only); `fallback`: share answered by the per-triangle method (none: the
 // contour path has no such fallback).
 void BM_BunnyQuad(benchmark::State& state) {
-  const bool contour = state.range(0) != 0;
+  const int method = int(state.range(0));
+  const bool contour = method != 0;
   const bool on_bunny = state.range(1) != 0;
   const int levels = int(state.range(2));
   const prt::bake::Mesh& m = bunny(levels);
@@ -273,8 +274,9 @@ void BM_BunnyQuad(benchmark::State& state) {
   std::vector<prt::bake::Arc> arcs;
   auto shade = [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
     const prt::bake::ShadePoint point{.p = s.p, .n = s.n};
-    kept += contour ? mesh.visible_light(kBunnyLight, point, arcs, ws)
-                    : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
+    kept += method == 2   ? mesh.visible_light(kBunnyLight, point, arcs, ws)
+            : method == 1 ? mesh.visible_light_kept_images(kBunnyLight, point, arcs, ws)
+                          : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
     shadowed += arcs.size() != ws.clipped.size();
     return s.n.dot(prt::bake::vector_irradiance(arcs));
   };
@@ -290,24 +292,48 @@ void BM_BunnyQuad(benchmark::State& state) {
     state.counters["cut_edges"] = double(st.boundary_edges) / q;
     state.counters["special"] = double(st.special) / q;
     state.counters["uncharted"] = double(st.uncharted) / q;
+    if (method == 2) {
+      // The cone path: share of queries it answered (the rest took the kept-images path), welded
+      // edges found in the cone, triangles passed on (meeting a light edge's or a found edge's
+      // fan) and edge-tree nodes visited, per query it answered.
+      const double c = double(std::max<size_t>(st.cone, 1));
+      state.counters["cone"] = double(st.cone) / q;
+      state.counters["cone_edges"] = double(st.cone_edges) / c;
+      state.counters["passed"] = double(st.cone_candidates) / c;
+      state.counters["edge_nodes"] = double(st.edge_nodes) / q;
+      state.counters["fan_tests"] = double(st.fan_tests) / c;
+    }
   }
   state.counters["fallback"] = 0;
   state.counters["triangles"] = double(m.triangles.size());
   state.counters["points"] = double(points.size());
 }
 BENCHMARK(BM_BunnyQuad)
-    ->ArgNames({"contour", "on_bunny", "loop"})
+    ->ArgNames({"method", "on_bunny", "loop"})
     ->Args({0, 0, 0})
     ->Args({1, 0, 0})
+    ->Args({2, 0, 0})
     ->Args({0, 1, 0})
     ->Args({1, 1, 0})
+    ->Args({2, 1, 0})
     ->Args({0, 0, 1})
     ->Args({1, 0, 1})
+    ->Args({2, 0, 1})
+    ->Args({0, 0, 2})
     ->Args({1, 0, 2})
+    ->Args({2, 0, 2})
     ->Args({1, 0, 3})
+    ->Args({2, 0, 3})
+    ->Args({1, 0, 4})
+    ->Args({2, 0, 4})
     ->Args({1, 1, 1})
+    ->Args({2, 1, 1})
     ->Args({1, 1, 2})
+    ->Args({2, 1, 2})
     ->Args({1, 1, 3})
+    ->Args({2, 1, 3})
+    ->Args({1, 1, 4})
+    ->Args({2, 1, 4})
     ->Unit(benchmark::kMicrosecond);
 
 // Cost against the silhouette's size: one quad light (kQuad) and one convex occluder, an N-gon

@@ -70,6 +70,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace prt::bake {
@@ -112,7 +113,17 @@ public:
       size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
       size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
       size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
+      // The cone path (visible_light): queries it answered (the rest fell back to the kept-images
+      // path: a clipped or ε-limit image in the pyramid), the welded edges it found in the cone
+      // and the triangles whose images it passed on (those meeting a cut edge's or a light
+      // edge's fan), summed over the queries it answered; edge-tree nodes visited.
+      size_t cone = 0, cone_edges = 0, cone_candidates = 0, edge_nodes = 0, fan_tests = 0;
     } stats;
+    // The cone path's scratch: per welded edge the query that found it in the cone.
+    std::vector<uint32_t> group_stamp, cone, edge_stack;
+    std::vector<Plane> fan;
+    std::vector<std::pair<uint32_t, uint64_t>> fan_stack;  // node, live fans
+    uint32_t group_mark = 0;
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -127,10 +138,28 @@ public:
   // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
   // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
   // dropped by the depth test).
+  // By the cone path (file comment), which falls back to the kept-images contour path below when
+  // a clipped or ε-limit image lies in the light's pyramid.
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
+    return query(light, point, out, ws, Method::cone);
+  }
+  // The contour path over every kept triangle's image (the fast path before the cone path): the
+  // same arcs' integrals.
+  size_t visible_light_kept_images(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                                   std::vector<Arc>& out, Workspace& ws) const {
     return query(light, point, out, ws, Method::contour);
   }
+  // The cone path's first step alone: the welded mesh edges (OccluderMesh::edge_count numbering)
+  // that may bound the occluders' union inside the light's pyramid, ascending (file comment
+  // "cone path"), by the edge tree. Returns false when some triangle in the pyramid has a
+  // clipped or an ε-limit image (then `edges` is incomplete and the cone path is not taken).
+  bool cone_edges(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<uint32_t>& edges,
+                  Workspace& ws) const;
+  // Reference of cone_edges: the same rule over every welded edge, without the tree. Equal sets.
+  bool cone_edges_brute_force(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                              std::vector<uint32_t>& edges, Workspace& ws) const;
+  size_t edge_count() const { return edge_group_start_.empty() ? 0 : edge_group_start_.size() - 1; }
   // The per-triangle method (paper 003 §4.4; the fast path before issue 32): the same culling
   // and images, then visible_region over every kept image's edges, O(E²). The slow reference of
   // the contour path: the same arcs' integrals.
@@ -155,7 +184,18 @@ private:
     uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
-  enum class Method { contour, per_triangle, reference };
+  enum class Method { cone, contour, per_triangle, reference };
+  // The edge tree (cone path): a binary tree over the welded edges (median splits, leaves of ≤ 4),
+  // each node with the box of its edges' faces, that box's bounding sphere and a cone of its
+  // faces' unit normals (axis, and spread ≥ |n̂ − axis| for every face), and whether an edge
+  // under it is `flagged` (not two faces of distinct welded corners running it both ways).
+  struct EdgeNode {
+    Eigen::Vector3d lo, hi, centre, axis;
+    double radius, spread;
+    uint32_t index;  // leaf: first entry of edge_order_; inner: right child (left child is this + 1)
+    uint32_t count;  // leaf: edge count (> 0); inner: 0
+    bool flagged;
+  };
   enum class ImageKind : uint8_t { none, triangle, special };  // special: clipped or an ε-limit cone
 
   uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
@@ -164,6 +204,20 @@ private:
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
+  template <class Keep>
+  void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  // Calls keep(t) (possibly more than once) for each triangle not outside every fan, a fan being
+  // five consecutive planes of `planes` (≤ 64 fans): one walk, each node carrying its live fans.
+  template <class Keep>
+  void walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  uint32_t build_edges(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centres);
+  // 1: edge g may bound the union in the cone; 0: it cannot; −1: a face of it in the pyramid has a
+  // clipped or ε-limit image.
+  int classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws) const;
+  uint32_t next_stamp(Workspace& ws) const;  // a fresh mark of ws.tri_stamp
+  void cone_query(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out, Workspace& ws) const;
+  bool find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const;
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
@@ -173,6 +227,10 @@ private:
   // pair, group g = edge_slots_[edge_group_start_[g] .. edge_group_start_[g + 1]).
   std::vector<uint32_t> edge_slots_, slot_group_, edge_group_start_;
   std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
+  std::vector<Eigen::Vector3d> face_normal_;  // unit normal of (b − a)×(c − a), zero when degenerate
+  std::vector<uint8_t> edge_flagged_;         // per welded edge (see EdgeNode)
+  std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
+  std::vector<EdgeNode> edge_nodes_;
 };
 
 } // namespace prt::bake
