@@ -24,6 +24,11 @@ namespace {
 constexpr double kMargin = 1e-12;
 constexpr uint32_t kLeafSize = 4;
 constexpr size_t kFanBatch = 64;  // fans walked together (one bit each)
+// Method::choose takes the cone path when the edges in the pyramid (estimated) exceed this many
+// per found edge: bench/bench_area.cpp BM_BunnyQuad's crossover (bench/RESULTS.md "the cone path").
+constexpr size_t kConeRatio = 75;
+constexpr size_t kConeMinKept = 2000;  // … and never below this many triangles in the pyramid (estimated)
+constexpr int kEstimateDepth = 7;      // estimate_kept's walk: the tree's top levels only
 
 }  // namespace
 
@@ -140,11 +145,13 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
   edge_order_.resize(groups);
   for (uint32_t g = 0; g < groups; ++g) edge_order_[g] = g;
   if (groups > 0) build_edges(0, uint32_t(groups), centres);
+  edge_rank_.resize(groups);
+  for (uint32_t i = 0; i < groups; ++i) edge_rank_[edge_order_[i]] = i;
 }
 
 uint32_t OccluderMesh::build_edges(uint32_t first, uint32_t count, std::vector<V3>& centres) {
   const uint32_t at = uint32_t(edge_nodes_.size());
-  edge_nodes_.push_back({V3::Zero(), V3::Zero(), V3::Zero(), V3::Zero(), 0, 0, 0, 0, false});
+  edge_nodes_.push_back({V3::Zero(), V3::Zero(), V3::Zero(), V3::Zero(), 0, 0, 0, 0, count, false});
   V3 lo = V3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   V3 clo = lo, chi = hi, sum = V3::Zero();
   bool flagged = false;
@@ -361,9 +368,19 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     out.clear();
     return 0;
   }
-  if (method == Method::cone && find_cone_edges(point, frame, ws, false)) {
-    cone_query(point, frame, out, ws);
-    return ws.kept.size();
+  if (method == Method::cone || method == Method::choose) {
+    // The choice (Method::choose): the cone path's cost follows the found edges (a fan walk and
+    // the images on it each), the kept-images path's the triangles in the pyramid, ~2/3 of the
+    // edges the walk reached or passed over inside it (cone_estimate).
+    // Method::choose: a small pyramid (the triangles in it, estimated from the tree's top) takes
+    // the kept-images path at once.
+    const bool small = method == Method::choose && estimate_kept(ws) < kConeMinKept;
+    if (!small) find_cone_edges(point, frame, ws, false);
+    if (method == Method::cone || (!small && ws.cone_estimate > kConeRatio * ws.cone.size())) {
+      cone_query(point, frame, out, ws);
+      return ws.kept.size();
+    }
+    ws.kept.clear();
   }
   if (method == Method::reference) {
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
@@ -464,16 +481,7 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
   // Each fan is bounded by five planes (the slab first: most boxes miss it; the light's plane
   // last); a light edge's fan is the pyramid's side k between its neighbours k − 1 and k + 1.
   ws.fan.clear();
-  const size_t sides = ws.planes.size() - 1;
-  for (size_t k = 0; k < sides; ++k) {
-    const auto& side = ws.planes[k];
-    ws.fan.insert(ws.fan.end(), {{-side.m, side.o, side.margin_coef}, side, ws.planes[k == 0 ? sides - 1 : k - 1],
-                                 ws.planes[k + 1 == sides ? 0 : k + 1], ws.planes.back()});
-  }
-  for (uint32_t g : ws.cone) {
-    const uint32_t slot = edge_slots_[edge_group_start_[g]];
-    const auto& tri = triangles_[slot / 3];
-    const V3 a = positions_[tri[slot % 3]] - point.p, b = positions_[tri[(slot % 3 + 1) % 3]] - point.p;
+  auto add_fan = [&ws, &point](const V3& a, const V3& b) {  // the rays from p through a, b (relative to p)
     const double la = a.norm(), lb = b.norm();
     const V3 m = a.cross(b);
     // The plane through p, a and b (both sides), and the wedge between the rays to a and b: the
@@ -481,6 +489,32 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
     const double coef = kMargin * la * lb;
     ws.fan.insert(ws.fan.end(), {{m, point.p, coef}, {-m, point.p, coef}, {m.cross(a), point.p, coef * la},
                                  {b.cross(m), point.p, coef * lb}, ws.planes.back()});
+  };
+  // A special face (clipped, or p in its plane) has every image edge cut: a fan for each.
+  for (uint32_t t : ws.special_faces) {
+    ws.image_count = 0;
+    add_image(t, point, frame, ws);
+    for (size_t i = 0; i < ws.image_count; ++i) {
+      const auto& image = ws.images[i];
+      for (size_t k = 0; k < image.size(); ++k) add_fan(image[k], image[k + 1 == image.size() ? 0 : k + 1]);
+    }
+  }
+  ws.image_count = 0;
+  for (uint32_t t : ws.special_faces) keep(t);
+  const size_t sides = ws.planes.size() - 1;
+  for (size_t k = 0; k < sides; ++k) {
+    const auto& side = ws.planes[k];
+    ws.fan.insert(ws.fan.end(), {{-side.m, side.o, side.margin_coef}, side, ws.planes[k == 0 ? sides - 1 : k - 1],
+                                 ws.planes[k + 1 == sides ? 0 : k + 1], ws.planes.back()});
+  }
+  // The found edges' fans in the edge tree's leaf order: neighbouring fans share a batch, and
+  // so most of the nodes their walk visits.
+  ws.edge_stack.assign(ws.cone.begin(), ws.cone.end());
+  std::sort(ws.edge_stack.begin(), ws.edge_stack.end(), [this](uint32_t x, uint32_t y) { return edge_rank_[x] < edge_rank_[y]; });
+  for (uint32_t g : ws.edge_stack) {
+    const uint32_t slot = edge_slots_[edge_group_start_[g]];
+    const auto& tri = triangles_[slot / 3];
+    add_fan(positions_[tri[slot % 3]] - point.p, positions_[tri[(slot % 3 + 1) % 3]] - point.p);
   }
   for (size_t first = 0; first < ws.fan.size(); first += 5 * kFanBatch)
     walk_fans(std::span<const Workspace::Plane>(ws.fan).subspan(first, std::min(5 * kFanBatch, ws.fan.size() - first)),
@@ -517,11 +551,45 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
                         std::span<const uint8_t>(ws.boundary.data(), ws.image_count), out, ws.region);
   ++ws.stats.queries;
   ++ws.stats.cone;
+  ws.stats.special += !ws.special_faces.empty();
   ws.stats.kept += ws.kept.size();
   ws.stats.boundary_edges += ws.region.boundary_edges;
   ws.stats.uncharted += !ws.region.charted;
   ws.stats.cone_edges += ws.cone.size();
   ws.stats.cone_candidates += ws.kept.size();
+}
+
+size_t OccluderMesh::estimate_kept(Workspace& ws) const {
+  // The triangles under the nodes of the tree's top kEstimateDepth levels not outside a culling
+  // plane: an upper bound of what cull() keeps (a choice of method only, never of an answer).
+  if (nodes_.empty()) return 0;
+  size_t total = 0;
+  ws.fan_stack.assign(1, {0, 0});
+  while (!ws.fan_stack.empty()) {
+    const auto [at, depth] = ws.fan_stack.back();
+    ws.fan_stack.pop_back();
+    const Node& node = nodes_[at];
+    const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
+    bool outside = false, inside = true;
+    for (const auto& plane : ws.planes) {
+      const V3 r = centre - plane.o;
+      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
+      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
+      if (mid + spread < -margin) {
+        outside = true;
+        break;
+      }
+      inside = inside && mid - spread > margin;
+    }
+    if (outside) continue;
+    if (inside || node.count > 0 || depth >= kEstimateDepth) {
+      total += node.total;
+      continue;
+    }
+    ws.fan_stack.push_back({node.index, depth + 1});
+    ws.fan_stack.push_back({at + 1, depth + 1});
+  }
+  return total;
 }
 
 void OccluderMesh::cull(Workspace& ws) const {
@@ -583,9 +651,20 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
   }
 }
 
+namespace {
+
+// x is strictly outside the culling plane (beyond its margin at x: the exact value is negative).
+bool outside_plane(const OccluderMesh::Workspace::Plane& plane, const V3& x) {
+  const V3 r = x - plane.o;
+  return plane.m.dot(r) < -plane.margin_coef * r.cwiseAbs().sum();
+}
+
+}  // namespace
+
 template <class Keep>
 void OccluderMesh::walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty() || planes.empty()) return;
+  const std::span<const Workspace::Plane> pyramid(ws.planes);
   const size_t fans = planes.size() / 5;
   // A box is outside a fan when it is outside one of its five planes (beyond the margin, as walk()).
   // Every fan plane but the fifth (the light's) passes through o = planes[0].o (p): the node's
@@ -624,6 +703,16 @@ void OccluderMesh::walk_fans(std::span<const Workspace::Plane> planes, Workspace
     const Node& node = nodes_[at];
     const V3 half = (node.hi - node.lo) / 2, r = (node.lo + node.hi) / 2 - o;
     const double extent = r.cwiseAbs().sum() + half.cwiseAbs().sum();
+    // Outside the pyramid (or behind the light) a triangle's image misses the light: no fan
+    // needs it.
+    bool out_of_pyramid = false;
+    for (size_t k = 0; k < pyramid.size() && !out_of_pyramid; ++k) {
+      const auto& plane = pyramid[k];
+      const V3 rp = r + (o - plane.o);
+      const double margin = plane.margin_coef * (rp.cwiseAbs().sum() + half.cwiseAbs().sum());
+      out_of_pyramid = plane.m.dot(rp) + plane.m.cwiseAbs().dot(half) < -margin;
+    }
+    if (out_of_pyramid) continue;
     for (uint64_t bits = live; bits != 0; bits &= bits - 1) {
       const auto fan = size_t(std::countr_zero(bits));
       ++ws.stats.fan_tests;
@@ -637,6 +726,17 @@ void OccluderMesh::walk_fans(std::span<const Workspace::Plane> planes, Workspace
     }
     for (uint32_t i = node.index; i < node.index + node.count; ++i) {
       const uint32_t t = order_[i];
+      if (ws.tri_stamp[t] == ws.stamp) continue;  // already kept by another fan
+      bool culled = false;
+      for (const auto& plane : pyramid) {
+        bool all = true;
+        for (int c = 0; c < 3 && all; ++c) all = outside_plane(plane, positions_[triangles_[t][c]]);
+        if (all) {
+          culled = true;
+          break;
+        }
+      }
+      if (culled) continue;
       for (uint64_t bits = live; bits != 0; bits &= bits - 1)
         if (!triangle_outside(t, size_t(std::countr_zero(bits)))) {
           keep(t);
@@ -646,18 +746,8 @@ void OccluderMesh::walk_fans(std::span<const Workspace::Plane> planes, Workspace
   }
 }
 
-namespace {
-
-// x is strictly outside the culling plane (beyond its margin at x: the exact value is negative).
-bool outside_plane(const OccluderMesh::Workspace::Plane& plane, const V3& x) {
-  const V3 r = x - plane.o;
-  return plane.m.dot(r) < -plane.margin_coef * r.cwiseAbs().sum();
-}
-
-}  // namespace
-
-int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame,
-                                const Workspace& ws) const {
+int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws,
+                                std::vector<uint32_t>& special) const {
   const std::span<const Workspace::Plane> sides(ws.planes.data(), ws.planes.size() - 1);  // the pyramid's sides
   const uint32_t first = edge_group_start_[group], end = edge_group_start_[group + 1];
   int whole = 0, other = 0, facing[2] = {0, 0};
@@ -681,13 +771,16 @@ int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const L
       ++other;
       continue;
     }
-    if (any_back) return -1;  // clipped by the light's plane
-    const int side = orient3d_exact(*x[0], *x[1], *x[2], point.p);
-    if (side == 0) return -1;  // p in its plane: an ε-limit cone or an image of no area
+    const int side = any_back ? 0 : orient3d_exact(*x[0], *x[1], *x[2], point.p);
+    if (side == 0) {  // clipped by the light's plane, or p in its plane (ε-limit cones or no image)
+      special.push_back(edge_slots_[at] / 3);
+      ++other;
+      continue;
+    }
     if (whole < 2) facing[whole] = side;
     ++whole;
   }
-  if (whole == 0) return 0;  // no image on this edge
+  if (whole == 0) return 0;  // no whole image on this edge (a special face's image edges are all cut)
   const uint32_t slot = edge_slots_[first];
   const auto& tri = triangles_[slot / 3];
   const V3 &a = positions_[tri[slot % 3]], &b = positions_[tri[(slot % 3 + 1) % 3]];
@@ -697,16 +790,22 @@ int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const L
   return facing[0] != facing[1] ? 1 : 0;  // a consistently wound pair: a contour edge iff they face apart
 }
 
-bool OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const {
+void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const {
   ws.cone.clear();
-  if (edge_nodes_.empty()) return true;
+  ws.special_faces.clear();
+  ws.cone_estimate = 0;
+  auto finish = [&ws] {
+    std::sort(ws.cone.begin(), ws.cone.end());
+    std::sort(ws.special_faces.begin(), ws.special_faces.end());
+    ws.special_faces.erase(std::unique(ws.special_faces.begin(), ws.special_faces.end()), ws.special_faces.end());
+  };
+  if (edge_nodes_.empty()) return;
   if (brute) {
     for (uint32_t g = 0; g < edge_count(); ++g) {
-      const int c = classify_edge(g, point, frame, ws);
-      if (c < 0) return false;
-      if (c > 0) ws.cone.push_back(g);
+      if (classify_edge(g, point, frame, ws, ws.special_faces) > 0) ws.cone.push_back(g);
     }
-    return true;
+    finish();
+    return;
   }
   const Workspace::Plane& light_plane = ws.planes.back();
   ws.edge_stack.assign(1, 0);
@@ -737,42 +836,46 @@ bool OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& fr
       const V3 d = point.p - node.centre;
       const double ad = node.axis.dot(d), dn = d.norm();
       const double bound = node.spread * dn + node.radius + 1e-9 * (dn + node.radius);
-      if (ad > bound || ad < -bound) continue;
+      if (ad > bound || ad < -bound) {
+        ws.cone_estimate += node.total;
+        continue;
+      }
     }
     if (node.count == 0) {
       ws.edge_stack.push_back(node.index);
       ws.edge_stack.push_back(at + 1);
       continue;
     }
+    ws.cone_estimate += node.count;
     for (uint32_t i = node.index; i < node.index + node.count; ++i) {
       const uint32_t g = edge_order_[i];
-      const int c = classify_edge(g, point, frame, ws);
-      if (c < 0) return false;
-      if (c > 0) ws.cone.push_back(g);
+      if (classify_edge(g, point, frame, ws, ws.special_faces) > 0) ws.cone.push_back(g);
     }
   }
-  std::sort(ws.cone.begin(), ws.cone.end());
-  return true;
+  finish();
 }
 
-bool OccluderMesh::cone_edges(std::span<const V3> light, const ShadePoint& point, std::vector<uint32_t>& edges,
-                              Workspace& ws) const {
+void OccluderMesh::cone_edges(std::span<const V3> light, const ShadePoint& point, std::vector<uint32_t>& edges,
+                              std::vector<uint32_t>& special, Workspace& ws) const {
   LightFrame frame;
   edges.clear();
-  if (!prepare(light, point, ws, frame)) return true;
-  const bool ok = find_cone_edges(point, frame, ws, false);
+  special.clear();
+  if (!prepare(light, point, ws, frame)) return;
+  find_cone_edges(point, frame, ws, false);
   edges = ws.cone;
-  return ok;
+  special = ws.special_faces;
 }
 
-bool OccluderMesh::cone_edges_brute_force(std::span<const V3> light, const ShadePoint& point,
-                                          std::vector<uint32_t>& edges, Workspace& ws) const {
+void OccluderMesh::cone_edges_brute_force(std::span<const V3> light, const ShadePoint& point,
+                                          std::vector<uint32_t>& edges, std::vector<uint32_t>& special,
+                                          Workspace& ws) const {
   LightFrame frame;
   edges.clear();
-  if (!prepare(light, point, ws, frame)) return true;
-  const bool ok = find_cone_edges(point, frame, ws, true);
+  special.clear();
+  if (!prepare(light, point, ws, frame)) return;
+  find_cone_edges(point, frame, ws, true);
   edges = ws.cone;
-  return ok;
+  special = ws.special_faces;
 }
 
 } // namespace prt::bake

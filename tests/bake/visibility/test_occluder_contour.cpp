@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -37,6 +38,7 @@ constexpr int kOrder = 4;
 
 struct Totals {
   size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0, special = 0, uncharted = 0;
+  size_t queries = 0;  // that reached the union (the light not empty above the horizon)
   size_t cone = 0, cone_edges = 0, cone_candidates = 0, all_kept = 0;
 };
 
@@ -44,9 +46,10 @@ struct Totals {
 void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, const std::string& what,
              Totals& totals) {
   static const prt::bake::PolygonSH sh(kOrder);
-  OccluderMesh::Workspace ws_fast, ws_slow, ws_bare, ws_kept;
-  std::vector<Arc> fast, slow, bare, kept_images;
-  mesh.visible_light(light, s, fast, ws_fast);
+  OccluderMesh::Workspace ws_fast, ws_slow, ws_bare, ws_kept, ws_chosen;
+  std::vector<Arc> fast, slow, bare, kept_images, chosen;
+  mesh.visible_light_cone(light, s, fast, ws_fast);
+  mesh.visible_light(light, s, chosen, ws_chosen);
   const size_t kept = mesh.visible_light_kept_images(light, s, kept_images, ws_kept);
   mesh.visible_light_per_triangle(light, s, slow, ws_slow);
   OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
@@ -63,6 +66,11 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   const bool fast_ok = directions(fast, "cone path"), slow_ok = directions(slow, "per triangle"),
              kept_ok = directions(kept_images, "contour path over the kept images");
   if (!fast_ok || !slow_ok || !kept_ok) return;
+  // visible_light chooses one of the two paths: the very same arcs as the path it chose.
+  const auto& expected = ws_chosen.stats.cone ? fast : kept_images;
+  EXPECT_TRUE(std::equal(chosen.begin(), chosen.end(), expected.begin(), expected.end(),
+                         [](const Arc& x, const Arc& y) { return x.a == y.a && x.b == y.b; }))
+      << what;
   const double e_slow = s.n.dot(prt::bake::vector_irradiance(slow));
   std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
   sh.project(std::span<const Arc>(slow), b);
@@ -78,19 +86,18 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   totals.kept += kept;
   totals.special += ws_kept.stats.special;
   totals.uncharted += ws_kept.stats.uncharted;
+  totals.queries += ws_kept.stats.queries;
   totals.cone += ws_fast.stats.cone;
   totals.cone_edges += ws_fast.stats.cone_edges;
   totals.cone_candidates += ws_fast.stats.cone_candidates;
   totals.all_kept += ws_fast.stats.cone ? kept : 0;
   // The cone path's edges: the tree's answer is the brute-force rule's, edge for edge.
-  std::vector<uint32_t> tree, brute;
+  std::vector<uint32_t> tree, brute, tree_special, brute_special;
   OccluderMesh::Workspace ws_tree, ws_brute;
-  const bool tree_ok = mesh.cone_edges(light, s, tree, ws_tree);
-  const bool brute_ok = mesh.cone_edges_brute_force(light, s, brute, ws_brute);
-  EXPECT_EQ(tree_ok, brute_ok) << what;
-  if (tree_ok && brute_ok) {
-    EXPECT_EQ(tree, brute) << what;
-  }
+  mesh.cone_edges(light, s, tree, tree_special, ws_tree);
+  mesh.cone_edges_brute_force(light, s, brute, brute_special, ws_brute);
+  EXPECT_EQ(tree, brute) << what;
+  EXPECT_EQ(tree_special, brute_special) << what;
 }
 
 std::vector<V3> positions_of(const prt::bake::Mesh& m) {
@@ -141,7 +148,7 @@ TEST(OccluderContour, BunnyGroundPointsEqualPerTriangle) {
   EXPECT_LT(totals.boundary_edges * 4, totals.kept * 3);  // < a quarter of the per-triangle edges
   // Nothing of the bunny is clipped by the light's plane or has p in its plane: every query
   // takes the cone path, which passes on fewer images than culling keeps.
-  EXPECT_EQ(totals.cone, totals.points);
+  EXPECT_EQ(totals.cone, totals.queries);
   EXPECT_LT(totals.cone_candidates, totals.all_kept);
 }
 
@@ -156,6 +163,7 @@ TEST(OccluderContour, BunnyOwnVerticesEqualPerTriangle) {
   EXPECT_GT(totals.points, 250u);
   EXPECT_GT(totals.shadowed, 20u);
   EXPECT_GT(totals.special, totals.points / 2);  // the own 1-ring's ε-limit cones were cut
+  EXPECT_EQ(totals.cone, totals.queries);          // … by the cone path too (special faces' fans)
 }
 
 TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
@@ -177,6 +185,7 @@ TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
   const auto points = prt::bake::vertex_shade_points(bunny, prt::bake::build_topology(bunny));
   for (size_t v = 3; v < points.size(); v += 41) compare(mesh, kBunnyLight, points[v], "vertex", totals);
   EXPECT_GT(totals.shadowed, 40u);
+  EXPECT_EQ(totals.cone, totals.queries);
 }
 
 // Light z = 3 (2 × 2), p near the origin: a random selection of points and normals, the same for
@@ -258,10 +267,11 @@ TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
   for (const V3& n : {V3(0, 0, 1), V3(0.3, -0.2, 1).normalized()}) {
     OccluderMesh::Workspace ws;
     std::vector<Arc> arcs;
-    std::vector<uint32_t> edges;
-    EXPECT_TRUE(roof_mesh.cone_edges(light, {.p = V3(0.2, 0.1, 0), .n = n}, edges, ws));
+    std::vector<uint32_t> edges, special;
+    roof_mesh.cone_edges(light, {.p = V3(0.2, 0.1, 0), .n = n}, edges, special, ws);
     EXPECT_TRUE(edges.empty());
-    roof_mesh.visible_light(light, {.p = V3(0.2, 0.1, 0), .n = n}, arcs, ws);
+    EXPECT_TRUE(special.empty());
+    roof_mesh.visible_light_cone(light, {.p = V3(0.2, 0.1, 0), .n = n}, arcs, ws);
     EXPECT_TRUE(arcs.empty());  // hidden: no arc at all, E = 0 exactly
     EXPECT_EQ(ws.stats.cone, 1u);
     EXPECT_EQ(ws.stats.cone_candidates, 2u);
@@ -270,14 +280,14 @@ TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
   auto pos = roof;
   add_tetrahedron(pos, under_roof, V3(0.1, 0.2, 1.2), 0.3);
   Totals totals = compare_scene(pos, under_roof, "tetrahedron under a roof", 41, 200);
-  EXPECT_EQ(totals.cone, totals.points);
+  EXPECT_EQ(totals.cone, totals.queries);
   EXPECT_GT(totals.cone_edges, 2 * totals.points);
 
   std::vector<V3> wall{{0, -9, 2.5}, {9, -9, 2.5}, {9, 9, 2.5}, {0, 9, 2.5}};
   std::vector<Tri> wall_tris{{0, 1, 2}, {0, 2, 3}};
   add_tetrahedron(wall, wall_tris, V3(-0.2, 0.1, 1.4), 0.35);
   totals = compare_scene(wall, wall_tris, "tetrahedron beside a wall", 42, 150);
-  EXPECT_EQ(totals.cone, totals.points);
+  EXPECT_EQ(totals.cone, totals.queries);
 
   // A fine plate inside the light's image with a small tetrahedron under its middle: the plate's
   // triangles over the tetrahedron meet neither a light edge's fan nor a plate border's; only
@@ -295,13 +305,13 @@ TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
     }
   add_tetrahedron(plate, plate_tris, V3(0.05, -0.05, 1.5), 0.08);
   totals = compare_scene(plate, plate_tris, "tetrahedron under a plate", 44, 150);
-  EXPECT_EQ(totals.cone, totals.points);
+  EXPECT_EQ(totals.cone, totals.queries);
 
   std::vector<V3> alone;
   std::vector<Tri> alone_tris;
   add_tetrahedron(alone, alone_tris, V3(0.3, -0.2, 1.5), 0.4);
   totals = compare_scene(alone, alone_tris, "tetrahedron alone", 43, 100);
-  EXPECT_EQ(totals.cone, totals.points);
+  EXPECT_EQ(totals.cone, totals.queries);
 }
 
 TEST(OccluderContour, NonManifoldEdgeAndInconsistentWinding) {
@@ -408,6 +418,7 @@ TEST(OccluderContour, IntegerGridSoupsFullOfTies) {
   }
   EXPECT_GT(totals.shadowed, 100u);
   EXPECT_GT(totals.special, 20u);
+  EXPECT_EQ(totals.cone, totals.queries);  // the cone path answers every query (no fallback left)
 }
 
 TEST(OccluderContour, LightTooWideForTheChart) {

@@ -120,10 +120,11 @@ public:
       size_t cone = 0, cone_edges = 0, cone_candidates = 0, edge_nodes = 0, fan_tests = 0;
     } stats;
     // The cone path's scratch: per welded edge the query that found it in the cone.
-    std::vector<uint32_t> group_stamp, cone, edge_stack;
+    std::vector<uint32_t> group_stamp, cone, special_faces, edge_stack;
     std::vector<Plane> fan;
     std::vector<std::pair<uint32_t, uint64_t>> fan_stack;  // node, live fans
     uint32_t group_mark = 0;
+    size_t cone_estimate = 0;  // the last walk's edges in the pyramid (an upper estimate, see find_cone_edges)
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -142,6 +143,11 @@ public:
   // a clipped or ε-limit image lies in the light's pyramid.
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
+    return query(light, point, out, ws, Method::choose);
+  }
+  // The cone path whenever it applies (no choice by cost; the same fallback).
+  size_t visible_light_cone(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
+                            Workspace& ws) const {
     return query(light, point, out, ws, Method::cone);
   }
   // The contour path over every kept triangle's image (the fast path before the cone path): the
@@ -150,15 +156,15 @@ public:
                                    std::vector<Arc>& out, Workspace& ws) const {
     return query(light, point, out, ws, Method::contour);
   }
-  // The cone path's first step alone: the welded mesh edges (OccluderMesh::edge_count numbering)
-  // that may bound the occluders' union inside the light's pyramid, ascending (file comment
-  // "cone path"), by the edge tree. Returns false when some triangle in the pyramid has a
-  // clipped or an ε-limit image (then `edges` is incomplete and the cone path is not taken).
-  bool cone_edges(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<uint32_t>& edges,
-                  Workspace& ws) const;
+  // The cone path's first step alone: the welded mesh edges (numbered 0 .. edge_count() − 1)
+  // that may bound the occluders' union inside the light's pyramid, and the special triangles
+  // there (clipped by the light's plane, or with p in their plane: every image edge cut), both
+  // ascending (file comment "cone path"), by the edge tree.
+  void cone_edges(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<uint32_t>& edges,
+                  std::vector<uint32_t>& special, Workspace& ws) const;
   // Reference of cone_edges: the same rule over every welded edge, without the tree. Equal sets.
-  bool cone_edges_brute_force(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
-                              std::vector<uint32_t>& edges, Workspace& ws) const;
+  void cone_edges_brute_force(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                              std::vector<uint32_t>& edges, std::vector<uint32_t>& special, Workspace& ws) const;
   size_t edge_count() const { return edge_group_start_.empty() ? 0 : edge_group_start_.size() - 1; }
   // The per-triangle method (paper 003 §4.4; the fast path before issue 32): the same culling
   // and images, then visible_region over every kept image's edges, O(E²). The slow reference of
@@ -184,7 +190,7 @@ private:
     uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
-  enum class Method { cone, contour, per_triangle, reference };
+  enum class Method { choose, cone, contour, per_triangle, reference };
   // The edge tree (cone path): a binary tree over the welded edges (median splits, leaves of ≤ 4),
   // each node with the box of its edges' faces, that box's bounding sphere and a cone of its
   // faces' unit normals (axis, and spread ≥ |n̂ − axis| for every face), and whether an edge
@@ -194,6 +200,7 @@ private:
     double radius, spread;
     uint32_t index;  // leaf: first entry of edge_order_; inner: right child (left child is this + 1)
     uint32_t count;  // leaf: edge count (> 0); inner: 0
+    uint32_t total;  // the subtree's edges
     bool flagged;
   };
   enum class ImageKind : uint8_t { none, triangle, special };  // special: clipped or an ε-limit cone
@@ -204,6 +211,7 @@ private:
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  size_t estimate_kept(Workspace& ws) const;  // ≥ what cull() keeps, from the tree's top levels
   // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
   template <class Keep>
   void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
@@ -212,12 +220,13 @@ private:
   template <class Keep>
   void walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
   uint32_t build_edges(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centres);
-  // 1: edge g may bound the union in the cone; 0: it cannot; −1: a face of it in the pyramid has a
-  // clipped or ε-limit image.
-  int classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws) const;
+  // 1: edge g may bound the union in the cone; 0: it cannot. Its faces in the pyramid with a
+  // clipped image or p in their plane are appended to `special`.
+  int classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws,
+                    std::vector<uint32_t>& special) const;
   uint32_t next_stamp(Workspace& ws) const;  // a fresh mark of ws.tri_stamp
   void cone_query(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out, Workspace& ws) const;
-  bool find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const;
+  void find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const;
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
@@ -230,6 +239,7 @@ private:
   std::vector<Eigen::Vector3d> face_normal_;  // unit normal of (b − a)×(c − a), zero when degenerate
   std::vector<uint8_t> edge_flagged_;         // per welded edge (see EdgeNode)
   std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
+  std::vector<uint32_t> edge_rank_;           // per welded edge: its place in edge_order_
   std::vector<EdgeNode> edge_nodes_;
 };
 
