@@ -19,9 +19,11 @@
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
 //                 (on_bunny:0) or the bunny's own vertices (on_bunny:1: every 8th, 230, at
-//                 level 0; ~515 from level 1 on), Loop-
-//                 subdivided 0–3 times (loop), by the contour path (contour:1, issue 32) or the
-//                 per-triangle method (contour:0), side by side
+//                 level 0; ~515 from level 1 on), Loop-subdivided 0–4 times (loop), side by
+//                 side by the per-triangle method (method:0), the contour path over every kept
+//                 image (method:1, visible_light_kept_images), the cone path (method:2,
+//                 visible_light_cone, issue 32) and visible_light's choice between the last two
+//                 (method:3)
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
@@ -247,14 +249,15 @@ std::vector<V3> positions_of(const prt::bake::Mesh& m) {
   return p;
 }
 
-// Shade points per CPU second, one quad light over the bunny (Loop-subdivided `levels` times):
-// the contour path (OccluderMesh::visible_light, issue 32) or the per-triangle method
-// (visible_light_per_triangle), receivers on the ground or the bunny's own vertices. Counters
-// (untimed pass): kept triangles and cut edges (contour edges reaching into the light) per
-// query; `special`: share of queries with a clipped or ε-limit image (the point's own 1-ring:
-// all its edges cut, still the contour path); `uncharted`: share whose light was too wide for the
-// chart (caps filter only); `fallback`: share answered by the per-triangle method (none: the
-// contour path has no such fallback).
+// Shade points per CPU second, one quad light over the bunny (Loop-subdivided `levels` times)
+// by `method` (see the file comment), receivers on the ground or the bunny's own vertices.
+// Counters (untimed pass): triangles whose images were built (kept_triangles) and cut edges
+// (image edges reaching into the light) per query; `special`: share of queries with a clipped or
+// ε-limit image (the point's own 1-ring: all its edges cut); `uncharted`: share whose light was
+// too wide for the chart (caps filter only); `fallback`: share answered by the per-triangle
+// method (none). The cone path's (methods 2, 3): `cone`, the share of queries it answered;
+// per query it answered, `cone_edges` (welded edges found in the cone), `passed` (images built)
+// and `fan_tests`; per query, `edge_nodes` (edge-tree nodes visited).
 void BM_BunnyQuad(benchmark::State& state) {
   const int method = int(state.range(0));
   const bool contour = method != 0;

@@ -27,10 +27,44 @@
 //    face's plane that cone has no interior and is dropped (ShadePoint::t is not used: such a face
 //    blocks nothing, as with t = 0).
 // Then V = light \ ∪ images exactly (every orientation decided by orient3d_exact, after a
-// floating-point filter whose bound is far above its error; unions counted once), by one of two
+// floating-point filter whose bound is far above its error; unions counted once), by one of three
 // methods that give the same arcs up to cuts of rounding size. Triangles are passed in index
-// order whatever the tree's walk, so both and the unculled reference make the same decisions on ties.
-//  * The contour path (visible_light; issue 32): the boundary of the union of images lies only on
+// order whatever the tree's walk, so all of them and the unculled reference make the same
+// decisions on ties.
+//  * The cone path (visible_light_cone; issue 32): the images are not all built. The boundary of
+//    the union of images inside the light lies on the image edges of the welded mesh edges that
+//    may bound it seen from p (paper 003 §3.1 silhouette edges; paper 001 §3.1 contour edges
+//    seen from p): an edge of two whole faces (every corner strictly on p's side of the light's
+//    plane) with distinct welded corners that run it both ways bounds nothing when p is strictly
+//    on the same side of both faces' planes (their images lie on opposite sides of the edge).
+//    Every other welded edge not outside the pyramid may: contour edges (the faces facing
+//    apart), boundary and non-manifold edges, edges wound the same way by both faces, edges of
+//    degenerate faces, and edges of a face that is dropped or special. A special face is one in
+//    the pyramid clipped by the light's plane or with p in its plane (the shade point's own
+//    1-ring, an occluder edge through p, a face seen edge-on): its images' edges are all cut.
+//    These edges and special faces are found by an edge tree (a binary tree over the welded
+//    edges; per node the box of its edges' faces, the box's bounding sphere (centre c, radius r)
+//    and a cone of its faces' unit normals (axis a, |n̂ − a| ≤ s)) walked against the pyramid:
+//    a node is passed over when its box is outside a culling plane, or when it holds only such
+//    consistently wound pairs, its box lies strictly on p's side of the light's plane and
+//    |a·(p − c)| > s|p − c| + r + 1e-9(|p − c| + r) (then n̂·(p − x) has one strict sign for every
+//    face point x and normal n̂ of the node, far beyond the rounding of n̂); the leaves decide each
+//    edge exactly (orient3d_exact, the light frame's exact depth, the culling planes' margins).
+//    cone_edges_brute_force applies the leaves' rule to every edge: the same sets.
+//    Coverage needs only the images that meet a cut edge: for each light edge, each found edge
+//    and each special image's edge, its fan (the rays from p through it, up to the light's plane:
+//    the plane through p and the edge, both sides with a margin far above the rounding of its
+//    normal, the wedge between the two rays, the light's plane) is walked in the triangle tree,
+//    64 fans at a time, each node carrying its live fans, nodes and triangles outside the
+//    pyramid skipped. The triangles met, and the special faces, become images (in index order);
+//    an image edge is cut iff its welded edge was found, except that of a consistently wound pair
+//    whose other face, listed first, has a whole image (a fold's second edge, or an edge whose far
+//    side that face covers: the rule below), and every edge of a special image; then
+//    visible_region_sparse. Each cut edge meets exactly the images it met among all kept images
+//    (every image meeting it lies on its fan), and an edge not cut emits nothing either way, so
+//    the arcs are the kept-images path's.
+//  * The contour path over every kept image (visible_light_kept_images, the fast path before the
+//    cone path): the boundary of the union of images lies only on
 //    image edges whose far side (right of the edge, away from its own image) is not covered along
 //    the edge by the image of another face on the same mesh edge (paper 003 §3.1: silhouette
 //    edges; §4.4 and [OZ06]: about √e of them). The mesh's edge → faces map is built once
@@ -44,20 +78,21 @@
 //    images near it: contour edges (faces of different facing), boundary and non-manifold edges,
 //    T-junctions and coincident sheets (no shared vertex index after welding), edges next to a
 //    culled, dropped, clipped or ε-limit face, and every edge of a clipped image or of an
-//    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). None of these
-//    falls back to the per-triangle method: there is no fallback; the only degraded case is a
-//    light of ≥ 84° radius seen from p, where the chart is not used and each edge meets every
-//    image whose cap meets its own (Workspace::stats counts it, and the queries with clipped or
-//    ε-limit images).
+//    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). The only
+//    degraded case is a light of ≥ 84° radius seen from p, where the chart is not used and each
+//    edge meets every image whose cap meets its own (Workspace::stats counts it, and the queries
+//    with clipped or ε-limit images).
 //  * The per-triangle method (visible_light_per_triangle; visible_light_reference without the
 //    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
-//    reference the tests hold the contour path to (1e-9 of the light's solid angle, E and SH).
-// Cost: culling and the images are linear in the triangles inside the light's pyramid; the
-// contour path then costs the chart's grid over them plus, per edge cut, the images near it
-// (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: contour path": the bunny
-// under a quad light: 6.2–6.8k ground points/s and 44–47k of its own vertices/s per core,
-// 9–13x the per-triangle method; over Loop levels 0–3 the ground rate falls as T^-0.9 while the
-// edges cut grow as T^0.45: the part linear in the kept triangles dominates).
+//    reference the tests hold both paths to (1e-9 of the light's solid angle, E and SH).
+// visible_light chooses between the first two per query, by cost (never by answer: both are
+// exact): the kept-images path when the triangles in the pyramid, estimated from the top levels
+// of the triangle tree, are fewer than 2,000, or when the edge tree's walk reached or passed
+// over fewer than 75 welded edges in the pyramid per found edge; the cone path otherwise.
+// Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
+// images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
+// found edges: the edge tree's walk, per found edge a fan walk and the images on it
+// (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: the cone path").
 #pragma once
 
 #include <bake/mesh/mesh.h>
@@ -113,13 +148,14 @@ public:
       size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
       size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
       size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
-      // The cone path (visible_light): queries it answered (the rest fell back to the kept-images
-      // path: a clipped or ε-limit image in the pyramid), the welded edges it found in the cone
-      // and the triangles whose images it passed on (those meeting a cut edge's or a light
-      // edge's fan), summed over the queries it answered; edge-tree nodes visited.
+      // The cone path: queries it answered (the rest took the kept-images path), the welded
+      // edges it found in the cone and the triangles whose images it passed on (those met by a
+      // fan, and the special faces), summed over the queries it answered; edge-tree nodes
+      // visited and fan tests (a fan against a tree node), over every walk.
       size_t cone = 0, cone_edges = 0, cone_candidates = 0, edge_nodes = 0, fan_tests = 0;
     } stats;
-    // The cone path's scratch: per welded edge the query that found it in the cone.
+    // The cone path's scratch: per welded edge the query that found it in the cone; the found
+    // edges and special faces; the fans' planes (five per fan).
     std::vector<uint32_t> group_stamp, cone, special_faces, edge_stack;
     std::vector<Plane> fan;
     std::vector<std::pair<uint32_t, uint64_t>> fan_stack;  // node, live fans
@@ -133,19 +169,19 @@ public:
   // one-sided light's back side is the caller's decision). Empty when p lies in the light's plane
   // or nothing of it is above the horizon. Integrate with point.n·vector_irradiance(out) (the
   // irradiance from unit radiance) and PolygonSH::project(out) (bake/sphere/polygon_sh.h).
-  // By the contour path (file comment). Returns the number of triangles kept after culling
-  // (those whose images are passed on).
+  // Every method below returns the number of triangles whose images were built (kept by
+  // culling, or met by a fan on the cone path).
   // Thread-safe (const) with one Workspace per thread. A convex emitter (box, cylinder, sphere as
   // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
   // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
   // dropped by the depth test).
-  // By the cone path (file comment), which falls back to the kept-images contour path below when
-  // a clipped or ε-limit image lies in the light's pyramid.
+  // By the cone path or the kept-images path, whichever the file comment's cost rule picks:
+  // the same arcs' integrals. Returns the triangles whose images were built.
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
     return query(light, point, out, ws, Method::choose);
   }
-  // The cone path whenever it applies (no choice by cost; the same fallback).
+  // The cone path, always (file comment).
   size_t visible_light_cone(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                             Workspace& ws) const {
     return query(light, point, out, ws, Method::cone);
