@@ -24,11 +24,9 @@ namespace {
 constexpr double kMargin = 1e-12;
 constexpr uint32_t kLeafSize = 4;
 constexpr size_t kFanBatch = 64;  // fans walked together (one bit each)
-// Method::choose takes the cone path when the edges in the pyramid (estimated) exceed this many
-// per found edge: bench/bench_area.cpp BM_BunnyQuad's crossover (bench/RESULTS.md "the cone path").
-constexpr size_t kConeRatio = 75;
-constexpr size_t kConeMinKept = 2000;  // … and never below this many triangles in the pyramid (estimated)
-constexpr int kEstimateDepth = 7;      // estimate_kept's walk: the tree's top levels only
+// Method::choose takes the kept-images path while culling keeps at most this many triangles:
+// bench/bench_area.cpp BM_BunnyQuad's crossover (bench/RESULTS.md "area lights: the cone path").
+constexpr size_t kConeMinKept = 5000;
 
 }  // namespace
 
@@ -368,24 +366,22 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     out.clear();
     return 0;
   }
-  if (method == Method::cone || method == Method::choose) {
-    // The choice (Method::choose): the cone path's cost follows the found edges (a fan walk and
-    // the images on it each), the kept-images path's the triangles in the pyramid, ~2/3 of the
-    // edges the walk reached or passed over inside it (cone_estimate).
-    // Method::choose: a small pyramid (the triangles in it, estimated from the tree's top) takes
-    // the kept-images path at once.
-    const bool small = method == Method::choose && estimate_kept(ws) < kConeMinKept;
-    if (!small) find_cone_edges(point, frame, ws, false);
-    if (method == Method::cone || (!small && ws.cone_estimate > kConeRatio * ws.cone.size())) {
-      cone_query(point, frame, out, ws);
-      return ws.kept.size();
-    }
-    ws.kept.clear();
+  // Method::choose: the kept-images path while the pyramid holds at most kConeMinKept
+  // triangles (culling is its first step anyway); beyond, the cone path.
+  bool culled = false;
+  if (method == Method::choose) {
+    culled = cull(ws, kConeMinKept);
+    if (!culled) ws.kept.clear();
+  }
+  if (method == Method::cone || (method == Method::choose && !culled)) {
+    find_cone_edges(point, frame, ws, false);
+    cone_query(point, frame, out, ws);
+    return ws.kept.size();
   }
   if (method == Method::reference) {
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
   } else {
-    cull(ws);
+    if (!culled) cull(ws, std::numeric_limits<size_t>::max());
     std::sort(ws.kept.begin(), ws.kept.end());
   }
   if (method == Method::per_triangle || method == Method::reference) {
@@ -559,46 +555,16 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
   ws.stats.cone_candidates += ws.kept.size();
 }
 
-size_t OccluderMesh::estimate_kept(Workspace& ws) const {
-  // The triangles under the nodes of the tree's top kEstimateDepth levels not outside a culling
-  // plane: an upper bound of what cull() keeps (a choice of method only, never of an answer).
-  if (nodes_.empty()) return 0;
-  size_t total = 0;
-  ws.fan_stack.assign(1, {0, 0});
-  while (!ws.fan_stack.empty()) {
-    const auto [at, depth] = ws.fan_stack.back();
-    ws.fan_stack.pop_back();
-    const Node& node = nodes_[at];
-    const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    bool outside = false, inside = true;
-    for (const auto& plane : ws.planes) {
-      const V3 r = centre - plane.o;
-      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
-      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
-      if (mid + spread < -margin) {
-        outside = true;
-        break;
-      }
-      inside = inside && mid - spread > margin;
-    }
-    if (outside) continue;
-    if (inside || node.count > 0 || depth >= kEstimateDepth) {
-      total += node.total;
-      continue;
-    }
-    ws.fan_stack.push_back({node.index, depth + 1});
-    ws.fan_stack.push_back({at + 1, depth + 1});
-  }
-  return total;
-}
-
-void OccluderMesh::cull(Workspace& ws) const {
-  walk(ws.planes, ws, [&ws](uint32_t t) { ws.kept.push_back(t); });
+bool OccluderMesh::cull(Workspace& ws, size_t limit) const {
+  return walk(ws.planes, ws, [&ws, limit](uint32_t t) {
+    ws.kept.push_back(t);
+    return ws.kept.size() <= limit;
+  });
 }
 
 template <class Keep>
-void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
-  if (nodes_.empty()) return;
+bool OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
+  if (nodes_.empty()) return true;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
   // margin (so is every triangle in it); 0: neither.
   auto box_test = [&](const Node& node) {
@@ -635,7 +601,8 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
     const int test = box_test(node);
     if (test < 0) continue;
     if (test > 0) {
-      for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
+      for (uint32_t i = node.first; i < node.first + node.total; ++i)
+        if (!keep(order_[i])) return false;
       continue;
     }
     if (node.count == 0) {
@@ -647,8 +614,9 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
     for (size_t k = 0; k < planes.size(); ++k)
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i])) keep(order_[i]);
+      if (!triangle_outside(order_[i]) && !keep(order_[i])) return false;
   }
+  return true;
 }
 
 namespace {
@@ -793,7 +761,6 @@ int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const L
 void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const {
   ws.cone.clear();
   ws.special_faces.clear();
-  ws.cone_estimate = 0;
   auto finish = [&ws] {
     std::sort(ws.cone.begin(), ws.cone.end());
     std::sort(ws.special_faces.begin(), ws.special_faces.end());
@@ -837,7 +804,6 @@ void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& fr
       const double ad = node.axis.dot(d), dn = d.norm();
       const double bound = node.spread * dn + node.radius + 1e-9 * (dn + node.radius);
       if (ad > bound || ad < -bound) {
-        ws.cone_estimate += node.total;
         continue;
       }
     }
@@ -846,7 +812,6 @@ void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& fr
       ws.edge_stack.push_back(at + 1);
       continue;
     }
-    ws.cone_estimate += node.count;
     for (uint32_t i = node.index; i < node.index + node.count; ++i) {
       const uint32_t g = edge_order_[i];
       if (classify_edge(g, point, frame, ws, ws.special_faces) > 0) ws.cone.push_back(g);

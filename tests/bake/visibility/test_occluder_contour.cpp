@@ -314,6 +314,48 @@ TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
   EXPECT_EQ(totals.cone, totals.queries);
 }
 
+TEST(OccluderContour, VisibleLightChoosesTheConePathForAFullPyramid) {
+  // A fine plate with a hole (80,000 triangles, ~9,000 of them in the pyramid) and a tetrahedron
+  // under the hole: culling keeps more than visible_light's 5,000, so it takes the cone path;
+  // the same integrals as the kept-images path (held to the per-triangle method above; the
+  // per-triangle method itself is O(E²) here).
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  const int cells = 200;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) pos.emplace_back(-2 + 4.0 * i / cells, -2 + 4.0 * j / cells, 2);
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      if (std::abs(i - 100) < 15 && std::abs(j - 95) < 10) continue;  // the hole
+      const auto a = uint32_t(j * (cells + 1) + i), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
+      tris.push_back({a, b, d});
+      tris.push_back({a, d, c});
+    }
+  add_tetrahedron(pos, tris, V3(0.05, -0.1, 1.2), 0.15);
+  const OccluderMesh mesh(pos, tris);
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  static const prt::bake::PolygonSH sh(kOrder);
+  for (const V3& p : {V3(0, 0, 0), V3(0.1, -0.2, 0.3), V3(-0.05, 0.1, -0.2)}) {
+    const ShadePoint s{.p = p, .n = V3(0.1, 0.05, 1).normalized()};
+    OccluderMesh::Workspace ws_chosen, ws_kept, ws_bare;
+    std::vector<Arc> chosen, kept, bare;
+    mesh.visible_light(light, s, chosen, ws_chosen);
+    const size_t culled = mesh.visible_light_kept_images(light, s, kept, ws_kept);
+    OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
+    EXPECT_GT(culled, 5000u);
+    EXPECT_EQ(ws_chosen.stats.cone, 1u);
+    const double scale = std::abs(prt::bake::solid_angle(bare));
+    const double e = s.n.dot(prt::bake::vector_irradiance(kept));
+    EXPECT_NEAR(s.n.dot(prt::bake::vector_irradiance(chosen)), e, kExact * scale);
+    EXPECT_GT(e, 1e-3 * scale);  // light through the hole, partly hidden by the tetrahedron
+    EXPECT_LT(e, 0.5 * s.n.dot(prt::bake::vector_irradiance(bare)));
+    std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
+    sh.project(std::span<const Arc>(chosen), a);
+    sh.project(std::span<const Arc>(kept), b);
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], kExact * scale) << "SH " << i;
+  }
+}
+
 TEST(OccluderContour, NonManifoldEdgeAndInconsistentWinding) {
   // Three triangles on one edge (a "book"), a fourth wound against its neighbour, and a fan of
   // four triangles around a vertical edge.

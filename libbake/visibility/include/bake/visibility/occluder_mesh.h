@@ -86,9 +86,8 @@
 //    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
 //    reference the tests hold both paths to (1e-9 of the light's solid angle, E and SH).
 // visible_light chooses between the first two per query, by cost (never by answer: both are
-// exact): the kept-images path when the triangles in the pyramid, estimated from the top levels
-// of the triangle tree, are fewer than 2,000, or when the edge tree's walk reached or passed
-// over fewer than 75 welded edges in the pyramid per found edge; the cone path otherwise.
+// exact): the kept-images path while culling keeps at most 5,000 triangles (culling is its first
+// step), the cone path beyond.
 // Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
 // images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
 // found edges: the edge tree's walk, per found edge a fan walk and the images on it
@@ -160,7 +159,6 @@ public:
     std::vector<Plane> fan;
     std::vector<std::pair<uint32_t, uint64_t>> fan_stack;  // node, live fans
     uint32_t group_mark = 0;
-    size_t cone_estimate = 0;  // the last walk's edges in the pyramid (an upper estimate, see find_cone_edges)
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -246,11 +244,13 @@ private:
   ImageKind add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
-  void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
-  size_t estimate_kept(Workspace& ws) const;  // ≥ what cull() keeps, from the tree's top levels
-  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
+  // ws.kept += the triangles not outside a culling plane (tree walk); false (ws.kept incomplete)
+  // as soon as it holds more than `limit`.
+  bool cull(Workspace& ws, size_t limit) const;
+  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins)
+  // until keep returns false (then returns false).
   template <class Keep>
-  void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  bool walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
   // Calls keep(t) (possibly more than once) for each triangle not outside every fan, a fan being
   // five consecutive planes of `planes` (≤ 64 fans): one walk, each node carrying its live fans.
   template <class Keep>
