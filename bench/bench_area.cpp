@@ -21,9 +21,8 @@
 //                 (on_bunny:0) or the bunny's own vertices (on_bunny:1: every 8th, 230, at
 //                 level 0; ~515 from level 1 on), Loop-subdivided 0–4 times (loop), side by
 //                 side by the per-triangle method (method:0), the contour path over every kept
-//                 image (method:1, visible_light_kept_images), the cone path (method:2,
-//                 visible_light_cone, issue 32) and visible_light's choice between the last two
-//                 (method:3)
+//                 image (method:1, visible_light_kept_images = visible_light) and the cone
+//                 path (method:2, visible_light_cone, issue 32)
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
@@ -255,7 +254,7 @@ std::vector<V3> positions_of(const prt::bake::Mesh& m) {
 // (image edges reaching into the light) per query; `special`: share of queries with a clipped or
 // ε-limit image (the point's own 1-ring: all its edges cut); `uncharted`: share whose light was
 // too wide for the chart (caps filter only); `fallback`: share answered by the per-triangle
-// method (none). The cone path's (methods 2, 3): `cone`, the share of queries it answered;
+// method (none). The cone path's (method 2): `cone`, the share of queries it answered;
 // per query it answered, `cone_edges` (welded edges found in the cone), `passed` (images built)
 // and `fan_tests`; per query, `edge_nodes` (edge-tree nodes visited).
 void BM_BunnyQuad(benchmark::State& state) {
@@ -277,8 +276,7 @@ void BM_BunnyQuad(benchmark::State& state) {
   std::vector<prt::bake::Arc> arcs;
   auto shade = [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
     const prt::bake::ShadePoint point{.p = s.p, .n = s.n};
-    kept += method == 3   ? mesh.visible_light(kBunnyLight, point, arcs, ws)
-            : method == 2 ? mesh.visible_light_cone(kBunnyLight, point, arcs, ws)
+    kept += method == 2   ? mesh.visible_light_cone(kBunnyLight, point, arcs, ws)
             : method == 1 ? mesh.visible_light_kept_images(kBunnyLight, point, arcs, ws)
                           : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
     shadowed += arcs.size() != ws.clipped.size();
@@ -296,7 +294,7 @@ void BM_BunnyQuad(benchmark::State& state) {
     state.counters["cut_edges"] = double(st.boundary_edges) / q;
     state.counters["special"] = double(st.special) / q;
     state.counters["uncharted"] = double(st.uncharted) / q;
-    if (method >= 2) {
+    if (method == 2) {
       // The cone path: share of queries it answered (the rest took the kept-images path), welded
       // edges found in the cone, triangles passed on (meeting a light edge's or a found edge's
       // fan) and edge-tree nodes visited, per query it answered.
@@ -318,7 +316,7 @@ void BM_BunnyQuad(benchmark::State& state) {
 void bunny_rows(benchmark::internal::Benchmark* b) {
   for (int on_bunny = 0; on_bunny < 2; ++on_bunny)
     for (int loop = 0; loop <= 4; ++loop)
-      for (int method = 0; method < 4; ++method)
+      for (int method = 0; method < 3; ++method)
         if (method > 0 || loop <= (on_bunny ? 0 : 2)) b->Args({method, on_bunny, loop});
 }
 BENCHMARK(BM_BunnyQuad)->ArgNames({"method", "on_bunny", "loop"})->Apply(bunny_rows)->Unit(benchmark::kMicrosecond);

@@ -24,9 +24,6 @@ namespace {
 constexpr double kMargin = 1e-12;
 constexpr uint32_t kLeafSize = 4;
 constexpr size_t kFanBatch = 64;  // fans walked together (one bit each)
-// Method::choose takes the kept-images path while culling keeps at most this many triangles:
-// bench/bench_area.cpp BM_BunnyQuad's crossover (bench/RESULTS.md "area lights: the cone path").
-constexpr size_t kConeMinKept = 5000;
 
 }  // namespace
 
@@ -366,14 +363,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     out.clear();
     return 0;
   }
-  // Method::choose: the kept-images path while the pyramid holds at most kConeMinKept
-  // triangles (culling is its first step anyway); beyond, the cone path.
-  bool culled = false;
-  if (method == Method::choose) {
-    culled = cull(ws, kConeMinKept);
-    if (!culled) ws.kept.clear();
-  }
-  if (method == Method::cone || (method == Method::choose && !culled)) {
+  if (method == Method::cone) {
     find_cone_edges(point, frame, ws, false);
     cone_query(point, frame, out, ws);
     return ws.kept.size();
@@ -381,7 +371,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   if (method == Method::reference) {
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
   } else {
-    if (!culled) cull(ws, std::numeric_limits<size_t>::max());
+    cull(ws);
     std::sort(ws.kept.begin(), ws.kept.end());
   }
   if (method == Method::per_triangle || method == Method::reference) {
@@ -555,16 +545,13 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
   ws.stats.cone_candidates += ws.kept.size();
 }
 
-bool OccluderMesh::cull(Workspace& ws, size_t limit) const {
-  return walk(ws.planes, ws, [&ws, limit](uint32_t t) {
-    ws.kept.push_back(t);
-    return ws.kept.size() <= limit;
-  });
+void OccluderMesh::cull(Workspace& ws) const {
+  walk(ws.planes, ws, [&ws](uint32_t t) { ws.kept.push_back(t); });
 }
 
 template <class Keep>
-bool OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
-  if (nodes_.empty()) return true;
+void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
+  if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
   // margin (so is every triangle in it); 0: neither.
   auto box_test = [&](const Node& node) {
@@ -601,8 +588,7 @@ bool OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
     const int test = box_test(node);
     if (test < 0) continue;
     if (test > 0) {
-      for (uint32_t i = node.first; i < node.first + node.total; ++i)
-        if (!keep(order_[i])) return false;
+      for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
       continue;
     }
     if (node.count == 0) {
@@ -614,9 +600,8 @@ bool OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
     for (size_t k = 0; k < planes.size(); ++k)
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i]) && !keep(order_[i])) return false;
+      if (!triangle_outside(order_[i])) keep(order_[i]);
   }
-  return true;
 }
 
 namespace {

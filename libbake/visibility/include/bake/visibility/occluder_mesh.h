@@ -85,9 +85,11 @@
 //  * The per-triangle method (visible_light_per_triangle; visible_light_reference without the
 //    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
 //    reference the tests hold both paths to (1e-9 of the light's solid angle, E and SH).
-// visible_light chooses between the first two per query, by cost (never by answer: both are
-// exact): the kept-images path while culling keeps at most 5,000 triangles (culling is its first
-// step), the cone path beyond.
+// visible_light takes the kept-images path. The cone path is faster where the pyramid holds many
+// more triangles than the edges it finds (the bunny Loop-subdivided 3–4 times: 1.5–2.1x) and
+// slower on small pyramids and on the CAD engine (long thin triangles: its fans meet nearly every
+// kept triangle, and it cuts more edges): a choice per query by the triangles culling keeps
+// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet.
 // Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
 // images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
 // found edges: the edge tree's walk, per found edge a fan walk and the images on it
@@ -173,19 +175,18 @@ public:
   // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
   // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
   // dropped by the depth test).
-  // By the cone path or the kept-images path, whichever the file comment's cost rule picks:
-  // the same arcs' integrals. Returns the triangles whose images were built.
+  // By the contour path over every kept image (file comment: the cone path is not the default;
+  // bench/RESULTS.md "area lights: the cone path" says where each is faster).
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
-    return query(light, point, out, ws, Method::choose);
+    return query(light, point, out, ws, Method::contour);
   }
-  // The cone path, always (file comment).
+  // The cone path (file comment): the same arcs' integrals.
   size_t visible_light_cone(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                             Workspace& ws) const {
     return query(light, point, out, ws, Method::cone);
   }
-  // The contour path over every kept triangle's image (the fast path before the cone path): the
-  // same arcs' integrals.
+  // The same as visible_light, by name (the tests and bench_area hold the paths side by side).
   size_t visible_light_kept_images(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
                                    std::vector<Arc>& out, Workspace& ws) const {
     return query(light, point, out, ws, Method::contour);
@@ -224,7 +225,7 @@ private:
     uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
-  enum class Method { choose, cone, contour, per_triangle, reference };
+  enum class Method { cone, contour, per_triangle, reference };
   // The edge tree (cone path): a binary tree over the welded edges (median splits, leaves of ≤ 4),
   // each node with the box of its edges' faces, that box's bounding sphere and a cone of its
   // faces' unit normals (axis, and spread ≥ |n̂ − axis| for every face), and whether an edge
@@ -244,13 +245,10 @@ private:
   ImageKind add_image(uint32_t triangle, const ShadePoint& point, const LightFrame& frame, Workspace& ws) const;
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
-  // ws.kept += the triangles not outside a culling plane (tree walk); false (ws.kept incomplete)
-  // as soon as it holds more than `limit`.
-  bool cull(Workspace& ws, size_t limit) const;
-  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins)
-  // until keep returns false (then returns false).
+  void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
   template <class Keep>
-  bool walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
   // Calls keep(t) (possibly more than once) for each triangle not outside every fan, a fan being
   // five consecutive planes of `planes` (≤ 64 fans): one walk, each node carrying its live fans.
   template <class Keep>
