@@ -312,7 +312,7 @@ void BM_BunnyQuad(benchmark::State& state) {
 }
 // Rows: per ground level 0–4 and own-vertex level 0–4 the three fast methods side by side; the
 // per-triangle method on the ground at levels 0–2 and on the own vertices at level 0 (at level 3
-// its O(E²) pairs over ~15k kept triangles would take ~15 min an iteration).
+// its O(E²) pairs over ~15k kept triangles would take ~10 min an iteration).
 void bunny_rows(benchmark::internal::Benchmark* b) {
   for (int on_bunny = 0; on_bunny < 2; ++on_bunny)
     for (int loop = 0; loop <= 4; ++loop)
