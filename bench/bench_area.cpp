@@ -19,9 +19,10 @@
 //   BM_BunnyQuad  data/bunny.obj (3674 triangles, 0 ≤ y ≤ 9.7) under a 6 × 4 quad light at y = 12;
 //                 256 shade points on the ground y = 0 (|x| ≤ 8, |z| ≤ 6, normals tilted ≤ 60°)
 //                 (on_bunny:0) or the bunny's own vertices (on_bunny:1: every 8th, 230, at
-//                 level 0; ~515 from level 1 on), Loop-
-//                 subdivided 0–3 times (loop), by the contour path (contour:1, issue 32) or the
-//                 per-triangle method (contour:0), side by side
+//                 level 0; ~515 from level 1 on), Loop-subdivided 0–4 times (loop), side by
+//                 side by the per-triangle method (method:0), the contour path over every kept
+//                 image (method:1, visible_light_kept_images = visible_light) and the cone
+//                 path (method:2, visible_light_cone, issue 32)
 #include <bake/lights/lights.h>
 #include <bake/mesh/mesh.h>
 #include <bake/mesh/receivers.h>
@@ -247,16 +248,18 @@ std::vector<V3> positions_of(const prt::bake::Mesh& m) {
   return p;
 }
 
-// Shade points per CPU second, one quad light over the bunny (Loop-subdivided `levels` times):
-// the contour path (OccluderMesh::visible_light, issue 32) or the per-triangle method
-// (visible_light_per_triangle), receivers on the ground or the bunny's own vertices. Counters
-// (untimed pass): kept triangles and cut edges (contour edges reaching into the light) per
-// query; `special`: share of queries with a clipped or ε-limit image (the point's own 1-ring:
-// all its edges cut, still the contour path); `uncharted`: share whose light was too wide for the
-// chart (caps filter only); `fallback`: share answered by the per-triangle method (none: the
-// contour path has no such fallback).
+// Shade points per CPU second, one quad light over the bunny (Loop-subdivided `levels` times)
+// by `method` (see the file comment), receivers on the ground or the bunny's own vertices.
+// Counters (untimed pass): triangles whose images were built (kept_triangles) and cut edges
+// (image edges reaching into the light) per query; `special`: share of queries with a clipped or
+// ε-limit image (the point's own 1-ring: all its edges cut); `uncharted`: share whose light was
+// too wide for the chart (caps filter only); `fallback`: share answered by the per-triangle
+// method (none). The cone path's (method 2): `cone`, the share of queries it answered;
+// per query it answered, `cone_edges` (welded edges found in the cone), `passed` (images built)
+// and `fan_tests`; per query, `edge_nodes` (edge-tree nodes visited).
 void BM_BunnyQuad(benchmark::State& state) {
-  const bool contour = state.range(0) != 0;
+  const int method = int(state.range(0));
+  const bool contour = method != 0;
   const bool on_bunny = state.range(1) != 0;
   const int levels = int(state.range(2));
   const prt::bake::Mesh& m = bunny(levels);
@@ -273,8 +276,9 @@ void BM_BunnyQuad(benchmark::State& state) {
   std::vector<prt::bake::Arc> arcs;
   auto shade = [&](const ShadePoint& s, size_t& kept, size_t& shadowed) {
     const prt::bake::ShadePoint point{.p = s.p, .n = s.n};
-    kept += contour ? mesh.visible_light(kBunnyLight, point, arcs, ws)
-                    : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
+    kept += method == 2   ? mesh.visible_light_cone(kBunnyLight, point, arcs, ws)
+            : method == 1 ? mesh.visible_light_kept_images(kBunnyLight, point, arcs, ws)
+                          : mesh.visible_light_per_triangle(kBunnyLight, point, arcs, ws);
     shadowed += arcs.size() != ws.clipped.size();
     return s.n.dot(prt::bake::vector_irradiance(arcs));
   };
@@ -290,25 +294,32 @@ void BM_BunnyQuad(benchmark::State& state) {
     state.counters["cut_edges"] = double(st.boundary_edges) / q;
     state.counters["special"] = double(st.special) / q;
     state.counters["uncharted"] = double(st.uncharted) / q;
+    if (method == 2) {
+      // The cone path: share of queries it answered (the rest took the kept-images path), welded
+      // edges found in the cone, triangles passed on (meeting a light edge's or a found edge's
+      // fan) and edge-tree nodes visited, per query it answered.
+      const double c = double(std::max<size_t>(st.cone, 1));
+      state.counters["cone"] = double(st.cone) / q;
+      state.counters["cone_edges"] = double(st.cone_edges) / c;
+      state.counters["passed"] = double(st.cone_candidates) / c;
+      state.counters["edge_nodes"] = double(st.edge_nodes) / q;
+      state.counters["fan_tests"] = double(st.fan_tests) / c;
+    }
   }
   state.counters["fallback"] = 0;
   state.counters["triangles"] = double(m.triangles.size());
   state.counters["points"] = double(points.size());
 }
-BENCHMARK(BM_BunnyQuad)
-    ->ArgNames({"contour", "on_bunny", "loop"})
-    ->Args({0, 0, 0})
-    ->Args({1, 0, 0})
-    ->Args({0, 1, 0})
-    ->Args({1, 1, 0})
-    ->Args({0, 0, 1})
-    ->Args({1, 0, 1})
-    ->Args({1, 0, 2})
-    ->Args({1, 0, 3})
-    ->Args({1, 1, 1})
-    ->Args({1, 1, 2})
-    ->Args({1, 1, 3})
-    ->Unit(benchmark::kMicrosecond);
+// Rows: per ground level 0–4 and own-vertex level 0–4 the three fast methods side by side; the
+// per-triangle method on the ground at levels 0–2 and on the own vertices at level 0 (at level 3
+// its O(E²) pairs over ~15k kept triangles would take ~10 min an iteration).
+void bunny_rows(benchmark::internal::Benchmark* b) {
+  for (int on_bunny = 0; on_bunny < 2; ++on_bunny)
+    for (int loop = 0; loop <= 4; ++loop)
+      for (int method = 0; method < 3; ++method)
+        if (method > 0 || loop <= (on_bunny ? 0 : 2)) b->Args({method, on_bunny, loop});
+}
+BENCHMARK(BM_BunnyQuad)->ArgNames({"method", "on_bunny", "loop"})->Apply(bunny_rows)->Unit(benchmark::kMicrosecond);
 
 // Cost against the silhouette's size: one quad light (kQuad) and one convex occluder, an N-gon
 // prism (radius 0.3, height 0.2, axis +z, centred at height 1), so that its silhouette from the

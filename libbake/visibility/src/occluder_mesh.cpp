@@ -8,6 +8,7 @@
 #include <bake/visibility/visible_region.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -22,6 +23,7 @@ namespace {
 // plane values err by a few ulps of |factors| · |x − o|; 1e-12 is ~4500 ulps.
 constexpr double kMargin = 1e-12;
 constexpr uint32_t kLeafSize = 4;
+constexpr size_t kFanBatch = 64;  // fans walked together (one bit each)
 
 }  // namespace
 
@@ -103,6 +105,96 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
     slot_group_[edge_slots_[i]] = uint32_t(edge_group_start_.size() - 1);
   }
   edge_group_start_.push_back(uint32_t(slots));
+
+  // The edge tree (cone path): unit face normals, flagged edges, then the tree.
+  face_normal_.resize(triangles_.size());
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    const auto& tri = triangles_[t];
+    const V3 n = (positions_[tri[1]] - positions_[tri[0]]).cross(positions_[tri[2]] - positions_[tri[0]]);
+    const double len = n.norm();
+    face_normal_[t] = len > 0 && std::isfinite(len) ? V3(n / len) : V3::Zero();
+  }
+  const size_t groups = edge_count();
+  edge_flagged_.assign(groups, 0);
+  for (size_t g = 0; g < groups; ++g) {
+    const uint32_t first = edge_group_start_[g], end = edge_group_start_[g + 1];
+    bool flagged = end - first != 2;
+    for (uint32_t at = first; at < end; ++at) {
+      const auto& tri = triangles_[edge_slots_[at] / 3];
+      const uint32_t a = welded_[tri[0]], b = welded_[tri[1]], c = welded_[tri[2]];
+      flagged = flagged || a == b || b == c || c == a || face_normal_[edge_slots_[at] / 3] == V3::Zero();
+    }
+    if (!flagged) {
+      const uint32_t s0 = edge_slots_[first], s1 = edge_slots_[first + 1];
+      // Two faces of distinct corners running the edge both ways (a consistently wound pair).
+      flagged = s0 / 3 == s1 / 3 || welded_[triangles_[s0 / 3][s0 % 3]] == welded_[triangles_[s1 / 3][s1 % 3]];
+    }
+    edge_flagged_[g] = uint8_t(flagged);
+  }
+  std::vector<V3> centres(groups);
+  for (size_t g = 0; g < groups; ++g) {
+    const uint32_t slot = edge_slots_[edge_group_start_[g]];
+    const auto& tri = triangles_[slot / 3];
+    centres[g] = (positions_[tri[slot % 3]] + positions_[tri[(slot % 3 + 1) % 3]]) / 2;
+  }
+  edge_order_.resize(groups);
+  for (uint32_t g = 0; g < groups; ++g) edge_order_[g] = g;
+  if (groups > 0) build_edges(0, uint32_t(groups), centres);
+  edge_rank_.resize(groups);
+  for (uint32_t i = 0; i < groups; ++i) edge_rank_[edge_order_[i]] = i;
+}
+
+uint32_t OccluderMesh::build_edges(uint32_t first, uint32_t count, std::vector<V3>& centres) {
+  const uint32_t at = uint32_t(edge_nodes_.size());
+  edge_nodes_.push_back({V3::Zero(), V3::Zero(), V3::Zero(), V3::Zero(), 0, 0, 0, 0, count, false});
+  V3 lo = V3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  V3 clo = lo, chi = hi, sum = V3::Zero();
+  bool flagged = false;
+  for (uint32_t i = first; i < first + count; ++i) {
+    const uint32_t g = edge_order_[i];
+    flagged = flagged || edge_flagged_[g];
+    for (uint32_t s = edge_group_start_[g]; s < edge_group_start_[g + 1]; ++s) {
+      const uint32_t t = edge_slots_[s] / 3;
+      for (uint32_t v : triangles_[t]) {
+        lo = lo.cwiseMin(positions_[v]);
+        hi = hi.cwiseMax(positions_[v]);
+      }
+      sum += face_normal_[t];
+    }
+    clo = clo.cwiseMin(centres[g]);
+    chi = chi.cwiseMax(centres[g]);
+  }
+  EdgeNode& node = edge_nodes_[at];
+  node.lo = lo;
+  node.hi = hi;
+  node.centre = (lo + hi) / 2;
+  // Every face point x has |x − centre| ≤ |half| (computed: widened far beyond its rounding).
+  node.radius = ((hi - lo) / 2).norm() * (1 + 1e-12);
+  node.flagged = flagged;
+  const double len = sum.norm();
+  node.axis = len > 0 && std::isfinite(len) ? V3(sum / len) : V3::Zero();
+  double spread = node.axis == V3::Zero() ? 4.0 : 0.0;
+  for (uint32_t i = first; i < first + count && spread < 4; ++i) {
+    const uint32_t g = edge_order_[i];
+    for (uint32_t s = edge_group_start_[g]; s < edge_group_start_[g + 1]; ++s)
+      spread = std::max(spread, (face_normal_[edge_slots_[s] / 3] - node.axis).norm());
+  }
+  node.spread = spread * (1 + 1e-12) + 1e-12;
+  if (count <= kLeafSize) {
+    node.index = first;
+    node.count = count;
+    return at;
+  }
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const uint32_t half = count / 2;
+  std::nth_element(edge_order_.begin() + first, edge_order_.begin() + first + half, edge_order_.begin() + first + count,
+                   [&](uint32_t x, uint32_t y) { return centres[x][axis] < centres[y][axis]; });
+  build_edges(first, half, centres);
+  const uint32_t right = build_edges(first + half, count - half, centres);
+  edge_nodes_[at].index = right;
+  edge_nodes_[at].count = 0;
+  return at;
 }
 
 uint32_t OccluderMesh::build(uint32_t first, uint32_t count, std::vector<V3>& centroids) {
@@ -271,13 +363,18 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     out.clear();
     return 0;
   }
+  if (method == Method::cone) {
+    find_cone_edges(point, frame, ws, false);
+    cone_query(point, frame, out, ws);
+    return ws.kept.size();
+  }
   if (method == Method::reference) {
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
   } else {
     cull(ws);
     std::sort(ws.kept.begin(), ws.kept.end());
   }
-  if (method != Method::contour) {
+  if (method == Method::per_triangle || method == Method::reference) {
     for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
     visible_region(ws.clipped, std::span<const std::vector<V3>>(ws.images.data(), ws.image_count), out);
     return ws.kept.size();
@@ -285,16 +382,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
 
   // The contour path: each kept triangle's image and kind, then the edges that may bound the
   // union (the header's rule), then visible_region_sparse.
-  if (ws.tri_stamp.size() != triangles_.size()) {
-    ws.tri_stamp.assign(triangles_.size(), 0);
-    ws.tri_side.assign(triangles_.size(), 0);
-    ws.stamp = 0;
-  }
-  if (ws.stamp == std::numeric_limits<uint32_t>::max()) {
-    std::fill(ws.tri_stamp.begin(), ws.tri_stamp.end(), 0);
-    ws.stamp = 0;
-  }
-  const uint32_t stamp = ++ws.stamp;
+  const uint32_t stamp = next_stamp(ws);
   ws.image_kind.clear();
   bool special = false;
   for (uint32_t t : ws.kept) {
@@ -342,14 +430,134 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   return ws.kept.size();
 }
 
+uint32_t OccluderMesh::next_stamp(Workspace& ws) const {
+  if (ws.tri_stamp.size() != triangles_.size()) {
+    ws.tri_stamp.assign(triangles_.size(), 0);
+    ws.tri_side.assign(triangles_.size(), 0);
+    ws.stamp = 0;
+  }
+  if (ws.stamp == std::numeric_limits<uint32_t>::max()) {
+    std::fill(ws.tri_stamp.begin(), ws.tri_stamp.end(), 0);
+    ws.stamp = 0;
+  }
+  return ++ws.stamp;
+}
+
+void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out,
+                              Workspace& ws) const {
+  // The edges found: their images are the only ones cut (every other image edge has its far side
+  // covered by its neighbour along the whole edge, or misses the light).
+  if (ws.group_stamp.size() != edge_count()) {
+    ws.group_stamp.assign(edge_count(), 0);
+    ws.group_mark = 0;
+  }
+  if (ws.group_mark == std::numeric_limits<uint32_t>::max()) {
+    std::fill(ws.group_stamp.begin(), ws.group_stamp.end(), 0);
+    ws.group_mark = 0;
+  }
+  const uint32_t mark = ++ws.group_mark;
+  for (uint32_t g : ws.cone) ws.group_stamp[g] = mark;
+  // The triangles meeting the fan of a light edge or of a found edge (the rays from p through it,
+  // inside the pyramid and on p's side of the light's plane): every image that meets an edge
+  // visible_region_sparse cuts, so each cut gets the same pieces as with every kept image.
+  const uint32_t stamp = next_stamp(ws);
+  auto keep = [&ws, stamp](uint32_t t) {
+    if (ws.tri_stamp[t] != stamp) ws.tri_stamp[t] = stamp, ws.kept.push_back(t);
+  };
+  // Each fan is bounded by five planes (the slab first: most boxes miss it; the light's plane
+  // last); a light edge's fan is the pyramid's side k between its neighbours k − 1 and k + 1.
+  ws.fan.clear();
+  auto add_fan = [&ws, &point](const V3& a, const V3& b) {  // the rays from p through a, b (relative to p)
+    const double la = a.norm(), lb = b.norm();
+    const V3 m = a.cross(b);
+    // The plane through p, a and b (both sides), and the wedge between the rays to a and b: the
+    // margins cover the rounding of m (≤ a few ulps of |a||b|) and of m × a, b × m.
+    const double coef = kMargin * la * lb;
+    ws.fan.insert(ws.fan.end(), {{m, point.p, coef}, {-m, point.p, coef}, {m.cross(a), point.p, coef * la},
+                                 {b.cross(m), point.p, coef * lb}, ws.planes.back()});
+  };
+  // A special face (clipped, or p in its plane) has every image edge cut: a fan for each.
+  for (uint32_t t : ws.special_faces) {
+    ws.image_count = 0;
+    add_image(t, point, frame, ws);
+    for (size_t i = 0; i < ws.image_count; ++i) {
+      const auto& image = ws.images[i];
+      for (size_t k = 0; k < image.size(); ++k) add_fan(image[k], image[k + 1 == image.size() ? 0 : k + 1]);
+    }
+  }
+  ws.image_count = 0;
+  for (uint32_t t : ws.special_faces) keep(t);
+  const size_t sides = ws.planes.size() - 1;
+  for (size_t k = 0; k < sides; ++k) {
+    const auto& side = ws.planes[k];
+    ws.fan.insert(ws.fan.end(), {{-side.m, side.o, side.margin_coef}, side, ws.planes[k == 0 ? sides - 1 : k - 1],
+                                 ws.planes[k + 1 == sides ? 0 : k + 1], ws.planes.back()});
+  }
+  // The found edges' fans in the edge tree's leaf order: neighbouring fans share a batch, and
+  // so most of the nodes their walk visits.
+  ws.edge_stack.assign(ws.cone.begin(), ws.cone.end());
+  std::sort(ws.edge_stack.begin(), ws.edge_stack.end(), [this](uint32_t x, uint32_t y) { return edge_rank_[x] < edge_rank_[y]; });
+  for (uint32_t g : ws.edge_stack) {
+    const uint32_t slot = edge_slots_[edge_group_start_[g]];
+    const auto& tri = triangles_[slot / 3];
+    add_fan(positions_[tri[slot % 3]] - point.p, positions_[tri[(slot % 3 + 1) % 3]] - point.p);
+  }
+  for (size_t first = 0; first < ws.fan.size(); first += 5 * kFanBatch)
+    walk_fans(std::span<const Workspace::Plane>(ws.fan).subspan(first, std::min(5 * kFanBatch, ws.fan.size() - first)),
+              ws, keep);
+  std::sort(ws.kept.begin(), ws.kept.end());
+  ws.image_kind.clear();
+  ws.boundary.clear();
+  for (uint32_t t : ws.kept) {
+    const ImageKind kind = add_image(t, point, frame, ws);
+    ws.image_kind.resize(ws.image_count, uint8_t(kind));
+    ws.tri_side[t] = kind == ImageKind::triangle ? int8_t(ws.last_side) : int8_t(0);
+    if (kind != ImageKind::triangle) {  // a clipped or ε-limit image cannot be in the pyramid here; cut all
+      ws.boundary.resize(ws.image_count, 0xff);
+      continue;
+    }
+    uint8_t mask = 0;
+    for (uint32_t e = 0; e < 3; ++e) {
+      const uint32_t k = ws.last_side > 0 ? e : (e == 2 ? 2 : 1 - e);  // as in query()
+      const uint32_t group = slot_group_[3 * t + k];
+      if (ws.group_stamp[group] != mark) continue;
+      // A consistently wound pair whose other face, listed first, has a whole image passed on:
+      // on the same side (a fold) its image edge is the same arc and owns it, on the other side
+      // its image covers this edge's far side along the whole edge (the kept-images rule).
+      if (!edge_flagged_[group]) {
+        const uint32_t first = edge_slots_[edge_group_start_[group]] / 3, second = edge_slots_[edge_group_start_[group] + 1] / 3;
+        const uint32_t other = first == t ? second : first;
+        if (other < t && ws.tri_stamp[other] == stamp && ws.tri_side[other] != 0) continue;
+      }
+      mask = uint8_t(mask | (1u << e));
+    }
+    ws.boundary.push_back(mask);
+  }
+  visible_region_sparse(ws.clipped, std::span<const std::vector<V3>>(ws.images.data(), ws.image_count),
+                        std::span<const uint8_t>(ws.boundary.data(), ws.image_count), out, ws.region);
+  ++ws.stats.queries;
+  ++ws.stats.cone;
+  ws.stats.special += !ws.special_faces.empty();
+  ws.stats.kept += ws.kept.size();
+  ws.stats.boundary_edges += ws.region.boundary_edges;
+  ws.stats.uncharted += !ws.region.charted;
+  ws.stats.cone_edges += ws.cone.size();
+  ws.stats.cone_candidates += ws.kept.size();
+}
+
 void OccluderMesh::cull(Workspace& ws) const {
+  walk(ws.planes, ws, [&ws](uint32_t t) { ws.kept.push_back(t); });
+}
+
+template <class Keep>
+void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
   // margin (so is every triangle in it); 0: neither.
   auto box_test = [&](const Node& node) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
     bool inside = true;
-    for (const auto& plane : ws.planes) {
+    for (const auto& plane : planes) {
       const V3 r = centre - plane.o;
       const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
       // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
@@ -362,10 +570,10 @@ void OccluderMesh::cull(Workspace& ws) const {
   // A triangle of a leaf is outside a plane when its highest vertex is below −margin, the
   // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
   std::vector<double>& leaf_margin = ws.margins;
-  leaf_margin.assign(ws.planes.size(), 0.0);
+  leaf_margin.assign(planes.size(), 0.0);
   auto triangle_outside = [&](uint32_t t) {
-    for (size_t k = 0; k < ws.planes.size(); ++k) {
-      const auto& plane = ws.planes[k];
+    for (size_t k = 0; k < planes.size(); ++k) {
+      const auto& plane = planes[k];
       double top = -std::numeric_limits<double>::infinity();
       for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
       if (top < -leaf_margin[k]) return true;
@@ -380,7 +588,7 @@ void OccluderMesh::cull(Workspace& ws) const {
     const int test = box_test(node);
     if (test < 0) continue;
     if (test > 0) {
-      ws.kept.insert(ws.kept.end(), order_.begin() + node.first, order_.begin() + node.first + node.total);
+      for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
       continue;
     }
     if (node.count == 0) {
@@ -389,11 +597,235 @@ void OccluderMesh::cull(Workspace& ws) const {
       continue;
     }
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (size_t k = 0; k < ws.planes.size(); ++k)
-      leaf_margin[k] = ws.planes[k].margin_coef * ((centre - ws.planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
+    for (size_t k = 0; k < planes.size(); ++k)
+      leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i])) ws.kept.push_back(order_[i]);
+      if (!triangle_outside(order_[i])) keep(order_[i]);
   }
+}
+
+namespace {
+
+// x is strictly outside the culling plane (beyond its margin at x: the exact value is negative).
+bool outside_plane(const OccluderMesh::Workspace::Plane& plane, const V3& x) {
+  const V3 r = x - plane.o;
+  return plane.m.dot(r) < -plane.margin_coef * r.cwiseAbs().sum();
+}
+
+}  // namespace
+
+template <class Keep>
+void OccluderMesh::walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
+  if (nodes_.empty() || planes.empty()) return;
+  const std::span<const Workspace::Plane> pyramid(ws.planes);
+  const size_t fans = planes.size() / 5;
+  // A box is outside a fan when it is outside one of its five planes (beyond the margin, as walk()).
+  // Every fan plane but the fifth (the light's) passes through o = planes[0].o (p): the node's
+  // offset from it and its |·|₁ are shared. The slab (two opposite planes) is one test.
+  const V3 o = planes[0].o;
+  auto box_outside = [&](const V3& r, const V3& half, double extent, size_t fan) {
+    const auto* plane = &planes[5 * fan];
+    const double mid = plane[0].m.dot(r), spread = plane[0].m.cwiseAbs().dot(half);
+    if (std::abs(mid) - spread > plane[0].margin_coef * extent) return true;  // both slab planes have this margin
+    for (int k = 2; k < 4; ++k) {
+      if (plane[k].m.dot(r) + plane[k].m.cwiseAbs().dot(half) < -plane[k].margin_coef * extent) return true;
+    }
+    const V3 rl = r + (o - plane[4].o);
+    const double margin = plane[4].margin_coef * (rl.cwiseAbs().sum() + half.cwiseAbs().sum());
+    return plane[4].m.dot(rl) + plane[4].m.cwiseAbs().dot(half) < -margin;
+  };
+  // A triangle is outside a fan when all three corners are outside one plane (each beyond the
+  // margin at that corner: its exact value is negative).
+  auto triangle_outside = [&](uint32_t t, size_t fan) {
+    const auto& tri = triangles_[t];
+    for (size_t k = 5 * fan; k < 5 * fan + 5; ++k) {
+      const auto& plane = planes[k];
+      bool all = true;
+      for (int c = 0; c < 3 && all; ++c) {
+        const V3 r = positions_[tri[c]] - plane.o;
+        all = plane.m.dot(r) < -plane.margin_coef * r.cwiseAbs().sum();
+      }
+      if (all) return true;
+    }
+    return false;
+  };
+  ws.fan_stack.assign(1, {0, fans == 64 ? ~uint64_t(0) : (uint64_t(1) << fans) - 1});
+  while (!ws.fan_stack.empty()) {
+    auto [at, live] = ws.fan_stack.back();
+    ws.fan_stack.pop_back();
+    const Node& node = nodes_[at];
+    const V3 half = (node.hi - node.lo) / 2, r = (node.lo + node.hi) / 2 - o;
+    const double extent = r.cwiseAbs().sum() + half.cwiseAbs().sum();
+    // Outside the pyramid (or behind the light) a triangle's image misses the light: no fan
+    // needs it.
+    bool out_of_pyramid = false;
+    for (size_t k = 0; k < pyramid.size() && !out_of_pyramid; ++k) {
+      const auto& plane = pyramid[k];
+      const V3 rp = r + (o - plane.o);
+      const double margin = plane.margin_coef * (rp.cwiseAbs().sum() + half.cwiseAbs().sum());
+      out_of_pyramid = plane.m.dot(rp) + plane.m.cwiseAbs().dot(half) < -margin;
+    }
+    if (out_of_pyramid) continue;
+    for (uint64_t bits = live; bits != 0; bits &= bits - 1) {
+      const auto fan = size_t(std::countr_zero(bits));
+      ++ws.stats.fan_tests;
+      if (box_outside(r, half, extent, fan)) live &= ~(uint64_t(1) << fan);
+    }
+    if (live == 0) continue;
+    if (node.count == 0) {
+      ws.fan_stack.push_back({node.index, live});
+      ws.fan_stack.push_back({at + 1, live});
+      continue;
+    }
+    for (uint32_t i = node.index; i < node.index + node.count; ++i) {
+      const uint32_t t = order_[i];
+      if (ws.tri_stamp[t] == ws.stamp) continue;  // already kept by another fan
+      bool culled = false;
+      for (const auto& plane : pyramid) {
+        bool all = true;
+        for (int c = 0; c < 3 && all; ++c) all = outside_plane(plane, positions_[triangles_[t][c]]);
+        if (all) {
+          culled = true;
+          break;
+        }
+      }
+      if (culled) continue;
+      for (uint64_t bits = live; bits != 0; bits &= bits - 1)
+        if (!triangle_outside(t, size_t(std::countr_zero(bits)))) {
+          keep(t);
+          break;
+        }
+    }
+  }
+}
+
+int OccluderMesh::classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws,
+                                std::vector<uint32_t>& special) const {
+  const std::span<const Workspace::Plane> sides(ws.planes.data(), ws.planes.size() - 1);  // the pyramid's sides
+  const uint32_t first = edge_group_start_[group], end = edge_group_start_[group + 1];
+  int whole = 0, other = 0, facing[2] = {0, 0};
+  for (uint32_t at = first; at < end; ++at) {
+    const auto& tri = triangles_[edge_slots_[at] / 3];
+    const V3* x[3] = {&positions_[tri[0]], &positions_[tri[1]], &positions_[tri[2]]};
+    bool outside = false;
+    for (const auto& plane : sides)
+      outside = outside || (outside_plane(plane, *x[0]) && outside_plane(plane, *x[1]) && outside_plane(plane, *x[2]));
+    if (outside) {  // its image misses the closed light
+      ++other;
+      continue;
+    }
+    bool any_front = false, any_back = false;
+    for (const V3* v : x) {
+      const int d = frame.depth_side(*v);
+      any_front = any_front || d > 0;
+      any_back = any_back || d < 0;
+    }
+    if (!any_front) {  // dropped (behind the light or in its plane)
+      ++other;
+      continue;
+    }
+    const int side = any_back ? 0 : orient3d_exact(*x[0], *x[1], *x[2], point.p);
+    if (side == 0) {  // clipped by the light's plane, or p in its plane (ε-limit cones or no image)
+      special.push_back(edge_slots_[at] / 3);
+      ++other;
+      continue;
+    }
+    if (whole < 2) facing[whole] = side;
+    ++whole;
+  }
+  if (whole == 0) return 0;  // no whole image on this edge (a special face's image edges are all cut)
+  const uint32_t slot = edge_slots_[first];
+  const auto& tri = triangles_[slot / 3];
+  const V3 &a = positions_[tri[slot % 3]], &b = positions_[tri[(slot % 3 + 1) % 3]];
+  for (const auto& plane : sides)
+    if (outside_plane(plane, a) && outside_plane(plane, b)) return 0;  // its image misses the closed light
+  if (edge_flagged_[group] || other > 0) return 1;
+  return facing[0] != facing[1] ? 1 : 0;  // a consistently wound pair: a contour edge iff they face apart
+}
+
+void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const {
+  ws.cone.clear();
+  ws.special_faces.clear();
+  auto finish = [&ws] {
+    std::sort(ws.cone.begin(), ws.cone.end());
+    std::sort(ws.special_faces.begin(), ws.special_faces.end());
+    ws.special_faces.erase(std::unique(ws.special_faces.begin(), ws.special_faces.end()), ws.special_faces.end());
+  };
+  if (edge_nodes_.empty()) return;
+  if (brute) {
+    for (uint32_t g = 0; g < edge_count(); ++g) {
+      if (classify_edge(g, point, frame, ws, ws.special_faces) > 0) ws.cone.push_back(g);
+    }
+    finish();
+    return;
+  }
+  const Workspace::Plane& light_plane = ws.planes.back();
+  ws.edge_stack.assign(1, 0);
+  while (!ws.edge_stack.empty()) {
+    const uint32_t at = ws.edge_stack.back();
+    ws.edge_stack.pop_back();
+    const EdgeNode& node = edge_nodes_[at];
+    ++ws.stats.edge_nodes;
+    // The box against the pyramid's sides and the light's plane (the same margins as walk()).
+    const V3 half = (node.hi - node.lo) / 2;
+    bool outside = false, front = false;
+    for (const auto& plane : ws.planes) {
+      const V3 r = node.centre - plane.o;
+      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
+      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
+      if (mid + spread < -margin) {
+        outside = true;
+        break;
+      }
+      if (&plane == &light_plane) front = mid - spread > margin;
+    }
+    if (outside) continue;  // every face outside a side (its image misses the light) or behind the light
+    if (front && !node.flagged) {
+      // Every face strictly on p's side of the light's plane (whole images), every edge a
+      // consistently wound pair: none is a contour edge when every face has p strictly on the
+      // same side of its plane. For a face point x (|x − centre| ≤ radius) and unit normal n̂
+      // (|n̂ − axis| ≤ spread): n̂·(p − x) = axis·d + (n̂ − axis)·d − n̂·(x − centre), d = p − centre.
+      const V3 d = point.p - node.centre;
+      const double ad = node.axis.dot(d), dn = d.norm();
+      const double bound = node.spread * dn + node.radius + 1e-9 * (dn + node.radius);
+      if (ad > bound || ad < -bound) {
+        continue;
+      }
+    }
+    if (node.count == 0) {
+      ws.edge_stack.push_back(node.index);
+      ws.edge_stack.push_back(at + 1);
+      continue;
+    }
+    for (uint32_t i = node.index; i < node.index + node.count; ++i) {
+      const uint32_t g = edge_order_[i];
+      if (classify_edge(g, point, frame, ws, ws.special_faces) > 0) ws.cone.push_back(g);
+    }
+  }
+  finish();
+}
+
+void OccluderMesh::cone_edges(std::span<const V3> light, const ShadePoint& point, std::vector<uint32_t>& edges,
+                              std::vector<uint32_t>& special, Workspace& ws) const {
+  LightFrame frame;
+  edges.clear();
+  special.clear();
+  if (!prepare(light, point, ws, frame)) return;
+  find_cone_edges(point, frame, ws, false);
+  edges = ws.cone;
+  special = ws.special_faces;
+}
+
+void OccluderMesh::cone_edges_brute_force(std::span<const V3> light, const ShadePoint& point,
+                                          std::vector<uint32_t>& edges, std::vector<uint32_t>& special,
+                                          Workspace& ws) const {
+  LightFrame frame;
+  edges.clear();
+  special.clear();
+  if (!prepare(light, point, ws, frame)) return;
+  find_cone_edges(point, frame, ws, true);
+  edges = ws.cone;
+  special = ws.special_faces;
 }
 
 } // namespace prt::bake

@@ -37,15 +37,18 @@ constexpr int kOrder = 4;
 
 struct Totals {
   size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0, special = 0, uncharted = 0;
+  size_t queries = 0;  // that reached the union (the light not empty above the horizon)
+  size_t cone = 0, cone_edges = 0, cone_candidates = 0, all_kept = 0;
 };
 
 // E and the order-4 SH of the visible light by both methods at s; EXPECTs their agreement.
 void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, const std::string& what,
              Totals& totals) {
   static const prt::bake::PolygonSH sh(kOrder);
-  OccluderMesh::Workspace ws_fast, ws_slow, ws_bare;
-  std::vector<Arc> fast, slow, bare;
-  const size_t kept = mesh.visible_light(light, s, fast, ws_fast);
+  OccluderMesh::Workspace ws_fast, ws_slow, ws_bare, ws_kept;
+  std::vector<Arc> fast, slow, bare, kept_images;
+  mesh.visible_light_cone(light, s, fast, ws_fast);
+  const size_t kept = mesh.visible_light(light, s, kept_images, ws_kept);
   mesh.visible_light_per_triangle(light, s, slow, ws_slow);
   OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
   const double scale = std::abs(prt::bake::solid_angle(bare));
@@ -58,20 +61,36 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
       }
     return true;
   };
-  const bool fast_ok = directions(fast, "contour path"), slow_ok = directions(slow, "per triangle");
-  if (!fast_ok || !slow_ok) return;
-  const double e_fast = s.n.dot(prt::bake::vector_irradiance(fast)), e_slow = s.n.dot(prt::bake::vector_irradiance(slow));
-  EXPECT_NEAR(e_fast, e_slow, kExact * scale) << what;
+  const bool fast_ok = directions(fast, "cone path"), slow_ok = directions(slow, "per triangle"),
+             kept_ok = directions(kept_images, "contour path over the kept images");
+  if (!fast_ok || !slow_ok || !kept_ok) return;
+  const double e_slow = s.n.dot(prt::bake::vector_irradiance(slow));
   std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
-  sh.project(std::span<const Arc>(fast), a);
   sh.project(std::span<const Arc>(slow), b);
-  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], kExact * scale) << what << " SH " << i;
+  for (const auto* arcs : {&fast, &kept_images}) {
+    const char* which = arcs == &fast ? " (cone path)" : " (kept images)";
+    EXPECT_NEAR(s.n.dot(prt::bake::vector_irradiance(*arcs)), e_slow, kExact * scale) << what << which;
+    sh.project(std::span<const Arc>(*arcs), a);
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], kExact * scale) << what << which << " SH " << i;
+  }
   ++totals.points;
   totals.shadowed += e_slow < s.n.dot(prt::bake::vector_irradiance(bare)) - 1e-6 * scale;
-  totals.boundary_edges += ws_fast.stats.boundary_edges;
+  totals.boundary_edges += ws_kept.stats.boundary_edges;
   totals.kept += kept;
-  totals.special += ws_fast.stats.special;
-  totals.uncharted += ws_fast.stats.uncharted;
+  totals.special += ws_kept.stats.special;
+  totals.uncharted += ws_kept.stats.uncharted;
+  totals.queries += ws_kept.stats.queries;
+  totals.cone += ws_fast.stats.cone;
+  totals.cone_edges += ws_fast.stats.cone_edges;
+  totals.cone_candidates += ws_fast.stats.cone_candidates;
+  totals.all_kept += ws_fast.stats.cone ? kept : 0;
+  // The cone path's edges: the tree's answer is the brute-force rule's, edge for edge.
+  std::vector<uint32_t> tree, brute, tree_special, brute_special;
+  OccluderMesh::Workspace ws_tree, ws_brute;
+  mesh.cone_edges(light, s, tree, tree_special, ws_tree);
+  mesh.cone_edges_brute_force(light, s, brute, brute_special, ws_brute);
+  EXPECT_EQ(tree, brute) << what;
+  EXPECT_EQ(tree_special, brute_special) << what;
 }
 
 std::vector<V3> positions_of(const prt::bake::Mesh& m) {
@@ -120,6 +139,10 @@ TEST(OccluderContour, BunnyGroundPointsEqualPerTriangle) {
   }
   EXPECT_GT(totals.shadowed, 60u);
   EXPECT_LT(totals.boundary_edges * 4, totals.kept * 3);  // < a quarter of the per-triangle edges
+  // Nothing of the bunny is clipped by the light's plane or has p in its plane: every query
+  // takes the cone path, which passes on fewer images than culling keeps.
+  EXPECT_EQ(totals.cone, totals.queries);
+  EXPECT_LT(totals.cone_candidates, totals.all_kept);
 }
 
 TEST(OccluderContour, BunnyOwnVerticesEqualPerTriangle) {
@@ -133,6 +156,7 @@ TEST(OccluderContour, BunnyOwnVerticesEqualPerTriangle) {
   EXPECT_GT(totals.points, 250u);
   EXPECT_GT(totals.shadowed, 20u);
   EXPECT_GT(totals.special, totals.points / 2);  // the own 1-ring's ε-limit cones were cut
+  EXPECT_EQ(totals.cone, totals.queries);          // … by the cone path too (special faces' fans)
 }
 
 TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
@@ -154,12 +178,13 @@ TEST(OccluderContour, BunnyOnAGroundPlaneEqualsPerTriangle) {
   const auto points = prt::bake::vertex_shade_points(bunny, prt::bake::build_topology(bunny));
   for (size_t v = 3; v < points.size(); v += 41) compare(mesh, kBunnyLight, points[v], "vertex", totals);
   EXPECT_GT(totals.shadowed, 40u);
+  EXPECT_EQ(totals.cone, totals.queries);
 }
 
 // Light z = 3 (2 × 2), p near the origin: a random selection of points and normals, the same for
 // every small scene below.
-void compare_scene(const std::vector<V3>& pos, const std::vector<Tri>& tris, const std::string& what, uint64_t seed,
-                   size_t min_shadowed) {
+Totals compare_scene(const std::vector<V3>& pos, const std::vector<Tri>& tris, const std::string& what, uint64_t seed,
+                     size_t min_shadowed) {
   const OccluderMesh mesh(pos, tris);
   const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
   std::mt19937_64 rng(seed);
@@ -171,6 +196,7 @@ void compare_scene(const std::vector<V3>& pos, const std::vector<Tri>& tris, con
     compare(mesh, light, s, what + " " + std::to_string(k), totals);
   }
   EXPECT_GE(totals.shadowed, min_shadowed) << what;
+  return totals;
 }
 
 // A crumpled open n × n sheet over [-1.2, 1.2]² at heights 1–2.
@@ -204,6 +230,123 @@ TEST(OccluderContour, OpenSheetsFacingEitherWay) {
     compare_scene(pos, tris, flip ? "sheet facing down" : "sheet facing up", 11, 100);
     tris.erase(tris.begin() + 22, tris.begin() + 26);
     compare_scene(pos, tris, "sheet with a hole", 12, 80);
+  }
+}
+
+// A closed tetrahedron (outward faces) with corners c + r·(±1, ±1, ±1) of even parity.
+void add_tetrahedron(std::vector<V3>& pos, std::vector<Tri>& tris, const V3& c, double r) {
+  const auto b = uint32_t(pos.size());
+  for (const V3& d : {V3(1, 1, 1), V3(1, -1, -1), V3(-1, 1, -1), V3(-1, -1, 1)}) pos.push_back(c + r * d);
+  for (const Tri& t : {Tri{0, 1, 2}, Tri{0, 3, 1}, Tri{0, 2, 3}, Tri{1, 3, 2}}) {
+    const Tri face{b + t[0], b + t[1], b + t[2]};
+    // Outward: the corner left out lies behind the face.
+    const uint32_t other = b + 6 - (t[0] + t[1] + t[2]);
+    const V3 n = (pos[face[1]] - pos[face[0]]).cross(pos[face[2]] - pos[face[0]]);
+    tris.push_back(n.dot(pos[other] - pos[face[0]]) < 0 ? face : Tri{face[0], face[2], face[1]});
+  }
+}
+
+TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
+  // The cone path's coverage comes only from the images meeting a light edge's or a found
+  // edge's fan. A wide two-triangle roof between every point and the light has no edge in the
+  // cone (its diagonal is seen from below by both faces, its border is outside the pyramid): the
+  // light edges' fans alone find it hidden. Then a tetrahedron under the roof (its contour edges
+  // are found, the roof covers their far side), one beside a wall across half the light, and a
+  // tetrahedron alone.
+  std::vector<V3> roof{{-9, -9, 2}, {9, -9, 2}, {9, 9, 2}, {-9, 9, 2}};
+  std::vector<Tri> roof_tris{{0, 1, 2}, {0, 2, 3}};
+  const OccluderMesh roof_mesh(roof, roof_tris);
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  for (const V3& n : {V3(0, 0, 1), V3(0.3, -0.2, 1).normalized()}) {
+    OccluderMesh::Workspace ws;
+    std::vector<Arc> arcs;
+    std::vector<uint32_t> edges, special;
+    roof_mesh.cone_edges(light, {.p = V3(0.2, 0.1, 0), .n = n}, edges, special, ws);
+    EXPECT_TRUE(edges.empty());
+    EXPECT_TRUE(special.empty());
+    roof_mesh.visible_light_cone(light, {.p = V3(0.2, 0.1, 0), .n = n}, arcs, ws);
+    EXPECT_TRUE(arcs.empty());  // hidden: no arc at all, E = 0 exactly
+    EXPECT_EQ(ws.stats.cone, 1u);
+    EXPECT_EQ(ws.stats.cone_candidates, 2u);
+  }
+  auto under_roof = roof_tris;
+  auto pos = roof;
+  add_tetrahedron(pos, under_roof, V3(0.1, 0.2, 1.2), 0.3);
+  Totals totals = compare_scene(pos, under_roof, "tetrahedron under a roof", 41, 200);
+  EXPECT_EQ(totals.cone, totals.queries);
+  EXPECT_GT(totals.cone_edges, 2 * totals.points);
+
+  std::vector<V3> wall{{0, -9, 2.5}, {9, -9, 2.5}, {9, 9, 2.5}, {0, 9, 2.5}};
+  std::vector<Tri> wall_tris{{0, 1, 2}, {0, 2, 3}};
+  add_tetrahedron(wall, wall_tris, V3(-0.2, 0.1, 1.4), 0.35);
+  totals = compare_scene(wall, wall_tris, "tetrahedron beside a wall", 42, 150);
+  EXPECT_EQ(totals.cone, totals.queries);
+
+  // A fine plate inside the light's image with a small tetrahedron under its middle: the plate's
+  // triangles over the tetrahedron meet neither a light edge's fan nor a plate border's; only
+  // the tetrahedron's contour edges' fans pass them on (left out, the tetrahedron would show).
+  std::vector<V3> plate;
+  std::vector<Tri> plate_tris;
+  const int cells = 8;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) plate.emplace_back(-0.5 + 1.0 * i / cells, -0.5 + 1.0 * j / cells, 2);
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      const auto a = uint32_t(j * (cells + 1) + i), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
+      plate_tris.push_back({a, b, d});
+      plate_tris.push_back({a, d, c});
+    }
+  add_tetrahedron(plate, plate_tris, V3(0.05, -0.05, 1.5), 0.08);
+  totals = compare_scene(plate, plate_tris, "tetrahedron under a plate", 44, 150);
+  EXPECT_EQ(totals.cone, totals.queries);
+
+  std::vector<V3> alone;
+  std::vector<Tri> alone_tris;
+  add_tetrahedron(alone, alone_tris, V3(0.3, -0.2, 1.5), 0.4);
+  totals = compare_scene(alone, alone_tris, "tetrahedron alone", 43, 100);
+  EXPECT_EQ(totals.cone, totals.queries);
+}
+
+TEST(OccluderContour, ConePathOnAFullPyramid) {
+  // A fine plate with a hole (80,000 triangles, ~9,000 of them in the pyramid) and a tetrahedron
+  // under the hole: the cone path passes on far fewer images than culling keeps and gives the
+  // same integrals as the kept-images path (held to the per-triangle method above; the
+  // per-triangle method itself is O(E²) here).
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  const int cells = 200;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) pos.emplace_back(-2 + 4.0 * i / cells, -2 + 4.0 * j / cells, 2);
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      if (std::abs(i - 100) < 15 && std::abs(j - 95) < 10) continue;  // the hole
+      const auto a = uint32_t(j * (cells + 1) + i), b = a + 1, c = a + uint32_t(cells + 1), d = c + 1;
+      tris.push_back({a, b, d});
+      tris.push_back({a, d, c});
+    }
+  add_tetrahedron(pos, tris, V3(0.05, -0.1, 1.2), 0.15);
+  const OccluderMesh mesh(pos, tris);
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  static const prt::bake::PolygonSH sh(kOrder);
+  for (const V3& p : {V3(0, 0, 0), V3(0.1, -0.2, 0.3), V3(-0.05, 0.1, -0.2)}) {
+    const ShadePoint s{.p = p, .n = V3(0.1, 0.05, 1).normalized()};
+    OccluderMesh::Workspace ws_chosen, ws_kept, ws_bare;
+    std::vector<Arc> chosen, kept, bare;
+    mesh.visible_light_cone(light, s, chosen, ws_chosen);
+    const size_t culled = mesh.visible_light_kept_images(light, s, kept, ws_kept);
+    OccluderMesh({}, {}).visible_light(light, s, bare, ws_bare);
+    EXPECT_GT(culled, 5000u);
+    EXPECT_EQ(ws_chosen.stats.cone, 1u);
+    EXPECT_LT(ws_chosen.stats.cone_candidates * 5, culled);  // the fans cross the plate along lines
+    const double scale = std::abs(prt::bake::solid_angle(bare));
+    const double e = s.n.dot(prt::bake::vector_irradiance(kept));
+    EXPECT_NEAR(s.n.dot(prt::bake::vector_irradiance(chosen)), e, kExact * scale);
+    EXPECT_GT(e, 1e-3 * scale);  // light through the hole, partly hidden by the tetrahedron
+    EXPECT_LT(e, 0.5 * s.n.dot(prt::bake::vector_irradiance(bare)));
+    std::vector<double> a(kOrder * kOrder), b(kOrder * kOrder);
+    sh.project(std::span<const Arc>(chosen), a);
+    sh.project(std::span<const Arc>(kept), b);
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], kExact * scale) << "SH " << i;
   }
 }
 
@@ -311,6 +454,7 @@ TEST(OccluderContour, IntegerGridSoupsFullOfTies) {
   }
   EXPECT_GT(totals.shadowed, 100u);
   EXPECT_GT(totals.special, 20u);
+  EXPECT_EQ(totals.cone, totals.queries);  // the cone path answers every query (no fallback left)
 }
 
 TEST(OccluderContour, LightTooWideForTheChart) {

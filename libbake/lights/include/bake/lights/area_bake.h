@@ -8,11 +8,12 @@
 //            (the SH projection of the visible light, prtshade's basis: glossy receivers shade
 //            with it against their lobe)
 // The visible part comes from bake/visibility/occluder_mesh.h (culling, exact depth against each emitting
-// face's plane, the shade point's ε-limit) over the scene's occluder mesh, by its contour path
-// (issue 32: only the image edges that may bound the occluders' union are cut — contour,
-// boundary and non-manifold edges, the point's own 1-ring — each against the images near it;
-// paper 003 §3.1, §4.4; the per-triangle method stays as the tests' reference,
-// OccluderMesh::visible_light_per_triangle); E from Lambert's vector
+// face's plane, the shade point's ε-limit) over the scene's occluder mesh, by
+// OccluderMesh::visible_light (issue 32: only the image edges that may bound the occluders' union
+// are cut — contour, boundary and non-manifold edges, the point's own 1-ring — each against the
+// images near it; paper 003 §3.1, §4.4; the per-triangle method stays as the tests' reference,
+// OccluderMesh::visible_light_per_triangle, and the output-sensitive cone path is beside it as
+// OccluderMesh::visible_light_cone, not used here yet); E from Lambert's vector
 // irradiance and S from the polygon's closed-form SH projection (bake/sphere/spherical_polygon.h,
 // bake/sphere/polygon_sh.h). A light's faces (bake/lights/lights.h) emit towards their counter-clockwise side
 // (both sides for two_sided planar lights); a face contributes where p is strictly on an emitting

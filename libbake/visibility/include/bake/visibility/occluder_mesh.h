@@ -27,10 +27,44 @@
 //    face's plane that cone has no interior and is dropped (ShadePoint::t is not used: such a face
 //    blocks nothing, as with t = 0).
 // Then V = light \ ∪ images exactly (every orientation decided by orient3d_exact, after a
-// floating-point filter whose bound is far above its error; unions counted once), by one of two
+// floating-point filter whose bound is far above its error; unions counted once), by one of three
 // methods that give the same arcs up to cuts of rounding size. Triangles are passed in index
-// order whatever the tree's walk, so both and the unculled reference make the same decisions on ties.
-//  * The contour path (visible_light; issue 32): the boundary of the union of images lies only on
+// order whatever the tree's walk, so all of them and the unculled reference make the same
+// decisions on ties.
+//  * The cone path (visible_light_cone; issue 32): the images are not all built. The boundary of
+//    the union of images inside the light lies on the image edges of the welded mesh edges that
+//    may bound it seen from p (paper 003 §3.1 silhouette edges; paper 001 §3.1 contour edges
+//    seen from p): an edge of two whole faces (every corner strictly on p's side of the light's
+//    plane) with distinct welded corners that run it both ways bounds nothing when p is strictly
+//    on the same side of both faces' planes (their images lie on opposite sides of the edge).
+//    Every other welded edge not outside the pyramid may: contour edges (the faces facing
+//    apart), boundary and non-manifold edges, edges wound the same way by both faces, edges of
+//    degenerate faces, and edges of a face that is dropped or special. A special face is one in
+//    the pyramid clipped by the light's plane or with p in its plane (the shade point's own
+//    1-ring, an occluder edge through p, a face seen edge-on): its images' edges are all cut.
+//    These edges and special faces are found by an edge tree (a binary tree over the welded
+//    edges; per node the box of its edges' faces, the box's bounding sphere (centre c, radius r)
+//    and a cone of its faces' unit normals (axis a, |n̂ − a| ≤ s)) walked against the pyramid:
+//    a node is passed over when its box is outside a culling plane, or when it holds only such
+//    consistently wound pairs, its box lies strictly on p's side of the light's plane and
+//    |a·(p − c)| > s|p − c| + r + 1e-9(|p − c| + r) (then n̂·(p − x) has one strict sign for every
+//    face point x and normal n̂ of the node, far beyond the rounding of n̂); the leaves decide each
+//    edge exactly (orient3d_exact, the light frame's exact depth, the culling planes' margins).
+//    cone_edges_brute_force applies the leaves' rule to every edge: the same sets.
+//    Coverage needs only the images that meet a cut edge: for each light edge, each found edge
+//    and each special image's edge, its fan (the rays from p through it, up to the light's plane:
+//    the plane through p and the edge, both sides with a margin far above the rounding of its
+//    normal, the wedge between the two rays, the light's plane) is walked in the triangle tree,
+//    64 fans at a time, each node carrying its live fans, nodes and triangles outside the
+//    pyramid skipped. The triangles met, and the special faces, become images (in index order);
+//    an image edge is cut iff its welded edge was found, except that of a consistently wound pair
+//    whose other face, listed first, has a whole image (a fold's second edge, or an edge whose far
+//    side that face covers: the rule below), and every edge of a special image; then
+//    visible_region_sparse. Each cut edge meets exactly the images it met among all kept images
+//    (every image meeting it lies on its fan), and an edge not cut emits nothing either way, so
+//    the arcs are the kept-images path's.
+//  * The contour path over every kept image (visible_light_kept_images, the fast path before the
+//    cone path): the boundary of the union of images lies only on
 //    image edges whose far side (right of the edge, away from its own image) is not covered along
 //    the edge by the image of another face on the same mesh edge (paper 003 §3.1: silhouette
 //    edges; §4.4 and [OZ06]: about √e of them). The mesh's edge → faces map is built once
@@ -44,20 +78,22 @@
 //    images near it: contour edges (faces of different facing), boundary and non-manifold edges,
 //    T-junctions and coincident sheets (no shared vertex index after welding), edges next to a
 //    culled, dropped, clipped or ε-limit face, and every edge of a clipped image or of an
-//    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). None of these
-//    falls back to the per-triangle method: there is no fallback; the only degraded case is a
-//    light of ≥ 84° radius seen from p, where the chart is not used and each edge meets every
-//    image whose cap meets its own (Workspace::stats counts it, and the queries with clipped or
-//    ε-limit images).
+//    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). The only
+//    degraded case is a light of ≥ 84° radius seen from p, where the chart is not used and each
+//    edge meets every image whose cap meets its own (Workspace::stats counts it, and the queries
+//    with clipped or ε-limit images).
 //  * The per-triangle method (visible_light_per_triangle; visible_light_reference without the
 //    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
-//    reference the tests hold the contour path to (1e-9 of the light's solid angle, E and SH).
-// Cost: culling and the images are linear in the triangles inside the light's pyramid; the
-// contour path then costs the chart's grid over them plus, per edge cut, the images near it
-// (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: contour path": the bunny
-// under a quad light: 6.2–6.8k ground points/s and 44–47k of its own vertices/s per core,
-// 9–13x the per-triangle method; over Loop levels 0–3 the ground rate falls as T^-0.9 while the
-// edges cut grow as T^0.45: the part linear in the kept triangles dominates).
+//    reference the tests hold both paths to (1e-9 of the light's solid angle, E and SH).
+// visible_light takes the kept-images path. The cone path is faster where the pyramid holds many
+// more triangles than the edges it finds (the bunny Loop-subdivided 3–4 times: 1.5–2.1x) and
+// slower on small pyramids and on the CAD engine (long thin triangles: its fans meet nearly every
+// kept triangle, and it cuts more edges): a choice per query by the triangles culling keeps
+// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet.
+// Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
+// images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
+// found edges: the edge tree's walk, per found edge a fan walk and the images on it
+// (bench/bench_area.cpp BM_BunnyQuad, bench/RESULTS.md "area lights: the cone path").
 #pragma once
 
 #include <bake/mesh/mesh.h>
@@ -70,6 +106,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace prt::bake {
@@ -112,7 +149,18 @@ public:
       size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
       size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
       size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
+      // The cone path: queries it answered (the rest took the kept-images path), the welded
+      // edges it found in the cone and the triangles whose images it passed on (those met by a
+      // fan, and the special faces), summed over the queries it answered; edge-tree nodes
+      // visited and fan tests (a fan against a tree node), over every walk.
+      size_t cone = 0, cone_edges = 0, cone_candidates = 0, edge_nodes = 0, fan_tests = 0;
     } stats;
+    // The cone path's scratch: per welded edge the query that found it in the cone; the found
+    // edges and special faces; the fans' planes (five per fan).
+    std::vector<uint32_t> group_stamp, cone, special_faces, edge_stack;
+    std::vector<Plane> fan;
+    std::vector<std::pair<uint32_t, uint64_t>> fan_stack;  // node, live fans
+    uint32_t group_mark = 0;
   };
 
   // out = the boundary arcs (bake/sphere/spherical_polygon.h Arc, directions from p) of the part of the
@@ -121,16 +169,38 @@ public:
   // one-sided light's back side is the caller's decision). Empty when p lies in the light's plane
   // or nothing of it is above the horizon. Integrate with point.n·vector_irradiance(out) (the
   // irradiance from unit radiance) and PolygonSH::project(out) (bake/sphere/polygon_sh.h).
-  // By the contour path (file comment). Returns the number of triangles kept after culling
-  // (those whose images are passed on).
+  // Every method below returns the number of triangles whose images were built (kept by
+  // culling, or met by a fan on the cone path).
   // Thread-safe (const) with one Workspace per thread. A convex emitter (box, cylinder, sphere as
   // a polyhedron) is the sum of its faces facing p, each a planar light here; the emitter's own
   // triangles may stay in the mesh (each lies in or behind the plane of a front face, and is
   // dropped by the depth test).
+  // By the contour path over every kept image (file comment: the cone path is not the default;
+  // bench/RESULTS.md "area lights: the cone path" says where each is faster).
   size_t visible_light(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
                        Workspace& ws) const {
     return query(light, point, out, ws, Method::contour);
   }
+  // The cone path (file comment): the same arcs' integrals.
+  size_t visible_light_cone(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out,
+                            Workspace& ws) const {
+    return query(light, point, out, ws, Method::cone);
+  }
+  // The same as visible_light, by name (the tests and bench_area hold the paths side by side).
+  size_t visible_light_kept_images(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                                   std::vector<Arc>& out, Workspace& ws) const {
+    return query(light, point, out, ws, Method::contour);
+  }
+  // The cone path's first step alone: the welded mesh edges (numbered 0 .. edge_count() − 1)
+  // that may bound the occluders' union inside the light's pyramid, and the special triangles
+  // there (clipped by the light's plane, or with p in their plane: every image edge cut), both
+  // ascending (file comment "cone path"), by the edge tree.
+  void cone_edges(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<uint32_t>& edges,
+                  std::vector<uint32_t>& special, Workspace& ws) const;
+  // Reference of cone_edges: the same rule over every welded edge, without the tree. Equal sets.
+  void cone_edges_brute_force(std::span<const Eigen::Vector3d> light, const ShadePoint& point,
+                              std::vector<uint32_t>& edges, std::vector<uint32_t>& special, Workspace& ws) const;
+  size_t edge_count() const { return edge_group_start_.empty() ? 0 : edge_group_start_.size() - 1; }
   // The per-triangle method (paper 003 §4.4; the fast path before issue 32): the same culling
   // and images, then visible_region over every kept image's edges, O(E²). The slow reference of
   // the contour path: the same arcs' integrals.
@@ -155,7 +225,19 @@ private:
     uint32_t first, total;  // the subtree's triangles: order_[first, first + total)
   };
   struct LightFrame;
-  enum class Method { contour, per_triangle, reference };
+  enum class Method { cone, contour, per_triangle, reference };
+  // The edge tree (cone path): a binary tree over the welded edges (median splits, leaves of ≤ 4),
+  // each node with the box of its edges' faces, that box's bounding sphere and a cone of its
+  // faces' unit normals (axis, and spread ≥ |n̂ − axis| for every face), and whether an edge
+  // under it is `flagged` (not two faces of distinct welded corners running it both ways).
+  struct EdgeNode {
+    Eigen::Vector3d lo, hi, centre, axis;
+    double radius, spread;
+    uint32_t index;  // leaf: first entry of edge_order_; inner: right child (left child is this + 1)
+    uint32_t count;  // leaf: edge count (> 0); inner: 0
+    uint32_t total;  // the subtree's edges
+    bool flagged;
+  };
   enum class ImageKind : uint8_t { none, triangle, special };  // special: clipped or an ε-limit cone
 
   uint32_t build(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centroids);
@@ -164,6 +246,21 @@ private:
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
+  template <class Keep>
+  void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  // Calls keep(t) (possibly more than once) for each triangle not outside every fan, a fan being
+  // five consecutive planes of `planes` (≤ 64 fans): one walk, each node carrying its live fans.
+  template <class Keep>
+  void walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
+  uint32_t build_edges(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centres);
+  // 1: edge g may bound the union in the cone; 0: it cannot. Its faces in the pyramid with a
+  // clipped image or p in their plane are appended to `special`.
+  int classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws,
+                    std::vector<uint32_t>& special) const;
+  uint32_t next_stamp(Workspace& ws) const;  // a fresh mark of ws.tri_stamp
+  void cone_query(const ShadePoint& point, const LightFrame& frame, std::vector<Arc>& out, Workspace& ws) const;
+  void find_cone_edges(const ShadePoint& point, const LightFrame& frame, Workspace& ws, bool brute) const;
 
   std::vector<Eigen::Vector3d> positions_;
   std::vector<std::array<uint32_t, 3>> triangles_;
@@ -173,6 +270,11 @@ private:
   // pair, group g = edge_slots_[edge_group_start_[g] .. edge_group_start_[g + 1]).
   std::vector<uint32_t> edge_slots_, slot_group_, edge_group_start_;
   std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
+  std::vector<Eigen::Vector3d> face_normal_;  // unit normal of (b − a)×(c − a), zero when degenerate
+  std::vector<uint8_t> edge_flagged_;         // per welded edge (see EdgeNode)
+  std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
+  std::vector<uint32_t> edge_rank_;           // per welded edge: its place in edge_order_
+  std::vector<EdgeNode> edge_nodes_;
 };
 
 } // namespace prt::bake
