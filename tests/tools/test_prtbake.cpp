@@ -494,6 +494,10 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   const F::Dataset* surface = F::find_dataset(f, "/fiv/occluders/spider/surface_radius");
   ASSERT_NE(surface, nullptr);
   EXPECT_EQ(surface->shape, (std::vector<uint64_t>{5, 8}));
+  // ... and the tight proxy's cone table beside the surface-following shells (the default bake).
+  const F::Dataset* cones = F::find_dataset(f, "/fiv/occluders/spider/cones");
+  ASSERT_NE(cones, nullptr);
+  EXPECT_EQ(cones->shape[3], 4u);
   EXPECT_EQ(std::get<int64_t>(F::find_attr(f.root_attrs, "format_version")->value), 7);
   // --radial geometric: paper 004's spheres (no radial_scheme, no surface_radius); the file is
   // still version 7 for its cone table (the tight proxy every bake writes).

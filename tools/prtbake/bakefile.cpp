@@ -355,9 +355,9 @@ F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const b
                                "0: the integrator found the offset inside the occluder; its value is extrapolated "
                                "along the radial line",
                                {}};
-    return o;
+  } else {
+    o.valid = F::OccluderValid{std::move(shells.valid), "0: the offset lies inside the occluder (nothing visible)", {}};
   }
-  o.valid = F::OccluderValid{std::move(shells.valid), "0: the offset lies inside the occluder (nothing visible)", {}};
   if (!shells.cones.empty()) {  // the tight proxy (v7)
     o.cones = F::OccluderCones{std::move(shells.cones),
                                "(m, Omega)(s) = (Int (1 - V(s,w)) w dw, Int (1 - V(s,w)) dw), layout [rho][theta][phi][4]", {}};
