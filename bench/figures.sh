@@ -220,11 +220,12 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   shells"): each direction's samples start 0.005 R outside the bunny's outer surface along the
   ray and grow geometrically, so the contact shadow within the 0.07-unit gap is sampled where
   paper 004's spheres (~0.6 units apart there, their samples inside the bunny dropped, §4.3.2)
-  could not; the error falls with resolution again. At equal memory the spheres' row (64x33x30,
-  --radial geometric) shows the gain. Most of what is left is the partial-occluder factor: the
-  bunny's bounding sphere (R = 6.64, centre 4.8 above the ground) puts every ground receiver in
-  case B, and (h + R)/2R = 0.86 scales the whole shadow down; the diagnostic row without the
-  factor is the shells' own error (the rest: the ears' thin shadows at 64x33 directions).
+  could not; the error falls with resolution again (32x17x15, 64x33x30, 256x129x30). At equal
+  memory the spheres' row (64x33x30, --radial geometric, same cone proxy) shows the gain. With the
+  cone proxy the partial-occluder correction no longer scales the shadow down (the paper's
+  (h + R)/2R did: 0.86 for every ground receiver); the diagnostic row without it is the same
+  error. What is left at 64x33x30 is mostly the ears' thin shadows at 64x33 directions: the
+  finer angular grid takes it further down.
 - **Overlap correction (eq. 13-14) and the occluder proxy.** The paper's unit bounding discs are
   the bounding spheres (R = 6.64 for the 9.65 x 7.5 bunny): from the ground between two bunnies
   they overlap far more than the occluded parts of the sky do, and the correction adds back light
@@ -241,6 +242,12 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   cap's part below the horizon (a closed-form clamped cosine) lit by the receiver's mean radiance
   from below, E_tot(-n)/pi from the DifMap — small under forest.exr, large under a bright ground
   (the paper's kind of scene, Fig. 17's chess queen).
+- **50 dynamic occluders.** Copies of three baked occluders (20 bunnies, 15 spiders, 15 statues;
+  data/fiv_instances50.json) placed at run time on one ground, 36 touching it and 14 floating:
+  many overlapping shadows from occluders of three shapes. The paper's bounding spheres
+  over-correct the overlaps (their discs cover far more sky than a spider's legs do); the cone
+  proxy's caps follow the objects, and its overlap correction lowers the error a little more.
+  The frame's cost at 1080p on one core is in bench/RESULTS.md ("50 dynamic occluders").
 - **Default scene.** Order-3 transfer cannot hold sunset.exr's sun (a lobe 4,000x the mean):
   NRMSE 0.03, mostly in the contact and self-shadows; order 8 and band-1 radiance (exact at the
   vertices; what is left is Gouraud interpolation between vertices) are within 0.006-0.008.
