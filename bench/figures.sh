@@ -29,11 +29,11 @@ done
 
 if ((build)); then
   cmake --preset release >/dev/null
-  cmake --build --preset release --target prtbake prtview -j 2
+  cmake --build --preset release --target prtbake prtview sky_exr -j 2
 fi
 BAKE=build/release/tools/prtbake
 VIEW=build/release/tools/prtview
-for b in "$BAKE" "$VIEW"; do [ -x "$b" ] || { echo "figures.sh: $b not built (run without --no-build)" >&2; exit 1; }; done
+for b in "$BAKE" "$VIEW" build/release/bench/sky_exr; do [ -x "$b" ] || { echo "figures.sh: $b not built (run without --no-build)" >&2; exit 1; }; done
 
 work=out/figures
 mkdir -p "$work"
@@ -127,9 +127,9 @@ view "Bunny partly below the ground, partial-occluder factor (h+R)/2R on (boundi
 # ---- the paper's kind of scene (issue 33): Fig. 15, three bunnies in a row whose occluded cones overlap in
 # the sky under an overcast sky (uniform radiance above the horizon, eq. 14's own assumption); Fig. 17, the
 # sunk bunny under a bright ground (light from below the receiver's horizon matters). Two-tone
-# environments made by bench/sky_exr.py ----
-run python3 bench/sky_exr.py "$work/overcast.exr" 1,1,1 0.1,0.1,0.1
-run python3 bench/sky_exr.py "$work/bright_ground.exr" 0.6,0.7,0.9 2.0,1.8,1.5
+# environments made by bench/sky_exr.cpp (build/release/bench/sky_exr) ----
+run build/release/bench/sky_exr "$work/overcast.exr" 1,1,1 0.1,0.1,0.1
+run build/release/bench/sky_exr "$work/bright_ground.exr" 0.6,0.7,0.9 2.0,1.8,1.5
 run "$BAKE" fiv "$BUNNY" --env "$work/overcast.exr" --shells 64x33x30 --report 0 --quiet -o "$work/bunny_overcast.prt.h5"
 run "$BAKE" fiv "$BUNNY" --env "$work/bright_ground.exr" --shells 64x33x30 --report 0 --quiet -o "$work/bunny_bright.prt.h5"
 CAMR="eye=34,24,0:at=0,0,0:fov=55"
