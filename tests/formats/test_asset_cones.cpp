@@ -7,6 +7,7 @@
 #include <formats/names.h>
 #include <formats/testing.h>
 
+#include <fiv_asset.h>
 #include <gtest/gtest.h>
 #include <schema_refusal.h>
 
@@ -19,17 +20,8 @@ using prt::testing::expect_refused;
 namespace {
 
 Asset fiv_asset() {
-  Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake fiv bunny.obj", "bunny.obj", std::string(64, 'a'),
-            "y", "real orthonormal", {}};
-  Occluder& o = a.occluders.emplace_back();
-  o.name = "bunny";
-  o.n_rho = 2, o.n_theta = 2, o.n_phi = 3;
-  o.shells.assign(2 * 2 * 3 * 9, 0.25f);
-  o.centre = {0, 1, 0};
-  o.radius = 1.5;
-  o.radii = {1.5, 3};
-  o.valid = OccluderValid{std::vector<uint8_t>(12, 1), "0: inside", {}};
+  Asset a = prt::testing::small_fiv_asset(0.25f, 1.5, {1.5, 3}, "0: inside");
+  Occluder& o = a.occluders.front();
   o.cones = OccluderCones{std::vector<float>(12 * 4, 0.5f), "(m, Omega)", {}};
   o.proxy = "cone";
   return a;

@@ -9,6 +9,7 @@
 #include <formats/names.h>
 #include <formats/testing.h>
 
+#include <fiv_asset.h>
 #include <gtest/gtest.h>
 #include <schema_refusal.h>
 
@@ -22,17 +23,8 @@ using prt::testing::expect_refused;
 namespace {
 
 Asset fiv_asset(bool surface) {
-  Asset a;
-  a.root = {kFormatVersion, "test", "2024-01-02T03:04:05Z", "prtbake fiv bunny.obj", "bunny.obj", std::string(64, 'a'),
-            "y", "real orthonormal", {}};
-  Occluder& o = a.occluders.emplace_back();
-  o.name = "bunny";
-  o.n_rho = 2, o.n_theta = 2, o.n_phi = 3;
-  o.shells.assign(2 * 2 * 3 * 9, 0.5f);
-  o.centre = {0, 1, 0};
-  o.radius = 2;
-  o.radii = {0.01, 0.04};
-  o.valid = OccluderValid{std::vector<uint8_t>(12, 1), "0: extrapolated", {}};
+  Asset a = prt::testing::small_fiv_asset(0.5f, 2, {0.01, 0.04}, "0: extrapolated");
+  Occluder& o = a.occluders.front();
   if (surface) {
     o.radial_scheme = "surface";
     o.first_offset = 0.005;
