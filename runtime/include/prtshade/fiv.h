@@ -77,7 +77,8 @@
 //     Ω(s) = ∫ (1 − V_O(s, ω)) dω,   m(s) = ∫ (1 − V_O(s, ω)) ω dω,
 //   baked exactly by the same integrals as the shells (bake/bake/fiv.h), on the same grid and
 //   looked up with the same stencil (the valid mask, renormalisation, clamp and (ρ_last/ρ)² falloff
-//   of the shells: both are integrals over the occluded set, so both fall off like it). From p,
+//   of the shells — for surface-following shells their plain trilinear stencil and falloff, no
+//   mask: both are integrals over the occluded set, so both fall off like it). From p,
 //   occluder i is then the cap (its cone) of axis a = m/|m| (the direction towards the centre
 //   when m = 0) and half-angle α with 2π(1 − cos α) = Ω (the cap of the occluded solid angle,
 //   centred on the occluded directions' mean). With FivShadeOptions::proxy == cone:
