@@ -5,6 +5,7 @@
 #include <bake/sphere/spherical_polygon.h>
 #include <bake/visibility/raycast.h>
 
+#include <prtshade/lights.h>
 #include <prtshade/sh.h>
 
 #include <algorithm>
@@ -22,18 +23,13 @@ const char* punctual_kind_name(PunctualKind k) {
   return "?";
 }
 
+// KHR_lights_punctual's falloffs have one home, the runtime's contract (prtshade/lights.h): a baked
+// light and one a runtime shades live agree wherever nothing shadows.
 double spot_falloff(double cos_angle, double inner_cone, double outer_cone) {
-  const double cos_outer = std::cos(outer_cone);
-  const double scale = 1.0 / std::max(0.001, std::cos(inner_cone) - cos_outer);
-  const double a = std::clamp(cos_angle * scale - cos_outer * scale, 0.0, 1.0);
-  return a * a;
+  return shade::spot_falloff(cos_angle, inner_cone, outer_cone);
 }
 
-double range_window(double distance, double range) {
-  if (!(range > 0)) return 1;
-  const double x = distance / range, x2 = x * x;
-  return std::clamp(1 - x2 * x2, 0.0, 1.0);
-}
+double range_window(double distance, double range) { return shade::range_window(distance, range); }
 
 void validate_punctual_light(const PunctualLight& l, const std::string& file, const std::string& what) {
   auto fail = [&](const std::string& defect) { throw InputError(file, what + ": " + defect); };
