@@ -19,7 +19,9 @@
 //   BM_ShadeFivCones/occluders:N    shade_fiv with the tight proxy (prtshade/fiv.h "Tight proxies"):
 //                                   the same scene, every occluder with a cone table (the exact
 //                                   cone of a ball of radius 0.7 R on the same grid)
-//   BM_ShadeFivSurfaceCones/occluders:N  both: what a default bake gives (surface shells, cone proxy)
+//   BM_ShadeFivSurfaceCones/occluders:N  both, float tables (a --precision float bake)
+//   BM_ShadeFivSurfaceConesHalf/occluders:N  both with half-float tables (prtshade/fiv.h "Half-float
+//                                   tables"): what a default bake gives
 //
 // Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
 // "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
@@ -34,6 +36,7 @@
 #include <prtshade/glossy.h>
 #include <prtshade/shade.h>
 
+#include <Imath/half.h>
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -156,10 +159,11 @@ BENCHMARK(BM_ShadeBand1);
 struct FivScene {
   int n_phi = 64, n_theta = 33, n_rho = 30;
   std::vector<float> radii, shells, cube, positions, surface, offsets, cones;
+  std::vector<uint16_t> shells_half, cones_half;
   std::vector<uint8_t> valid;
   std::vector<prt::shade::FivOccluder> occluders;
 
-  explicit FivScene(int count, bool surface_scheme = false, bool with_cones = false) {
+  explicit FivScene(int count, bool surface_scheme = false, bool with_cones = false, bool half_tables = false) {
     std::mt19937 rng(42);
     std::uniform_real_distribution<float> u01(0, 1);
     for (int k = 0; k < n_rho; ++k) radii.push_back(0.5f * std::pow(32.0f, float(k) / float(n_rho - 1)));
@@ -196,6 +200,14 @@ struct FivScene {
         o.surface_radius = surface.data();
       }
     }
+    if (half_tables) {  // the same values rounded to binary16 (Imath::half, as the bake rounds them)
+      for (float v : shells) shells_half.push_back(Imath::half(v).bits());
+      for (float v : cones) cones_half.push_back(Imath::half(v).bits());
+      for (prt::shade::FivOccluder& o : occluders) {
+        o.shells = nullptr, o.shells_half = shells_half.data();
+        if (o.cones) o.cones = nullptr, o.cones_half = cones_half.data();
+      }
+    }
     for (int p = 0; p < kItems; ++p) {
       positions.push_back(40 * u01(rng) - 20);
       positions.push_back(0);
@@ -206,9 +218,9 @@ struct FivScene {
 
 enum class FivPath { fast, reference };
 
-template <FivPath kPath, bool kOverlap = true, bool kSurface = false, bool kCones = false>
+template <FivPath kPath, bool kOverlap = true, bool kSurface = false, bool kCones = false, bool kHalf = false>
 void shade_fiv_case(benchmark::State& state) {
-  const FivScene scene(int(state.range(0)), kSurface, kCones);
+  const FivScene scene(int(state.range(0)), kSurface, kCones, kHalf);
   const prt::shade::DifMap map{32, scene.cube.data()};
   const float n[3] = {0, 1, 0};
   const prt::shade::FivShadeOptions options{true, kOverlap};
@@ -241,6 +253,8 @@ BENCHMARK(BM_ShadeFivSurface)->ArgName("occluders")->Arg(1)->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivCones)->ArgName("occluders")->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivConesReference)->ArgName("occluders")->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivSurfaceCones)->ArgName("occluders")->Arg(10)->Arg(100);
+void BM_ShadeFivSurfaceConesHalf(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true, true, true>(state); }
+BENCHMARK(BM_ShadeFivSurfaceConesHalf)->ArgName("occluders")->Arg(10)->Arg(100);
 
 } // namespace
 

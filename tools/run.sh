@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 # What the libraries and the three tools need to build and run: each is a find_package or
 # pkg-config module of formats/, libbake/, view/ or tools/ (README "From zero to a baked file").
 TOOLS_PACKAGES=(build-essential cmake pkg-config libembree-dev libhdf5-dev
-                libopenexr-dev libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev
+                libopenexr-dev libimath-dev libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libpng-dev
                 libssl-dev libtinygltf-dev libdeflate-dev)
 # What only the tests, the benchmarks, the fuzz targets and CI need, and who uses it: OpenMesh
 # (Loop subdivision makes the tests' and benchmarks' large meshes; libopenmesh-dev pulls in

@@ -315,10 +315,18 @@ void add_vertex_set(File& f, const std::string& prefix, const std::string& repor
   add_report(f, report_dir, s.report);
 }
 
+// float32 values as they are, or rounded to float16 (v8).
+DatasetData stored(const std::vector<float>& v, bool float16) {
+  if (!float16) return v;
+  std::vector<Float16> h(v.size());
+  std::transform(v.begin(), v.end(), h.begin(), to_float16);
+  return h;
+}
+
 void add_occluder(File& f, const Occluder& o) {
   const std::string dir = occluder_dir(o.name) + "/";
   const std::vector<uint64_t> grid = {uint64_t(o.n_rho), uint64_t(o.n_theta), uint64_t(o.n_phi)};
-  add_array(f, cat(dir, N::kShells), {grid[0], grid[1], grid[2], 3, 3}, o.shells, shells_attrs(o));
+  add_array(f, cat(dir, N::kShells), {grid[0], grid[1], grid[2], 3, 3}, stored(o.shells, o.float16), shells_attrs(o));
   if (o.valid)
     add_array(f, cat(dir, N::kValid), grid, o.valid->values,
               attrs_of<OccluderValid>(*o.valid, kValidFields, o.valid->extra));
@@ -326,7 +334,7 @@ void add_occluder(File& f, const Occluder& o) {
     add_array(f, cat(dir, N::kSurfaceRadius), {grid[1], grid[2]}, o.surface_radius->values,
               attrs_of<OccluderSurfaceRadius>(*o.surface_radius, kSurfaceRadiusFields, o.surface_radius->extra));
   if (o.cones)  // v7
-    add_array(f, cat(dir, N::kCones), {grid[0], grid[1], grid[2], 4}, o.cones->values,
+    add_array(f, cat(dir, N::kCones), {grid[0], grid[1], grid[2], 4}, stored(o.cones->values, o.cones->float16),
               attrs_of<OccluderCones>(*o.cones, kConesFields, o.cones->extra));
   if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
 }
@@ -343,6 +351,16 @@ void add_light(File& f, const Light& l) {
 // ---- File -> Asset -----------------------------------------------------------------------
 
 template <class T> const std::vector<T>& values(const Dataset& d) { return std::get<std::vector<T>>(d.data); }
+
+// The values of a float32 or float16 (v8) dataset as floats; `float16` says which it was.
+std::vector<float> float_values(const Dataset& d, bool& float16) {
+  float16 = d.data.index() == 4;
+  if (!float16) return values<float>(d);
+  const std::vector<Float16>& h = values<Float16>(d);
+  std::vector<float> v(h.size());
+  std::transform(h.begin(), h.end(), v.begin(), static_cast<float (*)(Float16)>(to_float));
+  return v;
+}
 
 template <class T> Array<T> array_of(const Dataset& d) { return {values<T>(d), d.attrs}; }
 
@@ -567,7 +585,8 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
       const std::string_view rest = after(d.path, occluders_dir);
       Occluder& o = named(a.occluders, rest.substr(0, rest.find('/')));
       if (kind == DatasetKind::occluder_cones) {
-        o.cones.emplace().values = values<float>(d);
+        OccluderCones& cones = o.cones.emplace();
+        cones.values = float_values(d, cones.float16);
         take_attrs<OccluderCones>(*o.cones, kConesFields, d.attrs, o.cones->extra);
         break;
       }
@@ -577,7 +596,7 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
         break;
       }
       o.n_rho = int(d.shape[0]), o.n_theta = int(d.shape[1]), o.n_phi = int(d.shape[2]);
-      o.shells = values<float>(d);
+      o.shells = float_values(d, o.float16);
       take_attrs<Occluder>(o, kShellsFields, d.attrs, o.extra);
       break;
     }

@@ -64,6 +64,13 @@ inline Hid attr_id(hid_t id) { return {id, &H5Aclose}; }
 inline Hid plist_id(hid_t id) { return {id, &H5Pclose}; }
 inline Hid object_id(hid_t id) { return {id, &H5Oclose}; }
 
+// IEEE 754 binary16, little-endian (sign bit 15, exponent bits 10–14 with bias 15, mantissa bits
+// 0–9): the file and memory type of float16 datasets (v8), as h5py writes numpy's float16.
+// Invalid (get() < 0) when HDF5 refuses a step.
+Hid make_float16_type();
+// True when `type` is that layout (either byte order): the only 2-byte float the reader accepts.
+bool is_float16_layout(hid_t type);
+
 // A fixed-length, NUL-padded UTF-8 string type of `bytes` bytes (at least 1): the type of every
 // string attribute we write. Fixed-length strings live inside the (checksummed) object header;
 // variable-length ones live in the global heap, which HDF5 1.10 reads without bounds checks,

@@ -5,6 +5,8 @@
 #include "h5util.h"
 #include "utf8.h"
 
+#include <Imath/half.h>
+
 #include <limits>
 
 namespace prt::formats {
@@ -36,9 +38,13 @@ std::string_view dtype_name(const DatasetData& data) {
   case 0: return "float32";
   case 1: return "uint32";
   case 2: return "uint8";
-  default: return "float64";
+  case 3: return "float64";
+  default: return "float16";
   }
 }
+
+float to_float(Float16 h) { return float(Imath::half(Imath::half::FromBits, h.bits)); }
+Float16 to_float16(float f) { return Float16{Imath::half(f).bits()}; }
 
 std::size_t element_count(const DatasetData& data) {
   return std::visit([](const auto& v) { return v.size(); }, data);
@@ -111,6 +117,22 @@ bool valid_utf8(std::string_view s) {
     i += n + 1;
   }
   return true;
+}
+
+Hid make_float16_type() {
+  Hid t = type_id(H5Tcopy(H5T_IEEE_F32LE));
+  if (!t.valid() || H5Tset_fields(t.get(), 15, 10, 5, 0, 10) < 0 || H5Tset_size(t.get(), 2) < 0 ||
+      H5Tset_ebias(t.get(), 15) < 0)
+    return {};
+  return t;
+}
+
+bool is_float16_layout(hid_t type) {
+  std::size_t spos = 0, epos = 0, esize = 0, mpos = 0, msize = 0;
+  return H5Tget_class(type) == H5T_FLOAT && H5Tget_size(type) == 2 && H5Tget_precision(type) == 16 &&
+         H5Tget_offset(type) == 0 && H5Tget_fields(type, &spos, &epos, &esize, &mpos, &msize) >= 0 && spos == 15 &&
+         epos == 10 && esize == 5 && mpos == 0 && msize == 10 && H5Tget_ebias(type) == 15 &&
+         H5Tget_norm(type) == H5T_NORM_IMPLIED;
 }
 
 Hid make_utf8_string_type(std::size_t bytes) {

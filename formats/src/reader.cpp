@@ -278,6 +278,7 @@ public:
     if (n > std::numeric_limits<uint64_t>::max() / 8 || !plausible(n * std::max<std::size_t>(size, 1), true))
       fail(name + " claims " + std::to_string(n) + " values, more than the file can hold (damaged?)");
     hid_t mem = H5I_INVALID_HID;
+    detail::Hid half;  // the float16 memory type, when the dataset is one
     void* buf = nullptr;
     try {
       if (tclass == H5T_FLOAT && size == 4) {
@@ -292,8 +293,15 @@ public:
       } else if (tclass == H5T_FLOAT && size == 8) {
         out.data = std::vector<double>(n);
         buf = std::get<3>(out.data).data(), mem = H5T_NATIVE_DOUBLE;
+      } else if (tclass == H5T_FLOAT && size == 2) {
+        if (!detail::is_float16_layout(type.get()))
+          fail(name + " is a 2-byte float that is not IEEE binary16 (the schema's float16)");
+        half = detail::make_float16_type();
+        if (!half.valid()) fail("cannot make the float16 type to read " + name);
+        out.data = std::vector<Float16>(n);
+        buf = std::get<4>(out.data).data(), mem = half.get();
       } else {
-        fail(name + " has an unsupported type (the schema uses float32, float64, uint32 and uint8)");
+        fail(name + " has an unsupported type (the schema uses float32, float64, float16, uint32 and uint8)");
       }
     } catch (const std::bad_alloc&) {
       fail(name + " is too large to read (" + std::to_string(n) + " values)");

@@ -207,7 +207,7 @@ public:
   }
 
   void dtype(const Dataset& d, std::size_t want) const {
-    static constexpr std::array<std::string_view, 4> names = {"float32", "uint32", "uint8", "float64"};
+    static constexpr std::array<std::string_view, 5> names = {"float32", "uint32", "uint8", "float64", "float16"};
     if (d.data.index() != want)
       fail("dataset '" + d.path + "' must be " + std::string(names[want]) + ", not " +
            std::string(dtype_name(d.data)));
@@ -407,6 +407,9 @@ bool is_lightmap_kind(DatasetKind kind) {
 }
 
 int64_t written_format_version(const File& file) {
+  // Version 8: float16 datasets (an occluder's shells or cones).
+  if (std::any_of(file.datasets.begin(), file.datasets.end(), [](const Dataset& d) { return d.data.index() == 4; }))
+    return kFormatVersionWithHalfShells;
   // Version 7: surface-following FIV shells (a surface_radius dataset, or the shells' radial_scheme
   // or first_offset attribute).
   if (std::any_of(file.datasets.begin(), file.datasets.end(), [](const Dataset& d) {
@@ -415,7 +418,7 @@ int64_t written_format_version(const File& file) {
                (k == Kind::occluder_shells &&
                 (find_attr(d.attrs, N::kRadialScheme) != nullptr || find_attr(d.attrs, N::kFirstOffset) != nullptr));
       }))
-    return kFormatVersion;
+    return kFormatVersionWithCones;
   const bool cones = std::any_of(file.datasets.begin(), file.datasets.end(),
                                  [](const Dataset& d) { return dataset_kind(d.path) == Kind::occluder_cones; }) ||
                      std::any_of(file.group_attrs.begin(), file.group_attrs.end(),
@@ -486,6 +489,11 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     if (k == Kind::occluder_surface_radius && version < 7)
       c.fail("dataset '" + d.path + "' is a surface-following shell grid's, which needs format_version 7 (the file says " +
              std::to_string(version) + ")");
+    if (d.data.index() == 4 && k != Kind::occluder_shells && k != Kind::occluder_cones)
+      c.fail("dataset '" + d.path + "' is float16, which the schema allows only for an occluder's shells and cones");
+    if (d.data.index() == 4 && version < 8)
+      c.fail("dataset '" + d.path + "' is float16, which needs format_version 8 (the file says " + std::to_string(version) +
+             ")");
     if (k == Kind::occluder_cones && version < 7)
       c.fail("dataset '" + d.path + "' is an occluder's cone table, which needs format_version 7 (the file says " +
              std::to_string(version) + ")");
@@ -514,12 +522,19 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
              " values but shape " + shape_str(d.shape) + " needs " + std::to_string(n));
     std::visit(
         [&]<class T>(const std::vector<T>& f) {
-          if constexpr (std::is_floating_point_v<T>)
+          if constexpr (std::is_floating_point_v<T>) {
             for (std::size_t i = 0; i < f.size(); ++i)
               if (!std::isfinite(f[i]))
                 c.fail("dataset '" + d.path + "' has a non-finite value (" +
                        (std::isnan(f[i]) ? std::string("NaN") : std::string("Inf")) + ") at index " +
                        std::to_string(i) + " " + index_str(i, d.shape));
+          } else if constexpr (std::is_same_v<T, Float16>) {
+            for (std::size_t i = 0; i < f.size(); ++i)
+              if ((f[i].bits & 0x7c00u) == 0x7c00u)  // exponent all ones: ±inf or NaN
+                c.fail("dataset '" + d.path + "' has a non-finite value (" +
+                       ((f[i].bits & 0x3ffu) != 0 ? std::string("NaN") : std::string("Inf")) + ") at index " +
+                       std::to_string(i) + " " + index_str(i, d.shape));
+          }
         },
         d.data);
     c.attrs(d.attrs, "dataset '" + d.path + "'");
@@ -687,7 +702,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
                "; expected [6, S, S, 3] with S >= 1");
       break;
     case Kind::occluder_shells: {
-      c.dtype(d, 0);
+      c.dtype(d, d.data.index() == 4 ? 4 : 0);  // float32, or float16 (v8, checked above)
       if (d.shape.size() != 5 || d.shape[3] != 3 || d.shape[4] != 3 || d.shape[0] == 0 ||
           d.shape[1] == 0 || d.shape[2] == 0)
         c.fail("dataset '" + d.path + "' has shape " + shape_str(d.shape) +
@@ -758,7 +773,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];
     if (kinds[i] != Kind::occluder_cones) continue;
-    c.dtype(d, 0);
+    c.dtype(d, d.data.index() == 4 ? 4 : 0);  // float32, or float16 (v8, checked above)
     const auto it = shells.find(d.path.substr(0, d.path.size() - N::kCones.size()));
     if (it == shells.end())
       c.fail("dataset '" + d.path + "' has no '" + std::string(N::kShells) + "' dataset beside it");

@@ -178,6 +178,11 @@ public:
     if (d.data.index() == 1) file_type = H5T_STD_U32LE, mem_type = H5T_NATIVE_UINT32;
     if (d.data.index() == 2) file_type = H5T_STD_U8LE, mem_type = H5T_NATIVE_UINT8, elem = 1;
     if (d.data.index() == 3) file_type = H5T_IEEE_F64LE, mem_type = H5T_NATIVE_DOUBLE, elem = 8;
+    Hid half;
+    if (d.data.index() == 4) {  // float16 (v8): the bits as they are, in the same type in memory and on disk
+      half = check(detail::make_float16_type(), "cannot make the float16 type of " + name);
+      file_type = mem_type = half.get(), elem = 2;
+    }
 
     Hid dcpl = check(detail::plist_id(H5Pcreate(H5P_DATASET_CREATE)), "cannot create properties of " + name);
     check(H5Pset_obj_track_times(dcpl.get(), false), "cannot disable time tracking of " + name);

@@ -22,11 +22,15 @@
 //          ivec4 dims;                    // 16: n_rho (>= 1), n_theta (>= 2), n_phi (>= 1),
 //                                         //     radial scheme (0 geometric, 1 surface: prtshade/fiv.h)
 //          uvec4 offsets;                 // 32: first radius in prt_fiv_radii (floats),
-//                                         //     first value in prt_fiv_shells (floats),
+//                                         //     first value in prt_fiv_shells (floats), or
+//                                         //     in prt_fiv_halves (halves) when extra.z bit 0,
 //                                         //     first WORD in prt_fiv_valid (uints),
 //                                         //     surface scheme: first r_surf in prt_fiv_radii
 //          uvec4 extra;                   // 48: 1 when the occluder has a cone table, else 0,
-//        };                               //     first value in prt_fiv_cones (floats), 0, 0
+//                                         //     first value in prt_fiv_cones (floats), or in
+//                                         //     prt_fiv_halves (halves) when extra.z bit 1,
+//                                         //     half tables: bit 0 shells, bit 1 cones; 0
+//        };
 //   PRT_FIV_RADII_BINDING (3)      float prt_fiv_radii[]    each occluder's n_rho radii, increasing
 //                                  (surface scheme: the offsets τ_k from the surface), and for the
 //                                  surface scheme its [n_theta][n_phi] surface_radius (anywhere:
@@ -43,6 +47,12 @@
 //                                  [4] floats (m_x, m_y, m_z, Ω) as in /fiv/occluders/<name>/cones
 //                                  (prtshade/fiv.h "Tight proxies"; bind a buffer even when no
 //                                  occluder has one: it is read only where extra.x == 1)
+//   PRT_FIV_HALVES_BINDING (8)     uint prt_fiv_halves[]    half-float tables (float16 files, v8;
+//                                  prtshade/fiv.h "Half-float tables"): the shells and cone tables
+//                                  whose extra.z bit says so, as binary16 bits, two per uint,
+//                                  LITTLE-ENDIAN (value i is bits 16·(i mod 2) … of word i/2: the
+//                                  file's uint16 array as is on a little-endian host); bind a
+//                                  buffer even when no table is half
 //   PRT_FIV_DIFMAP_BINDING (6)     uvec4 prt_difmap_header; float prt_difmap_texels[];
 //        header.x = face size S, header.yzw unused; texels from byte 16: /fiv/irradiance_cube
 //        [6][S][S][RGB] floats, faces +X, −X, +Y, −Y, +Z, −Z, OpenGL's cube orientation

@@ -20,8 +20,9 @@
 //   PRT_FIV_OCCLUDERS_BINDING (2)  StructuredBuffer<PrtFivOccluder> prt_fiv_occluders   64 bytes each:
 //        struct PrtFivOccluder { float4 centre_radius; int4 dims; uint4 offsets; uint4 extra; }
 //        (centre xyz + bounding radius; n_rho, n_theta, n_phi, radial scheme (0 geometric, 1
-//        surface); first radius, first shell float, first valid WORD, first surface radius; 1 with
-//        a cone table else 0, first cone float, 0, 0)
+//        surface); first radius, first shell float (or half: extra.z bit 0), first valid WORD,
+//        first surface radius; 1 with a cone table else 0, first cone float (or half: extra.z
+//        bit 1), half tables (bit 0 shells, bit 1 cones), 0)
 //   PRT_FIV_RADII_BINDING (3)      StructuredBuffer<float> prt_fiv_radii    each occluder's radii
 //        (surface scheme: offsets from the surface) and, surface scheme, its surface_radius
 //   PRT_FIV_SHELLS_BINDING (4)     StructuredBuffer<float> prt_fiv_shells   [n_rho][n_theta][n_phi][RGB][xyz]
@@ -29,6 +30,8 @@
 //        packed 4 per uint, little-endian, each occluder's from a word boundary
 //   PRT_FIV_CONES_BINDING (7)      StructuredBuffer<float> prt_fiv_cones    [n_rho][n_theta][n_phi][4]
 //        (m_x, m_y, m_z, Ω) of each cone occluder (prtshade/fiv.h "Tight proxies"), read where extra.x == 1
+//   PRT_FIV_HALVES_BINDING (8)     StructuredBuffer<uint> prt_fiv_halves    half-float shells and
+//        cone tables (float16 files, v8), binary16 bits two per uint, little-endian
 //   PRT_FIV_DIFMAP_BINDING (6)     StructuredBuffer<float> prt_fiv_difmap   4 header words (word 0:
 //        the face size S as a uint, read with asuint) then /fiv/irradiance_cube [6][S][S][RGB]
 //        floats from word 4, faces +X, −X, +Y, −Y, +Z, −Z, OpenGL's cube orientation

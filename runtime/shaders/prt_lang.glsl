@@ -11,6 +11,8 @@
 //   PRT_MAT3_ZERO             the zero 3×3 matrix
 //   PRT_MAT3_DOTS(v, m)       (dot(v, m[0]), dot(v, m[1]), dot(v, m[2]))
 //   PRT_ANY_POSITIVE(v)       whether a component of the vec3 v is > 0
+//   PRT_UNPACK_HALF(bits)     the float of the binary16 bits in the low 16 bits of a uint (GLSL
+//       unpackHalf2x16(bits).x, HLSL f16tof32(bits)): exact for every finite half
 //   PRT_READONLY_BUFFER(block, type, name, set, binding)   a read-only array `name` of `type` at
 //       (set, binding): GLSL a std430 SSBO `block { type name[]; }`, HLSL a StructuredBuffer<type>
 //       (the same descriptor and bytes; `block` names the GLSL block only)
@@ -26,6 +28,7 @@
 #define PRT_MAT3_ZERO mat3(0.0)
 #define PRT_MAT3_DOTS(v, m) ((v) * (m))
 #define PRT_ANY_POSITIVE(v) any(greaterThan((v), vec3(0.0)))
+#define PRT_UNPACK_HALF(bits) unpackHalf2x16(bits).x
 #define PRT_READONLY_BUFFER(block, type, name, set_, binding_) \
   layout(std430, set = set_, binding = binding_) readonly buffer block { type name[]; };
 #endif  // PRT_LANG

@@ -15,6 +15,7 @@
 #define PRT_MAT3_ZERO ((float3x3)0)
 #define PRT_MAT3_DOTS(v, m) mul((m), (v))
 #define PRT_ANY_POSITIVE(v) any((v) > 0.0)
+#define PRT_UNPACK_HALF(bits) f16tof32(bits)
 #define PRT_READONLY_BUFFER(block, type, name, set_, binding_) \
   [[vk::binding(binding_, set_)]] StructuredBuffer<type> name;
 #endif  // PRT_LANG

@@ -51,6 +51,7 @@ namespace {
 struct OwnedOccluder {
   std::vector<float> radii, shells, surface_radius, cones;
   std::vector<uint8_t> valid;
+  std::vector<uint16_t> shells_half, cones_half;
 };
 
 } // namespace
@@ -264,25 +265,33 @@ prt_status prt_fiv_scene_add_occluder(prt_fiv_scene* scene, const prt_fiv_occlud
                               occluder->valid,
                               occluder->radial_scheme,
                               occluder->surface_radius,
-                              occluder->cones};
+                              occluder->cones,
+                              occluder->shells_half,
+                              occluder->cones_half};
     prt::shade::validate_occluder(v);
     require(scene->views.size() < size_t(1) << 30, "too many occluders");
     auto own = std::make_unique<OwnedOccluder>();
     const size_t samples = size_t(v.n_rho) * size_t(v.n_theta) * size_t(v.n_phi);
     own->radii.assign(v.radii, v.radii + v.n_rho);
-    own->shells.assign(v.shells, v.shells + samples * 9);
+    if (v.shells != nullptr) own->shells.assign(v.shells, v.shells + samples * 9);
+    else own->shells_half.assign(v.shells_half, v.shells_half + samples * 9);
     // The surface scheme reads no valid mask (it may be null): an all-ones one stands in.
     if (v.valid != nullptr) own->valid.assign(v.valid, v.valid + samples);
     else own->valid.assign(samples, 1);
     if (v.radial_scheme == prt::shade::kFivRadialSurface)
       own->surface_radius.assign(v.surface_radius, v.surface_radius + size_t(v.n_theta) * size_t(v.n_phi));
     v.radii = own->radii.data();
-    v.shells = own->shells.data();
+    v.shells = v.shells != nullptr ? own->shells.data() : nullptr;
+    v.shells_half = v.shells_half != nullptr ? own->shells_half.data() : nullptr;
     v.valid = own->valid.data();
     v.surface_radius = own->surface_radius.empty() ? nullptr : own->surface_radius.data();
     if (v.cones != nullptr) {
       own->cones.assign(v.cones, v.cones + samples * 4);
       v.cones = own->cones.data();
+    }
+    if (v.cones_half != nullptr) {
+      own->cones_half.assign(v.cones_half, v.cones_half + samples * 4);
+      v.cones_half = own->cones_half.data();
     }
     scene->views.reserve(scene->views.size() + 1);
     scene->owned.push_back(std::move(own));

@@ -122,9 +122,11 @@ void validate_occluder(const FivOccluder& o) {
   PRT_SHADE_REQUIRE(o.radial_scheme == kFivRadialGeometric || o.radial_scheme == kFivRadialSurface,
                     "occluder radial scheme " + std::to_string(o.radial_scheme) + ": must be 0 (geometric) or 1 (surface)");
   const bool surface = o.radial_scheme == kFivRadialSurface;
-  PRT_SHADE_REQUIRE(o.radii != nullptr && o.shells != nullptr && (surface || o.valid != nullptr) &&
-                        (!surface || o.surface_radius != nullptr),
+  PRT_SHADE_REQUIRE(o.radii != nullptr && (o.shells != nullptr || o.shells_half != nullptr) &&
+                        (surface || o.valid != nullptr) && (!surface || o.surface_radius != nullptr),
                     "occluder with a null array");
+  PRT_SHADE_REQUIRE(o.shells == nullptr || o.shells_half == nullptr, "occluder with both float and half shells");
+  PRT_SHADE_REQUIRE(o.cones == nullptr || o.cones_half == nullptr, "occluder with both a float and a half cone table");
   PRT_SHADE_REQUIRE(o.n_rho >= 1 && o.n_theta >= 2 && o.n_phi >= 1,
                     "occluder grid " + std::to_string(o.n_rho) + "x" + std::to_string(o.n_theta) + "x" +
                         std::to_string(o.n_phi) + " (rho x theta x phi): need n_rho >= 1, n_theta >= 2, n_phi >= 1");
@@ -141,9 +143,13 @@ void validate_occluder(const FivOccluder& o) {
                       "shell radii must increase strictly (radius " + std::to_string(k) + ")");
   }
   const size_t n = sample_index(o, o.n_rho, 0, 0) * 9;
-  for (size_t i = 0; i < n; ++i)
-    PRT_SHADE_REQUIRE(std::isfinite(o.shells[i]) && std::fabs(o.shells[i]) <= kFivValueLimit,
-                      "shell value " + std::to_string(i) + " = " + value_text(o.shells[i]) + value_limit_text);
+  for (size_t i = 0; i < n; ++i) {
+    PRT_SHADE_REQUIRE(o.shells != nullptr || (o.shells_half[i] & 0x7c00u) != 0x7c00u,
+                      "shell value " + std::to_string(i) + " (half bits " + std::to_string(o.shells_half[i]) + ") is not finite");
+    const float v = o.shells != nullptr ? o.shells[i] : half_to_float(o.shells_half[i]);
+    PRT_SHADE_REQUIRE(std::isfinite(v) && std::fabs(v) <= kFivValueLimit,
+                      "shell value " + std::to_string(i) + " = " + value_text(v) + value_limit_text);
+  }
   if (surface) {
     const size_t directions = size_t(o.n_theta) * size_t(o.n_phi);
     for (size_t i = 0; i < directions; ++i)
@@ -160,11 +166,21 @@ void validate_occluder(const FivOccluder& o) {
                             ": the offsets must grow geometrically (tau_k = tau_0 g^k)");
     }
   }
-  if (o.cones != nullptr) {
-    constexpr double kMargin = 1.0 + 0x1p-10;
+  if (has_cones(o)) {
+    // The bake's rounding; a half table's m and Ω are each rounded by up to 2^-11 of themselves.
+    const double kMargin = o.cones != nullptr ? 1.0 + 0x1p-10 : 1.0 + 0x1p-9;
     const size_t samples = sample_index(o, o.n_rho, 0, 0);
     for (size_t i = 0; i < samples; ++i) {
-      const float* v = o.cones + 4 * i;
+      float v[4];
+      for (int e = 0; e < 4; ++e) {
+        if (o.cones != nullptr) {
+          v[e] = o.cones[4 * i + size_t(e)];
+          continue;
+        }
+        const uint16_t h = o.cones_half[4 * i + size_t(e)];
+        PRT_SHADE_REQUIRE((h & 0x7c00u) != 0x7c00u, "cone sample " + std::to_string(i) + " has a non-finite half value");
+        v[e] = half_to_float(h);
+      }
       const double omega = v[3];
       bool ok = std::isfinite(omega) && omega >= 0 && omega <= 4 * kPi * kMargin;
       for (int e = 0; e < 3 && ok; ++e) ok = std::isfinite(v[e]) && std::fabs(double(v[e])) <= omega * kMargin + 0x1p-20;
@@ -375,8 +391,17 @@ void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellSt
 // The masked trilinear value of a table of `width` floats per sample over a stencil: neighbours
 // with valid == 0 at weight 0 and the rest renormalised; the plain trilinear value only when no
 // valid neighbour carries weight (so it is summed only then); times the falloff.
-template <int kWidth>
-void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* table, float out[kWidth]) {
+// The kWidth values of the sample at `p`: floats as they are, half-float bits decoded into `buf`
+// (header "Half-float tables": exact, so everything after is the float path's arithmetic).
+template <int kWidth> inline const float* sample_values(const float* p, float (&)[kWidth]) { return p; }
+template <int kWidth> inline const float* sample_values(const uint16_t* p, float (&buf)[kWidth]) {
+  for (int e = 0; e < kWidth; ++e) buf[e] = half_to_float(p[e]);
+  return buf;
+}
+
+template <int kWidth, class T>
+void sample_table(const FivOccluder& occ, const ShellStencil& st, const T* table, float out[kWidth]) {
+  float decoded[kWidth];
   float masked[kWidth] = {};
   float masked_weight = 0;
   if (occ.radial_scheme != kFivRadialSurface)  // the surface scheme's samples are all valid: plain trilinear
@@ -387,10 +412,11 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* t
         if (occ.valid[idx] == 0) continue;
         const float w = st.weight(a, b, c);
         masked_weight += w;
+        const float* v = sample_values<kWidth>(table + idx * kWidth, decoded);
         if constexpr (kWidth == 9) {
-          add_weighted_fiv(masked, w, table + idx * 9);
+          add_weighted_fiv(masked, w, v);
         } else {
-          for (int e = 0; e < kWidth; ++e) masked[e] += w * table[idx * kWidth + size_t(e)];
+          for (int e = 0; e < kWidth; ++e) masked[e] += w * v[e];
         }
       }
   if (masked_weight > 0) {
@@ -403,7 +429,7 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const float* t
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
         const float w = st.weight(a, b, c);
-        const float* v = table + st.index(a, b, c) * kWidth;
+        const float* v = sample_values<kWidth>(table + st.index(a, b, c) * kWidth, decoded);
         if constexpr (kWidth == 9) {
           add_weighted_fiv(plain, w, v);  // the same float operations per element as the loop
         } else {
@@ -421,13 +447,21 @@ inline void prefetch_stencil(const FivOccluder& occ, const ShellStencil& st, boo
   for (int a = 0; a < st.layers; ++a)
     for (int b = 0; b < 2; ++b) {  // the φ neighbours j0, j1 of a ring
       const size_t i0 = st.index(a, b, 0), i1 = st.index(a, b, 1);
-      __builtin_prefetch(occ.shells + i0 * 9);
-      __builtin_prefetch(occ.shells + i0 * 9 + 8);
-      __builtin_prefetch(occ.shells + i1 * 9 + 8);
+      if (occ.shells != nullptr) {
+        __builtin_prefetch(occ.shells + i0 * 9);
+        __builtin_prefetch(occ.shells + i0 * 9 + 8);
+        __builtin_prefetch(occ.shells + i1 * 9 + 8);
+      } else {
+        __builtin_prefetch(occ.shells_half + i0 * 9);
+        __builtin_prefetch(occ.shells_half + i1 * 9 + 8);
+      }
       if (occ.valid) __builtin_prefetch(occ.valid + i0);
       if (cones && occ.cones) {
         __builtin_prefetch(occ.cones + i0 * 4);
         __builtin_prefetch(occ.cones + i1 * 4 + 3);
+      } else if (cones && occ.cones_half) {
+        __builtin_prefetch(occ.cones_half + i0 * 4);
+        __builtin_prefetch(occ.cones_half + i1 * 4 + 3);
       }
     }
 #else
@@ -436,9 +470,15 @@ inline void prefetch_stencil(const FivOccluder& occ, const ShellStencil& st, boo
 }
 
 // The trilinear lookup of the shells (header comment) at a stencil.
-inline void sample_shells(const FivOccluder& occ, const ShellStencil& st, float out[9]) { sample_table<9>(occ, st, occ.shells, out); }
+inline void sample_shells(const FivOccluder& occ, const ShellStencil& st, float out[9]) {
+  if (occ.shells != nullptr) sample_table<9>(occ, st, occ.shells, out);
+  else sample_table<9>(occ, st, occ.shells_half, out);
+}
 // The cone table (m, Ω) at the same stencil (header "Tight proxies").
-inline void sample_cones(const FivOccluder& occ, const ShellStencil& st, float out[4]) { sample_table<4>(occ, st, occ.cones, out); }
+inline void sample_cones(const FivOccluder& occ, const ShellStencil& st, float out[4]) {
+  if (occ.cones != nullptr) sample_table<4>(occ, st, occ.cones, out);
+  else sample_table<4>(occ, st, occ.cones_half, out);
+}
 
 // Grid coordinates (t, u) of an offset with the angles from std::atan2 and ρ = |s| (ρ = 0 for a
 // zero or NaN offset: d = +Y, θ = 0): lookup_fiv, lookup_cone, occluded_irradiance and the slow
@@ -713,7 +753,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     offset_from_centre(occ, p, s);
     const float h = float(-(double(n[0]) * s[0] + double(n[1]) * s[1] + double(n[2]) * s[2]));
     // A tight occluder's partial correction comes in pass 3; its case C is the sphere's.
-    const float f = case_factor(h, occ.radius, options.partial_occluders && !(use_cones && occ.cones));
+    const float f = case_factor(h, occ.radius, options.partial_occluders && !(use_cones && has_cones(occ)));
     if (f == 0) continue;
     const int k = candidates++;
     c.index[k] = i;
@@ -754,7 +794,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
     const ShellStencil& st = block[slot];
     sample_shells(occ, st, fv);
     project_fiv(fv, n, e);
-    if (use_cones && occ.cones) {
+    if (use_cones && has_cones(occ)) {
       // The occluder's cone (header "Tight proxies"): axis m/|m| (towards the centre when m = 0).
       float cone[4];
       sample_cones(occ, st, cone);
@@ -820,7 +860,7 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
       end[pos] = stop;
       pax[pos] = ax[k], pay[pos] = ay[k], paz[pos] = az[k];
       pcos[pos] = cos_alpha[k], psin[pos] = sin_alpha[k], palpha[pos] = alpha[k];
-      ptight[pos] = use_cones && occluders[c.index[k]].cones != nullptr ? 1.0f : 0.0f;
+      ptight[pos] = use_cones && has_cones(occluders[c.index[k]]) ? 1.0f : 0.0f;
       pinv[pos] = ptight[pos] != 0 && alpha[k] > 0 ? 1.0f / (alpha[k] * alpha[k]) : 0.0f;
       c.weight[pos] = 0;
     };
@@ -986,7 +1026,7 @@ namespace {
 // correction) and its disc (axis, α) for eq. 13–14 (header "Tight proxies").
 void reference_terms(const FivOccluder& o, const float p[3], const float n[3], const FivShadeOptions& options,
                      const double below[3], double I[3], double axis[3], double& alpha) {
-  const bool tight = options.proxy == FivProxy::cone && o.cones != nullptr;
+  const bool tight = options.proxy == FivProxy::cone && has_cones(o);
   float Ib[3];
   occluded_irradiance_unit(o, p, n, options.partial_occluders && !tight, Ib);
   for (int c = 0; c < 3; ++c) I[c] = Ib[c];
@@ -1039,7 +1079,7 @@ void shade_fiv_reference(const DifMap& map, const FivOccluder* occluders, int co
   for (int i = 0; i < count; ++i) {
     Terms& ti = t[size_t(i)];
     reference_terms(occluders[i], p, n, options, below, ti.I, ti.axis, ti.alpha);
-    ti.tight = options.proxy == FivProxy::cone && occluders[i].cones != nullptr;
+    ti.tight = options.proxy == FivProxy::cone && has_cones(occluders[i]);
     for (int c = 0; c < 3; ++c) e[c] -= ti.I[c];
   }
   const auto hides = [](const Terms& x) { return x.I[0] > 0 || x.I[1] > 0 || x.I[2] > 0; };

@@ -167,6 +167,7 @@ int prt_c_check_fiv(char* msg, size_t size) {
   desc.n_rho = NR, desc.n_theta = NT, desc.n_phi = NP;
   desc.radii = radii, desc.shells = shells, desc.valid = valid, desc.cones = NULL;
   desc.radial_scheme = 0, desc.surface_radius = NULL; /* paper 004's spheres */
+  desc.shells_half = NULL, desc.cones_half = NULL;   /* float tables (format_version 8 adds half ones) */
 
   CHECK_STATUS(prt_fiv_scene_create(S, cube, env, &scene), PRT_OK);
   CHECK_STATUS(prt_fiv_scene_add_occluder(scene, &desc, &index), PRT_OK);

@@ -7,10 +7,12 @@
 #include <prtshade/fiv.h>
 #include <prtshade/prtshade.h>
 
+#include <Imath/half.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 #include <cstdio>
@@ -1240,4 +1242,157 @@ TEST(Validate, RejectsBrokenConeTables) {
     v.cones = bad.data();
     EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument) << index << " " << value;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Half-float tables (prtshade/fiv.h "Half-float tables")
+
+namespace halves {
+
+std::vector<uint16_t> bits_of(const std::vector<float>& values) {
+  std::vector<uint16_t> out;
+  for (float v : values) out.push_back(Imath::half(v).bits());
+  return out;
+}
+void round_to_half(std::vector<float>& values) {
+  for (float& v : values) v = float(Imath::half(v));
+}
+
+} // namespace halves
+
+// half_to_float against OpenEXR's Imath::half for every finite binary16 value, bit for bit
+// (subnormals, ±0 and 65504 among them).
+TEST(HalfTables, HalfToFloatIsExactForEveryFiniteHalf) {
+  int checked = 0;
+  for (uint32_t b = 0; b < 0x10000u; ++b) {
+    if ((b & 0x7c00u) == 0x7c00u) continue;  // ±inf, NaN: not finite halves
+    const float want = float(Imath::half(Imath::half::FromBits, uint16_t(b)));
+    const float got = shade::half_to_float(uint16_t(b));
+    ASSERT_EQ(std::bit_cast<uint32_t>(got), std::bit_cast<uint32_t>(want)) << "half bits " << b;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 63488);
+}
+
+// A half table shades bit for bit as the float table of its values: lookups, the fast path and
+// the slow reference, with both proxies, the geometric and the surface scheme, 100 scattered
+// occluders (so the overlap sweep and the partial correction run on them).
+TEST(HalfTables, ShadeExactlyAsTheFloatTableOfTheirValues) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<float> u01(0, 1);
+  Shells asset(12, 17, 32, [&](int, int, int, int) { return u01(rng) - 0.2f; });
+  for (int k = 0; k < 12; ++k) asset.radii[size_t(k)] = float(0.75 * std::pow(40.0 / 0.75, k / 11.0));
+  std::vector<float> table = cones::ball_cones(asset, 0.7);
+  halves::round_to_half(asset.shells);
+  halves::round_to_half(table);
+  for (size_t i = 0; i < 40; ++i) asset.shells[9 * i] = float(i) * 0x1p-24f;  // subnormal halves
+  const std::vector<uint16_t> shell_bits = halves::bits_of(asset.shells), cone_bits = halves::bits_of(table);
+  Cube cube(4);
+  for (float& t : cube.texels) t += 300.0f;
+  std::vector<FivOccluder> floats, halfs;
+  for (int i = 0; i < 100; ++i) {
+    FivOccluder v = asset.view();
+    v.cones = table.data();
+    v.centre[0] = 40 * u01(rng) - 20, v.centre[1] = 3.0f * u01(rng) - 0.5f, v.centre[2] = 40 * u01(rng) - 20;
+    floats.push_back(v);
+    v.shells = nullptr, v.cones = nullptr, v.shells_half = shell_bits.data(), v.cones_half = cone_bits.data();
+    ASSERT_NO_THROW(shade::validate_occluder(v));
+    halfs.push_back(v);
+  }
+  const auto same = [](const float* a, const float* b, int n) {
+    for (int e = 0; e < n; ++e)
+      if (std::bit_cast<uint32_t>(a[e]) != std::bit_cast<uint32_t>(b[e])) return false;
+    return true;
+  };
+  int nonzero = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const float p[3] = {40 * u01(rng) - 20, 0, 40 * u01(rng) - 20};
+    const float n[3] = {u01(rng) - 0.5f, 1.0f, u01(rng) - 0.5f};
+    const float s[3] = {p[0] - floats[0].centre[0], p[1] - floats[0].centre[1], p[2] - floats[0].centre[2]};
+    float a[9], b[9];
+    shade::lookup_fiv(floats[0], s, a), shade::lookup_fiv(halfs[0], s, b);
+    ASSERT_TRUE(same(a, b, 9)) << trial;
+    shade::lookup_cone(floats[0], s, a), shade::lookup_cone(halfs[0], s, b);
+    ASSERT_TRUE(same(a, b, 4)) << trial;
+    for (const shade::FivShadeOptions options :
+         {shade::FivShadeOptions{}, shade::FivShadeOptions{true, true, shade::FivProxy::sphere}}) {
+      shade::shade_fiv(cube.view(), floats.data(), 100, p, n, options, a);
+      shade::shade_fiv(cube.view(), halfs.data(), 100, p, n, options, b);
+      ASSERT_TRUE(same(a, b, 3)) << trial;
+      nonzero += a[0] != 0;
+      shade::shade_fiv_reference(cube.view(), floats.data(), 100, p, n, options, a);
+      shade::shade_fiv_reference(cube.view(), halfs.data(), 100, p, n, options, b);
+      ASSERT_TRUE(same(a, b, 3)) << trial;
+    }
+  }
+  EXPECT_GT(nonzero, 60);  // not a comparison of clamped zeros
+  // The surface scheme (plain trilinear, no mask) likewise.
+  SurfaceShells surf(6, 9, 12, [&](int, int, int, int) { return u01(rng); }, bumpy);
+  halves::round_to_half(surf.shells);
+  const std::vector<uint16_t> surf_bits = halves::bits_of(surf.shells);
+  FivOccluder f = surf.view(), h = f;
+  h.shells = nullptr, h.shells_half = surf_bits.data();
+  for (int trial = 0; trial < 200; ++trial) {
+    const float s[3] = {4 * u01(rng) - 2, 4 * u01(rng) - 2, 4 * u01(rng) - 2};
+    float a[9], b[9];
+    shade::lookup_fiv(f, s, a), shade::lookup_fiv(h, s, b);
+    ASSERT_TRUE(same(a, b, 9)) << trial;
+  }
+}
+
+TEST(HalfTables, ValidateRefusesNonFiniteHalvesAndTwoTables) {
+  Shells asset(2, 3, 4, [](int, int, int, int) { return 0.5f; });
+  std::vector<uint16_t> bits = halves::bits_of(asset.shells);
+  FivOccluder v = asset.view();
+  v.shells = nullptr, v.shells_half = bits.data();
+  EXPECT_NO_THROW(shade::validate_occluder(v));
+  bits[5] = 0x7c00;  // +inf
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  bits[5] = 0xfe00;  // NaN
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  bits[5] = 0x7bff;  // 65504, the largest finite half
+  EXPECT_NO_THROW(shade::validate_occluder(v));
+  v.shells = asset.shells.data();  // both tables
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+  v.shells = nullptr, v.shells_half = nullptr;  // neither
+  EXPECT_THROW(shade::validate_occluder(v), std::invalid_argument);
+}
+
+// The C API takes half tables (prt_fiv_occluder_desc::shells_half, cones_half), copies them and
+// shades what the C++ core shades on them (and on the float tables of their values).
+TEST(HalfTables, TheCApiCopiesHalfTables) {
+  Cube cube(4);
+  for (float& t : cube.texels) t += 50.0f;
+  const float f[3] = {0.3f, 0.7f, -0.2f};
+  Shells o(12, 17, 32, [&](int, int, int, int e) { return f[e % 3] * float(1 + e / 3); });
+  for (int k = 0; k < 12; ++k) o.radii[size_t(k)] = float(1.05 * std::pow(20.0 / 1.05, k / 11.0));
+  o.centre[2] = 3.0f;
+  std::vector<float> table = cones::ball_cones(o, 0.8);
+  halves::round_to_half(o.shells);
+  halves::round_to_half(table);
+  std::vector<uint16_t> shell_bits = halves::bits_of(o.shells), cone_bits = halves::bits_of(table);
+  FivOccluder v = o.view();
+  v.cones = table.data();  // the float tables of the same values
+  prt_fiv_scene* scene = nullptr;
+  const float env[9] = {};
+  ASSERT_EQ(prt_fiv_scene_create(4, cube.texels.data(), env, &scene), PRT_OK);
+  prt_fiv_occluder_desc d{{v.centre[0], v.centre[1], v.centre[2]}, v.radius, v.n_rho, v.n_theta, v.n_phi,
+                          v.radii, nullptr, v.valid, 0, nullptr, nullptr, shell_bits.data(), cone_bits.data()};
+  ASSERT_EQ(prt_fiv_scene_add_occluder(scene, &d, nullptr), PRT_OK);
+  std::fill(shell_bits.begin(), shell_bits.end(), uint16_t(0));  // the scene holds its own copy
+  std::fill(cone_bits.begin(), cone_bits.end(), uint16_t(0));
+  d.shells = o.shells.data();  // both a float and a half table: refused
+  EXPECT_EQ(prt_fiv_scene_add_occluder(scene, &d, nullptr), PRT_ERROR_INVALID_ARGUMENT);
+  const float points[6] = {0, 0, 0, 0.5f, 0, 0.4f}, normals[6] = {0, 1, 0, 0.1f, 1, 0};
+  const prt_fiv_options options{1, 1, 0};
+  float out[6], e[3];
+  ASSERT_EQ(prt_fiv_scene_shade(scene, points, normals, 2, &options, out), PRT_OK);
+  for (int k = 0; k < 2; ++k) {
+    shade::shade_fiv(cube.view(), &v, 1, points + 3 * k, normals + 3 * k, {}, e);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]) << k << " " << ch;
+    float tot[3];
+    shade::lookup_difmap(cube.view(), normals + 3 * k, tot);
+    EXPECT_LT(e[1], tot[1] - 0.1f);  // in the occluder's shadow: the comparison is not of E_tot alone
+  }
+  prt_fiv_scene_destroy(scene);
 }

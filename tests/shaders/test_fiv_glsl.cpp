@@ -23,6 +23,8 @@
 
 #include <prtshade/fiv.h>
 
+#include <Imath/half.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -113,34 +115,52 @@ struct GpuOccluder {
 static_assert(sizeof(GpuOccluder) == 64, "std430 PrtFivOccluder is 64 bytes");
 
 struct GpuScene {
-  std::vector<std::byte> occluders, radii, shells, valid, difmap, cones;
+  std::vector<std::byte> occluders, radii, shells, valid, difmap, cones, halves;
 };
 
-GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std::vector<float>& texels) {
+// half_tables: every shell and cone table as binary16 bits in the halves buffer (fiv.glsl,
+// PRT_FIV_HALVES_BINDING; extra.z bits 0 and 1) instead of floats; the values must be halves.
+GpuScene pack(const std::vector<SynthOccluder>& occ, int difmap_size, const std::vector<float>& texels,
+              bool half_tables = false) {
   std::vector<GpuOccluder> table;
   std::vector<float> radii, shells, cones;
+  std::vector<uint16_t> halves;
   std::vector<uint8_t> valid;
+  const auto put_halves = [&halves](const std::vector<float>& values) {
+    for (float v : values) {
+      const Imath::half h(v);
+      EXPECT_EQ(float(h), v) << "pack: a half table needs half values";
+      halves.push_back(h.bits());
+    }
+  };
   for (const SynthOccluder& o : occ) {
+    const bool half_cones = half_tables && !o.cones.empty();
+    const uint32_t shells_at = uint32_t(half_tables ? halves.size() : shells.size());
+    if (half_tables) put_halves(o.shells);
+    else shells.insert(shells.end(), o.shells.begin(), o.shells.end());
+    const uint32_t cones_at = uint32_t(half_cones ? halves.size() : cones.size());
+    if (half_cones) put_halves(o.cones);
+    else cones.insert(cones.end(), o.cones.begin(), o.cones.end());
     GpuOccluder g{{o.centre[0], o.centre[1], o.centre[2], o.radius},
                   {o.n_rho, o.n_theta, o.n_phi, o.scheme},
-                  {uint32_t(radii.size()), uint32_t(shells.size()), uint32_t(valid.size() / 4),
-                   uint32_t(radii.size() + o.radii.size())},
-                  {o.cones.empty() ? 0u : 1u, uint32_t(cones.size()), 0, 0}};
+                  {uint32_t(radii.size()), shells_at, uint32_t(valid.size() / 4), uint32_t(radii.size() + o.radii.size())},
+                  {o.cones.empty() ? 0u : 1u, cones_at, (half_tables ? 1u : 0u) | (half_cones ? 2u : 0u), 0}};
     table.push_back(g);
-    cones.insert(cones.end(), o.cones.begin(), o.cones.end());
     radii.insert(radii.end(), o.radii.begin(), o.radii.end());
     radii.insert(radii.end(), o.surface.begin(), o.surface.end());  // surface scheme: offsets.w
-    shells.insert(shells.end(), o.shells.begin(), o.shells.end());
     valid.insert(valid.end(), o.valid.begin(), o.valid.end());
     valid.resize((valid.size() + 3) / 4 * 4, 0);  // next occluder starts on a word boundary
   }
   GpuScene s;
   s.occluders = prt::test::to_bytes(table);
   s.radii = prt::test::to_bytes(radii);
-  s.shells = prt::test::to_bytes(shells);
   s.valid = prt::test::to_bytes(valid);  // little-endian host: the bytes are the packed words
   cones.resize(std::max<std::size_t>(cones.size(), 4), 0.0f);  // a buffer is bound even without cones
   s.cones = prt::test::to_bytes(cones);
+  shells.resize(std::max<std::size_t>(shells.size(), 4), 0.0f);  // and without float shells
+  s.shells = prt::test::to_bytes(shells);
+  halves.resize(std::max<std::size_t>((halves.size() + 1) / 2 * 2, 4), 0);  // whole words; one bound even without halves
+  s.halves = prt::test::to_bytes(halves);  // little-endian host: the bytes are the packed words
   const uint32_t header[4] = {uint32_t(difmap_size), 0, 0, 0};
   s.difmap.resize(16 + texels.size() * sizeof(float));
   std::memcpy(s.difmap.data(), header, 16);
@@ -488,17 +508,21 @@ protected:
   void SetUp() override {
     std::vector<float>*& results = results_[static_cast<std::size_t>(GetParam())];
     if (!results) {
-      GpuScene g = pack(scene_->occ, scene_->difmap_size, scene_->texels);
-      auto in = prt::test::to_bytes(*receivers_);
-      std::vector<std::byte> res(receivers_->size() * 36 * sizeof(float));
-      PushBlock push{uint32_t(receivers_->size()), {}};
-      std::copy_n(scene_->env, 9, push.env);
-      const bool ran = prt::test::run_kernel(kernel("fiv_eval"),
-                                             {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res, &g.cones},
-                                             prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
-      results = new std::vector<float>(ran ? prt::test::from_bytes<float>(res) : std::vector<float>{});
+      results = new std::vector<float>(run(*scene_, false));
     }
     ASSERT_FALSE(results->empty()) << "the " << language() << " fiv_eval kernel did not run (see the failure above)";
+  }
+  // The kernel's results for every receiver on `scene` (empty when it did not run).
+  std::vector<float> run(const Scene& scene, bool half_tables) const {
+    GpuScene g = pack(scene.occ, scene.difmap_size, scene.texels, half_tables);
+    auto in = prt::test::to_bytes(*receivers_);
+    std::vector<std::byte> res(receivers_->size() * 36 * sizeof(float));
+    PushBlock push{uint32_t(receivers_->size()), {}};
+    std::copy_n(scene.env, 9, push.env);
+    const bool ran = prt::test::run_kernel(
+        kernel("fiv_eval"), {&g.occluders, &g.radii, &g.shells, &g.valid, &g.difmap, &in, &res, &g.cones, &g.halves},
+        prt::test::push_bytes(push), 4 * uint32_t(receivers_->size()));
+    return ran ? prt::test::from_bytes<float>(res) : std::vector<float>{};
   }
 
   static const float* result(std::size_t r) { return &(*results_[static_cast<std::size_t>(GetParam())])[36 * r]; }
@@ -512,6 +536,33 @@ Scene* FivMirror::scene_ = nullptr;
 std::vector<Receiver>* FivMirror::receivers_ = nullptr;
 std::array<std::vector<float>*, 2> FivMirror::results_ = {nullptr, nullptr};
 PRT_SHADER_MIRROR_LANGUAGES(FivMirror);
+
+// Half-float tables (prtshade/fiv.h "Half-float tables"; fiv.glsl PRT_FIV_HALVES_BINDING): the
+// scene with every shell and cone value rounded to binary16, packed as halves, gives bit for bit
+// what the same values packed as floats give — PRT_UNPACK_HALF is exact, and everything after the
+// load is the same code. Subnormal halves, −0 and the largest half are among the values.
+TEST_P(FivMirror, HalfTablesGiveWhatTheirFloatsGive) {
+  Scene rounded = *scene_;
+  for (SynthOccluder& o : rounded.occ) {
+    for (float& v : o.shells) v = float(Imath::half(v));
+    for (float& v : o.cones) v = float(Imath::half(v));
+  }
+  // Occluder 0's first samples (the receivers near it read them): subnormals (2^-24, the
+  // smallest; −1023·2^-24, the largest), −0, 2^-14 (the smallest normal), 65504 and −2^-14 (1 + 2^-10).
+  const float special[] = {0x1p-24f, -1023 * 0x1p-24f, -0.0f, 0x1p-14f, 65504.0f, -0x1.004p-14f};
+  for (std::size_t k = 0; k < std::size(special); ++k)
+    for (std::size_t s = 0; s < 4; ++s) rounded.occ[0].shells[9 * s + k] = special[k];
+  const std::vector<float> floats = run(rounded, false), halves = run(rounded, true);
+  ASSERT_FALSE(floats.empty());
+  ASSERT_EQ(floats.size(), halves.size());
+  std::size_t differ = 0, nonzero = 0;
+  for (std::size_t i = 0; i < floats.size(); ++i) {
+    differ += std::memcmp(&floats[i], &halves[i], sizeof(float)) != 0 ? 1 : 0;
+    nonzero += floats[i] != 0 ? 1 : 0;
+  }
+  EXPECT_EQ(differ, 0u) << "of " << floats.size() << " results";
+  EXPECT_GT(nonzero, floats.size() / 2);  // the comparison is not of zeros
+}
 
 // One lookup of occluder o from receiver point p: the offset as both implementations form it
 // (float subtraction), its coordinates, the reference value and the shader-vs-core tolerance.

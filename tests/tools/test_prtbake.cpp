@@ -498,18 +498,24 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   const F::Dataset* cones = F::find_dataset(f, "/fiv/occluders/spider/cones");
   ASSERT_NE(cones, nullptr);
   EXPECT_EQ(cones->shape[3], 4u);
-  EXPECT_EQ(std::get<int64_t>(F::find_attr(f.root_attrs, "format_version")->value), 7);
-  // --radial geometric: paper 004's spheres (no radial_scheme, no surface_radius); the file is
-  // still version 7 for its cone table (the tight proxy every bake writes).
+  // ... both in half floats (format_version 8, formats/SCHEMA.md "Half-float FIV tables").
+  EXPECT_EQ(F::dtype_name(shells->data), "float16");
+  EXPECT_EQ(F::dtype_name(cones->data), "float16");
+  EXPECT_EQ(std::get<int64_t>(F::find_attr(f.root_attrs, "format_version")->value), 8);
+  // --radial geometric: paper 004's spheres (no radial_scheme, no surface_radius); with
+  // --precision float the file is version 7 for its cone table (the tight proxy every bake writes).
   ASSERT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env " + (kData / "studio.exr").string() +
-                " --shells 8x5x4 --cube 2 --samples 1024 --radial geometric --report 0 --quiet -o " + out.string())
+                " --shells 8x5x4 --cube 2 --samples 1024 --radial geometric --precision float --report 0 --quiet -o " +
+                out.string())
                 .code,
             0);
   const F::File g = F::read_file(out);
   EXPECT_EQ(F::find_attr(F::find_dataset(g, "/fiv/occluders/spider/shells")->attrs, "radial_scheme"), nullptr);
   EXPECT_EQ(F::find_dataset(g, "/fiv/occluders/spider/surface_radius"), nullptr);
   EXPECT_NE(F::find_dataset(g, "/fiv/occluders/spider/cones"), nullptr);
+  EXPECT_EQ(F::dtype_name(F::find_dataset(g, "/fiv/occluders/spider/shells")->data), "float32");
   EXPECT_EQ(std::get<int64_t>(F::find_attr(g.root_attrs, "format_version")->value), 7);
+  EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --precision double -o " + out.string()).code, 2);
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --radial spherical -o " + out.string()).code, 2);
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " -o " + out.string()).code, 2) << "no --env";
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);

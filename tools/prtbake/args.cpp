@@ -469,6 +469,16 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
          "offsets from the occluder's outer surface along the ray, graded from\n"
          "0.005 R; geometric = spheres around the centre from 0.5 R (paper 004)")
       ->option_text("surface|geometric");
+  cmd.add_option_function<std::string>(
+         "--precision",
+         [&a](const std::string& r) {
+           if (!bake::parse_shell_precision(r, a.shell_spec.float16))
+             throw CLI::ValidationError("--precision", "expects half or float, got '" + r + "'");
+         },
+         "how the file stores the shells and cones: half (default) = float16,\n"
+         "half the memory at no measurable error (a value moves by at most\n"
+         "2^-11 of itself; format_version 8); float = float32")
+      ->option_text("half|float");
   cmd.add_option("--first-offset", a.shell_spec.first_offset,
                  "the surface scheme's first offset from the surface, as a fraction of\n"
                  "the bounding radius R (default 0.005; strictly between 0 and 1)")

@@ -328,6 +328,7 @@ F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const b
   o.n_theta = shells.n_theta;
   o.n_phi = shells.n_phi;
   o.shells = std::move(shells.values);
+  o.float16 = shells.float16;  // v8: already rounded to float16 by the bake (FivShells::float16)
   o.environment = env_path;
   o.environment_sha256 = env.sha256;
   o.integrand = "F_c(s) = Int (1 - V(s,w)) L_c(w) w dw, layout [rho][theta][phi][RGB][xyz]";
@@ -360,7 +361,8 @@ F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const b
   }
   if (!shells.cones.empty()) {  // the tight proxy (v7)
     o.cones = F::OccluderCones{std::move(shells.cones),
-                               "(m, Omega)(s) = (Int (1 - V(s,w)) w dw, Int (1 - V(s,w)) dw), layout [rho][theta][phi][4]", {}};
+                               "(m, Omega)(s) = (Int (1 - V(s,w)) w dw, Int (1 - V(s,w)) dw), layout [rho][theta][phi][4]", {},
+                               shells.float16};
     o.proxy = std::string(F::names::kProxyCone);
   }
   return o;

@@ -28,6 +28,7 @@ std::string element(const pf::DatasetData& data, std::size_t i) {
   if (const auto* f = std::get_if<std::vector<float>>(&data)) return num((*f)[i]);
   if (const auto* f = std::get_if<std::vector<double>>(&data)) return num((*f)[i]);
   if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return std::to_string((*u)[i]);
+  if (const auto* h = std::get_if<std::vector<pf::Float16>>(&data)) return num(pf::to_float((*h)[i]));
   return std::to_string(std::get<std::vector<uint8_t>>(data)[i]);
 }
 
@@ -42,6 +43,7 @@ Json json_element(const pf::DatasetData& data, std::size_t i) {
   if (const auto* f = std::get_if<std::vector<float>>(&data)) return json_float((*f)[i]);
   if (const auto* f = std::get_if<std::vector<double>>(&data)) return json_double((*f)[i]);
   if (const auto* u = std::get_if<std::vector<uint32_t>>(&data)) return (*u)[i];
+  if (const auto* h = std::get_if<std::vector<pf::Float16>>(&data)) return json_float(pf::to_float((*h)[i]));
   return std::get<std::vector<uint8_t>>(data)[i];
 }
 
@@ -111,10 +113,18 @@ namespace {
 constexpr std::size_t kMaxColumnsForStats = 16;
 
 double element_value(const pf::DatasetData& data, std::size_t i) {
-  return std::visit([i](const auto& v) { return static_cast<double>(v[i]); }, data);
+  return std::visit(
+      [i]<class T>(const std::vector<T>& v) {
+        if constexpr (std::is_same_v<T, pf::Float16>) return static_cast<double>(pf::to_float(v[i]));
+        else return static_cast<double>(v[i]);
+      },
+      data);
 }
 
-bool is_float32(const pf::Dataset& d) { return std::holds_alternative<std::vector<float>>(d.data); }
+// float32 or float16: values a float holds exactly, printed as floats.
+bool is_float32(const pf::Dataset& d) {
+  return std::holds_alternative<std::vector<float>>(d.data) || std::holds_alternative<std::vector<pf::Float16>>(d.data);
+}
 bool is_float(const pf::Dataset& d) { return is_float32(d) || std::holds_alternative<std::vector<double>>(d.data); }
 
 // min/max are values of the dataset: print them in the dataset's own precision.

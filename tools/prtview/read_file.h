@@ -107,6 +107,9 @@ struct BakedOccluder {
   std::array<double, 3> centre{};
   double radius = 0;
   std::vector<float> radii;  // view.radii points here
+  // A float16 file's tables as the runtime holds them (prtshade/fiv.h "Half-float tables"):
+  // view.shells_half / cones_half point here.
+  std::vector<uint16_t> shells_half, cones_half;
   shade::FivOccluder view{};
 };
 BakedOccluder read_occluder(const formats::Asset& f, const std::string& file, const std::string& name, const bake::EnvMap& env);

@@ -202,6 +202,7 @@ struct OccluderCones {
   std::vector<float> values;
   std::optional<std::string> integrand;
   ExtraAttrs extra;
+  bool float16 = false;  // v8: stored as float16 (values rounded to it on write)
   bool operator==(const OccluderCones&) const = default;
 };
 
@@ -212,6 +213,9 @@ struct Occluder {
   std::string name;
   int n_rho = 0, n_theta = 0, n_phi = 0;
   std::vector<float> shells;  // [Nrho][Ntheta][Nphi][RGB][xyz]
+  // v8: the shells stored as float16 (half the bytes; the writer rounds each value to nearest, the
+  // reader gives the float16 values back as floats). false: float32.
+  bool float16 = false;
   std::array<double, 3> centre{};
   double radius = 0;
   std::vector<double> radii;  // [Nrho]

@@ -18,8 +18,9 @@
 //
 // Writer contract (write_file)
 //   * Validates the whole File against schema v5 (validate()) before touching the disk.
-//   * Adds format="prtbake" and format_version=written_format_version(file) itself: 7 when the
-//     file holds an FIV cone table (/fiv/occluders/<name>/cones or `proxy`), else 6 with a
+//   * Adds format="prtbake" and format_version=written_format_version(file) itself: 8 when a
+//     dataset is float16 (FIV shells or cones), 7 when the file holds surface-following shells or
+//     an FIV cone table (/fiv/occluders/<name>/cones or `proxy`), else 6 with a
 //     punctual light, else 5 when the
 //     file holds a version-5 dataset (/mesh/uv, /lightmap/..., in any vertex set), else 4, so a
 //     file that needs nothing of version 5 keeps the bytes version 4 gave it (SCHEMA.md,
@@ -88,14 +89,16 @@
 namespace prt::formats {
 
 // The newest schema version this library reads, and the one it writes for a file that holds a
-// surface-following FIV shells and the FIV cone table (written_format_version; policy: SCHEMA.md
-// "Versioning"). 7 added surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the
+// float16 FIV shells or cone table (written_format_version; policy: SCHEMA.md "Versioning").
+// 8 added dtype float16 for /fiv/occluders/<name>/shells and cones (half the memory; issue 33). 7 added surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the
 // shells' radial_scheme and first_offset attributes) and the tight occluder proxy
 // (/fiv/occluders/<name>/cones and the group attribute `proxy`); 6 punctual lights (/lights/<name>
 // of shape point, spot or directional: attributes, no geometry); 5 lightmaps (/mesh/uv,
 // /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights (/lights,
 // area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 7;
+inline constexpr int kFormatVersion = 8;
+// The version written for a file with float16 FIV shells or cones.
+inline constexpr int kFormatVersionWithHalfShells = 8;
 // The version written for a file with FIV cones (/fiv/occluders/<name>/cones or a `proxy`
 // attribute: the tight occluder proxy) or surface-following shells.
 inline constexpr int kFormatVersionWithCones = 7;
@@ -118,13 +121,23 @@ struct Attr {
   bool operator==(const Attr&) const = default;
 };
 
-using DatasetData =
-    std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>, std::vector<double>>;
+// An IEEE 754 binary16 value by its bits: dtype "float16" (v8), the FIV shells and cone tables
+// stored compactly (SCHEMA.md "/fiv"). to_float / to_float16 convert (OpenEXR's Imath::half:
+// exact one way, round to nearest even the other).
+struct Float16 {
+  uint16_t bits = 0;
+  bool operator==(const Float16&) const = default;
+};
+float to_float(Float16 h);
+Float16 to_float16(float f);  // |f| beyond 65504 rounds to ±inf (the schema refuses it)
+
+using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>, std::vector<double>,
+                                 std::vector<Float16>>;
 
 struct Dataset {
   std::string path;              // absolute, e.g. "/transfer/diffuse"; parent groups are created
   std::vector<uint64_t> shape;   // row-major; data.size() == product(shape)
-  DatasetData data;              // float32 / uint32 / uint8 / float64 on disk
+  DatasetData data;              // float32 / uint32 / uint8 / float64 / float16 (v8) on disk
   std::vector<Attr> attrs;
   bool operator==(const Dataset&) const = default;
 };
@@ -182,8 +195,8 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersion (= kFormatVersionWithCones) when it
-// holds surface-following FIV shells (an occluder's surface_radius dataset, or a shells dataset
+// The format_version write_file gives `file`: kFormatVersionWithHalfShells when a dataset is
+// float16, else kFormatVersionWithCones when it holds surface-following FIV shells (an occluder's surface_radius dataset, or a shells dataset
 // with a radial_scheme or first_offset attribute) or an FIV cone table (/fiv/occluders/<name>/cones
 // or a group attribute `proxy`), else kFormatVersionWithPunctualLights when it holds a punctual
 // light (a /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps
@@ -227,7 +240,7 @@ std::vector<std::string> split_light_list(std::string_view list);
 // The inverse: names joined with '\n'.
 std::string join_light_list(const std::vector<std::string>& names);
 
-// "float32", "uint32", "uint8" or "float64".
+// "float32", "uint32", "uint8", "float64" or "float16".
 std::string_view dtype_name(const DatasetData& data);
 // Number of elements of `data`.
 std::size_t element_count(const DatasetData& data);

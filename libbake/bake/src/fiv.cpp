@@ -1,4 +1,5 @@
 #include <bake/bake/fiv.h>
+
 #include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>
 #include <bake/environment/irradiance.h>
@@ -6,6 +7,7 @@
 #include <bake/sphere/sampling.h>
 #include <bake/visibility/raycast.h>
 
+#include <Imath/half.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -100,6 +102,14 @@ Eigen::Vector3d shell_direction(int i_theta, int n_theta, int j_phi, int n_phi) 
 
 std::string_view radial_scheme_name(RadialScheme scheme) {
   return scheme == RadialScheme::surface ? "surface" : "geometric";
+}
+
+std::string_view shell_precision_name(bool float16) { return float16 ? "half" : "float"; }
+
+bool parse_shell_precision(std::string_view text, bool& float16) {
+  if (text != "half" && text != "float") return false;
+  float16 = text == "half";
+  return true;
 }
 
 bool parse_radial_scheme(std::string_view text, RadialScheme& scheme) {
@@ -345,7 +355,19 @@ std::vector<double> FivShellRows::rows(int shell, size_t begin, size_t end, Task
 // (then r_surf + τ_k >= R too).
 bool FivShellRows::may_stop_after(int shell) const { return radius(shell) >= std::max(frame_.radius, 1e-30); }
 
-void FivShellRows::finish(FivShells& shells) const { extrapolate_inside_samples(shells); }
+void FivShellRows::finish(FivShells& shells) const {
+  extrapolate_inside_samples(shells);
+  if (!spec_.float16) return;
+  // What a float16 file holds (ShellSpec::float16): round to nearest even, by Imath::half.
+  for (std::vector<float>* table : {&shells.values, &shells.cones})
+    for (float& v : *table) {
+      if (!(std::fabs(v) <= 65504.0f))
+        throw InputError("", "an occluded FIV value of " + std::to_string(v) +
+                                 " exceeds float16's largest, 65504: this environment needs precision \"float\"");
+      v = float(Imath::half(v));
+    }
+  shells.float16 = true;
+}
 
 bool FivShellRows::stops_after(int shell, std::span<const double> rows) const {
   PRT_CHECK_OP(rows.size(), ==, rows_per_shell() * kRowWidth);

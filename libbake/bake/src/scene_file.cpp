@@ -211,7 +211,12 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
       if (sc.bounces == 0) r.fail("bake.bounce_rays applies with bake.bounces >= 1");
     }
     if (const Json* f = find_key(*bake, "fiv")) {
-      r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial"});
+      r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial", "precision"});
+      if (const Json* x = find_key(*f, "precision")) {
+        const std::string& g = r.string(*x, "bake.fiv.precision");
+        if (!parse_shell_precision(g, sc.fiv.float16))
+          r.fail("bake.fiv.precision must be \"half\" or \"float\", not \"" + g + "\"");
+      }
       if (const Json* x = find_key(*f, "radial")) {
         const std::string& g = r.string(*x, "bake.fiv.radial");
         if (!parse_radial_scheme(g, sc.fiv.radial))

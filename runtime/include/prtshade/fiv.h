@@ -113,6 +113,13 @@
 //     K = (x acos(q) − (c/s) z) s² + atan2(z, c/s),   q = −(c/s)(x/y),  z = y √(1 − q²);
 //   for α > π/2 the complement: K(x, α) = π − K(−x, π − α). Continuous at x = ±s; tested against
 //   numerical integration (tests/runtime/test_fiv_runtime.cpp CapClampedCosine).
+// Half-float tables (issue 33; file dtype float16, schema v8): an occluder's shells and cone table
+//   may be held as IEEE 754 binary16 bits (FivOccluder::shells_half, cones_half) instead of floats,
+//   half the memory: at the paper's 2.17 MiB for 64x33x30 float shells, 96x49x26 half shells, or
+//   84x43x24 shells and cones (docs/FIGURES.md). A lookup decodes each sample it reads exactly
+//   (half_to_float: every finite half is a float) and then does what it does for floats, so a
+//   half table gives bit for bit what the float table of the decoded values gives. Rounding a
+//   value to half moves it by at most 2^-11 of itself (2^-25 absolute below 2^-14).
 // Self-shadows (§4.3.2, eq. 12): a receiver ON occluder O sees unoccluded light only in its
 //   positive hemisphere, so E = max(0, n·F^env − n·F(p − centre)) per channel.
 //
@@ -138,6 +145,7 @@
 // on the stack (about 22 KB). Thread-safe (no shared state).
 #pragma once
 
+#include <bit>
 #include <cstdint>
 
 namespace prt::shade {
@@ -164,7 +172,25 @@ struct FivOccluder {
   // The tight proxy (header "Tight proxies"): cones [n_rho][n_theta][n_phi][4] = (m_x, m_y, m_z, Ω),
   // or nullptr: the occluder's proxy is its bounding sphere.
   const float* cones = nullptr;
+  // Half-float tables (header comment): the shells as binary16 bits (then shells is nullptr) and
+  // the cone table likewise (then cones is nullptr); the same layouts.
+  const uint16_t* shells_half = nullptr;
+  const uint16_t* cones_half = nullptr;
 };
+
+// True when the occluder carries a cone table (float or half).
+inline bool has_cones(const FivOccluder& o) { return o.cones != nullptr || o.cones_half != nullptr; }
+
+// The value of finite binary16 bits h, exactly (sign, 5 exponent bits with bias 15, 10 mantissa
+// bits; exponent 0: subnormal m·2^-24). Bits with exponent 31 (±inf, NaN) are not finite halves:
+// validate_occluder refuses them and the result is unspecified.
+inline float half_to_float(uint16_t h) {
+  const uint32_t sign = uint32_t(h & 0x8000u) << 16;
+  // A normal half: the exponent rebased from 15 to 127, the mantissa moved to the top of float's.
+  const uint32_t normal = ((uint32_t(h & 0x7fffu) << 13) + (112u << 23)) | sign;
+  const float subnormal = float(h & 0x3ffu) * 0x1p-24f;  // exact: m < 2^10
+  return (h & 0x7c00u) != 0 ? std::bit_cast<float>(normal) : (sign != 0 ? -subnormal : subnormal);
+}
 
 // Which proxy the corrections use (header "Tight proxies").
 enum class FivProxy : int {

@@ -106,8 +106,11 @@ prt_status prt_shade_glossy_radiance(const float* shadowed, int order, const flo
  * the offsets from the surface, surface_radius [n_theta][n_phi] is /fiv/occluders/<name>/
  * surface_radius, valid may be null); prtshade/fiv.h "Surface-following shells". cones
  * [n_rho][n_theta][n_phi][4] the tight proxy (/fiv/occluders/<name>/cones when its `proxy` is
- * "cone"; fiv.h "Tight proxies") or NULL (the bounding sphere). Set every member (or
- * zero-initialise the struct): the three last members came with format_version 7. */
+ * "cone"; fiv.h "Tight proxies") or NULL (the bounding sphere). shells_half / cones_half: the
+ * same tables as IEEE binary16 bits (float16 datasets, format_version 8; fiv.h "Half-float
+ * tables"), given instead of shells / cones (leave those NULL). Set every member (or
+ * zero-initialise the struct): radial_scheme, surface_radius and cones came with format_version
+ * 7, shells_half and cones_half with 8. */
 typedef struct prt_fiv_occluder_desc {
   float centre[3];
   float radius;
@@ -118,6 +121,8 @@ typedef struct prt_fiv_occluder_desc {
   int radial_scheme;
   const float* surface_radius;
   const float* cones;
+  const uint16_t* shells_half;
+  const uint16_t* cones_half;
 } prt_fiv_occluder_desc;
 
 typedef struct prt_fiv_options {

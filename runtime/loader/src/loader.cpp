@@ -42,6 +42,13 @@ LoadedVertexSet vertex_set_of(const formats::VertexSet& s, const std::string& na
   return v;
 }
 
+// The binary16 bits of values read from a float16 dataset (each one a half: exact).
+std::vector<uint16_t> half_bits(const std::vector<float>& values) {
+  std::vector<uint16_t> bits(values.size());
+  std::transform(values.begin(), values.end(), bits.begin(), [](float v) { return formats::to_float16(v).bits; });
+  return bits;
+}
+
 LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) {
   if (!o.valid) throw FormatError(file, "occluder '" + o.name + "' needs shells and a valid mask of the same grid");
   LoadedOccluder out;
@@ -50,7 +57,8 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   out.radius = float(o.radius);
   out.n_rho = o.n_rho, out.n_theta = o.n_theta, out.n_phi = o.n_phi;
   out.radii.assign(o.radii.begin(), o.radii.end());
-  out.shells = o.shells;
+  if (o.float16) out.shells_half = half_bits(o.shells);
+  else out.shells = o.shells;
   out.valid = o.valid->values;
   // Version 7 (formats/SCHEMA.md): no radial_scheme attribute is the geometric scheme.
   if (o.radial_scheme.value_or("geometric") == "surface") {
@@ -61,7 +69,8 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   if (o.proxy == std::string(formats::names::kProxyCone)) {
     if (!o.cones) throw FormatError(file, "occluder '" + o.name + "' says proxy \"cone\" without a cone table");
     out.proxy = o.proxy.value();
-    out.cones = o.cones->values;
+    if (o.cones->float16) out.cones_half = half_bits(o.cones->values);
+    else out.cones = o.cones->values;
   }
   out.grid = o.grid.value_or("");
   out.attrs = formats::shells_attrs(o);
@@ -82,11 +91,13 @@ FivOccluder LoadedOccluder::view() const noexcept {
                      n_theta,
                      n_phi,
                      radii.data(),
-                     shells.data(),
+                     shells_half.empty() ? shells.data() : nullptr,
                      valid.data(),
                      radial_scheme,
                      radial_scheme == kFivRadialSurface ? surface_radius.data() : nullptr,
-                     cones.empty() ? nullptr : cones.data()};
+                     cones.empty() ? nullptr : cones.data(),
+                     shells_half.empty() ? nullptr : shells_half.data(),
+                     cones_half.empty() ? nullptr : cones_half.data()};
 }
 
 const LoadedVertexSet* LoadedAsset::find_vertex_set(std::string_view name) const noexcept {

@@ -9,6 +9,7 @@
 #include <prtshade/fiv.h>
 #include <prtshade/sh.h>
 
+#include <Imath/half.h>
 #include <gtest/gtest.h>
 #include <test_scenes.h>
 
@@ -292,6 +293,7 @@ TEST(Fiv, FrameOnlyShellRowsAgreeWithTheIntegratingOnes) {
     ASSERT_EQ(frame.stops_after(k, rows), baker.stops_after(k, rows)) << "shell " << k;
     if (baker.stops_after(k, rows)) break;
   }
+  baker.finish(a), frame.finish(b);  // the extrapolation and the rounding to float16 (ShellSpec::float16)
   const FivShells whole = bake_fiv_shells(p.m, p.topo, p.env, p.spec);
   EXPECT_EQ(b.radii, whole.radii);
   EXPECT_EQ(b.values, whole.values);
@@ -521,4 +523,38 @@ TEST(FivSurface, SceneFilesChooseTheRadialScheme) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bake.fiv.radial"), std::string::npos) << e.what();
   }
+  // bake.fiv.precision: half floats by default (formats/SCHEMA.md "Half-float FIV tables").
+  EXPECT_TRUE(load_scene(write("half.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.float16);
+  EXPECT_FALSE(load_scene(write("float.json", R"({"fiv": {"precision": "float"}})"), std::nullopt).fiv.float16);
+  try {
+    load_scene(write("bad_precision.json", R"({"fiv": {"precision": "double"}})"), std::nullopt);
+    ADD_FAILURE() << "\"double\" accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bake.fiv.precision"), std::string::npos) << e.what();
+  }
+}
+
+// ShellSpec::float16: the bake rounds the shells and the cones to the nearest float16 (what the
+// file stores, so the error report measures it), and the float bake's values round to them.
+TEST(FivSurface, HalfPrecisionRoundsTheShellsAndConesToFloat16) {
+  ShellSpec spec;
+  spec.n_phi = 8, spec.n_theta = 5, spec.n_rho = 4;
+  const Mesh m = load_mesh(std::string(PRT_DATA_DIR) + "/spider.obj", {.use_file_normals = false});
+  const Topology topo = build_topology(m);
+  const EnvMap env = EnvMap::load(std::string(PRT_DATA_DIR) + "/studio.exr", UpAxis::Y);
+  spec.float16 = false;
+  const FivShells full = bake_fiv_shells(m, topo, env, spec);
+  spec.float16 = true;
+  const FivShells half = bake_fiv_shells(m, topo, env, spec);
+  EXPECT_FALSE(full.float16);
+  EXPECT_TRUE(half.float16);
+  ASSERT_EQ(half.values.size(), full.values.size());
+  ASSERT_EQ(half.cones.size(), full.cones.size());
+  size_t changed = 0;
+  for (size_t i = 0; i < full.values.size(); ++i) {
+    EXPECT_EQ(half.values[i], float(Imath::half(full.values[i]))) << i;
+    changed += half.values[i] != full.values[i] ? 1 : 0;
+  }
+  for (size_t i = 0; i < full.cones.size(); ++i) EXPECT_EQ(half.cones[i], float(Imath::half(full.cones[i]))) << i;
+  EXPECT_GT(changed, full.values.size() / 2);  // the values were rounded, not left as floats
 }

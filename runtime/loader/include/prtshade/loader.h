@@ -65,7 +65,10 @@ struct LoadedOccluder {
   float radius = 0;
   int n_rho = 0, n_theta = 0, n_phi = 0;
   std::vector<float> radii;     // [Nρ]
-  std::vector<float> shells;    // [Nρ][Nθ][Nφ][3][3]
+  std::vector<float> shells;    // [Nρ][Nθ][Nφ][3][3]; empty when shells_half holds them
+  // A float16 file's shells (v8) as binary16 bits, as the runtime reads them (prtshade/fiv.h
+  // "Half-float tables"), else empty; cones_half likewise for the cone table.
+  std::vector<uint16_t> shells_half, cones_half;
   std::vector<uint8_t> valid;   // [Nρ][Nθ][Nφ]
   int radial_scheme = kFivRadialGeometric;  // the file's radial_scheme (v7; absent: geometric)
   std::vector<float> surface_radius;        // [Nθ][Nφ], surface scheme only

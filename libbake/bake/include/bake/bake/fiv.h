@@ -95,8 +95,19 @@ struct ShellSpec {
   double fraction = 1e-3;  // stop once |occluded FIV| is below this fraction of ∫ L dω
   // The silhouette integrator's k (silhouette_isolines(k) u-isolines, bake/integrators/integrator.h).
   uint32_t silhouette_k = IntegratorSpec::kDefaultSilhouetteK;
-  int cube = 16;           // DifMap face size S (irradiance_cube)
+  // DifMap face size S (irradiance_cube). 32: its bilinear lookup at a face centre (a receiver
+  // facing ±X, ±Y, ±Z) reads texels 1/S off the axis, which under forest.exr darkens a ground
+  // receiver by 0.39 % at S = 16 (every pixel of Figure 12, NRMSE 0.0039 alone), 0.11 % at 32 and
+  // 0.03 % at 64, for 2.2, 6.8 and 28.7 s of bake (docs/FIGURES.md).
+  int cube = 32;
+  // The precision the file stores the shells and cones in (formats: dtype float16, schema v8;
+  // prtshade/fiv.h "Half-float tables"): true halves their memory at no measurable error.
+  bool float16 = true;
 };
+// "half" (float16) or "float" (float32), as tools spell ShellSpec::float16; parse returns false
+// and leaves `float16` as it was for anything else.
+std::string_view shell_precision_name(bool float16);
+bool parse_shell_precision(std::string_view text, bool& float16);
 // The grid as files and tools spell it, "NPHIxNTHETAxNRHO" (e.g. "128x65x30"). Returns false and
 // leaves `spec` as it was unless 1 <= NPHI <= 4096, 2 <= NTHETA <= 4096 (poles included) and
 // 1 <= NRHO <= 1024.
@@ -115,6 +126,9 @@ struct FivShells {
   std::vector<float> cones;     // occluded moment and solid angle (m_x, m_y, m_z, Ω): [Nρ][Nθ][Nφ][4]
   std::vector<double> surface_radius;  // [Nθ][Nφ] r_surf, surface scheme only
   size_t extrapolated = 0;      // surface scheme: samples filled from their radial line
+  // ShellSpec::float16: values and cones rounded to the nearest float16 (what the file stores),
+  // before any report measures them.
+  bool float16 = false;
   // Where sample (k, i, j) sits, in the mesh's frame (header comment).
   Eigen::Vector3d sample_position(int k, int i, int j) const;
   double seconds = 0;

@@ -21,7 +21,8 @@
 //       "bounces": 0, "bounce_rays": 256,      B bounces of diffuse interreflection in the diffuse
 //                                              transfer and band-1 radiance (bake/bake/bounce.h;
 //                                              the rule below), K gather rays per receiver row
-//       "fiv": {"shells": "128x65x30", "cube": 16, "fraction": 0.001, "radial": "surface"}   (bake/bake/fiv.h ShellSpec)
+//       "fiv": {"shells": "128x65x30", "cube": 32, "fraction": 0.001, "radial": "surface",
+//               "precision": "half"}   (bake/bake/fiv.h ShellSpec)
 //       "lightmap": {...}                      every receiver per texel (below), unless its own says
 //     },                                       otherwise
 //     "lights": [ {                              optional: area lights (bake/lights/lights.h, paper 003)
@@ -213,7 +214,8 @@ struct SceneDescription {
   bool relight = false;
   int bounces = 0;           // "bounces": interreflections (the plan rule "bounces")
   uint32_t bounce_rays = 0;  // "bounce_rays" (0: BounceSpec::kDefaultRays)
-  // "fiv": shells, cube, fraction, radial ("surface" or "geometric"); the shells' k is integrator.silhouette_k ("samples" for a
+  // "fiv": shells, cube, fraction, radial ("surface" or "geometric"), precision ("half" or
+  // "float": the file's dtype of shells and cones); the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
   std::optional<LightmapSpec> lightmap;  // bake.lightmap: every object's unless its own says otherwise
