@@ -45,6 +45,11 @@ std::string_view dtype_name(const DatasetData& data) {
 
 float to_float(Float16 h) { return float(Imath::half(Imath::half::FromBits, h.bits)); }
 Float16 to_float16(float f) { return Float16{Imath::half(f).bits()}; }
+std::vector<uint16_t> float16_bits(const std::vector<float>& values) {
+  std::vector<uint16_t> bits(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) bits[i] = to_float16(values[i]).bits;
+  return bits;
+}
 
 std::size_t element_count(const DatasetData& data) {
   return std::visit([](const auto& v) { return v.size(); }, data);

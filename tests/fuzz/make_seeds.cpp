@@ -5,6 +5,7 @@
 //   prt/vertex.prt.h5, prt/fiv.prt.h5   small files from our writer (formats::write_asset): a
 //        tetrahedron's vertex products (ao, diffuse and visibility transfer, band-1 radiance);
 //        an FIV file (environment, DifMap, one occluder), for fuzz_prt_dump and fuzz_prt_loader;
+//   prt/fiv_float16.prt.h5   the FIV file with its shells in half floats (format_version 8);
 //   prt/annotated.prt.h5   vertex.prt.h5 with attributes as h5py adds them (issue 28):
 //        variable-length strings on the root (a scalar and an array of three), on /mesh and on
 //        /ao, their text in a global heap collection that the targets then damage;
@@ -218,6 +219,9 @@ int main(int argc, char** argv) {
     write_exr(dir / "exr" / "cube.exr", 4, 24, Imf::ENVMAP_CUBE, Imf::NO_COMPRESSION);
     pf::write_asset(dir / "prt" / "vertex.prt.h5", vertex_asset());
     pf::write_asset(dir / "prt" / "fiv.prt.h5", fiv_asset());
+    pf::Asset half = fiv_asset();  // the same occluder in half floats (format_version 8)
+    half.occluders[0].float16 = true;
+    pf::write_asset(dir / "prt" / "fiv_float16.prt.h5", half);
     write_old_format(dir / "prt" / "old_format.prt.h5");
     write_annotated(dir / "prt" / "annotated.prt.h5");
   } catch (const std::exception& e) {

@@ -13,6 +13,7 @@
 #include <hdf5_bytes.h>
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -355,3 +356,65 @@ TEST(Loader, DamagedAndOldFormatFilesAreRefusedNeverACrash) {
     EXPECT_NE(std::string(e.what()).find("oldest file format"), std::string::npos) << e.what();
   }
 }
+
+namespace {
+
+// Schema v8 (formats/SCHEMA.md "Half-float FIV tables"): a float16 file's shells and cones reach
+// the runtime as halves (shells_half, cones_half; the float vectors empty), shade exactly as the
+// float tables of their values, and h5py reads them as numpy float16 with those values.
+TEST(Loader, HalfFloatTablesReachTheViewAsHalves) {
+  File f = make_file(false);
+  const uint64_t nr = 2, nt = 3, np = 4;
+  std::vector<float> cones;
+  for (uint64_t k = 0; k < nr * nt * np; ++k) cones.insert(cones.end(), {0.0f, 0.25f, 0.5f, 1.0f});
+  std::vector<float> shells = std::get<std::vector<float>>(f.datasets[8].data);
+  std::vector<prt::formats::Float16> shell_halves, cone_halves;
+  for (float& v : shells) shell_halves.push_back(prt::formats::to_float16(v)), v = prt::formats::to_float(shell_halves.back());
+  for (float v : cones) cone_halves.push_back(prt::formats::to_float16(v));
+  f.datasets[8].data = shell_halves;
+  f.datasets.push_back({"/fiv/occluders/rock/cones", {nr, nt, np, 4}, cone_halves, {}});
+  f.group_attrs.push_back({"/fiv/occluders/rock", {{"proxy", std::string("cone")}}});
+  const auto dir = tmp("loader_float16");
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "a.prt.h5";
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  EXPECT_EQ(a.format_version, 8);
+  const prt::shade::LoadedOccluder& o = a.occluders.at(0);
+  EXPECT_TRUE(o.shells.empty());
+  EXPECT_TRUE(o.cones.empty());
+  ASSERT_EQ(o.shells_half.size(), shell_halves.size());
+  for (std::size_t i = 0; i < shell_halves.size(); ++i) EXPECT_EQ(o.shells_half[i], shell_halves[i].bits) << i;
+  ASSERT_EQ(o.cones_half.size(), cone_halves.size());
+  const std::vector<prt::shade::FivOccluder> views = a.occluder_views();
+  EXPECT_EQ(views[0].shells, nullptr);
+  EXPECT_EQ(views[0].cones, nullptr);
+  ASSERT_NE(views[0].shells_half, nullptr);
+  ASSERT_NE(views[0].cones_half, nullptr);
+  const auto& valid = std::get<std::vector<uint8_t>>(f.datasets[9].data);
+  const std::vector<float> radii = {0.375f, 1.5f};
+  const prt::shade::FivOccluder floats{{0.5f, 2.0f, -1.0f}, 0.75f, 2, 3, 4, radii.data(), shells.data(), valid.data(),
+                                       prt::shade::kFivRadialGeometric, nullptr, cones.data()};
+  const float p[3] = {0.2f, 0.1f, -0.3f}, n[3] = {0, 1, 0};
+  float e_half[3], e_float[3];
+  prt::shade::shade_fiv(a.difmap(), views.data(), 1, p, n, {}, e_half);
+  prt::shade::shade_fiv(a.difmap(), &floats, 1, p, n, {}, e_float);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(e_half[c], e_float[c]) << c;
+  const std::string python = prt::testing::python_with_h5py(dir);
+  if (python.empty()) GTEST_SKIP() << "h5py is not installed (apt-get install python3-h5py to run this test)";
+  std::string expected = "[";
+  for (float v : shells) {  // the shortest text that reads back to v (as float32)
+    char buf[32];
+    expected += std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr) + ",";
+  }
+  EXPECT_EQ(prt::testing::edit_with_h5py(python, path,
+                                         "d = f['fiv/occluders/rock/shells']\n"
+                                         "assert d.dtype == numpy.float16, d.dtype\n"
+                                         "want = numpy.array(" + expected + "], dtype=numpy.float32)\n"
+                                         "got = d[...].astype(numpy.float32).ravel()\n"
+                                         "assert numpy.array_equal(got, want), (got, want)\n"
+                                         "assert f['fiv/occluders/rock/cones'].dtype == numpy.float16\n"),
+            "");
+}
+
+} // namespace

@@ -291,13 +291,6 @@ Band1 read_band1(const F::Asset& f, const std::string& file, const std::string& 
   return b;
 }
 
-// The binary16 bits of values read from a float16 dataset (each one a half: exact).
-std::vector<uint16_t> half_bits(const std::vector<float>& values) {
-  std::vector<uint16_t> bits(values.size());
-  std::transform(values.begin(), values.end(), bits.begin(), [](float v) { return F::to_float16(v).bits; });
-  return bits;
-}
-
 BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const std::string& name, const bake::EnvMap& env) {
   const F::Occluder* baked = f.find_occluder(name);
   if (!baked) throw InputError(file, "no dataset " + shells_path(name));
@@ -316,7 +309,7 @@ BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const st
   o.radii = b.radii.data();
   o.shells = baked->shells.data();
   if (baked->float16) {  // what an engine holds of a float16 file (v8): the half bits
-    b.shells_half = half_bits(baked->shells);
+    b.shells_half = F::float16_bits(baked->shells);
     o.shells = nullptr, o.shells_half = b.shells_half.data();
   }
   o.valid = baked->valid->values.data();
@@ -331,7 +324,7 @@ BakedOccluder read_occluder(const F::Asset& f, const std::string& file, const st
     if (!baked->cones) throw InputError(file, cat(occluder_dir(name), "") + " says proxy \"cone\" without a cone table");
     o.cones = baked->cones->values.data();
     if (baked->cones->float16) {
-      b.cones_half = half_bits(baked->cones->values);
+      b.cones_half = F::float16_bits(baked->cones->values);
       o.cones = nullptr, o.cones_half = b.cones_half.data();
     }
   }

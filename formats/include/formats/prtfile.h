@@ -130,6 +130,9 @@ struct Float16 {
 };
 float to_float(Float16 h);
 Float16 to_float16(float f);  // |f| beyond 65504 rounds to ±inf (the schema refuses it)
+// The binary16 bits of each value (to_float16): for a runtime that holds a float16 table as
+// read (asset.h gives its values as floats, each one a half).
+std::vector<uint16_t> float16_bits(const std::vector<float>& values);
 
 using DatasetData = std::variant<std::vector<float>, std::vector<uint32_t>, std::vector<uint8_t>, std::vector<double>,
                                  std::vector<Float16>>;

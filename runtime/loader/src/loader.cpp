@@ -42,13 +42,6 @@ LoadedVertexSet vertex_set_of(const formats::VertexSet& s, const std::string& na
   return v;
 }
 
-// The binary16 bits of values read from a float16 dataset (each one a half: exact).
-std::vector<uint16_t> half_bits(const std::vector<float>& values) {
-  std::vector<uint16_t> bits(values.size());
-  std::transform(values.begin(), values.end(), bits.begin(), [](float v) { return formats::to_float16(v).bits; });
-  return bits;
-}
-
 LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) {
   if (!o.valid) throw FormatError(file, "occluder '" + o.name + "' needs shells and a valid mask of the same grid");
   LoadedOccluder out;
@@ -57,7 +50,7 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   out.radius = float(o.radius);
   out.n_rho = o.n_rho, out.n_theta = o.n_theta, out.n_phi = o.n_phi;
   out.radii.assign(o.radii.begin(), o.radii.end());
-  if (o.float16) out.shells_half = half_bits(o.shells);
+  if (o.float16) out.shells_half = formats::float16_bits(o.shells);
   else out.shells = o.shells;
   out.valid = o.valid->values;
   // Version 7 (formats/SCHEMA.md): no radial_scheme attribute is the geometric scheme.
@@ -69,7 +62,7 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
   if (o.proxy == std::string(formats::names::kProxyCone)) {
     if (!o.cones) throw FormatError(file, "occluder '" + o.name + "' says proxy \"cone\" without a cone table");
     out.proxy = o.proxy.value();
-    if (o.cones->float16) out.cones_half = half_bits(o.cones->values);
+    if (o.cones->float16) out.cones_half = formats::float16_bits(o.cones->values);
     else out.cones = o.cones->values;
   }
   out.grid = o.grid.value_or("");
