@@ -22,6 +22,8 @@
 //   BM_ShadeFivSurfaceCones/occluders:N  both, float tables (a --precision float bake)
 //   BM_ShadeFivSurfaceConesHalf/occluders:N  both with half-float tables (prtshade/fiv.h "Half-float
 //                                   tables"): what a default bake gives
+//   BM_ShadeFivTenAssets[Half]/occluders:100  surface + cone, float [half] tables, the occluders
+//                                   copies of 10 assets with their own tables (33 MB [16.5 MB])
 //
 // Counters: `per_item` = CPU seconds per vertex or per pixel (printed with an SI prefix, e.g.
 // "2.1ns"). Single thread. Synthetic data, seeded: random transfer/radiance rows; FIV shells of
@@ -163,7 +165,10 @@ struct FivScene {
   std::vector<uint8_t> valid;
   std::vector<prt::shade::FivOccluder> occluders;
 
-  explicit FivScene(int count, bool surface_scheme = false, bool with_cones = false, bool half_tables = false) {
+  // assets: the occluders are copies of that many baked assets (occluder i of asset i mod assets),
+  // each with its own tables in memory (the same values): 1 = a forest of one tree.
+  explicit FivScene(int count, bool surface_scheme = false, bool with_cones = false, bool half_tables = false,
+                    int assets = 1) {
     std::mt19937 rng(42);
     std::uniform_real_distribution<float> u01(0, 1);
     for (int k = 0; k < n_rho; ++k) radii.push_back(0.5f * std::pow(32.0f, float(k) / float(n_rho - 1)));
@@ -184,10 +189,17 @@ struct FivScene {
           for (int e = 0; e < 3; ++e) cones.push_back(float(-len * d[e]));
           cones.push_back(float(2 * std::numbers::pi * (1 - ca)));
         }
+    const std::vector<float> one_shells = shells, one_cones = cones;
+    for (int a = 1; a < assets; ++a) {
+      shells.insert(shells.end(), one_shells.begin(), one_shells.end());
+      cones.insert(cones.end(), one_cones.begin(), one_cones.end());
+    }
     for (int i = 0; i < count; ++i) {
       const float c[3] = {40 * u01(rng) - 20, 5.5f * u01(rng) - 1.5f, 40 * u01(rng) - 20};
-      prt::shade::FivOccluder o{{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(), shells.data(), valid.data()};
-      o.cones = with_cones ? cones.data() : nullptr;
+      const size_t asset = size_t(i % assets);
+      prt::shade::FivOccluder o{{c[0], c[1], c[2]}, 1.0f, n_rho, n_theta, n_phi, radii.data(),
+                                shells.data() + asset * samples * 9, valid.data()};
+      o.cones = with_cones ? cones.data() + asset * samples * 4 : nullptr;
       occluders.push_back(o);
     }
     if (surface_scheme) {  // drawn after everything above, so the scene is the same
@@ -204,8 +216,8 @@ struct FivScene {
       for (float v : shells) shells_half.push_back(Imath::half(v).bits());
       for (float v : cones) cones_half.push_back(Imath::half(v).bits());
       for (prt::shade::FivOccluder& o : occluders) {
-        o.shells = nullptr, o.shells_half = shells_half.data();
-        if (o.cones) o.cones = nullptr, o.cones_half = cones_half.data();
+        o.shells_half = shells_half.data() + (o.shells - shells.data()), o.shells = nullptr;
+        if (o.cones) o.cones_half = cones_half.data() + (o.cones - cones.data()), o.cones = nullptr;
       }
     }
     for (int p = 0; p < kItems; ++p) {
@@ -218,9 +230,10 @@ struct FivScene {
 
 enum class FivPath { fast, reference };
 
-template <FivPath kPath, bool kOverlap = true, bool kSurface = false, bool kCones = false, bool kHalf = false>
+template <FivPath kPath, bool kOverlap = true, bool kSurface = false, bool kCones = false, bool kHalf = false,
+          int kAssets = 1>
 void shade_fiv_case(benchmark::State& state) {
-  const FivScene scene(int(state.range(0)), kSurface, kCones, kHalf);
+  const FivScene scene(int(state.range(0)), kSurface, kCones, kHalf, kAssets);
   const prt::shade::DifMap map{32, scene.cube.data()};
   const float n[3] = {0, 1, 0};
   const prt::shade::FivShadeOptions options{true, kOverlap};
@@ -255,6 +268,12 @@ BENCHMARK(BM_ShadeFivConesReference)->ArgName("occluders")->Arg(10)->Arg(100);
 BENCHMARK(BM_ShadeFivSurfaceCones)->ArgName("occluders")->Arg(10)->Arg(100);
 void BM_ShadeFivSurfaceConesHalf(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true, true, true>(state); }
 BENCHMARK(BM_ShadeFivSurfaceConesHalf)->ArgName("occluders")->Arg(10)->Arg(100);
+// The same 100 occluders as copies of 10 assets, each with its own tables: 33 MB of float tables
+// (beyond a 32 MB L3), 16.5 MB of half ones.
+void BM_ShadeFivTenAssets(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true, true, false, 10>(state); }
+void BM_ShadeFivTenAssetsHalf(benchmark::State& state) { shade_fiv_case<FivPath::fast, true, true, true, true, 10>(state); }
+BENCHMARK(BM_ShadeFivTenAssets)->ArgName("occluders")->Arg(100);
+BENCHMARK(BM_ShadeFivTenAssetsHalf)->ArgName("occluders")->Arg(100);
 
 } // namespace
 
