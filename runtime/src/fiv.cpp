@@ -15,6 +15,9 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>  // _mm_cvtph_ps, used only in a function compiled for F16C (decode_stencil_f16c)
+#endif
 
 namespace prt::shade {
 namespace {
@@ -391,9 +394,8 @@ void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellSt
 // The masked trilinear value of a table of `width` floats per sample over a stencil: neighbours
 // with valid == 0 at weight 0 and the rest renormalised; the plain trilinear value only when no
 // valid neighbour carries weight (so it is summed only then); times the falloff.
-// The kWidth values of the sample at `p`: floats as they are, half-float bits decoded into `buf`
-// (header "Half-float tables": exact, so everything after is the float path's arithmetic).
-template <int kWidth> inline const float* sample_values(const float* p, float (&)[kWidth]) { return p; }
+// The kWidth values of the half-float sample at `p` decoded into `buf` with SSE2 (header
+// "Half-float tables": exact, so everything after is the float path's arithmetic).
 #if defined(__SSE2__)
 // half_to_float of four halves in the low 16 bits of x's lanes: the same formula, lane by lane.
 inline __m128 halves_to_floats(__m128i x) {
@@ -409,7 +411,7 @@ inline __m128 halves_to_floats(__m128i x) {
   return _mm_or_ps(_mm_and_ps(is_normal, _mm_castsi128_ps(normal)), _mm_andnot_ps(is_normal, subnormal));
 }
 #endif
-template <int kWidth> inline const float* sample_values(const uint16_t* p, float (&buf)[kWidth]) {
+template <int kWidth> inline const float* sample_values(const uint16_t* p, float* buf) {
   int e = 0;
 #if defined(__SSE2__)
   if constexpr (kWidth >= 8) {  // 8 halves (16 bytes of the sample) at once
@@ -428,9 +430,69 @@ template <int kWidth> inline const float* sample_values(const uint16_t* p, float
   return buf;
 }
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// The stencil's samples decoded with F16C's vcvtph2ps (the same exact values as half_to_float),
+// where the CPU has it (every x86-64 CPU since 2012; checked once at run time, so the library
+// needs nothing beyond x86-64's SSE2).
+#define PRT_FIV_F16C 1
+template <int kWidth>
+__attribute__((target("f16c"))) void decode_stencil_f16c(const uint16_t* table, const ShellStencil& st,
+                                                         float (*out)[kWidth]) {
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const uint16_t* p = table + st.index(a, b, c) * kWidth;
+        float* o = out[(a * 2 + b) * 2 + c];
+        if constexpr (kWidth >= 8) {
+          const __m128i h = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+          _mm_storeu_ps(o, _mm_cvtph_ps(h));
+          _mm_storeu_ps(o + 4, _mm_cvtph_ps(_mm_srli_si128(h, 8)));
+          for (int e = 8; e < kWidth; ++e) o[e] = _mm_cvtss_f32(_mm_cvtph_ps(_mm_cvtsi32_si128(p[e])));
+        } else {
+          static_assert(kWidth == 4);
+          _mm_storeu_ps(o, _mm_cvtph_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+        }
+      }
+}
+// Whether this CPU has F16C (asked once; __builtin_cpu_init first, as before main it may not have run).
+bool has_f16c() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("f16c") != 0;
+  }();
+  return yes;
+}
+#endif
+
+// The kWidth floats of each stencil corner (a, b, c) at corner[(a·2 + b)·2 + c]: a float table's
+// own samples, or a half table's decoded into `decoded` (exact: header "Half-float tables").
+template <int kWidth>
+void stencil_samples(const float* table, const ShellStencil& st, float (*)[kWidth], const float* corner[8]) {
+  for (int a = 0; a < st.layers; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) corner[(a * 2 + b) * 2 + c] = table + st.index(a, b, c) * kWidth;
+}
+template <int kWidth>
+void stencil_samples(const uint16_t* table, const ShellStencil& st, float (*decoded)[kWidth], const float* corner[8]) {
+#if defined(PRT_FIV_F16C)
+  if (has_f16c()) {
+    decode_stencil_f16c<kWidth>(table, st, decoded);
+  } else
+#endif
+  {
+    for (int a = 0; a < st.layers; ++a)
+      for (int b = 0; b < 2; ++b)
+        for (int c = 0; c < 2; ++c)
+          sample_values<kWidth>(table + st.index(a, b, c) * kWidth, decoded[(a * 2 + b) * 2 + c]);
+  }
+  for (int k = 0; k < 4 * st.layers; ++k) corner[k] = decoded[k];
+}
+
 template <int kWidth, class T>
 void sample_table(const FivOccluder& occ, const ShellStencil& st, const T* table, float out[kWidth]) {
-  float decoded[kWidth];
+  float decoded[8][kWidth];
+  const float* corner[8];
+  stencil_samples<kWidth>(table, st, decoded, corner);
   float masked[kWidth] = {};
   float masked_weight = 0;
   if (occ.radial_scheme != kFivRadialSurface)  // the surface scheme's samples are all valid: plain trilinear
@@ -441,7 +503,7 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const T* table
         if (occ.valid[idx] == 0) continue;
         const float w = st.weight(a, b, c);
         masked_weight += w;
-        const float* v = sample_values<kWidth>(table + idx * kWidth, decoded);
+        const float* v = corner[(a * 2 + b) * 2 + c];
         if constexpr (kWidth == 9) {
           add_weighted_fiv(masked, w, v);
         } else {
@@ -458,7 +520,7 @@ void sample_table(const FivOccluder& occ, const ShellStencil& st, const T* table
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
         const float w = st.weight(a, b, c);
-        const float* v = sample_values<kWidth>(table + st.index(a, b, c) * kWidth, decoded);
+        const float* v = corner[(a * 2 + b) * 2 + c];
         if constexpr (kWidth == 9) {
           add_weighted_fiv(plain, w, v);  // the same float operations per element as the loop
         } else {
@@ -975,6 +1037,12 @@ void shade_fiv_fast(const DifMap& map, const FivOccluder* occluders, int count, 
 void lookup_fiv(const FivOccluder& occ, const float s[3], float out[9]) {
   const double sd[3] = {s[0], s[1], s[2]};
   lookup_fiv_at(occ, sd, out);
+}
+
+void halves_to_floats(const uint16_t* halves, float* out, size_t n) {
+  size_t i = 0;
+  for (; i + 9 <= n; i += 9) sample_values<9>(halves + i, out + i);
+  for (; i < n; ++i) out[i] = half_to_float(halves[i]);
 }
 
 void lookup_cone(const FivOccluder& occ, const float s[3], float out[4]) {

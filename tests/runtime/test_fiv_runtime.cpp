@@ -1272,6 +1272,16 @@ TEST(HalfTables, HalfToFloatIsExactForEveryFiniteHalf) {
     ++checked;
   }
   EXPECT_EQ(checked, 63488);
+  // The SSE2 decode of lookups on CPUs without F16C (halves_to_floats), on the same values in
+  // runs of 9 and a tail.
+  std::vector<uint16_t> finite;
+  for (uint32_t b = 0; b < 0x10000u; ++b)
+    if ((b & 0x7c00u) != 0x7c00u) finite.push_back(uint16_t(b));
+  std::vector<float> decoded(finite.size());
+  shade::halves_to_floats(finite.data(), decoded.data(), finite.size());
+  for (size_t i = 0; i < finite.size(); ++i)
+    ASSERT_EQ(std::bit_cast<uint32_t>(decoded[i]), std::bit_cast<uint32_t>(shade::half_to_float(finite[i])))
+        << "half bits " << finite[i];
 }
 
 // A half table shades bit for bit as the float table of its values: lookups, the fast path and

@@ -146,6 +146,7 @@
 #pragma once
 
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 
 namespace prt::shade {
@@ -267,6 +268,10 @@ void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int 
                       const float n[3], bool partial, float out[3]);
 
 // --- pieces and references (tests, mirrors) ----------------------------------------------------
+
+// half_to_float of n halves, 8 at a time with SSE2 where present: the decode lookups use on a CPU
+// without F16C (with it they use vcvtph2ps; both give half_to_float's values).
+void halves_to_floats(const uint16_t* halves, float* out, size_t n);
 
 // Area of the intersection (lens) of two planar discs of radii r1, r2 >= 0 whose centres are d >= 0
 // apart: 0 when d >= r1 + r2, π min(r1, r2)² when d <= |r1 − r2|, else the closed form
