@@ -382,6 +382,21 @@ prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, con
   });
 }
 
+prt_status prt_fiv_scene_shade_member_given_self(const prt_fiv_scene* scene, int index, const float* positions,
+                                                 const float* normals, const float* self_irradiance, size_t count,
+                                                 int partial, float* out) {
+  return guarded(__func__, [&] {
+    require(scene != nullptr, "scene is null");
+    occluder_at(scene, index);  // checks the index
+    if (count == 0) return;
+    require(positions != nullptr && normals != nullptr && self_irradiance != nullptr && out != nullptr, "null pointer");
+    for (size_t k = 0; k < 3 * count; ++k) require(std::isfinite(self_irradiance[k]), "self_irradiance is not finite");
+    for (size_t k = 0; k < count; ++k)
+      prt::shade::shade_fiv_member_given_self(self_irradiance + 3 * k, scene->views.data(), int(scene->views.size()), index,
+                                              positions + 3 * k, normals + 3 * k, partial != 0, out + 3 * k);
+  });
+}
+
 prt_status prt_shade_lights(const float* irradiance, size_t count, size_t lights, const float* emission,
                             const float* albedo, int albedo_per_receiver, float* out) {
   return guarded(__func__, [&] {

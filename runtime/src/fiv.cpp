@@ -1088,7 +1088,16 @@ void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int 
                       const float n_in[3], bool partial, float out[3]) {
   const UnitNormal unit(n_in);
   const float* n = unit.v;
-  shade_fiv_self_unit(env_fiv, occluders[self], p, n, out);
+  float own[3];
+  shade_fiv_self_unit(env_fiv, occluders[self], p, n, own);
+  shade_fiv_member_given_self(own, occluders, count, self, p, n, partial, out);
+}
+
+void shade_fiv_member_given_self(const float self_irradiance[3], const FivOccluder* occluders, int count, int self,
+                                 const float p[3], const float n_in[3], bool partial, float out[3]) {
+  const UnitNormal unit(n_in);
+  const float* n = unit.v;
+  for (int c = 0; c < 3; ++c) out[c] = std::max(0.0f, self_irradiance[c]);
   for (int j = 0; j < count; ++j) {
     if (j == self) continue;
     float o[3];

@@ -719,6 +719,27 @@ TEST(ShadeFivMember, OwnSelfShadowsMinusTheOtherOccludersShadows) {
     for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]);
   }
   EXPECT_NE(prt_fiv_scene_shade_member(scene, 4, points, normals, 1, 1, out), PRT_OK);  // no occluder 4
+  // Given its own self-shadows, shade_fiv_member_given_self subtracts the same others' shadows:
+  // shade_fiv_member bit for bit when given shade_fiv_self, 3 − 2 − ¾ = ¼ per (c + 1) given
+  // 3 (c + 1), and a negative given value counts as 0. The C API entry computes the same.
+  float own[3], given[3] = {3, 6, 9}, negative[3] = {-1, -1, -1};
+  shade::shade_fiv_self(env, occ[0], p, up, own);
+  shade::shade_fiv_member_given_self(own, occ, 4, 0, p, up, true, s);
+  shade::shade_fiv_member(env, occ, 4, 0, p, up, true, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(s[ch], e[ch]);
+  shade::shade_fiv_member_given_self(given, occ, 4, 0, p, up, true, e);
+  // (Within 4 ulps: the lookups' trilinear weights round, which 7 (c + 1) above absorbed.)
+  for (int ch = 0; ch < 3; ++ch) EXPECT_FLOAT_EQ(e[ch], 0.25f * float(ch + 1)) << ch;
+  shade::shade_fiv_member_given_self(negative, occ, 1, 0, p, up, true, e);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(e[ch], 0.0f);
+  const float given2[6] = {3, 6, 9, 3, 6, 9};
+  ASSERT_EQ(prt_fiv_scene_shade_member_given_self(scene, 0, points, normals, given2, 2, 1, out), PRT_OK);
+  for (int k = 0; k < 2; ++k) {
+    shade::shade_fiv_member_given_self(given2 + 3 * k, occ, 4, 0, points + 3 * k, normals + 3 * k, true, e);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(out[3 * k + ch], e[ch]);
+  }
+  const float nan3[3] = {std::numeric_limits<float>::quiet_NaN(), 0, 0};
+  EXPECT_EQ(prt_fiv_scene_shade_member_given_self(scene, 0, points, normals, nan3, 1, 1, out), PRT_ERROR_INVALID_ARGUMENT);
   prt_fiv_scene_destroy(scene);
 }
 

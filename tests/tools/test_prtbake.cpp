@@ -521,6 +521,35 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   EXPECT_EQ(run("fiv " + (kData / "spider.obj").string() + " --env x.exr --shells 8x1x4 -o " + out.string()).code, 2);
 }
 
+// --self-shadows vertex (the default): the occluder's band-1 radiance at its vertices, in the
+// file's vertex set, the very rows `prtbake vertex --radiance` bakes with the same integrator;
+// --self-shadows shells writes none, and a sharded bake none (it says so).
+TEST(Prtbake, FivSelfShadowsAreTheOccludersBand1RadianceAtItsVertices) {
+  const fs::path fiv = scratch("self.prt.h5"), vertex = scratch("self_vertex.prt.h5"), shells = scratch("self_shells.prt.h5");
+  const std::string env = (kData / "studio.exr").string(), bunny = (kData / "bunny.obj").string();
+  const Outcome a = run("fiv " + bunny + " --env " + env + " --shells 8x5x4 --cube 2 --samples 1024 --report 0 -o " + fiv.string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  EXPECT_NE(a.out.find("self-shadows: band-1 radiance at 1839 vertices"), std::string::npos) << a.out;
+  const Outcome b = run("vertex " + bunny + " --radiance " + env + " --integrator silhouette --samples 1024 --report 0 -o " +
+                        vertex.string());
+  ASSERT_EQ(b.code, 0) << b.err;
+  const F::Asset f = F::read_asset(fiv), v = F::read_asset(vertex);
+  ASSERT_TRUE(f.vertices.radiance_band1.has_value());
+  ASSERT_TRUE(v.vertices.radiance_band1.has_value());
+  EXPECT_EQ(f.vertices.radiance_band1->values.size(), 1839u * 9u);
+  EXPECT_EQ(f.vertices.radiance_band1->values, v.vertices.radiance_band1->values);
+  EXPECT_EQ(f.vertices.positions->values, v.vertices.positions->values);
+  EXPECT_EQ(f.vertices.normals->values, v.vertices.normals->values);
+  const Outcome c = run("fiv " + bunny + " --env " + env + " --shells 8x5x4 --cube 2 --samples 1024 --report 0 --self-shadows shells -o " +
+                        shells.string());
+  ASSERT_EQ(c.code, 0) << c.err;
+  const F::Asset g = F::read_asset(shells);
+  EXPECT_FALSE(g.vertices.radiance_band1.has_value());
+  EXPECT_FALSE(g.vertices.positions.has_value());
+  EXPECT_EQ(g.occluders.at(0).shells, f.occluders.at(0).shells);  // the shells do not depend on it
+  EXPECT_EQ(run("fiv " + bunny + " --env " + env + " --self-shadows faces -o " + shells.string()).code, 2);
+}
+
 TEST(Prtbake, TheBand1ReportRowCarriesTheRmsItsRelativeErrorDividesBy) {
   // formats/SCHEMA.md "Error reports": a band-1 row's mesh_rms is the RMS of the file's band-1 over
   // every vertex (the bake's doubles; the file holds floats, within 2^-24 relative of them).

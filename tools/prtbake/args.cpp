@@ -479,6 +479,20 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
          "half the memory at no measurable error (a value moves by at most\n"
          "2^-11 of itself; format_version 8); float = float32")
       ->option_text("half|float");
+  cmd.add_option_function<std::string>(
+         "--self-shadows",
+         [&a](const std::string& r) {
+           if (r != "vertex" && r != "shells")
+             throw CLI::ValidationError("--self-shadows", "expects vertex or shells, got '" + r + "'");
+           a.fiv_vertex_self_shadows = r == "vertex";
+         },
+         "the occluder's own shadows: vertex (default) = its band-1 radiance at\n"
+         "its vertices (exact there; /mesh and /radiance/band1 in the file), which\n"
+         "prtview and shade_fiv_member_given_self use; shells = nothing more: the\n"
+         "runtime's eq. 12 from the shells, wrong where the surface is not the\n"
+         "outermost along its ray from the centre (ears, concavities). Not with\n"
+         "--shard: a sharded bake writes shells only")
+      ->option_text("vertex|shells");
   cmd.add_option("--first-offset", a.shell_spec.first_offset,
                  "the surface scheme's first offset from the surface, as a fraction of\n"
                  "the bounding radius R (default 0.005; strictly between 0 and 1)")

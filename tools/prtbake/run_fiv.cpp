@@ -2,9 +2,11 @@
 // Vectors on shells around it, the environment's FIV and the DifMap, in one process or sharded
 // (shards.h), and their error against a QMC reference.
 #include <bake/bake/fiv.h>
+#include <bake/bake/vertex_bake.h>
 #include <bake/core/error.h>
 #include <bake/environment/envmap.h>
 #include <bake/environment/irradiance.h>
+#include <bake/integrators/registry.h>
 #include <bake/mesh/mesh.h>
 #include <formats/asset.h>
 
@@ -18,6 +20,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -191,6 +194,26 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
                   r.reference_rms > 0 ? r.rmse / r.reference_rms : 0.0,
                   r.reference_std_error);
     report = tool::fiv_report_of(name, r, shells, a.reproducible);
+  }
+  // Self-shadows (--self-shadows vertex): the occluder's band-1 radiance at its vertices, by the
+  // silhouette integrator at the shells' k and seed (prtshade/fiv.h shade_fiv_member_given_self).
+  // Not in a sharded bake (its chunks are the DifMap's and the shells' rows).
+  if (a.fiv_vertex_self_shadows && !sharded) {
+    bake::ProductRequest req;
+    req.radiance = &*env;
+    bake::IntegratorSpec spec;
+    spec.kind = bake::IntegratorKind::Silhouette;
+    spec.silhouette_k = a.shell_spec.silhouette_k;
+    spec.seed = a.integrator.seed;
+    const std::unique_ptr<bake::Integrator> integrator = bake::make_integrator(spec, mesh, *topo, req);
+    const bake::VertexBake self = bake::bake_vertices(mesh, *topo, *integrator, run.progress, "baking self-shadows");
+    if (run.say)
+      std::printf("self-shadows: band-1 radiance at %zu vertices in %.2f s\n", mesh.positions.size(), self.seconds);
+    tool::set_mesh(asset.vertices, mesh);
+    tool::set_products(asset.vertices, self,
+                       {integrator->name(), integrator->description(), spec.samples(), spec.seed, 0, 0, &*env, a.environment});
+  } else if (a.fiv_vertex_self_shadows && run.say) {
+    std::printf("self-shadows: none baked (a sharded bake writes the shells only; the runtime uses eq. 12)\n");
   }
   // The shells move into the file's occluder (the report above was their last reader).
   asset.occluders.push_back(tool::occluder_of(name, std::move(shells), env_info, a.environment, a.shell_spec.fraction,

@@ -90,8 +90,10 @@ WHAT IS DRAWN
     plane (the receiver), and each pixel is shaded by prtshade: the ground with
     prt::shade::shade_fiv (DifMap minus each occluder's trilinear FIV lookup, cases A/B/C with
     the partial-occluder factor, overlap correction for several occluders: paper 004 sec. 4.3.1),
-    the occluder with prt::shade::shade_fiv_member: its self-shadows (shade_fiv_self, sec. 4.3.2)
-    minus the other copies' shadows.
+    the occluder with its self-shadows minus the other copies' shadows: the self-shadows from the
+    file's per-vertex band-1 radiance when it holds it (prtbake fiv --self-shadows vertex, the
+    default; shade_fiv_member_given_self), else eq. 12 from the shells (shade_fiv_self, sec.
+    4.3.2; shade_fiv_member).
   FIV scenes (dynamic occluders): a scene file whose objects have FIV shells, with --shade fiv or
     --instance/--instances: those objects are the occluders, placed as copies moved from where
     they were baked (default: each once, in place), on a ground plane, shaded as above. The

@@ -223,7 +223,22 @@ struct PlaceableOccluder {
   bake::Mesh mesh;
   std::string mesh_from;  // where the mesh came from, for the summary
   double lowest = 0;      // the mesh's lowest y
+  // Its self-shadowed irradiance E [V][3] at the mesh's vertices, from an FIV file's band-1
+  // radiance (prtbake fiv --self-shadows vertex: the occluder alone), or empty: then eq. 12 from
+  // the shells (prtshade/fiv.h shade_fiv_member_given_self says why the vertices are better).
+  std::vector<float> self;
 };
+
+// E at each vertex of a band-1 product (shade_band1 at the baked normals), checked against the mesh.
+std::vector<float> self_irradiance(const Band1& b, const bake::Mesh& mesh, size_t vertices, const std::string& file,
+                                   const std::string& what) {
+  if (vertices != mesh.positions.size())
+    throw bake::InputError(file, what + " holds band-1 radiance for " + std::to_string(vertices) + " vertices, but its mesh has " +
+                                     std::to_string(mesh.positions.size()));
+  std::vector<float> e(3 * vertices);
+  shade::shade_band1_vertices(b.normals, b.radiance(), vertices, e.data());
+  return e;
+}
 
 std::map<std::string, PlaceableOccluder> placeable_occluders(const F::Asset& f, const std::string& file, const FivView& options,
                                                               const bake::EnvMap& env, const std::set<std::string>& wanted) {
@@ -231,7 +246,9 @@ std::map<std::string, PlaceableOccluder> placeable_occluders(const F::Asset& f, 
   if (options.scene) {
     for (SceneObject& o : read_scene_objects(f, file, &env)) {
       if (!o.shells || !wanted.count(o.name)) continue;
-      PlaceableOccluder p{std::move(*o.shells), std::move(o.mesh), "/objects/" + o.name, 0};
+      // (A scene object's band1, if any, holds the other objects' shadows where they were baked:
+      // not its self-shadows once copies move. Its self-shadows come from its shells.)
+      PlaceableOccluder p{std::move(*o.shells), std::move(o.mesh), "/objects/" + o.name, 0, {}};
       out.emplace(o.name, std::move(p));
     }
   } else {
@@ -241,7 +258,11 @@ std::map<std::string, PlaceableOccluder> placeable_occluders(const F::Asset& f, 
     mopt.use_file_normals = false;
     for (const std::string& w : wanted)
       if (w != name) throw bake::InputError(file, "has no occluder '" + w + "' to place (it holds '" + name + "')");
-    out.emplace(name, PlaceableOccluder{read_occluder(f, file, name, env), bake::load_mesh(mesh_path, mopt), mesh_path, 0});
+    PlaceableOccluder p{read_occluder(f, file, name, env), bake::load_mesh(mesh_path, mopt), mesh_path, 0, {}};
+    if (has_band1(f) && f.vertices.positions)
+      p.self = self_irradiance(read_band1(f, file, "", env), p.mesh, f.vertices.positions->values.size() / 3, file,
+                               "its vertex set");
+    out.emplace(name, std::move(p));
   }
   for (const std::string& w : wanted)
     if (!out.count(w)) {
@@ -391,11 +412,17 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
                   kinds.size(), list.c_str(), ground_y, half);
   }
   scene.what = buf;
-  const bool cones = !options.sphere_proxy && std::any_of(occluders.begin(), occluders.end(), [](const shade::FivOccluder& o) { return o.cones != nullptr; });
+  const bool cones = !options.sphere_proxy && std::any_of(occluders.begin(), occluders.end(), [](const shade::FivOccluder& o) { return shade::has_cones(o); });
   scene.how = std::string("prt::shade::shade_fiv per pixel (overlap correction ") + (options.overlap ? "on" : "off") +
               ", partial-occluder correction " + (options.partial ? "on" : "off") + ", proxy " +
               (cones ? "cone (tight)" : "bounding sphere") +
-              "), shade_fiv_member on the occluders (self-shadows minus the other copies' shadows)";
+              "), on the occluders their self-shadows (" +
+              (std::all_of(kinds.begin(), kinds.end(), [](const auto& k) { return !k.second.self.empty(); })
+                   ? std::string("per-vertex band-1 radiance, Gouraud")
+                   : std::any_of(kinds.begin(), kinds.end(), [](const auto& k) { return !k.second.self.empty(); })
+                         ? std::string("per-vertex band-1 radiance where baked, else eq. 12 from the shells")
+                         : std::string("eq. 12 from the shells")) +
+              ") minus the other copies' shadows (shade_fiv_member_given_self)";
 
   const shade::FivShadeOptions opts{options.partial, options.overlap,
                                     options.sphere_proxy ? shade::FivProxy::sphere : shade::FivProxy::cone};
@@ -411,7 +438,16 @@ view::Image render_fiv_file(const F::Asset& f, const std::string& file, const Fi
     } else {
       const size_t t = size_t(fr.triangle) - scene.receiver_triangles;
       const size_t k = size_t(std::upper_bound(first_triangle.begin(), first_triangle.end(), t) - first_triangle.begin()) - 1;
-      shade::shade_fiv_member(env_fiv, occluders.data(), int(occluders.size()), int(k), p, n, options.partial, e);
+      const PlaceableOccluder& kind = kinds.at(inst[k].occluder);
+      if (kind.self.empty()) {
+        shade::shade_fiv_member(env_fiv, occluders.data(), int(occluders.size()), int(k), p, n, options.partial, e);
+      } else {  // the per-vertex self-shadows, Gouraud across the triangle
+        const auto& tri = kind.mesh.triangles[t - first_triangle[k]];
+        float own[3] = {0, 0, 0};
+        for (int c = 0; c < 3; ++c)
+          for (int v = 0; v < 3; ++v) own[c] += fr.bary[size_t(v)] * kind.self[3 * size_t(tri[v]) + size_t(c)];
+        shade::shade_fiv_member_given_self(own, occluders.data(), int(occluders.size()), int(k), p, n, options.partial, e);
+      }
     }
     for (int c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi);
   });

@@ -266,6 +266,16 @@ void shade_fiv_self(const float env_fiv[9], const FivOccluder& occ, const float 
 // I_i). count >= 1, 0 <= self < count.
 void shade_fiv_member(const float env_fiv[9], const FivOccluder* occluders, int count, int self, const float p[3],
                       const float n[3], bool partial, float out[3]);
+// shade_fiv_member with the self-shadowed irradiance given instead of eq. 12's n·(F^env − F(p)):
+// max(0, self_irradiance) minus what each other occluder hides, clamped after each subtraction.
+// For the occluder's per-vertex band-1 radiance (exact at its vertices, E = (4π/3) Σ_m y_1m(n) R_m
+// interpolated across its triangles): eq. 12 needs the FIV just outside the surface at p, which
+// the shells hold only where p's surface is the outermost along its ray from the centre
+// (surface-following shells) or between valid samples (paper 004's spheres) — not inside an
+// ear or a concavity. shade_fiv_member(env, o, count, self, p, n, partial) is this with
+// self_irradiance = shade_fiv_self(env, o[self], p, n).
+void shade_fiv_member_given_self(const float self_irradiance[3], const FivOccluder* occluders, int count, int self,
+                                 const float p[3], const float n[3], bool partial, float out[3]);
 
 // --- pieces and references (tests, mirrors) ----------------------------------------------------
 

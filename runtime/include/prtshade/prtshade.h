@@ -164,6 +164,12 @@ prt_status prt_fiv_scene_shade_self(const prt_fiv_scene* scene, int index, const
  * case-B factor to the others). */
 prt_status prt_fiv_scene_shade_member(const prt_fiv_scene* scene, int index, const float* positions,
                                       const float* normals, size_t count, int partial, float* out);
+/* The same with each receiver's self-shadowed irradiance given, self_irradiance [count][3] (e.g.
+ * the occluder's per-vertex band-1 radiance, prt_shade_band1, interpolated: what `prtbake fiv`
+ * writes by default; shade_fiv_member_given_self). Non-finite self_irradiance is refused. */
+prt_status prt_fiv_scene_shade_member_given_self(const prt_fiv_scene* scene, int index, const float* positions,
+                                                 const float* normals, const float* self_irradiance, size_t count,
+                                                 int partial, float* out);
 
 /* ---- baked lights (<prtshade/lights.h>) and LTC GGX (<prtshade/ltc.h>) ------------------- */
 
