@@ -545,16 +545,16 @@ TEST(FivSurface, HalfPrecisionRoundsTheShellsAndConesToFloat16) {
   spec.float16 = false;
   const FivShells full = bake_fiv_shells(m, topo, env, spec);
   spec.float16 = true;
-  const FivShells half = bake_fiv_shells(m, topo, env, spec);
+  const FivShells rounded = bake_fiv_shells(m, topo, env, spec);
   EXPECT_FALSE(full.float16);
-  EXPECT_TRUE(half.float16);
-  ASSERT_EQ(half.values.size(), full.values.size());
-  ASSERT_EQ(half.cones.size(), full.cones.size());
+  EXPECT_TRUE(rounded.float16);
+  ASSERT_EQ(rounded.values.size(), full.values.size());
+  ASSERT_EQ(rounded.cones.size(), full.cones.size());
   size_t changed = 0;
   for (size_t i = 0; i < full.values.size(); ++i) {
-    EXPECT_EQ(half.values[i], float(Imath::half(full.values[i]))) << i;
-    changed += half.values[i] != full.values[i] ? 1 : 0;
+    EXPECT_EQ(rounded.values[i], float(Imath::half(full.values[i]))) << i;
+    changed += rounded.values[i] != full.values[i] ? 1 : 0;
   }
-  for (size_t i = 0; i < full.cones.size(); ++i) EXPECT_EQ(half.cones[i], float(Imath::half(full.cones[i]))) << i;
+  for (size_t i = 0; i < full.cones.size(); ++i) EXPECT_EQ(rounded.cones[i], float(Imath::half(full.cones[i]))) << i;
   EXPECT_GT(changed, full.values.size() / 2);  // the values were rounded, not left as floats
 }
