@@ -482,7 +482,10 @@ TEST(Prtbake, FivWritesEnvironmentDifMapShellsAndValid) {
   EXPECT_EQ(shells->shape[1], 5u);
   EXPECT_EQ(shells->shape[2], 8u);
   EXPECT_NE(F::find_dataset(f, "/fiv/occluders/spider/valid"), nullptr);
-  EXPECT_EQ(F::find_dataset(f, "/mesh/positions"), nullptr) << "no per-vertex data was asked for";
+  // The vertex set holds the occluder's self-shadows only (--self-shadows vertex, the default).
+  EXPECT_NE(F::find_dataset(f, "/radiance/band1"), nullptr);
+  EXPECT_EQ(F::find_dataset(f, "/ao"), nullptr) << "no other per-vertex data was asked for";
+  EXPECT_EQ(F::find_dataset(f, "/transfer/diffuse"), nullptr);
   const F::Dataset* rep = F::find_dataset(f, "/report/fiv/spider");
   ASSERT_NE(rep, nullptr) << "every bake reports its error (--report defaults to 32)";
   const auto& rv = std::get<std::vector<float>>(rep->data);

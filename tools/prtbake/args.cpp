@@ -490,8 +490,8 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
          "its vertices (exact there; /mesh and /radiance/band1 in the file), which\n"
          "prtview and shade_fiv_member_given_self use; shells = nothing more: the\n"
          "runtime's eq. 12 from the shells, wrong where the surface is not the\n"
-         "outermost along its ray from the centre (ears, concavities). Not with\n"
-         "--shard: a sharded bake writes shells only")
+         "outermost along its ray from the centre (ears, concavities). A sharded\n"
+         "bake bakes them in the process that writes the file")
       ->option_text("vertex|shells");
   cmd.add_option("--first-offset", a.shell_spec.first_offset,
                  "the surface scheme's first offset from the surface, as a fraction of\n"

@@ -140,7 +140,9 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
   // the manifest and the file) but not its pixels, nor the mesh's topology, unless its error
   // report integrates a reference. The workers loaded the same bytes (the manifest holds their
   // SHA-256) and checked the pixels.
-  const bool integrates = !a.worker || a.worker->computes || a.integrator.report_points > 0;
+  // The self-shadows (--self-shadows vertex) are baked by the process that writes the file, the
+  // merge of a sharded bake included: it needs the environment's pixels and the topology too.
+  const bool integrates = !a.worker || a.worker->computes || a.integrator.report_points > 0 || a.fiv_vertex_self_shadows;
   std::optional<bake::Topology> topo;
   std::optional<bake::EnvMap> env;
   if (integrates) {
@@ -196,9 +198,10 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
     report = tool::fiv_report_of(name, r, shells, a.reproducible);
   }
   // Self-shadows (--self-shadows vertex): the occluder's band-1 radiance at its vertices, by the
-  // silhouette integrator at the shells' k and seed (prtshade/fiv.h shade_fiv_member_given_self).
-  // Not in a sharded bake (its chunks are the DifMap's and the shells' rows).
-  if (a.fiv_vertex_self_shadows && !sharded) {
+  // silhouette integrator at the shells' k and seed (prtshade/fiv.h shade_fiv_member_given_self),
+  // here in the process that writes the file (a sharded bake's merge too: the same bytes; an
+  // occluder's vertices take a fraction of its shells' time, so they are not cut into chunks).
+  if (a.fiv_vertex_self_shadows) {
     bake::ProductRequest req;
     req.radiance = &*env;
     bake::IntegratorSpec spec;
@@ -212,8 +215,6 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
     tool::set_mesh(asset.vertices, mesh);
     tool::set_products(asset.vertices, self,
                        {integrator->name(), integrator->description(), spec.samples(), spec.seed, 0, 0, &*env, a.environment});
-  } else if (a.fiv_vertex_self_shadows && run.say) {
-    std::printf("self-shadows: none baked (a sharded bake writes the shells only; the runtime uses eq. 12)\n");
   }
   // The shells move into the file's occluder (the report above was their last reader).
   asset.occluders.push_back(tool::occluder_of(name, std::move(shells), env_info, a.environment, a.shell_spec.fraction,
