@@ -131,6 +131,13 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
     }
     edge_flagged_[g] = uint8_t(flagged);
   }
+  twin_slot_.assign(slots, kNoTwin);
+  for (size_t g = 0; g < groups; ++g)
+    if (!edge_flagged_[g]) {
+      const uint32_t s0 = edge_slots_[edge_group_start_[g]], s1 = edge_slots_[edge_group_start_[g] + 1];
+      twin_slot_[s0] = s1;
+      twin_slot_[s1] = s0;
+    }
   std::vector<V3> centres(groups);
   for (size_t g = 0; g < groups; ++g) {
     const uint32_t slot = edge_slots_[edge_group_start_[g]];
@@ -372,7 +379,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
   } else {
     cull(ws);
-    std::sort(ws.kept.begin(), ws.kept.end());
+    sort_kept(ws);
   }
   if (method == Method::per_triangle || method == Method::reference) {
     for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
@@ -405,9 +412,17 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     for (uint32_t e = 0; e < 3; ++e) {
       // Image edge e runs along the mesh edge of slot k (the image is reversed when sigma < 0).
       const uint32_t k = sigma > 0 ? e : (e == 2 ? 2 : 1 - e);
-      const uint32_t slot = 3 * t + k, u = welded_[triangles_[t][k]];
-      const uint32_t group = slot_group_[slot];
+      const uint32_t slot = 3 * t + k;
       bool interior = false;
+      if (const uint32_t twin = twin_slot_[slot]; twin != kNoTwin) {
+        // A consistently wound pair: the twin runs the edge the other way (side2 = −tri_side),
+        // the loop below's rule in one step.
+        const uint32_t t2 = twin / 3;
+        interior = ws.tri_stamp[t2] == stamp && ws.tri_side[t2] != 0 && (ws.tri_side[t2] * sigma > 0 || t2 < t);
+        if (!interior) mask = uint8_t(mask | (1u << e));
+        continue;
+      }
+      const uint32_t u = welded_[triangles_[t][k]], group = slot_group_[slot];
       for (uint32_t at = edge_group_start_[group]; at < edge_group_start_[group + 1] && !interior; ++at) {
         const uint32_t other = edge_slots_[at], t2 = other / 3;
         if (t2 == t || ws.tri_stamp[t2] != stamp || ws.tri_side[t2] == 0) continue;
@@ -428,6 +443,18 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   ws.stats.special += special;
   ws.stats.uncharted += !ws.region.charted;
   return ws.kept.size();
+}
+
+void OccluderMesh::sort_kept(Workspace& ws) const {
+  // Ascending, as std::sort would give (the walk keeps each triangle once): a bitmap over the
+  // triangles, read word by word.
+  const size_t words = (triangles_.size() + 63) / 64;
+  ws.kept_bits.assign(words, 0);
+  for (uint32_t t : ws.kept) ws.kept_bits[t >> 6] |= uint64_t(1) << (t & 63);
+  ws.kept.clear();
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t bits = ws.kept_bits[w]; bits != 0; bits &= bits - 1)
+      ws.kept.push_back(uint32_t(w * 64 + size_t(std::countr_zero(bits))));
 }
 
 uint32_t OccluderMesh::next_stamp(Workspace& ws) const {

@@ -133,6 +133,7 @@ public:
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
+    std::vector<uint64_t> kept_bits;  // sort_kept's bitmap over the triangles
     size_t image_count = 0;
     // The contour path's scratch: per image its triangle, kind and boundary-edge mask; per
     // triangle the query that last kept it and its image's orientation (0: not a whole triangle).
@@ -246,6 +247,7 @@ private:
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  void sort_kept(Workspace& ws) const;  // ws.kept ascending (its triangles distinct)
   // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
   template <class Keep>
   void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
@@ -272,6 +274,10 @@ private:
   std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
   std::vector<Eigen::Vector3d> face_normal_;  // unit normal of (b − a)×(c − a), zero when degenerate
   std::vector<uint8_t> edge_flagged_;         // per welded edge (see EdgeNode)
+  // Per slot: the other slot of its welded edge when that is a consistently wound pair (not
+  // flagged), else kNoTwin.
+  static constexpr uint32_t kNoTwin = ~0u;
+  std::vector<uint32_t> twin_slot_;
   std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
   std::vector<uint32_t> edge_rank_;           // per welded edge: its place in edge_order_
   std::vector<EdgeNode> edge_nodes_;
