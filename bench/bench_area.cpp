@@ -294,6 +294,8 @@ void BM_BunnyQuad(benchmark::State& state) {
     state.counters["cut_edges"] = double(st.boundary_edges) / q;
     state.counters["special"] = double(st.special) / q;
     state.counters["uncharted"] = double(st.uncharted) / q;
+    state.counters["one_facing"] = double(st.one_facing) / q;
+    state.counters["hidden"] = double(st.hidden) / q;
     if (method == 2) {
       // The cone path: share of queries it answered (the rest took the kept-images path), welded
       // edges found in the cone, triangles passed on (meeting a light edge's or a found edge's

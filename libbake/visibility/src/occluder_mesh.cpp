@@ -131,6 +131,7 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
     }
     edge_flagged_[g] = uint8_t(flagged);
   }
+  closed_ = groups > 0 && std::none_of(edge_flagged_.begin(), edge_flagged_.end(), [](uint8_t f) { return f != 0; });
   twin_slot_.assign(slots, kNoTwin);
   for (size_t g = 0; g < groups; ++g)
     if (!edge_flagged_[g]) {
@@ -292,6 +293,7 @@ OccluderMesh::ImageKind OccluderMesh::add_image(uint32_t triangle, const ShadePo
     s[k] = frame.depth_side(*x[k]);
     any_front = any_front || s[k] > 0;
     any_back = any_back || s[k] < 0;
+    ws.settled = ws.settled && s[k] != 0;
   }
   if (!any_front) return ImageKind::none;  // behind the light (or in its plane)
   auto& poly = ws.poly;
@@ -321,6 +323,7 @@ OccluderMesh::ImageKind OccluderMesh::add_image(uint32_t triangle, const ShadePo
 
   const int side = orient3d_exact(*x[0], *x[1], *x[2], point.p);
   ws.last_side = side;
+  ws.settled = ws.settled && side != 0 && !any_back;
   if (side != 0) {  // p off the plane: the directions to the corners
     push([&](std::vector<V3>& image) {
       for (const V3& v : poly) image.push_back(v - point.p);
@@ -392,6 +395,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   const uint32_t stamp = next_stamp(ws);
   ws.image_kind.clear();
   bool special = false;
+  ws.settled = true;
   for (uint32_t t : ws.kept) {
     const ImageKind kind = add_image(t, point, frame, ws);
     ws.image_kind.resize(ws.image_count, uint8_t(kind));
@@ -402,6 +406,41 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
       ws.tri_side[t] = int8_t(ws.last_side);
     }
     special = special || kind == ImageKind::special;
+  }
+  if (closed_ && ws.settled && ws.image_count > 0) {
+    // A closed mesh with every image whole: one facing's images cover what all do (header,
+    // "one facing"), or the light is hidden entirely.
+    const int facing = one_facing(ws);
+    if (facing == 2) {
+      out.clear();
+      ++ws.stats.queries;
+      ++ws.stats.one_facing;
+      ++ws.stats.hidden;
+      ws.stats.kept += ws.kept.size();
+      return ws.kept.size();
+    }
+    if (facing != 0) {
+      // Only the images of that facing stay (in index order); the others' triangles count as
+      // not kept for the edge masks, so a contour edge is cut on its remaining face.
+      size_t kept_images = 0;
+      for (size_t i = 0; i < ws.image_count; ++i) {
+        const uint32_t t = ws.image_triangle[i];
+        if (ws.tri_side[t] != facing) {
+          ws.tri_side[t] = 0;
+          continue;
+        }
+        if (kept_images != i) {
+          std::swap(ws.images[kept_images], ws.images[i]);
+          ws.image_triangle[kept_images] = t;
+          ws.image_kind[kept_images] = ws.image_kind[i];
+        }
+        ++kept_images;
+      }
+      ws.image_count = kept_images;
+      ws.image_triangle.resize(kept_images);
+      ws.image_kind.resize(kept_images);
+      ++ws.stats.one_facing;
+    }
   }
   ws.boundary.assign(ws.image_count, 0xff);
   for (size_t i = 0; i < ws.image_count; ++i) {
@@ -443,6 +482,34 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   ws.stats.special += special;
   ws.stats.uncharted += !ws.region.charted;
   return ws.kept.size();
+}
+
+int OccluderMesh::one_facing(const Workspace& ws) const {
+  // A direction d strictly inside the light (a positive sum of its corners' directions, checked
+  // exactly) and on no image edge: k = Σ σ_t over the images containing d.
+  V3 d = V3::Zero();
+  for (const V3& c : ws.clipped) d += c.normalized();
+  const size_t n = ws.clipped.size();
+  for (size_t k = 0; k < n; ++k)
+    if (orient3d_exact(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d, V3::Zero()) <= 0) return 0;
+  int sum = 0;
+  size_t positive = 0;
+  for (size_t i = 0; i < ws.image_count; ++i) {
+    const auto& image = ws.images[i];
+    const int sigma = ws.tri_side[ws.image_triangle[i]];
+    // The image as computed (rounded corner directions) is oriented as its triangle seen from p.
+    if (image.size() != 3 || orient3d_exact(image[0], image[1], image[2], V3::Zero()) <= 0) return 0;
+    bool inside = true;
+    for (int k = 0; k < 3 && inside; ++k) {
+      const int side = orient3d_exact(image[size_t(k)], image[k == 2 ? 0 : size_t(k + 1)], d, V3::Zero());
+      if (side == 0) return 0;  // d on an image edge's great circle: not a generic direction
+      inside = side > 0;
+    }
+    sum += inside ? sigma : 0;
+    positive += sigma > 0;
+  }
+  if (sum != 0) return 2;
+  return 2 * positive <= ws.image_count ? 1 : -1;  // the facing with fewer images
 }
 
 void OccluderMesh::sort_kept(Workspace& ws) const {
