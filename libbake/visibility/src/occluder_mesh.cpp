@@ -48,6 +48,16 @@ struct OccluderMesh::LightFrame {
 
 namespace {
 
+// Exact sign of det(c, d, x) (orient3d_exact with the origin), by a filter first: (c × d)·x in
+// double errs by less than 8u |c|₁|d|₁|x|₁ (u = 2⁻⁵³); beyond 1e-14 of that product its sign is
+// the exact one (visible_region.cpp's side filter).
+int det_sign(const V3& c, const V3& d, const V3& x) {
+  const double v = c.cross(d).dot(x), bound = 1e-14 * c.cwiseAbs().sum() * d.cwiseAbs().sum() * x.cwiseAbs().sum();
+  if (v > bound) return 1;
+  if (v < -bound) return -1;
+  return orient3d_exact(c, d, x, V3::Zero());
+}
+
 std::vector<V3> world_positions(const Mesh& mesh) {
   std::vector<V3> out;
   out.reserve(mesh.positions.size());
@@ -491,17 +501,17 @@ int OccluderMesh::one_facing(const Workspace& ws) const {
   for (const V3& c : ws.clipped) d += c.normalized();
   const size_t n = ws.clipped.size();
   for (size_t k = 0; k < n; ++k)
-    if (orient3d_exact(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d, V3::Zero()) <= 0) return 0;
+    if (det_sign(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d) <= 0) return 0;
   int sum = 0;
   size_t positive = 0;
   for (size_t i = 0; i < ws.image_count; ++i) {
     const auto& image = ws.images[i];
     const int sigma = ws.tri_side[ws.image_triangle[i]];
     // The image as computed (rounded corner directions) is oriented as its triangle seen from p.
-    if (image.size() != 3 || orient3d_exact(image[0], image[1], image[2], V3::Zero()) <= 0) return 0;
+    if (image.size() != 3 || det_sign(image[0], image[1], image[2]) <= 0) return 0;
     bool inside = true;
     for (int k = 0; k < 3 && inside; ++k) {
-      const int side = orient3d_exact(image[size_t(k)], image[k == 2 ? 0 : size_t(k + 1)], d, V3::Zero());
+      const int side = det_sign(image[size_t(k)], image[k == 2 ? 0 : size_t(k + 1)], d);
       if (side == 0) return 0;  // d on an image edge's great circle: not a generic direction
       inside = side > 0;
     }
@@ -647,26 +657,32 @@ template <class Keep>
 void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
-  // margin (so is every triangle in it); 0: neither.
-  auto box_test = [&](const Node& node) {
+  // margin (so is every triangle in it); 0: neither. `open` has bit k for the planes still to
+  // test: a box inside plane k by more than the margin has every point strictly inside it, and
+  // so has each child's box (it lies in the parent's), whose triangles that plane never culls;
+  // the bit is cleared for the subtree (the same triangles are kept as when testing it again).
+  PRT_CHECK(planes.size() <= 32);
+  auto box_test = [&](const Node& node, uint32_t& open) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    bool inside = true;
-    for (const auto& plane : planes) {
+    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+      const auto k = uint32_t(std::countr_zero(bits));
+      const auto& plane = planes[k];
       const V3 r = centre - plane.o;
       const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
       // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
       const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
       if (mid + spread < -margin) return -1;
-      inside = inside && mid - spread > margin;
+      if (mid - spread > margin) open &= ~(uint32_t(1) << k);
     }
-    return inside ? 1 : 0;
+    return open == 0 ? 1 : 0;
   };
   // A triangle of a leaf is outside a plane when its highest vertex is below −margin, the
   // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
   std::vector<double>& leaf_margin = ws.margins;
   leaf_margin.assign(planes.size(), 0.0);
-  auto triangle_outside = [&](uint32_t t) {
-    for (size_t k = 0; k < planes.size(); ++k) {
+  auto triangle_outside = [&](uint32_t t, uint32_t open) {
+    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+      const auto k = size_t(std::countr_zero(bits));
       const auto& plane = planes[k];
       double top = -std::numeric_limits<double>::infinity();
       for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
@@ -674,27 +690,30 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
     }
     return false;
   };
-  ws.stack.assign(1, 0);
-  while (!ws.stack.empty()) {
-    const uint32_t at = ws.stack.back();
+  const uint32_t all = planes.size() == 32 ? ~uint32_t(0) : (uint32_t(1) << planes.size()) - 1;
+  ws.walk_stack.assign(1, {0, all});
+  while (!ws.walk_stack.empty()) {
+    auto [at, open] = ws.walk_stack.back();
     const Node& node = nodes_[at];
-    ws.stack.pop_back();
-    const int test = box_test(node);
+    ws.walk_stack.pop_back();
+    const int test = box_test(node, open);
     if (test < 0) continue;
     if (test > 0) {
       for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
       continue;
     }
     if (node.count == 0) {
-      ws.stack.push_back(node.index);
-      ws.stack.push_back(at + 1);
+      ws.walk_stack.push_back({node.index, open});
+      ws.walk_stack.push_back({at + 1, open});
       continue;
     }
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (size_t k = 0; k < planes.size(); ++k)
+    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+      const auto k = size_t(std::countr_zero(bits));
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
+    }
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i])) keep(order_[i]);
+      if (!triangle_outside(order_[i], open)) keep(order_[i]);
   }
 }
 

@@ -159,6 +159,7 @@ public:
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
+    std::vector<std::pair<uint32_t, uint32_t>> walk_stack;  // node, culling planes still to test (bits)
     std::vector<uint64_t> kept_bits;  // sort_kept's bitmap over the triangles
     size_t image_count = 0;
     // The contour path's scratch: per image its triangle, kind and boundary-edge mask; per
