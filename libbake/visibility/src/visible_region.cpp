@@ -655,6 +655,17 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       const V3& a = poly[k];
       const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
       if (a == b) continue;
+      // Both ends strictly right of one light edge (the float filter of side_filtered, deciding
+      // only beyond its bound): inside_intervals would find e outside the light.
+      bool outside = false;
+      const double la = 1e-14 * a.cwiseAbs().sum(), lb = 1e-14 * b.cwiseAbs().sum();
+      for (const EdgeNormal& edge : s.light_normals) {
+        if (edge.m.dot(a) < -la * edge.cd && edge.m.dot(b) < -lb * edge.cd) {
+          outside = true;
+          break;
+        }
+      }
+      if (outside) continue;
       const V3 ends[2] = {a, b};
       if (disjoint(cap_of(ends), light_cap)) continue;
       Interval in[2];
