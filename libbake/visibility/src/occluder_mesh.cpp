@@ -406,8 +406,20 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   ws.image_kind.clear();
   bool special = false;
   ws.settled = true;
+  // The closed-mesh rule's count at a generic direction d (header, "one facing"), taken while
+  // each image is at hand: Σ σ_t over the images containing d, and the images facing +1.
+  V3 probe = V3::Zero();
+  bool probing = closed_ && probe_direction(ws, probe);
+  int probe_sum = 0;
+  size_t positive = 0;
   for (uint32_t t : ws.kept) {
     const ImageKind kind = add_image(t, point, frame, ws);
+    if (probing && kind == ImageKind::triangle) {
+      const int inside = probe_image(ws.images[ws.image_count - 1], probe);
+      probing = inside >= 0;
+      probe_sum += inside > 0 ? ws.last_side : 0;
+      positive += ws.last_side > 0;
+    }
     ws.image_kind.resize(ws.image_count, uint8_t(kind));
     ws.tri_stamp[t] = stamp;
     ws.tri_side[t] = 0;
@@ -417,10 +429,10 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     }
     special = special || kind == ImageKind::special;
   }
-  if (closed_ && ws.settled && ws.image_count > 0) {
+  if (probing && ws.settled && ws.image_count > 0) {
     // A closed mesh with every image whole: one facing's images cover what all do (header,
-    // "one facing"), or the light is hidden entirely.
-    const int facing = one_facing(ws);
+    // "one facing"; the facing with fewer images), or the light is hidden entirely.
+    const int facing = probe_sum != 0 ? 2 : 2 * positive <= ws.image_count ? 1 : -1;
     if (facing == 2) {
       out.clear();
       ++ws.stats.queries;
@@ -429,28 +441,26 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
       ws.stats.kept += ws.kept.size();
       return ws.kept.size();
     }
-    if (facing != 0) {
-      // Only the images of that facing stay (in index order); the others' triangles count as
-      // not kept for the edge masks, so a contour edge is cut on its remaining face.
-      size_t kept_images = 0;
-      for (size_t i = 0; i < ws.image_count; ++i) {
-        const uint32_t t = ws.image_triangle[i];
-        if (ws.tri_side[t] != facing) {
-          ws.tri_side[t] = 0;
-          continue;
-        }
-        if (kept_images != i) {
-          std::swap(ws.images[kept_images], ws.images[i]);
-          ws.image_triangle[kept_images] = t;
-          ws.image_kind[kept_images] = ws.image_kind[i];
-        }
-        ++kept_images;
+    // Only the images of that facing stay (in index order); the others' triangles count as
+    // not kept for the edge masks, so a contour edge is cut on its remaining face.
+    size_t kept_images = 0;
+    for (size_t i = 0; i < ws.image_count; ++i) {
+      const uint32_t t = ws.image_triangle[i];
+      if (ws.tri_side[t] != facing) {
+        ws.tri_side[t] = 0;
+        continue;
       }
-      ws.image_count = kept_images;
-      ws.image_triangle.resize(kept_images);
-      ws.image_kind.resize(kept_images);
-      ++ws.stats.one_facing;
+      if (kept_images != i) {
+        std::swap(ws.images[kept_images], ws.images[i]);
+        ws.image_triangle[kept_images] = t;
+        ws.image_kind[kept_images] = ws.image_kind[i];
+      }
+      ++kept_images;
     }
+    ws.image_count = kept_images;
+    ws.image_triangle.resize(kept_images);
+    ws.image_kind.resize(kept_images);
+    ++ws.stats.one_facing;
   }
   ws.boundary.assign(ws.image_count, 0xff);
   for (size_t i = 0; i < ws.image_count; ++i) {
@@ -494,32 +504,26 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   return ws.kept.size();
 }
 
-int OccluderMesh::one_facing(const Workspace& ws) const {
-  // A direction d strictly inside the light (a positive sum of its corners' directions, checked
-  // exactly) and on no image edge: k = Σ σ_t over the images containing d.
-  V3 d = V3::Zero();
+bool OccluderMesh::probe_direction(const Workspace& ws, V3& d) const {
+  // A positive sum of the light's corner directions, strictly inside every light edge (exactly).
+  d = V3::Zero();
   for (const V3& c : ws.clipped) d += c.normalized();
   const size_t n = ws.clipped.size();
   for (size_t k = 0; k < n; ++k)
-    if (det_sign(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d) <= 0) return 0;
-  int sum = 0;
-  size_t positive = 0;
-  for (size_t i = 0; i < ws.image_count; ++i) {
-    const auto& image = ws.images[i];
-    const int sigma = ws.tri_side[ws.image_triangle[i]];
-    // The image as computed (rounded corner directions) is oriented as its triangle seen from p.
-    if (image.size() != 3 || det_sign(image[0], image[1], image[2]) <= 0) return 0;
-    bool inside = true;
-    for (int k = 0; k < 3 && inside; ++k) {
-      const int side = det_sign(image[size_t(k)], image[k == 2 ? 0 : size_t(k + 1)], d);
-      if (side == 0) return 0;  // d on an image edge's great circle: not a generic direction
-      inside = side > 0;
-    }
-    sum += inside ? sigma : 0;
-    positive += sigma > 0;
+    if (det_sign(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d) <= 0) return false;
+  return true;
+}
+
+int OccluderMesh::probe_image(std::span<const V3> image, const V3& d) {
+  // The image as computed (rounded corner directions) must be oriented as its triangle seen
+  // from p (it was reversed by that sign), and d on no edge of it.
+  if (image.size() != 3 || det_sign(image[0], image[1], image[2]) <= 0) return -1;
+  for (size_t k = 0; k < 3; ++k) {
+    const int side = det_sign(image[k], image[k == 2 ? 0 : k + 1], d);
+    if (side == 0) return -1;  // d on an image edge's great circle: not a generic direction
+    if (side < 0) return 0;    // strictly outside (off its boundary)
   }
-  if (sum != 0) return 2;
-  return 2 * positive <= ws.image_count ? 1 : -1;  // the facing with fewer images
+  return 1;
 }
 
 void OccluderMesh::sort_kept(Workspace& ws) const {

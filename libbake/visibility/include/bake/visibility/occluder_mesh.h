@@ -278,11 +278,12 @@ private:
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
   void sort_kept(Workspace& ws) const;  // ws.kept ascending (its triangles distinct)
-  // The closed-mesh rule (file comment "one facing"), on the whole images of ws: the facing
-  // (tri_side, ±1) whose images alone give the union, 2 when the light is hidden entirely, or 0
-  // when the rule cannot be applied (no generic direction found, or a rounded image's
-  // orientation differs from its triangle's).
-  int one_facing(const Workspace& ws) const;
+  // The closed-mesh rule (file comment "one facing"): d, a direction strictly inside the light
+  // (false: none found); then per whole image (positively oriented), 1 when d is strictly inside
+  // it, 0 when strictly outside, −1 when the rule cannot be used (d on an edge's great circle,
+  // or the rounded image not positively oriented).
+  bool probe_direction(const Workspace& ws, Eigen::Vector3d& d) const;
+  static int probe_image(std::span<const Eigen::Vector3d> image, const Eigen::Vector3d& d);
   // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
   template <class Keep>
   void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
