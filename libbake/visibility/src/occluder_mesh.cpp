@@ -663,14 +663,14 @@ template <class Keep>
 void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
-  // margin (so is every triangle in it); 0: neither. `open` has bit k for the planes still to
+  // margin (so is every triangle in it); 0: neither. `pending` has bit k for the planes still to
   // test: a box inside plane k by more than the margin has every point strictly inside it, and
   // so has each child's box (it lies in the parent's), whose triangles that plane never culls;
   // the bit is cleared for the subtree (the same triangles are kept as when testing it again).
   PRT_CHECK(planes.size() <= 32);
-  auto box_test = [&](const Node& node, uint32_t& open) {
+  auto box_test = [&](const Node& node, uint32_t& pending) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
       const auto k = uint32_t(std::countr_zero(bits));
       const auto& plane = planes[k];
       const V3 r = centre - plane.o;
@@ -678,16 +678,16 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
       // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
       const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
       if (mid + spread < -margin) return -1;
-      if (mid - spread > margin) open &= ~(uint32_t(1) << k);
+      if (mid - spread > margin) pending &= ~(uint32_t(1) << k);
     }
-    return open == 0 ? 1 : 0;
+    return pending == 0 ? 1 : 0;
   };
   // A triangle of a leaf is outside a plane when its highest vertex is below −margin, the
   // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
   std::vector<double>& leaf_margin = ws.margins;
   leaf_margin.assign(planes.size(), 0.0);
-  auto triangle_outside = [&](uint32_t t, uint32_t open) {
-    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+  auto triangle_outside = [&](uint32_t t, uint32_t pending) {
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
       const auto k = size_t(std::countr_zero(bits));
       const auto& plane = planes[k];
       double top = -std::numeric_limits<double>::infinity();
@@ -699,27 +699,27 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
   const uint32_t all = planes.size() == 32 ? ~uint32_t(0) : (uint32_t(1) << planes.size()) - 1;
   ws.walk_stack.assign(1, {0, all});
   while (!ws.walk_stack.empty()) {
-    auto [at, open] = ws.walk_stack.back();
+    auto [at, pending] = ws.walk_stack.back();
     const Node& node = nodes_[at];
     ws.walk_stack.pop_back();
-    const int test = box_test(node, open);
+    const int test = box_test(node, pending);
     if (test < 0) continue;
     if (test > 0) {
       for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
       continue;
     }
     if (node.count == 0) {
-      ws.walk_stack.push_back({node.index, open});
-      ws.walk_stack.push_back({at + 1, open});
+      ws.walk_stack.push_back({node.index, pending});
+      ws.walk_stack.push_back({at + 1, pending});
       continue;
     }
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (uint32_t bits = open; bits != 0; bits &= bits - 1) {
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
       const auto k = size_t(std::countr_zero(bits));
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
     }
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i], open)) keep(order_[i]);
+      if (!triangle_outside(order_[i], pending)) keep(order_[i]);
   }
 }
 

@@ -100,11 +100,13 @@
 //    edges, of measure zero): only the facing with fewer images is subtracted, its contour
 //    edges cut as edges whose other face is not passed. k is counted at one direction d (a
 //    positive sum of the light's corner directions, strictly inside every light edge, exactly)
-//    that lies on no image edge's great circle (exact signs; else the rule is not used), and
-//    only when every image as computed (rounded corner directions) has its triangle's
-//    orientation (exact sign; else not used), so the argument holds for the images that
-//    visible_region_sparse gets. On the bunny's ground points it halves the images and their
-//    cuts (Workspace::stats::one_facing; tests/bake/visibility/test_occluder_contour.cpp
+//    that lies on no image edge (exact signs; d on the great circle of an edge of an image it
+//    is not strictly outside of, and the rule is not used), as each image is built, and only
+//    when every image as computed (rounded corner directions) has its triangle's orientation
+//    (exact sign; else not used), so the argument holds for the images that
+//    visible_region_sparse gets. On the bunny's ground points it halves the images, and so the
+//    candidates of every cut (Workspace::stats::one_facing;
+//    tests/bake/visibility/test_occluder_contour.cpp
 //    ClosedMeshesFromOneFacing holds it to the per-triangle method from inside and outside
 //    closed meshes, overlapping and inverted ones, a cavity, a box around and through the
 //    light, and a direction d on an image edge).
