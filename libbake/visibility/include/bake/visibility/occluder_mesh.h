@@ -117,7 +117,10 @@
 // more triangles than the edges it finds (the bunny Loop-subdivided 3–4 times: 1.5–2.1x) and
 // slower on small pyramids and on the CAD engine (long thin triangles: its fans meet nearly every
 // kept triangle, and it cuts more edges): a choice per query by the triangles culling keeps
-// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet.
+// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet. With the
+// one-facing rule the kept-images path is 1.5–2.8x faster than the cone path on the bunny's
+// ground points at Loop levels 0–3 and about even at level 4 (bench/RESULTS.md "area lights:
+// ground points").
 // Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
 // images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
 // found edges: the edge tree's walk, per found edge a fan walk and the images on it
