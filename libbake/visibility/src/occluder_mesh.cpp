@@ -663,40 +663,55 @@ template <class Keep>
 void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
-  // margin (so is every triangle in it); 0: neither. `pending` has bit k for the planes still to
-  // test: a box inside plane k by more than the margin has every point strictly inside it, and
-  // so has each child's box (it lies in the parent's), whose triangles that plane never culls;
-  // the bit is cleared for the subtree (the same triangles are kept as when testing it again).
-  PRT_CHECK(planes.size() <= 32);
+  // margin (so is every triangle in it); 0: neither. `pending` has bit k for the planes k < 32
+  // still to test: a box inside plane k by more than the margin has every point strictly inside
+  // it, and so has each child's box (it lies in the parent's), whose triangles that plane never
+  // culls; the bit is cleared for the subtree (the same triangles are kept as when testing it
+  // again). Planes from the 33rd on (a light of many sides) are tested at every node.
+  const size_t masked = std::min<size_t>(planes.size(), 32);
+  auto plane_test = [&](size_t k, const V3& centre, const V3& half) {
+    const auto& plane = planes[k];
+    const V3 r = centre - plane.o;
+    const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
+    // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
+    const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
+    if (mid + spread < -margin) return -1;
+    return mid - spread > margin ? 1 : 0;
+  };
   auto box_test = [&](const Node& node, uint32_t& pending) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
     for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
       const auto k = uint32_t(std::countr_zero(bits));
-      const auto& plane = planes[k];
-      const V3 r = centre - plane.o;
-      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
-      // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
-      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
-      if (mid + spread < -margin) return -1;
-      if (mid - spread > margin) pending &= ~(uint32_t(1) << k);
+      const int test = plane_test(k, centre, half);
+      if (test < 0) return -1;
+      if (test > 0) pending &= ~(uint32_t(1) << k);
     }
-    return pending == 0 ? 1 : 0;
+    bool inside = pending == 0;
+    for (size_t k = masked; k < planes.size(); ++k) {
+      const int test = plane_test(k, centre, half);
+      if (test < 0) return -1;
+      inside = inside && test > 0;
+    }
+    return inside ? 1 : 0;
   };
   // A triangle of a leaf is outside a plane when its highest vertex is below −margin, the
   // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
   std::vector<double>& leaf_margin = ws.margins;
   leaf_margin.assign(planes.size(), 0.0);
+  auto outside = [&](uint32_t t, size_t k) {
+    const auto& plane = planes[k];
+    double top = -std::numeric_limits<double>::infinity();
+    for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
+    return top < -leaf_margin[k];
+  };
   auto triangle_outside = [&](uint32_t t, uint32_t pending) {
-    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
-      const auto k = size_t(std::countr_zero(bits));
-      const auto& plane = planes[k];
-      double top = -std::numeric_limits<double>::infinity();
-      for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
-      if (top < -leaf_margin[k]) return true;
-    }
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1)
+      if (outside(t, size_t(std::countr_zero(bits)))) return true;
+    for (size_t k = masked; k < planes.size(); ++k)
+      if (outside(t, k)) return true;
     return false;
   };
-  const uint32_t all = planes.size() == 32 ? ~uint32_t(0) : (uint32_t(1) << planes.size()) - 1;
+  const uint32_t all = masked == 32 ? ~uint32_t(0) : (uint32_t(1) << masked) - 1;
   ws.walk_stack.assign(1, {0, all});
   while (!ws.walk_stack.empty()) {
     auto [at, pending] = ws.walk_stack.back();
@@ -714,10 +729,11 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
       continue;
     }
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
-      const auto k = size_t(std::countr_zero(bits));
+    auto margin = [&](size_t k) {
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
-    }
+    };
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) margin(size_t(std::countr_zero(bits)));
+    for (size_t k = masked; k < planes.size(); ++k) margin(k);
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
       if (!triangle_outside(order_[i], pending)) keep(order_[i]);
   }

@@ -358,6 +358,20 @@ TEST(OccluderContour, ClosedMeshesFromOneFacing) {
     }
     EXPECT_GT(line.hidden, 3u) << what;
     EXPECT_GT(line.one_facing, line.hidden) << what;
+    // A 40-sided disc light: more culling planes than the walk's 32 plane bits (the rest are
+    // tested at every node).
+    Poly disc;
+    for (int k = 0; k < 40; ++k) {
+      const double a = 6.283185307179586 * k / 40;
+      disc.emplace_back(3 * std::cos(a), 12, 2 * std::sin(a));
+    }
+    Totals round;
+    for (int k = 0; k < 24; ++k) {
+      const ShadePoint s{.p = V3(12 * u(rng) - 6, 0, 8 * u(rng) - 4), .n = V3(0.2 * u(rng) - 0.1, 1, 0.1).normalized()};
+      compare(mesh, disc, s, what + "disc light, ground point " + std::to_string(k), round);
+    }
+    EXPECT_GT(round.shadowed, 5u) << what;
+    EXPECT_GT(round.one_facing, 20u) << what;
   }
 
   // Two overlapping boxes (their union's interior partly counted twice), a box with a cavity
