@@ -254,7 +254,9 @@ std::vector<V3> positions_of(const prt::bake::Mesh& m) {
 // (image edges reaching into the light) per query; `special`: share of queries with a clipped or
 // ε-limit image (the point's own 1-ring: all its edges cut); `uncharted`: share whose light was
 // too wide for the chart (caps filter only); `fallback`: share answered by the per-triangle
-// method (none). The cone path's (method 2): `cone`, the share of queries it answered;
+// method (none); `one_facing`: share of queries answered from one facing's images by the
+// closed-mesh rule (occluder_mesh.h "one facing"), `hidden`: of which the light was found hidden
+// at once. The cone path's (method 2): `cone`, the share of queries it answered;
 // per query it answered, `cone_edges` (welded edges found in the cone), `passed` (images built)
 // and `fan_tests`; per query, `edge_nodes` (edge-tree nodes visited).
 void BM_BunnyQuad(benchmark::State& state) {
@@ -294,6 +296,8 @@ void BM_BunnyQuad(benchmark::State& state) {
     state.counters["cut_edges"] = double(st.boundary_edges) / q;
     state.counters["special"] = double(st.special) / q;
     state.counters["uncharted"] = double(st.uncharted) / q;
+    state.counters["one_facing"] = double(st.one_facing) / q;
+    state.counters["hidden"] = double(st.hidden) / q;
     if (method == 2) {
       // The cone path: share of queries it answered (the rest took the kept-images path), welded
       // edges found in the cone, triangles passed on (meeting a light edge's or a found edge's

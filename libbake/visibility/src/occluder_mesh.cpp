@@ -48,6 +48,16 @@ struct OccluderMesh::LightFrame {
 
 namespace {
 
+// Exact sign of det(c, d, x) (orient3d_exact with the origin), by a filter first: (c × d)·x in
+// double errs by less than 8u |c|₁|d|₁|x|₁ (u = 2⁻⁵³); beyond 1e-14 of that product its sign is
+// the exact one (visible_region.cpp's side filter).
+int det_sign(const V3& c, const V3& d, const V3& x) {
+  const double v = c.cross(d).dot(x), bound = 1e-14 * c.cwiseAbs().sum() * d.cwiseAbs().sum() * x.cwiseAbs().sum();
+  if (v > bound) return 1;
+  if (v < -bound) return -1;
+  return orient3d_exact(c, d, x, V3::Zero());
+}
+
 std::vector<V3> world_positions(const Mesh& mesh) {
   std::vector<V3> out;
   out.reserve(mesh.positions.size());
@@ -131,6 +141,14 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
     }
     edge_flagged_[g] = uint8_t(flagged);
   }
+  closed_ = groups > 0 && std::none_of(edge_flagged_.begin(), edge_flagged_.end(), [](uint8_t f) { return f != 0; });
+  twin_slot_.assign(slots, kNoTwin);
+  for (size_t g = 0; g < groups; ++g)
+    if (!edge_flagged_[g]) {
+      const uint32_t s0 = edge_slots_[edge_group_start_[g]], s1 = edge_slots_[edge_group_start_[g] + 1];
+      twin_slot_[s0] = s1;
+      twin_slot_[s1] = s0;
+    }
   std::vector<V3> centres(groups);
   for (size_t g = 0; g < groups; ++g) {
     const uint32_t slot = edge_slots_[edge_group_start_[g]];
@@ -285,6 +303,7 @@ OccluderMesh::ImageKind OccluderMesh::add_image(uint32_t triangle, const ShadePo
     s[k] = frame.depth_side(*x[k]);
     any_front = any_front || s[k] > 0;
     any_back = any_back || s[k] < 0;
+    ws.settled = ws.settled && s[k] != 0;
   }
   if (!any_front) return ImageKind::none;  // behind the light (or in its plane)
   auto& poly = ws.poly;
@@ -314,6 +333,7 @@ OccluderMesh::ImageKind OccluderMesh::add_image(uint32_t triangle, const ShadePo
 
   const int side = orient3d_exact(*x[0], *x[1], *x[2], point.p);
   ws.last_side = side;
+  ws.settled = ws.settled && side != 0 && !any_back;
   if (side != 0) {  // p off the plane: the directions to the corners
     push([&](std::vector<V3>& image) {
       for (const V3& v : poly) image.push_back(v - point.p);
@@ -372,7 +392,7 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     for (uint32_t t = 0; t < triangles_.size(); ++t) ws.kept.push_back(t);
   } else {
     cull(ws);
-    std::sort(ws.kept.begin(), ws.kept.end());
+    sort_kept(ws);
   }
   if (method == Method::per_triangle || method == Method::reference) {
     for (uint32_t t : ws.kept) add_image(t, point, frame, ws);
@@ -385,8 +405,21 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   const uint32_t stamp = next_stamp(ws);
   ws.image_kind.clear();
   bool special = false;
+  ws.settled = true;
+  // The closed-mesh rule's count at a generic direction d (header, "one facing"), taken while
+  // each image is at hand: Σ σ_t over the images containing d, and the images facing +1.
+  V3 probe = V3::Zero();
+  bool probing = closed_ && probe_direction(ws, probe);
+  int probe_sum = 0;
+  size_t positive = 0;
   for (uint32_t t : ws.kept) {
     const ImageKind kind = add_image(t, point, frame, ws);
+    if (probing && kind == ImageKind::triangle) {
+      const int inside = probe_image(ws.images[ws.image_count - 1], probe);
+      probing = inside >= 0;
+      probe_sum += inside > 0 ? ws.last_side : 0;
+      positive += ws.last_side > 0;
+    }
     ws.image_kind.resize(ws.image_count, uint8_t(kind));
     ws.tri_stamp[t] = stamp;
     ws.tri_side[t] = 0;
@@ -395,6 +428,41 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
       ws.tri_side[t] = int8_t(ws.last_side);
     }
     special = special || kind == ImageKind::special;
+  }
+  if (probing && ws.settled && ws.image_count > 0) {
+    // A closed mesh with every image whole: one facing's images cover what all do (header,
+    // "one facing"; the facing with fewer images), or the light is hidden entirely.
+    const int facing = probe_sum != 0 ? 2 : 2 * positive <= ws.image_count ? 1 : -1;
+    if (facing == 2) {
+      out.clear();
+      ++ws.stats.queries;
+      ++ws.stats.one_facing;
+      ++ws.stats.hidden;
+      ws.stats.kept += ws.kept.size();
+      return ws.kept.size();
+    }
+    // Only the images of that facing stay (in index order); the others' triangles count as
+    // not kept for the edge masks, so a contour edge is cut on its remaining face.
+    size_t kept_images = 0;
+    for (size_t i = 0; i < ws.image_count; ++i) {
+      const uint32_t t = ws.image_triangle[i];
+      if (ws.tri_side[t] != facing) {
+        ws.tri_side[t] = 0;
+        continue;
+      }
+      if (kept_images != i) {
+        // Copied, not swapped: each slot keeps its own storage, allocated in order (swapping
+        // scatters them over queries; at Loop level 4 that cost more than the rule saved).
+        ws.images[kept_images].assign(ws.images[i].begin(), ws.images[i].end());
+        ws.image_triangle[kept_images] = t;
+        ws.image_kind[kept_images] = ws.image_kind[i];
+      }
+      ++kept_images;
+    }
+    ws.image_count = kept_images;
+    ws.image_triangle.resize(kept_images);
+    ws.image_kind.resize(kept_images);
+    ++ws.stats.one_facing;
   }
   ws.boundary.assign(ws.image_count, 0xff);
   for (size_t i = 0; i < ws.image_count; ++i) {
@@ -405,9 +473,17 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
     for (uint32_t e = 0; e < 3; ++e) {
       // Image edge e runs along the mesh edge of slot k (the image is reversed when sigma < 0).
       const uint32_t k = sigma > 0 ? e : (e == 2 ? 2 : 1 - e);
-      const uint32_t slot = 3 * t + k, u = welded_[triangles_[t][k]];
-      const uint32_t group = slot_group_[slot];
+      const uint32_t slot = 3 * t + k;
       bool interior = false;
+      if (const uint32_t twin = twin_slot_[slot]; twin != kNoTwin) {
+        // A consistently wound pair: the twin runs the edge the other way (side2 = −tri_side),
+        // the loop below's rule in one step.
+        const uint32_t t2 = twin / 3;
+        interior = ws.tri_stamp[t2] == stamp && ws.tri_side[t2] != 0 && (ws.tri_side[t2] * sigma > 0 || t2 < t);
+        if (!interior) mask = uint8_t(mask | (1u << e));
+        continue;
+      }
+      const uint32_t u = welded_[triangles_[t][k]], group = slot_group_[slot];
       for (uint32_t at = edge_group_start_[group]; at < edge_group_start_[group + 1] && !interior; ++at) {
         const uint32_t other = edge_slots_[at], t2 = other / 3;
         if (t2 == t || ws.tri_stamp[t2] != stamp || ws.tri_side[t2] == 0) continue;
@@ -428,6 +504,40 @@ size_t OccluderMesh::query(std::span<const V3> light, const ShadePoint& point, s
   ws.stats.special += special;
   ws.stats.uncharted += !ws.region.charted;
   return ws.kept.size();
+}
+
+bool OccluderMesh::probe_direction(const Workspace& ws, V3& d) const {
+  // A positive sum of the light's corner directions, strictly inside every light edge (exactly).
+  d = V3::Zero();
+  for (const V3& c : ws.clipped) d += c.normalized();
+  const size_t n = ws.clipped.size();
+  for (size_t k = 0; k < n; ++k)
+    if (det_sign(ws.clipped[k], ws.clipped[k + 1 == n ? 0 : k + 1], d) <= 0) return false;
+  return true;
+}
+
+int OccluderMesh::probe_image(std::span<const V3> image, const V3& d) {
+  // The image as computed (rounded corner directions) must be oriented as its triangle seen
+  // from p (it was reversed by that sign), and d on no edge of it.
+  if (image.size() != 3 || det_sign(image[0], image[1], image[2]) <= 0) return -1;
+  for (size_t k = 0; k < 3; ++k) {
+    const int side = det_sign(image[k], image[k == 2 ? 0 : k + 1], d);
+    if (side == 0) return -1;  // d on an image edge's great circle: not a generic direction
+    if (side < 0) return 0;    // strictly outside (off its boundary)
+  }
+  return 1;
+}
+
+void OccluderMesh::sort_kept(Workspace& ws) const {
+  // Ascending, as std::sort would give (the walk keeps each triangle once): a bitmap over the
+  // triangles, read word by word.
+  const size_t words = (triangles_.size() + 63) / 64;
+  ws.kept_bits.assign(words, 0);
+  for (uint32_t t : ws.kept) ws.kept_bits[t >> 6] |= uint64_t(1) << (t & 63);
+  ws.kept.clear();
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t bits = ws.kept_bits[w]; bits != 0; bits &= bits - 1)
+      ws.kept.push_back(uint32_t(w * 64 + size_t(std::countr_zero(bits))));
 }
 
 uint32_t OccluderMesh::next_stamp(Workspace& ws) const {
@@ -553,17 +663,34 @@ template <class Keep>
 void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const {
   if (nodes_.empty()) return;
   // -1: the box is outside a plane (beyond the margin); +1: inside every plane by more than the
-  // margin (so is every triangle in it); 0: neither.
-  auto box_test = [&](const Node& node) {
+  // margin (so is every triangle in it); 0: neither. `pending` has bit k for the planes k < 32
+  // still to test: a box inside plane k by more than the margin has every point strictly inside
+  // it, and so has each child's box (it lies in the parent's), whose triangles that plane never
+  // culls; the bit is cleared for the subtree (the same triangles are kept as when testing it
+  // again). Planes from the 33rd on (a light of many sides) are tested at every node.
+  const size_t masked = std::min<size_t>(planes.size(), 32);
+  auto plane_test = [&](size_t k, const V3& centre, const V3& half) {
+    const auto& plane = planes[k];
+    const V3 r = centre - plane.o;
+    const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
+    // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
+    const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
+    if (mid + spread < -margin) return -1;
+    return mid - spread > margin ? 1 : 0;
+  };
+  auto box_test = [&](const Node& node, uint32_t& pending) {
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    bool inside = true;
-    for (const auto& plane : planes) {
-      const V3 r = centre - plane.o;
-      const double mid = plane.m.dot(r), spread = plane.m.cwiseAbs().dot(half);
-      // |r|₁ + |half|₁ ≥ |r| + |half|: a margin at least as large as the header's, without roots.
-      const double margin = plane.margin_coef * (r.cwiseAbs().sum() + half.cwiseAbs().sum());
-      if (mid + spread < -margin) return -1;
-      inside = inside && mid - spread > margin;
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) {
+      const auto k = uint32_t(std::countr_zero(bits));
+      const int test = plane_test(k, centre, half);
+      if (test < 0) return -1;
+      if (test > 0) pending &= ~(uint32_t(1) << k);
+    }
+    bool inside = pending == 0;
+    for (size_t k = masked; k < planes.size(); ++k) {
+      const int test = plane_test(k, centre, half);
+      if (test < 0) return -1;
+      inside = inside && test > 0;
     }
     return inside ? 1 : 0;
   };
@@ -571,36 +698,44 @@ void OccluderMesh::walk(std::span<const Workspace::Plane> planes, Workspace& ws,
   // leaf's margin for that plane (|x − o| ≤ |centre − o|₁ + |half|₁ for x in the leaf's box).
   std::vector<double>& leaf_margin = ws.margins;
   leaf_margin.assign(planes.size(), 0.0);
-  auto triangle_outside = [&](uint32_t t) {
-    for (size_t k = 0; k < planes.size(); ++k) {
-      const auto& plane = planes[k];
-      double top = -std::numeric_limits<double>::infinity();
-      for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
-      if (top < -leaf_margin[k]) return true;
-    }
+  auto outside = [&](uint32_t t, size_t k) {
+    const auto& plane = planes[k];
+    double top = -std::numeric_limits<double>::infinity();
+    for (uint32_t v : triangles_[t]) top = std::max(top, plane.m.dot(positions_[v] - plane.o));
+    return top < -leaf_margin[k];
+  };
+  auto triangle_outside = [&](uint32_t t, uint32_t pending) {
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1)
+      if (outside(t, size_t(std::countr_zero(bits)))) return true;
+    for (size_t k = masked; k < planes.size(); ++k)
+      if (outside(t, k)) return true;
     return false;
   };
-  ws.stack.assign(1, 0);
-  while (!ws.stack.empty()) {
-    const uint32_t at = ws.stack.back();
+  const uint32_t all = masked == 32 ? ~uint32_t(0) : (uint32_t(1) << masked) - 1;
+  ws.walk_stack.assign(1, {0, all});
+  while (!ws.walk_stack.empty()) {
+    auto [at, pending] = ws.walk_stack.back();
     const Node& node = nodes_[at];
-    ws.stack.pop_back();
-    const int test = box_test(node);
+    ws.walk_stack.pop_back();
+    const int test = box_test(node, pending);
     if (test < 0) continue;
     if (test > 0) {
       for (uint32_t i = node.first; i < node.first + node.total; ++i) keep(order_[i]);
       continue;
     }
     if (node.count == 0) {
-      ws.stack.push_back(node.index);
-      ws.stack.push_back(at + 1);
+      ws.walk_stack.push_back({node.index, pending});
+      ws.walk_stack.push_back({at + 1, pending});
       continue;
     }
     const V3 centre = (node.lo + node.hi) / 2, half = (node.hi - node.lo) / 2;
-    for (size_t k = 0; k < planes.size(); ++k)
+    auto margin = [&](size_t k) {
       leaf_margin[k] = planes[k].margin_coef * ((centre - planes[k].o).cwiseAbs().sum() + half.cwiseAbs().sum());
+    };
+    for (uint32_t bits = pending; bits != 0; bits &= bits - 1) margin(size_t(std::countr_zero(bits)));
+    for (size_t k = masked; k < planes.size(); ++k) margin(k);
     for (uint32_t i = node.index; i < node.index + node.count; ++i)
-      if (!triangle_outside(order_[i])) keep(order_[i]);
+      if (!triangle_outside(order_[i], pending)) keep(order_[i]);
   }
 }
 

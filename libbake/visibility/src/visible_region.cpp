@@ -222,9 +222,11 @@ struct EdgeScratch {
 
 // The pieces of edge e = (a, b) of polygons[i] that bound V, appended to out (the per-edge step
 // of the header's method). for_others(f) calls f(j) for the occluders j ≥ 1, j ≠ i, ascending,
-// that may overlap e: every other one must give an empty interval (up to rounding) and share no
-// piece of e's great circle with e. Occluder edges are first clipped to the light (the caller
-// has found in[1] of the light when i ≠ 0: passed as `in_light`).
+// that may overlap e, and may stop once f returns false (nothing of e is left to cut): every
+// other one must give an empty interval (up to rounding) and share no piece of e's great circle
+// with e. Occluder edges are first clipped to the light (the caller has found in[1] of the light
+// when i ≠ 0: passed as `in_light`). normals_of(j) gives polygon j's EdgeNormals (j = 0: the
+// light's) or nullptr (then side() computes them).
 template <class ForOthers, class NormalsOf>
 void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const V3& b, const Interval* in_light,
                  ForOthers&& for_others, NormalsOf&& normals_of, EdgeScratch& s, std::vector<Arc>& out) {
@@ -235,21 +237,27 @@ void edge_pieces(std::span<const Polygon> polygons, size_t i, const V3& a, const
   pieces.assign(1, i == 0 ? Interval{{0.0, a}, {1.0, b}, false} : *in_light);
   s.collinear.clear();
   for_others([&](size_t j) {
-    if (pieces.empty()) return;
+    if (pieces.empty()) return false;
     uint32_t collinear = 0;
     inside_intervals(a, b, polygons[j], i < j, in, &collinear, normals_of(j));
     subtract(pieces, in[which], s.tmp);
     if ((collinear != 0 || polygons[j].size() > 32) && j < i) s.collinear.emplace_back(uint32_t(j), collinear);
+    return !pieces.empty();
   });
   // Pieces on a great circle shared with an edge of an earlier polygon belong to that edge.
   auto collinear = [&](size_t j, uint32_t mask) {
     const Polygon other = polygons[j];
+    const EdgeNormal* normals = nullptr;
     for (size_t f = 0; f < other.size() && !pieces.empty(); ++f) {
       const bool unknown = mask == kUnknownSides || f >= 32;  // else mask says it
       if (!unknown && !(mask & (1u << f))) continue;
       const V3& c = other[f];
       const V3& d = other[f + 1 == other.size() ? 0 : f + 1];
-      if (unknown && (side(c, d, a) != 0 || side(c, d, b) != 0)) continue;
+      if (unknown) {  // the same exact signs as side(), with the normals already computed
+        if (!normals) normals = normals_of(j);
+        const int sa = normals ? side_filtered(normals[f].m, normals[f].cd, c, d, a) : side(c, d, a);
+        if (sa != 0 || (normals ? side_filtered(normals[f].m, normals[f].cd, c, d, b) : side(c, d, b)) != 0) continue;
+      }
       subtract(pieces, collinear_overlap(a, b, c, d, same_direction(a, b, c, d, other)), s.tmp);
     }
   };
@@ -292,7 +300,7 @@ void visible_region(std::span<const V3> light, std::span<const std::vector<V3>> 
       }
       edge_pieces(polygons, i, a, b, &in[1], [&](auto&& f) {
         for (size_t j = 1; j < polygons.size(); ++j)
-          if (j != i && !disjoint(edge_cap, caps[j])) f(j);
+          if (j != i && !disjoint(edge_cap, caps[j]) && !f(j)) return;
       }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, scratch, out);
     }
   }
@@ -351,9 +359,13 @@ struct RegionScratch::Impl {
   std::vector<Cap> caps;
   std::vector<Box> boxes;
   std::vector<std::array<double, 2>> points;
-  std::vector<EdgeNormal> normals;  // per polygon vertex k: its edge (k, k + 1), from boxes[j].first
-  std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp;
-  uint32_t mark = 0;
+  // Per polygon vertex k: its edge (k, k + 1), from boxes[j].first; computed when polygon j is
+  // first cut against (normal_stamp[j] == normal_mark); light_normals: the light's edges.
+  std::vector<EdgeNormal> normals, light_normals;
+  std::vector<uint32_t> wide, cell_start, cell_fill, cell_items, near, stamp, normal_stamp;
+  uint32_t mark = 0, normal_mark = 0;
+  // The chord's filter of near() (see there), for the edge being cut.
+  double box_lo[2] = {0, 0}, box_hi[2] = {0, 0}, nx = 0, ny = 0, nz = 0, slack = 0;
   EdgeScratch edge;
 };
 
@@ -387,6 +399,18 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   s.wide.clear();
   s.caps.clear();
   if (s.stamp.size() < count) s.stamp.resize(count, 0);
+  if (s.normal_stamp.size() < count) s.normal_stamp.resize(count, 0);
+  if (s.normal_mark == std::numeric_limits<uint32_t>::max()) {
+    std::fill(s.normal_stamp.begin(), s.normal_stamp.end(), 0);
+    s.normal_mark = 0;
+  }
+  ++s.normal_mark;
+  s.light_normals.clear();
+  for (size_t k = 0; k < light.size(); ++k) {
+    const V3& c = light[k];
+    const V3& d = light[k + 1 == light.size() ? 0 : k + 1];
+    s.light_normals.push_back({c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum()});
+  }
   double scale = 1;  // the chart's: 1 + the largest |coordinate| of the light's points
   if (charted) {
     chart.c = light_cap.c;
@@ -415,13 +439,10 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       Box& box = s.boxes[j];
       box.in = false;
       if (poly.empty()) continue;
-      // Points and normals share the index base: one slot per vertex (points only for charted).
+      // Points and normals share the index base: one slot per vertex (points only for charted;
+      // normals filled by normals_of when first needed).
       box.first = uint32_t(s.normals.size());
-      for (size_t k = 0; k < poly.size(); ++k) {
-        const V3& c = poly[k];
-        const V3& d = poly[k + 1 == poly.size() ? 0 : k + 1];
-        s.normals.push_back({c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum()});
-      }
+      s.normals.resize(s.normals.size() + poly.size());
       s.points.resize(s.normals.size());
       bool front = true;
       for (const V3& v : poly) front = front && chart.c.dot(v) > kFrontCos * v.cwiseAbs().sum();  // |v|₁ ≥ |v|
@@ -498,10 +519,27 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
   }
   scratch.charted = charted;
 
+  // Polygon j's edge normals (charted polygons, and the light as j = 0), computed once per call.
+  auto normals_of = [&](size_t j) -> const EdgeNormal* {
+    if (j == 0) return s.light_normals.data();
+    EdgeNormal* normals = s.normals.data() + s.boxes[j].first;
+    if (s.normal_stamp[j] != s.normal_mark) {
+      s.normal_stamp[j] = s.normal_mark;
+      const Polygon poly = polygons[j];
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const V3& c = poly[k];
+        const V3& d = poly[k + 1 == poly.size() ? 0 : k + 1];
+        normals[k] = {c.cross(d), c.cwiseAbs().sum() * d.cwiseAbs().sum()};
+      }
+    }
+    return normals;
+  };
+
   // s.near = the occluders that may meet the arc from x to y (both in the light, so c·ω > 0):
   // those in the cells the chord of their chart points passes (row by row, with margins) and
-  // the wide ones, ascending.
-  auto near = [&](size_t i, const V3& a, const V3& b, const V3& x, const V3& y) {
+  // the wide ones, in that order; near_keep(i, j) then filters each (below), only while e is
+  // not yet covered.
+  auto near = [&](const V3& a, const V3& b, const V3& x, const V3& y) {
     s.near.clear();
     if (s.mark == std::numeric_limits<uint32_t>::max()) {
       std::fill(s.stamp.begin(), s.stamp.end(), 0);
@@ -548,33 +586,29 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     // f(g) = m·(g₀e1 + g₁e2 + c) = m·ω/(c·ω): f > 0 is det(a, b, ω) > 0, left of e. A point
     // within the slack (the chart points' margin and the rounding of m, both far above their
     // errors) may be on either side or on it.
-    const double box_lo[2] = {std::min(gx[0], gy[0]) - m, std::min(gx[1], gy[1]) - m};
-    const double box_hi[2] = {std::max(gx[0], gy[0]) + m, std::max(gx[1], gy[1]) + m};
+    s.box_lo[0] = std::min(gx[0], gy[0]) - m, s.box_lo[1] = std::min(gx[1], gy[1]) - m;
+    s.box_hi[0] = std::max(gx[0], gy[0]) + m, s.box_hi[1] = std::max(gx[1], gy[1]) + m;
     const V3 normal = a.cross(b);
-    const double nx = normal.dot(chart.e1), ny = normal.dot(chart.e2), nz = normal.dot(chart.c);
-    const double slack = 4 * m * normal.cwiseAbs().sum() + 1e-13 * a.cwiseAbs().sum() * b.cwiseAbs().sum() * scale;
-    size_t kept = 0;
-    for (uint32_t j : s.near) {
-      if (j == i) continue;
-      const Box& box = s.boxes[j];
-      bool keep = !box.in;
-      if (!keep && box.lo[0] <= box_hi[0] && box.hi[0] >= box_lo[0] && box.lo[1] <= box_hi[1] &&
-          box.hi[1] >= box_lo[1]) {
-        int left = 0, right = 0, unsure = 0;
-        for (size_t k = 0; k < polygons[j].size(); ++k) {
-          const auto& g = s.points[box.first + k];
-          const double f = nx * g[0] + ny * g[1] + nz;
-          left += f > slack;
-          right += f < -slack;
-          unsure += !(f > slack) && !(f < -slack);
-        }
-        keep = i == 0 ? left + unsure > 0 && right + unsure > 0
-                      : (right + unsure > 0 && left + unsure > 0) || (j < i && unsure >= 2);
-        // (an occluder's right side: a point right and one left or on; the light's left likewise)
-      }
-      if (keep) s.near[kept++] = j;
+    s.nx = normal.dot(chart.e1), s.ny = normal.dot(chart.e2), s.nz = normal.dot(chart.c);
+    s.slack = 4 * m * normal.cwiseAbs().sum() + 1e-13 * a.cwiseAbs().sum() * b.cwiseAbs().sum() * scale;
+  };
+  auto near_keep = [&](size_t i, uint32_t j) {
+    if (j == i) return false;
+    const Box& box = s.boxes[j];
+    if (!box.in) return true;
+    if (!(box.lo[0] <= s.box_hi[0] && box.hi[0] >= s.box_lo[0] && box.lo[1] <= s.box_hi[1] && box.hi[1] >= s.box_lo[1]))
+      return false;
+    int left = 0, right = 0, unsure = 0;
+    for (size_t k = 0; k < polygons[j].size(); ++k) {
+      const auto& g = s.points[box.first + k];
+      const double f = s.nx * g[0] + s.ny * g[1] + s.nz;
+      left += f > s.slack;
+      right += f < -s.slack;
+      unsure += !(f > s.slack) && !(f < -s.slack);
     }
-    s.near.resize(kept);
+    // (an occluder's right side: a point right and one left or on; the light's left likewise)
+    return i == 0 ? left + unsure > 0 && right + unsure > 0
+                  : (right + unsure > 0 && left + unsure > 0) || (j < i && unsure >= 2);
   };
 
   auto run = [&](size_t i, const V3& a, const V3& b, const Interval* in_light) {
@@ -589,10 +623,11 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     const bool chord_in_chart = charted && chart.c.dot(x) > kFrontCos * x.cwiseAbs().sum() &&
                                 chart.c.dot(y) > kFrontCos * y.cwiseAbs().sum();
     if (chord_in_chart) {
-      near(i, a, b, x, y);
+      near(a, b, x, y);
       edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
-        for (uint32_t j : s.near) f(j);
-      }, [&](size_t j) { return s.normals.data() + s.boxes[j].first; }, s.edge, out);
+        for (uint32_t j : s.near)
+          if (near_keep(i, j) && !f(j)) return;
+      }, normals_of, s.edge, out);
       return;
     }
     // Not charted (or this chord leaves the chart's hemisphere): caps only.
@@ -604,7 +639,7 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
     const Cap edge_cap = cap_of(ends);
     edge_pieces(polygons, i, a, b, in_light, [&](auto&& f) {
       for (size_t j = 1; j < count; ++j)
-        if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j])) f(j);
+        if (j != i && !polygons[j].empty() && !disjoint(edge_cap, s.caps[j]) && !f(j)) return;
     }, [](size_t) { return static_cast<const EdgeNormal*>(nullptr); }, s.edge, out);
   };
   for (size_t k = 0; k < light.size(); ++k) {
@@ -620,10 +655,21 @@ void visible_region_sparse(std::span<const V3> light, std::span<const std::vecto
       const V3& a = poly[k];
       const V3& b = poly[k + 1 == poly.size() ? 0 : k + 1];
       if (a == b) continue;
+      // Both ends strictly right of one light edge (the float filter of side_filtered, deciding
+      // only beyond its bound): inside_intervals would find e outside the light.
+      bool outside = false;
+      const double la = 1e-14 * a.cwiseAbs().sum(), lb = 1e-14 * b.cwiseAbs().sum();
+      for (const EdgeNormal& edge : s.light_normals) {
+        if (edge.m.dot(a) < -la * edge.cd && edge.m.dot(b) < -lb * edge.cd) {
+          outside = true;
+          break;
+        }
+      }
+      if (outside) continue;
       const V3 ends[2] = {a, b};
       if (disjoint(cap_of(ends), light_cap)) continue;
       Interval in[2];
-      inside_intervals(a, b, light, false, in);
+      inside_intervals(a, b, light, false, in, nullptr, s.light_normals.data());
       if (in[1].empty) continue;
       ++scratch.boundary_edges;
       run(i, a, b, &in[1]);

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -39,6 +40,7 @@ struct Totals {
   size_t points = 0, shadowed = 0, boundary_edges = 0, kept = 0, special = 0, uncharted = 0;
   size_t queries = 0;  // that reached the union (the light not empty above the horizon)
   size_t cone = 0, cone_edges = 0, cone_candidates = 0, all_kept = 0;
+  size_t one_facing = 0, hidden = 0;  // visible_light's closed-mesh rule (occluder_mesh.h "one facing")
 };
 
 // E and the order-4 SH of the visible light by both methods at s; EXPECTs their agreement.
@@ -79,6 +81,8 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   totals.kept += kept;
   totals.special += ws_kept.stats.special;
   totals.uncharted += ws_kept.stats.uncharted;
+  totals.one_facing += ws_kept.stats.one_facing;
+  totals.hidden += ws_kept.stats.hidden;
   totals.queries += ws_kept.stats.queries;
   totals.cone += ws_fast.stats.cone;
   totals.cone_edges += ws_fast.stats.cone_edges;
@@ -305,6 +309,128 @@ TEST(OccluderContour, ConePathCoverWithoutEdgesInTheCone) {
   add_tetrahedron(alone, alone_tris, V3(0.3, -0.2, 1.5), 0.4);
   totals = compare_scene(alone, alone_tris, "tetrahedron alone", 43, 100);
   EXPECT_EQ(totals.cone, totals.queries);
+}
+
+// A closed box [lo, hi] (12 triangles), faces counter-clockwise seen from outside, or from
+// inside when `inward` (a cavity's walls).
+void add_box(std::vector<V3>& pos, std::vector<Tri>& tris, const V3& lo, const V3& hi, bool inward) {
+  const auto b = uint32_t(pos.size());
+  for (int k = 0; k < 8; ++k) pos.emplace_back(k & 1 ? hi.x() : lo.x(), k & 2 ? hi.y() : lo.y(), k & 4 ? hi.z() : lo.z());
+  for (const std::array<uint32_t, 4> q : {std::array<uint32_t, 4>{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                          {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}) {
+    for (const Tri& t : {Tri{b + q[0], b + q[1], b + q[2]}, Tri{b + q[0], b + q[2], b + q[3]}})
+      tris.push_back(inward ? Tri{t[0], t[2], t[1]} : t);
+  }
+}
+
+TEST(OccluderContour, ClosedMeshesFromOneFacing) {
+  // On a closed oriented mesh (every welded edge a consistently wound pair) with every image
+  // whole, visible_light subtracts one facing's images only, or finds the light hidden when the
+  // facings' counts differ at a generic direction (occluder_mesh.h "one facing"). Held to the
+  // per-triangle method over every image: the bunny from the ground, from inside and turned
+  // inside out; overlapping boxes (a region counted twice), a cavity, a box around the light.
+  const prt::bake::Mesh bunny = prt::bake::load_mesh(std::filesystem::path(PRT_DATA_DIR) / "bunny.obj");
+  std::vector<Tri> reversed;
+  for (const Tri& t : bunny.triangles) reversed.push_back({t[0], t[2], t[1]});
+  for (const std::vector<Tri>* tris : {&bunny.triangles, const_cast<const std::vector<Tri>*>(&reversed)}) {
+    const OccluderMesh mesh(positions_of(bunny), *tris);
+    const std::string what = tris == &reversed ? "bunny inside out, " : "bunny, ";
+    std::mt19937_64 rng(33);
+    std::uniform_real_distribution<double> u(0, 1);
+    Totals totals;
+    for (int k = 0; k < 120; ++k) {
+      const double tilt = 1.2 * u(rng), phi = 6.283185307179586 * u(rng);
+      const ShadePoint s{.p = V3(16 * u(rng) - 8, 0, 12 * u(rng) - 6),
+                         .n = V3(std::sin(tilt) * std::cos(phi), std::cos(tilt), std::sin(tilt) * std::sin(phi))};
+      compare(mesh, kBunnyLight, s, what + "ground point " + std::to_string(k), totals);
+    }
+    EXPECT_GT(totals.shadowed, 20u) << what;
+    EXPECT_GT(totals.one_facing * 10, totals.queries * 9) << what;  // nearly every ground query
+    // Points along a vertical line through the bunny's body, in and out of it: from inside,
+    // every ray meets the surface (E = 0 by every method), and the rule finds that at once.
+    V3 centre = V3::Zero();
+    for (const V3& x : positions_of(bunny)) centre += x;
+    centre /= double(bunny.positions.size());
+    Totals line;
+    for (int k = 0; k <= 40; ++k) {
+      const ShadePoint s{.p = V3(centre.x() + 0.013, 11.5 * k / 40, centre.z() - 0.007), .n = V3(0.05, 1, 0.02).normalized()};
+      compare(mesh, kBunnyLight, s, what + "line point " + std::to_string(k), line);
+    }
+    EXPECT_GT(line.hidden, 3u) << what;
+    EXPECT_GT(line.one_facing, line.hidden) << what;
+    // A 40-sided disc light: more culling planes than the walk's 32 plane bits (the rest are
+    // tested at every node).
+    Poly disc;
+    for (int k = 0; k < 40; ++k) {
+      const double a = 6.283185307179586 * k / 40;
+      disc.emplace_back(3 * std::cos(a), 12, 2 * std::sin(a));
+    }
+    Totals round;
+    for (int k = 0; k < 24; ++k) {
+      const ShadePoint s{.p = V3(12 * u(rng) - 6, 0, 8 * u(rng) - 4), .n = V3(0.2 * u(rng) - 0.1, 1, 0.1).normalized()};
+      compare(mesh, disc, s, what + "disc light, ground point " + std::to_string(k), round);
+    }
+    EXPECT_GT(round.shadowed, 5u) << what;
+    EXPECT_GT(round.one_facing, 20u) << what;
+  }
+
+  // Two overlapping boxes (their union's interior partly counted twice), a box with a cavity
+  // (an inward box inside it), and a box around the light (the light inside a closed surface);
+  // points below, inside the overlap, inside the cavity and inside the walls.
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  add_box(pos, tris, V3(-0.6, -0.5, 1.0), V3(0.4, 0.3, 1.6), false);
+  add_box(pos, tris, V3(-0.1, -0.2, 1.3), V3(0.7, 0.6, 2.0), false);
+  Totals totals = compare_scene(pos, tris, "overlapping boxes", 51, 100);
+  EXPECT_GT(totals.one_facing * 10, totals.queries * 9);
+  std::vector<V3> cavity;
+  std::vector<Tri> cavity_tris;
+  add_box(cavity, cavity_tris, V3(-2, -2, 0.5), V3(2, 2, 2.5), false);
+  add_box(cavity, cavity_tris, V3(-1.8, -1.8, 0.7), V3(1.8, 1.8, 2.3), true);
+  const Poly light{{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
+  std::vector<V3> around = pos;
+  std::vector<Tri> around_tris = tris;
+  add_box(around, around_tris, V3(-1.5, -1.5, 2.8), V3(1.5, 1.5, 3.2), false);
+  for (const auto& [scene, scene_tris, name] :
+       {std::tuple{&pos, &tris, "overlapping boxes"}, std::tuple{&cavity, &cavity_tris, "cavity"},
+        std::tuple{&around, &around_tris, "box around the light"}}) {
+    const OccluderMesh mesh(*scene, *scene_tris);
+    Totals inside;
+    for (const V3& p : {V3(0.1, 0.05, 1.45), V3(0.2, 0.1, 1.1), V3(0.5, 0.4, 1.8), V3(0.03, -0.02, 1.2),
+                        V3(0.3, -0.4, 2.4), V3(-1.9, 0.1, 1.0), V3(0.1, 0.2, 0.1)}) {
+      compare(mesh, light, {.p = p, .n = V3(0.1, -0.05, 1).normalized()}, std::string(name) + " inside", inside);
+    }
+    EXPECT_GT(inside.hidden, 0u) << name;
+  }
+  // From below, the box around the light hides it (its bottom face alone counts at d).
+  totals = compare_scene(around, around_tris, "box around the light, from below", 52, 0);
+  EXPECT_EQ(totals.hidden, totals.queries);
+  // A box through the light (walls crossing the light's plane inside it, their images clipped):
+  // no rule, the ordinary path, equal all the same.
+  std::vector<V3> through = pos;
+  std::vector<Tri> through_tris = tris;
+  add_box(through, through_tris, V3(-0.5, -2, 2.8), V3(0.5, 2, 3.2), false);
+  totals = compare_scene(through, through_tris, "box through the light", 53, 100);
+  EXPECT_EQ(totals.one_facing, 0u);
+  EXPECT_GT(totals.special, totals.queries / 2);
+
+  // A generic direction is looked for, not assumed: the light's centre direction from p here
+  // lies on the great circle of a tetrahedron edge (det = 0 exactly), so the rule is not used.
+  std::vector<V3> tet{{-0.5, 1, 0}, {0.5, 1, 0}, {0, 1, 0.5}, {0, 1.5, 0.2}};
+  std::vector<Tri> tet_tris;
+  for (const Tri& t : {Tri{0, 1, 2}, Tri{0, 3, 1}, Tri{0, 2, 3}, Tri{1, 3, 2}}) {
+    const uint32_t other = 6 - (t[0] + t[1] + t[2]);
+    const V3 n = (tet[t[1]] - tet[t[0]]).cross(tet[t[2]] - tet[t[0]]);
+    tet_tris.push_back(n.dot(tet[other] - tet[t[0]]) < 0 ? t : Tri{t[0], t[2], t[1]});
+  }
+  const OccluderMesh tet_mesh(tet, tet_tris);
+  const Poly square{{-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}};
+  Totals tie;
+  compare(tet_mesh, square, {.p = V3::Zero(), .n = V3(0, 1, 0)}, "edge through the light's centre direction", tie);
+  EXPECT_EQ(tie.queries, 1u);
+  EXPECT_EQ(tie.one_facing, 0u);
+  compare(tet_mesh, square, {.p = V3(0.01, 0, 0.02), .n = V3(0, 1, 0)}, "tetrahedron, off the tie", tie);
+  EXPECT_EQ(tie.one_facing, 1u);
 }
 
 TEST(OccluderContour, ConePathOnAFullPyramid) {

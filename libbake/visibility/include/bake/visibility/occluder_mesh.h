@@ -81,7 +81,35 @@
 //    ε-limit cone (the shade point's own 1-ring, as every vertex receiver has). The only
 //    degraded case is a light of ≥ 84° radius seen from p, where the chart is not used and each
 //    edge meets every image whose cap meets its own (Workspace::stats counts it, and the queries
-//    with clipped or ε-limit images).
+//    with clipped or ε-limit images). Kept triangles are put in index order by a bitmap; an
+//    edge of a consistently wound pair finds its other face through a twin slot.
+//    One facing (issue 32, ground points): when the mesh is closed and oriented (every welded
+//    edge a consistently wound pair: `closed_`) and every kept triangle is whole (no corner in
+//    the light's plane, none straddling it, p strictly off every plane: no clipped or ε-limit
+//    image), let σ_t = ±1 be triangle t's orientation seen from p. Then for directions ω in the
+//    light's cone, c(ω) = Σ σ_t over the images containing ω is the same integer k everywhere
+//    off the image edges: crossing a mesh edge's image either swaps one face's image for the
+//    other's (same σ, opposite sides) or enters or leaves both (a fold: opposite σ, same side);
+//    every mesh edge whose image meets the cone has both faces kept and whole (a face culled by
+//    a side plane has the edge outside it; one behind the light shares no corner with a face in
+//    front of it). (c(ω) is the winding number of the surface about p minus that about the
+//    light point on the ray: the surface does not meet the light.) So with A = {σ = +1},
+//    B = {σ = −1}: #A(ω) − #B(ω) = k; if k > 0 every ω is in some A image and if k < 0 in some
+//    B image: the light is hidden (no arc); if k = 0 a ray meets an A image iff it meets a B
+//    image, and the union of either facing's images is the union of all (up to the image
+//    edges, of measure zero): only the facing with fewer images is subtracted, its contour
+//    edges cut as edges whose other face is not passed. k is counted at one direction d (a
+//    positive sum of the light's corner directions, strictly inside every light edge, exactly)
+//    that lies on no image edge (exact signs; d on the great circle of an edge of an image it
+//    is not strictly outside of, and the rule is not used), as each image is built, and only
+//    when every image as computed (rounded corner directions) has its triangle's orientation
+//    (exact sign; else not used), so the argument holds for the images that
+//    visible_region_sparse gets. On the bunny's ground points it halves the images, and so the
+//    candidates of every cut (Workspace::stats::one_facing;
+//    tests/bake/visibility/test_occluder_contour.cpp
+//    ClosedMeshesFromOneFacing holds it to the per-triangle method from inside and outside
+//    closed meshes, overlapping and inverted ones, a cavity, a box around and through the
+//    light, and a direction d on an image edge).
 //  * The per-triangle method (visible_light_per_triangle; visible_light_reference without the
 //    culling): visible_region over every image's edges, O(E²) in the kept edges E; the slow
 //    reference the tests hold both paths to (1e-9 of the light's solid angle, E and SH).
@@ -89,7 +117,10 @@
 // more triangles than the edges it finds (the bunny Loop-subdivided 3–4 times: 1.5–2.1x) and
 // slower on small pyramids and on the CAD engine (long thin triangles: its fans meet nearly every
 // kept triangle, and it cuts more edges): a choice per query by the triangles culling keeps
-// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet.
+// (≤ 5,000: kept images) was measured and lost on the engine, so there is no choice yet. With the
+// one-facing rule the kept-images path is 1.5–2.8x faster than the cone path on the bunny's
+// ground points at Loop levels 0–3 and about even at level 4 (bench/RESULTS.md "area lights:
+// ground points").
 // Cost: the kept-images path is linear in the triangles inside the light's pyramid (culling,
 // images, the chart's grid), plus per edge cut the images near it. The cone path's follows the
 // found edges: the edge tree's walk, per found edge a fan walk and the images on it
@@ -133,6 +164,8 @@ public:
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
     std::vector<uint32_t> kept, stack;
+    std::vector<std::pair<uint32_t, uint32_t>> walk_stack;  // node, culling planes still to test (bits)
+    std::vector<uint64_t> kept_bits;  // sort_kept's bitmap over the triangles
     size_t image_count = 0;
     // The contour path's scratch: per image its triangle, kind and boundary-edge mask; per
     // triangle the query that last kept it and its image's orientation (0: not a whole triangle).
@@ -141,6 +174,7 @@ public:
     std::vector<int8_t> tri_side;
     uint32_t stamp = 0;
     int last_side = 0;
+    bool settled = false;  // every image so far whole, no corner in the light's plane, p off every plane
     RegionScratch region;
     // Counters of the contour path, summed over this workspace's queries (never reset here).
     struct Stats {
@@ -149,6 +183,8 @@ public:
       size_t boundary_edges = 0;  // image edges cut (may bound the union and reach into the light)
       size_t special = 0;         // queries with a clipped or ε-limit image (all its edges cut)
       size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
+      size_t one_facing = 0;      // queries answered from one facing's images (closed mesh)
+      size_t hidden = 0;          // … of which the light was found hidden entirely
       // The cone path: queries it answered (the rest took the kept-images path), the welded
       // edges it found in the cone and the triangles whose images it passed on (those met by a
       // fan, and the special faces), summed over the queries it answered; edge-tree nodes
@@ -246,6 +282,13 @@ private:
   size_t query(std::span<const Eigen::Vector3d> light, const ShadePoint& point, std::vector<Arc>& out, Workspace& ws,
                Method method) const;
   void cull(Workspace& ws) const;  // ws.kept += the triangles not outside a culling plane (tree walk)
+  void sort_kept(Workspace& ws) const;  // ws.kept ascending (its triangles distinct)
+  // The closed-mesh rule (file comment "one facing"): d, a direction strictly inside the light
+  // (false: none found); then per whole image (positively oriented), 1 when d is strictly inside
+  // it, 0 when strictly outside, −1 when the rule cannot be used (d on an edge's great circle,
+  // or the rounded image not positively oriented).
+  bool probe_direction(const Workspace& ws, Eigen::Vector3d& d) const;
+  static int probe_image(std::span<const Eigen::Vector3d> image, const Eigen::Vector3d& d);
   // Calls keep(t) for each triangle not outside one of `planes` (the same tree walk and margins).
   template <class Keep>
   void walk(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
@@ -272,6 +315,11 @@ private:
   std::vector<uint32_t> welded_;  // per vertex: the first vertex of its bitwise-equal position
   std::vector<Eigen::Vector3d> face_normal_;  // unit normal of (b − a)×(c − a), zero when degenerate
   std::vector<uint8_t> edge_flagged_;         // per welded edge (see EdgeNode)
+  // Per slot: the other slot of its welded edge when that is a consistently wound pair (not
+  // flagged), else kNoTwin.
+  static constexpr uint32_t kNoTwin = ~0u;
+  std::vector<uint32_t> twin_slot_;
+  bool closed_ = false;  // every welded edge a consistently wound pair (a closed oriented surface)
   std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
   std::vector<uint32_t> edge_rank_;           // per welded edge: its place in edge_order_
   std::vector<EdgeNode> edge_nodes_;
