@@ -253,7 +253,10 @@ load_end=$(cut -d' ' -f1-3 /proc/loadavg)
   Eq. 12 from the shells (the diagnostic row, `--self-shadows shells`) needs the FIV just outside
   the surface, which surface-following shells hold only where the surface is the outermost along
   its ray from the centre: not on the ears' inner faces or in the concavities, which it draws
-  black or blue.
+  black or blue. Under the bright ground (Fig. 17's kind) the bunny's own pixels are off by 0.15
+  with either (0.148 from the vertices, 0.151 from the shells: the ground plane hides the bright
+  lower sky from the bunny in the reference, and paper 004's model has no occluder for a receiver
+  plane).
 - **Figure 12 at the paper's memory.** prtbake stores the shells and cones in half floats by
   default (prtshade/fiv.h "Half-float tables"): each value moves by at most 2^-11 of itself, and
   the 64x33x30 float32 diagnostic row gives the same error as the half-float 64x33x30 row to the
