@@ -391,11 +391,6 @@ void shell_stencil(const FivOccluder& occ, float t, float u, double rho, ShellSt
   st.falloff = falloff;
 }
 
-// The masked trilinear value of a table of `width` floats per sample over a stencil: neighbours
-// with valid == 0 at weight 0 and the rest renormalised; the plain trilinear value only when no
-// valid neighbour carries weight (so it is summed only then); times the falloff.
-// The kWidth values of the half-float sample at `p` decoded into `buf` with SSE2 (header
-// "Half-float tables": exact, so everything after is the float path's arithmetic).
 #if defined(__SSE2__)
 // half_to_float of four halves in the low 16 bits of x's lanes: the same formula, lane by lane.
 inline __m128 halves_to_floats(__m128i x) {
@@ -411,6 +406,8 @@ inline __m128 halves_to_floats(__m128i x) {
   return _mm_or_ps(_mm_and_ps(is_normal, _mm_castsi128_ps(normal)), _mm_andnot_ps(is_normal, subnormal));
 }
 #endif
+// The kWidth values of the half-float sample at `p` decoded into `buf` with SSE2 (header
+// "Half-float tables": exact, so everything after is the float path's arithmetic).
 template <int kWidth> inline const float* sample_values(const uint16_t* p, float* buf) {
   int e = 0;
 #if defined(__SSE2__)
@@ -488,6 +485,9 @@ void stencil_samples(const uint16_t* table, const ShellStencil& st, float (*deco
   for (int k = 0; k < 4 * st.layers; ++k) corner[k] = decoded[k];
 }
 
+// The masked trilinear value of a table of kWidth values per sample (float, or half bits) over a
+// stencil: neighbours with valid == 0 at weight 0 and the rest renormalised; the plain trilinear
+// value only when no valid neighbour carries weight (so it is summed only then); times the falloff.
 template <int kWidth, class T>
 void sample_table(const FivOccluder& occ, const ShellStencil& st, const T* table, float out[kWidth]) {
   float decoded[8][kWidth];
