@@ -16,6 +16,7 @@
 #include <emmintrin.h>
 #endif
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
 #include <immintrin.h>  // _mm_cvtph_ps, used only in a function compiled for F16C (decode_stencil_f16c)
 #endif
 
@@ -451,11 +452,18 @@ __attribute__((target("f16c"))) void decode_stencil_f16c(const uint16_t* table, 
         }
       }
 }
-// Whether this CPU has F16C (asked once; __builtin_cpu_init first, as before main it may not have run).
+// Whether this CPU has F16C and the OS enables the VEX encoding it uses (CPUID.1:ECX F16C, AVX and
+// OSXSAVE; XCR0 saves the XMM and YMM state), asked once. (By CPUID, not __builtin_cpu_supports:
+// clang 14 does not know "f16c".)
 bool has_f16c() {
   static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("f16c") != 0;
+    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+    if (__get_cpuid(1, &eax, &ebx, &ecx, &edx) == 0) return false;
+    constexpr unsigned kF16c = 1u << 29, kAvx = 1u << 28, kOsxsave = 1u << 27;
+    if ((ecx & (kF16c | kAvx | kOsxsave)) != (kF16c | kAvx | kOsxsave)) return false;
+    unsigned xcr0_lo = 0, xcr0_hi = 0;
+    __asm__("xgetbv" : "=a"(xcr0_lo), "=d"(xcr0_hi) : "c"(0));
+    return (xcr0_lo & 6u) == 6u;
   }();
   return yes;
 }
