@@ -51,7 +51,13 @@ void check_layout(const prt::shade::LoadedAsset& a) {
   for (const prt::shade::LoadedOccluder& o : a.occluders) {
     const size_t cells = size_t(o.n_rho) * size_t(o.n_theta) * size_t(o.n_phi);
     require(o.n_rho > 0 && o.n_theta > 0 && o.n_phi > 0, "occluder grid sizes > 0");
-    require(o.radii.size() == size_t(o.n_rho) && o.shells.size() == 9 * cells, "radii [Nrho], shells [..][3][3]");
+    // The shells as floats or (a float16 file, v8) as half bits: exactly one of the two.
+    require(o.radii.size() == size_t(o.n_rho) && (o.shells.size() == 9 * cells) != (o.shells_half.size() == 9 * cells) &&
+                (o.shells.empty() || o.shells_half.empty()),
+            "radii [Nrho], shells or shells_half [..][3][3]");
+    require((o.cones.empty() || o.cones.size() == 4 * cells) && (o.cones_half.empty() || o.cones_half.size() == 4 * cells) &&
+                (o.cones.empty() || o.cones_half.empty()),
+            "cones or cones_half [..][4]");
     require(o.valid.empty() || o.valid.size() == cells, "valid [Nrho][Ntheta][Nphi]");
     require(o.radial_scheme == prt::shade::kFivRadialGeometric
                 ? o.surface_radius.empty()
