@@ -11,6 +11,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 namespace prt::bake {
@@ -24,6 +25,8 @@ namespace {
 constexpr double kMargin = 1e-12;
 constexpr uint32_t kLeafSize = 4;
 constexpr size_t kFanBatch = 64;  // fans walked together (one bit each)
+constexpr size_t kConeSides = 8;     // lights of more sides are culled by an octagonal pyramid (header)
+constexpr double kConeMinCos = 0.1;  // … while the cone around the light is narrower than 84°
 
 }  // namespace
 
@@ -102,21 +105,25 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
     const uint32_t u = welded_[t[slot % 3]], v = welded_[t[(slot % 3 + 1) % 3]];
     return std::pair(std::min(u, v), std::max(u, v));
   };
+  // Sorted as (key, slot) pairs with the key packed in 64 bits: the same order as comparing
+  // keys, then slots, without looking the key up in every comparison.
+  std::vector<std::pair<uint64_t, uint32_t>> keyed(slots);
+  for (uint32_t i = 0; i < slots; ++i) {
+    const auto [u, v] = key(i);
+    keyed[i] = {uint64_t(u) << 32 | v, i};
+  }
+  std::sort(keyed.begin(), keyed.end());
   edge_slots_.resize(slots);
-  for (uint32_t i = 0; i < slots; ++i) edge_slots_[i] = i;
-  std::sort(edge_slots_.begin(), edge_slots_.end(), [&](uint32_t x, uint32_t y) {
-    const auto kx = key(x), ky = key(y);
-    return kx != ky ? kx < ky : x < y;
-  });
   slot_group_.resize(slots);
   edge_group_start_.clear();
   for (uint32_t i = 0; i < slots; ++i) {
-    if (i == 0 || key(edge_slots_[i]) != key(edge_slots_[i - 1])) edge_group_start_.push_back(i);
+    edge_slots_[i] = keyed[i].second;
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) edge_group_start_.push_back(i);
     slot_group_[edge_slots_[i]] = uint32_t(edge_group_start_.size() - 1);
   }
   edge_group_start_.push_back(uint32_t(slots));
 
-  // The edge tree (cone path): unit face normals, flagged edges, then the tree.
+  // Unit face normals and flagged edges (the edge tree is built by the first cone query).
   face_normal_.resize(triangles_.size());
   for (size_t t = 0; t < triangles_.size(); ++t) {
     const auto& tri = triangles_[t];
@@ -149,20 +156,26 @@ OccluderMesh::OccluderMesh(std::vector<V3> positions, std::vector<std::array<uin
       twin_slot_[s0] = s1;
       twin_slot_[s1] = s0;
     }
-  std::vector<V3> centres(groups);
-  for (size_t g = 0; g < groups; ++g) {
-    const uint32_t slot = edge_slots_[edge_group_start_[g]];
-    const auto& tri = triangles_[slot / 3];
-    centres[g] = (positions_[tri[slot % 3]] + positions_[tri[(slot % 3 + 1) % 3]]) / 2;
-  }
-  edge_order_.resize(groups);
-  for (uint32_t g = 0; g < groups; ++g) edge_order_[g] = g;
-  if (groups > 0) build_edges(0, uint32_t(groups), centres);
-  edge_rank_.resize(groups);
-  for (uint32_t i = 0; i < groups; ++i) edge_rank_[edge_order_[i]] = i;
 }
 
-uint32_t OccluderMesh::build_edges(uint32_t first, uint32_t count, std::vector<V3>& centres) {
+void OccluderMesh::edge_tree() const {
+  std::call_once(*edge_tree_once_, [this] {
+    const size_t groups = edge_count();
+    std::vector<V3> centres(groups);
+    for (size_t g = 0; g < groups; ++g) {
+      const uint32_t slot = edge_slots_[edge_group_start_[g]];
+      const auto& tri = triangles_[slot / 3];
+      centres[g] = (positions_[tri[slot % 3]] + positions_[tri[(slot % 3 + 1) % 3]]) / 2;
+    }
+    edge_order_.resize(groups);
+    for (uint32_t g = 0; g < groups; ++g) edge_order_[g] = g;
+    if (groups > 0) build_edges(0, uint32_t(groups), centres);
+    edge_rank_.resize(groups);
+    for (uint32_t i = 0; i < groups; ++i) edge_rank_[edge_order_[i]] = i;
+  });
+}
+
+uint32_t OccluderMesh::build_edges(uint32_t first, uint32_t count, std::vector<V3>& centres) const {
   const uint32_t at = uint32_t(edge_nodes_.size());
   edge_nodes_.push_back({V3::Zero(), V3::Zero(), V3::Zero(), V3::Zero(), 0, 0, 0, 0, count, false});
   V3 lo = V3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -289,6 +302,30 @@ bool OccluderMesh::prepare(std::span<const V3> light, const ShadePoint& point, W
   ws.planes.push_back({-double(frame.p_side) * ab.cross(ac), frame.a, kMargin * ab.norm() * ac.norm()});
   frame.m = ws.planes.back().m;
   frame.bound_coef = 1e-14 * ab.cwiseAbs().sum() * ac.cwiseAbs().sum();
+
+  // A many-sided light's culling pyramid: 8 planes tangent to a cone around it (header).
+  ws.cull_planes.clear();
+  if (c.size() > kConeSides) {
+    V3 axis = V3::Zero();
+    for (const V3& u : c) axis += u.normalized();
+    const double norm = axis.norm();
+    if (norm > 0 && std::isfinite(norm)) {
+      axis /= norm;
+      double cos_t = 1;
+      for (const V3& u : c) cos_t = std::min(cos_t, axis.dot(u.normalized()));
+      cos_t -= 1e-9;
+      if (cos_t > kConeMinCos) {
+        const double sin_t = std::sqrt((1 - cos_t) * (1 + cos_t));
+        const V3 e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+        for (size_t j = 0; j < kConeSides; ++j) {
+          const double angle = 2 * std::numbers::pi * double(j) / double(kConeSides);
+          const V3 e = std::cos(angle) * e1 + std::sin(angle) * e2;
+          ws.cull_planes.push_back({sin_t * axis - cos_t * e, point.p, kMargin});
+        }
+        ws.cull_planes.push_back(ws.planes.back());
+      }
+    }
+  }
   return true;
 }
 
@@ -529,9 +566,13 @@ int OccluderMesh::probe_image(std::span<const V3> image, const V3& d) {
 }
 
 void OccluderMesh::sort_kept(Workspace& ws) const {
-  // Ascending, as std::sort would give (the walk keeps each triangle once): a bitmap over the
-  // triangles, read word by word.
+  // Ascending (the walk keeps each triangle once). A few among many (a small light over a large
+  // mesh) by std::sort; else by a bitmap over the triangles, read word by word.
   const size_t words = (triangles_.size() + 63) / 64;
+  if (ws.kept.size() * 16 < words) {
+    std::sort(ws.kept.begin(), ws.kept.end());
+    return;
+  }
   ws.kept_bits.assign(words, 0);
   for (uint32_t t : ws.kept) ws.kept_bits[t >> 6] |= uint64_t(1) << (t & 63);
   ws.kept.clear();
@@ -656,7 +697,8 @@ void OccluderMesh::cone_query(const ShadePoint& point, const LightFrame& frame, 
 }
 
 void OccluderMesh::cull(Workspace& ws) const {
-  walk(ws.planes, ws, [&ws](uint32_t t) { ws.kept.push_back(t); });
+  ws.stats.octagon += !ws.cull_planes.empty();
+  walk(ws.cull_planes.empty() ? ws.planes : ws.cull_planes, ws, [&ws](uint32_t t) { ws.kept.push_back(t); });
 }
 
 template <class Keep>
@@ -886,6 +928,7 @@ void OccluderMesh::find_cone_edges(const ShadePoint& point, const LightFrame& fr
     std::sort(ws.special_faces.begin(), ws.special_faces.end());
     ws.special_faces.erase(std::unique(ws.special_faces.begin(), ws.special_faces.end()), ws.special_faces.end());
   };
+  edge_tree();
   if (edge_nodes_.empty()) return;
   if (brute) {
     for (uint32_t g = 0; g < edge_count(); ++g) {

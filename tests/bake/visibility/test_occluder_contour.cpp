@@ -358,8 +358,7 @@ TEST(OccluderContour, ClosedMeshesFromOneFacing) {
     }
     EXPECT_GT(line.hidden, 3u) << what;
     EXPECT_GT(line.one_facing, line.hidden) << what;
-    // A 40-sided disc light: more culling planes than the walk's 32 plane bits (the rest are
-    // tested at every node).
+    // A 40-sided disc light (culled by the octagonal pyramid around it).
     Poly disc;
     for (int k = 0; k < 40; ++k) {
       const double a = 6.283185307179586 * k / 40;
@@ -600,6 +599,59 @@ TEST(OccluderContour, LightTooWideForTheChart) {
             "wide " + std::to_string(k), totals);
   EXPECT_EQ(totals.uncharted, totals.points);
   EXPECT_GT(totals.shadowed, 50u);
+}
+
+TEST(OccluderContour, ManySidedLightsCulledByAnOctagon) {
+  // A 64-sided disc (radius 2, 10 above the points) and small triangles half-way up, around the
+  // rim of its pyramid (radius 1 there) at random angles: straddling it, just inside, just
+  // outside, and out to 1.09, past the corners of the octagonal culling pyramid (1/cos(π/8) =
+  // 1.082); more at radius 1.3–2, outside the octagon. The octagon drops none that hides light
+  // (the unculled per-triangle method agrees), it is used, and it drops the far ones.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<V3> pos;
+  std::vector<Tri> tris;
+  auto add_small = [&](double rho) {
+    const double psi = 6.283185307179586 * u(rng);
+    const V3 c(rho * std::cos(psi), 5 + 0.02 * (u(rng) - 0.5), rho * std::sin(psi));
+    const auto first = uint32_t(pos.size());
+    for (int k = 0; k < 3; ++k) pos.push_back(c + 0.012 * V3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
+    tris.push_back({first, first + 1, first + 2});
+  };
+  for (int k = 0; k < 300; ++k) add_small(0.97 + 0.12 * u(rng));
+  for (int k = 0; k < 100; ++k) add_small(1.3 + 0.7 * u(rng));
+  const OccluderMesh mesh(pos, tris);
+  Poly disc;
+  for (int k = 0; k < 64; ++k) {
+    const double a = 6.283185307179586 * k / 64;
+    disc.emplace_back(2 * std::cos(a), 10, 2 * std::sin(a));
+  }
+  Totals totals;
+  for (int k = 0; k < 20; ++k) {
+    const ShadePoint s{.p = V3(0.05 * (u(rng) - 0.5), 0, 0.05 * (u(rng) - 0.5)), .n = V3(0, 1, 0)};
+    compare(mesh, disc, s, "rim point " + std::to_string(k), totals);
+    OccluderMesh::Workspace ws;
+    std::vector<Arc> arcs;
+    const size_t kept = mesh.visible_light(disc, s, arcs, ws);
+    EXPECT_EQ(ws.stats.octagon, 1u) << k;
+    EXPECT_LE(kept, 300u) << k;
+    EXPECT_GT(kept, 100u) << k;
+  }
+  EXPECT_EQ(totals.shadowed, totals.points);
+  // A wide many-sided light (86° from the points): the octagon is not used, its 41 planes are.
+  Poly wide;
+  for (int k = 0; k < 40; ++k) {
+    const double a = 6.283185307179586 * k / 40;
+    wide.emplace_back(150 * std::cos(a), 10, 150 * std::sin(a));
+  }
+  for (int k = 0; k < 10; ++k) {
+    const ShadePoint s{.p = V3(0.5 * (u(rng) - 0.5), 0, 0.5 * (u(rng) - 0.5)), .n = V3(0, 1, 0)};
+    compare(mesh, wide, s, "wide point " + std::to_string(k), totals);
+    OccluderMesh::Workspace ws;
+    std::vector<Arc> arcs;
+    mesh.visible_light(wide, s, arcs, ws);
+    EXPECT_EQ(ws.stats.octagon, 0u) << k;
+  }
 }
 
 }  // namespace

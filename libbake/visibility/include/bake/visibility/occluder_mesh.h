@@ -12,6 +12,17 @@
 //    m_i·(x − p) ≥ 0) and the light's own plane (p's side): a box or a triangle entirely outside
 //    one plane by more than a rounding margin (1e-12 relative: far above the error of the
 //    floating-point plane values) is dropped. Nothing dropped overlaps the light's interior.
+//    A light of more than 8 sides (a disc or a sun as a many-sided polygon, whose every side
+//    plane would be tested at each node along its thin pyramid) is culled instead by the light's
+//    plane and the 8 planes through p tangent to a circular cone around it: axis a the
+//    normalised sum of the clipped corner directions, cos θ the least cosine of a corner
+//    direction to a, less 1e-9 (used while θ < 84°, so the cone's cap is geodesically convex
+//    and holds the light's edges too); tangent plane j has the inward normal
+//    sin θ a − cos θ e_j (e_j ⊥ a at angles 2πj/8), and every ω at angle φ ≤ θ from a has
+//    n_j·ω ≥ sin(θ − φ) ≥ 0. This pyramid holds the light's, so what it drops is outside the
+//    light's pyramid too (the one-facing rule's "a culled face has the edge outside it"); it
+//    keeps a few more triangles (a regular octagon around a disc: 5.5% more area) for 9 planes
+//    in place of n + 1 (bench/RESULTS.md "area lights: many-sided lights").
 //  * the light's plane decides depth EXACTLY (orient3d_exact on three light vertices): a triangle
 //    with no vertex strictly on p's side is behind the light and dropped; one straddling the
 //    plane is clipped to p's side (crossing points in floating point). Since the light is planar
@@ -136,6 +147,8 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <span>
 #include <utility>
 #include <vector>
@@ -160,6 +173,9 @@ public:
       double margin_coef;  // margin = margin_coef · (|x − o| bound)
     };
     std::vector<Plane> planes;
+    // A light of more than 8 sides (a disc, a sun) is culled by the planes of an octagonal
+    // pyramid around it instead of its own sides (file comment, culling); empty otherwise.
+    std::vector<Plane> cull_planes;
     std::vector<double> margins;  // per plane, of the leaf being culled
     std::vector<Eigen::Vector3d> rel, clipped, poly;
     std::vector<std::vector<Eigen::Vector3d>> images;
@@ -185,6 +201,7 @@ public:
       size_t uncharted = 0;       // queries whose light was too wide for the chart (caps only)
       size_t one_facing = 0;      // queries answered from one facing's images (closed mesh)
       size_t hidden = 0;          // … of which the light was found hidden entirely
+      size_t octagon = 0;         // queries culled by the octagonal pyramid (a light of > 8 sides)
       // The cone path: queries it answered (the rest took the kept-images path), the welded
       // edges it found in the cone and the triangles whose images it passed on (those met by a
       // fan, and the special faces), summed over the queries it answered; edge-tree nodes
@@ -296,7 +313,7 @@ private:
   // five consecutive planes of `planes` (≤ 64 fans): one walk, each node carrying its live fans.
   template <class Keep>
   void walk_fans(std::span<const Workspace::Plane> planes, Workspace& ws, Keep&& keep) const;
-  uint32_t build_edges(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centres);
+  uint32_t build_edges(uint32_t first, uint32_t count, std::vector<Eigen::Vector3d>& centres) const;
   // 1: edge g may bound the union in the cone; 0: it cannot. Its faces in the pyramid with a
   // clipped image or p in their plane are appended to `special`.
   int classify_edge(uint32_t group, const ShadePoint& point, const LightFrame& frame, const Workspace& ws,
@@ -320,9 +337,13 @@ private:
   static constexpr uint32_t kNoTwin = ~0u;
   std::vector<uint32_t> twin_slot_;
   bool closed_ = false;  // every welded edge a consistently wound pair (a closed oriented surface)
-  std::vector<uint32_t> edge_order_;          // welded edges, the edge tree's leaves' ranges
-  std::vector<uint32_t> edge_rank_;           // per welded edge: its place in edge_order_
-  std::vector<EdgeNode> edge_nodes_;
+  // The edge tree, built by the first cone-path query (edge_tree()): only visible_light_cone and
+  // cone_edges use it, and it costs as much as the rest of the constructor on a large mesh.
+  void edge_tree() const;
+  mutable std::unique_ptr<std::once_flag> edge_tree_once_ = std::make_unique<std::once_flag>();
+  mutable std::vector<uint32_t> edge_order_;  // welded edges, the edge tree's leaves' ranges
+  mutable std::vector<uint32_t> edge_rank_;   // per welded edge: its place in edge_order_
+  mutable std::vector<EdgeNode> edge_nodes_;
 };
 
 } // namespace prt::bake
