@@ -152,6 +152,7 @@ constexpr Field<Light> kLightFields[] = {
 constexpr Field<OccluderValid> kValidFields[] = {{N::kMeaning, &OccluderValid::meaning}};
 constexpr Field<OccluderSurfaceRadius> kSurfaceRadiusFields[] = {{N::kMeaning, &OccluderSurfaceRadius::meaning}};
 constexpr Field<OccluderCones> kConesFields[] = {{N::kIntegrand, &OccluderCones::integrand}};
+constexpr Field<OccluderSelfBand1> kSelfBand1Fields[] = {{N::kMeaning, &OccluderSelfBand1::meaning}};
 
 constexpr Field<SceneInfo> kSceneFields[] = {
     {N::kSceneFile, &SceneInfo::scene_file},
@@ -336,6 +337,9 @@ void add_occluder(File& f, const Occluder& o) {
   if (o.cones)  // v7
     add_array(f, cat(dir, N::kCones), {grid[0], grid[1], grid[2], 4}, stored(o.cones->values, o.cones->float16),
               attrs_of<OccluderCones>(*o.cones, kConesFields, o.cones->extra));
+  if (o.self_band1)  // v9
+    add_array(f, cat(dir, N::kSelfBand1), {o.self_band1->values.size() / 9, 3, 3}, o.self_band1->values,
+              attrs_of<OccluderSelfBand1>(*o.self_band1, kSelfBand1Fields, o.self_band1->extra));
   if (o.report) add_row(f, fiv_report_path(o.name), *o.report);
 }
 
@@ -570,6 +574,13 @@ Asset to_asset(const File& f, const std::filesystem::path& file_for_messages) {
       c.size = int(d.shape[1]);
       c.values = values<float>(d);
       take_attrs<IrradianceCube>(c, kCubeFields, d.attrs, c.extra);
+      break;
+    }
+    case DatasetKind::occluder_self_band1: {
+      const std::string_view rest = after(d.path, occluders_dir);
+      Occluder& o = named(a.occluders, rest.substr(0, rest.find('/')));
+      o.self_band1.emplace().values = values<float>(d);
+      take_attrs<OccluderSelfBand1>(*o.self_band1, kSelfBand1Fields, d.attrs, o.self_band1->extra);
       break;
     }
     case DatasetKind::occluder_surface_radius: {

@@ -85,7 +85,7 @@ std::string allowed_paths() {
     s += std::string(p) + ", ";
   return s + "the same under " + std::string(N::kObjects) + "/<name>/, " + std::string(N::kFivEnvironment) + ", " +
          std::string(N::kIrradianceCube) + ", " + std::string(N::kOccluders) + "/<name>/{" +
-         std::string(N::kShells) + "," + std::string(N::kValid) + "," + std::string(N::kSurfaceRadius) + "," + std::string(N::kCones) + "}, " + std::string(N::kLights) + "/<name>/{" +
+         std::string(N::kShells) + "," + std::string(N::kValid) + "," + std::string(N::kSurfaceRadius) + "," + std::string(N::kCones) + "," + std::string(N::kSelfBand1) + "}, " + std::string(N::kLights) + "/<name>/{" +
          std::string(N::kLightVertices) + "," + std::string(N::kLightFaceSizes) + "," +
          std::string(N::kLightFaceIndices) + "} and anything under " +
          std::string(N::kReport) + "/";
@@ -197,6 +197,7 @@ public:
       if (p.back() == N::kValid) return Kind::occluder_valid;
       if (p.back() == N::kSurfaceRadius) return Kind::occluder_surface_radius;
       if (p.back() == N::kCones) return Kind::occluder_cones;
+      if (p.back() == N::kSelfBand1) return Kind::occluder_self_band1;
     }
     if (path.starts_with(std::string(N::kLights) + "/") && p.size() == split_path(N::kLights).size() + 2) {
       if (p.back() == N::kLightVertices) return Kind::light_vertices;
@@ -407,6 +408,10 @@ bool is_lightmap_kind(DatasetKind kind) {
 }
 
 int64_t written_format_version(const File& file) {
+  // Version 9: an FIV occluder's self-shadows at its object's vertices.
+  if (std::any_of(file.datasets.begin(), file.datasets.end(),
+                  [](const Dataset& d) { return dataset_kind(d.path) == Kind::occluder_self_band1; }))
+    return kFormatVersionWithSelfShadows;
   // Version 8: float16 datasets (an occluder's shells or cones).
   if (std::any_of(file.datasets.begin(), file.datasets.end(), [](const Dataset& d) { return d.data.index() == 4; }))
     return kFormatVersionWithHalfShells;
@@ -494,6 +499,9 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
     if (d.data.index() == 4 && version < 8)
       c.fail("dataset '" + d.path + "' is float16, which needs format_version 8 (the file says " + std::to_string(version) +
              ")");
+    if (k == Kind::occluder_self_band1 && version < 9)
+      c.fail("dataset '" + d.path + "' is an occluder's self-shadows, which needs format_version 9 (the file says " +
+             std::to_string(version) + ")");
     if (k == Kind::occluder_cones && version < 7)
       c.fail("dataset '" + d.path + "' is an occluder's cone table, which needs format_version 7 (the file says " +
              std::to_string(version) + ")");
@@ -750,6 +758,7 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       break;
     case Kind::occluder_valid:
     case Kind::occluder_cones:
+    case Kind::occluder_self_band1:
     case Kind::report:
     case Kind::unknown:
       break;
@@ -769,6 +778,23 @@ void validate(const File& file, const std::filesystem::path& file_for_messages) 
       if (!std::isfinite(r[j]) || r[j] < 0)
         c.fail("dataset '" + d.path + "' must hold finite distances >= 0, not " + std::to_string(r[j]) + " at index " +
                std::to_string(j));
+  }
+  for (std::size_t i = 0; i < file.datasets.size(); ++i) {
+    const Dataset& d = file.datasets[i];
+    if (kinds[i] != Kind::occluder_self_band1) continue;
+    c.dtype(d, 0);
+    const std::string dir = d.path.substr(0, d.path.size() - N::kSelfBand1.size());  // "/fiv/occluders/<name>/"
+    if (shells.find(dir) == shells.end())
+      c.fail("dataset '" + d.path + "' has no '" + std::string(N::kShells) + "' dataset beside it");
+    const std::string name = dir.substr(N::kOccluders.size() + 1, dir.size() - N::kOccluders.size() - 2);
+    const std::string object = std::string(N::kObjects) + "/" + name;
+    const VertexSet vs = vertex_set(object);
+    if (vs.positions == nullptr)
+      c.fail("dataset '" + d.path + "' holds the self-shadows of scene object '" + name + "', but the file has no " + object +
+             std::string(N::kPositions));
+    if (!vs.has_normals)
+      c.fail("dataset '" + d.path + "' needs " + object + std::string(N::kNormals) + " (the normals the bake used)");
+    c.shape(d, {vs.V, 3, 3}, "[V, 3 (RGB), 3 (m)] with V = rows of " + object + std::string(N::kPositions));
   }
   for (std::size_t i = 0; i < file.datasets.size(); ++i) {
     const Dataset& d = file.datasets[i];

@@ -290,8 +290,8 @@ INSTANTIATE_TEST_SUITE_P(
                "'up_axis' must be \"y\" or \"z\""},
         Defect{"bad_sha", [](File& f) { drop_root(f, "source_sha256"); f.root_attrs.push_back({"source_sha256", std::string("abc")}); },
                "'source_sha256' must be 64 lowercase hex digits"},
-        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{9}}); },
-               "'format_version' must be an integer in 1..8"},
+        Defect{"wrong_version", [](File& f) { f.root_attrs.push_back({"format_version", int64_t{10}}); },
+               "'format_version' must be an integer in 1..9"},
         Defect{"object_in_v1_file",
                [](File& f) {
                  f.root_attrs.push_back({"format_version", int64_t{1}});
@@ -505,9 +505,9 @@ TEST(Reader, NewerVersionIsRejectedClearly) {
   const fs::path dir = scratch("newer");
   File f = make_file();
   f.root_attrs.push_back({"format", std::string("prtbake")});
-  f.root_attrs.push_back({"format_version", int64_t{9}});
-  prt::formats::testing::write_file_unvalidated(dir / "v9.prt.h5", f);
-  expect_read_error(dir / "v9.prt.h5", "written by a newer prtbake (format_version 9 > 8)");
+  f.root_attrs.push_back({"format_version", int64_t{10}});
+  prt::formats::testing::write_file_unvalidated(dir / "v10.prt.h5", f);
+  expect_read_error(dir / "v10.prt.h5", "written by a newer prtbake (format_version 10 > 9)");
 }
 
 TEST(Reader, Version1FilesStayReadable) {

@@ -206,6 +206,15 @@ struct OccluderCones {
   bool operator==(const OccluderCones&) const = default;
 };
 
+// /fiv/occluders/<name>/self_band1 (v9, scene files): the occluder's band-1 radiance from itself
+// alone at the vertices of /objects/<name>, [V][RGB][m] (SCHEMA.md "FIV self-shadows").
+struct OccluderSelfBand1 {
+  std::vector<float> values;
+  std::optional<std::string> meaning;
+  ExtraAttrs extra;
+  bool operator==(const OccluderSelfBand1&) const = default;
+};
+
 // /fiv/occluders/<name>: FIVs on shells around an occluder's bounding sphere, and its report.
 // radial_scheme (v7) "surface": radii are offsets from the surface and surface_radius is there;
 // absent or "geometric": radii are the shell radii (SCHEMA.md).
@@ -228,6 +237,7 @@ struct Occluder {
   std::optional<OccluderValid> valid;
   std::optional<OccluderSurfaceRadius> surface_radius;  // (v7)
   std::optional<OccluderCones> cones;  // v7
+  std::optional<OccluderSelfBand1> self_band1;  // v9 (scene files)
   // v7: the group attribute `proxy` of /fiv/occluders/<name>, "sphere" or "cone" (needs cones);
   // absent (older files): the sphere.
   std::optional<std::string> proxy;

@@ -55,6 +55,9 @@ inline constexpr std::string_view kShells = "shells";  // leaf under /fiv/occlud
 inline constexpr std::string_view kValid = "valid";    // leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kSurfaceRadius = "surface_radius";  // (v7) leaf under /fiv/occluders/<name>/
 inline constexpr std::string_view kCones = "cones";    // leaf under /fiv/occluders/<name>/ (v7): the tight proxy
+// Leaf under /fiv/occluders/<name>/ (v9, scene files): the occluder's band-1 radiance from itself
+// alone at the vertices of /objects/<name> ([V][RGB][m], as /radiance/band1): its self-shadows.
+inline constexpr std::string_view kSelfBand1 = "self_band1";
 // Attribute of the group /fiv/occluders/<name> (v7): the proxy its corrections use, "sphere" or "cone".
 inline constexpr std::string_view kProxy = "proxy";
 inline constexpr std::string_view kProxySphere = "sphere";

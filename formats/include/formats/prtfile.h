@@ -90,14 +90,17 @@ namespace prt::formats {
 
 // The newest schema version this library reads, and the one it writes for a file that holds a
 // float16 FIV shells or cone table (written_format_version; policy: SCHEMA.md "Versioning").
+// 9 added /fiv/occluders/<name>/self_band1 (a scene file's FIV occluder's self-shadows at its vertices; issue 33).
 // 8 added dtype float16 for /fiv/occluders/<name>/shells and cones (half the memory; issue 33). 7 added surface-following FIV shells (/fiv/occluders/<name>/surface_radius, the
 // shells' radial_scheme and first_offset attributes) and the tight occluder proxy
 // (/fiv/occluders/<name>/cones and the group attribute `proxy`); 6 punctual lights (/lights/<name>
 // of shape point, spot or directional: attributes, no geometry); 5 lightmaps (/mesh/uv,
 // /lightmap/...); 4 shadowed radiance (/radiance/shadowed); 3 area lights (/lights,
 // area_lights/*); 2 scene objects (/objects). Older files still read.
-inline constexpr int kFormatVersion = 8;
-// The version written for a file with float16 FIV shells or cones.
+inline constexpr int kFormatVersion = 9;
+// The version written for a file with an FIV occluder's self_band1.
+inline constexpr int kFormatVersionWithSelfShadows = 9;
+// The version written for a file with float16 FIV shells or cones (and no self_band1).
 inline constexpr int kFormatVersionWithHalfShells = 8;
 // The version written for a file with FIV cones (/fiv/occluders/<name>/cones or a `proxy`
 // attribute: the tight occluder proxy) or surface-following shells.
@@ -198,8 +201,8 @@ File read_file(const std::filesystem::path& path, ReadCheck check = ReadCheck::f
 // FormatError on the first defect found.
 void validate(const File& file, const std::filesystem::path& file_for_messages);
 
-// The format_version write_file gives `file`: kFormatVersionWithHalfShells when a dataset is
-// float16, else kFormatVersionWithCones when it holds surface-following FIV shells (an occluder's surface_radius dataset, or a shells dataset
+// The format_version write_file gives `file`: kFormatVersionWithSelfShadows when it holds an
+// occluder's self_band1, else kFormatVersionWithHalfShells when a dataset is float16, else kFormatVersionWithCones when it holds surface-following FIV shells (an occluder's surface_radius dataset, or a shells dataset
 // with a radial_scheme or first_offset attribute) or an FIV cone table (/fiv/occluders/<name>/cones
 // or a group attribute `proxy`), else kFormatVersionWithPunctualLights when it holds a punctual
 // light (a /lights/<name> group whose shape is_punctual_shape), else kFormatVersionWithLightmaps
@@ -224,6 +227,7 @@ enum class DatasetKind {
   radiance_band1, radiance_shadowed, area_irradiance, area_sh, fiv_environment, irradiance_cube, occluder_shells, occluder_valid,
   occluder_surface_radius,  // v7
   occluder_cones,  // v7
+  occluder_self_band1,  // v9
   light_vertices, light_face_sizes, light_face_indices,
   uv, lightmap_state, lightmap_positions, lightmap_normals, lightmap_ao, lightmap_transfer_diffuse,  // v5
   lightmap_transfer_visibility, lightmap_radiance_band1, lightmap_radiance_shadowed,                // v5
