@@ -6,6 +6,8 @@
 //        tetrahedron's vertex products (ao, diffuse and visibility transfer, band-1 radiance);
 //        an FIV file (environment, DifMap, one occluder), for fuzz_prt_dump and fuzz_prt_loader;
 //   prt/fiv_float16.prt.h5   the FIV file with its shells in half floats (format_version 8);
+//   prt/fiv_scene_self.prt.h5   the FIV file as a scene file: the tetrahedron an object too, with
+//        its self-shadows at its vertices (/fiv/occluders/tetra/self_band1, format_version 9);
 //   prt/annotated.prt.h5   vertex.prt.h5 with attributes as h5py adds them (issue 28):
 //        variable-length strings on the root (a scalar and an array of three), on /mesh and on
 //        /ao, their text in a global heap collection that the targets then damage;
@@ -222,6 +224,16 @@ int main(int argc, char** argv) {
     pf::Asset half = fiv_asset();  // the same occluder in half floats (format_version 8)
     half.occluders[0].float16 = true;
     pf::write_asset(dir / "prt" / "fiv_float16.prt.h5", half);
+    pf::Asset scene = fiv_asset();  // a scene file whose object "tetra" has self-shadows (format_version 9)
+    scene.scene.emplace().scene_file = "scene.json";
+    pf::SceneObject& tetra = scene.objects.emplace_back();
+    tetra.name = "tetra";
+    tetra.role = "occluder";
+    tetra.set = vertex_asset().vertices;
+    tetra.set.ao.reset(), tetra.set.transfer_diffuse.reset(), tetra.set.transfer_visibility.reset();
+    tetra.set.radiance_band1.reset();
+    scene.occluders[0].self_band1 = pf::OccluderSelfBand1{ramp(4 * 9, 0.02f, 0.1f), "self", {}};
+    pf::write_asset(dir / "prt" / "fiv_scene_self.prt.h5", scene);
     write_old_format(dir / "prt" / "old_format.prt.h5");
     write_annotated(dir / "prt" / "annotated.prt.h5");
   } catch (const std::exception& e) {

@@ -482,9 +482,8 @@ void add_fiv(CLI::App& app, Args& a, uint32_t& samples) {
   cmd.add_option_function<std::string>(
          "--self-shadows",
          [&a](const std::string& r) {
-           if (r != "vertex" && r != "shells")
+           if (!bake::parse_self_shadows(r, a.shell_spec.vertex_self_shadows))
              throw CLI::ValidationError("--self-shadows", "expects vertex or shells, got '" + r + "'");
-           a.fiv_vertex_self_shadows = r == "vertex";
          },
          "the occluder's own shadows: vertex (default) = its band-1 radiance at\n"
          "its vertices (exact there; /mesh and /radiance/band1 in the file), which\n"

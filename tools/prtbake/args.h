@@ -29,9 +29,6 @@ struct Args {
   // vertex: the integrator; fiv: seed and report (its k is shell_spec.silhouette_k); scene: --report.
   bake::IntegratorSpec integrator;
   bake::ShellSpec shell_spec;  // fiv
-  // fiv: the occluder's self-shadows as per-vertex band-1 radiance in the file's vertex set
-  // (--self-shadows vertex, the default), or none (shells: the runtime's eq. 12 from the shells).
-  bool fiv_vertex_self_shadows = true;
   bool report_given = false;  // scene: --report overrides the scene file's
   // texel: the lightmap's texels (--resolution W[xH]; 0 x 0: chosen from --density, texels per
   // unit), the UV set (--uv; empty: the default rule of run_texel.cpp), generated UVs (--unwrap,

@@ -99,6 +99,14 @@ void set_bounces(F::Product& product, Bounced which, int applied, const bake::Bo
                                      : " + bounces: T^{b+1}_i(p) = (1/pi) Int (1 - V) H albedo T^b_i(hit) (n.w) dw, b < bounces";
 }
 
+F::OccluderSelfBand1 self_band1_of(const bake::VertexBake& self) {
+  PRT_CHECK(self.layout.radiance_count == 9);
+  return {to_float(self.values, self.layout.width, self.layout.radiance, 9),
+          "R_c,m = Int L_c V_self H y_1m dw of the occluder alone (V_self: its own geometry), layout [vertex][RGB][m=-1,0,1]; "
+          "E_c = (4 pi / 3) sum_m y_1m(n) R_c,m at /objects/<name>/mesh/normals",
+          {}};
+}
+
 void set_products(F::VertexSet& set, const bake::VertexBake& bake, const ProductInfo& info) {
   const auto& L = bake.layout;
   const size_t W = L.width;

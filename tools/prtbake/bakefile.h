@@ -92,6 +92,9 @@ void set_fiv_environment(F::Asset& asset, const bake::EnvMapInfo& env, const std
 // An occluder's shells and valid mask (moved from `shells`).
 F::Occluder occluder_of(const std::string& name, bake::FivShells shells, const bake::EnvMapInfo& env,
                         const std::string& env_path, double fraction, uint32_t silhouette_k);
+// An occluder's self-shadows for /fiv/occluders/<name>/self_band1: the band-1 columns of a
+// bake_fiv_self_shadows bake, [V][RGB][m] as float.
+F::OccluderSelfBand1 self_band1_of(const bake::VertexBake& self);
 // The error report row of an occluder's shells.
 F::ReportRow fiv_report_of(const std::string& name, const bake::FivErrorReport& report, const bake::FivShells& shells,
                            bool reproducible);

@@ -142,7 +142,7 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
   // SHA-256) and checked the pixels.
   // The self-shadows (--self-shadows vertex) are baked by the process that writes the file, the
   // merge of a sharded bake included: it needs the environment's pixels and the topology too.
-  const bool integrates = !a.worker || a.worker->computes || a.integrator.report_points > 0 || a.fiv_vertex_self_shadows;
+  const bool integrates = !a.worker || a.worker->computes || a.integrator.report_points > 0 || a.shell_spec.vertex_self_shadows;
   std::optional<bake::Topology> topo;
   std::optional<bake::EnvMap> env;
   if (integrates) {
@@ -201,20 +201,14 @@ int run_fiv(const Args& a, const RunContext& run, std::optional<ShardedRows>& sh
   // silhouette integrator at the shells' k and seed (prtshade/fiv.h shade_fiv_member_given_self),
   // here in the process that writes the file (a sharded bake's merge too: the same bytes; an
   // occluder's vertices take a fraction of its shells' time, so they are not cut into chunks).
-  if (a.fiv_vertex_self_shadows) {
-    bake::ProductRequest req;
-    req.radiance = &*env;
-    bake::IntegratorSpec spec;
-    spec.kind = bake::IntegratorKind::Silhouette;
-    spec.silhouette_k = a.shell_spec.silhouette_k;
-    spec.seed = a.integrator.seed;
-    const std::unique_ptr<bake::Integrator> integrator = bake::make_integrator(spec, mesh, *topo, req);
-    const bake::VertexBake self = bake::bake_vertices(mesh, *topo, *integrator, run.progress, "baking self-shadows");
+  if (a.shell_spec.vertex_self_shadows) {
+    const bake::FivSelfShadows self = bake::bake_fiv_self_shadows(mesh, *topo, *env, a.shell_spec, a.integrator.seed, run.progress);
     if (run.say)
-      std::printf("self-shadows: band-1 radiance at %zu vertices in %.2f s\n", mesh.positions.size(), self.seconds);
+      std::printf("self-shadows: band-1 radiance at %zu vertices in %.2f s\n", mesh.positions.size(), self.values.seconds);
     tool::set_mesh(asset.vertices, mesh);
-    tool::set_products(asset.vertices, self,
-                       {integrator->name(), integrator->description(), spec.samples(), spec.seed, 0, 0, &*env, a.environment});
+    tool::set_products(asset.vertices, self.values,
+                       {self.integrator_name, self.integrator_description, self.integrator.samples(), self.integrator.seed, 0, 0,
+                        &*env, a.environment});
   }
   // The shells move into the file's occluder (the report above was their last reader).
   asset.occluders.push_back(tool::occluder_of(name, std::move(shells), env_info, a.environment, a.shell_spec.fraction,

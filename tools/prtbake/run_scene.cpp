@@ -300,6 +300,7 @@ int run_scene(const Args& a, const RunContext& run, std::optional<ShardedRows>& 
         F::Occluder& occluder =
             asset.occluders.emplace_back(tool::occluder_of(o.name, *ob.shells, env->info(), env_path, scene.fiv.fraction, scene.fiv.silhouette_k));
         if (ob.fiv_report) occluder.report = tool::fiv_report_of(o.name, *ob.fiv_report, *ob.shells, a.reproducible);
+        if (ob.fiv_self) occluder.self_band1 = tool::self_band1_of(ob.fiv_self->values);
       }
     }
     for (const bake::AreaLight& light : scene.lights) asset.lights.push_back(tool::light_of(light));

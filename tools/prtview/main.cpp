@@ -96,7 +96,9 @@ WHAT IS DRAWN
     4.3.2; shade_fiv_member).
   FIV scenes (dynamic occluders): a scene file whose objects have FIV shells, with --shade fiv or
     --instance/--instances: those objects are the occluders, placed as copies moved from where
-    they were baked (default: each once, in place), on a ground plane, shaded as above. The
+    they were baked (default: each once, in place), on a ground plane, shaded as above (the
+    self-shadows from /fiv/occluders/<name>/self_band1 when the file has it, prtbake scene's
+    default bake.fiv.self_shadows "vertex"; else from the shells). The
     frame's cost (rasterise + shade, the file's reading not counted) is printed. E.g. 50 copies
     of three occluders (data/scene_fiv_occluders.json, data/fiv_instances50.json):
       prtbake scene data/scene_fiv_occluders.json -o occ.prt.h5
@@ -113,9 +115,11 @@ WHAT IS DRAWN
                 land here with their AO-shaded diffuse response; their highlights are drawn by
                 --shade glossy (below).
       FIV self  objects without per-vertex products (occluder-only) that have FIV shells
-                (/fiv/occluders/<name>) and /fiv/environment: per pixel with shade_fiv_member
-                (self-shadows, eq. 12, minus the shadows of the other objects that have FIV
-                shells, eq. 11: the same composition as the copies of an FIV file), else
+                (/fiv/occluders/<name>) and /fiv/environment: per pixel, the self-shadows minus
+                the shadows of the other objects that have FIV shells (eq. 11: the same
+                composition as the copies of an FIV file); the self-shadows Gouraud from the
+                object's self_band1 (shade_fiv_member_given_self) when the file has it, else
+                eq. 12 from its shells (shade_fiv_member), else
       flat      grey: 0.5 x the environment's mean radiance.
     The environment must be the one of /scene (checked by SHA-256); default: its 'environment'.
     --shade (but glossy, area, area-exact, and fiv: FIV scenes below), --occluder-mesh,

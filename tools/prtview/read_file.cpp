@@ -4,6 +4,7 @@
 #include <bake/core/error.h>
 #include <bake/core/sha256.h>
 #include <formats/names.h>
+#include <prtshade/shade.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -458,7 +459,17 @@ std::vector<SceneObject> read_scene_objects(const F::Asset& f, const std::string
         for (size_t k = 0; k < 3; ++k) o.specular[k] = float(std::max(0.0, (*c)[k]));
       }
     }
-    if (f.fiv_environment && f.find_occluder(baked.name)) o.shells = read_occluder(f, file, baked.name, *env);
+    if (f.fiv_environment && f.find_occluder(baked.name)) {
+      o.shells = read_occluder(f, file, baked.name, *env);
+      if (const F::Occluder* occ = f.find_occluder(baked.name); occ->self_band1) {
+        // The schema holds it to the object's V rows and normals.
+        const size_t V = s.positions->values.size() / 3;
+        if (!s.normals || occ->self_band1->values.size() != 9 * V)
+          throw InputError(file, cat(occluder_dir(baked.name) + "/", N::kSelfBand1) + " does not match " + prefix);
+        o.fiv_self.resize(3 * V);
+        shade::shade_band1_vertices(s.normals->values.data(), occ->self_band1->values.data(), V, o.fiv_self.data());
+      }
+    }
     objects.push_back(std::move(o));
   }
   if (objects.empty())

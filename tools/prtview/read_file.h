@@ -145,6 +145,9 @@ struct SceneObject {
   std::optional<TexelProduct> texels;
   std::string texel_kind;
   std::optional<BakedOccluder> shells;   // read when the file also holds the environment FIV
+  // With shells and /fiv/occluders/<name>/self_band1 (v9): its self-shadowed irradiance E [V][3]
+  // at its vertices, from itself alone (shade_band1 at its normals); else empty: eq. 12 from the shells.
+  std::vector<float> fiv_self;
   bool glossy_only = false;              // visibility transfer only
   // Glossy objects (a phong_exponent > 0 and /transfer/visibility or /radiance/shadowed): the
   // lobe and its colour, and what shades it: U (route A) and S [V][3][L*L] baked under `env`

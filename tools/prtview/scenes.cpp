@@ -247,8 +247,9 @@ std::map<std::string, PlaceableOccluder> placeable_occluders(const F::Asset& f, 
     for (SceneObject& o : read_scene_objects(f, file, &env)) {
       if (!o.shells || !wanted.count(o.name)) continue;
       // (A scene object's band1, if any, holds the other objects' shadows where they were baked:
-      // not its self-shadows once copies move. Its self-shadows come from its shells.)
-      PlaceableOccluder p{std::move(*o.shells), std::move(o.mesh), "/objects/" + o.name, 0, {}};
+      // not its self-shadows once copies move. Its self-shadows come from its self_band1 when the
+      // file has it (v9), else from its shells.)
+      PlaceableOccluder p{std::move(*o.shells), std::move(o.mesh), "/objects/" + o.name, 0, std::move(o.fiv_self)};
       out.emplace(o.name, std::move(p));
     }
   } else {
@@ -523,7 +524,10 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       }
       if (o.texel_kind == "ao" && !exact) exact.emplace(env);
     } else if (o.shells) {
-      how_of[k] = "FIV self-shadows per pixel minus the other FIV occluders' shadows (shade_fiv_member)" + glossy_note;
+      how_of[k] = (o.fiv_self.empty() ? "FIV self-shadows per pixel from its shells (eq. 12)"
+                                       : "FIV self-shadows from its vertices (self_band1, Gouraud)") +
+                  std::string(" minus the other FIV occluders' shadows (shade_fiv_member") +
+                  (o.fiv_self.empty() ? ")" : "_given_self)") + glossy_note;
     } else {
       rgb_of[k].assign(3 * V, flat);
       how_of[k] = "flat grey (no per-vertex products, no FIV shells)" + glossy_note;
@@ -588,7 +592,16 @@ view::Image render_scene_file(const F::Asset& f, const std::string& file, const 
       for (size_t c = 0; c < 3; ++c) out[c] = e[c] * objects[k].albedo[c];
       return;
     }
-    shade::shade_fiv_member(env_fiv, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
+    if (const std::vector<float>& self = objects[k].fiv_self; !self.empty()) {
+      // The per-vertex self-shadows (/fiv/occluders/<name>/self_band1), Gouraud across the triangle.
+      const auto& tri = objects[k].mesh.triangles[size_t(fr.triangle) - scene.first_triangle[k]];
+      float own[3] = {0, 0, 0};
+      for (int c = 0; c < 3; ++c)
+        for (int v = 0; v < 3; ++v) own[c] += fr.bary[size_t(v)] * self[3 * size_t(tri[v]) + size_t(c)];
+      shade::shade_fiv_member_given_self(own, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
+    } else {
+      shade::shade_fiv_member(env_fiv, fiv_occluders.data(), int(fiv_occluders.size()), fiv_index[k], p, n, true, e);
+    }
     for (size_t c = 0; c < 3; ++c) out[c] = e[c] * float(std::numbers::inv_pi) * objects[k].albedo[c];
   });
   scene.texel_pixels = texel_pixels, scene.empty_texel_pixels = empty_hits;

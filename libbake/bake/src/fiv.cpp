@@ -4,6 +4,7 @@
 #include <bake/core/error.h>
 #include <bake/environment/irradiance.h>
 #include <bake/integrators/qmc.h>
+#include <bake/integrators/registry.h>
 #include <bake/sphere/sampling.h>
 #include <bake/visibility/raycast.h>
 
@@ -105,6 +106,27 @@ std::string_view radial_scheme_name(RadialScheme scheme) {
 }
 
 std::string_view shell_precision_name(bool float16) { return float16 ? "half" : "float"; }
+
+bool parse_self_shadows(std::string_view text, bool& vertex) {
+  if (text != "vertex" && text != "shells") return false;
+  vertex = text == "vertex";
+  return true;
+}
+
+FivSelfShadows bake_fiv_self_shadows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                                     uint64_t seed, const Monitor& monitor) {
+  ProductRequest request;
+  request.radiance = &env;
+  FivSelfShadows out;
+  out.integrator.kind = IntegratorKind::Silhouette;
+  out.integrator.silhouette_k = spec.silhouette_k;
+  out.integrator.seed = seed;
+  const std::unique_ptr<Integrator> shadows = make_integrator(out.integrator, occluder, topology, request);
+  out.integrator_name = shadows->name();
+  out.integrator_description = shadows->description();
+  out.values = bake_vertices(occluder, topology, *shadows, monitor, "baking self-shadows");
+  return out;
+}
 
 bool parse_shell_precision(std::string_view text, bool& float16) {
   if (text != "half" && text != "float") return false;

@@ -314,24 +314,38 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
   std::vector<size_t> movers;
   for (size_t i = 0; i < scene.objects.size() && !rows.rows_only; ++i)
     if (plan.objects[i].fiv) movers.push_back(i);
+  // With self-shadows, each occluder's vertices follow its shells in the same stage.
+  const bool self_shadows = scene.fiv.vertex_self_shadows;
   const uint64_t share = uint64_t(scene.fiv.n_rho) * uint64_t(scene.fiv.n_phi) * uint64_t(scene.fiv.n_theta);
-  const uint64_t fiv_total = share * movers.size();
+  uint64_t fiv_total = share * movers.size();
+  if (self_shadows)
+    for (size_t i : movers) fiv_total += meshes[i].positions.size();
   uint64_t fiv_before = 0;
   bool fiv_last = false;
-  const Monitor fiv_stage = fold_tasks(monitor, "baking FIV shells", fiv_total, fiv_before, std::chrono::steady_clock::now(), &fiv_last);
+  const Monitor fiv_stage = fold_tasks(monitor, self_shadows ? "baking FIV shells and self-shadows" : "baking FIV shells",
+                                       fiv_total, fiv_before, std::chrono::steady_clock::now(), &fiv_last);
   for (size_t k = 0; k < movers.size(); ++k) {
     const size_t i = movers[k];
     const Mesh& m = meshes[i];
     const Topology t = build_topology(m);
     ObjectBake& ob = out.objects[i];
-    fiv_last = k + 1 == movers.size();
+    fiv_last = k + 1 == movers.size() && !self_shadows;
     ob.shells = bake_fiv_shells(m, t, *env, scene.fiv, fiv_stage);
     fiv_before += share;
+    if (self_shadows) {
+      fiv_last = k + 1 == movers.size();
+      ob.fiv_self = bake_fiv_self_shadows(m, t, *env, scene.fiv, scene.integrator.seed, fiv_stage);
+      fiv_before += m.positions.size();
+      out.fiv_seconds += ob.fiv_self->values.seconds;
+    }
     out.fiv_seconds += ob.shells->seconds;
     if (movers.size() <= kObjectLinesUpTo)
       log(label_of(scene.objects[i]) + ": FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +
           std::to_string(scene.fiv.n_theta) + "x" + std::to_string(ob.shells->radii.size()) + " in " +
-          printf_string("%.2f s", ob.shells->seconds));
+          printf_string("%.2f s", ob.shells->seconds) +
+          (ob.fiv_self ? ", self-shadows at " + std::to_string(m.positions.size()) + " vertices in " +
+                             printf_string("%.2f s", ob.fiv_self->values.seconds)
+                       : std::string()));
   }
   if (movers.size() > kObjectLinesUpTo)
     log(std::to_string(movers.size()) + " occluders' FIV shells " + std::to_string(scene.fiv.n_phi) + "x" +

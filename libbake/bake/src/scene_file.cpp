@@ -211,7 +211,12 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
       if (sc.bounces == 0) r.fail("bake.bounce_rays applies with bake.bounces >= 1");
     }
     if (const Json* f = find_key(*bake, "fiv")) {
-      r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial", "precision"});
+      r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial", "precision", "self_shadows"});
+      if (const Json* x = find_key(*f, "self_shadows")) {
+        const std::string& g = r.string(*x, "bake.fiv.self_shadows");
+        if (!parse_self_shadows(g, sc.fiv.vertex_self_shadows))
+          r.fail("bake.fiv.self_shadows must be \"vertex\" or \"shells\", not \"" + g + "\"");
+      }
       if (const Json* x = find_key(*f, "precision")) {
         const std::string& g = r.string(*x, "bake.fiv.precision");
         if (!parse_shell_precision(g, sc.fiv.float16))

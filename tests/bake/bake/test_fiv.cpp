@@ -532,6 +532,17 @@ TEST(FivSurface, SceneFilesChooseTheRadialScheme) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bake.fiv.precision"), std::string::npos) << e.what();
   }
+  // bake.fiv.self_shadows: the vertices by default (/fiv/occluders/<name>/self_band1).
+  EXPECT_TRUE(load_scene(write("self.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.vertex_self_shadows);
+  EXPECT_FALSE(load_scene(write("shells.json", R"({"fiv": {"self_shadows": "shells"}})"), std::nullopt).fiv.vertex_self_shadows);
+  try {
+    load_scene(write("bad_self.json", R"({"fiv": {"self_shadows": "none"}})"), std::nullopt);
+    ADD_FAILURE() << "\"none\" accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bake.fiv.self_shadows must be \"vertex\" or \"shells\", not \"none\""),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // ShellSpec::float16: the bake rounds the shells and the cones to the nearest float16 (what the

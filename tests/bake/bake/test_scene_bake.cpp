@@ -51,9 +51,9 @@ TEST(SceneBake, TheReceiversAreOneProgressStageOverAllTheirVertices) {
 
 TEST(SceneBake, EveryOccludersShellsAreOneProgressStage) {
   // Issue 29: each moving occluder's shells were a stage of their own, so a log restarted at 0%
-  // per part with no ETA for the scene. They are one stage, "baking FIV shells", over every
-  // occluder's share (n_rho shells each; a share that stops early is counted whole once done),
-  // which never goes backwards and finishes once, at its total.
+  // per part with no ETA for the scene. They are one stage, "baking FIV shells and self-shadows",
+  // over every occluder's share (n_rho shells each; a share that stops early is counted whole once
+  // done) and its vertices, which never goes backwards and finishes once, at its total.
   SceneDescription scene = load_scene(fs::path(PRT_DATA_DIR) / "scene_example.json");
   scene.integrator.report_points = 0;
   scene.integrator.set_samples(256);
@@ -63,14 +63,17 @@ TEST(SceneBake, EveryOccludersShellsAreOneProgressStage) {
   const std::vector<Mesh> meshes = load_scene_meshes(scene, warnings);
   const EnvMap env = EnvMap::load(*scene.environment, scene.up);
   const ScenePlan plan = plan_scene(scene, meshes);
-  size_t movers = 0;
-  for (const ObjectPlan& p : plan.objects) movers += p.fiv ? 1 : 0;
+  size_t movers = 0, vertices = 0;
+  for (size_t i = 0; i < plan.objects.size(); ++i)
+    if (plan.objects[i].fiv) ++movers, vertices += meshes[i].positions.size();
   ASSERT_GE(movers, 2u) << "the stage must span several occluders";
-  const uint64_t total = uint64_t(movers) * 6 * 8 * 5;
+  // The shells' samples, then (by default) each occluder's self-shadows at its vertices.
+  ASSERT_TRUE(scene.fiv.vertex_self_shadows);
+  const uint64_t total = uint64_t(movers) * 6 * 8 * 5 + vertices;
   std::vector<ProgressUpdate> seen;
   Monitor monitor;
   monitor.on_progress = [&](const ProgressUpdate& u) {
-    if (u.task == "baking FIV shells") seen.push_back(u);
+    if (u.task == "baking FIV shells and self-shadows") seen.push_back(u);
   };
   const SceneBake out = bake_scene(scene, plan, meshes, &env, monitor, [](const std::string&) {});
   ASSERT_FALSE(seen.empty());
@@ -86,6 +89,11 @@ TEST(SceneBake, EveryOccludersShellsAreOneProgressStage) {
   EXPECT_TRUE(seen.back().finished);
   EXPECT_EQ(seen.back().done, total);
   size_t baked = 0;
-  for (const ObjectBake& ob : out.objects) baked += ob.shells ? 1 : 0;
+  for (size_t i = 0; i < out.objects.size(); ++i) {
+    const ObjectBake& ob = out.objects[i];
+    baked += ob.shells ? 1 : 0;
+    EXPECT_EQ(ob.fiv_self.has_value(), ob.shells.has_value()) << i;
+    if (ob.fiv_self) EXPECT_EQ(ob.fiv_self->values.values.size(), meshes[i].positions.size() * ob.fiv_self->values.layout.width);
+  }
   EXPECT_EQ(baked, movers);
 }

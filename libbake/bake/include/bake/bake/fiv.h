@@ -44,6 +44,7 @@
 //   +X (1, −t, −s)   −X (−1, −t, s)   +Y (s, 1, t)   −Y (s, −1, −t)   +Z (s, −t, 1)   −Z (−s, −t, −1).
 #pragma once
 
+#include <bake/bake/vertex_bake.h>
 #include <bake/core/progress.h>
 #include <bake/environment/envmap.h>
 #include <bake/integrators/silhouette.h>
@@ -103,7 +104,15 @@ struct ShellSpec {
   // The precision the file stores the shells and cones in (formats: dtype float16, schema v8;
   // prtshade/fiv.h "Half-float tables"): true halves their memory at no measurable error.
   bool float16 = true;
+  // The occluder's self-shadows (prtshade/fiv.h shade_fiv_member_given_self): true bakes its
+  // band-1 radiance from itself alone at its vertices (bake_fiv_self_shadows: exact there, where
+  // eq. 12 from the shells is wrong in concavities and on faces that are not the outermost along
+  // their ray from the centre); false leaves them to the shells.
+  bool vertex_self_shadows = true;
 };
+// "vertex" or "shells", as tools spell ShellSpec::vertex_self_shadows; parse returns false and
+// leaves `vertex` as it was for anything else.
+bool parse_self_shadows(std::string_view text, bool& vertex);
 // "half" (float16) or "float" (float32), as tools spell ShellSpec::float16; parse returns false
 // and leaves `float16` as it was for anything else.
 std::string_view shell_precision_name(bool float16);
@@ -151,6 +160,18 @@ void bounding_sphere(const Mesh& mesh, Eigen::Vector3d& centre, double& radius);
 
 FivShells bake_fiv_shells(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
                           const Monitor& monitor = {});
+
+// The occluder's self-shadows: its band-1 shadowed radiance under `env` from itself alone at its
+// vertices (ProductRequest::radiance; rows in the mesh's vertex order), by the silhouette
+// integrator at spec.silhouette_k and `seed`, as a vertex bake of that mesh would give them; with
+// what baked them, for the file.
+struct FivSelfShadows {
+  VertexBake values;
+  IntegratorSpec integrator;
+  std::string integrator_name, integrator_description;
+};
+FivSelfShadows bake_fiv_self_shadows(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                                     uint64_t seed, const Monitor& monitor = {});
 
 // What an FIV step would cost, for a dry run's estimate (bake/bake/scene_bake.h): its setup's wall
 // seconds (done for real: the integrator's tables, the environment's cell hierarchy) and the CPU

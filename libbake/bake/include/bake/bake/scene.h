@@ -22,7 +22,10 @@
 //                                              transfer and band-1 radiance (bake/bake/bounce.h;
 //                                              the rule below), K gather rays per receiver row
 //       "fiv": {"shells": "128x65x30", "cube": 32, "fraction": 0.001, "radial": "surface",
-//               "precision": "half"}   (bake/bake/fiv.h ShellSpec)
+//               "precision": "half",   (bake/bake/fiv.h ShellSpec)
+//               "self_shadows": "vertex"}  each FIV occluder's band-1 radiance from itself alone
+//                                      at its vertices (/fiv/occluders/<name>/self_band1), or
+//                                      "shells": none (the runtime's eq. 12 from the shells)
 //       "lightmap": {...}                      every receiver per texel (below), unless its own says
 //     },                                       otherwise
 //     "lights": [ {                              optional: area lights (bake/lights/lights.h, paper 003)
@@ -215,7 +218,7 @@ struct SceneDescription {
   int bounces = 0;           // "bounces": interreflections (the plan rule "bounces")
   uint32_t bounce_rays = 0;  // "bounce_rays" (0: BounceSpec::kDefaultRays)
   // "fiv": shells, cube, fraction, radial ("surface" or "geometric"), precision ("half" or
-  // "float": the file's dtype of shells and cones); the shells' k is integrator.silhouette_k ("samples" for a
+  // "float": the file's dtype of shells and cones), self_shadows ("vertex" or "shells"); the shells' k is integrator.silhouette_k ("samples" for a
   // silhouette scene, else the default).
   ShellSpec fiv;
   std::optional<LightmapSpec> lightmap;  // bake.lightmap: every object's unless its own says otherwise

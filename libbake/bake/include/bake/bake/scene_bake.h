@@ -35,6 +35,9 @@ struct ObjectBake {
   // Occluders with shells (in world space: centre and radii in scene units).
   std::optional<FivShells> shells;
   std::optional<FivErrorReport> fiv_report;
+  // Their self-shadows (ShellSpec::vertex_self_shadows): band-1 radiance from the object alone at
+  // the vertices of its world mesh.
+  std::optional<FivSelfShadows> fiv_self;
   // Receivers with area lights: [V][lights][1 + n²] per vertex and light, E then the SH at
   // order n = area_sh_order (AreaLightIntegrator's rows); per valid texel of `lightmap` for an
   // object baked per texel.
