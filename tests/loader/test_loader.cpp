@@ -169,6 +169,26 @@ TEST(Loader, SceneObjectsAreSeparateVertexSets) {
   EXPECT_EQ(a.find_vertex_set("nope"), nullptr);
 }
 
+TEST(Loader, SceneOccluderSelfShadowsAreReadBesideTheirVertexSet) {
+  // Schema v9: /fiv/occluders/<name>/self_band1, [V][3][3] at the vertices of /objects/<name>.
+  File f = make_file(false);
+  f.datasets.push_back({"/objects/rock/mesh/positions", {2, 3}, std::vector<float>{5, 5, 5, 6, 6, 6}, {}});
+  f.datasets.push_back({"/objects/rock/mesh/normals", {2, 3}, std::vector<float>{0, 1, 0, 1, 0, 0}, {}});
+  const std::vector<float> self = ramp(2 * 9, 0.0625f);
+  f.datasets.push_back({"/fiv/occluders/rock/self_band1", {2, 3, 3}, self, {}});
+  const auto path = tmp("loader_self.prt.h5");
+  prt::formats::write_file(path, f);
+  const prt::shade::LoadedAsset a = prt::shade::load_prt(path);
+  EXPECT_EQ(a.format_version, 9);
+  ASSERT_EQ(a.occluders.size(), 1u);
+  EXPECT_EQ(a.occluders[0].self_band1, self);
+  ASSERT_NE(a.find_vertex_set("rock"), nullptr);
+  EXPECT_EQ(a.find_vertex_set("rock")->vertex_count(), 2u);
+  // Without it (every older file): empty.
+  prt::formats::write_file(tmp("loader_no_self.prt.h5"), make_file(false));
+  EXPECT_TRUE(prt::shade::load_prt(tmp("loader_no_self.prt.h5")).occluders.at(0).self_band1.empty());
+}
+
 TEST(Loader, ConeProxyIsReadWhereTheFileSaysSoAndOlderFilesAreTheSphere) {
   // Schema v7 (formats/SCHEMA.md): /fiv/occluders/<name>/cones with the group attribute proxy.
   // "cone": the view carries the table and shades as the core does with it; "sphere" or no

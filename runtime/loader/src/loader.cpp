@@ -65,6 +65,7 @@ LoadedOccluder occluder_of(const formats::Occluder& o, const std::string& file) 
     if (o.cones->float16) out.cones_half = formats::float16_bits(o.cones->values);
     else out.cones = o.cones->values;
   }
+  if (o.self_band1) out.self_band1 = o.self_band1->values;
   out.grid = o.grid.value_or("");
   out.attrs = formats::shells_attrs(o);
   try {

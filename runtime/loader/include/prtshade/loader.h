@@ -77,6 +77,11 @@ struct LoadedOccluder {
   // "Tight proxies").
   std::string proxy = "sphere";
   std::vector<float> cones;
+  // A scene file's self-shadows of this occluder (v9, /fiv/occluders/<name>/self_band1): band-1
+  // radiance from itself alone at the vertices of the vertex set of the same name, [V][3][3] as
+  // radiance_band1; empty when the file has none. E_self = shade_band1_vertices at that set's
+  // normals, then shade_fiv_member_given_self (prtshade/fiv.h).
+  std::vector<float> self_band1;
   std::string grid;             // the file's angular-convention string ("" if absent)
   std::vector<formats::Attr> attrs;  // every attribute of the shells dataset, as stored
 
