@@ -5,6 +5,7 @@
 #include <bake/environment/irradiance.h>
 #include <bake/integrators/qmc.h>
 #include <bake/integrators/registry.h>
+#include <bake/mesh/receivers.h>
 #include <bake/sphere/sampling.h>
 #include <bake/visibility/raycast.h>
 
@@ -466,6 +467,29 @@ FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const En
   for (size_t q = 0; q < picks.size(); ++q) (void)baker.rows(int(q % size_t(baker.shell_count())), picks[q], picks[q] + 1);
   cost.timed = picks.size();
   cost.cpu_seconds = (thread_cpu_seconds() - c0) * double(total) / double(std::max<size_t>(picks.size(), 1));
+  return cost;
+}
+
+FivCost fiv_self_shadows_cost(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                              size_t samples) {
+  FivCost cost;
+  const auto t0 = std::chrono::steady_clock::now();
+  ProductRequest request;
+  request.radiance = &env;
+  IntegratorSpec integrator;
+  integrator.kind = IntegratorKind::Silhouette;
+  integrator.silhouette_k = spec.silhouette_k;
+  const std::unique_ptr<Integrator> shadows = make_integrator(integrator, occluder, topology, request);
+  const std::vector<ShadePoint> points = vertex_shade_points(occluder, topology);
+  shadows->prepare(points);
+  cost.setup_seconds = seconds_since(t0);
+  if (points.empty()) return cost;
+  const std::vector<uint32_t> picks = seeded_sample(uint32_t(points.size()), samples, 0x73656c66ull);
+  std::vector<double> values(shadows->layout().width), std_error(values.size());
+  const double c0 = thread_cpu_seconds();
+  for (uint32_t v : picks) shadows->integrate(points[v], v, values, std_error);
+  cost.timed = picks.size();
+  cost.cpu_seconds = (thread_cpu_seconds() - c0) * double(points.size()) / double(std::max<size_t>(picks.size(), 1));
   return cost;
 }
 

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <tuple>
 #include <utility>
 
@@ -249,16 +250,24 @@ SceneBake bake_scene(const SceneDescription& scene, const ScenePlan& plan, std::
     for (size_t i = 0; i < scene.objects.size(); ++i)
       if (plan.objects[i].fiv) {
         const Topology t = build_topology(meshes[i]);
-        const FivCost c = fiv_shells_cost(meshes[i], t, *env, scene.fiv, kEstimatePoints);
+        FivCost c = fiv_shells_cost(meshes[i], t, *env, scene.fiv, kEstimatePoints);
+        std::optional<FivCost> self;  // the self-shadows at its vertices (ShellSpec::vertex_self_shadows)
+        if (scene.fiv.vertex_self_shadows) self = fiv_self_shadows_cost(meshes[i], t, *env, scene.fiv, kEstimatePoints);
         if (movers <= kObjectLinesUpTo) {
           fiv_line(label_of(scene.objects[i]) + ": " + grid + every, c);
+          if (self)
+            fiv_line(label_of(scene.objects[i]) + ": FIV self-shadows at its " + std::to_string(meshes[i].positions.size()) +
+                         " vertices",
+                     *self);
           continue;
         }
+        if (self) c.setup_seconds += self->setup_seconds, c.cpu_seconds += self->cpu_seconds, c.timed += self->timed;
         all.setup_seconds += c.setup_seconds, all.cpu_seconds += c.cpu_seconds, all.timed += c.timed;
         if (c.cpu_seconds > dearest_cpu) dearest_cpu = c.cpu_seconds, dearest = label_of(scene.objects[i]);
       }
     if (movers > kObjectLinesUpTo)
-      fiv_line(std::to_string(movers) + " occluders' " + grid + ", the dearest " + dearest +
+      fiv_line(std::to_string(movers) + " occluders' " + grid + (scene.fiv.vertex_self_shadows ? " and self-shadows" : "") +
+                   ", the dearest " + dearest +
                    printf_string(" at %.3g CPU s", dearest_cpu) + every,
                all);
     log(printf_string("in all about %.3g s on ", total + planned) + std::to_string(int(threads)) +

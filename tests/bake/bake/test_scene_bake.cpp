@@ -93,7 +93,9 @@ TEST(SceneBake, EveryOccludersShellsAreOneProgressStage) {
     const ObjectBake& ob = out.objects[i];
     baked += ob.shells ? 1 : 0;
     EXPECT_EQ(ob.fiv_self.has_value(), ob.shells.has_value()) << i;
-    if (ob.fiv_self) EXPECT_EQ(ob.fiv_self->values.values.size(), meshes[i].positions.size() * ob.fiv_self->values.layout.width);
+    if (ob.fiv_self) {
+      EXPECT_EQ(ob.fiv_self->values.values.size(), meshes[i].positions.size() * ob.fiv_self->values.layout.width);
+    }
   }
   EXPECT_EQ(baked, movers);
 }

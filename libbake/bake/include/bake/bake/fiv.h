@@ -187,6 +187,9 @@ FivCost environment_fiv_cost(const EnvMap& env, int size, size_t samples);
 // |F| < spec.fraction; under a sun it seldom does), the samples spread over the shells.
 FivCost fiv_shells_cost(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
                         size_t samples);
+// bake_fiv_self_shadows: the integrator's setup, then `samples` seeded vertices timed.
+FivCost fiv_self_shadows_cost(const Mesh& occluder, const Topology& topology, const EnvMap& env, const ShellSpec& spec,
+                              size_t samples);
 
 // The shell bake as rows, for bakes cut into chunks (sharded and resumable bakes): bake_fiv_shells
 // is this class's rows shell after shell, stopping where stops_after() says, so any cut of the
