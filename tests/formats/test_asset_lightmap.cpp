@@ -17,6 +17,7 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::dataset;
 using prt::testing::expect_refused;
 
 namespace {
@@ -82,13 +83,6 @@ Asset asset(bool scene, double offset = 0) {
   o.role = "receiver";
   o.set = lightmap_set(offset);
   return a;
-}
-
-Dataset& dataset(File& f, std::string_view path) {
-  for (Dataset& d : f.datasets)
-    if (d.path == path) return d;
-  ADD_FAILURE() << "no dataset " << path;
-  return f.datasets.front();
 }
 
 void erase(File& f, std::string_view path) {

@@ -17,6 +17,7 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::dataset;
 using prt::testing::expect_refused;
 
 namespace {
@@ -71,13 +72,6 @@ Asset lit_asset() {
   return a;
 }
 
-
-Dataset& dataset(File& f, const std::string& path) {
-  for (Dataset& d : f.datasets)
-    if (d.path == path) return d;
-  ADD_FAILURE() << "no dataset " << path;
-  return f.datasets.front();
-}
 
 Attr& attr(std::vector<Attr>& attrs, std::string_view name) {
   for (Attr& a : attrs)

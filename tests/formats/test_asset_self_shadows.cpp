@@ -17,7 +17,9 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::dataset;
 using prt::testing::expect_refused;
+using prt::testing::with_version;
 
 namespace {
 
@@ -44,18 +46,6 @@ Asset scene_asset() {
   for (std::size_t i = 0; i < r.size(); ++i) r[i] = 0.125f * float(i) - 1.0f;
   a.occluders[0].self_band1 = OccluderSelfBand1{r, "band-1 radiance of the occluder alone", {}};
   return a;
-}
-
-File with_version(File f, int64_t v) {
-  f.root_attrs.push_back({std::string(names::kFormatVersion), v});
-  return f;
-}
-
-Dataset& dataset(File& f, const std::string& path) {
-  for (Dataset& d : f.datasets)
-    if (d.path == path) return d;
-  ADD_FAILURE() << path;
-  return f.datasets.front();
 }
 
 TEST(AssetSelfShadows, RoundTripAsVersion9) {

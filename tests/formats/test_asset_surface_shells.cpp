@@ -18,7 +18,9 @@
 
 namespace fs = std::filesystem;
 using namespace prt::formats;
+using prt::testing::dataset;
 using prt::testing::expect_refused;
+using prt::testing::with_version;
 
 namespace {
 
@@ -31,18 +33,6 @@ Asset fiv_asset(bool surface) {
     o.surface_radius = OccluderSurfaceRadius{{1.5f, 1.25f, 1, 0.5f, 0, 2}, "r_surf", {}};
   }
   return a;
-}
-
-File with_version(File f, int64_t v) {
-  f.root_attrs.push_back({std::string(names::kFormatVersion), v});
-  return f;
-}
-
-Dataset& dataset(File& f, const std::string& path) {
-  for (Dataset& d : f.datasets)
-    if (d.path == path) return d;
-  ADD_FAILURE() << "no dataset " << path;
-  return f.datasets.front();
 }
 
 } // namespace
