@@ -487,6 +487,19 @@ Eigen::Vector3d EnvMap::sample_texel(int texel, double u0, double u1) const {
 void EnvMap::sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out) const {
   PRT_CHECK(k >= 1 && k <= 16 && out.size() >= size_t(k) * size_t(k));
   PRT_CHECK(texel >= 0 && texel < texel_count());
+  if (layout_ == Layout::LatLong && k == kGridTableK) {
+    // The 4 × 4 grid (texel moments, cut texels of the irradiance sums): its sines and cosines
+    // per row and per column, formed once below by this function's own arithmetic (same bits).
+    const GridTables& g = grid_tables();
+    const auto& row = g.rows[size_t(texel / width_)];
+    const auto& col = g.cols[size_t(texel % width_)];
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b)
+        out[size_t(a * k + b)] = scene_from_map(Eigen::Vector3d(col[size_t(b)] * row[size_t(k + a)], row[size_t(a)],
+                                                                col[size_t(k + b)] * row[size_t(k + a)]),
+                                                up_);
+    return;
+  }
   const Region r = region(texel);
   if (r.face >= 0) {
     for (int a = 0; a < k; ++a)
@@ -511,7 +524,38 @@ void EnvMap::sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out)
 struct EnvMap::Midpoints {
   std::once_flag once;
   std::vector<Eigen::Vector3d> directions;
+  // sample_texel_grid's lat-long tables for k = kGridTableK: per row {s[a]..., c[a]...}, per
+  // column {sin(lon_b)..., cos(lon_b)...}.
+  std::once_flag grid_once;
+  GridTables grid;
 };
+
+const EnvMap::GridTables& EnvMap::grid_tables() const {
+  PRT_CHECK(midpoints_ != nullptr);
+  std::call_once(midpoints_->grid_once, [&] {
+    constexpr int k = kGridTableK;
+    GridTables& g = midpoints_->grid;
+    g.rows.resize(size_t(height_));
+    g.cols.resize(size_t(width_));
+    for (int y = 0; y < height_; ++y) {  // sample_texel_grid's arithmetic, from the row's first texel
+      const Region r = region(y * width_);
+      for (int a = 0; a < k; ++a) {
+        const double s = std::clamp(r.t0 + ((a + 0.5) / k) * (r.t1 - r.t0), -1.0, 1.0);
+        g.rows[size_t(y)][size_t(a)] = s;
+        g.rows[size_t(y)][size_t(k + a)] = std::sqrt(std::max(0.0, (1.0 - s) * (1.0 + s)));
+      }
+    }
+    for (int x = 0; x < width_; ++x) {  // … from the column's first texel
+      const Region r = region(x);
+      for (int b = 0; b < k; ++b) {
+        const double lon = r.s0 + ((b + 0.5) / k) * (r.s1 - r.s0);
+        g.cols[size_t(x)][size_t(b)] = std::sin(lon);
+        g.cols[size_t(x)][size_t(k + b)] = std::cos(lon);
+      }
+    }
+  });
+  return midpoints_->grid;
+}
 
 EnvMap::EnvMap() : midpoints_(std::make_shared<Midpoints>()) {}
 

@@ -53,6 +53,7 @@ UnshadowedIrradiance::UnshadowedIrradiance(const EnvMap& env) : env_(env) {
     }
     x.r = std::min(1.5 * r + 1e-6, std::numbers::pi / 2);
     x.sin_r = std::sin(x.r);
+    x.omega = env.texel_solid_angle(t);
     x.index = t;
     texels_.push_back(x);
   }
@@ -112,7 +113,7 @@ void UnshadowedIrradiance::add_texel(const Vector3d& n, const Texel& x, double e
     env_.sample_texel_grid(x.index, kS, d);
     double acc = 0;
     for (const Vector3d& di : d) acc += std::max(0.0, n.dot(di));
-    w = acc * env_.texel_solid_angle(x.index) / (kS * kS);
+    w = acc * x.omega / (kS * kS);
   }
   e[0] += x.L[0] * w;
   e[1] += x.L[1] * w;

@@ -69,6 +69,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -176,7 +177,8 @@ public:
   std::vector<Eigen::Vector3d> texel_polygon(int texel, double max_relative_area_error = 1e-6) const;
   // The k × k stratified sub-samples sample_texel(texel, (a + ½)/k, (b + ½)/k) into out[a·k + b]
   // (1 ≤ k ≤ 16), the same values bit for bit; lat-long texels share the k latitudes and k
-  // longitudes (2k transcendental pairs instead of k²).
+  // longitudes (2k transcendental pairs instead of k²), and at k = 4 (the texel moments, the
+  // irradiance sums' cut texels) read them from per-row and per-column tables built on first use.
   void sample_texel_grid(int texel, int k, std::span<Eigen::Vector3d> out) const;
   // sample_texel_grid(t, 1) of every texel (the same values bit for bit), computed on first use
   // (thread-safe) and kept, 24 bytes per texel: the silhouette integrator's point masses need them
@@ -214,6 +216,14 @@ private:
   double inv_total_ = 0;
   struct Midpoints;                         // texel_midpoints()'s cache (envmap.cpp), shared by copies
   std::shared_ptr<Midpoints> midpoints_;
+  // sample_texel_grid's sines and cosines for lat-long maps at k = kGridTableK, per row and per
+  // column (a lat-long texel's latitude bounds depend on its row only, its longitudes on its
+  // column only), built on first use into the same shared cache.
+  static constexpr int kGridTableK = 4;
+  struct GridTables {
+    std::vector<std::array<double, 2 * kGridTableK>> rows, cols;
+  };
+  const GridTables& grid_tables() const;
 };
 
 } // namespace prt::bake

@@ -44,9 +44,9 @@ public:
   Rgb reference(const Eigen::Vector3d& n) const;
 
 private:
-  // One non-black texel: value, moment M_t, centre direction, cone half-angle r and sin r.
+  // One non-black texel: value, moment M_t, centre direction, cone half-angle r and sin r, solid angle.
   struct Texel {
-    double L[3], m[3], c[3], r, sin_r;
+    double L[3], m[3], c[3], r, sin_r, omega;
     int index;
   };
   struct Cell {
