@@ -212,21 +212,16 @@ void parse_settings(const Reader& r, const Json& root, const std::filesystem::pa
     }
     if (const Json* f = find_key(*bake, "fiv")) {
       r.object(*f, "bake.fiv", {"shells", "cube", "fraction", "radial", "precision", "self_shadows"});
-      if (const Json* x = find_key(*f, "self_shadows")) {
-        const std::string& g = r.string(*x, "bake.fiv.self_shadows");
-        if (!parse_self_shadows(g, sc.fiv.vertex_self_shadows))
-          r.fail("bake.fiv.self_shadows must be \"vertex\" or \"shells\", not \"" + g + "\"");
-      }
-      if (const Json* x = find_key(*f, "precision")) {
-        const std::string& g = r.string(*x, "bake.fiv.precision");
-        if (!parse_shell_precision(g, sc.fiv.float16))
-          r.fail("bake.fiv.precision must be \"half\" or \"float\", not \"" + g + "\"");
-      }
-      if (const Json* x = find_key(*f, "radial")) {
-        const std::string& g = r.string(*x, "bake.fiv.radial");
-        if (!parse_radial_scheme(g, sc.fiv.radial))
-          r.fail("bake.fiv.radial must be \"surface\" or \"geometric\", not \"" + g + "\"");
-      }
+      // The two-word keys: each its parser and the words it takes.
+      const auto choice = [&](const char* key, const char* words, auto&& parse) {
+        if (const Json* x = find_key(*f, key)) {
+          const std::string& g = r.string(*x, std::string("bake.fiv.") + key);
+          if (!parse(g)) r.fail(std::string("bake.fiv.") + key + " must be " + words + ", not \"" + g + "\"");
+        }
+      };
+      choice("self_shadows", "\"vertex\" or \"shells\"", [&](const std::string& g) { return parse_self_shadows(g, sc.fiv.vertex_self_shadows); });
+      choice("precision", "\"half\" or \"float\"", [&](const std::string& g) { return parse_shell_precision(g, sc.fiv.float16); });
+      choice("radial", "\"surface\" or \"geometric\"", [&](const std::string& g) { return parse_radial_scheme(g, sc.fiv.radial); });
       if (const Json* x = find_key(*f, "shells")) {
         const std::string& g = r.string(*x, "bake.fiv.shells");
         if (!parse_shell_grid(g, sc.fiv))

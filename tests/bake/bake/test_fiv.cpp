@@ -517,32 +517,25 @@ TEST(FivSurface, SceneFilesChooseTheRadialScheme) {
             RadialScheme::geometric);
   EXPECT_EQ(load_scene(write("surface.json", R"({"fiv": {"radial": "surface"}})"), std::nullopt).fiv.radial,
             RadialScheme::surface);
-  try {
-    load_scene(write("bad.json", R"({"fiv": {"radial": "spheres"}})"), std::nullopt);
-    ADD_FAILURE() << "\"spheres\" accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bake.fiv.radial"), std::string::npos) << e.what();
-  }
+  // A bad value: an InputError that names the key.
+  const auto refused = [&](const std::string& name, const std::string& bake, const std::string& part) {
+    try {
+      load_scene(write(name, bake), std::nullopt);
+      ADD_FAILURE() << bake << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+  };
+  refused("bad.json", R"({"fiv": {"radial": "spheres"}})", "bake.fiv.radial");
   // bake.fiv.precision: half floats by default (formats/SCHEMA.md "Half-float FIV tables").
   EXPECT_TRUE(load_scene(write("half.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.float16);
   EXPECT_FALSE(load_scene(write("float.json", R"({"fiv": {"precision": "float"}})"), std::nullopt).fiv.float16);
-  try {
-    load_scene(write("bad_precision.json", R"({"fiv": {"precision": "double"}})"), std::nullopt);
-    ADD_FAILURE() << "\"double\" accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bake.fiv.precision"), std::string::npos) << e.what();
-  }
+  refused("bad_precision.json", R"({"fiv": {"precision": "double"}})", "bake.fiv.precision");
   // bake.fiv.self_shadows: the vertices by default (/fiv/occluders/<name>/self_band1).
   EXPECT_TRUE(load_scene(write("self.json", R"({"fiv": {"shells": "8x5x4"}})"), std::nullopt).fiv.vertex_self_shadows);
   EXPECT_FALSE(load_scene(write("shells.json", R"({"fiv": {"self_shadows": "shells"}})"), std::nullopt).fiv.vertex_self_shadows);
-  try {
-    load_scene(write("bad_self.json", R"({"fiv": {"self_shadows": "none"}})"), std::nullopt);
-    ADD_FAILURE() << "\"none\" accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bake.fiv.self_shadows must be \"vertex\" or \"shells\", not \"none\""),
-              std::string::npos)
-        << e.what();
-  }
+  refused("bad_self.json", R"({"fiv": {"self_shadows": "none"}})",
+          "bake.fiv.self_shadows must be \"vertex\" or \"shells\", not \"none\"");
 }
 
 // ShellSpec::float16: the bake rounds the shells and the cones to the nearest float16 (what the

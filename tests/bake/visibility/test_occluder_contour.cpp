@@ -97,6 +97,16 @@ void compare(const OccluderMesh& mesh, const Poly& light, const ShadePoint& s, c
   EXPECT_EQ(tree_special, brute_special) << what;
 }
 
+// An n-gon light in the plane y = h around the y axis, corners (rx cos a, h, rz sin a), a = 2πk/n.
+Poly disc_light(int n, double rx, double rz, double h) {
+  Poly p;
+  for (int k = 0; k < n; ++k) {
+    const double a = 6.283185307179586 * k / n;
+    p.emplace_back(rx * std::cos(a), h, rz * std::sin(a));
+  }
+  return p;
+}
+
 std::vector<V3> positions_of(const prt::bake::Mesh& m) {
   std::vector<V3> p;
   for (const auto& x : m.positions) p.push_back(x.cast<double>());
@@ -359,11 +369,7 @@ TEST(OccluderContour, ClosedMeshesFromOneFacing) {
     EXPECT_GT(line.hidden, 3u) << what;
     EXPECT_GT(line.one_facing, line.hidden) << what;
     // A 40-sided disc light (culled by the octagonal pyramid around it).
-    Poly disc;
-    for (int k = 0; k < 40; ++k) {
-      const double a = 6.283185307179586 * k / 40;
-      disc.emplace_back(3 * std::cos(a), 12, 2 * std::sin(a));
-    }
+    const Poly disc = disc_light(40, 3, 2, 12);  // an ellipse 3 x 2
     Totals round;
     for (int k = 0; k < 24; ++k) {
       const ShadePoint s{.p = V3(12 * u(rng) - 6, 0, 8 * u(rng) - 4), .n = V3(0.2 * u(rng) - 0.1, 1, 0.1).normalized()};
@@ -621,11 +627,7 @@ TEST(OccluderContour, ManySidedLightsCulledByAnOctagon) {
   for (int k = 0; k < 300; ++k) add_small(0.97 + 0.12 * u(rng));
   for (int k = 0; k < 100; ++k) add_small(1.3 + 0.7 * u(rng));
   const OccluderMesh mesh(pos, tris);
-  Poly disc;
-  for (int k = 0; k < 64; ++k) {
-    const double a = 6.283185307179586 * k / 64;
-    disc.emplace_back(2 * std::cos(a), 10, 2 * std::sin(a));
-  }
+  const Poly disc = disc_light(64, 2, 2, 10);
   Totals totals;
   for (int k = 0; k < 20; ++k) {
     const ShadePoint s{.p = V3(0.05 * (u(rng) - 0.5), 0, 0.05 * (u(rng) - 0.5)), .n = V3(0, 1, 0)};
@@ -639,11 +641,7 @@ TEST(OccluderContour, ManySidedLightsCulledByAnOctagon) {
   }
   EXPECT_EQ(totals.shadowed, totals.points);
   // A wide many-sided light (86° from the points): the octagon is not used, its 41 planes are.
-  Poly wide;
-  for (int k = 0; k < 40; ++k) {
-    const double a = 6.283185307179586 * k / 40;
-    wide.emplace_back(150 * std::cos(a), 10, 150 * std::sin(a));
-  }
+  const Poly wide = disc_light(40, 150, 150, 10);
   for (int k = 0; k < 10; ++k) {
     const ShadePoint s{.p = V3(0.5 * (u(rng) - 0.5), 0, 0.5 * (u(rng) - 0.5)), .n = V3(0, 1, 0)};
     compare(mesh, wide, s, "wide point " + std::to_string(k), totals);
